@@ -1,0 +1,81 @@
+"""meshcore — structured, boundary-fitted 2-D grids in generalized coordinates.
+
+The headless core of gcmesh: boundaries and borders, parametric splines,
+point distributions, algebraic grids, the elliptic (Thompson–Thames–Mastin /
+Winslow) solver, quality metrics, readers/writers and a CLI.  It never imports Qt.
+
+>>> import meshcore
+>>> g = meshcore.generate_block([[0, 0], [1, 0]], [[1, 0], [1, 1]],
+...                             [[0, 1], [1, 1]], [[0, 0], [0, 1]], cells=(8, 8))
+>>> meshcore.quality(g).n_folded
+0
+"""
+
+from __future__ import annotations
+
+from . import _numba_setup  # noqa: F401  (must run before numba compiles anything)
+from .algebraic import algebraic_grid, tfi, weighted_average
+from .boundary import BorderSpec, Borders, borders_from_loop, borders_from_polylines
+from .curves import LinearSpline, SmoothCurve, make_curve
+from .distribution import distribute
+from .elliptic import EllipticConfig, SolverProgress, iterate, solve
+from .errors import (
+    BorderMismatchError,
+    BoundaryError,
+    CaseFileError,
+    FoldedGridError,
+    InvalidInputError,
+    MeshcoreError,
+    MeshcoreWarning,
+    ReadError,
+    SolverError,
+    TopologyError,
+    WriteError,
+)
+from .generate import generate_block, initial_grid, prepare_borders
+from .grid import BORDER_NAMES, SolveInfo, StructuredGrid
+from .metrics import Metrics, metrics
+from .quality import QualityReport, cell_quality, quality
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "BORDER_NAMES",
+    "BorderMismatchError",
+    "BorderSpec",
+    "Borders",
+    "BoundaryError",
+    "CaseFileError",
+    "EllipticConfig",
+    "FoldedGridError",
+    "InvalidInputError",
+    "LinearSpline",
+    "MeshcoreError",
+    "MeshcoreWarning",
+    "Metrics",
+    "QualityReport",
+    "ReadError",
+    "SmoothCurve",
+    "SolveInfo",
+    "SolverError",
+    "SolverProgress",
+    "StructuredGrid",
+    "TopologyError",
+    "WriteError",
+    "__version__",
+    "algebraic_grid",
+    "borders_from_loop",
+    "borders_from_polylines",
+    "cell_quality",
+    "distribute",
+    "generate_block",
+    "initial_grid",
+    "iterate",
+    "make_curve",
+    "metrics",
+    "prepare_borders",
+    "quality",
+    "solve",
+    "tfi",
+    "weighted_average",
+]

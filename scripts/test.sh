@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Set up, then run the whole test suite (headless Qt, single-threaded numba).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+export QT_QPA_PLATFORM=offscreen
+export OMP_WAIT_POLICY=passive
+export NUMBA_NUM_THREADS=${NUMBA_NUM_THREADS:-2}
+exec .venv/bin/python -m pytest -q -p no:cacheprovider "$@"

@@ -1,0 +1,52 @@
+"""Test configuration: headless Qt, single-threaded numba, shared fixtures."""
+
+from __future__ import annotations
+
+import os
+
+# Must happen before any QApplication exists (environment.md §5): a pytest run
+# with no display and no platform aborts the interpreter instead of failing.
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+# Parallel numba spin-waits under CPU contention (environment.md §2).
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+
+import math  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = Path(__file__).resolve().parent / "data"
+SHARED_LAKES = ROOT.parent / "shared" / "data" / "lakes"
+
+
+def annulus_sector(ni: int, nj: int, r0: float = 1.0, r1: float = 3.0,
+                   th0: float = 0.0, th1: float = math.pi / 2):
+    """Exact Winslow grid of an annulus sector: i along ln r (geometric), j along θ."""
+    r = r0 * (r1 / r0) ** np.linspace(0.0, 1.0, ni + 1)
+    th = np.linspace(th0, th1, nj + 1)
+    R, T = np.meshgrid(r, th, indexing="ij")
+    return R * np.cos(T), R * np.sin(T)
+
+
+def borders_of(x: np.ndarray, y: np.ndarray):
+    """The four borders (bottom, right, top, left) of node arrays."""
+    return (
+        np.column_stack([x[:, 0], y[:, 0]]),
+        np.column_stack([x[-1, :], y[-1, :]]),
+        np.column_stack([x[:, -1], y[:, -1]]),
+        np.column_stack([x[0, :], y[0, :]]),
+    )
+
+
+def rectangle_borders(w: float = 2.0, h: float = 1.0, ni: int = 8, nj: int = 4):
+    xi = np.linspace(0, w, ni + 1)
+    eta = np.linspace(0, h, nj + 1)
+    X, Y = np.meshgrid(xi, eta, indexing="ij")
+    return borders_of(X, Y)
+
+
+@pytest.fixture
+def data_dir() -> Path:
+    return DATA
