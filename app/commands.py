@@ -1,0 +1,203 @@
+"""Undoable edits: QUndoCommand subclasses that swap immutable project states.
+
+Each command stores the project before and after; ``redo`` sets *after*,
+``undo`` sets *before*, so undo returns the exact previous state.  Commands
+with a merge key (a drag, typing in a spin box) merge consecutive pushes into
+one undo step.  :class:`Editor` is the facade the tools and panels call.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+
+from PySide6.QtGui import QUndoCommand, QUndoStack
+
+from meshcore import BorderSpec
+
+from . import project as pj
+from .document import Document
+from .project import Block, Project, SolverSettings
+
+__all__ = [
+    "AddBlock",
+    "AddCutLine",
+    "AddPoint",
+    "CloseLoop",
+    "DeletePoints",
+    "Editor",
+    "InsertPoint",
+    "MovePoints",
+    "ProjectCommand",
+    "SetBlockOptions",
+    "SetBorderSpec",
+    "SetCorners",
+    "SetSolver",
+]
+
+_MERGE_ID = 4711
+
+
+class ProjectCommand(QUndoCommand):
+    """Swap the document's project between ``before`` and ``after``."""
+
+    def __init__(self, doc: Document, after: Project, text: str, *, merge_key=None,
+                 before: Project | None = None) -> None:
+        super().__init__(text)
+        self.doc = doc
+        self.before = before if before is not None else doc.project
+        self.after = after
+        self.merge_key = merge_key
+
+    def redo(self) -> None:
+        self.doc.set_project(self.after)
+
+    def undo(self) -> None:
+        self.doc.set_project(self.before)
+
+    def id(self) -> int:  # noqa: A003 (Qt API name)
+        return _MERGE_ID if self.merge_key is not None else -1
+
+    def mergeWith(self, other: QUndoCommand) -> bool:  # noqa: N802 (Qt API name)
+        if not isinstance(other, ProjectCommand) or other.merge_key != self.merge_key:
+            return False
+        self.after = other.after
+        return True
+
+
+class AddPoint(ProjectCommand):
+    """Append a point to the block being drawn."""
+
+
+class CloseLoop(ProjectCommand):
+    """Close the drawn polyline into a loop."""
+
+
+class MovePoints(ProjectCommand):
+    """Move points (a drag merges into one step)."""
+
+
+class InsertPoint(ProjectCommand):
+    """Insert a point on a segment."""
+
+
+class DeletePoints(ProjectCommand):
+    """Delete the selected points."""
+
+
+class SetCorners(ProjectCommand):
+    """Set the four corners (sw, se, ne, nw)."""
+
+
+class SetBlockOptions(ProjectCommand):
+    """Cells, weights, initial method, curve of a block."""
+
+
+class SetBorderSpec(ProjectCommand):
+    """Distribution/clustering/name of one border."""
+
+
+class SetSolver(ProjectCommand):
+    """Solver method, tolerance, iterations, omega."""
+
+
+class AddBlock(ProjectCommand):
+    """Add a new (empty) block."""
+
+
+class AddCutLine(ProjectCommand):
+    """Add a cut line (multiblock)."""
+
+
+_drag_ids = itertools.count(1)
+
+
+class Editor:
+    """Turns intentions into commands pushed on the undo stack."""
+
+    def __init__(self, doc: Document, stack: QUndoStack) -> None:
+        self.doc = doc
+        self.stack = stack
+
+    def new_drag_id(self) -> int:
+        return next(_drag_ids)
+
+    def _push(self, cls: type[ProjectCommand], after: Project, text: str, merge_key=None) -> None:
+        if after == self.doc.project:
+            return
+        self.stack.push(cls(self.doc, after, text, merge_key=merge_key))
+
+    def _edit_block(self, cls, fn: Callable[[Block], Block], text: str, merge_key=None,
+                    index: int | None = None) -> None:
+        k = self.doc.active if index is None else index
+        p = self.doc.project
+        self._push(cls, p.with_block(k, fn(p.blocks[k])), text, merge_key)
+
+    # ----------------------------------------------------------- points
+    def add_point(self, xy) -> None:
+        self._edit_block(AddPoint, lambda b: pj.with_point_added(b, xy), "Add point")
+
+    def close_loop(self) -> None:
+        b = self.doc.block
+        if b.closed or len(b.points) < 3:
+            return
+        self._edit_block(CloseLoop, pj.with_loop_closed, "Close boundary")
+
+    def move_points(self, indices, delta, drag_id=None) -> None:
+        key = ("move", drag_id) if drag_id is not None else None
+        self._edit_block(MovePoints, lambda b: pj.with_points_moved(b, indices, delta),
+                         "Move point" if len(indices) == 1 else f"Move {len(indices)} points", key)
+
+    def set_point(self, index, xy, drag_id=None) -> None:
+        key = ("move", drag_id) if drag_id is not None else None
+        self._edit_block(MovePoints, lambda b: pj.with_point_set(b, index, xy), "Move point", key)
+
+    def insert_point(self, after: int, xy) -> None:
+        self._edit_block(InsertPoint, lambda b: pj.with_point_inserted(b, after, xy), "Insert point")
+
+    def delete_points(self, indices) -> None:
+        idx = sorted(indices)
+        if not idx:
+            return
+        self.doc.set_selection(())
+        self._edit_block(DeletePoints, lambda b: pj.with_points_deleted(b, idx),
+                         "Delete point" if len(idx) == 1 else f"Delete {len(idx)} points")
+
+    def set_corners(self, corners) -> None:
+        b = self.doc.block
+        cells = b.cells
+        if corners is not None and b.corners is None and b.boundary is None:
+            cells = pj.default_cells(b.points, tuple(corners), total=max(b.cells))
+        self._edit_block(SetCorners, lambda bb: pj.with_corners(bb, corners).replaced(cells=cells),
+                         "Set corners")
+
+    # ---------------------------------------------------------- options
+    def set_block_options(self, merge_key=None, index: int | None = None, **kw) -> None:
+        names = ", ".join(kw)
+        self._edit_block(SetBlockOptions, lambda b: b.replaced(**kw), f"Set {names}",
+                         merge_key=("opt", names, merge_key) if merge_key else None, index=index)
+
+    def set_border_spec(self, border: str, spec: BorderSpec, index: int | None = None) -> None:
+        self._edit_block(SetBorderSpec, lambda b: pj.with_border_spec(b, border, spec),
+                         f"Set {border} border", index=index)
+
+    def set_solver(self, merge_key=None, **kw) -> None:
+        p = self.doc.project
+        s = SolverSettings(**{**{f: getattr(p.solver, f) for f in
+                                 ("method", "tolerance", "max_iterations", "omega")}, **kw})
+        self._push(SetSolver, p.replaced(solver=s), "Set solver " + ", ".join(kw),
+                   ("solver", tuple(kw), merge_key) if merge_key else None)
+
+    def add_block(self) -> None:
+        p = self.doc.project
+        after = p.replaced(blocks=(*p.blocks, Block(name=pj.next_block_name(p))))
+        self._push(AddBlock, after, "Add block")
+        self.doc.set_active(len(after.blocks) - 1)
+
+    def add_cut_line(self, points) -> None:
+        p = self.doc.project
+        self._push(AddCutLine, p.replaced(cut_lines=(*p.cut_lines, pj.frozen_points(points))),
+                   "Add cut line")
+
+    def replace_project(self, after: Project, text: str) -> None:
+        self._push(ProjectCommand, after, text)

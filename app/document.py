@@ -1,0 +1,132 @@
+"""The document: the single source of truth the views draw (psygnal, no Qt widgets).
+
+It holds the immutable :class:`~app.project.Project`, the grids of the last
+solve (and the live preview while solving), the selection and the active
+block.  Views subscribe to its signals; edits go through undo commands
+(:mod:`app.commands`) that call :meth:`Document.set_project`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from psygnal import Signal
+
+from meshcore import StructuredGrid
+
+from .project import Block, Project
+
+__all__ = ["Document"]
+
+
+class Document:
+    """Project + grids + selection, with change signals.
+
+    Signals
+    -------
+    project_changed(Project)
+        After any edit (or undo/redo, or open).
+    grids_changed()
+        The grids (final or preview) changed.
+    selection_changed(frozenset)
+        Selected point indices of the active block changed.
+    active_changed(int)
+        The active block changed.
+    path_changed(object)
+        The file path of the project changed (None for unsaved).
+    message(str)
+        A human-readable status message (errors included).
+    """
+
+    project_changed = Signal(object)
+    grids_changed = Signal()
+    selection_changed = Signal(object)
+    active_changed = Signal(int)
+    path_changed = Signal(object)
+    message = Signal(str)
+
+    def __init__(self, project: Project | None = None) -> None:
+        self.project: Project = project or Project()
+        self.grids: dict[int, StructuredGrid] = {}
+        self.initial: dict[int, StructuredGrid] = {}
+        self.stale: bool = False
+        self.selection: frozenset[int] = frozenset()
+        self.active: int = 0
+        self.path: Path | None = None
+
+    # ----------------------------------------------------------- project
+    @property
+    def block(self) -> Block:
+        """The active block."""
+        return self.project.blocks[min(self.active, len(self.project.blocks) - 1)]
+
+    def set_project(self, project: Project) -> None:
+        """Replace the project (commands call this) and tell the views."""
+        if project is self.project:
+            return
+        self.project = project
+        if self.active >= len(project.blocks):
+            self.set_active(len(project.blocks) - 1)
+        n = len(self.block.points)
+        if any(i >= n for i in self.selection):
+            self.set_selection(frozenset(i for i in self.selection if i < n))
+        self.stale = True
+        self.project_changed.emit(project)
+
+    def reset(self, project: Project, path: Path | None = None) -> None:
+        """Start over with ``project`` (open/new): grids and selection cleared."""
+        self.grids = {}
+        self.initial = {}
+        self.selection = frozenset()
+        self.active = 0
+        self.project = project
+        self.path = Path(path) if path else None
+        self.stale = True
+        self.project_changed.emit(project)
+        self.grids_changed.emit()
+        self.selection_changed.emit(self.selection)
+        self.active_changed.emit(0)
+        self.path_changed.emit(self.path)
+
+    # ------------------------------------------------------------- grids
+    def set_grid(self, index: int, grid: StructuredGrid, *, final: bool = False) -> None:
+        self.grids[index] = grid
+        if final:
+            self.stale = False
+        self.grids_changed.emit()
+
+    def set_grids(self, grids: dict[int, StructuredGrid], initial: dict | None = None) -> None:
+        self.grids = dict(grids)
+        if initial is not None:
+            self.initial = dict(initial)
+        self.stale = False
+        self.grids_changed.emit()
+
+    def clear_grids(self) -> None:
+        self.grids = {}
+        self.initial = {}
+        self.grids_changed.emit()
+
+    @property
+    def grid(self) -> StructuredGrid | None:
+        """The grid of the active block, if any."""
+        return self.grids.get(self.active)
+
+    # --------------------------------------------------------- selection
+    def set_selection(self, indices) -> None:
+        sel = frozenset(int(i) for i in indices)
+        if sel != self.selection:
+            self.selection = sel
+            self.selection_changed.emit(sel)
+
+    def set_active(self, index: int) -> None:
+        index = max(0, min(int(index), len(self.project.blocks) - 1))
+        if index != self.active:
+            self.active = index
+            self.selection = frozenset()
+            self.active_changed.emit(index)
+            self.selection_changed.emit(self.selection)
+
+    def set_path(self, path) -> None:
+        self.path = Path(path) if path else None
+        self.path_changed.emit(self.path)

@@ -1,0 +1,205 @@
+"""Hit-testing and drawing helpers for the canvas (pure NumPy, no Qt; tested).
+
+Everything here works in model coordinates; tolerances are given in model
+units by the caller (the canvas converts a few screen pixels to model units).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "auto_corners",
+    "border_polylines",
+    "grid_lines",
+    "nearest_point",
+    "nearest_segment",
+    "points_in_box",
+    "similarity_from_pairs",
+    "snap",
+]
+
+
+def nearest_point(points: np.ndarray, xy, tol: float) -> int | None:
+    """Index of the point closest to ``xy`` if it is within ``tol``, else None."""
+    if len(points) == 0:
+        return None
+    d = np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
+    k = int(np.argmin(d))
+    return k if d[k] <= tol else None
+
+
+def nearest_segment(points: np.ndarray, xy, tol: float, *, closed: bool = True):
+    """The segment ``(k, k+1)`` nearest to ``xy`` within ``tol``.
+
+    Returns ``(k, t, foot)``: segment start index, the parameter ``t ∈ [0, 1]``
+    of the foot of the perpendicular and the foot point, or None.  With
+    ``closed`` the segment from the last point back to the first counts too.
+    """
+    n = len(points)
+    if n < 2:
+        return None
+    a = points
+    b = np.roll(points, -1, axis=0)
+    if not closed:
+        a, b = a[:-1], b[:-1]
+    ab = b - a
+    L2 = np.einsum("ij,ij->i", ab, ab)
+    p = np.asarray(xy, float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+    foot = a + t[:, None] * ab
+    d = np.hypot(foot[:, 0] - p[0], foot[:, 1] - p[1])
+    k = int(np.argmin(d))
+    if d[k] > tol:
+        return None
+    return k, float(t[k]), (float(foot[k, 0]), float(foot[k, 1]))
+
+
+def points_in_box(points: np.ndarray, x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
+    """Indices of points inside the axis-aligned box spanned by two corners."""
+    if len(points) == 0:
+        return np.zeros(0, dtype=int)
+    xa, xb = sorted((x0, x1))
+    ya, yb = sorted((y0, y1))
+    m = (points[:, 0] >= xa) & (points[:, 0] <= xb) & (points[:, 1] >= ya) & (points[:, 1] <= yb)
+    return np.flatnonzero(m)
+
+
+def snap(xy, points: np.ndarray, tol: float, *, exclude=()) -> tuple[float, float]:
+    """Snap ``xy`` onto the nearest point (other than ``exclude``) within ``tol``."""
+    if len(points):
+        d = np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
+        for k in exclude:
+            if 0 <= k < len(d):
+                d[k] = np.inf
+        k = int(np.argmin(d))
+        if d[k] <= tol:
+            return float(points[k, 0]), float(points[k, 1])
+    return float(xy[0]), float(xy[1])
+
+
+def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
+    """Four corner indices ``(sw, se, ne, nw)`` of a closed loop.
+
+    The vertices nearest to the four corners of the loop's principal-axis
+    bounding box (the box aligned with the eigenvectors of the point
+    covariance, the longer axis as ξ).  A stand-in until
+    ``meshcore.corners`` is available; distinctness and cyclic order are
+    enforced.
+    """
+    p = np.asarray(points, float)
+    n = len(p)
+    if n < 4:
+        raise ValueError(f"a loop needs at least 4 points for corners, got {n}")
+    c = p.mean(axis=0)
+    q = p - c
+    w, v = np.linalg.eigh(q.T @ q)
+    e1 = v[:, np.argmax(w)]
+    if e1[0] < 0 or (e1[0] == 0 and e1[1] < 0):
+        e1 = -e1
+    e2 = np.array([-e1[1], e1[0]])
+    u, s = q @ e1, q @ e2
+    box = [(u.min(), s.min()), (u.max(), s.min()), (u.max(), s.max()), (u.min(), s.max())]
+    # scale-free distance: normalise by the box extents
+    su = max(u.max() - u.min(), 1e-300)
+    ss = max(s.max() - s.min(), 1e-300)
+    chosen: list[int] = []
+    for bu, bs in box:
+        d = np.hypot((u - bu) / su, (s - bs) / ss)
+        d[chosen] = np.inf
+        chosen.append(int(np.argmin(d)))
+    # cyclic order along the CCW loop
+    ccw = _signed_area(p) > 0
+    order = [(k if ccw else (n - k) % n) for k in chosen]
+    rel = [(o - order[0]) % n for o in order]
+    if not (rel[0] < rel[1] < rel[2] < rel[3]):
+        # fall back: keep the SW corner and take the other three in loop order
+        others = sorted(chosen[1:], key=lambda k: ((k if ccw else (n - k) % n) - order[0]) % n)
+        chosen = [chosen[0], *others]
+    return tuple(chosen)  # type: ignore[return-value]
+
+
+def _signed_area(p: np.ndarray) -> float:
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def grid_lines(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All grid lines as one NaN-separated polyline (for ``connect="finite"``).
+
+    The i-lines (constant i, varying j) and then the j-lines, each followed by
+    a NaN.  Returns flat ``(X, Y)`` of length ``ni1·(nj1+1) + nj1·(ni1+1)``.
+    """
+    ni1, nj1 = x.shape
+    a = np.empty((ni1, nj1 + 1))
+    a[:, :-1] = x
+    a[:, -1] = np.nan
+    b = np.empty((nj1, ni1 + 1))
+    b[:, :-1] = x.T
+    b[:, -1] = np.nan
+    c = np.empty((ni1, nj1 + 1))
+    c[:, :-1] = y
+    c[:, -1] = np.nan
+    d = np.empty((nj1, ni1 + 1))
+    d[:, :-1] = y.T
+    d[:, -1] = np.nan
+    return np.concatenate([a.ravel(), b.ravel()]), np.concatenate([c.ravel(), d.ravel()])
+
+
+def border_polylines(points: np.ndarray, corners) -> dict[str, np.ndarray]:
+    """The four borders of a loop walked in loop order between the corners.
+
+    Unlike :func:`meshcore.borders_from_loop` this never raises: it is for
+    drawing while the user edits (bottom = sw→se, right = se→ne, top = ne→nw,
+    left = nw→sw, in the loop's own direction; arrows follow the loop).
+    """
+    n = len(points)
+    names = ("bottom", "right", "top", "left")
+    out = {}
+    for k, name in enumerate(names):
+        a, b = corners[k], corners[(k + 1) % 4]
+        m = (b - a) % n
+        idx = [(a + s) % n for s in range(m + 1)]
+        out[name] = points[idx]
+    return out
+
+
+def similarity_from_pairs(uv0, xy0, uv1, xy1) -> tuple[float, float, float, float]:
+    """Similarity map ``(a, b, tx, ty)`` taking image points uv0→xy0 and uv1→xy1.
+
+    ``x = a·u − b·v + tx``, ``y = b·u + a·v + ty`` (rotation + uniform scale +
+    translation), i.e. complex multiplication ``z = (a + ib)·w + t``.
+    """
+    w0, w1 = complex(*uv0), complex(*uv1)
+    z0, z1 = complex(*xy0), complex(*xy1)
+    if w1 == w0:
+        raise ValueError("the two calibration points must be different pixels")
+    m = (z1 - z0) / (w1 - w0)
+    t = z0 - m * w0
+    return (m.real, m.imag, t.real, t.imag)
+
+
+def polyline_length(p: np.ndarray) -> float:
+    if len(p) < 2:
+        return 0.0
+    d = np.diff(p, axis=0)
+    return float(np.hypot(d[:, 0], d[:, 1]).sum())
+
+
+def arrow_at_middle(p: np.ndarray) -> tuple[float, float, float] | None:
+    """Position and angle (degrees, math convention) half-way along a polyline."""
+    if len(p) < 2:
+        return None
+    d = np.diff(p, axis=0)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(d[:, 0], d[:, 1]))])
+    if s[-1] <= 0:
+        return None
+    h = 0.5 * s[-1]
+    k = int(min(np.searchsorted(s, h) - 1, len(d) - 1))
+    k = max(k, 0)
+    t = (h - s[k]) / max(s[k + 1] - s[k], 1e-300)
+    pt = p[k] + t * d[k]
+    return float(pt[0]), float(pt[1]), math.degrees(math.atan2(d[k, 1], d[k, 0]))

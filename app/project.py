@@ -1,0 +1,309 @@
+"""The editable project: immutable state and pure edit functions (no Qt).
+
+A :class:`Project` is a frozen snapshot of everything the user edits: the
+blocks (boundary points, corners, cells, weights, initial method, per-border
+distributions), the solver settings, cut lines, the background image and the
+coordinate reference.  Every edit is a pure function ``Project -> Project``
+(``with_point_added``, ``with_points_moved`` …); undo commands store the
+states before and after and swap them, so undo restores the *exact* previous
+state.
+
+Blocks come in two forms, both accepted by :func:`meshcore.generate_block`:
+
+* a closed **loop** of points plus four corner indices ``(sw, se, ne, nw)``
+  (``Block.points`` / ``Block.corners``) — the form the editing tools work on;
+* four **border polylines** (``Block.boundary``), as read from a case file
+  whose borders are given explicitly (e.g. the paper's doubly-connected case
+  where left and right coincide).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from meshcore import BORDER_NAMES, BorderSpec, EllipticConfig
+
+__all__ = [
+    "Background",
+    "Block",
+    "Project",
+    "SolverSettings",
+    "frozen_points",
+]
+
+
+def frozen_points(points: Any) -> np.ndarray:
+    """An ``(n, 2)`` float64 read-only copy of ``points`` (``(0, 2)`` for none)."""
+    a = np.array(points if points is not None and len(points) else np.zeros((0, 2)), dtype=np.float64)
+    a = a.reshape(-1, 2).copy()
+    a.setflags(write=False)
+    return a
+
+
+def _eq_arrays(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    if a is None or b is None:
+        return a is b
+    return a.shape == b.shape and bool(np.array_equal(a, b))
+
+
+@dataclass(frozen=True, slots=True)
+class SolverSettings:
+    """The solver part of a project (mirrors :class:`meshcore.EllipticConfig`)."""
+
+    method: str = "auto"
+    tolerance: float | None = None
+    max_iterations: int = 50_000
+    omega: float | None = None
+
+    def config(self, **kw: Any) -> EllipticConfig:
+        """The :class:`EllipticConfig` (raises InvalidInputError when invalid)."""
+        return EllipticConfig(method=self.method, tolerance=self.tolerance,
+                              max_iterations=self.max_iterations, omega=self.omega, **kw)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Block:
+    """One block of the project.
+
+    ``points`` is the closed loop (first point not repeated) when ``closed``;
+    while the user is still drawing it is an open polyline.  ``corners`` are
+    four indices into ``points`` (sw, se, ne, nw) or None.  ``boundary``
+    (four polylines) replaces points/corners for blocks given by borders.
+    """
+
+    name: str = "block"
+    points: np.ndarray = field(default_factory=lambda: frozen_points(None))
+    closed: bool = False
+    corners: tuple[int, int, int, int] | None = None
+    boundary: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+    cells: tuple[int, int] = (32, 16)
+    weights: tuple[float, float] = (0.5, 0.5)
+    initial: str = "weighted"
+    curve: str = "linear"
+    periodic: bool = False
+    borders: tuple[tuple[str, BorderSpec], ...] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "points", frozen_points(self.points))
+        if self.boundary is not None:
+            object.__setattr__(self, "boundary", tuple(frozen_points(b) for b in self.boundary))
+        if self.corners is not None:
+            object.__setattr__(self, "corners", tuple(int(c) for c in self.corners))
+        object.__setattr__(self, "cells", (int(self.cells[0]), int(self.cells[1])))
+        object.__setattr__(self, "weights", (float(self.weights[0]), float(self.weights[1])))
+        object.__setattr__(self, "borders", tuple(sorted(
+            (n, BorderSpec.coerce(s, border=n)) for n, s in dict(self.borders).items())))
+
+    # ------------------------------------------------------------ queries
+    @property
+    def ready(self) -> bool:
+        """True when the block has a full boundary and can be generated."""
+        if self.boundary is not None:
+            return True
+        return self.closed and self.corners is not None and len(self.points) >= 4
+
+    def spec(self, border: str) -> BorderSpec:
+        """The :class:`BorderSpec` of ``border`` (uniform by default)."""
+        return dict(self.borders).get(border, BorderSpec())
+
+    def border_specs(self) -> dict[str, BorderSpec]:
+        return dict(self.borders)
+
+    def node_count(self, border: str) -> int:
+        ni, nj = self.cells
+        return (ni if border in ("bottom", "top") else nj) + 1
+
+    def replaced(self, **kw: Any) -> Block:
+        return dataclasses.replace(self, **kw)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Block):
+            return NotImplemented
+        if self.boundary is None or other.boundary is None:
+            same_boundary = self.boundary is None and other.boundary is None
+        else:
+            same_boundary = all(_eq_arrays(a, b) for a, b in zip(self.boundary, other.boundary, strict=True))
+        return (
+            _eq_arrays(self.points, other.points) and same_boundary
+            and (self.name, self.closed, self.corners, self.cells, self.weights, self.initial,
+                 self.curve, self.periodic, self.borders)
+            == (other.name, other.closed, other.corners, other.cells, other.weights, other.initial,
+                other.curve, other.periodic, other.borders)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Background:
+    """A background image placed in model coordinates.
+
+    ``transform`` = ``(a, b, tx, ty)`` of the similarity map
+    ``x = a·u − b·v + tx, y = b·u + a·v + ty`` from image pixels ``(u, v)``
+    (v downwards in the file, flipped on load) to model coordinates.
+    """
+
+    path: str
+    transform: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Background) and (self.path, self.transform) == (other.path, other.transform)
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Project:
+    """Everything the user edits (immutable; edits return new projects)."""
+
+    blocks: tuple[Block, ...] = (Block(name="block"),)
+    solver: SolverSettings = SolverSettings()
+    cut_lines: tuple[np.ndarray, ...] = ()
+    background: Background | None = None
+    crs: str = ""  # e.g. "EPSG:32632" when points were projected from lon/lat
+    title: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "blocks", tuple(self.blocks))
+        object.__setattr__(self, "cut_lines", tuple(frozen_points(c) for c in self.cut_lines))
+
+    def replaced(self, **kw: Any) -> Project:
+        return dataclasses.replace(self, **kw)
+
+    def with_block(self, index: int, block: Block) -> Project:
+        blocks = list(self.blocks)
+        blocks[index] = block
+        return self.replaced(blocks=tuple(blocks))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Project):
+            return NotImplemented
+        return (
+            self.blocks == other.blocks and self.solver == other.solver
+            and len(self.cut_lines) == len(other.cut_lines)
+            and all(_eq_arrays(a, b) for a, b in zip(self.cut_lines, other.cut_lines, strict=True))
+            and self.background == other.background and self.crs == other.crs
+            and self.title == other.title
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def bounds(self) -> tuple[float, float, float, float] | None:
+        """Bounding box of all points (None when empty)."""
+        pts = [b.points for b in self.blocks if len(b.points)]
+        pts += [np.vstack(b.boundary) for b in self.blocks if b.boundary is not None]
+        if not pts:
+            return None
+        a = np.vstack(pts)
+        return (float(a[:, 0].min()), float(a[:, 1].min()), float(a[:, 0].max()), float(a[:, 1].max()))
+
+
+# ------------------------------------------------------------------ edits on a block
+def with_point_added(block: Block, xy: tuple[float, float]) -> Block:
+    """Append a point to an open (being drawn) block."""
+    return block.replaced(points=np.vstack([block.points, np.asarray(xy, float).reshape(1, 2)]))
+
+
+def with_loop_closed(block: Block) -> Block:
+    """Close the drawn polyline (needs ≥ 3 points); drops a repeated last point."""
+    p = block.points
+    if len(p) >= 2 and np.allclose(p[0], p[-1]):
+        p = p[:-1]
+    if len(p) < 3:
+        return block
+    return block.replaced(points=p, closed=True)
+
+
+def with_points_moved(block: Block, indices: Any, delta: tuple[float, float]) -> Block:
+    """Move the points ``indices`` by ``delta``."""
+    p = np.array(block.points)
+    idx = np.asarray(list(indices), dtype=int)
+    p[idx] += np.asarray(delta, float)
+    return block.replaced(points=p)
+
+
+def with_point_set(block: Block, index: int, xy: tuple[float, float]) -> Block:
+    """Put point ``index`` at ``xy``."""
+    p = np.array(block.points)
+    p[int(index)] = xy
+    return block.replaced(points=p)
+
+
+def with_point_inserted(block: Block, after: int, xy: tuple[float, float]) -> Block:
+    """Insert a point after index ``after`` (on segment after → after+1); corners follow."""
+    p = np.insert(np.array(block.points), after + 1, np.asarray(xy, float), axis=0)
+    corners = None
+    if block.corners is not None:
+        corners = tuple(c + 1 if c > after else c for c in block.corners)
+    return block.replaced(points=p, corners=corners)
+
+
+def with_points_deleted(block: Block, indices: Any) -> Block:
+    """Delete points; corners on deleted points are cleared, others re-indexed."""
+    idx = sorted({int(i) for i in indices})
+    if not idx:
+        return block
+    keep = np.ones(len(block.points), dtype=bool)
+    keep[idx] = False
+    p = block.points[keep]
+    corners = None
+    if block.corners is not None and not any(c in idx for c in block.corners):
+        newidx = np.cumsum(keep) - 1
+        corners = tuple(int(newidx[c]) for c in block.corners)
+    closed = block.closed and len(p) >= 3
+    return block.replaced(points=p, corners=corners, closed=closed)
+
+
+def with_corners(block: Block, corners: Any) -> Block:
+    return block.replaced(corners=None if corners is None else tuple(int(c) for c in corners))
+
+
+def with_border_spec(block: Block, border: str, spec: BorderSpec) -> Block:
+    if border not in BORDER_NAMES:
+        raise ValueError(f"unknown border {border!r}")
+    d = dict(block.borders)
+    d[border] = spec
+    return block.replaced(borders=tuple(d.items()))
+
+
+def boundary_to_loop(block: Block) -> Block:
+    """Turn a four-polyline block into loop + corners (for editing), when possible."""
+    if block.boundary is None:
+        return block
+    b, r, t, l = block.boundary
+    loop = np.vstack([b[:-1], r[:-1], t[::-1][:-1], l[::-1][:-1]])
+    nb, nr, nt = len(b) - 1, len(r) - 1, len(t) - 1
+    corners = (0, nb, nb + nr, nb + nr + nt)
+    return block.replaced(points=loop, closed=True, corners=corners, boundary=None)
+
+
+def next_block_name(project: Project) -> str:
+    names = {b.name for b in project.blocks}
+    k = len(project.blocks) + 1
+    while f"block{k}" in names:
+        k += 1
+    return f"block{k}"
+
+
+def default_cells(points: np.ndarray, corners: tuple[int, int, int, int], total: int = 40) -> tuple[int, int]:
+    """Cell counts proportional to the mean lengths of opposite borders (≈ ``total`` along the longer)."""
+    n = len(points)
+
+    def arc(a: int, b: int) -> float:
+        idx = [(a + k) % n for k in range((b - a) % n + 1)]
+        seg = np.diff(points[idx], axis=0)
+        return float(np.hypot(seg[:, 0], seg[:, 1]).sum())
+
+    sw, se, ne, nw = corners
+    lxi = 0.5 * (arc(sw, se) + arc(ne, nw))
+    leta = 0.5 * (arc(se, ne) + arc(nw, sw))
+    if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
+        return (total, total)
+    if lxi >= leta:
+        return (total, max(2, round(total * leta / lxi)))
+    return (max(2, round(total * lxi / leta)), total)

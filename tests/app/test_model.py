@@ -1,0 +1,168 @@
+"""The app's document, pure edit functions, hit-testing and undo commands — no window."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app import geometry as geo
+from app import project as pj
+from app.commands import Editor
+from app.document import Document
+from app.pipeline import block_initial_grid, solve_project
+from app.project import Block, Project
+from meshcore import BorderSpec, borders_from_loop
+
+
+def square_block(n=4, cells=(8, 8)):
+    """A square loop with n points per side, corners at the four vertices."""
+    t = np.linspace(0, 1, n + 1)[:-1]
+    pts = np.vstack([np.c_[t, 0 * t], np.c_[1 + 0 * t, t], np.c_[1 - t, 1 + 0 * t], np.c_[0 * t, 1 - t]])
+    return Block(points=pts, closed=True, corners=(0, n, 2 * n, 3 * n), cells=cells)
+
+
+def test_nearest_point_and_segment():
+    p = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    assert geo.nearest_point(p, (0.98, 0.03), 0.1) == 1
+    assert geo.nearest_point(p, (0.5, 0.5), 0.1) is None
+    k, t, foot = geo.nearest_segment(p, (0.25, 0.02), 0.05)
+    assert (k, t) == (0, pytest.approx(0.25)) and foot == pytest.approx((0.25, 0.0))
+    # the closing segment 3 -> 0 counts only for closed loops
+    assert geo.nearest_segment(p, (0.01, 0.5), 0.05)[0] == 3
+    assert geo.nearest_segment(p, (-0.01, 0.5), 0.05, closed=False) is None
+    assert list(geo.points_in_box(p, 1.1, -0.1, 0.5, 1.1)) == [1, 2]
+    assert geo.snap((0.97, 1.02), p, 0.05, exclude=[2]) == (0.97, 1.02)
+    assert geo.snap((0.97, 1.02), p, 0.05) == (1.0, 1.0)
+
+
+def test_grid_lines_are_nan_separated_polylines():
+    x, y = np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij")
+    X, Y = geo.grid_lines(x, y)
+    assert X.shape == (4 * 4 + 3 * 5,)
+    assert np.isnan(X).sum() == 4 + 3
+    # first i-line: i = 0, j = 0..2 then NaN
+    assert X[:4].tolist()[:3] == [0, 0, 0] and Y[:3].tolist() == [0, 1, 2] and np.isnan(Y[3])
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_auto_corners_of_rotated_rectangle_loop(reverse):
+    b = square_block(5)
+    pts = np.array(b.points) * [3.0, 1.0]
+    th = 0.4
+    rot = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    pts = pts @ rot.T
+    if reverse:
+        pts = pts[::-1].copy()
+    c = geo.auto_corners(pts)
+    # the chosen points are the rectangle's four vertices
+    verts = (np.array([[0, 0], [3, 0], [3, 1], [0, 1]]) @ rot.T)
+    assert sorted(map(tuple, np.round(pts[list(c)], 9))) == sorted(map(tuple, np.round(verts, 9)))
+    bd = borders_from_loop(pts, c)  # meshcore accepts them: cyclic order is right
+    assert len(bd.bottom) == len(bd.top) == 6
+
+
+def test_similarity_from_two_pairs():
+    a, b, tx, ty = geo.similarity_from_pairs((0, 0), (10, 20), (100, 0), (10, 220))
+    m = complex(a, b)
+    assert m == pytest.approx(2j) and (tx, ty) == pytest.approx((10, 20))
+
+
+def test_edit_functions_keep_corners_consistent():
+    b = square_block(2)
+    assert b.corners == (0, 2, 4, 6)
+    b2 = pj.with_point_inserted(b, 0, (0.25, 0.0))
+    assert b2.corners == (0, 3, 5, 7) and len(b2.points) == 9
+    b3 = pj.with_points_deleted(b2, [1])
+    assert b3 == b
+    # deleting a corner clears the corners
+    assert pj.with_points_deleted(b, [2]).corners is None
+    b4 = pj.with_points_moved(b, [1], (0.0, 0.1))
+    assert b4.points[1].tolist() == [0.5, 0.1] and b.points[1].tolist() == [0.5, 0.0]
+    assert not b4.points.flags.writeable
+
+
+def test_boundary_polylines_round_trip_to_loop():
+    b = square_block(3)
+    bd = borders_from_loop(b.points, b.corners)
+    poly = Block(boundary=(bd.bottom, bd.right, bd.top, bd.left), cells=(6, 6))
+    loop = pj.boundary_to_loop(poly)
+    assert loop.ready and loop.boundary is None
+    g1, g2 = block_initial_grid(poly), block_initial_grid(loop)
+    assert g1 == g2
+
+
+def test_undo_redo_restore_exact_states():
+    pytest.importorskip("PySide6")
+    from PySide6.QtGui import QUndoStack
+
+    doc = Document()
+    stack = QUndoStack()
+    ed = Editor(doc, stack)
+    seen = []
+    doc.project_changed.connect(seen.append)
+    states = [doc.project]
+    for xy in [(0, 0), (2, 0), (2, 1), (0, 1)]:
+        ed.add_point(xy)
+        states.append(doc.project)
+    ed.close_loop()
+    states.append(doc.project)
+    ed.set_corners((0, 1, 2, 3))
+    states.append(doc.project)
+    drag = ed.new_drag_id()
+    for k in range(5):  # a drag merges into a single undo step
+        ed.set_point(2, (2 + 0.1 * k, 1 + 0.05 * k), drag_id=drag)
+    states.append(doc.project)
+    ed.set_border_spec("bottom", BorderSpec("tanh", first=0.01))
+    states.append(doc.project)
+    ed.set_solver(method="sor", tolerance=1e-5)
+    states.append(doc.project)
+    assert stack.count() == len(states) - 1
+    assert len(seen) >= stack.count()
+    for k in range(len(states) - 1, 0, -1):
+        assert doc.project == states[k]
+        stack.undo()
+        assert doc.project == states[k - 1]
+        assert doc.project is states[k - 1]  # the very same object: nothing recomputed
+    for k in range(1, len(states)):
+        stack.redo()
+        assert doc.project is states[k]
+    assert doc.block.corners == (0, 1, 2, 3) and doc.block.closed
+    assert doc.block.points[2].tolist() == pytest.approx([2.4, 1.2])
+    # a no-op edit pushes nothing
+    n = stack.count()
+    ed.set_solver(method="sor")
+    assert stack.count() == n
+
+
+def test_solve_project_generator_returns_grids_and_warm_start_helps():
+    proj = Project(blocks=(square_block(4, cells=(16, 16)),))
+    p = np.array(proj.blocks[0].points)
+    p[2] += (0.0, 0.3)  # bulge the bottom: the algebraic grid is not the solution
+    proj = proj.with_block(0, proj.blocks[0].replaced(points=p))
+    gen = solve_project(proj)
+    seen = []
+    try:
+        while True:
+            seen.append(next(gen))
+    except StopIteration as fin:
+        res = fin.value
+    g = res.grids[0]
+    assert g.cells == (16, 16) and g.converged
+    assert seen[0][0] == 0 and seen[0][1] == res.initial[0]
+    # warm start after a small boundary move converges in fewer iterations
+    p2 = p.copy()
+    p2[2] += (0.0, 0.02)
+    proj2 = proj.with_block(0, proj.blocks[0].replaced(points=p2))
+    cold = _drain(solve_project(proj2)).grids[0]
+    warm = _drain(solve_project(proj2, warm={0: (res.initial[0], g)})).grids[0]
+    assert warm.converged and cold.converged
+    assert warm.iterations < cold.iterations
+    assert np.abs(warm.x - cold.x).max() < 1e-4
+
+
+def _drain(gen):
+    try:
+        while True:
+            next(gen)
+    except StopIteration as fin:
+        return fin.value
