@@ -148,6 +148,12 @@ class Editor:
         self._edit_block(MovePoints, lambda b: pj.with_points_moved(b, indices, delta),
                          "Move point" if len(indices) == 1 else f"Move {len(indices)} points", key)
 
+    def set_points(self, indices, positions, drag_id=None) -> None:
+        key = ("move", drag_id) if drag_id is not None else None
+        idx = list(indices)
+        self._edit_block(MovePoints, lambda b: pj.with_points_set(b, idx, positions),
+                         "Move point" if len(idx) == 1 else f"Move {len(idx)} points", key)
+
     def set_point(self, index, xy, drag_id=None) -> None:
         key = ("move", drag_id) if drag_id is not None else None
         self._edit_block(MovePoints, lambda b: pj.with_point_set(b, index, xy), "Move point", key)

@@ -150,21 +150,27 @@ def grid_lines(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def border_polylines(points: np.ndarray, corners) -> dict[str, np.ndarray]:
-    """The four borders of a loop walked in loop order between the corners.
+    """The four borders of a loop in the grid convention, for drawing.
 
-    Unlike :func:`meshcore.borders_from_loop` this never raises: it is for
-    drawing while the user edits (bottom = sw→se, right = se→ne, top = ne→nw,
-    left = nw→sw, in the loop's own direction; arrows follow the loop).
+    Like :func:`meshcore.borders_from_loop` (bottom/top run sw→se / nw→ne,
+    left/right run sw→nw / se→ne, walking the loop counter-clockwise) but it
+    never raises: it is used while the user edits.
     """
-    n = len(points)
-    names = ("bottom", "right", "top", "left")
-    out = {}
-    for k, name in enumerate(names):
-        a, b = corners[k], corners[(k + 1) % 4]
-        m = (b - a) % n
-        idx = [(a + s) % n for s in range(m + 1)]
-        out[name] = points[idx]
-    return out
+    p = np.asarray(points, float)
+    n = len(p)
+    step = 1 if _signed_area(p) >= 0 else -1
+
+    def walk(a: int, b: int) -> np.ndarray:
+        m = ((b - a) * step) % n
+        return p[[(a + step * s) % n for s in range(m + 1)]]
+
+    sw, se, ne, nw = (int(c) for c in corners)
+    return {
+        "bottom": walk(sw, se),
+        "right": walk(se, ne),
+        "top": walk(ne, nw)[::-1],
+        "left": walk(nw, sw)[::-1],
+    }
 
 
 def similarity_from_pairs(uv0, xy0, uv1, xy1) -> tuple[float, float, float, float]:

@@ -61,10 +61,12 @@ def solve_project(
     smooth: bool = True,
     blocks: list[int] | None = None,
 ) -> Generator[tuple[int, object], object, BlockResult]:
-    """Solve every ready block; yield ``(index, progress)``; return :class:`BlockResult`.
+    """Solve every ready block; yield snapshots; return :class:`BlockResult`.
 
-    ``warm`` maps a block index to ``(previous start grid, previous result)``.
-    Yields ``(index, StructuredGrid)`` once with the start grid before iterating.
+    Yields ``(index, item, algebraic)``: first ``item`` = the start grid
+    (a :class:`StructuredGrid`), then :class:`meshcore.SolverProgress`
+    snapshots; ``algebraic`` is the block's algebraic grid (for warm starts).
+    ``warm`` maps a block index to ``(previous algebraic grid, previous grid)``.
     """
     cfg = project.solver.config(report_interval=report_interval)
     grids: dict[int, StructuredGrid] = {}
@@ -81,7 +83,7 @@ def solve_project(
             a_old, g_old = warm[k]
             if a_old.shape == g0.shape and g_old.shape == g0.shape:
                 start = g0.replaced(x=g0.x + (g_old.x - a_old.x), y=g0.y + (g_old.y - a_old.y))
-        yield k, start
+        yield k, start, g0
         if not smooth:
             grids[k] = g0
             continue
@@ -89,7 +91,7 @@ def solve_project(
         try:
             snap = next(gen)
             while True:
-                cmd = yield k, snap
+                cmd = yield k, snap, g0
                 snap = gen.send(cmd)
         except StopIteration as fin:
             grids[k] = fin.value

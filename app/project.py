@@ -145,7 +145,7 @@ class Background:
 
     ``transform`` = ``(a, b, tx, ty)`` of the similarity map
     ``x = a·u − b·v + tx, y = b·u + a·v + ty`` from image pixels ``(u, v)``
-    (v downwards in the file, flipped on load) to model coordinates.
+    (u to the right, v *upwards* from the bottom row) to model coordinates.
     """
 
     path: str
@@ -231,6 +231,13 @@ def with_point_set(block: Block, index: int, xy: tuple[float, float]) -> Block:
     """Put point ``index`` at ``xy``."""
     p = np.array(block.points)
     p[int(index)] = xy
+    return block.replaced(points=p)
+
+
+def with_points_set(block: Block, indices: Any, positions: Any) -> Block:
+    """Put the points ``indices`` at ``positions`` (``(k, 2)``)."""
+    p = np.array(block.points)
+    p[np.asarray(list(indices), dtype=int)] = np.asarray(positions, float).reshape(-1, 2)
     return block.replaced(points=p)
 
 

@@ -148,7 +148,7 @@ def test_solve_project_generator_returns_grids_and_warm_start_helps():
         res = fin.value
     g = res.grids[0]
     assert g.cells == (16, 16) and g.converged
-    assert seen[0][0] == 0 and seen[0][1] == res.initial[0]
+    assert seen[0][0] == 0 and seen[0][1] == res.initial[0] == seen[0][2]
     # warm start after a small boundary move converges in fewer iterations
     p2 = p.copy()
     p2[2] += (0.0, 0.02)
@@ -166,3 +166,18 @@ def _drain(gen):
             next(gen)
     except StopIteration as fin:
         return fin.value
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_border_polylines_match_meshcore(reverse):
+    b = square_block(3)
+    pts = np.array(b.points)
+    c = list(b.corners)
+    if reverse:
+        pts = pts[::-1].copy()
+        n = len(pts)
+        c = [(n - 1 - k) for k in c]  # the same geometric corners in the reversed loop
+    mine = geo.border_polylines(pts, c)
+    ref = borders_from_loop(pts, c)
+    for name in ("bottom", "right", "top", "left"):
+        np.testing.assert_allclose(mine[name], ref[name])

@@ -1,0 +1,238 @@
+"""Runs the solver in a worker thread and feeds the document at a bounded rate.
+
+The worker (superqt ``GeneratorWorker``) iterates :func:`app.pipeline.solve_project`
+and only emits signals; the slots here run in the GUI thread.  Snapshots are
+kept as the *latest* one per block and pushed to the document by a ~30 Hz
+timer, so stale frames are dropped, never queued.  Stop sets a
+``threading.Event`` checked by meshcore after every sweep/cycle, so it takes
+effect within one sweep.  With ``auto`` on, every project edit restarts the
+solve (coalesced in one event-loop pass), warm-started from the last grid.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from PySide6 import QtCore
+from superqt.utils import create_worker
+
+from meshcore import MeshcoreError, SolverProgress, StructuredGrid
+
+from .document import Document
+from .pipeline import solve_project
+
+__all__ = ["SolverController"]
+
+
+def _run(run_id, project, warm, stop_event, smooth):
+    """The worker body: tag every item with the run id; errors become results."""
+    gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth)
+    try:
+        while True:
+            k, item, g0 = next(gen)
+            yield run_id, k, item, g0
+    except StopIteration as fin:
+        return run_id, fin.value, None
+    except MeshcoreError as exc:
+        return run_id, None, str(exc)
+    except Exception as exc:  # a bug must not kill the window: report it
+        return run_id, None, f"internal error: {type(exc).__name__}: {exc}"
+
+
+class SolverController(QtCore.QObject):
+    """Start/pause/stop the solver; throttle snapshots into the document."""
+
+    state_changed = QtCore.Signal(str)  # "idle" | "running" | "paused"
+    progress = QtCore.Signal(int, object)  # block index, SolverProgress (throttled)
+    finished = QtCore.Signal(object)  # BlockResult, or None on error/stop
+    error = QtCore.Signal(str)
+    redrawn = QtCore.Signal()
+
+    def __init__(self, doc: Document, parent=None, *, frame_interval_ms: int = 33) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.auto = False
+        self.smooth = True
+        self._worker = None
+        self._run = 0
+        self._stop_event: threading.Event | None = None
+        self._latest: dict[int, tuple[object, StructuredGrid]] = {}
+        self._dirty = False
+        self.state = "idle"
+        self.t_start = 0.0
+        self.t_done = 0.0
+        self.last_result = None
+        self.gui_thread = QtCore.QThread.currentThread()
+        self.thread_violations = 0  # slots found running outside the GUI thread (tests)
+        self._timer = QtCore.QTimer(self)
+        self._timer.setInterval(frame_interval_ms)
+        self._timer.timeout.connect(self._flush)
+        self._debounce = QtCore.QTimer(self)
+        self._debounce.setSingleShot(True)
+        self._debounce.setInterval(0)
+        self._debounce.timeout.connect(self.start)
+        doc.project_changed.connect(self._on_project_changed)
+
+    # ------------------------------------------------------------ control
+    @property
+    def running(self) -> bool:
+        return self.state in ("running", "paused")
+
+    def set_auto(self, on: bool) -> None:
+        self.auto = bool(on)
+        if self.auto and self.doc.stale:
+            self._debounce.start()
+
+    def _on_project_changed(self, _project) -> None:
+        if self.auto:
+            self._debounce.start()
+
+    def start(self) -> bool:
+        """(Re)start solving the current project; returns False when nothing is ready."""
+        self._debounce.stop()
+        project = self.doc.project
+        if not any(b.ready for b in project.blocks):
+            self.doc.clear_grids()
+            return False
+        self._abandon()
+        self._run += 1
+        warm = {}
+        for k, g in self.doc.grids.items():
+            a = self.doc.initial.get(k)
+            if a is not None and a.shape == g.shape:
+                warm[k] = (a, g)
+        ev = threading.Event()
+        self._stop_event = ev
+        self._latest = {}
+        worker = create_worker(_run, self._run, project, warm, ev, self.smooth, _start_thread=False)
+        worker.yielded.connect(self._on_yielded)
+        worker.returned.connect(self._on_returned)
+        worker.errored.connect(self._on_errored)
+        self._worker = worker
+        self.t_start = time.perf_counter()
+        self._set_state("running")
+        self._timer.start()
+        worker.start()
+        return True
+
+    def stop(self) -> None:
+        """Ask the solver to stop; it returns the current grid at the next sweep."""
+        if self._stop_event is not None:
+            self._stop_event.set()
+        if self._worker is not None:
+            if self.state == "paused":
+                self._worker.resume()
+            self._worker.quit()
+
+    def pause(self) -> None:
+        if self._worker is not None and self.state == "running":
+            self._worker.pause()
+            self._set_state("paused")
+
+    def resume(self) -> None:
+        if self._worker is not None and self.state == "paused":
+            self._worker.resume()
+            self._set_state("running")
+
+    def toggle_pause(self) -> None:
+        self.resume() if self.state == "paused" else self.pause()
+
+    def wait(self, timeout_s: float = 5.0) -> bool:
+        """Process events until idle (for scripts/tests); True when idle."""
+        app = QtCore.QCoreApplication.instance()
+        t0 = time.perf_counter()
+        while self.running or self._debounce.isActive():
+            app.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 10)
+            if time.perf_counter() - t0 > timeout_s:
+                return False
+        return True
+
+    def shutdown(self) -> None:
+        """Stop and wait for every worker (window close)."""
+        self._abandon()
+        from superqt.utils._qthreading import WorkerBase
+
+        WorkerBase.await_workers(msecs=2000)
+
+    def _abandon(self) -> None:
+        if self._stop_event is not None:
+            self._stop_event.set()
+        if self._worker is not None:
+            try:
+                self._worker.resume()
+                self._worker.quit()
+            except RuntimeError:
+                pass
+        self._worker = None
+
+    def _set_state(self, s: str) -> None:
+        if s != self.state:
+            self.state = s
+            self.state_changed.emit(s)
+
+    def _check_thread(self) -> None:
+        if QtCore.QThread.currentThread() is not self.gui_thread:
+            self.thread_violations += 1
+
+    # -------------------------------------------------------------- slots
+    @QtCore.Slot(object)
+    def _on_yielded(self, value) -> None:
+        self._check_thread()
+        run, k, item, g0 = value
+        if run != self._run:
+            return
+        self._latest[k] = (item, g0)
+        self._dirty = True
+
+    def _flush(self) -> None:
+        if not self._dirty:
+            return
+        self._dirty = False
+        for k, (item, g0) in self._latest.items():
+            grid = item.grid if isinstance(item, SolverProgress) else item
+            self.doc.grids[k] = grid
+            self.doc.initial[k] = g0
+            if isinstance(item, SolverProgress):
+                self.progress.emit(k, item)
+        self.doc.grids_changed.emit()
+        self.redrawn.emit()
+
+    @QtCore.Slot(object)
+    def _on_returned(self, value) -> None:
+        self._check_thread()
+        run, result, err = value
+        if run != self._run:
+            return
+        self._timer.stop()
+        self._worker = None
+        self.t_done = time.perf_counter()
+        if err is not None:
+            self._dirty = False
+            self.error.emit(err)
+            self.doc.message.emit(err)
+            self._set_state("idle")
+            self.finished.emit(None)
+            return
+        self._flush()
+        grids = dict(self.doc.grids)
+        grids.update(result.grids)
+        initial = dict(self.doc.initial)
+        initial.update(result.initial)
+        ready = {k for k, b in enumerate(self.doc.project.blocks) if b.ready}
+        grids = {k: g for k, g in grids.items() if k in ready}
+        self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready})
+        self.last_result = result
+        self._set_state("idle")
+        self.finished.emit(result)
+
+    @QtCore.Slot(object)
+    def _on_errored(self, exc) -> None:
+        self._check_thread()
+        self._timer.stop()
+        self._worker = None
+        msg = f"solver failed: {exc}"
+        self.error.emit(msg)
+        self.doc.message.emit(msg)
+        self._set_state("idle")
+        self.finished.emit(None)

@@ -1,0 +1,318 @@
+"""Interaction tools: small state machines turning mouse input into commands.
+
+A tool receives model coordinates from the canvas (``click``, ``double_click``,
+``drag(phase, xy, start)``, ``hover``, ``key``) and returns True when it used
+the event (otherwise the canvas pans/zooms).  Geometry is done by the tested
+helpers in :mod:`app.geometry`; edits go through :class:`app.commands.Editor`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from PySide6 import QtCore
+
+from . import geometry as geo
+
+__all__ = ["CornersTool", "CutTool", "DrawTool", "EditTool", "PanTool", "TOOLS", "Tool"]
+
+SHIFT = QtCore.Qt.KeyboardModifier.ShiftModifier
+CTRL = QtCore.Qt.KeyboardModifier.ControlModifier
+
+
+class Tool:
+    """Base tool: uses nothing, so the canvas pans and zooms."""
+
+    name = "pan"
+    label = "Pan"
+    shortcut = "P"
+    tip = "Pan (drag) and zoom (wheel) the view"
+
+    def __init__(self, doc, editor, canvas, status: Callable[[str], None] = lambda s: None) -> None:
+        self.doc = doc
+        self.editor = editor
+        self.canvas = canvas
+        self.status = status
+
+    def tol(self) -> float:
+        return self.canvas.tolerance(8.0) if self.canvas is not None else 1e-2
+
+    def activate(self) -> None:
+        self.status(self.tip)
+
+    def deactivate(self) -> None:
+        if self.canvas is not None:
+            self.canvas.rubber_line.setData([], [])
+            self.canvas.rubber_box.hide()
+
+    def click(self, xy, modifiers=None) -> bool:
+        return False
+
+    def double_click(self, xy, modifiers=None) -> bool:
+        return False
+
+    def right_click(self, xy) -> bool:
+        return False
+
+    def drag(self, phase: str, xy, start, modifiers=None) -> bool:
+        return False
+
+    def hover(self, xy) -> None:
+        pass
+
+    def key(self, key: int) -> bool:
+        return False
+
+
+class PanTool(Tool):
+    pass
+
+
+class DrawTool(Tool):
+    """Click to add boundary points; double-click, Enter or a click on the first point closes the loop."""
+
+    name = "draw"
+    label = "Draw"
+    shortcut = "D"
+    tip = "Draw: click to add points · double-click, Enter or click the first point to close · drag to pan"
+
+    def _ensure_open_block(self) -> None:
+        b = self.doc.block
+        if b.closed or b.boundary is not None:
+            self.editor.add_block()
+
+    def click(self, xy, modifiers=None) -> bool:
+        self._ensure_open_block()
+        b = self.doc.block
+        if len(b.points) >= 3 and geo.nearest_point(b.points[:1], xy, self.tol()) == 0:
+            self.editor.close_loop()
+            self.finish()
+            return True
+        self.editor.add_point(xy)
+        return True
+
+    def double_click(self, xy, modifiers=None) -> bool:
+        self.editor.close_loop()
+        self.finish()
+        return True
+
+    def key(self, key: int) -> bool:
+        if key in (QtCore.Qt.Key.Key_Return, QtCore.Qt.Key.Key_Enter):
+            self.editor.close_loop()
+            self.finish()
+            return True
+        return False
+
+    def finish(self) -> None:
+        if self.canvas is not None:
+            self.canvas.rubber_line.setData([], [])
+        if self.doc.block.closed:
+            self.status("Loop closed: pick four corners (Corners tool) or use Auto corners")
+
+    def hover(self, xy) -> None:
+        b = self.doc.block
+        if self.canvas is None:
+            return
+        if b.closed or b.boundary is not None or len(b.points) == 0:
+            self.canvas.rubber_line.setData([], [])
+            return
+        p = b.points[-1]
+        self.canvas.rubber_line.setData([p[0], xy[0]], [p[1], xy[1]])
+
+
+class EditTool(Tool):
+    """Drag points (Shift: snap), click a segment to insert, box-select, Del deletes."""
+
+    name = "edit"
+    label = "Edit"
+    shortcut = "E"
+    tip = "Edit: drag points (Shift snaps) · click a segment to insert · drag on empty space to box-select · Del deletes"
+
+    def __init__(self, *a, **kw) -> None:
+        super().__init__(*a, **kw)
+        self._drag = None  # (kind, data)
+
+    def click(self, xy, modifiers=None) -> bool:
+        b = self.doc.block
+        if b.boundary is not None:
+            self.status("This block is given by four border polylines; use Block ▸ Convert to loop to edit points")
+            return True
+        k = geo.nearest_point(b.points, xy, self.tol())
+        add = modifiers is not None and bool(modifiers & (SHIFT | CTRL))
+        if k is not None:
+            sel = set(self.doc.selection) ^ {k} if add else {k}
+            self.doc.set_selection(sel)
+            return True
+        seg = geo.nearest_segment(b.points, xy, self.tol(), closed=b.closed)
+        if seg is not None:
+            kseg, _t, foot = seg
+            self.editor.insert_point(kseg, foot)
+            self.doc.set_selection({kseg + 1})
+            return True
+        self.doc.set_selection(())
+        return True
+
+    def drag(self, phase, xy, start, modifiers=None) -> bool:
+        b = self.doc.block
+        if phase == "start":
+            k = geo.nearest_point(b.points, start, self.tol()) if b.boundary is None else None
+            if k is not None:
+                sel = self.doc.selection if k in self.doc.selection else frozenset({k})
+                self.doc.set_selection(sel)
+                self._drag = ("move", dict(idx=sorted(sel), origin=np.array(b.points[sorted(sel)]),
+                                           anchor=k, id=self.editor.new_drag_id(), start=start))
+            else:
+                self._drag = ("box", dict(start=start))
+        if self._drag is None:
+            return False
+        kind, d = self._drag
+        if kind == "move":
+            target = xy
+            if modifiers is not None and bool(modifiers & SHIFT):
+                target = geo.snap(xy, np.asarray(b.points), self.tol(), exclude=d["idx"])
+            anchor_origin = d["origin"][d["idx"].index(d["anchor"])]
+            new = d["origin"] + (np.asarray(target) - anchor_origin)
+            self.editor.set_points(d["idx"], new, drag_id=d["id"])
+        else:
+            x0, y0 = d["start"]
+            if self.canvas is not None:
+                self.canvas.rubber_box.setRect(QtCore.QRectF(min(x0, xy[0]), min(y0, xy[1]),
+                                                             abs(xy[0] - x0), abs(xy[1] - y0)))
+                self.canvas.rubber_box.show()
+            if phase == "finish":
+                idx = geo.points_in_box(np.asarray(b.points), x0, y0, xy[0], xy[1])
+                add = modifiers is not None and bool(modifiers & (SHIFT | CTRL))
+                self.doc.set_selection(set(idx) | (set(self.doc.selection) if add else set()))
+                if self.canvas is not None:
+                    self.canvas.rubber_box.hide()
+        if phase == "finish":
+            self._drag = None
+        return True
+
+    def key(self, key: int) -> bool:
+        if key in (QtCore.Qt.Key.Key_Delete, QtCore.Qt.Key.Key_Backspace):
+            self.editor.delete_points(self.doc.selection)
+            return True
+        return False
+
+
+class CornersTool(Tool):
+    """Click four points in order SW, SE, NE, NW (bottom/right/top/left follow)."""
+
+    name = "corners"
+    label = "Corners"
+    shortcut = "C"
+    tip = "Corners: click four boundary points in order SW → SE → NE → NW"
+
+    def __init__(self, *a, **kw) -> None:
+        super().__init__(*a, **kw)
+        self.picked: list[int] = []
+
+    def activate(self) -> None:
+        self.picked = []
+        super().activate()
+
+    def click(self, xy, modifiers=None) -> bool:
+        b = self.doc.block
+        if not b.closed or b.boundary is not None:
+            self.status("Corners need a closed loop of points: draw or import one first")
+            return True
+        k = geo.nearest_point(b.points, xy, self.tol())
+        if k is None or k in self.picked:
+            return True
+        self.picked.append(k)
+        self.doc.set_selection(self.picked)
+        names = ("SW", "SE", "NE", "NW")
+        if len(self.picked) == 4:
+            self.editor.set_corners(tuple(self.picked))
+            self.picked = []
+            self.doc.set_selection(())
+            self.status("Corners set: bottom = SW→SE, right = SE→NE, top = NW→NE, left = SW→NW")
+        else:
+            self.status(f"Corner {names[len(self.picked) - 1]} = point {k}; now click {names[len(self.picked)]}")
+        return True
+
+
+class CutTool(Tool):
+    """Draw a cut polyline across a region (multiblock); double-click/Enter finishes it."""
+
+    name = "cut"
+    label = "Cut line"
+    shortcut = "L"
+    tip = ("Cut line: click points of a polyline across the region, double-click or Enter to finish "
+           "(multiblock splitting is stored in the project; block generation from cuts is not wired yet)")
+
+    def __init__(self, *a, **kw) -> None:
+        super().__init__(*a, **kw)
+        self.points: list[tuple[float, float]] = []
+
+    def click(self, xy, modifiers=None) -> bool:
+        self.points.append(tuple(xy))
+        self._show()
+        return True
+
+    def double_click(self, xy, modifiers=None) -> bool:
+        self._finish()
+        return True
+
+    def key(self, key: int) -> bool:
+        if key in (QtCore.Qt.Key.Key_Return, QtCore.Qt.Key.Key_Enter):
+            self._finish()
+            return True
+        if key == QtCore.Qt.Key.Key_Escape:
+            self.points = []
+            self._show()
+            return True
+        return False
+
+    def _finish(self) -> None:
+        if len(self.points) >= 2:
+            self.editor.add_cut_line(np.array(self.points))
+        self.points = []
+        self._show()
+
+    def _show(self, extra=None) -> None:
+        if self.canvas is None:
+            return
+        pts = self.points + ([extra] if extra is not None and self.points else [])
+        if pts:
+            a = np.array(pts)
+            self.canvas.rubber_line.setData(a[:, 0], a[:, 1])
+        else:
+            self.canvas.rubber_line.setData([], [])
+
+    def hover(self, xy) -> None:
+        if self.points:
+            self._show(tuple(xy))
+
+
+class CalibrateTool(Tool):
+    """Pick two points on the background image; the window asks for their true coordinates."""
+
+    name = "calibrate"
+    label = "Calibrate"
+    shortcut = ""
+    tip = "Calibrate background: click two points whose coordinates you know"
+
+    def __init__(self, *a, on_pair=None, **kw) -> None:
+        super().__init__(*a, **kw)
+        self.on_pair = on_pair
+        self.picked: list[tuple[float, float]] = []
+
+    def activate(self) -> None:
+        self.picked = []
+        super().activate()
+
+    def click(self, xy, modifiers=None) -> bool:
+        self.picked.append(tuple(xy))
+        if len(self.picked) == 2:
+            pair, self.picked = self.picked, []
+            if self.on_pair is not None:
+                self.on_pair(pair)
+        else:
+            self.status("Calibrate: now click the second point")
+        return True
+
+
+TOOLS = (PanTool, DrawTool, EditTool, CornersTool, CutTool)

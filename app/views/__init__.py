@@ -1,0 +1,1 @@
+"""Views: widgets that only draw the document and forward user input."""

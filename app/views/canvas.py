@@ -1,0 +1,382 @@
+"""The pyqtgraph canvas: fixed items updated with ``setData``; mouse → active tool.
+
+Items (created once): background image, quality colouring (PColorMeshItem),
+the grid as ONE NaN-separated PlotCurveItem (width-1 cosmetic pen,
+``connect="finite"``, ``skipFiniteCheck=True``; environment.md §3), the
+boundary loop, four coloured border curves with direction arrows and node
+counts, the points, the selection, corner labels, cut lines, folded cells,
+and the tool overlay (rubber band / rubber line).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6 import QtCore, QtGui
+from PySide6.QtWidgets import QGraphicsRectItem
+
+from meshcore import StructuredGrid
+
+from .. import geometry as geo
+from ..document import Document
+
+__all__ = ["BORDER_COLOURS", "Canvas"]
+
+BORDER_COLOURS = {
+    "bottom": "#1f77b4",  # blue
+    "right": "#d62728",  # red
+    "top": "#2ca02c",  # green
+    "left": "#ff7f0e",  # orange
+}
+CORNER_LABELS = ("SW", "SE", "NE", "NW")
+
+
+class _ViewBox(pg.ViewBox):
+    """A ViewBox that offers mouse events to the active tool before panning."""
+
+    def __init__(self, canvas: Canvas) -> None:
+        super().__init__(lockAspect=True, enableMenu=False)
+        self._canvas = canvas
+
+    def mouseClickEvent(self, ev) -> None:  # noqa: N802 (Qt API)
+        tool = self._canvas.tool
+        if tool is not None and ev.button() == QtCore.Qt.MouseButton.LeftButton:
+            xy = self._canvas.to_model(ev.scenePos())
+            handled = tool.double_click(xy, ev.modifiers()) if ev.double() else tool.click(xy, ev.modifiers())
+            if handled:
+                ev.accept()
+                return
+        if ev.button() == QtCore.Qt.MouseButton.RightButton and tool is not None:
+            if tool.right_click(self._canvas.to_model(ev.scenePos())):
+                ev.accept()
+                return
+        super().mouseClickEvent(ev)
+
+    def mouseDragEvent(self, ev, axis=None) -> None:  # noqa: N802 (Qt API)
+        tool = self._canvas.tool
+        if tool is not None and ev.button() == QtCore.Qt.MouseButton.LeftButton:
+            xy = self._canvas.to_model(ev.scenePos())
+            start = self._canvas.to_model(ev.buttonDownScenePos())
+            phase = "start" if ev.isStart() else "finish" if ev.isFinish() else "move"
+            if tool.drag(phase, xy, start, ev.modifiers()):
+                ev.accept()
+                return
+        super().mouseDragEvent(ev, axis)
+
+
+class Canvas(pg.PlotWidget):
+    """The drawing area.  ``tool`` receives mouse events in model coordinates."""
+
+    hovered = QtCore.Signal(float, float)
+
+    def __init__(self, doc: Document, parent=None) -> None:
+        self._vb = _ViewBox(self)
+        super().__init__(parent=parent, viewBox=self._vb, background="w")
+        self.doc = doc
+        self.tool = None
+        self.setAntialiasing(False)
+        pi = self.getPlotItem()
+        pi.showGrid(x=True, y=True, alpha=0.15)
+        for ax in ("left", "bottom"):
+            pi.getAxis(ax).setPen(pg.mkPen("#666"))
+            pi.getAxis(ax).setTextPen(pg.mkPen("#333"))
+        self.setMouseTracking(True)
+
+        self.background_item = pg.ImageItem()
+        self.background_item.setZValue(-100)
+        self.background_item.setOpacity(0.6)
+        self.background_item.hide()
+        self.addItem(self.background_item)
+
+        self.quality_item: pg.PColorMeshItem | None = None
+        self.colorbar: pg.ColorBarItem | None = None
+
+        self.grid_curve = pg.PlotCurveItem(pen=pg.mkPen("#303030", width=1, cosmetic=True),
+                                           connect="finite", skipFiniteCheck=True)
+        self.grid_curve.setZValue(0)
+        self.addItem(self.grid_curve)
+
+        self.loop_curve = pg.PlotCurveItem(pen=pg.mkPen("#888", width=1, style=QtCore.Qt.PenStyle.DashLine))
+        self.loop_curve.setZValue(5)
+        self.addItem(self.loop_curve)
+
+        self.cut_curve = pg.PlotCurveItem(pen=pg.mkPen("#9467bd", width=2, style=QtCore.Qt.PenStyle.DashDotLine),
+                                          connect="finite")
+        self.cut_curve.setZValue(6)
+        self.addItem(self.cut_curve)
+
+        self.border_curves = {}
+        self.border_arrows = {}
+        self.border_labels = {}
+        for name, col in BORDER_COLOURS.items():
+            c = pg.PlotCurveItem(pen=pg.mkPen(col, width=3))
+            c.setZValue(10)
+            self.addItem(c)
+            self.border_curves[name] = c
+            a = pg.ArrowItem(headLen=14, tipAngle=35, tailLen=0, brush=col, pen=pg.mkPen(col))
+            a.setZValue(11)
+            a.hide()
+            self.addItem(a)
+            self.border_arrows[name] = a
+            t = pg.TextItem("", color=col, anchor=(0.5, 0.5))
+            t.setZValue(12)
+            f = QtGui.QFont()
+            f.setBold(True)
+            t.setFont(f)
+            self.addItem(t)
+            self.border_labels[name] = t
+
+        self.points_item = pg.ScatterPlotItem(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
+        self.points_item.setZValue(20)
+        self.addItem(self.points_item)
+        self.other_points_item = pg.ScatterPlotItem(size=5, pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
+        self.other_points_item.setZValue(19)
+        self.addItem(self.other_points_item)
+        self.selected_item = pg.ScatterPlotItem(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
+        self.selected_item.setZValue(21)
+        self.addItem(self.selected_item)
+        self.corner_item = pg.ScatterPlotItem(size=13, symbol="s", pen=pg.mkPen("#000", width=2),
+                                              brush=pg.mkBrush("#ffd700"))
+        self.corner_item.setZValue(22)
+        self.addItem(self.corner_item)
+        self.corner_labels = []
+        for lab in CORNER_LABELS:
+            t = pg.TextItem(lab, color="#000", anchor=(-0.2, 1.2))
+            t.setZValue(23)
+            t.hide()
+            self.addItem(t)
+            self.corner_labels.append(t)
+
+        self.folded_item = pg.ScatterPlotItem(size=9, symbol="x", pen=pg.mkPen("#ff0000", width=2))
+        self.folded_item.setZValue(30)
+        self.addItem(self.folded_item)
+
+        # tool overlays
+        self.rubber_line = pg.PlotCurveItem(pen=pg.mkPen("#1f77b4", width=1, style=QtCore.Qt.PenStyle.DashLine))
+        self.rubber_line.setZValue(40)
+        self.addItem(self.rubber_line)
+        self.rubber_box = QGraphicsRectItem()
+        self.rubber_box.setPen(pg.mkPen("#1f77b4", width=1, style=QtCore.Qt.PenStyle.DashLine, cosmetic=True))
+        self.rubber_box.setBrush(pg.mkBrush(31, 119, 180, 30))
+        self.rubber_box.setZValue(41)
+        self.rubber_box.hide()
+        self.addItem(self.rubber_box)
+        self.highlight_item = pg.ScatterPlotItem(size=16, symbol="o", pen=pg.mkPen("#ff00ff", width=2), brush=None)
+        self.highlight_item.setZValue(42)
+        self.addItem(self.highlight_item)
+
+        self.scene().sigMouseMoved.connect(self._on_mouse_moved)
+        doc.project_changed.connect(self.refresh_boundary)
+        doc.selection_changed.connect(lambda _: self.refresh_selection())
+        doc.active_changed.connect(lambda _: self.refresh_boundary())
+        self.refresh_boundary()
+
+    # ------------------------------------------------------------ helpers
+    def to_model(self, scene_pos) -> tuple[float, float]:
+        p = self._vb.mapSceneToView(scene_pos)
+        return (float(p.x()), float(p.y()))
+
+    def pixel(self) -> float:
+        """Size of one screen pixel in model units."""
+        px = self._vb.viewPixelSize()
+        return float(max(px[0], px[1])) if px[0] > 0 else 1.0
+
+    def tolerance(self, pixels: float = 8.0) -> float:
+        return pixels * self.pixel()
+
+    def _on_mouse_moved(self, pos) -> None:
+        if self._vb.sceneBoundingRect().contains(pos):
+            xy = self.to_model(pos)
+            self.hovered.emit(*xy)
+            if self.tool is not None:
+                self.tool.hover(xy)
+
+    def zoom_to(self, bounds, margin: float = 0.08) -> None:
+        if bounds is None:
+            return
+        x0, y0, x1, y1 = bounds
+        w, h = max(x1 - x0, 1e-12), max(y1 - y0, 1e-12)
+        self._vb.setRange(xRange=(x0 - margin * w, x1 + margin * w),
+                          yRange=(y0 - margin * h, y1 + margin * h), padding=0)
+
+    def fit(self) -> None:
+        b = self.doc.project.bounds()
+        if b is None and self.doc.grids:
+            gs = list(self.doc.grids.values())
+            bb = np.array([g.bounds() for g in gs])
+            b = (bb[:, 0].min(), bb[:, 1].min(), bb[:, 2].max(), bb[:, 3].max())
+        if b is None:
+            b = (0.0, 0.0, 1.0, 1.0)
+        self.zoom_to(b)
+
+    # ------------------------------------------------------------ drawing
+    def refresh_boundary(self, *_args) -> None:
+        doc = self.doc
+        block = doc.block
+        pts = block.points
+        # other blocks: their points, faint
+        others = [b for k, b in enumerate(doc.project.blocks) if k != doc.active]
+        op = [b.points for b in others if len(b.points)]
+        op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
+        if op:
+            a = np.vstack(op)
+            self.other_points_item.setData(a[:, 0], a[:, 1])
+        else:
+            self.other_points_item.setData([], [])
+        # loops of all blocks as a faint dashed line (NaN separated)
+        segs = []
+        for b in doc.project.blocks:
+            p = b.points if b.boundary is None else np.vstack([b.boundary[0], b.boundary[1],
+                                                                b.boundary[2][::-1], b.boundary[3][::-1]])
+            if len(p) == 0:
+                continue
+            if b.closed or b.boundary is not None:
+                p = np.vstack([p, p[:1]])
+            segs += [p, np.full((1, 2), np.nan)]
+        if segs:
+            a = np.vstack(segs)
+            self.loop_curve.setData(a[:, 0], a[:, 1], connect="finite")
+        else:
+            self.loop_curve.setData([], [])
+        # borders of the active block
+        borders = None
+        if block.boundary is not None:
+            borders = dict(zip(("bottom", "right", "top", "left"), block.boundary, strict=True))
+        elif block.closed and block.corners is not None and len(pts) >= 4:
+            try:
+                borders = geo.border_polylines(pts, block.corners)
+            except (IndexError, ValueError):
+                borders = None
+        for name in ("bottom", "right", "top", "left"):
+            c, a, t = self.border_curves[name], self.border_arrows[name], self.border_labels[name]
+            if borders is None:
+                c.setData([], [])
+                a.hide()
+                t.setText("")
+                continue
+            p = borders[name]
+            c.setData(p[:, 0], p[:, 1])
+            m = geo.arrow_at_middle(p)
+            if m is None:
+                a.hide()
+                t.setText("")
+                continue
+            x, y, ang = m
+            a.setPos(x, y)
+            a.setStyle(angle=180.0 - ang)  # ArrowItem points along −x at angle 0, y down in screen
+            a.show()
+            t.setText(f"{name} · {block.node_count(name)}")
+            t.setPos(x, y)
+            t.setAnchor(self._label_anchor(name))
+        if len(pts):
+            self.points_item.setData(pts[:, 0], pts[:, 1])
+        else:
+            self.points_item.setData([], [])
+        if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
+            cp = pts[list(block.corners)]
+            self.corner_item.setData(cp[:, 0], cp[:, 1])
+            for lab, p in zip(self.corner_labels, cp, strict=True):
+                lab.setPos(float(p[0]), float(p[1]))
+                lab.show()
+        else:
+            self.corner_item.setData([], [])
+            for lab in self.corner_labels:
+                lab.hide()
+        cuts = []
+        for c in doc.project.cut_lines:
+            cuts += [c, np.full((1, 2), np.nan)]
+        if cuts:
+            a = np.vstack(cuts)
+            self.cut_curve.setData(a[:, 0], a[:, 1], connect="finite")
+        else:
+            self.cut_curve.setData([], [])
+        self.refresh_selection()
+
+    @staticmethod
+    def _label_anchor(name: str):
+        return {"bottom": (0.5, -0.6), "top": (0.5, 1.6), "left": (1.1, 0.5), "right": (-0.1, 0.5)}[name]
+
+    def refresh_selection(self) -> None:
+        pts = self.doc.block.points
+        sel = [i for i in sorted(self.doc.selection) if i < len(pts)]
+        if sel:
+            self.selected_item.setData(pts[sel, 0], pts[sel, 1])
+        else:
+            self.selected_item.setData([], [])
+
+    def set_grids(self, grids: dict[int, StructuredGrid]) -> None:
+        """Draw all block grids as one NaN-separated curve."""
+        if not grids:
+            self.grid_curve.setData([], [])
+            return
+        xs, ys = [], []
+        for g in grids.values():
+            X, Y = geo.grid_lines(g.x, g.y)
+            xs.append(X)
+            ys.append(Y)
+        X = np.concatenate(xs) if len(xs) > 1 else xs[0]
+        Y = np.concatenate(ys) if len(ys) > 1 else ys[0]
+        self.grid_curve.setData(X, Y, connect="finite", skipFiniteCheck=True)
+
+    def set_folded(self, grid: StructuredGrid | None, cells: np.ndarray | None) -> None:
+        if grid is None or cells is None or len(cells) == 0:
+            self.folded_item.setData([], [])
+            return
+        i, j = cells[:, 0], cells[:, 1]
+        cx = 0.25 * (grid.x[i, j] + grid.x[i + 1, j] + grid.x[i + 1, j + 1] + grid.x[i, j + 1])
+        cy = 0.25 * (grid.y[i, j] + grid.y[i + 1, j] + grid.y[i + 1, j + 1] + grid.y[i, j + 1])
+        self.folded_item.setData(cx, cy)
+
+    def set_quality(self, grid: StructuredGrid | None, values: np.ndarray | None, *,
+                    levels=None, cmap: str = "viridis", label: str = "") -> None:
+        """Colour the cells of ``grid`` by ``values`` (shape (ni, nj)); None hides it."""
+        if self.quality_item is not None:
+            self.removeItem(self.quality_item)
+            self.quality_item = None
+        if grid is None or values is None:
+            if self.colorbar is not None:
+                self.colorbar.hide()
+            return
+        v = np.where(np.isfinite(values), values, np.nan)
+        if levels is None:
+            finite = v[np.isfinite(v)]
+            levels = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+            if levels[0] == levels[1]:
+                levels = (levels[0] - 0.5, levels[1] + 0.5)
+        v = np.nan_to_num(v, nan=levels[1])
+        cm = pg.colormap.get(cmap)
+        item = pg.PColorMeshItem(grid.x, grid.y, v, colorMap=cm, levels=levels, enableAutoLevels=False,
+                                 edgecolors=None, antialiasing=False)
+        item.setZValue(-10)
+        self.addItem(item)
+        self.quality_item = item
+        if self.colorbar is None:
+            self.colorbar = pg.ColorBarItem(values=levels, colorMap=cm, interactive=False, width=15,
+                                            label=label)
+            self.colorbar.setImageItem(item, insert_in=self.getPlotItem())
+        else:
+            self.colorbar.setColorMap(cm)
+            self.colorbar.setLevels(levels)
+            self.colorbar.setImageItem(item)
+            self.colorbar.getAxis("right").setLabel(label) if hasattr(self.colorbar, "getAxis") else None
+            self.colorbar.show()
+
+    def set_background(self, image: np.ndarray | None, transform=None) -> None:
+        """Show an RGB(A) image (row 0 = bottom row) placed by the similarity ``transform``."""
+        if image is None:
+            self.background_item.hide()
+            return
+        a, b, tx, ty = transform or (1.0, 0.0, 0.0, 0.0)
+        self.background_item.setImage(image, axisOrder="row-major")
+        tr = QtGui.QTransform(a, b, -b, a, tx, ty)  # pixel (u, v), v up → (a u − b v + tx, b u + a v + ty)
+        self.background_item.setTransform(tr)
+        self.background_item.show()
+
+    def export_image(self, path: str) -> None:
+        """Write the canvas to PNG (raster) or SVG (vector) by the file suffix."""
+        import pyqtgraph.exporters as ex
+
+        if str(path).lower().endswith(".svg"):
+            ex.SVGExporter(self.getPlotItem()).export(str(path))
+        else:
+            self.grab().save(str(path))
