@@ -109,6 +109,8 @@ class BorderSpec:
 def _drop_duplicates(p: np.ndarray, *, name: str, tol: float) -> np.ndarray:
     seg = np.hypot(np.diff(p[:, 0]), np.diff(p[:, 1]))
     dup = np.flatnonzero(seg <= tol)
+    if dup.size == len(seg):
+        raise BoundaryError(f"{name}: zero-length border (all points coincide)")
     if dup.size:
         warnings.warn(
             f"{name}: dropped {dup.size} duplicate consecutive point(s) at index "
