@@ -182,7 +182,7 @@ class Borders:
         *,
         specs: Mapping[str, Any] | None = None,
         curve: str = "linear",
-        snap_angle: float | None = 30.0,
+        snap_angle: float | None = None,
     ) -> Borders:
         """Re-sample each border on its curve with ``cells = (ni, nj)``.
 
@@ -191,7 +191,8 @@ class Borders:
         ``snap_angle``: input vertices where a linear border turns by more than
         this many degrees (the corners of a cutout, say) receive a node
         exactly — the nearest re-sampled node moves onto them — so the grid
-        keeps the drawn geometry; ``None`` keeps the pure distribution (paper).
+        keeps the drawn geometry; ``None`` (default) keeps the pure
+        distribution, as in the paper.
         """
         ni = validate_count(cells[0], name="cells ξ (ni)")
         nj = validate_count(cells[1], name="cells η (nj)")

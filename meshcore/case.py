@@ -18,6 +18,7 @@ list the valid ones.  Example (the paper's bottle, refinement 1)::
     initial = "weighted"          # weighted (paper) | tfi
     curve = "linear"              # linear (paper) | cubic | catmull-rom
     periodic = false              # true: O-grid, left = right is a seam solved like the interior
+    snap_angle = 30               # optional: input vertices turning > 30° get a node exactly
 
     [blocks.boundary]             # either four borders (inline points or a point-file name) ...
     bottom = [[-3.0, 0.0], [-1.0, 0.0], [1.0, 0.0], [3.0, 0.0]]
@@ -68,7 +69,7 @@ __all__ = [
 
 TOP_KEYS = {"title", "description", "solver", "blocks"}
 BLOCK_KEYS = {
-    "name", "cells", "weights", "initial", "curve", "periodic", "boundary", "borders",
+    "name", "cells", "weights", "initial", "curve", "periodic", "snap_angle", "boundary", "borders",
 }
 BOUNDARY_KEYS = {"bottom", "right", "top", "left", "points", "corners"}
 BORDER_KEYS = {"distribution", "first", "last", "name"}
@@ -95,6 +96,7 @@ class BlockCase:
     initial: str = "weighted"
     curve: str = "linear"
     periodic: bool = False
+    snap_angle: float | None = None
     borders: Mapping[str, np.ndarray] | None = None  # four polylines
     loop: np.ndarray | None = None  # or a closed loop ...
     corners: tuple[int, int, int, int] | None = None  # ... with corners (sw, se, ne, nw)
@@ -111,6 +113,7 @@ class BlockCase:
             "initial": self.initial,
             "curve": self.curve,
             "periodic": self.periodic,
+            "snap_angle": self.snap_angle,
             "borders": {
                 k: {kk: vv for kk, vv in dataclasses.asdict(v).items() if vv is not None}
                 for k, v in self.border_specs.items()
@@ -216,6 +219,11 @@ def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) ->
         if not isinstance(tbl["periodic"], bool):
             raise CaseFileError(f"{where}: periodic must be true or false")
         kw["periodic"] = tbl["periodic"]
+    if "snap_angle" in tbl:
+        v = tbl["snap_angle"]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < 180:
+            raise CaseFileError(f"{where}: snap_angle must be an angle in degrees in (0, 180), got {v!r}")
+        kw["snap_angle"] = float(v)
     bnd = tbl.get("boundary")
     if not isinstance(bnd, Mapping):
         raise CaseFileError(f"{where}: missing [blocks.boundary] table (four borders or points + corners)")
@@ -351,6 +359,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         t["curve"] = b.curve
         if b.periodic:
             t["periodic"] = True
+        if b.snap_angle is not None:
+            t["snap_angle"] = b.snap_angle
         if b.loop is not None:
             t["boundary"] = {"points": b.loop, "corners": list(b.corners or ())}
         else:

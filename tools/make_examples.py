@@ -85,8 +85,10 @@ def main():
         "bottle-fine": ("Bottle (paper Table 3, refinement 2)", bottle(), (12, 30), (1.0, 0.5)),
     }
     for name, (title, b, cells, w) in cases.items():
+        # The cutout's corners are kept as nodes (snap_angle); the paper's
+        # uniform re-sampling would cut them off.
         block = BlockCase(name=name.rsplit("-", 1)[0], cells=cells, weights=w, borders=b,
-                          border_specs={})
+                          border_specs={}, snap_angle=30.0 if "cutout" in name else None)
         save_case(Case(blocks=(block,), title=title,
                        description="Input points designed to match the paper's description and counts."),
                   OUT / f"{name}.toml")

@@ -94,3 +94,22 @@ def test_smooth_curve_arc_length(kind):
     chords = np.hypot(*np.diff(q, axis=0).T)
     assert np.ptp(chords) < 5e-3 * chords.mean()
     assert np.all(np.abs(np.hypot(q[:, 0], q[:, 1]) - 1) < 2e-3)
+
+
+def test_snap_angle_keeps_sharp_vertices_as_nodes():
+    import meshcore
+
+    bottom = np.array([[0.0, 0], [10, 0]])
+    top = np.array([[0.0, 4], [3.5, 4], [3.5, 2.5], [6.5, 2.5], [6.5, 4], [10, 4]])
+    left = np.array([[0.0, 0], [0, 4]])
+    right = np.array([[10.0, 0], [10, 4]])
+    corners = top[1:-1]
+    plain = meshcore.prepare_borders(bottom, right, top, left, cells=(15, 6))
+    snapped = meshcore.prepare_borders(bottom, right, top, left, cells=(15, 6), snap_angle=30)
+
+    def has(nodes, p):
+        return np.min(np.hypot(*(nodes - p).T)) < 1e-12
+
+    assert not all(has(plain.top, c) for c in corners)  # the paper's uniform re-sampling cuts corners
+    assert all(has(snapped.top, c) for c in corners)
+    assert np.all(np.diff(np.concatenate([[0], np.cumsum(np.hypot(*np.diff(snapped.top, axis=0).T))])) > 0)
