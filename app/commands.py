@@ -180,6 +180,8 @@ class Editor:
     # ---------------------------------------------------------- options
     def set_block_options(self, merge_key=None, index: int | None = None, **kw) -> None:
         names = ", ".join(kw)
+        if "cells" in kw:
+            kw["keep_nodes"] = False
         self._edit_block(SetBlockOptions, lambda b: b.replaced(**kw), f"Set {names}",
                          merge_key=("opt", names, merge_key) if merge_key else None, index=index)
 

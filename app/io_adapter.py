@@ -11,7 +11,6 @@ import csv
 import json
 import math
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,10 +18,11 @@ import numpy as np
 
 from meshcore import BORDER_NAMES, BorderSpec, ReadError, StructuredGrid, WriteError
 
-from .project import Block, Project, SolverSettings
+from .project import Block, Project, SolverSettings, boundary_to_loop
 
 __all__ = [
     "PointData",
+    "block_from_case",
     "load_project",
     "mesh_formats",
     "project_lonlat",
@@ -54,17 +54,64 @@ def _core_io():
 
 # ------------------------------------------------------------------- points
 def read_points(path) -> PointData:
-    """Read a boundary point file (meshcore.io.read_points when available)."""
+    """Read a boundary point file: meshcore.io.read_points, else the built-in readers.
+
+    ``lonlat`` is True when the reader says so, for KML/GeoJSON (always
+    WGS84 degrees) and for delimited text whose header starts with lon/lat.
+    """
     path = Path(path)
     mio = _core_io()
     if mio is not None and hasattr(mio, "read_points"):
-        res = mio.read_points(path)
-        pts = getattr(res, "points", res)
-        lonlat = bool(getattr(res, "lonlat", getattr(res, "geographic", False)))
-        pts = np.asarray(pts, float)[:, :2]
-        if not lonlat:
-            lonlat = _looks_lonlat(pts) and path.suffix.lower() in (".kml", ".geojson")
-        return PointData(_drop_closing(pts), lonlat, str(path))
+        try:
+            res = mio.read_points(path)
+        except (ReadError, ValueError):
+            res = None
+        if res is not None:
+            return _from_core(res, path)
+    return _read_points_builtin(path)
+
+
+def _from_core(res, path: Path) -> PointData:
+    geo_flag = None
+    for attr in ("lonlat", "geographic", "is_geographic"):
+        if hasattr(res, attr):
+            geo_flag = bool(getattr(res, attr))
+    crs = str(getattr(res, "crs", "") or "")
+    if geo_flag is None and crs:
+        geo_flag = crs.upper() in ("EPSG:4326", "WGS84", "OGC:CRS84")
+    if hasattr(res, "polylines"):
+        pl = res.polylines[0]
+        pts = np.asarray(getattr(pl, "points", pl), float)
+    else:
+        pts = np.asarray(getattr(res, "points", res), float)
+    pts = pts[:, :2]
+    if geo_flag is None:
+        geo_flag = path.suffix.lower() in (".kml", ".kmz", ".geojson") or _header_is_lonlat(path)
+        if _header_is_latlon(path):
+            pts = pts[:, ::-1].copy()
+    return PointData(_drop_closing(pts), bool(geo_flag), str(path))
+
+
+def _first_line(path: Path) -> list[str]:
+    try:
+        with path.open(encoding="utf-8-sig") as fh:
+            line = fh.readline()
+    except (OSError, UnicodeDecodeError):
+        return []
+    return [p.lower() for p in re.split(r"[,;\s]+", line.strip()) if p]
+
+
+def _header_is_lonlat(path: Path) -> bool:
+    h = _first_line(path)
+    return bool(h) and h[0] in ("lon", "long", "longitude", "lng") or _header_is_latlon(path)
+
+
+def _header_is_latlon(path: Path) -> bool:
+    h = _first_line(path)
+    return h[:2] in (["lat", "lon"], ["latitude", "longitude"], ["lat", "lng"])
+
+
+def _read_points_builtin(path: Path) -> PointData:
     suf = path.suffix.lower()
     try:
         text = path.read_text(encoding="utf-8-sig")
@@ -147,121 +194,89 @@ def project_lonlat(points: np.ndarray, epsg: int | None = None) -> tuple[np.ndar
 
 
 # ------------------------------------------------------------------ project
-def _block_to_dict(b: Block) -> dict:
-    d: dict = {"name": b.name, "cells": list(b.cells), "weights": list(b.weights),
-               "initial": b.initial, "curve": b.curve}
-    if b.periodic:
-        d["periodic"] = True
+def block_from_case(bc) -> Block:
+    """A :class:`Block` from a :class:`meshcore.case.BlockCase`."""
+    specs = tuple(dict(bc.border_specs).items())
+    common = dict(name=bc.name, weights=tuple(bc.weights), initial=bc.initial, curve=bc.curve,
+                  periodic=bool(bc.periodic), borders=specs, snap_angle=bc.snap_angle,
+                  keep_nodes=bc.cells is None)
+    if bc.loop is not None:
+        pts = np.asarray(bc.loop, float)
+        if len(pts) > 3 and np.allclose(pts[0], pts[-1]):
+            pts = pts[:-1]
+        corners = tuple(int(c) % len(pts) for c in bc.corners)
+        cells = bc.cells
+        if cells is None:
+            n = len(pts)
+            sw, se, ne, nw = corners
+            cells = ((se - sw) % n, (ne - se) % n)
+        return Block(points=pts, closed=True, corners=corners, cells=cells, **common)
+    bd = tuple(np.asarray(bc.borders[n], float) for n in BORDER_NAMES)
+    cells = bc.cells or (len(bd[0]) - 1, len(bd[3]) - 1)
+    block = Block(boundary=bd, cells=cells, **common)
+    # four separate borders become an editable loop unless left and right coincide (a cut/seam)
+    cut = bd[1].shape == bd[3].shape and np.allclose(bd[1], bd[3])
+    return block if (cut or bc.periodic) else boundary_to_loop(block)
+
+
+def block_to_case(b: Block):
+    from meshcore.case import BlockCase
+
+    kw = dict(name=b.name, cells=None if b.keep_nodes else tuple(b.cells), weights=tuple(b.weights),
+              initial=b.initial, curve=b.curve, periodic=b.periodic, snap_angle=b.snap_angle,
+              border_specs=dict(b.borders))
     if b.boundary is not None:
-        d["boundary"] = {n: np.asarray(p).tolist() for n, p in zip(BORDER_NAMES, b.boundary, strict=True)}
-    else:
-        d["points"] = np.asarray(b.points).tolist()
-        if b.corners is not None:
-            d["corners"] = list(b.corners)
-    borders = {}
-    for n, s in b.borders:
-        e = {"distribution": s.distribution}
-        for k in ("first", "last", "name"):
-            if getattr(s, k) is not None:
-                e[k] = getattr(s, k)
-        if e != {"distribution": "uniform"}:
-            borders[n] = e
-    if borders:
-        d["borders"] = borders
-    return d
+        return BlockCase(borders={n: np.asarray(p) for n, p in zip(BORDER_NAMES, b.boundary, strict=True)}, **kw)
+    return BlockCase(loop=np.asarray(b.points), corners=tuple(b.corners), **kw)
 
 
-def project_to_dict(p: Project) -> dict:
-    s = p.solver
-    solver = {"method": s.method, "max_iterations": s.max_iterations}
-    if s.tolerance is not None:
-        solver["tolerance"] = s.tolerance
-    if s.omega is not None:
-        solver["omega"] = s.omega
-    out: dict = {"solver": solver, "blocks": [_block_to_dict(b) for b in p.blocks if len(b.points) or b.boundary]}
-    if p.title:
-        out["title"] = p.title
-    if p.crs:
-        out["crs"] = p.crs
-    return out
+def project_from_case(case) -> Project:
+    s = case.solver
+    solver = SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations,
+                            omega=s.omega)
+    return Project(blocks=tuple(block_from_case(b) for b in case.blocks), solver=solver,
+                   title=case.title, crs=str(dict(case.extra).get("crs", "")))
 
 
-def project_from_dict(d: dict, where: str = "project") -> Project:
-    blocks = []
-    for k, bd in enumerate(d.get("blocks", [])):
-        name = bd.get("name", f"block{k + 1}")
-        boundary = None
-        if "boundary" in bd:
-            boundary = tuple(np.asarray(bd["boundary"][n], float) for n in BORDER_NAMES)
-        borders = {n: BorderSpec(**v) for n, v in bd.get("borders", {}).items()}
-        pts = np.asarray(bd.get("points", np.zeros((0, 2))), float).reshape(-1, 2)
-        corners = bd.get("corners")
-        blocks.append(Block(
-            name=name, points=pts, closed=len(pts) >= 3, corners=tuple(corners) if corners else None,
-            boundary=boundary, cells=tuple(bd.get("cells", (32, 16))), weights=tuple(bd.get("weights", (0.5, 0.5))),
-            initial=bd.get("initial", "weighted"), curve=bd.get("curve", "linear"),
-            periodic=bool(bd.get("periodic", False)), borders=tuple(borders.items()),
-        ))
-    sd = d.get("solver", {})
-    solver = SolverSettings(method=sd.get("method", "auto"), tolerance=sd.get("tolerance"),
-                            max_iterations=int(sd.get("max_iterations", 50_000)), omega=sd.get("omega"))
-    return Project(blocks=tuple(blocks) or (Block(name="block"),), solver=solver,
-                   crs=d.get("crs", ""), title=d.get("title", ""))
+def project_to_case(project: Project):
+    """The :class:`meshcore.case.Case` of the ready blocks (raises ValueError when none is)."""
+    from meshcore import EllipticConfig
+    from meshcore.case import Case
+
+    blocks = tuple(block_to_case(b) for b in project.blocks if b.ready)
+    if not blocks:
+        raise ValueError("nothing to save yet: no block has a closed boundary with four corners")
+    s = project.solver
+    solver = EllipticConfig(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations,
+                            omega=s.omega)
+    return Case(blocks=blocks, title=project.title, solver=solver)
 
 
 def load_project(path) -> Project:
-    """Read a project/case TOML file."""
-    path = Path(path)
-    try:
-        d = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise ReadError(f"{path}: cannot read ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ReadError(f"{path}: {exc}") from None
-    _resolve_files(d, path.parent)
-    return project_from_dict(d, where=str(path))
+    """Read a case file into a project (meshcore.case.load_case)."""
+    from meshcore.case import load_case
 
-
-def _resolve_files(d: dict, base: Path) -> None:
-    """Case files may reference point files (``points = "file.csv"``)."""
-    for bd in d.get("blocks", []):
-        if isinstance(bd.get("points"), str):
-            pd = read_points(base / bd["points"])
-            pts = pd.points
-            if pd.lonlat:
-                pts, crs = project_lonlat(pts)
-                d.setdefault("crs", crs)
-            bd["points"] = pts.tolist()
+    return project_from_case(load_case(path))
 
 
 def save_project(project: Project, path) -> None:
-    """Write the project as a TOML case file (atomically)."""
-    import tomli_w
+    """Write the project's ready blocks as a case file (meshcore.case.save_case)."""
+    from meshcore.case import save_case
 
-    path = Path(path)
-    data = tomli_w.dumps(project_to_dict(project))
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(data, encoding="utf-8")
-        tmp.replace(path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise WriteError(f"{path}: cannot write ({exc.strerror})") from None
+    save_case(project_to_case(project), path)
 
 
 # --------------------------------------------------------------------- mesh
 def mesh_formats() -> list[tuple[str, str]]:
     """``(description, pattern)`` pairs for the export dialog."""
     mio = _core_io()
-    fmts = getattr(mio, "FORMATS", None) if mio is not None else None
-    out = []
-    if isinstance(fmts, dict):
-        for name, exts in fmts.items():
-            exts = exts if isinstance(exts, (list, tuple)) else [exts]
-            out.append((name, " ".join(f"*{e}" for e in exts)))
-    if not out:
-        out = [("VTK structured grid", "*.vts"), ("CSV nodes i,j,x,y", "*.csv")]
-    return out
+    suffixes = getattr(mio, "_SUFFIX", None) if mio is not None else None
+    if not isinstance(suffixes, dict) or not suffixes:
+        return [("VTK structured grid", "*.vts"), ("CSV nodes i,j,x,y", "*.csv")]
+    by_fmt: dict[str, list[str]] = {}
+    for suf, fmt in suffixes.items():
+        by_fmt.setdefault(fmt, []).append(f"*{suf}")
+    return [(fmt, " ".join(pats)) for fmt, pats in by_fmt.items()]
 
 
 def write_mesh(path, grids: list[StructuredGrid]) -> None:

@@ -29,13 +29,15 @@ __all__ = ["BlockResult", "block_borders", "block_initial_grid", "solve_project"
 def block_borders(block: Block):
     """The re-sampled :class:`meshcore.Borders` of a ready block (may raise MeshcoreError)."""
     specs = block.border_specs()
+    cells = None if block.keep_nodes else block.cells
     if block.boundary is not None:
         # copies: meshcore snaps corners in place (read-only input arrays would fail)
         b, r, t, l = (np.array(a) for a in block.boundary)
-        return prepare_borders(b, r, t, l, cells=block.cells, borders=specs, curve=block.curve,
-                               periodic=block.periodic, where=block.name)
-    return prepare_borders(loop=np.array(block.points), corners=block.corners, cells=block.cells,
-                           borders=specs, curve=block.curve, where=block.name)
+        return prepare_borders(b, r, t, l, cells=cells, borders=specs, curve=block.curve,
+                               periodic=block.periodic, snap_angle=block.snap_angle, where=block.name)
+    return prepare_borders(loop=np.array(block.points), corners=block.corners, cells=cells,
+                           borders=specs, curve=block.curve, snap_angle=block.snap_angle,
+                           where=block.name)
 
 
 def block_initial_grid(block: Block) -> StructuredGrid:

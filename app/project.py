@@ -87,6 +87,8 @@ class Block:
     curve: str = "linear"
     periodic: bool = False
     borders: tuple[tuple[str, BorderSpec], ...] = ()
+    snap_angle: float | None = None
+    keep_nodes: bool = False  # True: the given border points are the nodes (no re-sampling)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", frozen_points(self.points))
@@ -131,9 +133,9 @@ class Block:
         return (
             _eq_arrays(self.points, other.points) and same_boundary
             and (self.name, self.closed, self.corners, self.cells, self.weights, self.initial,
-                 self.curve, self.periodic, self.borders)
+                 self.curve, self.periodic, self.borders, self.snap_angle, self.keep_nodes)
             == (other.name, other.closed, other.corners, other.cells, other.weights, other.initial,
-                other.curve, other.periodic, other.borders)
+                other.curve, other.periodic, other.borders, other.snap_angle, other.keep_nodes)
         )
 
     __hash__ = None  # type: ignore[assignment]

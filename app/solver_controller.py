@@ -109,6 +109,7 @@ class SolverController(QtCore.QObject):
         worker.yielded.connect(self._on_yielded)
         worker.returned.connect(self._on_returned)
         worker.errored.connect(self._on_errored)
+        worker.finished.connect(self._on_finished)
         self._worker = worker
         self.t_start = time.perf_counter()
         self._set_state("running")
@@ -120,10 +121,11 @@ class SolverController(QtCore.QObject):
         """Ask the solver to stop; it returns the current grid at the next sweep."""
         if self._stop_event is not None:
             self._stop_event.set()
-        if self._worker is not None:
-            if self.state == "paused":
-                self._worker.resume()
-            self._worker.quit()
+        # no worker.quit(): an aborted superqt worker never emits `returned`; the
+        # generator sees the event after the current sweep and returns the grid itself
+        if self._worker is not None and self.state == "paused":
+            self._worker.resume()
+            self._set_state("running")
 
     def pause(self) -> None:
         if self._worker is not None and self.state == "running":
@@ -225,6 +227,15 @@ class SolverController(QtCore.QObject):
         self.last_result = result
         self._set_state("idle")
         self.finished.emit(result)
+
+    @QtCore.Slot()
+    def _on_finished(self) -> None:
+        # fallback: a worker that ended without returning (aborted) must not leave us "running"
+        if self._worker is not None and self.sender() is self._worker.signals:
+            self._timer.stop()
+            self._worker = None
+            self._set_state("idle")
+            self.finished.emit(None)
 
     @QtCore.Slot(object)
     def _on_errored(self, exc) -> None:

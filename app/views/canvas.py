@@ -31,6 +31,16 @@ BORDER_COLOURS = {
 CORNER_LABELS = ("SW", "SE", "NE", "NW")
 
 
+class _Scatter(pg.ScatterPlotItem):
+    """A scatter that is only a picture: clicks on its spots go to the ViewBox (the tool)."""
+
+    def mouseClickEvent(self, ev) -> None:  # noqa: N802 (Qt API)
+        ev.ignore()
+
+    def hoverEvent(self, ev) -> None:  # noqa: N802 (Qt API)
+        pass
+
+
 class _ViewBox(pg.ViewBox):
     """A ViewBox that offers mouse events to the active tool before panning."""
 
@@ -126,16 +136,16 @@ class Canvas(pg.PlotWidget):
             self.addItem(t)
             self.border_labels[name] = t
 
-        self.points_item = pg.ScatterPlotItem(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
+        self.points_item = _Scatter(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
         self.points_item.setZValue(20)
         self.addItem(self.points_item)
-        self.other_points_item = pg.ScatterPlotItem(size=5, pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
+        self.other_points_item = _Scatter(size=5, pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
         self.other_points_item.setZValue(19)
         self.addItem(self.other_points_item)
-        self.selected_item = pg.ScatterPlotItem(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
+        self.selected_item = _Scatter(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
         self.selected_item.setZValue(21)
         self.addItem(self.selected_item)
-        self.corner_item = pg.ScatterPlotItem(size=13, symbol="s", pen=pg.mkPen("#000", width=2),
+        self.corner_item = _Scatter(size=13, symbol="s", pen=pg.mkPen("#000", width=2),
                                               brush=pg.mkBrush("#ffd700"))
         self.corner_item.setZValue(22)
         self.addItem(self.corner_item)
@@ -147,7 +157,7 @@ class Canvas(pg.PlotWidget):
             self.addItem(t)
             self.corner_labels.append(t)
 
-        self.folded_item = pg.ScatterPlotItem(size=9, symbol="x", pen=pg.mkPen("#ff0000", width=2))
+        self.folded_item = _Scatter(size=9, symbol="x", pen=pg.mkPen("#ff0000", width=2))
         self.folded_item.setZValue(30)
         self.addItem(self.folded_item)
 
@@ -161,10 +171,13 @@ class Canvas(pg.PlotWidget):
         self.rubber_box.setZValue(41)
         self.rubber_box.hide()
         self.addItem(self.rubber_box)
-        self.highlight_item = pg.ScatterPlotItem(size=16, symbol="o", pen=pg.mkPen("#ff00ff", width=2), brush=None)
+        self.highlight_item = _Scatter(size=16, symbol="o", pen=pg.mkPen("#ff00ff", width=2), brush=None)
         self.highlight_item.setZValue(42)
         self.addItem(self.highlight_item)
 
+        # items are pictures only: every click goes to the ViewBox and so to the tool
+        for it in self.getPlotItem().items:
+            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
         doc.project_changed.connect(self.refresh_boundary)
         doc.selection_changed.connect(lambda _: self.refresh_selection())
@@ -268,8 +281,9 @@ class Canvas(pg.PlotWidget):
             t.setText(f"{name} · {block.node_count(name)}")
             t.setPos(x, y)
             t.setAnchor(self._label_anchor(name))
-        if len(pts):
-            self.points_item.setData(pts[:, 0], pts[:, 1])
+        disp = pts if block.boundary is None else np.vstack(block.boundary)
+        if len(disp):
+            self.points_item.setData(disp[:, 0], disp[:, 1])
         else:
             self.points_item.setData([], [])
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
@@ -348,6 +362,7 @@ class Canvas(pg.PlotWidget):
         item = pg.PColorMeshItem(grid.x, grid.y, v, colorMap=cm, levels=levels, enableAutoLevels=False,
                                  edgecolors=None, antialiasing=False)
         item.setZValue(-10)
+        item.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.addItem(item)
         self.quality_item = item
         if self.colorbar is None:

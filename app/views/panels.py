@@ -293,6 +293,8 @@ class ConvergencePanel(pg.PlotWidget):
         self.addItem(self.tol_line)
         self.tol_line.hide()
         self.setMinimumHeight(120)
+        for ax in ("left", "bottom"):
+            self.getAxis(ax).enableAutoSIPrefix(False)
 
     def set_history(self, history, tolerance: float | None = None) -> None:
         if not history:
@@ -348,8 +350,10 @@ class QualityPanel(QtWidgets.QWidget):
         self.hist = pg.PlotWidget(background="w")
         self.hist.setMinimumHeight(110)
         self.hist.setLabel("left", "cells")
-        self.hist_curve = pg.PlotCurveItem(stepMode="center", fillLevel=0, brush=(31, 119, 180, 120),
-                                           pen=pg.mkPen("#1f77b4"))
+        for ax in ("left", "bottom"):
+            self.hist.getAxis(ax).enableAutoSIPrefix(False)
+        self.hist_curve = pg.PlotCurveItem([0.0, 1.0], [0.0], stepMode="center", fillLevel=0,
+                                           brush=(31, 119, 180, 120), pen=pg.mkPen("#1f77b4"))
         self.hist.addItem(self.hist_curve)
         lay.addWidget(self.hist, 2)
         lay.addWidget(QtWidgets.QLabel("Folded / non-convex cells (click to zoom):"))
@@ -394,7 +398,7 @@ class QualityPanel(QtWidgets.QWidget):
         self.folded.clear()
         bad = {tuple(c) for c in r.nonconvex.tolist()}
         fold = {tuple(c) for c in r.folded.tolist()}
-        for c in sorted(bad | fold)[:500]:
+        for c in sorted(bad | fold, key=lambda c: (c not in fold, c))[:500]:
             it = QtWidgets.QListWidgetItem(f"cell ({c[0]}, {c[1]})  {'folded' if c in fold else 'non-convex'}")
             it.setForeground(QtGui.QBrush(QtGui.QColor("#d00" if c in fold else "#a60")))
             it.setData(QtCore.Qt.ItemDataRole.UserRole, c)

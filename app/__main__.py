@@ -1,0 +1,85 @@
+"""``python -m app [FILE] [--example NAME] [--solve] [--screenshot OUT.png]`` (also ``gcmesh``)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import threading
+import time
+from pathlib import Path
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="gcmesh", description="gcmesh: structured boundary-fitted grids")
+    p.add_argument("file", nargs="?", help="a project (.toml case file) or a boundary point file")
+    p.add_argument("--example", metavar="NAME", help="open a bundled example (see the Examples menu)")
+    p.add_argument("--solve", action="store_true", help="generate the grid after opening")
+    p.add_argument("--quality", metavar="METRIC", default=None,
+                   help="colour cells by a quality metric after solving (e.g. skewness)")
+    p.add_argument("--screenshot", metavar="OUT.png",
+                   help="render (off screen if there is no display), save a screenshot and exit")
+    p.add_argument("--size", default="1400x880", help="window size WxH (default 1400x880)")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    t0 = time.perf_counter()
+    # compile/load the numba kernels while Qt starts (warm cache: well under a second)
+    import meshcore.elliptic as elliptic
+
+    threading.Thread(target=elliptic.warmup, name="numba-warmup", daemon=True).start()
+
+    import pyqtgraph as pg
+    from PySide6 import QtCore, QtWidgets
+
+    pg.setConfigOptions(antialias=False, background="w", foreground="k")
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    app.setApplicationName("gcmesh")
+    app.setOrganizationName("gcmesh")
+
+    from .main_window import MainWindow
+
+    win = MainWindow()
+    w, h = (int(v) for v in args.size.lower().split("x"))
+    win.resize(w, h)
+    if args.screenshot:
+        win.quiet = True
+    win.show()
+    app.processEvents()
+    startup = time.perf_counter() - t0
+    win.message(f"Ready in {startup:.2f} s. " + win._status.text())
+    if not args.screenshot and not args.file and not args.example:
+        win.offer_recovery()
+    if args.example:
+        if not win.open_example(args.example, confirm=False):
+            return 2
+    elif args.file:
+        if not win.open_path(Path(args.file)):
+            return 2
+    app.processEvents()
+    win.canvas.fit()
+    if args.solve:
+        win.generate()
+        win.solver.wait(timeout_s=120)
+        app.processEvents()
+        if args.quality:
+            i = win.quality_panel.metric.findText(args.quality, QtCore.Qt.MatchFlag.MatchStartsWith)
+            if i >= 0:
+                win.quality_panel.metric.setCurrentIndex(i)
+    if args.screenshot:
+        for _ in range(5):
+            app.processEvents()
+            time.sleep(0.02)
+        ok = win.grab().save(args.screenshot)
+        win.stack.setClean()
+        win.close()
+        return 0 if ok else 1
+    return app.exec()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,59 @@
+"""The Examples menu: the paper's cases (``resources/examples/*.toml``) and real lakes.
+
+Lakes (``app/resources/*.csv``, lon/lat) are projected to UTM metres, given
+corners by :func:`app.geometry.auto_corners` and cell counts proportional to
+their shape.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from . import geometry as geo
+from .io_adapter import load_project, project_lonlat, read_points
+from .project import Block, Project, default_cells
+
+__all__ = ["EXAMPLE_DIRS", "LAKES", "example_names", "load_example"]
+
+_HERE = Path(__file__).resolve().parent
+EXAMPLE_DIRS = (_HERE.parent / "resources" / "examples", _HERE / "resources" / "examples")
+LAKES = {
+    "lake-bolsena": ("lake_bolsena.csv", "Lake Bolsena, Italy (GSHHG)"),
+    "lake-zurich": ("lake_zurich.csv", "Lake Zurich, Switzerland (GSHHG)"),
+    "windermere": ("windermere.csv", "Windermere, England (GSHHG)"),
+}
+
+
+def _case_files() -> dict[str, Path]:
+    out: dict[str, Path] = {}
+    for d in EXAMPLE_DIRS:
+        if d.is_dir():
+            for f in sorted(d.glob("*.toml")):
+                out.setdefault(f.stem, f)
+    return out
+
+
+def example_names() -> list[str]:
+    """Names for ``--example`` and the Examples menu (cases first, then lakes)."""
+    return [*_case_files(), *[k for k, (f, _t) in LAKES.items() if (_HERE / "resources" / f).exists()]]
+
+
+def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
+    """A lake: projected shoreline, auto corners, cells by shape."""
+    pd = read_points(csv_path)
+    pts, crs = project_lonlat(pd.points) if pd.lonlat else (pd.points, "")
+    corners = geo.auto_corners(pts)
+    block = Block(name=csv_path.stem, points=pts, closed=True, corners=corners,
+                  cells=default_cells(pts, corners, total=cells), curve="linear")
+    return Project(blocks=(block,), crs=crs, title=title)
+
+
+def load_example(name: str) -> tuple[Project, Path | None]:
+    """The project of example ``name`` and its case file (None for lakes)."""
+    cases = _case_files()
+    if name in cases:
+        return load_project(cases[name]), cases[name]
+    if name in LAKES:
+        f, title = LAKES[name]
+        return lake_project(_HERE / "resources" / f, title), None
+    raise KeyError(f"unknown example {name!r}; known: {', '.join(example_names())}")

