@@ -255,7 +255,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.solver.state_changed.connect(self._on_solver_state)
         self.solver.progress.connect(self._on_progress)
         self.solver.finished.connect(lambda _r: self._on_final())
-        self.stack.cleanChanged.connect(lambda _c: self._update_title())
+        self.stack.cleanChanged.connect(self._update_title)
 
     # -------------------------------------------------------------- tools
     def set_tool(self, key: str) -> None:
@@ -392,8 +392,12 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ------------------------------------------------------------- files
     def _update_title(self, *_a) -> None:
+        try:
+            clean = self.stack.isClean()
+        except RuntimeError:  # the stack is gone while the window is being destroyed
+            return
         name = self.doc.path.name if self.doc.path else (self.doc.project.title or "untitled")
-        self.setWindowTitle(f"{name}{'' if self.stack.isClean() else ' *'} — {APP_NAME}")
+        self.setWindowTitle(f"{name}{'' if clean else ' *'} — {APP_NAME}")
 
     def maybe_save(self) -> bool:
         """Ask about unsaved changes; False when the user cancels."""

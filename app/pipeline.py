@@ -59,7 +59,7 @@ def solve_project(
     *,
     warm: Mapping[int, tuple[StructuredGrid, StructuredGrid]] | None = None,
     stop_event: threading.Event | None = None,
-    report_interval: float = 1 / 30,
+    report_interval: float = 1 / 40,
     smooth: bool = True,
     blocks: list[int] | None = None,
 ) -> Generator[tuple[int, object], object, BlockResult]:

@@ -49,7 +49,7 @@ class SolverController(QtCore.QObject):
     error = QtCore.Signal(str)
     redrawn = QtCore.Signal()
 
-    def __init__(self, doc: Document, parent=None, *, frame_interval_ms: int = 33) -> None:
+    def __init__(self, doc: Document, parent=None, *, frame_interval_ms: int = 25) -> None:
         super().__init__(parent)
         self.doc = doc
         self.auto = False
@@ -65,8 +65,12 @@ class SolverController(QtCore.QObject):
         self.last_result = None
         self.gui_thread = QtCore.QThread.currentThread()
         self.thread_violations = 0  # slots found running outside the GUI thread (tests)
+        # leading-edge throttle: draw a snapshot at once unless the last frame was
+        # less than `frame_interval_ms` ago; then draw the latest one when the gap is over
+        self.frame_interval = frame_interval_ms / 1000.0
+        self._last_flush = 0.0
         self._timer = QtCore.QTimer(self)
-        self._timer.setInterval(frame_interval_ms)
+        self._timer.setSingleShot(True)
         self._timer.timeout.connect(self._flush)
         self._debounce = QtCore.QTimer(self)
         self._debounce.setSingleShot(True)
@@ -113,7 +117,6 @@ class SolverController(QtCore.QObject):
         self._worker = worker
         self.t_start = time.perf_counter()
         self._set_state("running")
-        self._timer.start()
         worker.start()
         return True
 
@@ -186,11 +189,17 @@ class SolverController(QtCore.QObject):
             return
         self._latest[k] = (item, g0)
         self._dirty = True
+        wait = self._last_flush + self.frame_interval - time.perf_counter()
+        if wait <= 0:
+            self._flush()
+        elif not self._timer.isActive():
+            self._timer.start(max(1, int(wait * 1000)))
 
     def _flush(self) -> None:
         if not self._dirty:
             return
         self._dirty = False
+        self._last_flush = time.perf_counter()
         for k, (item, g0) in self._latest.items():
             grid = item.grid if isinstance(item, SolverProgress) else item
             self.doc.grids[k] = grid

@@ -123,7 +123,7 @@ def test_stop_during_a_long_solve(qtbot, win):
     win.open_example("bottle-fine", confirm=False)
     b = win.doc.block
     win.editor.set_block_options(cells=(300, 300))
-    win.editor.set_solver(method="sor", tolerance=1e-14, max_iterations=10_000_000)
+    win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     win.generate()
     qtbot.waitUntil(lambda: win.doc.grid is not None and win.doc.grid.cells == (300, 300), timeout=10_000)
     qtbot.wait(200)
@@ -141,7 +141,7 @@ def test_stop_during_a_long_solve(qtbot, win):
 def test_pause_and_resume(qtbot, win):
     win.open_example("bottle-fine", confirm=False)
     win.editor.set_block_options(cells=(200, 200))
-    win.editor.set_solver(method="sor", tolerance=1e-14, max_iterations=10_000_000)
+    win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     win.generate()
     qtbot.waitUntil(lambda: win.solver.state == "running" and bool(win.solver._latest), timeout=10_000)
     win.solver.pause()

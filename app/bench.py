@@ -1,0 +1,121 @@
+"""Measure the app's interactive numbers: ``python -m app.bench`` (offscreen is fine).
+
+* redraws/s of the grid curve at 257×257 nodes (setData + forced paint), and
+  the live rate the window reaches during a solve at that size;
+* Stop latency during a long solve;
+* drag-to-converged latency with auto-generate on a ~100×100 grid;
+* start-up time of the main window (see also ``python -m app --screenshot``).
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+import time
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+
+def _wait(app, cond, timeout=60.0):
+    from PySide6 import QtCore
+
+    t0 = time.perf_counter()
+    while not cond():
+        app.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 5)
+        if time.perf_counter() - t0 > timeout:
+            raise TimeoutError
+    return time.perf_counter() - t0
+
+
+def main() -> int:
+    t0 = time.perf_counter()
+    import meshcore.elliptic
+
+    meshcore.elliptic.warmup()
+    import numpy as np
+    from PySide6 import QtWidgets
+
+    from app.main_window import MainWindow
+    from meshcore import StructuredGrid
+
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    win = MainWindow()
+    win.quiet = True
+    win.resize(1400, 880)
+    win.show()
+    app.processEvents()
+    print(f"start-up to a shown window (warm numba cache, in-process): {time.perf_counter() - t0:.2f} s")
+
+    # 1. raw redraw rate at 257 × 257 nodes
+    n = 257
+    xi, eta = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n), indexing="ij")
+    win.canvas.zoom_to((0, 0, 1, 1))
+    times = []
+    for k in range(30):
+        g = StructuredGrid(xi + 0.01 * np.sin(k + 6 * eta), eta)
+        t = time.perf_counter()
+        win.canvas.set_grids({0: g})
+        win.canvas.viewport().repaint()
+        times.append(time.perf_counter() - t)
+    med = statistics.median(times)
+    print(f"redraw 257x257 (setData + paint): median {med * 1000:.1f} ms = {1 / med:.1f} redraws/s")
+
+    # 2. live rate during a solve at 256 × 256 cells, then Stop latency
+    win.open_example("bottle-fine", confirm=False)
+    win.editor.set_block_options(cells=(256, 256))
+    win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
+    frames = []
+    win.solver.redrawn.connect(lambda: frames.append(time.perf_counter()))
+    win.generate()
+    _wait(app, lambda: len(frames) > 0)
+    t = time.perf_counter()
+    _wait(app, lambda: time.perf_counter() - t > 3.0)
+    fr = [f for f in frames if f >= t]
+    print(f"live redraws during a 257x257 solve: {len(fr) / 3.0:.1f} /s")
+    lat = []
+    for _ in range(5):
+        if not win.solver.running:
+            win.generate()
+            _wait(app, lambda: win.solver.running)
+            t1 = time.perf_counter()
+            _wait(app, lambda: time.perf_counter() - t1 > 0.5)
+        t = time.perf_counter()
+        win.solver.stop()
+        lat.append(_wait(app, lambda: not win.solver.running))
+    print(f"stop latency (5 runs): median {statistics.median(lat) * 1000:.0f} ms, max {max(lat) * 1000:.0f} ms")
+
+    # 3. drag-to-converged on a ~100 x 100 grid, auto-generate on
+    win.open_example("annulus-sector", confirm=False)
+    win.editor.set_block_options(cells=(100, 100))
+    win.editor.set_solver(method="auto")
+    win.a_auto.trigger()
+    _wait(app, lambda: not win.solver.running and win.doc.grid is not None)
+    k = int(win.doc.block.corners[2])
+    p = np.array(win.doc.block.points[k])
+    results = []
+    for rep in range(5):
+        drag = win.editor.new_drag_id()
+        previews = [0]
+        win.solver.redrawn.connect(lambda: previews.__setitem__(0, previews[0] + 1))
+        for s in np.linspace(0, 1, 30)[1:]:  # ~0.5 s of dragging at 60 Hz
+            d = (0.15 if rep % 2 == 0 else 0.0) * s
+            win.editor.set_points([k], [p + [d, 0.5 * d]], drag_id=drag)
+            t = time.perf_counter()
+            _wait(app, lambda: time.perf_counter() - t > 1 / 60)
+        t_release = time.perf_counter()
+        dt = _wait(app, lambda: not win.solver.running and not win.solver._debounce.isActive())
+        g = win.doc.grid
+        results.append(dt)
+        win.solver.redrawn.disconnect()
+        print(f"  drag {rep}: {previews[0]} preview redraws while dragging; converged={g.converged} "
+              f"({g.info.method}, {g.iterations} it) {dt * 1000:.0f} ms after release")
+        _ = t_release
+    print(f"drag-to-converged 101x101 nodes: median {statistics.median(results) * 1000:.0f} ms")
+    win.stack.setClean()
+    win.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
