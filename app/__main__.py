@@ -15,10 +15,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("file", nargs="?", help="a project (.toml case file) or a boundary point file")
     p.add_argument("--example", metavar="NAME", help="open a bundled example (see the Examples menu)")
     p.add_argument("--solve", action="store_true", help="generate the grid after opening")
-    p.add_argument("--quality", metavar="METRIC", default=None,
-                   help="colour cells by a quality metric after solving (e.g. skewness)")
-    p.add_argument("--screenshot", metavar="OUT.png",
-                   help="render (off screen if there is no display), save a screenshot and exit")
+    p.add_argument(
+        "--quality",
+        metavar="METRIC",
+        default=None,
+        help="colour cells by a quality metric after solving (e.g. skewness)",
+    )
+    p.add_argument(
+        "--screenshot", metavar="OUT.png", help="render (off screen if there is no display), save a screenshot and exit"
+    )
     p.add_argument("--size", default="1400x880", help="window size WxH (default 1400x880)")
     return p
 
@@ -57,9 +62,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.example:
         if not win.open_example(args.example, confirm=False):
             return 2
-    elif args.file:
-        if not win.open_path(Path(args.file)):
-            return 2
+    elif args.file and not win.open_path(Path(args.file)):
+        return 2
     app.processEvents()
     win.canvas.fit()
     if args.solve:

@@ -41,8 +41,9 @@ _MERGE_ID = 4711
 class ProjectCommand(QUndoCommand):
     """Swap the document's project between ``before`` and ``after``."""
 
-    def __init__(self, doc: Document, after: Project, text: str, *, merge_key=None,
-                 before: Project | None = None) -> None:
+    def __init__(
+        self, doc: Document, after: Project, text: str, *, merge_key=None, before: Project | None = None
+    ) -> None:
         super().__init__(text)
         self.doc = doc
         self.before = before if before is not None else doc.project
@@ -55,10 +56,10 @@ class ProjectCommand(QUndoCommand):
     def undo(self) -> None:
         self.doc.set_project(self.before)
 
-    def id(self) -> int:  # noqa: A003 (Qt API name)
+    def id(self) -> int:
         return _MERGE_ID if self.merge_key is not None else -1
 
-    def mergeWith(self, other: QUndoCommand) -> bool:  # noqa: N802 (Qt API name)
+    def mergeWith(self, other: QUndoCommand) -> bool:
         if not isinstance(other, ProjectCommand) or other.merge_key != self.merge_key:
             return False
         self.after = other.after
@@ -127,8 +128,9 @@ class Editor:
             return
         self.stack.push(cls(self.doc, after, text, merge_key=merge_key))
 
-    def _edit_block(self, cls, fn: Callable[[Block], Block], text: str, merge_key=None,
-                    index: int | None = None) -> None:
+    def _edit_block(
+        self, cls, fn: Callable[[Block], Block], text: str, merge_key=None, index: int | None = None
+    ) -> None:
         k = self.doc.active if index is None else index
         p = self.doc.project
         self._push(cls, p.with_block(k, fn(p.blocks[k])), text, merge_key)
@@ -145,14 +147,22 @@ class Editor:
 
     def move_points(self, indices, delta, drag_id=None) -> None:
         key = ("move", drag_id) if drag_id is not None else None
-        self._edit_block(MovePoints, lambda b: pj.with_points_moved(b, indices, delta),
-                         "Move point" if len(indices) == 1 else f"Move {len(indices)} points", key)
+        self._edit_block(
+            MovePoints,
+            lambda b: pj.with_points_moved(b, indices, delta),
+            "Move point" if len(indices) == 1 else f"Move {len(indices)} points",
+            key,
+        )
 
     def set_points(self, indices, positions, drag_id=None) -> None:
         key = ("move", drag_id) if drag_id is not None else None
         idx = list(indices)
-        self._edit_block(MovePoints, lambda b: pj.with_points_set(b, idx, positions),
-                         "Move point" if len(idx) == 1 else f"Move {len(idx)} points", key)
+        self._edit_block(
+            MovePoints,
+            lambda b: pj.with_points_set(b, idx, positions),
+            "Move point" if len(idx) == 1 else f"Move {len(idx)} points",
+            key,
+        )
 
     def set_point(self, index, xy, drag_id=None) -> None:
         key = ("move", drag_id) if drag_id is not None else None
@@ -166,35 +176,48 @@ class Editor:
         if not idx:
             return
         self.doc.set_selection(())
-        self._edit_block(DeletePoints, lambda b: pj.with_points_deleted(b, idx),
-                         "Delete point" if len(idx) == 1 else f"Delete {len(idx)} points")
+        self._edit_block(
+            DeletePoints,
+            lambda b: pj.with_points_deleted(b, idx),
+            "Delete point" if len(idx) == 1 else f"Delete {len(idx)} points",
+        )
 
     def set_corners(self, corners) -> None:
         b = self.doc.block
         cells = b.cells
         if corners is not None and b.corners is None and b.boundary is None:
             cells = pj.default_cells(b.points, tuple(corners), total=max(b.cells))
-        self._edit_block(SetCorners, lambda bb: pj.with_corners(bb, corners).replaced(cells=cells),
-                         "Set corners")
+        self._edit_block(SetCorners, lambda bb: pj.with_corners(bb, corners).replaced(cells=cells), "Set corners")
 
     # ---------------------------------------------------------- options
     def set_block_options(self, merge_key=None, index: int | None = None, **kw) -> None:
         names = ", ".join(kw)
         if "cells" in kw:
             kw["keep_nodes"] = False
-        self._edit_block(SetBlockOptions, lambda b: b.replaced(**kw), f"Set {names}",
-                         merge_key=("opt", names, merge_key) if merge_key else None, index=index)
+        self._edit_block(
+            SetBlockOptions,
+            lambda b: b.replaced(**kw),
+            f"Set {names}",
+            merge_key=("opt", names, merge_key) if merge_key else None,
+            index=index,
+        )
 
     def set_border_spec(self, border: str, spec: BorderSpec, index: int | None = None) -> None:
-        self._edit_block(SetBorderSpec, lambda b: pj.with_border_spec(b, border, spec),
-                         f"Set {border} border", index=index)
+        self._edit_block(
+            SetBorderSpec, lambda b: pj.with_border_spec(b, border, spec), f"Set {border} border", index=index
+        )
 
     def set_solver(self, merge_key=None, **kw) -> None:
         p = self.doc.project
-        s = SolverSettings(**{**{f: getattr(p.solver, f) for f in
-                                 ("method", "tolerance", "max_iterations", "omega")}, **kw})
-        self._push(SetSolver, p.replaced(solver=s), "Set solver " + ", ".join(kw),
-                   ("solver", tuple(kw), merge_key) if merge_key else None)
+        s = SolverSettings(
+            **{**{f: getattr(p.solver, f) for f in ("method", "tolerance", "max_iterations", "omega")}, **kw}
+        )
+        self._push(
+            SetSolver,
+            p.replaced(solver=s),
+            "Set solver " + ", ".join(kw),
+            ("solver", tuple(kw), merge_key) if merge_key else None,
+        )
 
     def add_block(self) -> None:
         p = self.doc.project
@@ -204,8 +227,7 @@ class Editor:
 
     def add_cut_line(self, points) -> None:
         p = self.doc.project
-        self._push(AddCutLine, p.replaced(cut_lines=(*p.cut_lines, pj.frozen_points(points))),
-                   "Add cut line")
+        self._push(AddCutLine, p.replaced(cut_lines=(*p.cut_lines, pj.frozen_points(points))), "Add cut line")
 
     def replace_project(self, after: Project, text: str) -> None:
         self._push(ProjectCommand, after, text)

@@ -43,8 +43,14 @@ def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
     pd = read_points(csv_path)
     pts, crs = project_lonlat(pd.points) if pd.lonlat else (pd.points, "")
     corners = geo.auto_corners(pts)
-    block = Block(name=csv_path.stem, points=pts, closed=True, corners=corners,
-                  cells=default_cells(pts, corners, total=cells), curve="linear")
+    block = Block(
+        name=csv_path.stem,
+        points=pts,
+        closed=True,
+        corners=corners,
+        cells=default_cells(pts, corners, total=cells),
+        curve="linear",
+    )
     return Project(blocks=(block,), crs=crs, title=title)
 
 

@@ -98,6 +98,7 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
     q = p - c
     w, v = np.linalg.eigh(q.T @ q)
     e1 = v[:, np.argmax(w)]
+
     if e1[0] < 0 or (e1[0] == 0 and e1[1] < 0):
         e1 = -e1
     e2 = np.array([-e1[1], e1[0]])

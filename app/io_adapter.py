@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from meshcore import BORDER_NAMES, BorderSpec, ReadError, StructuredGrid, WriteError
+from meshcore import BORDER_NAMES, ReadError, StructuredGrid, WriteError
 
 from .project import Block, Project, SolverSettings, boundary_to_loop
 
@@ -103,7 +103,7 @@ def _first_line(path: Path) -> list[str]:
 
 def _header_is_lonlat(path: Path) -> bool:
     h = _first_line(path)
-    return bool(h) and h[0] in ("lon", "long", "longitude", "lng") or _header_is_latlon(path)
+    return (bool(h) and h[0] in ("lon", "long", "longitude", "lng")) or _header_is_latlon(path)
 
 
 def _header_is_latlon(path: Path) -> bool:
@@ -178,7 +178,7 @@ def _drop_closing(p: np.ndarray) -> np.ndarray:
 
 def utm_epsg(lon: float, lat: float) -> int:
     """EPSG code of the WGS84 UTM zone containing (lon, lat)."""
-    zone = int(math.floor((lon + 180.0) / 6.0)) % 60 + 1
+    zone = math.floor((lon + 180.0) / 6.0) % 60 + 1
     return (32600 if lat >= 0 else 32700) + zone
 
 
@@ -197,9 +197,16 @@ def project_lonlat(points: np.ndarray, epsg: int | None = None) -> tuple[np.ndar
 def block_from_case(bc) -> Block:
     """A :class:`Block` from a :class:`meshcore.case.BlockCase`."""
     specs = tuple(dict(bc.border_specs).items())
-    common = dict(name=bc.name, weights=tuple(bc.weights), initial=bc.initial, curve=bc.curve,
-                  periodic=bool(bc.periodic), borders=specs, snap_angle=bc.snap_angle,
-                  keep_nodes=bc.cells is None)
+    common = {
+        "name": bc.name,
+        "weights": tuple(bc.weights),
+        "initial": bc.initial,
+        "curve": bc.curve,
+        "periodic": bool(bc.periodic),
+        "borders": specs,
+        "snap_angle": bc.snap_angle,
+        "keep_nodes": bc.cells is None,
+    }
     if bc.loop is not None:
         pts = np.asarray(bc.loop, float)
         if len(pts) > 3 and np.allclose(pts[0], pts[-1]):
@@ -208,7 +215,7 @@ def block_from_case(bc) -> Block:
         cells = bc.cells
         if cells is None:
             n = len(pts)
-            sw, se, ne, nw = corners
+            sw, se, ne, _nw = corners
             cells = ((se - sw) % n, (ne - se) % n)
         return Block(points=pts, closed=True, corners=corners, cells=cells, **common)
     bd = tuple(np.asarray(bc.borders[n], float) for n in BORDER_NAMES)
@@ -222,9 +229,16 @@ def block_from_case(bc) -> Block:
 def block_to_case(b: Block):
     from meshcore.case import BlockCase
 
-    kw = dict(name=b.name, cells=None if b.keep_nodes else tuple(b.cells), weights=tuple(b.weights),
-              initial=b.initial, curve=b.curve, periodic=b.periodic, snap_angle=b.snap_angle,
-              border_specs=dict(b.borders))
+    kw = {
+        "name": b.name,
+        "cells": None if b.keep_nodes else tuple(b.cells),
+        "weights": tuple(b.weights),
+        "initial": b.initial,
+        "curve": b.curve,
+        "periodic": b.periodic,
+        "snap_angle": b.snap_angle,
+        "border_specs": dict(b.borders),
+    }
     if b.boundary is not None:
         return BlockCase(borders={n: np.asarray(p) for n, p in zip(BORDER_NAMES, b.boundary, strict=True)}, **kw)
     return BlockCase(loop=np.asarray(b.points), corners=tuple(b.corners), **kw)
@@ -232,10 +246,13 @@ def block_to_case(b: Block):
 
 def project_from_case(case) -> Project:
     s = case.solver
-    solver = SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations,
-                            omega=s.omega)
-    return Project(blocks=tuple(block_from_case(b) for b in case.blocks), solver=solver,
-                   title=case.title, crs=str(dict(case.extra).get("crs", "")))
+    solver = SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega)
+    return Project(
+        blocks=tuple(block_from_case(b) for b in case.blocks),
+        solver=solver,
+        title=case.title,
+        crs=str(dict(case.extra).get("crs", "")),
+    )
 
 
 def project_to_case(project: Project):
@@ -247,8 +264,7 @@ def project_to_case(project: Project):
     if not blocks:
         raise ValueError("nothing to save yet: no block has a closed boundary with four corners")
     s = project.solver
-    solver = EllipticConfig(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations,
-                            omega=s.omega)
+    solver = EllipticConfig(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega)
     return Case(blocks=blocks, title=project.title, solver=solver)
 
 

@@ -84,9 +84,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self._make_toolbar()
         self._connect()
 
-        self.recovery_path = recovery or Path(
-            QtCore.QStandardPaths.writableLocation(QtCore.QStandardPaths.StandardLocation.AppDataLocation)
-        ) / "recovery.gcmesh"
+        self.recovery_path = (
+            recovery
+            or Path(QtCore.QStandardPaths.writableLocation(QtCore.QStandardPaths.StandardLocation.AppDataLocation))
+            / "recovery.gcmesh"
+        )
         self._autosave = QtCore.QTimer(self)
         self._autosave.setInterval(15_000)
         self._autosave.timeout.connect(self.autosave)
@@ -94,8 +96,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.set_tool("draw")
         self._update_title()
         self.canvas.fit()
-        self.message("Draw a boundary (click points, double-click to close), import points (Ctrl+I) "
-                     "or pick an example from the Examples menu")
+        self.message(
+            "Draw a boundary (click points, double-click to close), import points (Ctrl+I) "
+            "or pick an example from the Examples menu"
+        )
 
     # ------------------------------------------------------------ building
     def _make_docks(self) -> None:
@@ -163,8 +167,12 @@ class MainWindow(QtWidgets.QMainWindow):
         self.a_open = self._act("&Open project…", self.open_dialog, K.Open)
         self.a_save = self._act("&Save project", self.save, K.Save)
         self.a_save_as = self._act("Save project &as…", self.save_as, K.SaveAs)
-        self.a_import = self._act("&Import boundary points…", self.import_dialog, "Ctrl+I",
-                                  "CSV x,y or lon,lat; KML; GeoJSON; every format meshcore reads")
+        self.a_import = self._act(
+            "&Import boundary points…",
+            self.import_dialog,
+            "Ctrl+I",
+            "CSV x,y or lon,lat; KML; GeoJSON; every format meshcore reads",
+        )
         self.a_bg = self._act("Load &background image…", self.background_dialog)
         self.a_calib = self._act("&Calibrate background by two points", lambda: self.set_tool("calibrate"))
         self.a_export = self._act("&Export mesh…", self.export_dialog, "Ctrl+E")
@@ -174,19 +182,30 @@ class MainWindow(QtWidgets.QMainWindow):
         self.a_undo.setShortcut(QtGui.QKeySequence("Ctrl+Z"))
         self.a_redo = self.stack.createRedoAction(self, "&Redo")
         self.a_redo.setShortcuts([QtGui.QKeySequence("Ctrl+Shift+Z"), QtGui.QKeySequence("Ctrl+Y")])
-        self.a_delete = self._act("&Delete selected points", lambda: self.editor.delete_points(self.doc.selection),
-                                  K.Delete)
-        self.a_select_all = self._act("Select &all points",
-                                      lambda: self.doc.set_selection(range(len(self.doc.block.points))), K.SelectAll)
-        self.a_auto_corners = self._act("&Auto corners", self.auto_corners, "A",
-                                        "corners at the vertices nearest the principal-axis bounding box corners")
+        self.a_delete = self._act(
+            "&Delete selected points", lambda: self.editor.delete_points(self.doc.selection), K.Delete
+        )
+        self.a_select_all = self._act(
+            "Select &all points", lambda: self.doc.set_selection(range(len(self.doc.block.points))), K.SelectAll
+        )
+        self.a_auto_corners = self._act(
+            "&Auto corners",
+            self.auto_corners,
+            "A",
+            "corners at the vertices nearest the principal-axis bounding box corners",
+        )
         self.a_add_block = self._act("Add &block", self.editor.add_block)
         self.a_to_loop = self._act("&Convert borders to an editable loop", self.convert_to_loop)
         self.a_generate = self._act("&Generate", self.generate, "F5", "build the algebraic grid and solve")
         self.a_pause = self._act("&Pause", self.solver.toggle_pause, "Space", "pause / resume", checkable=True)
         self.a_stop = self._act("&Stop", self.solver.stop, "Esc", "stop the solver (keeps the current grid)")
-        self.a_auto = self._act("A&uto-generate on edit", self.solver.set_auto, "Ctrl+Shift+A",
-                                "re-solve automatically after every edit (live remesh)", checkable=True)
+        self.a_auto = self._act(
+            "A&uto-generate on edit",
+            self.solver.set_auto,
+            "Ctrl+Shift+A",
+            "re-solve automatically after every edit (live remesh)",
+            checkable=True,
+        )
         self.a_fit = self._act("&Fit view", self.canvas.fit, "F")
         self.a_shortcuts = self._act("&Keyboard shortcuts", self.show_shortcuts, K.HelpContents)
         self.a_about = self._act("&About", self.show_about)
@@ -236,7 +255,8 @@ class MainWindow(QtWidgets.QMainWindow):
         tb.addActions(list(self.tool_actions.values()))
         self.tool_actions["cut"].setToolTip(
             "Cut line: draw polylines that will split the region into blocks. The cuts are stored in "
-            "the project; generating blocks from them waits for meshcore's multiblock support.")
+            "the project; generating blocks from them waits for meshcore's multiblock support."
+        )
         tb.addAction(self.a_auto_corners)
         tb.addSeparator()
         tb.addActions([self.a_generate, self.a_pause, self.a_stop, self.a_auto])
@@ -267,7 +287,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.tool_actions[key].setChecked(True)
         tool.activate()
 
-    def keyPressEvent(self, ev: QtGui.QKeyEvent) -> None:  # noqa: N802 (Qt API)
+    def keyPressEvent(self, ev: QtGui.QKeyEvent) -> None:
         if self.canvas.tool is not None and self.canvas.tool.key(ev.key()):
             ev.accept()
             return
@@ -307,9 +327,13 @@ class MainWindow(QtWidgets.QMainWindow):
     def generate(self) -> None:
         if not any(b.ready for b in self.doc.project.blocks):
             b = self.doc.block
-            hint = ("draw a boundary first" if len(b.points) == 0 else
-                    "close the loop first (double-click or Enter)" if not b.closed else
-                    "pick four corners (Corners tool) or use Auto corners (A)")
+            hint = (
+                "draw a boundary first"
+                if len(b.points) == 0
+                else "close the loop first (double-click or Enter)"
+                if not b.closed
+                else "pick four corners (Corners tool) or use Auto corners (A)"
+            )
             self.message(f"Nothing to generate yet: {hint}")
             return
         self.conv_panel.clear_history()
@@ -340,7 +364,8 @@ class MainWindow(QtWidgets.QMainWindow):
         fr = [t for t in self._frames if t > self._frames[-1] - 1.0] if self._frames else []
         self._solver_label.setText(
             f"{snap.method}: iteration {snap.iteration}, residual {snap.residual:.2e} "
-            f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s")
+            f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s"
+        )
 
     def _on_solver_state(self, state: str) -> None:
         running = state != "idle"
@@ -384,7 +409,7 @@ class MainWindow(QtWidgets.QMainWindow):
         ni, nj = g.cells
         i0, i1 = max(i - 3, 0), min(i + 4, ni)
         j0, j1 = max(j - 3, 0), min(j + 4, nj)
-        xs, ys = g.x[i0:i1 + 1, j0:j1 + 1], g.y[i0:i1 + 1, j0:j1 + 1]
+        xs, ys = g.x[i0 : i1 + 1, j0 : j1 + 1], g.y[i0 : i1 + 1, j0 : j1 + 1]
         self.canvas.zoom_to((xs.min(), ys.min(), xs.max(), ys.max()), margin=0.1)
         cx = 0.25 * (g.x[i, j] + g.x[i + 1, j] + g.x[i + 1, j + 1] + g.x[i, j + 1])
         cy = 0.25 * (g.y[i, j] + g.y[i + 1, j] + g.y[i + 1, j + 1] + g.y[i, j + 1])
@@ -404,9 +429,13 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.stack.isClean() or getattr(self, "quiet", False):
             return True
         r = QtWidgets.QMessageBox.question(
-            self, "Unsaved changes", "The project has unsaved changes. Save them?",
-            QtWidgets.QMessageBox.StandardButton.Save | QtWidgets.QMessageBox.StandardButton.Discard
-            | QtWidgets.QMessageBox.StandardButton.Cancel)
+            self,
+            "Unsaved changes",
+            "The project has unsaved changes. Save them?",
+            QtWidgets.QMessageBox.StandardButton.Save
+            | QtWidgets.QMessageBox.StandardButton.Discard
+            | QtWidgets.QMessageBox.StandardButton.Cancel,
+        )
         if r == QtWidgets.QMessageBox.StandardButton.Cancel:
             return False
         if r == QtWidgets.QMessageBox.StandardButton.Save:
@@ -434,7 +463,8 @@ class MainWindow(QtWidgets.QMainWindow):
         if not self.maybe_save():
             return
         path, _ = QtWidgets.QFileDialog.getOpenFileName(
-            self, "Open project", self._last_dir(), "gcmesh case (*.toml);;All files (*)")
+            self, "Open project", self._last_dir(), "gcmesh case (*.toml);;All files (*)"
+        )
         if path:
             self.open_path(path)
 
@@ -473,8 +503,7 @@ class MainWindow(QtWidgets.QMainWindow):
         return self._save_to(self.doc.path)
 
     def save_as(self) -> bool:
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Save project", self._last_dir(), "gcmesh case (*.toml)")
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(self, "Save project", self._last_dir(), "gcmesh case (*.toml)")
         if not path:
             return False
         if not path.endswith(".toml"):
@@ -494,8 +523,9 @@ class MainWindow(QtWidgets.QMainWindow):
         return True
 
     def import_dialog(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(self, "Import boundary points", self._last_dir(),
-                                                        fio.POINT_FILTER)
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self, "Import boundary points", self._last_dir(), fio.POINT_FILTER
+        )
         if path:
             self.import_points(Path(path))
 
@@ -512,9 +542,11 @@ class MainWindow(QtWidgets.QMainWindow):
             if project_lonlat is None and not getattr(self, "quiet", False):
                 code = fio.utm_epsg(*np.mean(pts, axis=0))
                 r = QtWidgets.QMessageBox.question(
-                    self, "Geographic coordinates",
+                    self,
+                    "Geographic coordinates",
                     f"{path.name} holds longitude/latitude degrees.\n\nProject them to metres "
-                    f"(UTM, EPSG:{code})? Grids in degrees are distorted.")
+                    f"(UTM, EPSG:{code})? Grids in degrees are distorted.",
+                )
                 project_lonlat = r == QtWidgets.QMessageBox.StandardButton.Yes
             if project_lonlat is None or project_lonlat:
                 try:
@@ -529,8 +561,13 @@ class MainWindow(QtWidgets.QMainWindow):
         except (ValueError, MeshcoreError):
             corners = None
         p = self.doc.project
-        block = Block(name=path.stem, points=pts, closed=True, corners=corners,
-                      cells=default_cells(pts, corners, total=40) if corners else (32, 16))
+        block = Block(
+            name=path.stem,
+            points=pts,
+            closed=True,
+            corners=corners,
+            cells=default_cells(pts, corners, total=40) if corners else (32, 16),
+        )
         empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
         if empty:
             after = p.with_block(empty[0], block)
@@ -543,9 +580,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.canvas.fit()
         self.set_tool("edit")
         self._remember_dir(path)
-        self.message(f"Imported {len(pts)} points from {path.name}"
-                     f"{' (projected to ' + crs + ')' if crs and pd.lonlat else ''}; corners chosen "
-                     f"automatically — adjust with the Corners tool, then F5")
+        self.message(
+            f"Imported {len(pts)} points from {path.name}"
+            f"{' (projected to ' + crs + ')' if crs and pd.lonlat else ''}; corners chosen "
+            f"automatically — adjust with the Corners tool, then F5"
+        )
         return True
 
     def export_dialog(self) -> None:
@@ -574,8 +613,9 @@ class MainWindow(QtWidgets.QMainWindow):
         return True
 
     def figure_dialog(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(self, "Export figure", self._last_dir(),
-                                                        "PNG image (*.png);;SVG vector (*.svg)")
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Export figure", self._last_dir(), "PNG image (*.png);;SVG vector (*.svg)"
+        )
         if path:
             if not Path(path).suffix:
                 path += ".png"
@@ -585,11 +625,11 @@ class MainWindow(QtWidgets.QMainWindow):
             except Exception as exc:
                 self.error("Cannot export figure", exc)
 
-    def dragEnterEvent(self, ev: QtGui.QDragEnterEvent) -> None:  # noqa: N802 (Qt API)
+    def dragEnterEvent(self, ev: QtGui.QDragEnterEvent) -> None:
         if ev.mimeData().hasUrls():
             ev.acceptProposedAction()
 
-    def dropEvent(self, ev: QtGui.QDropEvent) -> None:  # noqa: N802 (Qt API)
+    def dropEvent(self, ev: QtGui.QDropEvent) -> None:
         for url in ev.mimeData().urls():
             if url.isLocalFile():
                 self.open_path(Path(url.toLocalFile()))
@@ -612,8 +652,9 @@ class MainWindow(QtWidgets.QMainWindow):
         return arr
 
     def background_dialog(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(self, "Background image", self._last_dir(),
-                                                        "Images (*.png *.jpg *.jpeg *.tif *.bmp)")
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self, "Background image", self._last_dir(), "Images (*.png *.jpg *.jpeg *.tif *.bmp)"
+        )
         if path:
             self.load_background(path)
 
@@ -628,8 +669,7 @@ class MainWindow(QtWidgets.QMainWindow):
             tr = (s, 0.0, b[0], b[1])
         else:
             tr = (1.0, 0.0, 0.0, 0.0)
-        self.editor.replace_project(self.doc.project.replaced(background=Background(str(path), tr)),
-                                    "Load background")
+        self.editor.replace_project(self.doc.project.replaced(background=Background(str(path), tr)), "Load background")
         self.canvas.fit() if b is None else None
         self.message("Background loaded: File ▸ Calibrate to place it by two known points, then trace with Draw")
 
@@ -650,8 +690,9 @@ class MainWindow(QtWidgets.QMainWindow):
             row.addWidget(ey)
             f.addRow(f"true x, y of point {k + 1}", row)
             edits += [ex, ey]
-        bb = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.StandardButton.Ok
-                                        | QtWidgets.QDialogButtonBox.StandardButton.Cancel)
+        bb = QtWidgets.QDialogButtonBox(
+            QtWidgets.QDialogButtonBox.StandardButton.Ok | QtWidgets.QDialogButtonBox.StandardButton.Cancel
+        )
         bb.accepted.connect(dlg.accept)
         bb.rejected.connect(dlg.reject)
         f.addRow(bb)
@@ -683,8 +724,9 @@ class MainWindow(QtWidgets.QMainWindow):
         try:
             self.recovery_path.parent.mkdir(parents=True, exist_ok=True)
             tmp = self.recovery_path.with_suffix(".tmp")
-            tmp.write_bytes(pickle.dumps({"project": self.doc.project,
-                                          "path": str(self.doc.path) if self.doc.path else None}))
+            tmp.write_bytes(
+                pickle.dumps({"project": self.doc.project, "path": str(self.doc.path) if self.doc.path else None})
+            )
             tmp.replace(self.recovery_path)
         except OSError as exc:
             self.message(f"autosave failed: {exc}")
@@ -700,8 +742,8 @@ class MainWindow(QtWidgets.QMainWindow):
             self.recovery_path.unlink(missing_ok=True)
             return False
         r = QtWidgets.QMessageBox.question(
-            self, "Recover project",
-            "gcmesh did not shut down cleanly last time. Restore the autosaved project?")
+            self, "Recover project", "gcmesh did not shut down cleanly last time. Restore the autosaved project?"
+        )
         if r != QtWidgets.QMessageBox.StandardButton.Yes:
             self.recovery_path.unlink(missing_ok=True)
             return False
@@ -710,7 +752,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._update_title()
         return True
 
-    def closeEvent(self, ev: QtGui.QCloseEvent) -> None:  # noqa: N802 (Qt API)
+    def closeEvent(self, ev: QtGui.QCloseEvent) -> None:
         if not self.maybe_save():
             ev.ignore()
             return
@@ -756,9 +798,11 @@ class MainWindow(QtWidgets.QMainWindow):
         import meshcore
 
         QtWidgets.QMessageBox.about(
-            self, "About gcmesh",
+            self,
+            "About gcmesh",
             f"<b>gcmesh</b> {meshcore.__version__}<br>Structured boundary-fitted grids in generalized "
-            "coordinates: algebraic start grid + Thompson–Thames–Mastin / Winslow elliptic smoothing.")
+            "coordinates: algebraic start grid + Thompson–Thames–Mastin / Winslow elliptic smoothing.",
+        )
 
 
 def _corners(points) -> tuple[int, int, int, int]:

@@ -33,11 +33,27 @@ def block_borders(block: Block):
     if block.boundary is not None:
         # copies: meshcore snaps corners in place (read-only input arrays would fail)
         b, r, t, l = (np.array(a) for a in block.boundary)
-        return prepare_borders(b, r, t, l, cells=cells, borders=specs, curve=block.curve,
-                               periodic=block.periodic, snap_angle=block.snap_angle, where=block.name)
-    return prepare_borders(loop=np.array(block.points), corners=block.corners, cells=cells,
-                           borders=specs, curve=block.curve, snap_angle=block.snap_angle,
-                           where=block.name)
+        return prepare_borders(
+            b,
+            r,
+            t,
+            l,
+            cells=cells,
+            borders=specs,
+            curve=block.curve,
+            periodic=block.periodic,
+            snap_angle=block.snap_angle,
+            where=block.name,
+        )
+    return prepare_borders(
+        loop=np.array(block.points),
+        corners=block.corners,
+        cells=cells,
+        borders=specs,
+        curve=block.curve,
+        snap_angle=block.snap_angle,
+        where=block.name,
+    )
 
 
 def block_initial_grid(block: Block) -> StructuredGrid:
@@ -105,6 +121,7 @@ def solve_project(
 def folded_cells(grid: StructuredGrid) -> np.ndarray:
     """``(k, 2)`` indices of cells with non-positive area (cheap; for live checks)."""
     x, y = grid.x, grid.y
-    area = 0.5 * ((x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1])
-                  - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1]))
+    area = 0.5 * (
+        (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1]) - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
+    )
     return np.argwhere(area <= 0)

@@ -62,8 +62,9 @@ class SolverSettings:
 
     def config(self, **kw: Any) -> EllipticConfig:
         """The :class:`EllipticConfig` (raises InvalidInputError when invalid)."""
-        return EllipticConfig(method=self.method, tolerance=self.tolerance,
-                              max_iterations=self.max_iterations, omega=self.omega, **kw)
+        return EllipticConfig(
+            method=self.method, tolerance=self.tolerance, max_iterations=self.max_iterations, omega=self.omega, **kw
+        )
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -98,8 +99,9 @@ class Block:
             object.__setattr__(self, "corners", tuple(int(c) for c in self.corners))
         object.__setattr__(self, "cells", (int(self.cells[0]), int(self.cells[1])))
         object.__setattr__(self, "weights", (float(self.weights[0]), float(self.weights[1])))
-        object.__setattr__(self, "borders", tuple(sorted(
-            (n, BorderSpec.coerce(s, border=n)) for n, s in dict(self.borders).items())))
+        object.__setattr__(
+            self, "borders", tuple(sorted((n, BorderSpec.coerce(s, border=n)) for n, s in dict(self.borders).items()))
+        )
 
     # ------------------------------------------------------------ queries
     @property
@@ -131,11 +133,34 @@ class Block:
         else:
             same_boundary = all(_eq_arrays(a, b) for a, b in zip(self.boundary, other.boundary, strict=True))
         return (
-            _eq_arrays(self.points, other.points) and same_boundary
-            and (self.name, self.closed, self.corners, self.cells, self.weights, self.initial,
-                 self.curve, self.periodic, self.borders, self.snap_angle, self.keep_nodes)
-            == (other.name, other.closed, other.corners, other.cells, other.weights, other.initial,
-                other.curve, other.periodic, other.borders, other.snap_angle, other.keep_nodes)
+            _eq_arrays(self.points, other.points)
+            and same_boundary
+            and (
+                self.name,
+                self.closed,
+                self.corners,
+                self.cells,
+                self.weights,
+                self.initial,
+                self.curve,
+                self.periodic,
+                self.borders,
+                self.snap_angle,
+                self.keep_nodes,
+            )
+            == (
+                other.name,
+                other.closed,
+                other.corners,
+                other.cells,
+                other.weights,
+                other.initial,
+                other.curve,
+                other.periodic,
+                other.borders,
+                other.snap_angle,
+                other.keep_nodes,
+            )
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -186,10 +211,12 @@ class Project:
         if not isinstance(other, Project):
             return NotImplemented
         return (
-            self.blocks == other.blocks and self.solver == other.solver
+            self.blocks == other.blocks
+            and self.solver == other.solver
             and len(self.cut_lines) == len(other.cut_lines)
             and all(_eq_arrays(a, b) for a, b in zip(self.cut_lines, other.cut_lines, strict=True))
-            and self.background == other.background and self.crs == other.crs
+            and self.background == other.background
+            and self.crs == other.crs
             and self.title == other.title
         )
 

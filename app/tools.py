@@ -15,7 +15,7 @@ from PySide6 import QtCore
 
 from . import geometry as geo
 
-__all__ = ["CornersTool", "CutTool", "DrawTool", "EditTool", "PanTool", "TOOLS", "Tool"]
+__all__ = ["TOOLS", "CornersTool", "CutTool", "DrawTool", "EditTool", "PanTool", "Tool"]
 
 SHIFT = QtCore.Qt.KeyboardModifier.ShiftModifier
 CTRL = QtCore.Qt.KeyboardModifier.ControlModifier
@@ -127,7 +127,9 @@ class EditTool(Tool):
     name = "edit"
     label = "Edit"
     shortcut = "E"
-    tip = "Edit: drag points (Shift snaps) · click a segment to insert · drag on empty space to box-select · Del deletes"
+    tip = (
+        "Edit: drag points (Shift snaps) · click a segment to insert · drag on empty space to box-select · Del deletes"
+    )
 
     def __init__(self, *a, **kw) -> None:
         super().__init__(*a, **kw)
@@ -160,10 +162,18 @@ class EditTool(Tool):
             if k is not None:
                 sel = self.doc.selection if k in self.doc.selection else frozenset({k})
                 self.doc.set_selection(sel)
-                self._drag = ("move", dict(idx=sorted(sel), origin=np.array(b.points[sorted(sel)]),
-                                           anchor=k, id=self.editor.new_drag_id(), start=start))
+                self._drag = (
+                    "move",
+                    {
+                        "idx": sorted(sel),
+                        "origin": np.array(b.points[sorted(sel)]),
+                        "anchor": k,
+                        "id": self.editor.new_drag_id(),
+                        "start": start,
+                    },
+                )
             else:
-                self._drag = ("box", dict(start=start))
+                self._drag = ("box", {"start": start})
         if self._drag is None:
             return False
         kind, d = self._drag
@@ -177,8 +187,9 @@ class EditTool(Tool):
         else:
             x0, y0 = d["start"]
             if self.canvas is not None:
-                self.canvas.rubber_box.setRect(QtCore.QRectF(min(x0, xy[0]), min(y0, xy[1]),
-                                                             abs(xy[0] - x0), abs(xy[1] - y0)))
+                self.canvas.rubber_box.setRect(
+                    QtCore.QRectF(min(x0, xy[0]), min(y0, xy[1]), abs(xy[0] - x0), abs(xy[1] - y0))
+                )
                 self.canvas.rubber_box.show()
             if phase == "finish":
                 idx = geo.points_in_box(np.asarray(b.points), x0, y0, xy[0], xy[1])
@@ -240,8 +251,10 @@ class CutTool(Tool):
     name = "cut"
     label = "Cut line"
     shortcut = "L"
-    tip = ("Cut line: click points of a polyline across the region, double-click or Enter to finish "
-           "(multiblock splitting is stored in the project; block generation from cuts is not wired yet)")
+    tip = (
+        "Cut line: click points of a polyline across the region, double-click or Enter to finish "
+        "(multiblock splitting is stored in the project; block generation from cuts is not wired yet)"
+    )
 
     def __init__(self, *a, **kw) -> None:
         super().__init__(*a, **kw)

@@ -34,10 +34,10 @@ CORNER_LABELS = ("SW", "SE", "NE", "NW")
 class _Scatter(pg.ScatterPlotItem):
     """A scatter that is only a picture: clicks on its spots go to the ViewBox (the tool)."""
 
-    def mouseClickEvent(self, ev) -> None:  # noqa: N802 (Qt API)
+    def mouseClickEvent(self, ev) -> None:
         ev.ignore()
 
-    def hoverEvent(self, ev) -> None:  # noqa: N802 (Qt API)
+    def hoverEvent(self, ev) -> None:
         pass
 
 
@@ -48,7 +48,7 @@ class _ViewBox(pg.ViewBox):
         super().__init__(lockAspect=True, enableMenu=False)
         self._canvas = canvas
 
-    def mouseClickEvent(self, ev) -> None:  # noqa: N802 (Qt API)
+    def mouseClickEvent(self, ev) -> None:
         tool = self._canvas.tool
         if tool is not None and ev.button() == QtCore.Qt.MouseButton.LeftButton:
             xy = self._canvas.to_model(ev.scenePos())
@@ -56,13 +56,13 @@ class _ViewBox(pg.ViewBox):
             if handled:
                 ev.accept()
                 return
-        if ev.button() == QtCore.Qt.MouseButton.RightButton and tool is not None:
-            if tool.right_click(self._canvas.to_model(ev.scenePos())):
-                ev.accept()
-                return
+        right = ev.button() == QtCore.Qt.MouseButton.RightButton
+        if right and tool is not None and tool.right_click(self._canvas.to_model(ev.scenePos())):
+            ev.accept()
+            return
         super().mouseClickEvent(ev)
 
-    def mouseDragEvent(self, ev, axis=None) -> None:  # noqa: N802 (Qt API)
+    def mouseDragEvent(self, ev, axis=None) -> None:
         tool = self._canvas.tool
         if tool is not None and ev.button() == QtCore.Qt.MouseButton.LeftButton:
             xy = self._canvas.to_model(ev.scenePos())
@@ -101,8 +101,9 @@ class Canvas(pg.PlotWidget):
         self.quality_item: pg.PColorMeshItem | None = None
         self.colorbar: pg.ColorBarItem | None = None
 
-        self.grid_curve = pg.PlotCurveItem(pen=pg.mkPen("#303030", width=1, cosmetic=True),
-                                           connect="finite", skipFiniteCheck=True)
+        self.grid_curve = pg.PlotCurveItem(
+            pen=pg.mkPen("#303030", width=1, cosmetic=True), connect="finite", skipFiniteCheck=True
+        )
         self.grid_curve.setZValue(0)
         self.addItem(self.grid_curve)
 
@@ -110,8 +111,9 @@ class Canvas(pg.PlotWidget):
         self.loop_curve.setZValue(5)
         self.addItem(self.loop_curve)
 
-        self.cut_curve = pg.PlotCurveItem(pen=pg.mkPen("#9467bd", width=2, style=QtCore.Qt.PenStyle.DashDotLine),
-                                          connect="finite")
+        self.cut_curve = pg.PlotCurveItem(
+            pen=pg.mkPen("#9467bd", width=2, style=QtCore.Qt.PenStyle.DashDotLine), connect="finite"
+        )
         self.cut_curve.setZValue(6)
         self.addItem(self.cut_curve)
 
@@ -145,8 +147,7 @@ class Canvas(pg.PlotWidget):
         self.selected_item = _Scatter(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
         self.selected_item.setZValue(21)
         self.addItem(self.selected_item)
-        self.corner_item = _Scatter(size=13, symbol="s", pen=pg.mkPen("#000", width=2),
-                                              brush=pg.mkBrush("#ffd700"))
+        self.corner_item = _Scatter(size=13, symbol="s", pen=pg.mkPen("#000", width=2), brush=pg.mkBrush("#ffd700"))
         self.corner_item.setZValue(22)
         self.addItem(self.corner_item)
         self.corner_labels = []
@@ -204,13 +205,14 @@ class Canvas(pg.PlotWidget):
             if self.tool is not None:
                 self.tool.hover(xy)
 
-    def zoom_to(self, bounds, margin: float = 0.08) -> None:
+    def zoom_to(self, bounds, margin: float = 0.12) -> None:
         if bounds is None:
             return
         x0, y0, x1, y1 = bounds
         w, h = max(x1 - x0, 1e-12), max(y1 - y0, 1e-12)
-        self._vb.setRange(xRange=(x0 - margin * w, x1 + margin * w),
-                          yRange=(y0 - margin * h, y1 + margin * h), padding=0)
+        self._vb.setRange(
+            xRange=(x0 - margin * w, x1 + margin * w), yRange=(y0 - margin * h, y1 + margin * h), padding=0
+        )
 
     def fit(self) -> None:
         b = self.doc.project.bounds()
@@ -239,8 +241,11 @@ class Canvas(pg.PlotWidget):
         # loops of all blocks as a faint dashed line (NaN separated)
         segs = []
         for b in doc.project.blocks:
-            p = b.points if b.boundary is None else np.vstack([b.boundary[0], b.boundary[1],
-                                                                b.boundary[2][::-1], b.boundary[3][::-1]])
+            p = (
+                b.points
+                if b.boundary is None
+                else np.vstack([b.boundary[0], b.boundary[1], b.boundary[2][::-1], b.boundary[3][::-1]])
+            )
             if len(p) == 0:
                 continue
             if b.closed or b.boundary is not None:
@@ -341,8 +346,15 @@ class Canvas(pg.PlotWidget):
         cy = 0.25 * (grid.y[i, j] + grid.y[i + 1, j] + grid.y[i + 1, j + 1] + grid.y[i, j + 1])
         self.folded_item.setData(cx, cy)
 
-    def set_quality(self, grid: StructuredGrid | None, values: np.ndarray | None, *,
-                    levels=None, cmap: str = "viridis", label: str = "") -> None:
+    def set_quality(
+        self,
+        grid: StructuredGrid | None,
+        values: np.ndarray | None,
+        *,
+        levels=None,
+        cmap: str = "viridis",
+        label: str = "",
+    ) -> None:
         """Colour the cells of ``grid`` by ``values`` (shape (ni, nj)); None hides it."""
         if self.quality_item is not None:
             self.removeItem(self.quality_item)
@@ -359,15 +371,15 @@ class Canvas(pg.PlotWidget):
                 levels = (levels[0] - 0.5, levels[1] + 0.5)
         v = np.nan_to_num(v, nan=levels[1])
         cm = pg.colormap.get(cmap)
-        item = pg.PColorMeshItem(grid.x, grid.y, v, colorMap=cm, levels=levels, enableAutoLevels=False,
-                                 edgecolors=None, antialiasing=False)
+        item = pg.PColorMeshItem(
+            grid.x, grid.y, v, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
+        )
         item.setZValue(-10)
         item.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.addItem(item)
         self.quality_item = item
         if self.colorbar is None:
-            self.colorbar = pg.ColorBarItem(values=levels, colorMap=cm, interactive=False, width=15,
-                                            label=label)
+            self.colorbar = pg.ColorBarItem(values=levels, colorMap=cm, interactive=False, width=15, label=label)
             self.colorbar.setImageItem(item, insert_in=self.getPlotItem())
         else:
             self.colorbar.setColorMap(cm)

@@ -35,7 +35,8 @@ class BlocksPanel(QtWidgets.QTreeWidget):
         self.doc = doc
         self.setHeaderLabels(["Block / border", "nodes", "distribution"])
         self.setRootIsDecorated(True)
-        self.setColumnWidth(0, 150)
+        self.setColumnWidth(0, 120)
+        self.setColumnWidth(1, 60)
         self.itemClicked.connect(self._clicked)
         doc.project_changed.connect(lambda _p: self.refresh())
         doc.active_changed.connect(lambda _k: self.refresh())
@@ -45,8 +46,7 @@ class BlocksPanel(QtWidgets.QTreeWidget):
         self.blockSignals(True)
         self.clear()
         for k, b in enumerate(self.doc.project.blocks):
-            status = ("ready" if b.ready else "closed, needs corners" if b.closed
-                      else f"{len(b.points)} points, open")
+            status = "ready" if b.ready else "closed, needs corners" if b.closed else f"{len(b.points)} points, open"
             it = QtWidgets.QTreeWidgetItem([b.name, f"{b.cells[0] + 1}×{b.cells[1] + 1}", status])
             it.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("block", k))
             f = it.font(0)
@@ -98,10 +98,14 @@ class ParamsPanel(QtWidgets.QScrollArea):
         cells.addWidget(QtWidgets.QLabel("η"))
         cells.addWidget(self.nj)
         f.addRow("Cells", cells)
-        self.wx = QtWidgets.QDoubleSpinBox(minimum=0.0, maximum=1.0, singleStep=0.05, decimals=3,
-                                           toolTip="p13_x: weight of the left/right interpolation (paper eq. 34)")
-        self.wy = QtWidgets.QDoubleSpinBox(minimum=0.0, maximum=1.0, singleStep=0.05, decimals=3,
-                                           toolTip="p13_y")
+        self.wx = QtWidgets.QDoubleSpinBox(
+            minimum=0.0,
+            maximum=1.0,
+            singleStep=0.05,
+            decimals=3,
+            toolTip="p13_x: weight of the left/right interpolation (paper eq. 34)",
+        )
+        self.wy = QtWidgets.QDoubleSpinBox(minimum=0.0, maximum=1.0, singleStep=0.05, decimals=3, toolTip="p13_y")
         wts = QtWidgets.QHBoxLayout()
         wts.addWidget(self.wx)
         wts.addWidget(self.wy)
@@ -244,8 +248,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         if dist == "uniform":
             first = last = None
         try:
-            spec = BorderSpec(distribution=dist, first=first, last=last,
-                              name=self.bname.text().strip() or None)
+            spec = BorderSpec(distribution=dist, first=first, last=last, name=self.bname.text().strip() or None)
         except InvalidInputError as exc:
             self.border_msg.setText(str(exc))
             (self.first if first is None or "first" in str(exc) else self.last).setStyleSheet(_BAD)
@@ -345,6 +348,8 @@ class QualityPanel(QtWidgets.QWidget):
         self.table.setHorizontalHeaderLabels(["metric", "value"])
         self.table.horizontalHeader().setStretchLastSection(True)
         self.table.verticalHeader().hide()
+        self.table.verticalHeader().setDefaultSectionSize(20)
+        self.table.setMinimumHeight(150)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         lay.addWidget(self.table, 2)
         self.hist = pg.PlotWidget(background="w")
@@ -352,8 +357,9 @@ class QualityPanel(QtWidgets.QWidget):
         self.hist.setLabel("left", "cells")
         for ax in ("left", "bottom"):
             self.hist.getAxis(ax).enableAutoSIPrefix(False)
-        self.hist_curve = pg.PlotCurveItem([0.0, 1.0], [0.0], stepMode="center", fillLevel=0,
-                                           brush=(31, 119, 180, 120), pen=pg.mkPen("#1f77b4"))
+        self.hist_curve = pg.PlotCurveItem(
+            [0.0, 1.0], [0.0], stepMode="center", fillLevel=0, brush=(31, 119, 180, 120), pen=pg.mkPen("#1f77b4")
+        )
         self.hist.addItem(self.hist_curve)
         lay.addWidget(self.hist, 2)
         lay.addWidget(QtWidgets.QLabel("Folded / non-convex cells (click to zoom):"))
@@ -395,6 +401,7 @@ class QualityPanel(QtWidgets.QWidget):
             self.table.setItem(k, 0, ia)
             self.table.setItem(k, 1, ib)
         self.table.resizeColumnToContents(0)
+        self.table.resizeRowsToContents()
         self.folded.clear()
         bad = {tuple(c) for c in r.nonconvex.tolist()}
         fold = {tuple(c) for c in r.folded.tolist()}

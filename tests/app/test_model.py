@@ -55,7 +55,7 @@ def test_auto_corners_of_rotated_rectangle_loop(reverse):
         pts = pts[::-1].copy()
     c = geo.auto_corners(pts)
     # the chosen points are the rectangle's four vertices
-    verts = (np.array([[0, 0], [3, 0], [3, 1], [0, 1]]) @ rot.T)
+    verts = np.array([[0, 0], [3, 0], [3, 1], [0, 1]]) @ rot.T
     assert sorted(map(tuple, np.round(pts[list(c)], 9))) == sorted(map(tuple, np.round(verts, 9)))
     bd = borders_from_loop(pts, c)  # meshcore accepts them: cyclic order is right
     assert len(bd.bottom) == len(bd.top) == 6
@@ -181,3 +181,24 @@ def test_border_polylines_match_meshcore(reverse):
     ref = borders_from_loop(pts, c)
     for name in ("bottom", "right", "top", "left"):
         np.testing.assert_allclose(mine[name], ref[name])
+
+
+def test_document_model_is_free_of_qt():
+    """The document, project, geometry and solve pipeline import no Qt at all."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import sys, app.document, app.project, app.geometry, app.pipeline, app.io_adapter;"
+        "bad = sorted(m for m in sys.modules if m.startswith(('PySide6', 'pyqtgraph', 'superqt')));"
+        "assert not bad, bad"
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        cwd=Path(__file__).resolve().parents[2],
+        timeout=60,
+    )
+    assert r.returncode == 0, r.stderr
