@@ -38,19 +38,14 @@ def example_names() -> list[str]:
     return [*_case_files(), *[k for k, (f, _t) in LAKES.items() if (_HERE / "resources" / f).exists()]]
 
 
-def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
+def lake_project(csv_path: Path, title: str = "", cells: int = 64) -> Project:
     """A lake: projected shoreline, auto corners, cells by shape."""
     pd = read_points(csv_path)
     pts, crs = project_lonlat(pd.points) if pd.lonlat else (pd.points, "")
     corners = geo.auto_corners(pts)
-    block = Block(
-        name=csv_path.stem,
-        points=pts,
-        closed=True,
-        corners=corners,
-        cells=default_cells(pts, corners, total=cells),
-        curve="linear",
-    )
+    ni, nj = default_cells(pts, corners, total=cells)
+    ni, nj = max(ni, 12), max(nj, 12)  # long, narrow lakes still get a dozen cells across
+    block = Block(name=csv_path.stem, points=pts, closed=True, corners=corners, cells=(ni, nj))
     return Project(blocks=(block,), crs=crs, title=title)
 
 

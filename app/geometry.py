@@ -103,6 +103,10 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         e1 = -e1
     e2 = np.array([-e1[1], e1[0]])
     u, s = q @ e1, q @ e2
+    if w.max() > 9.0 * max(w.min(), 1e-300):  # long and narrow (aspect ≳ 3): cap both ends
+        c = _elongated_corners(p, u)
+        if c is not None:
+            return c
     box = [(u.min(), s.min()), (u.max(), s.min()), (u.max(), s.max()), (u.min(), s.max())]
     # scale-free distance: normalise by the box extents
     su = max(u.max() - u.min(), 1e-300)
@@ -121,6 +125,40 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         others = sorted(chosen[1:], key=lambda k: ((k if ccw else (n - k) % n) - order[0]) % n)
         chosen = [chosen[0], *others]
     return tuple(chosen)  # type: ignore[return-value]
+
+
+def _elongated_corners(p: np.ndarray, u: np.ndarray) -> tuple[int, int, int, int] | None:
+    """Corners of a long, narrow loop: two on each side of both tips.
+
+    The tips are the extreme vertices along the main axis ``u``.  At each tip
+    the corners are the nearest vertices, walking both ways along the loop,
+    that are at least 0.6 mean widths apart (mean width ``W = area /
+    half-perimeter``), so the tips become the left/right borders.
+    """
+    n = len(p)
+    ccw = _signed_area(p) > 0
+    q = p if ccw else p[::-1]
+    uq = u if ccw else u[::-1]
+    seg = np.hypot(*np.diff(np.vstack([q, q[:1]]), axis=0).T)
+    width = 2.0 * abs(_signed_area(q)) / seg.sum()
+    a, b = int(np.argmin(uq)), int(np.argmax(uq))
+
+    def spread(tip: int) -> int | None:
+        for j in range(1, n // 4):
+            if math.hypot(*(q[(tip + j) % n] - q[(tip - j) % n])) >= 0.6 * width:
+                return j
+        return None
+
+    ja, jb = spread(a), spread(b)
+    if ja is None or jb is None:
+        return None
+    c = [(a + ja) % n, (b - jb) % n, (b + jb) % n, (a - ja) % n]  # sw, se, ne, nw walking CCW
+    rel = [(k - c[0]) % n for k in c]
+    if not (rel[0] < rel[1] < rel[2] < rel[3]):
+        return None
+    if not ccw:
+        c = [n - 1 - k for k in c]
+    return tuple(int(k) for k in c)  # type: ignore[return-value]
 
 
 def _signed_area(p: np.ndarray) -> float:
