@@ -86,7 +86,9 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
 
     The vertices nearest to the four corners of the loop's principal-axis
     bounding box (the box aligned with the eigenvectors of the point
-    covariance, the longer axis as ξ).  A stand-in until
+    covariance, the longer axis as ξ).  Long, narrow, curved outlines
+    (``4·area / perimeter² < 0.12``, i.e. width ≲ length / 8, and filling
+    less than 70 % of their box) get two corners beside each tip instead.  A stand-in until
     ``meshcore.corners`` is available; distinctness and cyclic order are
     enforced.
     """
@@ -103,7 +105,11 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         e1 = -e1
     e2 = np.array([-e1[1], e1[0]])
     u, s = q @ e1, q @ e2
-    if w.max() > 9.0 * max(w.min(), 1e-300):  # long and narrow (aspect ≳ 3): cap both ends
+    area = abs(_signed_area(p))
+    perimeter = float(np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T).sum())
+    fill = area / max((u.max() - u.min()) * (s.max() - s.min()), 1e-300)
+    if 4.0 * area / max(perimeter**2, 1e-300) < 0.12 and fill < 0.7:
+        # long, narrow and curved (a lake, a river): cap both tips instead of box corners
         c = _elongated_corners(p, u)
         if c is not None:
             return c
@@ -131,9 +137,9 @@ def _elongated_corners(p: np.ndarray, u: np.ndarray) -> tuple[int, int, int, int
     """Corners of a long, narrow loop: two on each side of both tips.
 
     The tips are the extreme vertices along the main axis ``u``.  At each tip
-    the corners are the nearest vertices, walking both ways along the loop,
-    that are at least 0.6 mean widths apart (mean width ``W = area /
-    half-perimeter``), so the tips become the left/right borders.
+    the corners are the first vertices, walking both ways along the loop, at
+    least half a mean width of arc from the tip (mean width ``W = area /
+    half-perimeter``), so the tips become short left/right borders.
     """
     n = len(p)
     ccw = _signed_area(p) > 0
@@ -143,18 +149,20 @@ def _elongated_corners(p: np.ndarray, u: np.ndarray) -> tuple[int, int, int, int
     width = 2.0 * abs(_signed_area(q)) / seg.sum()
     a, b = int(np.argmin(uq)), int(np.argmax(uq))
 
-    def spread(tip: int) -> int | None:
-        for j in range(1, n // 4):
-            if math.hypot(*(q[(tip + j) % n] - q[(tip - j) % n])) >= 0.6 * width:
-                return j
-        return None
+    def walk(tip: int, step: int) -> int:
+        """First vertex at least half a mean width of arc away from the tip."""
+        arc, k = 0.0, tip
+        for _ in range(n // 4):
+            nxt = (k + step) % n
+            arc += float(np.hypot(*(q[nxt] - q[k])))
+            k = nxt
+            if arc >= 0.5 * width:
+                break
+        return k
 
-    ja, jb = spread(a), spread(b)
-    if ja is None or jb is None:
-        return None
-    c = [(a + ja) % n, (b - jb) % n, (b + jb) % n, (a - ja) % n]  # sw, se, ne, nw walking CCW
+    c = [walk(a, 1), walk(b, -1), walk(b, 1), walk(a, -1)]  # sw, se, ne, nw walking CCW
     rel = [(k - c[0]) % n for k in c]
-    if not (rel[0] < rel[1] < rel[2] < rel[3]):
+    if len(set(c)) < 4 or not (rel[0] < rel[1] < rel[2] < rel[3]):
         return None
     if not ccw:
         c = [n - 1 - k for k in c]

@@ -202,3 +202,18 @@ def test_document_model_is_free_of_qt():
         timeout=60,
     )
     assert r.returncode == 0, r.stderr
+
+
+def test_auto_corners_cap_the_tips_of_a_curved_channel():
+    """A long curved band (an arc of an annulus): the corners sit at its two ends."""
+    th_in = np.linspace(0.0, np.pi, 40)
+    outer = np.c_[10 * np.cos(th_in), 10 * np.sin(th_in)]
+    inner = np.c_[9 * np.cos(th_in[::-1]), 9 * np.sin(th_in[::-1])]
+    loop = np.vstack([outer, inner])[::-1].copy()  # counter-clockwise
+    c = geo.auto_corners(loop)
+    ends = loop[list(c)]
+    # two corners at each end of the band (y ≈ 0, x ≈ ±9..10)
+    assert np.all(np.abs(ends[:, 1]) < 1.0)
+    assert sorted(np.sign(ends[:, 0])) == [-1, -1, 1, 1]
+    b = borders_from_loop(loop, c)
+    assert len(b.left) < 6 and len(b.right) < 6  # the short ends are left/right
