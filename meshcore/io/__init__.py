@@ -20,8 +20,8 @@ Examples
 >>> from meshcore.io import write, read_grid
 >>> xi, eta = np.meshgrid(np.linspace(0, 2, 5), np.linspace(0, 1, 3), indexing="ij")
 >>> d = tempfile.mkdtemp()
->>> write(os.path.join(d, "g.xyz"), StructuredGrid(xi, eta))
->>> read_grid(os.path.join(d, "g.xyz")).shape
+>>> p = write(os.path.join(d, "g.xyz"), StructuredGrid(xi, eta))
+>>> read_grid(os.path.join(d, "g.xyz"))[0].shape
 (5, 3)
 """
 
@@ -41,6 +41,7 @@ from ._base import (
     PointSet,
     Polyline,
     as_blocks,
+    atomic_path,
     block_names as _block_names,
     coerce_interfaces,
     find_interfaces,
@@ -51,6 +52,8 @@ __all__ = [
     "FORMATS",
     "Format",
     "GridSet",
+    "atomic_write_bytes",
+    "atomic_write_text",
     "Interface",
     "PointSet",
     "Polyline",
@@ -234,17 +237,13 @@ def read_blocks(path: Any, *, format: str | None = None, **options: Any) -> Grid
         return fmt._load(fmt.grid_reader)(p, **options)
 
 
-def read_grid(path: Any, *, block: int | None = None, format: str | None = None,
-              **options: Any) -> StructuredGrid:
-    """Read one grid (the only block, or block ``block``) in local coordinates."""
-    gs = read_blocks(path, format=format, **options)
-    if block is None:
-        if len(gs.blocks) != 1:
-            raise ReadError(f"{path}: holds {len(gs.blocks)} blocks; give block= or use read_blocks")
-        return gs.blocks[0]
-    if not -len(gs.blocks) <= block < len(gs.blocks):
-        raise ReadError(f"{path}: no block {block} (the file has {len(gs.blocks)})")
-    return gs.blocks[block]
+def read_grid(path: Any, *, format: str | None = None, **options: Any) -> list[StructuredGrid]:
+    """Read the blocks of a grid file as a list of grids in local coordinates.
+
+    ``read_grid(path)[0]`` is the grid of a one-block file; use
+    :func:`read_blocks` to get the CRS/origin and block names as well.
+    """
+    return list(read_blocks(path, format=format, **options).blocks)
 
 
 def read(path: Any, **options: Any) -> StructuredGrid | GridSet | PointSet:
@@ -261,6 +260,18 @@ def read(path: Any, **options: Any) -> StructuredGrid | GridSet | PointSet:
     return gs.blocks[0] if len(gs.blocks) == 1 else gs
 
 
+def atomic_write_text(path: Any, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically (temporary file, then rename)."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+def atomic_write_bytes(path: Any, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (temporary file, then rename)."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+
+
 def _is_metrics_csv(p: Path) -> bool:
     try:
         with open(p, encoding="utf-8", errors="replace") as f:
@@ -275,7 +286,7 @@ def _is_metrics_csv(p: Path) -> bool:
 # ------------------------------------------------------------------- writing
 def write(path: Any, grid_or_blocks: Any, format: str | None = None, *, crs: Any = None,
           origin: Any = None, block_names: Any = None, connectivity: Any = None,
-          **options: Any) -> None:
+          **options: Any) -> Path:
     """Write a grid or a list of blocks; the format comes from the suffix or ``format``.
 
     Parameters
@@ -323,6 +334,7 @@ def write(path: Any, grid_or_blocks: Any, format: str | None = None, *, crs: Any
     if len(gs.blocks) > 1 and not fmt.multiblock:
         raise WriteError(f"{p}: the {fmt.name} format holds one block, got {len(gs.blocks)}")
     fmt._load(fmt.writer)(p, gs, **options)
+    return p
 
 
 _ = Frame

@@ -33,8 +33,8 @@ def write_figure(path: Path, gs: GridSet, *, dpi: int = 150, title: str | None =
     except ImportError:
         plot_grid = None
     if plot_grid is not None:
-        blocks = gs.blocks if len(gs.blocks) > 1 else gs.blocks[0]
-        plot_grid(blocks, ax, **options)
+        world = [g.replaced(x=gs.world(k)[0], y=gs.world(k)[1]) for k, g in enumerate(gs.blocks)]
+        plot_grid(world if len(world) > 1 else world[0], ax=ax, **options)
     else:
         for k, g in enumerate(gs.blocks):
             X, Y = gs.world(k)
