@@ -325,3 +325,34 @@ def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
         pts = np.column_stack([lon, lat])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     return float(0.5 * (lo[0] + hi[0])), float(0.5 * (lo[1] + hi[1]))
+
+
+# ------------------------------------------------------------ case files
+def frame_from_case(case: Any) -> Frame | None:
+    """The :class:`Frame` stored in a case's top-level ``crs`` table, or None.
+
+    The table (written by ``meshcore import``) reads::
+
+        crs = { crs = "EPSG:32632", origin = [480000.0, 5240000.0],
+                source_crs = "EPSG:4326" }
+    """
+    t = (getattr(case, "extra", None) or {}).get("crs")
+    if not isinstance(t, dict):
+        return None
+    o = t.get("origin", [0.0, 0.0])
+    try:
+        origin = (float(o[0]), float(o[1]))
+    except (TypeError, ValueError, IndexError):
+        raise InvalidInputError(f"case crs.origin must be [x0, y0], got {o!r}") from None
+    return Frame(normalize_crs(t.get("crs")), origin, normalize_crs(t.get("source_crs")))
+
+
+def _register_case_keys() -> None:
+    try:
+        from .case import register_keys
+    except ImportError:  # pragma: no cover - case.py not present
+        return
+    register_keys(top=["crs"])
+
+
+_register_case_keys()
