@@ -166,8 +166,8 @@ def _nice_origin(points: np.ndarray) -> tuple[float, float]:
     size = float(math.hypot(*(hi - lo))) or 1.0
     if math.hypot(*c) <= 10 * size:
         return (0.0, 0.0)
-    step = 10.0 ** math.floor(math.log10(size))
-    return (float(round(c[0] / step) * step), float(round(c[1] / step) * step))
+    e = math.floor(math.log10(size))
+    return (float(round(float(c[0]), -e)), float(round(float(c[1]), -e)))
 
 
 @dataclass(frozen=True, slots=True)
