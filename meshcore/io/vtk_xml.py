@@ -180,7 +180,7 @@ def _parse(data: bytes, path: Path):
         if start < 0 or us < 0 or end < us:
             raise ReadError(f"{path}: malformed <AppendedData> section")
         appended = data[us + 1:end]
-        data = data[:marker] + b"<AppendedData/>" + data[end + len(b"</AppendedData>"):]
+        data = data[:start + 1] + b"</AppendedData>" + data[end + len(b"</AppendedData>"):]
     root = _parse_xml(data, str(path))
     return root, appended
 
@@ -205,23 +205,27 @@ class _Decoder:
 
     def _unpack(self, buf: bytes, b64: bool) -> bytes:
         hs = self.header.itemsize
+
+        def chars(nbytes: int) -> int:
+            return ((nbytes + 2) // 3) * 4
+
         if b64:
-            buf = buf.strip()
+            buf = buf.lstrip()
+            first = base64.b64decode(buf[: chars(hs)])
+            n0 = int(np.frombuffer(first[:hs], dtype=self.header)[0])
             if not self.compressed:
-                # header and data may be encoded separately or together
-                first = base64.b64decode(buf[: ((hs + 2) // 3) * 4])
-                n = int(np.frombuffer(first[:hs], dtype=self.header)[0])
-                whole = base64.b64decode(buf)
-                if len(whole) >= hs + n:
-                    return whole[hs:hs + n]
-                rest = base64.b64decode(buf[((hs + 2) // 3) * 4:])
-                return rest[:n]
-            nb = int(np.frombuffer(base64.b64decode(buf[: ((hs + 2) // 3) * 4])[:hs],
-                                   dtype=self.header)[0])
-            hlen = (3 + nb) * hs
-            hdr_chars = ((hlen + 2) // 3) * 4
-            hdr = np.frombuffer(base64.b64decode(buf[:hdr_chars])[:hlen], dtype=self.header)
-            body = base64.b64decode(buf[hdr_chars:])
+                # VTK encodes the header and the data separately; accept both ways
+                data = base64.b64decode(buf[chars(hs): chars(hs) + chars(n0)])
+                if len(data) >= n0:
+                    return data[:n0]
+                whole = base64.b64decode(buf[: chars(hs + n0)])
+                if len(whole) < hs + n0:
+                    raise ReadError(f"{self.path}: base64 data truncated")
+                return whole[hs:hs + n0]
+            hlen = (3 + n0) * hs
+            hdr = np.frombuffer(base64.b64decode(buf[: chars(hlen)])[:hlen], dtype=self.header)
+            total = int(hdr[3:3 + n0].astype(np.int64).sum())
+            body = base64.b64decode(buf[chars(hlen): chars(hlen) + chars(total)])
             return self._inflate(hdr, body)
         n0 = int(np.frombuffer(buf[:hs], dtype=self.header)[0])
         if not self.compressed:
