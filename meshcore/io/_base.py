@@ -157,7 +157,10 @@ def read_guard(path: Any, what: str = "file") -> Iterator[None]:
     """
     try:
         yield
-    except ReadError:
+    except ReadError as exc:
+        msg = str(exc)
+        if "\n" in msg or "\r" in msg or len(msg) > 400:
+            raise ReadError(one_line(msg)) from exc
         raise
     except FileNotFoundError:
         raise ReadError(f"{path}: no such file") from None
@@ -166,12 +169,21 @@ def read_guard(path: Any, what: str = "file") -> Iterator[None]:
     except PermissionError:
         raise ReadError(f"{path}: permission denied") from None
     except MeshcoreError as exc:
-        raise ReadError(f"{path}: {exc}") from exc
+        raise ReadError(one_line(f"{path}: {exc}")) from exc
     except RecursionError:
         raise ReadError(f"{path}: nesting too deep, not a valid {what}") from None
     except Exception as exc:  # the safety net (see docstring)
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise ReadError(f"{path}: not a valid {what} ({type(exc).__name__}: {msg})") from exc
+        msg = one_line(str(exc)) if str(exc) else type(exc).__name__
+        raise ReadError(one_line(f"{path}: not a valid {what} ({type(exc).__name__}: {msg})")) \
+            from exc
+
+
+def one_line(msg: str, limit: int = 400) -> str:
+    """Collapse line breaks (a third-party message may hold some) and cap the length."""
+    import re
+
+    s = re.sub(r"\s*[\r\n]+\s*", " ", msg).strip()
+    return s if len(s) <= limit else s[: limit - 1] + "…"
 
 
 def read_bytes(path: Path, *, limit: int = 512 * 2**20) -> bytes:
