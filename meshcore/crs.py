@@ -105,9 +105,10 @@ def looks_lonlat(points: Any) -> bool:
     """Heuristic: do these unlabelled coordinates look like lon/lat degrees?
 
     True when every point lies in ``[-180, 180] × [-90, 90]``, the extent is
-    at most 20° (a lake or river region, not a whole continent) and the centre
-    is more than 1° away from ``(0, 0)`` (so unit squares and other local
-    model coordinates are not mistaken for degrees).
+    at most 20° (a lake or river region, not a whole continent), the centre
+    is more than 1° away from ``(0, 0)`` and the values carry at least three
+    decimals (digitised degrees do; unit squares and other small model
+    coordinates such as ``0 … 8`` or ``0.5, 1.25`` are not mistaken for degrees).
     """
     p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     if p.size == 0 or not np.isfinite(p).all():
@@ -118,7 +119,10 @@ def looks_lonlat(points: Any) -> bool:
     if max(hi - lo) > 20:
         return False
     c = 0.5 * (lo + hi)
-    return bool(math.hypot(*c) > 1.0)
+    if math.hypot(*c) <= 1.0:
+        return False
+    frac = np.abs(p * 100 - np.round(p * 100))
+    return bool((frac > 1e-6).any())
 
 
 def check_lonlat(points: np.ndarray, *, where: str) -> None:
@@ -271,9 +275,9 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto",
 
     src = normalize_crs(source_crs) if source_crs is not None else pointset.crs
     pts = pointset.all_points()
-    if src is None and looks_lonlat(pts):
-        src = LONLAT
     target_in = crs.strip().lower() if isinstance(crs, str) else crs
+    if src is None and target_in not in (None, "none", "local") and looks_lonlat(pts):
+        src = LONLAT
     if target_in == "auto":
         if src is not None and is_geographic(src):
             lon, lat = _lonlat_centroid(pts, src)

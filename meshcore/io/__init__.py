@@ -42,21 +42,23 @@ from ._base import (
     Polyline,
     as_blocks,
     atomic_path,
-    block_names as _block_names,
     coerce_interfaces,
     find_interfaces,
     read_guard,
+)
+from ._base import (
+    block_names as _block_names,
 )
 
 __all__ = [
     "FORMATS",
     "Format",
     "GridSet",
-    "atomic_write_bytes",
-    "atomic_write_text",
     "Interface",
     "PointSet",
     "Polyline",
+    "atomic_write_bytes",
+    "atomic_write_text",
     "find_format",
     "find_interfaces",
     "read",
@@ -116,7 +118,8 @@ for _f in (
     Format("npz", (".npz",), "NumPy archive: coordinates, metrics, CRS",
            writer="native:write_npz", grid_reader="native:read_npz", crs=True, multiblock=True),
     Format("metrics-csv", (".csv",), "metrics table per node (CSV)",
-           writer="native:write_metrics_csv", grid_reader="native:read_metrics_csv", crs=True),
+           writer="native:write_metrics_csv", grid_reader="native:read_metrics_csv", crs=True,
+           multiblock=True),
     Format("cgns", (".cgns",), "CGNS/HDF5 structured zones", writer="cgns:write_cgns",
            grid_reader="cgns:read_cgns", crs=True, markers=True, multiblock=True),
     Format("gmsh", (".msh",), "Gmsh MSH 4.1 (quads + physical border lines)",

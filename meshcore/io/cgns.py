@@ -111,63 +111,62 @@ def write_cgns(path: Path, gs: GridSet, **_: Any) -> None:
     for it in gs.connectivity:
         iface.setdefault((it.a, it.border_a), []).append((it, True))
         iface.setdefault((it.b, it.border_b), []).append((it, False))
-    with atomic_path(path) as tmp:
-        with h5py.File(tmp, "w", track_order=True) as f:
-            f.attrs.create("name", np.array(b"HDF5 MotherNode", dtype="S33"))
-            f.attrs.create("label", np.array(b"Root Node of HDF5 File", dtype="S33"))
-            f.attrs.create("type", np.array(b"MT", dtype="S3"))
-            f.create_dataset(" format", data=np.frombuffer(b"IEEE_LITTLE_64\x00", dtype=np.int8))
-            ver = f"HDF5 Version {h5py.version.hdf5_version}".encode().ljust(33, b"\x00")
-            f.create_dataset(" hdf5version", data=np.frombuffer(ver, dtype=np.int8))
-            _node(f, "CGNSLibraryVersion", "CGNSLibraryVersion_t", "R4", [4.2])
-            base = _node(f, "Base", "CGNSBase_t", "I4", [2, 2])
-            if gs.frame.crs:
-                _node(base, "CRS", "Descriptor_t", "C1", gs.frame.crs)
-            o = gs.frame.origin
-            if o != (0.0, 0.0):
-                _node(base, "LocalOrigin", "Descriptor_t", "C1", f"{o[0]!r} {o[1]!r}")
-            for k, g in enumerate(gs.blocks):
-                ni, nj = g.cells
-                z = _node(base, zones[k], "Zone_t", "I4",
-                          np.array([[ni + 1, nj + 1], [ni, nj], [0, 0]]).T)
-                _node(z, "ZoneType", "ZoneType_t", "C1", "Structured")
-                gc = _node(z, "GridCoordinates", "GridCoordinates_t")
-                X, Y = gs.world(k)
-                _node(gc, "CoordinateX", "DataArray_t", "R8", X)
-                _node(gc, "CoordinateY", "DataArray_t", "R8", Y)
-                names = border_names(g)
-                bcs = [b for b in BORDER_NAMES if (k, b) not in iface
-                       and not (g.periodic and b in ("left", "right"))]
-                if bcs:
-                    zbc = _node(z, "ZoneBC", "ZoneBC_t")
-                    used: set[str] = set()
-                    for b in bcs:
-                        nm = names[b] if names[b] not in used else f"{names[b]}_{b}"
-                        used.add(nm)
-                        bc = _node(zbc, nm, "BC_t", "C1", bc_type(names[b]))
-                        _node(bc, "PointRange", "IndexRange_t", "I4",
-                              np.array(_RANGES[b](ni, nj)).T)
-                        _node(bc, "GridLocation", "GridLocation_t", "C1", "Vertex")
-                conns = [(b, it, first) for b in BORDER_NAMES for it, first in iface.get((k, b), [])]
-                if conns:
-                    zgc = _node(z, "ZoneGridConnectivity", "ZoneGridConnectivity_t")
-                    for n_c, (b, it, first) in enumerate(conns):
-                        other = it.b if first else it.a
-                        ob = it.border_b if first else it.border_a
-                        og = gs.blocks[other]
-                        oni, onj = og.cells
-                        nm = f"{zones[k]}_{b}_to_{zones[other]}"[:32]
-                        if nm in zgc:
-                            nm = f"{nm[:28]}_{n_c}"
-                        c = _node(zgc, nm, "GridConnectivity1to1_t", "C1", zones[other])
-                        _node(c, "PointRange", "IndexRange_t", "I4",
-                              np.array(_RANGES[b](ni, nj)).T)
-                        dr = _RANGES[ob](oni, onj)
-                        if it.reversed:
-                            dr = [dr[1], dr[0]]
-                        _node(c, "PointRangeDonor", "IndexRange_t", "I4", np.array(dr).T)
-                        _node(c, "Transform", '"int[IndexDimension]"', "I4",
-                              transform(b, ob, it.reversed))
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", track_order=True) as f:
+        f.attrs.create("name", np.array(b"HDF5 MotherNode", dtype="S33"))
+        f.attrs.create("label", np.array(b"Root Node of HDF5 File", dtype="S33"))
+        f.attrs.create("type", np.array(b"MT", dtype="S3"))
+        f.create_dataset(" format", data=np.frombuffer(b"IEEE_LITTLE_64\x00", dtype=np.int8))
+        ver = f"HDF5 Version {h5py.version.hdf5_version}".encode().ljust(33, b"\x00")
+        f.create_dataset(" hdf5version", data=np.frombuffer(ver, dtype=np.int8))
+        _node(f, "CGNSLibraryVersion", "CGNSLibraryVersion_t", "R4", [4.2])
+        base = _node(f, "Base", "CGNSBase_t", "I4", [2, 2])
+        if gs.frame.crs:
+            _node(base, "CRS", "Descriptor_t", "C1", gs.frame.crs)
+        o = gs.frame.origin
+        if o != (0.0, 0.0):
+            _node(base, "LocalOrigin", "Descriptor_t", "C1", f"{o[0]!r} {o[1]!r}")
+        for k, g in enumerate(gs.blocks):
+            ni, nj = g.cells
+            z = _node(base, zones[k], "Zone_t", "I4",
+                      np.array([[ni + 1, nj + 1], [ni, nj], [0, 0]]).T)
+            _node(z, "ZoneType", "ZoneType_t", "C1", "Structured")
+            gc = _node(z, "GridCoordinates", "GridCoordinates_t")
+            X, Y = gs.world(k)
+            _node(gc, "CoordinateX", "DataArray_t", "R8", X)
+            _node(gc, "CoordinateY", "DataArray_t", "R8", Y)
+            names = border_names(g)
+            bcs = [b for b in BORDER_NAMES if (k, b) not in iface
+                   and not (g.periodic and b in ("left", "right"))]
+            if bcs:
+                zbc = _node(z, "ZoneBC", "ZoneBC_t")
+                used: set[str] = set()
+                for b in bcs:
+                    nm = names[b] if names[b] not in used else f"{names[b]}_{b}"
+                    used.add(nm)
+                    bc = _node(zbc, nm, "BC_t", "C1", bc_type(names[b]))
+                    _node(bc, "PointRange", "IndexRange_t", "I4",
+                          np.array(_RANGES[b](ni, nj)).T)
+                    _node(bc, "GridLocation", "GridLocation_t", "C1", "Vertex")
+            conns = [(b, it, first) for b in BORDER_NAMES for it, first in iface.get((k, b), [])]
+            if conns:
+                zgc = _node(z, "ZoneGridConnectivity", "ZoneGridConnectivity_t")
+                for n_c, (b, it, first) in enumerate(conns):
+                    other = it.b if first else it.a
+                    ob = it.border_b if first else it.border_a
+                    og = gs.blocks[other]
+                    oni, onj = og.cells
+                    nm = f"{zones[k]}_{b}_to_{zones[other]}"[:32]
+                    if nm in zgc:
+                        nm = f"{nm[:28]}_{n_c}"
+                    c = _node(zgc, nm, "GridConnectivity1to1_t", "C1", zones[other])
+                    _node(c, "PointRange", "IndexRange_t", "I4",
+                          np.array(_RANGES[b](ni, nj)).T)
+                    dr = _RANGES[ob](oni, onj)
+                    if it.reversed:
+                        dr = [dr[1], dr[0]]
+                    _node(c, "PointRangeDonor", "IndexRange_t", "I4", np.array(dr).T)
+                    _node(c, "Transform", '"int[IndexDimension]"', "I4",
+                          transform(b, ob, it.reversed))
 
 
 def _text(node) -> str:

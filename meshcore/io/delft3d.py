@@ -133,7 +133,7 @@ def read_grd(path: Path, **_: Any) -> GridSet:
     a = np.array(vals)
     X = a[: mmax * nmax].reshape((nmax, mmax)).T
     Y = a[mmax * nmax:].reshape((nmax, mmax)).T
-    if np.any(X == missing) or np.any(Y == missing):
+    if np.any(missing == X) or np.any(missing == Y):
         raise ReadError(f"{path}: grid has missing (inactive) points; only full grids are read")
     frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
     return GridSet((StructuredGrid(X, Y),), frame, source=str(path))

@@ -36,7 +36,7 @@ def write_figure(path: Path, gs: GridSet, *, dpi: int = 150, title: str | None =
         world = [g.replaced(x=gs.world(k)[0], y=gs.world(k)[1]) for k, g in enumerate(gs.blocks)]
         plot_grid(world if len(world) > 1 else world[0], ax=ax, **options)
     else:
-        for k, g in enumerate(gs.blocks):
+        for k in range(len(gs.blocks)):
             X, Y = gs.world(k)
             ax.plot(X, Y, color="0.2", lw=0.5)
             ax.plot(X.T, Y.T, color="0.2", lw=0.5)

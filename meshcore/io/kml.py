@@ -115,10 +115,8 @@ def _find_child(elem, tag: str) -> str | None:
 
 
 def _inside_polygon(root, ring) -> bool:
-    for poly in root.iter():
-        if _local(poly.tag) == "Polygon" and any(r is ring for r in poly.iter()):
-            return True
-    return False
+    return any(_local(poly.tag) == "Polygon" and any(r is ring for r in poly.iter())
+               for poly in root.iter())
 
 
 def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:

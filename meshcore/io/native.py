@@ -98,7 +98,7 @@ def write_metrics_csv(path: Path, gs: GridSet, **_: Any) -> None:
         vals = np.column_stack([t[c].ravel() for c in list(COLUMNS)[3:]])
         ints = np.column_stack(cols).astype(np.int64)
         for r in range(len(ints)):
-            buf.write("%d,%d,%d," % tuple(ints[r]))
+            buf.write(f"{ints[r][0]},{ints[r][1]},{ints[r][2]},")
             buf.write(",".join(f"{v:.17g}" for v in vals[r]) + "\n")
     with atomic_path(path) as tmp:
         tmp.write_text(buf.getvalue(), encoding="utf-8")
@@ -163,9 +163,8 @@ def write_npz(path: Path, gs: GridSet, **_: Any) -> None:
     arrays["block_names"] = np.array(json.dumps(list(gs.block_names)))
     arrays["border_names"] = np.array(json.dumps([dict(g.names) for g in gs.blocks]))
     arrays["columns"] = np.array(json.dumps(COLUMNS))
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as f:
-            np.savez(f, **arrays)
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        np.savez(f, **arrays)
 
 
 def read_npz(path: Path, **_: Any) -> GridSet:

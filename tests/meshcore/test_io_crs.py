@@ -36,6 +36,7 @@ def test_looks_lonlat():
     assert not looks_lonlat([[0, 0], [1, 0], [1, 1]])  # a unit square is model units
     assert not looks_lonlat([[500000, 5e6], [500100, 5e6]])
     assert not looks_lonlat([[-170, 10], [170, 10]])  # 340° wide: not a lake
+    assert not looks_lonlat([[0, 0], [8, 0], [8, 4], [0, 4.5]])  # model units, few decimals
 
 
 def test_project_to_utm_and_back():
@@ -72,11 +73,11 @@ def test_project_to_given_epsg_and_none():
 
 def test_unknown_crs_cannot_be_projected():
     ps = PointSet((Polyline("a", [[0, 0], [1000, 0], [1000, 1000]]),), None, "model.csv")
-    local, frame = project(ps)  # auto: unknown and not lon/lat -> left as is
+    _, frame = project(ps)  # auto: unknown and not lon/lat -> left as is
     assert frame.crs is None and frame.origin == (0.0, 0.0)
-    with pytest.raises(InvalidInputError, match="model.csv.*unknown"):
+    with pytest.raises(InvalidInputError, match=r"model\.csv.*unknown"):
         project(ps, 32632)
-    with pytest.raises(InvalidInputError, match="no CRS|unknown"):
+    with pytest.raises(InvalidInputError, match=r"no CRS|unknown"):
         Frame().to_lonlat([0.0], [0.0])
 
 

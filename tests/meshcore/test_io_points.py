@@ -229,7 +229,7 @@ def test_kmz_without_kml(tmp_path):
     f = tmp_path / "nokml.kmz"
     with zipfile.ZipFile(f, "w") as z:
         z.writestr("image.png", b"\x89PNG")
-    with pytest.raises(ReadError, match="no .kml"):
+    with pytest.raises(ReadError, match=r"no \.kml"):
         read_points(f)
 
 
@@ -257,7 +257,23 @@ def test_missing_file_and_unknown_suffix(tmp_path):
     with pytest.raises(ReadError, match="no such file"):
         read_points(tmp_path / "nope.csv")
     f = _write(tmp_path, "a.weird", "1 2\n3 4\n")
-    with pytest.raises(ReadError, match="cannot read points from .weird"):
+    with pytest.raises(ReadError, match=r"cannot read points from \.weird"):
         read_points(f)
     # a format name overrides the suffix
     assert len(read_points(f, format="points-csv").polylines[0]) == 2
+
+
+@pytest.mark.parametrize(("name", "n", "zone"), [("lake_bolsena.kml", 102, 32632),
+                                                 ("shasta_lake_sparse.kml", 54, 32610),
+                                                 ("lake_bolsena_sparse.geojson", 40, 32632)])
+def test_more_real_lakes_read_and_project(name, n, zone):
+    pytest.importorskip("pyproj")
+    from meshcore.crs import project
+
+    ps = read_points(DATA / name)
+    (pl,) = ps.polylines
+    assert len(pl) == n and pl.closed and pl.orientation == "ccw"
+    local, frame = project(ps)
+    assert frame.crs == f"EPSG:{zone}"
+    lon, lat = frame.to_lonlat(*local.polylines[0].points.T)
+    np.testing.assert_allclose(np.column_stack([lon, lat]), pl.points, rtol=0, atol=1e-9)
