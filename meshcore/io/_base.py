@@ -375,11 +375,22 @@ def coerce_interfaces(conn: Any, blocks: Sequence[StructuredGrid]) -> tuple[Inte
     if conn is None:
         return find_interfaces(blocks) if len(blocks) > 1 else ()
     out = []
-    for r in conn:
+    for k, r in enumerate(conn):
         if isinstance(r, Interface):
             out.append(r)
             continue
-        get = r.get if isinstance(r, dict) else (lambda k, d=None, r=r: getattr(r, k, d))
-        out.append(Interface(int(get("a")), str(get("border_a")), int(get("b")),
-                             str(get("border_b")), bool(get("reversed", False))))
+        get = r.get if isinstance(r, dict) else (lambda key, d=None, r=r: getattr(r, key, d))
+        try:
+            it = Interface(int(get("a")), str(get("border_a")), int(get("b")),
+                           str(get("border_b")), bool(get("reversed", False)))
+        except (TypeError, ValueError) as exc:
+            raise WriteError(
+                f"connectivity record {k} must have a, border_a, b, border_b "
+                f"(and optionally reversed): {exc}"
+            ) from None
+        if it.border_a not in BORDER_NAMES or it.border_b not in BORDER_NAMES or not (
+            0 <= it.a < len(blocks) and 0 <= it.b < len(blocks)
+        ):
+            raise WriteError(f"connectivity record {k} names an unknown block or border: {it}")
+        out.append(it)
     return tuple(out)

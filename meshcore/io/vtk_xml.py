@@ -21,7 +21,6 @@ appended (raw or base64) data, UInt32/UInt64 headers and zlib compression.
 from __future__ import annotations
 
 import base64
-import contextlib
 import os
 import shutil
 import struct
@@ -350,8 +349,8 @@ def read_vtm(path: Path, **_: Any) -> GridSet:
         sub = (path.parent / fn).resolve()
         if not str(sub).endswith(".vts"):
             raise ReadError(f"{path}: block file {fn!r} is not a .vts")
-        with contextlib.suppress(ValueError):
-            sub.relative_to(path.parent.resolve())
+        if not sub.is_file():
+            raise ReadError(f"{path}: block file {fn!r} not found")
         gs = read_vts(sub)
         blocks.append(gs.blocks[0])
         names.append(e.get("name") or f"block{len(names) + 1}")

@@ -525,3 +525,26 @@ def test_generate_and_rewrite_a_lake_grid(tmp_path):
     g2 = meshcore.solve(g)
     assert g2.converged and g2.shape == g0.shape
     np.testing.assert_array_equal(g2.border("bottom"), g0.border("bottom"))
+
+
+def test_explicit_connectivity_records_and_grid_borders_as_points(tmp_path, blocks):
+    f = write(tmp_path / "m.su2", blocks,
+              connectivity=[{"a": 0, "border_a": "right", "b": 1, "border_b": "left"}])
+    assert "MARKER_TAG= right" not in f.read_text()
+    with pytest.raises(WriteError, match="unknown block or border"):
+        write(tmp_path / "x.su2", blocks,
+              connectivity=[{"a": 0, "border_a": "east", "b": 1, "border_b": "left"}])
+    # a grid file read as points gives its borders, named
+    from meshcore.io import read_points
+
+    g = write(tmp_path / "g.vts", blocks[0], crs=CRS, origin=ORIGIN)
+    ps = read_points(g)
+    assert ps.names == ("bottom", "right", "top", "inlet") and ps.crs == CRS
+    np.testing.assert_allclose(ps["inlet"].points, blocks[0].border("left"), atol=1e-9)
+
+
+def test_vtm_with_missing_block_file(tmp_path, blocks):
+    f = write(tmp_path / "m.vtm", blocks)
+    (tmp_path / "m" / "m_1.vts").unlink()
+    with pytest.raises(ReadError, match=r"m_1\.vts.*not found"):
+        read_blocks(f)
