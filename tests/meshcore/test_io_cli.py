@@ -91,3 +91,24 @@ def test_top_level_reexports(tmp_path):
     s, t = np.meshgrid(np.linspace(0, 1, 3), np.linspace(0, 1, 2), indexing="ij")
     f = meshcore.write(tmp_path / "g.vts", meshcore.StructuredGrid(s, t))
     assert meshcore.read_grid(f)[0].shape == (3, 2)
+
+
+SUFFIXES = [".xyz", ".vts", ".vtm", ".npz", ".csv", ".cgns", ".msh", ".su2", ".grd", ".nc",
+            ".png", ".svg", ".pdf"]
+
+
+def test_generate_writes_every_format(tmp_path, capsys):
+    pytest.importorskip("pyproj")
+    case = tmp_path / "w.toml"
+    assert main(["import", str(DATA / "windermere_sparse.csv"), "-o", str(case),
+                 "--cells", "16", "4"]) == 0
+    frame = frame_from_case(load_case(case))
+    for suffix in SUFFIXES:
+        out = tmp_path / f"w{suffix}"
+        assert main(["generate", str(case), "-o", str(out), "-q"]) == 0, suffix
+        assert out.stat().st_size > 0
+        if suffix in (".vts", ".vtm", ".npz", ".csv", ".cgns", ".nc", ".grd"):
+            gs = read_blocks(out)
+            assert gs.frame.crs == frame.crs == "EPSG:32630", suffix
+            assert gs.blocks[0].cells == (16, 4)
+    capsys.readouterr()
