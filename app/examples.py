@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import geometry as geo
-from .io_adapter import load_project, project_lonlat, read_points
+from .io_adapter import load_project, read_points, to_local
 from .project import Block, Project, default_cells
 
 __all__ = ["EXAMPLE_DIRS", "LAKES", "example_names", "load_example"]
@@ -41,12 +41,16 @@ def example_names() -> list[str]:
 def lake_project(csv_path: Path, title: str = "", cells: int = 64) -> Project:
     """A lake: projected shoreline, auto corners, cells by shape."""
     pd = read_points(csv_path)
-    pts, crs = project_lonlat(pd.points) if pd.lonlat else (pd.points, "")
+    if pd.lonlat:
+        pts, frame = to_local(pd)
+        crs, origin, src = frame.crs or "", frame.origin, frame.source_crs or ""
+    else:
+        pts, crs, origin, src = pd.points, "", (0.0, 0.0), ""
     corners = geo.auto_corners(pts)
     ni, nj = default_cells(pts, corners, total=cells)
     ni, nj = max(ni, 12), max(nj, 12)  # long, narrow lakes still get a dozen cells across
     block = Block(name=csv_path.stem, points=pts, closed=True, corners=corners, cells=(ni, nj))
-    return Project(blocks=(block,), crs=crs, title=title)
+    return Project(blocks=(block,), crs=crs, origin=origin, source_crs=src, title=title)
 
 
 def load_example(name: str) -> tuple[Project, Path | None]:

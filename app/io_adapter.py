@@ -1,22 +1,19 @@
-"""File I/O for the app: points, projects, meshes (thin adapters over meshcore).
+"""File I/O for the app: thin adapters over ``meshcore.io``, ``meshcore.crs`` and ``meshcore.case``.
 
-Uses ``meshcore.io`` / ``meshcore.case`` when present; small built-in
-fallbacks keep the app usable on their own (CSV/KML/GeoJSON points, TOML
-project in the case-file layout, VTK ``.vts`` and CSV mesh output).
+Points come from :func:`meshcore.io.read_points` (every format it reads);
+lon/lat outlines are projected by :func:`meshcore.crs.project` to local metric
+coordinates (UTM minus a round origin) and the :class:`~meshcore.crs.Frame` is
+kept in the project, saved in the case file and passed to every exporter.
 """
 
 from __future__ import annotations
 
-import csv
-import json
-import math
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from meshcore import BORDER_NAMES, ReadError, StructuredGrid, WriteError
+from meshcore import BORDER_NAMES, ReadError, StructuredGrid
 
 from .project import Block, Project, SolverSettings, boundary_to_loop
 
@@ -25,149 +22,62 @@ __all__ = [
     "block_from_case",
     "load_project",
     "mesh_formats",
-    "project_lonlat",
+    "project_frame",
     "read_points",
     "save_project",
-    "utm_epsg",
+    "to_local",
     "write_mesh",
 ]
 
-POINT_FILTER = "Point files (*.csv *.txt *.xy *.dat *.kml *.geojson *.json *.shp *.dxf);;All files (*)"
+POINT_FILTER = "Point files (*.csv *.txt *.xy *.dat *.tsv *.kml *.kmz *.geojson *.json *.shp *.dxf);;All files (*)"
 
 
 @dataclass(frozen=True)
 class PointData:
-    """Points read from a file; ``lonlat`` when they are geographic degrees."""
+    """The first polyline of a point file; ``lonlat`` when it is in geographic degrees."""
 
     points: np.ndarray
     lonlat: bool
     path: str = ""
+    pointset: object = None  # the meshcore.io.PointSet, when meshcore read the file
 
 
-def _core_io():
-    try:
-        from meshcore import io as mio
-    except ImportError:
-        return None
-    return mio
-
-
-# ------------------------------------------------------------------- points
 def read_points(path) -> PointData:
-    """Read a boundary point file: meshcore.io.read_points, else the built-in readers.
+    """Read a boundary point file with :func:`meshcore.io.read_points` (every format it knows)."""
+    from meshcore import crs as mcrs
+    from meshcore import io as mio
 
-    ``lonlat`` is True when the reader says so, for KML/GeoJSON (always
-    WGS84 degrees) and for delimited text whose header starts with lon/lat.
-    """
     path = Path(path)
-    mio = _core_io()
-    if mio is not None and hasattr(mio, "read_points"):
-        try:
-            res = mio.read_points(path)
-        except (ReadError, ValueError):
-            res = None
-        if res is not None:
-            return _from_core(res, path)
-    return _read_points_builtin(path)
+    ps = mio.read_points(path)
+    if not ps.polylines:
+        raise ReadError(f"{path}: the file holds no polyline")
+    pts = np.asarray(ps.polylines[0].points, float)
+    geographic = (ps.crs is not None and mcrs.is_geographic(ps.crs)) or (
+        ps.crs is None and mcrs.looks_lonlat(pts) and path.suffix.lower() in (".kml", ".kmz", ".geojson")
+    )
+    return PointData(_drop_closing(pts), bool(geographic), str(path), ps)
 
 
-def _from_core(res, path: Path) -> PointData:
-    geo_flag = None
-    for attr in ("lonlat", "geographic", "is_geographic"):
-        if hasattr(res, attr):
-            geo_flag = bool(getattr(res, attr))
-    crs = str(getattr(res, "crs", "") or "")
-    if geo_flag is None and crs:
-        geo_flag = crs.upper() in ("EPSG:4326", "WGS84", "OGC:CRS84")
-    if hasattr(res, "polylines"):
-        pl = res.polylines[0]
-        pts = np.asarray(getattr(pl, "points", pl), float)
+def to_local(pd: PointData, frame=None) -> tuple[np.ndarray, object]:
+    """Project lon/lat points to local metric coordinates.
+
+    With ``frame`` (a :class:`meshcore.crs.Frame` already used by the project)
+    the points go to that CRS and origin; otherwise to the UTM zone of their
+    centroid with a round local origin (:func:`meshcore.crs.project`).
+    Returns ``(points, frame)``.
+    """
+    from meshcore import crs as mcrs
+    from meshcore.io import PointSet, Polyline
+
+    ps = pd.pointset
+    if ps is None:
+        ps = PointSet((Polyline("points", pd.points, closed=True),), mcrs.LONLAT, pd.path)
+    src = mcrs.LONLAT if pd.lonlat and ps.crs is None else None
+    if frame is not None and frame.crs:
+        local, fr = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)
     else:
-        pts = np.asarray(getattr(res, "points", res), float)
-    pts = pts[:, :2]
-    if geo_flag is None:
-        geo_flag = path.suffix.lower() in (".kml", ".kmz", ".geojson") or _header_is_lonlat(path)
-        if _header_is_latlon(path):
-            pts = pts[:, ::-1].copy()
-    return PointData(_drop_closing(pts), bool(geo_flag), str(path))
-
-
-def _first_line(path: Path) -> list[str]:
-    try:
-        with path.open(encoding="utf-8-sig") as fh:
-            line = fh.readline()
-    except (OSError, UnicodeDecodeError):
-        return []
-    return [p.lower() for p in re.split(r"[,;\s]+", line.strip()) if p]
-
-
-def _header_is_lonlat(path: Path) -> bool:
-    h = _first_line(path)
-    return (bool(h) and h[0] in ("lon", "long", "longitude", "lng")) or _header_is_latlon(path)
-
-
-def _header_is_latlon(path: Path) -> bool:
-    h = _first_line(path)
-    return h[:2] in (["lat", "lon"], ["latitude", "longitude"], ["lat", "lng"])
-
-
-def _read_points_builtin(path: Path) -> PointData:
-    suf = path.suffix.lower()
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise ReadError(f"{path}: cannot read ({exc.strerror})") from None
-    if suf == ".kml":
-        m = re.search(r"<coordinates>(.*?)</coordinates>", text, re.S)
-        if not m:
-            raise ReadError(f"{path}: no <coordinates> element found")
-        pts = np.array([[float(v) for v in tok.split(",")[:2]] for tok in m.group(1).split()])
-        return PointData(_drop_closing(pts), True, str(path))
-    if suf in (".geojson", ".json"):
-        try:
-            obj = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ReadError(f"{path}: line {exc.lineno}: invalid JSON ({exc.msg})") from None
-        geom = obj
-        if obj.get("type") == "FeatureCollection":
-            geom = obj["features"][0]
-        if geom.get("type") == "Feature":
-            geom = geom["geometry"]
-        coords = geom["coordinates"]
-        if geom["type"] == "Polygon":
-            coords = coords[0]
-        elif geom["type"] == "MultiPolygon":
-            coords = coords[0][0]
-        pts = np.asarray(coords, float)[:, :2]
-        return PointData(_drop_closing(pts), True, str(path))
-    # delimited text: x,y or lon,lat with an optional header
-    rows = []
-    header = None
-    for lineno, line in enumerate(text.splitlines(), 1):
-        s = line.strip()
-        if not s or s.startswith("#"):
-            continue
-        parts = [p for p in re.split(r"[,;\s]+", s) if p]
-        try:
-            rows.append([float(parts[0]), float(parts[1])])
-        except (ValueError, IndexError):
-            if not rows and header is None:
-                header = [p.lower() for p in parts]
-                continue
-            raise ReadError(f"{path}: line {lineno}: expected two numbers, got {s!r}") from None
-    if len(rows) < 3:
-        raise ReadError(f"{path}: needs at least 3 points, found {len(rows)}")
-    pts = np.array(rows)
-    if header and header[:2] in (["lat", "lon"], ["latitude", "longitude"]):
-        pts = pts[:, ::-1].copy()
-        lonlat = True
-    else:
-        lonlat = bool(header and header[0] in ("lon", "long", "longitude", "lng"))
-    return PointData(_drop_closing(pts), lonlat, str(path))
-
-
-def _looks_lonlat(p: np.ndarray) -> bool:
-    return bool(len(p) and np.all(np.abs(p[:, 0]) <= 180) and np.all(np.abs(p[:, 1]) <= 90))
+        local, fr = mcrs.project(ps, "auto", source_crs=src)
+    return _drop_closing(np.asarray(local.polylines[0].points, float)), fr
 
 
 def _drop_closing(p: np.ndarray) -> np.ndarray:
@@ -176,21 +86,13 @@ def _drop_closing(p: np.ndarray) -> np.ndarray:
     return p
 
 
-def utm_epsg(lon: float, lat: float) -> int:
-    """EPSG code of the WGS84 UTM zone containing (lon, lat)."""
-    zone = math.floor((lon + 180.0) / 6.0) % 60 + 1
-    return (32600 if lat >= 0 else 32700) + zone
+def project_frame(project: Project):
+    """The :class:`meshcore.crs.Frame` of a project (None when it has no CRS)."""
+    if not project.crs:
+        return None
+    from meshcore.crs import Frame
 
-
-def project_lonlat(points: np.ndarray, epsg: int | None = None) -> tuple[np.ndarray, str]:
-    """Project lon/lat degrees to metres (UTM of the centroid by default)."""
-    from pyproj import Transformer
-
-    lon0, lat0 = np.mean(points, axis=0)
-    code = epsg or utm_epsg(float(lon0), float(lat0))
-    tr = Transformer.from_crs("EPSG:4326", f"EPSG:{code}", always_xy=True)
-    x, y = tr.transform(points[:, 0], points[:, 1])
-    return np.column_stack([x, y]), f"EPSG:{code}"
+    return Frame(project.crs, tuple(project.origin), project.source_crs or None)
 
 
 # ------------------------------------------------------------------ project
@@ -247,11 +149,15 @@ def block_to_case(b: Block):
 def project_from_case(case) -> Project:
     s = case.solver
     solver = SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega)
+    frame = dict(case.extra).get("crs") or {}
+    origin = frame.get("origin", (0.0, 0.0))
     return Project(
         blocks=tuple(block_from_case(b) for b in case.blocks),
         solver=solver,
         title=case.title,
-        crs=str(dict(case.extra).get("crs", "")),
+        crs=str(frame.get("crs", "") or ""),
+        origin=(float(origin[0]), float(origin[1])),
+        source_crs=str(frame.get("source_crs", "") or ""),
     )
 
 
@@ -265,7 +171,11 @@ def project_to_case(project: Project):
         raise ValueError("nothing to save yet: no block has a closed boundary with four corners")
     s = project.solver
     solver = EllipticConfig(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega)
-    return Case(blocks=blocks, title=project.title, solver=solver)
+    extra = {}
+    frame = project_frame(project)
+    if frame is not None:
+        extra["crs"] = frame.as_dict()
+    return Case(blocks=blocks, title=project.title, solver=solver, extra=extra)
 
 
 def load_project(path) -> Project:
@@ -284,53 +194,18 @@ def save_project(project: Project, path) -> None:
 
 # --------------------------------------------------------------------- mesh
 def mesh_formats() -> list[tuple[str, str]]:
-    """``(description, pattern)`` pairs for the export dialog."""
-    mio = _core_io()
-    suffixes = getattr(mio, "_SUFFIX", None) if mio is not None else None
-    if not isinstance(suffixes, dict) or not suffixes:
-        return [("VTK structured grid", "*.vts"), ("CSV nodes i,j,x,y", "*.csv")]
-    by_fmt: dict[str, list[str]] = {}
-    for suf, fmt in suffixes.items():
-        by_fmt.setdefault(fmt, []).append(f"*{suf}")
-    return [(fmt, " ".join(pats)) for fmt, pats in by_fmt.items()]
+    """``(description, pattern)`` pairs of every format meshcore writes (export dialog)."""
+    from meshcore.io import FORMATS
+
+    out = []
+    for f in FORMATS.values():
+        if f.writer:
+            out.append((f"{f.description} [{f.name}]", " ".join(f"*{x}" for x in f.suffixes)))
+    return out
 
 
-def write_mesh(path, grids: list[StructuredGrid]) -> None:
-    """Write the grid(s) with meshcore.io.write, or the built-in .vts/.csv writers."""
-    path = Path(path)
-    mio = _core_io()
-    if mio is not None and hasattr(mio, "write"):
-        mio.write(path, grids[0] if len(grids) == 1 else grids)
-        return
-    g = grids[0]
-    suf = path.suffix.lower()
-    try:
-        if suf == ".vts":
-            _write_vts(path, g)
-        elif suf == ".csv":
-            with path.open("w", newline="") as fh:
-                w = csv.writer(fh)
-                w.writerow(["i", "j", "x", "y"])
-                ni1, nj1 = g.shape
-                for j in range(nj1):
-                    for i in range(ni1):
-                        w.writerow([i, j, repr(float(g.x[i, j])), repr(float(g.y[i, j]))])
-        else:
-            raise WriteError(f"{path}: unknown mesh format {suf!r} (use .vts or .csv)")
-    except OSError as exc:
-        raise WriteError(f"{path}: cannot write ({exc.strerror})") from None
+def write_mesh(path, grids: list[StructuredGrid], frame=None) -> None:
+    """Write the block grid(s) with :func:`meshcore.io.write` (format from the suffix)."""
+    from meshcore.io import write
 
-
-def _write_vts(path: Path, g: StructuredGrid) -> None:
-    ni1, nj1 = g.shape
-    pts = np.column_stack([g.x.T.ravel(), g.y.T.ravel(), np.zeros(ni1 * nj1)])  # i fastest
-    body = "\n".join(" ".join(repr(float(v)) for v in row) for row in pts)
-    ext = f"0 {ni1 - 1} 0 {nj1 - 1} 0 0"
-    path.write_text(
-        '<?xml version="1.0"?>\n'
-        '<VTKFile type="StructuredGrid" version="1.0" byte_order="LittleEndian">\n'
-        f'  <StructuredGrid WholeExtent="{ext}">\n    <Piece Extent="{ext}">\n'
-        '      <Points>\n        <DataArray type="Float64" NumberOfComponents="3" format="ascii">\n'
-        f"{body}\n        </DataArray>\n      </Points>\n    </Piece>\n  </StructuredGrid>\n</VTKFile>\n",
-        encoding="utf-8",
-    )
+    write(Path(path), grids[0] if len(grids) == 1 else list(grids), crs=frame)

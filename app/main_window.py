@@ -268,7 +268,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.doc.grids_changed.connect(self._on_grids)
         self.doc.project_changed.connect(self._on_project)
         self.doc.active_changed.connect(lambda _k: self._on_final())
-        self.canvas.hovered.connect(lambda x, y: self._coords.setText(f"x = {x:.6g}   y = {y:.6g}"))
+        self.canvas.hovered.connect(self._show_coords)
         self.blocks_panel.border_selected.connect(self.params_panel.select_border)
         self.quality_panel.colour_requested.connect(self._colour)
         self.quality_panel.zoom_to_cell.connect(self.zoom_to_cell)
@@ -276,6 +276,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.solver.progress.connect(self._on_progress)
         self.solver.finished.connect(lambda _r: self._on_final())
         self.stack.cleanChanged.connect(self._update_title)
+
+    def _show_coords(self, x: float, y: float) -> None:
+        p = self.doc.project
+        text = f"x = {x:.6g}   y = {y:.6g}"
+        if p.crs:
+            text += f"   ({p.crs}: E {x + p.origin[0]:.1f}  N {y + p.origin[1]:.1f})"
+        self._coords.setText(text)
 
     # -------------------------------------------------------------- tools
     def set_tool(self, key: str) -> None:
@@ -537,22 +544,24 @@ class MainWindow(QtWidgets.QMainWindow):
             self.error("Cannot import points", exc)
             return False
         pts = pd.points
-        crs = self.doc.project.crs
+        p = self.doc.project
+        frame = fio.project_frame(p)
         if pd.lonlat:
             if project_lonlat is None and not getattr(self, "quiet", False):
-                code = fio.utm_epsg(*np.mean(pts, axis=0))
+                target = frame.crs if frame is not None else "the UTM zone of the outline"
                 r = QtWidgets.QMessageBox.question(
                     self,
                     "Geographic coordinates",
                     f"{path.name} holds longitude/latitude degrees.\n\nProject them to metres "
-                    f"(UTM, EPSG:{code})? Grids in degrees are distorted.",
+                    f"({target}, relative to a round local origin)? Grids in degrees are distorted.",
                 )
                 project_lonlat = r == QtWidgets.QMessageBox.StandardButton.Yes
             if project_lonlat is None or project_lonlat:
                 try:
-                    pts, crs = fio.project_lonlat(pts)
-                except Exception as exc:  # pyproj missing or failing: keep degrees
+                    pts, frame = fio.to_local(pd, frame)
+                except (MeshcoreError, ValueError) as exc:
                     self.error("Cannot project coordinates", exc)
+                    return False
         if len(pts) < 4:
             self.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
@@ -575,14 +584,16 @@ class MainWindow(QtWidgets.QMainWindow):
         else:
             after = p.replaced(blocks=(*p.blocks, block))
             k = len(after.blocks) - 1
-        self.editor.replace_project(after.replaced(crs=crs), f"Import {path.name}")
+        if frame is not None and frame.crs:
+            after = after.replaced(crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "")
+        self.editor.replace_project(after, f"Import {path.name}")
         self.doc.set_active(k)
         self.canvas.fit()
         self.set_tool("edit")
         self._remember_dir(path)
         self.message(
             f"Imported {len(pts)} points from {path.name}"
-            f"{' (projected to ' + crs + ')' if crs and pd.lonlat else ''}; corners chosen "
+            f"{' (projected to ' + frame.crs + ')' if frame is not None and pd.lonlat else ''}; corners chosen "
             f"automatically — adjust with the Corners tool, then F5"
         )
         return True
@@ -604,7 +615,7 @@ class MainWindow(QtWidgets.QMainWindow):
     def export_mesh(self, path: Path) -> bool:
         grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
         try:
-            fio.write_mesh(path, grids)
+            fio.write_mesh(path, grids, fio.project_frame(self.doc.project))
         except (MeshcoreError, OSError) as exc:
             self.error("Cannot export mesh", exc)
             return False

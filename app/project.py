@@ -192,7 +192,9 @@ class Project:
     solver: SolverSettings = SolverSettings()
     cut_lines: tuple[np.ndarray, ...] = ()
     background: Background | None = None
-    crs: str = ""  # e.g. "EPSG:32632" when points were projected from lon/lat
+    crs: str = ""  # metric CRS of the world coordinates, e.g. "EPSG:32632"
+    origin: tuple[float, float] = (0.0, 0.0)  # local origin: world = local + origin
+    source_crs: str = ""  # CRS the points were read in ("EPSG:4326" for lon/lat)
     title: str = ""
 
     def __post_init__(self) -> None:

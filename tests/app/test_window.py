@@ -170,7 +170,9 @@ def test_import_kml_projects_to_utm(qtbot, win):
     assert b.closed and b.ready and len(b.points) == 40
     tr = Transformer.from_crs("EPSG:4326", "EPSG:32632", always_xy=True)
     x, y = tr.transform(11.854996, 42.585556)  # the file's first vertex
-    np.testing.assert_allclose(b.points[0], (x, y), atol=1e-6)
+    origin = np.array(win.doc.project.origin)
+    assert np.all(np.abs(b.points) < 2e4)  # local coordinates: UTM minus a round origin
+    np.testing.assert_allclose(b.points[0] + origin, (x, y), rtol=0, atol=1e-6)
     win.stack.undo()
     assert len(win.doc.block.points) == 0
 
@@ -327,3 +329,26 @@ def test_export_figure(qtbot, win, tmp_path, suffix):
         import xml.etree.ElementTree as ET
 
         assert ET.parse(out).getroot().tag.endswith("svg")
+
+
+def test_lake_keeps_its_frame_through_save_and_export(qtbot, win, tmp_path):
+    from meshcore.io import read_blocks
+
+    win.open_example("windermere", confirm=False)
+    p = win.doc.project
+    assert p.crs == "EPSG:32630" and p.source_crs == "EPSG:4326" and p.origin != (0.0, 0.0)
+    win.generate()
+    wait_idle(qtbot, win)
+    case = tmp_path / "lake.toml"
+    assert win._save_to(case)
+    assert win.open_path(case)
+    q = win.doc.project
+    assert (q.crs, q.origin) == (p.crs, p.origin) and q.blocks == p.blocks
+    win.generate()
+    wait_idle(qtbot, win)
+    out = tmp_path / "lake.vts"
+    assert win.export_mesh(out)
+    gs = read_blocks(out)
+    assert gs.frame.crs == p.crs
+    g = win.doc.grid
+    np.testing.assert_allclose(gs.blocks[0].x + gs.frame.origin[0], g.x + p.origin[0], rtol=0, atol=1e-6)
