@@ -38,7 +38,7 @@ def example_names() -> list[str]:
     return [*_case_files(), *[k for k, (f, _t) in LAKES.items() if (_HERE / "resources" / f).exists()]]
 
 
-def lake_project(csv_path: Path, title: str = "", cells: int = 64) -> Project:
+def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
     """A lake: projected shoreline, auto corners, cells by shape."""
     pd = read_points(csv_path)
     if pd.lonlat:

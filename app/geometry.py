@@ -112,7 +112,7 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         # long, narrow and curved (a lake, a river): cap both tips instead of box corners
         c = _elongated_corners(p, u)
         if c is not None:
-            return c
+            return _upright(p, c)
     box = [(u.min(), s.min()), (u.max(), s.min()), (u.max(), s.max()), (u.min(), s.max())]
     # scale-free distance: normalise by the box extents
     su = max(u.max() - u.min(), 1e-300)
@@ -130,7 +130,22 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         # fall back: keep the SW corner and take the other three in loop order
         others = sorted(chosen[1:], key=lambda k: ((k if ccw else (n - k) % n) - order[0]) % n)
         chosen = [chosen[0], *others]
-    return tuple(chosen)  # type: ignore[return-value]
+    return _upright(p, tuple(chosen))
+
+
+def _upright(p: np.ndarray, c) -> tuple[int, int, int, int]:
+    """Rotate the corner roles (a cyclic shift) so that SW→SE points most nearly along +x.
+
+    The same four corners give the same grid up to a renaming of the borders;
+    this keeps "bottom" at the bottom of the screen, as a user expects.
+    """
+    best, best_cos = 0, -2.0
+    for k in range(4):
+        d = p[c[(k + 1) % 4]] - p[c[k]]
+        cos = float(d[0] / max(math.hypot(*d), 1e-300))
+        if cos > best_cos + 1e-12:
+            best, best_cos = k, cos
+    return tuple(int(c[(best + j) % 4]) for j in range(4))  # type: ignore[return-value]
 
 
 def _elongated_corners(p: np.ndarray, u: np.ndarray) -> tuple[int, int, int, int] | None:

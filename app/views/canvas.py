@@ -151,10 +151,10 @@ class Canvas(pg.PlotWidget):
         self.corner_item.setZValue(22)
         self.addItem(self.corner_item)
         self.corner_labels = []
-        for lab in CORNER_LABELS:
-            t = pg.TextItem(lab, color="#000", anchor=(-0.2, 1.2))
+        for _name in CORNER_LABELS:
+            # never hidden (a TextItem shown again only repaints after a view change): empty text instead
+            t = pg.TextItem("", color="#000", anchor=(-0.2, 1.2))
             t.setZValue(23)
-            t.hide()
             self.addItem(t)
             self.corner_labels.append(t)
 
@@ -294,13 +294,13 @@ class Canvas(pg.PlotWidget):
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
             cp = pts[list(block.corners)]
             self.corner_item.setData(cp[:, 0], cp[:, 1])
-            for lab, p in zip(self.corner_labels, cp, strict=True):
+            for lab, name, p in zip(self.corner_labels, CORNER_LABELS, cp, strict=True):
                 lab.setPos(float(p[0]), float(p[1]))
-                lab.show()
+                lab.setText(name)
         else:
             self.corner_item.setData([], [])
             for lab in self.corner_labels:
-                lab.hide()
+                lab.setText("")
         cuts = []
         for c in doc.project.cut_lines:
             cuts += [c, np.full((1, 2), np.nan)]

@@ -217,3 +217,16 @@ def test_auto_corners_cap_the_tips_of_a_curved_channel():
     assert sorted(np.sign(ends[:, 0])) == [-1, -1, 1, 1]
     b = borders_from_loop(loop, c)
     assert len(b.left) < 6 and len(b.right) < 6  # the short ends are left/right
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.3, 1.2, 2.0, -2.5])
+def test_auto_corners_keep_bottom_at_the_bottom(angle):
+    """Whatever the principal axes, SW→SE is the corner pair whose direction is closest to +x."""
+    b = square_block(4)
+    pts = np.array(b.points) * [2.0, 1.0]
+    rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    pts = pts @ rot.T
+    sw, se, ne, nw = geo.auto_corners(pts)
+    d = [pts[c1] - pts[c0] for c0, c1 in ((sw, se), (se, ne), (ne, nw), (nw, sw))]
+    cos = [v[0] / np.hypot(*v) for v in d]
+    assert cos[0] == max(cos)

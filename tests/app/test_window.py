@@ -352,3 +352,43 @@ def test_lake_keeps_its_frame_through_save_and_export(qtbot, win, tmp_path):
     assert gs.frame.crs == p.crs
     g = win.doc.grid
     np.testing.assert_allclose(gs.blocks[0].x + gs.frame.origin[0], g.x + p.origin[0], rtol=0, atol=1e-6)
+
+
+def test_drop_a_point_file_on_the_window(qtbot, win):
+    from PySide6 import QtGui
+
+    mime = QtCore.QMimeData()
+    mime.setUrls([QtCore.QUrl.fromLocalFile(str(DATA / "lake_bolsena_sparse.kml"))])
+    pos = QtCore.QPointF(200, 200)
+    ev = QtGui.QDropEvent(
+        pos,
+        QtCore.Qt.DropAction.CopyAction,
+        mime,
+        QtCore.Qt.MouseButton.NoButton,
+        QtCore.Qt.KeyboardModifier.NoModifier,
+    )
+    win.dropEvent(ev)
+    assert len(win.doc.block.points) == 40 and win.doc.project.crs == "EPSG:32632"
+
+
+def test_background_image_calibrated_by_two_points(qtbot, win, tmp_path):
+    from PySide6 import QtGui
+
+    img = QtGui.QImage(40, 20, QtGui.QImage.Format.Format_RGB32)
+    img.fill(QtGui.QColor("steelblue"))
+    path = tmp_path / "bg.png"
+    assert img.save(str(path))
+    win.load_background(str(path))
+    bg = win.doc.project.background
+    assert bg is not None and win.canvas.background_item.isVisible()
+    # pixel (u, v) = (0, 0) and (40, 0) currently shown at these model points ...
+    a, b, tx, ty = bg.transform
+    shown = [(tx, ty), (a * 40 + tx, b * 40 + ty)]
+    # ... are really at (100, 50) and (100, 130): a 90° turn, scale 2
+    win.calibrate_background(shown, [(100.0, 50.0), (100.0, 130.0)])
+    a, b, tx, ty = win.doc.project.background.transform
+    m, t = complex(a, b), complex(tx, ty)
+    assert m * 0 + t == pytest.approx(complex(100, 50))
+    assert m * 40 + t == pytest.approx(complex(100, 130))
+    win.stack.undo()
+    assert win.doc.project.background == bg
