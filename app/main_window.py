@@ -265,6 +265,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _connect(self) -> None:
         self.doc.message.connect(self.message)
+        self.solver.error.connect(self._on_solver_error)
         self.doc.grids_changed.connect(self._on_grids)
         self.doc.project_changed.connect(self._on_project)
         self.doc.active_changed.connect(lambda _k: self._on_final())
@@ -300,13 +301,14 @@ class MainWindow(QtWidgets.QMainWindow):
             return
         super().keyPressEvent(ev)
 
-    def message(self, text: str, timeout_ms: int = 0) -> None:
+    def message(self, text: str, *, error: bool = False) -> None:
         self._status.setText(text)
         self._status.setToolTip(text)
+        self._status.setStyleSheet("color: #b00000; font-weight: bold;" if error else "")
 
     def error(self, title: str, exc: BaseException | str) -> None:
         text = str(exc)
-        self.message(f"{title}: {text}")
+        self.message(f"{title}: {text}", error=True)
         if not getattr(self, "quiet", False):
             QtWidgets.QMessageBox.warning(self, title, text)
 
@@ -382,10 +384,20 @@ class MainWindow(QtWidgets.QMainWindow):
         if state == "paused":
             self._solver_label.setText("paused")
 
+    def _on_solver_error(self, text: str) -> None:
+        # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why
+        self.canvas.set_grid_stale(True)
+        self.canvas.set_quality(None, None)
+        self.message(f"Cannot generate: {text}", error=True)
+        self._solver_label.setText("error")
+
     def _on_final(self) -> None:
         g = self.doc.grid
         if self.solver.running:
             return
+        if self.solver.last_error:
+            return
+        self.canvas.set_grid_stale(False)
         self.quality_panel.update_grid(g)
         if g is None:
             self._solver_label.setText("idle")

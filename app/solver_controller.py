@@ -63,6 +63,7 @@ class SolverController(QtCore.QObject):
         self.t_start = 0.0
         self.t_done = 0.0
         self.last_result = None
+        self.last_error: str | None = None
         self.gui_thread = QtCore.QThread.currentThread()
         self.thread_violations = 0  # slots found running outside the GUI thread (tests)
         # leading-edge throttle: draw a snapshot at once unless the last frame was
@@ -101,6 +102,7 @@ class SolverController(QtCore.QObject):
             return False
         self._abandon()
         self._run += 1
+        self.last_error = None
         warm = {}
         for k, g in self.doc.grids.items():
             a = self.doc.initial.get(k)
@@ -218,10 +220,10 @@ class SolverController(QtCore.QObject):
         self._timer.stop()
         self._worker = None
         self.t_done = time.perf_counter()
+        self.last_error = err
         if err is not None:
             self._dirty = False
             self.error.emit(err)
-            self.doc.message.emit(err)
             self._set_state("idle")
             self.finished.emit(None)
             return
@@ -252,7 +254,7 @@ class SolverController(QtCore.QObject):
         self._timer.stop()
         self._worker = None
         msg = f"solver failed: {exc}"
+        self.last_error = msg
         self.error.emit(msg)
-        self.doc.message.emit(msg)
         self._set_state("idle")
         self.finished.emit(None)

@@ -337,6 +337,11 @@ class Canvas(pg.PlotWidget):
         Y = np.concatenate(ys) if len(ys) > 1 else ys[0]
         self.grid_curve.setData(X, Y, connect="finite", skipFiniteCheck=True)
 
+    def set_grid_stale(self, stale: bool) -> None:
+        """Grey the grid when it no longer matches the boundary (the last solve failed)."""
+        col = "#b0b0b0" if stale else "#303030"
+        self.grid_curve.setPen(pg.mkPen(col, width=1, cosmetic=True))
+
     def set_folded(self, grid: StructuredGrid | None, cells: np.ndarray | None) -> None:
         if grid is None or cells is None or len(cells) == 0:
             self.folded_item.setData([], [])

@@ -392,3 +392,47 @@ def test_background_image_calibrated_by_two_points(qtbot, win, tmp_path):
     assert m * 40 + t == pytest.approx(complex(100, 130))
     win.stack.undo()
     assert win.doc.project.background == bg
+
+
+def test_box_select_and_snapping(qtbot, win):
+    sq = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (0.0, 1.0)]
+    for xy in sq:
+        win.editor.add_point(xy)
+    win.editor.close_loop()
+    win.canvas.zoom_to((0, 0, 2, 1))
+    qtbot.wait(20)
+    win.set_tool("edit")
+    tool = win.canvas.tool
+    # a drag on empty space selects the points inside the box
+    tool.drag("start", (0.5, -0.5), (0.5, -0.5))
+    tool.drag("finish", (2.5, 0.5), (0.5, -0.5))
+    assert win.doc.selection == {1, 2}
+    # dragging one selected point moves the whole selection by the same amount
+    tool.drag("start", (1.0, 0.0), (1.0, 0.0))
+    tool.drag("finish", (1.0, -0.25), (1.0, 0.0))
+    np.testing.assert_allclose(win.doc.block.points[[1, 2]], [[1.0, -0.25], [2.0, -0.25]])
+    # Shift snaps the dragged point onto a nearby point
+    win.doc.set_selection(())
+    tol = win.canvas.tolerance()
+    tool.drag("start", (1.0, 1.0), (1.0, 1.0))
+    tool.drag("finish", (2.0 - tol / 3, 1.0 + tol / 3), (1.0, 1.0), QtCore.Qt.KeyboardModifier.ShiftModifier)
+    assert tuple(win.doc.block.points[4]) == (2.0, 1.0)
+
+
+def test_failed_solve_greys_the_old_grid(qtbot, win):
+    win.open_example("bottle-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    assert win.doc.grid is not None
+    k = 3
+    p = win.doc.block.points
+    far = (float(p[:, 0].max() + 5), float(p[:, 1].mean()))  # drag a left point across the domain
+    win.editor.set_points([len(p) - k], [far])
+    win.generate()
+    wait_idle(qtbot, win)
+    assert "Cannot generate" in win._status.text()
+    assert win.canvas.grid_curve.opts["pen"].color().name() == "#b0b0b0"
+    win.stack.undo()
+    win.generate()
+    wait_idle(qtbot, win)
+    assert win.canvas.grid_curve.opts["pen"].color().name() == "#303030"
