@@ -33,10 +33,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     t0 = time.perf_counter()
-    # compile/load the numba kernels while Qt starts (warm cache: well under a second)
-    import meshcore.elliptic as elliptic
+    # load the numba kernels (warm cache: well under a second) and shapely while Qt starts
+    from .pipeline import warmup
 
-    threading.Thread(target=elliptic.warmup, name="numba-warmup", daemon=True).start()
+    threading.Thread(target=warmup, name="gcmesh-warmup", daemon=True).start()
 
     import pyqtgraph as pg
     from PySide6 import QtCore, QtWidgets

@@ -23,7 +23,7 @@ from meshcore import StructuredGrid, initial_grid, iterate, prepare_borders
 
 from .project import Block, Project
 
-__all__ = ["BlockResult", "block_borders", "block_initial_grid", "solve_project"]
+__all__ = ["BlockResult", "block_borders", "block_initial_grid", "solve_project", "warmup"]
 
 
 def block_borders(block: Block):
@@ -125,3 +125,22 @@ def folded_cells(grid: StructuredGrid) -> np.ndarray:
         (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1]) - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
     )
     return np.argwhere(area <= 0)
+
+
+def warmup() -> None:
+    """Load the numba kernels and shapely and run the whole pipeline once on a tiny square.
+
+    Run in a background thread at start-up so that the first real solve (and
+    the first drag with auto-generate) pays no one-time costs.
+    """
+    from meshcore import elliptic
+
+    elliptic.warmup()
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.5]])
+    project = Project(blocks=(Block(points=sq, closed=True, corners=(0, 1, 2, 3), cells=(4, 4)),))
+    gen = solve_project(project)
+    try:
+        while True:
+            next(gen)
+    except StopIteration:
+        pass

@@ -64,6 +64,7 @@ class SolverController(QtCore.QObject):
         self.t_done = 0.0
         self.last_result = None
         self.last_error: str | None = None
+        self._restart_pending = False
         self.gui_thread = QtCore.QThread.currentThread()
         self.thread_violations = 0  # slots found running outside the GUI thread (tests)
         # leading-edge throttle: draw a snapshot at once unless the last frame was
@@ -98,9 +99,16 @@ class SolverController(QtCore.QObject):
         self._debounce.stop()
         project = self.doc.project
         if not any(b.ready for b in project.blocks):
+            self.stop()
             self.doc.clear_grids()
             return False
-        self._abandon()
+        if self._worker is not None:
+            # chain: stop the running solve (within one sweep) and restart from its
+            # latest iterate when it returns, so that a drag's corrections accumulate
+            self._restart_pending = True
+            self._interrupt()
+            return True
+        self._restart_pending = False
         self._run += 1
         self.last_error = None
         warm = {}
@@ -124,6 +132,10 @@ class SolverController(QtCore.QObject):
 
     def stop(self) -> None:
         """Ask the solver to stop; it returns the current grid at the next sweep."""
+        self._restart_pending = False
+        self._interrupt()
+
+    def _interrupt(self) -> None:
         if self._stop_event is not None:
             self._stop_event.set()
         # no worker.quit(): an aborted superqt worker never emits `returned`; the
@@ -220,6 +232,16 @@ class SolverController(QtCore.QObject):
         self._timer.stop()
         self._worker = None
         self.t_done = time.perf_counter()
+        if self._restart_pending:
+            # an edit arrived while solving: keep this iterate as the warm start, go again
+            if result is not None:
+                for k, g in result.grids.items():
+                    if k in result.initial:
+                        self.doc.grids[k] = g
+                        self.doc.initial[k] = result.initial[k]
+                self.doc.grids_changed.emit()
+            self.start()
+            return
         self.last_error = err
         if err is not None:
             self._dirty = False
