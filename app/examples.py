@@ -47,8 +47,7 @@ def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
     else:
         pts, crs, origin, src = pd.points, "", (0.0, 0.0), ""
     corners = geo.auto_corners(pts)
-    ni, nj = default_cells(pts, corners, total=cells)
-    ni, nj = max(ni, 12), max(nj, 12)  # long, narrow lakes still get a dozen cells across
+    ni, nj = default_cells(pts, corners, total=cells, minimum=12)  # a dozen cells across narrow lakes
     block = Block(name=csv_path.stem, points=pts, closed=True, corners=corners, cells=(ni, nj))
     return Project(blocks=(block,), crs=crs, origin=origin, source_crs=src, title=title)
 

@@ -587,7 +587,7 @@ class MainWindow(QtWidgets.QMainWindow):
             points=pts,
             closed=True,
             corners=corners,
-            cells=default_cells(pts, corners, total=40) if corners else (32, 16),
+            cells=default_cells(pts, corners, total=40, minimum=8) if corners else (32, 16),
         )
         empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
         if empty:

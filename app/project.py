@@ -328,8 +328,13 @@ def next_block_name(project: Project) -> str:
     return f"block{k}"
 
 
-def default_cells(points: np.ndarray, corners: tuple[int, int, int, int], total: int = 40) -> tuple[int, int]:
-    """Cell counts proportional to the mean lengths of opposite borders (≈ ``total`` along the longer)."""
+def default_cells(
+    points: np.ndarray, corners: tuple[int, int, int, int], total: int = 40, minimum: int = 2
+) -> tuple[int, int]:
+    """Cell counts proportional to the mean lengths of opposite borders.
+
+    About ``total`` cells along the longer direction, at least ``minimum`` along either.
+    """
     n = len(points)
 
     def arc(a: int, b: int) -> float:
@@ -343,5 +348,5 @@ def default_cells(points: np.ndarray, corners: tuple[int, int, int, int], total:
     if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
         return (total, total)
     if lxi >= leta:
-        return (total, max(2, round(total * leta / lxi)))
-    return (max(2, round(total * lxi / leta)), total)
+        return (total, max(minimum, round(total * leta / lxi)))
+    return (max(minimum, round(total * lxi / leta)), total)
