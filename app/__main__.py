@@ -49,6 +49,14 @@ def main(argv: list[str] | None = None) -> int:
     from .main_window import MainWindow
 
     win = MainWindow()
+
+    def excepthook(kind, value, tb):  # a bug in a slot must not leave the user guessing
+        import traceback
+
+        traceback.print_exception(kind, value, tb)
+        win.message(f"internal error: {kind.__name__}: {value}", error=True)
+
+    sys.excepthook = excepthook
     w, h = (int(v) for v in args.size.lower().split("x"))
     win.resize(w, h)
     if args.screenshot:

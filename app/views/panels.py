@@ -362,6 +362,7 @@ class QualityPanel(QtWidgets.QWidget):
         )
         self.hist.addItem(self.hist_curve)
         lay.addWidget(self.hist, 2)
+        self.hist.hide()
         lay.addWidget(QtWidgets.QLabel("Folded / non-convex cells (click to zoom):"))
         self.folded = QtWidgets.QListWidget()
         self.folded.setMaximumHeight(110)
@@ -376,11 +377,13 @@ class QualityPanel(QtWidgets.QWidget):
             self.report = None
             self.table.setRowCount(0)
             self.hist_curve.setData([0, 1], [0])
+            self.hist.hide()
             self.folded.clear()
             self.colour_requested.emit(None, None, "")
             return
         r = quality(grid)
         self.report = r
+        self.hist.show()
         rows = [
             ("cells (ξ × η)", f"{r.cells[0]} × {r.cells[1]}"),
             ("folded cells", f"{r.n_folded}"),
