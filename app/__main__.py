@@ -24,7 +24,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--screenshot", metavar="OUT.png", help="render (off screen if there is no display), save a screenshot and exit"
     )
-    p.add_argument("--size", default="1400x880", help="window size WxH (default 1400x880)")
+    p.add_argument("--size", default=None, help="window size WxH (default: last session, or 1400x880)")
     return p
 
 
@@ -57,8 +57,9 @@ def main(argv: list[str] | None = None) -> int:
         win.message(f"internal error: {kind.__name__}: {value}", error=True)
 
     sys.excepthook = excepthook
-    w, h = (int(v) for v in args.size.lower().split("x"))
-    win.resize(w, h)
+    if args.size or args.screenshot:
+        w, h = (int(v) for v in (args.size or "1400x880").lower().split("x"))
+        win.resize(w, h)
     if args.screenshot:
         win.quiet = True
     win.show()

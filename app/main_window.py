@@ -95,6 +95,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._autosave.start()
         self.set_tool("draw")
         self._update_title()
+        self._restore_layout()
         self.canvas.fit()
         self.message(
             "Draw a boundary (click points, double-click to close), import points (Ctrl+I) "
@@ -784,9 +785,20 @@ class MainWindow(QtWidgets.QMainWindow):
         with contextlib.suppress(OSError):
             self.recovery_path.unlink(missing_ok=True)
         self.settings.setValue("geometry", self.saveGeometry())
+        self.settings.setValue("window_state", self.saveState())
         ev.accept()
 
     # ----------------------------------------------------------- settings
+    def _restore_layout(self) -> None:
+        """Window size and dock layout from the last session (if any)."""
+        geom = self.settings.value("geometry")
+        state = self.settings.value("window_state")
+        with contextlib.suppress(TypeError):
+            if geom is not None:
+                self.restoreGeometry(geom)
+            if state is not None:
+                self.restoreState(state)
+
     def _last_dir(self) -> str:
         return str(self.settings.value("last_dir", str(Path.home())))
 
