@@ -48,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from .main_window import MainWindow
 
-    win = MainWindow()
+    win = MainWindow(restore_layout=not args.screenshot)  # screenshots: the default layout
 
     def excepthook(kind, value, tb):  # a bug in a slot must not leave the user guessing
         import traceback

@@ -21,7 +21,7 @@ from . import geometry as geo
 from . import io_adapter as fio
 from .commands import Editor, SetBlockOptions
 from .document import Document
-from .examples import example_names, load_example
+from .examples import LAKES, example_names, load_example
 from .project import Background, Block, Project, boundary_to_loop, default_cells
 from .solver_controller import SolverController
 from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, PanTool
@@ -56,9 +56,18 @@ SHORTCUTS = [
 class MainWindow(QtWidgets.QMainWindow):
     """The gcmesh main window."""
 
-    def __init__(self, *, settings: QtCore.QSettings | None = None, recovery: Path | None = None) -> None:
+    def __init__(
+        self,
+        *,
+        settings: QtCore.QSettings | None = None,
+        recovery: Path | None = None,
+        restore_layout: bool = True,
+    ) -> None:
         super().__init__()
         self.setWindowTitle(APP_NAME)
+        icon = Path(__file__).resolve().parent.parent / "resources" / "icons" / "gcmesh.svg"
+        if icon.exists():
+            self.setWindowIcon(QtGui.QIcon(str(icon)))
         self.resize(1400, 880)
         self.setAcceptDrops(True)
         self.settings = settings or QtCore.QSettings("gcmesh", "gcmesh")
@@ -95,7 +104,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self._autosave.start()
         self.set_tool("draw")
         self._update_title()
-        self._restore_layout()
+        if restore_layout:
+            self._restore_layout()
         self.canvas.fit()
         self.message(
             "Draw a boundary (click points, double-click to close), import points (Ctrl+I) "
@@ -241,8 +251,15 @@ class MainWindow(QtWidgets.QMainWindow):
         for d in self.docks.values():
             m.addAction(d.toggleViewAction())
         m = mb.addMenu("E&xamples")
+        lakes = [n for n in example_names() if n in LAKES]
+        m.addSection("Paper cases")
         for name in example_names():
-            m.addAction(name, lambda n=name: self.open_example(n))
+            if name not in LAKES:
+                m.addAction(name, lambda n=name: self.open_example(n))
+        m.addSection("Real lakes (GSHHG, lon/lat → UTM)")
+        for name in lakes:
+            a = m.addAction(name, lambda n=name: self.open_example(n))
+            a.setToolTip(LAKES[name][1])
         m = mb.addMenu("&Help")
         m.addActions([self.a_shortcuts, self.a_about])
         self._refresh_recent()
@@ -353,6 +370,14 @@ class MainWindow(QtWidgets.QMainWindow):
     # ---------------------------------------------------------- reactions
     def _on_project(self, project: Project) -> None:
         self._update_title()
+        pi = self.canvas.getPlotItem()
+        if project.crs:
+            ox, oy = project.origin
+            pi.setLabel("bottom", f"x = E − {ox:.0f} m ({project.crs})")
+            pi.setLabel("left", f"y = N − {oy:.0f} m")
+        else:
+            pi.setLabel("bottom", "")
+            pi.setLabel("left", "")
         bg = project.background
         if bg is None:
             self.canvas.set_background(None)
