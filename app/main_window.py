@@ -138,6 +138,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tabifyDockWidget(self.docks["convergence"], self.docks["history"])
         self.docks["convergence"].raise_()
         self.resizeDocks([self.docks["blocks"], self.docks["params"]], [230, 520], QtCore.Qt.Orientation.Vertical)
+        self.resizeDocks([self.docks["quality"], self.docks["convergence"]], [560, 260], QtCore.Qt.Orientation.Vertical)
         self.resizeDocks([self.docks["blocks"], self.docks["quality"]], [300, 330], QtCore.Qt.Orientation.Horizontal)
 
     def _make_tools(self) -> None:
