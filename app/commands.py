@@ -225,6 +225,13 @@ class Editor:
         self._push(AddBlock, after, "Add block")
         self.doc.set_active(len(after.blocks) - 1)
 
+    def delete_block(self, index: int | None = None) -> None:
+        """Remove a block (the last one is replaced by an empty block)."""
+        p = self.doc.project
+        k = self.doc.active if index is None else index
+        blocks = [b for j, b in enumerate(p.blocks) if j != k] or [Block(name="block")]
+        self._push(AddBlock, p.replaced(blocks=tuple(blocks)), f"Delete block {p.blocks[k].name}")
+
     def add_cut_line(self, points) -> None:
         p = self.doc.project
         self._push(AddCutLine, p.replaced(cut_lines=(*p.cut_lines, pj.frozen_points(points))), "Add cut line")

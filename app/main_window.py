@@ -207,6 +207,7 @@ class MainWindow(QtWidgets.QMainWindow):
             "corners at the vertices nearest the principal-axis bounding box corners",
         )
         self.a_add_block = self._act("Add &block", self.editor.add_block)
+        self.a_del_block = self._act("&Delete block", lambda: self.editor.delete_block())
         self.a_to_loop = self._act("&Convert borders to an editable loop", self.convert_to_loop)
         self.a_generate = self._act("&Generate", self.generate, "F5", "build the algebraic grid and solve")
         self.a_pause = self._act("&Pause", self.solver.toggle_pause, "Space", "pause / resume", checkable=True)
@@ -243,7 +244,7 @@ class MainWindow(QtWidgets.QMainWindow):
         m = mb.addMenu("&Tools")
         m.addActions(list(self.tool_actions.values()))
         m = mb.addMenu("&Block")
-        m.addActions([self.a_auto_corners, self.a_add_block, self.a_to_loop])
+        m.addActions([self.a_auto_corners, self.a_add_block, self.a_del_block, self.a_to_loop])
         m = mb.addMenu("&Generate")
         m.addActions([self.a_generate, self.a_pause, self.a_stop, self.a_auto])
         m = mb.addMenu("&View")

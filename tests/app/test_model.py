@@ -230,3 +230,21 @@ def test_auto_corners_keep_bottom_at_the_bottom(angle):
     d = [pts[c1] - pts[c0] for c0, c1 in ((sw, se), (se, ne), (ne, nw), (nw, sw))]
     cos = [v[0] / np.hypot(*v) for v in d]
     assert cos[0] == max(cos)
+
+
+def test_add_and_delete_blocks_are_undoable():
+    from PySide6.QtGui import QUndoStack
+
+    doc = Document(Project(blocks=(square_block(2),)))
+    stack = QUndoStack()
+    ed = Editor(doc, stack)
+    first = doc.project
+    ed.add_block()
+    assert len(doc.project.blocks) == 2 and doc.active == 1
+    ed.delete_block(0)
+    assert len(doc.project.blocks) == 1 and not doc.block.closed
+    ed.delete_block()
+    assert len(doc.project.blocks) == 1 and len(doc.block.points) == 0
+    for _ in range(3):
+        stack.undo()
+    assert doc.project is first
