@@ -151,6 +151,7 @@ class MainWindow(QtWidgets.QMainWindow):
             "cut": CutTool(*ctx),
             "calibrate": CalibrateTool(*ctx, on_pair=self._calibrate_pair),
         }
+        self.tools["draw"].on_closed = lambda: self.set_tool("corners")
         self.tool_group = QtGui.QActionGroup(self)
         self.tool_actions = {}
         for key, t in self.tools.items():

@@ -104,11 +104,15 @@ class DrawTool(Tool):
             return True
         return False
 
+    on_closed = None  # callback: the window switches to the Corners tool
+
     def finish(self) -> None:
         if self.canvas is not None:
             self.canvas.rubber_line.setData([], [])
         if self.doc.block.closed:
-            self.status("Loop closed: pick four corners (Corners tool) or use Auto corners")
+            if self.on_closed is not None:
+                self.on_closed()
+            self.status("Loop closed: click the four corners SW → SE → NE → NW, or press A for automatic corners")
 
     def hover(self, xy) -> None:
         b = self.doc.block
