@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import validate_count
+from ._validation import validate_choice, validate_count
 from .algebraic import algebraic_grid
 from .boundary import Borders, borders_from_loop, borders_from_polylines
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve
@@ -111,6 +111,7 @@ def generate_block(
     callback: Callable[[SolverProgress], Any] | None = None,
     smooth: bool = True,
     periodic: bool = False,
+    repair: str = "auto",
 ) -> StructuredGrid:
     """Generate one block's grid from its boundary.
 
@@ -146,6 +147,17 @@ def generate_block(
     periodic : bool
         Periodic ξ direction (O-grid): left and right borders coincide and the
         seam nodes are solved like interior nodes.
+    repair : {"auto", "strict", "off"}
+        What to do when the elliptic result has folded or non-convex cells
+        (a corner Jacobian ≤ 0): ``"auto"`` repairs them with the fold-free
+        barrier method (:func:`meshcore.foldfree.repair`; ``info.method``
+        becomes e.g. ``"multigrid+foldfree"`` and ``info.message`` says why)
+        and, if no fold-free grid exists for these boundary nodes, returns the
+        best grid with ``converged=False`` and a message naming the cells and
+        the fix; ``"strict"`` raises :class:`~meshcore.errors.FoldedGridError`
+        instead; ``"off"`` returns the elliptic result as it is.
+        ``method="foldfree"`` minimises the barrier functional over the whole
+        block after the elliptic solve (:func:`meshcore.foldfree.smooth`).
 
     Returns
     -------
@@ -173,10 +185,24 @@ def generate_block(
     g0 = initial_grid(b, initial=initial, weights=weights, names=names)
     if not smooth:
         return g0
+    repair = validate_choice(repair, ("auto", "strict", "off"), name="repair")
+    foldfree = (config.method if config is not None else str(method).lower()) == "foldfree"
     cfg = config or EllipticConfig(
-        method=method, tolerance=tolerance, max_iterations=max_iterations, omega=omega
+        method="auto" if foldfree else method, tolerance=tolerance, max_iterations=max_iterations,
+        omega=omega,
     )
-    return solve(g0, cfg, callback=callback, p=p, q=q)
+    if foldfree and cfg.method == "foldfree":
+        cfg = cfg.replaced(method="auto")
+    g = solve(g0, cfg, callback=callback, p=p, q=q)
+    if foldfree:
+        from .foldfree import smooth as _ff_smooth
+
+        return _ff_smooth(g, strict=repair == "strict").grid
+    if repair == "off":
+        return g
+    from .foldfree import repair as _ff_repair
+
+    return _ff_repair(g, strict=repair == "strict").grid
 
 
 # Re-export for convenience

@@ -61,7 +61,10 @@ _INF = np.inf
 def _chi(d, eps):
     if eps == 0.0:
         return d if d > 0.0 else 0.0
-    return 0.5 * (d + math.sqrt(eps * eps + d * d))
+    s = math.sqrt(eps * eps + d * d)
+    if d >= 0.0:
+        return 0.5 * (d + s)
+    return 0.5 * eps * eps / (s - d)  # = (d + s)/2 without cancellation
 
 
 @njit(cache=True, nogil=True)
@@ -95,7 +98,9 @@ def _tri_node(px, py, ax, ay, bx, by, role, eps, out):
         c2 = 0.0
     else:
         s = math.sqrt(eps * eps + d * d)
-        c = 0.5 * (d + s)
+        c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
+        if c <= 0.0 or s <= 0.0:
+            return False
         c1 = c / s
         c2 = eps * eps / (2.0 * s * s * s)
     if role == 0:
@@ -213,14 +218,13 @@ def sweep(x, y, nodes, eps, max_step):
         for _ in range(30):
             nx = qx + alpha * sx
             ny = qy + alpha * sy
-            if node_local(x, y, i, j, nx, ny, eps, trial):
-                if trial[0] <= e0 + 1e-4 * alpha * slope:
-                    x[i, j] = nx
-                    y[i, j] = ny
-                    dd = alpha * math.sqrt(sx * sx + sy * sy)
-                    if dd > dmax:
-                        dmax = dd
-                    break
+            if node_local(x, y, i, j, nx, ny, eps, trial) and trial[0] <= e0 + 1e-4 * alpha * slope:
+                x[i, j] = nx
+                y[i, j] = ny
+                dd = alpha * math.sqrt(sx * sx + sy * sy)
+                if dd > dmax:
+                    dmax = dd
+                break
             alpha *= 0.5
     return dmax
 
@@ -280,5 +284,6 @@ def corner_jacobians(x, y):
             for t in range(4):
                 ta = (t + 1) % 4
                 tb = (t + 3) % 4
-                out[t, ci, cj] = (cx[ta] - cx[t]) * (cy[tb] - cy[t]) - (cy[ta] - cy[t]) * (cx[tb] - cx[t])
+                ux, uy = cx[ta] - cx[t], cy[ta] - cy[t]
+                out[t, ci, cj] = ux * (cy[tb] - cy[t]) - uy * (cx[tb] - cx[t])
     return out

@@ -38,6 +38,7 @@ coordinates and the fix.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -187,8 +188,8 @@ def _minimise(
     *,
     tol: float,
     max_sweeps: int,
-    max_outer: int = 200,
-    inner: int = 10,
+    max_outer: int = 500,
+    inner: int = 1,
 ) -> tuple[bool, int]:
     """Untangle (if needed) then minimise the barrier energy over ``nodes`` in place.
 
@@ -198,7 +199,8 @@ def _minimise(
     step = np.inf
     _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
     if dmin <= 0.0:
-        eps = math.sqrt(1e-300 + 0.04 * dmin * dmin)
+        eps_floor = 1e-12 * _median_area(x, y, cells)
+        eps = max(math.sqrt(0.04 * dmin * dmin), eps_floor)
         e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
         for _outer in range(max_outer):
             for _ in range(inner):
@@ -212,7 +214,8 @@ def _minimise(
             sigma = max(1.0 - e / e_prev, 0.1)
             chi = 0.5 * (dmin + math.sqrt(eps * eps + dmin * dmin))
             mu = (1.0 - sigma) * chi
-            eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else 1e-12 * abs(dmin)
+            eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
+            eps = max(eps, eps_floor)
             e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
         if dmin <= 0.0:
             return False, sweeps
@@ -283,7 +286,7 @@ def _folded(x, y) -> int:
 def repair(
     grid: StructuredGrid,
     *,
-    radius: int = 3,
+    radius: int = 2,
     tolerance: float = 1e-4,
     max_sweeps: int = 400,
     strict: bool = True,
@@ -314,7 +317,7 @@ def repair(
     """
     t0 = time.perf_counter()
     if grid.periodic:
-        return _periodic_unsupported(grid, t0)
+        return _periodic_unsupported(grid, t0, strict)
     exempt = block_corner_problems(grid)
     ex_bits = _exempt_bits(grid, exempt)
     x = np.array(grid.x, dtype=np.float64, order="C")
@@ -333,15 +336,18 @@ def repair(
     total = 0
     nfree = 0
     ok = False
+    inner = 1
     while True:
-        patch = _dilate(bad, r)
+        patch = _dilate(bad, r) if r < max(ni, nj) else np.ones_like(bad)
         nodes = _nodes_of(patch, grid.periodic)
         if nodes.size == 0:
             break
         cells = _touched_cells(nodes, (ni, nj))
         h = _median_edge(x, y, cells)
         xs, ys = x.copy(), y.copy()
-        ok, sw = _minimise(x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps)
+        ok, sw = _minimise(
+            x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps, inner=inner
+        )
         total += sw
         nfree = len(nodes)
         if ok:
@@ -353,7 +359,9 @@ def repair(
         else:
             x[...], y[...] = xs, ys
         if patch.all():
-            break
+            if inner > 1:
+                break
+            inner = 10  # last resort: the whole block, a full minimisation per ε
         r *= 2
     method = f"{grid.info.method}+foldfree"
     if ok:
@@ -393,7 +401,7 @@ def smooth(
     """
     t0 = time.perf_counter()
     if grid.periodic:
-        return _periodic_unsupported(grid, t0)
+        return _periodic_unsupported(grid, t0, strict)
     exempt = block_corner_problems(grid)
     ex_bits = _exempt_bits(grid, exempt)
     x = np.array(grid.x, dtype=np.float64, order="C")
@@ -404,7 +412,14 @@ def smooth(
     nodes = _nodes_of(np.ones(grid.cells, dtype=bool), False)
     cells = _touched_cells(nodes, grid.cells) if nodes.size else np.zeros((0, 2), np.int32)
     h = _median_edge(x, y, cells) if nodes.size else 0.0
+    x0, y0 = x.copy(), y.copy()
     ok, sw = _minimise(x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps)
+    if not ok:
+        x[...], y[...] = x0, y0
+        ok, sw2 = _minimise(
+            x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps, inner=10
+        )
+        sw += sw2
     exempt_note = ("; " + "; ".join(c.message for c in exempt)) if exempt else ""
     if ok and not invalid_cells(x, y, ex_bits).any():
         msg = (
@@ -427,6 +442,14 @@ def smooth(
     )
 
 
+def _median_area(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
+    ci, cj = cells[:, 0], cells[:, 1]
+    a = (x[ci + 1, cj + 1] - x[ci, cj]) * (y[ci, cj + 1] - y[ci + 1, cj]) - (
+        x[ci, cj + 1] - x[ci + 1, cj]
+    ) * (y[ci + 1, cj + 1] - y[ci, cj])
+    return float(np.median(np.abs(0.5 * a)))
+
+
 def _median_edge(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
     ci, cj = cells[:, 0], cells[:, 1]
     e1 = np.hypot(x[ci + 1, cj] - x[ci, cj], y[ci + 1, cj] - y[ci, cj])
@@ -434,13 +457,20 @@ def _median_edge(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
     return float(np.median(np.concatenate([e1, e2])))
 
 
-def _periodic_unsupported(grid: StructuredGrid, t0: float):
+def _periodic_unsupported(grid: StructuredGrid, t0: float, strict: bool) -> FoldFreeResult:
     bad = invalid_cells(grid.x, grid.y)
-    msg = "fold-free repair does not handle periodic (O-grid) blocks yet"
-    if bad.any():
-        raise FoldedGridError(f"{msg}; the grid has {int(bad.sum())} non-convex cell(s)")
+    n = int(bad.sum())
+    msg = grid.info.message
+    if n:
+        msg = (
+            f"the periodic (O-grid) block has {n} folded or non-convex cell(s); the fold-free "
+            f"repair does not handle periodic blocks yet: split the ring into blocks"
+        )
+        if strict:
+            raise FoldedGridError(msg)
+        grid = grid.replaced(info=dataclasses.replace(grid.info, converged=False, message=msg))
     return FoldFreeResult(
-        grid=grid, ok=True, invalid_before=0, folded_before=0, invalid_after=0, exempt=(),
-        free_nodes=0, sweeps=0, elapsed=time.perf_counter() - t0, message=msg,
-        bad_cells=np.zeros((0, 2), dtype=np.int64),
+        grid=grid, ok=n == 0, invalid_before=n, folded_before=_folded(grid.x, grid.y),
+        invalid_after=n, exempt=(), free_nodes=0, sweeps=0, elapsed=time.perf_counter() - t0,
+        message=msg, bad_cells=np.argwhere(bad),
     )
