@@ -21,7 +21,8 @@ outline alone:
     directions, so they are always a valid (sw, se, ne, nw).
 
 Both methods fall back to ``"hull"`` when the ``"bbox"`` picks coincide or are
-not in counter-clockwise cyclic order.
+not in counter-clockwise cyclic order, and then to convex vertices near the
+quarter points of the perimeter measured from the ``sw`` pick.
 
 A corner on a reflex vertex makes its corner cell non-convex whatever the
 interior nodes do (the corner Jacobian of that cell depends on the three
@@ -153,6 +154,8 @@ def choose_corners(points: Any, *, method: str = "bbox") -> tuple[int, int, int,
             cand = np.flatnonzero(proj >= proj.max() - 1e-12 * max(1.0, abs(proj.max())))
             picks.append(int(cand[np.argmin(((st[cand] - b) ** 2).sum(axis=1))]))
         if not _cyclic_ok(picks, n):
+            picks = _by_arc_length(q, picks[0])
+        if not _cyclic_ok(picks, n):
             raise BoundaryError(
                 "could not find four distinct corners in counter-clockwise order on the "
                 f"loop of {n} points (picked {picks}); give corners= explicitly"
@@ -160,6 +163,26 @@ def choose_corners(points: Any, *, method: str = "bbox") -> tuple[int, int, int,
     if not ccw:
         picks = [n - 1 - k for k in picks]
     return tuple(int(k) for k in picks)  # type: ignore[return-value]
+
+
+def _by_arc_length(q: np.ndarray, start: int) -> list[int]:
+    """Four vertices near the quarter points of the perimeter from ``start`` (convex preferred)."""
+    n = len(q)
+    order = [(start + k) % n for k in range(n)]
+    seg = np.hypot(*(np.roll(q, -1, axis=0) - q).T)
+    s = np.concatenate([[0.0], np.cumsum(seg[order][:-1])])
+    per = float(seg.sum())
+    convex = interior_angles(q)[order] < 180.0
+    picks = [0]
+    for k in (1, 2, 3):
+        lo = picks[-1] + 1
+        hi = n - (3 - k)  # leave room for the remaining corners
+        cand = np.arange(lo, hi)
+        if cand.size == 0:
+            return []
+        good = cand[convex[cand]] if convex[cand].any() else cand
+        picks.append(int(good[np.argmin(np.abs(s[good] - k * per / 4))]))
+    return [order[k] for k in picks]
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,7 +198,8 @@ class CornerProblem:
     @property
     def message(self) -> str:
         s = (
-            f"corner {self.corner} (point {self.index} at ({self.point[0]:.6g}, {self.point[1]:.6g})) "
+            f"corner {self.corner} (point {self.index} at "
+            f"({self.point[0]:.6g}, {self.point[1]:.6g})) "
             f"is a reflex vertex (interior angle {self.angle:.1f}° ≥ 180°): its corner cell cannot "
             f"be convex; move corner {self.corner} to a convex vertex"
         )

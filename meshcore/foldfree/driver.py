@@ -59,7 +59,6 @@ __all__ = [
 ]
 
 
-
 @dataclass(frozen=True, slots=True)
 class BoundaryCorner:
     """A block corner whose boundary angle is ≥ 180° (its corner cell cannot be convex)."""
@@ -102,7 +101,12 @@ def block_corner_problems(grid: StructuredGrid) -> list[BoundaryCorner]:
     x, y = grid.x, grid.y
     ni, nj = grid.cells
     # (name, cell, corner index m of that cell): corners c0..c3 = 00, 10, 11, 01
-    table = (("sw", (0, 0), 0), ("se", (ni - 1, 0), 1), ("ne", (ni - 1, nj - 1), 2), ("nw", (0, nj - 1), 3))
+    table = (
+        ("sw", (0, 0), 0),
+        ("se", (ni - 1, 0), 1),
+        ("ne", (ni - 1, nj - 1), 2),
+        ("nw", (0, nj - 1), 3),
+    )
     out = []
     for name, (ci, cj), m in table:
         cx = [x[ci, cj], x[ci + 1, cj], x[ci + 1, cj + 1], x[ci, cj + 1]]
@@ -255,7 +259,9 @@ def _failure_message(grid: StructuredGrid, bad: np.ndarray, exempt: list[Boundar
     return msg
 
 
-def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg):
+def _result(
+    grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg
+):
     bad = invalid_cells(x, y, ex_bits)
     ok = ok and not bad.any()
     info = SolveInfo(
@@ -270,9 +276,17 @@ def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sw
     )
     g = StructuredGrid(x, y, info=info, names=grid.names, periodic=grid.periodic)
     return FoldFreeResult(
-        grid=g, ok=ok, invalid_before=before, folded_before=folded_before,
-        invalid_after=int(bad.sum()), exempt=tuple(exempt), free_nodes=int(nodes),
-        sweeps=sweeps, elapsed=time.perf_counter() - t0, message=msg, bad_cells=np.argwhere(bad),
+        grid=g,
+        ok=ok,
+        invalid_before=before,
+        folded_before=folded_before,
+        invalid_after=int(bad.sum()),
+        exempt=tuple(exempt),
+        free_nodes=int(nodes),
+        sweeps=sweeps,
+        elapsed=time.perf_counter() - t0,
+        message=msg,
+        bad_cells=np.argwhere(bad),
     )
 
 
@@ -328,8 +342,19 @@ def repair(
     exempt_note = ("; " + "; ".join(c.message for c in exempt)) if exempt else ""
     if before == 0:
         return _result(
-            grid, x, y, ok=True, before=0, folded_before=folded_before, exempt=exempt, ex_bits=ex_bits,
-            nodes=0, sweeps=0, t0=t0, method=grid.info.method, msg=grid.info.message + exempt_note,
+            grid,
+            x,
+            y,
+            ok=True,
+            before=0,
+            folded_before=folded_before,
+            exempt=exempt,
+            ex_bits=ex_bits,
+            nodes=0,
+            sweeps=0,
+            t0=t0,
+            method=grid.info.method,
+            msg=grid.info.message + exempt_note,
         )
     ni, nj = grid.cells
     r = max(1, int(radius))
@@ -366,23 +391,49 @@ def repair(
     method = f"{grid.info.method}+foldfree"
     if ok:
         msg = (
+            f"{grid.info.message + '; ' if grid.info.message else ''}"
             f"{grid.info.method} result had {before} non-convex cell(s) ({folded_before} folded); "
-            f"repaired by the fold-free barrier method on {nfree} node(s) ({total} sweeps){exempt_note}"
+            f"repaired by the fold-free barrier method on {nfree} node(s) ({total} sweeps)"
+            f"{exempt_note}"
         )
     else:
         bad_now = invalid_cells(x, y, ex_bits)
         msg = _failure_message(StructuredGrid(x, y), bad_now, exempt)
+        if grid.info.message:
+            msg = f"{grid.info.message}; {msg}"
         if strict:
             res = _result(
-                grid, x, y, ok=False, before=before, folded_before=folded_before, exempt=exempt,
-                ex_bits=ex_bits, nodes=nfree, sweeps=total, t0=t0, method=method, msg=msg,
+                grid,
+                x,
+                y,
+                ok=False,
+                before=before,
+                folded_before=folded_before,
+                exempt=exempt,
+                ex_bits=ex_bits,
+                nodes=nfree,
+                sweeps=total,
+                t0=t0,
+                method=method,
+                msg=msg,
             )
             err = FoldedGridError(msg)
             err.result = res  # type: ignore[attr-defined]
             raise err
     return _result(
-        grid, x, y, ok=ok, before=before, folded_before=folded_before, exempt=exempt, ex_bits=ex_bits,
-        nodes=nfree, sweeps=total, t0=t0, method=method, msg=msg,
+        grid,
+        x,
+        y,
+        ok=ok,
+        before=before,
+        folded_before=folded_before,
+        exempt=exempt,
+        ex_bits=ex_bits,
+        nodes=nfree,
+        sweeps=total,
+        t0=t0,
+        method=method,
+        msg=msg,
     )
 
 
@@ -432,13 +483,35 @@ def smooth(
         if strict:
             err = FoldedGridError(msg)
             err.result = _result(  # type: ignore[attr-defined]
-                grid, x, y, ok=False, before=before, folded_before=folded_before, exempt=exempt,
-                ex_bits=ex_bits, nodes=len(nodes), sweeps=sw, t0=t0, method="foldfree", msg=msg,
+                grid,
+                x,
+                y,
+                ok=False,
+                before=before,
+                folded_before=folded_before,
+                exempt=exempt,
+                ex_bits=ex_bits,
+                nodes=len(nodes),
+                sweeps=sw,
+                t0=t0,
+                method="foldfree",
+                msg=msg,
             )
             raise err
     return _result(
-        grid, x, y, ok=ok, before=before, folded_before=folded_before, exempt=exempt, ex_bits=ex_bits,
-        nodes=len(nodes), sweeps=sw, t0=t0, method="foldfree", msg=msg,
+        grid,
+        x,
+        y,
+        ok=ok,
+        before=before,
+        folded_before=folded_before,
+        exempt=exempt,
+        ex_bits=ex_bits,
+        nodes=len(nodes),
+        sweeps=sw,
+        t0=t0,
+        method="foldfree",
+        msg=msg,
     )
 
 
@@ -470,7 +543,15 @@ def _periodic_unsupported(grid: StructuredGrid, t0: float, strict: bool) -> Fold
             raise FoldedGridError(msg)
         grid = grid.replaced(info=dataclasses.replace(grid.info, converged=False, message=msg))
     return FoldFreeResult(
-        grid=grid, ok=n == 0, invalid_before=n, folded_before=_folded(grid.x, grid.y),
-        invalid_after=n, exempt=(), free_nodes=0, sweeps=0, elapsed=time.perf_counter() - t0,
-        message=msg, bad_cells=np.argwhere(bad),
+        grid=grid,
+        ok=n == 0,
+        invalid_before=n,
+        folded_before=_folded(grid.x, grid.y),
+        invalid_after=n,
+        exempt=(),
+        free_nodes=0,
+        sweeps=0,
+        elapsed=time.perf_counter() - t0,
+        message=msg,
+        bad_cells=np.argwhere(bad),
     )
