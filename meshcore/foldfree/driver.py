@@ -220,6 +220,8 @@ def _minimise(
             mu = (1.0 - sigma) * chi
             eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
             eps = max(eps, eps_floor)
+            if eps < 1e-4 * abs(dmin):
+                break  # stagnated: ε has vanished next to the worst inverted corner
             e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
         if dmin <= 0.0:
             return False, sweeps
@@ -357,43 +359,34 @@ def repair(
             msg=grid.info.message + exempt_note,
         )
     ni, nj = grid.cells
-    r = max(1, int(radius))
-    total = 0
-    nfree = 0
-    ok = False
-    inner = 1
-    while True:
-        patch = _dilate(bad, r) if r < max(ni, nj) else np.ones_like(bad)
-        nodes = _nodes_of(patch, grid.periodic)
-        if nodes.size == 0:
-            break
-        cells = _touched_cells(nodes, (ni, nj))
-        h = _median_edge(x, y, cells)
-        xs, ys = x.copy(), y.copy()
-        ok, sw = _minimise(
-            x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps, inner=inner
+    opts = {"tolerance": tolerance, "max_sweeps": max_sweeps}
+    x0, y0 = x.copy(), y.copy()
+    ok, nfree, total = _patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, **opts)
+    how = ""
+    if not ok:
+        x[...], y[...] = x0, y0
+        start = _coarse_start(grid) if min(ni, nj) >= 8 else None
+        if start is not None:
+            x2, y2 = start
+            bad2 = invalid_cells(x2, y2, ex_bits)
+            ok2, nf2, sw2 = _patches(x2, y2, bad2, ex_bits, radius=radius, max_fraction=0.3, **opts)
+            total += sw2
+            if ok2:
+                x[...], y[...] = x2, y2
+                ok, nfree, how = True, nf2, " after a coarse-grid (multilevel) start"
+    if not ok:
+        # last resort: the whole block, a full minimisation per ε
+        x[...], y[...] = x0, y0
+        ok, nfree, sw = _patches(
+            x, y, bad, ex_bits, radius=max(ni, nj), max_fraction=1.0, inner=10, **opts
         )
         total += sw
-        nfree = len(nodes)
-        if ok:
-            bad_now = invalid_cells(x, y, ex_bits)
-            if not bad_now.any():
-                break
-            bad = bad | bad_now
-            ok = False
-        else:
-            x[...], y[...] = xs, ys
-        if patch.all():
-            if inner > 1:
-                break
-            inner = 10  # last resort: the whole block, a full minimisation per ε
-        r *= 2
     method = f"{grid.info.method}+foldfree"
     if ok:
         msg = (
             f"{grid.info.message + '; ' if grid.info.message else ''}"
             f"{grid.info.method} result had {before} non-convex cell(s) ({folded_before} folded); "
-            f"repaired by the fold-free barrier method on {nfree} node(s) ({total} sweeps)"
+            f"repaired by the fold-free barrier method on {nfree} node(s) ({total} sweeps){how}"
             f"{exempt_note}"
         )
     else:
@@ -435,6 +428,95 @@ def repair(
         method=method,
         msg=msg,
     )
+
+
+def _patches(
+    x: np.ndarray,
+    y: np.ndarray,
+    bad: np.ndarray,
+    ex_bits: np.ndarray,
+    *,
+    radius: int,
+    max_fraction: float,
+    tolerance: float,
+    max_sweeps: int,
+    inner: int = 1,
+) -> tuple[bool, int, int]:
+    """Barrier minimisation on patches around ``bad``; the radius doubles on failure.
+
+    Stops when the patch covers more than ``max_fraction`` of the cells (the
+    whole block is always allowed when ``max_fraction ≥ 1``).  On failure the
+    nodes are left as they were.  Returns ``(ok, free nodes, sweeps)``.
+    """
+    ni, nj = bad.shape
+    r = max(1, int(radius))
+    total = 0
+    nfree = 0
+    while True:
+        patch = _dilate(bad, r) if r < max(ni, nj) else np.ones_like(bad)
+        if patch.mean() > max_fraction and max_fraction < 1.0:
+            return False, nfree, total
+        nodes = _nodes_of(patch, False)
+        if nodes.size == 0:
+            return False, 0, total
+        cells = _touched_cells(nodes, (ni, nj))
+        h = _median_edge(x, y, cells)
+        xs, ys = x.copy(), y.copy()
+        ok, sw = _minimise(
+            x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps, inner=inner
+        )
+        total += sw
+        nfree = len(nodes)
+        if ok:
+            bad_now = invalid_cells(x, y, ex_bits)
+            if not bad_now.any():
+                return True, nfree, total
+            bad = bad | bad_now
+        x[...], y[...] = xs, ys
+        if patch.all():
+            return False, nfree, total
+        r *= 2
+
+
+def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
+    """Multilevel start: every second grid line, Winslow + repair there, bilinear prolongation.
+
+    Inside a convex coarse cell the bilinear map is injective and its
+    iso-lines are straight, so the fine cells it creates are convex (their
+    corner Jacobians are the bilinear Jacobian times the index steps); only
+    fine cells near the boundary (whose nodes are the true, finer boundary)
+    and across coarse-cell edges may need a local repair afterwards.
+    """
+    from ..elliptic import solve
+
+    ni, nj = grid.cells
+    ic = np.unique(np.r_[np.arange(0, ni + 1, 2), ni])
+    jc = np.unique(np.r_[np.arange(0, nj + 1, 2), nj])
+    gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)]))
+    res = repair(gc, strict=False)
+    if not res.ok:
+        return None
+    xc, yc = res.grid.x, res.grid.y
+
+    def param(n: int, idx: np.ndarray):
+        k = np.clip(np.searchsorted(idx, np.arange(n + 1), side="right") - 1, 0, len(idx) - 2)
+        u = (np.arange(n + 1) - idx[k]) / (idx[k + 1] - idx[k])
+        return k, u
+
+    ki, u = param(ni, ic)
+    kj, v = param(nj, jc)
+    u = u[:, None]
+    v = v[None, :]
+    out = []
+    for c, f in ((xc, grid.x), (yc, grid.y)):
+        a00 = c[np.ix_(ki, kj)]
+        a10 = c[np.ix_(ki + 1, kj)]
+        a11 = c[np.ix_(ki + 1, kj + 1)]
+        a01 = c[np.ix_(ki, kj + 1)]
+        z = (1 - u) * (1 - v) * a00 + u * (1 - v) * a10 + u * v * a11 + (1 - u) * v * a01
+        z[0, :], z[-1, :], z[:, 0], z[:, -1] = f[0, :], f[-1, :], f[:, 0], f[:, -1]
+        out.append(np.ascontiguousarray(z))
+    return out[0], out[1]
 
 
 def smooth(

@@ -272,6 +272,16 @@ def test_c_shaped_domain_has_no_nonconvex_cells():
         assert meshcore.quality(g).ok, g.info.message
 
 
+def test_heavily_folded_c_shape_needs_and_gets_the_multilevel_start():
+    # at 60 × 120 cells Winslow folds dozens of cells across the slot; local patches fail
+    loop = c_shape()
+    w = meshcore.generate_block(loop=loop, corners=(0, 1, 6, 7), cells=(60, 120), repair="off")
+    assert meshcore.quality(w).n_folded > 20
+    r = repair(w)
+    assert r.ok and meshcore.quality(r.grid).ok
+    assert "multilevel" in r.message
+
+
 @pytest.mark.parametrize("case", ["annulus", "trapezoid"])
 def test_foldfree_method_stays_close_to_valid_winslow(case):
     if case == "annulus":
