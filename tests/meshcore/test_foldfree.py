@@ -243,9 +243,7 @@ def test_lakes_6000_nodes_fold_free(name):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    "name", ["shasta_lake", "shasta_lake_sparse", "lake_bolsena", "lake_bolsena_sparse"]
-)
+@pytest.mark.parametrize("name", LAKE_NAMES)
 def test_lakes_24000_nodes_fold_free(name):
     g = _lake_grid(name, 24000)
     assert abs(g.n_nodes - 24000) < 800
