@@ -172,14 +172,16 @@ def node_local(x, y, i, j, qx, qy, eps, out):
 
 
 @njit(cache=True, nogil=True)
-def sweep(x, y, nodes, eps, max_step):
+def sweep(x, y, nodes, eps, max_step, omega=1.0):
     """One damped-Newton Gauss–Seidel sweep over ``nodes`` (int32 (k, 2), colour ordered).
 
     Each node minimises its local energy (12 corner triangles) along the
     Newton direction (the Hessian shifted to be positive definite), with
     backtracking until the energy decreases; under ``ε = 0`` the barrier
     rejects every step that would invert a triangle.  ``max_step`` caps the
-    step length (in units of the coordinates).
+    step length (in units of the coordinates).  ``omega > 1`` first tries the
+    over-relaxed step ``ω·δ`` (nonlinear SOR) and falls back to backtracking
+    from the plain Newton step when it does not lower the energy.
 
     Returns the largest node displacement.
     """
@@ -215,6 +217,16 @@ def sweep(x, y, nodes, eps, max_step):
         if not (slope < 0.0):
             continue
         alpha = 1.0
+        if omega > 1.0:
+            nx = qx + omega * sx
+            ny = qy + omega * sy
+            if node_local(x, y, i, j, nx, ny, eps, trial) and trial[0] < e0:
+                x[i, j] = nx
+                y[i, j] = ny
+                dd = omega * math.sqrt(sx * sx + sy * sy)
+                if dd > dmax:
+                    dmax = dd
+                continue
         for _ in range(30):
             nx = qx + alpha * sx
             ny = qy + alpha * sy

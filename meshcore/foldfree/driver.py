@@ -19,7 +19,8 @@ Minimise ``E = Σ_cells Σ_corners F/χ(D, ε)`` (see
    rule of Garanzha et al. (2021): ``σ = max(1 − E/E_prev, 0.1)``,
    ``μ = (1 − σ) χ(D_min, ε)``, ``ε ← 2 sqrt(μ (μ − D_min))`` if
    ``D_min < μ`` — it shrinks ``χ`` at the worst corner by ``1 − σ``.
-2. *Barrier* (``ε = 0``): node-wise damped Newton in 4-colour order; every
+2. *Barrier* (``ε = 0``): node-wise damped Newton in 4-colour order, trying
+   the over-relaxed step ``1.9·δ`` first (nonlinear SOR); every
    accepted step lowers the energy and the barrier ``E = ∞`` at ``D = 0``
    keeps every corner Jacobian positive, so the grid stays valid.
 
@@ -194,6 +195,7 @@ def _minimise(
     max_sweeps: int,
     max_outer: int = 500,
     inner: int = 1,
+    omega: float = 1.9,
 ) -> tuple[bool, int]:
     """Untangle (if needed) then minimise the barrier energy over ``nodes`` in place.
 
@@ -226,7 +228,7 @@ def _minimise(
         if dmin <= 0.0:
             return False, sweeps
     for _ in range(max_sweeps):
-        d = _kernels.sweep(x, y, nodes, 0.0, step)
+        d = _kernels.sweep(x, y, nodes, 0.0, step, omega)
         sweeps += 1
         if d <= tol:
             break
