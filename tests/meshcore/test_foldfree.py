@@ -280,24 +280,55 @@ def test_heavily_folded_c_shape_needs_and_gets_the_multilevel_start():
     assert "multilevel" in r.message
 
 
-@pytest.mark.parametrize("case", ["annulus", "trapezoid"])
-def test_foldfree_method_stays_close_to_valid_winslow(case):
+def cutout_borders():
+    """Paper-like "rectangle with cutout": a rectangular notch in the bottom border."""
+    bottom = np.array([[0, 0], [1.2, 0], [1.2, 0.5], [1.8, 0.5], [1.8, 0], [3, 0]], float)
+    right = np.array([[3, 0], [3, 1]], float)
+    return bottom, right, np.array([[0, 1], [3, 1]], float), np.array([[0, 0], [0, 1]], float)
+
+
+def bottle_borders():
+    """Paper-like "bottle": body, shoulders and neck; the neck opening is the top border."""
+    right = np.array([[1, 0], [1, 1.2], [0.8, 1.5], [0.65, 1.6], [0.65, 2.2]], float)
+    left = right.copy()
+    left[:, 0] = 1 - left[:, 0]
+    return np.array([[0, 0], [1, 0]], float), right, np.array([left[-1], right[-1]]), left
+
+
+def _paper_like(case):
     if case == "annulus":
-        X, Y = annulus_sector(24, 16)
-        bs = borders_of(X, Y)
-    else:
+        return borders_of(*annulus_sector(24, 16)), {}
+    if case == "trapezoid":
         X, Y = np.meshgrid(np.linspace(0, 3, 25), np.linspace(0, 1, 13), indexing="ij")
         X = X * (1 - 0.3 * Y)
         Y = Y * (1 + 0.2 * np.sin(np.pi * X / 3))
-        bs = borders_of(X, Y)
-    w = meshcore.generate_block(*bs)
+        return borders_of(X, Y), {}
+    if case == "cutout":
+        return cutout_borders(), {"cells": (15, 6), "weights": (0.1, 0.0)}
+    return bottle_borders(), {"cells": (12, 30), "weights": (1.0, 0.5)}
+
+
+@pytest.mark.parametrize("case", ["annulus", "trapezoid", "cutout", "bottle"])
+def test_foldfree_method_stays_close_to_valid_winslow(case):
+    bs, kw = _paper_like(case)
+    w = meshcore.generate_block(*bs, **kw, repair="off")
     assert meshcore.quality(w).ok
-    assert w.method == "multigrid" or "foldfree" not in w.method  # valid Winslow is returned as is
-    f = meshcore.generate_block(*bs, method="foldfree")
-    assert f.method == "foldfree" and meshcore.quality(f).ok
+    g = meshcore.generate_block(*bs, **kw)  # a valid Winslow grid is returned unchanged
+    assert "foldfree" not in g.method
+    np.testing.assert_array_equal(g.x, w.x)
+    f = meshcore.generate_block(*bs, **kw, method="foldfree")
+    qf = meshcore.quality(f)
+    assert f.method == "foldfree" and f.converged and qf.ok
     h = np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0)))
-    dist = np.hypot(f.x - w.x, f.y - w.y).max()
-    assert dist < 0.5 * h
+    assert np.hypot(f.x - w.x, f.y - w.y).max() < 0.5 * h
+
+
+def test_paper_like_cutout_refined_is_repaired():
+    bs = cutout_borders()
+    w = meshcore.generate_block(*bs, cells=(30, 12), weights=(0.1, 0.0), repair="off")
+    assert meshcore.quality(w).n_nonconvex > 0
+    g = meshcore.generate_block(*bs, cells=(30, 12), weights=(0.1, 0.0))
+    assert g.converged and meshcore.quality(g).ok and g.method.endswith("+foldfree")
 
 
 # ------------------------------------------------------------------- "cannot"
