@@ -6,7 +6,10 @@ the lengths of opposite borders.  Times are the minimum of ``--repeat`` runs
 (the machine is shared: compare the ratio repair / Winslow, measured in the
 same run).  Prints a Markdown table.
 
-    /work/venv/bin/python benchmarks/foldfree.py [--repeat 3] [--nodes 6000 24000]
+    PYTHONPATH=. /work/venv/bin/python benchmarks/foldfree.py [--repeat 3] [--nodes 6000 24000]
+
+A second table covers paper-like cases and a C-shaped domain (repair and the
+whole-block ``method="foldfree"``, with the largest node distance to Winslow).
 """
 
 from __future__ import annotations
@@ -59,11 +62,16 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--nodes", type=int, nargs="+", default=[6000, 24000])
     ap.add_argument("--lakes", nargs="*", default=None)
+    ap.add_argument("--shapes-only", action="store_true")
     args = ap.parse_args()
+    if args.shapes_only:
+        shapes(args.repeat)
+        return
     names = args.lakes or sorted(p.stem for p in LAKES.glob("*.csv"))
     # warm up the numba caches
-    meshcore.generate_block(loop=load_lake(names[0]), corners=choose_corners(load_lake(names[0])),
-                            cells=(20, 10))
+    meshcore.generate_block(
+        loop=load_lake(names[0]), corners=choose_corners(load_lake(names[0])), cells=(20, 10)
+    )
     print(
         "| lake | nodes | cells | Winslow folded/non-convex | after folded/non-convex | "
         "min Jacobian ratio | max orthogonality (°) | Winslow s | repair s | "
@@ -88,6 +96,51 @@ def main() -> None:
                 f"{tr / tw:.2f} | {res.free_nodes} |",
                 flush=True,
             )
+    shapes(args.repeat)
+
+
+def shapes(repeat: int) -> None:
+    """Paper-like cases and the C-shaped domain: repair vs the whole-block fold-free method."""
+    from tests.conftest import annulus_sector, borders_of
+    from tests.meshcore.test_foldfree import bottle_borders, c_shape, cutout_borders
+
+    cases = [
+        ("annulus sector", borders_of(*annulus_sector(24, 16)), {}),
+        ("rectangle with cutout", cutout_borders(), {"cells": (15, 6), "weights": (0.1, 0.0)}),
+        ("rectangle with cutout", cutout_borders(), {"cells": (30, 12), "weights": (0.1, 0.0)}),
+        ("bottle", bottle_borders(), {"cells": (6, 15), "weights": (1.0, 0.5)}),
+        ("bottle", bottle_borders(), {"cells": (12, 30), "weights": (1.0, 0.5)}),
+    ]
+    for cells in [(20, 40), (30, 60), (60, 120)]:
+        cases.append(
+            (
+                "C (square, slot 0.2 × 0.8)",
+                (),
+                {"loop": c_shape(), "corners": (0, 1, 6, 7), "cells": cells},
+            )
+        )
+    print()
+    print(
+        "| case | cells | Winslow folded/non-convex | auto: method, folded/non-convex | "
+        "foldfree method: folded/non-convex | max node distance foldfree–Winslow (h) | "
+        "min Jacobian ratio W / auto / foldfree | Winslow s | auto s | foldfree s |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name, bs, kw in cases:
+        gen = partial(meshcore.generate_block, *bs, **kw)
+        tw, w = best_of(repeat, partial(gen, repair="off"))
+        tg, g = best_of(repeat, gen)
+        tf, f = best_of(repeat, partial(gen, method="foldfree"))
+        qw, qg, qf = meshcore.quality(w), meshcore.quality(g), meshcore.quality(f)
+        h = float(np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0))))
+        d = float(np.hypot(f.x - w.x, f.y - w.y).max()) / h
+        print(
+            f"| {name} | {w.cells[0]}×{w.cells[1]} | {qw.n_folded}/{qw.n_nonconvex} | "
+            f"{g.method}, {qg.n_folded}/{qg.n_nonconvex} | {qf.n_folded}/{qf.n_nonconvex} | "
+            f"{d:.3f} | {qw.min_jacobian_ratio:.3f} / {qg.min_jacobian_ratio:.3f} / "
+            f"{qf.min_jacobian_ratio:.3f} | {tw:.3f} | {tg:.3f} | {tf:.3f} |",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -547,13 +547,17 @@ def smooth(
     nodes = _nodes_of(np.ones(grid.cells, dtype=bool), False)
     cells = _touched_cells(nodes, grid.cells) if nodes.size else np.zeros((0, 2), np.int32)
     h = _median_edge(x, y, cells) if nodes.size else 0.0
-    x0, y0 = x.copy(), y.copy()
-    ok, sw = _minimise(x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps)
-    if not ok:
-        x[...], y[...] = x0, y0
-        ok, sw2 = _minimise(
-            x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps, inner=10
-        )
+    sw = 0
+    ok = True
+    if before and nodes.size:
+        # untangle first where it is cheap: local patches, multilevel start, whole block
+        fixed = repair(grid, strict=False)
+        sw += fixed.sweeps
+        ok = fixed.ok
+        if ok:
+            x[...], y[...] = fixed.grid.x, fixed.grid.y
+    if ok and nodes.size:
+        ok, sw2 = _minimise(x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps)
         sw += sw2
     exempt_note = ("; " + "; ".join(c.message for c in exempt)) if exempt else ""
     if ok and not invalid_cells(x, y, ex_bits).any():
