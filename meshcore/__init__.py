@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from . import _numba_setup  # noqa: F401  (must run before numba compiles anything)
 from .algebraic import algebraic_grid, tfi, weighted_average
-from .boundary import BorderSpec, Borders, borders_from_loop, borders_from_polylines
+from .boundary import Borders, BorderSpec, borders_from_loop, borders_from_polylines
 from .curves import LinearSpline, SmoothCurve, make_curve
 from .distribution import distribute
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve
@@ -79,3 +79,16 @@ __all__ = [
     "tfi",
     "weighted_average",
 ]
+
+
+# Readers/writers are re-exported lazily so that ``import meshcore`` stays light
+# (meshcore.io imports nothing heavy either, but keeps optional readers out).
+_LAZY_IO = {"read_points", "read_grid", "read_blocks", "write", "PointSet", "GridSet"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY_IO:
+        from . import io as _io
+
+        return getattr(_io, name)
+    raise AttributeError(f"module 'meshcore' has no attribute {name!r}")

@@ -42,6 +42,7 @@ def prepare_borders(
     borders: Mapping[str, Any] | None = None,
     curve: str = "linear",
     periodic: bool = False,
+    snap_angle: float | None = None,
     where: str = "",
 ) -> Borders:
     """Validate the boundary and re-sample it (or use the given nodes when ``cells`` is None)."""
@@ -67,7 +68,7 @@ def prepare_borders(
             raise InvalidInputError("border distributions need cells= (the borders are re-sampled)")
         b.check_counts()
         return b
-    return b.resampled(c, specs=borders, curve=curve)
+    return b.resampled(c, specs=borders, curve=curve, snap_angle=snap_angle)
 
 
 def initial_grid(
@@ -112,6 +113,7 @@ def generate_block(
     smooth: bool = True,
     periodic: bool = False,
     repair: str = "auto",
+    snap_angle: float | None = None,
 ) -> StructuredGrid:
     """Generate one block's grid from its boundary.
 
@@ -158,6 +160,10 @@ def generate_block(
         instead; ``"off"`` returns the elliptic result as it is.
         ``method="foldfree"`` minimises the barrier functional over the whole
         block after the elliptic solve (:func:`meshcore.foldfree.smooth`).
+    snap_angle : float, optional
+        When re-sampling, input vertices where a border turns by more than this
+        many degrees get a node exactly (keeps the corners of a cutout);
+        ``None`` = pure distribution (the paper).
 
     Returns
     -------
@@ -175,7 +181,7 @@ def generate_block(
     """
     b = prepare_borders(
         bottom, right, top, left, loop=loop, corners=corners, cells=cells, borders=borders, curve=curve,
-        periodic=periodic,
+        periodic=periodic, snap_angle=snap_angle,
     )
     names = {
         k: v["name"]
