@@ -69,9 +69,7 @@ def main() -> None:
         return
     names = args.lakes or sorted(p.stem for p in LAKES.glob("*.csv"))
     # warm up the numba caches
-    meshcore.generate_block(
-        loop=load_lake(names[0]), corners=choose_corners(load_lake(names[0])), cells=(20, 10)
-    )
+    meshcore.generate_block(loop=load_lake(names[0]), corners=choose_corners(load_lake(names[0])), cells=(20, 10))
     print(
         "| lake | nodes | cells | Winslow folded/non-convex | after folded/non-convex | "
         "min Jacobian ratio | max orthogonality (°) | Winslow s | repair s | "
@@ -101,16 +99,16 @@ def main() -> None:
 
 def shapes(repeat: int) -> None:
     """Paper-like cases and the C-shaped domain: repair vs the whole-block fold-free method."""
-    from tests.conftest import annulus_sector, borders_of
-    from tests.meshcore.test_foldfree import bottle_borders, c_shape, cutout_borders
+    from meshcore.case import load_case
+    from tests.meshcore.test_foldfree import c_shape
 
-    cases = [
-        ("annulus sector", borders_of(*annulus_sector(24, 16)), {}),
-        ("rectangle with cutout", cutout_borders(), {"cells": (15, 6), "weights": (0.1, 0.0)}),
-        ("rectangle with cutout", cutout_borders(), {"cells": (30, 12), "weights": (0.1, 0.0)}),
-        ("bottle", bottle_borders(), {"cells": (6, 15), "weights": (1.0, 0.5)}),
-        ("bottle", bottle_borders(), {"cells": (12, 30), "weights": (1.0, 0.5)}),
-    ]
+    cases = []
+    root = Path(__file__).resolve().parent.parent / "resources" / "examples"
+    for path in sorted(root.glob("*.toml")):
+        case = load_case(path)
+        kw = dict(case.blocks[0].generate_kwargs())
+        kw["config"] = case.solver
+        cases.append((path.stem, (), kw))
     for cells in [(20, 40), (30, 60), (60, 120)]:
         cases.append(
             (
@@ -130,7 +128,11 @@ def shapes(repeat: int) -> None:
         gen = partial(meshcore.generate_block, *bs, **kw)
         tw, w = best_of(repeat, partial(gen, repair="off"))
         tg, g = best_of(repeat, gen)
-        tf, f = best_of(repeat, partial(gen, method="foldfree"))
+        if "config" in kw:
+            ff = partial(gen, config=kw["config"].replaced(method="foldfree"))
+        else:
+            ff = partial(gen, method="foldfree")
+        tf, f = best_of(repeat, ff)
         qw, qg, qf = meshcore.quality(w), meshcore.quality(g), meshcore.quality(f)
         h = float(np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0))))
         d = float(np.hypot(f.x - w.x, f.y - w.y).max()) / h

@@ -280,55 +280,47 @@ def test_heavily_folded_c_shape_needs_and_gets_the_multilevel_start():
     assert "multilevel" in r.message
 
 
-def cutout_borders():
-    """Paper-like "rectangle with cutout": a rectangular notch in the bottom border."""
-    bottom = np.array([[0, 0], [1.2, 0], [1.2, 0.5], [1.8, 0.5], [1.8, 0], [3, 0]], float)
-    right = np.array([[3, 0], [3, 1]], float)
-    return bottom, right, np.array([[0, 1], [3, 1]], float), np.array([[0, 0], [0, 1]], float)
+EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "resources" / "examples").glob("*.toml"))
 
 
-def bottle_borders():
-    """Paper-like "bottle": body, shoulders and neck; the neck opening is the top border."""
-    right = np.array([[1, 0], [1, 1.2], [0.8, 1.5], [0.65, 1.6], [0.65, 2.2]], float)
-    left = right.copy()
-    left[:, 0] = 1 - left[:, 0]
-    return np.array([[0, 0], [1, 0]], float), right, np.array([left[-1], right[-1]]), left
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_paper_cases_fold_free_and_close_to_valid_winslow(path):
+    from meshcore.case import generate_case, load_case
+
+    case = load_case(path)
+    kw = case.blocks[0].generate_kwargs()
+    w = meshcore.generate_block(**kw, config=case.solver, repair="off")
+    g = generate_case(case)[0]
+    qw, qg = meshcore.quality(w), meshcore.quality(g)
+    assert qg.ok and g.converged, g.info.message
+    if qw.ok:  # a valid Winslow grid is returned unchanged ...
+        assert "foldfree" not in g.method
+        np.testing.assert_array_equal(g.x, w.x)
+    else:  # ... an invalid one is repaired, and the message says so
+        assert g.method.endswith("+foldfree")
+        assert f"{qw.n_nonconvex} non-convex cell(s)" in g.info.message
+    f = meshcore.generate_block(**kw, config=case.solver.replaced(method="foldfree"))
+    assert f.method == "foldfree" and f.converged and meshcore.quality(f).ok
+    if qw.ok:  # the whole-block barrier minimiser stays close to a valid Winslow grid
+        h = np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0)))
+        assert np.hypot(f.x - w.x, f.y - w.y).max() < 0.1 * h
 
 
-def _paper_like(case):
+@pytest.mark.parametrize("case", ["annulus", "trapezoid"])
+def test_foldfree_method_stays_close_to_valid_winslow(case):
     if case == "annulus":
-        return borders_of(*annulus_sector(24, 16)), {}
-    if case == "trapezoid":
+        bs = borders_of(*annulus_sector(24, 16))
+    else:
         X, Y = np.meshgrid(np.linspace(0, 3, 25), np.linspace(0, 1, 13), indexing="ij")
         X = X * (1 - 0.3 * Y)
         Y = Y * (1 + 0.2 * np.sin(np.pi * X / 3))
-        return borders_of(X, Y), {}
-    if case == "cutout":
-        return cutout_borders(), {"cells": (15, 6), "weights": (0.1, 0.0)}
-    return bottle_borders(), {"cells": (12, 30), "weights": (1.0, 0.5)}
-
-
-@pytest.mark.parametrize("case", ["annulus", "trapezoid", "cutout", "bottle"])
-def test_foldfree_method_stays_close_to_valid_winslow(case):
-    bs, kw = _paper_like(case)
-    w = meshcore.generate_block(*bs, **kw, repair="off")
-    assert meshcore.quality(w).ok
-    g = meshcore.generate_block(*bs, **kw)  # a valid Winslow grid is returned unchanged
-    assert "foldfree" not in g.method
-    np.testing.assert_array_equal(g.x, w.x)
-    f = meshcore.generate_block(*bs, **kw, method="foldfree")
-    qf = meshcore.quality(f)
-    assert f.method == "foldfree" and f.converged and qf.ok
+        bs = borders_of(X, Y)
+    w = meshcore.generate_block(*bs)
+    assert meshcore.quality(w).ok and "foldfree" not in w.method
+    f = meshcore.generate_block(*bs, method="foldfree")
+    assert f.method == "foldfree" and meshcore.quality(f).ok
     h = np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0)))
-    assert np.hypot(f.x - w.x, f.y - w.y).max() < 0.5 * h
-
-
-def test_paper_like_cutout_refined_is_repaired():
-    bs = cutout_borders()
-    w = meshcore.generate_block(*bs, cells=(30, 12), weights=(0.1, 0.0), repair="off")
-    assert meshcore.quality(w).n_nonconvex > 0
-    g = meshcore.generate_block(*bs, cells=(30, 12), weights=(0.1, 0.0))
-    assert g.converged and meshcore.quality(g).ok and g.method.endswith("+foldfree")
+    assert np.hypot(f.x - w.x, f.y - w.y).max() < 0.05 * h
 
 
 # ------------------------------------------------------------------- "cannot"
