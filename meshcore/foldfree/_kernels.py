@@ -126,12 +126,14 @@ def _tri_node(px, py, ax, ay, bx, by, role, eps, out):
 
 
 @njit(cache=True, nogil=True)
-def node_local(x, y, i, j, qx, qy, eps, out):
+def node_local(x, y, i, j, qx, qy, eps, out, periodic=False):
     """Local energy, gradient and Hessian of node ``(i, j)`` placed at ``(qx, qy)``.
 
     Sums the (up to) 12 corner triangles that contain the node, skipping none
     (a triangle that contains a free node is never all-fixed).  Returns False
-    when a triangle is inverted under the ε = 0 barrier.
+    when a triangle is inverted under the ε = 0 barrier.  ``periodic``: column
+    ``ni`` repeats column 0, and a seam node ``(0, j)`` also belongs to the
+    cells of column ``ni − 1`` (as their corner in column ``ni``).
     """
     ni1, nj1 = x.shape
     for k in range(6):
@@ -141,6 +143,10 @@ def node_local(x, y, i, j, qx, qy, eps, out):
     for dc in range(4):
         ci = i - 1 + (dc & 1)
         cj = j - 1 + (dc >> 1)
+        di = i - ci
+        if periodic and ci < 0:
+            ci = ni1 - 2
+            di = 1
         if ci < 0 or cj < 0 or ci >= ni1 - 1 or cj >= nj1 - 1:
             continue
         # corners c0..c3 of cell (ci, cj)
@@ -149,7 +155,6 @@ def node_local(x, y, i, j, qx, qy, eps, out):
         cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
         cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
         # which corner is the node: (i,j) = (ci + di, cj + dj)
-        di = i - ci
         dj = j - cj
         if dj == 0:
             m = di  # 0 -> c0, 1 -> c1
@@ -172,13 +177,14 @@ def node_local(x, y, i, j, qx, qy, eps, out):
 
 
 @njit(cache=True, nogil=True)
-def sweep(x, y, nodes, eps, max_step, omega=1.0):
+def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
     """One damped-Newton Gauss–Seidel sweep over ``nodes`` (int32 (k, 2), colour ordered).
 
     Each node minimises its local energy (12 corner triangles) along the
     Newton direction (the Hessian shifted to be positive definite), with
     backtracking until the energy decreases; under ``ε = 0`` the barrier
-    rejects every step that would invert a triangle.  ``max_step`` caps the
+    rejects every step that would invert a triangle.  ``periodic``: seam
+    nodes are given as column 0 and their copy in column ``ni`` follows.  ``max_step`` caps the
     step length (in units of the coordinates).  ``omega > 1`` first tries the
     over-relaxed step ``ω·δ`` (nonlinear SOR) and falls back to backtracking
     from the plain Newton step when it does not lower the energy.
@@ -192,7 +198,7 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0):
         i = nodes[k, 0]
         j = nodes[k, 1]
         qx, qy = x[i, j], y[i, j]
-        if not node_local(x, y, i, j, qx, qy, eps, out):
+        if not node_local(x, y, i, j, qx, qy, eps, out, periodic):
             continue
         e0, gx, gy = out[0], out[1], out[2]
         hxx, hxy, hyy = out[3], out[4], out[5]
@@ -220,9 +226,12 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0):
         if omega > 1.0:
             nx = qx + omega * sx
             ny = qy + omega * sy
-            if node_local(x, y, i, j, nx, ny, eps, trial) and trial[0] < e0:
+            if node_local(x, y, i, j, nx, ny, eps, trial, periodic) and trial[0] < e0:
                 x[i, j] = nx
                 y[i, j] = ny
+                if periodic and i == 0:
+                    x[x.shape[0] - 1, j] = nx
+                    y[x.shape[0] - 1, j] = ny
                 dd = omega * math.sqrt(sx * sx + sy * sy)
                 if dd > dmax:
                     dmax = dd
@@ -230,9 +239,12 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0):
         for _ in range(30):
             nx = qx + alpha * sx
             ny = qy + alpha * sy
-            if node_local(x, y, i, j, nx, ny, eps, trial) and trial[0] <= e0 + 1e-4 * alpha * slope:
+            if node_local(x, y, i, j, nx, ny, eps, trial, periodic) and trial[0] <= e0 + 1e-4 * alpha * slope:
                 x[i, j] = nx
                 y[i, j] = ny
+                if periodic and i == 0:
+                    x[x.shape[0] - 1, j] = nx
+                    y[x.shape[0] - 1, j] = ny
                 dd = alpha * math.sqrt(sx * sx + sy * sy)
                 if dd > dmax:
                     dmax = dd

@@ -34,9 +34,7 @@ def energy(x: np.ndarray, y: np.ndarray, eps: float) -> float:
         d = ux * vy - uy * vx
         ch = chi(d, eps)
         with np.errstate(divide="ignore"):
-            f = np.where(
-                ch > 0, (ux**2 + uy**2 + vx**2 + vy**2) / np.where(ch > 0, ch, 1.0), np.inf
-            )
+            f = np.where(ch > 0, (ux**2 + uy**2 + vx**2 + vy**2) / np.where(ch > 0, ch, 1.0), np.inf)
         e += float(f.sum())
     return e
 

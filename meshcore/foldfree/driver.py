@@ -39,7 +39,6 @@ coordinates and the fix.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -147,7 +146,10 @@ def _nodes_of(cells_mask: np.ndarray, periodic: bool) -> np.ndarray:
     nm[1:, :-1] |= cells_mask
     nm[1:, 1:] |= cells_mask
     nm[:-1, 1:] |= cells_mask
-    nm[0, :] = False
+    if periodic:  # column ni repeats column 0: a seam node is listed once, as column 0
+        nm[0, :] |= nm[-1, :]
+    else:
+        nm[0, :] = False
     nm[-1, :] = False
     nm[:, 0] = False
     nm[:, -1] = False
@@ -156,21 +158,25 @@ def _nodes_of(cells_mask: np.ndarray, periodic: bool) -> np.ndarray:
     return np.ascontiguousarray(idx[np.argsort(colour, kind="stable")])
 
 
-def _touched_cells(nodes: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+def _touched_cells(nodes: np.ndarray, shape: tuple[int, int], periodic: bool = False) -> np.ndarray:
     ni, nj = shape
     m = np.zeros((ni, nj), dtype=bool)
     for di in (0, 1):
         for dj in (0, 1):
             ci = nodes[:, 0] - di
+            if periodic:
+                ci = ci % ni
             cj = nodes[:, 1] - dj
             ok = (ci >= 0) & (cj >= 0) & (ci < ni) & (cj < nj)
             m[ci[ok], cj[ok]] = True
     return np.ascontiguousarray(np.argwhere(m).astype(np.int32))
 
 
-def _dilate(mask: np.ndarray, r: int) -> np.ndarray:
+def _dilate(mask: np.ndarray, r: int, periodic: bool = False) -> np.ndarray:
     out = mask.copy()
     for _ in range(r):
+        if periodic:  # wrap across the seam in ξ
+            out = out | np.roll(out, 1, axis=0) | np.roll(out, -1, axis=0)
         m = out.copy()
         m[1:, :] |= out[:-1, :]
         m[:-1, :] |= out[1:, :]
@@ -196,6 +202,7 @@ def _minimise(
     max_outer: int = 500,
     inner: int = 1,
     omega: float = 1.9,
+    periodic: bool = False,
 ) -> tuple[bool, int]:
     """Untangle (if needed) then minimise the barrier energy over ``nodes`` in place.
 
@@ -210,7 +217,7 @@ def _minimise(
         e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
         for _outer in range(max_outer):
             for _ in range(inner):
-                d = _kernels.sweep(x, y, nodes, eps, step)
+                d = _kernels.sweep(x, y, nodes, eps, step, 1.0, periodic)
                 sweeps += 1
                 if d <= tol:
                     break
@@ -228,7 +235,7 @@ def _minimise(
         if dmin <= 0.0:
             return False, sweeps
     for _ in range(max_sweeps):
-        d = _kernels.sweep(x, y, nodes, 0.0, step, omega)
+        d = _kernels.sweep(x, y, nodes, 0.0, step, omega, periodic)
         sweeps += 1
         if d <= tol:
             break
@@ -263,9 +270,7 @@ def _failure_message(grid: StructuredGrid, bad: np.ndarray, exempt: list[Boundar
     return msg
 
 
-def _result(
-    grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg
-):
+def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg):
     bad = invalid_cells(x, y, ex_bits)
     ok = ok and not bad.any()
     info = SolveInfo(
@@ -295,9 +300,7 @@ def _result(
 
 
 def _folded(x, y) -> int:
-    a = (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1]) - (x[:-1, 1:] - x[1:, :-1]) * (
-        y[1:, 1:] - y[:-1, :-1]
-    )
+    a = (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1]) - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
     return int((a <= 0).sum())
 
 
@@ -334,8 +337,6 @@ def repair(
         ``+foldfree`` when nodes moved, ``info.message`` says why).
     """
     t0 = time.perf_counter()
-    if grid.periodic:
-        return _periodic_unsupported(grid, t0, strict)
     exempt = block_corner_problems(grid)
     ex_bits = _exempt_bits(grid, exempt)
     x = np.array(grid.x, dtype=np.float64, order="C")
@@ -361,7 +362,7 @@ def repair(
             msg=grid.info.message + exempt_note,
         )
     ni, nj = grid.cells
-    opts = {"tolerance": tolerance, "max_sweeps": max_sweeps}
+    opts = {"tolerance": tolerance, "max_sweeps": max_sweeps, "periodic": grid.periodic}
     x0, y0 = x.copy(), y.copy()
     ok, nfree, total = _patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, **opts)
     how = ""
@@ -379,9 +380,7 @@ def repair(
     if not ok:
         # last resort: the whole block, a full minimisation per ε
         x[...], y[...] = x0, y0
-        ok, nfree, sw = _patches(
-            x, y, bad, ex_bits, radius=max(ni, nj), max_fraction=1.0, inner=10, **opts
-        )
+        ok, nfree, sw = _patches(x, y, bad, ex_bits, radius=max(ni, nj), max_fraction=1.0, inner=10, **opts)
         total += sw
     method = f"{grid.info.method}+foldfree"
     if ok:
@@ -443,6 +442,7 @@ def _patches(
     tolerance: float,
     max_sweeps: int,
     inner: int = 1,
+    periodic: bool = False,
 ) -> tuple[bool, int, int]:
     """Barrier minimisation on patches around ``bad``; the radius doubles on failure.
 
@@ -455,17 +455,25 @@ def _patches(
     total = 0
     nfree = 0
     while True:
-        patch = _dilate(bad, r) if r < max(ni, nj) else np.ones_like(bad)
+        patch = _dilate(bad, r, periodic) if r < max(ni, nj) else np.ones_like(bad)
         if patch.mean() > max_fraction and max_fraction < 1.0:
             return False, nfree, total
-        nodes = _nodes_of(patch, False)
+        nodes = _nodes_of(patch, periodic)
         if nodes.size == 0:
             return False, 0, total
-        cells = _touched_cells(nodes, (ni, nj))
+        cells = _touched_cells(nodes, (ni, nj), periodic)
         h = _median_edge(x, y, cells)
         xs, ys = x.copy(), y.copy()
         ok, sw = _minimise(
-            x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps, inner=inner
+            x,
+            y,
+            nodes,
+            cells,
+            ex_bits,
+            tol=tolerance * h,
+            max_sweeps=max_sweeps,
+            inner=inner,
+            periodic=periodic,
         )
         total += sw
         nfree = len(nodes)
@@ -494,7 +502,7 @@ def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
     ni, nj = grid.cells
     ic = np.unique(np.r_[np.arange(0, ni + 1, 2), ni])
     jc = np.unique(np.r_[np.arange(0, nj + 1, 2), nj])
-    gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)]))
+    gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)], periodic=grid.periodic))
     res = repair(gc, strict=False)
     if not res.ok:
         return None
@@ -535,8 +543,6 @@ def smooth(
     as in :func:`repair`; ``tolerance`` is relative to the median edge length.
     """
     t0 = time.perf_counter()
-    if grid.periodic:
-        return _periodic_unsupported(grid, t0, strict)
     exempt = block_corner_problems(grid)
     ex_bits = _exempt_bits(grid, exempt)
     x = np.array(grid.x, dtype=np.float64, order="C")
@@ -544,8 +550,8 @@ def smooth(
     bad = invalid_cells(x, y, ex_bits)
     before = int(bad.sum())
     folded_before = _folded(x, y)
-    nodes = _nodes_of(np.ones(grid.cells, dtype=bool), False)
-    cells = _touched_cells(nodes, grid.cells) if nodes.size else np.zeros((0, 2), np.int32)
+    nodes = _nodes_of(np.ones(grid.cells, dtype=bool), grid.periodic)
+    cells = _touched_cells(nodes, grid.cells, grid.periodic) if nodes.size else np.zeros((0, 2), np.int32)
     h = _median_edge(x, y, cells) if nodes.size else 0.0
     sw = 0
     ok = True
@@ -557,7 +563,16 @@ def smooth(
         if ok:
             x[...], y[...] = fixed.grid.x, fixed.grid.y
     if ok and nodes.size:
-        ok, sw2 = _minimise(x, y, nodes, cells, ex_bits, tol=tolerance * h, max_sweeps=max_sweeps)
+        ok, sw2 = _minimise(
+            x,
+            y,
+            nodes,
+            cells,
+            ex_bits,
+            tol=tolerance * h,
+            max_sweeps=max_sweeps,
+            periodic=grid.periodic,
+        )
         sw += sw2
     exempt_note = ("; " + "; ".join(c.message for c in exempt)) if exempt else ""
     if ok and not invalid_cells(x, y, ex_bits).any():
@@ -605,9 +620,9 @@ def smooth(
 
 def _median_area(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
     ci, cj = cells[:, 0], cells[:, 1]
-    a = (x[ci + 1, cj + 1] - x[ci, cj]) * (y[ci, cj + 1] - y[ci + 1, cj]) - (
-        x[ci, cj + 1] - x[ci + 1, cj]
-    ) * (y[ci + 1, cj + 1] - y[ci, cj])
+    a = (x[ci + 1, cj + 1] - x[ci, cj]) * (y[ci, cj + 1] - y[ci + 1, cj]) - (x[ci, cj + 1] - x[ci + 1, cj]) * (
+        y[ci + 1, cj + 1] - y[ci, cj]
+    )
     return float(np.median(np.abs(0.5 * a)))
 
 
@@ -616,30 +631,3 @@ def _median_edge(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
     e1 = np.hypot(x[ci + 1, cj] - x[ci, cj], y[ci + 1, cj] - y[ci, cj])
     e2 = np.hypot(x[ci, cj + 1] - x[ci, cj], y[ci, cj + 1] - y[ci, cj])
     return float(np.median(np.concatenate([e1, e2])))
-
-
-def _periodic_unsupported(grid: StructuredGrid, t0: float, strict: bool) -> FoldFreeResult:
-    bad = invalid_cells(grid.x, grid.y)
-    n = int(bad.sum())
-    msg = grid.info.message
-    if n:
-        msg = (
-            f"the periodic (O-grid) block has {n} folded or non-convex cell(s); the fold-free "
-            f"repair does not handle periodic blocks yet: split the ring into blocks"
-        )
-        if strict:
-            raise FoldedGridError(msg)
-        grid = grid.replaced(info=dataclasses.replace(grid.info, converged=False, message=msg))
-    return FoldFreeResult(
-        grid=grid,
-        ok=n == 0,
-        invalid_before=n,
-        folded_before=_folded(grid.x, grid.y),
-        invalid_after=n,
-        exempt=(),
-        free_nodes=0,
-        sweeps=0,
-        elapsed=time.perf_counter() - t0,
-        message=msg,
-        bad_cells=np.argwhere(bad),
-    )

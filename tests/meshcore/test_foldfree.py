@@ -148,6 +148,45 @@ def test_untangles_a_folded_grid():
         np.testing.assert_array_equal(r.grid.border(name), g.border(name))
 
 
+def o_grid(ni=48, nj=12):
+    """Periodic O-grid between an ellipse and a wavy circle (i clockwise: positive Jacobian)."""
+    t = -np.linspace(0, 2 * np.pi, ni + 1)
+    t[-1] = 0.0
+    s = np.linspace(0, 1, nj + 1)
+    r = 3 + 0.6 * np.cos(5 * t)
+    X = 1.5 * np.cos(t)[:, None] * (1 - s) + (r * np.cos(t))[:, None] * s
+    Y = 0.6 * np.sin(t)[:, None] * (1 - s) + (r * np.sin(t))[:, None] * s
+    X[-1], Y[-1] = X[0], Y[0]
+    return X, Y
+
+
+def test_periodic_seam_gradient_matches_reference():
+    x, y = o_grid()
+    x[0, 5] += 0.05
+    x[-1, 5] = x[0, 5]
+    gx, gy = _reference.gradient(x, y, 0.0)
+    out = np.empty(6)
+    assert _kernels.node_local(x, y, 0, 5, x[0, 5], y[0, 5], 0.0, out, True)
+    # the seam node is column 0 and column ni at once
+    assert out[1] == pytest.approx(gx[0, 5] + gx[-1, 5], rel=1e-10)
+    assert out[2] == pytest.approx(gy[0, 5] + gy[-1, 5], rel=1e-10)
+
+
+def test_periodic_grid_is_repaired_across_the_seam():
+    X, Y = o_grid()
+    assert meshcore.quality(meshcore.StructuredGrid(X, Y, periodic=True)).ok
+    X[0, 4:8] += 0.9  # fold cells on both sides of the seam
+    X[-1] = X[0]
+    g = meshcore.StructuredGrid(X, Y, periodic=True)
+    assert meshcore.quality(g).n_folded > 0
+    for r in (repair(g), smooth(g)):
+        assert r.ok and meshcore.quality(r.grid).ok and r.grid.periodic
+        np.testing.assert_array_equal(r.grid.x[0], r.grid.x[-1])
+        np.testing.assert_array_equal(r.grid.y[0], r.grid.y[-1])
+        for name in ("bottom", "top"):
+            np.testing.assert_array_equal(r.grid.border(name), g.border(name))
+
+
 # ----------------------------------------------------------------------- corners
 def test_choose_corners_rectangle_and_orientation():
     pts = np.array([[0, 0], [1, 0], [2, 0], [3, 0], [3, 1], [2, 1], [1, 1], [0, 1]], float)
