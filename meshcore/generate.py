@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -14,7 +15,7 @@ from ._validation import validate_choice, validate_count
 from .algebraic import algebraic_grid
 from .boundary import Borders, borders_from_loop, borders_from_polylines
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve
-from .errors import InvalidInputError
+from .errors import InvalidInputError, MeshcoreWarning
 from .grid import BORDER_NAMES, StructuredGrid
 
 __all__ = ["generate_block", "initial_grid", "prepare_borders"]
@@ -50,7 +51,13 @@ def prepare_borders(
         if any(v is not None for v in (bottom, right, top, left)):
             raise InvalidInputError("give either four borders or loop + corners, not both")
         if corners is None:
-            raise InvalidInputError("a closed loop needs four corner indices (corners=)")
+            raise InvalidInputError(
+                'a closed loop needs four corner indices (corners=) or corners="auto"'
+            )
+        if isinstance(corners, str) and corners == "auto":
+            from .corners import choose_corners
+
+            corners = choose_corners(loop)
         b = borders_from_loop(loop, corners, where=where)
         if periodic:
             raise InvalidInputError("periodic=True needs four borders (left = right is the seam)")
@@ -123,7 +130,8 @@ def generate_block(
         Border polylines in the orientation of :mod:`meshcore.grid` (bottom/top
         left→right, left/right bottom→top).  Alternatively ``loop`` + ``corners``.
     loop : (n, 2) array_like, optional
-        A closed boundary loop; ``corners = (sw, se, ne, nw)`` point indices.
+        A closed boundary loop; ``corners = (sw, se, ne, nw)`` point indices,
+        or ``corners="auto"`` (:func:`meshcore.corners.choose_corners`).
     cells : (ni, nj), optional
         Re-sample each border by the paper's linear spline (or ``curve``),
         uniformly in arc length unless ``borders`` says otherwise.  With
@@ -202,6 +210,15 @@ def generate_block(
     g = solve(g0, cfg, callback=callback, p=p, q=q)
     if foldfree:
         from .foldfree import smooth as _ff_smooth
+
+        if p is not None or q is not None:
+            warnings.warn(
+                'method="foldfree": the source terms P, Q shape only the elliptic start grid; '
+                "the fold-free minimisation has none (the default method keeps them and "
+                "repairs only the invalid cells)",
+                MeshcoreWarning,
+                stacklevel=2,
+            )
 
         return _ff_smooth(g, strict=repair == "strict").grid
     if repair == "off":

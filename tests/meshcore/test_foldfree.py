@@ -244,6 +244,20 @@ def test_reflex_block_corner_is_exempt_and_named():
     assert_valid_except_exempt(g)
 
 
+def test_generate_block_accepts_automatic_corners():
+    loop = load_lake("windermere_sparse")
+    g = meshcore.generate_block(loop=loop, corners="auto", cells=(60, 8))
+    h = meshcore.generate_block(loop=loop, corners=choose_corners(loop), cells=(60, 8))
+    np.testing.assert_array_equal(g.x, h.x)
+
+
+def test_foldfree_method_warns_that_sources_shape_only_the_start():
+    bs = borders_of(*annulus_sector(12, 8))
+    with pytest.warns(meshcore.MeshcoreWarning, match="P, Q"):
+        g = meshcore.generate_block(*bs, method="foldfree", q=0.1)
+    assert meshcore.quality(g).ok
+
+
 # ------------------------------------------------------------------ real lakes
 def _lake_grid(name: str, nodes: int):
     loop = load_lake(name)
