@@ -57,13 +57,60 @@ def best_of(n: int, fn):
     return best, out
 
 
+def figure(path: str) -> None:
+    """Shasta Lake at ~6000 nodes: Winslow (invalid cells in red) and after the repair."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Polygon
+
+    loop = load_lake("shasta_lake")
+    c = choose_corners(loop)
+    cells = cells_for(loop, c, 6000)
+    w = meshcore.generate_block(loop=loop, corners=c, cells=cells, repair="off")
+    g = meshcore.generate_block(loop=loop, corners=c, cells=cells)
+    qw = meshcore.quality(w)
+    fi = qw.folded[0]
+    fx, fy = w.x[fi[0], fi[1]], w.y[fi[0], fi[1]]
+    fig, axs = plt.subplots(2, 2, figsize=(12, 10))
+    for col, gr in enumerate((w, g)):
+        q = meshcore.quality(gr)
+        for row in range(2):
+            ax = axs[row, col]
+            ax.plot(gr.x, gr.y, "k-", lw=0.25)
+            ax.plot(gr.x.T, gr.y.T, "k-", lw=0.25)
+            ax.plot(*np.vstack([loop, loop[:1]]).T, "b-", lw=0.6)
+            for i, j in q.nonconvex:
+                quad = [(gr.x[i + a, j + b], gr.y[i + a, j + b]) for a, b in ((0, 0), (1, 0), (1, 1), (0, 1))]
+                ax.add_patch(Polygon(quad, color="r", alpha=0.6))
+            ax.set_aspect("equal")
+            if row == 0:
+                ax.set_title(f"{gr.method}: {q.n_folded} folded, {q.n_nonconvex} non-convex cells")
+                for k, nm in zip(c, ("sw", "se", "ne", "nw"), strict=True):
+                    ax.annotate(nm, loop[k], color="g", fontsize=12)
+            else:
+                ax.set_xlim(fx - 1500, fx + 1500)
+                ax.set_ylim(fy - 1500, fy + 1500)
+    fig.suptitle(
+        f"Shasta Lake, one block, automatic corners, {cells[0]} × {cells[1]} cells "
+        f"({w.n_nodes} nodes); bottom: zoom on a fold"
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=72)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--nodes", type=int, nargs="+", default=[6000, 24000])
     ap.add_argument("--lakes", nargs="*", default=None)
     ap.add_argument("--shapes-only", action="store_true")
+    ap.add_argument("--figure", metavar="PNG", help="only draw the Shasta figure to PNG")
     args = ap.parse_args()
+    if args.figure:
+        figure(args.figure)
+        return
     if args.shapes_only:
         shapes(args.repeat)
         return
