@@ -26,15 +26,24 @@ Minimise ``E = Σ_cells Σ_corners F/χ(D, ε)`` (see
 
 :func:`repair` applies this to *patches*: the invalid cells dilated by ``r``
 cells, with all other nodes fixed; ``r`` doubles until the patch succeeds or
-is the whole block.  A Winslow grid that folds in a few places is repaired
+covers 30 % of the block.  If that fails, a *multilevel start*: every second
+grid line gives a coarse grid, which is solved (Winslow) and repaired; its
+bilinear prolongation is convex inside every convex coarse cell (iso-lines
+of a bilinear map are straight, so a fine corner Jacobian is the bilinear
+Jacobian times the index steps), and only cells near the finer boundary
+need a local repair.  The last resort is the whole block with a full
+minimisation per ε.  A Winslow grid that folds in a few places is repaired
 at a small fraction of the cost of the elliptic solve.  :func:`smooth`
 minimises over the whole block (``method="foldfree"`` of
-:func:`meshcore.generate_block`).
+:func:`meshcore.generate_block`).  Periodic (O-grid) blocks are supported:
+the seam nodes are free and column ``ni`` follows column 0.
 
-When the whole block cannot be untangled (a narrow arm with too few border
-nodes, a corner on a reflex vertex, …) the functions raise
-:class:`~meshcore.errors.FoldedGridError` naming the cells, their
-coordinates and the fix.
+When no valid grid is found (a narrow arm with too few border nodes, a
+boundary that crosses itself after re-sampling, …) the functions raise
+:class:`~meshcore.errors.FoldedGridError` (``strict=True``, the default) or
+return the best grid with ``converged=False``; the message names the cells,
+their coordinates and the fix.  An invalid grid is never reported as
+converged.
 """
 
 from __future__ import annotations
