@@ -333,6 +333,16 @@ def test_heavily_folded_c_shape_needs_and_gets_the_multilevel_start():
     assert "multilevel" in r.message
 
 
+@pytest.mark.parametrize("cells", [(20, 30), (40, 60)])
+def test_hairpin_slot_is_repaired(cells):
+    # a slot 0.02 wide and 9 long: Winslow folds tens of cells around its end
+    loop = np.array([[0, 0], [10, 0], [10, 2.02], [0, 2.02], [0, 1.02], [9, 1.02], [9, 1], [0, 1]], float)
+    w = meshcore.generate_block(loop=loop, corners=(0, 1, 2, 3), cells=cells, repair="off")
+    assert meshcore.quality(w).n_folded > 10
+    g = meshcore.generate_block(loop=loop, corners=(0, 1, 2, 3), cells=cells)
+    assert g.converged and meshcore.quality(g).ok, g.info.message
+
+
 EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "resources" / "examples").glob("*.toml"))
 
 
