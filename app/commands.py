@@ -210,7 +210,7 @@ class Editor:
     def set_solver(self, merge_key=None, **kw) -> None:
         p = self.doc.project
         s = SolverSettings(
-            **{**{f: getattr(p.solver, f) for f in ("method", "tolerance", "max_iterations", "omega")}, **kw}
+            **{**{f: getattr(p.solver, f) for f in ("method", "tolerance", "max_iterations", "omega", "repair")}, **kw}
         )
         self._push(
             SetSolver,

@@ -112,7 +112,7 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         # long, narrow and curved (a lake, a river): cap both tips instead of box corners
         c = _elongated_corners(p, u)
         if c is not None:
-            return _upright(p, c)
+            return _upright(p, _off_reflex(p, c))
     box = [(u.min(), s.min()), (u.max(), s.min()), (u.max(), s.max()), (u.min(), s.max())]
     # scale-free distance: normalise by the box extents
     su = max(u.max() - u.min(), 1e-300)
@@ -130,7 +130,34 @@ def auto_corners(points: np.ndarray) -> tuple[int, int, int, int]:
         # fall back: keep the SW corner and take the other three in loop order
         others = sorted(chosen[1:], key=lambda k: ((k if ccw else (n - k) % n) - order[0]) % n)
         chosen = [chosen[0], *others]
-    return _upright(p, tuple(chosen))
+    return _upright(p, _off_reflex(p, tuple(chosen)))
+
+
+def _off_reflex(p: np.ndarray, c) -> tuple[int, int, int, int]:
+    """Move corners off reflex vertices (their corner cell could never be convex).
+
+    Uses :func:`meshcore.corners.corner_problems` (which suggests the nearest
+    convex vertex); a move is kept only if the corners stay distinct and in
+    cyclic order.
+    """
+    try:
+        from meshcore.corners import corner_problems
+    except ImportError:  # older meshcore
+        return tuple(int(k) for k in c)  # type: ignore[return-value]
+    c = [int(k) for k in c]
+    n = len(p)
+    for prob in corner_problems(p, c):
+        if prob.suggestion is None:
+            continue
+        k = ("sw", "se", "ne", "nw").index(prob.corner)
+        trial = c.copy()
+        trial[k] = prob.suggestion
+        ccw = _signed_area(p) > 0
+        order = [(t if ccw else (n - t) % n) for t in trial]
+        rel = [(o - order[0]) % n for o in order]
+        if len(set(trial)) == 4 and rel[0] < rel[1] < rel[2] < rel[3]:
+            c = trial
+    return tuple(c)  # type: ignore[return-value]
 
 
 def _upright(p: np.ndarray, c) -> tuple[int, int, int, int]:

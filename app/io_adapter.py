@@ -148,7 +148,14 @@ def block_to_case(b: Block):
 
 def project_from_case(case) -> Project:
     s = case.solver
-    solver = SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega)
+    repair = str(getattr(case, "repair", "auto"))  # "strict" has no meaning in the app: auto
+    solver = SolverSettings(
+        method=s.method,
+        tolerance=s.tolerance,
+        max_iterations=s.max_iterations,
+        omega=s.omega,
+        repair="off" if repair == "off" else "auto",
+    )
     frame = dict(case.extra).get("crs") or {}
     origin = frame.get("origin", (0.0, 0.0))
     return Project(
@@ -175,7 +182,7 @@ def project_to_case(project: Project):
     frame = project_frame(project)
     if frame is not None:
         extra["crs"] = frame.as_dict()
-    return Case(blocks=blocks, title=project.title, solver=solver, extra=extra)
+    return Case(blocks=blocks, title=project.title, solver=solver, extra=extra, repair=s.repair)
 
 
 def load_project(path) -> Project:

@@ -115,7 +115,21 @@ def solve_project(
             grids[k] = fin.value
         if stop_event is not None and stop_event.is_set():
             break
+        grids[k] = _fold_free(grids[k], project.solver)
     return BlockResult(grids=grids, initial=starts)
+
+
+def _fold_free(grid: StructuredGrid, solver) -> StructuredGrid:
+    """The fold-free step of :func:`meshcore.generate_block` (repair, or smooth for "foldfree")."""
+    try:
+        from meshcore import foldfree
+    except ImportError:  # older meshcore
+        return grid
+    if solver.method == "foldfree":
+        return foldfree.smooth(grid, strict=False).grid
+    if solver.repair == "off":
+        return grid
+    return foldfree.repair(grid, strict=False).grid
 
 
 def folded_cells(grid: StructuredGrid) -> np.ndarray:

@@ -59,11 +59,21 @@ class SolverSettings:
     tolerance: float | None = None
     max_iterations: int = 50_000
     omega: float | None = None
+    repair: str = "auto"  # "auto": fold-free repair of invalid cells after the solve; or "off"
 
     def config(self, **kw: Any) -> EllipticConfig:
-        """The :class:`EllipticConfig` (raises InvalidInputError when invalid)."""
+        """The :class:`EllipticConfig` (raises InvalidInputError when invalid).
+
+        ``method="foldfree"`` solves with ``"auto"`` first; the pipeline then
+        minimises the barrier functional (as :func:`meshcore.generate_block` does).
+        """
+        method = "auto" if self.method == "foldfree" else self.method
         return EllipticConfig(
-            method=self.method, tolerance=self.tolerance, max_iterations=self.max_iterations, omega=self.omega, **kw
+            method=method,
+            tolerance=self.tolerance,
+            max_iterations=self.max_iterations,
+            omega=self.omega,
+            **kw,
         )
 
 

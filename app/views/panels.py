@@ -143,9 +143,16 @@ class ParamsPanel(QtWidgets.QScrollArea):
         g = QtWidgets.QGroupBox("Solver")
         f = QtWidgets.QFormLayout(g)
         self.method = QtWidgets.QComboBox()
-        self.method.addItems(["auto", *sorted(METHODS)])
-        self.method.setToolTip("auto = multigrid when available and the grid is large enough, else SOR")
+        self.method.addItems(["auto", *sorted(METHODS), "foldfree"])
+        self.method.setToolTip(
+            "auto = multigrid when available and the grid is large enough, else SOR; "
+            "foldfree = elliptic solve, then fold-free barrier smoothing of the whole block"
+        )
         f.addRow("Method", self.method)
+        self.repair = QtWidgets.QComboBox()
+        self.repair.addItems(["auto", "off"])
+        self.repair.setToolTip("auto: repair folded / non-convex cells after the solve (fold-free barrier method)")
+        f.addRow("Repair folds", self.repair)
         self.tol = QtWidgets.QLineEdit(placeholderText="default (scale-aware)")
         self.tol.setToolTip("relative tolerance: largest Jacobi update ≤ tol · bbox diagonal")
         f.addRow("Tolerance", self.tol)
@@ -173,6 +180,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         for e in (self.first, self.last, self.bname):
             e.editingFinished.connect(self._border_edit)
         self.method.currentTextChanged.connect(lambda s: self._solver(method=s))
+        self.repair.currentTextChanged.connect(lambda s: self._solver(repair=s))
         self.tol.editingFinished.connect(self._solver_text)
         self.omega.editingFinished.connect(self._solver_text)
         self.maxit.valueChanged.connect(lambda v: self._solver(max_iterations=v))
@@ -205,6 +213,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
             self.solver_msg.setText("")
             sv = self.doc.project.solver
             self.method.setCurrentText(sv.method)
+            self.repair.setCurrentText(sv.repair)
             self.tol.setText("" if sv.tolerance is None else f"{sv.tolerance:.6g}")
             self.maxit.setValue(sv.max_iterations)
             self.omega.setText("" if sv.omega is None else f"{sv.omega:.6g}")

@@ -436,3 +436,24 @@ def test_failed_solve_greys_the_old_grid(qtbot, win):
     win.generate()
     wait_idle(qtbot, win)
     assert win.canvas.grid_curve.opts["pen"].color().name() == "#303030"
+
+
+def test_fold_free_repair_setting_round_trips_and_applies(qtbot, win, tmp_path):
+    win.open_example("windermere", confirm=False)
+    win.editor.set_solver(repair="off")
+    win.generate()
+    wait_idle(qtbot, win)
+    raw = win.doc.grid
+    path = tmp_path / "w.toml"
+    assert win._save_to(path)
+    assert win.open_path(path)
+    assert win.doc.project.solver.repair == "off"
+    win.params_panel.repair.setCurrentText("auto")
+    assert win.doc.project.solver.repair == "auto"
+    win.generate()
+    wait_idle(qtbot, win)
+    from meshcore import quality
+
+    assert quality(raw).n_nonconvex >= 1  # Windermere's narrow south arm: one bad cell unrepaired
+    assert quality(win.doc.grid).n_nonconvex == 0
+    assert win.doc.grid.info.method.endswith("+foldfree")
