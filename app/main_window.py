@@ -869,13 +869,6 @@ class MainWindow(QtWidgets.QMainWindow):
 
 
 def _corners(points) -> tuple[int, int, int, int]:
-    """Automatic corners: meshcore.corners when available, else the principal-axis box."""
-    try:
-        from meshcore import corners as mc_corners  # issue 8
-    except ImportError:
-        mc_corners = None
-    fn = getattr(mc_corners, "auto_corners", None) or getattr(mc_corners, "find_corners", None)
-    if fn is not None:
-        res = fn(np.asarray(points))
-        return tuple(int(c) for c in getattr(res, "corners", res))
+    """Automatic corners: :func:`app.geometry.auto_corners` (principal box or tip caps,
+    off reflex vertices via :mod:`meshcore.corners`, bottom kept at the bottom)."""
     return geo.auto_corners(np.asarray(points))
