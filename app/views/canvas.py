@@ -179,6 +179,8 @@ class Canvas(pg.PlotWidget):
         # items are pictures only: every click goes to the ViewBox and so to the tool
         for it in self.getPlotItem().items:
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+        self._label_at: dict[str, tuple[float, float, float]] = {}
+        self._vb.sigRangeChanged.connect(self._place_labels)
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
         doc.project_changed.connect(self.refresh_boundary)
         doc.selection_changed.connect(lambda _: self.refresh_selection())
@@ -205,7 +207,7 @@ class Canvas(pg.PlotWidget):
             if self.tool is not None:
                 self.tool.hover(xy)
 
-    def zoom_to(self, bounds, margin: float = 0.12) -> None:
+    def zoom_to(self, bounds, margin: float = 0.16) -> None:
         if bounds is None:
             return
         x0, y0, x1, y1 = bounds
@@ -271,6 +273,7 @@ class Canvas(pg.PlotWidget):
                 c.setData([], [])
                 a.hide()
                 t.setText("")
+                self._label_at.pop(name, None)
                 continue
             p = borders[name]
             c.setData(p[:, 0], p[:, 1])
@@ -284,8 +287,8 @@ class Canvas(pg.PlotWidget):
             a.setStyle(angle=180.0 - ang)  # ArrowItem points along −x at angle 0, y down in screen
             a.show()
             t.setText(f"{name} · {block.node_count(name)}")
-            t.setPos(x, y)
-            t.setAnchor(self._label_anchor(name))
+            self._label_at[name] = (x, y, ang)
+        self._place_labels()
         disp = pts if block.boundary is None else np.vstack(block.boundary)
         if len(disp):
             self.points_item.setData(disp[:, 0], disp[:, 1])
@@ -311,9 +314,22 @@ class Canvas(pg.PlotWidget):
             self.cut_curve.setData([], [])
         self.refresh_selection()
 
-    @staticmethod
-    def _label_anchor(name: str):
-        return {"bottom": (0.5, -0.6), "top": (0.5, 1.6), "left": (1.1, 0.5), "right": (-0.1, 0.5)}[name]
+    #: outward normal = this sign × the left-hand normal of the border direction
+    #: (bottom/right have the interior on their left, top/left on their right)
+    _OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
+
+    def _place_labels(self, *_args) -> None:
+        """Put each border label just outside the middle of its border (any orientation)."""
+        px = self.pixel()
+        for name, (x, y, ang) in self._label_at.items():
+            a = np.radians(ang)
+            sgn = self._OUTWARD[name]
+            nx, ny = -np.sin(a) * sgn, np.cos(a) * sgn
+            t = self.border_labels[name]
+            r = t.textItem.boundingRect()  # pixels (the text ignores the view transform)
+            off = (8.0 + 0.5 * r.width() * abs(nx) + 0.5 * r.height() * abs(ny)) * px
+            t.setAnchor((0.5, 0.5))
+            t.setPos(x + off * nx, y + off * ny)
 
     def refresh_selection(self) -> None:
         pts = self.doc.block.points
