@@ -29,6 +29,9 @@ BORDER_COLOURS = {
     "left": "#ff7f0e",  # orange
 }
 CORNER_LABELS = ("SW", "SE", "NE", "NW")
+#: outward normal = this sign × the left-hand normal of the border direction
+#: (bottom/right have the interior on their left, top/left on their right)
+_OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
 
 
 class _Scatter(pg.ScatterPlotItem):
@@ -314,16 +317,12 @@ class Canvas(pg.PlotWidget):
             self.cut_curve.setData([], [])
         self.refresh_selection()
 
-    #: outward normal = this sign × the left-hand normal of the border direction
-    #: (bottom/right have the interior on their left, top/left on their right)
-    _OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
-
     def _place_labels(self, *_args) -> None:
         """Put each border label just outside the middle of its border (any orientation)."""
         px = self.pixel()
         for name, (x, y, ang) in self._label_at.items():
             a = np.radians(ang)
-            sgn = self._OUTWARD[name]
+            sgn = _OUTWARD[name]
             nx, ny = -np.sin(a) * sgn, np.cos(a) * sgn
             t = self.border_labels[name]
             r = t.textItem.boundingRect()  # pixels (the text ignores the view transform)
