@@ -457,3 +457,14 @@ def test_fold_free_repair_setting_round_trips_and_applies(qtbot, win, tmp_path):
     assert quality(raw).n_nonconvex >= 1  # Windermere's narrow south arm: one bad cell unrepaired
     assert quality(win.doc.grid).n_nonconvex == 0
     assert win.doc.grid.info.method.endswith("+foldfree")
+
+
+def test_border_labels_sit_outside_their_borders(qtbot, win):
+    win.open_example("bottle-coarse", confirm=False)
+    qtbot.wait(20)
+    c = win.canvas
+    pos = {n: c.border_labels[n].pos() for n in ("bottom", "right", "top", "left")}
+    at = c._label_at  # the middle of each border, where its arrow is
+    assert pos["bottom"].y() < at["bottom"][1] and pos["top"].y() > at["top"][1]
+    assert pos["left"].x() < at["left"][0] and pos["right"].x() > at["right"][0]
+    assert all("·" in c.border_labels[n].textItem.toPlainText() for n in pos)
