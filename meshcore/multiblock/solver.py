@@ -107,6 +107,11 @@ class MultiBlockGrid:
     def __len__(self) -> int:
         return len(self.grids)
 
+    @property
+    def blocks(self) -> tuple[StructuredGrid, ...]:
+        """The block grids (what writers take: ``meshcore.io.write(path, mbgrid)``)."""
+        return self.grids
+
     def __iter__(self) -> Iterator[StructuredGrid]:
         return iter(self.grids)
 
@@ -305,7 +310,7 @@ def solve_multiblock(
             elapsed=time.perf_counter() - t0,
             message="converged" if conv else "a block did not converge",
         )
-        final = [g.replaced(info=g.info) for g in solved]
+        final = [g.replaced(names={**g.names, "block": n}) for g, n in zip(solved, names, strict=True)]
         return MultiBlockGrid(tuple(final), names, topology.interfaces, mode, info, topology)
 
     x, y = _assemble(solved, m)
@@ -327,8 +332,8 @@ def solve_multiblock(
         message=message or ("converged" if conv else f"not converged after {iters} iterations"),
     )
     final = []
-    for g, ids in zip(grids, m.ids, strict=True):
-        final.append(StructuredGrid(x[ids], y[ids], info=info, names=g.names))
+    for g, ids, n in zip(grids, m.ids, names, strict=True):
+        final.append(StructuredGrid(x[ids], y[ids], info=info, names={**g.names, "block": n}))
     return MultiBlockGrid(tuple(final), names, topology.interfaces, mode, info, topology)
 
 

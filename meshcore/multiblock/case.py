@@ -1,0 +1,225 @@
+r"""Multiblock case files: ``[multiblock]``, ``[[interfaces]]`` and ``[outline]``.
+
+Registered with :mod:`meshcore.case` (extra top-level keys and a case
+generator), so ``meshcore generate`` handles multiblock cases.  Two ways to
+describe the blocks:
+
+**Blocks with explicit interfaces** — ordinary ``[[blocks]]`` tables, glued by::
+
+    [multiblock]
+    mode = "smooth"              # smooth (interfaces solved) | frozen (paper: interfaces fixed)
+    start = "frozen"             # smooth mode: start from the frozen solution | algebraic
+
+    [[interfaces]]
+    a = "main.right"             # block.border, optionally a node range: "main.top[4:12]"
+    b = "arm.left"
+    reversed = false             # optional; default: read from the coordinates
+
+**One outline split by cut lines** (the lake workflow, no ``[[blocks]]``)::
+
+    [outline]
+    points = "../lakes/shasta_lake.csv"   # closed shoreline (file or inline [[x, y], ...])
+    crs = "lonlat"               # lonlat: degrees → local equirectangular metres | xy
+    cuts = [[15, 200], [[-122.3, 40.7], [-122.2, 40.8]]]   # outline indices or points
+    snap = 10.0                  # optional snap distance (model units)
+
+    [[outline.blocks]]
+    name = "main"
+    corners = [15, 35, 99, 200]  # sw, se, ne, nw: outline indices or points
+    cells = [48, 13]
+
+Unknown keys are :class:`~meshcore.errors.CaseFileError` naming the key and
+the valid ones.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..case import Case, _check_keys, _points, register_case_generator, register_keys
+from ..elliptic import EllipticConfig
+from ..errors import CaseFileError, InvalidInputError
+from .outline import from_outline, project_lonlat
+from .solver import MODES, MultiBlockGrid, solve_multiblock
+from .topology import Block, Interface, MultiBlockTopology, parse_side
+
+__all__ = ["case_topology", "generate_multiblock_case", "is_multiblock_case"]
+
+MULTIBLOCK_KEYS = {"mode", "start"}
+INTERFACE_KEYS = {"a", "b", "reversed"}
+OUTLINE_KEYS = {"points", "crs", "origin", "cuts", "snap", "blocks"}
+OUTLINE_BLOCK_KEYS = {"name", "corners", "cells", "initial"}
+
+register_keys(top=("multiblock", "interfaces", "outline"))
+
+
+def is_multiblock_case(case: Case) -> bool:
+    return any(k in case.extra for k in ("multiblock", "interfaces", "outline"))
+
+
+def _src(case: Case) -> str:
+    return str(case.path) if case.path else "<case>"
+
+
+def _settings(case: Case) -> tuple[str, str]:
+    src = _src(case)
+    mb = case.extra.get("multiblock", {})
+    if not isinstance(mb, Mapping):
+        raise CaseFileError(f"{src}: [multiblock] must be a table")
+    _check_keys(mb, MULTIBLOCK_KEYS, f"{src}: [multiblock]")
+    mode = str(mb.get("mode", "smooth"))
+    if mode not in MODES:
+        raise CaseFileError(f"{src}: [multiblock] mode must be one of {', '.join(MODES)}, got {mode!r}")
+    start = str(mb.get("start", "frozen"))
+    if start not in ("frozen", "algebraic"):
+        raise CaseFileError(f"{src}: [multiblock] start must be frozen or algebraic, got {start!r}")
+    return mode, start
+
+
+def _outline_point(v: Any, where: str) -> Any:
+    if isinstance(v, int) and not isinstance(v, bool):
+        return v
+    if isinstance(v, list) and len(v) == 2 and all(isinstance(e, (int, float)) for e in v):
+        return [float(e) for e in v]
+    raise CaseFileError(f"{where}: expected an outline point index or an [x, y] pair, got {v!r}")
+
+
+def _outline_topology(case: Case) -> MultiBlockTopology:
+    src = _src(case)
+    base = case.path.parent if case.path else None
+    tbl = case.extra["outline"]
+    where = f"{src}: [outline]"
+    if not isinstance(tbl, Mapping):
+        raise CaseFileError(f"{where} must be a table")
+    _check_keys(tbl, OUTLINE_KEYS, where)
+    if case.blocks:
+        raise CaseFileError(
+            f"{src}: an [outline] case defines its blocks in [[outline.blocks]]; remove [[blocks]]"
+        )
+    for key in ("points", "cuts", "blocks"):
+        if key not in tbl:
+            raise CaseFileError(f"{where}: missing key {key!r}")
+    pts = _points(tbl["points"], base, f"{where} points")
+    crs = str(tbl.get("crs", "xy"))
+    if crs not in ("xy", "lonlat"):
+        raise CaseFileError(f"{where}: crs must be 'xy' or 'lonlat', got {crs!r}")
+    cuts_raw = tbl["cuts"]
+    if not isinstance(cuts_raw, list) or not cuts_raw:
+        raise CaseFileError(f"{where}: cuts must be a list of polylines")
+    cuts = []
+    for k, c in enumerate(cuts_raw):
+        if not isinstance(c, list) or len(c) < 2:
+            raise CaseFileError(f"{where}: cut {k} must list at least two points")
+        cuts.append([_outline_point(v, f"{where}: cut {k}") for v in c])
+    blocks_raw = tbl["blocks"]
+    if not isinstance(blocks_raw, list) or not blocks_raw:
+        raise CaseFileError(f"{where}: needs [[outline.blocks]] tables")
+    blocks = []
+    for k, b in enumerate(blocks_raw):
+        bw = f"{src}: [[outline.blocks]] #{k + 1}"
+        if not isinstance(b, Mapping):
+            raise CaseFileError(f"{bw}: expected a table")
+        _check_keys(b, OUTLINE_BLOCK_KEYS, bw)
+        for key in ("name", "corners", "cells"):
+            if key not in b:
+                raise CaseFileError(f"{bw}: missing key {key!r}")
+        corners = b["corners"]
+        if not isinstance(corners, list) or len(corners) != 4:
+            raise CaseFileError(f"{bw}: corners must be 4 points (sw, se, ne, nw)")
+        blocks.append({
+            "name": str(b["name"]),
+            "corners": [_outline_point(v, f"{bw}: corners") for v in corners],
+            "cells": list(b["cells"]),
+            "initial": str(b.get("initial", "tfi")),
+        })
+    if crs == "lonlat":
+        origin = tbl.get("origin")
+        xy, org = project_lonlat(pts, origin=tuple(origin) if origin is not None else None)
+
+        def proj(v: Any) -> Any:
+            return v if isinstance(v, int) else project_lonlat([v], origin=org)[0][0].tolist()
+
+        cuts = [[proj(v) for v in c] for c in cuts]
+        for b in blocks:
+            b["corners"] = [proj(v) for v in b["corners"]]
+    else:
+        xy = pts
+    snap = tbl.get("snap")
+    try:
+        return from_outline(xy, cuts=cuts, blocks=blocks, snap=snap).topology
+    except InvalidInputError as exc:
+        raise type(exc)(f"{src}: {exc}") from None
+
+
+def _interface_topology(case: Case) -> MultiBlockTopology:
+    from ..generate import prepare_borders
+
+    src = _src(case)
+    raw = case.extra.get("interfaces", [])
+    if not isinstance(raw, list):
+        raise CaseFileError(f"{src}: interfaces must be an array of tables [[interfaces]]")
+    blocks = []
+    for b in case.blocks:
+        kw = b.generate_kwargs()
+        kw.pop("weights")
+        kw.pop("initial")
+        try:
+            bd = prepare_borders(**kw, where=f"block {b.name!r}")
+        except InvalidInputError as exc:
+            raise type(exc)(f"{src}: {exc}") from None
+        names = {k: s.name for k, s in b.border_specs.items() if s.name}
+        blocks.append(Block(b.name, bd, initial=b.initial, weights=b.weights, names=names))
+    itfs = []
+    for k, t in enumerate(raw):
+        where = f"{src}: [[interfaces]] #{k + 1}"
+        if not isinstance(t, Mapping):
+            raise CaseFileError(f"{where}: expected a table")
+        _check_keys(t, INTERFACE_KEYS, where)
+        if "a" not in t or "b" not in t:
+            raise CaseFileError(f"{where}: needs a = 'block.border' and b = 'block.border'")
+        rev = t.get("reversed")
+        if rev is not None and not isinstance(rev, bool):
+            raise CaseFileError(f"{where}: reversed must be true or false")
+        try:
+            itfs.append(Interface(parse_side(str(t["a"])), parse_side(str(t["b"])), rev))
+        except InvalidInputError as exc:
+            raise type(exc)(f"{where}: {exc}") from None
+    try:
+        return MultiBlockTopology(tuple(blocks), tuple(itfs))
+    except InvalidInputError as exc:
+        raise type(exc)(f"{src}: {exc}") from None
+
+
+def case_topology(case: Case) -> MultiBlockTopology:
+    """The validated topology of a multiblock case."""
+    _settings(case)
+    if "outline" in case.extra:
+        return _outline_topology(case)
+    return _interface_topology(case)
+
+
+def generate_multiblock_case(
+    case: Case,
+    *,
+    callback: Callable[..., Any] | None = None,
+    config: EllipticConfig | None = None,
+) -> MultiBlockGrid:
+    """Generate a multiblock case (the hook :func:`meshcore.case.generate_case` calls)."""
+    del callback  # progress snapshots are per block; the multiblock solve reports at the end
+    mode, start = _settings(case)
+    topo = case_topology(case)
+    return solve_multiblock(topo, mode=mode, start=start, config=config or case.solver)
+
+
+def load_points_lonlat(path: str | Path) -> np.ndarray:
+    """Read a lon/lat point file and project it (convenience for scripts)."""
+    from ..io import read_points
+
+    return project_lonlat(read_points(path))[0]
+
+
+register_case_generator(is_multiblock_case, generate_multiblock_case)
