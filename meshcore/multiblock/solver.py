@@ -13,7 +13,14 @@ r"""Solve a multiblock grid: ``frozen`` or ``smooth`` interfaces.
     cross interfaces without kinks.  Nodes where 3, 5, … blocks meet get a
     Laplacian update over their ring of edge neighbours (documented in
     :mod:`._kernels`).  The iteration is SOR over an explicit neighbour table
-    (numba, :func:`._kernels.table_sweep`).  By default it starts from the
+    (numba, :func:`._kernels.table_sweep`).  Two engines give the same
+    iterates' fixed point: ``engine="blocks"`` (default) sweeps each block's
+    interior with the single-block kernel :func:`meshcore.elliptic._kernels.sweep4`
+    on the block's own array, then the border nodes with the table kernel, and
+    exchanges the values next to the borders after every sweep (a
+    block-Schwarz/Gauss–Seidel iteration with a one-node overlap);
+    ``engine="table"`` sweeps every node through the neighbour table (about
+    2× slower per sweep, measured in ``benchmarks/multiblock.py``).  By default it starts from the
     ``frozen`` solution (``start="frozen"``): the blocks are first solved
     separately with the fast single-block solver, so the global sweeps only
     have to relax the difference near the interfaces.  (This is one
@@ -250,6 +257,7 @@ def solve_multiblock(
     config: EllipticConfig | None = None,
     initial: list[StructuredGrid] | None = None,
     start: str = "frozen",
+    engine: str = "blocks",
     callback: Callable[[int, float], Any] | None = None,
     **overrides: Any,
 ) -> MultiBlockGrid:
@@ -269,6 +277,9 @@ def solve_multiblock(
     start : {"frozen", "algebraic"}
         ``smooth`` mode only: start the global iteration from the frozen
         solution (fast) or from the algebraic grids.
+    engine : {"blocks", "table"}
+        ``smooth`` mode only: block sweeps with border exchange, or one sweep
+        over the global neighbour table (see module docstring).
     callback : callable, optional
         ``callback(iteration, relative_residual)`` after each residual check
         of the smooth iteration; return ``"stop"`` to stop.
@@ -280,6 +291,7 @@ def solve_multiblock(
     """
     mode = validate_choice(mode, MODES, name="mode")
     start = validate_choice(start, ("frozen", "algebraic"), name="start")
+    engine = validate_choice(engine, ("blocks", "table"), name="engine")
     cfg = config or EllipticConfig()
     if overrides:
         try:
@@ -319,10 +331,10 @@ def solve_multiblock(
     n_big = max(max(g.shape) for g in grids)
     tol_rel = cfg.tolerance if cfg.tolerance is not None else default_tolerance((n_big, n_big))
     tol = tol_rel * length
-    iters, r, history, message = _smooth_sor(x, y, m, cfg, tol, callback)
+    iters, r, history, message = _smooth_sor(x, y, m, cfg, tol, callback, engine)
     conv = r <= tol * (1 + 1e-12)
     info = SolveInfo(
-        method="smooth/table-sor" + ("+frozen-start" if start == "frozen" else ""),
+        method=f"smooth/{engine}-sor" + ("+frozen-start" if start == "frozen" else ""),
         converged=conv,
         iterations=iters,
         residual=r / length,
@@ -337,42 +349,141 @@ def solve_multiblock(
     return MultiBlockGrid(tuple(final), names, topology.interfaces, mode, info, topology)
 
 
-def _smooth_sor(x, y, m, cfg: EllipticConfig, tol: float, callback) -> tuple[int, float, list, str]:
-    args = (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring)
+class _TableEngine:
+    """Every free node through the global neighbour table."""
+
+    def __init__(self, x, y, m) -> None:
+        self.x, self.y = x, y
+        self.args = (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring)
+
+    def sweep(self, omega: float) -> float:
+        return float(_kernels.table_sweep(self.x, self.y, *self.args, omega))
+
+    def residual(self) -> float:
+        return float(_kernels.table_residual(self.x, self.y, *self.args))
+
+    def save(self):
+        return (self.x.copy(), self.y.copy())
+
+    def restore(self, saved) -> None:
+        self.x[...] = saved[0]
+        self.y[...] = saved[1]
+
+    def finish(self) -> None:
+        pass
+
+
+class _BlockEngine:
+    """Block interiors with the single-block kernel, border nodes with the table.
+
+    One sweep: (1) ``sweep4`` on each block's own array (its frame fixed);
+    (2) copy each block's first interior ring — the only interior values a
+    border stencil reads — into the global array; (3) table sweep over the
+    free border nodes; (4) copy the border values back into the block frames.
+    """
+
+    def __init__(self, x, y, m) -> None:
+        from ..elliptic import _kernels as bk
+
+        self.bk = bk
+        self.x, self.y = x, y
+        self.e = np.zeros((0, 0))
+        k0 = m.n_interior
+        self.args = (m.nodes[k0:], m.nbr[k0:], m.irr_nodes, m.irr_ptr, m.irr_ring)
+        self.bx = [np.ascontiguousarray(x[ids]) for ids in m.ids]
+        self.by = [np.ascontiguousarray(y[ids]) for ids in m.ids]
+        needed = np.zeros(m.n_nodes, dtype=bool)
+        needed[self.args[1].ravel()] = True
+        needed[m.irr_ring] = True
+        self.ring, self.frame = [], []
+        for ids in m.ids:
+            flat = ids.ravel()
+            inner = np.zeros(ids.shape, dtype=bool)
+            inner[1:-1, 1:-1] = True
+            li = np.flatnonzero(inner.ravel() & needed[flat])
+            self.ring.append((li, flat[li]))
+            fr = np.flatnonzero(~inner.ravel())
+            self.frame.append((fr, flat[fr]))
+        self.ids = m.ids
+
+    def sweep(self, omega: float) -> float:
+        d = 0.0
+        for bx, by, (li, gi) in zip(self.bx, self.by, self.ring, strict=True):
+            if bx.shape[0] > 2 and bx.shape[1] > 2:
+                d = max(d, self.bk.sweep4(bx, by, self.e, self.e, omega, False))
+            self.x[gi] = bx.reshape(-1)[li]
+            self.y[gi] = by.reshape(-1)[li]
+        d = max(d, float(_kernels.table_sweep(self.x, self.y, *self.args, omega)))
+        for bx, by, (fr, gf) in zip(self.bx, self.by, self.frame, strict=True):
+            bx.reshape(-1)[fr] = self.x[gf]
+            by.reshape(-1)[fr] = self.y[gf]
+        return d
+
+    def residual(self) -> float:
+        r = float(_kernels.table_residual(self.x, self.y, *self.args))
+        for bx, by in zip(self.bx, self.by, strict=True):
+            r = max(r, float(self.bk.jacobi_residual(bx, by, self.e, self.e, False)))
+        return r
+
+    def save(self):
+        return ([b.copy() for b in self.bx], [b.copy() for b in self.by], self.x.copy(), self.y.copy())
+
+    def restore(self, saved) -> None:
+        for b, s in zip(self.bx, saved[0], strict=True):
+            b[...] = s
+        for b, s in zip(self.by, saved[1], strict=True):
+            b[...] = s
+        self.x[...] = saved[2]
+        self.y[...] = saved[3]
+
+    def finish(self) -> None:
+        for bx, by, ids in zip(self.bx, self.by, self.ids, strict=True):
+            self.x[ids] = bx
+            self.y[ids] = by
+
+
+def _smooth_sor(
+    x, y, m, cfg: EllipticConfig, tol: float, callback, engine: str = "blocks"
+) -> tuple[int, float, list, str]:
+    eng = _BlockEngine(x, y, m) if engine == "blocks" else _TableEngine(x, y, m)
+    try:
+        return _sor_loop(eng, m, cfg, tol, callback)
+    finally:
+        eng.finish()
+
+
+def _sor_loop(eng, m, cfg: EllipticConfig, tol: float, callback) -> tuple[int, float, list, str]:
     n_eff = max(math.sqrt(2.0 * max(m.n_nodes, 4)), 2.0)
     omega = cfg.omega if cfg.omega is not None else 2.0 / (1.0 + math.sin(math.pi / n_eff))
     auto = cfg.omega is None
-    r = float(_kernels.table_residual(x, y, *args))
+    r = eng.residual()
     history = [(0, r)]
     if r <= tol:
         return 0, r, history, ""
     best = r
-    saved = (x.copy(), y.copy())
+    saved = eng.save()
     check_every, since, message = 1, 0, ""
     it = 0
     for it in range(1, cfg.max_iterations + 1):
-        d = _kernels.table_sweep(x, y, *args, omega) / omega
+        d = eng.sweep(omega) / omega
         since += 1
         if not math.isfinite(d) or since >= check_every or d < 4.0 * tol:
             since = 0
-            r = float(_kernels.table_residual(x, y, *args)) if math.isfinite(d) else math.inf
+            r = eng.residual() if math.isfinite(d) else math.inf
             history.append((it, r))
             if callback is not None and callback(it, r) == "stop":
                 return it, r, history, "stopped"
             if r <= tol:
                 return it, r, history, ""
             if not math.isfinite(r) or r > 1e3 * best:
-                x[...] = saved[0]
-                y[...] = saved[1]
+                eng.restore(saved)
                 if not auto and omega <= 1.0:
-                    return it, float(_kernels.table_residual(x, y, *args)), history, "diverged"
+                    return it, eng.residual(), history, "diverged"
                 omega = 1.0 + 0.5 * (omega - 1.0) if omega > 1.05 else 0.7 * omega
                 message = f"omega reduced to {omega:.3f}"
                 check_every = 1
             elif r < best:
                 best = r
-                saved[0][...] = x
-                saved[1][...] = y
+                saved = eng.save()
                 check_every = min(2 * check_every, 32)
-    r = float(_kernels.table_residual(x, y, *args))
-    return it, r, history, message
+    return it, eng.residual(), history, message

@@ -181,7 +181,7 @@ class NodeMap:
     ids: tuple[np.ndarray, ...]  # per block, (ni+1, nj+1) global ids
     boundary: np.ndarray  # bool (n_nodes,): on the outer boundary (fixed)
     shared: np.ndarray  # bool (n_nodes,): in more than one block
-    nodes: np.ndarray  # int64 (m,): free regular nodes in sweep order
+    nodes: np.ndarray  # int64 (m,): free regular nodes in sweep order (block interiors first)
     nbr: np.ndarray  # int64 (m, 8): E, W, N, S, NE, NW, SE, SW
     irr_nodes: np.ndarray
     irr_ptr: np.ndarray
@@ -189,6 +189,7 @@ class NodeMap:
     corners: tuple[Corner, ...]
     cells: np.ndarray  # int64 (n_cells, 4) CCW corner ids
     cell_block: np.ndarray  # int32 (n_cells,): block index of each cell
+    n_interior: int = 0  # nodes[:n_interior] are block-interior nodes, the rest lie on borders
 
 
 def _union_find(n: int) -> tuple[np.ndarray, Any, Any]:
@@ -540,6 +541,7 @@ class MultiBlockTopology:
                     free=not bool(boundary[n]),
                 )
             )
+        n_interior = int(sum(len(c) for c in nodes_l))
         if reg_n:
             nodes_l.append(np.array(reg_n, dtype=np.int64))
             nbr_l.append(np.array(reg_nb, dtype=np.int64))
@@ -558,6 +560,7 @@ class MultiBlockTopology:
             corners=tuple(sorted(corners, key=lambda c: c.node)),
             cells=cells,
             cell_block=cell_block,
+            n_interior=n_interior,
         )
 
     def _node_owners(self, n: int, ids: Iterable[np.ndarray]) -> tuple[str, ...]:

@@ -99,10 +99,12 @@ def assert_glued(mb) -> None:
 
 
 # ------------------------------------------------ equivalence with one block
-@pytest.mark.parametrize("start", ["algebraic", "frozen"])
-def test_two_blocks_smooth_equals_single_block(rect, start):
+@pytest.mark.parametrize(("start", "engine"), [("algebraic", "blocks"), ("frozen", "blocks"),
+                                               ("algebraic", "table")])
+def test_two_blocks_smooth_equals_single_block(rect, start, engine):
     X, Y, ref = rect
-    mb = solve_multiblock(two_blocks(X, Y, 10), mode="smooth", tolerance=TIGHT, start=start)
+    mb = solve_multiblock(two_blocks(X, Y, 10), mode="smooth", tolerance=TIGHT, start=start,
+                          engine=engine)
     assert mb.converged
     size = ref.size
     d = max(
@@ -115,12 +117,13 @@ def test_two_blocks_smooth_equals_single_block(rect, start):
     assert np.hypot(mb["a"].x[-1] - X[10], mb["a"].y[-1] - Y[10]).max() > 1e-3 * size
 
 
-def test_four_blocks_smooth_equals_single_block(rect):
+@pytest.mark.parametrize("engine", ["blocks", "table"])
+def test_four_blocks_smooth_equals_single_block(rect, engine):
     X, Y, ref = rect
     topo = four_blocks(X, Y, 14, 5)
     (corner,) = topo.node_map.corners  # the node where four blocks meet
     assert corner.valence == 4 and corner.free and len(corner.blocks) == 4
-    mb = solve_multiblock(topo, mode="smooth", tolerance=TIGHT)
+    mb = solve_multiblock(topo, mode="smooth", tolerance=TIGHT, engine=engine)
     assert mb.converged
     d = 0.0
     for name, sl in (("sw", np.s_[:15, :6]), ("se", np.s_[14:, :6]),
@@ -206,8 +209,9 @@ def star(k: int, n: int = 8):
     return MultiBlockTopology(tuple(blocks), tuple(itfs))
 
 
+@pytest.mark.parametrize("engine", ["blocks", "table"])
 @pytest.mark.parametrize("k", [3, 5])
-def test_irregular_corner_of_k_blocks(k):
+def test_irregular_corner_of_k_blocks(k, engine):
     topo = star(k)
     m = topo.node_map
     (corner,) = [c for c in m.corners if c.free]
@@ -221,7 +225,8 @@ def test_irregular_corner_of_k_blocks(k):
         x, y = np.array(g.x), np.array(g.y)
         x[1:-1, 1:-1] += 0.05
         shifted.append(meshcore.StructuredGrid(x, y))
-    mb = solve_multiblock(topo, mode="smooth", tolerance=1e-11, initial=shifted, start="algebraic")
+    mb = solve_multiblock(topo, mode="smooth", tolerance=1e-11, initial=shifted, start="algebraic",
+                          engine=engine)
     assert mb.converged
     assert_glued(mb)
     centre = mb["q0"].x[0, 0], mb["q0"].y[0, 0]
