@@ -8,7 +8,7 @@ describe the blocks:
 
     [multiblock]
     mode = "smooth"              # smooth (interfaces solved) | frozen (paper: interfaces fixed)
-    start = "frozen"             # smooth mode: start from the frozen solution | algebraic
+    start = "algebraic"          # smooth mode: start from the algebraic grids | frozen solution
 
     [[interfaces]]
     a = "main.right"             # block.border, optionally a node range: "main.top[4:12]"
@@ -40,14 +40,23 @@ from typing import Any
 
 import numpy as np
 
-from ..case import Case, _check_keys, _points, register_case_generator, register_keys
+from ..boundary import BorderSpec
+from ..case import (
+    BlockCase,
+    Case,
+    _check_keys,
+    _points,
+    register_case_generator,
+    register_keys,
+)
 from ..elliptic import EllipticConfig
 from ..errors import CaseFileError, InvalidInputError
+from ..grid import BORDER_NAMES
 from .outline import from_outline, project_lonlat
 from .solver import MODES, MultiBlockGrid, solve_multiblock
 from .topology import Block, Interface, MultiBlockTopology, parse_side
 
-__all__ = ["case_topology", "generate_multiblock_case", "is_multiblock_case"]
+__all__ = ["case_topology", "generate_multiblock_case", "is_multiblock_case", "topology_case"]
 
 MULTIBLOCK_KEYS = {"mode", "start"}
 INTERFACE_KEYS = {"a", "b", "reversed"}
@@ -74,7 +83,7 @@ def _settings(case: Case) -> tuple[str, str]:
     mode = str(mb.get("mode", "smooth"))
     if mode not in MODES:
         raise CaseFileError(f"{src}: [multiblock] mode must be one of {', '.join(MODES)}, got {mode!r}")
-    start = str(mb.get("start", "frozen"))
+    start = str(mb.get("start", "algebraic"))
     if start not in ("frozen", "algebraic"):
         raise CaseFileError(f"{src}: [multiblock] start must be frozen or algebraic, got {start!r}")
     return mode, start
@@ -213,6 +222,45 @@ def generate_multiblock_case(
     mode, start = _settings(case)
     topo = case_topology(case)
     return solve_multiblock(topo, mode=mode, start=start, config=config or case.solver)
+
+
+def topology_case(
+    topology: MultiBlockTopology,
+    *,
+    mode: str = "smooth",
+    title: str = "",
+    description: str = "",
+    solver: EllipticConfig | None = None,
+) -> Case:
+    """A case with explicit blocks (their boundary nodes) and ``[[interfaces]]``.
+
+    This writes the block connectivity into the case file: e.g. an
+    ``[outline]`` case's derived blocks and shared borders become explicit
+    ``[[blocks]]`` + ``[[interfaces]]`` entries (node ranges and orientation),
+    which :func:`meshcore.case.load_case` reads back to the same grid.
+    """
+    if mode not in MODES:
+        raise InvalidInputError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    blocks = []
+    for b in topology.blocks:
+        specs = {n: BorderSpec(name=v) for n, v in b.names.items() if n in BORDER_NAMES and v}
+        blocks.append(BlockCase(
+            name=b.name, cells=None, weights=tuple(b.weights), initial=b.initial,
+            borders={n: np.asarray(b.borders[n]) for n in BORDER_NAMES}, border_specs=specs,
+        ))
+    itfs = [
+        {
+            "a": f"{i.a.block}.{i.a.border}[{i.a.start}:{i.a.stop}]",
+            "b": f"{i.b.block}.{i.b.border}[{i.b.start}:{i.b.stop}]",
+            "reversed": bool(i.reversed),
+        }
+        for i in topology.interfaces
+    ]
+    return Case(
+        blocks=tuple(blocks), title=title, description=description,
+        solver=solver or EllipticConfig(),
+        extra={"multiblock": {"mode": mode}, "interfaces": itfs},
+    )
 
 
 def load_points_lonlat(path: str | Path) -> np.ndarray:

@@ -20,11 +20,14 @@ r"""Solve a multiblock grid: ``frozen`` or ``smooth`` interfaces.
     exchanges the values next to the borders after every sweep (a
     block-Schwarz/Gauss–Seidel iteration with a one-node overlap);
     ``engine="table"`` sweeps every node through the neighbour table (about
-    2× slower per sweep, measured in ``benchmarks/multiblock.py``).  By default it starts from the
-    ``frozen`` solution (``start="frozen"``): the blocks are first solved
-    separately with the fast single-block solver, so the global sweeps only
-    have to relax the difference near the interfaces.  (This is one
-    block-Schwarz step followed by global SOR.)
+    2× slower per sweep, measured in ``benchmarks/multiblock.py``).
+
+    The iteration starts from the algebraic grids (``start="algebraic"``,
+    default) or from the ``frozen`` solution (``start="frozen"``: the blocks
+    are first solved separately with the single-block solver — multigrid when
+    registered — and the global sweeps then relax the rest).  With SOR as the
+    block solver the frozen start saved no time in the benchmark, because the
+    slowest error modes span the whole domain either way.
 
 Stopping rule: the single-block one (largest point-Jacobi displacement ≤
 ``tolerance × L``, L = bounding-box diagonal of the whole domain).
@@ -256,7 +259,7 @@ def solve_multiblock(
     mode: str = "smooth",
     config: EllipticConfig | None = None,
     initial: list[StructuredGrid] | None = None,
-    start: str = "frozen",
+    start: str = "algebraic",
     engine: str = "blocks",
     callback: Callable[[int, float], Any] | None = None,
     **overrides: Any,
@@ -274,9 +277,9 @@ def solve_multiblock(
         global smooth iteration, and the whole config to the per-block solves.
     initial : list of StructuredGrid, optional
         Start grids per block (default: each block's algebraic grid).
-    start : {"frozen", "algebraic"}
-        ``smooth`` mode only: start the global iteration from the frozen
-        solution (fast) or from the algebraic grids.
+    start : {"algebraic", "frozen"}
+        ``smooth`` mode only: start the global iteration from the algebraic
+        grids or from the frozen solution.
     engine : {"blocks", "table"}
         ``smooth`` mode only: block sweeps with border exchange, or one sweep
         over the global neighbour table (see module docstring).

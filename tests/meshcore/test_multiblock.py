@@ -620,3 +620,20 @@ def test_vtm_writer_read_by_vtk(tmp_path, rect):
         assert pt[:2] == pytest.approx((g.x[1, 1], g.y[1, 1]), abs=0)
     rep = write_report(tmp_path / "rect.txt", mb).read_text(encoding="utf-8")
     assert "sw.right nodes 0…5" in rep and "max adjacent-cell size ratio across" in rep
+
+
+def test_connectivity_case_round_trip(tmp_path, shasta_topology):
+    """The derived blocks + interfaces saved as an explicit case give the same grid."""
+    from meshcore.case import generate_case, load_case, save_case
+    from meshcore.multiblock.case import topology_case
+
+    case = topology_case(shasta_topology, title="Shasta, explicit connectivity")
+    p = save_case(case, tmp_path / "explicit.toml")
+    text = p.read_text(encoding="utf-8")
+    assert text.count("[[interfaces]]") == len(shasta_topology.interfaces)
+    assert 'a = "main.top[' in text or 'b = "main.top[' in text
+    again = generate_case(load_case(p))
+    direct = solve_multiblock(shasta_topology)
+    assert again.names == direct.names
+    for g, h in zip(again, direct, strict=True):
+        assert np.array_equal(g.x, h.x) and np.array_equal(g.y, h.y)
