@@ -637,3 +637,27 @@ def test_connectivity_case_round_trip(tmp_path, shasta_topology):
     assert again.names == direct.names
     for g, h in zip(again, direct, strict=True):
         assert np.array_equal(g.x, h.x) and np.array_equal(g.y, h.y)
+
+
+def test_from_outline_cut_ending_on_another_cut():
+    # a vertical cut across the lake, and a second cut from the west shore that ends on it
+    ring = np.array([[0, 0], [4, 0], [4, 2], [0, 2]], float)
+    cuts = [[[2, 0], [2, 2]], [[0, 1.0], [2.0 + 1e-4, 1.1]]]  # ends (within snap) on cut 0
+    blocks = [
+        {"name": "sw", "corners": [[0, 0], [2, 0], [2, 1.1], [0, 1]], "cells": [6, 3]},
+        {"name": "nw", "corners": [[0, 1], [2, 1.1], [2, 2], [0, 2]], "cells": [6, 3]},
+        {"name": "east", "corners": [[2, 0], [4, 0], [4, 2], [2, 2]], "cells": [6, 6]},
+    ]
+    ob = from_outline(ring, cuts=cuts, blocks=blocks, snap=1e-3)
+    topo = ob.topology
+    # the snapped end is exactly on cut 0 and is a node of all three blocks
+    (t,) = [c for c in topo.node_map.corners if len(c.blocks) == 3]
+    assert t.point == (2.0, 1.1) and t.valence == 4 and t.free
+    east_parts = sorted((s.start, s.stop) for i in topo.interfaces for s in (i.a, i.b)
+                        if s.block == "east")
+    assert east_parts == [(0, 3), (3, 6)]  # east.left is split at the T point
+    mb = solve_multiblock(topo)
+    assert mb.converged and mb.quality().n_folded == 0
+    assert_glued(mb)
+    # the T node moved along with the solution (it is solved like an interior node)
+    assert abs(mb["east"].y[0, 3] - 1.1) > 1e-3
