@@ -191,7 +191,7 @@ def lake(repeat: int, quick: bool) -> None:
         for label, kw in (
             ("smooth, blocks engine, frozen start", {"mode": "smooth", "start": "frozen"}),
             ("smooth, blocks engine, algebraic start", {"mode": "smooth", "start": "algebraic"}),
-            ("smooth, table engine, frozen start", {"mode": "smooth", "engine": "table"}),
+            ("smooth, table engine, algebraic start", {"mode": "smooth", "engine": "table"}),
             ("frozen (blocks solved separately)", {"mode": "frozen"}),
         ):
             t, mb = best(lambda kw=kw, tol=tol, topo=topo: solve_multiblock(topo, tolerance=tol, **kw),

@@ -661,3 +661,19 @@ def test_from_outline_cut_ending_on_another_cut():
     assert_glued(mb)
     # the T node moved along with the solution (it is solved like an interior node)
     assert abs(mb["east"].y[0, 3] - 1.1) > 1e-3
+
+
+def test_confluence_case_three_blocks_meet_at_the_centre():
+    from meshcore.case import generate_case, load_case
+
+    mb = generate_case(load_case(EXAMPLES / "confluence-multiblock.toml"))
+    assert mb.converged and mb.quality().n_folded == 0
+    assert_glued(mb)
+    corners = [c for c in mb.topology.node_map.corners if c.free and c.valence == 3]
+    assert len(corners) == 1 and corners[0].point == (0.0, 0.0)
+    # the centre stays at the centre, and the arms are rotations of each other by 120°
+    g = mb["junction-ne"]
+    assert math.hypot(g.x[0, 0], g.y[0, 0]) < 1e-5
+    a = -2.0 * np.pi / 3.0
+    n, se = mb["north"], mb["southeast"]
+    assert np.abs(math.cos(a) * n.x - math.sin(a) * n.y - se.x).max() < 1e-4
