@@ -79,3 +79,16 @@ __all__ = [
     "tfi",
     "weighted_average",
 ]
+
+
+# Readers/writers are re-exported lazily so that ``import meshcore`` stays light
+# (meshcore.io imports nothing heavy either, but keeps optional readers out).
+_LAZY_IO = {"read_points", "read_grid", "read_blocks", "write", "PointSet", "GridSet"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY_IO:
+        from . import io as _io
+
+        return getattr(_io, name)
+    raise AttributeError(f"module 'meshcore' has no attribute {name!r}")
