@@ -16,18 +16,16 @@ sys.path.insert(0, str(ROOT))
 import numpy as np  # noqa: E402
 
 from meshcore.case import load_case  # noqa: E402
-from meshcore.io import read_points  # noqa: E402
 from meshcore.multiblock import solve_multiblock  # noqa: E402
-from meshcore.multiblock.case import case_topology  # noqa: E402
+from meshcore.multiblock.case import case_topology, outline_points  # noqa: E402
 from meshcore.multiblock.figure import plot_multiblock  # noqa: E402
-from meshcore.multiblock.outline import project_lonlat  # noqa: E402
 
 FIG = ROOT / "docs" / "figures"
 EX = ROOT / "resources" / "examples"
 
 
 def main() -> None:
-    shore = project_lonlat(read_points(ROOT / "resources" / "lakes" / "shasta_lake.csv"))[0]
+    shore = outline_points(load_case(EX / "shasta-multiblock-coarse.toml"))
     out = {}
     for tag in ("coarse", "fine"):
         case = load_case(EX / f"shasta-multiblock-{tag}.toml")

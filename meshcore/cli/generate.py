@@ -70,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     prog.done()
     elapsed = time.perf_counter() - t0
     blocks = list(getattr(result, "blocks", result))
+    frame = getattr(result, "frame", None) or frame  # multiblock outline cases project lon/lat
     if args.output:
         write(Path(args.output), result, crs=frame)
     if args.png:

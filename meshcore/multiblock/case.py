@@ -19,7 +19,9 @@ describe the blocks:
 
     [outline]
     points = "../lakes/shasta_lake.csv"   # closed shoreline (file or inline [[x, y], ...])
-    crs = "lonlat"               # lonlat: degrees → local equirectangular metres | xy
+    crs = "utm"                  # lon/lat → metres: utm (pyproj, UTM zone of the centroid, local
+                                 # origin; the writers store the CRS) | lonlat (local equirectangular
+                                 # about the centroid, no pyproj) | "EPSG:nnnn" | xy (no projection)
     cuts = [[15, 200], [[-122.3, 40.7], [-122.2, 40.8]]]   # outline indices or points
     snap = 10.0                  # optional snap distance (model units)
 
@@ -34,6 +36,7 @@ the valid ones.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -56,12 +59,22 @@ from .outline import from_outline, project_lonlat
 from .solver import MODES, MultiBlockGrid, solve_multiblock
 from .topology import Block, Interface, MultiBlockTopology, parse_side
 
-__all__ = ["case_topology", "generate_multiblock_case", "is_multiblock_case", "topology_case"]
+__all__ = [
+    "case_frame",
+    "case_topology",
+    "generate_multiblock_case",
+    "is_multiblock_case",
+    "outline_points",
+    "topology_case",
+]
 
 MULTIBLOCK_KEYS = {"mode", "start"}
 INTERFACE_KEYS = {"a", "b", "reversed"}
 OUTLINE_KEYS = {"points", "crs", "origin", "cuts", "snap", "blocks"}
 OUTLINE_BLOCK_KEYS = {"name", "corners", "cells", "initial"}
+#: ``crs`` of an outline: no projection, local equirectangular, UTM of the centroid (pyproj);
+#: any other value is a target CRS for pyproj (``"EPSG:32610"``, ``32610``).
+OUTLINE_CRS = ("xy", "none", "lonlat", "utm", "auto")
 
 register_keys(top=("multiblock", "interfaces", "outline"))
 
@@ -97,7 +110,34 @@ def _outline_point(v: Any, where: str) -> Any:
     raise CaseFileError(f"{where}: expected an outline point index or an [x, y] pair, got {v!r}")
 
 
-def _outline_topology(case: Case) -> MultiBlockTopology:
+def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where: str):
+    """Project the outline and the extra [lon, lat] points; return (xy, extra_xy, frame)."""
+    from ..crs import LONLAT, Frame, _pyproj, project
+    from ..io._base import PointSet, Polyline
+
+    if crs == "lonlat":  # local equirectangular about the centroid (no pyproj)
+        xy, org = project_lonlat(pts, origin=tuple(origin) if origin is not None else None)
+        ex = project_lonlat(extra, origin=org)[0] if extra else np.zeros((0, 2))
+        return xy, ex, Frame(None, (0.0, 0.0), LONLAT)
+    target = "auto" if crs in ("utm", "auto") else crs
+    ps = PointSet((Polyline("outline", pts, closed=True),), LONLAT, source=where)
+    try:
+        local, frame = project(ps, target, origin="auto" if origin is None else origin)
+    except InvalidInputError as exc:
+        raise CaseFileError(f"{where}: {exc}") from None
+    ex = np.zeros((0, 2))
+    if extra:
+        e = np.asarray(extra, dtype=np.float64)
+        if frame.crs != frame.source_crs:
+            t = _pyproj().Transformer.from_crs(frame.source_crs, frame.crs, always_xy=True)
+            X, Y = t.transform(e[:, 0], e[:, 1])
+            e = np.column_stack([X, Y])
+        ex = e - np.asarray(frame.origin)
+    return local.polylines[0].points, ex, frame
+
+
+def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, Any]:
+    """(outline xy, cuts, blocks, snap, frame) of an ``[outline]`` case, in model units."""
     src = _src(case)
     base = case.path.parent if case.path else None
     tbl = case.extra["outline"]
@@ -113,9 +153,11 @@ def _outline_topology(case: Case) -> MultiBlockTopology:
         if key not in tbl:
             raise CaseFileError(f"{where}: missing key {key!r}")
     pts = _points(tbl["points"], base, f"{where} points")
-    crs = str(tbl.get("crs", "xy"))
-    if crs not in ("xy", "lonlat"):
-        raise CaseFileError(f"{where}: crs must be 'xy' or 'lonlat', got {crs!r}")
+    crs = tbl.get("crs", "xy")
+    if isinstance(crs, bool) or not isinstance(crs, (str, int)):
+        raise CaseFileError(f"{where}: crs must be a string or an EPSG code, got {crs!r}")
+    if isinstance(crs, str):
+        crs = crs.strip().lower() if crs.strip().lower() in OUTLINE_CRS else crs.strip()
     cuts_raw = tbl["cuts"]
     if not isinstance(cuts_raw, list) or not cuts_raw:
         raise CaseFileError(f"{where}: cuts must be a list of polylines")
@@ -145,23 +187,42 @@ def _outline_topology(case: Case) -> MultiBlockTopology:
             "cells": list(b["cells"]),
             "initial": str(b.get("initial", "tfi")),
         })
-    if crs == "lonlat":
-        origin = tbl.get("origin")
-        xy, org = project_lonlat(pts, origin=tuple(origin) if origin is not None else None)
-
-        def proj(v: Any) -> Any:
-            return v if isinstance(v, int) else project_lonlat([v], origin=org)[0][0].tolist()
-
-        cuts = [[proj(v) for v in c] for c in cuts]
+    frame = None
+    if crs not in ("xy", "none"):
+        extra = [v for c in cuts for v in c if not isinstance(v, int)]
+        extra += [v for b in blocks for v in b["corners"] if not isinstance(v, int)]
+        xy, ex, frame = _project_outline(pts, extra, crs, tbl.get("origin"), where)
+        it = iter(ex.tolist())
+        cuts = [[v if isinstance(v, int) else next(it) for v in c] for c in cuts]
         for b in blocks:
-            b["corners"] = [proj(v) for v in b["corners"]]
+            b["corners"] = [v if isinstance(v, int) else next(it) for v in b["corners"]]
     else:
         xy = pts
-    snap = tbl.get("snap")
+    return xy, cuts, blocks, tbl.get("snap"), frame
+
+
+def outline_points(case: Case) -> np.ndarray:
+    """The outline of an ``[outline]`` case in model units (projected like the grid)."""
+    return _outline_geometry(case)[0]
+
+
+def case_frame(case: Case) -> Any:
+    """The :class:`meshcore.crs.Frame` of a case's grid coordinates (None if unknown)."""
+    from ..crs import frame_from_case
+
+    if "outline" in case.extra:
+        fr = _outline_geometry(case)[4]
+        if fr is not None and fr.crs is not None:
+            return fr
+    return frame_from_case(case)
+
+
+def _outline_topology(case: Case) -> MultiBlockTopology:
+    xy, cuts, blocks, snap, _ = _outline_geometry(case)
     try:
         return from_outline(xy, cuts=cuts, blocks=blocks, snap=snap).topology
     except InvalidInputError as exc:
-        raise type(exc)(f"{src}: {exc}") from None
+        raise type(exc)(f"{_src(case)}: {exc}") from None
 
 
 def _interface_topology(case: Case) -> MultiBlockTopology:
@@ -221,7 +282,8 @@ def generate_multiblock_case(
     del callback  # progress snapshots are per block; the multiblock solve reports at the end
     mode, start = _settings(case)
     topo = case_topology(case)
-    return solve_multiblock(topo, mode=mode, start=start, config=config or case.solver)
+    mb = solve_multiblock(topo, mode=mode, start=start, config=config or case.solver)
+    return dataclasses.replace(mb, frame=case_frame(case))
 
 
 def topology_case(

@@ -113,6 +113,7 @@ class MultiBlockGrid:
     mode: str = "smooth"
     info: SolveInfo = field(default_factory=SolveInfo)
     topology: MultiBlockTopology | None = field(default=None, repr=False)
+    frame: Any = field(default=None, repr=False)  # meshcore.crs.Frame of the coordinates
 
     def __len__(self) -> int:
         return len(self.grids)

@@ -570,7 +570,7 @@ def test_case_outline_unknown_key_and_mode(tmp_path):
         (tmp_path / "lakes" / f.name).write_text(f.read_text())
     d = tmp_path / "ex"
     d.mkdir()
-    (d / "a.toml").write_text(text.replace('crs = "lonlat"', 'crs = "lonlat"\ncolour = 1'))
+    (d / "a.toml").write_text(text.replace('crs = "utm"', 'crs = "utm"\ncolour = 1'))
     with pytest.raises(CaseFileError, match=r"'colour'.*valid keys"):
         generate_case(load_case(d / "a.toml"))
     (d / "b.toml").write_text(text.replace('mode = "smooth"', 'mode = "wobbly"'))
@@ -594,17 +594,19 @@ def test_cli_generate_multiblock_case(tmp_path):
     from meshcore.case import generate_case, load_case
 
     mb = generate_case(load_case(EXAMPLES / "shasta-multiblock-coarse.toml"))
+    ox, oy = mb.frame.origin  # files hold world (UTM) coordinates
     for g, h in zip(mb, blocks, strict=True):
-        assert np.array_equal(g.x, h.x) and np.array_equal(g.y, h.y)
+        assert np.abs(g.x + ox - h.x).max() < 1e-6 and np.abs(g.y + oy - h.y).max() < 1e-6
 
 
-def test_vtm_writer_read_by_vtk(tmp_path, rect):
+def test_vtm_and_plot3d_via_io_read_by_vtk(tmp_path, rect):
     vtk = pytest.importorskip("vtkmodules.vtkIOXML")
-    from meshcore.multiblock.export import write_report, write_vtm
+    from meshcore.io import read_grid, write
+    from meshcore.multiblock.export import write_report
 
     X, Y, _ = rect
     mb = solve_multiblock(four_blocks(X, Y, 14, 5))
-    p = write_vtm(tmp_path / "rect.vtm", mb)
+    p = write(tmp_path / "rect.vtm", mb)
     reader = vtk.vtkXMLMultiBlockDataReader()
     reader.SetFileName(str(p))
     reader.Update()
@@ -612,14 +614,69 @@ def test_vtm_writer_read_by_vtk(tmp_path, rect):
     assert data.GetNumberOfBlocks() == 4
     for k, g in enumerate(mb):
         blk = data.GetBlock(k)
+        assert data.GetMetaData(k).Get(data.NAME()) == mb.names[k]
         assert blk.GetNumberOfPoints() == g.n_nodes
         dims = [0, 0, 0]
         blk.GetDimensions(dims)
         assert tuple(dims[:2]) == g.shape
         pt = blk.GetPoint(g.shape[0] + 1)  # node (1, 1): VTK order, i fastest
-        assert pt[:2] == pytest.approx((g.x[1, 1], g.y[1, 1]), abs=0)
+        assert pt[:2] == pytest.approx((g.x[1, 1], g.y[1, 1]), abs=1e-12)
+    back = read_grid(write(tmp_path / "rect.xyz", mb))
+    assert len(back) == 4
+    assert all(np.array_equal(g.x, h.x) for g, h in zip(mb, back, strict=True))
     rep = write_report(tmp_path / "rect.txt", mb).read_text(encoding="utf-8")
     assert "sw.right nodes 0…5" in rep and "max adjacent-cell size ratio across" in rep
+
+
+def test_lonlat_outline_projections_agree(tmp_path):
+    """utm (pyproj) and lonlat (equirectangular) give nearly the same lake, in metres."""
+    from meshcore.case import load_case
+    from meshcore.multiblock.case import case_frame, outline_points
+
+    text = (EXAMPLES / "shasta-multiblock-coarse.toml").read_text()
+    (tmp_path / "lakes").mkdir()
+    for f in (ROOT / "resources" / "lakes").glob("*.csv"):
+        (tmp_path / "lakes" / f.name).write_text(f.read_text())
+    (tmp_path / "ex").mkdir()
+    (tmp_path / "ex" / "utm.toml").write_text(text)
+    (tmp_path / "ex" / "eq.toml").write_text(text.replace('crs = "utm"', 'crs = "lonlat"'))
+    cu, ce = load_case(tmp_path / "ex" / "utm.toml"), load_case(tmp_path / "ex" / "eq.toml")
+    fr = case_frame(cu)
+    assert fr.crs == "EPSG:32610" and fr.source_crs == "EPSG:4326"
+    pu, pe = outline_points(cu), outline_points(ce)
+    # same shape up to a rigid motion; lengths agree to < 0.5 % (equirectangular E–W
+    # distortion over ±0.1° of latitude ≈ 0.2 %, UTM scale 0.7° off the central meridian)
+    lu, le = np.hypot(*(pu - pu[0]).T), np.hypot(*(pe - pe[0]).T)
+    assert np.abs(lu - le).max() < 5e-3 * le.max()
+    # the grid nodes on the shore map back to the lon/lat shoreline
+    from meshcore.case import generate_case
+
+    mb = generate_case(cu)
+    lon, lat = mb.frame.to_lonlat(mb["main"].x[:, 0], mb["main"].y[:, 0])
+    shore = np.loadtxt(ROOT / "resources" / "lakes" / "shasta_lake.csv", delimiter=",", skiprows=1)
+    from shapely.geometry import LinearRing, Point
+
+    ring = LinearRing(shore)
+    assert max(ring.distance(Point(a, b)) for a, b in zip(lon, lat, strict=True)) < 1e-7
+
+
+def test_cli_generate_vtm_with_crs(tmp_path):
+    vtk = pytest.importorskip("vtkmodules.vtkIOXML")
+    out = tmp_path / "lake.vtm"
+    r = subprocess.run(
+        [sys.executable, "-m", "meshcore", "generate", str(EXAMPLES / "shasta-multiblock-coarse.toml"),
+         "-o", str(out), "-q"],
+        capture_output=True, text=True, cwd=ROOT, timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    reader = vtk.vtkXMLMultiBlockDataReader()
+    reader.SetFileName(str(out))
+    reader.Update()
+    data = reader.GetOutput()
+    assert data.GetNumberOfBlocks() == 7
+    # world coordinates (UTM 10N metres) are written, not the local ones
+    x0 = data.GetBlock(0).GetPoint(0)[0]
+    assert 5e5 < x0 < 6.5e5
 
 
 def test_connectivity_case_round_trip(tmp_path, shasta_topology):
