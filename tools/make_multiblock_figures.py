@@ -54,7 +54,9 @@ def main() -> None:
 
     topo, res = out["coarse"]
     fig, axes = plt.subplots(1, 2, figsize=(14, 6))
-    win = (-0.5, -5.6, 8.5, 1.0)
+    # window: the east junction block and the end of the main basin (km)
+    ex0, ey0, ex1, ey1 = (v * 1e-3 for v in res["smooth"]["east"].bounds())
+    win = (ex0 - 4.0, ey0 - 0.6, ex1 + 1.5, ey1 + 1.2)
     for ax, m in zip(axes, ("frozen", "smooth"), strict=True):
         plot_multiblock(res[m], ax=ax, outline=shore, scale=1e-3, unit="km", window=win,
                         labels=True, linewidth=0.6,
