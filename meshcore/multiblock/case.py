@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -323,13 +322,6 @@ def topology_case(
         solver=solver or EllipticConfig(),
         extra={"multiblock": {"mode": mode}, "interfaces": itfs},
     )
-
-
-def load_points_lonlat(path: str | Path) -> np.ndarray:
-    """Read a lon/lat point file and project it (convenience for scripts)."""
-    from ..io import read_points
-
-    return project_lonlat(read_points(path))[0]
 
 
 register_case_generator(is_multiblock_case, generate_multiblock_case)
