@@ -24,6 +24,7 @@ describe the blocks:
                                  # about the centroid, no pyproj) | "EPSG:nnnn" | xy (no projection)
     cuts = [[15, 200], [[-122.3, 40.7], [-122.2, 40.8]]]   # outline indices or points
     snap = 10.0                  # optional snap distance (model units)
+    multiple = 2                 # optional: every shared part gets a multiple of 2 cells (multigrid)
 
     [[outline.blocks]]
     name = "main"
@@ -69,7 +70,7 @@ __all__ = [
 
 MULTIBLOCK_KEYS = {"mode", "start"}
 INTERFACE_KEYS = {"a", "b", "reversed"}
-OUTLINE_KEYS = {"points", "crs", "origin", "cuts", "snap", "blocks"}
+OUTLINE_KEYS = {"points", "crs", "origin", "cuts", "snap", "multiple", "blocks"}
 OUTLINE_BLOCK_KEYS = {"name", "corners", "cells", "initial"}
 #: ``crs`` of an outline: no projection, local equirectangular, UTM of the centroid (pyproj);
 #: any other value is a target CRS for pyproj (``"EPSG:32610"``, ``32610``).
@@ -218,8 +219,11 @@ def case_frame(case: Case) -> Any:
 
 def _outline_topology(case: Case) -> MultiBlockTopology:
     xy, cuts, blocks, snap, _ = _outline_geometry(case)
+    multiple = case.extra["outline"].get("multiple", 1)
+    if isinstance(multiple, bool) or not isinstance(multiple, int) or multiple < 1:
+        raise CaseFileError(f"{_src(case)}: [outline] multiple must be a positive integer")
     try:
-        return from_outline(xy, cuts=cuts, blocks=blocks, snap=snap).topology
+        return from_outline(xy, cuts=cuts, blocks=blocks, snap=snap, multiple=multiple).topology
     except InvalidInputError as exc:
         raise type(exc)(f"{_src(case)}: {exc}") from None
 

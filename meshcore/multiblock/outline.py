@@ -160,6 +160,7 @@ def from_outline(
     cuts: Sequence[Any],
     blocks: Sequence[Any],
     snap: float | None = None,
+    multiple: int = 1,
 ) -> OutlineBlocks:
     """Split a closed outline by cut lines into four-sided blocks glued by interfaces.
 
@@ -173,6 +174,10 @@ def from_outline(
         ``{"name", "corners": [sw, se, ne, nw], "cells": [ni, nj]}``; a corner is
         an ``[x, y]`` point (snapped to the nearest outline/cut vertex) or an
         integer index of an outline point.
+    multiple : int
+        Every chain gets a multiple of this many cells (all block cells must be
+        multiples of it): ``2**k`` lets the multigrid coarsen the blocks ``k``
+        times.
     snap : float, optional
         Distance within which cut ends and corners are snapped
         (default ``1e-3 ×`` the outline's bounding-box diagonal).
@@ -365,6 +370,13 @@ def from_outline(
                 f"{', '.join(repr(a) for a in around) or 'no block'}) is covered by no block; "
                 f"add a block with its four corners there"
             )
+    multiple = validate_count(multiple, name="multiple")
+    for s in specs:
+        if s.cells[0] % multiple or s.cells[1] % multiple:
+            raise TopologyError(
+                f"block {s.name!r}: cells {list(s.cells)} must be multiples of {multiple} "
+                f"(multiple = {multiple})"
+            )
     # --- sides → chains
     breaks = set(corner_set) | {v for v, nb in nbrs.items() if len(nb) >= 3}
     side_chains: dict[tuple[str, str], list[tuple]] = {}  # (block, side) → [chain keys]
@@ -434,18 +446,19 @@ def from_outline(
         bs, keys = open_sides[0]
         unknown = [k for k in keys if k not in count]
         rest = need[bs] - sum(count[k] for k in keys if k in count)
-        if rest < len(unknown):
+        if rest < len(unknown) * multiple:
             raise TopologyError(
                 f"cell counts disagree at block {bs[0]!r} {bs[1]} border: {need[bs]} cells cannot "
-                f"hold its parts {describe(bs)} with at least one cell each"
+                f"hold its parts {describe(bs)} with at least {multiple} cell(s) each"
             )
+        units = rest // multiple  # shares in units of `multiple` cells
         w = np.array([arclen(k) for k in unknown])
-        share = 1 + (rest - len(unknown)) * w / w.sum()
+        share = 1 + (units - len(unknown)) * w / w.sum()
         base = np.floor(share).astype(int)
-        for k in np.argsort(-(share - base))[: rest - int(base.sum())]:
+        for k in np.argsort(-(share - base))[: units - int(base.sum())]:
             base[k] += 1
         for k, c in zip(unknown, base.tolist(), strict=True):
-            count[k] = int(c)
+            count[k] = int(c) * multiple
         changed = True
     for bs, keys in side_chains.items():
         if sum(count[k] for k in keys) != need[bs]:

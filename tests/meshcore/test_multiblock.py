@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import subprocess
 import sys
@@ -100,7 +101,7 @@ def assert_glued(mb) -> None:
 
 # ------------------------------------------------ equivalence with one block
 @pytest.mark.parametrize(("start", "engine"), [("algebraic", "blocks"), ("frozen", "blocks"),
-                                               ("algebraic", "table")])
+                                               ("algebraic", "table"), ("algebraic", "multigrid")])
 def test_two_blocks_smooth_equals_single_block(rect, start, engine):
     X, Y, ref = rect
     mb = solve_multiblock(two_blocks(X, Y, 10), mode="smooth", tolerance=TIGHT, start=start,
@@ -117,7 +118,7 @@ def test_two_blocks_smooth_equals_single_block(rect, start, engine):
     assert np.hypot(mb["a"].x[-1] - X[10], mb["a"].y[-1] - Y[10]).max() > 1e-3 * size
 
 
-@pytest.mark.parametrize("engine", ["blocks", "table"])
+@pytest.mark.parametrize("engine", ["blocks", "table", "multigrid"])
 def test_four_blocks_smooth_equals_single_block(rect, engine):
     X, Y, ref = rect
     topo = four_blocks(X, Y, 14, 5)
@@ -209,7 +210,7 @@ def star(k: int, n: int = 8):
     return MultiBlockTopology(tuple(blocks), tuple(itfs))
 
 
-@pytest.mark.parametrize("engine", ["blocks", "table"])
+@pytest.mark.parametrize("engine", ["blocks", "table", "multigrid"])
 @pytest.mark.parametrize("k", [3, 5])
 def test_irregular_corner_of_k_blocks(k, engine):
     topo = star(k)
@@ -734,3 +735,66 @@ def test_confluence_case_three_blocks_meet_at_the_centre():
     a = -2.0 * np.pi / 3.0
     n, se = mb["north"], mb["southeast"]
     assert np.abs(math.cos(a) * n.x - math.sin(a) * n.y - se.x).max() < 1e-4
+
+
+def test_multigrid_hierarchy_and_convergence(rect):
+    """FAS over the blocks: coarse levels keep the topology; the defect drops ≥ 5× per cycle."""
+    from meshcore.multiblock.multigrid import coarsen, levels
+
+    X, Y, ref = rect
+    topo = four_blocks(X, Y, 12, 6)
+    lv = levels(topo)
+    assert [lv_.topo.blocks[0].cells for lv_ in lv] == [(12, 6), (6, 3)]  # 3 is odd: stop
+    c = coarsen(topo)
+    assert len(c.interfaces) == 4 and c.node_map.corners[0].valence == 4
+    assert coarsen(four_blocks(X, Y, 14, 5)) is None  # odd counts do not coarsen
+    X2, Y2 = curved_rectangle(64, 32)
+    mb = solve_multiblock(four_blocks(X2, Y2, 32, 16), tolerance=1e-10, engine="multigrid")
+    assert mb.converged and mb.info.method.startswith("smooth/multigrid(")
+    h = [v for _, v in mb.info.residual_history]
+    assert len(h) <= 12
+    assert all(b <= a / 5.0 for a, b in itertools.pairwise(h[1:]))
+    # the same discrete solution as SOR
+    sor = solve_multiblock(four_blocks(X2, Y2, 32, 16), tolerance=1e-10, engine="blocks")
+    for g, k in zip(mb, sor, strict=True):
+        assert np.abs(g.x - k.x).max() < 1e-7 * ref.size
+
+
+def test_multigrid_kernels_match_reference():
+    """table_defect with f = 0 equals the NumPy Jacobi targets minus u."""
+    topo = star(5)
+    m = topo.node_map
+    x = np.empty(m.n_nodes)
+    y = np.empty(m.n_nodes)
+    for g, ids in zip(meshcore.multiblock.initial_grids(topo), m.ids, strict=True):
+        x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
+    x += 0.01 * np.sin(7 * y) * ~m.boundary
+    args = (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring)
+    tx, ty = _reference.jacobi_targets(x, y, *args)
+    rx, ry = np.zeros(m.n_nodes), np.zeros(m.n_nodes)
+    z = np.zeros(m.n_nodes)
+    r = _kernels.table_defect(x, y, z, z, *args, rx, ry)
+    assert np.allclose(rx, tx - x, atol=1e-14) and np.allclose(ry, ty - y, atol=1e-14)
+    assert r == pytest.approx(np.hypot(tx - x, ty - y).max(), rel=1e-12)
+    # a sweep with f = (T − u) of the current state leaves u fixed at nodes already solved
+    fx, fy = 0.3 * np.ones(m.n_nodes), np.zeros(m.n_nodes)
+    x2, y2 = x.copy(), y.copy()
+    _kernels.table_sweep_rhs(x2, y2, fx, fy, *args, 1.0)
+    assert np.array_equal(x2[m.boundary], x[m.boundary])
+
+
+def test_outline_multiple_gives_coarsenable_blocks():
+    from meshcore.multiblock.multigrid import levels
+
+    ring = np.array([[0, 0], [6, 0], [6, 1], [4, 1], [4, 3], [2, 3], [2, 1], [0, 1]], float)
+    blocks = [
+        {"name": "main", "corners": [0, 1, 2, 7], "cells": [24, 4]},
+        {"name": "arm", "corners": [[2, 1], [4, 1], 4, 5], "cells": [8, 8]},
+    ]
+    topo = from_outline(ring, cuts=[[6, 3]], blocks=blocks, multiple=4).topology
+    (itf,) = topo.interfaces
+    assert all(v % 4 == 0 for s in (itf.a, itf.b) for v in (s.start, s.stop))
+    assert len(levels(topo)) == 2  # 24×4 → 12×2; 6×1 would be below MIN_CELLS
+    bad = [{**blocks[0], "cells": [22, 4]}, blocks[1]]
+    msg = _err(lambda: from_outline(ring, cuts=[[6, 3]], blocks=bad, multiple=4))
+    assert "'main'" in msg and "multiples of 4" in msg
