@@ -8,9 +8,10 @@ Run from the repository root (serial kernels; timings are best of ``--repeat``):
    kernel ``sweep4``, the multiblock table kernel (``engine="table"``) and
    the block engine (``sweep4`` per block + table on the border nodes).
 2. Whole solves to the same tolerance from the same algebraic start: one
-   block (SOR, and ``auto``) against the same nodes split in 2 and 4 blocks
-   (smooth mode, both engines).  In this test the multiblock solution equals
-   the single-block one.
+   block (SOR, and multigrid when registered) against the same nodes split in
+   2 and 4 blocks (smooth mode: multigrid over all blocks, block-engine SOR,
+   table-engine SOR).  In this test the multiblock solution equals the
+   single-block one.
 3. Shasta Lake (the example cases): smooth (frozen start / algebraic start)
    and frozen, against one curved-rectangle block with the same node count.
 """
@@ -143,22 +144,22 @@ def whole_solves(repeat: int, sizes) -> None:
             rows.append(("1 block, multigrid", gm.iterations, tm, float(np.abs(gm.x - ref.x).max())))
         for nb in (2, 4):
             topo = split(X, Y, nb)
-            for engine in ("blocks", "table"):
-                for start in ("algebraic", "frozen"):
-                    tb, mb = best(lambda topo=topo, engine=engine, start=start, tol=tol: solve_multiblock(
-                        topo, mode="smooth", tolerance=tol, engine=engine, start=start), repeat)
-                    xs = np.full(X.shape, np.nan)
-                    ys = np.full(X.shape, np.nan)
-                    h, v = ni // 2, nj // 2
-                    offs = {"a": (0, 0), "b": (h, 0), "sw": (0, 0), "se": (h, 0), "nw": (0, v),
-                            "ne": (h, v)}
-                    for name, g in zip(mb.names, mb.grids, strict=True):
-                        i0, j0 = offs[name]
-                        xs[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.x
-                        ys[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.y
-                    dist = float(np.hypot(xs - ref.x, ys - ref.y).max()) / ref.size
-                    rows.append((f"{nb} blocks smooth, {engine}, {start} start", mb.info.iterations,
-                                 tb, dist))
+            for engine, start in (("multigrid", "algebraic"), ("blocks", "algebraic"),
+                                  ("blocks", "frozen"), ("table", "algebraic")):
+                tb, mb = best(lambda topo=topo, engine=engine, start=start, tol=tol: solve_multiblock(
+                    topo, mode="smooth", tolerance=tol, engine=engine, start=start), repeat)
+                xs = np.full(X.shape, np.nan)
+                ys = np.full(X.shape, np.nan)
+                h, v = ni // 2, nj // 2
+                offs = {"a": (0, 0), "b": (h, 0), "sw": (0, 0), "se": (h, 0), "nw": (0, v),
+                        "ne": (h, v)}
+                for name, g in zip(mb.names, mb.grids, strict=True):
+                    i0, j0 = offs[name]
+                    xs[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.x
+                    ys[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.y
+                dist = float(np.hypot(xs - ref.x, ys - ref.y).max()) / ref.size
+                rows.append((f"{nb} blocks smooth, {engine}, {start} start", mb.info.iterations,
+                             tb, dist))
         for label, it, t, d in rows:
             print(f"| {X.size} | {label} | {it} | {t:.3f} | {t / t1:.2f} | {d:.1e} |")
     print()
@@ -189,15 +190,16 @@ def lake(repeat: int, quick: bool) -> None:
             print(f"| {tag} | {X.size} | one block {ni}×{nj}, multigrid | {gm.iterations} | {tm:.3f} | "
                   f"{tm / t1:.2f} |")
         for label, kw in (
-            ("smooth, blocks engine, frozen start", {"mode": "smooth", "start": "frozen"}),
-            ("smooth, blocks engine, algebraic start", {"mode": "smooth", "start": "algebraic"}),
-            ("smooth, table engine, algebraic start", {"mode": "smooth", "engine": "table"}),
+            ("smooth, auto (default)", {"mode": "smooth"}),
+            ("smooth, multigrid only", {"mode": "smooth", "engine": "multigrid"}),
+            ("smooth, blocks engine (SOR)", {"mode": "smooth", "engine": "blocks"}),
+            ("smooth, table engine (SOR)", {"mode": "smooth", "engine": "table"}),
             ("frozen (blocks solved separately)", {"mode": "frozen"}),
         ):
             t, mb = best(lambda kw=kw, tol=tol, topo=topo: solve_multiblock(topo, tolerance=tol, **kw),
                          repeat)
-            print(f"| {tag} | {n} | {len(topo.blocks)} blocks {label} | {mb.info.iterations} | "
-                  f"{t:.3f} | {t / t1:.2f} |")
+            print(f"| {tag} | {n} | {len(topo.blocks)} blocks {label}: {mb.info.method} | "
+                  f"{mb.info.iterations} | {t:.3f} | {t / t1:.2f} |")
     print()
 
 
@@ -210,7 +212,7 @@ def main() -> None:
     meshcore.elliptic.warmup()
     sizes = [(128, 64)] if a.quick else [(128, 64), (256, 128), (512, 256)]
     per_sweep(a.repeat, sizes)
-    whole_solves(a.repeat, [(64, 32)] if a.quick else [(128, 64), (256, 128)])
+    whole_solves(a.repeat, [(64, 32)] if a.quick else [(128, 64), (256, 128), (512, 256)])
     lake(a.repeat, a.quick)
 
 
