@@ -364,7 +364,7 @@ def solve_multiblock(
         iters, r, history, message = _smooth_sor(x, y, m, cfg, tol, callback, engine)
         if mg_cycles:
             history = mg_history + [(mg_cycles + i, v) for i, v in history[1:]]
-            message = message or f"multigrid converged slowly; SOR after {mg_cycles} cycles"
+            message = message or f"multigrid was slow; SOR after {mg_cycles} cycles"
     conv = r <= tol * (1 + 1e-12)
     info = SolveInfo(
         method=(f"smooth/multigrid({n_levels} levels)" if engine == "multigrid"
@@ -377,7 +377,8 @@ def solve_multiblock(
         tolerance=tol_rel,
         residual_history=tuple((int(i), float(v) / length) for i, v in history),
         elapsed=time.perf_counter() - t0,
-        message=message or ("converged" if conv else f"not converged after {iters} iterations"),
+        message=(("converged" if conv else f"not converged after {iters} iterations")
+                 + (f" ({message})" if message else "")),
     )
     final = []
     for g, ids, n in zip(grids, m.ids, names, strict=True):
