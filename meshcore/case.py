@@ -67,7 +67,8 @@ __all__ = [
     "save_case",
 ]
 
-TOP_KEYS = {"title", "description", "solver", "blocks"}
+TOP_KEYS = {"title", "description", "solver", "blocks", "crs"}
+CRS_KEYS = {"crs", "origin", "source_crs", "source"}
 BLOCK_KEYS = {
     "name", "cells", "weights", "initial", "curve", "periodic", "snap_angle", "boundary", "borders",
 }
@@ -153,29 +154,52 @@ def _check_keys(table: Mapping[str, Any], valid: set[str], where: str) -> None:
         )
 
 
-def _read_point_file(path: Path, where: str) -> np.ndarray:
+def _read_point_file(path: Path, where: str, ctx: dict[str, Any]) -> np.ndarray:
+    """Read the first polyline of a point file, projected into the case's frame.
+
+    Lon/lat files are projected to the case's ``crs`` (and shifted by its
+    origin); with no ``crs`` table the first lon/lat file picks the UTM zone of
+    its centroid and a local origin, recorded in ``ctx["crs"]`` so that the
+    case (and every export) keeps it.
+    """
     if not path.exists():
         raise CaseFileError(f"{where}: point file {str(path)!r} not found")
+    from . import crs as _crs
+    from . import io as _io
+
     try:
-        from . import io as _io
-
-        res = _io.read_points(path)
-    except MeshcoreError as exc:
-        raise CaseFileError(f"{where}: {exc}") from None
-    if hasattr(res, "polylines"):
-        if not res.polylines:
+        ps = _io.read_points(path)
+        if not ps.polylines:
             raise CaseFileError(f"{where}: {path} holds no polyline")
-        pl = res.polylines[0]
-        return np.asarray(getattr(pl, "points", pl), dtype=np.float64)
-    return np.asarray(res, dtype=np.float64)
+        geographic = (ps.crs is not None and _crs.is_geographic(ps.crs)) or (
+            ps.crs is None and _crs.looks_lonlat(ps.all_points())
+        )
+        frame = ctx.get("frame")
+        if geographic or (frame is not None and ps.crs is not None and ps.crs != frame.crs):
+            if frame is None:
+                local, frame = _crs.project(ps, "auto")
+                ctx["frame"] = frame
+                ctx["crs"] = frame.as_dict() | {"source": path.name}
+            else:
+                local, _ = _crs.project(ps, frame.crs or "auto", origin=frame.origin)
+            ps = local
+        elif frame is not None and frame.origin != (0.0, 0.0):
+            # a projected file in the case's CRS: shift to the local origin
+            local, _ = _crs.project(ps, None, origin=frame.origin)
+            ps = local
+    except MeshcoreError as exc:
+        if isinstance(exc, CaseFileError):
+            raise
+        raise CaseFileError(f"{where}: {exc}") from None
+    return np.asarray(ps.polylines[0].points, dtype=np.float64)
 
 
-def _points(value: Any, base: Path | None, where: str) -> np.ndarray:
+def _points(value: Any, base: Path | None, where: str, ctx: dict[str, Any]) -> np.ndarray:
     if isinstance(value, str):
         p = Path(value)
         if not p.is_absolute() and base is not None:
             p = base / p
-        return _read_point_file(p, where)
+        return _read_point_file(p, where, ctx)
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -200,7 +224,8 @@ def _int(v: Any) -> int:
     return v
 
 
-def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) -> BlockCase:
+def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str,
+                 ctx: dict[str, Any]) -> BlockCase:
     where = f"{src}: [[blocks]] #{k + 1}"
     if not isinstance(tbl, Mapping):
         raise CaseFileError(f"{where}: expected a table")
@@ -233,7 +258,7 @@ def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) ->
             raise CaseFileError(f"{where}: boundary: give either points + corners or four borders, not both")
         if "corners" not in bnd:
             raise CaseFileError(f"{where}: boundary: points need corners = [sw, se, ne, nw]")
-        kw["loop"] = _points(bnd["points"], base, f"{where}: boundary.points")
+        kw["loop"] = _points(bnd["points"], base, f"{where}: boundary.points", ctx)
         c = bnd["corners"]
         if not isinstance(c, list) or len(c) != 4 or not all(isinstance(v, int) and not isinstance(v, bool) for v in c):
             raise CaseFileError(f"{where}: boundary.corners must be 4 integer point indices, got {c!r}")
@@ -242,7 +267,7 @@ def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) ->
         missing = [n for n in BORDER_NAMES if n not in bnd]
         if missing:
             raise CaseFileError(f"{where}: boundary: missing border(s) {', '.join(missing)}")
-        kw["borders"] = {n: _points(bnd[n], base, f"{where}: boundary.{n}") for n in BORDER_NAMES}
+        kw["borders"] = {n: _points(bnd[n], base, f"{where}: boundary.{n}", ctx) for n in BORDER_NAMES}
     specs = {}
     borders_tbl = tbl.get("borders", {})
     if not isinstance(borders_tbl, Mapping):
@@ -275,7 +300,19 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         blocks_raw = []  # multiblock outline cases list their blocks in [[outline.blocks]]
     elif not isinstance(blocks_raw, list) or not blocks_raw:
         raise CaseFileError(f"{source}: needs at least one [[blocks]] table")
-    blocks = tuple(_parse_block(b, k, base, source) for k, b in enumerate(blocks_raw))
+    ctx: dict[str, Any] = {}
+    if "crs" in data:
+        tbl = data["crs"]
+        if not isinstance(tbl, Mapping):
+            raise CaseFileError(f"{source}: crs must be a table (crs, origin, source_crs)")
+        _check_keys(tbl, CRS_KEYS, f"{source}: crs")
+        from .crs import frame_from_case
+
+        try:
+            ctx["frame"] = frame_from_case(Case(blocks=(), extra={"crs": dict(tbl)}))
+        except InvalidInputError as exc:
+            raise CaseFileError(f"{source}: {exc}") from None
+    blocks = tuple(_parse_block(b, k, base, source, ctx) for k, b in enumerate(blocks_raw))
     names = [b.name for b in blocks]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
@@ -294,7 +331,8 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         description=str(data.get("description", "")),
         solver=solver,
         path=None,
-        extra={k: data[k] for k in _EXTRA_TOP if k in data},
+        extra={k: data[k] for k in (_EXTRA_TOP | {"crs"}) if k in data}
+        | ({"crs": ctx["crs"]} if "crs" in ctx else {}),
     )
 
 

@@ -349,14 +349,3 @@ def frame_from_case(case: Any) -> Frame | None:
     except (TypeError, ValueError, IndexError):
         raise InvalidInputError(f"case crs.origin must be [x0, y0], got {o!r}") from None
     return Frame(normalize_crs(t.get("crs")), origin, normalize_crs(t.get("source_crs")))
-
-
-def _register_case_keys() -> None:
-    try:
-        from .case import register_keys
-    except ImportError:  # pragma: no cover - case.py not present
-        return
-    register_keys(top=["crs"])
-
-
-_register_case_keys()
