@@ -22,6 +22,7 @@ describe the blocks:
     crs = "utm"                  # lon/lat → metres: utm (pyproj, UTM zone of the centroid, local
                                  # origin; the writers store the CRS) | lonlat (local equirectangular
                                  # about the centroid, no pyproj) | "EPSG:nnnn" | xy (no projection)
+                                 # | auto (default: utm for lon/lat input, else xy)
     cuts = [[15, 200], [[-122.3, 40.7], [-122.2, 40.8]]]   # outline indices or points
     snap = 10.0                  # optional snap distance (model units)
     multiple = 2                 # optional: every shared part gets a multiple of 2 cells (multigrid)
@@ -48,7 +49,6 @@ from ..case import (
     BlockCase,
     Case,
     _check_keys,
-    _points,
     register_case_generator,
     register_keys,
 )
@@ -110,8 +110,38 @@ def _outline_point(v: Any, where: str) -> Any:
     raise CaseFileError(f"{where}: expected an outline point index or an [x, y] pair, got {v!r}")
 
 
-def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where: str):
-    """Project the outline and the extra [lon, lat] points; return (xy, extra_xy, frame)."""
+def _read_outline(value: Any, base: Any, where: str) -> tuple[np.ndarray, Any]:
+    """The outline points as given (no projection) and their CRS (None if unknown)."""
+    if isinstance(value, str):
+        from pathlib import Path
+
+        from ..errors import MeshcoreError
+        from ..io import read_points
+
+        p = Path(value)
+        if not p.is_absolute() and base is not None:
+            p = base / p
+        if not p.exists():
+            raise CaseFileError(f"{where}: point file {str(p)!r} not found")
+        try:
+            ps = read_points(p)
+        except MeshcoreError as exc:
+            raise CaseFileError(f"{where}: {exc}") from None
+        if not ps.polylines:
+            raise CaseFileError(f"{where}: {p} holds no polyline")
+        return np.asarray(ps.polylines[0].points, dtype=np.float64), ps.crs
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise CaseFileError(f"{where}: expected a list of [x, y] pairs or a file name") from None
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise CaseFileError(f"{where}: expected a list of [x, y] pairs, got shape {arr.shape}")
+    return arr, None
+
+
+def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where: str,
+                     src_crs: Any, case_frame: Any):
+    """Project the outline and the extra points; return (xy, extra_xy, frame)."""
     from ..crs import LONLAT, Frame, _pyproj, project
     from ..io._base import PointSet, Polyline
 
@@ -119,8 +149,14 @@ def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where:
         xy, org = project_lonlat(pts, origin=tuple(origin) if origin is not None else None)
         ex = project_lonlat(extra, origin=org)[0] if extra else np.zeros((0, 2))
         return xy, ex, Frame(None, (0.0, 0.0), LONLAT)
-    target = "auto" if crs in ("utm", "auto") else crs
-    ps = PointSet((Polyline("outline", pts, closed=True),), LONLAT, source=where)
+    target: Any = crs
+    if crs in ("utm", "auto"):
+        target = "auto"
+        if case_frame is not None and case_frame.crs is not None:  # the case's [crs] table
+            target = case_frame.crs
+            if origin is None:
+                origin = case_frame.origin
+    ps = PointSet((Polyline("outline", pts, closed=True),), src_crs or LONLAT, source=where)
     try:
         local, frame = project(ps, target, origin="auto" if origin is None else origin)
     except InvalidInputError as exc:
@@ -152,8 +188,8 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, Any]:
     for key in ("points", "cuts", "blocks"):
         if key not in tbl:
             raise CaseFileError(f"{where}: missing key {key!r}")
-    pts = _points(tbl["points"], base, f"{where} points")
-    crs = tbl.get("crs", "xy")
+    pts, src_crs = _read_outline(tbl["points"], base, f"{where} points")
+    crs = tbl.get("crs", "auto")
     if isinstance(crs, bool) or not isinstance(crs, (str, int)):
         raise CaseFileError(f"{where}: crs must be a string or an EPSG code, got {crs!r}")
     if isinstance(crs, str):
@@ -187,11 +223,19 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, Any]:
             "cells": list(b["cells"]),
             "initial": str(b.get("initial", "tfi")),
         })
+    from ..crs import frame_from_case, is_geographic, looks_lonlat
+
     frame = None
-    if crs not in ("xy", "none"):
+    # like [[blocks]] point files: a lon/lat *file* is projected by default; inline points
+    # only with an explicit crs
+    geographic = isinstance(tbl["points"], str) and (
+        (src_crs is not None and is_geographic(src_crs)) or (src_crs is None and looks_lonlat(pts))
+    )
+    if crs not in ("xy", "none") and (crs != "auto" or geographic):
         extra = [v for c in cuts for v in c if not isinstance(v, int)]
         extra += [v for b in blocks for v in b["corners"] if not isinstance(v, int)]
-        xy, ex, frame = _project_outline(pts, extra, crs, tbl.get("origin"), where)
+        xy, ex, frame = _project_outline(pts, extra, crs, tbl.get("origin"), where, src_crs,
+                                         frame_from_case(case))
         it = iter(ex.tolist())
         cuts = [[v if isinstance(v, int) else next(it) for v in c] for c in cuts]
         for b in blocks:
