@@ -347,12 +347,13 @@ def solve_multiblock(
     tol = tol_rel * length
     n_levels, mg_cycles, mg_history = 1, 0, []
     if engine in ("auto", "multigrid"):
-        from .multigrid import AUTO_GIVE_UP_RATE, coarsen, solve_fas
+        from .multigrid import AUTO_GIVE_UP_RATE, levels, solve_fas
 
-        if coarsen(topology) is not None:
+        lvs = levels(topology)
+        if len(lvs) > 1:
             give_up = AUTO_GIVE_UP_RATE if engine == "auto" else None
             iters, r, history, message, n_levels = solve_fas(
-                x, y, topology, tol, cfg.max_iterations, callback, give_up
+                x, y, topology, tol, cfg.max_iterations, callback, give_up, lvs
             )
             if message in ("diverged", "slow"):  # continue with SOR from the current grid
                 engine, mg_cycles, mg_history = "blocks", iters, history

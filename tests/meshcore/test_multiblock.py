@@ -743,7 +743,7 @@ def test_multigrid_hierarchy_and_convergence(rect):
 
     X, Y, ref = rect
     topo = four_blocks(X, Y, 12, 6)
-    lv = levels(topo)
+    lv = levels(topo, semi=False)
     assert [lv_.topo.blocks[0].cells for lv_ in lv] == [(12, 6), (6, 3)]  # 3 is odd: stop
     c = coarsen(topo)
     assert len(c.interfaces) == 4 and c.node_map.corners[0].valence == 4
@@ -794,7 +794,22 @@ def test_outline_multiple_gives_coarsenable_blocks():
     topo = from_outline(ring, cuts=[[6, 3]], blocks=blocks, multiple=4).topology
     (itf,) = topo.interfaces
     assert all(v % 4 == 0 for s in (itf.a, itf.b) for v in (s.start, s.stop))
-    assert len(levels(topo)) == 2  # 24×4 → 12×2; 6×1 would be below MIN_CELLS
+    assert len(levels(topo, semi=False)) == 2  # 24×4 → 12×2; 6×1 would be below MIN_CELLS
     bad = [{**blocks[0], "cells": [22, 4]}, blocks[1]]
     msg = _err(lambda: from_outline(ring, cuts=[[6, 3]], blocks=bad, multiple=4))
     assert "'main'" in msg and "multiples of 4" in msg
+
+
+def test_multigrid_semi_coarsening_on_stretched_blocks():
+    """Cells 4× longer in η: only ξ is coarsened first (in both blocks, across the interface)."""
+    from meshcore.multiblock.multigrid import levels, plan
+
+    X, Y = curved_rectangle(128, 16)  # cells ≈ 0.016 × 0.07
+    topo = two_blocks(X, Y, 64)
+    assert plan(topo, np.array([0.25, 0.25])) == [(2, 1), (2, 1)]
+    lv = levels(topo)
+    assert [l.topo.blocks[0].cells for l in lv[:3]] == [(64, 16), (32, 16), (16, 16)]
+    mb = solve_multiblock(topo, tolerance=1e-10, engine="multigrid")
+    h = [v for _, v in mb.info.residual_history]
+    assert mb.converged and len(h) <= 12
+    assert max(b / a for a, b in itertools.pairwise(h[1:])) < 0.35
