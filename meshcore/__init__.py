@@ -67,6 +67,7 @@ __all__ = [
     "borders_from_loop",
     "borders_from_polylines",
     "cell_quality",
+    "choose_corners",
     "distribute",
     "generate_block",
     "initial_grid",

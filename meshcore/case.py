@@ -7,7 +7,8 @@ list the valid ones.  Example (the paper's bottle, refinement 1)::
     title = "Bottle (paper, refinement 1)"
 
     [solver]                      # optional; fields of meshcore.EllipticConfig
-    method = "auto"               # auto | sor | multigrid | ...
+    method = "auto"               # auto | sor | multigrid | foldfree
+    repair = "auto"               # auto | strict | off: fold-free repair of invalid cells
     tolerance = 1e-6              # relative to the bounding-box diagonal (omit: scale-aware default)
     max_iterations = 50000
 
@@ -74,7 +75,8 @@ BLOCK_KEYS = {
 }
 BOUNDARY_KEYS = {"bottom", "right", "top", "left", "points", "corners"}
 BORDER_KEYS = {"distribution", "first", "last", "name"}
-SOLVER_KEYS = {f.name for f in dataclasses.fields(EllipticConfig)}
+SOLVER_KEYS = {f.name for f in dataclasses.fields(EllipticConfig)} | {"repair"}
+REPAIR_CHOICES = ("auto", "strict", "off")
 
 #: Extension hooks: extra top-level / per-block keys registered by other modules.
 _EXTRA_TOP: set[str] = set()
@@ -138,6 +140,7 @@ class Case:
     title: str = ""
     description: str = ""
     solver: EllipticConfig = field(default_factory=EllipticConfig)
+    repair: str = "auto"
     path: Path | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
 
@@ -321,8 +324,12 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
     if not isinstance(solver_tbl, Mapping):
         raise CaseFileError(f"{source}: [solver] must be a table")
     _check_keys(solver_tbl, SOLVER_KEYS, f"{source}: [solver]")
+    solver_tbl = dict(solver_tbl)
+    repair = solver_tbl.pop("repair", "auto")
+    if repair not in REPAIR_CHOICES:
+        raise CaseFileError(f"{source}: [solver]: repair must be one of {', '.join(REPAIR_CHOICES)}; got {repair!r}")
     try:
-        solver = EllipticConfig(**dict(solver_tbl))
+        solver = EllipticConfig(**solver_tbl)
     except InvalidInputError as exc:
         raise CaseFileError(f"{source}: [solver]: {exc}") from None
     return Case(
@@ -330,6 +337,7 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         title=str(data.get("title", "")),
         description=str(data.get("description", "")),
         solver=solver,
+        repair=repair,
         path=None,
         extra={k: data[k] for k in (_EXTRA_TOP | {"crs"}) if k in data}
         | ({"crs": ctx["crs"]} if "crs" in ctx else {}),
@@ -387,6 +395,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         for f in dataclasses.fields(EllipticConfig)
         if getattr(case.solver, f.name) != getattr(default, f.name)
     }
+    if case.repair != "auto":
+        solver["repair"] = case.repair
     if solver:
         out["solver"] = solver
     blocks = []
@@ -497,7 +507,7 @@ def generate_case(case: Case, *, callback: Callable[..., Any] | None = None,
     for b in case.blocks:
         src = str(case.path) if case.path else "<case>"
         try:
-            g = generate_block(**b.generate_kwargs(), config=cfg, callback=callback)
+            g = generate_block(**b.generate_kwargs(), config=cfg, callback=callback, repair=case.repair)
         except CaseFileError:
             raise
         except InvalidInputError as exc:

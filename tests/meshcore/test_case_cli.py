@@ -200,3 +200,16 @@ def test_lonlat_point_file_in_a_case_is_projected(tmp_path):
     assert again.extra["crs"]["origin"] == case.extra["crs"]["origin"]
     g1, g2 = generate_case(case)[0], generate_case(again)[0]
     np.testing.assert_allclose(g1.x, g2.x, atol=1e-6)
+
+
+def test_solver_repair_key(tmp_path):
+    text = example_path("rectangle-cutout-coarse").read_text() + '\n[solver]\nrepair = "off"\n'
+    c = loads_case(text, source="t.toml")
+    assert c.repair == "off"
+    off = generate_case(c)[0]
+    on = generate_case(c.replaced(repair="auto"))[0]
+    assert meshcore.quality(off).n_nonconvex > 0  # Winslow leaves non-convex cells at the cutout
+    assert meshcore.quality(on).n_nonconvex == 0 and "foldfree" in on.info.method
+    assert loads_case(dumps_case(c), source="t2").repair == "off"
+    with pytest.raises(CaseFileError, match="repair must be one of auto, strict, off"):
+        loads_case(example_path("bottle-fine").read_text() + '\n[solver]\nrepair = "maybe"\n', source="t")
