@@ -128,9 +128,21 @@ class Editor:
             return
         self.stack.push(cls(self.doc, after, text, merge_key=merge_key))
 
+    def _locked(self) -> bool:
+        """Multiblock cases are solved as read; their geometry is not edited in the app."""
+        if self.doc.project.multiblock is not None:
+            self.doc.message.emit(
+                "This is a multiblock case: its blocks and interfaces come from the case file and "
+                "cannot be edited here (solver settings can); edit the case file, or start a new project"
+            )
+            return True
+        return False
+
     def _edit_block(
         self, cls, fn: Callable[[Block], Block], text: str, merge_key=None, index: int | None = None
     ) -> None:
+        if self._locked():
+            return
         k = self.doc.active if index is None else index
         p = self.doc.project
         self._push(cls, p.with_block(k, fn(p.blocks[k])), text, merge_key)
@@ -220,6 +232,8 @@ class Editor:
         )
 
     def add_block(self) -> None:
+        if self._locked():
+            return
         p = self.doc.project
         after = p.replaced(blocks=(*p.blocks, Block(name=pj.next_block_name(p))))
         self._push(AddBlock, after, "Add block")
@@ -227,12 +241,16 @@ class Editor:
 
     def delete_block(self, index: int | None = None) -> None:
         """Remove a block (the last one is replaced by an empty block)."""
+        if self._locked():
+            return
         p = self.doc.project
         k = self.doc.active if index is None else index
         blocks = [b for j, b in enumerate(p.blocks) if j != k] or [Block(name="block")]
         self._push(AddBlock, p.replaced(blocks=tuple(blocks)), f"Delete block {p.blocks[k].name}")
 
     def add_cut_line(self, points) -> None:
+        if self._locked():
+            return
         p = self.doc.project
         self._push(AddCutLine, p.replaced(cut_lines=(*p.cut_lines, pj.frozen_points(points))), "Add cut line")
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from meshcore import BORDER_NAMES, ReadError, StructuredGrid
+from meshcore import BORDER_NAMES, BorderSpec, ReadError
 
 from .project import Block, Project, SolverSettings, boundary_to_loop
 
@@ -186,16 +186,83 @@ def project_to_case(project: Project):
 
 
 def load_project(path) -> Project:
-    """Read a case file into a project (meshcore.case.load_case)."""
+    """Read a case file into a project (meshcore.case.load_case); multiblock cases too."""
     from meshcore.case import load_case
 
-    return project_from_case(load_case(path))
+    case = load_case(path)
+    try:
+        from meshcore.multiblock.case import is_multiblock_case
+    except ImportError:  # older meshcore
+        return project_from_case(case)
+    if is_multiblock_case(case):
+        return project_from_multiblock_case(case)
+    return project_from_case(case)
+
+
+def project_from_multiblock_case(case) -> Project:
+    """A project showing a multiblock case: one boundary block per topology block."""
+    from meshcore.multiblock.case import case_frame, case_topology
+
+    topo = case_topology(case)
+    blocks = []
+    for b in topo.blocks:
+        bd = tuple(np.asarray(b.borders[n], float) for n in BORDER_NAMES)
+        names = {n: BorderSpec(name=v) for n, v in dict(b.names).items() if n in BORDER_NAMES and v}
+        blocks.append(
+            Block(
+                name=b.name,
+                boundary=bd,
+                cells=(len(bd[0]) - 1, len(bd[3]) - 1),
+                keep_nodes=True,
+                weights=tuple(b.weights),
+                initial=b.initial,
+                borders=tuple(names.items()),
+            )
+        )
+    s = case.solver
+    frame = case_frame(case)
+    return Project(
+        blocks=tuple(blocks),
+        solver=SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega),
+        title=case.title,
+        crs=(frame.crs or "") if frame is not None else "",
+        origin=tuple(frame.origin) if frame is not None else (0.0, 0.0),
+        source_crs=(frame.source_crs or "") if frame is not None else "",
+        multiblock=case,
+    )
 
 
 def save_project(project: Project, path) -> None:
-    """Write the project's ready blocks as a case file (meshcore.case.save_case)."""
+    """Write the project as a case file (meshcore.case.save_case).
+
+    A multiblock case is written back as read, with the app's solver settings.
+    """
+    from meshcore import EllipticConfig
     from meshcore.case import save_case
 
+    if project.multiblock is not None:
+        s = project.solver
+        cfg = EllipticConfig(
+            method="auto" if s.method == "foldfree" else s.method,
+            tolerance=s.tolerance,
+            max_iterations=s.max_iterations,
+            omega=s.omega,
+        )
+        case = project.multiblock
+        if "outline" in case.extra:
+            # written as explicit [[blocks]] + [[interfaces]] (meshcore's dump of an [outline]
+            # case does not load back: it writes ``blocks = []``)
+            from meshcore.multiblock.case import _settings, case_topology, topology_case
+
+            mode, _start = _settings(case)
+            case = topology_case(
+                case_topology(case), mode=mode, title=case.title, description=case.description, solver=cfg
+            )
+            frame = project_frame(project)
+            if frame is not None:
+                case = case.replaced(extra={**dict(case.extra), "crs": frame.as_dict()})
+        save_case(case.replaced(solver=cfg, path=None), path)
+        return
     save_case(project_to_case(project), path)
 
 
@@ -211,8 +278,10 @@ def mesh_formats() -> list[tuple[str, str]]:
     return out
 
 
-def write_mesh(path, grids: list[StructuredGrid], frame=None) -> None:
-    """Write the block grid(s) with :func:`meshcore.io.write` (format from the suffix)."""
+def write_mesh(path, grids, frame=None) -> None:
+    """Write the block grid(s) (a list, or a MultiBlockGrid) with :func:`meshcore.io.write`."""
     from meshcore.io import write
 
-    write(Path(path), grids[0] if len(grids) == 1 else list(grids), crs=frame)
+    if isinstance(grids, (list, tuple)):
+        grids = grids[0] if len(grids) == 1 else list(grids)
+    write(Path(path), grids, crs=frame)

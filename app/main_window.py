@@ -656,7 +656,11 @@ class MainWindow(QtWidgets.QMainWindow):
     def export_mesh(self, path: Path) -> bool:
         grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
         try:
-            fio.write_mesh(path, grids, fio.project_frame(self.doc.project))
+            mb = getattr(self.solver.last_result, "multiblock", None)
+            if mb is not None and self.doc.project.multiblock is not None and not self.doc.stale:
+                fio.write_mesh(path, mb, fio.project_frame(self.doc.project))  # with its connectivity
+            else:
+                fio.write_mesh(path, grids, fio.project_frame(self.doc.project))
         except (MeshcoreError, OSError) as exc:
             self.error("Cannot export mesh", exc)
             return False

@@ -68,6 +68,7 @@ class BlockResult:
 
     grids: dict
     initial: dict
+    multiblock: object = None  # the meshcore MultiBlockGrid of a multiblock case (connectivity)
 
 
 def solve_project(
@@ -87,6 +88,8 @@ def solve_project(
     ``warm`` maps a block index to ``(previous algebraic grid, previous grid)``.
     """
     cfg = project.solver.config(report_interval=report_interval)
+    if project.multiblock is not None:
+        return (yield from _solve_multiblock(project, cfg, stop_event))
     grids: dict[int, StructuredGrid] = {}
     starts: dict[int, StructuredGrid] = {}
     indices = blocks if blocks is not None else range(len(project.blocks))
@@ -117,6 +120,30 @@ def solve_project(
             break
         grids[k] = _fold_free(grids[k], project.solver)
     return BlockResult(grids=grids, initial=starts)
+
+
+def _solve_multiblock(project: Project, cfg, stop_event):
+    """A multiblock case: all blocks solved together by :func:`meshcore.multiblock.solve_multiblock`.
+
+    Yields the algebraic start grids (for display), then runs the global
+    solve, whose callback honours ``stop_event``; returns every block's grid.
+    """
+    from meshcore.multiblock import initial_grids, solve_multiblock
+    from meshcore.multiblock.case import _settings, case_topology
+
+    case = project.multiblock
+    mode, start = _settings(case)
+    topo = case_topology(case)
+    starts = dict(enumerate(initial_grids(topo)))
+    for k, g in starts.items():
+        yield k, g, g
+
+    def callback(_iteration, _residual):
+        return "stop" if stop_event is not None and stop_event.is_set() else None
+
+    mb = solve_multiblock(topo, mode=mode, start=start, config=cfg, callback=callback)
+    grids = dict(enumerate(mb.grids))
+    return BlockResult(grids=grids, initial=starts, multiblock=mb)
 
 
 def _fold_free(grid: StructuredGrid, solver) -> StructuredGrid:

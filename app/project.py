@@ -206,6 +206,9 @@ class Project:
     origin: tuple[float, float] = (0.0, 0.0)  # local origin: world = local + origin
     source_crs: str = ""  # CRS the points were read in ("EPSG:4326" for lon/lat)
     title: str = ""
+    #: a multiblock case (meshcore.case.Case with [multiblock]/[outline]/[[interfaces]]):
+    #: its blocks are shown and solved together by meshcore.multiblock; not editable in the app
+    multiblock: Any = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "blocks", tuple(self.blocks))

@@ -236,8 +236,10 @@ class Canvas(pg.PlotWidget):
         pts = block.points
         # other blocks: their points, faint
         others = [b for k, b in enumerate(doc.project.blocks) if k != doc.active]
+        multiblock = doc.project.multiblock is not None  # boundary nodes, not editable points
         op = [b.points for b in others if len(b.points)]
-        op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
+        if not multiblock:
+            op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
         if op:
             a = np.vstack(op)
             self.other_points_item.setData(a[:, 0], a[:, 1])
@@ -292,7 +294,10 @@ class Canvas(pg.PlotWidget):
             t.setText(f"{name} · {block.node_count(name)}")
             self._label_at[name] = (x, y, ang)
         self._place_labels()
-        disp = pts if block.boundary is None else np.vstack(block.boundary)
+        if block.boundary is None:
+            disp = pts
+        else:
+            disp = np.zeros((0, 2)) if multiblock else np.vstack(block.boundary)
         if len(disp):
             self.points_item.setData(disp[:, 0], disp[:, 1])
         else:

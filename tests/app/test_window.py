@@ -468,3 +468,28 @@ def test_border_labels_sit_outside_their_borders(qtbot, win):
     assert pos["bottom"].y() < at["bottom"][1] and pos["top"].y() > at["top"][1]
     assert pos["left"].x() < at["left"][0] and pos["right"].x() > at["right"][0]
     assert all("·" in c.border_labels[n].textItem.toPlainText() for n in pos)
+
+
+def test_multiblock_case_solves_exports_and_refuses_edits(qtbot, win, tmp_path):
+    from meshcore.io import read_blocks
+
+    assert win.open_example("confluence-multiblock", confirm=False)
+    p = win.doc.project
+    assert p.multiblock is not None and len(p.blocks) == 6
+    win.generate()
+    wait_idle(qtbot, win, timeout=60_000)
+    assert sorted(win.doc.grids) == list(range(6))
+    assert all(g.converged for g in win.doc.grids.values())
+    out = tmp_path / "mb.vtm"
+    assert win.export_mesh(out)
+    assert len(read_blocks(out).blocks) == 6
+    n = win.stack.count()
+    win.editor.add_point((0.0, 0.0))
+    win.editor.set_block_options(cells=(4, 4))
+    assert win.stack.count() == n and "multiblock" in win._status.text()
+    win.editor.set_solver(tolerance=1e-7)  # solver settings stay editable
+    assert win.stack.count() == n + 1
+    case = tmp_path / "mb.toml"
+    assert win._save_to(case)
+    assert win.open_path(case) and win.doc.project.multiblock is not None
+    assert win.doc.project.solver.tolerance == 1e-7
