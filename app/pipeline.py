@@ -4,11 +4,12 @@
 start grid with meshcore and iterates :func:`meshcore.iterate` on it, yielding
 ``(block_index, SolverProgress)`` snapshots and returning ``{index: grid}``.
 
-Warm start (live remesh): when the previous converged grid of a block has the
-same shape, the start grid is ``A_new + (G_old − A_old)`` — the new algebraic
-grid plus the correction the solver applied last time.  Boundary nodes stay
-exactly those of ``A_new`` (the correction vanishes on the boundary), and after
-a small boundary edit the start is already close to the new solution.
+Warm start (live remesh): when the previous grid of a block has the same
+shape, the candidate start grid is ``A_new + (G_old − A_old)`` — the new
+algebraic grid plus the correction the solver applied last time.  Boundary
+nodes stay exactly those of ``A_new`` (the correction vanishes on the
+boundary).  It is used when its residual (the solver's stopping measure) is
+smaller than that of ``A_new``; after a small edit it usually is.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshcore import StructuredGrid, initial_grid, iterate, prepare_borders
+from meshcore.elliptic import residual
 
 from .project import Block, Project
 
@@ -103,7 +105,10 @@ def solve_project(
         if warm and k in warm:
             a_old, g_old = warm[k]
             if a_old.shape == g0.shape and g_old.shape == g0.shape:
-                start = g0.replaced(x=g0.x + (g_old.x - a_old.x), y=g0.y + (g_old.y - a_old.y))
+                cand = g0.replaced(x=g0.x + (g_old.x - a_old.x), y=g0.y + (g_old.y - a_old.y))
+                # keep whichever start is closer to the solution (the stopping measure)
+                if residual(cand) < residual(g0):
+                    start = cand
         yield k, start, g0
         if not smooth:
             grids[k] = g0
