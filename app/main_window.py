@@ -45,6 +45,7 @@ SHORTCUTS = [
     ("drag on empty space", "box-select points (Edit); pan (other tools)"),
     ("wheel / right-drag", "zoom"),
     ("A", "auto corners"),
+    ("Ctrl+K", "split the loop into blocks by the drawn cut lines"),
     ("F5", "generate"),
     ("Space", "pause / resume the solver"),
     ("Esc", "stop the solver"),
@@ -210,6 +211,12 @@ class MainWindow(QtWidgets.QMainWindow):
         self.a_add_block = self._act("Add &block", self.editor.add_block)
         self.a_del_block = self._act("&Delete block", lambda: self.editor.delete_block())
         self.a_to_loop = self._act("&Convert borders to an editable loop", self.convert_to_loop)
+        self.a_split = self._act(
+            "&Split into blocks by cut lines",
+            self.split_by_cuts,
+            "Ctrl+K",
+            "each region between the cut lines becomes a block; all blocks are solved together (meshcore.multiblock)",
+        )
         self.a_generate = self._act("&Generate", self.generate, "F5", "build the algebraic grid and solve")
         self.a_pause = self._act("&Pause", self.solver.toggle_pause, "Space", "pause / resume", checkable=True)
         self.a_stop = self._act("&Stop", self.solver.stop, "Esc", "stop the solver (keeps the current grid)")
@@ -246,6 +253,8 @@ class MainWindow(QtWidgets.QMainWindow):
         m.addActions(list(self.tool_actions.values()))
         m = mb.addMenu("&Block")
         m.addActions([self.a_auto_corners, self.a_add_block, self.a_del_block, self.a_to_loop])
+        m.addSeparator()
+        m.addAction(self.a_split)
         m = mb.addMenu("&Generate")
         m.addActions([self.a_generate, self.a_pause, self.a_stop, self.a_auto])
         m = mb.addMenu("&View")
@@ -275,8 +284,8 @@ class MainWindow(QtWidgets.QMainWindow):
         tb.addSeparator()
         tb.addActions(list(self.tool_actions.values()))
         self.tool_actions["cut"].setToolTip(
-            "Cut line: draw polylines that will split the region into blocks. The cuts are stored in "
-            "the project; generating blocks from them waits for meshcore's multiblock support."
+            "Cut line: click a polyline from shore to shore (double-click / Enter ends it), then "
+            "Block ▸ Split into blocks by cut lines (Ctrl+K)"
         )
         tb.addAction(self.a_auto_corners)
         tb.addSeparator()
@@ -353,6 +362,36 @@ class MainWindow(QtWidgets.QMainWindow):
             self.message("This block is already an editable loop")
             return
         self.editor._edit_block(SetBlockOptions, boundary_to_loop, "Convert borders to loop")
+
+    def split_by_cuts(self) -> bool:
+        """Turn the active loop + the drawn cut lines into a multiblock case (undoable)."""
+        import tomli_w
+
+        from meshcore.case import loads_case
+
+        from .cutsplit import case_dict_from_cuts
+
+        p = self.doc.project
+        b = self.doc.block
+        if p.multiblock is not None or not b.closed or b.boundary is not None:
+            self.message("Split needs a closed loop of points (draw or import one) and cut lines across it")
+            return False
+        try:
+            d = case_dict_from_cuts(b.points, list(p.cut_lines), cells_across=b.cells[1], title=p.title)
+            case = loads_case(tomli_w.dumps(d), source="cut lines")
+            after = fio.project_from_multiblock_case(case)
+        except (MeshcoreError, ValueError) as exc:
+            self.error("Cannot split by cut lines", exc)
+            return False
+        after = after.replaced(crs=p.crs, origin=p.origin, source_crs=p.source_crs, title=p.title)
+        self.editor.replace_project(after, f"Split into {len(after.blocks)} blocks")
+        self.doc.set_active(0)
+        self.set_tool("pan")
+        self.message(
+            f"Split into {len(after.blocks)} blocks (η cells {b.cells[1]} across every block); "
+            "F5 solves them together — Ctrl+Z undoes the split"
+        )
+        return True
 
     def generate(self) -> None:
         if not any(b.ready for b in self.doc.project.blocks):

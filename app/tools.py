@@ -264,8 +264,8 @@ class CutTool(Tool):
     label = "Cut line"
     shortcut = "L"
     tip = (
-        "Cut line: click points of a polyline across the region, double-click or Enter to finish "
-        "(multiblock splitting is stored in the project; block generation from cuts is not wired yet)"
+        "Cut line: click a polyline from shore to shore, double-click or Enter to finish; "
+        "then Block ▸ Split into blocks by cut lines (Ctrl+K)"
     )
 
     def __init__(self, *a, **kw) -> None:

@@ -248,3 +248,16 @@ def test_add_and_delete_blocks_are_undoable():
     for _ in range(3):
         stack.undo()
     assert doc.project is first
+
+
+def test_cut_ends_snap_onto_the_outline_as_vertices():
+    from app.cutsplit import snap_cuts_to_outline
+    from meshcore.errors import TopologyError
+
+    ring = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [0.0, 1.0]])
+    new, cuts = snap_cuts_to_outline(ring, [np.array([[1.0, -0.05], [1.1, 1.04]])], snap=0.1)
+    assert len(new) == 6
+    assert cuts[0][0].tolist() == [1.0, 0.0] and cuts[0][-1].tolist() == [1.1, 1.0]
+    assert any(np.array_equal(v, [1.1, 1.0]) for v in new)
+    with pytest.raises(TopologyError, match="cut 1"):
+        snap_cuts_to_outline(ring, [np.array([[1.0, -0.5], [1.0, 1.0]])], snap=0.1)

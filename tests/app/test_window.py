@@ -493,3 +493,39 @@ def test_multiblock_case_solves_exports_and_refuses_edits(qtbot, win, tmp_path):
     assert win._save_to(case)
     assert win.open_path(case) and win.doc.project.multiblock is not None
     assert win.doc.project.solver.tolerance == 1e-7
+
+
+def test_cut_lines_split_a_channel_into_blocks(qtbot, win):
+    t = np.linspace(0, 6, 13)
+    ring = np.vstack([np.c_[t, 0 * t], np.c_[t[::-1], 1 + 0 * t]])
+    for xy in ring:
+        win.editor.add_point(tuple(xy))
+    win.editor.close_loop()
+    win.editor.set_block_options(cells=(24, 8))
+    win.set_tool("cut")
+    tool = win.canvas.tool
+    for cut in ([(2.0, -0.01), (2.05, 1.01)], [(4.0, 1.0), (4.0, 0.0)]):  # drawn roughly, by hand
+        for xy in cut:
+            tool.click(xy)
+        tool.key(QtCore.Qt.Key.Key_Return)
+    assert len(win.doc.project.cut_lines) == 2
+    before = win.doc.project
+    assert win.split_by_cuts()
+    p = win.doc.project
+    assert p.multiblock is not None and len(p.blocks) == 3
+    assert all(b.cells[1] == 8 for b in p.blocks)  # the η count is shared along the chain
+    win.generate()
+    wait_idle(qtbot, win, timeout=60_000)
+    g = [win.doc.grids[k] for k in range(3)]
+    assert all(x.converged for x in g)
+    # interface nodes are identical: each of the two cuts is a side of two blocks, node for node
+    sides = [(k, n, g[k].border(n)) for k in range(3) for n in ("bottom", "right", "top", "left")]
+    shared = {
+        (k, n)
+        for k, n, mine in sides
+        for j, _m, other in sides
+        if j != k and other.shape == mine.shape and (np.array_equal(other, mine) or np.array_equal(other[::-1], mine))
+    }
+    assert len(shared) == 4
+    win.stack.undo()
+    assert win.doc.project is before
