@@ -64,7 +64,21 @@ class Document:
         """Replace the project (commands call this) and tell the views."""
         if project is self.project:
             return
+        old = self.project
         self.project = project
+        if project.multiblock is not old.multiblock or len(project.blocks) != len(old.blocks):
+            # a different block structure (split by cuts, undo of it, add/delete block): keep
+            # only the grids of blocks that are still there, unchanged, at the same index
+            keep = {
+                k
+                for k in self.grids
+                if project.multiblock is old.multiblock
+                and k < min(len(project.blocks), len(old.blocks))
+                and project.blocks[k] is old.blocks[k]
+            }
+            self.grids = {k: g for k, g in self.grids.items() if k in keep}
+            self.initial = {k: g for k, g in self.initial.items() if k in keep}
+            self.grids_changed.emit()
         if self.active >= len(project.blocks):
             self.set_active(len(project.blocks) - 1)
         n = len(self.block.points)
