@@ -22,6 +22,7 @@ from . import io_adapter as fio
 from .commands import Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names, load_example
+from .pipeline import ALL_BLOCKS
 from .project import Background, Block, Project, boundary_to_loop, default_cells
 from .solver_controller import SolverController
 from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, PanTool
@@ -435,6 +436,10 @@ class MainWindow(QtWidgets.QMainWindow):
             self.canvas.set_quality(None, None)
 
     def _on_progress(self, k: int, snap) -> None:
+        if k == ALL_BLOCKS:  # a multiblock solve: relative residuals of the global iteration
+            self.conv_panel.set_history(list(snap.history))
+            self._solver_label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
+            return
         if k == self.doc.active:
             length = max(snap.grid.size, 1e-300)  # history is absolute, residual relative
             self.conv_panel.set_history([(i, r / length) for i, r in snap.history], snap.tolerance)

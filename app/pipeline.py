@@ -65,6 +65,24 @@ def block_initial_grid(block: Block) -> StructuredGrid:
 
 
 @dataclass(frozen=True, slots=True)
+class ResidualProgress:
+    """Progress of a solve that has no grid snapshots (multiblock): relative residuals only.
+
+    Yielded as ``(ALL_BLOCKS, progress, None)``.
+    """
+
+    iteration: int
+    residual: float
+    history: tuple[tuple[int, float], ...]
+    method: str = "multiblock"
+    tolerance: float = float("nan")
+
+
+#: block index of progress items that concern all blocks at once
+ALL_BLOCKS = -1
+
+
+@dataclass(frozen=True, slots=True)
 class BlockResult:
     """What the worker returns: final grids and start grids per block."""
 
@@ -143,10 +161,31 @@ def _solve_multiblock(project: Project, cfg, stop_event):
     for k, g in starts.items():
         yield k, g, g
 
-    def callback(_iteration, _residual):
+    history: list[tuple[int, float]] = []
+    out: dict = {}
+
+    def callback(iteration, rel_residual):
+        history.append((int(iteration), float(rel_residual)))
         return "stop" if stop_event is not None and stop_event.is_set() else None
 
-    mb = solve_multiblock(topo, mode=mode, start=start, config=cfg, callback=callback)
+    def run() -> None:  # the global solve reports only through its callback: run it aside
+        try:
+            out["mb"] = solve_multiblock(topo, mode=mode, start=start, config=cfg, callback=callback)
+        except BaseException as exc:  # handed back to the worker below
+            out["error"] = exc
+
+    th = threading.Thread(target=run, name="multiblock-solve", daemon=True)
+    th.start()
+    seen = 0
+    while th.is_alive():
+        th.join(cfg.report_interval)
+        if len(history) > seen:
+            seen = len(history)
+            it, r = history[-1]
+            yield ALL_BLOCKS, ResidualProgress(it, r, tuple(history)), None
+    if "error" in out:
+        raise out["error"]
+    mb = out["mb"]
     grids = dict(enumerate(mb.grids))
     return BlockResult(grids=grids, initial=starts, multiblock=mb)
 

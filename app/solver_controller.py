@@ -20,7 +20,7 @@ from superqt.utils import create_worker
 from meshcore import MeshcoreError, SolverProgress, StructuredGrid
 
 from .document import Document
-from .pipeline import solve_project
+from .pipeline import ResidualProgress, solve_project
 
 __all__ = ["SolverController"]
 
@@ -215,6 +215,9 @@ class SolverController(QtCore.QObject):
         self._dirty = False
         self._last_flush = time.perf_counter()
         for k, (item, g0) in self._latest.items():
+            if isinstance(item, ResidualProgress):  # all blocks at once, no grid snapshot
+                self.progress.emit(k, item)
+                continue
             grid = item.grid if isinstance(item, SolverProgress) else item
             self.doc.grids[k] = grid
             self.doc.initial[k] = g0

@@ -480,6 +480,8 @@ def test_multiblock_case_solves_exports_and_refuses_edits(qtbot, win, tmp_path):
     wait_idle(qtbot, win, timeout=60_000)
     assert sorted(win.doc.grids) == list(range(6))
     assert all(g.converged for g in win.doc.grids.values())
+    x, _y = win.conv_panel.curve.getData()
+    assert x is not None and len(x) > 1  # the global residual history reached the plot
     out = tmp_path / "mb.vtm"
     assert win.export_mesh(out)
     assert len(read_blocks(out).blocks) == 6
