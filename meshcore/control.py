@@ -224,7 +224,7 @@ class ControlSpec:
     attractors: tuple[Attractor, ...] = ()
     relaxation: float = 0.1
     feedback: float = 0.3
-    limit: float = 4.0
+    limit: float = 8.0
     every: int = 1
     floating: tuple[str, ...] = ()
     float_every: int = 10
@@ -483,6 +483,11 @@ class _Polyline:
         self.s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(self.p, axis=0).T))])
         self.length = float(self.s[-1])
         self.closed = closed
+        if closed:  # three turns, parameters −L … 2L, so windows never wrap
+            self.pe = np.vstack([self.p[:-1], self.p[:-1], self.p])
+            self.se = np.concatenate([self.s[:-1] - self.length, self.s[:-1], self.s + self.length])
+        else:
+            self.pe, self.se = self.p, self.s
 
     def at(self, s: np.ndarray) -> np.ndarray:
         s = np.mod(s, self.length) if self.closed else np.clip(s, 0.0, self.length)
@@ -504,11 +509,11 @@ class _Polyline:
 
     def project(self, q: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """Arc length of the nearest point to ``q[k]`` with parameter in ``[lo[k], hi[k]]``."""
-        a = self.p[:-1]
-        d = np.diff(self.p, axis=0)
+        a = self.pe[:-1]
+        d = np.diff(self.pe, axis=0)
         L2 = (d * d).sum(axis=1)
         L = np.sqrt(L2)
-        s0 = self.s[:-1]
+        s0 = self.se[:-1]
         t = ((q[:, None, :] - a[None]) * d[None]).sum(axis=2) / L2[None]
         # restrict the foot parameter to the window [lo, hi]
         tlo = (lo[:, None] - s0[None]) / L[None]
@@ -571,7 +576,7 @@ class ControlSources:
         self.curves_in = dict(curves or {})
         self.history: list[tuple[int, float]] = []
         self._change = math.inf
-        self._moved = 0.0
+        self._moved = math.inf if spec.floating else 0.0
         self._initialized = False
 
     # -- protocol ---------------------------------------------------------
@@ -670,10 +675,15 @@ class ControlSources:
                 else (r0 if pts is None else np.asarray(pts, float))
             )
             c = _Polyline(pts, closed)
-            self._curves[name] = c
             s = c.locate(r0)
             if closed:
                 s = np.unwrap(s, period=c.length)
+            if s[-1] < s[0]:  # the curve runs against the border: reverse it
+                c = _Polyline(np.asarray(pts)[::-1], closed)
+                s = c.locate(r0)
+                if closed:
+                    s = np.unwrap(s, period=c.length)
+            self._curves[name] = c
             self._fl_s[name] = s
         self._initialized = True
         self._recompute_tm(x, y)
@@ -689,9 +699,9 @@ class ControlSources:
             self._wake_step(x, y)
             if it % sp.every:
                 return
-        moved = 0.0
+        moved = self._moved
         if sp.floating and it % sp.float_every == 0:
-            moved = self._float_step(x, y)
+            moved = self._moved = self._float_step(x, y)
             self._recompute_tm(x, y)
         change = 0.0
         for bs in self._bstate.values():
@@ -851,14 +861,7 @@ class ControlSources:
                 sl, sr = s[ks - 1], s[ks + 1]
             lo = s[ks] + 0.6 * (sl - s[ks])
             hi = s[ks] + 0.6 * (sr - s[ks])
-            tgt = c.project(
-                r1[ks],
-                np.mod(lo, c.length) if closed else lo,
-                np.mod(hi, c.length) if closed else hi,
-            )
-            if closed:
-                # bring the target next to the current parameter
-                tgt = tgt + c.length * np.round((s[ks] - tgt) / c.length)
+            tgt = c.project(r1[ks], lo, hi)
             new = s[ks] + w * (tgt - s[ks])
             new = np.clip(new, lo, hi)
             pts = c.at(new)
