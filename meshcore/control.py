@@ -44,17 +44,19 @@ Components (all optional, summed):
   .. math::  A(r_{tt} + s_t r_t) − 2B r_{tn} + C(r_{nn} + s_n r_n) = 0,
              \quad A = |r_n|^2,\ B = r_t·r_n,\ C = |r_t|^2
 
-  gives the border values of the normalised sources :math:`(s_t, s_n)`.  They are
-  under-relaxed, :math:`s ← s + ω (s^* − s)`, clipped to ``limit`` and decay into
-  the interior like :math:`e^{−a\,n}`.  The *effective* targets are corrected
-  by feedback on the measured first cell (Hilgenstock–White style):
-  :math:`S_\text{eff} ← S_\text{eff} (S/s_1)^{ω_f}`,
-  :math:`θ_\text{eff} ← θ_\text{eff} + ω_f(θ − θ_1)`, so at the fixed point the
-  discrete first-cell height :math:`s_1 = |r_1 − r_0|` and angle θ₁ equal the
-  request, not only to truncation error.  ``kind="hilgenstock-white"`` uses the
-  feedback alone (:math:`s_n ← s_n − ω\ln(s_1/S)`, :math:`s_t ← s_t + ω\,2\,
-  (s_1/|r_t|)^{-1}(θ_1−θ)` with the cell aspect ratio), without the Taylor
-  targets.
+  gives the Steger–Sorenson targets for the border values of the normalised
+  sources :math:`(s_t, s_n)`; they are under-relaxed, :math:`s ← s + ω (s^* − s)`,
+  clipped to ``limit`` and decay into the interior like :math:`e^{−a\,n}`.  The
+  Taylor targets are only accurate to truncation error (on a coarse, strongly
+  stretched grid the first cell can miss the request by tens of per cent), so
+  an integral **Hilgenstock–White** feedback on the *measured* first cell is
+  added, :math:`s_n \mathrel{−}= σ g \ln(s_1/S)`,
+  :math:`s_t \mathrel{+}= ∓ g\, 2\,\mathrm{AR}\,(θ − θ_1)` (AR = tangential
+  spacing / first-cell height, capped at 50; ``g = feedback · ω``): at the fixed
+  point the discrete first-cell height :math:`s_1 = |r_1 − r_0|` and angle θ₁
+  equal the request.  ``kind="hilgenstock-white"`` (the default) uses the
+  feedback alone (``g = ω``); it is the robust choice at sharp boundary kinks
+  and corners of coarse blocks, where the Taylor targets oscillate.
 * **Floating boundary nodes**: every ``float_every`` sweeps the non-corner nodes
   of the listed borders slide along the border curve towards the foot of the
   perpendicular from their interior neighbour (relaxed by ``float_relaxation``,
@@ -96,7 +98,7 @@ __all__ = [
     "first_spacing",
 ]
 
-BOUNDARY_KINDS = ("steger-sorenson", "hilgenstock-white")
+BOUNDARY_KINDS = ("hilgenstock-white", "steger-sorenson")
 
 # border -> (sigma: +1 if the interior is at increasing normal index,
 #            rho: rotation sign from the tangent into the interior,
@@ -191,8 +193,8 @@ class ControlSpec:
 
     Parameters
     ----------
-    kind : {"steger-sorenson", "hilgenstock-white"}
-        Boundary-control method for ``borders``.
+    kind : {"hilgenstock-white", "steger-sorenson"}
+        Boundary-control method for ``borders`` (see module docstring).
     borders : mapping of border name to BorderControl (or dict)
         Controlled borders.
     thomas_middlecoff : bool
@@ -202,8 +204,9 @@ class ControlSpec:
     relaxation : float
         Under-relaxation ω of the boundary sources per update, in (0, 1].
     feedback : float
-        Relaxation ω_f of the target correction from the measured first cell;
-        0 disables it (pure Steger–Sorenson).
+        Steger–Sorenson only: gain of the added measured-first-cell feedback,
+        as a multiple of ``relaxation``; 0 = classic Steger–Sorenson (targets
+        met to truncation error only).
     limit : float
         Bound on |normalised source| at a border.
     every : int
@@ -218,12 +221,12 @@ class ControlSpec:
         C-grid: number of cells of the wake cut on each side (0 = none).
     """
 
-    kind: str = "steger-sorenson"
+    kind: str = "hilgenstock-white"
     borders: Mapping[str, BorderControl] = field(default_factory=dict)
     thomas_middlecoff: bool = False
     attractors: tuple[Attractor, ...] = ()
     relaxation: float = 0.1
-    feedback: float = 0.3
+    feedback: float = 1.0
     limit: float = 8.0
     every: int = 1
     floating: tuple[str, ...] = ()
@@ -539,6 +542,14 @@ class _BorderState:
     spacing_eff: np.ndarray
     angle_eff: np.ndarray  # radians
     weight: np.ndarray  # decay field (full node shape)
+    ss_t: np.ndarray = None  # Steger–Sorenson part
+    ss_n: np.ndarray = None
+    hw_t: np.ndarray = None  # Hilgenstock–White integrators
+    hw_n: np.ndarray = None
+
+    def __post_init__(self) -> None:
+        n = len(self.s_t)
+        self.ss_t, self.ss_n, self.hw_t, self.hw_n = (np.zeros(n) for _ in range(4))
 
 
 class ControlSources:
@@ -631,7 +642,7 @@ class ControlSources:
         # boundary control state
         self._bstate: dict[str, _BorderState] = {}
         for name, bc in sp.borders.items():
-            sigma, rho, along = _FRAME[name]
+            _sigma, rho, along = _FRAME[name]
             r0, r1, _ = _border_rows(x, y, name)
             n = len(r0)
             per = self.periodic and along == "xi"
@@ -759,16 +770,9 @@ class ControlSources:
         if req_a is None:
             bs.angle_eff[k] = ang1[k]
         old_t, old_n = bs.s_t[k].copy(), bs.s_n[k].copy()
+        lim = sp.limit
         w = sp.relaxation
         if sp.kind == "steger-sorenson":
-            if sp.feedback > 0:
-                f = sp.feedback
-                if req_s is not None:
-                    bs.spacing_eff[k] *= (req_s / np.maximum(s1[k], 1e-300)) ** f
-                    bs.spacing_eff[k] = np.clip(bs.spacing_eff[k], 0.2 * req_s, 5.0 * req_s)
-                if req_a is not None:
-                    bs.angle_eff[k] += f * np.angle(np.exp(1j * (req_a - ang1[k])))
-                    bs.angle_eff[k] = np.clip(bs.angle_eff[k], req_a - 0.6, req_a + 0.6)
             S = bs.spacing_eff
             tx, ty = rt[:, 0] / np.maximum(lt, 1e-300), rt[:, 1] / np.maximum(lt, 1e-300)
             nx, ny = _rot(tx, ty, rho * bs.angle_eff)
@@ -784,31 +788,32 @@ class ControlSources:
             # [rt rn] [A s_t; C s_n] = −R
             as_t = -(rn[:, 1] * R[:, 0] - rn[:, 0] * R[:, 1]) / det
             cs_n = -(rt[:, 0] * R[:, 1] - rt[:, 1] * R[:, 0]) / det
-            tgt_t = as_t / np.maximum(A, 1e-300)
-            tgt_n = cs_n / np.maximum(C, 1e-300)
-            lim = sp.limit
-            bs.s_t[k] += w * (np.clip(tgt_t[k], -lim, lim) - bs.s_t[k])
-            bs.s_n[k] += w * (np.clip(tgt_n[k], -lim, lim) - bs.s_n[k])
-        else:  # hilgenstock-white: pure feedback on the measured first cell
-            lim = sp.limit
+            tgt_t = np.nan_to_num(as_t / np.maximum(A, 1e-300))
+            tgt_n = np.nan_to_num(cs_n / np.maximum(C, 1e-300))
+            if not per:
+                # next to a corner the Taylor targets see both walls: leave those
+                # nodes to the feedback part
+                tgt_t[[1, -2]] = 0.0
+                tgt_n[[1, -2]] = 0.0
+            bs.ss_t[k] += w * (np.clip(tgt_t[k], -lim, lim) - bs.ss_t[k])
+            bs.ss_n[k] += w * (np.clip(tgt_n[k], -lim, lim) - bs.ss_n[k])
+            g = sp.feedback * w
+        else:
+            g = w
+        # Hilgenstock–White: integral feedback on the measured first cell
+        if g > 0:
             if req_s is not None:
-                bs.s_n[k] -= (
-                    sigma * w * np.clip(np.log(np.maximum(s1[k], 1e-300) / req_s), -1.0, 1.0)
-                )
+                e = np.clip(np.log(np.maximum(s1[k], 1e-300) / req_s), -1.0, 1.0)
+                bs.hw_n[k] -= sigma * g * e
             if req_a is not None:
-                ar = lt[k] / np.maximum(s1[k], 1e-300)
+                ar = np.minimum(lt[k] / np.maximum(s1[k], 1e-300), 50.0)
                 err = np.clip(np.angle(np.exp(1j * (req_a - ang1[k]))), -0.5, 0.5)
-                bs.s_t[k] += (
-                    -rho
-                    * sigma
-                    * w
-                    * 2.0
-                    * np.minimum(ar, 50.0)
-                    * err
-                    * (1 if along == "xi" else -1)
-                )
-            bs.s_t[k] = np.clip(bs.s_t[k], -lim, lim)
-            bs.s_n[k] = np.clip(bs.s_n[k], -lim, lim)
+                sgn = -rho * sigma * (1 if along == "xi" else -1)
+                bs.hw_t[k] += sgn * g * 2.0 * ar * err
+            bs.hw_t[k] = np.clip(bs.hw_t[k], -lim, lim)
+            bs.hw_n[k] = np.clip(bs.hw_n[k], -lim, lim)
+        bs.s_t[k] = np.clip(bs.ss_t[k] + bs.hw_t[k], -lim, lim)
+        bs.s_n[k] = np.clip(bs.ss_n[k] + bs.hw_n[k], -lim, lim)
         return float(
             max(
                 np.max(np.abs(bs.s_t[k] - old_t), initial=0.0),
