@@ -227,7 +227,7 @@ class ControlSpec:
     attractors: tuple[Attractor, ...] = ()
     relaxation: float = 0.1
     feedback: float = 1.0
-    limit: float = 8.0
+    limit: float = 20.0
     every: int = 1
     floating: tuple[str, ...] = ()
     float_every: int = 10

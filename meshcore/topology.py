@@ -216,15 +216,15 @@ def cgrid(
     bottom = np.vstack([lower[:-1], b[:-1], upper])
     nb = len(b) - 1
     ni = 2 * nw + nb
-    # top: straight lines below/above the wake, a semicircle around the front
+    # top: a semicircle around the front, uniform in angle, and straight lines
+    # above/below the wake whose first spacing matches the arc's
     cx, cy = te[0], te[1]
-    top_low = np.column_stack([lower[:, 0], np.full(nw + 1, cy - radius)])
-    top_up = np.column_stack([upper[:, 0], np.full(nw + 1, cy + radius)])
-    # body nodes → angle by arc length along the body
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(b, axis=0).T))])
-    s /= s[-1]
-    th = -0.5 * math.pi - math.pi * s
+    th = -0.5 * math.pi - math.pi * np.linspace(0.0, 1.0, nb + 1)
     arc = np.column_stack([cx + radius * np.cos(th), cy + radius * np.sin(th)])
+    h = min(math.pi * radius / nb, 0.9 * wake_length / nw)
+    line = radial_nodes((cx, 0.0), (cx + wake_length, 0.0), nw, first=h)[:, 0]
+    top_low = np.column_stack([line[::-1], np.full(nw + 1, cy - radius)])
+    top_up = np.column_stack([line, np.full(nw + 1, cy + radius)])
     top = np.vstack([top_low[:-1], arc[:-1], top_up])
     left = radial_nodes(bottom[0], top[0], nj, first=first)
     right = radial_nodes(bottom[-1], top[-1], nj, first=first)

@@ -261,7 +261,7 @@ def test_naca0012_cgrid_wall_orthogonal_wake_cut_solved():
         kind="hilgenstock-white",
         thomas_middlecoff=True,
         wake=C.wake,
-        borders={"bottom": {"spacing": dy, "start": C.body[0], "stop": C.body[1] + 1}},
+        borders={"bottom": {"spacing": dy, "start": C.body[0] + 1, "stop": C.body[1]}},
     )
     g = solve(C.grid, spec, max_iterations=40000)
     assert g.converged and meshcore.quality(g).n_folded == 0
@@ -279,7 +279,9 @@ def test_steger_sorenson_targets_plus_feedback_on_smooth_walls():
     g0 = ogrid(inner, outer, (60, 16))
     sp = {"bottom": 0.05, "top": 0.2}
     borders = {k: {"spacing": v} for k, v in sp.items()}
-    classic = solve(g0, ControlSpec(kind="steger-sorenson", feedback=0.0, borders=borders), periodic=True)
+    classic = solve(
+        g0, ControlSpec(kind="steger-sorenson", feedback=0.0, borders=borders), periodic=True
+    )
     full = solve(g0, ControlSpec(kind="steger-sorenson", borders=borders), periodic=True)
     assert classic.converged and full.converged
     rc = boundary_report(classic, ("bottom", "top"), sp)
