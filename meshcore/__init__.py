@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from . import _numba_setup  # noqa: F401  (must run before numba compiles anything)
 from .algebraic import algebraic_grid, tfi, weighted_average
-from .boundary import BorderSpec, Borders, borders_from_loop, borders_from_polylines
+from .boundary import Borders, BorderSpec, borders_from_loop, borders_from_polylines
 from .curves import LinearSpline, SmoothCurve, make_curve
 from .distribution import distribute
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve

@@ -42,6 +42,7 @@ def prepare_borders(
     borders: Mapping[str, Any] | None = None,
     curve: str = "linear",
     periodic: bool = False,
+    snap_angle: float | None = None,
     where: str = "",
 ) -> Borders:
     """Validate the boundary and re-sample it (or use the given nodes when ``cells`` is None)."""
@@ -67,7 +68,7 @@ def prepare_borders(
             raise InvalidInputError("border distributions need cells= (the borders are re-sampled)")
         b.check_counts()
         return b
-    return b.resampled(c, specs=borders, curve=curve)
+    return b.resampled(c, specs=borders, curve=curve, snap_angle=snap_angle)
 
 
 def initial_grid(
@@ -111,6 +112,7 @@ def generate_block(
     callback: Callable[[SolverProgress], Any] | None = None,
     smooth: bool = True,
     periodic: bool = False,
+    snap_angle: float | None = None,
 ) -> StructuredGrid:
     """Generate one block's grid from its boundary.
 
@@ -146,6 +148,10 @@ def generate_block(
     periodic : bool
         Periodic ξ direction (O-grid): left and right borders coincide and the
         seam nodes are solved like interior nodes.
+    snap_angle : float, optional
+        When re-sampling, input vertices where a border turns by more than this
+        many degrees get a node exactly (keeps the corners of a cutout);
+        ``None`` = pure distribution (the paper).
 
     Returns
     -------
@@ -163,7 +169,7 @@ def generate_block(
     """
     b = prepare_borders(
         bottom, right, top, left, loop=loop, corners=corners, cells=cells, borders=borders, curve=curve,
-        periodic=periodic,
+        periodic=periodic, snap_angle=snap_angle,
     )
     names = {
         k: v["name"]

@@ -1,0 +1,8 @@
+"""``python -m meshcore`` = the ``meshcore`` command."""
+
+import sys
+
+from .cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

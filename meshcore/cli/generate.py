@@ -1,0 +1,86 @@
+"""``meshcore generate CASE -o OUT [--png FIG]``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from ..case import generate_case, load_case
+from ..elliptic import SolverProgress
+from ..errors import InvalidInputError
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("case", help="case file (.toml)")
+    p.add_argument("-o", "--output", help="output mesh file (format from the suffix: .vts, .xyz, .npz, ...)")
+    p.add_argument("--png", help="also draw the grid to this figure file (.png/.svg/.pdf)")
+    p.add_argument("--method", help="solver method (auto, sor, multigrid, ...)")
+    p.add_argument("--tolerance", type=float, help="relative tolerance of the stopping rule")
+    p.add_argument("--max-iterations", type=int, help="iteration cap")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress or quality table")
+
+
+class _Progress:
+    """Progress on stderr once a solve has taken more than ~1 s."""
+
+    def __init__(self, quiet: bool) -> None:
+        self.quiet = quiet
+        self.t0 = time.perf_counter()
+        self.shown = False
+
+    def __call__(self, snap: SolverProgress) -> None:
+        if self.quiet or snap.elapsed < 1.0:
+            return
+        self.shown = True
+        print(
+            f"\r  {snap.method}: iteration {snap.iteration:6d}  residual {snap.residual:.3e} "
+            f"(tolerance {snap.tolerance:.1e})  {snap.elapsed:5.1f} s",
+            end="", file=sys.stderr, flush=True,
+        )
+
+    def done(self) -> None:
+        if self.shown:
+            print(file=sys.stderr)
+            self.shown = False
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..io import write
+    from ..quality import quality
+
+    case = load_case(args.case)
+    overrides = {}
+    if args.method:
+        overrides["method"] = args.method
+    if args.tolerance is not None:
+        overrides["tolerance"] = args.tolerance
+    if args.max_iterations is not None:
+        overrides["max_iterations"] = args.max_iterations
+    try:
+        cfg = case.solver.replaced(**overrides)
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{args.case}: {exc}") from None
+    prog = _Progress(args.quiet)
+    t0 = time.perf_counter()
+    result = generate_case(case, callback=prog, config=cfg)
+    prog.done()
+    elapsed = time.perf_counter() - t0
+    blocks = list(getattr(result, "blocks", result))
+    if args.output:
+        write(Path(args.output), result)
+    if args.png:
+        write(Path(args.png), result)
+    converged = all(g.converged for g in blocks)
+    if not args.quiet:
+        for g in blocks:
+            name = next((b.name for b, gg in zip(case.blocks, blocks, strict=False) if gg is g), "")
+            print(f"block {name!r}: {g.cells[0]}×{g.cells[1]} cells, {g.info.method}, "
+                  f"{g.info.message}, {g.iterations} iterations, residual {g.residual:.3e}")
+            print(quality(g).table())
+        print(f"done in {elapsed:.3f} s" + (f"; wrote {args.output}" if args.output else ""))
+    if not converged:
+        print("meshcore generate: warning: the solver did not converge (exit code 3)", file=sys.stderr)
+        return 3
+    return 0
