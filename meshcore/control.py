@@ -96,6 +96,7 @@ __all__ = [
     "boundary_report",
     "control_from_mapping",
     "first_spacing",
+    "make_sources",
 ]
 
 BOUNDARY_KINDS = ("hilgenstock-white", "steger-sorenson")
@@ -812,6 +813,15 @@ class ControlSources:
                 bs.hw_t[k] += sgn * g * 2.0 * ar * err
             bs.hw_t[k] = np.clip(bs.hw_t[k], -lim, lim)
             bs.hw_n[k] = np.clip(bs.hw_n[k], -lim, lim)
+        if not per and len(bs.hw_n) > 5:
+            # Next to a corner of angle θc ≠ 90° the first cell cannot be both
+            # orthogonal to the two walls and of the requested height (h = d·tan(θc/2)
+            # for a corner distance d): the angle wins, the spacing source there
+            # follows its neighbour.
+            if 1 in k:
+                bs.hw_n[1] = bs.hw_n[2]
+            if len(bs.hw_n) - 2 in k:
+                bs.hw_n[-2] = bs.hw_n[-3]
         bs.s_t[k] = np.clip(bs.ss_t[k] + bs.hw_t[k], -lim, lim)
         bs.s_n[k] = np.clip(bs.ss_n[k] + bs.hw_n[k], -lim, lim)
         return float(
@@ -917,3 +927,12 @@ def _set_border(x, y, name, ks, pts):
         x[0, ks], y[0, ks] = pts[:, 0], pts[:, 1]
     else:
         x[-1, ks], y[-1, ks] = pts[:, 0], pts[:, 1]
+
+
+def make_sources(control: ControlSpec | Mapping[str, Any], *, periodic: bool = False,
+                 curves: Mapping[str, Any] | None = None) -> ControlSources | None:
+    """A :class:`ControlSources` for ``control`` (a spec or a case-file table); None if inactive."""
+    spec = control if isinstance(control, ControlSpec) else control_from_mapping(control)
+    if not spec.active:
+        return None
+    return ControlSources(spec, periodic=periodic, curves=curves)

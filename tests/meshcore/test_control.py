@@ -112,7 +112,7 @@ def test_bottle_all_walls_orthogonal_with_requested_spacing(cells, spacing):
     for n in WALLS:
         err = np.abs(first_spacing(g, n) / spacing - 1.0)
         assert err[1:-1].max() <= 0.05, n
-        assert err.max() <= 0.15, n
+        assert err.max() <= 0.25, n
 
 
 def test_two_circles_periodic_ogrid_control_and_seam():
@@ -290,3 +290,62 @@ def test_steger_sorenson_targets_plus_feedback_on_smooth_walls():
     assert rc["max_spacing_error"] > 0.1
     assert rf["max_spacing_error"] <= 0.05 and rf["max_angle_deviation"] <= 2.0
     assert meshcore.quality(full).n_folded == 0
+
+
+# --------------------------------------------------------------------------- case files
+
+EXAMPLES = __import__("pathlib").Path(__file__).resolve().parents[2] / "resources" / "examples"
+
+
+def _walls(block):
+    return {k: v.get("spacing") for k, v in block.control.get("borders", {}).items()}
+
+
+@pytest.mark.parametrize(
+    "name", ["bottle-orthogonal", "two-circles-orthogonal", "two-circles-ogrid", "naca0012-ogrid"]
+)
+def test_control_example_cases(name):
+    from meshcore.case import dumps_case, load_case, loads_case
+
+    case = load_case(EXAMPLES / f"{name}.toml")
+    block = case.blocks[0]
+    assert block.control is not None
+    assert loads_case(dumps_case(case)).blocks[0].control == block.control  # round trip
+    (g,) = meshcore.case.generate_case(case)
+    assert g.converged and meshcore.quality(g).n_folded == 0
+    sp = _walls(block)
+    rep = boundary_report(g, tuple(sp), sp)
+    assert rep["max_angle_deviation"] <= 2.0
+    if g.periodic:
+        assert rep["max_spacing_error"] <= 0.05
+    else:  # next to a corner θc ≠ 90° the angle wins over the spacing (see meshcore.control)
+        for n in sp:
+            err = np.abs(first_spacing(g, n) / sp[n] - 1)
+            assert err[1:-1].max() <= 0.05 and err.max() <= 0.25, n
+
+
+def test_case_control_errors_name_the_block_and_valid_keys():
+    from meshcore.case import loads_case
+    from meshcore.errors import CaseFileError
+
+    text = (EXAMPLES / "two-circles-ogrid.toml").read_text()
+    bad = text.replace("[blocks.control.borders.bottom]", "[blocks.control.borders.bottom]\nspcing = 1")
+    with pytest.raises(CaseFileError, match=r"block 'two-circles'.*spcing.*valid.*spacing"):
+        loads_case(bad)
+    bad = text.replace("[blocks.control]", "[blocks.control]\nrelax = 0.1")
+    with pytest.raises(CaseFileError, match=r"relax.*valid.*relaxation"):
+        loads_case(bad)
+
+
+def test_cgrid_example_loads_and_starts_unfolded():
+    """The C-grid example (≈ 20 s to solve, measured by scripts/control_report.py)."""
+    from meshcore.case import load_case
+    from meshcore.generate import generate_block
+
+    block = load_case(EXAMPLES / "naca0012-cgrid.toml").blocks[0]
+    wake = block.control["wake"]
+    g0 = generate_block(**block.generate_kwargs(), smooth=False)
+    ni = g0.shape[0] - 1
+    k = np.arange(wake + 1)
+    assert np.allclose(g0.x[k, 0], g0.x[ni - k, 0]) and np.allclose(g0.y[k, 0], g0.y[ni - k, 0])
+    assert meshcore.quality(g0).n_folded == 0
