@@ -171,6 +171,12 @@ class BorderControl:
     start, stop : int, optional
         Controlled node range along the border (default: all but the corners),
         e.g. the airfoil part of a C-grid's bottom border.
+    corner_blend : int
+        Over this many nodes next to each corner, blend the requested angle
+        linearly towards the corner's own angle θc (node k ≥ 1 from the corner
+        aims at ``θc + (θ − θc)·min(1, k/corner_blend)``); for blocks whose
+        corners sit on a smooth shore (θc ≈ 180°), where orthogonality to both
+        borders next to the corner is impossible.  0 = off.
     """
 
     spacing: float | None = None
@@ -178,8 +184,11 @@ class BorderControl:
     decay: float = 0.5
     start: int | None = None
     stop: int | None = None
+    corner_blend: int = 0
 
     def __post_init__(self) -> None:
+        if not (isinstance(self.corner_blend, int) and self.corner_blend >= 0):
+            raise InvalidInputError(f"corner_blend must be an integer ≥ 0, got {self.corner_blend!r}")
         if self.spacing is not None and not (self.spacing > 0 and math.isfinite(self.spacing)):
             raise InvalidInputError(f"spacing must be > 0, got {self.spacing!r}")
         if self.angle is not None and not (0.0 < self.angle < 180.0):
@@ -381,9 +390,10 @@ def _scale_factors(x: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.nda
     g = xx * xx + yx * yx
     d = xx * ye - xe * yx
     with np.errstate(all="ignore"):
-        d2 = d * d
-        floor = 1e-12 * max(float(np.max(a * g)), 1e-300)
-        d2 = np.maximum(d2, floor)
+        # D² ≥ 10⁻³·αγ (corner angle ≥ ~1.8°): near-degenerate or folded nodes get a
+        # bounded source instead of an explosive one
+        d2 = np.maximum(d * d, 1e-3 * a * g)
+        d2 = np.maximum(d2, 1e-300)
         return a / d2, g / d2
 
 
@@ -663,6 +673,15 @@ class ControlSources:
             ang1 = np.arctan2(rho * (rt[:, 0] * d[:, 1] - rt[:, 1] * d[:, 0]), (rt * d).sum(axis=1))
             s_eff = np.full(n, bc.spacing) if bc.spacing is not None else s1
             a_eff = np.full(n, math.radians(bc.angle)) if bc.angle is not None else ang1
+            if bc.corner_blend and bc.angle is not None and not per:
+                a_eff = a_eff.astype(float)
+                for end, step in ((0, 1), (n - 1, -1)):
+                    th_c = _corner_angle(x, y, name, end)
+                    if end:  # measured from the increasing-index direction, which points into it
+                        th_c = math.pi - th_c
+                    for kk in range(1, min(bc.corner_blend, n // 2)):
+                        f = kk / bc.corner_blend
+                        a_eff[end + step * kk] = th_c + (a_eff[end + step * kk] - th_c) * f
             dist = {"bottom": J, "top": nj - J, "left": I, "right": ni - I}[name]
             self._bstate[name] = _BorderState(
                 name=name,
@@ -765,11 +784,13 @@ class ControlSources:
         ang1 = np.arctan2(rho * (rt[:, 0] * d[:, 1] - rt[:, 1] * d[:, 0]), (rt * d).sum(axis=1))
         lt = np.hypot(rt[:, 0], rt[:, 1])
         req_s = bs.spec.spacing
-        req_a = None if bs.spec.angle is None else math.radians(bs.spec.angle)
         if req_s is None:
             bs.spacing_eff[k] = s1[k]
-        if req_a is None:
+        if bs.spec.angle is None:
             bs.angle_eff[k] = ang1[k]
+            req_a = None
+        else:
+            req_a = bs.angle_eff[k]
         old_t, old_n = bs.s_t[k].copy(), bs.s_n[k].copy()
         lim = sp.limit
         w = sp.relaxation
@@ -916,6 +937,24 @@ class ControlSources:
         for c, arr in enumerate(X):
             arr[i, 0] = new[c]
             arr[m, 0] = new[c]
+
+
+def _corner_angle(x, y, name, end) -> float:
+    """Interior angle (radians) of the block at the corner where ``name`` has node ``end``."""
+    r0 = _border_rows(x, y, name)[0]
+    c = r0[end]
+    a = r0[1] if end == 0 else r0[-2]
+    # the other border leaving the same corner
+    ni, nj = x.shape[0] - 1, x.shape[1] - 1
+    i, j = {("bottom", 0): (0, 0), ("bottom", 1): (ni, 0), ("top", 0): (0, nj), ("top", 1): (ni, nj),
+            ("left", 0): (0, 0), ("left", 1): (0, nj), ("right", 0): (ni, 0), ("right", 1): (ni, nj)}[
+        (name, 0 if end == 0 else 1)]
+    if name in ("bottom", "top"):
+        b = np.array([x[i, 1 if j == 0 else nj - 1], y[i, 1 if j == 0 else nj - 1]])
+    else:
+        b = np.array([x[1 if i == 0 else ni - 1, j], y[1 if i == 0 else ni - 1, j]])
+    u, v = a - c, b - c
+    return float(np.arccos(np.clip(np.dot(u, v) / (np.hypot(*u) * np.hypot(*v)), -1.0, 1.0)))
 
 
 def _set_border(x, y, name, ks, pts):

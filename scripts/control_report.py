@@ -307,9 +307,8 @@ def lakes(figures):
         g0 = initial_grid(b)
         variants = [
             ("Winslow", None),
-            ("HW angle 90° all shores", ControlSpec(borders={n: {} for n in WALLS})),
-            ("floating all shores", ControlSpec(floating=WALLS)),
-            ("HW + floating", ControlSpec(borders={n: {} for n in WALLS}, floating=WALLS)),
+            ("floating nodes, all shores", ControlSpec(floating=WALLS)),
+            ("HW angle 90°, corner_blend 4", ControlSpec(relaxation=0.05, borders={n: {"corner_blend": 4} for n in WALLS})),
         ]
         for name, spec in variants:
             g, _ = run(
