@@ -134,7 +134,7 @@ def bottle(figures):
         print(row("Winslow (P=Q=0)", gw, tw, WALLS, None))
         for kind in ("hilgenstock-white", "steger-sorenson"):
             g, t = run(g0, ControlSpec(kind=kind, borders={n: {"spacing": sp} for n in WALLS}))
-            print(row(f"{kind}, spacing {sp}", g, t, WALLS, {n: sp for n in WALLS}))
+            print(row(f"{kind}, spacing {sp}", g, t, WALLS, dict.fromkeys(WALLS, sp)))
             errs = [np.abs(first_spacing(g, n) / sp - 1)[1:-1].max() for n in WALLS]
             print(
                 f"|  ↳ first-cell error without the corner-adjacent nodes: {100 * max(errs):.2f} % | | | | | | | | | |"
@@ -151,9 +151,7 @@ def bottle(figures):
 
 
 def two_circles(figures):
-    print(
-        "\n### Two circles: periodic O-grid (the cut is a seam), inner and outer wall controlled\n"
-    )
+    print("\n### Two circles: periodic O-grid (the cut is a seam), inner and outer wall controlled\n")
     print(HEAD)
     inner, outer = circle((0, 0), 1.0), circle((0.8, 0.4), 3.0)
     sp = {"bottom": 0.05, "top": 0.2}
@@ -161,9 +159,7 @@ def two_circles(figures):
     for cells in ((30, 6), (40, 8), (120, 32)):
         g0 = ogrid(inner, outer, cells)
         gw, tw = run(g0)
-        g, t = run(
-            g0, ControlSpec(borders={k: {"spacing": v} for k, v in sp.items()}), periodic=True
-        )
+        g, t = run(g0, ControlSpec(borders={k: {"spacing": v} for k, v in sp.items()}), periodic=True)
         print(row("Winslow", gw, tw, ("bottom", "top")))
         print(row("HW, spacing 0.05 / 0.2", g, t, ("bottom", "top"), sp))
         for nm, gg in (("Winslow", gw), ("controlled", g)):
@@ -177,24 +173,21 @@ def two_circles(figures):
             )[:, 1:-1].max(axis=1)
             print(
                 f"|  ↳ seam, {nm}: size ratio seam cols {sr[0]:.3f}/{sr[-1]:.3f} vs others ≤ {sr[1:-1].max():.3f}; "
-                f"orthogonality seam {orr[0]:.2f}/{orr[-1]:.2f}° vs others {orr[1:-1].min():.2f}–{orr[1:-1].max():.2f}°; "
+                f"orthogonality seam {orr[0]:.2f}/{orr[-1]:.2f}° vs others "
+                f"{orr[1:-1].min():.2f}–{orr[1:-1].max():.2f}°; "
                 f"max ξ 2nd difference at seam {d2[0]:.4f} vs elsewhere ≤ {d2[1:].max():.4f} | | | | | | | | | |"
             )
         if cells == (40, 8):
             keep = (gw, g)
     # concentric: log-polar convergence
-    print(
-        "\nConcentric circles r = 1 … 4 (exact grid x = 4^η (cos θ, sin θ)), Winslow, periodic:\n"
-    )
+    print("\nConcentric circles r = 1 … 4 (exact grid x = 4^η (cos θ, sin θ)), Winslow, periodic:\n")
     print("| cells | max node error | rate |\n|---|---|---|")
     prev = None
     for n in (16, 32, 64):
         ni, nj = 2 * n, n // 2
         th = -np.linspace(0, 2 * np.pi, ni + 1)
         ring = np.column_stack([np.cos(th), np.sin(th)])[:-1]
-        g = meshcore.solve(
-            ogrid(ring, 4 * ring, (ni, nj)), method="sor", tolerance=1e-12, max_iterations=200000
-        )
+        g = meshcore.solve(ogrid(ring, 4 * ring, (ni, nj)), method="sor", tolerance=1e-12, max_iterations=200000)
         R = 4.0 ** np.linspace(0, 1, nj + 1)
         e = np.max(np.hypot(g.x - np.cos(th)[:, None] * R, g.y - np.sin(th)[:, None] * R))
         print(f"| {ni}×{nj} | {e:.3e} | {'' if prev is None else f'{math.log2(prev / e):.2f}'} |")
@@ -219,13 +212,9 @@ def naca(figures):
     th = -np.linspace(0, 2 * np.pi, 2 * n + 1)
     top = np.column_stack([0.5 + R * np.cos(th), R * np.sin(th)])
     cut = radial_nodes(body[0], top[0], nj, first=dy)
-    g0 = algebraic_grid(
-        Borders(bottom=body, right=cut.copy(), top=top, left=cut, periodic=True), "tfi"
-    )
+    g0 = algebraic_grid(Borders(bottom=body, right=cut.copy(), top=top, left=cut, periodic=True), "tfi")
     gw, tw = run(g0)
-    g, t = run(
-        g0, ControlSpec(thomas_middlecoff=True, borders={"bottom": {"spacing": dy}}), periodic=True
-    )
+    g, t = run(g0, ControlSpec(thomas_middlecoff=True, borders={"bottom": {"spacing": dy}}), periodic=True)
     print(row("O-grid Winslow", gw, tw, ("bottom",), {"bottom": dy}))
     print(row("O-grid TM + HW wall", g, t, ("bottom",), {"bottom": dy}))
     og = (gw, g)
@@ -298,7 +287,7 @@ def lakes(figures):
     for f in sorted(LAKES.glob("*_sparse.csv")):
         p, corners, ar = lake_loop(f)
         nj = 12
-        ni = int(round(nj * min(max(ar, 1.0), 6.0)))
+        ni = round(nj * min(max(ar, 1.0), 6.0))
         try:
             b = prepare_borders(loop=p, corners=corners, cells=(ni, nj))
         except meshcore.MeshcoreError as exc:
@@ -308,7 +297,10 @@ def lakes(figures):
         variants = [
             ("Winslow", None),
             ("floating nodes, all shores", ControlSpec(floating=WALLS)),
-            ("HW angle 90°, corner_blend 4", ControlSpec(relaxation=0.05, borders={n: {"corner_blend": 4} for n in WALLS})),
+            (
+                "HW angle 90°, corner_blend 4",
+                ControlSpec(relaxation=0.05, borders={n: {"corner_blend": 4} for n in WALLS}),
+            ),
         ]
         for name, spec in variants:
             g, _ = run(
@@ -320,7 +312,8 @@ def lakes(figures):
             q = meshcore.quality(g)
             rep = boundary_report(g, WALLS)
             print(
-                f"| {f.stem.replace('_sparse', '')} | {ni}×{nj} | {name} | {g.converged} | {g.iterations} | {q.n_folded} "
+                f"| {f.stem.replace('_sparse', '')} | {ni}×{nj} | {name} | {g.converged} "
+                f"| {g.iterations} | {q.n_folded} "
                 f"| {q.n_nonconvex} | {q.mean_orthogonality:.2f} | {rep['mean_angle_deviation']:.2f} "
                 f"| {rep['max_angle_deviation']:.2f} |"
             )

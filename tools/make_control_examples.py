@@ -21,14 +21,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from meshcore.airfoil import first_cell_height, naca4_body  # noqa: E402
-from meshcore.boundary import BorderSpec  # noqa: E402
-from meshcore.case import BlockCase, Case, save_case  # noqa: E402
-from meshcore.elliptic import EllipticConfig  # noqa: E402
-from meshcore.topology import cgrid, radial_nodes  # noqa: E402
+from meshcore.airfoil import first_cell_height, naca4_body
+from meshcore.boundary import BorderSpec
+from meshcore.case import BlockCase, Case, save_case
+from meshcore.elliptic import EllipticConfig
+from meshcore.topology import cgrid, radial_nodes
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from make_examples import bottle, two_circles  # noqa: E402
+from make_examples import bottle, two_circles
 
 OUT = Path(__file__).resolve().parent.parent / "resources" / "examples"
 WALLS = ("bottom", "right", "top", "left")
@@ -46,28 +46,50 @@ def main():
         title="Bottle (paper Table 3, refinement 2), orthogonal walls, first cell 0.05",
         description="Hilgenstock-White boundary control on all four walls; borders clustered to the same spacing.",
         solver=sor,
-        blocks=(BlockCase(
-            name="bottle", cells=(12, 30), weights=(1.0, 0.5), borders=bottle(),
-            border_specs={n: BorderSpec(distribution="vinokur", first=sp, last=sp) for n in WALLS},
-            control={"kind": "hilgenstock-white", "borders": {n: {"spacing": sp} for n in WALLS}},
-        ),),
+        blocks=(
+            BlockCase(
+                name="bottle",
+                cells=(12, 30),
+                weights=(1.0, 0.5),
+                borders=bottle(),
+                border_specs={n: BorderSpec(distribution="vinokur", first=sp, last=sp) for n in WALLS},
+                control={"kind": "hilgenstock-white", "borders": {n: {"spacing": sp} for n in WALLS}},
+            ),
+        ),
     )
     tc = two_circles()
     cases["two-circles-orthogonal"] = Case(
         title="Two circles joined by a cut (paper Table 2, refinement 2), circles met at 90°",
-        description="The cut is held fixed (clustered to 0.05 at both circles); both circles are walls with a first cell of 0.05.",
+        description=(
+            "The cut is held fixed (clustered to 0.05 at both circles); both circles are walls "
+            "with a first cell of 0.05."
+        ),
         solver=sor,
-        blocks=(BlockCase(name="two-circles", cells=(40, 8), weights=(0.05, 0.0), borders=tc,
-                          border_specs={n: BorderSpec(distribution="vinokur", first=0.05, last=0.05)
-                                        for n in ("left", "right")},
-                          control={"borders": {"bottom": {"spacing": 0.05}, "top": {"spacing": 0.05}}}),),
+        blocks=(
+            BlockCase(
+                name="two-circles",
+                cells=(40, 8),
+                weights=(0.05, 0.0),
+                borders=tc,
+                border_specs={n: BorderSpec(distribution="vinokur", first=0.05, last=0.05) for n in ("left", "right")},
+                control={"borders": {"bottom": {"spacing": 0.05}, "top": {"spacing": 0.05}}},
+            ),
+        ),
     )
     cases["two-circles-ogrid"] = Case(
         title="Two circles as a periodic O-grid (no seam), circles met at 90°",
         description="left = right is the seam, solved like the interior.",
         solver=sor,
-        blocks=(BlockCase(name="two-circles", cells=(40, 8), initial="tfi", borders=tc, periodic=True,
-                          control={"borders": {"bottom": {"spacing": 0.05}, "top": {"spacing": 0.05}}}),),
+        blocks=(
+            BlockCase(
+                name="two-circles",
+                cells=(40, 8),
+                initial="tfi",
+                borders=tc,
+                periodic=True,
+                control={"borders": {"bottom": {"spacing": 0.05}, "top": {"spacing": 0.05}}},
+            ),
+        ),
     )
     dy = first_cell_height(30.0, 1e6)
     n, nj, R = 64, 48, 5.0
@@ -80,12 +102,17 @@ def main():
         title="NACA 0012 O-grid 128×48, far field 5 chords, y+ ≈ 30 at Re 1e6",
         description=f"Nodes given; wall first cell {dy:.3e} chords, orthogonal; Thomas-Middlecoff interior.",
         solver=sor,
-        blocks=(BlockCase(
-            name="naca0012", cells=None, initial="tfi", periodic=True,
-            borders=dict(bottom=r(body), right=r(cut), top=r(top), left=r(cut)),
-            border_specs={"bottom": BorderSpec(name="wall"), "top": BorderSpec(name="farfield")},
-            control={"thomas-middlecoff": True, "borders": {"bottom": {"spacing": float(f"{dy:.4e}")}}},
-        ),),
+        blocks=(
+            BlockCase(
+                name="naca0012",
+                cells=None,
+                initial="tfi",
+                periodic=True,
+                borders={"bottom": r(body), "right": r(cut), "top": r(top), "left": r(cut)},
+                border_specs={"bottom": BorderSpec(name="wall"), "top": BorderSpec(name="farfield")},
+                control={"thomas-middlecoff": True, "borders": {"bottom": {"spacing": float(f"{dy:.4e}")}}},
+            ),
+        ),
     )
     C = cgrid(naca4_body("0012", 48), cells_wake=24, cells_normal=40, first=dy)
     g = C.grid
@@ -97,17 +124,29 @@ def main():
     }
     cases["naca0012-cgrid"] = Case(
         title="NACA 0012 C-grid 144×40 (wake 24 cells per side), y+ ≈ 30 at Re 1e6",
-        description=("Nodes given; the bottom border runs along the lower wake cut, around the airfoil and out "
-                     "along the upper cut; control.wake = 24 solves the cut nodes like interior nodes."),
+        description=(
+            "Nodes given; the bottom border runs along the lower wake cut, around the airfoil and out "
+            "along the upper cut; control.wake = 24 solves the cut nodes like interior nodes."
+        ),
         solver=sor,
-        blocks=(BlockCase(
-            name="naca0012", cells=None, initial="tfi", borders={k: r(v) for k, v in bd.items()},
-            border_specs={"top": BorderSpec(name="farfield"), "left": BorderSpec(name="outflow"),
-                          "right": BorderSpec(name="outflow")},
-            control={"thomas-middlecoff": True, "wake": C.wake,
-                     "borders": {"bottom": {"spacing": float(f"{dy:.4e}"), "start": C.body[0] + 1,
-                                            "stop": C.body[1]}}},
-        ),),
+        blocks=(
+            BlockCase(
+                name="naca0012",
+                cells=None,
+                initial="tfi",
+                borders={k: r(v) for k, v in bd.items()},
+                border_specs={
+                    "top": BorderSpec(name="farfield"),
+                    "left": BorderSpec(name="outflow"),
+                    "right": BorderSpec(name="outflow"),
+                },
+                control={
+                    "thomas-middlecoff": True,
+                    "wake": C.wake,
+                    "borders": {"bottom": {"spacing": float(f"{dy:.4e}"), "start": C.body[0] + 1, "stop": C.body[1]}},
+                },
+            ),
+        ),
     )
     for name, case in cases.items():
         save_case(case, OUT / f"{name}.toml")

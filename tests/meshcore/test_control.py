@@ -58,9 +58,7 @@ def circle(c, r, n=20):
 
 def solve(g0, spec=None, periodic=False, **kw):
     src = None if spec is None else ControlSources(spec, periodic=periodic)
-    return meshcore.solve(
-        g0, method="sor", sources=src, max_iterations=kw.pop("max_iterations", 20000), **kw
-    )
+    return meshcore.solve(g0, method="sor", sources=src, max_iterations=kw.pop("max_iterations", 20000), **kw)
 
 
 # --------------------------------------------------------------------------- spec parsing
@@ -145,9 +143,7 @@ def test_concentric_ogrid_converges_to_log_polar_at_second_order():
         ni, nj = 2 * n, n // 2
         th = -np.linspace(0, 2 * np.pi, ni + 1)  # clockwise: i around, j out
         inner = np.column_stack([np.cos(th), np.sin(th)])[:-1]
-        g = meshcore.solve(
-            ogrid(inner, 4 * inner, (ni, nj)), method="sor", tolerance=1e-12, max_iterations=100000
-        )
+        g = meshcore.solve(ogrid(inner, 4 * inner, (ni, nj)), method="sor", tolerance=1e-12, max_iterations=100000)
         assert g.converged
         R = 4.0 ** np.linspace(0, 1, nj + 1)
         errs.append(np.max(np.hypot(g.x - np.cos(th)[:, None] * R, g.y - np.sin(th)[:, None] * R)))
@@ -176,10 +172,7 @@ def test_thomas_middlecoff_reproduces_boundary_distribution_on_a_rectangle():
 
 def test_eta_line_attraction_clusters_and_repulsion_spreads():
     b = prepare_borders(
-        *[
-            np.asarray(p)
-            for p in ([[0, 0], [1, 0]], [[1, 0], [1, 1]], [[0, 1], [1, 1]], [[0, 0], [0, 1]])
-        ],
+        *[np.asarray(p) for p in ([[0, 0], [1, 0]], [[1, 0], [1, 1]], [[0, 1], [1, 1]], [[0, 0], [0, 1]])],
         cells=(10, 20),
     )
     g0 = initial_grid(b)
@@ -201,9 +194,7 @@ def test_floating_nodes_untwist_an_ogrid_and_stay_on_the_curve():
     bottom = closed_curve_nodes(inner, ni)
     top = closed_curve_nodes(outer, ni, start=outer[6])  # twisted by 6/64 of a turn
     cut = radial_nodes(bottom[0], top[0], nj)
-    g0 = algebraic_grid(
-        Borders(bottom=bottom, right=cut.copy(), top=top, left=cut, periodic=True), "tfi"
-    )
+    g0 = algebraic_grid(Borders(bottom=bottom, right=cut.copy(), top=top, left=cut, periodic=True), "tfi")
     gw = solve(g0)
     spec = ControlSpec(floating=("top",), float_every=5)
     src = ControlSources(spec, periodic=True, curves={"top": outer})  # slide on the 64-gon
@@ -239,12 +230,8 @@ def test_naca0012_ogrid_wall_orthogonal_no_folds():
     th = -np.linspace(0, 2 * np.pi, 65)
     top = np.column_stack([0.5 + R * np.cos(th), R * np.sin(th)])
     cut = radial_nodes(body[0], top[0], nj, first=dy)
-    g0 = algebraic_grid(
-        Borders(bottom=body, right=cut.copy(), top=top, left=cut, periodic=True), "tfi"
-    )
-    spec = ControlSpec(
-        kind="hilgenstock-white", thomas_middlecoff=True, borders={"bottom": {"spacing": dy}}
-    )
+    g0 = algebraic_grid(Borders(bottom=body, right=cut.copy(), top=top, left=cut, periodic=True), "tfi")
+    spec = ControlSpec(kind="hilgenstock-white", thomas_middlecoff=True, borders={"bottom": {"spacing": dy}})
     g, gw = solve(g0, spec, periodic=True), solve(g0)
     assert g.converged and meshcore.quality(g).n_folded == 0
     rep = boundary_report(g, ("bottom",), {"bottom": dy})
@@ -279,9 +266,7 @@ def test_steger_sorenson_targets_plus_feedback_on_smooth_walls():
     g0 = ogrid(inner, outer, (60, 16))
     sp = {"bottom": 0.05, "top": 0.2}
     borders = {k: {"spacing": v} for k, v in sp.items()}
-    classic = solve(
-        g0, ControlSpec(kind="steger-sorenson", feedback=0.0, borders=borders), periodic=True
-    )
+    classic = solve(g0, ControlSpec(kind="steger-sorenson", feedback=0.0, borders=borders), periodic=True)
     full = solve(g0, ControlSpec(kind="steger-sorenson", borders=borders), periodic=True)
     assert classic.converged and full.converged
     rc = boundary_report(classic, ("bottom", "top"), sp)
@@ -301,9 +286,7 @@ def _walls(block):
     return {k: v.get("spacing") for k, v in block.control.get("borders", {}).items()}
 
 
-@pytest.mark.parametrize(
-    "name", ["bottle-orthogonal", "two-circles-orthogonal", "two-circles-ogrid", "naca0012-ogrid"]
-)
+@pytest.mark.parametrize("name", ["bottle-orthogonal", "two-circles-orthogonal", "two-circles-ogrid", "naca0012-ogrid"])
 def test_control_example_cases(name):
     from meshcore.case import dumps_case, load_case, loads_case
 
@@ -349,3 +332,51 @@ def test_cgrid_example_loads_and_starts_unfolded():
     k = np.arange(wake + 1)
     assert np.allclose(g0.x[k, 0], g0.x[ni - k, 0]) and np.allclose(g0.y[k, 0], g0.y[ni - k, 0])
     assert meshcore.quality(g0).n_folded == 0
+
+
+def test_generate_block_control_floating_slides_on_the_input_loop():
+    # a quarter annulus given as a loop; floating outer arc, nodes stay on the input polyline
+    th = np.linspace(0, np.pi / 2, 40)
+    outer = np.column_stack([3 * np.cos(th), 3 * np.sin(th)])
+    inner = np.column_stack([np.cos(th), np.sin(th)])[::-1]
+    loop = np.vstack([[[1, 0]], [[2, 0]], outer, [[0, 2]], inner[:-1]])
+    sw, se = 0, 2
+    ne, nw = 2 + 39, 2 + 40 + 1
+    # the outer arc is clustered at one end, so the Winslow lines lean on it
+    common = {
+        "loop": loop,
+        "corners": (sw, se, ne, nw),
+        "cells": (10, 12),
+        "method": "sor",
+        "borders": {"right": {"distribution": "tanh", "first": 0.1}},
+    }
+    g = meshcore.generate_block(**common, control={"floating": ["right"], "float_every": 5})
+    gw = meshcore.generate_block(**common)
+    assert g.converged and meshcore.quality(g).n_folded == 0
+    r = np.hypot(g.x[-1], g.y[-1])
+    assert np.all(np.abs(r - 3) <= 3 * (1 - math.cos(np.pi / 2 / 39 / 2)) + 1e-9)
+    dev_f = np.abs(border_angles(g, "right") - 90).max()
+    dev_w = np.abs(border_angles(gw, "right") - 90).max()
+    assert dev_w > 10 and dev_f < 0.2 * dev_w
+
+
+def test_corner_blend_aims_at_the_corner_angle_next_to_corners():
+    # a trapezoid with 120° / 60° corners: plain 90° control is over-constrained there
+    bottom = np.array([[0, 0], [4, 0]], float)
+    top = np.array([[1, 2], [3, 2]], float)
+    left = np.array([[0, 0], [1, 2]], float)
+    right = np.array([[4, 0], [3, 2]], float)
+    b = prepare_borders(bottom, right, top, left, cells=(16, 8))
+    g0 = initial_grid(b)
+    spec = ControlSpec(borders={"bottom": {"corner_blend": 4}})
+    src = ControlSources(spec)
+    g = meshcore.solve(g0, method="sor", sources=src, max_iterations=20000)
+    assert g.converged and meshcore.quality(g).n_folded == 0
+    a = border_angles(g, "bottom")
+    theta_c = math.degrees(math.atan2(2, 1))  # bottom-left corner angle, 63.4°
+    want = theta_c + (90 - theta_c) * np.array([0.25, 0.5, 0.75])
+    assert np.allclose(a[:3], want, atol=0.5)
+    assert np.allclose(a[3:-3], 90, atol=0.5)
+    assert np.allclose(a[-3:], (180 - want)[::-1], atol=0.5)
+    with pytest.raises(InvalidInputError, match="corner_blend"):
+        ControlSpec(borders={"bottom": {"corner_blend": -1}})
