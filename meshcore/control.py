@@ -599,6 +599,7 @@ class ControlSources:
         self.history: list[tuple[int, float]] = []
         self._change = math.inf
         self._moved = math.inf if spec.floating else 0.0
+        self._wake_move = math.inf
         self._initialized = False
 
     # -- protocol ---------------------------------------------------------
@@ -727,7 +728,7 @@ class ControlSources:
         """Advance the controls one step and rewrite ``p, q`` (and floating/wake nodes)."""
         sp = self.spec
         if sp.wake:
-            self._wake_step(x, y)
+            self._wake_move = self._wake_step(x, y) / self.L
             if it % sp.every:
                 return
         moved = self._moved
@@ -743,6 +744,8 @@ class ControlSources:
 
     def settled(self, tol: float = 1e-4) -> bool:
         """True when the last update changed the sources (and nodes) by less than ``tol``."""
+        if self.spec.wake and self._wake_move > 1e-8:
+            return False  # the cut nodes are not in the solver's residual
         if not (self._bstate or self.spec.floating):
             return True
         return self._change <= tol
@@ -911,7 +914,7 @@ class ControlSources:
                 y[-1, :] = y[0, :]
         return moved * 100.0  # relative to 1 % of the size per update
 
-    def _wake_step(self, x, y) -> None:
+    def _wake_step(self, x, y) -> float:
         """Jacobi update of the C-grid wake-cut nodes with mirrored η neighbours."""
         ni = x.shape[0] - 1
         n = self.spec.wake
@@ -934,9 +937,11 @@ class ControlSources:
             se, sw = arr[m - 1, 1], arr[m + 1, 1]
             cross = ne - nw - se + sw
             new.append((a * (xe_[c] + xw_[c]) + g * (xn_[c] + xs_[c]) - 0.5 * b * cross) / den)
+        move = float(np.max(np.hypot(new[0] - x[i, 0], new[1] - y[i, 0]), initial=0.0))
         for c, arr in enumerate(X):
             arr[i, 0] = new[c]
             arr[m, 0] = new[c]
+        return move
 
 
 def _corner_angle(x, y, name, end) -> float:

@@ -380,3 +380,21 @@ def test_corner_blend_aims_at_the_corner_angle_next_to_corners():
     assert np.allclose(a[-3:], (180 - want)[::-1], atol=0.5)
     with pytest.raises(InvalidInputError, match="corner_blend"):
         ControlSpec(borders={"bottom": {"corner_blend": -1}})
+
+
+def test_xi_line_and_point_attraction():
+    b = prepare_borders(
+        *[np.asarray(p, float) for p in ([[0, 0], [1, 0]], [[1, 0], [1, 1]], [[0, 1], [1, 1]], [[0, 0], [0, 1]])],
+        cells=(20, 20),
+    )
+    g0 = initial_grid(b)
+    line = solve(g0, ControlSpec(attractors=[{"kind": "xi", "xi": 0.25, "amplitude": 0.3}]))
+    dx = np.diff(line.x[:, 10])
+    assert np.argmin(dx) in (4, 5) and dx.min() < 0.65 * 0.05  # cells shrink at ξ = 5 of 20
+    point = solve(g0, ControlSpec(attractors=[{"kind": "point", "xi": 0.5, "eta": 0.5, "amplitude": 0.3}]))
+    area = np.abs(meshcore.cell_quality(point)["area"])
+    i, j = np.unravel_index(np.argmin(area), area.shape)
+    assert {int(i), int(j)} <= {9, 10} and area.min() < 0.5 * area.max()
+    assert meshcore.quality(point).n_folded == 0
+    with pytest.raises(InvalidInputError, match="fraction"):
+        ControlSpec(attractors=[{"kind": "point", "xi": 1.5, "eta": 0.5}])
