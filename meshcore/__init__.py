@@ -67,6 +67,7 @@ __all__ = [
     "borders_from_loop",
     "borders_from_polylines",
     "cell_quality",
+    "choose_corners",
     "distribute",
     "generate_block",
     "initial_grid",
@@ -79,3 +80,16 @@ __all__ = [
     "tfi",
     "weighted_average",
 ]
+
+
+# Readers/writers are re-exported lazily so that ``import meshcore`` stays light
+# (meshcore.io imports nothing heavy either, but keeps optional readers out).
+_LAZY_IO = {"read_points", "read_grid", "read_blocks", "write", "PointSet", "GridSet"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY_IO:
+        from . import io as _io
+
+        return getattr(_io, name)
+    raise AttributeError(f"module 'meshcore' has no attribute {name!r}")

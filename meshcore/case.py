@@ -7,7 +7,8 @@ list the valid ones.  Example (the paper's bottle, refinement 1)::
     title = "Bottle (paper, refinement 1)"
 
     [solver]                      # optional; fields of meshcore.EllipticConfig
-    method = "auto"               # auto | sor | multigrid | ...
+    method = "auto"               # auto | sor | multigrid | foldfree
+    repair = "auto"               # auto | strict | off: fold-free repair of invalid cells
     tolerance = 1e-6              # relative to the bounding-box diagonal (omit: scale-aware default)
     max_iterations = 50000
 
@@ -76,14 +77,16 @@ __all__ = [
     "save_case",
 ]
 
-TOP_KEYS = {"title", "description", "solver", "blocks"}
+TOP_KEYS = {"title", "description", "solver", "blocks", "crs"}
+CRS_KEYS = {"crs", "origin", "source_crs", "source"}
 BLOCK_KEYS = {
     "name", "cells", "weights", "initial", "curve", "periodic", "snap_angle", "boundary", "borders",
     "control",
 }
 BOUNDARY_KEYS = {"bottom", "right", "top", "left", "points", "corners"}
 BORDER_KEYS = {"distribution", "first", "last", "name"}
-SOLVER_KEYS = {f.name for f in dataclasses.fields(EllipticConfig)}
+SOLVER_KEYS = {f.name for f in dataclasses.fields(EllipticConfig)} | {"repair"}
+REPAIR_CHOICES = ("auto", "strict", "off")
 
 #: Extension hooks: extra top-level / per-block keys registered by other modules.
 _EXTRA_TOP: set[str] = set()
@@ -150,6 +153,7 @@ class Case:
     title: str = ""
     description: str = ""
     solver: EllipticConfig = field(default_factory=EllipticConfig)
+    repair: str = "auto"
     path: Path | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
 
@@ -166,29 +170,52 @@ def _check_keys(table: Mapping[str, Any], valid: set[str], where: str) -> None:
         )
 
 
-def _read_point_file(path: Path, where: str) -> np.ndarray:
+def _read_point_file(path: Path, where: str, ctx: dict[str, Any]) -> np.ndarray:
+    """Read the first polyline of a point file, projected into the case's frame.
+
+    Lon/lat files are projected to the case's ``crs`` (and shifted by its
+    origin); with no ``crs`` table the first lon/lat file picks the UTM zone of
+    its centroid and a local origin, recorded in ``ctx["crs"]`` so that the
+    case (and every export) keeps it.
+    """
     if not path.exists():
         raise CaseFileError(f"{where}: point file {str(path)!r} not found")
+    from . import crs as _crs
+    from . import io as _io
+
     try:
-        from . import io as _io
-
-        res = _io.read_points(path)
-    except MeshcoreError as exc:
-        raise CaseFileError(f"{where}: {exc}") from None
-    if hasattr(res, "polylines"):
-        if not res.polylines:
+        ps = _io.read_points(path)
+        if not ps.polylines:
             raise CaseFileError(f"{where}: {path} holds no polyline")
-        pl = res.polylines[0]
-        return np.asarray(getattr(pl, "points", pl), dtype=np.float64)
-    return np.asarray(res, dtype=np.float64)
+        geographic = (ps.crs is not None and _crs.is_geographic(ps.crs)) or (
+            ps.crs is None and _crs.looks_lonlat(ps.all_points())
+        )
+        frame = ctx.get("frame")
+        if geographic or (frame is not None and ps.crs is not None and ps.crs != frame.crs):
+            if frame is None:
+                local, frame = _crs.project(ps, "auto")
+                ctx["frame"] = frame
+                ctx["crs"] = frame.as_dict() | {"source": path.name}
+            else:
+                local, _ = _crs.project(ps, frame.crs or "auto", origin=frame.origin)
+            ps = local
+        elif frame is not None and frame.origin != (0.0, 0.0):
+            # a projected file in the case's CRS: shift to the local origin
+            local, _ = _crs.project(ps, None, origin=frame.origin)
+            ps = local
+    except MeshcoreError as exc:
+        if isinstance(exc, CaseFileError):
+            raise
+        raise CaseFileError(f"{where}: {exc}") from None
+    return np.asarray(ps.polylines[0].points, dtype=np.float64)
 
 
-def _points(value: Any, base: Path | None, where: str) -> np.ndarray:
+def _points(value: Any, base: Path | None, where: str, ctx: dict[str, Any]) -> np.ndarray:
     if isinstance(value, str):
         p = Path(value)
         if not p.is_absolute() and base is not None:
             p = base / p
-        return _read_point_file(p, where)
+        return _read_point_file(p, where, ctx)
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -213,7 +240,8 @@ def _int(v: Any) -> int:
     return v
 
 
-def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) -> BlockCase:
+def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str,
+                 ctx: dict[str, Any]) -> BlockCase:
     where = f"{src}: [[blocks]] #{k + 1}"
     if not isinstance(tbl, Mapping):
         raise CaseFileError(f"{where}: expected a table")
@@ -246,7 +274,7 @@ def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) ->
             raise CaseFileError(f"{where}: boundary: give either points + corners or four borders, not both")
         if "corners" not in bnd:
             raise CaseFileError(f"{where}: boundary: points need corners = [sw, se, ne, nw]")
-        kw["loop"] = _points(bnd["points"], base, f"{where}: boundary.points")
+        kw["loop"] = _points(bnd["points"], base, f"{where}: boundary.points", ctx)
         c = bnd["corners"]
         if not isinstance(c, list) or len(c) != 4 or not all(isinstance(v, int) and not isinstance(v, bool) for v in c):
             raise CaseFileError(f"{where}: boundary.corners must be 4 integer point indices, got {c!r}")
@@ -255,7 +283,7 @@ def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str) ->
         missing = [n for n in BORDER_NAMES if n not in bnd]
         if missing:
             raise CaseFileError(f"{where}: boundary: missing border(s) {', '.join(missing)}")
-        kw["borders"] = {n: _points(bnd[n], base, f"{where}: boundary.{n}") for n in BORDER_NAMES}
+        kw["borders"] = {n: _points(bnd[n], base, f"{where}: boundary.{n}", ctx) for n in BORDER_NAMES}
     specs = {}
     borders_tbl = tbl.get("borders", {})
     if not isinstance(borders_tbl, Mapping):
@@ -294,7 +322,19 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
     blocks_raw = data.get("blocks")
     if not isinstance(blocks_raw, list) or not blocks_raw:
         raise CaseFileError(f"{source}: needs at least one [[blocks]] table")
-    blocks = tuple(_parse_block(b, k, base, source) for k, b in enumerate(blocks_raw))
+    ctx: dict[str, Any] = {}
+    if "crs" in data:
+        tbl = data["crs"]
+        if not isinstance(tbl, Mapping):
+            raise CaseFileError(f"{source}: crs must be a table (crs, origin, source_crs)")
+        _check_keys(tbl, CRS_KEYS, f"{source}: crs")
+        from .crs import frame_from_case
+
+        try:
+            ctx["frame"] = frame_from_case(Case(blocks=(), extra={"crs": dict(tbl)}))
+        except InvalidInputError as exc:
+            raise CaseFileError(f"{source}: {exc}") from None
+    blocks = tuple(_parse_block(b, k, base, source, ctx) for k, b in enumerate(blocks_raw))
     names = [b.name for b in blocks]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
@@ -303,8 +343,12 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
     if not isinstance(solver_tbl, Mapping):
         raise CaseFileError(f"{source}: [solver] must be a table")
     _check_keys(solver_tbl, SOLVER_KEYS, f"{source}: [solver]")
+    solver_tbl = dict(solver_tbl)
+    repair = solver_tbl.pop("repair", "auto")
+    if repair not in REPAIR_CHOICES:
+        raise CaseFileError(f"{source}: [solver]: repair must be one of {', '.join(REPAIR_CHOICES)}; got {repair!r}")
     try:
-        solver = EllipticConfig(**dict(solver_tbl))
+        solver = EllipticConfig(**solver_tbl)
     except InvalidInputError as exc:
         raise CaseFileError(f"{source}: [solver]: {exc}") from None
     return Case(
@@ -312,8 +356,10 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         title=str(data.get("title", "")),
         description=str(data.get("description", "")),
         solver=solver,
+        repair=repair,
         path=None,
-        extra={k: data[k] for k in _EXTRA_TOP if k in data},
+        extra={k: data[k] for k in (_EXTRA_TOP | {"crs"}) if k in data}
+        | ({"crs": ctx["crs"]} if "crs" in ctx else {}),
     )
 
 
@@ -368,6 +414,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         for f in dataclasses.fields(EllipticConfig)
         if getattr(case.solver, f.name) != getattr(default, f.name)
     }
+    if case.repair != "auto":
+        solver["repair"] = case.repair
     if solver:
         out["solver"] = solver
     blocks = []
@@ -480,7 +528,7 @@ def generate_case(case: Case, *, callback: Callable[..., Any] | None = None,
     for b in case.blocks:
         src = str(case.path) if case.path else "<case>"
         try:
-            g = generate_block(**b.generate_kwargs(), config=cfg, callback=callback)
+            g = generate_block(**b.generate_kwargs(), config=cfg, callback=callback, repair=case.repair)
         except CaseFileError:
             raise
         except InvalidInputError as exc:

@@ -620,6 +620,9 @@ class ControlSources:
                     f"boundary control on the {name} border needs ≥ 3 cells across it"
                 )
         self.shape = x.shape
+        from .elliptic.solver import default_tolerance
+
+        self._wake_tol = default_tolerance(x.shape)  # the solver's default stopping rule
         self.L = float(math.hypot(np.ptp(x), np.ptp(y))) or 1.0
         I, J = np.meshgrid(np.arange(ni1, dtype=float), np.arange(nj1, dtype=float), indexing="ij")
         self._I, self._J = I, J
@@ -744,7 +747,7 @@ class ControlSources:
 
     def settled(self, tol: float = 1e-4) -> bool:
         """True when the last update changed the sources (and nodes) by less than ``tol``."""
-        if self.spec.wake and self._wake_move > 1e-8:
+        if self.spec.wake and self._wake_move > self._wake_tol:
             return False  # the cut nodes are not in the solver's residual
         if not (self._bstate or self.spec.floating):
             return True
@@ -938,9 +941,11 @@ class ControlSources:
             cross = ne - nw - se + sw
             new.append((a * (xe_[c] + xw_[c]) + g * (xn_[c] + xs_[c]) - 0.5 * b * cross) / den)
         move = float(np.max(np.hypot(new[0] - x[i, 0], new[1] - y[i, 0]), initial=0.0))
+        w = 1.5  # over-relaxed like the SOR interior (the cut is a line of nodes)
         for c, arr in enumerate(X):
-            arr[i, 0] = new[c]
-            arr[m, 0] = new[c]
+            v = arr[i, 0] + w * (new[c] - arr[i, 0])
+            arr[i, 0] = v
+            arr[m, 0] = v
         return move
 
 

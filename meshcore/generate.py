@@ -5,16 +5,17 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
-from ._validation import validate_count
+from ._validation import validate_choice, validate_count
 from .algebraic import algebraic_grid
 from .boundary import Borders, borders_from_loop, borders_from_polylines
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve
-from .errors import InvalidInputError
+from .errors import InvalidInputError, MeshcoreError, MeshcoreWarning
 from .grid import BORDER_NAMES, StructuredGrid
 
 __all__ = ["generate_block", "initial_grid", "prepare_borders"]
@@ -50,7 +51,13 @@ def prepare_borders(
         if any(v is not None for v in (bottom, right, top, left)):
             raise InvalidInputError("give either four borders or loop + corners, not both")
         if corners is None:
-            raise InvalidInputError("a closed loop needs four corner indices (corners=)")
+            raise InvalidInputError(
+                'a closed loop needs four corner indices (corners=) or corners="auto"'
+            )
+        if isinstance(corners, str) and corners == "auto":
+            from .corners import choose_corners
+
+            corners = choose_corners(loop)
         b = borders_from_loop(loop, corners, where=where)
         if periodic:
             raise InvalidInputError("periodic=True needs four borders (left = right is the seam)")
@@ -112,6 +119,7 @@ def generate_block(
     callback: Callable[[SolverProgress], Any] | None = None,
     smooth: bool = True,
     periodic: bool = False,
+    repair: str = "auto",
     snap_angle: float | None = None,
     control: Any = None,
 ) -> StructuredGrid:
@@ -123,7 +131,8 @@ def generate_block(
         Border polylines in the orientation of :mod:`meshcore.grid` (bottom/top
         left→right, left/right bottom→top).  Alternatively ``loop`` + ``corners``.
     loop : (n, 2) array_like, optional
-        A closed boundary loop; ``corners = (sw, se, ne, nw)`` point indices.
+        A closed boundary loop; ``corners = (sw, se, ne, nw)`` point indices,
+        or ``corners="auto"`` (:func:`meshcore.corners.choose_corners`).
     cells : (ni, nj), optional
         Re-sample each border by the paper's linear spline (or ``curve``),
         uniformly in arc length unless ``borders`` says otherwise.  With
@@ -149,6 +158,17 @@ def generate_block(
     periodic : bool
         Periodic ξ direction (O-grid): left and right borders coincide and the
         seam nodes are solved like interior nodes.
+    repair : {"auto", "strict", "off"}
+        What to do when the elliptic result has folded or non-convex cells
+        (a corner Jacobian ≤ 0): ``"auto"`` repairs them with the fold-free
+        barrier method (:func:`meshcore.foldfree.repair`; ``info.method``
+        becomes e.g. ``"multigrid+foldfree"`` and ``info.message`` says why)
+        and, if no fold-free grid exists for these boundary nodes, returns the
+        best grid with ``converged=False`` and a message naming the cells and
+        the fix; ``"strict"`` raises :class:`~meshcore.errors.FoldedGridError`
+        instead; ``"off"`` returns the elliptic result as it is.
+        ``method="foldfree"`` minimises the barrier functional over the whole
+        block after the elliptic solve (:func:`meshcore.foldfree.smooth`).
     snap_angle : float, optional
         When re-sampling, input vertices where a border turns by more than this
         many degrees get a node exactly (keeps the corners of a cutout);
@@ -195,8 +215,11 @@ def generate_block(
     g0 = initial_grid(b, initial=initial, weights=weights, names=names)
     if not smooth:
         return g0
+    repair = validate_choice(repair, ("auto", "strict", "off"), name="repair")
+    foldfree = (config.method if config is not None else str(method).lower()) == "foldfree"
     cfg = config or EllipticConfig(
-        method=method, tolerance=tolerance, max_iterations=max_iterations, omega=omega
+        method="auto" if foldfree else method, tolerance=tolerance, max_iterations=max_iterations,
+        omega=omega,
     )
     sources = None
     if control is not None:
@@ -204,17 +227,38 @@ def generate_block(
 
         curves = {n: b[n] for n in ("bottom", "right", "top", "left")}
         if cells is not None:  # slide on the input polylines, not on the re-sampled nodes
-            import warnings
-
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # already reported by prepare_borders
-                if loop is not None:
-                    raw = borders_from_loop(loop, corners)
-                else:
-                    raw = borders_from_polylines(bottom, right, top, left, periodic=periodic)
-            curves = {n: raw[n] for n in curves}
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")  # already reported by prepare_borders
+                    if loop is not None:
+                        raw = borders_from_loop(loop, corners)
+                    else:
+                        raw = borders_from_polylines(bottom, right, top, left, periodic=periodic)
+                curves = {n: raw[n] for n in curves}
+            except MeshcoreError:  # e.g. corners="auto": slide on the re-sampled nodes
+                pass
         sources = make_sources(control, periodic=periodic, curves=curves)
-    return solve(g0, cfg, callback=callback, p=p, q=q, sources=sources)
+    if foldfree and cfg.method == "foldfree":
+        cfg = cfg.replaced(method="auto")
+    g = solve(g0, cfg, callback=callback, p=p, q=q, sources=sources)
+    if foldfree:
+        from .foldfree import smooth as _ff_smooth
+
+        if p is not None or q is not None:
+            warnings.warn(
+                'method="foldfree": the source terms P, Q shape only the elliptic start grid; '
+                "the fold-free minimisation has none (the default method keeps them and "
+                "repairs only the invalid cells)",
+                MeshcoreWarning,
+                stacklevel=2,
+            )
+
+        return _ff_smooth(g, strict=repair == "strict").grid
+    if repair == "off":
+        return g
+    from .foldfree import repair as _ff_repair
+
+    return _ff_repair(g, strict=repair == "strict").grid
 
 
 def _wake_cells(control: Any) -> int:

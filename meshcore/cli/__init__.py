@@ -26,6 +26,8 @@ SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("generate", "generate", "generate a grid from a case file"),
     ("quality", "quality", "print the quality table of a mesh file"),
     ("examples", "examples", "list bundled example cases, or copy one to a folder"),
+    ("convert", "convert", "convert a grid file to another format (PLOT3D, VTK, CGNS, ...)"),
+    ("import", "import_", "make a case file from a shoreline point file (KML, GeoJSON, CSV, ...)"),
 ]
 
 

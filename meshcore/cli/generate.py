@@ -47,10 +47,12 @@ class _Progress:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..crs import frame_from_case  # also registers the case file's top-level `crs` key
     from ..io import write
     from ..quality import quality
 
     case = load_case(args.case)
+    frame = frame_from_case(case)
     overrides = {}
     if args.method:
         overrides["method"] = args.method
@@ -69,9 +71,9 @@ def run(args: argparse.Namespace) -> int:
     elapsed = time.perf_counter() - t0
     blocks = list(getattr(result, "blocks", result))
     if args.output:
-        write(Path(args.output), result)
+        write(Path(args.output), result, crs=frame)
     if args.png:
-        write(Path(args.png), result)
+        write(Path(args.png), result, crs=frame)
     converged = all(g.converged for g in blocks)
     if not args.quiet:
         for g in blocks:

@@ -1,215 +1,343 @@
-"""Readers and writers (minimal core set; the I/O issue extends this package).
+"""Readers and writers: point files in, grids out (and back in).
 
-* ``write(path, grid_or_blocks, format=None)`` — format from the suffix:
-  ``.npz`` (numpy), ``.vts`` (VTK XML StructuredGrid, ASCII),
-  ``.xyz``/``.x``/``.p3d`` (PLOT3D 2-D, ASCII, multi-block), ``.png``/``.svg``/``.pdf``.
-* ``read_grid(path)`` — ``.npz``, ``.vts`` and ASCII PLOT3D back to grids.
-* ``read_points(path)`` — a CSV/TXT of x, y columns.
+Point files → :class:`PointSet` (named polylines + CRS) with :func:`read_points`;
+grid files → :class:`GridSet` with :func:`read_blocks` (or one grid with
+:func:`read_grid`); any grid or list of blocks → any format with :func:`write`.
+The format comes from the suffix or ``format=``; :data:`FORMATS` lists them
+(``python -m meshcore.io`` prints the table).
 
-Every file is written atomically: to a temporary file in the same directory,
-then renamed, so nothing partial is left behind on error.
+Every writer is atomic (temporary file in the same directory, then
+``os.replace``), raises :class:`~meshcore.errors.WriteError` on failure and
+leaves nothing behind.  Every reader raises only
+:class:`~meshcore.errors.ReadError`, naming the file and line or feature.
+Heavy libraries (vtk, h5py, netCDF4, pyproj, ezdxf, pyshp, matplotlib) are
+imported only inside the functions that need them.
+
+Examples
+--------
+>>> import numpy as np, tempfile, os
+>>> from meshcore import StructuredGrid
+>>> from meshcore.io import write, read_grid
+>>> xi, eta = np.meshgrid(np.linspace(0, 2, 5), np.linspace(0, 1, 3), indexing="ij")
+>>> d = tempfile.mkdtemp()
+>>> p = write(os.path.join(d, "g.xyz"), StructuredGrid(xi, eta))
+>>> read_grid(os.path.join(d, "g.xyz"))[0].shape
+(5, 3)
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
-from collections.abc import Callable, Sequence
+import importlib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from ..crs import Frame, as_frame
 from ..errors import ReadError, WriteError
 from ..grid import StructuredGrid
+from ._base import (
+    GridSet,
+    Interface,
+    PointSet,
+    Polyline,
+    as_blocks,
+    atomic_path,
+    coerce_interfaces,
+    find_interfaces,
+    read_guard,
+)
+from ._base import (
+    block_names as _block_names,
+)
 
-__all__ = ["atomic_write_bytes", "atomic_write_text", "read_grid", "read_points", "write"]
-
-
-def _atomic(path: Path, writer: Callable[[Path], None]) -> None:
-    path = Path(path)
-    d = path.parent if str(path.parent) else Path(".")
-    if not d.is_dir():
-        raise WriteError(f"{path}: directory {str(d)!r} does not exist")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=d)
-    except OSError as exc:
-        raise WriteError(f"{path}: cannot write ({exc.strerror})") from None
-    os.close(fd)
-    try:
-        writer(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        if isinstance(exc, OSError):
-            raise WriteError(f"{path}: cannot write ({exc})") from None
-        raise
-
-
-def atomic_write_text(path: str | Path, text: str) -> None:
-    _atomic(Path(path), lambda t: t.write_text(text, encoding="utf-8"))
-
-
-def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    _atomic(Path(path), lambda t: t.write_bytes(data))
-
-
-def _blocks(obj: Any) -> list[StructuredGrid]:
-    if isinstance(obj, StructuredGrid):
-        return [obj]
-    blocks = getattr(obj, "blocks", obj)
-    if isinstance(blocks, Sequence) and all(isinstance(b, StructuredGrid) for b in blocks) and blocks:
-        return list(blocks)
-    raise WriteError(f"cannot write {type(obj).__name__}: expected a StructuredGrid or a list of them")
+__all__ = [
+    "FORMATS",
+    "Format",
+    "GridSet",
+    "Interface",
+    "PointSet",
+    "Polyline",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "find_format",
+    "find_interfaces",
+    "read",
+    "read_blocks",
+    "read_grid",
+    "read_points",
+    "write",
+]
 
 
-def _write_npz(path: Path, blocks: list[StructuredGrid]) -> None:
-    arrays = {}
-    for k, g in enumerate(blocks):
-        arrays[f"x{k}"] = g.x
-        arrays[f"y{k}"] = g.y
-    with open(path, "wb") as f:
-        np.savez(f, nblocks=len(blocks), **arrays)
+@dataclass(frozen=True, slots=True)
+class Format:
+    """One file format: suffixes and the functions (``"module:function"``) that handle it."""
+
+    name: str
+    suffixes: tuple[str, ...]
+    description: str
+    writer: str | None = None
+    grid_reader: str | None = None
+    points_reader: str | None = None
+    crs: bool = False
+    markers: bool = False
+    multiblock: bool = False
+
+    def _load(self, spec: str):
+        mod, fn = spec.split(":")
+        return getattr(importlib.import_module(f"{__name__}.{mod}"), fn)
 
 
-def _write_vts(path: Path, blocks: list[StructuredGrid]) -> None:
-    if len(blocks) != 1:
-        raise WriteError(f"{path}: .vts holds one block; use .vtm for {len(blocks)} blocks")
-    g = blocks[0]
-    ni1, nj1 = g.shape
-    # VTK point order: i fastest → transpose our (i, j) C-order arrays
-    pts = np.column_stack([g.x.T.ravel(), g.y.T.ravel(), np.zeros(g.n_nodes)])
-    body = "\n".join(f"{a:.17g} {b:.17g} {c:.17g}" for a, b, c in pts)
-    ext = f"0 {ni1 - 1} 0 {nj1 - 1} 0 0"
-    text = (
-        '<?xml version="1.0"?>\n'
-        '<VTKFile type="StructuredGrid" version="1.0" byte_order="LittleEndian">\n'
-        f'  <StructuredGrid WholeExtent="{ext}">\n'
-        f'    <Piece Extent="{ext}">\n'
-        "      <Points>\n"
-        '        <DataArray type="Float64" NumberOfComponents="3" format="ascii">\n'
-        f"{body}\n"
-        "        </DataArray>\n"
-        "      </Points>\n"
-        "    </Piece>\n"
-        "  </StructuredGrid>\n"
-        "</VTKFile>\n"
+FORMATS: dict[str, Format] = {}
+
+
+def register_format(fmt: Format) -> None:
+    """Add (or replace) a format in :data:`FORMATS` (meshio-style registry)."""
+    FORMATS[fmt.name] = fmt
+
+
+for _f in (
+    Format("points-csv", (".csv", ".txt", ".xy", ".dat", ".tsv"),
+           "delimited x/y or lon/lat points", points_reader="points_csv:read_points_csv",
+           crs=True),
+    Format("geojson", (".geojson", ".json"), "GeoJSON lines and polygons",
+           points_reader="geojson:read_points_geojson", crs=True),
+    Format("kml", (".kml",), "Google Earth KML", points_reader="kml:read_points_kml", crs=True),
+    Format("kmz", (".kmz",), "Google Earth KMZ (zipped KML)",
+           points_reader="kml:read_points_kmz", crs=True),
+    Format("shapefile", (".shp",), "ESRI shapefile (+ .shx, .dbf, .prj)",
+           points_reader="shp:read_points_shp", crs=True),
+    Format("dxf", (".dxf",), "AutoCAD DXF polylines and splines",
+           points_reader="dxf:read_points_dxf"),
+    Format("plot3d", (".xyz", ".x", ".p3d", ".g"), "PLOT3D 2-D grid (ASCII / binary)",
+           writer="plot3d:write_plot3d", grid_reader="plot3d:read_plot3d", multiblock=True),
+    Format("vts", (".vts",), "VTK XML StructuredGrid", writer="vtk_xml:write_vts",
+           grid_reader="vtk_xml:read_vts", crs=True),
+    Format("vtm", (".vtm",), "VTK XML MultiBlock of .vts", writer="vtk_xml:write_vtm",
+           grid_reader="vtk_xml:read_vtm", crs=True, multiblock=True),
+    Format("npz", (".npz",), "NumPy archive: coordinates, metrics, CRS",
+           writer="native:write_npz", grid_reader="native:read_npz", crs=True, multiblock=True),
+    Format("metrics-csv", (".csv",), "metrics table per node (CSV)",
+           writer="native:write_metrics_csv", grid_reader="native:read_metrics_csv", crs=True,
+           multiblock=True),
+    Format("cgns", (".cgns",), "CGNS/HDF5 structured zones", writer="cgns:write_cgns",
+           grid_reader="cgns:read_cgns", crs=True, markers=True, multiblock=True),
+    Format("gmsh", (".msh",), "Gmsh MSH 4.1 (quads + physical border lines)",
+           writer="unstructured:write_msh", markers=True, multiblock=True),
+    Format("su2", (".su2",), "SU2 mesh with markers", writer="unstructured:write_su2",
+           markers=True, multiblock=True),
+    Format("delft3d", (".grd",), "Delft3D RGFGRID grid (+ .enc enclosure)",
+           writer="delft3d:write_grd", grid_reader="delft3d:read_grd", crs=True),
+    Format("sgrid", (".nc",), "NetCDF (SGRID conventions, CF grid mapping)",
+           writer="sgrid:write_sgrid", grid_reader="sgrid:read_sgrid", crs=True),
+    Format("figure", (".png", ".svg", ".pdf"), "figure (matplotlib)",
+           writer="figure:write_figure", multiblock=True),
+):
+    register_format(_f)
+
+
+def find_format(path: Any, format: str | None = None, *, role: str) -> Format:
+    """The :class:`Format` for ``path`` (by suffix) or ``format`` (by name).
+
+    ``role`` is ``"write"``, ``"grid"`` or ``"points"``; among formats sharing a
+    suffix (``.csv``) the one that can play the role is chosen.
+    """
+    attr = {"write": "writer", "grid": "grid_reader", "points": "points_reader"}[role]
+    if format is not None:
+        fmt = FORMATS.get(format) or next(
+            (f for f in FORMATS.values() if format.lower().lstrip(".") in
+             (s.lstrip(".") for s in f.suffixes) and getattr(f, attr)), None)
+        if fmt is None:
+            raise (WriteError if role == "write" else ReadError)(
+                f"unknown format {format!r} (known: {', '.join(FORMATS)})"
+            )
+        return fmt
+    suffix = Path(str(path)).suffix.lower()
+    cands = [f for f in FORMATS.values() if suffix in f.suffixes]
+    for f in cands:
+        if getattr(f, attr):
+            return f
+    can = sorted({s for f in FORMATS.values() if getattr(f, attr) for s in f.suffixes})
+    verb = {"write": "write", "grid": "read grids from", "points": "read points from"}[role]
+    raise (WriteError if role == "write" else ReadError)(
+        f"{path}: cannot {verb} {suffix or 'files without a suffix'} files "
+        f"(known suffixes: {' '.join(can)})"
     )
-    path.write_text(text, encoding="utf-8")
 
 
-def _write_plot3d(path: Path, blocks: list[StructuredGrid]) -> None:
-    lines = [str(len(blocks))]
-    lines += [f"{g.shape[0]} {g.shape[1]}" for g in blocks]
-    for g in blocks:
-        for arr in (g.x, g.y):
-            vals = arr.T.ravel()  # i fastest
-            lines += [" ".join(f"{v:.17g}" for v in vals[k:k + 4]) for k in range(0, len(vals), 4)]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+# ------------------------------------------------------------------- reading
+def read_points(path: Any, *, format: str | None = None, columns: Any = None,
+                crs: Any = None, closed: bool | None = None, **options: Any) -> PointSet:
+    """Read named polylines and their CRS from a point file.
 
+    Parameters
+    ----------
+    path : path-like
+        ``.csv/.txt/.xy/.dat``, ``.geojson/.json``, ``.kml``, ``.kmz``,
+        ``.shp``, ``.dxf`` — or a grid file, whose four borders are returned.
+    format : str, optional
+        Format name (see :data:`FORMATS`) overriding the suffix.
+    columns : (x, y), optional
+        CSV: column names or 0-based indices.
+    crs : optional
+        Declared CRS of the coordinates (EPSG code or string).
+    closed : bool, optional
+        CSV: force rings / open lines.
 
-def _write_figure(path: Path, blocks: list[StructuredGrid]) -> None:
-    from ..plot import plot_grid
+    Returns
+    -------
+    PointSet
+        ``.polylines`` (name, ``(n, 2)`` points, closed, orientation) and ``.crs``.
 
-    plot_grid(blocks, path=path, fmt=path.suffix.lstrip(".") if path.suffix else "png")
-
-
-_WRITERS: dict[str, Callable[[Path, list[StructuredGrid]], None]] = {
-    "npz": _write_npz,
-    "vts": _write_vts,
-    "plot3d": _write_plot3d,
-    "png": _write_figure,
-    "svg": _write_figure,
-    "pdf": _write_figure,
-}
-_SUFFIX = {".npz": "npz", ".vts": "vts", ".xyz": "plot3d", ".x": "plot3d", ".p3d": "plot3d",
-           ".png": "png", ".svg": "svg", ".pdf": "pdf"}
-
-
-def write(path: str | Path, obj: Any, format: str | None = None) -> Path:
-    """Write a grid (or a list of block grids) to ``path``; format from the suffix."""
+    Raises
+    ------
+    ReadError
+        Naming the file and line or feature.
+    """
     p = Path(path)
-    fmt = format or _SUFFIX.get(p.suffix.lower())
-    if fmt not in _WRITERS:
-        raise WriteError(
-            f"{p}: unknown output format {p.suffix or format!r}; known: {', '.join(sorted(_SUFFIX))}"
-        )
-    blocks = _blocks(obj)
-    writer = _WRITERS[fmt]
-    if fmt in ("png", "svg", "pdf"):
-        # matplotlib picks the format from the suffix; the temp file must keep it
-        def w(t: Path) -> None:
-            tt = t.with_suffix(p.suffix)
-            writer(tt, blocks)
-            os.replace(tt, t)
-        _atomic(p, w)
+    fmt = find_format(p, format, role="points") if format or not _is_grid_suffix(p) else None
+    with read_guard(p, "point file"):
+        if fmt is None:  # a grid file: its borders
+            return _grid_as_points(read_blocks(p), p)
+        if not p.exists():
+            raise ReadError(f"{p}: no such file")
+        if p.is_dir():
+            raise ReadError(f"{p}: is a directory, not a point file")
+        fn = fmt._load(fmt.points_reader)
+        return fn(p, columns=columns, crs=crs, closed=closed, **options)
+
+
+def _is_grid_suffix(p: Path) -> bool:
+    s = p.suffix.lower()
+    return any(s in f.suffixes and f.grid_reader and not f.points_reader for f in FORMATS.values()) \
+        and not any(s in f.suffixes and f.points_reader for f in FORMATS.values())
+
+
+def _grid_as_points(gs: GridSet, p: Path) -> PointSet:
+    from ..grid import BORDER_NAMES
+
+    pls = []
+    for k, g in enumerate(gs.blocks):
+        for b in BORDER_NAMES:
+            nm = f"{gs.block_names[k]} {g.names.get(b, b)}" if len(gs.blocks) > 1 else g.names.get(b, b)
+            pls.append(Polyline(nm, g.border(b)))
+    return PointSet(tuple(pls), gs.frame.crs, str(p), {"frame": gs.frame})
+
+
+def read_blocks(path: Any, *, format: str | None = None, **options: Any) -> GridSet:
+    """Read every block of a grid file (PLOT3D, .vts, .vtm, .npz, .cgns, .grd, .nc, metrics CSV).
+
+    Returns a :class:`GridSet`: blocks in local coordinates, the frame (CRS,
+    origin), block names and (where stored) connectivity.
+    """
+    p = Path(path)
+    fmt = find_format(p, format, role="grid")
+    with read_guard(p, f"{fmt.name} file"):
+        if not p.exists():
+            raise ReadError(f"{p}: no such file")
+        if p.is_dir():
+            raise ReadError(f"{p}: is a directory, not a {fmt.name} file")
+        return fmt._load(fmt.grid_reader)(p, **options)
+
+
+def read_grid(path: Any, *, format: str | None = None, **options: Any) -> list[StructuredGrid]:
+    """Read the blocks of a grid file as a list of grids in local coordinates.
+
+    ``read_grid(path)[0]`` is the grid of a one-block file; use
+    :func:`read_blocks` to get the CRS/origin and block names as well.
+    """
+    return list(read_blocks(path, format=format, **options).blocks)
+
+
+def read(path: Any, **options: Any) -> StructuredGrid | GridSet | PointSet:
+    """Read anything: a point file → PointSet, a one-block grid → StructuredGrid,
+    a multi-block grid → GridSet."""
+    p = Path(path)
+    try:
+        fmt = find_format(p, options.get("format"), role="points")
+    except ReadError:
+        fmt = None
+    if fmt is not None and not (p.suffix.lower() == ".csv" and _is_metrics_csv(p)):
+        return read_points(p, **options)
+    gs = read_blocks(p, **options)
+    return gs.blocks[0] if len(gs.blocks) == 1 else gs
+
+
+def atomic_write_text(path: Any, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically (temporary file, then rename)."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+def atomic_write_bytes(path: Any, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (temporary file, then rename)."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+
+
+def _is_metrics_csv(p: Path) -> bool:
+    try:
+        with open(p, encoding="utf-8", errors="replace") as f:
+            for ln in f:
+                if not ln.startswith("#"):
+                    return ln.replace(" ", "").lower().startswith("block,i,j,x,y")
+    except OSError:
+        return False
+    return False
+
+
+# ------------------------------------------------------------------- writing
+def write(path: Any, grid_or_blocks: Any, format: str | None = None, *, crs: Any = None,
+          origin: Any = None, block_names: Any = None, connectivity: Any = None,
+          **options: Any) -> Path:
+    """Write a grid or a list of blocks; the format comes from the suffix or ``format``.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file (see :data:`FORMATS` for suffixes).
+    grid_or_blocks : StructuredGrid, sequence of StructuredGrid, GridSet or multiblock
+        Grids in local coordinates.  Border names come from ``grid.names``
+        (e.g. ``{"bottom": "inlet"}``; defaults ``bottom/right/top/left``).
+    format : str, optional
+        Format name overriding the suffix (``"plot3d"``, ``"vts"`` …).
+    crs : Frame, EPSG int or CRS string, optional
+        CRS of the world coordinates; stored by formats that can hold it.
+    origin : (x0, y0), optional
+        Local origin added to every coordinate on output.
+    block_names : sequence of str, optional
+    connectivity : sequence of Interface or dicts, optional
+        1-to-1 interfaces between blocks; found from coordinates when omitted.
+    **options
+        Format options, e.g. PLOT3D ``mode="ascii"|"fortran"|"binary"``,
+        ``lonlat=True`` (SGRID: also store lon/lat), figure options.
+
+    Raises
+    ------
+    WriteError
+        The file could not be written; nothing partial is left behind.
+    """
+    p = Path(path)
+    fmt = find_format(p, format, role="write")
+    if isinstance(grid_or_blocks, GridSet):
+        gs = grid_or_blocks
+        if crs is not None or origin is not None:
+            gs = GridSet(gs.blocks, as_frame(crs if crs is not None else gs.frame, origin),
+                         gs.block_names, gs.connectivity, gs.source)
     else:
-        _atomic(p, lambda t: writer(t, blocks))
+        blocks = as_blocks(grid_or_blocks)
+        names = (tuple(block_names) if block_names is not None
+                 else _block_names(grid_or_blocks, len(blocks)))
+        if len(names) != len(blocks):
+            raise WriteError(f"{p}: {len(names)} block names for {len(blocks)} blocks")
+        if connectivity is None:
+            connectivity = getattr(grid_or_blocks, "connectivity", None)
+        gs = GridSet(blocks, as_frame(crs, origin), names,
+                     coerce_interfaces(connectivity, blocks))
+    if len(gs.blocks) > 1 and not fmt.multiblock:
+        raise WriteError(f"{p}: the {fmt.name} format holds one block, got {len(gs.blocks)}")
+    fmt._load(fmt.writer)(p, gs, **options)
     return p
 
 
-def read_grid(path: str | Path) -> list[StructuredGrid]:
-    """Read block grids from ``.npz``, ``.vts`` or ASCII PLOT3D."""
-    p = Path(path)
-    if not p.exists():
-        raise ReadError(f"{p}: file not found")
-    suf = p.suffix.lower()
-    try:
-        if suf == ".npz":
-            with np.load(p) as z:
-                n = int(z["nblocks"])
-                return [StructuredGrid(z[f"x{k}"], z[f"y{k}"]) for k in range(n)]
-        if suf == ".vts":
-            import re
-
-            text = p.read_text(encoding="utf-8")
-            m = re.search(r'WholeExtent="0 (\d+) 0 (\d+) 0 0"', text)
-            body = re.search(r"<DataArray[^>]*>(.*?)</DataArray>", text, re.S)
-            if not m or not body:
-                raise ReadError(f"{p}: not an ASCII VTK StructuredGrid written by meshcore")
-            ni1, nj1 = int(m.group(1)) + 1, int(m.group(2)) + 1
-            pts = np.array(body.group(1).split(), dtype=float).reshape(nj1, ni1, 3)
-            return [StructuredGrid(pts[..., 0].T, pts[..., 1].T)]
-        if suf in (".xyz", ".x", ".p3d"):
-            tok = p.read_text(encoding="utf-8").split()
-            nb = int(tok[0])
-            dims = [(int(tok[1 + 2 * k]), int(tok[2 + 2 * k])) for k in range(nb)]
-            vals = np.array(tok[1 + 2 * nb:], dtype=float)
-            out, off = [], 0
-            for ni1, nj1 in dims:
-                n = ni1 * nj1
-                x = vals[off:off + n].reshape(nj1, ni1).T
-                y = vals[off + n:off + 2 * n].reshape(nj1, ni1).T
-                off += 2 * n
-                out.append(StructuredGrid(x, y))
-            return out
-    except ReadError:
-        raise
-    except (ValueError, KeyError, IndexError, OSError) as exc:
-        raise ReadError(f"{p}: cannot read grid ({exc})") from None
-    raise ReadError(f"{p}: unknown grid format {suf!r}; known: .npz, .vts, .xyz/.x/.p3d")
-
-
-def read_points(path: str | Path) -> np.ndarray:
-    """Read an ``(n, 2)`` array of points from a CSV/TXT with two numeric columns."""
-    p = Path(path)
-    if not p.exists():
-        raise ReadError(f"{p}: file not found")
-    rows = []
-    for ln, line in enumerate(p.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
-        s = line.strip()
-        if not s or s.startswith("#"):
-            continue
-        parts = s.replace(",", " ").replace(";", " ").split()
-        try:
-            rows.append((float(parts[0]), float(parts[1])))
-        except (ValueError, IndexError):
-            if rows:
-                raise ReadError(f"{p}, line {ln}: expected two numbers, got {s!r}") from None
-            continue  # header
-    if not rows:
-        raise ReadError(f"{p}: no numeric x, y rows")
-    return np.array(rows)
+_ = Frame

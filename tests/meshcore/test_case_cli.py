@@ -177,3 +177,39 @@ def test_import_meshcore_does_not_import_qt():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           cwd=Path(__file__).resolve().parents[2])
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_lonlat_point_file_in_a_case_is_projected(tmp_path):
+    """A case that points at a lon/lat CSV is meshed in metres (UTM of the centroid, local origin)."""
+    import shutil
+
+    from tests.conftest import DATA
+
+    shutil.copy(DATA / "windermere_sparse.csv", tmp_path / "lake.csv")
+    (tmp_path / "c.toml").write_text(
+        '[[blocks]]\ncells = [40, 6]\n[blocks.boundary]\npoints = "lake.csv"\ncorners = [0, 10, 20, 30]\n'
+    )
+    case = load_case(tmp_path / "c.toml")
+    assert case.extra["crs"]["crs"] == "EPSG:32630"  # Windermere is in UTM zone 30N
+    loop = case.blocks[0].loop
+    assert 10_000 < np.ptp(loop[:, 1]) < 20_000  # ~14 km long, in metres, not degrees
+    assert np.abs(loop).max() < 1e5  # relative to a local origin
+    # saved and re-loaded, the case keeps its frame and gives the same grid
+    p = save_case(case, tmp_path / "saved.toml")
+    again = load_case(p)
+    assert again.extra["crs"]["origin"] == case.extra["crs"]["origin"]
+    g1, g2 = generate_case(case)[0], generate_case(again)[0]
+    np.testing.assert_allclose(g1.x, g2.x, atol=1e-6)
+
+
+def test_solver_repair_key(tmp_path):
+    text = example_path("rectangle-cutout-coarse").read_text() + '\n[solver]\nrepair = "off"\n'
+    c = loads_case(text, source="t.toml")
+    assert c.repair == "off"
+    off = generate_case(c)[0]
+    on = generate_case(c.replaced(repair="auto"))[0]
+    assert meshcore.quality(off).n_nonconvex > 0  # Winslow leaves non-convex cells at the cutout
+    assert meshcore.quality(on).n_nonconvex == 0 and "foldfree" in on.info.method
+    assert loads_case(dumps_case(c), source="t2").repair == "off"
+    with pytest.raises(CaseFileError, match="repair must be one of auto, strict, off"):
+        loads_case(example_path("bottle-fine").read_text() + '\n[solver]\nrepair = "maybe"\n', source="t")

@@ -1,0 +1,351 @@
+r"""Coordinate reference systems: lon/lat detection, UTM projection, local origin.
+
+Shorelines usually arrive in WGS84 longitude/latitude.  A grid is generated in
+a *metric* CRS — by default the UTM zone of the outline's centroid, or a
+user-given EPSG code — and, to keep every digit, *relative to a local origin*:
+
+.. math::
+
+    (x, y)_{\text{local}} = (E, N) - (E_0, N_0),
+
+where ``(E, N)`` are projected coordinates (UTM northings are ≈ 7·10⁶ m, so
+an absolute float64 keeps only ≈ 1e-9 m of the digits, and differences of
+them cancel) and ``(E_0, N_0)`` is the bounding-box centre rounded to a power
+of ten of the outline's size (an exactly representable integer of metres).
+:class:`Frame` carries the CRS and the origin to every writer, which adds the
+origin back (``to_world``) or returns to lon/lat (``to_lonlat``).
+
+pyproj is imported lazily, inside the functions that need it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidInputError, ReadError
+
+__all__ = [
+    "LONLAT",
+    "Frame",
+    "crs_wkt",
+    "is_geographic",
+    "looks_lonlat",
+    "project",
+    "utm_epsg",
+]
+
+#: The CRS of GeoJSON, KML and lon/lat CSV files (axis order lon, lat).
+LONLAT = "EPSG:4326"
+_GEOGRAPHIC_ALIASES = {"EPSG:4326", "OGC:CRS84", "WGS84", "CRS84", "EPSG:4979", "LONLAT"}
+
+
+def _pyproj():
+    try:
+        import pyproj
+    except ImportError as exc:  # pragma: no cover - pyproj is in the io extra
+        raise InvalidInputError(
+            "map projections need pyproj (pip install 'gcmesh[io]')"
+        ) from exc
+    return pyproj
+
+
+def normalize_crs(crs: Any) -> str | None:
+    """An authority string (``"EPSG:32632"``) for ``crs``, or its WKT, or None.
+
+    Accepts an int EPSG code, ``"EPSG:nnnn"``, ``"epsg:nnnn"``, a WKT / PROJ
+    string or a ``pyproj.CRS``.
+    """
+    if crs is None:
+        return None
+    if isinstance(crs, (int, np.integer)):
+        return f"EPSG:{int(crs)}"
+    if isinstance(crs, str):
+        s = crs.strip()
+        if not s or s.lower() in {"none", "local"}:
+            return None
+        if s.upper() in _GEOGRAPHIC_ALIASES:
+            return LONLAT
+        if s.isdigit():
+            return f"EPSG:{s}"
+        if s.upper().startswith("EPSG:") and s[5:].isdigit():
+            return f"EPSG:{s[5:]}"
+        try:
+            c = _pyproj().CRS.from_user_input(s)
+        except Exception as exc:
+            raise InvalidInputError(f"crs: cannot understand {s[:60]!r} ({exc})") from None
+        auth = c.to_authority(min_confidence=90)
+        return f"{auth[0]}:{auth[1]}" if auth else c.to_wkt()
+    to_wkt = getattr(crs, "to_wkt", None)
+    if to_wkt is not None:
+        return normalize_crs(to_wkt())
+    raise InvalidInputError(f"crs: expected an EPSG code or a CRS string, got {type(crs).__name__}")
+
+
+def is_geographic(crs: str | None) -> bool:
+    """True when ``crs`` is a geographic (degrees) CRS."""
+    if crs is None:
+        return False
+    if crs.upper() in _GEOGRAPHIC_ALIASES:
+        return True
+    return bool(_pyproj().CRS.from_user_input(crs).is_geographic)
+
+
+def crs_wkt(crs: str | None) -> str | None:
+    """WKT2 of ``crs`` (None for an unknown CRS)."""
+    if crs is None:
+        return None
+    return _pyproj().CRS.from_user_input(crs).to_wkt()
+
+
+def looks_lonlat(points: Any) -> bool:
+    """Heuristic: do these unlabelled coordinates look like lon/lat degrees?
+
+    True when every point lies in ``[-180, 180] × [-90, 90]``, the extent is
+    at most 20° (a lake or river region, not a whole continent), the centre
+    is more than 1° away from ``(0, 0)`` and the values carry at least three
+    decimals (digitised degrees do; unit squares and other small model
+    coordinates such as ``0 … 8`` or ``0.5, 1.25`` are not mistaken for degrees).
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    if p.size == 0 or not np.isfinite(p).all():
+        return False
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    if lo[0] < -180 or hi[0] > 180 or lo[1] < -90 or hi[1] > 90:
+        return False
+    if max(hi - lo) > 20:
+        return False
+    c = 0.5 * (lo + hi)
+    if math.hypot(*c) <= 1.0:
+        return False
+    frac = np.abs(p * 100 - np.round(p * 100))
+    return bool((frac > 1e-6).any())
+
+
+def check_lonlat(points: np.ndarray, *, where: str) -> None:
+    """Raise :class:`ReadError` naming the first point outside lon/lat range."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ReadError(
+            f"{where}: point {k} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range "
+            f"[-180, 180] × [-90, 90]"
+        )
+
+
+def utm_epsg(lon: float, lat: float) -> int:
+    """EPSG code of the WGS84 UTM zone containing ``(lon, lat)``.
+
+    Zones are 6° wide from −180°; 326zz north of the equator, 327zz south.
+    The Norway (32V) and Svalbard (31X–37X) exceptions are applied.
+    """
+    if not (-180 <= lon <= 180 and -80 <= lat <= 84):
+        raise InvalidInputError(f"no UTM zone for lon={lon:g}, lat={lat:g} (UTM covers 80°S–84°N)")
+    zone = int((lon + 180) // 6) + 1
+    zone = min(zone, 60)
+    if 56 <= lat < 64 and 3 <= lon < 12:
+        zone = 32
+    if 72 <= lat < 84 and lon >= 0:
+        if lon < 9:
+            zone = 31
+        elif lon < 21:
+            zone = 33
+        elif lon < 33:
+            zone = 35
+        elif lon < 42:
+            zone = 37
+    return (32600 if lat >= 0 else 32700) + zone
+
+
+def _nice_origin(points: np.ndarray) -> tuple[float, float]:
+    """Bounding-box centre rounded to a power of ten of the extent (0 when small)."""
+    if len(points) == 0:
+        return (0.0, 0.0)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    c = 0.5 * (lo + hi)
+    size = float(math.hypot(*(hi - lo))) or 1.0
+    if math.hypot(*c) <= 10 * size:
+        return (0.0, 0.0)
+    e = math.floor(math.log10(size))
+    return (float(round(float(c[0]), -e)), float(round(float(c[1]), -e)))
+
+
+@dataclass(frozen=True, slots=True)
+class Frame:
+    """Where local grid coordinates live: a CRS and a local origin.
+
+    World coordinates are ``(x + origin[0], y + origin[1])`` in ``crs``.
+
+    Parameters
+    ----------
+    crs : str or None
+        Metric CRS of the world coordinates (``"EPSG:32632"``), None if unknown.
+    origin : (float, float)
+        Local origin in world coordinates.
+    source_crs : str or None
+        CRS the points were read in (``"EPSG:4326"`` for lon/lat files).
+    """
+
+    crs: str | None = None
+    origin: tuple[float, float] = (0.0, 0.0)
+    source_crs: str | None = None
+
+    def to_world(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Local → world (projected) coordinates."""
+        return (np.asarray(x, dtype=np.float64) + self.origin[0],
+                np.asarray(y, dtype=np.float64) + self.origin[1])
+
+    def to_local(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+        """World (projected) → local coordinates."""
+        return (np.asarray(x, dtype=np.float64) - self.origin[0],
+                np.asarray(y, dtype=np.float64) - self.origin[1])
+
+    def to_lonlat(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Local coordinates → WGS84 longitude, latitude (degrees)."""
+        if self.crs is None:
+            raise InvalidInputError("cannot convert to lon/lat: the grid's CRS is unknown")
+        X, Y = self.to_world(x, y)
+        if is_geographic(self.crs):
+            return X, Y
+        t = _pyproj().Transformer.from_crs(self.crs, LONLAT, always_xy=True)
+        lon, lat = t.transform(X, Y)
+        return np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64)
+
+    @property
+    def wkt(self) -> str | None:
+        return crs_wkt(self.crs)
+
+    def as_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"origin": [float(self.origin[0]), float(self.origin[1])]}
+        if self.crs:
+            d["crs"] = self.crs
+        if self.source_crs:
+            d["source_crs"] = self.source_crs
+        return d
+
+
+def as_frame(crs: Any = None, origin: Any = None) -> Frame:
+    """Coerce ``crs`` (a Frame, CRS string/EPSG int or None) and ``origin`` to a Frame."""
+    if isinstance(crs, Frame):
+        if origin is None:
+            return crs
+        return Frame(crs.crs, (float(origin[0]), float(origin[1])), crs.source_crs)
+    o = (0.0, 0.0) if origin is None else (float(origin[0]), float(origin[1]))
+    return Frame(normalize_crs(crs), o)
+
+
+def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto",
+            source_crs: Any = None) -> tuple[Any, Frame]:
+    """Project a :class:`~meshcore.io.PointSet` to local metric coordinates.
+
+    Parameters
+    ----------
+    pointset : PointSet
+        As returned by :func:`meshcore.io.read_points`.
+    crs : "auto", int, str or None
+        Target CRS.  ``"auto"``: lon/lat input (declared, or unlabelled and
+        :func:`looks_lonlat`) goes to the UTM zone of its centroid; projected
+        input stays in its CRS; unknown non-geographic input is left as is.
+        An EPSG code / CRS string projects to that CRS.  ``None``/``"none"``:
+        no projection.
+    origin : "auto", (x0, y0) or None
+        Local origin subtracted after projecting (see module docstring);
+        ``None`` means ``(0, 0)``.
+    source_crs : optional
+        Overrides the CRS the points were read in.
+
+    Returns
+    -------
+    (PointSet, Frame)
+        The points in local coordinates and the frame that maps them back.
+
+    Examples
+    --------
+    >>> from meshcore.io import PointSet, Polyline
+    >>> ps = PointSet((Polyline("a", [[8.5, 47.3], [8.6, 47.3], [8.6, 47.4]]),), "EPSG:4326")
+    >>> local, frame = project(ps)
+    >>> frame.crs, frame.origin
+    ('EPSG:32632', (470000.0, 5240000.0))
+    """
+    from .io._base import Polyline
+
+    src = normalize_crs(source_crs) if source_crs is not None else pointset.crs
+    pts = pointset.all_points()
+    target_in = crs.strip().lower() if isinstance(crs, str) else crs
+    if src is None and target_in not in (None, "none", "local") and looks_lonlat(pts):
+        src = LONLAT
+    if target_in == "auto":
+        if src is not None and is_geographic(src):
+            lon, lat = _lonlat_centroid(pts, src)
+            target = f"EPSG:{utm_epsg(lon, lat)}"
+        else:
+            target = src
+    elif target_in in (None, "none", "local"):
+        target = src
+    else:
+        target = normalize_crs(crs)
+        if src is None:
+            raise InvalidInputError(
+                f"{pointset.source}: cannot project to {target}: the points' CRS is unknown "
+                f"(give source_crs / --source-crs)"
+            )
+    if src is not None and is_geographic(src):
+        check_lonlat(pts, where=pointset.source or "points")
+    if target is not None and src is not None and target != src:
+        t = _pyproj().Transformer.from_crs(src, target, always_xy=True)
+        new = []
+        for pl in pointset.polylines:
+            X, Y = t.transform(pl.points[:, 0], pl.points[:, 1])
+            P = np.column_stack([X, Y]).astype(np.float64)
+            if not np.isfinite(P).all():
+                raise InvalidInputError(
+                    f"{pointset.source}: {pl.name}: points cannot be projected to {target}"
+                )
+            new.append((pl, P))
+    else:
+        new = [(pl, pl.points) for pl in pointset.polylines]
+    allp = np.vstack([p for _, p in new]) if new else np.zeros((0, 2))
+    if isinstance(origin, str) and origin == "auto":
+        o = _nice_origin(allp)
+    elif origin is None:
+        o = (0.0, 0.0)
+    else:
+        o = (float(origin[0]), float(origin[1]))
+    off = np.array(o)
+    polylines = [
+        Polyline(pl.name, p - off, closed=pl.closed, orientation=pl.orientation) for pl, p in new
+    ]
+    return pointset.with_points(polylines, target), Frame(target, o, src)
+
+
+def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
+    if src != LONLAT:
+        t = _pyproj().Transformer.from_crs(src, LONLAT, always_xy=True)
+        lon, lat = t.transform(pts[:, 0], pts[:, 1])
+        pts = np.column_stack([lon, lat])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    return float(0.5 * (lo[0] + hi[0])), float(0.5 * (lo[1] + hi[1]))
+
+
+# ------------------------------------------------------------ case files
+def frame_from_case(case: Any) -> Frame | None:
+    """The :class:`Frame` stored in a case's top-level ``crs`` table, or None.
+
+    The table (written by ``meshcore import``) reads::
+
+        crs = { crs = "EPSG:32632", origin = [480000.0, 5240000.0],
+                source_crs = "EPSG:4326" }
+    """
+    t = (getattr(case, "extra", None) or {}).get("crs")
+    if not isinstance(t, dict):
+        return None
+    o = t.get("origin", [0.0, 0.0])
+    try:
+        origin = (float(o[0]), float(o[1]))
+    except (TypeError, ValueError, IndexError):
+        raise InvalidInputError(f"case crs.origin must be [x0, y0], got {o!r}") from None
+    return Frame(normalize_crs(t.get("crs")), origin, normalize_crs(t.get("source_crs")))

@@ -1,0 +1,313 @@
+r"""numba kernels of the fold-free (barrier) grid functional (functions only).
+
+Corner-triangle energy
+----------------------
+Every cell with corners ``c0 = (i, j)``, ``c1 = (i+1, j)``, ``c2 = (i+1, j+1)``,
+``c3 = (i, j+1)`` (counter-clockwise) is split into its four *corner
+triangles* ``T_m = (p, a, b) = (c_m, c_{m+1}, c_{m−1})``.  With
+``u = a − p``, ``v = b − p``:
+
+.. math::
+
+    F = |u|^2 + |v|^2,\qquad D = u \times v = u_x v_y − u_y v_x,
+
+    f_ε(T) = \frac{F}{χ(D, ε)},\qquad χ(D, ε) = \frac{D + \sqrt{ε^2 + D^2}}{2}.
+
+``D`` is the corner Jacobian of the cell at ``c_m``; a cell is convex and
+positively oriented iff its four ``D > 0``.  For ``ε = 0`` (``χ = D`` for
+``D > 0``, ``+∞`` otherwise) the sum ``E = Σ f_0`` is the discrete
+Winslow–Ivanenko functional (harmonic energy divided by the Jacobian,
+``∫ (g11 + g22)/J``): ``f_0 ≥ 2`` with equality for a square corner, and
+``E → ∞`` as any corner Jacobian → 0⁺, so a descent method started on a
+valid grid can never fold a cell (Ivanenko; Charakhch'yan & Ivanenko 1997).
+For ``ε > 0`` the energy is finite on folded grids and its minimisation with
+decreasing ``ε`` untangles them (Garanzha et al., "Foldover-free maps in 50
+lines of code", ACM TOG 40(4), 2021).
+
+Per-node Newton
+---------------
+With all other nodes fixed, ``D`` is affine and ``F`` quadratic in one node
+``q``: for the apex ``p`` (``∇F = −2(u+v)``, ``∇²F = 4I``,
+``∇D = (u_y − v_y, v_x − u_x)``), for ``a`` (``∇F = 2u``, ``∇²F = 2I``,
+``∇D = (v_y, −v_x)``), for ``b`` (``∇F = 2v``, ``∇²F = 2I``,
+``∇D = (−u_y, u_x)``).  With ``χ' = χ/s``, ``χ'' = ε²/(2s³)``,
+``s = \sqrt{ε² + D²}``:
+
+.. math::
+
+    ∇f = \frac{∇F}{χ} − \frac{F χ'}{χ^2} ∇D,\qquad
+    ∇^2 f = \frac{∇^2F}{χ} − \frac{χ'}{χ^2}(∇F∇D^T + ∇D∇F^T)
+            + F\Bigl(\frac{2χ'^2}{χ^3} − \frac{χ''}{χ^2}\Bigr)∇D∇D^T.
+
+For ``ε = 0`` each ``f`` is convex in ``q`` on ``D > 0`` (a quadratic over an
+affine function), so the per-node problem is convex.  Each node belongs to 12
+corner triangles (3 in each of its ≤ 4 cells).  :func:`sweep` applies a
+damped Newton step with backtracking on the node's local energy, node by node
+in 4-colour order (nodes of one colour share no cell).  Triangles whose three
+nodes are all fixed are constant and ignored.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_INF = np.inf
+
+
+@njit(cache=True, nogil=True)
+def _chi(d, eps):
+    if eps == 0.0:
+        return d if d > 0.0 else 0.0
+    s = math.sqrt(eps * eps + d * d)
+    if d >= 0.0:
+        return 0.5 * (d + s)
+    return 0.5 * eps * eps / (s - d)  # = (d + s)/2 without cancellation
+
+
+@njit(cache=True, nogil=True)
+def tri_energy(px, py, ax, ay, bx, by, eps):
+    """``f_ε`` of one corner triangle (``+inf`` when ``ε = 0`` and ``D ≤ 0``)."""
+    ux, uy = ax - px, ay - py
+    vx, vy = bx - px, by - py
+    d = ux * vy - uy * vx
+    c = _chi(d, eps)
+    if c <= 0.0:
+        return _INF
+    return (ux * ux + uy * uy + vx * vx + vy * vy) / c
+
+
+@njit(cache=True, nogil=True)
+def _tri_node(px, py, ax, ay, bx, by, role, eps, out):
+    """Add f, ∇f, ∇²f w.r.t. node ``role`` (0 = p, 1 = a, 2 = b) into ``out``.
+
+    ``out = [E, gx, gy, hxx, hxy, hyy]``.  Returns False if the triangle is
+    inverted under the ε = 0 barrier (energy infinite).
+    """
+    ux, uy = ax - px, ay - py
+    vx, vy = bx - px, by - py
+    d = ux * vy - uy * vx
+    f2 = ux * ux + uy * uy + vx * vx + vy * vy
+    if eps == 0.0:
+        if d <= 0.0:
+            return False
+        c = d
+        c1 = 1.0
+        c2 = 0.0
+    else:
+        s = math.sqrt(eps * eps + d * d)
+        c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
+        if c <= 0.0 or s <= 0.0:
+            return False
+        c1 = c / s
+        c2 = eps * eps / (2.0 * s * s * s)
+    if role == 0:
+        gfx, gfy, hf = -2.0 * (ux + vx), -2.0 * (uy + vy), 4.0
+        gdx, gdy = uy - vy, vx - ux
+    elif role == 1:
+        gfx, gfy, hf = 2.0 * ux, 2.0 * uy, 2.0
+        gdx, gdy = vy, -vx
+    else:
+        gfx, gfy, hf = 2.0 * vx, 2.0 * vy, 2.0
+        gdx, gdy = -uy, ux
+    ic = 1.0 / c
+    k1 = f2 * c1 * ic * ic
+    out[0] += f2 * ic
+    out[1] += gfx * ic - k1 * gdx
+    out[2] += gfy * ic - k1 * gdy
+    k2 = c1 * ic * ic
+    k3 = f2 * (2.0 * c1 * c1 * ic * ic * ic - c2 * ic * ic)
+    out[3] += hf * ic - 2.0 * k2 * gfx * gdx + k3 * gdx * gdx
+    out[4] += -k2 * (gfx * gdy + gdx * gfy) + k3 * gdx * gdy
+    out[5] += hf * ic - 2.0 * k2 * gfy * gdy + k3 * gdy * gdy
+    return True
+
+
+@njit(cache=True, nogil=True)
+def node_local(x, y, i, j, qx, qy, eps, out, periodic=False):
+    """Local energy, gradient and Hessian of node ``(i, j)`` placed at ``(qx, qy)``.
+
+    Sums the (up to) 12 corner triangles that contain the node, skipping none
+    (a triangle that contains a free node is never all-fixed).  Returns False
+    when a triangle is inverted under the ε = 0 barrier.  ``periodic``: column
+    ``ni`` repeats column 0, and a seam node ``(0, j)`` also belongs to the
+    cells of column ``ni − 1`` (as their corner in column ``ni``).
+    """
+    ni1, nj1 = x.shape
+    for k in range(6):
+        out[k] = 0.0
+    cx = np.empty(4)
+    cy = np.empty(4)
+    for dc in range(4):
+        ci = i - 1 + (dc & 1)
+        cj = j - 1 + (dc >> 1)
+        di = i - ci
+        if periodic and ci < 0:
+            ci = ni1 - 2
+            di = 1
+        if ci < 0 or cj < 0 or ci >= ni1 - 1 or cj >= nj1 - 1:
+            continue
+        # corners c0..c3 of cell (ci, cj)
+        cx[0], cy[0] = x[ci, cj], y[ci, cj]
+        cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
+        cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
+        cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
+        # which corner is the node: (i,j) = (ci + di, cj + dj)
+        dj = j - cj
+        if dj == 0:
+            m = di  # 0 -> c0, 1 -> c1
+        else:
+            m = 3 - di  # di=1 -> c2, di=0 -> c3
+        cx[m], cy[m] = qx, qy
+        for r in range(3):
+            # triangle with apex t = m, m-1 (node is a), m+1 (node is b)
+            if r == 0:
+                t = m
+            elif r == 1:
+                t = (m + 3) % 4
+            else:
+                t = (m + 1) % 4
+            ta = (t + 1) % 4
+            tb = (t + 3) % 4
+            if not _tri_node(cx[t], cy[t], cx[ta], cy[ta], cx[tb], cy[tb], r, eps, out):
+                return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
+    """One damped-Newton Gauss–Seidel sweep over ``nodes`` (int32 (k, 2), colour ordered).
+
+    Each node minimises its local energy (12 corner triangles) along the
+    Newton direction (the Hessian shifted to be positive definite), with
+    backtracking until the energy decreases; under ``ε = 0`` the barrier
+    rejects every step that would invert a triangle.  ``periodic``: seam
+    nodes are given as column 0 and their copy in column ``ni`` follows.  ``max_step`` caps the
+    step length (in units of the coordinates).  ``omega > 1`` first tries the
+    over-relaxed step ``ω·δ`` (nonlinear SOR) and falls back to backtracking
+    from the plain Newton step when it does not lower the energy.
+
+    Returns the largest node displacement.
+    """
+    out = np.empty(6)
+    trial = np.empty(6)
+    dmax = 0.0
+    for k in range(nodes.shape[0]):
+        i = nodes[k, 0]
+        j = nodes[k, 1]
+        qx, qy = x[i, j], y[i, j]
+        if not node_local(x, y, i, j, qx, qy, eps, out, periodic):
+            continue
+        e0, gx, gy = out[0], out[1], out[2]
+        hxx, hxy, hyy = out[3], out[4], out[5]
+        # positive-definite shift
+        tr = hxx + hyy
+        det = hxx * hyy - hxy * hxy
+        lam_min = 0.5 * tr - math.sqrt(max(0.25 * (hxx - hyy) ** 2 + hxy * hxy, 0.0))
+        if lam_min <= 1e-12 * max(abs(tr), 1e-300):
+            shift = -lam_min + 1e-6 * max(abs(tr), 1e-300) + 1e-300
+            hxx += shift
+            hyy += shift
+            det = hxx * hyy - hxy * hxy
+        if det <= 0.0:
+            continue
+        sx = -(hyy * gx - hxy * gy) / det
+        sy = -(-hxy * gx + hxx * gy) / det
+        slen = math.sqrt(sx * sx + sy * sy)
+        if slen > max_step:
+            sx *= max_step / slen
+            sy *= max_step / slen
+        slope = gx * sx + gy * sy
+        if not (slope < 0.0):
+            continue
+        alpha = 1.0
+        if omega > 1.0:
+            nx = qx + omega * sx
+            ny = qy + omega * sy
+            if node_local(x, y, i, j, nx, ny, eps, trial, periodic) and trial[0] < e0:
+                x[i, j] = nx
+                y[i, j] = ny
+                if periodic and i == 0:
+                    x[x.shape[0] - 1, j] = nx
+                    y[x.shape[0] - 1, j] = ny
+                dd = omega * math.sqrt(sx * sx + sy * sy)
+                if dd > dmax:
+                    dmax = dd
+                continue
+        for _ in range(30):
+            nx = qx + alpha * sx
+            ny = qy + alpha * sy
+            if node_local(x, y, i, j, nx, ny, eps, trial, periodic) and trial[0] <= e0 + 1e-4 * alpha * slope:
+                x[i, j] = nx
+                y[i, j] = ny
+                if periodic and i == 0:
+                    x[x.shape[0] - 1, j] = nx
+                    y[x.shape[0] - 1, j] = ny
+                dd = alpha * math.sqrt(sx * sx + sy * sy)
+                if dd > dmax:
+                    dmax = dd
+                break
+            alpha *= 0.5
+    return dmax
+
+
+@njit(cache=True, nogil=True)
+def patch_stats(x, y, cells, eps, exempt):
+    """Energy ``Σ f_ε`` and the smallest corner Jacobian over ``cells`` (int32 (k, 2)).
+
+    ``exempt`` (uint8, shape (ni, nj)) marks cells whose corner triangles are
+    skipped (block-corner cells on reflex boundary vertices are passed with
+    only that corner excluded via bit flags: bit m excludes corner m).
+    """
+    e = 0.0
+    dmin = _INF
+    cx = np.empty(4)
+    cy = np.empty(4)
+    for k in range(cells.shape[0]):
+        ci = cells[k, 0]
+        cj = cells[k, 1]
+        cx[0], cy[0] = x[ci, cj], y[ci, cj]
+        cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
+        cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
+        cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
+        ex = exempt[ci, cj]
+        for t in range(4):
+            if (ex >> t) & 1:
+                continue
+            ta = (t + 1) % 4
+            tb = (t + 3) % 4
+            ux, uy = cx[ta] - cx[t], cy[ta] - cy[t]
+            vx, vy = cx[tb] - cx[t], cy[tb] - cy[t]
+            d = ux * vy - uy * vx
+            if d < dmin:
+                dmin = d
+            c = _chi(d, eps)
+            if c <= 0.0:
+                e = _INF
+            else:
+                e += (ux * ux + uy * uy + vx * vx + vy * vy) / c
+    return e, dmin
+
+
+@njit(cache=True, nogil=True)
+def corner_jacobians(x, y):
+    """Corner Jacobians, shape ``(4, ni, nj)`` (same as :func:`meshcore.quality.cell_quality`)."""
+    ni = x.shape[0] - 1
+    nj = x.shape[1] - 1
+    out = np.empty((4, ni, nj))
+    cx = np.empty(4)
+    cy = np.empty(4)
+    for ci in range(ni):
+        for cj in range(nj):
+            cx[0], cy[0] = x[ci, cj], y[ci, cj]
+            cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
+            cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
+            cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
+            for t in range(4):
+                ta = (t + 1) % 4
+                tb = (t + 3) % 4
+                ux, uy = cx[ta] - cx[t], cy[ta] - cy[t]
+                out[t, ci, cj] = ux * (cy[tb] - cy[t]) - uy * (cx[tb] - cx[t])
+    return out

@@ -1,0 +1,396 @@
+"""Shared pieces of the readers and writers: point sets, atomic writes, errors.
+
+Every reader raises :class:`~meshcore.errors.ReadError` naming the file and the
+line or feature; every writer writes to a temporary file in the target's
+directory and renames it over the target (``os.replace``), so a failed write
+leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import MeshcoreError, ReadError, WriteError
+from ..grid import BORDER_NAMES, StructuredGrid
+
+__all__ = [
+    "PointSet",
+    "Polyline",
+    "as_blocks",
+    "atomic_path",
+    "border_names",
+    "read_guard",
+]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Polyline:
+    """One named polyline read from a point file.
+
+    Parameters
+    ----------
+    name : str
+        Feature / placemark / layer name, or ``"<file stem>"`` / ``"line k"``.
+    points : (n, 2) ndarray
+        Coordinates in the file's CRS (lon, lat for geographic files).
+    closed : bool
+        True for rings (polygons, closed polylines).  The repeated closing
+        point is dropped: ``points[-1] != points[0]``.
+    orientation : {"ccw", "cw", ""}
+        For rings, the orientation as given in the file (sign of the shoelace
+        area in the file's axes); ``""`` for open polylines.
+    """
+
+    name: str
+    points: np.ndarray
+    closed: bool = False
+    orientation: str = ""
+
+    def __post_init__(self) -> None:
+        p = np.array(self.points, dtype=np.float64, order="C", copy=True)
+        if p.ndim != 2 or p.shape[1] != 2:
+            raise ValueError(f"polyline {self.name!r}: points must be (n, 2), got {p.shape}")
+        p.setflags(write=False)
+        object.__setattr__(self, "points", p)
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def __repr__(self) -> str:
+        kind = f"ring ({self.orientation})" if self.closed else "open"
+        return f"Polyline({self.name!r}, {len(self.points)} points, {kind})"
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PointSet:
+    """Named polylines read from one file, with their coordinate reference system.
+
+    Parameters
+    ----------
+    polylines : tuple of Polyline
+    crs : str or None
+        ``"EPSG:4326"`` for lon/lat files (KML, GeoJSON, CSV with lon/lat
+        columns), another authority string or WKT when the file declares one
+        (shapefile ``.prj``, legacy GeoJSON ``crs``), ``None`` when unknown.
+    source : str
+        The file it came from.
+    """
+
+    polylines: tuple[Polyline, ...]
+    crs: str | None = None
+    source: str = ""
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "polylines", tuple(self.polylines))
+
+    def __len__(self) -> int:
+        return len(self.polylines)
+
+    def __iter__(self) -> Iterator[Polyline]:
+        return iter(self.polylines)
+
+    def __getitem__(self, k: int | str) -> Polyline:
+        if isinstance(k, str):
+            for pl in self.polylines:
+                if pl.name == k:
+                    return pl
+            raise KeyError(f"{self.source}: no polyline named {k!r}")
+        return self.polylines[k]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(pl.name for pl in self.polylines)
+
+    def all_points(self) -> np.ndarray:
+        """All vertices stacked as one ``(N, 2)`` array."""
+        if not self.polylines:
+            return np.zeros((0, 2))
+        return np.vstack([pl.points for pl in self.polylines])
+
+    def with_points(self, polylines: Sequence[Polyline], crs: str | None) -> PointSet:
+        return PointSet(tuple(polylines), crs, self.source, dict(self.meta))
+
+
+def make_polyline(name: str, pts: np.ndarray, *, closed: bool | None = None,
+                  where: str = "") -> Polyline:
+    """Build a :class:`Polyline`, detecting a repeated closing point.
+
+    ``closed=None`` means: closed when the last point repeats the first.
+    The repeated point is dropped and the orientation of the ring recorded.
+    """
+    p = np.asarray(pts, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise ReadError(f"{where}: {name}: expected x, y pairs, got shape {p.shape}")
+    if not np.isfinite(p).all():
+        k = int(np.flatnonzero(~np.isfinite(p).all(axis=1))[0])
+        raise ReadError(f"{where}: {name}: point {k} is not a finite number")
+    repeated = len(p) > 2 and bool(np.array_equal(p[0], p[-1]))
+    if closed is None:
+        closed = repeated
+    if repeated:
+        p = p[:-1]
+    orientation = ""
+    if closed and len(p) >= 3:
+        c = p - p.mean(axis=0)
+        a = 0.5 * float(np.sum(c[:, 0] * np.roll(c[:, 1], -1) - np.roll(c[:, 0], -1) * c[:, 1]))
+        orientation = "ccw" if a > 0 else "cw" if a < 0 else ""
+    return Polyline(name, p, closed=bool(closed), orientation=orientation)
+
+
+# ----------------------------------------------------------------- reading
+@contextlib.contextmanager
+def read_guard(path: Any, what: str = "file") -> Iterator[None]:
+    """Turn any unexpected failure while parsing ``path`` into a ReadError.
+
+    Explicit checks raise well-worded :class:`ReadError` themselves; this guard
+    is the safety net that keeps library exceptions (``struct.error``,
+    ``UnicodeDecodeError``, a third-party parser's own errors …) from escaping.
+    """
+    try:
+        yield
+    except ReadError as exc:
+        msg = str(exc)
+        if "\n" in msg or "\r" in msg or len(msg) > 400:
+            raise ReadError(one_line(msg)) from exc
+        raise
+    except FileNotFoundError:
+        raise ReadError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise ReadError(f"{path}: is a directory, not a {what}") from None
+    except PermissionError:
+        raise ReadError(f"{path}: permission denied") from None
+    except MeshcoreError as exc:
+        raise ReadError(one_line(f"{path}: {exc}")) from exc
+    except RecursionError:
+        raise ReadError(f"{path}: nesting too deep, not a valid {what}") from None
+    except Exception as exc:  # the safety net (see docstring)
+        msg = one_line(str(exc)) if str(exc) else type(exc).__name__
+        raise ReadError(one_line(f"{path}: not a valid {what} ({type(exc).__name__}: {msg})")) \
+            from exc
+
+
+def one_line(msg: str, limit: int = 400) -> str:
+    """Collapse line breaks (a third-party message may hold some) and cap the length."""
+    import re
+
+    s = re.sub(r"\s*[\r\n]+\s*", " ", msg).strip()
+    return s if len(s) <= limit else s[: limit - 1] + "…"
+
+
+def read_bytes(path: Path, *, limit: int = 512 * 2**20) -> bytes:
+    """Read a whole file, refusing absurdly large ones."""
+    size = path.stat().st_size
+    if size > limit:
+        raise ReadError(f"{path}: file is {size} bytes, more than the limit of {limit}")
+    return path.read_bytes()
+
+
+def decode_text(path: Path, data: bytes) -> str:
+    """Decode text as UTF-8 (with or without BOM), falling back to Latin-1."""
+    if not data.strip():
+        raise ReadError(f"{path}: file is empty")
+    if b"\x00" in data[:4096]:
+        raise ReadError(f"{path}: binary data (NUL bytes) in a text file")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+# ----------------------------------------------------------------- writing
+@contextlib.contextmanager
+def atomic_path(path: Any, *, binary: bool = True) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; rename it over ``path`` on success.
+
+    On any error the temporary file is removed and a
+    :class:`~meshcore.errors.WriteError` naming ``path`` is raised, so nothing
+    partial is ever left at ``path``.
+    """
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise WriteError(f"{target}: cannot write here ({exc.strerror or exc})") from None
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.chmod(tmp_path, 0o644)
+        os.replace(tmp_path, target)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            tmp_path.unlink()
+        if isinstance(exc, MeshcoreError) or not isinstance(exc, Exception):
+            raise
+        if isinstance(exc, OSError):
+            raise WriteError(f"{target}: cannot write ({exc.strerror or exc})") from exc
+        raise WriteError(f"{target}: cannot write ({type(exc).__name__}: {exc})") from exc
+
+
+def as_blocks(obj: Any) -> tuple[StructuredGrid, ...]:
+    """Normalise a grid, a sequence of grids or a multiblock object to a tuple of grids."""
+    if isinstance(obj, StructuredGrid):
+        return (obj,)
+    blocks = getattr(obj, "blocks", None)
+    if blocks is not None and not isinstance(obj, (list, tuple)):
+        obj = blocks
+    if isinstance(obj, (list, tuple)) and obj:
+        out = []
+        for k, b in enumerate(obj):
+            g = getattr(b, "grid", b)
+            if not isinstance(g, StructuredGrid):
+                raise WriteError(f"block {k} is a {type(b).__name__}, not a StructuredGrid")
+            out.append(g)
+        return tuple(out)
+    raise WriteError(
+        f"expected a StructuredGrid, a list of them or a multiblock object, got {type(obj).__name__}"
+    )
+
+
+def block_names(obj: Any, n: int) -> tuple[str, ...]:
+    """Block names of a multiblock object (``blocks[k].name``) or ``block1…``."""
+    names = []
+    seq = getattr(obj, "blocks", obj) if not isinstance(obj, StructuredGrid) else (obj,)
+    for k in range(n):
+        name = None
+        with contextlib.suppress(Exception):
+            name = getattr(seq[k], "name", None) or seq[k].names.get("block")
+        names.append(str(name) if name else f"block{k + 1}")
+    # unique
+    seen: dict[str, int] = {}
+    for k, nm in enumerate(names):
+        if nm in seen:
+            names[k] = f"{nm}_{k + 1}"
+        seen[names[k]] = k
+    return tuple(names)
+
+
+def border_names(grid: StructuredGrid) -> dict[str, str]:
+    """Border → marker name, defaulting to the convention's names (``bottom`` …)."""
+    out = {}
+    for b in BORDER_NAMES:
+        nm = grid.names.get(b) if grid.names else None
+        out[b] = str(nm) if nm else b
+    return out
+
+
+def border_index(grid_shape: tuple[int, int], border: str) -> tuple[slice | int, slice | int]:
+    """Index of a border's nodes into the node arrays."""
+    return {
+        "bottom": (slice(None), 0),
+        "top": (slice(None), -1),
+        "left": (0, slice(None)),
+        "right": (-1, slice(None)),
+    }[border]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class GridSet:
+    """Grids read from (or about to be written to) a file.
+
+    Parameters
+    ----------
+    blocks : tuple of StructuredGrid
+        In *local* coordinates (world minus ``frame.origin``).
+    frame : Frame
+        CRS and local origin (see :mod:`meshcore.crs`).
+    block_names : tuple of str
+    connectivity : tuple of Interface
+        1-to-1 block interfaces (:func:`meshcore.io.find_interfaces`).
+    source : str
+    """
+
+    blocks: tuple[StructuredGrid, ...]
+    frame: Any = None
+    block_names: tuple[str, ...] = ()
+    connectivity: tuple[Any, ...] = ()
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        from ..crs import Frame
+
+        object.__setattr__(self, "blocks", tuple(self.blocks))
+        if self.frame is None:
+            object.__setattr__(self, "frame", Frame())
+        if not self.block_names:
+            object.__setattr__(
+                self, "block_names", tuple(f"block{k + 1}" for k in range(len(self.blocks)))
+            )
+
+    def __len__(self) -> int:
+        return len(self.blocks)
+
+    def world(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """World coordinates of block ``k`` (local + origin)."""
+        g = self.blocks[k]
+        return self.frame.to_world(g.x, g.y)
+
+
+@dataclass(frozen=True, slots=True)
+class Interface:
+    """A 1-to-1 connection: ``border_a`` of block ``a`` coincides node by node
+    with ``border_b`` of block ``b`` (``reversed``: the node order runs the other way)."""
+
+    a: int
+    border_a: str
+    b: int
+    border_b: str
+    reversed: bool = False
+
+
+def find_interfaces(blocks: Sequence[StructuredGrid], *, rtol: float = 1e-9) -> tuple[Interface, ...]:
+    """Whole-border 1-to-1 interfaces between blocks, found by coordinates.
+
+    Two borders connect when they have the same node count and every node
+    coincides (to ``rtol`` times the largest block size), in the same or the
+    reverse order.
+    """
+    size = max((g.size for g in blocks), default=1.0) or 1.0
+    tol = rtol * size
+    found = []
+    borders = [(k, b, g.border(b)) for k, g in enumerate(blocks) for b in BORDER_NAMES]
+    for m, (ka, ba, pa) in enumerate(borders):
+        for kb, bb, pb in borders[m + 1:]:
+            if kb == ka or len(pa) != len(pb):
+                continue
+            if np.max(np.abs(pa - pb)) <= tol:
+                found.append(Interface(ka, ba, kb, bb, False))
+            elif np.max(np.abs(pa - pb[::-1])) <= tol:
+                found.append(Interface(ka, ba, kb, bb, True))
+    return tuple(found)
+
+
+def coerce_interfaces(conn: Any, blocks: Sequence[StructuredGrid]) -> tuple[Interface, ...]:
+    """Interfaces from records (Interface, dicts or objects with a/border_a/b/border_b)."""
+    if conn is None:
+        return find_interfaces(blocks) if len(blocks) > 1 else ()
+    out = []
+    for k, r in enumerate(conn):
+        if isinstance(r, Interface):
+            out.append(r)
+            continue
+        get = r.get if isinstance(r, dict) else (lambda key, d=None, r=r: getattr(r, key, d))
+        try:
+            it = Interface(int(get("a")), str(get("border_a")), int(get("b")),
+                           str(get("border_b")), bool(get("reversed", False)))
+        except (TypeError, ValueError) as exc:
+            raise WriteError(
+                f"connectivity record {k} must have a, border_a, b, border_b "
+                f"(and optionally reversed): {exc}"
+            ) from None
+        if it.border_a not in BORDER_NAMES or it.border_b not in BORDER_NAMES or not (
+            0 <= it.a < len(blocks) and 0 <= it.b < len(blocks)
+        ):
+            raise WriteError(f"connectivity record {k} names an unknown block or border: {it}")
+        out.append(it)
+    return tuple(out)

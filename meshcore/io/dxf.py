@@ -1,0 +1,82 @@
+"""DXF drawings (ezdxf): LWPOLYLINE, POLYLINE (2-D/3-D, x and y used) and SPLINE.
+
+Each entity of the model space becomes a polyline named ``"<layer> <handle>"``;
+splines are flattened to within ``sagitta`` drawing units (default 1e-3 of the
+drawing's extent).  DXF carries no CRS, so the CRS is unknown (None) unless
+given.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..crs import normalize_crs
+from ..errors import ReadError
+from ._base import PointSet, Polyline, make_polyline
+
+__all__ = ["read_points_dxf"]
+
+
+def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None,
+                    **_: Any) -> PointSet:
+    """Read polylines and splines from the model space of a DXF file."""
+    try:
+        import ezdxf
+        from ezdxf.lldxf.const import DXFError
+    except ImportError as exc:  # pragma: no cover
+        raise ReadError(f"{path}: reading DXF needs ezdxf (pip install 'gcmesh[io]')") from exc
+    if not path.exists():
+        raise ReadError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise ReadError(f"{path}: file is empty")
+    try:
+        doc = ezdxf.readfile(str(path))
+    except (DXFError, OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ReadError(f"{path}: not a valid DXF file ({type(exc).__name__}: {exc})") from None
+    msp = doc.modelspace()
+    raw: list[tuple[str, np.ndarray, bool | None, Any]] = []
+    for e in msp:
+        kind = e.dxftype()
+        label = f"{e.dxf.get('layer', '0')} {e.dxf.handle}"
+        where = f"{path}: {kind} {e.dxf.handle} on layer {e.dxf.get('layer', '0')}"
+        if kind == "LWPOLYLINE":
+            pts = np.array([(p[0], p[1]) for p in e.get_points("xy")], dtype=np.float64)
+            raw.append((label, pts, bool(e.closed) or None, where))
+        elif kind == "POLYLINE":
+            if e.is_poly_face_mesh or e.is_polygon_mesh:
+                continue
+            pts = np.array([(v.dxf.location[0], v.dxf.location[1]) for v in e.vertices],
+                           dtype=np.float64)
+            raw.append((label, pts, bool(e.is_closed) or None, where))
+        elif kind == "SPLINE":
+            raw.append((label, e, None, where))
+    if not raw:
+        raise ReadError(f"{path}: no LWPOLYLINE, POLYLINE or SPLINE entities in the model space")
+    # flatten splines with a tolerance relative to the extent of everything
+    fixed = [r[1] for r in raw if isinstance(r[1], np.ndarray) and len(r[1])]
+    ctrl = []
+    for r in raw:
+        if not isinstance(r[1], np.ndarray):
+            cps = np.array([(p[0], p[1]) for p in r[1].control_points], dtype=np.float64)
+            if len(cps):
+                ctrl.append(cps)
+    allp = np.vstack(fixed + ctrl) if fixed or ctrl else np.zeros((1, 2))
+    ext = float(np.hypot(*(allp.max(axis=0) - allp.min(axis=0)))) or 1.0
+    tol = sagitta if sagitta is not None else 1e-3 * ext
+    out: list[Polyline] = []
+    for label, obj, closed, where in raw:
+        if isinstance(obj, np.ndarray):
+            pts = obj
+        else:
+            try:
+                pts = np.array([(v[0], v[1]) for v in obj.flattening(tol)], dtype=np.float64)
+            except (DXFError, ValueError, ZeroDivisionError, IndexError) as exc:
+                raise ReadError(f"{where}: cannot evaluate the spline ({exc})") from None
+            closed = bool(obj.closed) or None
+        if len(pts) < 2:
+            raise ReadError(f"{where}: fewer than 2 points")
+        out.append(make_polyline(label, pts, closed=closed, where=where))
+    return PointSet(tuple(out), normalize_crs(crs) if crs is not None else None, str(path))

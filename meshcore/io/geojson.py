@@ -1,0 +1,135 @@
+"""GeoJSON point files (RFC 7946): LineString, Polygon, Multi*, GeometryCollection.
+
+Coordinates are lon/lat (``EPSG:4326``) unless a legacy ``crs`` member names
+another CRS.  Polygon exterior rings become closed polylines named after the
+feature (``properties.name``/``id``); holes become ``"<name> hole k"``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..crs import LONLAT, check_lonlat, normalize_crs
+from ..errors import InvalidInputError, ReadError
+from ._base import PointSet, Polyline, decode_text, make_polyline, read_bytes
+
+__all__ = ["read_points_geojson"]
+
+
+def _coords(c: Any, where: str) -> np.ndarray:
+    if not isinstance(c, list) or not c:
+        raise ReadError(f"{where}: coordinates must be a non-empty list of positions")
+    dims = set()
+    for k, pos in enumerate(c):
+        if not isinstance(pos, list) or len(pos) < 2 or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in pos
+        ):
+            raise ReadError(f"{where}: position {k} is not a list of numbers: {str(pos)[:40]}")
+        dims.add(len(pos))
+    if len(dims) > 1:
+        raise ReadError(f"{where}: mixed dimensions {sorted(dims)} among positions")
+    return np.array([pos[:2] for pos in c], dtype=np.float64)
+
+
+def _geometry(geom: Any, name: str, where: str, out: list[Polyline]) -> None:
+    if geom is None:
+        return
+    if not isinstance(geom, dict) or "type" not in geom:
+        raise ReadError(f"{where}: geometry is not an object with a 'type'")
+    t = geom["type"]
+    c = geom.get("coordinates")
+    if t == "LineString":
+        out.append(make_polyline(name, _coords(c, where), closed=None, where=where))
+    elif t == "Polygon":
+        if not isinstance(c, list) or not c:
+            raise ReadError(f"{where}: Polygon without rings")
+        for k, ring in enumerate(c):
+            nm = name if k == 0 else f"{name} hole {k}"
+            out.append(make_polyline(nm, _coords(ring, f"{where} ring {k}"), closed=True,
+                                     where=where))
+    elif t in ("MultiLineString", "MultiPolygon"):
+        if not isinstance(c, list):
+            raise ReadError(f"{where}: {t} coordinates must be a list")
+        sub = t.removeprefix("Multi")
+        for k, part in enumerate(c):
+            _geometry({"type": sub, "coordinates": part},
+                      f"{name} {k + 1}" if len(c) > 1 else name, f"{where} part {k}", out)
+    elif t == "GeometryCollection":
+        for k, g in enumerate(geom.get("geometries") or []):
+            _geometry(g, f"{name} {k + 1}", f"{where} geometry {k}", out)
+    elif t in ("Point", "MultiPoint"):
+        pts = _coords([c] if t == "Point" else c, where)
+        out.append(Polyline(name, pts))  # gathered below
+        object.__setattr__(out[-1], "orientation", "point")
+    else:
+        raise ReadError(f"{where}: unsupported geometry type {t!r}")
+
+
+def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
+    """Read the line and polygon geometries of a GeoJSON file."""
+    text = decode_text(path, read_bytes(path))
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ReadError(f"{path}: line {exc.lineno}: invalid JSON ({exc.msg})") from None
+    except RecursionError:
+        raise ReadError(f"{path}: JSON nested too deeply") from None
+    if not isinstance(doc, dict) or "type" not in doc:
+        raise ReadError(f"{path}: not a GeoJSON object (no 'type')")
+    declared = LONLAT
+    legacy = doc.get("crs")
+    if isinstance(legacy, dict):
+        nm = (legacy.get("properties") or {}).get("name")
+        if isinstance(nm, str):
+            code = nm.split(":")[-1]
+            if nm.upper().endswith("CRS84"):
+                declared = LONLAT
+            elif code.isdigit():
+                declared = f"EPSG:{code}"
+    if crs is not None:
+        declared = normalize_crs(crs)
+    if doc["type"] == "FeatureCollection":
+        feats = doc.get("features")
+        if not isinstance(feats, list):
+            raise ReadError(f"{path}: FeatureCollection without a 'features' list")
+    elif doc["type"] == "Feature":
+        feats = [doc]
+    else:
+        feats = [{"type": "Feature", "geometry": doc, "properties": {}}]
+    out: list[Polyline] = []
+    for k, f in enumerate(feats):
+        if not isinstance(f, dict):
+            raise ReadError(f"{path}: feature {k} is not an object")
+        props = f.get("properties") or {}
+        name = None
+        if isinstance(props, dict):
+            name = props.get("name") or props.get("Name") or props.get("NAME")
+        name = str(name or f.get("id") or (path.stem if len(feats) == 1 else f"feature {k + 1}"))
+        _geometry(f.get("geometry"), name, f"{path}: feature {k} ({name})", out)
+    # consecutive Point features form one polyline (points picked by hand)
+    merged: list[Polyline] = []
+    run: list[np.ndarray] = []
+    for pl in [*out, None]:
+        if pl is not None and pl.orientation == "point":
+            run.append(pl.points)
+            continue
+        if run:
+            pts = np.vstack(run)
+            if len(pts) >= 2:
+                merged.append(make_polyline(f"{path.stem} points", pts, where=str(path)))
+            run = []
+        if pl is not None:
+            merged.append(pl)
+    if not merged:
+        raise ReadError(f"{path}: no LineString or Polygon coordinates in {len(feats)} feature(s)")
+    try:
+        if declared == LONLAT:
+            for pl in merged:
+                check_lonlat(pl.points, where=f"{path}: {pl.name}")
+    except InvalidInputError as exc:
+        raise ReadError(str(exc)) from None
+    return PointSet(tuple(merged), declared, str(path))

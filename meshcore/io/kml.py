@@ -1,0 +1,191 @@
+"""KML and KMZ point files as Google Earth saves them.
+
+Every ``Placemark`` with a ``LineString``, ``LinearRing`` or ``Polygon``
+(outer and inner boundaries, also inside ``MultiGeometry``) becomes a named
+polyline; consecutive ``Point`` placemarks (points picked by hand) are joined
+into one polyline.  Coordinates are ``lon,lat[,alt]`` tuples (``EPSG:4326``).
+
+Security: the XML is parsed by :mod:`defusedxml` with DTDs forbidden, so
+entity expansion ("billion laughs") and external entities are refused; a KMZ
+archive whose uncompressed size exceeds :data:`KMZ_LIMIT` is refused before
+anything is decompressed, and the KML member is read with the same cap.
+"""
+
+from __future__ import annotations
+
+import re
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..crs import LONLAT, check_lonlat, normalize_crs
+from ..errors import ReadError
+from ._base import PointSet, Polyline, make_polyline, read_bytes
+
+__all__ = ["KMZ_LIMIT", "read_points_kml", "read_points_kmz"]
+
+#: Largest uncompressed KMZ content accepted (bytes).
+KMZ_LIMIT = 64 * 2**20
+#: Largest number of members in a KMZ archive.
+KMZ_MAX_MEMBERS = 10_000
+
+
+def _local(tag: Any) -> str:
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+def _parse_xml(data: bytes, where: str):
+    try:
+        from defusedxml import DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden
+        from defusedxml.ElementTree import ParseError, fromstring
+    except ImportError as exc:  # pragma: no cover
+        raise ReadError(f"{where}: reading KML needs defusedxml (pip install 'gcmesh[io]')") from exc
+    if not data.strip():
+        raise ReadError(f"{where}: file is empty")
+    try:
+        return fromstring(data, forbid_dtd=True, forbid_entities=True, forbid_external=True)
+    except (DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden) as exc:
+        raise ReadError(
+            f"{where}: refused: the XML declares a DTD or entities ({type(exc).__name__}); "
+            f"KML files never need them"
+        ) from None
+    except ParseError as exc:
+        line = getattr(exc, "position", (None,))[0]
+        raise ReadError(f"{where}: line {line}: not well-formed XML ({exc})") from None
+
+
+_SPLIT = re.compile(r"\s+")
+
+
+def _coordinates(text: str | None, where: str) -> np.ndarray:
+    if text is None or not text.strip():
+        raise ReadError(f"{where}: empty <coordinates>")
+    pts = []
+    for k, tup in enumerate(_SPLIT.split(text.strip())):
+        vals = tup.split(",")
+        if len(vals) not in (2, 3):
+            raise ReadError(f"{where}: coordinate tuple {k} {tup[:40]!r} is not lon,lat[,alt]")
+        try:
+            pts.append((float(vals[0]), float(vals[1])))
+        except ValueError:
+            raise ReadError(f"{where}: coordinate tuple {k} {tup[:40]!r} is not numeric") from None
+    return np.array(pts, dtype=np.float64)
+
+
+def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
+    for child in elem.iter():
+        tag = _local(child.tag)
+        if tag == "LineString":
+            c = _find_child(child, "coordinates")
+            out.append(make_polyline(name, _coordinates(c, f"{where} LineString"),
+                                     closed=None, where=where))
+        elif tag == "Polygon":
+            k = 0
+            for bnd in child:
+                btag = _local(bnd.tag)
+                if btag not in ("outerBoundaryIs", "innerBoundaryIs"):
+                    continue
+                for ring in bnd.iter():
+                    if _local(ring.tag) != "LinearRing":
+                        continue
+                    c = _find_child(ring, "coordinates")
+                    nm = name if btag == "outerBoundaryIs" else f"{name} hole {k + 1}"
+                    if btag == "innerBoundaryIs":
+                        k += 1
+                    out.append(make_polyline(nm, _coordinates(c, f"{where} {btag}"),
+                                             closed=True, where=where))
+        elif tag == "LinearRing" and not _inside_polygon(elem, child):
+            c = _find_child(child, "coordinates")
+            out.append(make_polyline(name, _coordinates(c, f"{where} LinearRing"),
+                                     closed=True, where=where))
+        elif tag == "Point":
+            c = _find_child(child, "coordinates")
+            pl = Polyline(name, _coordinates(c, f"{where} Point"))
+            object.__setattr__(pl, "orientation", "point")
+            out.append(pl)
+
+
+def _find_child(elem, tag: str) -> str | None:
+    for c in elem:
+        if _local(c.tag) == tag:
+            return c.text or ""
+    return None
+
+
+def _inside_polygon(root, ring) -> bool:
+    return any(_local(poly.tag) == "Polygon" and any(r is ring for r in poly.iter())
+               for poly in root.iter())
+
+
+def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
+    root = _parse_xml(data, where)
+    if _local(root.tag) != "kml":
+        raise ReadError(f"{where}: root element is <{_local(root.tag)}>, not <kml>")
+    out: list[Polyline] = []
+    n_marks = 0
+    for pm in root.iter():
+        if _local(pm.tag) != "Placemark":
+            continue
+        n_marks += 1
+        nm = (_find_child(pm, "name") or "").strip() or f"placemark {n_marks}"
+        _placemark_geoms(pm, nm, f"{where}: placemark {n_marks} ({nm})", out)
+    merged: list[Polyline] = []
+    run: list[np.ndarray] = []
+    for pl in [*out, None]:
+        if pl is not None and pl.orientation == "point":
+            run.append(pl.points)
+            continue
+        if run:
+            pts = np.vstack(run)
+            if len(pts) >= 2:
+                merged.append(make_polyline(f"{stem} points", pts, where=where))
+            run = []
+        if pl is not None:
+            merged.append(pl)
+    if not merged:
+        raise ReadError(
+            f"{where}: no coordinates: none of {n_marks} placemark(s) has a LineString, "
+            f"LinearRing, Polygon or two or more Points"
+        )
+    declared = normalize_crs(crs) if crs is not None else LONLAT
+    if declared == LONLAT:
+        for pl in merged:
+            check_lonlat(pl.points, where=f"{where}: {pl.name}")
+    return PointSet(tuple(merged), declared, where)
+
+
+def read_points_kml(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
+    """Read the placemark geometries of a ``.kml`` file."""
+    return _from_xml(read_bytes(path, limit=KMZ_LIMIT), str(path), path.stem, crs)
+
+
+def read_points_kmz(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
+    """Read the main KML of a ``.kmz`` archive (``doc.kml`` or the first ``.kml``)."""
+    try:
+        zf = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, ValueError) as exc:
+        raise ReadError(f"{path}: corrupt KMZ (not a valid zip archive: {exc})") from None
+    with zf:
+        infos = zf.infolist()
+        if len(infos) > KMZ_MAX_MEMBERS:
+            raise ReadError(f"{path}: refused: KMZ has {len(infos)} members")
+        total = sum(i.file_size for i in infos)
+        if total > KMZ_LIMIT:
+            raise ReadError(
+                f"{path}: refused: KMZ would uncompress to {total} bytes "
+                f"(limit {KMZ_LIMIT})"
+            )
+        kmls = [i for i in infos if i.filename.lower().endswith(".kml")]
+        if not kmls:
+            raise ReadError(f"{path}: KMZ archive holds no .kml file")
+        main = next((i for i in kmls if i.filename.lower() == "doc.kml"), kmls[0])
+        try:
+            with zf.open(main) as fh:
+                data = fh.read(KMZ_LIMIT + 1)
+        except (zipfile.BadZipFile, EOFError, OSError, ValueError, NotImplementedError) as exc:
+            raise ReadError(f"{path}: corrupt KMZ member {main.filename} ({exc})") from None
+        if len(data) > KMZ_LIMIT:
+            raise ReadError(f"{path}: refused: {main.filename} uncompresses beyond {KMZ_LIMIT} bytes")
+    return _from_xml(data, f"{path}:{main.filename}", path.stem, crs)

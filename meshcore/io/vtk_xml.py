@@ -1,0 +1,360 @@
+r"""VTK XML StructuredGrid (``.vts``) and MultiBlock (``.vtm``) files.
+
+Written as raw appended binary (``header_type="UInt64"``, little endian,
+float64), readable by VTK/ParaView.  Contents of each ``.vts``:
+
+* ``Points`` — world coordinates ``(x + x0, y + y0, 0)``, i fastest;
+* ``PointData`` — the node metrics of :func:`meshcore.metrics.metrics`
+  (``jacobian`` = x_ξ y_η − x_η y_ξ, ``x_xi`` … ``eta_y``, ``alpha``,
+  ``beta``, ``gamma``);
+* ``CellData`` — :func:`meshcore.quality.cell_quality` (``area``,
+  ``jacobian_ratio``, ``orthogonality``, ``skewness``, ``aspect_ratio``,
+  ``size_ratio``; ``min_corner_jacobian``);
+* ``FieldData`` — ``crs`` (authority string or WKT), ``origin`` (x0, y0) and
+  ``border_names`` (``"bottom=inlet;right=right;…"``).
+
+A ``.vtm`` lists one ``.vts`` per block, stored in a directory named after the
+``.vtm`` stem next to it.  The reader accepts ASCII, inline base64 and
+appended (raw or base64) data, UInt32/UInt64 headers and zlib compression.
+"""
+
+from __future__ import annotations
+
+import base64
+import os
+import shutil
+import struct
+import tempfile
+import zlib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..crs import Frame
+from ..errors import ReadError, WriteError
+from ..grid import BORDER_NAMES, StructuredGrid
+from ._base import GridSet, atomic_path, border_names, read_bytes
+
+__all__ = ["read_vtm", "read_vts", "write_vtm", "write_vts"]
+
+
+def _string_array(name: str, s: str) -> str:
+    codes = " ".join(str(b) for b in s.encode("utf-8")) + " 0"
+    return (f'      <Array type="String" Name="{name}" NumberOfTuples="1" format="ascii">\n'
+            f"        {codes}\n      </Array>\n")
+
+
+def _vts_bytes(g: StructuredGrid, frame: Frame, *, data: bool = True) -> bytes:
+    from ..metrics import metrics
+    from ..quality import cell_quality
+
+    ni, nj = g.cells
+    X, Y = frame.to_world(g.x, g.y)
+    pts = np.column_stack([X.ravel(order="F"), Y.ravel(order="F"), np.zeros(X.size)])
+    arrays: list[tuple[str, str, int, np.ndarray]] = []  # (section, name, ncomp, values)
+    arrays.append(("Points", "Points", 3, pts))
+    if data:
+        m = metrics(g).as_dict()
+        for k, v in m.items():
+            arrays.append(("PointData", k, 1, v.ravel(order="F")))
+        cq = cell_quality(g)
+        for k, v in cq.items():
+            if k == "corner_jacobians":
+                arrays.append(("CellData", "min_corner_jacobian", 1, v.min(axis=0).ravel(order="F")))
+            else:
+                arrays.append(("CellData", k, 1, v.ravel(order="F")))
+    blobs = []
+    offset = 0
+    xml: dict[str, list[str]] = {"Points": [], "PointData": [], "CellData": []}
+    for section, name, nc, v in arrays:
+        raw = np.ascontiguousarray(v, dtype="<f8").tobytes()
+        blobs.append(struct.pack("<Q", len(raw)) + raw)
+        xml[section].append(
+            f'        <DataArray type="Float64" Name="{name}" NumberOfComponents="{nc}" '
+            f'format="appended" offset="{offset}"/>\n'
+        )
+        offset += 8 + len(raw)
+    names = border_names(g)
+    field = (
+        "    <FieldData>\n"
+        + (_string_array("crs", frame.crs) if frame.crs else "")
+        + '      <Array type="Float64" Name="origin" NumberOfTuples="1" NumberOfComponents="2" '
+        f'format="ascii">{frame.origin[0]!r} {frame.origin[1]!r}</Array>\n'
+        + _string_array("border_names", ";".join(f"{b}={names[b]}" for b in BORDER_NAMES))
+        + "    </FieldData>\n"
+    )
+    ext = f"0 {ni} 0 {nj} 0 0"
+    head = (
+        '<?xml version="1.0"?>\n'
+        '<VTKFile type="StructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n'
+        f'  <StructuredGrid WholeExtent="{ext}">\n' + field
+        + f'    <Piece Extent="{ext}">\n'
+        '      <PointData>\n' + "".join(xml["PointData"]) + "      </PointData>\n"
+        '      <CellData>\n' + "".join(xml["CellData"]) + "      </CellData>\n"
+        '      <Points>\n' + "".join(xml["Points"]) + "      </Points>\n"
+        "    </Piece>\n  </StructuredGrid>\n"
+        '  <AppendedData encoding="raw">\n   _'
+    )
+    return head.encode("utf-8") + b"".join(blobs) + b"\n  </AppendedData>\n</VTKFile>\n"
+
+
+def write_vts(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
+    """Write a single block as ``.vts`` (see module docstring)."""
+    if len(gs.blocks) != 1:
+        raise WriteError(f"{path}: .vts holds one block, got {len(gs.blocks)}; write a .vtm")
+    blob = _vts_bytes(gs.blocks[0], gs.frame, data=data)
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(blob)
+
+
+def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
+    """Write blocks as a ``.vtm`` plus a directory of ``.vts`` files."""
+    path = Path(path)
+    sub = path.with_suffix("")
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        tmpdir = Path(tempfile.mkdtemp(prefix=f".{sub.name}.", dir=parent))
+    except OSError as exc:
+        raise WriteError(f"{path}: cannot write here ({exc.strerror or exc})") from None
+    old = None
+    try:
+        entries = []
+        for k, g in enumerate(gs.blocks):
+            fn = f"{sub.name}_{k}.vts"
+            (tmpdir / fn).write_bytes(_vts_bytes(g, gs.frame, data=data))
+            entries.append(
+                f'    <DataSet index="{k}" name="{_xml_attr(gs.block_names[k])}" '
+                f'file="{sub.name}/{fn}"/>\n'
+            )
+        vtm = (
+            '<?xml version="1.0"?>\n'
+            '<VTKFile type="vtkMultiBlockDataSet" version="1.0" byte_order="LittleEndian" '
+            'header_type="UInt64">\n  <vtkMultiBlockDataSet>\n' + "".join(entries)
+            + "  </vtkMultiBlockDataSet>\n</VTKFile>\n"
+        )
+        os.chmod(tmpdir, 0o755)
+        with atomic_path(path) as tmp:
+            tmp.write_text(vtm, encoding="utf-8")
+            if sub.exists():
+                old = Path(tempfile.mkdtemp(prefix=f".{sub.name}.old.", dir=parent))
+                os.replace(sub, old / "d")
+            os.replace(tmpdir, sub)
+    except BaseException as exc:
+        shutil.rmtree(tmpdir, ignore_errors=True)
+        if old is not None and (old / "d").exists() and not sub.exists():
+            os.replace(old / "d", sub)
+        if isinstance(exc, OSError) and not isinstance(exc, WriteError):
+            raise WriteError(f"{path}: cannot write ({exc.strerror or exc})") from exc
+        raise
+    finally:
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+def _xml_attr(s: str) -> str:
+    return (s.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+            .replace(">", "&gt;"))
+
+
+# ----------------------------------------------------------------- reading
+_DTYPES = {
+    "Float64": "f8", "Float32": "f4", "Int8": "i1", "UInt8": "u1", "Int16": "i2",
+    "UInt16": "u2", "Int32": "i4", "UInt32": "u4", "Int64": "i8", "UInt64": "u8",
+    "String": "u1", "Char": "i1",
+}
+
+
+def _parse(data: bytes, path: Path):
+    from .kml import _parse_xml
+
+    # cut the raw appended section before XML parsing
+    marker = data.find(b"<AppendedData")
+    appended = b""
+    if marker >= 0:
+        start = data.find(b">", marker)
+        us = data.find(b"_", start)
+        end = data.rfind(b"</AppendedData>")
+        if start < 0 or us < 0 or end < us:
+            raise ReadError(f"{path}: malformed <AppendedData> section")
+        appended = data[us + 1:end]
+        data = data[:start + 1] + b"</AppendedData>" + data[end + len(b"</AppendedData>"):]
+    root = _parse_xml(data, str(path))
+    return root, appended
+
+
+class _Decoder:
+    def __init__(self, root, appended: bytes, path: Path):
+        self.path = path
+        bo = root.get("byte_order", "LittleEndian")
+        self.bo = "<" if bo == "LittleEndian" else ">"
+        self.header = np.dtype(self.bo + ("u8" if root.get("header_type") == "UInt64" else "u4"))
+        self.compressed = root.get("compressor") == "vtkZLibDataCompressor"
+        app = None
+        for e in root.iter():
+            if e.tag.rsplit("}", 1)[-1] == "AppendedData":
+                app = e
+        self.app_encoding = app.get("encoding", "raw") if app is not None else "raw"
+        if self.app_encoding == "base64":
+            self.appended = appended.strip()
+        else:
+            # the appended data may end with white space before </AppendedData>
+            self.appended = appended
+
+    def _unpack(self, buf: bytes, b64: bool) -> bytes:
+        hs = self.header.itemsize
+
+        def chars(nbytes: int) -> int:
+            return ((nbytes + 2) // 3) * 4
+
+        if b64:
+            buf = buf.lstrip()
+            first = base64.b64decode(buf[: chars(hs)])
+            n0 = int(np.frombuffer(first[:hs], dtype=self.header)[0])
+            if not self.compressed:
+                # VTK encodes the header and the data separately; accept both ways
+                data = base64.b64decode(buf[chars(hs): chars(hs) + chars(n0)])
+                if len(data) >= n0:
+                    return data[:n0]
+                whole = base64.b64decode(buf[: chars(hs + n0)])
+                if len(whole) < hs + n0:
+                    raise ReadError(f"{self.path}: base64 data truncated")
+                return whole[hs:hs + n0]
+            hlen = (3 + n0) * hs
+            hdr = np.frombuffer(base64.b64decode(buf[: chars(hlen)])[:hlen], dtype=self.header)
+            total = int(hdr[3:3 + n0].astype(np.int64).sum())
+            body = base64.b64decode(buf[chars(hlen): chars(hlen) + chars(total)])
+            return self._inflate(hdr, body)
+        n0 = int(np.frombuffer(buf[:hs], dtype=self.header)[0])
+        if not self.compressed:
+            if len(buf) < hs + n0:
+                raise ReadError(f"{self.path}: appended data truncated")
+            return buf[hs:hs + n0]
+        hdr = np.frombuffer(buf[: (3 + n0) * hs], dtype=self.header)
+        return self._inflate(hdr, buf[(3 + n0) * hs:])
+
+    def _inflate(self, hdr: np.ndarray, body: bytes) -> bytes:
+        nb = int(hdr[0])
+        sizes = hdr[3:3 + nb].astype(np.int64)
+        out, pos = [], 0
+        for s in sizes:
+            out.append(zlib.decompress(body[pos:pos + int(s)]))
+            pos += int(s)
+        return b"".join(out)
+
+    def array(self, e) -> np.ndarray:
+        typ = e.get("type", "Float64")
+        if typ not in _DTYPES:
+            raise ReadError(f"{self.path}: DataArray {e.get('Name')!r} has unknown type {typ!r}")
+        dt = np.dtype(self.bo + _DTYPES[typ])
+        fmt = e.get("format", "ascii")
+        if fmt == "ascii":
+            return np.array((e.text or "").split(), dtype=np.float64)
+        if fmt == "binary":
+            raw = self._unpack((e.text or "").encode("ascii"), True)
+        elif fmt == "appended":
+            off = int(e.get("offset", "0"))
+            raw = self._unpack(self.appended[off:], self.app_encoding == "base64")
+        else:
+            raise ReadError(f"{self.path}: unknown DataArray format {fmt!r}")
+        return np.frombuffer(raw[: len(raw) // dt.itemsize * dt.itemsize], dtype=dt).astype(
+            np.float64
+        )
+
+
+def _local(tag: str) -> str:
+    return tag.rsplit("}", 1)[-1]
+
+
+def read_vts(path: Path, **_: Any) -> GridSet:
+    """Read a ``.vts`` file (2-D: one k layer) with its CRS, origin and border names."""
+    root, appended = _parse(read_bytes(path), path)
+    if _local(root.tag) != "VTKFile" or root.get("type") != "StructuredGrid":
+        raise ReadError(f"{path}: not a VTK StructuredGrid file")
+    dec = _Decoder(root, appended, path)
+    sg = next((e for e in root.iter() if _local(e.tag) == "StructuredGrid"), None)
+    piece = next((e for e in root.iter() if _local(e.tag) == "Piece"), None)
+    if sg is None or piece is None:
+        raise ReadError(f"{path}: no <StructuredGrid>/<Piece>")
+    try:
+        ext = [int(v) for v in (piece.get("Extent") or sg.get("WholeExtent") or "").split()]
+    except ValueError:
+        raise ReadError(f"{path}: Extent is not 6 integers") from None
+    if len(ext) != 6:
+        raise ReadError(f"{path}: Extent is not 6 integers")
+    ni, nj, nk = ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1
+    if nk != 1 or ni < 2 or nj < 2:
+        raise ReadError(f"{path}: extent {ext} is not a 2-D grid of at least 2 × 2 nodes")
+    pts_el = next((e for e in piece.iter() if _local(e.tag) == "Points"), None)
+    arr_el = None if pts_el is None else next(
+        (e for e in pts_el if _local(e.tag) == "DataArray"), None)
+    if arr_el is None:
+        raise ReadError(f"{path}: no <Points> DataArray")
+    p = dec.array(arr_el)
+    if p.size != 3 * ni * nj:
+        raise ReadError(f"{path}: Points has {p.size} values, expected {3 * ni * nj}")
+    p = p.reshape(-1, 3)
+    X = p[:, 0].reshape((ni, nj), order="F")
+    Y = p[:, 1].reshape((ni, nj), order="F")
+    crs, origin, names = None, (0.0, 0.0), {}
+    for e in root.iter():
+        if _local(e.tag) != "Array" and _local(e.tag) != "DataArray":
+            continue
+        parent_is_field = False
+        name = e.get("Name")
+        if name == "crs" and e.get("type") == "String":
+            crs = _decode_string(e, dec)
+            parent_is_field = True
+        elif name == "origin" and e.get("format", "ascii") == "ascii":
+            o = [float(v) for v in (e.text or "").split()]
+            if len(o) >= 2:
+                origin = (o[0], o[1])
+        elif name == "border_names" and e.get("type") == "String":
+            s = _decode_string(e, dec)
+            for item in s.split(";"):
+                if "=" in item:
+                    b, n = item.split("=", 1)
+                    if b in BORDER_NAMES and n != b:
+                        names[b] = n
+        del parent_is_field
+    if not (np.isfinite(X).all() and np.isfinite(Y).all()):
+        raise ReadError(f"{path}: non-finite coordinates")
+    g = StructuredGrid(X - origin[0], Y - origin[1], names=names)
+    return GridSet((g,), Frame(crs, origin), source=str(path))
+
+
+def _decode_string(e, dec: _Decoder) -> str:
+    if e.get("format", "ascii") == "ascii":
+        codes = [int(v) for v in (e.text or "").split()]
+    else:
+        codes = [int(v) for v in dec.array(e)]
+    return bytes(c for c in codes if c != 0).decode("utf-8", errors="replace")
+
+
+def read_vtm(path: Path, **_: Any) -> GridSet:
+    """Read a ``.vtm`` whose blocks are ``.vts`` files."""
+    from .kml import _parse_xml
+
+    root = _parse_xml(read_bytes(path), str(path))
+    if _local(root.tag) != "VTKFile" or root.get("type") != "vtkMultiBlockDataSet":
+        raise ReadError(f"{path}: not a VTK MultiBlock file")
+    blocks, names, frame = [], [], None
+    for e in root.iter():
+        if _local(e.tag) != "DataSet":
+            continue
+        fn = e.get("file")
+        if not fn:
+            continue
+        sub = (path.parent / fn).resolve()
+        if not str(sub).endswith(".vts"):
+            raise ReadError(f"{path}: block file {fn!r} is not a .vts")
+        if not sub.is_file():
+            raise ReadError(f"{path}: block file {fn!r} not found")
+        gs = read_vts(sub)
+        blocks.append(gs.blocks[0])
+        names.append(e.get("name") or f"block{len(names) + 1}")
+        frame = frame or gs.frame
+    if not blocks:
+        raise ReadError(f"{path}: no .vts blocks listed")
+    return GridSet(tuple(blocks), frame, tuple(names), source=str(path))
