@@ -153,6 +153,8 @@ def shapes(repeat: int) -> None:
     root = Path(__file__).resolve().parent.parent / "resources" / "examples"
     for path in sorted(root.glob("*.toml")):
         case = load_case(path)
+        if not case.blocks or "multiblock" in case.extra:  # single-block cases only
+            continue
         kw = dict(case.blocks[0].generate_kwargs())
         kw["config"] = case.solver
         cases.append((path.stem, (), kw))

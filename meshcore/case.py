@@ -320,7 +320,9 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         raise CaseFileError(f"{source}: invalid TOML: {exc}") from None
     _check_keys(data, TOP_KEYS | _EXTRA_TOP, source)
     blocks_raw = data.get("blocks")
-    if not isinstance(blocks_raw, list) or not blocks_raw:
+    if "outline" in data and blocks_raw is None:
+        blocks_raw = []  # multiblock outline cases list their blocks in [[outline.blocks]]
+    elif not isinstance(blocks_raw, list) or not blocks_raw:
         raise CaseFileError(f"{source}: needs at least one [[blocks]] table")
     ctx: dict[str, Any] = {}
     if "crs" in data:
@@ -535,3 +537,8 @@ def generate_case(case: Case, *, callback: Callable[..., Any] | None = None,
             raise type(exc)(f"{src}: block {b.name!r}: {exc}") from None
         grids.append(g)
     return grids
+
+
+# Multiblock cases ([multiblock], [[interfaces]], [outline]) register their keys
+# and generator on import.
+from .multiblock import case as _multiblock_case  # noqa: E402, F401

@@ -70,17 +70,22 @@ def run(args: argparse.Namespace) -> int:
     prog.done()
     elapsed = time.perf_counter() - t0
     blocks = list(getattr(result, "blocks", result))
+    frame = getattr(result, "frame", None) or frame  # multiblock outline cases project lon/lat
     if args.output:
         write(Path(args.output), result, crs=frame)
     if args.png:
         write(Path(args.png), result, crs=frame)
     converged = all(g.converged for g in blocks)
     if not args.quiet:
-        for g in blocks:
-            name = next((b.name for b, gg in zip(case.blocks, blocks, strict=False) if gg is g), "")
+        block_names = list(getattr(result, "names", [b.name for b in case.blocks]))
+        for k, g in enumerate(blocks):
+            name = block_names[k] if k < len(block_names) else ""
             print(f"block {name!r}: {g.cells[0]}×{g.cells[1]} cells, {g.info.method}, "
                   f"{g.info.message}, {g.iterations} iterations, residual {g.residual:.3e}")
             print(quality(g).table())
+        if hasattr(result, "report"):  # multiblock: connectivity and interface quality
+            print(result.report())
+            print(result.quality().table())
         print(f"done in {elapsed:.3f} s" + (f"; wrote {args.output}" if args.output else ""))
     if not converged:
         print("meshcore generate: warning: the solver did not converge (exit code 3)", file=sys.stderr)

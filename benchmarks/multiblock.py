@@ -1,0 +1,220 @@
+"""Cost of multiblock smoothing versus one block of the same node count.
+
+Run from the repository root (serial kernels; timings are best of ``--repeat``)::
+
+    python benchmarks/multiblock.py [--repeat 3] [--quick]
+
+1. Per-sweep cost on a curved rectangle split in two blocks: the single-block
+   kernel ``sweep4``, the multiblock table kernel (``engine="table"``) and
+   the block engine (``sweep4`` per block + table on the border nodes).
+2. Whole solves to the same tolerance from the same algebraic start: one
+   block (SOR, and multigrid when registered) against the same nodes split in
+   2 and 4 blocks (smooth mode: multigrid over all blocks, block-engine SOR,
+   table-engine SOR).  In this test the multiblock solution equals the
+   single-block one.
+3. Shasta Lake (the example cases): smooth (frozen start / algebraic start)
+   and frozen, against one curved-rectangle block with the same node count.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+import meshcore  # noqa: E402
+from meshcore.boundary import Borders  # noqa: E402
+from meshcore.elliptic import _kernels as bk  # noqa: E402
+from meshcore.elliptic.solver import METHODS, default_tolerance  # noqa: E402
+from meshcore.multiblock import (  # noqa: E402
+    Block,
+    Interface,
+    MultiBlockTopology,
+    Side,
+    initial_grids,
+    solve_multiblock,
+)
+from meshcore.multiblock.solver import _BlockEngine, _TableEngine  # noqa: E402
+
+
+def curved_rectangle(ni: int, nj: int):
+    xs = np.linspace(0.0, 2.0, ni + 1)
+    t = np.linspace(0.0, 1.0, nj + 1)
+    xf = np.linspace(0.0, 2.0, 4001)
+    yf = 1.0 + 0.35 * np.sin(0.5 * np.pi * xf) * xf / 2.0
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(xf), np.diff(yf)))])
+    u = np.linspace(0.0, s[-1], ni + 1)
+    xt, yt = np.interp(u, s, xf), np.interp(u, s, yf)
+    X = xs[:, None] + (xt - xs)[:, None] * t[None, :]
+    Y = yt[:, None] * t[None, :]
+    return X, Y
+
+
+def borders(X, Y) -> Borders:
+    return Borders(
+        bottom=np.column_stack([X[:, 0], Y[:, 0]]), right=np.column_stack([X[-1], Y[-1]]),
+        top=np.column_stack([X[:, -1], Y[:, -1]]), left=np.column_stack([X[0], Y[0]]),
+    )
+
+
+def split(X, Y, nb: int) -> MultiBlockTopology:
+    ni, nj = X.shape[0] - 1, X.shape[1] - 1
+    if nb == 2:
+        h = ni // 2
+        return MultiBlockTopology(
+            (Block("a", borders(X[: h + 1], Y[: h + 1])), Block("b", borders(X[h:], Y[h:]))),
+            (Interface(Side("a", "right"), Side("b", "left")),),
+        )
+    h, v = ni // 2, nj // 2
+    parts = {"sw": np.s_[: h + 1, : v + 1], "se": np.s_[h:, : v + 1],
+             "nw": np.s_[: h + 1, v:], "ne": np.s_[h:, v:]}
+    bl = tuple(Block(n, borders(X[s], Y[s])) for n, s in parts.items())
+    itf = tuple(Interface(Side(a, ba), Side(b, bb)) for a, ba, b, bb in (
+        ("sw", "right", "se", "left"), ("nw", "right", "ne", "left"),
+        ("sw", "top", "nw", "bottom"), ("se", "top", "ne", "bottom")))
+    return MultiBlockTopology(bl, itf)
+
+
+def best(fn, repeat: int):
+    out, ts = None, []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        ts.append(time.perf_counter() - t)
+    return min(ts), out
+
+
+def per_sweep(repeat: int, sizes) -> None:
+    print("## 1. cost per sweep (ms), curved rectangle split in 2 blocks\n")
+    print("| nodes | sweep4 (1 block) | table engine | block engine | table/sweep4 | blocks/sweep4 |")
+    print("|---|---|---|---|---|---|")
+    e = np.zeros((0, 0))
+    for ni, nj in sizes:
+        X, Y = curved_rectangle(ni, nj)
+        n = max(20, int(2e6 / X.size))
+        x, y = X.copy(), Y.copy()
+        bk.sweep4(x, y, e, e, 1.5, False)
+
+        def run4(x=x, y=y, n=n):
+            for _ in range(n):
+                bk.sweep4(x, y, e, e, 1.5, False)
+
+        t4 = best(run4, repeat)[0] / n
+        topo = split(X, Y, 2)
+        m = topo.node_map
+        res = []
+        for cls in (_TableEngine, _BlockEngine):
+            gx, gy = np.empty(m.n_nodes), np.empty(m.n_nodes)
+            for g, ids in zip(initial_grids(topo), m.ids, strict=True):
+                gx[ids.ravel()], gy[ids.ravel()] = g.x.ravel(), g.y.ravel()
+            eng = cls(gx, gy, m)
+            eng.sweep(1.5)
+
+            def run(eng=eng, n=n):
+                for _ in range(n):
+                    eng.sweep(1.5)
+
+            res.append(best(run, repeat)[0] / n)
+        tt, tb = res
+        print(f"| {X.shape[0]}×{X.shape[1]} = {X.size} | {t4 * 1e3:.3f} | {tt * 1e3:.3f} | "
+              f"{tb * 1e3:.3f} | {tt / t4:.2f} | {tb / t4:.2f} |")
+    print()
+
+
+def whole_solves(repeat: int, sizes) -> None:
+    print("## 2. whole solves from the same algebraic start, same tolerance\n")
+    print("| nodes | solver | iterations | time (s) | × one block (SOR) | max distance to one block / size |")
+    print("|---|---|---|---|---|---|")
+    for ni, nj in sizes:
+        X, Y = curved_rectangle(ni, nj)
+        g0 = meshcore.StructuredGrid(X, Y)
+        tol = default_tolerance(g0.shape)
+        t1, ref = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="sor", tolerance=tol), repeat)
+        rows = [("1 block, SOR", ref.iterations, t1, 0.0)]
+        if "multigrid" in METHODS:
+            tm, gm = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="multigrid", tolerance=tol),
+                          repeat)
+            rows.append(("1 block, multigrid", gm.iterations, tm, float(np.abs(gm.x - ref.x).max())))
+        for nb in (2, 4):
+            topo = split(X, Y, nb)
+            for engine, start in (("multigrid", "algebraic"), ("blocks", "algebraic"),
+                                  ("blocks", "frozen"), ("table", "algebraic")):
+                tb, mb = best(lambda topo=topo, engine=engine, start=start, tol=tol: solve_multiblock(
+                    topo, mode="smooth", tolerance=tol, engine=engine, start=start), repeat)
+                xs = np.full(X.shape, np.nan)
+                ys = np.full(X.shape, np.nan)
+                h, v = ni // 2, nj // 2
+                offs = {"a": (0, 0), "b": (h, 0), "sw": (0, 0), "se": (h, 0), "nw": (0, v),
+                        "ne": (h, v)}
+                for name, g in zip(mb.names, mb.grids, strict=True):
+                    i0, j0 = offs[name]
+                    xs[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.x
+                    ys[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.y
+                dist = float(np.hypot(xs - ref.x, ys - ref.y).max()) / ref.size
+                rows.append((f"{nb} blocks smooth, {engine}, {start} start", mb.info.iterations,
+                             tb, dist))
+        for label, it, t, d in rows:
+            print(f"| {X.size} | {label} | {it} | {t:.3f} | {t / t1:.2f} | {d:.1e} |")
+    print()
+
+
+def lake(repeat: int, quick: bool) -> None:
+    from meshcore.case import load_case
+    from meshcore.multiblock.case import case_topology
+
+    print("## 3. Shasta Lake vs one block with the same node count\n")
+    print("| case | nodes | solver | iterations | time (s) | × one block (same nodes, same tolerance) |")
+    print("|---|---|---|---|---|---|")
+    for tag in ("coarse",) if quick else ("coarse", "fine"):
+        topo = case_topology(load_case(ROOT / "resources" / "examples" / f"shasta-multiblock-{tag}.toml"))
+        n = topo.node_map.n_nodes
+        # one block of (about) the same node count, aspect 2:1
+        nj = round(math.sqrt(n / 2.0)) - 1
+        ni = round(n / (nj + 1)) - 1
+        X, Y = curved_rectangle(ni, nj)
+        n_big = max(max(b.cells) + 1 for b in topo.blocks)
+        tol = default_tolerance((n_big, n_big))
+        g0 = meshcore.StructuredGrid(X, Y)
+        t1, one = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="sor", tolerance=tol), repeat)
+        print(f"| {tag} | {X.size} | one block {ni}×{nj}, SOR | {one.iterations} | {t1:.3f} | 1.00 |")
+        if "multigrid" in METHODS:
+            tm, gm = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="multigrid", tolerance=tol),
+                          repeat)
+            print(f"| {tag} | {X.size} | one block {ni}×{nj}, multigrid | {gm.iterations} | {tm:.3f} | "
+                  f"{tm / t1:.2f} |")
+        for label, kw in (
+            ("smooth, auto (default)", {"mode": "smooth"}),
+            ("smooth, multigrid only", {"mode": "smooth", "engine": "multigrid"}),
+            ("smooth, blocks engine (SOR)", {"mode": "smooth", "engine": "blocks"}),
+            ("smooth, table engine (SOR)", {"mode": "smooth", "engine": "table"}),
+            ("frozen (blocks solved separately)", {"mode": "frozen"}),
+        ):
+            t, mb = best(lambda kw=kw, tol=tol, topo=topo: solve_multiblock(topo, tolerance=tol, **kw),
+                         repeat)
+            print(f"| {tag} | {n} | {len(topo.blocks)} blocks {label}: {mb.info.method} | "
+                  f"{mb.info.iterations} | {t:.3f} | {t / t1:.2f} |")
+    print()
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="small sizes only")
+    a = ap.parse_args()
+    print(f"numba threading layer: {bk.threading_layer()}; serial kernels; best of {a.repeat}\n")
+    meshcore.elliptic.warmup()
+    sizes = [(128, 64)] if a.quick else [(128, 64), (256, 128), (512, 256)]
+    per_sweep(a.repeat, sizes)
+    whole_solves(a.repeat, [(64, 32)] if a.quick else [(128, 64), (256, 128), (512, 256)])
+    lake(a.repeat, a.quick)
+
+
+if __name__ == "__main__":
+    main()

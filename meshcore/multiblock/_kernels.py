@@ -1,0 +1,197 @@
+r"""numba kernels for the multiblock ``smooth`` mode (functions only, no state).
+
+All blocks are assembled into one node array ``x, y`` (each shared node stored
+once).  A free *regular* node ``n = nodes[k]`` has exactly four cells around
+it; ``nbr[k] = (E, W, N, S, NE, NW, SE, SW)`` are its eight neighbours in a
+local frame taken from its ring of cells (see :mod:`.topology`).  Its update is
+the single-block Winslow stencil of :mod:`meshcore.elliptic._kernels` with
+P = Q = 0:
+
+.. math::
+
+    2(α + γ) φ_P^* = α(φ_E + φ_W) + γ(φ_N + φ_S) − \tfrac{β}{2}(φ_{NE} − φ_{NW} − φ_{SE} + φ_{SW}).
+
+The discrete equation is invariant under the eight symmetries of the square
+(rotating or mirroring the local frame maps α ↔ γ, β → ±β), so any frame
+taken from the ring of cells gives the same equation as the owning block's.
+
+A free *irregular* node (a corner where 3, 5, … blocks meet: ``k ≠ 4`` cells
+around it) has no 9-point stencil.  It is moved to the mean of its ``k`` edge
+neighbours (a Laplacian update over its ring, ``irr_ring[irr_ptr[k]:irr_ptr[k+1]]``),
+which for a symmetric star of ``k`` equal cells is the symmetric position.
+
+Sweeps are Gauss–Seidel/SOR in table order (block by block, lexicographic),
+serial.  Each function returns the largest displacement (a length).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["table_defect", "table_residual", "table_sweep", "table_sweep_rhs"]
+
+
+@njit(cache=True, nogil=True)
+def _update(x, y, nb):  # pragma: no cover - compiled
+    e, w, n, s, ne, nw, se, sw = nb[0], nb[1], nb[2], nb[3], nb[4], nb[5], nb[6], nb[7]
+    xe = x[e]
+    xw = x[w]
+    xn = x[n]
+    xs = x[s]
+    ye = y[e]
+    yw = y[w]
+    yn = y[n]
+    ys = y[s]
+    xxi = 0.5 * (xe - xw)
+    yxi = 0.5 * (ye - yw)
+    xet = 0.5 * (xn - xs)
+    yet = 0.5 * (yn - ys)
+    a = xet * xet + yet * yet
+    b = xxi * xet + yxi * yet
+    g = xxi * xxi + yxi * yxi
+    den = 2.0 * (a + g)
+    cx = x[ne] - x[nw] - x[se] + x[sw]
+    cy = y[ne] - y[nw] - y[se] + y[sw]
+    rx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+    ry = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+    return rx, ry, den
+
+
+@njit(cache=True, nogil=True)
+def table_sweep(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omega):  # pragma: no cover
+    """One SOR sweep over the regular nodes, then the irregular ones."""
+    dmax = 0.0
+    for k in range(nodes.shape[0]):
+        p = nodes[k]
+        rx, ry, den = _update(x, y, nbr[k])
+        if den <= 0.0:
+            continue
+        dx = omega * (rx / den - x[p])
+        dy = omega * (ry / den - y[p])
+        x[p] += dx
+        y[p] += dy
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    for k in range(irr_nodes.shape[0]):
+        p = irr_nodes[k]
+        sx = 0.0
+        sy = 0.0
+        for r in range(irr_ptr[k], irr_ptr[k + 1]):
+            sx += x[irr_ring[r]]
+            sy += y[irr_ring[r]]
+        c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
+        dx = omega * (sx * c - x[p])
+        dy = omega * (sy * c - y[p])
+        x[p] += dx
+        y[p] += dy
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    return np.sqrt(dmax)
+
+
+@njit(cache=True, nogil=True)
+def table_residual(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring):  # pragma: no cover
+    """Largest point-Jacobi displacement (the shared stopping measure)."""
+    dmax = 0.0
+    for k in range(nodes.shape[0]):
+        p = nodes[k]
+        rx, ry, den = _update(x, y, nbr[k])
+        if den <= 0.0:
+            continue
+        dx = rx / den - x[p]
+        dy = ry / den - y[p]
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    for k in range(irr_nodes.shape[0]):
+        p = irr_nodes[k]
+        sx = 0.0
+        sy = 0.0
+        for r in range(irr_ptr[k], irr_ptr[k + 1]):
+            sx += x[irr_ring[r]]
+            sy += y[irr_ring[r]]
+        c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
+        dx = sx * c - x[p]
+        dy = sy * c - y[p]
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    return np.sqrt(dmax)
+
+
+# ---------------------------------------------------------------- multigrid
+# FAS form of the equations: A(u) = u − T(u) = f, with T the Jacobi target above
+# (9-point stencil or ring mean).  f = 0 on the finest level.
+
+
+@njit(cache=True, nogil=True)
+def table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omega):  # pragma: no cover
+    """One nonlinear Gauss–Seidel/SOR sweep of ``u − T(u) = f``: ``u_p ← u_p + ω (T_p + f_p − u_p)``."""
+    dmax = 0.0
+    for k in range(nodes.shape[0]):
+        p = nodes[k]
+        rx, ry, den = _update(x, y, nbr[k])
+        if den <= 0.0:
+            continue
+        dx = omega * (rx / den + fx[p] - x[p])
+        dy = omega * (ry / den + fy[p] - y[p])
+        x[p] += dx
+        y[p] += dy
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    for k in range(irr_nodes.shape[0]):
+        p = irr_nodes[k]
+        sx = 0.0
+        sy = 0.0
+        for r in range(irr_ptr[k], irr_ptr[k + 1]):
+            sx += x[irr_ring[r]]
+            sy += y[irr_ring[r]]
+        c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
+        dx = omega * (sx * c + fx[p] - x[p])
+        dy = omega * (sy * c + fy[p] - y[p])
+        x[p] += dx
+        y[p] += dy
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    return np.sqrt(dmax)
+
+
+@njit(cache=True, nogil=True)
+def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out, ry_out):  # pragma: no cover
+    """Defect ``r = f − (u − T(u))`` at every free node (other entries untouched); returns max |r|."""
+    dmax = 0.0
+    for k in range(nodes.shape[0]):
+        p = nodes[k]
+        rx, ry, den = _update(x, y, nbr[k])
+        if den <= 0.0:
+            rx_out[p] = 0.0
+            ry_out[p] = 0.0
+            continue
+        dx = rx / den + fx[p] - x[p]
+        dy = ry / den + fy[p] - y[p]
+        rx_out[p] = dx
+        ry_out[p] = dy
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    for k in range(irr_nodes.shape[0]):
+        p = irr_nodes[k]
+        sx = 0.0
+        sy = 0.0
+        for r in range(irr_ptr[k], irr_ptr[k + 1]):
+            sx += x[irr_ring[r]]
+            sy += y[irr_ring[r]]
+        c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
+        dx = sx * c + fx[p] - x[p]
+        dy = sy * c + fy[p] - y[p]
+        rx_out[p] = dx
+        ry_out[p] = dy
+        m = dx * dx + dy * dy
+        if m > dmax:
+            dmax = m
+    return np.sqrt(dmax)

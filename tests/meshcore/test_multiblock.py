@@ -1,0 +1,815 @@
+"""Multiblock grids: topology, validation, smooth/frozen solves, outline → blocks, case files."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import meshcore
+from meshcore.boundary import Borders
+from meshcore.errors import CaseFileError, TopologyError
+from meshcore.multiblock import (
+    Block,
+    Interface,
+    MultiBlockTopology,
+    Side,
+    _kernels,
+    _reference,
+    parse_side,
+    solve_multiblock,
+)
+from meshcore.multiblock.outline import from_outline, project_lonlat
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "resources" / "examples"
+TIGHT = 1e-12
+
+
+# ------------------------------------------------------------------ helpers
+def curved_rectangle(ni: int = 24, nj: int = 12):
+    """Algebraic start grid of [0, 2] × [0, f(x)] with a curved top (non-trivial solution)."""
+    xs = np.linspace(0.0, 2.0, ni + 1)
+    t = np.linspace(0.0, 1.0, nj + 1)
+    # top: y = 1 + 0.35 sin(πx/2)·x/2, nodes uniform in arc length (so x is not linear in ξ)
+    xf = np.linspace(0.0, 2.0, 4001)
+    yf = 1.0 + 0.35 * np.sin(0.5 * np.pi * xf) * xf / 2.0
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(xf), np.diff(yf)))])
+    u = np.linspace(0.0, s[-1], ni + 1)
+    xt, yt = np.interp(u, s, xf), np.interp(u, s, yf)
+    X = xs[:, None] + (xt - xs)[:, None] * t[None, :]
+    Y = yt[:, None] * t[None, :]
+    return X, Y
+
+
+def borders(X, Y) -> Borders:
+    return Borders(
+        bottom=np.column_stack([X[:, 0], Y[:, 0]]),
+        right=np.column_stack([X[-1], Y[-1]]),
+        top=np.column_stack([X[:, -1], Y[:, -1]]),
+        left=np.column_stack([X[0], Y[0]]),
+    )
+
+
+def block(name, X, Y) -> Block:
+    return Block(name, borders(X, Y))
+
+
+@pytest.fixture(scope="module")
+def rect():
+    X, Y = curved_rectangle()
+    ref = meshcore.solve(meshcore.StructuredGrid(X, Y), method="sor", tolerance=TIGHT)
+    assert ref.converged
+    return X, Y, ref
+
+
+def two_blocks(X, Y, cut: int):
+    a, b = block("a", X[: cut + 1], Y[: cut + 1]), block("b", X[cut:], Y[cut:])
+    return MultiBlockTopology((a, b), (Interface(Side("a", "right"), Side("b", "left")),))
+
+
+def four_blocks(X, Y, ci: int, cj: int):
+    bl = (
+        block("sw", X[: ci + 1, : cj + 1], Y[: ci + 1, : cj + 1]),
+        block("se", X[ci:, : cj + 1], Y[ci:, : cj + 1]),
+        block("nw", X[: ci + 1, cj:], Y[: ci + 1, cj:]),
+        block("ne", X[ci:, cj:], Y[ci:, cj:]),
+    )
+    itf = (
+        Interface(parse_side("sw.right"), parse_side("se.left")),
+        Interface(parse_side("nw.right"), parse_side("ne.left")),
+        Interface(parse_side("sw.top"), parse_side("nw.bottom")),
+        Interface(parse_side("se.top"), parse_side("ne.bottom")),
+    )
+    return MultiBlockTopology(bl, itf)
+
+
+def assert_glued(mb) -> None:
+    """Interface nodes are bit-identical in both adjoining blocks."""
+    assert mb.interfaces
+    for itf in mb.interfaces:
+        pa = mb[itf.a.block].border(itf.a.border)[itf.a.start : itf.a.stop + 1]
+        pb = mb[itf.b.block].border(itf.b.border)[itf.b.start : itf.b.stop + 1]
+        assert np.array_equal(pa, pb[::-1] if itf.reversed else pb), itf.label
+    assert mb.interface_mismatch() == 0.0
+
+
+# ------------------------------------------------ equivalence with one block
+@pytest.mark.parametrize(("start", "engine"), [("algebraic", "blocks"), ("frozen", "blocks"),
+                                               ("algebraic", "table"), ("algebraic", "multigrid")])
+def test_two_blocks_smooth_equals_single_block(rect, start, engine):
+    X, Y, ref = rect
+    mb = solve_multiblock(two_blocks(X, Y, 10), mode="smooth", tolerance=TIGHT, start=start,
+                          engine=engine)
+    assert mb.converged
+    size = ref.size
+    d = max(
+        np.abs(mb["a"].x - ref.x[:11]).max(), np.abs(mb["a"].y - ref.y[:11]).max(),
+        np.abs(mb["b"].x - ref.x[10:]).max(), np.abs(mb["b"].y - ref.y[10:]).max(),
+    )
+    assert d <= 1e-6 * size
+    assert_glued(mb)
+    # the interface really moved away from its algebraic start
+    assert np.hypot(mb["a"].x[-1] - X[10], mb["a"].y[-1] - Y[10]).max() > 1e-3 * size
+
+
+@pytest.mark.parametrize("engine", ["blocks", "table", "multigrid"])
+def test_four_blocks_smooth_equals_single_block(rect, engine):
+    X, Y, ref = rect
+    topo = four_blocks(X, Y, 14, 5)
+    (corner,) = topo.node_map.corners  # the node where four blocks meet
+    assert corner.valence == 4 and corner.free and len(corner.blocks) == 4
+    mb = solve_multiblock(topo, mode="smooth", tolerance=TIGHT, engine=engine)
+    assert mb.converged
+    d = 0.0
+    for name, sl in (("sw", np.s_[:15, :6]), ("se", np.s_[14:, :6]),
+                     ("nw", np.s_[:15, 5:]), ("ne", np.s_[14:, 5:])):
+        d = max(d, np.abs(mb[name].x - ref.x[sl]).max(), np.abs(mb[name].y - ref.y[sl]).max())
+    assert d <= 1e-6 * ref.size
+    assert_glued(mb)
+
+
+def test_frozen_mode_keeps_interfaces_and_differs_from_smooth(rect):
+    X, Y, ref = rect
+    topo = four_blocks(X, Y, 14, 5)
+    fz = solve_multiblock(topo, mode="frozen", tolerance=TIGHT)
+    assert fz.converged
+    assert_glued(fz)
+    # the interface nodes are the re-sampled (start) ones
+    assert np.array_equal(fz["sw"].x[-1], X[14, :6])
+    assert np.array_equal(fz["sw"].y[:, -1], Y[:15, 5])
+    sm = solve_multiblock(topo, mode="smooth", tolerance=TIGHT)
+    moved = np.hypot(sm["sw"].x[-1] - fz["sw"].x[-1], sm["sw"].y[-1] - fz["sw"].y[-1])
+    assert moved.max() > 1e-4 * ref.size
+
+
+def test_single_block_topology_matches_block_solver(rect):
+    X, Y, ref = rect
+    topo = MultiBlockTopology((block("only", X, Y),))
+    mb = solve_multiblock(topo, mode="smooth", tolerance=TIGHT, start="algebraic")
+    assert np.abs(mb["only"].x - ref.x).max() <= 1e-6 * ref.size
+
+
+# ---------------------------------------------------------------- kernels
+def test_table_kernel_matches_numpy_reference_and_block_kernel(rect):
+    X, Y, _ = rect
+    topo = four_blocks(X, Y, 14, 5)
+    m = topo.node_map
+    rng = np.random.default_rng(1)
+    x = np.empty(m.n_nodes)
+    y = np.empty(m.n_nodes)
+    for g, ids in zip(meshcore.multiblock.initial_grids(topo), m.ids, strict=True):
+        x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
+    x += 1e-3 * rng.standard_normal(x.size) * ~m.boundary
+    y += 1e-3 * rng.standard_normal(y.size) * ~m.boundary
+    args = (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring)
+    tx, ty = _reference.jacobi_targets(x, y, *args)
+    r = _kernels.table_residual(x, y, *args)
+    assert r == pytest.approx(np.hypot(tx - x, ty - y).max(), rel=1e-12)
+    # the same stencil as the single-block kernel on the assembled array
+    from meshcore.elliptic import _kernels as bk
+
+    sx, sy = np.zeros(X.shape), np.zeros(X.shape)
+    for name, (i0, j0) in (("sw", (0, 0)), ("se", (14, 0)), ("nw", (0, 5)), ("ne", (14, 5))):
+        ids = m.ids[topo.index(name)]
+        sx[i0 : i0 + ids.shape[0], j0 : j0 + ids.shape[1]] = x[ids]
+        sy[i0 : i0 + ids.shape[0], j0 : j0 + ids.shape[1]] = y[ids]
+    e = np.zeros((0, 0))
+    assert r == pytest.approx(bk.jacobi_residual(sx, sy, e, e, False), rel=1e-12)
+    # one SOR sweep with omega = 1 moves only free nodes
+    x0, y0 = x.copy(), y.copy()
+    _kernels.table_sweep(x, y, *args, 1.0)
+    assert np.array_equal(x[m.boundary], x0[m.boundary])
+    assert not np.array_equal(x, x0)
+    del y0
+
+
+# ---------------------------------------------------- 3- and 5-block corners
+def star(k: int, n: int = 8):
+    """A regular 2k-gon split into k quads meeting at the centre (valence k)."""
+    ang = np.pi / k
+    verts = [np.array([math.cos(a), math.sin(a)]) for a in ang * np.arange(2 * k)]
+    c = np.zeros(2)
+    blocks, itfs = [], []
+    lin = np.linspace(0.0, 1.0, n + 1)[:, None]
+    for q in range(k):
+        v0, v1, v2 = verts[(2 * q - 1) % (2 * k)], verts[2 * q], verts[(2 * q + 1) % (2 * k)]
+        # corners: sw = centre, se = midpoint vertex v0, ne = v1, nw = v2 (CCW)
+        sw, se, ne, nw = c, v0, v1, v2
+        bd = Borders(
+            bottom=sw + lin * (se - sw), right=se + lin * (ne - se),
+            top=nw + lin * (ne - nw), left=sw + lin * (nw - sw),
+        )
+        blocks.append(Block(f"q{q}", bd))
+        itfs.append(Interface(Side(f"q{q}", "left"), Side(f"q{(q + 1) % k}", "bottom")))
+    return MultiBlockTopology(tuple(blocks), tuple(itfs))
+
+
+@pytest.mark.parametrize("engine", ["blocks", "table", "multigrid"])
+@pytest.mark.parametrize("k", [3, 5])
+def test_irregular_corner_of_k_blocks(k, engine):
+    topo = star(k)
+    m = topo.node_map
+    (corner,) = [c for c in m.corners if c.free]
+    assert corner.valence == k and len(m.irr_nodes) == 1
+    assert "Laplacian" in corner.handling
+    assert "Laplacian" in topo.connectivity_report()
+    # push the centre off-centre; the symmetric solution brings it back
+    init = meshcore.multiblock.initial_grids(topo)
+    shifted = []
+    for g in init:
+        x, y = np.array(g.x), np.array(g.y)
+        x[1:-1, 1:-1] += 0.05
+        shifted.append(meshcore.StructuredGrid(x, y))
+    mb = solve_multiblock(topo, mode="smooth", tolerance=1e-11, initial=shifted, start="algebraic",
+                          engine=engine)
+    assert mb.converged
+    assert_glued(mb)
+    centre = mb["q0"].x[0, 0], mb["q0"].y[0, 0]
+    assert math.hypot(*centre) < 1e-8
+    q = mb.quality()
+    assert q.n_folded == 0
+    # the k blocks are rotations of each other
+    for j in range(1, k):
+        a = 2 * np.pi * j / k
+        g0, gj = mb["q0"], mb[f"q{j}"]
+        rx = math.cos(a) * g0.x - math.sin(a) * g0.y
+        assert np.abs(rx - gj.x).max() < 1e-8
+
+
+# --------------------------------------------------------------- the lake
+@pytest.fixture(scope="module")
+def shasta_topology():
+    from meshcore.case import load_case
+    from meshcore.multiblock.case import case_topology
+
+    return case_topology(load_case(EXAMPLES / "shasta-multiblock-coarse.toml"))
+
+
+def test_shasta_lake_has_arms_in_blocks(shasta_topology):
+    topo = shasta_topology
+    assert len(topo.blocks) >= 3
+    assert len(topo.interfaces) >= 2
+    # a partial interface: the main basin's top border carries two arms
+    parts = [i for i in topo.interfaces if "main" in (i.a.block, i.b.block)]
+    assert len(parts) >= 3
+    rep = topo.connectivity_report()
+    for b in topo.blocks:
+        assert b.name in rep
+
+
+@pytest.mark.parametrize("mode", ["smooth", "frozen"])
+def test_shasta_lake_quality_and_glue(shasta_topology, mode):
+    mb = solve_multiblock(shasta_topology, mode=mode)
+    assert mb.converged
+    assert_glued(mb)
+    q = mb.quality()
+    assert q.n_folded == 0
+    assert set(q.interfaces) == {
+        " ↔ ".join(sorted((i.a.block, i.b.block), key=mb.names.index)) for i in mb.interfaces
+    }
+    if mode == "smooth":
+        assert q.worst_interface <= 1.5 * q.worst_inside
+
+
+def test_smooth_interfaces_are_smoother_than_frozen(shasta_topology):
+    sm = solve_multiblock(shasta_topology, mode="smooth").quality()
+    fz = solve_multiblock(shasta_topology, mode="frozen").quality()
+    assert sm.worst_interface < fz.worst_interface
+
+
+@pytest.mark.slow
+def test_shasta_lake_fine_case():
+    from meshcore.case import generate_case, load_case
+
+    mb = generate_case(load_case(EXAMPLES / "shasta-multiblock-fine.toml"))
+    assert mb.converged
+    assert_glued(mb)
+    q = mb.quality()
+    assert q.n_folded == 0
+    assert q.worst_interface <= 1.5 * q.worst_inside
+
+
+def test_project_lonlat_distances():
+    # 1/1000 degree of latitude ≈ 111.2 m anywhere; of longitude ≈ 111.2 m × cos(lat)
+    xy, org = project_lonlat([[-122.0, 40.0], [-122.001, 40.0], [-122.0, 40.001]], origin=(-122.0, 40.0))
+    assert org == (-122.0, 40.0)
+    assert xy[2, 1] == pytest.approx(111.19, abs=0.01)
+    assert -xy[1, 0] == pytest.approx(111.19 * math.cos(math.radians(40.0)), abs=0.01)
+
+
+# -------------------------------------------------------- from an outline
+def outline_case():
+    xs = np.linspace(0, 2, 21)
+    top = np.c_[xs[::-1], 1 + 0.2 * np.sin(np.pi * xs[::-1] / 2)]
+    ring = np.vstack([np.c_[xs, 0 * xs], [[2, 0.55]], top, [[0, 0.5]]])
+    cuts = [[[1, 0], [1, 1.2]], [[0, 0.5], [2, 0.55]]]
+    ym = 0.525
+    blocks = [
+        {"name": "sw", "corners": [[0, 0], [1, 0], [1, ym], [0, 0.5]], "cells": [8, 4]},
+        {"name": "se", "corners": [[1, 0], [2, 0], [2, 0.55], [1, ym]], "cells": [8, 4]},
+        {"name": "nw", "corners": [[0, 0.5], [1, ym], [1, 1.2], [0, 1]], "cells": [8, 6]},
+        {"name": "ne", "corners": [[1, ym], [2, 0.55], [2, 1], [1, 1.2]], "cells": [8, 6]},
+    ]
+    return ring, cuts, blocks
+
+
+def test_from_outline_crossing_cuts_give_four_blocks():
+    ring, cuts, blocks = outline_case()
+    ob = from_outline(ring, cuts=cuts, blocks=blocks)
+    topo = ob.topology
+    assert len(ob.regions) == 4 and len(topo.interfaces) == 4
+    (c,) = topo.node_map.corners
+    assert c.valence == 4 and c.point == pytest.approx((1.0, 0.525))
+    mb = solve_multiblock(topo)
+    assert mb.converged and mb.quality().n_folded == 0
+    assert_glued(mb)
+    # the shore nodes stay on the outline
+    from shapely.geometry import LinearRing, Point
+
+    shore = LinearRing(ring)
+    for g in mb:
+        for b in ("bottom", "right", "top", "left"):
+            p = g.border(b)
+            d = [shore.distance(Point(q)) for q in p]
+            assert min(d) < 1e-12  # every border touches the shore
+    assert mb["sw"].border("bottom")[:, 1] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_from_outline_partial_interface_t_junction():
+    # a long main block with an arm attached to the middle of its top border
+    ring = np.array([[0, 0], [6, 0], [6, 1], [4, 1], [4, 3], [2, 3], [2, 1], [0, 1]], float)
+    blocks = [
+        {"name": "main", "corners": [0, 1, 2, 7], "cells": [12, 4]},
+        {"name": "arm", "corners": [[2, 1], [4, 1], 4, 5], "cells": [4, 4]},
+    ]
+    ob = from_outline(ring, cuts=[[6, 3]], blocks=blocks)
+    (itf,) = ob.topology.interfaces
+    sides = {itf.a.block: itf.a, itf.b.block: itf.b}
+    assert sides["main"].border == "top" and (sides["main"].start, sides["main"].stop) == (4, 8)
+    assert sides["arm"].border == "bottom"
+    mb = solve_multiblock(ob.topology)
+    assert mb.converged and mb.quality().n_folded == 0
+    assert_glued(mb)
+    # shore parts of main's top border stay fixed; the mouth moved
+    top = mb["main"].border("top")
+    assert np.allclose(top[:5, 1], 1.0) and np.allclose(top[8:, 1], 1.0)
+    assert np.abs(top[5:8, 1] - 1.0).max() > 1e-3
+
+
+# ------------------------------------------------- malformed topologies
+@pytest.fixture(scope="module")
+def pair():
+    X, Y = curved_rectangle(8, 4)
+    return X, Y
+
+
+def _err(fn) -> str:
+    with pytest.raises(TopologyError) as ei:
+        fn()
+    return str(ei.value)
+
+
+def test_error_unknown_block_and_border(pair):
+    X, Y = pair
+    a, b = block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])
+    msg = _err(lambda: MultiBlockTopology((a, b), (Interface(Side("a", "right"), Side("c", "left")),)))
+    assert "'c'" in msg and "a.right" in msg
+    msg = _err(lambda: MultiBlockTopology((a, b), (Interface(Side("a", "east"), Side("b", "left")),)))
+    assert "a.east" in msg and "bottom" in msg
+
+
+def test_error_counts_disagree(pair):
+    X, Y = pair
+    Xb, Yb = curved_rectangle(8, 4)
+    a = block("a", X[:5], Y[:5])
+    b2 = Block("b", borders(*[np.column_stack([v[4:, 0]] * 3) for v in (Xb, Yb)]))
+    msg = _err(lambda: MultiBlockTopology((a, b2), (Interface(Side("a", "right"), Side("b", "left")),)))
+    assert "a.right" in msg and "b.left" in msg and "4 cells" in msg and "2 on b.left" in msg
+
+
+def test_error_nodes_do_not_coincide(pair):
+    X, Y = pair
+    a, b = block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])
+    msg = _err(lambda: MultiBlockTopology((a, b), (Interface(Side("a", "left"), Side("b", "right")),)))
+    assert "a.left" in msg and "b.right" in msg and "do not coincide" in msg
+
+
+def test_error_range_outside_border(pair):
+    X, Y = pair
+    a, b = block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])
+    msg = _err(lambda: MultiBlockTopology((a, b), (Interface(Side("a", "right", 0, 9), Side("b", "left", 0, 9)),)))
+    assert "a.right[0:9]" in msg and "5 nodes" in msg
+
+
+def test_error_overlapping_blocks(pair):
+    X, Y = pair
+    a, b = block("a", X[:6], Y[:6]), block("b", X[4:], Y[4:])
+    msg = _err(lambda: MultiBlockTopology((a, b)))
+    assert "'a'" in msg and "'b'" in msg and "overlap" in msg
+
+
+def test_error_undeclared_shared_border(pair):
+    X, Y = pair
+    a, b = block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])
+    msg = _err(lambda: MultiBlockTopology((a, b)))
+    assert "'a'" in msg and "'b'" in msg and "touch" in msg
+
+
+def test_error_gap_hole_named():
+    # two L-shaped arrangements leaving a hole: blocks around it are named
+    def quad(sw, se, ne, nw):  # axis-parallel, cells of size 1
+        sw, se, ne, nw = (np.asarray(v, dtype=float) for v in (sw, se, ne, nw))
+        ni, nj = round(se[0] - sw[0]), round(nw[1] - sw[1])
+        li, lj = np.linspace(0, 1, ni + 1)[:, None], np.linspace(0, 1, nj + 1)[:, None]
+        return Borders(bottom=sw + li * (se - sw), right=se + lj * (ne - se),
+                       top=nw + li * (ne - nw), left=sw + lj * (nw - sw))
+
+    bl = (
+        Block("a", quad([0, 0], [2, 0], [2, 1], [0, 1])),
+        Block("b", quad([2, 0], [4, 0], [4, 1], [2, 1])),
+        Block("c", quad([0, 1], [1, 1], [1, 3], [0, 3])),
+        Block("d", quad([3, 1], [4, 1], [4, 3], [3, 3])),
+        Block("e", quad([0, 3], [2, 3], [2, 4], [0, 4])),
+        Block("f", quad([2, 3], [4, 3], [4, 4], [2, 4])),
+    )
+    S = Side
+    itf = (
+        Interface(S("a", "right"), S("b", "left")), Interface(S("e", "right"), S("f", "left")),
+        Interface(S("a", "top", 0, 1), S("c", "bottom")), Interface(S("b", "top", 1, 2), S("d", "bottom")),
+        Interface(S("c", "top"), S("e", "bottom", 0, 1)), Interface(S("d", "top"), S("f", "bottom", 1, 2)),
+    )
+    msg = _err(lambda: MultiBlockTopology(bl, itf))
+    assert "gap" in msg and "hole" in msg
+    assert all(f"'{n}'" in msg for n in "abcdef")
+
+
+def test_error_border_parts_overlap(pair):
+    X, Y = pair
+    a, b = block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])
+    itf = (Interface(Side("a", "right", 0, 3), Side("b", "left", 0, 3)),
+           Interface(Side("a", "right", 2, 4), Side("b", "left", 2, 4)))
+    msg = _err(lambda: MultiBlockTopology((a, b), itf))
+    assert "a.right" in msg and "overlap" in msg
+
+
+def test_outline_error_cut_not_ending_on_outline():
+    ring, cuts, blocks = outline_case()
+    cuts = [[[1, 0.3], [1, 1.2]], cuts[1]]
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
+    assert "cut 0" in msg and "first point" in msg
+
+
+def test_outline_error_block_not_four_sided():
+    ring, cuts, blocks = outline_case()
+    blocks[0] = {**blocks[0], "corners": [[0, 0], [1, 0], [2, 0.55], [0, 0.5]]}
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
+    assert "'sw'" in msg and "four" in msg
+
+
+def test_outline_error_corners_clockwise():
+    ring, cuts, blocks = outline_case()
+    blocks[0] = {**blocks[0], "corners": blocks[0]["corners"][::-1]}
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
+    assert "'sw'" in msg and "counter-clockwise" in msg
+
+
+def test_outline_error_gap_region_without_block():
+    ring, cuts, blocks = outline_case()
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks[:3]))
+    assert "gap" in msg and "'se'" in msg and "'nw'" in msg
+
+
+def test_outline_error_two_blocks_on_one_region():
+    ring, cuts, blocks = outline_case()
+    blocks[3] = {**blocks[2], "name": "other"}
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
+    assert "'nw'" in msg and "'other'" in msg and "overlap" in msg
+
+
+def test_outline_error_counts_disagree_across_interface():
+    ring, cuts, blocks = outline_case()
+    blocks[1] = {**blocks[1], "cells": [8, 5]}
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
+    assert "cell counts disagree" in msg
+    assert ("'sw'" in msg or "'se'" in msg) and "shared with" in msg
+
+
+def test_outline_error_cut_leaves_the_water():
+    ring, cuts, blocks = outline_case()
+    cuts = [[[1, 0], [1.5, -0.5], [1, 1.2]], cuts[1]]
+    msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
+    assert "cut 0" in msg and ("leaves" in msg or "touches" in msg)
+
+
+# -------------------------------------------------------------- case files
+INTERFACE_CASE = """
+title = "two blocks"
+[multiblock]
+mode = "smooth"
+[[blocks]]
+name = "left"
+cells = [6, 4]
+[blocks.boundary]
+bottom = [[0, 0], [1, 0]]
+right = [[1, 0], [1, 1]]
+top = [[0, 1], [1, 1]]
+left = [[0, 0], [0, 1]]
+[[blocks]]
+name = "right"
+cells = [8, 4]
+[blocks.boundary]
+bottom = [[1, 0], [2, 0]]
+right = [[2, 0], [2.2, 1.3]]
+top = [[1, 1], [2.2, 1.3]]
+left = [[1, 0], [1, 1]]
+[[interfaces]]
+a = "left.right"
+b = "right.left"
+"""
+
+
+def test_case_with_interfaces(tmp_path):
+    from meshcore.case import generate_case, load_case
+
+    p = tmp_path / "two.toml"
+    p.write_text(INTERFACE_CASE)
+    mb = generate_case(load_case(p))
+    assert mb.names == ("left", "right") and mb.mode == "smooth" and mb.converged
+    assert_glued(mb)
+    assert mb["left"].cells == (6, 4) and mb["right"].cells == (8, 4)
+
+
+@pytest.mark.parametrize(
+    ("edit", "key"),
+    [
+        (("[multiblock]\nmode", "[multiblock]\nspeed = 1\nmode"), "speed"),
+        (('a = "left.right"', 'a = "left.right"\nflip = true'), "flip"),
+    ],
+)
+def test_case_unknown_keys(tmp_path, edit, key):
+    from meshcore.case import generate_case, load_case
+
+    p = tmp_path / "bad.toml"
+    p.write_text(INTERFACE_CASE.replace(*edit))
+    with pytest.raises(CaseFileError) as ei:
+        generate_case(load_case(p))
+    assert repr(key) in str(ei.value) and "valid keys" in str(ei.value)
+
+
+def test_case_outline_unknown_key_and_mode(tmp_path):
+    from meshcore.case import generate_case, load_case
+
+    text = (EXAMPLES / "shasta-multiblock-coarse.toml").read_text()
+    (tmp_path / "lakes").mkdir()
+    for f in (ROOT / "resources" / "lakes").glob("*.csv"):
+        (tmp_path / "lakes" / f.name).write_text(f.read_text())
+    d = tmp_path / "ex"
+    d.mkdir()
+    (d / "a.toml").write_text(text.replace('crs = "utm"', 'crs = "utm"\ncolour = 1'))
+    with pytest.raises(CaseFileError, match=r"'colour'.*valid keys"):
+        generate_case(load_case(d / "a.toml"))
+    (d / "b.toml").write_text(text.replace('mode = "smooth"', 'mode = "wobbly"'))
+    with pytest.raises(CaseFileError, match="mode must be one of smooth, frozen"):
+        generate_case(load_case(d / "b.toml"))
+
+
+def test_cli_generate_multiblock_case(tmp_path):
+    out = tmp_path / "shasta.xyz"
+    r = subprocess.run(
+        [sys.executable, "-m", "meshcore", "generate", str(EXAMPLES / "shasta-multiblock-coarse.toml"),
+         "-o", str(out)],
+        capture_output=True, text=True, cwd=ROOT, timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "Interfaces" in r.stdout and "main.top" in r.stdout
+    from meshcore.io import read_grid
+
+    blocks = read_grid(out)
+    assert len(blocks) == 7
+    from meshcore.case import generate_case, load_case
+
+    mb = generate_case(load_case(EXAMPLES / "shasta-multiblock-coarse.toml"))
+    ox, oy = mb.frame.origin  # files hold world (UTM) coordinates
+    for g, h in zip(mb, blocks, strict=True):
+        assert np.abs(g.x + ox - h.x).max() < 1e-6 and np.abs(g.y + oy - h.y).max() < 1e-6
+
+
+def test_vtm_and_plot3d_via_io_read_by_vtk(tmp_path, rect):
+    vtk = pytest.importorskip("vtkmodules.vtkIOXML")
+    from meshcore.io import read_grid, write
+    from meshcore.multiblock.export import write_report
+
+    X, Y, _ = rect
+    mb = solve_multiblock(four_blocks(X, Y, 14, 5))
+    p = write(tmp_path / "rect.vtm", mb)
+    reader = vtk.vtkXMLMultiBlockDataReader()
+    reader.SetFileName(str(p))
+    reader.Update()
+    data = reader.GetOutput()
+    assert data.GetNumberOfBlocks() == 4
+    for k, g in enumerate(mb):
+        blk = data.GetBlock(k)
+        assert data.GetMetaData(k).Get(data.NAME()) == mb.names[k]
+        assert blk.GetNumberOfPoints() == g.n_nodes
+        dims = [0, 0, 0]
+        blk.GetDimensions(dims)
+        assert tuple(dims[:2]) == g.shape
+        pt = blk.GetPoint(g.shape[0] + 1)  # node (1, 1): VTK order, i fastest
+        assert pt[:2] == pytest.approx((g.x[1, 1], g.y[1, 1]), abs=1e-12)
+    back = read_grid(write(tmp_path / "rect.xyz", mb))
+    assert len(back) == 4
+    assert all(np.array_equal(g.x, h.x) for g, h in zip(mb, back, strict=True))
+    rep = write_report(tmp_path / "rect.txt", mb).read_text(encoding="utf-8")
+    assert "sw.right nodes 0…5" in rep and "max adjacent-cell size ratio across" in rep
+
+
+def test_lonlat_outline_projections_agree(tmp_path):
+    """utm (pyproj) and lonlat (equirectangular) give nearly the same lake, in metres."""
+    from meshcore.case import load_case
+    from meshcore.multiblock.case import case_frame, outline_points
+
+    text = (EXAMPLES / "shasta-multiblock-coarse.toml").read_text()
+    (tmp_path / "lakes").mkdir()
+    for f in (ROOT / "resources" / "lakes").glob("*.csv"):
+        (tmp_path / "lakes" / f.name).write_text(f.read_text())
+    (tmp_path / "ex").mkdir()
+    (tmp_path / "ex" / "utm.toml").write_text(text)
+    (tmp_path / "ex" / "eq.toml").write_text(text.replace('crs = "utm"', 'crs = "lonlat"'))
+    cu, ce = load_case(tmp_path / "ex" / "utm.toml"), load_case(tmp_path / "ex" / "eq.toml")
+    fr = case_frame(cu)
+    assert fr.crs == "EPSG:32610" and fr.source_crs == "EPSG:4326"
+    pu, pe = outline_points(cu), outline_points(ce)
+    # same shape up to a rigid motion; lengths agree to < 0.5 % (equirectangular E–W
+    # distortion over ±0.1° of latitude ≈ 0.2 %, UTM scale 0.7° off the central meridian)
+    lu, le = np.hypot(*(pu - pu[0]).T), np.hypot(*(pe - pe[0]).T)
+    assert np.abs(lu - le).max() < 5e-3 * le.max()
+    # the grid nodes on the shore map back to the lon/lat shoreline
+    from meshcore.case import generate_case
+
+    mb = generate_case(cu)
+    lon, lat = mb.frame.to_lonlat(mb["main"].x[:, 0], mb["main"].y[:, 0])
+    shore = np.loadtxt(ROOT / "resources" / "lakes" / "shasta_lake.csv", delimiter=",", skiprows=1)
+    from shapely.geometry import LinearRing, Point
+
+    ring = LinearRing(shore)
+    assert max(ring.distance(Point(a, b)) for a, b in zip(lon, lat, strict=True)) < 1e-7
+
+
+def test_cli_generate_vtm_with_crs(tmp_path):
+    vtk = pytest.importorskip("vtkmodules.vtkIOXML")
+    out = tmp_path / "lake.vtm"
+    r = subprocess.run(
+        [sys.executable, "-m", "meshcore", "generate", str(EXAMPLES / "shasta-multiblock-coarse.toml"),
+         "-o", str(out), "-q"],
+        capture_output=True, text=True, cwd=ROOT, timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    reader = vtk.vtkXMLMultiBlockDataReader()
+    reader.SetFileName(str(out))
+    reader.Update()
+    data = reader.GetOutput()
+    assert data.GetNumberOfBlocks() == 7
+    # world coordinates (UTM 10N metres) are written, not the local ones
+    x0 = data.GetBlock(0).GetPoint(0)[0]
+    assert 5e5 < x0 < 6.5e5
+
+
+def test_connectivity_case_round_trip(tmp_path, shasta_topology):
+    """The derived blocks + interfaces saved as an explicit case give the same grid."""
+    from meshcore.case import generate_case, load_case, save_case
+    from meshcore.multiblock.case import topology_case
+
+    case = topology_case(shasta_topology, title="Shasta, explicit connectivity")
+    p = save_case(case, tmp_path / "explicit.toml")
+    text = p.read_text(encoding="utf-8")
+    assert text.count("[[interfaces]]") == len(shasta_topology.interfaces)
+    assert 'a = "main.top[' in text or 'b = "main.top[' in text
+    again = generate_case(load_case(p))
+    direct = solve_multiblock(shasta_topology)
+    assert again.names == direct.names
+    for g, h in zip(again, direct, strict=True):
+        assert np.array_equal(g.x, h.x) and np.array_equal(g.y, h.y)
+
+
+def test_from_outline_cut_ending_on_another_cut():
+    # a vertical cut across the lake, and a second cut from the west shore that ends on it
+    ring = np.array([[0, 0], [4, 0], [4, 2], [0, 2]], float)
+    cuts = [[[2, 0], [2, 2]], [[0, 1.0], [2.0 + 1e-4, 1.1]]]  # ends (within snap) on cut 0
+    blocks = [
+        {"name": "sw", "corners": [[0, 0], [2, 0], [2, 1.1], [0, 1]], "cells": [6, 3]},
+        {"name": "nw", "corners": [[0, 1], [2, 1.1], [2, 2], [0, 2]], "cells": [6, 3]},
+        {"name": "east", "corners": [[2, 0], [4, 0], [4, 2], [2, 2]], "cells": [6, 6]},
+    ]
+    ob = from_outline(ring, cuts=cuts, blocks=blocks, snap=1e-3)
+    topo = ob.topology
+    # the snapped end is exactly on cut 0 and is a node of all three blocks
+    (t,) = [c for c in topo.node_map.corners if len(c.blocks) == 3]
+    assert t.point == (2.0, 1.1) and t.valence == 4 and t.free
+    east_parts = sorted((s.start, s.stop) for i in topo.interfaces for s in (i.a, i.b)
+                        if s.block == "east")
+    assert east_parts == [(0, 3), (3, 6)]  # east.left is split at the T point
+    mb = solve_multiblock(topo)
+    assert mb.converged and mb.quality().n_folded == 0
+    assert_glued(mb)
+    # the T node moved along with the solution (it is solved like an interior node)
+    assert abs(mb["east"].y[0, 3] - 1.1) > 1e-3
+
+
+def test_confluence_case_three_blocks_meet_at_the_centre():
+    from meshcore.case import generate_case, load_case
+
+    mb = generate_case(load_case(EXAMPLES / "confluence-multiblock.toml"))
+    assert mb.converged and mb.quality().n_folded == 0
+    assert_glued(mb)
+    corners = [c for c in mb.topology.node_map.corners if c.free and c.valence == 3]
+    assert len(corners) == 1 and corners[0].point == (0.0, 0.0)
+    # the centre stays at the centre, and the arms are rotations of each other by 120°
+    g = mb["junction-ne"]
+    assert math.hypot(g.x[0, 0], g.y[0, 0]) < 1e-5
+    a = -2.0 * np.pi / 3.0
+    n, se = mb["north"], mb["southeast"]
+    assert np.abs(math.cos(a) * n.x - math.sin(a) * n.y - se.x).max() < 1e-4
+
+
+def test_multigrid_hierarchy_and_convergence(rect):
+    """FAS over the blocks: coarse levels keep the topology; the defect drops ≥ 5× per cycle."""
+    from meshcore.multiblock.multigrid import coarsen, levels
+
+    X, Y, ref = rect
+    topo = four_blocks(X, Y, 12, 6)
+    lv = levels(topo, semi=False)
+    assert [lv_.topo.blocks[0].cells for lv_ in lv] == [(12, 6), (6, 3)]  # 3 is odd: stop
+    c = coarsen(topo)
+    assert len(c.interfaces) == 4 and c.node_map.corners[0].valence == 4
+    assert coarsen(four_blocks(X, Y, 14, 5)) is None  # odd counts do not coarsen
+    X2, Y2 = curved_rectangle(64, 32)
+    mb = solve_multiblock(four_blocks(X2, Y2, 32, 16), tolerance=1e-10, engine="multigrid")
+    assert mb.converged and mb.info.method.startswith("smooth/multigrid(")
+    h = [v for _, v in mb.info.residual_history]
+    assert len(h) <= 12
+    assert all(b <= a / 5.0 for a, b in itertools.pairwise(h[1:]))
+    # the same discrete solution as SOR
+    sor = solve_multiblock(four_blocks(X2, Y2, 32, 16), tolerance=1e-10, engine="blocks")
+    for g, k in zip(mb, sor, strict=True):
+        assert np.abs(g.x - k.x).max() < 1e-7 * ref.size
+
+
+def test_multigrid_kernels_match_reference():
+    """table_defect with f = 0 equals the NumPy Jacobi targets minus u."""
+    topo = star(5)
+    m = topo.node_map
+    x = np.empty(m.n_nodes)
+    y = np.empty(m.n_nodes)
+    for g, ids in zip(meshcore.multiblock.initial_grids(topo), m.ids, strict=True):
+        x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
+    x += 0.01 * np.sin(7 * y) * ~m.boundary
+    args = (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring)
+    tx, ty = _reference.jacobi_targets(x, y, *args)
+    rx, ry = np.zeros(m.n_nodes), np.zeros(m.n_nodes)
+    z = np.zeros(m.n_nodes)
+    r = _kernels.table_defect(x, y, z, z, *args, rx, ry)
+    assert np.allclose(rx, tx - x, atol=1e-14) and np.allclose(ry, ty - y, atol=1e-14)
+    assert r == pytest.approx(np.hypot(tx - x, ty - y).max(), rel=1e-12)
+    # a sweep with f = (T − u) of the current state leaves u fixed at nodes already solved
+    fx, fy = 0.3 * np.ones(m.n_nodes), np.zeros(m.n_nodes)
+    x2, y2 = x.copy(), y.copy()
+    _kernels.table_sweep_rhs(x2, y2, fx, fy, *args, 1.0)
+    assert np.array_equal(x2[m.boundary], x[m.boundary])
+
+
+def test_outline_multiple_gives_coarsenable_blocks():
+    from meshcore.multiblock.multigrid import levels
+
+    ring = np.array([[0, 0], [6, 0], [6, 1], [4, 1], [4, 3], [2, 3], [2, 1], [0, 1]], float)
+    blocks = [
+        {"name": "main", "corners": [0, 1, 2, 7], "cells": [24, 4]},
+        {"name": "arm", "corners": [[2, 1], [4, 1], 4, 5], "cells": [8, 8]},
+    ]
+    topo = from_outline(ring, cuts=[[6, 3]], blocks=blocks, multiple=4).topology
+    (itf,) = topo.interfaces
+    assert all(v % 4 == 0 for s in (itf.a, itf.b) for v in (s.start, s.stop))
+    assert len(levels(topo, semi=False)) == 2  # 24×4 → 12×2; 6×1 would be below MIN_CELLS
+    bad = [{**blocks[0], "cells": [22, 4]}, blocks[1]]
+    msg = _err(lambda: from_outline(ring, cuts=[[6, 3]], blocks=bad, multiple=4))
+    assert "'main'" in msg and "multiples of 4" in msg
+
+
+def test_multigrid_semi_coarsening_on_stretched_blocks():
+    """Cells 4× longer in η: only ξ is coarsened first (in both blocks, across the interface)."""
+    from meshcore.multiblock.multigrid import levels, plan
+
+    X, Y = curved_rectangle(128, 16)  # cells ≈ 0.016 × 0.07
+    topo = two_blocks(X, Y, 64)
+    assert plan(topo, np.array([0.25, 0.25])) == [(2, 1), (2, 1)]
+    lv = levels(topo)
+    assert [l.topo.blocks[0].cells for l in lv[:3]] == [(64, 16), (32, 16), (16, 16)]
+    mb = solve_multiblock(topo, tolerance=1e-10, engine="multigrid")
+    h = [v for _, v in mb.info.residual_history]
+    assert mb.converged and len(h) <= 12
+    assert max(b / a for a, b in itertools.pairwise(h[1:])) < 0.35
