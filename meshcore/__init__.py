@@ -16,6 +16,8 @@ from __future__ import annotations
 from . import _numba_setup  # noqa: F401  (must run before numba compiles anything)
 from .algebraic import algebraic_grid, tfi, weighted_average
 from .boundary import Borders, BorderSpec, borders_from_loop, borders_from_polylines
+from .control import ControlSpec, make_sources
+from .corners import choose_corners
 from .curves import LinearSpline, SmoothCurve, make_curve
 from .distribution import distribute
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve
@@ -43,6 +45,7 @@ __all__ = [
     "BORDER_NAMES",
     "BorderMismatchError",
     "BorderSpec",
+    "ControlSpec",
     "Borders",
     "BoundaryError",
     "CaseFileError",
@@ -73,6 +76,7 @@ __all__ = [
     "initial_grid",
     "iterate",
     "make_curve",
+    "make_sources",
     "metrics",
     "prepare_borders",
     "quality",

@@ -36,9 +36,18 @@ list the valid ones.  Example (the paper's bottle, refinement 1)::
     last = 0.05                   # absolute last spacing
     name = "wall"                 # boundary-condition name carried to exports
 
-Other features add their own tables (``[blocks.control]`` control functions,
-``[[interfaces]]``/``[multiblock]`` multiblock, ``crs``); they register their
-keys with :func:`register_keys` so that validation stays strict.
+    [blocks.control]              # optional grid control (meshcore.control)
+    kind = "hilgenstock-white"    # or "steger-sorenson" (Taylor targets + feedback)
+    thomas-middlecoff = false     # interior follows the boundary point distribution
+    relaxation = 0.1              # under-relaxation of the boundary sources
+    floating = []                 # borders whose nodes slide along the boundary curve
+    attractors = [{ kind = "xi", xi = 0.5, amplitude = 0.2, decay = 0.3 }]
+    [blocks.control.borders]      # per wall: first-cell height and angle (degrees)
+    bottom = { spacing = 0.05, angle = 90 }
+
+Other features add their own tables (``[[interfaces]]``/``[multiblock]``
+multiblock, ``crs``); they register their keys with :func:`register_keys` so
+that validation stays strict.
 """
 
 from __future__ import annotations
@@ -72,6 +81,7 @@ TOP_KEYS = {"title", "description", "solver", "blocks", "crs"}
 CRS_KEYS = {"crs", "origin", "source_crs", "source"}
 BLOCK_KEYS = {
     "name", "cells", "weights", "initial", "curve", "periodic", "snap_angle", "boundary", "borders",
+    "control",
 }
 BOUNDARY_KEYS = {"bottom", "right", "top", "left", "points", "corners"}
 BORDER_KEYS = {"distribution", "first", "last", "name"}
@@ -104,6 +114,7 @@ class BlockCase:
     loop: np.ndarray | None = None  # or a closed loop ...
     corners: tuple[int, int, int, int] | None = None  # ... with corners (sw, se, ne, nw)
     border_specs: Mapping[str, BorderSpec] = field(default_factory=dict)
+    control: Mapping[str, Any] | None = None  # [blocks.control] table (meshcore.control)
     extra: Mapping[str, Any] = field(default_factory=dict)
 
     def replaced(self, **kw: Any) -> BlockCase:
@@ -122,6 +133,8 @@ class BlockCase:
                 for k, v in self.border_specs.items()
             },
         }
+        if self.control is not None:
+            kw["control"] = self.control
         if self.loop is not None:
             kw["loop"] = self.loop
             kw["corners"] = self.corners
@@ -287,6 +300,14 @@ def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str,
         except TypeError as exc:
             raise CaseFileError(f"{where}: borders.{n}: {exc}") from None
     kw["border_specs"] = specs
+    if "control" in tbl:
+        from .control import control_from_mapping
+
+        try:
+            control_from_mapping(tbl["control"], where=f"{where}: control")
+        except InvalidInputError as exc:
+            raise CaseFileError(str(exc)) from None
+        kw["control"] = dict(tbl["control"])
     kw["extra"] = {k2: tbl[k2] for k2 in _EXTRA_BLOCK if k2 in tbl}
     return BlockCase(**kw)
 
@@ -417,6 +438,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
             t["boundary"] = {n: b.borders[n] for n in BORDER_NAMES}  # type: ignore[index]
         if b.border_specs:
             t["borders"] = {n: dataclasses.asdict(s) for n, s in b.border_specs.items()}
+        if b.control is not None:
+            t["control"] = dict(b.control)
         t.update(b.extra)
         blocks.append(t)
     out.update(case.extra)

@@ -172,13 +172,15 @@ def vinokur(n: int, first: float, last: float) -> np.ndarray:
 
     def resid(d: float, aa: float) -> np.ndarray:
         u = _vinokur_map(np.array([1.0 / n, 1.0 - 1.0 / n]), d, aa)
+        if not (np.isfinite(u).all() and 0.0 < u[0] and u[1] < 1.0):
+            return np.array([math.inf, math.inf])  # outside the valid parameter range
         return np.array([math.log(u[0] / first), math.log((1.0 - u[1]) / last)])
 
     # Newton on (δ, log A) with finite-difference Jacobian; the analytic guess is close.
     la = math.log(a)
     for _ in range(50):
         r = resid(delta, math.exp(la))
-        if np.max(np.abs(r)) < 1e-12:
+        if not np.isfinite(r).all() or np.max(np.abs(r)) < 1e-12:
             break
         h = 1e-7
         jd = (resid(delta + h, math.exp(la)) - r) / h

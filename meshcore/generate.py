@@ -15,7 +15,7 @@ from ._validation import validate_choice, validate_count
 from .algebraic import algebraic_grid
 from .boundary import Borders, borders_from_loop, borders_from_polylines
 from .elliptic import EllipticConfig, SolverProgress, iterate, solve
-from .errors import InvalidInputError, MeshcoreWarning
+from .errors import InvalidInputError, MeshcoreError, MeshcoreWarning
 from .grid import BORDER_NAMES, StructuredGrid
 
 __all__ = ["generate_block", "initial_grid", "prepare_borders"]
@@ -121,6 +121,7 @@ def generate_block(
     periodic: bool = False,
     repair: str = "auto",
     snap_angle: float | None = None,
+    control: Any = None,
 ) -> StructuredGrid:
     """Generate one block's grid from its boundary.
 
@@ -172,6 +173,11 @@ def generate_block(
         When re-sampling, input vertices where a border turns by more than this
         many degrees get a node exactly (keeps the corners of a cutout);
         ``None`` = pure distribution (the paper).
+    control : ControlSpec or mapping, optional
+        Grid control (:mod:`meshcore.control`): boundary orthogonality and
+        first-cell spacing, Thomas–Middlecoff, attraction, floating nodes
+        (which slide on the given border polylines), e.g.
+        ``{"borders": {"bottom": {"spacing": 0.01}}}``.
 
     Returns
     -------
@@ -187,10 +193,20 @@ def generate_block(
     >>> g.shape, g.converged
     ((5, 3), True)
     """
-    b = prepare_borders(
-        bottom, right, top, left, loop=loop, corners=corners, cells=cells, borders=borders, curve=curve,
-        periodic=periodic, snap_angle=snap_angle,
-    )
+    wake = _wake_cells(control)
+    if wake:
+        # C-grid: the bottom border folds back on itself along the wake cut, so the
+        # self-intersection check does not apply; the nodes are used as given
+        if cells is not None or loop is not None:
+            raise InvalidInputError("a C-grid (control wake > 0) needs four borders given node by node "
+                                    "(no cells=, no loop)")
+        b = borders_from_polylines(bottom, right, top, left, check_intersections=False)
+        b.check_counts()
+    else:
+        b = prepare_borders(
+            bottom, right, top, left, loop=loop, corners=corners, cells=cells, borders=borders,
+            curve=curve, periodic=periodic, snap_angle=snap_angle,
+        )
     names = {
         k: v["name"]
         for k, v in (borders or {}).items()
@@ -205,9 +221,26 @@ def generate_block(
         method="auto" if foldfree else method, tolerance=tolerance, max_iterations=max_iterations,
         omega=omega,
     )
+    sources = None
+    if control is not None:
+        from .control import make_sources
+
+        curves = {n: b[n] for n in ("bottom", "right", "top", "left")}
+        if cells is not None:  # slide on the input polylines, not on the re-sampled nodes
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")  # already reported by prepare_borders
+                    if loop is not None:
+                        raw = borders_from_loop(loop, corners)
+                    else:
+                        raw = borders_from_polylines(bottom, right, top, left, periodic=periodic)
+                curves = {n: raw[n] for n in curves}
+            except MeshcoreError:  # e.g. corners="auto": slide on the re-sampled nodes
+                pass
+        sources = make_sources(control, periodic=periodic, curves=curves)
     if foldfree and cfg.method == "foldfree":
         cfg = cfg.replaced(method="auto")
-    g = solve(g0, cfg, callback=callback, p=p, q=q)
+    g = solve(g0, cfg, callback=callback, p=p, q=q, sources=sources)
     if foldfree:
         from .foldfree import smooth as _ff_smooth
 
@@ -226,6 +259,15 @@ def generate_block(
     from .foldfree import repair as _ff_repair
 
     return _ff_repair(g, strict=repair == "strict").grid
+
+
+def _wake_cells(control: Any) -> int:
+    if control is None:
+        return 0
+    w = getattr(control, "wake", None)
+    if w is None and isinstance(control, Mapping):
+        w = control.get("wake", 0)
+    return int(w or 0)
 
 
 # Re-export for convenience

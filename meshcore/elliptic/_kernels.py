@@ -146,7 +146,9 @@ def jacobi_residual(x, y, p, q, periodic):  # pragma: no cover - compiled
             b = xxi * xet + yxi * yet
             g = xxi * xxi + yxi * yxi
             den = 2.0 * (a + g)
-            if den <= 0.0:
+            if not den > 0.0:
+                if den != den:
+                    return np.inf
                 continue
             cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
             cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
@@ -162,6 +164,8 @@ def jacobi_residual(x, y, p, q, periodic):  # pragma: no cover - compiled
             m = dx * dx + dy * dy
             if m > dmax:
                 dmax = m
+            elif m != m:  # NaN anywhere means "not converged", never a silent pass
+                return np.inf
     return np.sqrt(dmax)
 
 

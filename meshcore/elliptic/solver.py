@@ -173,6 +173,12 @@ def _pq(p, q, shape):
     return pp, qq
 
 
+def _sources_settled(state: SolverState) -> bool:
+    """False while a control-function updater says its sources are still moving."""
+    settled = getattr(state.sources, "settled", None)
+    return True if settled is None else bool(settled())
+
+
 def _sor(state: SolverState) -> Generator[str, None, bool]:
     """SOR in 4-colour order. Yields ``"tick"`` after each sweep; returns converged."""
     cfg = state.config
@@ -187,6 +193,9 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
     if r <= tol:
         return True
     best = r
+    # with a control-function updater the residual jumps when the sources move:
+    # judge divergence against a floor well above the tolerance
+    floor = 0.0 if state.sources is None else 1e3 * tol
     saved = (x.copy(), y.copy())
     since_check = 0
     check_every = 1
@@ -198,11 +207,13 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
         if not math.isfinite(d) or since_check >= check_every or d < 4.0 * tol:
             since_check = 0
             r = state.residual() if math.isfinite(d) else math.inf
+            if r <= tol and not (np.isfinite(x).all() and np.isfinite(y).all()):
+                r = math.inf  # the kernels skip NaN nodes: never call a NaN grid converged
             state.history.append((it, r))
-            if r <= tol:
+            if r <= tol and _sources_settled(state):
                 state.iterations = it
                 return True
-            if not math.isfinite(r) or r > 1e3 * best:
+            if not math.isfinite(r) or r > 1e3 * max(best, floor):
                 # diverging: restore the last good iterate and relax less
                 x[...] = saved[0]
                 y[...] = saved[1]

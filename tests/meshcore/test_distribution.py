@@ -113,3 +113,10 @@ def test_snap_angle_keeps_sharp_vertices_as_nodes():
     assert not all(has(plain.top, c) for c in corners)  # the paper's uniform re-sampling cuts corners
     assert all(has(snapped.top, c) for c in corners)
     assert np.all(np.diff(np.concatenate([[0], np.cumsum(np.hypot(*np.diff(snapped.top, axis=0).T))])) > 0)
+
+
+def test_vinokur_extreme_request():
+    # found by hypothesis: a first cell of 75 % of the border with 4 cells used to hit a math domain error
+    u = vinokur(4, 0.75, 1 / 12)
+    _check(u, 4)
+    assert u[1] == pytest.approx(0.75, rel=1e-9) and 1 - u[-2] == pytest.approx(1 / 12, rel=1e-9)

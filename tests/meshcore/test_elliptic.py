@@ -168,3 +168,11 @@ def test_tfi_reproduces_bilinear_maps(ni, nj, a, b, c, d):
     g = meshcore.tfi(meshcore.prepare_borders(*borders_of(X, Y)))
     np.testing.assert_allclose(g.x, X, atol=1e-12)
     np.testing.assert_allclose(g.y, Y, atol=1e-12)
+
+
+def test_nan_grid_is_never_converged():
+    X, Y = annulus_sector(6, 6)
+    X = X.copy()
+    X[3, 3] = np.nan
+    e = np.zeros((0, 0))
+    assert _kernels.jacobi_residual(np.ascontiguousarray(X), np.ascontiguousarray(Y), e, e, False) == np.inf

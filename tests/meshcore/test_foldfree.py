@@ -349,7 +349,12 @@ EXAMPLES = sorted(
 )
 
 
-@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+@pytest.mark.parametrize(
+    "path",
+    # the C-grid example takes ~10 s per solve with SOR (strongly stretched wall cells)
+    [pytest.param(p, marks=pytest.mark.slow) if "cgrid" in p.stem else p for p in EXAMPLES],
+    ids=[p.stem for p in EXAMPLES],
+)
 def test_paper_cases_fold_free_and_close_to_valid_winslow(path):
     from meshcore.case import generate_case, load_case
 
@@ -367,7 +372,9 @@ def test_paper_cases_fold_free_and_close_to_valid_winslow(path):
         assert f"{qw.n_nonconvex} non-convex cell(s)" in g.info.message
     f = meshcore.generate_block(**kw, config=case.solver.replaced(method="foldfree"))
     assert f.method == "foldfree" and f.converged and meshcore.quality(f).ok
-    if qw.ok:  # the whole-block barrier minimiser stays close to a valid Winslow grid
+    # the whole-block barrier minimiser stays close to a valid Winslow grid (it has no
+    # grid control, so controlled examples are not compared)
+    if qw.ok and case.blocks[0].control is None:
         h = np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0)))
         assert np.hypot(f.x - w.x, f.y - w.y).max() < 0.1 * h
 
