@@ -108,6 +108,7 @@ def block_from_case(bc) -> Block:
         "borders": specs,
         "snap_angle": bc.snap_angle,
         "keep_nodes": bc.cells is None,
+        "control": getattr(bc, "control", None),
     }
     if bc.loop is not None:
         pts = np.asarray(bc.loop, float)
@@ -124,8 +125,11 @@ def block_from_case(bc) -> Block:
     cells = bc.cells or (len(bd[0]) - 1, len(bd[3]) - 1)
     block = Block(boundary=bd, cells=cells, **common)
     # four separate borders become an editable loop unless left and right coincide (a cut/seam)
+    # or the block is a C-grid (its bottom folds back along the wake cut)
     cut = bd[1].shape == bd[3].shape and np.allclose(bd[1], bd[3])
-    return block if (cut or bc.periodic) else boundary_to_loop(block)
+    ctl = getattr(bc, "control", None)
+    wake = (ctl.get("wake", 0) if isinstance(ctl, dict) else getattr(ctl, "wake", 0)) if ctl else 0
+    return block if (cut or bc.periodic or wake) else boundary_to_loop(block)
 
 
 def block_to_case(b: Block):
@@ -141,6 +145,8 @@ def block_to_case(b: Block):
         "snap_angle": b.snap_angle,
         "border_specs": dict(b.borders),
     }
+    if b.control is not None:
+        kw["control"] = b.control
     if b.boundary is not None:
         return BlockCase(borders={n: np.asarray(p) for n, p in zip(BORDER_NAMES, b.boundary, strict=True)}, **kw)
     return BlockCase(loop=np.asarray(b.points), corners=tuple(b.corners), **kw)

@@ -20,12 +20,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from meshcore import StructuredGrid, initial_grid, iterate, prepare_borders
+from meshcore import StructuredGrid, borders_from_polylines, initial_grid, iterate, prepare_borders
 from meshcore.elliptic import residual
 
 from .project import Block, Project
 
 __all__ = ["BlockResult", "block_borders", "block_initial_grid", "solve_project", "warmup"]
+
+
+def _wake(block: Block) -> int:
+    c = block.control
+    if c is None:
+        return 0
+    w = getattr(c, "wake", None)
+    if w is None and isinstance(c, Mapping):
+        w = c.get("wake", 0)
+    return int(w or 0)
 
 
 def block_borders(block: Block):
@@ -35,6 +45,11 @@ def block_borders(block: Block):
     if block.boundary is not None:
         # copies: meshcore snaps corners in place (read-only input arrays would fail)
         b, r, t, l = (np.array(a) for a in block.boundary)
+        if _wake(block):
+            # a C-grid: the bottom folds back on itself along the wake cut; nodes as given
+            bd = borders_from_polylines(b, r, t, l, check_intersections=False)
+            bd.check_counts()
+            return bd
         return prepare_borders(
             b,
             r,
@@ -56,6 +71,32 @@ def block_borders(block: Block):
         snap_angle=block.snap_angle,
         where=block.name,
     )
+
+
+def block_sources(block: Block):
+    """The control-function updater of a block (None without ``control``), as in generate_block."""
+    if block.control is None:
+        return None
+    import warnings
+
+    from meshcore import MeshcoreError, borders_from_loop
+    from meshcore.control import make_sources
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # already reported when the borders were built
+            if block.boundary is not None:
+                raw = borders_from_polylines(
+                    *(np.array(a) for a in block.boundary),
+                    periodic=block.periodic,
+                    check_intersections=not _wake(block),
+                )
+            else:
+                raw = borders_from_loop(np.array(block.points), block.corners)
+        curves = {n: raw[n] for n in ("bottom", "right", "top", "left")}
+    except MeshcoreError:
+        curves = None
+    return make_sources(block.control, periodic=block.periodic, curves=curves)
 
 
 def block_initial_grid(block: Block) -> StructuredGrid:
@@ -131,7 +172,7 @@ def solve_project(
         if not smooth:
             grids[k] = g0
             continue
-        gen = iterate(start, cfg, stop_event=stop_event)
+        gen = iterate(start, cfg, stop_event=stop_event, sources=block_sources(block))
         try:
             snap = next(gen)
             while True:

@@ -100,6 +100,7 @@ class Block:
     borders: tuple[tuple[str, BorderSpec], ...] = ()
     snap_angle: float | None = None
     keep_nodes: bool = False  # True: the given border points are the nodes (no re-sampling)
+    control: Any = None  # grid control: a [blocks.control] mapping or a meshcore.control.ControlSpec
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", frozen_points(self.points))
@@ -157,6 +158,7 @@ class Block:
                 self.borders,
                 self.snap_angle,
                 self.keep_nodes,
+                self.control,
             )
             == (
                 other.name,
@@ -170,6 +172,7 @@ class Block:
                 other.borders,
                 other.snap_angle,
                 other.keep_nodes,
+                other.control,
             )
         )
 

@@ -8,6 +8,7 @@ not applied.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 import pyqtgraph as pg
@@ -161,10 +162,36 @@ class ParamsPanel(QtWidgets.QScrollArea):
         self.omega = QtWidgets.QLineEdit(placeholderText="auto")
         self.omega.setToolTip("SOR relaxation factor in (0, 2); empty = automatic")
         f.addRow("ω (SOR)", self.omega)
-        f.addRow(QtWidgets.QLabel("<i>Control functions P, Q: not available yet</i>"))
         self.solver_msg = QtWidgets.QLabel(wordWrap=True)
         self.solver_msg.setStyleSheet("color: #b00;")
         f.addRow(self.solver_msg)
+        lay.addWidget(g)
+        g = QtWidgets.QGroupBox("Control functions (P, Q)")
+        g.setToolTip(
+            "meshcore.control: boundary orthogonality with a first-cell height (Hilgenstock–White), "
+            "interior following the boundary spacing (Thomas–Middlecoff)"
+        )
+        f = QtWidgets.QFormLayout(g)
+        self.ctl_summary = QtWidgets.QLabel(wordWrap=True)
+        f.addRow(self.ctl_summary)
+        row = QtWidgets.QHBoxLayout()
+        self.ctl_borders = {}
+        for name in BORDER_NAMES:
+            cb = QtWidgets.QCheckBox(name)
+            cb.setStyleSheet(f"color: {BORDER_COLOURS[name]};")
+            cb.toggled.connect(lambda _on: self._control_edit())
+            row.addWidget(cb)
+            self.ctl_borders[name] = cb
+        f.addRow("Orthogonal at", row)
+        self.ctl_spacing = QtWidgets.QLineEdit(placeholderText="first cell height (empty: angle only)")
+        self.ctl_spacing.editingFinished.connect(self._control_edit)
+        f.addRow("First cell", self.ctl_spacing)
+        self.ctl_tm = QtWidgets.QCheckBox("interior follows the boundary spacing (Thomas–Middlecoff)")
+        self.ctl_tm.toggled.connect(lambda _on: self._control_edit())
+        f.addRow(self.ctl_tm)
+        self.ctl_msg = QtWidgets.QLabel(wordWrap=True)
+        self.ctl_msg.setStyleSheet("color: #b00;")
+        f.addRow(self.ctl_msg)
         lay.addWidget(g)
         lay.addStretch(1)
 
@@ -211,6 +238,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
                 e.setStyleSheet("")
             self.border_msg.setText("")
             self.solver_msg.setText("")
+            self._refresh_control(b)
             sv = self.doc.project.solver
             self.method.setCurrentText(sv.method)
             self.repair.setCurrentText(sv.repair)
@@ -264,6 +292,83 @@ class ParamsPanel(QtWidgets.QScrollArea):
             return
         self.border_msg.setText("")
         self.editor.set_border_spec(self.border.currentText(), spec)
+
+    # ------------------------------------------------------------ control
+    def _refresh_control(self, b) -> None:
+        c = b.control
+        if c is None:
+            self.ctl_summary.setText("none")
+        elif isinstance(c, Mapping):
+            kind = c.get("kind", "hilgenstock-white")
+            parts = [
+                f"{n} ⟂" + (f" {v['spacing']:.3g}" if isinstance(v, Mapping) and v.get("spacing") else "")
+                for n, v in dict(c.get("borders", {})).items()
+            ]
+            extra = sorted(k for k in c if k not in ("kind", "borders", "thomas-middlecoff", "thomas_middlecoff"))
+            tm = c.get("thomas-middlecoff", c.get("thomas_middlecoff", False))
+            self.ctl_summary.setText(
+                f"{kind}: "
+                + (", ".join(parts) or "no borders")
+                + (" · Thomas–Middlecoff" if tm else "")
+                + (f" · also {', '.join(extra)} (from the case file)" if extra else "")
+            )
+        else:
+            self.ctl_summary.setText(f"{type(c).__name__} (set in code; not editable here)")
+        borders = dict(c.get("borders", {})) if isinstance(c, Mapping) else {}
+        for name, cb in self.ctl_borders.items():
+            cb.setChecked(name in borders)
+            cb.setEnabled(c is None or isinstance(c, Mapping))
+        sp = [v.get("spacing") for v in borders.values() if isinstance(v, Mapping) and v.get("spacing")]
+        self.ctl_spacing.setText(f"{sp[0]:.6g}" if sp else "")
+        self.ctl_spacing.setStyleSheet("")
+        tm = bool(c.get("thomas-middlecoff", c.get("thomas_middlecoff", False))) if isinstance(c, Mapping) else False
+        self.ctl_tm.setChecked(tm)
+        self.ctl_msg.setText("")
+
+    def _control_edit(self) -> None:
+        if self._updating:
+            return
+        from meshcore.control import control_from_mapping
+
+        old = self.doc.block.control
+        if old is not None and not isinstance(old, Mapping):
+            return
+        self.ctl_spacing.setStyleSheet("")
+        try:
+            spacing = self._number(self.ctl_spacing)
+            if spacing is not None and spacing <= 0:
+                raise ValueError("the first cell height must be positive")
+        except ValueError as exc:
+            self.ctl_spacing.setStyleSheet(_BAD)
+            self.ctl_msg.setText(f"first cell: {exc}")
+            return
+        new = {k: v for k, v in dict(old or {}).items() if k not in ("borders", "thomas_middlecoff")}
+        old_borders = dict((old or {}).get("borders", {}))
+        borders = {}
+        for name, cb in self.ctl_borders.items():
+            if cb.isChecked():
+                entry = dict(old_borders.get(name, {}))
+                entry["angle"] = 90.0
+                if spacing is None:
+                    entry.pop("spacing", None)
+                else:
+                    entry["spacing"] = spacing
+                borders[name] = entry
+        if borders:
+            new["borders"] = borders
+        new["thomas-middlecoff"] = self.ctl_tm.isChecked()
+        if not borders and not new["thomas-middlecoff"] and set(new) <= {"kind", "thomas-middlecoff"}:
+            control = None
+        else:
+            control = new
+            try:
+                control_from_mapping(control)
+            except InvalidInputError as exc:
+                self.ctl_msg.setText(str(exc))
+                return
+        self.ctl_msg.setText("")
+        if control != old:
+            self.editor.set_block_options(control=control)
 
     def _solver(self, **kw) -> None:
         if self._updating:

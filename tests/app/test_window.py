@@ -531,3 +531,38 @@ def test_cut_lines_split_a_channel_into_blocks(qtbot, win):
     assert len(shared) == 4
     win.stack.undo()
     assert win.doc.project is before
+
+
+def test_control_functions_from_the_panel_match_meshcore(qtbot, win):
+    from meshcore import generate_block
+
+    win.open_example("bottle-coarse", confirm=False)
+    pp = win.params_panel
+    pp.ctl_spacing.setText("0.05")
+    pp.ctl_borders["bottom"].setChecked(True)
+    ctl = win.doc.block.control
+    assert ctl["borders"] == {"bottom": {"angle": 90.0, "spacing": 0.05}}
+    win.editor.set_solver(method="sor")
+    win.generate()
+    wait_idle(qtbot, win, timeout=60_000)
+    g = win.doc.grid
+    b = win.doc.block
+    ref = generate_block(
+        loop=np.array(b.points),
+        corners=b.corners,
+        cells=b.cells,
+        weights=b.weights,
+        initial=b.initial,
+        control=ctl,
+        method="sor",
+    )
+    np.testing.assert_array_equal(g.x, ref.x)
+    # the first cell above the bottom is about the requested height and leaves it at right angles
+    d = np.hypot(g.x[1:-1, 1] - g.x[1:-1, 0], g.y[1:-1, 1] - g.y[1:-1, 0])
+    assert np.median(d) == pytest.approx(0.05, rel=0.2)
+    pp.ctl_spacing.setText("-1")
+    pp.ctl_spacing.editingFinished.emit()
+    assert "positive" in pp.ctl_msg.text()
+    win.stack.undo()  # the solver change
+    win.stack.undo()  # the control
+    assert win.doc.block.control is None
