@@ -85,6 +85,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         self.doc = doc
         self.editor = editor
         self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         w = QtWidgets.QWidget()
         self.setWidget(w)
         lay = QtWidgets.QVBoxLayout(w)
@@ -174,19 +175,21 @@ class ParamsPanel(QtWidgets.QScrollArea):
         f = QtWidgets.QFormLayout(g)
         self.ctl_summary = QtWidgets.QLabel(wordWrap=True)
         f.addRow(self.ctl_summary)
-        row = QtWidgets.QHBoxLayout()
+        row = QtWidgets.QGridLayout()
         self.ctl_borders = {}
-        for name in BORDER_NAMES:
+        for k, name in enumerate(BORDER_NAMES):
             cb = QtWidgets.QCheckBox(name)
             cb.setStyleSheet(f"color: {BORDER_COLOURS[name]};")
             cb.toggled.connect(lambda _on: self._control_edit())
-            row.addWidget(cb)
+            row.addWidget(cb, k // 2, k % 2)
             self.ctl_borders[name] = cb
         f.addRow("Orthogonal at", row)
-        self.ctl_spacing = QtWidgets.QLineEdit(placeholderText="first cell height (empty: angle only)")
+        self.ctl_spacing = QtWidgets.QLineEdit(placeholderText="empty: angle only")
+        self.ctl_spacing.setToolTip("first-cell height at the orthogonal borders (model units)")
         self.ctl_spacing.editingFinished.connect(self._control_edit)
         f.addRow("First cell", self.ctl_spacing)
-        self.ctl_tm = QtWidgets.QCheckBox("interior follows the boundary spacing (Thomas–Middlecoff)")
+        self.ctl_tm = QtWidgets.QCheckBox("Thomas–Middlecoff")
+        self.ctl_tm.setToolTip("the interior follows the boundary point spacing")
         self.ctl_tm.toggled.connect(lambda _on: self._control_edit())
         f.addRow(self.ctl_tm)
         self.ctl_msg = QtWidgets.QLabel(wordWrap=True)
