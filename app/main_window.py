@@ -314,7 +314,29 @@ class MainWindow(QtWidgets.QMainWindow):
         text = f"x = {x:.6g}   y = {y:.6g}"
         if p.crs:
             text += f"   ({p.crs}: E {x + p.origin[0]:.1f}  N {y + p.origin[1]:.1f})"
-        self._coords.setText(text)
+        cell = self._cell_readout(x, y)
+        self._coords.setText(f"{cell}   {text}" if cell else text)
+
+    def _cell_readout(self, x: float, y: float) -> str:
+        """The coloured metric of the cell under the cursor (nearest cell centre, if inside it)."""
+        qp = self.quality_panel
+        values, label = qp._values()
+        g = qp._grid
+        if values is None or g is None or self.solver.running:
+            return ""
+        if getattr(self, "_centres_of", None) is not g:
+            self._centres = (
+                0.25 * (g.x[:-1, :-1] + g.x[1:, :-1] + g.x[1:, 1:] + g.x[:-1, 1:]),
+                0.25 * (g.y[:-1, :-1] + g.y[1:, :-1] + g.y[1:, 1:] + g.y[:-1, 1:]),
+            )
+            self._centres_of = g
+        cx, cy = self._centres
+        d = np.hypot(cx - x, cy - y)
+        i, j = np.unravel_index(int(np.argmin(d)), d.shape)
+        size = np.hypot(g.x[i + 1, j + 1] - g.x[i, j], g.y[i + 1, j + 1] - g.y[i, j])
+        if d[i, j] > size:
+            return ""
+        return f"cell ({i}, {j}): {label} {float(values[i, j]):.4g}"
 
     # -------------------------------------------------------------- tools
     def set_tool(self, key: str) -> None:
@@ -611,7 +633,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.doc.set_path(path)
         self.stack.setClean()
         self._add_recent(path)
-        self.message(f"Saved {path}")
+        p = self.doc.project
+        skipped = [b.name for b in p.blocks if not b.ready and (len(b.points) or b.boundary is not None)]
+        note = f" (not saved: {', '.join(skipped)} — no closed loop with corners yet)" if skipped else ""
+        self.message(f"Saved {path}{note}", error=bool(skipped))
         return True
 
     def import_dialog(self) -> None:

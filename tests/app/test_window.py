@@ -566,3 +566,18 @@ def test_control_functions_from_the_panel_match_meshcore(qtbot, win):
     win.stack.undo()  # the solver change
     win.stack.undo()  # the control
     assert win.doc.block.control is None
+
+
+def test_hover_reads_the_coloured_metric(qtbot, win):
+    win.open_example("bottle-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    win.quality_panel.metric.setCurrentText("skewness")
+    g = win.doc.grid
+    cx = 0.25 * (g.x[2, 3] + g.x[3, 3] + g.x[3, 4] + g.x[2, 4])
+    cy = 0.25 * (g.y[2, 3] + g.y[3, 3] + g.y[3, 4] + g.y[2, 4])
+    win._show_coords(cx, cy)
+    skew = win.quality_panel.report.arrays["skewness"][2, 3]
+    assert f"cell (2, 3): skewness {skew:.4g}" in win._coords.text()
+    win._show_coords(1e6, 1e6)  # far outside: no cell
+    assert "cell" not in win._coords.text()
