@@ -334,7 +334,8 @@ def borders_from_polylines(
     prefix = f"{where}: " if where else ""
     raw = {}
     for name, pts in zip(BORDER_NAMES, (bottom, right, top, left), strict=True):
-        raw[name] = validate_points(pts, name=f"{prefix}{name} border", min_points=2)
+        # a private copy: corners are snapped in place below, never in the caller's arrays
+        raw[name] = validate_points(pts, name=f"{prefix}{name} border", min_points=2).copy()
     allp = np.vstack(list(raw.values()))
     size = float(math.hypot(*(allp.max(axis=0) - allp.min(axis=0))))
     if size == 0:

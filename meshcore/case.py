@@ -443,7 +443,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         t.update(b.extra)
         blocks.append(t)
     out.update(case.extra)
-    out["blocks"] = blocks
+    if blocks:
+        out["blocks"] = blocks
     return _clean(out)
 
 

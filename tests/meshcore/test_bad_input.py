@@ -105,3 +105,15 @@ def test_bad_distribution_spec_names_border():
 def test_unknown_solver_method():
     with pytest.raises(InvalidInputError, match="method must be one of"):
         gen(method="newton-krylov-magic")
+
+
+def test_inputs_are_not_modified_and_read_only_inputs_work():
+    b, r, t, l = (a.copy() for a in (B, R, T, L))
+    l[0] += 1e-12  # within the corner tolerance: snapped, but only in meshcore's copy
+    before = [a.copy() for a in (b, r, t, l)]
+    for a in (b, r, t, l):
+        a.setflags(write=False)
+    g = meshcore.generate_block(b, r, t, l)
+    assert g.converged
+    for a, a0 in zip((b, r, t, l), before, strict=True):
+        np.testing.assert_array_equal(a, a0)

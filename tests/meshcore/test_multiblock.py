@@ -813,3 +813,14 @@ def test_multigrid_semi_coarsening_on_stretched_blocks():
     h = [v for _, v in mb.info.residual_history]
     assert mb.converged and len(h) <= 12
     assert max(b / a for a, b in itertools.pairwise(h[1:])) < 0.35
+
+
+def test_outline_case_round_trips_through_save_case(tmp_path):
+    from meshcore.case import load_case, save_case
+    from meshcore.cli.examples import example_path
+
+    c = load_case(example_path("shasta-multiblock-coarse"))
+    assert not c.blocks  # an [outline] case: blocks come from the cuts
+    p = save_case(c, tmp_path / "again.toml")
+    c2 = load_case(p)
+    assert c2.extra.keys() == c.extra.keys()
