@@ -1,0 +1,272 @@
+r"""Nonlinear multigrid (FAS) solver of the elliptic grid equations.
+
+The fine problem is ``N(u) = 0`` with ``N`` the Winslow/TTM operator of
+:mod:`._mg_kernels` (eq. 30, P and Q included, Dirichlet borders).  The
+Full Approximation Scheme keeps the full solution on every level:
+
+.. math::
+
+    N_c(u_c) = N_c(\hat R u) + s\, R\,(f - N(u)),\qquad
+    u \leftarrow u + P\,(u_c - \hat R u),
+
+with ``R̂`` injection (coarse nodes are fine nodes), ``R`` full weighting,
+``P`` bilinear interpolation and ``s = (a b)^2`` for coarsening factors
+``a, b ∈ {1, 2}`` in ξ, η: in index units ``N`` scales like ``h⁴``, and the
+equations are invariant under ``ξ → aξ, η → bη`` when ``P → P/a, Q → Q/b``,
+which is how P, Q are carried to the coarse levels.
+
+Hierarchy: each direction is coarsened (vertex-centred, see
+:func:`._mg_kernels.transfer_tables`) while it has at least
+:data:`MIN_COARSEN_CELLS` cells, so any size works (non-2^k sizes get one
+short coarse interval; a direction that is already short is left alone:
+semi-coarsening).  The coarsest level (≤ 3 cells a side) is solved by many
+Gauss–Seidel sweeps.  Periodic ξ (O-grids, column ``ni`` repeats column 0) is
+carried through every level.
+
+Iteration: a full-multigrid start (solve the coarsest level, interpolate the
+correction up, one cycle per level), then V (or W) cycles until the shared
+stopping rule holds.  The fine defect that a cycle restricts is computed first
+and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
+the convergence check costs nothing extra (a final check with
+:func:`._kernels.jacobi_residual` confirms it).  Cycles are V(``0``, ``POST``)
+after the first pre-smoothing, which is the same sequence of operations as
+V(1, POST−1) repeated.
+
+If the iteration diverges (a residual that grows 1000-fold or is not finite),
+the solver restores the start grid and falls back to SOR.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Generator
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from . import _mg_kernels as K
+from .solver import SolverState, _sor, register_method
+
+__all__ = ["MIN_COARSEN_CELLS", "hierarchy", "multigrid", "multigrid_w"]
+
+#: A direction is coarsened while it has at least this many cells.
+MIN_COARSEN_CELLS = 4
+#: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
+PRE, POST = 1, 2
+#: Sweeps on the coarsest level (at most 3 × 3 cells).
+COARSEST_SWEEPS = 24
+#: Levels with fewer nodes than this use the serial kernels even with threads > 1.
+PARALLEL_MIN_NODES = 8192
+#: FMG levels with more nodes than this yield to the driver (snapshots keep flowing).
+YIELD_NODES = 200_000
+
+_EMPTY = np.zeros((0, 0))
+
+
+def hierarchy(shape: tuple[int, int]) -> list[tuple[int, int]]:
+    """Cell counts ``(ni, nj)`` of every level, finest first."""
+    ni, nj = shape[0] - 1, shape[1] - 1
+    out = [(ni, nj)]
+    while True:
+        ci = ni >= MIN_COARSEN_CELLS
+        cj = nj >= MIN_COARSEN_CELLS
+        if not (ci or cj):
+            return out
+        ni = (ni + 1) // 2 if ci else ni
+        nj = (nj + 1) // 2 if cj else nj
+        out.append((ni, nj))
+
+
+@dataclass(slots=True)
+class _Level:
+    x: np.ndarray
+    y: np.ndarray
+    fx: np.ndarray
+    fy: np.ndarray
+    p: np.ndarray
+    q: np.ndarray
+    rx: np.ndarray | None = None  # defect (fine shape) / coarse-correction scratch
+    ry: np.ndarray | None = None
+    par: bool = False
+    # transfer to the next coarser level
+    ci: np.ndarray | None = None
+    cj: np.ndarray | None = None
+    ri: np.ndarray | None = None
+    rwi: np.ndarray | None = None
+    rj: np.ndarray | None = None
+    rwj: np.ndarray | None = None
+    li: np.ndarray | None = None
+    wli: np.ndarray | None = None
+    lj: np.ndarray | None = None
+    wlj: np.ndarray | None = None
+    scale: float = 1.0
+    pscale: float = 1.0
+    qscale: float = 1.0
+
+
+class _FAS:
+    """Working storage and cycles of one solve."""
+
+    def __init__(self, state: SolverState, gamma: int):
+        self.state = state
+        self.gamma = gamma
+        self.periodic = bool(state.periodic)
+        threads = state.config.threads
+        if threads > 1:
+            numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        cells = hierarchy(state.x.shape)
+        use_pq = state.p.size > 0
+        lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q)
+        self.levels = [lv0]
+        for k in range(1, len(cells)):
+            (ni, nj), (nci, ncj) = cells[k - 1], cells[k]
+            fine = self.levels[-1]
+            a = 2 if nci < ni else 1
+            b = 2 if ncj < nj else 1
+            tab_i = K.transfer_tables(ni, a == 2, self.periodic)
+            fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
+            fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = K.transfer_tables(nj, b == 2, False)
+            fine.scale = float((a * b) ** 2)
+            fine.pscale, fine.qscale = 1.0 / a, 1.0 / b
+            fine.rx = np.empty((ni + 1, nj + 1))
+            fine.ry = np.empty((ni + 1, nj + 1))
+            shp = (nci + 1, ncj + 1)
+            pc = np.empty(shp) if use_pq else _EMPTY
+            qc = np.empty(shp) if use_pq else _EMPTY
+            self.levels.append(
+                _Level(np.empty(shp), np.empty(shp), np.zeros(shp), np.zeros(shp), pc, qc)
+            )
+        last = self.levels[-1]
+        if last.rx is None and len(self.levels) > 1:
+            last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
+            last.ry = np.empty(last.x.shape)
+        for lv in self.levels:
+            lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
+        self.restrict_sources()
+
+    # ------------------------------------------------------------------ pieces
+    def restrict_sources(self) -> None:
+        """Carry P, Q to the coarse levels (injection, scaled by 1/a, 1/b)."""
+        for k in range(1, len(self.levels)):
+            f, c = self.levels[k - 1], self.levels[k]
+            if c.p.size:
+                K.inject(f.p, f.ci, f.cj, c.p)
+                K.inject(f.q, f.ci, f.cj, c.q)
+                if f.pscale != 1.0:
+                    c.p *= f.pscale
+                if f.qscale != 1.0:
+                    c.q *= f.qscale
+
+    def smooth(self, lv: _Level, sweeps: int) -> None:
+        if sweeps > 0:
+            fn = K.smooth_parallel if lv.par else K.smooth
+            fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
+
+    def defect(self, lv: _Level) -> float:
+        fn = K.defect_parallel if lv.par else K.defect
+        return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
+
+    def to_coarse(self, k: int) -> None:
+        """FAS right-hand side of level k+1 from the defect of level k."""
+        f, c = self.levels[k], self.levels[k + 1]
+        K.inject(f.x, f.ci, f.cj, c.x)
+        K.inject(f.y, f.ci, f.cj, c.y)
+        restrict = K.restrict_parallel if c.par else K.restrict
+        restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+        add = K.add_operator_parallel if c.par else K.add_operator
+        add(c.x, c.y, c.p, c.q, self.periodic, c.fx, c.fy)
+
+    def correct(self, k: int) -> None:
+        """``u_k += P(u_{k+1} − R̂ u_k)`` (the coarse level's scratch holds the correction)."""
+        f, c = self.levels[k], self.levels[k + 1]
+        fn = K.prolong_correct_parallel if f.par else K.prolong_correct
+        fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.ci, f.cj, f.li, f.lj, f.wli, f.wlj, self.periodic)
+
+    def cycle(self, k: int, *, have_defect: bool = False) -> None:
+        """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
+        lv = self.levels[k]
+        if k == len(self.levels) - 1:
+            self.smooth(lv, COARSEST_SWEEPS)
+            return
+        if not have_defect:
+            self.smooth(lv, PRE)
+            self.defect(lv)
+        self.to_coarse(k)
+        for _ in range(self.gamma if k + 1 < len(self.levels) - 1 else 1):
+            self.cycle(k + 1)
+        self.correct(k)
+        self.smooth(lv, POST)
+
+
+def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
+    cfg = state.config
+    tol = state.tol_abs
+    mg = _FAS(state, gamma)
+    levels = mg.levels
+    lv0 = levels[0]
+    if len(levels) == 1:  # too small to coarsen: plain Gauss–Seidel/SOR
+        return (yield from _sor(state))
+    backup = (state.x.copy(), state.y.copy())
+    # ----------------------------------------------------- full-multigrid start
+    r0 = state.residual()
+    state.history.append((0, r0))
+    if r0 <= tol:
+        return True
+    for k in range(1, len(levels)):
+        K.inject(levels[k - 1].x, levels[k - 1].ci, levels[k - 1].cj, levels[k].x)
+        K.inject(levels[k - 1].y, levels[k - 1].ci, levels[k - 1].cj, levels[k].y)
+        levels[k].fx[...] = 0.0
+        levels[k].fy[...] = 0.0
+    mg.smooth(levels[-1], COARSEST_SWEEPS)
+    for k in range(len(levels) - 2, 0, -1):
+        mg.correct(k)
+        levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
+        levels[k].fy[...] = 0.0
+        mg.cycle(k)
+        if levels[k].x.size >= YIELD_NODES:
+            yield "tick"
+    mg.correct(0)
+    mg.smooth(lv0, PRE)
+    # ------------------------------------------------------------------ cycles
+    # ``it`` counts finished fine-level cycles; the FMG start counts as the first.
+    best = math.inf
+    for it in range(1, cfg.max_iterations + 1):
+        state.iterations = it
+        r = math.sqrt(mg.defect(lv0))
+        if r <= tol:
+            r = state.residual()
+        state.history.append((it, r))
+        if r <= tol:
+            return True
+        if not math.isfinite(r) or r > 1e3 * min(best, r0):
+            state.x[...] = backup[0]
+            state.y[...] = backup[1]
+            state.message = "multigrid diverged; continued with SOR"
+            state.history.clear()
+            state.iterations = 0
+            return (yield from _sor(state))
+        best = min(best, r)
+        yield "tick"
+        if it == cfg.max_iterations:
+            break
+        if state.sources is not None and state.sources.wants_update(it):
+            state.sources.update(state.x, state.y, state.p, state.q, it)
+            mg.restrict_sources()
+            mg.defect(lv0)
+        mg.cycle(0, have_defect=True)
+    return False
+
+
+def multigrid(state: SolverState) -> Generator[str, None, bool]:
+    """FAS V-cycles with a full-multigrid start (method ``"multigrid"``)."""
+    return (yield from _fas(state, 1))
+
+
+def multigrid_w(state: SolverState) -> Generator[str, None, bool]:
+    """FAS W-cycles with a full-multigrid start (method ``"multigrid-w"``)."""
+    return (yield from _fas(state, 2))
+
+
+register_method("multigrid", multigrid)
+register_method("multigrid-w", multigrid_w)
