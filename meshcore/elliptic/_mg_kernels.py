@@ -334,53 +334,79 @@ prolong_correct = _serial(_prolong_correct)
 prolong_correct_parallel = _par(_prolong_correct)
 
 
-def coarse_indices(n: int, coarsen: bool) -> np.ndarray:
-    """Fine indices of the coarse nodes of a direction with ``n`` cells."""
+def coarse_indices(pos: np.ndarray, coarsen: bool) -> np.ndarray:
+    """Indices of the coarse nodes among nodes at (finest-level) positions ``pos``.
+
+    Both ends are kept; every coarse interval spans one or two intervals of
+    this level, and the coarse nodes are chosen greedily nearest to equal
+    spacing in finest-level units.  So an odd count puts its short interval
+    where equal spacing wants it and coarse levels stay nearly uniform instead
+    of accumulating short intervals at one end.
+    """
+    n = pos.size - 1
     if not coarsen:
         return np.arange(n + 1, dtype=np.int64)
     nc = (n + 1) // 2
-    return np.minimum(2 * np.arange(nc + 1, dtype=np.int64), n)
+    out = np.empty(nc + 1, dtype=np.int64)
+    out[0] = 0
+    k = 0
+    span = float(pos[n] - pos[0])
+    for I in range(1, nc):
+        target = pos[0] + span * I / nc
+        left = nc - I  # coarse intervals still to place after this node
+        cands = [c for c in (k + 1, k + 2) if c <= n and left <= n - c <= 2 * left]
+        k = min(cands, key=lambda c: (abs(pos[c] - target), -c))
+        out[I] = k
+    out[nc] = n
+    return out
 
 
-def transfer_tables(n: int, coarsen: bool, periodic: bool):
-    """Index/weight tables of one direction with ``n`` fine cells.
+def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
+    """Index/weight tables of one direction whose nodes sit at positions ``pos``.
 
-    Returns ``(c, r_idx, r_w, left, w_left)``: ``c[I]`` fine index of coarse
-    node ``I``; ``r_idx, r_w`` ``(nc+1, 3)`` full-weighting restriction
-    stencils (normalised, zero weight = unused); ``left[i], w_left[i]`` the
-    interpolation of fine node ``i`` from coarse ``left[i]`` and ``left[i]+1``.
+    ``pos`` are the nodes' indices on the finest level (so interpolation is
+    linear in the finest index).  Returns ``(c, r_idx, r_w, left, w_left)``:
+    ``c[I]`` the index of coarse node ``I``; ``r_idx, r_w`` ``(nc+1, 3)``
+    full-weighting stencils (the normalised transpose of the interpolation);
+    ``left[i], w_left[i]`` the interpolation of node ``i`` from coarse nodes
+    ``left[i]`` (weight ``w_left``) and ``left[i] + 1`` (weight ``1 − w_left``).
+    With ``periodic`` the last node repeats the first (it is always coarse)
+    and the restriction stencil of coarse node 0 wraps around.
     """
-    c = coarse_indices(n, coarsen)
+    pos = np.asarray(pos, dtype=np.float64)
+    n = pos.size - 1
+    c = coarse_indices(pos, coarsen)
     nc1 = c.size
-    is_coarse = np.zeros(n + 1, dtype=bool)
-    is_coarse[c] = True
+    left = np.zeros(n + 1, dtype=np.int64)
+    w_left = np.ones(n + 1)
+    for I in range(nc1 - 1):
+        a, b = c[I], c[I + 1]
+        for i in range(a, b):
+            left[i] = I
+            w_left[i] = (pos[b] - pos[i]) / (pos[b] - pos[a])
+    left[n] = max(nc1 - 2, 0)
+    w_left[n] = 0.0 if nc1 >= 2 else 1.0
+    # restriction: transpose of the interpolation, normalised per coarse node
     r_idx = np.zeros((nc1, 3), dtype=np.int64)
     r_w = np.zeros((nc1, 3))
+    is_coarse = np.zeros(n + 1, dtype=bool)
+    is_coarse[c] = True
     for I in range(nc1):
         fi = int(c[I])
         r_idx[I] = fi
         r_w[I, 1] = 1.0
-        if coarsen:
-            lo = fi - 1
-            if lo < 0 and periodic:
-                lo = n - 1
-            hi = fi + 1
-            if lo >= 0 and not is_coarse[lo]:
-                r_idx[I, 0] = lo
-                r_w[I, 0] = 0.5
-            if hi <= n and not is_coarse[hi]:
-                r_idx[I, 2] = hi
-                r_w[I, 2] = 0.5
+        if not coarsen:
+            continue
+        lo = fi - 1
+        if lo < 0 and periodic:
+            lo = n - 1
+        hi = fi + 1
+        if lo >= 0 and (I > 0 or periodic) and not is_coarse[lo]:
+            r_idx[I, 0] = lo
+            # weight of coarse node I in the interpolation of node lo
+            r_w[I, 0] = 1.0 - w_left[lo]
+        if hi <= n and not is_coarse[hi]:
+            r_idx[I, 2] = hi
+            r_w[I, 2] = w_left[hi]
         r_w[I] /= r_w[I].sum()
-    left = np.zeros(n + 1, dtype=np.int64)
-    w_left = np.ones(n + 1)
-    pos = np.full(n + 1, -1, dtype=np.int64)
-    pos[c] = np.arange(nc1)
-    for i in range(n + 1):
-        if is_coarse[i] and pos[i] < nc1 - 1:
-            left[i], w_left[i] = pos[i], 1.0
-        elif is_coarse[i]:  # last coarse node: weight 1 on the right neighbour
-            left[i], w_left[i] = pos[i] - 1, 0.0
-        else:
-            left[i], w_left[i] = pos[i - 1], 0.5
     return c, r_idx, r_w, left, w_left

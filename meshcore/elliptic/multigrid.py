@@ -17,10 +17,13 @@ which is how P, Q are carried to the coarse levels.
 
 Hierarchy: each direction is coarsened (vertex-centred, see
 :func:`._mg_kernels.transfer_tables`) while it has at least
-:data:`MIN_COARSEN_CELLS` cells, so any size works (non-2^k sizes get one
-short coarse interval; a direction that is already short is left alone:
-semi-coarsening).  The coarsest level (≤ 3 cells a side) is solved by many
-Gauss–Seidel sweeps.  Periodic ξ (O-grids, column ``ni`` repeats column 0) is
+:data:`MIN_COARSEN_CELLS` cells, so any size works (an odd count gets one
+short coarse interval, placed so that coarse levels stay nearly uniform in
+the finest index).  Where cells are clearly longer in one direction only the
+other direction is coarsened (automatic semi-coarsening, see
+:func:`coarsening`), so the point smoother still smooths.  The coarsest
+level (≤ 3 cells a side) is solved by many Gauss–Seidel sweeps.  Periodic ξ
+(O-grids, column ``ni`` repeats column 0) is
 carried through every level.
 
 Iteration: a full-multigrid start (solve the coarsest level, interpolate the
@@ -28,9 +31,10 @@ correction up, one cycle per level), then V (or W) cycles until the shared
 stopping rule holds.  The fine defect that a cycle restricts is computed first
 and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
 the convergence check costs nothing extra (a final check with
-:func:`._kernels.jacobi_residual` confirms it).  Cycles are V(``0``, ``POST``)
-after the first pre-smoothing, which is the same sequence of operations as
-V(1, POST−1) repeated.
+:func:`._kernels.jacobi_residual` confirms it).  On the finest level a cycle
+is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
+operations as V(1, ``POST`` − 1) repeated); coarse levels use
+V(``PRE``, ``POST``).
 
 If the iteration diverges (a residual that grows 1000-fold or is not finite),
 the solver restores the start grid and falls back to SOR.
@@ -48,13 +52,17 @@ import numpy as np
 from . import _mg_kernels as K
 from .solver import SolverState, _sor, register_method
 
-__all__ = ["MIN_COARSEN_CELLS", "hierarchy", "multigrid", "multigrid_w"]
+__all__ = ["MIN_COARSEN_CELLS", "coarsening", "hierarchy", "multigrid", "multigrid_w"]
 
 #: A direction is coarsened while it has at least this many cells.
 MIN_COARSEN_CELLS = 4
+#: A periodic ξ direction is not coarsened below this many cells.
+MIN_PERIODIC_CELLS = 8
+#: Cells longer than this times their height in one direction: coarsen only the other.
+SEMI_ASPECT = 1.7
 #: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
-PRE, POST = 1, 2
-#: Sweeps on the coarsest level (at most 3 × 3 cells).
+PRE, POST = 1, 3
+#: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
 COARSEST_SWEEPS = 24
 #: Levels with fewer nodes than this use the serial kernels even with threads > 1.
 PARALLEL_MIN_NODES = 8192
@@ -64,18 +72,52 @@ YIELD_NODES = 200_000
 _EMPTY = np.zeros((0, 0))
 
 
-def hierarchy(shape: tuple[int, int]) -> list[tuple[int, int]]:
-    """Cell counts ``(ni, nj)`` of every level, finest first."""
-    ni, nj = shape[0] - 1, shape[1] - 1
-    out = [(ni, nj)]
+def _aspect(x: np.ndarray, y: np.ndarray) -> float:
+    """Typical cell aspect ``|x_ξ| / |x_η|``: the median over the cells."""
+    dxi = np.hypot(np.diff(x, axis=0), np.diff(y, axis=0))
+    det = np.hypot(np.diff(x, axis=1), np.diff(y, axis=1))
+    lxi = 0.5 * (dxi[:, 1:] + dxi[:, :-1])
+    leta = 0.5 * (det[1:, :] + det[:-1, :])
+    ok = (lxi > 0) & (leta > 0)
+    if not ok.any():
+        return 1.0
+    return float(np.exp(np.median(np.log(lxi[ok] / leta[ok]))))
+
+
+def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) -> tuple[bool, bool]:
+    """Which directions to coarsen: both, or only the strongly coupled one.
+
+    Point Gauss–Seidel smooths only along the direction of strong coupling,
+    which is the direction of the *shorter* cell side.  With cells longer than
+    ``SEMI_ASPECT`` × their height in ξ only η is coarsened (and vice versa),
+    which brings the coarse cells back towards aspect 1.  A periodic ξ
+    direction keeps at least :data:`MIN_PERIODIC_CELLS` cells (a ring of
+    three cells is a triangle: its coarse problem says nothing useful).
+    """
+    ci = cells[0] >= (2 * MIN_PERIODIC_CELLS if periodic else MIN_COARSEN_CELLS)
+    cj = cells[1] >= MIN_COARSEN_CELLS
+    if ci and cj:
+        if aspect > SEMI_ASPECT:
+            ci = False
+        elif aspect < 1.0 / SEMI_ASPECT:
+            cj = False
+    return ci, cj
+
+
+def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tuple[int, int]]:
+    """Cell counts ``(ni, nj)`` of every level for the grid ``(x, y)``, finest first."""
+    out = [(x.shape[0] - 1, x.shape[1] - 1)]
+    pi = np.arange(x.shape[0])
+    pj = np.arange(x.shape[1])
     while True:
-        ci = ni >= MIN_COARSEN_CELLS
-        cj = nj >= MIN_COARSEN_CELLS
+        ci, cj = coarsening(out[-1], _aspect(x, y), periodic)
         if not (ci or cj):
             return out
-        ni = (ni + 1) // 2 if ci else ni
-        nj = (nj + 1) // 2 if cj else nj
-        out.append((ni, nj))
+        c_i = K.coarse_indices(pi, ci)
+        c_j = K.coarse_indices(pj, cj)
+        x, y = x[np.ix_(c_i, c_j)], y[np.ix_(c_i, c_j)]
+        pi, pj = pi[c_i], pj[c_j]
+        out.append((x.shape[0] - 1, x.shape[1] - 1))
 
 
 @dataclass(slots=True)
@@ -115,32 +157,41 @@ class _FAS:
         threads = state.config.threads
         if threads > 1:
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-        cells = hierarchy(state.x.shape)
         use_pq = state.p.size > 0
         lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q)
         self.levels = [lv0]
-        for k in range(1, len(cells)):
-            (ni, nj), (nci, ncj) = cells[k - 1], cells[k]
+        pos_i = np.arange(state.x.shape[0])
+        pos_j = np.arange(state.x.shape[1])
+        while True:
             fine = self.levels[-1]
-            a = 2 if nci < ni else 1
-            b = 2 if ncj < nj else 1
-            tab_i = K.transfer_tables(ni, a == 2, self.periodic)
+            ni, nj = fine.x.shape[0] - 1, fine.x.shape[1] - 1
+            ci, cj = coarsening((ni, nj), _aspect(fine.x, fine.y), self.periodic)
+            if not (ci or cj):
+                break
+            tab_i = K.transfer_tables(pos_i, ci, self.periodic)
+            tab_j = K.transfer_tables(pos_j, cj, False)
             fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
-            fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = K.transfer_tables(nj, b == 2, False)
-            fine.scale = float((a * b) ** 2)
+            fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = tab_j
+            pos_i, pos_j = pos_i[fine.ci], pos_j[fine.cj]
+            shp = (fine.ci.size, fine.cj.size)
+            a = ni / (shp[0] - 1)
+            b = nj / (shp[1] - 1)
+            fine.scale = (a * b) ** 2
             fine.pscale, fine.qscale = 1.0 / a, 1.0 / b
-            fine.rx = np.empty((ni + 1, nj + 1))
-            fine.ry = np.empty((ni + 1, nj + 1))
-            shp = (nci + 1, ncj + 1)
+            fine.rx = np.empty(fine.x.shape)
+            fine.ry = np.empty(fine.x.shape)
             pc = np.empty(shp) if use_pq else _EMPTY
             qc = np.empty(shp) if use_pq else _EMPTY
-            self.levels.append(
-                _Level(np.empty(shp), np.empty(shp), np.zeros(shp), np.zeros(shp), pc, qc)
-            )
+            xc, yc = np.empty(shp), np.empty(shp)
+            K.inject(fine.x, fine.ci, fine.cj, xc)  # for the next coarsening decision
+            K.inject(fine.y, fine.ci, fine.cj, yc)
+            self.levels.append(_Level(xc, yc, np.zeros(shp), np.zeros(shp), pc, qc))
         last = self.levels[-1]
         if last.rx is None and len(self.levels) > 1:
             last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
             last.ry = np.empty(last.x.shape)
+        n = max(self.levels[-1].x.shape) - 1
+        self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, 1000))
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
         self.restrict_sources()
@@ -187,7 +238,7 @@ class _FAS:
         """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
         lv = self.levels[k]
         if k == len(self.levels) - 1:
-            self.smooth(lv, COARSEST_SWEEPS)
+            self.smooth(lv, self.coarsest_sweeps)
             return
         if not have_defect:
             self.smooth(lv, PRE)
@@ -218,7 +269,7 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
         K.inject(levels[k - 1].y, levels[k - 1].ci, levels[k - 1].cj, levels[k].y)
         levels[k].fx[...] = 0.0
         levels[k].fy[...] = 0.0
-    mg.smooth(levels[-1], COARSEST_SWEEPS)
+    mg.smooth(levels[-1], mg.coarsest_sweeps)
     for k in range(len(levels) - 2, 0, -1):
         mg.correct(k)
         levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
