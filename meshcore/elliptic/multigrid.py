@@ -71,6 +71,10 @@ YIELD_NODES = 200_000
 
 _EMPTY = np.zeros((0, 0))
 
+#: Diagnostics of the most recent multigrid solve in this process (for benchmarks):
+#: ``levels`` (node shapes), ``node_updates`` (smoother node updates, all levels).
+last_run: dict = {}
+
 
 def _aspect(x: np.ndarray, y: np.ndarray) -> float:
     """Typical cell aspect ``|x_ξ| / |x_η|``: the median over the cells."""
@@ -153,6 +157,7 @@ class _FAS:
     def __init__(self, state: SolverState, gamma: int):
         self.state = state
         self.gamma = gamma
+        self.updates = 0
         self.periodic = bool(state.periodic)
         threads = state.config.threads
         if threads > 1:
@@ -211,6 +216,7 @@ class _FAS:
 
     def smooth(self, lv: _Level, sweeps: int) -> None:
         if sweeps > 0:
+            self.updates += sweeps * lv.x.size
             fn = K.smooth_parallel if lv.par else K.smooth
             fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
 
@@ -251,9 +257,18 @@ class _FAS:
 
 
 def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
+    mg = _FAS(state, gamma)
+    last_run.clear()
+    last_run["levels"] = [lv.x.shape for lv in mg.levels]
+    try:
+        return (yield from _fas_run(state, mg))
+    finally:
+        last_run["node_updates"] = mg.updates
+
+
+def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     cfg = state.config
     tol = state.tol_abs
-    mg = _FAS(state, gamma)
     levels = mg.levels
     lv0 = levels[0]
     if len(levels) == 1:  # too small to coarsen: plain Gauss–Seidel/SOR
