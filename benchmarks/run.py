@@ -188,18 +188,17 @@ def run_numpy(g0, quick, sweeps_model):
         ts.append(time.perf_counter() - t)
     t_sweep = statistics.median(ts)
     nmax = max(x0.shape) - 1
-    if nmax <= (128 if not quick else 64) or nodes <= 1000:
+    if nodes <= (70_000 if not quick else 20_000) or sweeps_model is None:
         sweeps = paper_jacobi.count_sweeps(x0, y0, tol)
-        how = "counted"
-    elif nmax <= 256 and not quick:
-        sweeps = paper_jacobi.count_sweeps(x0, y0, tol)
-        how = "counted (numba)"
+        how = "counted with the same iteration compiled by numba"
     else:
         sweeps = sweeps_model(nmax)
-        how = "model"
+        how = "power law fitted to the counted sweeps of the two largest counted squares"
+    if sweeps < 0:
+        raise RuntimeError("paper iteration did not converge within 2e6 sweeps")
     est = sweeps * t_sweep
     peak = peak_bytes(lambda: paper_jacobi.jacobi_sweep(x0.copy(), y0.copy()))
-    if est <= NUMPY_LIMIT and how == "counted":
+    if est <= NUMPY_LIMIT:
         x, y, k, secs, done = paper_jacobi.solve(x0, y0, tol, max_seconds=2 * NUMPY_LIMIT)
         folded, orth = quality_cols(x, y)
         return Row(time=secs, best=secs, iters=f"{k} sw", fse=k, ns=secs / max(k * nodes, 1) * 1e9,
@@ -484,7 +483,7 @@ def main(argv=None):
         rows = []
         if nodes <= 1e7:
             r = run_numpy(g0, quick, sweeps_model)
-            if name.startswith("wavy") and r.get("note", "").find("model") < 0:
+            if name.startswith("wavy") and "power law" not in r.get("note", ""):
                 counted[n] = r["fse"]
             rows.append(("NumPy Jacobi (paper)", r))
         if n <= (256 if quick else 1024):

@@ -37,7 +37,9 @@ operations as V(1, ``POST`` − 1) repeated); coarse levels use
 V(``PRE``, ``POST``).
 
 If the iteration diverges (a residual that grows 1000-fold or is not finite),
-the solver restores the start grid and falls back to SOR.
+the solver restores the start grid and falls back to SOR; if it stalls (less
+than a factor 2 in 6 cycles, see ``STALL_*``) SOR continues from the current
+grid.  Either way ``info.message`` of the result says so.
 """
 
 from __future__ import annotations
@@ -60,6 +62,11 @@ MIN_COARSEN_CELLS = 4
 MIN_PERIODIC_CELLS = 8
 #: Cells longer than this times their height in one direction: coarsen only the other.
 SEMI_ASPECT = 1.7
+#: Coarsening stops at a level with this many more folded cells (fraction) than its parent.
+MAX_NEW_FOLDED = 0.02
+#: After this many cycles, a residual that fell less than STALL_FACTOR in the last
+#: STALL_WINDOW cycles hands over to SOR (continuing from the current grid).
+STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.5
 #: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
 PRE, POST = 1, 3
 #: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
@@ -108,6 +115,22 @@ def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) ->
     return ci, cj
 
 
+def _folded_fraction(x: np.ndarray, y: np.ndarray) -> float:
+    """Fraction of cells whose signed area (half the diagonals' cross product) is ≤ 0."""
+    d1x, d1y = x[1:, 1:] - x[:-1, :-1], y[1:, 1:] - y[:-1, :-1]
+    d2x, d2y = x[:-1, 1:] - x[1:, :-1], y[:-1, 1:] - y[1:, :-1]
+    return float(np.mean(d1x * d2y - d1y * d2x <= 0.0))
+
+
+def _acceptable(xf, yf, xc, yc) -> bool:
+    """A coarse level must still represent the shape: not (many) more folded cells.
+
+    A ring cut into two cells, say, is a degenerate coarse grid whose FAS
+    correction is noise; coarsening stops before it.
+    """
+    return _folded_fraction(xc, yc) <= _folded_fraction(xf, yf) + MAX_NEW_FOLDED
+
+
 def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tuple[int, int]]:
     """Cell counts ``(ni, nj)`` of every level for the grid ``(x, y)``, finest first."""
     out = [(x.shape[0] - 1, x.shape[1] - 1)]
@@ -119,7 +142,10 @@ def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tupl
             return out
         c_i = K.coarse_indices(pi, ci)
         c_j = K.coarse_indices(pj, cj)
-        x, y = x[np.ix_(c_i, c_j)], y[np.ix_(c_i, c_j)]
+        xc, yc = x[np.ix_(c_i, c_j)], y[np.ix_(c_i, c_j)]
+        if not _acceptable(x, y, xc, yc):
+            return out
+        x, y = xc, yc
         pi, pj = pi[c_i], pj[c_j]
         out.append((x.shape[0] - 1, x.shape[1] - 1))
 
@@ -175,6 +201,9 @@ class _FAS:
                 break
             tab_i = K.transfer_tables(pos_i, ci, self.periodic)
             tab_j = K.transfer_tables(pos_j, cj, False)
+            sel = np.ix_(tab_i[0], tab_j[0])
+            if not _acceptable(fine.x, fine.y, fine.x[sel], fine.y[sel]):
+                break
             fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
             fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = tab_j
             pos_i, pos_j = pos_i[fine.ci], pos_j[fine.cj]
@@ -313,6 +342,11 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
             state.iterations = 0
             return (yield from _sor(state))
         best = min(best, r)
+        if it >= STALL_START and r > STALL_FACTOR * state.history[-1 - STALL_WINDOW][1]:
+            state.message = f"multigrid stalled after {it} cycles; continued with SOR"
+            state.history.clear()
+            state.iterations = 0
+            return (yield from _sor(state))
         yield "tick"
         if it == cfg.max_iterations:
             break

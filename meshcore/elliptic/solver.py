@@ -334,7 +334,7 @@ def iterate(
         msg = "stopped"
         converged = False
     elif converged:
-        msg = "converged"
+        msg = f"converged ({state.message})" if state.message else "converged"
     else:
         msg = state.message or f"not converged after {state.iterations} iterations"
     info = SolveInfo(

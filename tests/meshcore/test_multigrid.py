@@ -349,3 +349,16 @@ def test_max_iterations_caps_the_cycles():
     X, Y = annulus_sector(64, 64)
     g = meshcore.solve(_start(X, Y), method="multigrid", tolerance=1e-15, max_iterations=2)
     assert not g.converged and g.iterations == 2
+
+
+@pytest.mark.parametrize("cells", [(30, 6), (40, 8), (64, 16)])
+def test_full_ring_with_a_fixed_cut_does_not_coarsen_into_a_degenerate_ring(cells):
+    """The paper's doubly connected case: a ring of 2 cells is a folded coarse grid."""
+    t = np.linspace(0.0, -2 * np.pi, 41)
+    cut = np.column_stack([np.linspace(1.0, 3.0, 5), np.zeros(5)])
+    b = meshcore.Borders(bottom=np.column_stack([np.cos(t), np.sin(t)]), right=cut,
+                         top=np.column_stack([3 * np.cos(t), 3 * np.sin(t)]), left=cut)
+    g0 = meshcore.initial_grid(b.resampled(cells), weights=(0.05, 0.0))
+    levels = multigrid.hierarchy(g0.x, g0.y)
+    assert levels[-1][0] >= 4
+    _compare_with_sor(g0)
