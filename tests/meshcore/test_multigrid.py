@@ -360,5 +360,5 @@ def test_full_ring_with_a_fixed_cut_does_not_coarsen_into_a_degenerate_ring(cell
                          top=np.column_stack([3 * np.cos(t), 3 * np.sin(t)]), left=cut)
     g0 = meshcore.initial_grid(b.resampled(cells), weights=(0.05, 0.0))
     levels = multigrid.hierarchy(g0.x, g0.y)
-    assert levels[-1][0] >= 4
+    assert levels[-1][0] >= 3  # 2 cells around would be a folded coarse ring
     _compare_with_sor(g0)
