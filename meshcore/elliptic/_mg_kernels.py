@@ -96,6 +96,88 @@ def _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no
                 y[i, j] = sy / den
 
 
+@njit(cache=True, nogil=True)
+def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragma: no cover
+    """Gauss–Seidel update of row ``i`` for ``j0 ≤ j < j1`` (even j first, then odd)."""
+    for cj in range(2):
+        for j in range(j0 + ((j0 + cj) % 2), j1, 2):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            if den > 0.0:
+                if use_f:
+                    sx += fx[i, j]
+                    sy += fy[i, j]
+                x[i, j] = sx / den
+                y[i, j] = sy / den
+
+
+@njit(cache=True, nogil=True)
+def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cover - compiled
+    """Extra 4-colour Gauss–Seidel sweeps on the nodes within ``width`` of a border.
+
+    Local relaxation where the nonlinearity is strongest (next to curved
+    borders): costs O(n·width) per sweep.  Serial only (it is cheap), so it
+    is the same in serial and threaded solves.
+    """
+    ni1, nj1 = x.shape
+    use_f = fx.size > 0
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    nj = nj1 - 1
+    i0 = 0 if periodic else 1
+    for _ in range(sweeps):
+        for ci in range(2):
+            start = i0 + ((ci - i0) % 2)
+            for i in range(start, ni, 2):
+                if periodic and i == 0 and ni % 2 == 1:
+                    continue
+                iw = i - 1
+                if iw < 0:
+                    iw = ni - 1
+                near = (not periodic) and (i <= width or i >= ni - width)
+                if near or nj <= 2 * width + 2:
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, nj)
+                else:
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, width + 1)
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj - width, nj)
+            if periodic:
+                if ci == 0 and ni % 2 == 1:
+                    if nj <= 2 * width + 2:
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, nj)
+                    else:
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, width + 1)
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1,
+                                     nj - width, nj)
+                for j in range(nj1):
+                    x[ni, j] = x[0, j]
+                    y[ni, j] = y[0, j]
+
+
 def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compiled
     """``sweeps`` in-place 4-colour Gauss–Seidel sweeps of ``N(u) = f``.
 

@@ -38,7 +38,7 @@ V(``PRE``, ``POST``).
 
 If the iteration diverges (a residual that grows 1000-fold or is not finite),
 the solver restores the start grid and falls back to SOR; if it stalls (less
-than a factor 2 in 6 cycles, see ``STALL_*``) SOR continues from the current
+than 10 % in 6 cycles, see ``STALL_*``) SOR continues from the current
 grid.  Either way ``info.message`` of the result says so.
 """
 
@@ -66,9 +66,11 @@ SEMI_ASPECT = 1.7
 MAX_NEW_FOLDED = 0.02
 #: After this many cycles, a residual that fell less than STALL_FACTOR in the last
 #: STALL_WINDOW cycles hands over to SOR (continuing from the current grid).
-STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.5
+STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.9
 #: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
 PRE, POST = 1, 3
+#: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
+BAND_WIDTH, BAND_SWEEPS = 8, 4
 #: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
 COARSEST_SWEEPS = 24
 #: Levels with fewer nodes than this use the serial kernels even with threads > 1.
@@ -249,6 +251,11 @@ class _FAS:
             fn = K.smooth_parallel if lv.par else K.smooth
             fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
 
+    def smooth_band(self, lv: _Level) -> None:
+        if BAND_SWEEPS > 0:
+            K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, BAND_WIDTH,
+                          BAND_SWEEPS)
+
     def defect(self, lv: _Level) -> float:
         fn = K.defect_parallel if lv.par else K.defect
         return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
@@ -283,6 +290,7 @@ class _FAS:
             self.cycle(k + 1)
         self.correct(k)
         self.smooth(lv, POST)
+        self.smooth_band(lv)
 
 
 def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
