@@ -98,9 +98,9 @@ def _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no
 
 @njit(cache=True, nogil=True)
 def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragma: no cover
-    """Gauss–Seidel update of row ``i`` for ``j0 ≤ j < j1`` (even j first, then odd)."""
+    """Gauss–Seidel update of row ``i`` for ``j0 ≤ j < j1`` (odd j first, as in ``_smooth``)."""
     for cj in range(2):
-        for j in range(j0 + ((j0 + cj) % 2), j1, 2):
+        for j in range(j0 + ((1 + cj - j0) % 2), j1, 2):
             xe = x[ie, j]
             xw = x[iw, j]
             xn = x[i, j + 1]
