@@ -19,7 +19,7 @@ displacement of :func:`._kernels.jacobi_residual`).
 
 Ordering.  Gauss–Seidel in the **4-colour** (2×2 parity) order of
 :func:`._kernels.sweep4`, executed as two passes per sweep: all rows of even
-``i`` (in each row first the even-``j`` then the odd-``j`` nodes), then all
+``i`` (in each row first the odd-``j`` then the even-``j`` nodes), then all
 rows of odd ``i``.  Rows of one parity never appear in each other's 9-point
 stencils, so this is the same arithmetic as the 4-colour sweep and the rows of
 a pass are independent: the serial and ``parallel=True`` compilations of each
@@ -416,6 +416,61 @@ prolong_correct = _serial(_prolong_correct)
 prolong_correct_parallel = _par(_prolong_correct)
 
 
+@njit(cache=True, nogil=True)
+def _greedy_coarse(pos, nc):  # pragma: no cover - compiled
+    n = pos.size - 1
+    out = np.empty(nc + 1, dtype=np.int64)
+    out[0] = 0
+    k = 0
+    span = pos[n] - pos[0]
+    for I in range(1, nc):
+        target = pos[0] + span * I / nc
+        left = nc - I  # coarse intervals still to place after this node
+        best = -1
+        best_d = 0.0
+        for c in (k + 2, k + 1):  # prefer the regular step on ties
+            if c <= n and left <= n - c <= 2 * left:
+                d = abs(pos[c] - target)
+                if best < 0 or d < best_d:
+                    best = c
+                    best_d = d
+        k = best
+        out[I] = k
+    out[nc] = n
+    return out
+
+
+@njit(cache=True, nogil=True)
+def cell_stats(x, y, stride):  # pragma: no cover - compiled
+    """``(mean log aspect, folded fraction)`` of the cells of a node array.
+
+    Aspect = length of a cell's ξ side / length of its η side (first sides,
+    sampled every ``stride`` cells in each direction); a cell is folded when
+    the cross product of its diagonals is ≤ 0 (all cells).
+    """
+    ni1, nj1 = x.shape
+    s = 0.0
+    cnt = 0
+    folded = 0
+    for i in range(ni1 - 1):
+        for j in range(nj1 - 1):
+            d1x = x[i + 1, j + 1] - x[i, j]
+            d1y = y[i + 1, j + 1] - y[i, j]
+            d2x = x[i, j + 1] - x[i + 1, j]
+            d2y = y[i, j + 1] - y[i + 1, j]
+            if d1x * d2y - d1y * d2x <= 0.0:
+                folded += 1
+        if i % stride == 0:
+            for j in range(0, nj1 - 1, stride):
+                a2 = (x[i + 1, j] - x[i, j]) ** 2 + (y[i + 1, j] - y[i, j]) ** 2
+                b2 = (x[i, j + 1] - x[i, j]) ** 2 + (y[i, j + 1] - y[i, j]) ** 2
+                if a2 > 0.0 and b2 > 0.0:
+                    s += 0.5 * np.log(a2 / b2)
+                    cnt += 1
+    ncell = (ni1 - 1) * (nj1 - 1)
+    return (s / cnt if cnt else 0.0), folded / max(ncell, 1)
+
+
 def coarse_indices(pos: np.ndarray, coarsen: bool) -> np.ndarray:
     """Indices of the coarse nodes among nodes at (finest-level) positions ``pos``.
 
@@ -429,18 +484,9 @@ def coarse_indices(pos: np.ndarray, coarsen: bool) -> np.ndarray:
     if not coarsen:
         return np.arange(n + 1, dtype=np.int64)
     nc = (n + 1) // 2
-    out = np.empty(nc + 1, dtype=np.int64)
-    out[0] = 0
-    k = 0
-    span = float(pos[n] - pos[0])
-    for I in range(1, nc):
-        target = pos[0] + span * I / nc
-        left = nc - I  # coarse intervals still to place after this node
-        cands = [c for c in (k + 1, k + 2) if c <= n and left <= n - c <= 2 * left]
-        k = min(cands, key=lambda c: (abs(pos[c] - target), -c))
-        out[I] = k
-    out[nc] = n
-    return out
+    if n % 2 == 0 and np.all(np.diff(pos) == pos[1] - pos[0]):
+        return np.arange(0, n + 1, 2, dtype=np.int64)  # uniform and even: every other node
+    return _greedy_coarse(np.asarray(pos, dtype=np.float64), nc)
 
 
 def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
@@ -459,36 +505,32 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
     n = pos.size - 1
     c = coarse_indices(pos, coarsen)
     nc1 = c.size
-    left = np.zeros(n + 1, dtype=np.int64)
-    w_left = np.ones(n + 1)
-    for I in range(nc1 - 1):
-        a, b = c[I], c[I + 1]
-        for i in range(a, b):
-            left[i] = I
-            w_left[i] = (pos[b] - pos[i]) / (pos[b] - pos[a])
-    left[n] = max(nc1 - 2, 0)
-    w_left[n] = 0.0 if nc1 >= 2 else 1.0
-    # restriction: transpose of the interpolation, normalised per coarse node
-    r_idx = np.zeros((nc1, 3), dtype=np.int64)
+    fine = np.arange(n + 1)
+    if nc1 >= 2:
+        left = np.minimum(np.searchsorted(c, fine, side="right") - 1, nc1 - 2)
+        pa, pb = pos[c[left]], pos[c[left + 1]]
+        w_left = (pb - pos) / (pb - pa)
+    else:
+        left = np.zeros(n + 1, dtype=np.int64)
+        w_left = np.ones(n + 1)
+    left = left.astype(np.int64)
+    r_idx = np.repeat(c[:, None], 3, axis=1).astype(np.int64)
     r_w = np.zeros((nc1, 3))
-    is_coarse = np.zeros(n + 1, dtype=bool)
-    is_coarse[c] = True
-    for I in range(nc1):
-        fi = int(c[I])
-        r_idx[I] = fi
-        r_w[I, 1] = 1.0
-        if not coarsen:
-            continue
-        lo = fi - 1
-        if lo < 0 and periodic:
-            lo = n - 1
-        hi = fi + 1
-        if lo >= 0 and (I > 0 or periodic) and not is_coarse[lo]:
-            r_idx[I, 0] = lo
-            # weight of coarse node I in the interpolation of node lo
-            r_w[I, 0] = 1.0 - w_left[lo]
-        if hi <= n and not is_coarse[hi]:
-            r_idx[I, 2] = hi
-            r_w[I, 2] = w_left[hi]
-        r_w[I] /= r_w[I].sum()
+    r_w[:, 1] = 1.0
+    if coarsen:
+        is_coarse = np.zeros(n + 1, dtype=bool)
+        is_coarse[c] = True
+        lo = c - 1
+        if periodic:
+            lo[0] = n - 1
+        ok_lo = (lo >= 0) & ~is_coarse[np.clip(lo, 0, n)]
+        if not periodic:
+            ok_lo[0] = False
+        hi = c + 1
+        ok_hi = (hi <= n) & ~is_coarse[np.clip(hi, 0, n)]
+        r_idx[ok_lo, 0] = lo[ok_lo]
+        r_w[ok_lo, 0] = 1.0 - w_left[lo[ok_lo]]
+        r_idx[ok_hi, 2] = hi[ok_hi]
+        r_w[ok_hi, 2] = w_left[hi[ok_hi]]
+        r_w /= r_w.sum(axis=1, keepdims=True)
     return c, r_idx, r_w, left, w_left
