@@ -46,6 +46,7 @@ from meshcore.elliptic import (  # noqa: E402
     default_tolerance,
     multigrid,
 )
+from meshcore.elliptic.solver import _choose_method  # noqa: E402
 
 NUMPY_LIMIT = 60.0  # seconds: above this the NumPy paper iteration is extrapolated
 
@@ -450,7 +451,7 @@ def main(argv=None):
     emit(f"`python benchmarks/run.py{' --quick' if quick else ''}` on {platform.node()}: "
          f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
          f"Python {platform.python_version()}, numpy {np.__version__}, "
-         f"numba {__import__('numba').__version__} ({_kernels.threading_layer()} after first use), "
+         f"numba {__import__('numba').__version__}, "
          f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}. The machine is shared: timings "
          "are noisy; compare ratios within one run and best-of-N.\n")
     emit("Criterion for every row: largest point-Jacobi displacement of eq. 30 (P = Q = 0) ≤ "
@@ -466,7 +467,8 @@ def main(argv=None):
          f"node-update moves at least 32 bytes (x, y read and written) ⇒ bandwidth bound "
          f"{32 / bw * 1e9:.2f} ns/node-update. Measured 4-colour Gauss–Seidel smoother on "
          f"{513 if quick else 1025}²: {thr['serial']:.2f} ns/node-update serial, "
-         f"{thr['parallel']:.2f} parallel ({__import__('numba').get_num_threads()} threads).\n")
+         f"{thr['parallel']:.2f} parallel ({__import__('numba').get_num_threads()} threads, "
+         f"threading layer {_kernels.threading_layer()}).\n")
 
     paper = [("bottle 6×15", lambda: bottle((6, 15))), ("bottle 12×30", lambda: bottle((12, 30))),
              ("two circles 30×6", lambda: two_circles((30, 6))),
@@ -490,8 +492,10 @@ def main(argv=None):
     emit(HEAD)
     emit(SEP)
     summary = {}
+    cases_shape = {}
     for name, make in cases:
         g0 = make()
+        cases_shape[name] = g0.x.shape
         nodes = g0.x.size
         n = max(g0.x.shape) - 1
         reps = 7 if nodes < 3e4 else (5 if nodes < 3e5 else 3)
@@ -540,7 +544,8 @@ def main(argv=None):
     for case in [c for c, _ in paper]:
         s = summary[case]
         best = min(r["time"] for k, r in s.items() if k.startswith("meshcore") and "time" in r)
-        emit(f"| {case} (auto → {s['meshcore multigrid']['method_used']}) | "
+        auto = _choose_method(meshcore.EllipticConfig(), cases_shape[case])
+        emit(f"| {case} (auto → {auto}) | "
              f"{fmt_time(best)} (best meshcore row) | | ≤ 300 µs | |")
     ws = [(summary[c]["meshcore multigrid"]["time"], int(c.split()[-1][:-1]) ** 2)
           for c in summary if c.startswith("wavy") and int(c.split()[-1][:-1]) >= 129]
