@@ -10,8 +10,9 @@ Full Approximation Scheme keeps the full solution on every level:
     u \leftarrow u + P\,(u_c - \hat R u),
 
 with ``R̂`` injection (coarse nodes are fine nodes), ``R`` full weighting,
-``P`` bilinear interpolation and ``s = (a b)^2`` for coarsening factors
-``a, b ∈ {1, 2}`` in ξ, η: in index units ``N`` scales like ``h⁴``, and the
+``P`` bilinear interpolation (linear in the finest index) and
+``s = (a b)^2`` for coarsening factors ``a, b`` (≈ 1 or 2, the ratio of cell
+counts) in ξ, η: in index units ``N`` scales like ``h⁴``, and the
 equations are invariant under ``ξ → aξ, η → bη`` when ``P → P/a, Q → Q/b``,
 which is how P, Q are carried to the coarse levels.
 
@@ -21,10 +22,11 @@ Hierarchy: each direction is coarsened (vertex-centred, see
 short coarse interval, placed so that coarse levels stay nearly uniform in
 the finest index).  Where cells are clearly longer in one direction only the
 other direction is coarsened (automatic semi-coarsening, see
-:func:`coarsening`), so the point smoother still smooths.  The coarsest
-level (≤ 3 cells a side) is solved by many Gauss–Seidel sweeps.  Periodic ξ
-(O-grids, column ``ni`` repeats column 0) is
-carried through every level.
+:func:`coarsening`), so the point smoother still smooths.  Coarsening stops
+before a level that would fold (e.g. a ring of two cells) and keeps a
+periodic direction at ≥ :data:`MIN_PERIODIC_CELLS` cells.  The coarsest level
+is solved by many Gauss–Seidel sweeps.  Periodic ξ (O-grids, column ``ni``
+repeats column 0) is carried through every level.
 
 Iteration: a full-multigrid start (solve the coarsest level, interpolate the
 correction up, one cycle per level), then V (or W) cycles until the shared
@@ -34,7 +36,9 @@ the convergence check costs nothing extra (a final check with
 :func:`._kernels.jacobi_residual` confirms it).  On the finest level a cycle
 is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
 operations as V(1, ``POST`` − 1) repeated); coarse levels use
-V(``PRE``, ``POST``).
+V(``PRE``, ``POST``).  After post-smoothing, ``BAND_SWEEPS`` extra sweeps
+relax the nodes within ``BAND_WIDTH`` of the borders (local relaxation where
+the nonlinearity next to curved borders is strongest; O(n) work).
 
 If the iteration diverges (a residual that grows 1000-fold or is not finite),
 the solver restores the start grid and falls back to SOR; if it stalls (less
