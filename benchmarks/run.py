@@ -397,7 +397,8 @@ def level_breakdown(g0):
         for k, f in orig.items():
             setattr(F, k, f)
     shapes = multigrid.last_run["levels"]
-    rows = ["| level | nodes | smooth | defect | restrict (+N_c) | prolong | share |", "|---|" * 7]
+    rows = ["| level | nodes | smooth | defect | restrict (+N_c) | prolong | share |",
+            "|" + "---|" * 7]
     for lvl, shp in enumerate(shapes):
         v = [acc.get((lvl, k), 0.0) for k in ("smooth", "defect", "to_coarse", "correct")]
         rows.append(f"| {lvl} | {shp[0]}×{shp[1]} | " + " | ".join(fmt_time(t) for t in v)
