@@ -13,6 +13,7 @@ Equations (paper eqs. 25/26, errata applied):
 α x_ξξ − 2β x_ξη + γ x_ηη + D² (P x_ξ + Q x_η) = 0, same for y.
 """
 
+from . import multigrid as _multigrid  # noqa: F401  (registers "multigrid")
 from .solver import (
     METHODS,
     EllipticConfig,

@@ -1,0 +1,602 @@
+r"""numba kernels of the nonlinear multigrid (FAS) solver (functions only).
+
+Operator.  At an interior node the discrete Winslow/TTM equations (eq. 30,
+errata applied, Δξ = Δη = 1, see :mod:`._kernels`) are written as
+
+.. math::
+
+    N(u)_P = 2(α + γ)\, φ_P - \big[α(φ_E + φ_W) + γ(φ_N + φ_S)
+             - \tfrac{β}{2}(φ_{NE} - φ_{NW} - φ_{SE} + φ_{SW})
+             + D^2 (P φ_ξ + Q φ_η)\big] = f_P,\qquad φ ∈ \{x, y\},
+
+``N = −(α φ_ξξ − 2β φ_ξη + γ φ_ηη + D²(P φ_ξ + Q φ_η))``.  The coefficients
+α, β, γ, D use central differences that do not involve φ_P, so ``N`` is
+*linear in φ_P*: the pointwise nonlinear Gauss–Seidel update is exact,
+``φ_P ← (rhs + f_P) / (2(α + γ))``.  On the finest level ``f = 0``; on
+coarse levels ``f`` is the FAS right-hand side.  The largest ``|N(u)|/den``
+with ``f = 0`` is exactly the shared stopping measure (the point-Jacobi
+displacement of :func:`._kernels.jacobi_residual`).
+
+Ordering.  Gauss–Seidel in the **4-colour** (2×2 parity) order of
+:func:`._kernels.sweep4`, executed as two passes per sweep: all rows of even
+``i`` (in each row first the odd-``j`` then the even-``j`` nodes), then all
+rows of odd ``i``.  Rows of one parity never appear in each other's 9-point
+stencils, so this is the same arithmetic as the 4-colour sweep and the rows of
+a pass are independent: the serial and ``parallel=True`` compilations of each
+function give bit-identical results.  Periodic ξ with an odd number of cells
+(coarse O-grid levels) makes rows ``0`` and ``ni − 1`` neighbours of the same
+parity; row 0 is then updated after the others, in both compilations.
+
+Transfer operators (vertex-centred coarsening, any size).  A coarsened
+direction with ``n`` cells keeps the fine nodes ``min(2I, n)``,
+``I = 0..⌈n/2⌉``; for odd ``n`` the last coarse interval spans one fine cell.
+A fine node is either a coarse node (injection) or the midpoint of two coarse
+nodes (linear interpolation).  Restriction is full weighting, the normalised
+transpose of that interpolation, given to the kernels as 3-point index/weight
+tables per direction (:func:`transfer_tables`), so non-coarsened directions
+(semi-coarsening) and periodic wrap-around need no special code.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+#: Rows at least this long use the vectorised (compute-all, store-half) row update.
+VECTOR_ROW = 192
+#: Rows of one colour are split into at most this many chunks (parallel work units).
+ROW_CHUNKS = 16
+
+__all__ = [
+    "add_operator",
+    "add_operator_parallel",
+    "defect",
+    "defect_parallel",
+    "inject",
+    "prolong_correct",
+    "prolong_correct_parallel",
+    "restrict",
+    "restrict_parallel",
+    "smooth",
+    "smooth_parallel",
+]
+
+
+@njit(cache=True, nogil=True)
+def _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no cover
+    """Gauss–Seidel update of row ``i``: odd ``j`` first, then even ``j`` (stride-2 loops)."""
+    for cj in range(2):
+        for j in range(1 + cj, nj1 - 1, 2):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            if use_f:
+                sx += fx[i, j]
+                sy += fy[i, j]
+            if den > 0.0:
+                x[i, j] = sx / den
+                y[i, j] = sy / den
+
+
+@njit(cache=True, nogil=True)
+def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no cover
+    """:func:`_relax_row` for long rows, same arithmetic per node, so identical results.
+
+    Each half computes the targets of the *whole* row into fresh scratch rows
+    with unit-stride loops (which vectorise; the stride-2 loop does not; the
+    scratch must be local so that LLVM knows it does not alias ``x``) and
+    then stores its own half: twice the arithmetic, less time.
+    """
+    tx = np.empty(nj1)
+    ty = np.empty(nj1)
+    for cj in range(2):
+        for j in range(1, nj1 - 1):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            if use_f:
+                sx += fx[i, j]
+                sy += fy[i, j]
+            ok = den > 0.0
+            tx[j] = sx / den if ok else x[i, j]
+            ty[j] = sy / den if ok else y[i, j]
+        for j in range(1 + cj, nj1 - 1, 2):
+            x[i, j] = tx[j]
+            y[i, j] = ty[j]
+
+
+@njit(cache=True, nogil=True)
+def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragma: no cover
+    """Gauss–Seidel update of row ``i`` for ``j0 ≤ j < j1`` (odd j first, as in ``_smooth``)."""
+    for cj in range(2):
+        for j in range(j0 + ((1 + cj - j0) % 2), j1, 2):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            if use_f:
+                sx += fx[i, j]
+                sy += fy[i, j]
+            if den > 0.0:
+                x[i, j] = sx / den
+                y[i, j] = sy / den
+
+
+@njit(cache=True, nogil=True)
+def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cover - compiled
+    """Extra 4-colour Gauss–Seidel sweeps on the nodes within ``width`` of a border.
+
+    Local relaxation where the nonlinearity is strongest (next to curved
+    borders): costs O(n·width) per sweep.  Serial only (it is cheap), so it
+    is the same in serial and threaded solves.
+    """
+    ni1, nj1 = x.shape
+    use_f = fx.size > 0
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    nj = nj1 - 1
+    i0 = 0 if periodic else 1
+    for _ in range(sweeps):
+        for ci in range(2):
+            start = i0 + ((ci - i0) % 2)
+            for i in range(start, ni, 2):
+                if periodic and i == 0 and ni % 2 == 1:
+                    continue
+                iw = i - 1
+                if iw < 0:
+                    iw = ni - 1
+                near = (not periodic) and (i <= width or i >= ni - width)
+                if near or nj <= 2 * width + 2:
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, nj)
+                else:
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, width + 1)
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj - width, nj)
+            if periodic:
+                if ci == 0 and ni % 2 == 1:
+                    if nj <= 2 * width + 2:
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, nj)
+                    else:
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, width + 1)
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1,
+                                     nj - width, nj)
+                for j in range(nj1):
+                    x[ni, j] = x[0, j]
+                    y[ni, j] = y[0, j]
+
+
+def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compiled
+    """``sweeps`` in-place 4-colour Gauss–Seidel sweeps of ``N(u) = f``.
+
+    ``fx, fy`` (or ``p, q``) may be empty ``(0, 0)`` arrays for zero.
+    """
+    ni1, nj1 = x.shape
+    use_f = fx.size > 0
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    i0 = 0 if periodic else 1
+    # periodic with odd ni: rows 0 and ni-1 are same-parity neighbours
+    late0 = periodic and (ni % 2 == 1)
+    vec = nj1 >= VECTOR_ROW
+    for _ in range(sweeps):
+        for ci in range(2):
+            start = i0 + ((ci - i0) % 2)
+            if late0 and ci == 0:
+                start = 2
+            nrows = (ni - 1 - start) // 2 + 1 if start <= ni - 1 else 0
+            nchunks = min(nrows, ROW_CHUNKS)
+            for c in prange(nchunks):
+                for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
+                    i = start + 2 * k
+                    iw = i - 1
+                    if iw < 0:
+                        iw = ni - 1
+                    if vec:
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
+                    else:
+                        _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
+            if periodic:
+                if late0 and ci == 0:
+                    if vec:
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
+                    else:
+                        _relax_row(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
+                for j in range(nj1):
+                    x[ni, j] = x[0, j]
+                    y[ni, j] = y[0, j]
+
+
+def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
+    """``r = f − N(u)`` at interior nodes (0 on the boundary); returns max (|f−N|/den)².
+
+    With ``f = 0`` the square root of the return value is the stopping measure.
+    """
+    ni1, nj1 = x.shape
+    use_f = fx.size > 0
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    i0 = 0 if periodic else 1
+    row_max = np.zeros(ni1)
+    for i in prange(ni1):
+        if i < i0 or i >= ni:
+            for j in range(nj1):
+                rx[i, j] = 0.0
+                ry[i, j] = 0.0
+            continue
+        iw = i - 1
+        if iw < 0:
+            iw = ni - 1
+        ie = i + 1
+        m = 0.0
+        rx[i, 0] = 0.0
+        ry[i, 0] = 0.0
+        rx[i, nj1 - 1] = 0.0
+        ry[i, nj1 - 1] = 0.0
+        for j in range(1, nj1 - 1):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            dx = sx - den * x[i, j]
+            dy = sy - den * y[i, j]
+            if use_f:
+                dx += fx[i, j]
+                dy += fy[i, j]
+            rx[i, j] = dx
+            ry[i, j] = dy
+            if den > 0.0:
+                v = (dx * dx + dy * dy) / (den * den)
+                if v > m:
+                    m = v
+        row_max[i] = m
+    if periodic:
+        for j in range(nj1):
+            rx[ni, j] = rx[0, j]
+            ry[ni, j] = ry[0, j]
+    return row_max.max()
+
+
+def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
+    """``f += N(u)`` at interior nodes (the FAS coarse right-hand side)."""
+    ni1, nj1 = x.shape
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    i0 = 0 if periodic else 1
+    for i in prange(i0, ni):
+        iw = i - 1
+        if iw < 0:
+            iw = ni - 1
+        ie = i + 1
+        for j in range(1, nj1 - 1):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            fx[i, j] += den * x[i, j] - sx
+            fy[i, j] += den * y[i, j] - sy
+    if periodic:
+        for j in range(nj1):
+            fx[ni, j] = fx[0, j]
+            fy[ni, j] = fy[0, j]
+
+
+def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - compiled
+    """Full weighting ``f[I, J] = scale · Σ_ab wi[I,a] wj[J,b] r[ii[I,a], jj[J,b]]``.
+
+    ``ii, wi`` are ``(nI, 3)`` index/weight tables (see :func:`transfer_tables`).
+    """
+    nI = fx.shape[0]
+    nJ = fx.shape[1]
+    for I in prange(nI):
+        for J in range(nJ):
+            sx = 0.0
+            sy = 0.0
+            for a in range(3):
+                w_a = wi[I, a]
+                ia = ii[I, a]
+                for b in range(3):
+                    w = w_a * wj[J, b]
+                    jb = jj[J, b]
+                    sx += w * rx[ia, jb]
+                    sy += w * ry[ia, jb]
+            fx[I, J] = scale * sx
+            fy[I, J] = scale * sy
+
+
+def _prolong_correct(x, y, xc, yc, ex, ey, ci, cj, li, lj, wli, wlj, periodic):  # pragma: no cover
+    """``u += P(u_c − û)`` with ``û`` = injection of the fine ``u`` at the coarse nodes.
+
+    ``ci, cj`` map coarse to fine indices; ``li[i]`` is the left coarse
+    neighbour of fine ``i`` with weight ``wli[i]`` (the right one is ``li+1``
+    with ``1 − wli``; both are always valid indices).
+    ``ex, ey`` (coarse shape) receive the coarse correction.  Only unknowns
+    change (the correction vanishes on the boundary); with periodic ξ row 0
+    is an unknown and row ``ni`` is refreshed from it.
+    """
+    nI, nJ = xc.shape
+    ni1, nj1 = x.shape
+    for I in prange(nI):
+        fi = ci[I]
+        for J in range(nJ):
+            fj = cj[J]
+            ex[I, J] = xc[I, J] - x[fi, fj]
+            ey[I, J] = yc[I, J] - y[fi, fj]
+    i0 = 0 if periodic else 1
+    for i in prange(i0, ni1 - 1):
+        a = li[i]
+        wa = wli[i]
+        wb = 1.0 - wa
+        for j in range(1, nj1 - 1):
+            b = lj[j]
+            wc = wlj[j]
+            wd = 1.0 - wc
+            vx = wa * (wc * ex[a, b] + wd * ex[a, b + 1])
+            vx += wb * (wc * ex[a + 1, b] + wd * ex[a + 1, b + 1])
+            vy = wa * (wc * ey[a, b] + wd * ey[a, b + 1])
+            vy += wb * (wc * ey[a + 1, b] + wd * ey[a + 1, b + 1])
+            x[i, j] += vx
+            y[i, j] += vy
+    if periodic:
+        for j in range(nj1):
+            x[ni1 - 1, j] = x[0, j]
+            y[ni1 - 1, j] = y[0, j]
+
+
+@njit(cache=True, nogil=True)
+def inject(x, ci, cj, out):  # pragma: no cover - compiled
+    """``out[I, J] = x[ci[I], cj[J]]`` (coarse nodes are fine nodes)."""
+    for I in range(out.shape[0]):
+        fi = ci[I]
+        for J in range(out.shape[1]):
+            out[I, J] = x[fi, cj[J]]
+
+
+_serial = njit(cache=True, nogil=True)
+_par = njit(cache=True, nogil=True, parallel=True)
+
+smooth = _serial(_smooth)
+smooth_parallel = _par(_smooth)
+defect = _serial(_defect)
+defect_parallel = _par(_defect)
+add_operator = _serial(_add_operator)
+add_operator_parallel = _par(_add_operator)
+restrict = _serial(_restrict)
+restrict_parallel = _par(_restrict)
+prolong_correct = _serial(_prolong_correct)
+prolong_correct_parallel = _par(_prolong_correct)
+
+
+@njit(cache=True, nogil=True)
+def _greedy_coarse(pos, nc):  # pragma: no cover - compiled
+    n = pos.size - 1
+    out = np.empty(nc + 1, dtype=np.int64)
+    out[0] = 0
+    k = 0
+    span = pos[n] - pos[0]
+    for I in range(1, nc):
+        target = pos[0] + span * I / nc
+        left = nc - I  # coarse intervals still to place after this node
+        best = -1
+        best_d = 0.0
+        for c in (k + 2, k + 1):  # prefer the regular step on ties
+            if c <= n and left <= n - c <= 2 * left:
+                d = abs(pos[c] - target)
+                if best < 0 or d < best_d:
+                    best = c
+                    best_d = d
+        k = best
+        out[I] = k
+    out[nc] = n
+    return out
+
+
+@njit(cache=True, nogil=True)
+def cell_stats(x, y, stride):  # pragma: no cover - compiled
+    """``(mean log aspect, folded fraction)`` of the cells of a node array.
+
+    Aspect = length of a cell's ξ side / length of its η side (first sides,
+    sampled every ``stride`` cells in each direction); a cell is folded when
+    the cross product of its diagonals is ≤ 0 (all cells).
+    """
+    ni1, nj1 = x.shape
+    s = 0.0
+    cnt = 0
+    folded = 0
+    for i in range(ni1 - 1):
+        for j in range(nj1 - 1):
+            d1x = x[i + 1, j + 1] - x[i, j]
+            d1y = y[i + 1, j + 1] - y[i, j]
+            d2x = x[i, j + 1] - x[i + 1, j]
+            d2y = y[i, j + 1] - y[i + 1, j]
+            if d1x * d2y - d1y * d2x <= 0.0:
+                folded += 1
+        if i % stride == 0:
+            for j in range(0, nj1 - 1, stride):
+                a2 = (x[i + 1, j] - x[i, j]) ** 2 + (y[i + 1, j] - y[i, j]) ** 2
+                b2 = (x[i, j + 1] - x[i, j]) ** 2 + (y[i, j + 1] - y[i, j]) ** 2
+                if a2 > 0.0 and b2 > 0.0:
+                    s += 0.5 * np.log(a2 / b2)
+                    cnt += 1
+    ncell = (ni1 - 1) * (nj1 - 1)
+    return (s / cnt if cnt else 0.0), folded / max(ncell, 1)
+
+
+def coarse_indices(pos: np.ndarray, coarsen: bool) -> np.ndarray:
+    """Indices of the coarse nodes among nodes at (finest-level) positions ``pos``.
+
+    Both ends are kept; every coarse interval spans one or two intervals of
+    this level, and the coarse nodes are chosen greedily nearest to equal
+    spacing in finest-level units.  So an odd count puts its short interval
+    where equal spacing wants it and coarse levels stay nearly uniform instead
+    of accumulating short intervals at one end.
+    """
+    n = pos.size - 1
+    if not coarsen:
+        return np.arange(n + 1, dtype=np.int64)
+    nc = (n + 1) // 2
+    if n % 2 == 0 and np.all(np.diff(pos) == pos[1] - pos[0]):
+        return np.arange(0, n + 1, 2, dtype=np.int64)  # uniform and even: every other node
+    return _greedy_coarse(np.asarray(pos, dtype=np.float64), nc)
+
+
+def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
+    """Index/weight tables of one direction whose nodes sit at positions ``pos``.
+
+    ``pos`` are the nodes' indices on the finest level (so interpolation is
+    linear in the finest index).  Returns ``(c, r_idx, r_w, left, w_left)``:
+    ``c[I]`` the index of coarse node ``I``; ``r_idx, r_w`` ``(nc+1, 3)``
+    full-weighting stencils (the normalised transpose of the interpolation);
+    ``left[i], w_left[i]`` the interpolation of node ``i`` from coarse nodes
+    ``left[i]`` (weight ``w_left``) and ``left[i] + 1`` (weight ``1 − w_left``).
+    With ``periodic`` the last node repeats the first (it is always coarse)
+    and the restriction stencil of coarse node 0 wraps around.
+    """
+    pos = np.asarray(pos, dtype=np.float64)
+    n = pos.size - 1
+    c = coarse_indices(pos, coarsen)
+    nc1 = c.size
+    fine = np.arange(n + 1)
+    if nc1 >= 2:
+        left = np.minimum(np.searchsorted(c, fine, side="right") - 1, nc1 - 2)
+        pa, pb = pos[c[left]], pos[c[left + 1]]
+        w_left = (pb - pos) / (pb - pa)
+    else:
+        left = np.zeros(n + 1, dtype=np.int64)
+        w_left = np.ones(n + 1)
+    left = left.astype(np.int64)
+    r_idx = np.repeat(c[:, None], 3, axis=1).astype(np.int64)
+    r_w = np.zeros((nc1, 3))
+    r_w[:, 1] = 1.0
+    if coarsen:
+        is_coarse = np.zeros(n + 1, dtype=bool)
+        is_coarse[c] = True
+        lo = c - 1
+        if periodic:
+            lo[0] = n - 1
+        ok_lo = (lo >= 0) & ~is_coarse[np.clip(lo, 0, n)]
+        if not periodic:
+            ok_lo[0] = False
+        hi = c + 1
+        ok_hi = (hi <= n) & ~is_coarse[np.clip(hi, 0, n)]
+        r_idx[ok_lo, 0] = lo[ok_lo]
+        r_w[ok_lo, 0] = 1.0 - w_left[lo[ok_lo]]
+        r_idx[ok_hi, 2] = hi[ok_hi]
+        r_w[ok_hi, 2] = w_left[hi[ok_hi]]
+        r_w /= r_w.sum(axis=1, keepdims=True)
+    return c, r_idx, r_w, left, w_left

@@ -1,0 +1,378 @@
+r"""Nonlinear multigrid (FAS) solver of the elliptic grid equations.
+
+The fine problem is ``N(u) = 0`` with ``N`` the Winslow/TTM operator of
+:mod:`._mg_kernels` (eq. 30, P and Q included, Dirichlet borders).  The
+Full Approximation Scheme keeps the full solution on every level:
+
+.. math::
+
+    N_c(u_c) = N_c(\hat R u) + s\, R\,(f - N(u)),\qquad
+    u \leftarrow u + P\,(u_c - \hat R u),
+
+with ``R̂`` injection (coarse nodes are fine nodes), ``R`` full weighting,
+``P`` bilinear interpolation (linear in the finest index) and
+``s = (a b)^2`` for coarsening factors ``a, b`` (≈ 1 or 2, the ratio of cell
+counts) in ξ, η: in index units ``N`` scales like ``h⁴``, and the
+equations are invariant under ``ξ → aξ, η → bη`` when ``P → P/a, Q → Q/b``,
+which is how P, Q are carried to the coarse levels.
+
+Hierarchy: each direction is coarsened (vertex-centred, see
+:func:`._mg_kernels.transfer_tables`) while it has at least
+:data:`MIN_COARSEN_CELLS` cells, so any size works (an odd count gets one
+short coarse interval, placed so that coarse levels stay nearly uniform in
+the finest index).  Where cells are clearly longer in one direction only the
+other direction is coarsened (automatic semi-coarsening, see
+:func:`coarsening`), so the point smoother still smooths.  Coarsening stops
+before a level that would fold (e.g. a ring of two cells) and keeps a
+periodic direction at ≥ :data:`MIN_PERIODIC_CELLS` cells.  The coarsest level
+is solved by many Gauss–Seidel sweeps.  Periodic ξ (O-grids, column ``ni``
+repeats column 0) is carried through every level.
+
+Iteration: a full-multigrid start (solve the coarsest level, interpolate the
+correction up, one cycle per level), then V (or W) cycles until the shared
+stopping rule holds.  The fine defect that a cycle restricts is computed first
+and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
+the convergence check costs nothing extra (a final check with
+:func:`._kernels.jacobi_residual` confirms it).  On the finest level a cycle
+is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
+operations as V(1, ``POST`` − 1) repeated); coarse levels use
+V(``PRE``, ``POST``).  After post-smoothing, ``BAND_SWEEPS`` extra sweeps
+relax the nodes within ``BAND_WIDTH`` of the borders (local relaxation where
+the nonlinearity next to curved borders is strongest; O(n) work).
+
+If the iteration diverges (a residual that grows 1000-fold or is not finite),
+the solver restores the start grid and falls back to SOR; if it stalls (less
+than 10 % in 6 cycles, see ``STALL_*``) SOR continues from the current
+grid.  Either way ``info.message`` of the result says so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Generator
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from . import _mg_kernels as K
+from .solver import SolverState, _sor, _sources_settled, register_method
+
+__all__ = ["MIN_COARSEN_CELLS", "coarsening", "hierarchy", "multigrid", "multigrid_w"]
+
+#: A direction is coarsened while it has at least this many cells.
+MIN_COARSEN_CELLS = 4
+#: A periodic ξ direction is not coarsened below this many cells.
+MIN_PERIODIC_CELLS = 8
+#: Cells longer than this times their height in one direction: coarsen only the other.
+SEMI_ASPECT = 1.7
+#: Coarsening stops at a level with this many more folded cells (fraction) than its parent.
+MAX_NEW_FOLDED = 0.02
+#: After this many cycles, a residual that fell less than STALL_FACTOR in the last
+#: STALL_WINDOW cycles hands over to SOR (continuing from the current grid).
+STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.9
+#: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
+PRE, POST = 1, 3
+#: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
+BAND_WIDTH, BAND_SWEEPS = 8, 4
+#: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
+COARSEST_SWEEPS = 24
+#: Levels with fewer nodes than this use the serial kernels even with threads > 1.
+PARALLEL_MIN_NODES = 8192
+#: FMG levels with more nodes than this yield to the driver (snapshots keep flowing).
+YIELD_NODES = 200_000
+
+_EMPTY = np.zeros((0, 0))
+
+#: Diagnostics of the most recent multigrid solve in this process (for benchmarks):
+#: ``levels`` (node shapes), ``node_updates`` (smoother node updates, all levels).
+last_run: dict = {}
+
+
+def _aspect(x: np.ndarray, y: np.ndarray) -> float:
+    """Typical cell aspect ``|x_ξ| / |x_η|`` (geometric mean over the cells)."""
+    stride = max(1, max(x.shape) // 64)
+    return float(np.exp(K.cell_stats(x, y, stride)[0]))
+
+
+def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) -> tuple[bool, bool]:
+    """Which directions to coarsen: both, or only the strongly coupled one.
+
+    Point Gauss–Seidel smooths only along the direction of strong coupling,
+    which is the direction of the *shorter* cell side.  With cells longer than
+    ``SEMI_ASPECT`` × their height in ξ only η is coarsened (and vice versa),
+    which brings the coarse cells back towards aspect 1.  A periodic ξ
+    direction keeps at least :data:`MIN_PERIODIC_CELLS` cells (a ring of
+    three cells is a triangle: its coarse problem says nothing useful).
+    """
+    ci = cells[0] >= (2 * MIN_PERIODIC_CELLS if periodic else MIN_COARSEN_CELLS)
+    cj = cells[1] >= MIN_COARSEN_CELLS
+    if ci and cj:
+        if aspect > SEMI_ASPECT:
+            ci = False
+        elif aspect < 1.0 / SEMI_ASPECT:
+            cj = False
+    return ci, cj
+
+
+def _folded_fraction(x: np.ndarray, y: np.ndarray) -> float:
+    """Fraction of cells whose diagonals' cross product is ≤ 0."""
+    return float(K.cell_stats(x, y, max(x.shape))[1])
+
+
+def _acceptable(xf, yf, xc, yc) -> bool:
+    """A coarse level must still represent the shape: not (many) more folded cells.
+
+    A ring cut into two cells, say, is a degenerate coarse grid whose FAS
+    correction is noise; coarsening stops before it.
+    """
+    return _folded_fraction(xc, yc) <= _folded_fraction(xf, yf) + MAX_NEW_FOLDED
+
+
+def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tuple[int, int]]:
+    """Cell counts ``(ni, nj)`` of every level for the grid ``(x, y)``, finest first."""
+    out = [(x.shape[0] - 1, x.shape[1] - 1)]
+    pi = np.arange(x.shape[0])
+    pj = np.arange(x.shape[1])
+    while True:
+        ci, cj = coarsening(out[-1], _aspect(x, y), periodic)
+        if not (ci or cj):
+            return out
+        c_i = K.coarse_indices(pi, ci)
+        c_j = K.coarse_indices(pj, cj)
+        xc, yc = x[np.ix_(c_i, c_j)], y[np.ix_(c_i, c_j)]
+        if not _acceptable(x, y, xc, yc):
+            return out
+        x, y = xc, yc
+        pi, pj = pi[c_i], pj[c_j]
+        out.append((x.shape[0] - 1, x.shape[1] - 1))
+
+
+@dataclass(slots=True)
+class _Level:
+    x: np.ndarray
+    y: np.ndarray
+    fx: np.ndarray
+    fy: np.ndarray
+    p: np.ndarray
+    q: np.ndarray
+    rx: np.ndarray | None = None  # defect (fine shape) / coarse-correction scratch
+    ry: np.ndarray | None = None
+    par: bool = False
+    # transfer to the next coarser level
+    ci: np.ndarray | None = None
+    cj: np.ndarray | None = None
+    ri: np.ndarray | None = None
+    rwi: np.ndarray | None = None
+    rj: np.ndarray | None = None
+    rwj: np.ndarray | None = None
+    li: np.ndarray | None = None
+    wli: np.ndarray | None = None
+    lj: np.ndarray | None = None
+    wlj: np.ndarray | None = None
+    scale: float = 1.0
+    pscale: float = 1.0
+    qscale: float = 1.0
+
+
+class _FAS:
+    """Working storage and cycles of one solve."""
+
+    def __init__(self, state: SolverState, gamma: int):
+        self.state = state
+        self.gamma = gamma
+        self.updates = 0
+        self.periodic = bool(state.periodic)
+        threads = state.config.threads
+        if threads > 1:
+            numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        use_pq = state.p.size > 0
+        lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q)
+        self.levels = [lv0]
+        pos_i = np.arange(state.x.shape[0])
+        pos_j = np.arange(state.x.shape[1])
+        while True:
+            fine = self.levels[-1]
+            ni, nj = fine.x.shape[0] - 1, fine.x.shape[1] - 1
+            ci, cj = coarsening((ni, nj), _aspect(fine.x, fine.y), self.periodic)
+            if not (ci or cj):
+                break
+            tab_i = K.transfer_tables(pos_i, ci, self.periodic)
+            tab_j = K.transfer_tables(pos_j, cj, False)
+            sel = np.ix_(tab_i[0], tab_j[0])
+            if not _acceptable(fine.x, fine.y, fine.x[sel], fine.y[sel]):
+                break
+            fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
+            fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = tab_j
+            pos_i, pos_j = pos_i[fine.ci], pos_j[fine.cj]
+            shp = (fine.ci.size, fine.cj.size)
+            a = ni / (shp[0] - 1)
+            b = nj / (shp[1] - 1)
+            fine.scale = (a * b) ** 2
+            fine.pscale, fine.qscale = 1.0 / a, 1.0 / b
+            fine.rx = np.empty(fine.x.shape)
+            fine.ry = np.empty(fine.x.shape)
+            pc = np.empty(shp) if use_pq else _EMPTY
+            qc = np.empty(shp) if use_pq else _EMPTY
+            xc, yc = np.empty(shp), np.empty(shp)
+            K.inject(fine.x, fine.ci, fine.cj, xc)  # for the next coarsening decision
+            K.inject(fine.y, fine.ci, fine.cj, yc)
+            self.levels.append(_Level(xc, yc, np.zeros(shp), np.zeros(shp), pc, qc))
+        last = self.levels[-1]
+        if last.rx is None and len(self.levels) > 1:
+            last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
+            last.ry = np.empty(last.x.shape)
+        n = max(self.levels[-1].x.shape) - 1
+        self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, 1000))
+        for lv in self.levels:
+            lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
+        self.restrict_sources()
+
+    # ------------------------------------------------------------------ pieces
+    def restrict_sources(self) -> None:
+        """Carry P, Q to the coarse levels (injection, scaled by 1/a, 1/b)."""
+        for k in range(1, len(self.levels)):
+            f, c = self.levels[k - 1], self.levels[k]
+            if c.p.size:
+                K.inject(f.p, f.ci, f.cj, c.p)
+                K.inject(f.q, f.ci, f.cj, c.q)
+                if f.pscale != 1.0:
+                    c.p *= f.pscale
+                if f.qscale != 1.0:
+                    c.q *= f.qscale
+
+    def smooth(self, lv: _Level, sweeps: int) -> None:
+        if sweeps > 0:
+            self.updates += sweeps * lv.x.size
+            fn = K.smooth_parallel if lv.par else K.smooth
+            fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
+
+    def smooth_band(self, lv: _Level) -> None:
+        if BAND_SWEEPS > 0:
+            K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, BAND_WIDTH,
+                          BAND_SWEEPS)
+
+    def defect(self, lv: _Level) -> float:
+        fn = K.defect_parallel if lv.par else K.defect
+        return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
+
+    def to_coarse(self, k: int) -> None:
+        """FAS right-hand side of level k+1 from the defect of level k."""
+        f, c = self.levels[k], self.levels[k + 1]
+        K.inject(f.x, f.ci, f.cj, c.x)
+        K.inject(f.y, f.ci, f.cj, c.y)
+        restrict = K.restrict_parallel if c.par else K.restrict
+        restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+        add = K.add_operator_parallel if c.par else K.add_operator
+        add(c.x, c.y, c.p, c.q, self.periodic, c.fx, c.fy)
+
+    def correct(self, k: int) -> None:
+        """``u_k += P(u_{k+1} − R̂ u_k)`` (the coarse level's scratch holds the correction)."""
+        f, c = self.levels[k], self.levels[k + 1]
+        fn = K.prolong_correct_parallel if f.par else K.prolong_correct
+        fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.ci, f.cj, f.li, f.lj, f.wli, f.wlj, self.periodic)
+
+    def cycle(self, k: int, *, have_defect: bool = False) -> None:
+        """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
+        lv = self.levels[k]
+        if k == len(self.levels) - 1:
+            self.smooth(lv, self.coarsest_sweeps)
+            return
+        if not have_defect:
+            self.smooth(lv, PRE)
+            self.defect(lv)
+        self.to_coarse(k)
+        for _ in range(self.gamma if k + 1 < len(self.levels) - 1 else 1):
+            self.cycle(k + 1)
+        self.correct(k)
+        self.smooth(lv, POST)
+        self.smooth_band(lv)
+
+
+def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
+    mg = _FAS(state, gamma)
+    last_run.clear()
+    last_run["levels"] = [lv.x.shape for lv in mg.levels]
+    try:
+        return (yield from _fas_run(state, mg))
+    finally:
+        last_run["node_updates"] = mg.updates
+
+
+def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
+    cfg = state.config
+    tol = state.tol_abs
+    levels = mg.levels
+    lv0 = levels[0]
+    if len(levels) == 1:  # too small to coarsen: plain Gauss–Seidel/SOR
+        return (yield from _sor(state))
+    backup = (state.x.copy(), state.y.copy())
+    # ----------------------------------------------------- full-multigrid start
+    r0 = math.sqrt(mg.defect(lv0))  # the stopping measure (see the module docstring)
+    if r0 <= tol:
+        r0 = state.residual()
+    state.history.append((0, r0))
+    if r0 <= tol:
+        return True
+    for k in range(1, len(levels)):
+        K.inject(levels[k - 1].x, levels[k - 1].ci, levels[k - 1].cj, levels[k].x)
+        K.inject(levels[k - 1].y, levels[k - 1].ci, levels[k - 1].cj, levels[k].y)
+        levels[k].fx[...] = 0.0
+        levels[k].fy[...] = 0.0
+    mg.smooth(levels[-1], mg.coarsest_sweeps)
+    for k in range(len(levels) - 2, 0, -1):
+        mg.correct(k)
+        levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
+        levels[k].fy[...] = 0.0
+        mg.cycle(k)
+        if levels[k].x.size >= YIELD_NODES:
+            yield "tick"
+    mg.correct(0)
+    mg.smooth(lv0, PRE)
+    # ------------------------------------------------------------------ cycles
+    # ``it`` counts finished fine-level cycles; the FMG start counts as the first.
+    best = math.inf
+    for it in range(1, cfg.max_iterations + 1):
+        state.iterations = it
+        r = math.sqrt(mg.defect(lv0))
+        if r <= tol:
+            r = state.residual()
+        state.history.append((it, r))
+        if r <= tol and _sources_settled(state):
+            return True
+        if not math.isfinite(r) or r > 1e3 * max(min(best, r0), tol if state.sources is not None else 0.0):
+            state.x[...] = backup[0]
+            state.y[...] = backup[1]
+            state.message = "multigrid diverged; continued with SOR"
+            state.history.clear()
+            state.iterations = 0
+            return (yield from _sor(state))
+        best = min(best, r)
+        if it >= STALL_START and r > STALL_FACTOR * state.history[-1 - STALL_WINDOW][1]:
+            state.message = f"multigrid stalled after {it} cycles; continued with SOR"
+            state.history.clear()
+            state.iterations = 0
+            return (yield from _sor(state))
+        yield "tick"
+        if it == cfg.max_iterations:
+            break
+        if state.sources is not None and state.sources.wants_update(it):
+            state.sources.update(state.x, state.y, state.p, state.q, it)
+            mg.restrict_sources()
+            mg.defect(lv0)
+        mg.cycle(0, have_defect=True)
+    return False
+
+
+def multigrid(state: SolverState) -> Generator[str, None, bool]:
+    """FAS V-cycles with a full-multigrid start (method ``"multigrid"``)."""
+    return (yield from _fas(state, 1))
+
+
+def multigrid_w(state: SolverState) -> Generator[str, None, bool]:
+    """FAS W-cycles with a full-multigrid start (method ``"multigrid-w"``)."""
+    return (yield from _fas(state, 2))
+
+
+register_method("multigrid", multigrid)
+register_method("multigrid-w", multigrid_w)
