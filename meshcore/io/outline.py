@@ -38,40 +38,14 @@ def _ccw(loop: np.ndarray) -> bool:
 
 
 def guess_corners(loop: Any) -> tuple[int, int, int, int]:
-    """Four corner indices ``(sw, se, ne, nw)`` on a closed loop (see module docstring)."""
-    p = np.asarray(loop, dtype=np.float64)
-    if len(p) > 2 and np.array_equal(p[0], p[-1]):
-        p = p[:-1]
-    n = len(p)
-    if n < 4:
-        raise InvalidInputError(f"a loop needs at least 4 points for 4 corners, got {n}")
-    c = p - p.mean(axis=0)
-    w, vec = np.linalg.eigh(c.T @ c)
-    u_ax = vec[:, np.argmax(w)]
-    v_ax = np.array([-u_ax[1], u_ax[0]])
-    u, v = c @ u_ax, c @ v_ax
-    cand = [int(np.argmax(-u - v)), int(np.argmax(u - v)), int(np.argmax(u + v)),
-            int(np.argmax(-u + v))]
-    ccw = _ccw(p)
+    """Four corner indices ``(sw, se, ne, nw)`` on a closed loop.
 
-    def ok(cs: list[int]) -> bool:
-        if len(set(cs)) != 4:
-            return False
-        rel = [((k - cs[0]) if ccw else (cs[0] - k)) % n for k in cs]
-        return rel[0] < rel[1] < rel[2] < rel[3]
+    The same choice as :func:`meshcore.corners.choose_corners` (vertices nearest the
+    corners of the principal-axis bounding box, moved off reflex vertices).
+    """
+    from ..corners import choose_corners
 
-    if ok(cand):
-        return tuple(cand)  # type: ignore[return-value]
-    seg = np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T)
-    total = float(np.sum(seg))
-    s = np.concatenate([[0.0], np.cumsum(seg)])[:-1]
-    rel_s = (s - s[cand[0]]) % total
-    idx = [int(np.argmin(np.abs(rel_s - q * total))) for q in (0.0, 0.25, 0.5, 0.75)]
-    if not ccw:
-        idx = [idx[0], idx[3], idx[2], idx[1]]
-    if len(set(idx)) != 4:
-        raise InvalidInputError("cannot place four distinct corners on this loop; give --corners")
-    return tuple(idx)  # type: ignore[return-value]
+    return choose_corners(loop)
 
 
 def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, ni: int = 40) -> tuple[int, int]:
