@@ -7,6 +7,7 @@ their shape.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from . import geometry as geo
@@ -16,7 +17,11 @@ from .project import Block, Project, default_cells
 __all__ = ["EXAMPLE_DIRS", "LAKES", "example_names", "load_example"]
 
 _HERE = Path(__file__).resolve().parent
-EXAMPLE_DIRS = (_HERE.parent / "resources" / "examples", _HERE / "resources" / "examples")
+EXAMPLE_DIRS = (
+    _HERE.parent / "resources" / "examples",
+    _HERE / "resources" / "examples",
+    Path(sys.prefix) / "share" / "gcmesh" / "examples",  # non-editable installs
+)
 LAKES = {
     "lake-bolsena": ("lake_bolsena.csv", "Lake Bolsena, Italy (GSHHG)"),
     "lake-zurich": ("lake_zurich.csv", "Lake Zurich, Switzerland (GSHHG)"),

@@ -10,12 +10,22 @@ from pathlib import Path
 from ..errors import InvalidInputError
 
 
+def resources_dir() -> Path | None:
+    """The bundled ``resources`` folder: the source tree's, or ``<prefix>/share/gcmesh`` when installed."""
+    import sys
+
+    here = Path(__file__).resolve().parent.parent
+    for cand in (here.parent / "resources", Path(sys.prefix) / "share" / "gcmesh"):
+        if (cand / "examples").is_dir():
+            return cand
+    return None
+
+
 def examples_dir() -> Path:
     """Folder of the bundled example case files."""
-    here = Path(__file__).resolve().parent.parent
-    for cand in (here.parent / "resources" / "examples", here / "resources" / "examples"):
-        if cand.is_dir():
-            return cand
+    res = resources_dir()
+    if res is not None:
+        return res / "examples"
     raise InvalidInputError("bundled examples not found (resources/examples is missing from this install)")
 
 
@@ -62,10 +72,20 @@ def run(args: argparse.Namespace) -> int:
     src = example_path(args.name)
     dest = Path(args.dest)
     dest.mkdir(parents=True, exist_ok=True)
-    shutil.copy2(src, dest / src.name)
+    text = src.read_text(encoding="utf-8")
     for rel in _data_files(src):
-        target = dest / rel
+        origin = (src.parent / rel).resolve()
+        target_rel = rel
+        if Path(rel).is_absolute() or ".." in Path(rel).parts:
+            # keep everything inside DEST: copy next to the case and point the case at the copy
+            target_rel = origin.name
+            text = text.replace(f'"{rel}"', f'"{target_rel}"')
+        target = dest / target_rel
         target.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(src.parent / rel, target)
+        shutil.copy2(origin, target)
+        # data files travel with their licence
+        for lic in origin.parent.glob("LICENSE*"):
+            shutil.copy2(lic, target.parent / lic.name)
+    (dest / src.name).write_text(text, encoding="utf-8")
     print(dest / src.name)
     return 0

@@ -213,3 +213,12 @@ def test_solver_repair_key(tmp_path):
     assert loads_case(dumps_case(c), source="t2").repair == "off"
     with pytest.raises(CaseFileError, match="repair must be one of auto, strict, off"):
         loads_case(example_path("bottle-fine").read_text() + '\n[solver]\nrepair = "maybe"\n', source="t")
+
+
+def test_examples_copy_keeps_data_inside_dest(tmp_path, capsys):
+    dest = tmp_path / "dest"
+    assert main(["examples", "shasta-multiblock-coarse", str(dest)]) == 0
+    files = sorted(p.name for p in dest.iterdir())
+    assert "shasta_lake.csv" in files and any(f.startswith("LICENSE") for f in files)
+    assert not (tmp_path / "lakes").exists()  # nothing written outside DEST
+    assert main(["generate", str(dest / "shasta-multiblock-coarse.toml"), "-o", str(dest / "s.vtm"), "-q"]) == 0
