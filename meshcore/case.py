@@ -476,8 +476,10 @@ def _toml_value(v: Any) -> str:
 
 
 def _toml_table(d: Mapping[str, Any], prefix: str, out: list[str]) -> None:
-    scalars = {k: v for k, v in d.items()
-               if not isinstance(v, Mapping) and not (isinstance(v, list) and v and all(isinstance(e, Mapping) for e in v))}
+    def is_table_array(v: Any) -> bool:
+        return isinstance(v, list) and bool(v) and all(isinstance(e, Mapping) for e in v)
+
+    scalars = {k: v for k, v in d.items() if not isinstance(v, Mapping) and not is_table_array(v)}
     for k, v in scalars.items():
         out.append(f"{_toml_key(k)} = {_toml_value(v)}")
     for k, v in d.items():

@@ -172,7 +172,7 @@ def vinokur(n: int, first: float, last: float) -> np.ndarray:
 
     def resid(d: float, aa: float) -> np.ndarray:
         u = _vinokur_map(np.array([1.0 / n, 1.0 - 1.0 / n]), d, aa)
-        if not (np.isfinite(u).all() and 0.0 < u[0] and u[1] < 1.0):
+        if not (np.isfinite(u).all() and u[0] > 0.0 and u[1] < 1.0):
             return np.array([math.inf, math.inf])  # outside the valid parameter range
         return np.array([math.log(u[0] / first), math.log((1.0 - u[1]) / last)])
 

@@ -36,7 +36,7 @@ def rectangle_cutout():
                     [6.5, 2.5], [6.5, 3.25], [6.5, 4], [8.25, 4], [10, 4]], float)
     left = np.column_stack([np.zeros(4), np.linspace(0, 4, 4)])
     right = np.column_stack([np.full(4, 10.0), np.linspace(0, 4, 4)])
-    return dict(bottom=r(bottom), right=r(right), top=r(top), left=r(left))
+    return {"bottom": r(bottom), "right": r(right), "top": r(top), "left": r(left)}
 
 
 def two_circles():
@@ -48,7 +48,7 @@ def two_circles():
     outer[-1] = outer[0]
     inner[-1] = inner[0]
     cut = np.column_stack([np.linspace(2, 1, 4), np.zeros(4)])
-    return dict(bottom=r(outer), right=r(cut), top=r(inner), left=r(cut))
+    return {"bottom": r(outer), "right": r(cut), "top": r(inner), "left": r(cut)}
 
 
 def bottle():
@@ -57,7 +57,7 @@ def bottle():
     left = right * [-1, 1]
     bottom = np.column_stack([np.linspace(-3, 3, 4), np.zeros(4)])
     top = np.column_stack([np.linspace(-1.1, 1.1, 4), np.full(4, 8.0)])
-    return dict(bottom=r(bottom), right=r(right), top=r(top), left=r(left))
+    return {"bottom": r(bottom), "right": r(right), "top": r(top), "left": r(left)}
 
 
 def annulus(ni=24, nj=16, r0=1.0, r1=4.0, th1=math.pi / 2):
@@ -67,7 +67,7 @@ def annulus(ni=24, nj=16, r0=1.0, r1=4.0, th1=math.pi / 2):
     top = np.column_stack([rr * math.cos(th1), rr * math.sin(th1)])
     left = np.column_stack([r0 * np.cos(th), r0 * np.sin(th)])
     right = np.column_stack([r1 * np.cos(th), r1 * np.sin(th)])
-    return dict(bottom=bottom, right=right, top=top, left=left)
+    return {"bottom": bottom, "right": right, "top": top, "left": left}
 
 
 def main():

@@ -38,7 +38,7 @@ def test_paper_examples_are_bundled():
         assert n in names
 
 
-@pytest.mark.parametrize("name", [n for n in sorted(set(PAPER) | {"annulus-sector"})])
+@pytest.mark.parametrize("name", sorted(set(PAPER) | {"annulus-sector"}))
 def test_every_bundled_example_runs_through_the_cli(name, tmp_path, capsys):
     assert main(["examples", name, str(tmp_path)]) == 0
     case = tmp_path / f"{name}.toml"
@@ -111,7 +111,8 @@ def test_points_file_and_corners(tmp_path):
         (MINI + "[solver]\nomega = 2.5\n", r"\[solver\]: omega must be in \(0, 2\)"),
         (MINI + "[solver]\ntol = 1e-3\n", r"\[solver\]: unknown key 'tol'"),
         (MINI.replace("bottom = [[0, 0], [2, 0]]\n", ""), r"missing border\(s\) bottom"),
-        (MINI + "[blocks.borders.bottom]\ndistribution = 'tanh'\nfrist = 0.1\n", r"borders.bottom: unknown key 'frist'"),
+        (MINI + "[blocks.borders.bottom]\ndistribution = 'tanh'\nfrist = 0.1\n",
+         r"borders.bottom: unknown key 'frist'"),
         (MINI.replace("cells = [4, 3]", "cells = [4]"), r"cells: expected a pair"),
         ("[[blocks]]\nname = 'x'\n", r"missing \[blocks.boundary\]"),
         ("title = 'x'\n", r"needs at least one \[\[blocks\]\]"),
