@@ -600,3 +600,89 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
         r_w[ok_hi, 2] = w_left[hi[ok_hi]]
         r_w /= r_w.sum(axis=1, keepdims=True)
     return c, r_idx, r_w, left, w_left
+
+
+# ----------------------------------------------------------- fused coarse V-cycle
+#: Columns of the level table of :func:`vcycle` (offsets into the flat buffers).
+(M_N0, M_N1, M_X, M_Y, M_FX, M_FY, M_P, M_Q, M_RX, M_RY, M_PQ,
+ M_CI, M_CJ, M_RI, M_RJ, M_LI, M_LJ, M_RWI, M_RWJ, M_WLI, M_WLJ, M_NI, M_NJ) = range(23)
+META_COLS = 23
+
+
+@njit(cache=True, nogil=True)
+def _v2(buf, off, n0, n1):  # pragma: no cover - compiled
+    return buf[off:off + n0 * n1].reshape((n0, n1))
+
+
+@njit(cache=True, nogil=True)
+def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sweeps,
+           periodic):  # pragma: no cover - compiled
+    """One FAS V-cycle on levels ``k0 …`` whose arrays live in flat buffers.
+
+    Exactly the operations of :meth:`multigrid._FAS.cycle` (``gamma = 1``,
+    serial kernels) in one compiled call, which removes the per-kernel Python
+    dispatch that dominates on small levels.  ``meta[k]`` holds the shape
+    and the offsets of level k's arrays (``x, y, fx, fy, p, q, rx, ry`` in
+    ``fbuf``; transfer tables in ``ibuf``/``fbuf``), see ``M_*``.
+    """
+    nlev = meta.shape[0]
+    e = np.zeros((0, 0))
+    for k in range(k0, nlev - 1):
+        m = meta[k]
+        n0, n1 = m[M_N0], m[M_N1]
+        x = _v2(fbuf, m[M_X], n0, n1)
+        y = _v2(fbuf, m[M_Y], n0, n1)
+        fx = _v2(fbuf, m[M_FX], n0, n1)
+        fy = _v2(fbuf, m[M_FY], n0, n1)
+        p = _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e
+        q = _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e
+        rx = _v2(fbuf, m[M_RX], n0, n1)
+        ry = _v2(fbuf, m[M_RY], n0, n1)
+        smooth(x, y, fx, fy, p, q, periodic, pre)
+        defect(x, y, fx, fy, p, q, periodic, rx, ry)
+        c = meta[k + 1]
+        c0, c1 = c[M_N0], c[M_N1]
+        xc = _v2(fbuf, c[M_X], c0, c1)
+        yc = _v2(fbuf, c[M_Y], c0, c1)
+        fxc = _v2(fbuf, c[M_FX], c0, c1)
+        fyc = _v2(fbuf, c[M_FY], c0, c1)
+        pc = _v2(fbuf, c[M_P], c0, c1) if c[M_PQ] else e
+        qc = _v2(fbuf, c[M_Q], c0, c1) if c[M_PQ] else e
+        ci = ibuf[m[M_CI]:m[M_CI] + c0]
+        cj = ibuf[m[M_CJ]:m[M_CJ] + c1]
+        inject(x, ci, cj, xc)
+        inject(y, ci, cj, yc)
+        ri = _v2(ibuf, m[M_RI], c0, 3)
+        rj = _v2(ibuf, m[M_RJ], c1, 3)
+        rwi = _v2(fbuf, m[M_RWI], c0, 3)
+        rwj = _v2(fbuf, m[M_RWJ], c1, 3)
+        restrict(rx, ry, ri, rwi, rj, rwj, scale[k], fxc, fyc)
+        add_operator(xc, yc, pc, qc, periodic, fxc, fyc)
+    m = meta[nlev - 1]
+    n0, n1 = m[M_N0], m[M_N1]
+    smooth(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), _v2(fbuf, m[M_FX], n0, n1),
+           _v2(fbuf, m[M_FY], n0, n1), _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+           _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, coarsest)
+    for k in range(nlev - 2, k0 - 1, -1):
+        m = meta[k]
+        n0, n1 = m[M_N0], m[M_N1]
+        x = _v2(fbuf, m[M_X], n0, n1)
+        y = _v2(fbuf, m[M_Y], n0, n1)
+        fx = _v2(fbuf, m[M_FX], n0, n1)
+        fy = _v2(fbuf, m[M_FY], n0, n1)
+        p = _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e
+        q = _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e
+        c = meta[k + 1]
+        c0, c1 = c[M_N0], c[M_N1]
+        ci = ibuf[m[M_CI]:m[M_CI] + c0]
+        cj = ibuf[m[M_CJ]:m[M_CJ] + c1]
+        li = ibuf[m[M_LI]:m[M_LI] + n0]
+        lj = ibuf[m[M_LJ]:m[M_LJ] + n1]
+        wli = fbuf[m[M_WLI]:m[M_WLI] + n0]
+        wlj = fbuf[m[M_WLJ]:m[M_WLJ] + n1]
+        prolong_correct(x, y, _v2(fbuf, c[M_X], c0, c1), _v2(fbuf, c[M_Y], c0, c1),
+                        _v2(fbuf, c[M_RX], c0, c1), _v2(fbuf, c[M_RY], c0, c1),
+                        ci, cj, li, lj, wli, wlj, periodic)
+        smooth(x, y, fx, fy, p, q, periodic, post)
+        if band_sweeps > 0:
+            smooth_band(x, y, fx, fy, p, q, periodic, band_width, band_sweeps)

@@ -226,7 +226,76 @@ class _FAS:
         self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, 1000))
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
+        self._pack()
         self.restrict_sources()
+
+    def _pack(self) -> None:
+        """Move the arrays of the small levels into flat buffers for :func:`K.vcycle`.
+
+        Levels from ``kfuse`` on (all but the finest for V-cycles, or the
+        serial ones with threads) run a whole V-cycle in one compiled call;
+        their arrays become views of the buffers, so the Python code paths
+        (FMG start, sources, transfers from level ``kfuse − 1``) see the same
+        data.
+        """
+        levels = self.levels
+        nlev = len(levels)
+        self.kfuse = nlev  # no fused levels
+        if self.gamma != 1 or nlev < 2:
+            return
+        kf = 1
+        while kf < nlev and levels[kf].par:
+            kf += 1
+        if kf >= nlev:
+            return
+        fl, il = [], []
+        fpos = [0]
+        ipos = [0]
+
+        def put(arr, lst, pos):
+            off = pos[0]
+            lst.append(np.ascontiguousarray(arr).ravel())
+            pos[0] += arr.size
+            return off
+
+        meta = np.zeros((nlev - kf, K.META_COLS), dtype=np.int64)
+        fnames = ("x", "y", "fx", "fy", "p", "q", "rx", "ry")
+        for r, lv in enumerate(levels[kf:]):
+            m = meta[r]
+            m[K.M_N0], m[K.M_N1] = lv.x.shape
+            m[K.M_PQ] = lv.p.size > 0
+            for name, col in zip(fnames, (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX,
+                                          K.M_RY), strict=True):
+                arr = getattr(lv, name)
+                if arr is not None and arr.size:
+                    m[col] = put(arr, fl, fpos)
+            if lv.ci is not None:
+                for name, col in (("ci", K.M_CI), ("cj", K.M_CJ), ("ri", K.M_RI), ("rj", K.M_RJ),
+                                  ("li", K.M_LI), ("lj", K.M_LJ)):
+                    m[col] = put(np.asarray(getattr(lv, name), dtype=np.int64), il, ipos)
+                for name, col in (("rwi", K.M_RWI), ("rwj", K.M_RWJ), ("wli", K.M_WLI),
+                                  ("wlj", K.M_WLJ)):
+                    m[col] = put(np.asarray(getattr(lv, name), dtype=np.float64), fl, fpos)
+        fbuf = np.concatenate(fl) if fl else np.zeros(0)
+        ibuf = np.concatenate(il) if il else np.zeros(0, dtype=np.int64)
+        for r, lv in enumerate(levels[kf:]):
+            m = meta[r]
+            shp = lv.x.shape
+            n = shp[0] * shp[1]
+            for name, col in zip(fnames, (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX,
+                                          K.M_RY), strict=True):
+                arr = getattr(lv, name)
+                if arr is not None and arr.size:
+                    setattr(lv, name, fbuf[m[col]:m[col] + n].reshape(shp))
+        self.kfuse = kf
+        self.fbuf, self.ibuf, self.meta = fbuf, ibuf, meta
+        self.fscale = np.array([lv.scale for lv in levels[kf:]])
+        # smoother node updates of a fused cycle started at each level (for last_run)
+        cnt = [0] * nlev
+        cnt[-1] = self.coarsest_sweeps * levels[-1].x.size
+        for k in range(nlev - 2, kf - 1, -1):
+            cnt[k] = cnt[k + 1] + (PRE + POST) * levels[k].x.size
+        self.fused_updates = cnt
 
     # ------------------------------------------------------------------ pieces
     def restrict_sources(self) -> None:
@@ -275,6 +344,11 @@ class _FAS:
     def cycle(self, k: int, *, have_defect: bool = False) -> None:
         """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
         lv = self.levels[k]
+        if k >= self.kfuse:
+            self.updates += self.fused_updates[k]
+            K.vcycle(self.fbuf, self.ibuf, self.meta, self.fscale, k - self.kfuse, PRE, POST,
+                     self.coarsest_sweeps, BAND_WIDTH, BAND_SWEEPS, self.periodic)
+            return
         if k == len(self.levels) - 1:
             self.smooth(lv, self.coarsest_sweeps)
             return
