@@ -280,6 +280,8 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
     """``r = f − N(u)`` at interior nodes (0 on the boundary); returns max (|f−N|/den)².
 
     With ``f = 0`` the square root of the return value is the stopping measure.
+    Each row is computed into local scratch rows (unit stride, no aliasing:
+    the loop vectorises) and then stored; the maximum is a separate loop.
     """
     ni1, nj1 = x.shape
     use_f = fx.size > 0
@@ -287,61 +289,74 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
     ni = ni1 - 1
     i0 = 0 if periodic else 1
     row_max = np.zeros(ni1)
-    for i in prange(ni1):
-        if i < i0 or i >= ni:
+    for j in range(nj1):
+        rx[0, j] = 0.0
+        ry[0, j] = 0.0
+        rx[ni, j] = 0.0
+        ry[ni, j] = 0.0
+    nrows = ni - i0
+    nchunks = min(nrows, ROW_CHUNKS)
+    for c in prange(nchunks):
+        tx = np.empty(nj1)
+        ty = np.empty(nj1)
+        tq = np.empty(nj1)
+        td = np.empty(nj1)
+        for e in (0, nj1 - 1):
+            tx[e] = 0.0
+            ty[e] = 0.0
+            tq[e] = 0.0
+            td[e] = 0.0
+        for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
+            i = i0 + k
+            iw = i - 1
+            if iw < 0:
+                iw = ni - 1
+            ie = i + 1
+            for j in range(1, nj1 - 1):
+                xe = x[ie, j]
+                xw = x[iw, j]
+                xn = x[i, j + 1]
+                xs = x[i, j - 1]
+                ye = y[ie, j]
+                yw = y[iw, j]
+                yn = y[i, j + 1]
+                ys = y[i, j - 1]
+                xxi = 0.5 * (xe - xw)
+                yxi = 0.5 * (ye - yw)
+                xet = 0.5 * (xn - xs)
+                yet = 0.5 * (yn - ys)
+                a = xet * xet + yet * yet
+                b = xxi * xet + yxi * yet
+                g = xxi * xxi + yxi * yxi
+                den = 2.0 * (a + g)
+                cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+                cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+                sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+                sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+                if use_pq:
+                    d = xxi * yet - xet * yxi
+                    d2 = d * d
+                    pp = p[i, j]
+                    qq = q[i, j]
+                    sx += d2 * (pp * xxi + qq * xet)
+                    sy += d2 * (pp * yxi + qq * yet)
+                dx = sx - den * x[i, j]
+                dy = sy - den * y[i, j]
+                if use_f:
+                    dx += fx[i, j]
+                    dy += fy[i, j]
+                tx[j] = dx
+                ty[j] = dy
+                tq[j] = dx * dx + dy * dy
+                td[j] = den * den
+            m = 0.0
             for j in range(nj1):
-                rx[i, j] = 0.0
-                ry[i, j] = 0.0
-            continue
-        iw = i - 1
-        if iw < 0:
-            iw = ni - 1
-        ie = i + 1
-        m = 0.0
-        rx[i, 0] = 0.0
-        ry[i, 0] = 0.0
-        rx[i, nj1 - 1] = 0.0
-        ry[i, nj1 - 1] = 0.0
-        for j in range(1, nj1 - 1):
-            xe = x[ie, j]
-            xw = x[iw, j]
-            xn = x[i, j + 1]
-            xs = x[i, j - 1]
-            ye = y[ie, j]
-            yw = y[iw, j]
-            yn = y[i, j + 1]
-            ys = y[i, j - 1]
-            xxi = 0.5 * (xe - xw)
-            yxi = 0.5 * (ye - yw)
-            xet = 0.5 * (xn - xs)
-            yet = 0.5 * (yn - ys)
-            a = xet * xet + yet * yet
-            b = xxi * xet + yxi * yet
-            g = xxi * xxi + yxi * yxi
-            den = 2.0 * (a + g)
-            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
-            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
-            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-            if use_pq:
-                d = xxi * yet - xet * yxi
-                d2 = d * d
-                pp = p[i, j]
-                qq = q[i, j]
-                sx += d2 * (pp * xxi + qq * xet)
-                sy += d2 * (pp * yxi + qq * yet)
-            dx = sx - den * x[i, j]
-            dy = sy - den * y[i, j]
-            if use_f:
-                dx += fx[i, j]
-                dy += fy[i, j]
-            rx[i, j] = dx
-            ry[i, j] = dy
-            if den > 0.0:
-                v = (dx * dx + dy * dy) / (den * den)
-                if v > m:
-                    m = v
-        row_max[i] = m
+                rx[i, j] = tx[j]
+                ry[i, j] = ty[j]
+            for j in range(nj1):
+                if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
+                    m = tq[j] / td[j]
+            row_max[i] = m
     if periodic:
         for j in range(nj1):
             rx[ni, j] = rx[0, j]
