@@ -43,7 +43,7 @@ import numpy as np
 from numba import njit, prange
 
 #: Rows at least this long use the vectorised (compute-all, store-half) row update.
-VECTOR_ROW = 192
+VECTOR_ROW = 48
 #: Rows of one colour are split into at most this many chunks (parallel work units).
 ROW_CHUNKS = 16
 
@@ -103,16 +103,15 @@ def _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no
 
 
 @njit(cache=True, nogil=True)
-def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no cover
+def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1, tx, ty):  # pragma: no cover
     """:func:`_relax_row` for long rows, same arithmetic per node, so identical results.
 
     Each half computes the targets of the *whole* row into fresh scratch rows
     with unit-stride loops (which vectorise; the stride-2 loop does not; the
-    scratch must be local so that LLVM knows it does not alias ``x``) and
-    then stores its own half: twice the arithmetic, less time.
+    scratch ``tx, ty`` must be freshly allocated by the caller so that LLVM
+    knows it does not alias ``x``) and then stores its own half: twice the
+    arithmetic, less time.
     """
-    tx = np.empty(nj1)
-    ty = np.empty(nj1)
     for cj in range(2):
         for j in range(1, nj1 - 1):
             xe = x[ie, j]
@@ -256,19 +255,23 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
             nrows = (ni - 1 - start) // 2 + 1 if start <= ni - 1 else 0
             nchunks = min(nrows, ROW_CHUNKS)
             for c in prange(nchunks):
+                tx = np.empty(nj1)
+                ty = np.empty(nj1)
                 for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
                     i = start + 2 * k
                     iw = i - 1
                     if iw < 0:
                         iw = ni - 1
                     if vec:
-                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1, tx,
+                                       ty)
                     else:
                         _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
             if periodic:
                 if late0 and ci == 0:
                     if vec:
-                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1,
+                                       np.empty(nj1), np.empty(nj1))
                     else:
                         _relax_row(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
                 for j in range(nj1):

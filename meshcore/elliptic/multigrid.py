@@ -175,6 +175,23 @@ class _Level:
     qscale: float = 1.0
 
 
+_TABLES: dict = {}
+
+
+def _tables(pos: np.ndarray, coarsen: bool, periodic: bool):
+    """:func:`K.transfer_tables`, memoised (they depend on the sizes only; read-only)."""
+    key = (pos.tobytes(), coarsen, periodic)
+    tab = _TABLES.get(key)
+    if tab is None:
+        if len(_TABLES) > 256:
+            _TABLES.clear()
+        tab = K.transfer_tables(pos, coarsen, periodic)
+        for a in tab:
+            a.flags.writeable = False
+        _TABLES[key] = tab
+    return tab
+
+
 class _FAS:
     """Working storage and cycles of one solve."""
 
@@ -197,8 +214,8 @@ class _FAS:
             ci, cj = coarsening((ni, nj), _aspect(fine.x, fine.y), self.periodic)
             if not (ci or cj):
                 break
-            tab_i = K.transfer_tables(pos_i, ci, self.periodic)
-            tab_j = K.transfer_tables(pos_j, cj, False)
+            tab_i = _tables(pos_i, ci, self.periodic)
+            tab_j = _tables(pos_j, cj, False)
             sel = np.ix_(tab_i[0], tab_j[0])
             if not _acceptable(fine.x, fine.y, fine.x[sel], fine.y[sel]):
                 break
@@ -387,6 +404,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         r0 = state.residual()
     state.history.append((0, r0))
     if r0 <= tol:
+        state.final_residual = r0
         return True
     for k in range(1, len(levels)):
         K.inject(levels[k - 1].x, levels[k - 1].ci, levels[k - 1].cj, levels[k].x)
@@ -413,6 +431,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
             r = state.residual()
         state.history.append((it, r))
         if r <= tol and _sources_settled(state):
+            state.final_residual = r
             return True
         if not math.isfinite(r) or r > 1e3 * max(min(best, r0), tol if state.sources is not None else 0.0):
             state.x[...] = backup[0]

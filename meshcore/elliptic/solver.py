@@ -148,6 +148,9 @@ class SolverState:
     history: list = field(default_factory=list)
     message: str = ""
     iterations: int = 0
+    #: The stopping measure of the final grid, when the method computed it right before
+    #: returning converged (saves the driver recomputing it).
+    final_residual: float | None = None
 
     def residual(self) -> float:
         return float(_kernels.jacobi_residual(self.x, self.y, self.p, self.q, self.periodic))
@@ -212,6 +215,7 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
             state.history.append((it, r))
             if r <= tol and _sources_settled(state):
                 state.iterations = it
+                state.final_residual = r
                 return True
             if not math.isfinite(r) or r > 1e3 * max(best, floor):
                 # diverging: restore the last good iterate and relax less
@@ -342,7 +346,9 @@ def iterate(
         converged = bool(fin.value)
     finally:
         gen.close()
-    r_final = state.residual()
+    r_final = state.final_residual
+    if stopped or not converged or r_final is None:
+        r_final = state.residual()
     if stopped:
         msg = "stopped"
         converged = False
