@@ -98,8 +98,9 @@ def _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no
                 sx += fx[i, j]
                 sy += fy[i, j]
             if den > 0.0:
-                x[i, j] = sx / den
-                y[i, j] = sy / den
+                inv = 1.0 / den
+                x[i, j] = sx * inv
+                y[i, j] = sy * inv
 
 
 @njit(cache=True, nogil=True)
@@ -145,8 +146,9 @@ def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1, tx, ty):  
                 sx += fx[i, j]
                 sy += fy[i, j]
             ok = den > 0.0
-            tx[j] = sx / den if ok else x[i, j]
-            ty[j] = sy / den if ok else y[i, j]
+            inv = 1.0 / den if ok else 0.0
+            tx[j] = sx * inv if ok else x[i, j]
+            ty[j] = sy * inv if ok else y[i, j]
         for j in range(1 + cj, nj1 - 1, 2):
             x[i, j] = tx[j]
             y[i, j] = ty[j]
@@ -188,8 +190,9 @@ def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragm
                 sx += fx[i, j]
                 sy += fy[i, j]
             if den > 0.0:
-                x[i, j] = sx / den
-                y[i, j] = sy / den
+                inv = 1.0 / den
+                x[i, j] = sx * inv
+                y[i, j] = sy * inv
 
 
 @njit(cache=True, nogil=True)

@@ -75,6 +75,8 @@ STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.9
 PRE, POST = 1, 3
 #: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
 BAND_WIDTH, BAND_SWEEPS = 8, 4
+#: Cycles on each level of the full-multigrid start (the finest excepted).
+FMG_CYCLES = 1
 #: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
 COARSEST_SWEEPS = 24
 #: Levels with fewer nodes than this use the serial kernels even with threads > 1.
@@ -416,7 +418,8 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         mg.correct(k)
         levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
         levels[k].fy[...] = 0.0
-        mg.cycle(k)
+        for _ in range(FMG_CYCLES):
+            mg.cycle(k)
         if levels[k].x.size >= YIELD_NODES:
             yield "tick"
     mg.correct(0)
