@@ -39,6 +39,8 @@ tables per direction (:func:`transfer_tables`), so non-coarsened directions
 
 from __future__ import annotations
 
+import types
+
 import numpy as np
 from numba import njit, prange
 
@@ -488,8 +490,28 @@ def inject(x, ci, cj, out):  # pragma: no cover - compiled
             out[I, J] = x[fi, cj[J]]
 
 
-_serial = njit(cache=True, nogil=True)
-_par = njit(cache=True, nogil=True, parallel=True)
+def _renamed(fn, suffix):
+    """A copy of ``fn`` with its own name.
+
+    numba's on-disk cache files a function under its qualified name and line
+    and does not tell a ``parallel=True`` compilation from a serial one: the
+    two compilations of one Python function would load each other's machine
+    code (whichever was compiled first).  Each variant gets its own name.
+    """
+    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__,
+                             fn.__closure__)
+    out.__qualname__ = fn.__qualname__ + suffix
+    out.__doc__ = fn.__doc__
+    return out
+
+
+def _serial(fn):
+    return njit(cache=True, nogil=True)(_renamed(fn, "_serial"))
+
+
+def _par(fn):
+    return njit(cache=True, nogil=True, parallel=True)(_renamed(fn, "_parallel"))
+
 
 smooth = _serial(_smooth)
 smooth_parallel = _par(_smooth)
