@@ -284,6 +284,73 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
                     y[ni, j] = y[0, j]
 
 
+@njit(cache=True, nogil=True)
+def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
+                 row_max):  # pragma: no cover - compiled
+    """Rows of chunk ``c`` of :func:`_defect` (a separate function, so that the
+    serial and parallel compilations run the same vectorised machine code)."""
+    tx = np.empty(nj1)
+    ty = np.empty(nj1)
+    tq = np.empty(nj1)
+    td = np.empty(nj1)
+    for e in (0, nj1 - 1):
+        tx[e] = 0.0
+        ty[e] = 0.0
+        tq[e] = 0.0
+        td[e] = 0.0
+    for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
+        i = i0 + k
+        iw = i - 1
+        if iw < 0:
+            iw = ni - 1
+        ie = i + 1
+        for j in range(1, nj1 - 1):
+            xe = x[ie, j]
+            xw = x[iw, j]
+            xn = x[i, j + 1]
+            xs = x[i, j - 1]
+            ye = y[ie, j]
+            yw = y[iw, j]
+            yn = y[i, j + 1]
+            ys = y[i, j - 1]
+            xxi = 0.5 * (xe - xw)
+            yxi = 0.5 * (ye - yw)
+            xet = 0.5 * (xn - xs)
+            yet = 0.5 * (yn - ys)
+            a = xet * xet + yet * yet
+            b = xxi * xet + yxi * yet
+            g = xxi * xxi + yxi * yxi
+            den = 2.0 * (a + g)
+            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+            if use_pq:
+                d = xxi * yet - xet * yxi
+                d2 = d * d
+                pp = p[i, j]
+                qq = q[i, j]
+                sx += d2 * (pp * xxi + qq * xet)
+                sy += d2 * (pp * yxi + qq * yet)
+            dx = sx - den * x[i, j]
+            dy = sy - den * y[i, j]
+            if use_f:
+                dx += fx[i, j]
+                dy += fy[i, j]
+            tx[j] = dx
+            ty[j] = dy
+            tq[j] = dx * dx + dy * dy
+            td[j] = den * den
+        m = 0.0
+        for j in range(nj1):
+            rx[i, j] = tx[j]
+            ry[i, j] = ty[j]
+        for j in range(nj1):
+            if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
+                m = tq[j] / td[j]
+        row_max[i] = m
+
+
 def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
     """``r = f − N(u)`` at interior nodes (0 on the boundary); returns max (|f−N|/den)².
 
@@ -305,66 +372,8 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
     nrows = ni - i0
     nchunks = min(nrows, ROW_CHUNKS)
     for c in prange(nchunks):
-        tx = np.empty(nj1)
-        ty = np.empty(nj1)
-        tq = np.empty(nj1)
-        td = np.empty(nj1)
-        for e in (0, nj1 - 1):
-            tx[e] = 0.0
-            ty[e] = 0.0
-            tq[e] = 0.0
-            td[e] = 0.0
-        for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
-            i = i0 + k
-            iw = i - 1
-            if iw < 0:
-                iw = ni - 1
-            ie = i + 1
-            for j in range(1, nj1 - 1):
-                xe = x[ie, j]
-                xw = x[iw, j]
-                xn = x[i, j + 1]
-                xs = x[i, j - 1]
-                ye = y[ie, j]
-                yw = y[iw, j]
-                yn = y[i, j + 1]
-                ys = y[i, j - 1]
-                xxi = 0.5 * (xe - xw)
-                yxi = 0.5 * (ye - yw)
-                xet = 0.5 * (xn - xs)
-                yet = 0.5 * (yn - ys)
-                a = xet * xet + yet * yet
-                b = xxi * xet + yxi * yet
-                g = xxi * xxi + yxi * yxi
-                den = 2.0 * (a + g)
-                cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
-                cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
-                sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-                sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-                if use_pq:
-                    d = xxi * yet - xet * yxi
-                    d2 = d * d
-                    pp = p[i, j]
-                    qq = q[i, j]
-                    sx += d2 * (pp * xxi + qq * xet)
-                    sy += d2 * (pp * yxi + qq * yet)
-                dx = sx - den * x[i, j]
-                dy = sy - den * y[i, j]
-                if use_f:
-                    dx += fx[i, j]
-                    dy += fy[i, j]
-                tx[j] = dx
-                ty[j] = dy
-                tq[j] = dx * dx + dy * dy
-                td[j] = den * den
-            m = 0.0
-            for j in range(nj1):
-                rx[i, j] = tx[j]
-                ry[i, j] = ty[j]
-            for j in range(nj1):
-                if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
-                    m = tq[j] / td[j]
-            row_max[i] = m
+        _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
+                     row_max)
     if periodic:
         for j in range(nj1):
             rx[ni, j] = rx[0, j]
@@ -372,13 +381,10 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
     return row_max.max()
 
 
-def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
-    """``f += N(u)`` at interior nodes (the FAS coarse right-hand side)."""
-    ni1, nj1 = x.shape
-    use_pq = p.size > 0
-    ni = ni1 - 1
-    i0 = 0 if periodic else 1
-    for i in prange(i0, ni):
+@njit(cache=True, nogil=True)
+def _add_operator_rows(x, y, p, q, use_pq, ni, nj1, fx, fy, lo, hi):  # pragma: no cover
+    """Rows ``lo ≤ i < hi`` of :func:`_add_operator`."""
+    for i in range(lo, hi):
         iw = i - 1
         if iw < 0:
             iw = ni - 1
@@ -413,20 +419,30 @@ def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
                 sy += d2 * (pp * yxi + qq * yet)
             fx[i, j] += den * x[i, j] - sx
             fy[i, j] += den * y[i, j] - sy
+
+
+def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
+    """``f += N(u)`` at interior nodes (the FAS coarse right-hand side)."""
+    ni1, nj1 = x.shape
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    i0 = 0 if periodic else 1
+    nrows = ni - i0
+    nchunks = min(nrows, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _add_operator_rows(x, y, p, q, use_pq, ni, nj1, fx, fy, i0 + c * nrows // nchunks,
+                           i0 + (c + 1) * nrows // nchunks)
     if periodic:
         for j in range(nj1):
             fx[ni, j] = fx[0, j]
             fy[ni, j] = fy[0, j]
 
 
-def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - compiled
-    """Full weighting ``f[I, J] = scale · Σ_ab wi[I,a] wj[J,b] r[ii[I,a], jj[J,b]]``.
-
-    ``ii, wi`` are ``(nI, 3)`` index/weight tables (see :func:`transfer_tables`).
-    """
-    nI = fx.shape[0]
+@njit(cache=True, nogil=True)
+def _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, lo, hi):  # pragma: no cover
+    """Rows ``lo ≤ I < hi`` of :func:`_restrict`."""
     nJ = fx.shape[1]
-    for I in prange(nI):
+    for I in range(lo, hi):
         for J in range(nJ):
             sx = 0.0
             sy = 0.0
@@ -440,6 +456,37 @@ def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - comp
                     sy += w * ry[ia, jb]
             fx[I, J] = scale * sx
             fy[I, J] = scale * sy
+
+
+def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - compiled
+    """Full weighting ``f[I, J] = scale · Σ_ab wi[I,a] wj[J,b] r[ii[I,a], jj[J,b]]``.
+
+    ``ii, wi`` are ``(nI, 3)`` index/weight tables (see :func:`transfer_tables`).
+    """
+    nI = fx.shape[0]
+    nchunks = min(nI, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, c * nI // nchunks,
+                       (c + 1) * nI // nchunks)
+
+
+@njit(cache=True, nogil=True)
+def _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, lo, hi):  # pragma: no cover
+    """Rows ``lo ≤ i < hi`` of the update of :func:`_prolong_correct`."""
+    for i in range(lo, hi):
+        a = li[i]
+        wa = wli[i]
+        wb = 1.0 - wa
+        for j in range(1, nj1 - 1):
+            b = lj[j]
+            wc = wlj[j]
+            wd = 1.0 - wc
+            vx = wa * (wc * ex[a, b] + wd * ex[a, b + 1])
+            vx += wb * (wc * ex[a + 1, b] + wd * ex[a + 1, b + 1])
+            vy = wa * (wc * ey[a, b] + wd * ey[a, b + 1])
+            vy += wb * (wc * ey[a + 1, b] + wd * ey[a + 1, b + 1])
+            x[i, j] += vx
+            y[i, j] += vy
 
 
 def _prolong_correct(x, y, xc, yc, ex, ey, ci, cj, li, lj, wli, wlj, periodic):  # pragma: no cover
@@ -461,20 +508,11 @@ def _prolong_correct(x, y, xc, yc, ex, ey, ci, cj, li, lj, wli, wlj, periodic): 
             ex[I, J] = xc[I, J] - x[fi, fj]
             ey[I, J] = yc[I, J] - y[fi, fj]
     i0 = 0 if periodic else 1
-    for i in prange(i0, ni1 - 1):
-        a = li[i]
-        wa = wli[i]
-        wb = 1.0 - wa
-        for j in range(1, nj1 - 1):
-            b = lj[j]
-            wc = wlj[j]
-            wd = 1.0 - wc
-            vx = wa * (wc * ex[a, b] + wd * ex[a, b + 1])
-            vx += wb * (wc * ex[a + 1, b] + wd * ex[a + 1, b + 1])
-            vy = wa * (wc * ey[a, b] + wd * ey[a, b + 1])
-            vy += wb * (wc * ey[a + 1, b] + wd * ey[a + 1, b + 1])
-            x[i, j] += vx
-            y[i, j] += vy
+    nrows = ni1 - 1 - i0
+    nchunks = min(nrows, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, i0 + c * nrows // nchunks,
+                      i0 + (c + 1) * nrows // nchunks)
     if periodic:
         for j in range(nj1):
             x[ni1 - 1, j] = x[0, j]

@@ -321,8 +321,10 @@ def iterate(
         sources.initialize(x, y, pp, qq)
     t0 = time.perf_counter()
     last = t0
-    # until a snapshot has been timed: assume copying x, y runs at SNAPSHOT_BYTES_PER_S
-    interval_floor = SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S
+    # until a snapshot has been timed: assume copying x, y of a huge grid (arrays that numpy
+    # places in transparent huge pages, ≥ 4 MB) runs at SNAPSHOT_BYTES_PER_S
+    interval_floor = (SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S
+                      if x.nbytes >= 4 << 20 else 0.0)
     gen = METHODS[method](state)
     converged = False
     stopped = False
