@@ -36,7 +36,9 @@ the convergence check costs nothing extra (a final check with
 :func:`._kernels.jacobi_residual` confirms it).  On the finest level a cycle
 is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
 operations as V(1, ``POST`` − 1) repeated); coarse levels use
-V(``PRE``, ``POST``).  After post-smoothing, ``BAND_SWEEPS`` extra sweeps
+V(``PRE``, ``COARSE_POST``).  The serial coarse levels run a whole V-cycle in
+one compiled call (:func:`._mg_kernels.vcycle`, arrays packed into flat
+buffers).  After post-smoothing, ``BAND_SWEEPS`` extra sweeps
 relax the nodes within ``BAND_WIDTH`` of the borders (local relaxation where
 the nonlinearity next to curved borders is strongest; O(n) work).
 
@@ -73,6 +75,8 @@ MAX_NEW_FOLDED = 0.02
 STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.9
 #: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
 PRE, POST = 1, 3
+#: Post-smoothing sweeps on the coarse levels (``POST`` on the finest).
+COARSE_POST = 2
 #: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
 BAND_WIDTH, BAND_SWEEPS = 8, 4
 #: Cycles on each level of the full-multigrid start (the finest excepted).
@@ -313,7 +317,7 @@ class _FAS:
         cnt = [0] * nlev
         cnt[-1] = self.coarsest_sweeps * levels[-1].x.size
         for k in range(nlev - 2, kf - 1, -1):
-            cnt[k] = cnt[k + 1] + (PRE + POST) * levels[k].x.size
+            cnt[k] = cnt[k + 1] + (PRE + COARSE_POST) * levels[k].x.size
         self.fused_updates = cnt
 
     # ------------------------------------------------------------------ pieces
@@ -365,7 +369,7 @@ class _FAS:
         lv = self.levels[k]
         if k >= self.kfuse:
             self.updates += self.fused_updates[k]
-            K.vcycle(self.fbuf, self.ibuf, self.meta, self.fscale, k - self.kfuse, PRE, POST,
+            K.vcycle(self.fbuf, self.ibuf, self.meta, self.fscale, k - self.kfuse, PRE, COARSE_POST,
                      self.coarsest_sweeps, BAND_WIDTH, BAND_SWEEPS, self.periodic)
             return
         if k == len(self.levels) - 1:
@@ -378,7 +382,7 @@ class _FAS:
         for _ in range(self.gamma if k + 1 < len(self.levels) - 1 else 1):
             self.cycle(k + 1)
         self.correct(k)
-        self.smooth(lv, POST)
+        self.smooth(lv, POST if k == 0 else COARSE_POST)
         self.smooth_band(lv)
 
 
