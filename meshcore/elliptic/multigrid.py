@@ -83,6 +83,9 @@ BAND_WIDTH, BAND_SWEEPS = 8, 4
 FMG_CYCLES = 1
 #: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
 COARSEST_SWEEPS = 24
+#: At most this many sweeps on the coarsest level (a large coarsest level: the shape
+#: stopped the coarsening).
+COARSEST_MAX = 100
 #: Levels with fewer nodes than this use the serial kernels even with threads > 1.
 PARALLEL_MIN_NODES = 8192
 #: FMG levels with more nodes than this yield to the driver (snapshots keep flowing).
@@ -246,7 +249,7 @@ class _FAS:
             last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
             last.ry = np.empty(last.x.shape)
         n = max(self.levels[-1].x.shape) - 1
-        self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, 1000))
+        self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, COARSEST_MAX))
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
         self._pack()
