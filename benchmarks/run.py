@@ -387,15 +387,34 @@ def level_breakdown(g0):
             return r
         return w
 
+    K = multigrid.K
+    vcycle = K.vcycle
+    pack = F._pack
+    kfuse = []
+
+    def timed_vcycle(*a):
+        t = time.perf_counter()
+        r = vcycle(*a)
+        acc[("fused", "cycle")] = acc.get(("fused", "cycle"), 0.0) + time.perf_counter() - t
+        return r
+
+    def spy_pack(self):
+        pack(self)
+        kfuse.append(self.kfuse)
+
     try:
         for k in orig:
             setattr(F, k, wrap(k))
+        K.vcycle = timed_vcycle
+        F._pack = spy_pack
         t = time.perf_counter()
         g = meshcore.solve(g0, method="multigrid", report_interval=1e9)
         total = time.perf_counter() - t
     finally:
         for k, f in orig.items():
             setattr(F, k, f)
+        K.vcycle = vcycle
+        F._pack = pack
     shapes = multigrid.last_run["levels"]
     rows = ["| level | nodes | smooth | defect | restrict (+N_c) | prolong | share |",
             "|" + "---|" * 7]
@@ -403,6 +422,12 @@ def level_breakdown(g0):
         v = [acc.get((lvl, k), 0.0) for k in ("smooth", "defect", "to_coarse", "correct")]
         rows.append(f"| {lvl} | {shp[0]}×{shp[1]} | " + " | ".join(fmt_time(t) for t in v)
                     + f" | {100 * sum(v) / total:.0f} % |")
+    if ("fused", "cycle") in acc:
+        kf = kfuse[-1]
+        v = acc[("fused", "cycle")]
+        rows.append(f"| ≥ {kf} | {shapes[kf][0]}×{shapes[kf][1]} and coarser | whole V-cycles in "
+                    f"one numba call (`_mg_kernels.vcycle`): {fmt_time(v)} | | | | "
+                    f"{100 * v / total:.0f} % |")
     accounted = sum(acc.values())
     rest = 100 * (1 - accounted / total)
     rows.append(f"\nTotal {fmt_time(total)} ({g.iterations} cycles incl. FMG); kernels account "
@@ -556,6 +581,10 @@ def main(argv=None):
         p = float(np.polyfit(nn, t, 1)[0])
         emit(f"\nGrowth exponent (time ~ nodes^p, multigrid 1 thread, 129² and up): p = {p:.3f} "
              "(target ≤ 1.05).")
+        t2 = np.log([summary[c]["meshcore multigrid, 2 threads"]["time"] for c in summary
+                     if c.startswith("wavy") and int(c.split()[-1][:-1]) >= 129])
+        p2 = float(np.polyfit(nn, t2, 1)[0])
+        emit(f"With 2 threads: p = {p2:.3f}.")
 
     emit("\n## Where the time goes (multigrid, 1 thread, per level)\n")
     big = cases[-1][1]() if quick else wavy_square(1024)

@@ -34,6 +34,8 @@ column 0 is column ``ni − 1`` and after each colour column ``ni`` is refreshed
 
 from __future__ import annotations
 
+import types
+
 import numba
 import numpy as np
 from numba import njit, prange
@@ -108,8 +110,17 @@ def _sweep4(x, y, p, q, omega, periodic):  # pragma: no cover - compiled
     return np.sqrt(dmax)
 
 
-sweep4 = njit(cache=True, nogil=True)(_sweep4)
-sweep4_parallel = njit(cache=True, nogil=True, parallel=True)(_sweep4)
+def _renamed(fn, suffix):
+    """A copy of ``fn`` with its own name (see :func:`._mg_kernels._renamed`: numba's
+    disk cache does not tell the serial and ``parallel=True`` compilations apart)."""
+    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__,
+                             fn.__closure__)
+    out.__qualname__ = fn.__qualname__ + suffix
+    return out
+
+
+sweep4 = njit(cache=True, nogil=True)(_renamed(_sweep4, "_serial"))
+sweep4_parallel = njit(cache=True, nogil=True, parallel=True)(_renamed(_sweep4, "_parallel"))
 
 
 @njit(cache=True, nogil=True)

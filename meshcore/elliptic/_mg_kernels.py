@@ -39,11 +39,13 @@ tables per direction (:func:`transfer_tables`), so non-coarsened directions
 
 from __future__ import annotations
 
+import types
+
 import numpy as np
 from numba import njit, prange
 
 #: Rows at least this long use the vectorised (compute-all, store-half) row update.
-VECTOR_ROW = 192
+VECTOR_ROW = 48
 #: Rows of one colour are split into at most this many chunks (parallel work units).
 ROW_CHUNKS = 16
 
@@ -98,21 +100,21 @@ def _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no
                 sx += fx[i, j]
                 sy += fy[i, j]
             if den > 0.0:
-                x[i, j] = sx / den
-                y[i, j] = sy / den
+                inv = 1.0 / den
+                x[i, j] = sx * inv
+                y[i, j] = sy * inv
 
 
 @njit(cache=True, nogil=True)
-def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma: no cover
+def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1, tx, ty):  # pragma: no cover
     """:func:`_relax_row` for long rows, same arithmetic per node, so identical results.
 
     Each half computes the targets of the *whole* row into fresh scratch rows
     with unit-stride loops (which vectorise; the stride-2 loop does not; the
-    scratch must be local so that LLVM knows it does not alias ``x``) and
-    then stores its own half: twice the arithmetic, less time.
+    scratch ``tx, ty`` must be freshly allocated by the caller so that LLVM
+    knows it does not alias ``x``) and then stores its own half: twice the
+    arithmetic, less time.
     """
-    tx = np.empty(nj1)
-    ty = np.empty(nj1)
     for cj in range(2):
         for j in range(1, nj1 - 1):
             xe = x[ie, j]
@@ -146,8 +148,9 @@ def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1):  # pragma
                 sx += fx[i, j]
                 sy += fy[i, j]
             ok = den > 0.0
-            tx[j] = sx / den if ok else x[i, j]
-            ty[j] = sy / den if ok else y[i, j]
+            inv = 1.0 / den if ok else 0.0
+            tx[j] = sx * inv if ok else x[i, j]
+            ty[j] = sy * inv if ok else y[i, j]
         for j in range(1 + cj, nj1 - 1, 2):
             x[i, j] = tx[j]
             y[i, j] = ty[j]
@@ -189,8 +192,9 @@ def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragm
                 sx += fx[i, j]
                 sy += fy[i, j]
             if den > 0.0:
-                x[i, j] = sx / den
-                y[i, j] = sy / den
+                inv = 1.0 / den
+                x[i, j] = sx * inv
+                y[i, j] = sy * inv
 
 
 @njit(cache=True, nogil=True)
@@ -256,19 +260,23 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
             nrows = (ni - 1 - start) // 2 + 1 if start <= ni - 1 else 0
             nchunks = min(nrows, ROW_CHUNKS)
             for c in prange(nchunks):
+                tx = np.empty(nj1)
+                ty = np.empty(nj1)
                 for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
                     i = start + 2 * k
                     iw = i - 1
                     if iw < 0:
                         iw = ni - 1
                     if vec:
-                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1, tx,
+                                       ty)
                     else:
                         _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
             if periodic:
                 if late0 and ci == 0:
                     if vec:
-                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1,
+                                       np.empty(nj1), np.empty(nj1))
                     else:
                         _relax_row(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
                 for j in range(nj1):
@@ -276,32 +284,26 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
                     y[ni, j] = y[0, j]
 
 
-def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
-    """``r = f − N(u)`` at interior nodes (0 on the boundary); returns max (|f−N|/den)².
-
-    With ``f = 0`` the square root of the return value is the stopping measure.
-    """
-    ni1, nj1 = x.shape
-    use_f = fx.size > 0
-    use_pq = p.size > 0
-    ni = ni1 - 1
-    i0 = 0 if periodic else 1
-    row_max = np.zeros(ni1)
-    for i in prange(ni1):
-        if i < i0 or i >= ni:
-            for j in range(nj1):
-                rx[i, j] = 0.0
-                ry[i, j] = 0.0
-            continue
+@njit(cache=True, nogil=True)
+def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
+                 row_max):  # pragma: no cover - compiled
+    """Rows of chunk ``c`` of :func:`_defect` (a separate function, so that the
+    serial and parallel compilations run the same vectorised machine code)."""
+    tx = np.empty(nj1)
+    ty = np.empty(nj1)
+    tq = np.empty(nj1)
+    td = np.empty(nj1)
+    for e in (0, nj1 - 1):
+        tx[e] = 0.0
+        ty[e] = 0.0
+        tq[e] = 0.0
+        td[e] = 0.0
+    for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
+        i = i0 + k
         iw = i - 1
         if iw < 0:
             iw = ni - 1
         ie = i + 1
-        m = 0.0
-        rx[i, 0] = 0.0
-        ry[i, 0] = 0.0
-        rx[i, nj1 - 1] = 0.0
-        ry[i, nj1 - 1] = 0.0
         for j in range(1, nj1 - 1):
             xe = x[ie, j]
             xw = x[iw, j]
@@ -335,13 +337,43 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
             if use_f:
                 dx += fx[i, j]
                 dy += fy[i, j]
-            rx[i, j] = dx
-            ry[i, j] = dy
-            if den > 0.0:
-                v = (dx * dx + dy * dy) / (den * den)
-                if v > m:
-                    m = v
+            tx[j] = dx
+            ty[j] = dy
+            tq[j] = dx * dx + dy * dy
+            td[j] = den * den
+        m = 0.0
+        for j in range(nj1):
+            rx[i, j] = tx[j]
+            ry[i, j] = ty[j]
+        for j in range(nj1):
+            if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
+                m = tq[j] / td[j]
         row_max[i] = m
+
+
+def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
+    """``r = f − N(u)`` at interior nodes (0 on the boundary); returns max (|f−N|/den)².
+
+    With ``f = 0`` the square root of the return value is the stopping measure.
+    Each row is computed into local scratch rows (unit stride, no aliasing:
+    the loop vectorises) and then stored; the maximum is a separate loop.
+    """
+    ni1, nj1 = x.shape
+    use_f = fx.size > 0
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    i0 = 0 if periodic else 1
+    row_max = np.zeros(ni1)
+    for j in range(nj1):
+        rx[0, j] = 0.0
+        ry[0, j] = 0.0
+        rx[ni, j] = 0.0
+        ry[ni, j] = 0.0
+    nrows = ni - i0
+    nchunks = min(nrows, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
+                     row_max)
     if periodic:
         for j in range(nj1):
             rx[ni, j] = rx[0, j]
@@ -349,13 +381,10 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
     return row_max.max()
 
 
-def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
-    """``f += N(u)`` at interior nodes (the FAS coarse right-hand side)."""
-    ni1, nj1 = x.shape
-    use_pq = p.size > 0
-    ni = ni1 - 1
-    i0 = 0 if periodic else 1
-    for i in prange(i0, ni):
+@njit(cache=True, nogil=True)
+def _add_operator_rows(x, y, p, q, use_pq, ni, nj1, fx, fy, lo, hi):  # pragma: no cover
+    """Rows ``lo ≤ i < hi`` of :func:`_add_operator`."""
+    for i in range(lo, hi):
         iw = i - 1
         if iw < 0:
             iw = ni - 1
@@ -390,20 +419,30 @@ def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
                 sy += d2 * (pp * yxi + qq * yet)
             fx[i, j] += den * x[i, j] - sx
             fy[i, j] += den * y[i, j] - sy
+
+
+def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
+    """``f += N(u)`` at interior nodes (the FAS coarse right-hand side)."""
+    ni1, nj1 = x.shape
+    use_pq = p.size > 0
+    ni = ni1 - 1
+    i0 = 0 if periodic else 1
+    nrows = ni - i0
+    nchunks = min(nrows, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _add_operator_rows(x, y, p, q, use_pq, ni, nj1, fx, fy, i0 + c * nrows // nchunks,
+                           i0 + (c + 1) * nrows // nchunks)
     if periodic:
         for j in range(nj1):
             fx[ni, j] = fx[0, j]
             fy[ni, j] = fy[0, j]
 
 
-def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - compiled
-    """Full weighting ``f[I, J] = scale · Σ_ab wi[I,a] wj[J,b] r[ii[I,a], jj[J,b]]``.
-
-    ``ii, wi`` are ``(nI, 3)`` index/weight tables (see :func:`transfer_tables`).
-    """
-    nI = fx.shape[0]
+@njit(cache=True, nogil=True)
+def _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, lo, hi):  # pragma: no cover
+    """Rows ``lo ≤ I < hi`` of :func:`_restrict`."""
     nJ = fx.shape[1]
-    for I in prange(nI):
+    for I in range(lo, hi):
         for J in range(nJ):
             sx = 0.0
             sy = 0.0
@@ -417,6 +456,37 @@ def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - comp
                     sy += w * ry[ia, jb]
             fx[I, J] = scale * sx
             fy[I, J] = scale * sy
+
+
+def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - compiled
+    """Full weighting ``f[I, J] = scale · Σ_ab wi[I,a] wj[J,b] r[ii[I,a], jj[J,b]]``.
+
+    ``ii, wi`` are ``(nI, 3)`` index/weight tables (see :func:`transfer_tables`).
+    """
+    nI = fx.shape[0]
+    nchunks = min(nI, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, c * nI // nchunks,
+                       (c + 1) * nI // nchunks)
+
+
+@njit(cache=True, nogil=True)
+def _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, lo, hi):  # pragma: no cover
+    """Rows ``lo ≤ i < hi`` of the update of :func:`_prolong_correct`."""
+    for i in range(lo, hi):
+        a = li[i]
+        wa = wli[i]
+        wb = 1.0 - wa
+        for j in range(1, nj1 - 1):
+            b = lj[j]
+            wc = wlj[j]
+            wd = 1.0 - wc
+            vx = wa * (wc * ex[a, b] + wd * ex[a, b + 1])
+            vx += wb * (wc * ex[a + 1, b] + wd * ex[a + 1, b + 1])
+            vy = wa * (wc * ey[a, b] + wd * ey[a, b + 1])
+            vy += wb * (wc * ey[a + 1, b] + wd * ey[a + 1, b + 1])
+            x[i, j] += vx
+            y[i, j] += vy
 
 
 def _prolong_correct(x, y, xc, yc, ex, ey, ci, cj, li, lj, wli, wlj, periodic):  # pragma: no cover
@@ -438,20 +508,11 @@ def _prolong_correct(x, y, xc, yc, ex, ey, ci, cj, li, lj, wli, wlj, periodic): 
             ex[I, J] = xc[I, J] - x[fi, fj]
             ey[I, J] = yc[I, J] - y[fi, fj]
     i0 = 0 if periodic else 1
-    for i in prange(i0, ni1 - 1):
-        a = li[i]
-        wa = wli[i]
-        wb = 1.0 - wa
-        for j in range(1, nj1 - 1):
-            b = lj[j]
-            wc = wlj[j]
-            wd = 1.0 - wc
-            vx = wa * (wc * ex[a, b] + wd * ex[a, b + 1])
-            vx += wb * (wc * ex[a + 1, b] + wd * ex[a + 1, b + 1])
-            vy = wa * (wc * ey[a, b] + wd * ey[a, b + 1])
-            vy += wb * (wc * ey[a + 1, b] + wd * ey[a + 1, b + 1])
-            x[i, j] += vx
-            y[i, j] += vy
+    nrows = ni1 - 1 - i0
+    nchunks = min(nrows, ROW_CHUNKS)
+    for c in prange(nchunks):
+        _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, i0 + c * nrows // nchunks,
+                      i0 + (c + 1) * nrows // nchunks)
     if periodic:
         for j in range(nj1):
             x[ni1 - 1, j] = x[0, j]
@@ -467,8 +528,28 @@ def inject(x, ci, cj, out):  # pragma: no cover - compiled
             out[I, J] = x[fi, cj[J]]
 
 
-_serial = njit(cache=True, nogil=True)
-_par = njit(cache=True, nogil=True, parallel=True)
+def _renamed(fn, suffix):
+    """A copy of ``fn`` with its own name.
+
+    numba's on-disk cache files a function under its qualified name and line
+    and does not tell a ``parallel=True`` compilation from a serial one: the
+    two compilations of one Python function would load each other's machine
+    code (whichever was compiled first).  Each variant gets its own name.
+    """
+    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__,
+                             fn.__closure__)
+    out.__qualname__ = fn.__qualname__ + suffix
+    out.__doc__ = fn.__doc__
+    return out
+
+
+def _serial(fn):
+    return njit(cache=True, nogil=True)(_renamed(fn, "_serial"))
+
+
+def _par(fn):
+    return njit(cache=True, nogil=True, parallel=True)(_renamed(fn, "_parallel"))
+
 
 smooth = _serial(_smooth)
 smooth_parallel = _par(_smooth)
@@ -600,3 +681,89 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
         r_w[ok_hi, 2] = w_left[hi[ok_hi]]
         r_w /= r_w.sum(axis=1, keepdims=True)
     return c, r_idx, r_w, left, w_left
+
+
+# ----------------------------------------------------------- fused coarse V-cycle
+#: Columns of the level table of :func:`vcycle` (offsets into the flat buffers).
+(M_N0, M_N1, M_X, M_Y, M_FX, M_FY, M_P, M_Q, M_RX, M_RY, M_PQ,
+ M_CI, M_CJ, M_RI, M_RJ, M_LI, M_LJ, M_RWI, M_RWJ, M_WLI, M_WLJ, M_NI, M_NJ) = range(23)
+META_COLS = 23
+
+
+@njit(cache=True, nogil=True)
+def _v2(buf, off, n0, n1):  # pragma: no cover - compiled
+    return buf[off:off + n0 * n1].reshape((n0, n1))
+
+
+@njit(cache=True, nogil=True)
+def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sweeps,
+           periodic):  # pragma: no cover - compiled
+    """One FAS V-cycle on levels ``k0 …`` whose arrays live in flat buffers.
+
+    Exactly the operations of :meth:`multigrid._FAS.cycle` (``gamma = 1``,
+    serial kernels) in one compiled call, which removes the per-kernel Python
+    dispatch that dominates on small levels.  ``meta[k]`` holds the shape
+    and the offsets of level k's arrays (``x, y, fx, fy, p, q, rx, ry`` in
+    ``fbuf``; transfer tables in ``ibuf``/``fbuf``), see ``M_*``.
+    """
+    nlev = meta.shape[0]
+    e = np.zeros((0, 0))
+    for k in range(k0, nlev - 1):
+        m = meta[k]
+        n0, n1 = m[M_N0], m[M_N1]
+        x = _v2(fbuf, m[M_X], n0, n1)
+        y = _v2(fbuf, m[M_Y], n0, n1)
+        fx = _v2(fbuf, m[M_FX], n0, n1)
+        fy = _v2(fbuf, m[M_FY], n0, n1)
+        p = _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e
+        q = _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e
+        rx = _v2(fbuf, m[M_RX], n0, n1)
+        ry = _v2(fbuf, m[M_RY], n0, n1)
+        smooth(x, y, fx, fy, p, q, periodic, pre)
+        defect(x, y, fx, fy, p, q, periodic, rx, ry)
+        c = meta[k + 1]
+        c0, c1 = c[M_N0], c[M_N1]
+        xc = _v2(fbuf, c[M_X], c0, c1)
+        yc = _v2(fbuf, c[M_Y], c0, c1)
+        fxc = _v2(fbuf, c[M_FX], c0, c1)
+        fyc = _v2(fbuf, c[M_FY], c0, c1)
+        pc = _v2(fbuf, c[M_P], c0, c1) if c[M_PQ] else e
+        qc = _v2(fbuf, c[M_Q], c0, c1) if c[M_PQ] else e
+        ci = ibuf[m[M_CI]:m[M_CI] + c0]
+        cj = ibuf[m[M_CJ]:m[M_CJ] + c1]
+        inject(x, ci, cj, xc)
+        inject(y, ci, cj, yc)
+        ri = _v2(ibuf, m[M_RI], c0, 3)
+        rj = _v2(ibuf, m[M_RJ], c1, 3)
+        rwi = _v2(fbuf, m[M_RWI], c0, 3)
+        rwj = _v2(fbuf, m[M_RWJ], c1, 3)
+        restrict(rx, ry, ri, rwi, rj, rwj, scale[k], fxc, fyc)
+        add_operator(xc, yc, pc, qc, periodic, fxc, fyc)
+    m = meta[nlev - 1]
+    n0, n1 = m[M_N0], m[M_N1]
+    smooth(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), _v2(fbuf, m[M_FX], n0, n1),
+           _v2(fbuf, m[M_FY], n0, n1), _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+           _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, coarsest)
+    for k in range(nlev - 2, k0 - 1, -1):
+        m = meta[k]
+        n0, n1 = m[M_N0], m[M_N1]
+        x = _v2(fbuf, m[M_X], n0, n1)
+        y = _v2(fbuf, m[M_Y], n0, n1)
+        fx = _v2(fbuf, m[M_FX], n0, n1)
+        fy = _v2(fbuf, m[M_FY], n0, n1)
+        p = _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e
+        q = _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e
+        c = meta[k + 1]
+        c0, c1 = c[M_N0], c[M_N1]
+        ci = ibuf[m[M_CI]:m[M_CI] + c0]
+        cj = ibuf[m[M_CJ]:m[M_CJ] + c1]
+        li = ibuf[m[M_LI]:m[M_LI] + n0]
+        lj = ibuf[m[M_LJ]:m[M_LJ] + n1]
+        wli = fbuf[m[M_WLI]:m[M_WLI] + n0]
+        wlj = fbuf[m[M_WLJ]:m[M_WLJ] + n1]
+        prolong_correct(x, y, _v2(fbuf, c[M_X], c0, c1), _v2(fbuf, c[M_Y], c0, c1),
+                        _v2(fbuf, c[M_RX], c0, c1), _v2(fbuf, c[M_RY], c0, c1),
+                        ci, cj, li, lj, wli, wlj, periodic)
+        smooth(x, y, fx, fy, p, q, periodic, post)
+        if band_sweeps > 0:
+            smooth_band(x, y, fx, fy, p, q, periodic, band_width, band_sweeps)

@@ -36,7 +36,9 @@ the convergence check costs nothing extra (a final check with
 :func:`._kernels.jacobi_residual` confirms it).  On the finest level a cycle
 is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
 operations as V(1, ``POST`` − 1) repeated); coarse levels use
-V(``PRE``, ``POST``).  After post-smoothing, ``BAND_SWEEPS`` extra sweeps
+V(``PRE``, ``COARSE_POST``).  The serial coarse levels run a whole V-cycle in
+one compiled call (:func:`._mg_kernels.vcycle`, arrays packed into flat
+buffers).  After post-smoothing, ``BAND_SWEEPS`` extra sweeps
 relax the nodes within ``BAND_WIDTH`` of the borders (local relaxation where
 the nonlinearity next to curved borders is strongest; O(n) work).
 
@@ -73,10 +75,17 @@ MAX_NEW_FOLDED = 0.02
 STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.9
 #: Pre-/post-smoothing sweeps (4-colour Gauss–Seidel) per level.
 PRE, POST = 1, 3
+#: Post-smoothing sweeps on the coarse levels (``POST`` on the finest).
+COARSE_POST = 2
 #: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
 BAND_WIDTH, BAND_SWEEPS = 8, 4
+#: Cycles on each level of the full-multigrid start (the finest excepted).
+FMG_CYCLES = 1
 #: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
 COARSEST_SWEEPS = 24
+#: At most this many sweeps on the coarsest level (a large coarsest level: the shape
+#: stopped the coarsening).
+COARSEST_MAX = 100
 #: Levels with fewer nodes than this use the serial kernels even with threads > 1.
 PARALLEL_MIN_NODES = 8192
 #: FMG levels with more nodes than this yield to the driver (snapshots keep flowing).
@@ -175,6 +184,23 @@ class _Level:
     qscale: float = 1.0
 
 
+_TABLES: dict = {}
+
+
+def _tables(pos: np.ndarray, coarsen: bool, periodic: bool):
+    """:func:`K.transfer_tables`, memoised (they depend on the sizes only; read-only)."""
+    key = (pos.tobytes(), coarsen, periodic)
+    tab = _TABLES.get(key)
+    if tab is None:
+        if len(_TABLES) > 256:
+            _TABLES.clear()
+        tab = K.transfer_tables(pos, coarsen, periodic)
+        for a in tab:
+            a.flags.writeable = False
+        _TABLES[key] = tab
+    return tab
+
+
 class _FAS:
     """Working storage and cycles of one solve."""
 
@@ -197,8 +223,8 @@ class _FAS:
             ci, cj = coarsening((ni, nj), _aspect(fine.x, fine.y), self.periodic)
             if not (ci or cj):
                 break
-            tab_i = K.transfer_tables(pos_i, ci, self.periodic)
-            tab_j = K.transfer_tables(pos_j, cj, False)
+            tab_i = _tables(pos_i, ci, self.periodic)
+            tab_j = _tables(pos_j, cj, False)
             sel = np.ix_(tab_i[0], tab_j[0])
             if not _acceptable(fine.x, fine.y, fine.x[sel], fine.y[sel]):
                 break
@@ -223,10 +249,79 @@ class _FAS:
             last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
             last.ry = np.empty(last.x.shape)
         n = max(self.levels[-1].x.shape) - 1
-        self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, 1000))
+        self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, COARSEST_MAX))
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
+        self._pack()
         self.restrict_sources()
+
+    def _pack(self) -> None:
+        """Move the arrays of the small levels into flat buffers for :func:`K.vcycle`.
+
+        Levels from ``kfuse`` on (all but the finest for V-cycles, or the
+        serial ones with threads) run a whole V-cycle in one compiled call;
+        their arrays become views of the buffers, so the Python code paths
+        (FMG start, sources, transfers from level ``kfuse − 1``) see the same
+        data.
+        """
+        levels = self.levels
+        nlev = len(levels)
+        self.kfuse = nlev  # no fused levels
+        if self.gamma != 1 or nlev < 2:
+            return
+        kf = 1
+        while kf < nlev and levels[kf].par:
+            kf += 1
+        if kf >= nlev:
+            return
+        fl, il = [], []
+        fpos = [0]
+        ipos = [0]
+
+        def put(arr, lst, pos):
+            off = pos[0]
+            lst.append(np.ascontiguousarray(arr).ravel())
+            pos[0] += arr.size
+            return off
+
+        meta = np.zeros((nlev - kf, K.META_COLS), dtype=np.int64)
+        fnames = ("x", "y", "fx", "fy", "p", "q", "rx", "ry")
+        for r, lv in enumerate(levels[kf:]):
+            m = meta[r]
+            m[K.M_N0], m[K.M_N1] = lv.x.shape
+            m[K.M_PQ] = lv.p.size > 0
+            for name, col in zip(fnames, (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX,
+                                          K.M_RY), strict=True):
+                arr = getattr(lv, name)
+                if arr is not None and arr.size:
+                    m[col] = put(arr, fl, fpos)
+            if lv.ci is not None:
+                for name, col in (("ci", K.M_CI), ("cj", K.M_CJ), ("ri", K.M_RI), ("rj", K.M_RJ),
+                                  ("li", K.M_LI), ("lj", K.M_LJ)):
+                    m[col] = put(np.asarray(getattr(lv, name), dtype=np.int64), il, ipos)
+                for name, col in (("rwi", K.M_RWI), ("rwj", K.M_RWJ), ("wli", K.M_WLI),
+                                  ("wlj", K.M_WLJ)):
+                    m[col] = put(np.asarray(getattr(lv, name), dtype=np.float64), fl, fpos)
+        fbuf = np.concatenate(fl) if fl else np.zeros(0)
+        ibuf = np.concatenate(il) if il else np.zeros(0, dtype=np.int64)
+        for r, lv in enumerate(levels[kf:]):
+            m = meta[r]
+            shp = lv.x.shape
+            n = shp[0] * shp[1]
+            for name, col in zip(fnames, (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX,
+                                          K.M_RY), strict=True):
+                arr = getattr(lv, name)
+                if arr is not None and arr.size:
+                    setattr(lv, name, fbuf[m[col]:m[col] + n].reshape(shp))
+        self.kfuse = kf
+        self.fbuf, self.ibuf, self.meta = fbuf, ibuf, meta
+        self.fscale = np.array([lv.scale for lv in levels[kf:]])
+        # smoother node updates of a fused cycle started at each level (for last_run)
+        cnt = [0] * nlev
+        cnt[-1] = self.coarsest_sweeps * levels[-1].x.size
+        for k in range(nlev - 2, kf - 1, -1):
+            cnt[k] = cnt[k + 1] + (PRE + COARSE_POST) * levels[k].x.size
+        self.fused_updates = cnt
 
     # ------------------------------------------------------------------ pieces
     def restrict_sources(self) -> None:
@@ -275,6 +370,11 @@ class _FAS:
     def cycle(self, k: int, *, have_defect: bool = False) -> None:
         """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
         lv = self.levels[k]
+        if k >= self.kfuse:
+            self.updates += self.fused_updates[k]
+            K.vcycle(self.fbuf, self.ibuf, self.meta, self.fscale, k - self.kfuse, PRE, COARSE_POST,
+                     self.coarsest_sweeps, BAND_WIDTH, BAND_SWEEPS, self.periodic)
+            return
         if k == len(self.levels) - 1:
             self.smooth(lv, self.coarsest_sweeps)
             return
@@ -285,7 +385,7 @@ class _FAS:
         for _ in range(self.gamma if k + 1 < len(self.levels) - 1 else 1):
             self.cycle(k + 1)
         self.correct(k)
-        self.smooth(lv, POST)
+        self.smooth(lv, POST if k == 0 else COARSE_POST)
         self.smooth_band(lv)
 
 
@@ -313,6 +413,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         r0 = state.residual()
     state.history.append((0, r0))
     if r0 <= tol:
+        state.final_residual = r0
         return True
     for k in range(1, len(levels)):
         K.inject(levels[k - 1].x, levels[k - 1].ci, levels[k - 1].cj, levels[k].x)
@@ -324,7 +425,8 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         mg.correct(k)
         levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
         levels[k].fy[...] = 0.0
-        mg.cycle(k)
+        for _ in range(FMG_CYCLES):
+            mg.cycle(k)
         if levels[k].x.size >= YIELD_NODES:
             yield "tick"
     mg.correct(0)
@@ -339,6 +441,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
             r = state.residual()
         state.history.append((it, r))
         if r <= tol and _sources_settled(state):
+            state.final_residual = r
             return True
         if not math.isfinite(r) or r > 1e3 * max(min(best, r0), tol if state.sources is not None else 0.0):
             state.x[...] = backup[0]

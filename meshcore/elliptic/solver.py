@@ -55,6 +55,13 @@ __all__ = [
 #: Solver methods; "multigrid" and others register themselves (see register_method).
 METHODS: dict[str, Callable[..., Generator]] = {}
 
+#: Snapshots come at most every ``max(report_interval, SNAPSHOT_COST_FACTOR × t)``
+#: seconds, ``t`` the time the last snapshot took (copying x, y of a huge grid).
+SNAPSHOT_COST_FACTOR = 20.0
+#: Assumed snapshot copy speed before the first snapshot is timed: fresh pages included
+#: (measured: 67 MB in 130-150 ms when the kernel first compacts transparent huge pages).
+SNAPSHOT_BYTES_PER_S = 0.5e9
+
 
 def register_method(name: str, fn: Callable[..., Generator]) -> None:
     """Register a solver generator ``fn(state) -> Generator`` under ``name``."""
@@ -85,7 +92,8 @@ class EllipticConfig:
         SOR relaxation factor in (0, 2); ``None`` = ``2 / (1 + sin(π / n))``
         with automatic back-off if the iteration diverges.
     report_interval : float
-        Seconds between progress snapshots.
+        Seconds between progress snapshots (at least 20× the time one snapshot
+        takes, so that copying a huge grid costs < 5 %).
     threads : int
         1 = serial kernels; > 1 uses the ``parallel=True`` kernels (bit-identical).
     """
@@ -148,6 +156,9 @@ class SolverState:
     history: list = field(default_factory=list)
     message: str = ""
     iterations: int = 0
+    #: The stopping measure of the final grid, when the method computed it right before
+    #: returning converged (saves the driver recomputing it).
+    final_residual: float | None = None
 
     def residual(self) -> float:
         return float(_kernels.jacobi_residual(self.x, self.y, self.p, self.q, self.periodic))
@@ -212,6 +223,7 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
             state.history.append((it, r))
             if r <= tol and _sources_settled(state):
                 state.iterations = it
+                state.final_residual = r
                 return True
             if not math.isfinite(r) or r > 1e3 * max(best, floor):
                 # diverging: restore the last good iterate and relax less
@@ -309,6 +321,10 @@ def iterate(
         sources.initialize(x, y, pp, qq)
     t0 = time.perf_counter()
     last = t0
+    # until a snapshot has been timed: assume copying x, y of a huge grid (arrays that numpy
+    # places in transparent huge pages, ≥ 4 MB) runs at SNAPSHOT_BYTES_PER_S
+    interval_floor = (SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S
+                      if x.nbytes >= 4 << 20 else 0.0)
     gen = METHODS[method](state)
     converged = False
     stopped = False
@@ -319,8 +335,7 @@ def iterate(
                 stopped = True
                 break
             now = time.perf_counter()
-            if now - last >= cfg.report_interval:
-                last = now
+            if now - last >= max(cfg.report_interval, interval_floor):
                 r = state.history[-1][1] if state.history else float("nan")
                 snap = SolverProgress(
                     iteration=state.iterations,
@@ -331,6 +346,9 @@ def iterate(
                     method=method,
                     history=tuple(state.history),
                 )
+                last = time.perf_counter()
+                # a snapshot copies x, y: keep that below ~5 % of the solve on huge grids
+                interval_floor = SNAPSHOT_COST_FACTOR * (last - now)
                 cmd = yield snap
                 if cmd == "stop":
                     stopped = True
@@ -342,7 +360,9 @@ def iterate(
         converged = bool(fin.value)
     finally:
         gen.close()
-    r_final = state.residual()
+    r_final = state.final_residual
+    if stopped or not converged or r_final is None:
+        r_final = state.residual()
     if stopped:
         msg = "stopped"
         converged = False

@@ -208,6 +208,19 @@ def test_parallel_kernels_are_bit_identical(periodic):
         assert ma == mb and np.array_equal(ra[0], rb[0]) and np.array_equal(ra[1], rb[1])
 
 
+def test_serial_and_parallel_compilations_are_cached_under_distinct_names():
+    # numba's disk cache files a function by qualified name and line only: two compilations of
+    # one Python function (serial and parallel=True) would load each other's machine code
+    pairs = [(_kernels.sweep4, _kernels.sweep4_parallel)]
+    pairs += [(getattr(_mg_kernels, n), getattr(_mg_kernels, n + "_parallel"))
+              for n in ("smooth", "defect", "add_operator", "restrict", "prolong_correct")]
+    names = set()
+    for serial, parallel in pairs:
+        assert not serial.targetoptions.get("parallel") and parallel.targetoptions["parallel"]
+        names |= {serial.py_func.__qualname__, parallel.py_func.__qualname__}
+    assert len(names) == 2 * len(pairs)
+
+
 # --------------------------------------------------------------- solver
 def _compare_with_sor(g0, **kw):
     mg = meshcore.solve(g0, method="multigrid", tolerance=1e-12, **kw)
