@@ -14,6 +14,11 @@ whole-block ``method="foldfree"``, with the largest node distance to Winslow).
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path as _Path
+
+sys.path.insert(0, str(_Path(__file__).resolve().parent.parent))  # the repo's meshcore and tests
+
 import argparse
 import math
 import time
