@@ -113,6 +113,7 @@ def generate_block(
     tolerance: float | None = None,
     max_iterations: int = 50_000,
     omega: float | None = None,
+    threads: int = 1,
     p: np.ndarray | None = None,
     q: np.ndarray | None = None,
     config: EllipticConfig | None = None,
@@ -146,8 +147,9 @@ def generate_block(
     borders : dict, optional
         Per-border :class:`~meshcore.boundary.BorderSpec` (distribution, first,
         last, name), e.g. ``{"bottom": {"distribution": "tanh", "first": 0.01}}``.
-    method, tolerance, max_iterations, omega, config
-        Solver settings (see :class:`~meshcore.elliptic.EllipticConfig`).
+    method, tolerance, max_iterations, omega, threads, config
+        Solver settings (see :class:`~meshcore.elliptic.EllipticConfig`);
+        ``threads=2`` runs the bit-identical parallel kernels.
     p, q : array_like, optional
         Source terms P, Q of the node shape (zero by default).
     callback : callable, optional
@@ -219,7 +221,7 @@ def generate_block(
     foldfree = (config.method if config is not None else str(method).lower()) == "foldfree"
     cfg = config or EllipticConfig(
         method="auto" if foldfree else method, tolerance=tolerance, max_iterations=max_iterations,
-        omega=omega,
+        omega=omega, threads=threads,
     )
     sources = None
     if control is not None:

@@ -395,3 +395,14 @@ def test_band_smoother_is_gauss_seidel_restricted_to_the_border_band():
     _mg_kernels.smooth_band(b[0], b[1], E, E, E, E, False, 40, 2)
     _mg_kernels.smooth(c[0], c[1], E, E, E, E, False, 2)
     assert np.array_equal(b[0], c[0]) and np.array_equal(b[1], c[1])
+
+
+def test_generate_block_threads_option_is_bit_identical():
+    import meshcore
+    from tests.conftest import annulus_sector, borders_of
+
+    X, Y = annulus_sector(120, 90)
+    a = meshcore.generate_block(*borders_of(X, Y), threads=2)
+    b = meshcore.generate_block(*borders_of(X, Y), threads=1)
+    assert a.info.method.startswith("multigrid")
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
