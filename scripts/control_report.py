@@ -35,33 +35,9 @@ if not LAKES.exists():
     LAKES = Path("/work/shared/data/lakes")
 WALLS = ("bottom", "right", "top", "left")
 
-
-def bottle_points():
-    bottom = np.array([[0, 0], [1, 0], [2, 0], [3, 0]], float)
-    right = np.array(
-        [
-            [3, 0],
-            [3.1, 1],
-            [3.1, 2],
-            [3.0, 3],
-            [2.6, 4],
-            [2.0, 4.8],
-            [1.9, 5.6],
-            [1.9, 6.4],
-            [1.9, 7.2],
-            [1.9, 8],
-        ],
-        float,
-    )
-    left = right.copy()
-    left[:, 0] = 3.0 - left[:, 0]
-    top = np.array([[1.1, 8], [1.3667, 8], [1.6333, 8], [1.9, 8]])
-    return bottom, right, top, left
-
-
-def circle(c, r, n=20):
-    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    return np.column_stack([c[0] + r * np.cos(t), c[1] + r * np.sin(t)])
+# The measured shapes are the tests' shapes (one definition).
+sys.path.insert(0, str(ROOT))
+from tests.meshcore.test_control import bottle_points, circle  # noqa: E402
 
 
 def run(g0, spec=None, periodic=False, curves=None, max_iterations=50000):
