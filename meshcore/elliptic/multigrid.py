@@ -30,9 +30,10 @@ repeats column 0) is carried through every level.
 
 Iteration: a full-multigrid start (solve the coarsest level, interpolate the
 correction up, one cycle per level), then V (or W) cycles until the shared
-stopping rule holds.  After the FMG interpolation to the finest level the
-border band (see below) is relaxed before the first fine sweep: the coarse
-FMG solution misses the fine truncation error next to curved borders.
+stopping rule holds.  After the FMG interpolation to the finest level (and
+to coarse levels with ≥ :data:`FMG_BAND_MIN_CELLS` cells) the border band
+(see below) is relaxed before the first sweep: the coarser FMG solution
+misses the fine truncation error next to curved borders.
 The fine defect that a cycle restricts is computed first
 and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
 the convergence check costs nothing extra (a final check with
@@ -82,6 +83,9 @@ PRE, POST = 1, 3
 COARSE_POST = 2
 #: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
 BAND_WIDTH, BAND_SWEEPS = 8, 4
+#: FMG levels whose smaller side has at least this many cells (and the finest level) get
+#: a border-band pass right after the FMG interpolation.
+FMG_BAND_MIN_CELLS = 128
 #: Cycles on each level of the full-multigrid start (the finest excepted).
 FMG_CYCLES = 1
 #: Sweeps on the coarsest level (at least; more for a periodic ring, see _coarsest_sweeps).
@@ -428,6 +432,8 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         mg.correct(k)
         levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
         levels[k].fy[...] = 0.0
+        if min(levels[k].x.shape) - 1 >= FMG_BAND_MIN_CELLS:
+            mg.smooth_band(levels[k])  # as on the finest level below
         for _ in range(FMG_CYCLES):
             mg.cycle(k)
         if levels[k].x.size >= YIELD_NODES:
