@@ -30,10 +30,11 @@ repeats column 0) is carried through every level.
 
 Iteration: a full-multigrid start (solve the coarsest level, interpolate the
 correction up, one cycle per level), then V (or W) cycles until the shared
-stopping rule holds.  After the FMG interpolation to the finest level (and
-to coarse levels with ≥ :data:`FMG_BAND_MIN_CELLS` cells) the border band
-(see below) is relaxed before the first sweep: the coarser FMG solution
-misses the fine truncation error next to curved borders.
+stopping rule holds.  After the FMG interpolation to the finest level the
+nodes within :data:`FMG_BAND_WIDTH` of a border get :data:`FMG_BAND_SWEEPS`
+Gauss–Seidel sweeps before the first full sweep (and coarse levels with
+≥ :data:`FMG_BAND_MIN_CELLS` cells a border-band pass, see below): the
+coarser FMG solution misses the fine truncation error next to curved borders.
 The fine defect that a cycle restricts is computed first
 and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
 the convergence check costs nothing extra (a final check with
@@ -83,8 +84,11 @@ PRE, POST = 1, 3
 COARSE_POST = 2
 #: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
 BAND_WIDTH, BAND_SWEEPS = 8, 4
-#: FMG levels whose smaller side has at least this many cells (and the finest level) get
-#: a border-band pass right after the FMG interpolation.
+#: After the FMG interpolation to the finest level, this many Gauss–Seidel sweeps on the
+#: nodes within FMG_BAND_WIDTH of a border (a narrow band: the error sits right there).
+FMG_BAND_WIDTH, FMG_BAND_SWEEPS = 2, 24
+#: FMG levels whose smaller side has at least this many cells get a border-band pass
+#: (BAND_WIDTH, BAND_SWEEPS) right after the FMG interpolation.
 FMG_BAND_MIN_CELLS = 128
 #: Cycles on each level of the full-multigrid start (the finest excepted).
 FMG_CYCLES = 1
@@ -441,8 +445,9 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     mg.correct(0)
     # The FMG correction is interpolated from a coarse problem without the fine
     # truncation error, which is largest next to curved borders: relax the
-    # border band first (it takes about one cycle off the fine iteration).
-    mg.smooth_band(lv0)
+    # nodes next to the borders first (it takes one or two cycles off).
+    K.smooth_band(lv0.x, lv0.y, lv0.fx, lv0.fy, lv0.p, lv0.q, mg.periodic, FMG_BAND_WIDTH,
+                  FMG_BAND_SWEEPS)
     mg.smooth(lv0, PRE)
     # ------------------------------------------------------------------ cycles
     # ``it`` counts finished fine-level cycles; the FMG start counts as the first.
