@@ -32,9 +32,9 @@ Iteration: a full-multigrid start (solve the coarsest level, interpolate the
 correction up, one cycle per level), then V (or W) cycles until the shared
 stopping rule holds.  After the FMG interpolation to the finest level the
 nodes within :data:`FMG_BAND_WIDTH` of a border get :data:`FMG_BAND_SWEEPS`
-Gauss–Seidel sweeps before the first full sweep (and coarse levels with
-≥ :data:`FMG_BAND_MIN_CELLS` cells a border-band pass, see below): the
-coarser FMG solution misses the fine truncation error next to curved borders.
+Gauss–Seidel sweeps before the first full sweep (so do coarse FMG levels with
+≥ :data:`FMG_BAND_MIN_CELLS` cells): the coarser FMG solution misses the
+fine truncation error next to curved borders.
 The fine defect that a cycle restricts is computed first
 and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
 the convergence check costs nothing extra (a final check with
@@ -87,8 +87,8 @@ BAND_WIDTH, BAND_SWEEPS = 8, 4
 #: After the FMG interpolation to the finest level, this many Gauss–Seidel sweeps on the
 #: nodes within FMG_BAND_WIDTH of a border (a narrow band: the error sits right there).
 FMG_BAND_WIDTH, FMG_BAND_SWEEPS = 2, 24
-#: FMG levels whose smaller side has at least this many cells get a border-band pass
-#: (BAND_WIDTH, BAND_SWEEPS) right after the FMG interpolation.
+#: FMG levels whose smaller side has at least this many cells get the same narrow-band
+#: pass right after the FMG interpolation (on smaller levels it costs more than it saves).
 FMG_BAND_MIN_CELLS = 128
 #: Cycles on each level of the full-multigrid start (the finest excepted).
 FMG_CYCLES = 1
@@ -358,6 +358,10 @@ class _FAS:
             K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, BAND_WIDTH,
                           BAND_SWEEPS)
 
+    def fmg_band(self, lv: _Level) -> None:
+        K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, FMG_BAND_WIDTH,
+                      FMG_BAND_SWEEPS)
+
     def defect(self, lv: _Level) -> float:
         fn = K.defect_parallel if lv.par else K.defect
         return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
@@ -437,7 +441,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
         levels[k].fy[...] = 0.0
         if min(levels[k].x.shape) - 1 >= FMG_BAND_MIN_CELLS:
-            mg.smooth_band(levels[k])  # as on the finest level below
+            mg.fmg_band(levels[k])  # as on the finest level below
         for _ in range(FMG_CYCLES):
             mg.cycle(k)
         if levels[k].x.size >= YIELD_NODES:
@@ -446,8 +450,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     # The FMG correction is interpolated from a coarse problem without the fine
     # truncation error, which is largest next to curved borders: relax the
     # nodes next to the borders first (it takes one or two cycles off).
-    K.smooth_band(lv0.x, lv0.y, lv0.fx, lv0.fy, lv0.p, lv0.q, mg.periodic, FMG_BAND_WIDTH,
-                  FMG_BAND_SWEEPS)
+    mg.fmg_band(lv0)
     mg.smooth(lv0, PRE)
     # ------------------------------------------------------------------ cycles
     # ``it`` counts finished fine-level cycles; the FMG start counts as the first.
