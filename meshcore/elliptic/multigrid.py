@@ -109,10 +109,14 @@ _EMPTY = np.zeros((0, 0))
 last_run: dict = {}
 
 
+def _stride(x: np.ndarray) -> int:
+    """Sampling stride of the aspect estimate (about 64 samples per direction)."""
+    return max(1, max(x.shape) // 64)
+
+
 def _aspect(x: np.ndarray, y: np.ndarray) -> float:
     """Typical cell aspect ``|x_ξ| / |x_η|`` (geometric mean over the cells)."""
-    stride = max(1, max(x.shape) // 64)
-    return float(np.exp(K.cell_stats(x, y, stride)[0]))
+    return float(np.exp(K.cell_stats(x, y, _stride(x))[0]))
 
 
 def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) -> tuple[bool, bool]:
@@ -228,17 +232,23 @@ class _FAS:
         self.levels = [lv0]
         pos_i = np.arange(state.x.shape[0])
         pos_j = np.arange(state.x.shape[1])
+        # (log aspect, folded fraction) of the current finest level: computed once per
+        # level, the same numbers as _aspect and _acceptable
+        stats = K.cell_stats(state.x, state.y, _stride(state.x))
         while True:
             fine = self.levels[-1]
             ni, nj = fine.x.shape[0] - 1, fine.x.shape[1] - 1
-            ci, cj = coarsening((ni, nj), _aspect(fine.x, fine.y), self.periodic)
+            ci, cj = coarsening((ni, nj), float(np.exp(stats[0])), self.periodic)
             if not (ci or cj):
                 break
             tab_i = _tables(pos_i, ci, self.periodic)
             tab_j = _tables(pos_j, cj, False)
             sel = np.ix_(tab_i[0], tab_j[0])
-            if not _acceptable(fine.x, fine.y, fine.x[sel], fine.y[sel]):
+            xc, yc = fine.x[sel], fine.y[sel]  # injection (for the next coarsening decision)
+            cstats = K.cell_stats(xc, yc, _stride(xc))
+            if not cstats[1] <= stats[1] + MAX_NEW_FOLDED:
                 break
+            stats = cstats
             fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
             fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = tab_j
             pos_i, pos_j = pos_i[fine.ci], pos_j[fine.cj]
@@ -251,9 +261,6 @@ class _FAS:
             fine.ry = np.empty(fine.x.shape)
             pc = np.empty(shp) if use_pq else _EMPTY
             qc = np.empty(shp) if use_pq else _EMPTY
-            xc, yc = np.empty(shp), np.empty(shp)
-            K.inject(fine.x, fine.ci, fine.cj, xc)  # for the next coarsening decision
-            K.inject(fine.y, fine.ci, fine.cj, yc)
             self.levels.append(_Level(xc, yc, np.zeros(shp), np.zeros(shp), pc, qc))
         last = self.levels[-1]
         if last.rx is None and len(self.levels) > 1:
