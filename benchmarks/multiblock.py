@@ -30,7 +30,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import meshcore  # noqa: E402
-from meshcore.boundary import Borders  # noqa: E402
 from meshcore.elliptic import _kernels as bk  # noqa: E402
 from meshcore.elliptic.solver import METHODS, default_tolerance  # noqa: E402
 from meshcore.multiblock import (  # noqa: E402
@@ -42,26 +41,7 @@ from meshcore.multiblock import (  # noqa: E402
     solve_multiblock,
 )
 from meshcore.multiblock.solver import _BlockEngine, _TableEngine  # noqa: E402
-
-
-def curved_rectangle(ni: int, nj: int):
-    xs = np.linspace(0.0, 2.0, ni + 1)
-    t = np.linspace(0.0, 1.0, nj + 1)
-    xf = np.linspace(0.0, 2.0, 4001)
-    yf = 1.0 + 0.35 * np.sin(0.5 * np.pi * xf) * xf / 2.0
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(xf), np.diff(yf)))])
-    u = np.linspace(0.0, s[-1], ni + 1)
-    xt, yt = np.interp(u, s, xf), np.interp(u, s, yf)
-    X = xs[:, None] + (xt - xs)[:, None] * t[None, :]
-    Y = yt[:, None] * t[None, :]
-    return X, Y
-
-
-def borders(X, Y) -> Borders:
-    return Borders(
-        bottom=np.column_stack([X[:, 0], Y[:, 0]]), right=np.column_stack([X[-1], Y[-1]]),
-        top=np.column_stack([X[:, -1], Y[:, -1]]), left=np.column_stack([X[0], Y[0]]),
-    )
+from tests.meshcore.test_multiblock import borders, curved_rectangle  # noqa: E402  (one definition)
 
 
 def split(X, Y, nb: int) -> MultiBlockTopology:
