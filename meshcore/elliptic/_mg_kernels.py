@@ -203,7 +203,9 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
 
     Local relaxation where the nonlinearity is strongest (next to curved
     borders): costs O(n·width) per sweep.  Serial only (it is cheap), so it
-    is the same in serial and threaded solves.
+    is the same in serial and threaded solves.  Rows of one parity are
+    independent: the rows next to the ξ borders are relaxed whole (vectorised
+    when long), the other rows in their two strips next to the η borders.
     """
     ni1, nj1 = x.shape
     use_f = fx.size > 0
@@ -211,24 +213,44 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
     ni = ni1 - 1
     nj = nj1 - 1
     i0 = 0 if periodic else 1
+    late0 = periodic and ni % 2 == 1  # row 0 and ni - 1 share a parity: row 0 goes last
+    vec = nj1 >= VECTOR_ROW
+    strips = nj > 2 * width + 2
+    tx = np.empty(nj1)
+    ty = np.empty(nj1)
     for _ in range(sweeps):
         for ci in range(2):
             start = i0 + ((ci - i0) % 2)
-            for i in range(start, ni, 2):
-                if periodic and i == 0 and ni % 2 == 1:
+            if late0 and start == 0:
+                start = 2
+            last = start + 2 * ((ni - 1 - start) // 2)  # last row of this parity
+            lo, hi = start, last  # rows relaxed only in the strips
+            if not strips:
+                lo, hi = start, start - 2
+            elif not periodic:
+                while lo <= hi and lo <= width:
+                    lo += 2
+                while hi >= lo and hi >= ni - width:
+                    hi -= 2
+            for i in range(start, last + 1, 2):
+                if lo <= i <= hi:
                     continue
                 iw = i - 1
                 if iw < 0:
                     iw = ni - 1
-                near = (not periodic) and (i <= width or i >= ni - width)
-                if near or nj <= 2 * width + 2:
-                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, nj)
+                if vec:
+                    _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1, tx, ty)
                 else:
-                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, width + 1)
-                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj - width, nj)
+                    _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, nj)
+            for i in range(lo, hi + 1, 2):
+                iw = i - 1
+                if iw < 0:
+                    iw = ni - 1
+                _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, width + 1)
+                _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj - width, nj)
             if periodic:
-                if ci == 0 and ni % 2 == 1:
-                    if nj <= 2 * width + 2:
+                if ci == 0 and late0:
+                    if not strips:
                         _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, nj)
                     else:
                         _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, width + 1)

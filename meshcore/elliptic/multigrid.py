@@ -84,6 +84,8 @@ PRE, POST = 1, 3
 COARSE_POST = 2
 #: Extra Gauss–Seidel sweeps on the nodes within BAND_WIDTH of a border, after post-smoothing.
 BAND_WIDTH, BAND_SWEEPS = 8, 4
+#: The same on the coarse levels.
+COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS = 8, 4
 #: After the FMG interpolation to the finest level, this many Gauss–Seidel sweeps on the
 #: nodes within FMG_BAND_WIDTH of a border (a narrow band: the error sits right there).
 FMG_BAND_WIDTH, FMG_BAND_SWEEPS = 2, 24
@@ -360,10 +362,11 @@ class _FAS:
             fn = K.smooth_parallel if lv.par else K.smooth
             fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
 
-    def smooth_band(self, lv: _Level) -> None:
-        if BAND_SWEEPS > 0:
-            K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, BAND_WIDTH,
-                          BAND_SWEEPS)
+    def smooth_band(self, lv: _Level, fine: bool) -> None:
+        width, sweeps = (BAND_WIDTH, BAND_SWEEPS) if fine else (COARSE_BAND_WIDTH,
+                                                                COARSE_BAND_SWEEPS)
+        if sweeps > 0:
+            K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, width, sweeps)
 
     def fmg_band(self, lv: _Level) -> None:
         K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, FMG_BAND_WIDTH,
@@ -395,7 +398,7 @@ class _FAS:
         if k >= self.kfuse:
             self.updates += self.fused_updates[k]
             K.vcycle(self.fbuf, self.ibuf, self.meta, self.fscale, k - self.kfuse, PRE, COARSE_POST,
-                     self.coarsest_sweeps, BAND_WIDTH, BAND_SWEEPS, self.periodic)
+                     self.coarsest_sweeps, COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS, self.periodic)
             return
         if k == len(self.levels) - 1:
             self.smooth(lv, self.coarsest_sweeps)
@@ -408,7 +411,7 @@ class _FAS:
             self.cycle(k + 1)
         self.correct(k)
         self.smooth(lv, POST if k == 0 else COARSE_POST)
-        self.smooth_band(lv)
+        self.smooth_band(lv, k == 0)
 
 
 def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
