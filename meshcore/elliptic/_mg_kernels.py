@@ -46,6 +46,9 @@ from numba import njit, prange
 
 #: Rows at least this long use the vectorised (compute-all, store-half) row update.
 VECTOR_ROW = 48
+#: Band strips at most this wide are relaxed transposed (wider ones: the vectorised
+#: kernel's doubled arithmetic eats the gain; measured).
+TRANSPOSE_MAX_WIDTH = 4
 #: Rows of one colour are split into at most this many chunks (parallel work units).
 ROW_CHUNKS = 16
 
@@ -198,14 +201,46 @@ def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragm
 
 
 @njit(cache=True, nogil=True)
+def _strip_in(a, at, j0, periodic):  # pragma: no cover - compiled
+    """Columns ``j0 … j0 + at.shape[0] − 1`` of ``a`` as the rows of ``at`` (transposed).
+
+    Periodic ξ gets one extra entry in front (``i = ni − 1`` before ``i = 0``;
+    ``i = ni`` ≡ 0 is last), so every node of the ring is inside.
+    """
+    ni = a.shape[0] - 1
+    off = 1 if periodic else 0
+    for jj in range(at.shape[0]):
+        j = j0 + jj
+        if periodic:
+            at[jj, 0] = a[ni - 1, j]
+        for i in range(ni + 1):
+            at[jj, i + off] = a[i, j]
+
+
+@njit(cache=True, nogil=True)
+def _strip_out(at, a, j0, periodic):  # pragma: no cover - compiled
+    """Rows ``1 … at.shape[0] − 2`` of ``at`` back into their columns of ``a``."""
+    ni = a.shape[0] - 1
+    off = 1 if periodic else 0
+    for jj in range(1, at.shape[0] - 1):
+        j = j0 + jj
+        for i in range(1 - off, ni):
+            a[i, j] = at[jj, i + off]
+        if periodic:
+            a[ni, j] = a[0, j]
+
+
+@njit(cache=True, nogil=True)
 def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cover - compiled
-    """Extra 4-colour Gauss–Seidel sweeps on the nodes within ``width`` of a border.
+    """Extra Gauss–Seidel sweeps on the nodes within ``width`` of a border.
 
     Local relaxation where the nonlinearity is strongest (next to curved
     borders): costs O(n·width) per sweep.  Serial only (it is cheap), so it
-    is the same in serial and threaded solves.  Rows of one parity are
-    independent: the rows next to the ξ borders are relaxed whole (vectorised
-    when long), the other rows in their two strips next to the η borders.
+    is the same in serial and threaded solves.  Each sweep relaxes the rows
+    next to the ξ borders (4-colour order, vectorised when long), then the
+    strips next to the η borders: long narrow strips are copied transposed
+    (the equations are the same with ξ ↔ η and P ↔ Q) and relaxed row by row
+    with the vectorised row kernel; others row by row in place.
     """
     ni1, nj1 = x.shape
     use_f = fx.size > 0
@@ -216,8 +251,30 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
     late0 = periodic and ni % 2 == 1  # row 0 and ni - 1 share a parity: row 0 goes last
     vec = nj1 >= VECTOR_ROW
     strips = nj > 2 * width + 2
+    trans = strips and ni1 >= VECTOR_ROW and width <= TRANSPOSE_MAX_WIDTH
     tx = np.empty(nj1)
     ty = np.empty(nj1)
+    # transposed strips (rows 0 and width + 1 are their fixed neighbours)
+    L = ni1 + 1 if periodic else ni1
+    W = width + 2 if trans else 0
+    e = np.zeros((0, 0))
+    xs = np.empty((2, W, L))
+    ys = np.empty((2, W, L))
+    fxs = np.empty((2, W, L)) if (trans and use_f) else np.empty((2, 0, 0))
+    fys = np.empty((2, W, L)) if (trans and use_f) else np.empty((2, 0, 0))
+    ps = np.empty((2, W, L)) if (trans and use_pq) else np.empty((2, 0, 0))
+    qs = np.empty((2, W, L)) if (trans and use_pq) else np.empty((2, 0, 0))
+    sx = np.empty(L)
+    sy = np.empty(L)
+    j0s = (0, nj - width - 1)
+    if trans:
+        for k in range(2):
+            if use_f:
+                _strip_in(fx, fxs[k], j0s[k], periodic)
+                _strip_in(fy, fys[k], j0s[k], periodic)
+            if use_pq:
+                _strip_in(q, ps[k], j0s[k], periodic)  # ξ ↔ η: P ↔ Q
+                _strip_in(p, qs[k], j0s[k], periodic)
     for _ in range(sweeps):
         for ci in range(2):
             start = i0 + ((ci - i0) % 2)
@@ -242,6 +299,8 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
                     _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1, tx, ty)
                 else:
                     _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, 1, nj)
+            if trans:
+                continue
             for i in range(lo, hi + 1, 2):
                 iw = i - 1
                 if iw < 0:
@@ -259,6 +318,21 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
                 for j in range(nj1):
                     x[ni, j] = x[0, j]
                     y[ni, j] = y[0, j]
+        if trans:
+            for k in range(2):
+                xt = xs[k]
+                yt = ys[k]
+                _strip_in(x, xt, j0s[k], periodic)
+                _strip_in(y, yt, j0s[k], periodic)
+                fxt = fxs[k] if use_f else e
+                fyt = fys[k] if use_f else e
+                pt = ps[k] if use_pq else e
+                qt = qs[k] if use_pq else e
+                for jj in range(1, W - 1):
+                    _relax_row_vec(xt, yt, fxt, fyt, pt, qt, use_f, use_pq, jj, jj - 1, jj + 1, L,
+                                   sx, sy)
+                _strip_out(xt, x, j0s[k], periodic)
+                _strip_out(yt, y, j0s[k], periodic)
 
 
 def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compiled
@@ -368,15 +442,20 @@ def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks,
             rx[i, j] = tx[j]
             ry[i, j] = ty[j]
         for j in range(nj1):
-            if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
-                m = tq[j] / td[j]
+            t = tq[j]
+            if td[j] > 0.0 and t > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
+                m = t / td[j]
+            elif t != t:  # NaN (also a NaN den): never a silent pass
+                m = np.inf
+                break
         row_max[i] = m
 
 
 def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
     """``r = f − N(u)`` at interior nodes (0 on the boundary); returns max (|f−N|/den)².
 
-    With ``f = 0`` the square root of the return value is the stopping measure.
+    With ``f = 0`` the square root of the return value is the stopping measure
+    (``inf`` if any node gives NaN, as :func:`._kernels.jacobi_residual`).
     Each row is computed into local scratch rows (unit stride, no aliasing:
     the loop vectorises) and then stored; the maximum is a separate loop.
     """
@@ -618,7 +697,8 @@ def cell_stats(x, y, stride):  # pragma: no cover - compiled
     the cross product of its diagonals is ≤ 0 (all cells).
     """
     ni1, nj1 = x.shape
-    s = 0.0
+    s = 0.0  # sum of log(a²/b²), taken as the log of running products (few logs)
+    prod = 1.0
     cnt = 0
     folded = 0
     for i in range(ni1 - 1):
@@ -634,10 +714,18 @@ def cell_stats(x, y, stride):  # pragma: no cover - compiled
                 a2 = (x[i + 1, j] - x[i, j]) ** 2 + (y[i + 1, j] - y[i, j]) ** 2
                 b2 = (x[i, j + 1] - x[i, j]) ** 2 + (y[i, j + 1] - y[i, j]) ** 2
                 if a2 > 0.0 and b2 > 0.0:
-                    s += 0.5 * np.log(a2 / b2)
+                    r = a2 / b2
                     cnt += 1
+                    if 1e-100 < r < 1e100:
+                        prod *= r
+                        if not 1e-150 < prod < 1e150:
+                            s += np.log(prod)
+                            prod = 1.0
+                    else:
+                        s += np.log(r)
+    s += np.log(prod)
     ncell = (ni1 - 1) * (nj1 - 1)
-    return (s / cnt if cnt else 0.0), folded / max(ncell, 1)
+    return (0.5 * s / cnt if cnt else 0.0), folded / max(ncell, 1)
 
 
 def coarse_indices(pos: np.ndarray, coarsen: bool) -> np.ndarray:

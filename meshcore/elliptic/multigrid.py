@@ -37,8 +37,9 @@ Gauss–Seidel sweeps before the first full sweep (so do coarse FMG levels with
 fine truncation error next to curved borders.
 The fine defect that a cycle restricts is computed first
 and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
-the convergence check costs nothing extra (a final check with
-:func:`._kernels.jacobi_residual` confirms it).  On the finest level a cycle
+the convergence check costs nothing extra (the same number as
+:func:`._kernels.jacobi_residual` up to rounding, ``inf`` on NaN; a test
+holds them together).  On the finest level a cycle
 is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
 operations as V(1, ``POST`` − 1) repeated); coarse levels use
 V(``PRE``, ``COARSE_POST``).  The serial coarse levels run a whole V-cycle in
@@ -88,7 +89,7 @@ BAND_WIDTH, BAND_SWEEPS = 8, 4
 COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS = 8, 4
 #: After the FMG interpolation to the finest level, this many Gauss–Seidel sweeps on the
 #: nodes within FMG_BAND_WIDTH of a border (a narrow band: the error sits right there).
-FMG_BAND_WIDTH, FMG_BAND_SWEEPS = 2, 24
+FMG_BAND_WIDTH, FMG_BAND_SWEEPS = 2, 32
 #: FMG levels whose smaller side has at least this many cells get the same narrow-band
 #: pass right after the FMG interpolation (on smaller levels it costs more than it saves).
 FMG_BAND_MIN_CELLS = 128
@@ -104,7 +105,12 @@ PARALLEL_MIN_NODES = 8192
 #: FMG levels with more nodes than this yield to the driver (snapshots keep flowing).
 YIELD_NODES = 200_000
 
+#: Solves of at most this many nodes keep their working storage for the next solve of
+#: the same shape (see :meth:`_FAS.release`); this many workspaces are kept.
+WORKSPACE_MAX_NODES, WORKSPACE_CACHE_SIZE = 1 << 17, 4
+
 _EMPTY = np.zeros((0, 0))
+_WORKSPACES: dict = {}
 
 #: Diagnostics of the most recent multigrid solve in this process (for benchmarks):
 #: ``levels`` (node shapes), ``node_updates`` (smoother node updates, all levels).
@@ -114,11 +120,6 @@ last_run: dict = {}
 def _stride(x: np.ndarray) -> int:
     """Sampling stride of the aspect estimate (about 64 samples per direction)."""
     return max(1, max(x.shape) // 64)
-
-
-def _aspect(x: np.ndarray, y: np.ndarray) -> float:
-    """Typical cell aspect ``|x_ξ| / |x_η|`` (geometric mean over the cells)."""
-    return float(np.exp(K.cell_stats(x, y, _stride(x))[0]))
 
 
 def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) -> tuple[bool, bool]:
@@ -141,37 +142,44 @@ def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) ->
     return ci, cj
 
 
-def _folded_fraction(x: np.ndarray, y: np.ndarray) -> float:
-    """Fraction of cells whose diagonals' cross product is ≤ 0."""
-    return float(K.cell_stats(x, y, max(x.shape))[1])
+def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list:
+    """The coarsenings of the grid ``(x, y)``: ``(ci, cj, tables_i, tables_j)`` per level.
 
-
-def _acceptable(xf, yf, xc, yc) -> bool:
-    """A coarse level must still represent the shape: not (many) more folded cells.
-
-    A ring cut into two cells, say, is a degenerate coarse grid whose FAS
-    correction is noise; coarsening stops before it.
+    Each direction is coarsened as :func:`coarsening` says; a coarse level
+    (injected nodes) must still represent the shape: a level with (many) more
+    folded cells than its parent, a ring cut into two cells say, is a
+    degenerate grid whose FAS correction is noise, so coarsening stops
+    before it.
     """
-    return _folded_fraction(xc, yc) <= _folded_fraction(xf, yf) + MAX_NEW_FOLDED
+    out = []
+    pos_i = np.arange(x.shape[0])
+    pos_j = np.arange(x.shape[1])
+    stats = K.cell_stats(x, y, _stride(x))  # (log aspect, folded fraction)
+    while True:
+        ci, cj = coarsening((x.shape[0] - 1, x.shape[1] - 1), float(np.exp(stats[0])), periodic)
+        if not (ci or cj):
+            return out
+        tab_i = _tables(pos_i, ci, periodic)
+        tab_j = _tables(pos_j, cj, False)
+        xc = np.empty((tab_i[0].size, tab_j[0].size))
+        yc = np.empty(xc.shape)
+        K.inject(x, tab_i[0], tab_j[0], xc)
+        K.inject(y, tab_i[0], tab_j[0], yc)
+        cstats = K.cell_stats(xc, yc, _stride(xc))
+        if not cstats[1] <= stats[1] + MAX_NEW_FOLDED:
+            return out
+        out.append((ci, cj, tab_i, tab_j))
+        stats = cstats
+        x, y = xc, yc
+        pos_i, pos_j = pos_i[tab_i[0]], pos_j[tab_j[0]]
 
 
 def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tuple[int, int]]:
     """Cell counts ``(ni, nj)`` of every level for the grid ``(x, y)``, finest first."""
     out = [(x.shape[0] - 1, x.shape[1] - 1)]
-    pi = np.arange(x.shape[0])
-    pj = np.arange(x.shape[1])
-    while True:
-        ci, cj = coarsening(out[-1], _aspect(x, y), periodic)
-        if not (ci or cj):
-            return out
-        c_i = K.coarse_indices(pi, ci)
-        c_j = K.coarse_indices(pj, cj)
-        xc, yc = x[np.ix_(c_i, c_j)], y[np.ix_(c_i, c_j)]
-        if not _acceptable(x, y, xc, yc):
-            return out
-        x, y = xc, yc
-        pi, pj = pi[c_i], pj[c_j]
-        out.append((x.shape[0] - 1, x.shape[1] - 1))
+    for _, _, tab_i, tab_j in _plan(x, y, periodic):
+        out.append((tab_i[0].size - 1, tab_j[0].size - 1))
+    return out
 
 
 @dataclass(slots=True)
@@ -230,30 +238,50 @@ class _FAS:
         if threads > 1:
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
         use_pq = state.p.size > 0
+        plan = _plan(state.x, state.y, self.periodic)
+        self.key = (state.x.shape, self.periodic, use_pq, threads, gamma,
+                    tuple((ci, cj) for ci, cj, _, _ in plan))
+        ws = _WORKSPACES.pop(self.key, None)
+        if ws is None:
+            self._build(plan, use_pq, threads)
+        else:
+            (self.levels, self.kfuse, self.fbuf, self.ibuf, self.meta, self.fscale,
+             self.fused_updates, self.coarsest_sweeps) = ws
+        lv0 = self.levels[0]
+        lv0.x, lv0.y, lv0.p, lv0.q = state.x, state.y, state.p, state.q
+        self.restrict_sources()
+
+    def release(self) -> None:
+        """Keep the working storage of a small solve for the next one of the same shape.
+
+        Building the hierarchy (tables, flat buffers) costs as much as a cycle
+        on a 129² grid; a workspace is taken out of the cache while a solve
+        uses it, so concurrent solves never share one.
+        """
+        if self.state.x.size > WORKSPACE_MAX_NODES:
+            return
+        lv0 = self.levels[0]
+        lv0.x = lv0.y = lv0.p = lv0.q = _EMPTY  # no reference to the caller's arrays
+        _WORKSPACES[self.key] = (self.levels, self.kfuse, getattr(self, "fbuf", None),
+                                 getattr(self, "ibuf", None), getattr(self, "meta", None),
+                                 getattr(self, "fscale", None), getattr(self, "fused_updates", None),
+                                 self.coarsest_sweeps)
+        while len(_WORKSPACES) > WORKSPACE_CACHE_SIZE:
+            try:
+                del _WORKSPACES[next(iter(_WORKSPACES))]  # the oldest
+            except (KeyError, StopIteration, RuntimeError):  # another thread got there first
+                break
+
+    def _build(self, plan: list, use_pq: bool, threads: int) -> None:
+        """Allocate the levels of ``plan`` and pack the fused ones (see :meth:`_pack`)."""
+        state = self.state
         lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q)
         self.levels = [lv0]
-        pos_i = np.arange(state.x.shape[0])
-        pos_j = np.arange(state.x.shape[1])
-        # (log aspect, folded fraction) of the current finest level: computed once per
-        # level, the same numbers as _aspect and _acceptable
-        stats = K.cell_stats(state.x, state.y, _stride(state.x))
-        while True:
+        for _ci, _cj, tab_i, tab_j in plan:
             fine = self.levels[-1]
             ni, nj = fine.x.shape[0] - 1, fine.x.shape[1] - 1
-            ci, cj = coarsening((ni, nj), float(np.exp(stats[0])), self.periodic)
-            if not (ci or cj):
-                break
-            tab_i = _tables(pos_i, ci, self.periodic)
-            tab_j = _tables(pos_j, cj, False)
-            sel = np.ix_(tab_i[0], tab_j[0])
-            xc, yc = fine.x[sel], fine.y[sel]  # injection (for the next coarsening decision)
-            cstats = K.cell_stats(xc, yc, _stride(xc))
-            if not cstats[1] <= stats[1] + MAX_NEW_FOLDED:
-                break
-            stats = cstats
             fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
             fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = tab_j
-            pos_i, pos_j = pos_i[fine.ci], pos_j[fine.cj]
             shp = (fine.ci.size, fine.cj.size)
             a = ni / (shp[0] - 1)
             b = nj / (shp[1] - 1)
@@ -263,7 +291,8 @@ class _FAS:
             fine.ry = np.empty(fine.x.shape)
             pc = np.empty(shp) if use_pq else _EMPTY
             qc = np.empty(shp) if use_pq else _EMPTY
-            self.levels.append(_Level(xc, yc, np.zeros(shp), np.zeros(shp), pc, qc))
+            self.levels.append(_Level(np.empty(shp), np.empty(shp), np.zeros(shp), np.zeros(shp),
+                                      pc, qc))
         last = self.levels[-1]
         if last.rx is None and len(self.levels) > 1:
             last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
@@ -273,7 +302,6 @@ class _FAS:
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
         self._pack()
-        self.restrict_sources()
 
     def _pack(self) -> None:
         """Move the arrays of the small levels into flat buffers for :func:`K.vcycle`.
@@ -422,6 +450,7 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
         return (yield from _fas_run(state, mg))
     finally:
         last_run["node_updates"] = mg.updates
+        mg.release()
 
 
 def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
@@ -468,8 +497,6 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     for it in range(1, cfg.max_iterations + 1):
         state.iterations = it
         r = math.sqrt(mg.defect(lv0))
-        if r <= tol:
-            r = state.residual()
         state.history.append((it, r))
         if r <= tol and _sources_settled(state):
             state.final_residual = r

@@ -153,6 +153,17 @@ def test_defect_is_the_jacobi_displacement_times_the_diagonal_and_rhs_shifts_it(
     np.testing.assert_allclose(fy2, -ry, rtol=1e-12, atol=1e-12)
 
 
+def test_defect_measure_is_infinite_when_any_node_is_nan():
+    X, Y = np.meshgrid(np.arange(60.0), np.arange(50.0), indexing="ij")
+    rx, ry = np.empty_like(X), np.empty_like(X)
+    assert _mg_kernels.defect(X, Y, E, E, E, E, False, rx, ry) == 0.0
+    for i, j in [(1, 1), (30, 25), (58, 48)]:
+        Xn = X.copy()
+        Xn[i, j] = np.nan
+        assert _mg_kernels.defect(Xn, Y, E, E, E, E, False, rx, ry) == np.inf
+        assert _kernels.jacobi_residual(Xn, Y, E, E, False) == np.inf
+
+
 def test_restriction_and_prolongation_are_the_tensor_products_of_the_tables():
     rng = np.random.default_rng(5)
     ni, nj = 11, 8
@@ -360,6 +371,30 @@ def test_iterate_yields_snapshots_and_stops():
     assert fin.value.value.info.message == "stopped"
 
 
+def test_reused_workspaces_give_the_same_grids():
+    """Small solves keep their working storage; nothing of one solve leaks into the next."""
+    a0, b0 = _curved(64, 48), _curved(64, 48, amp=0.6)
+    ii = np.linspace(0.0, 1.0, 65)[:, None] * np.ones(49)
+    multigrid._WORKSPACES.clear()
+    ref_a = meshcore.solve(a0, method="multigrid")
+    multigrid._WORKSPACES.clear()
+    ref_b = meshcore.solve(b0, method="multigrid", p=5 * ii, q=-ii)
+    for _ in range(2):  # each from a workspace the other left behind
+        a = meshcore.solve(a0, method="multigrid")
+        b = meshcore.solve(b0, method="multigrid", p=5 * ii, q=-ii)
+        assert np.array_equal(a.x, ref_a.x) and np.array_equal(b.y, ref_b.y)
+    # two solves of one shape at once never share a workspace
+    gen = meshcore.iterate(a0, method="multigrid", report_interval=1e-9)
+    next(gen)
+    b = meshcore.solve(b0, method="multigrid", p=5 * ii, q=-ii)
+    for _ in gen:
+        pass
+    assert np.array_equal(b.x, ref_b.x)
+    a = meshcore.solve(a0, method="multigrid")
+    assert np.array_equal(a.x, ref_a.x)
+    assert all(lv[0].x.size == 0 for lv, *_ in multigrid._WORKSPACES.values())
+
+
 def test_max_iterations_caps_the_cycles():
     X, Y = annulus_sector(64, 64)
     g = meshcore.solve(_start(X, Y), method="multigrid", tolerance=1e-15, max_iterations=2)
@@ -395,6 +430,40 @@ def test_band_smoother_is_gauss_seidel_restricted_to_the_border_band():
     _mg_kernels.smooth_band(b[0], b[1], E, E, E, E, False, 40, 2)
     _mg_kernels.smooth(c[0], c[1], E, E, E, E, False, 2)
     assert np.array_equal(b[0], c[0]) and np.array_equal(b[1], c[1])
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_band_smoother_on_long_strips_solves_the_band_problem(periodic):
+    """Long η-border strips are relaxed transposed (ξ ↔ η, P ↔ Q): many band sweeps
+    must reach the solution of the equations on the band with everything else
+    held fixed — the fixed point of the NumPy point-Jacobi oracle restricted to it."""
+    rng = np.random.default_rng(9)
+    ni, nj, w = 60, 52, _mg_kernels.TRANSPOSE_MAX_WIDTH
+    if periodic:
+        X, Y = _ring(ni, nj)
+    else:
+        X, Y = np.meshgrid(np.linspace(0, 1, ni + 1), np.linspace(0, 1, nj + 1) ** 1.3, indexing="ij")
+        X = X + 0.05 * np.sin(3 * Y)
+    X[1:-1, 1:-1] += 0.002 * rng.standard_normal((ni - 1, nj - 1))
+    if periodic:
+        X[-1], Y[-1] = X[0], Y[0]
+    p, q = 0.3 * rng.standard_normal(X.shape), np.full(X.shape, -0.2)
+    band = np.zeros(X.shape, bool)
+    band[:, 1:w + 1] = band[:, nj - w:nj] = True
+    if not periodic:
+        band[1:w + 1, 1:-1] = band[ni - w:ni, 1:-1] = True
+        band[0] = band[-1] = False
+    a = [X.copy(), Y.copy()]
+    _mg_kernels.smooth_band(a[0], a[1], E, E, p, q, periodic, w, 300)
+    assert np.array_equal(a[0][~band], X[~band]) and np.array_equal(a[1][~band], Y[~band])
+    b = [X.copy(), Y.copy()]
+    for _ in range(3000):
+        nx, ny = _reference.jacobi_update(b[0], b[1], p, q, periodic)
+        b[0][band], b[1][band] = nx[band], ny[band]
+    moved = float(np.abs(a[0] - X).max())
+    assert moved > 1e-3
+    assert float(np.abs(a[0] - b[0]).max()) < 1e-10 * moved * 1e3
+    assert float(np.abs(a[1] - b[1]).max()) < 1e-10 * moved * 1e3
 
 
 def test_generate_block_threads_option_is_bit_identical():
