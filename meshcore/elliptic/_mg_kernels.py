@@ -877,3 +877,54 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         smooth(x, y, fx, fy, p, q, periodic, post)
         if band_sweeps > 0:
             smooth_band(x, y, fx, fy, p, q, periodic, band_width, band_sweeps)
+
+
+@njit(cache=True, nogil=True)
+def _up(fbuf, ibuf, meta, k, periodic):  # pragma: no cover - compiled
+    """``u_k += P(u_{k+1} − R̂ u_k)`` for fused level ``k`` (the up-leg step of :func:`vcycle`)."""
+    m = meta[k]
+    n0, n1 = m[M_N0], m[M_N1]
+    c = meta[k + 1]
+    c0, c1 = c[M_N0], c[M_N1]
+    prolong_correct(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1),
+                    _v2(fbuf, c[M_X], c0, c1), _v2(fbuf, c[M_Y], c0, c1),
+                    _v2(fbuf, c[M_RX], c0, c1), _v2(fbuf, c[M_RY], c0, c1),
+                    ibuf[m[M_CI]:m[M_CI] + c0], ibuf[m[M_CJ]:m[M_CJ] + c1],
+                    ibuf[m[M_LI]:m[M_LI] + n0], ibuf[m[M_LJ]:m[M_LJ] + n1],
+                    fbuf[m[M_WLI]:m[M_WLI] + n0], fbuf[m[M_WLJ]:m[M_WLJ] + n1], periodic)
+
+
+@njit(cache=True, nogil=True)
+def fmg_start(fbuf, ibuf, meta, scale, pre, post, coarsest, band_width, band_sweeps, fmg_width,
+              fmg_sweeps, fmg_min_cells, fmg_cycles, periodic):  # pragma: no cover - compiled
+    """The full-multigrid start on all fused levels in one compiled call.
+
+    Solve the coarsest level (``coarsest`` sweeps), then for each finer fused
+    level: interpolate the correction up, drop the FAS right-hand side (plain
+    coarse discretisation), relax the narrow border band on large levels and
+    run ``fmg_cycles`` V-cycles, exactly as the Python driver does level by
+    level.  Levels must hold the injected start grid.
+    """
+    nlev = meta.shape[0]
+    e = np.zeros((0, 0))
+    m = meta[nlev - 1]
+    n0, n1 = m[M_N0], m[M_N1]
+    smooth(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), _v2(fbuf, m[M_FX], n0, n1),
+           _v2(fbuf, m[M_FY], n0, n1), _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+           _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, coarsest)
+    for k in range(nlev - 2, -1, -1):
+        _up(fbuf, ibuf, meta, k, periodic)
+        m = meta[k]
+        n0, n1 = m[M_N0], m[M_N1]
+        fx = _v2(fbuf, m[M_FX], n0, n1)
+        fy = _v2(fbuf, m[M_FY], n0, n1)
+        fx[:] = 0.0
+        fy[:] = 0.0
+        if min(n0, n1) - 1 >= fmg_min_cells:
+            smooth_band(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), fx, fy,
+                        _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+                        _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, fmg_width,
+                        fmg_sweeps)
+        for _ in range(fmg_cycles):
+            vcycle(fbuf, ibuf, meta, scale, k, pre, post, coarsest, band_width, band_sweeps,
+                   periodic)

@@ -400,6 +400,15 @@ class _FAS:
         K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, FMG_BAND_WIDTH,
                       FMG_BAND_SWEEPS)
 
+    def fmg_fused(self) -> None:
+        """The FMG start on the fused levels in one compiled call (:func:`K.fmg_start`)."""
+        kf = self.kfuse
+        self.updates += self.coarsest_sweeps * self.levels[-1].x.size
+        self.updates += FMG_CYCLES * sum(self.fused_updates[kf:-1])
+        K.fmg_start(self.fbuf, self.ibuf, self.meta, self.fscale, PRE, COARSE_POST,
+                    self.coarsest_sweeps, COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS, FMG_BAND_WIDTH,
+                    FMG_BAND_SWEEPS, FMG_BAND_MIN_CELLS, FMG_CYCLES, self.periodic)
+
     def defect(self, lv: _Level) -> float:
         fn = K.defect_parallel if lv.par else K.defect
         return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
@@ -474,8 +483,13 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         K.inject(levels[k - 1].y, levels[k - 1].ci, levels[k - 1].cj, levels[k].y)
         levels[k].fx[...] = 0.0
         levels[k].fy[...] = 0.0
-    mg.smooth(levels[-1], mg.coarsest_sweeps)
-    for k in range(len(levels) - 2, 0, -1):
+    top = len(levels) - 1  # the levels below ``top`` run their FMG step from Python
+    if mg.kfuse < len(levels) and levels[mg.kfuse].x.size < YIELD_NODES:
+        mg.fmg_fused()
+        top = mg.kfuse
+    else:
+        mg.smooth(levels[-1], mg.coarsest_sweeps)
+    for k in range(top - 1, 0, -1):
         mg.correct(k)
         levels[k].fx[...] = 0.0  # plain coarse discretisation (f = 0) on this FMG level
         levels[k].fy[...] = 0.0

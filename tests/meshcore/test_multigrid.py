@@ -395,6 +395,17 @@ def test_reused_workspaces_give_the_same_grids():
     assert all(lv[0].x.size == 0 for lv, *_ in multigrid._WORKSPACES.values())
 
 
+@pytest.mark.parametrize("periodic", [False, True])
+def test_fused_fmg_start_is_the_level_by_level_one(monkeypatch, periodic):
+    g0 = _start(*_ring(64, 30), periodic=True) if periodic else _curved(100, 57)
+    a = meshcore.solve(g0, method="multigrid")
+    ua = multigrid.last_run["node_updates"]
+    monkeypatch.setattr(multigrid, "YIELD_NODES", 0)  # every FMG step from Python
+    b = meshcore.solve(g0, method="multigrid")
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+    assert a.iterations == b.iterations and ua == multigrid.last_run["node_updates"]
+
+
 def test_max_iterations_caps_the_cycles():
     X, Y = annulus_sector(64, 64)
     g = meshcore.solve(_start(X, Y), method="multigrid", tolerance=1e-15, max_iterations=2)
