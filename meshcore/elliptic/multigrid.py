@@ -9,7 +9,7 @@ Full Approximation Scheme keeps the full solution on every level:
     N_c(u_c) = N_c(\hat R u) + s\, R\,(f - N(u)),\qquad
     u \leftarrow u + P\,(u_c - \hat R u),
 
-with ``R̂`` injection (coarse nodes are fine nodes), ``R`` full weighting,
+with ``R̂`` sampling (injection where coarse nodes are fine nodes), ``R`` full weighting,
 ``P`` bilinear interpolation (linear in the finest index) and
 ``s = (a b)^2`` for coarsening factors ``a, b`` (≈ 1 or 2, the ratio of cell
 counts) in ξ, η: in index units ``N`` scales like ``h⁴``, and the
@@ -18,10 +18,10 @@ which is how P, Q are carried to the coarse levels.
 
 Hierarchy: each direction is coarsened (vertex-centred, see
 :func:`._mg_kernels.transfer_tables`) while it has at least
-:data:`MIN_COARSEN_CELLS` cells, so any size works (an odd count gets one
-short coarse interval, placed so that coarse levels stay nearly uniform in
-the finest index).  Where cells are clearly longer in one direction only the
-other direction is coarsened (automatic semi-coarsening, see
+:data:`MIN_COARSEN_CELLS` cells, so any size works (an odd count gets
+uniform coarse intervals whose nodes fall between fine nodes: every level is
+uniform in the finest index, and odd sizes converge as fast as even ones).
+Where cells are clearly longer in one direction only the other direction is coarsened (automatic semi-coarsening, see
 :func:`coarsening`), so the point smoother still smooths.  Coarsening stops
 before a level that would fold (e.g. a ring of two cells) and keeps a
 periodic direction at ≥ :data:`MIN_PERIODIC_CELLS` cells.  The coarsest level
@@ -161,24 +161,24 @@ def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list:
             return out
         tab_i = _tables(pos_i, ci, periodic)
         tab_j = _tables(pos_j, cj, False)
-        xc = np.empty((tab_i[0].size, tab_j[0].size))
+        xc = np.empty((tab_i[6].size, tab_j[6].size))
         yc = np.empty(xc.shape)
-        K.inject(x, tab_i[0], tab_j[0], xc)
-        K.inject(y, tab_i[0], tab_j[0], yc)
+        K.sample(x, tab_i[0], tab_i[1], tab_j[0], tab_j[1], xc)
+        K.sample(y, tab_i[0], tab_i[1], tab_j[0], tab_j[1], yc)
         cstats = K.cell_stats(xc, yc, _stride(xc))
         if not cstats[1] <= stats[1] + MAX_NEW_FOLDED:
             return out
         out.append((ci, cj, tab_i, tab_j))
         stats = cstats
         x, y = xc, yc
-        pos_i, pos_j = pos_i[tab_i[0]], pos_j[tab_j[0]]
+        pos_i, pos_j = tab_i[6], tab_j[6]
 
 
 def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tuple[int, int]]:
     """Cell counts ``(ni, nj)`` of every level for the grid ``(x, y)``, finest first."""
     out = [(x.shape[0] - 1, x.shape[1] - 1)]
     for _, _, tab_i, tab_j in _plan(x, y, periodic):
-        out.append((tab_i[0].size - 1, tab_j[0].size - 1))
+        out.append((tab_i[6].size - 1, tab_j[6].size - 1))
     return out
 
 
@@ -194,8 +194,10 @@ class _Level:
     ry: np.ndarray | None = None
     par: bool = False
     # transfer to the next coarser level
-    ci: np.ndarray | None = None
-    cj: np.ndarray | None = None
+    si: np.ndarray | None = None
+    swi: np.ndarray | None = None
+    sj: np.ndarray | None = None
+    swj: np.ndarray | None = None
     ri: np.ndarray | None = None
     rwi: np.ndarray | None = None
     rj: np.ndarray | None = None
@@ -280,9 +282,9 @@ class _FAS:
         for _ci, _cj, tab_i, tab_j in plan:
             fine = self.levels[-1]
             ni, nj = fine.x.shape[0] - 1, fine.x.shape[1] - 1
-            fine.ci, fine.ri, fine.rwi, fine.li, fine.wli = tab_i
-            fine.cj, fine.rj, fine.rwj, fine.lj, fine.wlj = tab_j
-            shp = (fine.ci.size, fine.cj.size)
+            fine.si, fine.swi, fine.ri, fine.rwi, fine.li, fine.wli, _ = tab_i
+            fine.sj, fine.swj, fine.rj, fine.rwj, fine.lj, fine.wlj, _ = tab_j
+            shp = (fine.si.size, fine.sj.size)
             a = ni / (shp[0] - 1)
             b = nj / (shp[1] - 1)
             fine.scale = (a * b) ** 2
@@ -343,12 +345,12 @@ class _FAS:
                 arr = getattr(lv, name)
                 if arr is not None and arr.size:
                     m[col] = put(arr, fl, fpos)
-            if lv.ci is not None:
-                for name, col in (("ci", K.M_CI), ("cj", K.M_CJ), ("ri", K.M_RI), ("rj", K.M_RJ),
+            if lv.si is not None:
+                for name, col in (("si", K.M_SI), ("sj", K.M_SJ), ("ri", K.M_RI), ("rj", K.M_RJ),
                                   ("li", K.M_LI), ("lj", K.M_LJ)):
                     m[col] = put(np.asarray(getattr(lv, name), dtype=np.int64), il, ipos)
-                for name, col in (("rwi", K.M_RWI), ("rwj", K.M_RWJ), ("wli", K.M_WLI),
-                                  ("wlj", K.M_WLJ)):
+                for name, col in (("swi", K.M_SWI), ("swj", K.M_SWJ), ("rwi", K.M_RWI),
+                                  ("rwj", K.M_RWJ), ("wli", K.M_WLI), ("wlj", K.M_WLJ)):
                     m[col] = put(np.asarray(getattr(lv, name), dtype=np.float64), fl, fpos)
         fbuf = np.concatenate(fl) if fl else np.zeros(0)
         ibuf = np.concatenate(il) if il else np.zeros(0, dtype=np.int64)
@@ -373,12 +375,12 @@ class _FAS:
 
     # ------------------------------------------------------------------ pieces
     def restrict_sources(self) -> None:
-        """Carry P, Q to the coarse levels (injection, scaled by 1/a, 1/b)."""
+        """Carry P, Q to the coarse levels (sampled, scaled by 1/a, 1/b)."""
         for k in range(1, len(self.levels)):
             f, c = self.levels[k - 1], self.levels[k]
             if c.p.size:
-                K.inject(f.p, f.ci, f.cj, c.p)
-                K.inject(f.q, f.ci, f.cj, c.q)
+                K.sample(f.p, f.si, f.swi, f.sj, f.swj, c.p)
+                K.sample(f.q, f.si, f.swi, f.sj, f.swj, c.q)
                 if f.pscale != 1.0:
                     c.p *= f.pscale
                 if f.qscale != 1.0:
@@ -416,8 +418,8 @@ class _FAS:
     def to_coarse(self, k: int) -> None:
         """FAS right-hand side of level k+1 from the defect of level k."""
         f, c = self.levels[k], self.levels[k + 1]
-        K.inject(f.x, f.ci, f.cj, c.x)
-        K.inject(f.y, f.ci, f.cj, c.y)
+        K.sample(f.x, f.si, f.swi, f.sj, f.swj, c.x)
+        K.sample(f.y, f.si, f.swi, f.sj, f.swj, c.y)
         restrict = K.restrict_parallel if c.par else K.restrict
         restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
         add = K.add_operator_parallel if c.par else K.add_operator
@@ -427,7 +429,8 @@ class _FAS:
         """``u_k += P(u_{k+1} − R̂ u_k)`` (the coarse level's scratch holds the correction)."""
         f, c = self.levels[k], self.levels[k + 1]
         fn = K.prolong_correct_parallel if f.par else K.prolong_correct
-        fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.ci, f.cj, f.li, f.lj, f.wli, f.wlj, self.periodic)
+        fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.si, f.swi, f.sj, f.swj, f.li, f.lj, f.wli, f.wlj,
+           self.periodic)
 
     def cycle(self, k: int, *, have_defect: bool = False) -> None:
         """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
@@ -479,8 +482,9 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         state.final_residual = r0
         return True
     for k in range(1, len(levels)):
-        K.inject(levels[k - 1].x, levels[k - 1].ci, levels[k - 1].cj, levels[k].x)
-        K.inject(levels[k - 1].y, levels[k - 1].ci, levels[k - 1].cj, levels[k].y)
+        f = levels[k - 1]
+        K.sample(f.x, f.si, f.swi, f.sj, f.swj, levels[k].x)
+        K.sample(f.y, f.si, f.swi, f.sj, f.swj, levels[k].y)
         levels[k].fx[...] = 0.0
         levels[k].fy[...] = 0.0
     top = len(levels) - 1  # the levels below ``top`` run their FMG step from Python
