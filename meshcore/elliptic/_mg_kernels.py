@@ -445,13 +445,12 @@ def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks,
             rx[i, j] = tx[j]
             ry[i, j] = ty[j]
         for j in range(nj1):
-            t = tq[j]
-            if td[j] > 0.0 and t > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
-                m = t / td[j]
-            elif t != t:  # NaN (also a NaN den): never a silent pass
-                m = np.inf
-                break
-        row_max[i] = m
+            if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
+                m = tq[j] / td[j]
+        nan = 0
+        for j in range(nj1):  # NaN (also from a NaN den) is never a silent pass
+            nan += tq[j] != tq[j]
+        row_max[i] = m if nan == 0 else np.inf
 
 
 def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
@@ -546,6 +545,22 @@ def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
 def _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, lo, hi):  # pragma: no cover
     """Rows ``lo ≤ I < hi`` of :func:`_restrict`."""
     nJ = fx.shape[1]
+    if ii.shape[1] == 3 and jj.shape[1] == 3:  # nested both ways: fixed trip counts (unrolled)
+        for I in range(lo, hi):
+            for J in range(nJ):
+                sx = 0.0
+                sy = 0.0
+                for a in range(3):
+                    w_a = wi[I, a]
+                    ia = ii[I, a]
+                    for b in range(3):
+                        w = w_a * wj[J, b]
+                        jb = jj[J, b]
+                        sx += w * rx[ia, jb]
+                        sy += w * ry[ia, jb]
+                fx[I, J] = scale * sx
+                fy[I, J] = scale * sy
+        return
     for I in range(lo, hi):
         for J in range(nJ):
             sx = 0.0
@@ -605,10 +620,11 @@ def _prolong_correct(x, y, xc, yc, ex, ey, si, swi, sj, swj, li, lj, wli, wlj,
     is an unknown and row ``ni`` is refreshed from it.
     """
     ni1, nj1 = x.shape
-    sample(x, si, swi, sj, swj, ex)
-    sample(y, si, swi, sj, swj, ey)
     nI = xc.shape[0]
+    bj, wbj, nested = _sample_cols(sj, swj)
     for I in prange(nI):
+        _sample_row(x, si[I], swi[I], bj, wbj, nested, ex, I)
+        _sample_row(y, si[I], swi[I], bj, wbj, nested, ey, I)
         for J in range(xc.shape[1]):
             ex[I, J] = xc[I, J] - ex[I, J]
             ey[I, J] = yc[I, J] - ey[I, J]
@@ -625,6 +641,50 @@ def _prolong_correct(x, y, xc, yc, ex, ey, si, swi, sj, swj, li, lj, wli, wlj,
 
 
 @njit(cache=True, nogil=True)
+def _sample_cols(sj, swj):  # pragma: no cover - compiled
+    """Column tables of :func:`sample` with weight-0 entries moved to the right neighbour:
+    ``(b, wb, nested)`` with ``wb == 1`` exactly at fine nodes; ``nested``: all of them."""
+    n = sj.size
+    b = np.empty(n, dtype=np.int64)
+    wb = np.empty(n)
+    nested = True
+    for J in range(n):
+        b[J] = sj[J]
+        wb[J] = swj[J]
+        if wb[J] == 0.0:
+            b[J] += 1
+            wb[J] = 1.0
+        elif wb[J] != 1.0:
+            nested = False
+    return b, wb, nested
+
+
+@njit(cache=True, nogil=True)
+def _sample_row(x, a, wa, bj, wbj, nested, out, I):  # pragma: no cover - compiled
+    """Row ``I`` of :func:`sample`: between fine rows ``a, a + 1`` (weight ``wa`` on ``a``)."""
+    if wa == 0.0:
+        a += 1
+        wa = 1.0
+    nJ = out.shape[1]
+    if wa == 1.0 and nested:  # injection
+        for J in range(nJ):
+            out[I, J] = x[a, bj[J]]
+        return
+    for J in range(nJ):
+        b = bj[J]
+        wb = wbj[J]
+        if wa == 1.0:
+            v = x[a, b]
+            if wb != 1.0:
+                v = wb * v + (1.0 - wb) * x[a, b + 1]
+        else:
+            v = wa * x[a, b] + (1.0 - wa) * x[a + 1, b]
+            if wb != 1.0:
+                v = wb * v + (1.0 - wb) * (wa * x[a, b + 1] + (1.0 - wa) * x[a + 1, b + 1])
+        out[I, J] = v
+
+
+@njit(cache=True, nogil=True)
 def sample(x, si, swi, sj, swj, out):  # pragma: no cover - compiled
     """``out = R̂ x``: ``x`` interpolated (bilinear in the index) at the coarse nodes.
 
@@ -632,25 +692,9 @@ def sample(x, si, swi, sj, swj, out):  # pragma: no cover - compiled
     weight ``swi[I]`` on the first (likewise in j).  Where a coarse node is a
     fine node the weight is exactly 1 (or 0), so this is injection there.
     """
+    bj, wbj, nested = _sample_cols(sj, swj)
     for I in range(out.shape[0]):
-        a = si[I]
-        wa = swi[I]
-        for J in range(out.shape[1]):
-            b = sj[J]
-            wb = swj[J]
-            if wa == 1.0:
-                v = x[a, b]
-                if wb != 1.0:
-                    v = wb * v + (1.0 - wb) * x[a, b + 1]
-            elif wa == 0.0:
-                v = x[a + 1, b]
-                if wb != 1.0:
-                    v = wb * v + (1.0 - wb) * x[a + 1, b + 1]
-            else:
-                v = wa * x[a, b] + (1.0 - wa) * x[a + 1, b]
-                if wb != 1.0:
-                    v = wb * v + (1.0 - wb) * (wa * x[a, b + 1] + (1.0 - wa) * x[a + 1, b + 1])
-            out[I, J] = v
+        _sample_row(x, si[I], swi[I], bj, wbj, nested, out, I)
 
 
 def _renamed(fn, suffix):
@@ -771,7 +815,7 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
     linear in the finest index), coarse positions from
     :func:`coarse_positions`.  Returns ``(si, swi, r_idx, r_w, left, w_left,
     pos_c)``: ``si, swi`` sample a fine array at the coarse nodes (``R̂``, see
-    :func:`sample`); ``r_idx, r_w`` ``(nc+1, RW)`` full-weighting stencils,
+    :func:`sample`); ``r_idx, r_w`` ``(nc+1, 3 or RW)`` full-weighting stencils,
     the normalised transpose of the interpolation (unused entries weigh 0);
     ``left[i], w_left[i]`` the interpolation of node ``i`` from coarse nodes
     ``left[i]`` (weight ``w_left``) and ``left[i] + 1`` (weight ``1 − w_left``);
@@ -794,10 +838,11 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
     if periodic:
         cols[0].sort(key=lambda t: t[0] if t[0] <= n // 2 else t[0] - n)  # across the seam
         cols[nc] = cols[0]
-    r_idx = np.zeros((nc + 1, RW), dtype=np.int64)
-    r_w = np.zeros((nc + 1, RW))
+    width = max(3, max(len(col) for col in cols))  # 3 (nested) or 4
+    r_idx = np.zeros((nc + 1, width), dtype=np.int64)
+    r_w = np.zeros((nc + 1, width))
     for I, col in enumerate(cols):
-        if len(col) > RW:
+        if len(col) > RW:  # pragma: no cover - spacing ratio < 2 makes this impossible
             raise AssertionError("restriction stencil wider than RW")
         for a, (i, w) in enumerate(col):
             r_idx[I, a] = i
@@ -810,8 +855,9 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
 # ----------------------------------------------------------- fused coarse V-cycle
 #: Columns of the level table of :func:`vcycle` (offsets into the flat buffers).
 (M_N0, M_N1, M_X, M_Y, M_FX, M_FY, M_P, M_Q, M_RX, M_RY, M_PQ,
- M_SI, M_SJ, M_RI, M_RJ, M_LI, M_LJ, M_RWI, M_RWJ, M_WLI, M_WLJ, M_SWI, M_SWJ) = range(23)
-META_COLS = 23
+ M_SI, M_SJ, M_RI, M_RJ, M_LI, M_LJ, M_RWI, M_RWJ, M_WLI, M_WLJ, M_SWI, M_SWJ,
+ M_WI, M_WJ) = range(25)
+META_COLS = 25
 
 
 @njit(cache=True, nogil=True)
@@ -859,10 +905,10 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         swj = fbuf[m[M_SWJ]:m[M_SWJ] + c1]
         sample(x, si, swi, sj, swj, xc)
         sample(y, si, swi, sj, swj, yc)
-        ri = _v2(ibuf, m[M_RI], c0, RW)
-        rj = _v2(ibuf, m[M_RJ], c1, RW)
-        rwi = _v2(fbuf, m[M_RWI], c0, RW)
-        rwj = _v2(fbuf, m[M_RWJ], c1, RW)
+        ri = _v2(ibuf, m[M_RI], c0, m[M_WI])
+        rj = _v2(ibuf, m[M_RJ], c1, m[M_WJ])
+        rwi = _v2(fbuf, m[M_RWI], c0, m[M_WI])
+        rwj = _v2(fbuf, m[M_RWJ], c1, m[M_WJ])
         restrict(rx, ry, ri, rwi, rj, rwj, scale[k], fxc, fyc)
         add_operator(xc, yc, pc, qc, periodic, fxc, fyc)
     m = meta[nlev - 1]

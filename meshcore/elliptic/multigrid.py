@@ -349,6 +349,7 @@ class _FAS:
                 for name, col in (("si", K.M_SI), ("sj", K.M_SJ), ("ri", K.M_RI), ("rj", K.M_RJ),
                                   ("li", K.M_LI), ("lj", K.M_LJ)):
                     m[col] = put(np.asarray(getattr(lv, name), dtype=np.int64), il, ipos)
+                m[K.M_WI], m[K.M_WJ] = lv.ri.shape[1], lv.rj.shape[1]
                 for name, col in (("swi", K.M_SWI), ("swj", K.M_SWJ), ("rwi", K.M_RWI),
                                   ("rwj", K.M_RWJ), ("wli", K.M_WLI), ("wlj", K.M_WLJ)):
                     m[col] = put(np.asarray(getattr(lv, name), dtype=np.float64), fl, fpos)
