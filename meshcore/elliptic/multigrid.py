@@ -523,6 +523,9 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         if not math.isfinite(r) or r > 1e3 * max(min(best, r0), tol if state.sources is not None else 0.0):
             state.x[...] = backup[0]
             state.y[...] = backup[1]
+            if state.sources is not None:  # the control starts over with the start grid
+                state.p[...], state.q[...] = state.pq_given
+                state.sources.initialize(state.x, state.y, state.p, state.q)
             state.message = "multigrid diverged; continued with SOR"
             state.history.clear()
             state.iterations = 0

@@ -152,6 +152,8 @@ class SolverState:
     length: float
     stop_event: threading.Event | None
     sources: Any = None
+    #: P, Q as given, before ``sources.initialize`` (to start the control over).
+    pq_given: tuple | None = None
     fixed: np.ndarray | None = None
     history: list = field(default_factory=list)
     message: str = ""
@@ -199,6 +201,7 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
     auto_omega = cfg.omega is None
     sweep = _kernels.sweep4_parallel if cfg.threads > 1 else _kernels.sweep4
     tol = state.tol_abs
+    prefix = f"{state.message}; " if state.message else ""  # e.g. why multigrid handed over
     r = state.residual()
     state.history.append((0, r))
     if r <= tol:
@@ -230,10 +233,10 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
                 x[...] = saved[0]
                 y[...] = saved[1]
                 if not auto_omega and omega <= 1.0:
-                    state.message = "diverged"
+                    state.message = f"{prefix}diverged"
                     return False
                 omega = 1.0 + 0.5 * (omega - 1.0) if omega > 1.05 else 0.7 * omega
-                state.message = f"omega reduced to {omega:.3f}"
+                state.message = f"{prefix}omega reduced to {omega:.3f}"
                 check_every = 1
             elif r < best:
                 best = r
@@ -318,6 +321,7 @@ def iterate(
         tol_abs=tol_rel * length, length=length, stop_event=stop_event, sources=sources,
     )
     if sources is not None:
+        state.pq_given = (pp.copy(), qq.copy())
         sources.initialize(x, y, pp, qq)
     t0 = time.perf_counter()
     last = t0
