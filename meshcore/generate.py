@@ -113,7 +113,7 @@ def generate_block(
     tolerance: float | None = None,
     max_iterations: int = 50_000,
     omega: float | None = None,
-    threads: int = 1,
+    threads: int = 0,
     p: np.ndarray | None = None,
     q: np.ndarray | None = None,
     config: EllipticConfig | None = None,
@@ -149,7 +149,8 @@ def generate_block(
         last, name), e.g. ``{"bottom": {"distribution": "tanh", "first": 0.01}}``.
     method, tolerance, max_iterations, omega, threads, config
         Solver settings (see :class:`~meshcore.elliptic.EllipticConfig`);
-        ``threads=2`` runs the bit-identical parallel kernels.
+        ``threads``: 0 (default) = all cores on large grids, 1 = serial, ``n`` = ``n``
+        threads; every choice gives the same grid bit for bit.
     p, q : array_like, optional
         Source terms P, Q of the node shape (zero by default).
     callback : callable, optional

@@ -19,6 +19,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", help="solver method (auto, sor, multigrid, ...)")
     p.add_argument("--tolerance", type=float, help="relative tolerance of the stopping rule")
     p.add_argument("--max-iterations", type=int, help="iteration cap")
+    p.add_argument("--threads", type=int,
+                   help="solver threads: 0 = all cores on large grids (default), 1 = serial")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress or quality table")
 
 
@@ -60,6 +62,8 @@ def run(args: argparse.Namespace) -> int:
         overrides["tolerance"] = args.tolerance
     if args.max_iterations is not None:
         overrides["max_iterations"] = args.max_iterations
+    if args.threads is not None:
+        overrides["threads"] = args.threads
     try:
         cfg = case.solver.replaced(**overrides)
     except InvalidInputError as exc:

@@ -95,7 +95,10 @@ class EllipticConfig:
         Seconds between progress snapshots (at least 20× the time one snapshot
         takes, so that copying a huge grid costs < 5 %).
     threads : int
-        1 = serial kernels; > 1 uses the ``parallel=True`` kernels (bit-identical).
+        0 (default) = automatic: all the threads numba may use (``NUMBA_NUM_THREADS``)
+        on grids of at least :data:`AUTO_THREADS_MIN_NODES` nodes, serial below;
+        1 = serial kernels; > 1 uses the ``parallel=True`` kernels.  Every choice
+        gives bit-identical grids.
     """
 
     method: str = "auto"
@@ -103,7 +106,7 @@ class EllipticConfig:
     max_iterations: int = 50_000
     omega: float | None = None
     report_interval: float = 1.0 / 30.0
-    threads: int = 1
+    threads: int = 0
 
     def __post_init__(self) -> None:
         if not isinstance(self.method, str):
@@ -115,7 +118,7 @@ class EllipticConfig:
         if self.omega is not None and not (0.0 < float(self.omega) < 2.0):
             raise InvalidInputError(f"omega must be in (0, 2), got {self.omega}")
         validate_positive(self.report_interval, name="report_interval")
-        validate_count(self.threads, name="threads", minimum=1)
+        validate_count(self.threads, name="threads", minimum=0)
 
     def replaced(self, **kw: Any) -> EllipticConfig:
         return dataclasses.replace(self, **kw)
@@ -251,6 +254,23 @@ def _sor(state: SolverState) -> Generator[str, None, bool]:
 register_method("sor", _sor)
 
 
+#: ``threads=0`` runs serial below this many nodes (measured with benchmarks/run.py: two
+#: threads gain 9 % at 129², 24 % at 257², 40 % from 513² on; on a few thousand nodes the
+#: threading overhead costs more than it saves).
+AUTO_THREADS_MIN_NODES = 16_000
+
+
+def resolve_threads(threads: int, nodes: int) -> int:
+    """The thread count ``threads`` (0 = automatic) means for a grid of ``nodes`` nodes."""
+    if threads:
+        return threads
+    if nodes < AUTO_THREADS_MIN_NODES:
+        return 1
+    import numba
+
+    return max(1, int(numba.config.NUMBA_NUM_THREADS))
+
+
 def _choose_method(cfg: EllipticConfig, shape: tuple[int, int]) -> str:
     m = cfg.method
     if m == "auto":
@@ -310,6 +330,8 @@ def iterate(
     y = np.array(initial.y, dtype=np.float64, order="C", copy=True)
     if not (np.isfinite(x).all() and np.isfinite(y).all()):
         raise InvalidInputError("initial grid contains NaN or inf coordinates")
+    if cfg.threads == 0:
+        cfg = cfg.replaced(threads=resolve_threads(0, x.size))
     pp, qq = _pq(p, q, x.shape)
     if sources is not None and pp.size == 0:
         pp, qq = np.zeros(x.shape), np.zeros(x.shape)

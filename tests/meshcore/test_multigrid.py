@@ -318,6 +318,19 @@ def test_serial_and_two_threads_give_bit_identical_grids():
     assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
 
 
+def test_default_threads_are_automatic_and_change_nothing():
+    from meshcore.elliptic.solver import AUTO_THREADS_MIN_NODES, resolve_threads
+
+    assert meshcore.EllipticConfig().threads == 0
+    assert resolve_threads(0, AUTO_THREADS_MIN_NODES - 1) == 1
+    assert resolve_threads(0, AUTO_THREADS_MIN_NODES) >= 1 and resolve_threads(3, 10) == 3
+    g0 = _curved(160, 120)  # 19 481 nodes: threaded by default
+    auto = meshcore.solve(g0)
+    serial = meshcore.solve(g0, threads=1)
+    assert auto.info.method == serial.info.method == "multigrid"
+    assert np.array_equal(auto.x, serial.x) and np.array_equal(auto.y, serial.y)
+
+
 @pytest.mark.parametrize("case", ["annulus", "curved"])
 def test_convergence_factor_per_cycle(case):
     if case == "annulus":
