@@ -411,7 +411,7 @@ def level_breakdown(g0):
         K.vcycle = timed_vcycle
         F._pack = spy_pack
         t = time.perf_counter()
-        g = meshcore.solve(g0, method="multigrid", report_interval=1e9)
+        g = meshcore.solve(g0, method="multigrid", threads=1, report_interval=1e9)
         total = time.perf_counter() - t
     finally:
         for k, f in orig.items():
@@ -601,8 +601,10 @@ def main(argv=None):
 
     emit("\n## Snapshot overhead of the driver\n")
     g0 = cases[-1][1]()
-    _, t_def, _ = timed(lambda: meshcore.solve(g0, method="multigrid", report_interval=1 / 30), 3)
-    _, t_none, _ = timed(lambda: meshcore.solve(g0, method="multigrid", report_interval=1e9), 3)
+    _, t_def, _ = timed(lambda: meshcore.solve(g0, method="multigrid", threads=1,
+                                               report_interval=1 / 30), 3)
+    _, t_none, _ = timed(lambda: meshcore.solve(g0, method="multigrid", threads=1,
+                                                report_interval=1e9), 3)
     emit(f"{g0.x.shape[0]}×{g0.x.shape[1]}: solve with snapshots every 1/30 s {fmt_time(t_def)}, "
          f"without snapshots {fmt_time(t_none)}: overhead {100 * (t_def / t_none - 1):.1f} %.")
 

@@ -473,7 +473,6 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     lv0 = levels[0]
     if len(levels) == 1:  # too small to coarsen: plain Gauss–Seidel/SOR
         return (yield from _sor(state))
-    backup = (state.x.copy(), state.y.copy())
     # ----------------------------------------------------- full-multigrid start
     r0 = math.sqrt(mg.defect(lv0))  # the stopping measure (see the module docstring)
     if r0 <= tol:
@@ -521,8 +520,8 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
             state.final_residual = r
             return True
         if not math.isfinite(r) or r > 1e3 * max(min(best, r0), tol if state.sources is not None else 0.0):
-            state.x[...] = backup[0]
-            state.y[...] = backup[1]
+            state.x[...] = state.start[0]
+            state.y[...] = state.start[1]
             if state.sources is not None:  # the control starts over with the start grid
                 state.p[...], state.q[...] = state.pq_given
                 state.sources.initialize(state.x, state.y, state.p, state.q)

@@ -157,6 +157,8 @@ class SolverState:
     sources: Any = None
     #: P, Q as given, before ``sources.initialize`` (to start the control over).
     pq_given: tuple | None = None
+    #: The start grid ``(x, y)`` (the caller's arrays: read, never written).
+    start: tuple | None = None
     fixed: np.ndarray | None = None
     history: list = field(default_factory=list)
     message: str = ""
@@ -341,6 +343,7 @@ def iterate(
     state = SolverState(
         x=x, y=y, p=pp, q=qq, periodic=initial.periodic, config=cfg,
         tol_abs=tol_rel * length, length=length, stop_event=stop_event, sources=sources,
+        start=(np.asarray(initial.x, dtype=np.float64), np.asarray(initial.y, dtype=np.float64)),
     )
     if sources is not None:
         state.pq_given = (pp.copy(), qq.copy())
