@@ -223,8 +223,10 @@ def test_restriction_and_prolongation_are_the_tensor_products_of_the_tables(ni, 
 @pytest.mark.parametrize("periodic", [False, True])
 def test_parallel_kernels_are_bit_identical(periodic):
     rng = np.random.default_rng(6)
-    for ni in (40, 41):  # odd periodic ni: rows 0 and ni-1 are same-parity neighbours
-        X, Y = np.meshgrid(np.arange(ni + 1.0), np.arange(34.0), indexing="ij")
+    # odd periodic ni: rows 0 and ni-1 are same-parity neighbours; 60 nodes per row: the
+    # vectorised row update; the serial smoother runs as a one-pass wavefront
+    for ni, nj1 in itertools.product((40, 41), (34, 60)):
+        X, Y = np.meshgrid(np.arange(ni + 1.0), np.arange(float(nj1)), indexing="ij")
         X = X + 0.2 * rng.standard_normal(X.shape)
         Y = Y + 0.2 * rng.standard_normal(Y.shape)
         if periodic:
