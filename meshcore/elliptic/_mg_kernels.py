@@ -384,10 +384,65 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
 
 
 @njit(cache=True, nogil=True)
-def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
-                 row_max):  # pragma: no cover - compiled
-    """Rows of chunk ``c`` of :func:`_defect` (a separate function, so that the
-    serial and parallel compilations run the same vectorised machine code)."""
+def _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, outx, outy, tx, ty, tq,
+                td):  # pragma: no cover - compiled
+    """Defect of row ``i`` into ``outx, outy`` (length ``nj1``, 0 at both ends); returns the
+    row's largest ``(|f − N|/den)²`` (``inf`` on NaN).  ``tx … td`` are scratch rows whose
+    end entries are 0 (fresh, so the unit-stride loop vectorises)."""
+    ie = i + 1
+    for j in range(1, nj1 - 1):
+        xe = x[ie, j]
+        xw = x[iw, j]
+        xn = x[i, j + 1]
+        xs = x[i, j - 1]
+        ye = y[ie, j]
+        yw = y[iw, j]
+        yn = y[i, j + 1]
+        ys = y[i, j - 1]
+        xxi = 0.5 * (xe - xw)
+        yxi = 0.5 * (ye - yw)
+        xet = 0.5 * (xn - xs)
+        yet = 0.5 * (yn - ys)
+        a = xet * xet + yet * yet
+        b = xxi * xet + yxi * yet
+        g = xxi * xxi + yxi * yxi
+        den = 2.0 * (a + g)
+        cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
+        cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
+        sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
+        sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
+        if use_pq:
+            d = xxi * yet - xet * yxi
+            d2 = d * d
+            pp = p[i, j]
+            qq = q[i, j]
+            sx += d2 * (pp * xxi + qq * xet)
+            sy += d2 * (pp * yxi + qq * yet)
+        dx = sx - den * x[i, j]
+        dy = sy - den * y[i, j]
+        if use_f:
+            dx += fx[i, j]
+            dy += fy[i, j]
+        tx[j] = dx
+        ty[j] = dy
+        tq[j] = dx * dx + dy * dy
+        td[j] = den * den
+    m = 0.0
+    for j in range(nj1):
+        outx[j] = tx[j]
+        outy[j] = ty[j]
+    for j in range(nj1):
+        if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
+            m = tq[j] / td[j]
+    nan = 0
+    for j in range(nj1):  # NaN (also from a NaN den) is never a silent pass
+        nan += tq[j] != tq[j]
+    return m if nan == 0 else np.inf
+
+
+@njit(cache=True, nogil=True)
+def _scratch_rows(nj1):  # pragma: no cover - compiled
+    """Four fresh scratch rows for :func:`_defect_row` (end entries 0)."""
     tx = np.empty(nj1)
     ty = np.empty(nj1)
     tq = np.empty(nj1)
@@ -397,60 +452,22 @@ def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks,
         ty[e] = 0.0
         tq[e] = 0.0
         td[e] = 0.0
+    return tx, ty, tq, td
+
+
+@njit(cache=True, nogil=True)
+def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
+                 row_max):  # pragma: no cover - compiled
+    """Rows of chunk ``c`` of :func:`_defect` (a separate function, so that the
+    serial and parallel compilations run the same vectorised machine code)."""
+    tx, ty, tq, td = _scratch_rows(nj1)
     for k in range(c * nrows // nchunks, (c + 1) * nrows // nchunks):
         i = i0 + k
         iw = i - 1
         if iw < 0:
             iw = ni - 1
-        ie = i + 1
-        for j in range(1, nj1 - 1):
-            xe = x[ie, j]
-            xw = x[iw, j]
-            xn = x[i, j + 1]
-            xs = x[i, j - 1]
-            ye = y[ie, j]
-            yw = y[iw, j]
-            yn = y[i, j + 1]
-            ys = y[i, j - 1]
-            xxi = 0.5 * (xe - xw)
-            yxi = 0.5 * (ye - yw)
-            xet = 0.5 * (xn - xs)
-            yet = 0.5 * (yn - ys)
-            a = xet * xet + yet * yet
-            b = xxi * xet + yxi * yet
-            g = xxi * xxi + yxi * yxi
-            den = 2.0 * (a + g)
-            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
-            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
-            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-            if use_pq:
-                d = xxi * yet - xet * yxi
-                d2 = d * d
-                pp = p[i, j]
-                qq = q[i, j]
-                sx += d2 * (pp * xxi + qq * xet)
-                sy += d2 * (pp * yxi + qq * yet)
-            dx = sx - den * x[i, j]
-            dy = sy - den * y[i, j]
-            if use_f:
-                dx += fx[i, j]
-                dy += fy[i, j]
-            tx[j] = dx
-            ty[j] = dy
-            tq[j] = dx * dx + dy * dy
-            td[j] = den * den
-        m = 0.0
-        for j in range(nj1):
-            rx[i, j] = tx[j]
-            ry[i, j] = ty[j]
-        for j in range(nj1):
-            if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
-                m = tq[j] / td[j]
-        nan = 0
-        for j in range(nj1):  # NaN (also from a NaN den) is never a silent pass
-            nan += tq[j] != tq[j]
-        row_max[i] = m if nan == 0 else np.inf
+        row_max[i] = _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, rx[i], ry[i],
+                                 tx, ty, tq, td)
 
 
 def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
@@ -697,6 +714,94 @@ def sample(x, si, swi, sj, swj, out):  # pragma: no cover - compiled
         _sample_row(x, si[I], swi[I], bj, wbj, nested, out, I)
 
 
+#: Fine rows held by a chunk of :func:`_defect_restrict` (a coarse row needs ≤ 4).
+RING = 6
+
+
+@njit(cache=True, nogil=True)
+def _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, scale, fxc, fyc,
+                          lo, hi):  # pragma: no cover - compiled
+    """Coarse rows ``lo ≤ I < hi`` of :func:`_defect_restrict`; returns the largest
+    ``(|f − N|/den)²`` of the fine rows it computed."""
+    ni1, nj1 = x.shape
+    ni = ni1 - 1
+    tx, ty, tq, td = _scratch_rows(nj1)
+    ringx = np.empty((RING, nj1))
+    ringy = np.empty((RING, nj1))
+    held = np.full(RING, -1, dtype=np.int64)
+    slot = np.empty(ii.shape[1], dtype=np.int64)
+    m = 0.0
+    nJ = fxc.shape[1]
+    for I in range(lo, hi):
+        for a in range(ii.shape[1]):
+            i = ii[I, a]
+            s = i % RING
+            slot[a] = s
+            if held[s] != i:
+                held[s] = i
+                if i == 0 or i == ni:  # boundary rows: no defect
+                    for j in range(nj1):
+                        ringx[s, j] = 0.0
+                        ringy[s, j] = 0.0
+                else:
+                    mm = _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, i - 1, nj1, ringx[s],
+                                     ringy[s], tx, ty, tq, td)
+                    if mm > m:
+                        m = mm
+        # the arithmetic of _restrict_rows, reading the ring instead of r
+        if ii.shape[1] == 3 and jj.shape[1] == 3:
+            for J in range(nJ):
+                sx = 0.0
+                sy = 0.0
+                for a in range(3):
+                    w_a = wi[I, a]
+                    sa = slot[a]
+                    for b in range(3):
+                        w = w_a * wj[J, b]
+                        jb = jj[J, b]
+                        sx += w * ringx[sa, jb]
+                        sy += w * ringy[sa, jb]
+                fxc[I, J] = scale * sx
+                fyc[I, J] = scale * sy
+        else:
+            for J in range(nJ):
+                sx = 0.0
+                sy = 0.0
+                for a in range(ii.shape[1]):
+                    w_a = wi[I, a]
+                    sa = slot[a]
+                    for b in range(jj.shape[1]):
+                        w = w_a * wj[J, b]
+                        jb = jj[J, b]
+                        sx += w * ringx[sa, jb]
+                        sy += w * ringy[sa, jb]
+                fxc[I, J] = scale * sx
+                fyc[I, J] = scale * sy
+    return m
+
+
+def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc):  # pragma: no cover
+    """:func:`_defect` followed by :func:`_restrict`, without the fine defect arrays.
+
+    Each chunk of coarse rows computes the fine defect rows its full-weighting
+    stencils need into a small ring buffer (rows shared by two chunks are
+    computed by both, with the same result) and restricts them at once: the
+    same numbers as ``defect`` + ``restrict`` bit for bit, without writing and
+    re-reading two fine arrays (the largest memory stream of a cycle on big
+    grids).  Not periodic (the seam's stencil wraps around).  Returns the
+    largest ``(|f − N|/den)²`` as :func:`_defect`.
+    """
+    use_f = fx.size > 0
+    use_pq = p.size > 0
+    nI = fxc.shape[0]
+    nchunks = min(nI, ROW_CHUNKS)
+    cmax = np.zeros(nchunks)
+    for c in prange(nchunks):
+        cmax[c] = _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, scale,
+                                        fxc, fyc, c * nI // nchunks, (c + 1) * nI // nchunks)
+    return cmax.max()
+
+
 def _renamed(fn, suffix):
     """A copy of ``fn`` with its own name.
 
@@ -759,6 +864,8 @@ def smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compiled
                 _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, r, r - 1, r + 1, nj1, tx, ty)
             else:
                 _relax_row(x, y, fx, fy, p, q, use_f, use_pq, r, r - 1, r + 1, nj1)
+
+
 defect = _serial(_defect)
 defect_parallel = _par(_defect)
 add_operator = _serial(_add_operator)
@@ -767,6 +874,8 @@ restrict = _serial(_restrict)
 restrict_parallel = _par(_restrict)
 prolong_correct = _serial(_prolong_correct)
 prolong_correct_parallel = _par(_prolong_correct)
+defect_restrict = _serial(_defect_restrict)
+defect_restrict_parallel = _par(_defect_restrict)
 
 
 @njit(cache=True, nogil=True)

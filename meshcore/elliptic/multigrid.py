@@ -251,6 +251,8 @@ class _FAS:
              self.fused_updates, self.coarsest_sweeps) = ws
         lv0 = self.levels[0]
         lv0.x, lv0.y, lv0.p, lv0.q = state.x, state.y, state.p, state.q
+        # restricted[k]: level k+1's right-hand side holds level k's restricted defect
+        self.restricted = [False] * len(self.levels)
         self.restrict_sources()
 
     def release(self) -> None:
@@ -289,8 +291,9 @@ class _FAS:
             b = nj / (shp[1] - 1)
             fine.scale = (a * b) ** 2
             fine.pscale, fine.qscale = 1.0 / a, 1.0 / b
-            fine.rx = np.empty(fine.x.shape)
-            fine.ry = np.empty(fine.x.shape)
+            if fine is not lv0 or self.periodic:  # level 0's defect is restricted on the fly
+                fine.rx = np.empty(fine.x.shape)
+                fine.ry = np.empty(fine.x.shape)
             pc = np.empty(shp) if use_pq else _EMPTY
             qc = np.empty(shp) if use_pq else _EMPTY
             self.levels.append(_Level(np.empty(shp), np.empty(shp), np.zeros(shp), np.zeros(shp),
@@ -416,13 +419,28 @@ class _FAS:
         fn = K.defect_parallel if lv.par else K.defect
         return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
 
+    def defect_restrict(self, k: int) -> float:
+        """Level k's defect measure (largest ``(|f − N|/den)²``), its restriction already in
+        level k+1's right-hand side unless periodic (:func:`K.defect_restrict`: no fine
+        defect arrays); :meth:`to_coarse` then only adds ``N_c``."""
+        f = self.levels[k]
+        if self.periodic:
+            self.restricted[k] = False
+            return self.defect(f)
+        c = self.levels[k + 1]
+        fn = K.defect_restrict_parallel if f.par else K.defect_restrict
+        self.restricted[k] = True
+        return fn(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+
     def to_coarse(self, k: int) -> None:
         """FAS right-hand side of level k+1 from the defect of level k."""
         f, c = self.levels[k], self.levels[k + 1]
         K.sample(f.x, f.si, f.swi, f.sj, f.swj, c.x)
         K.sample(f.y, f.si, f.swi, f.sj, f.swj, c.y)
-        restrict = K.restrict_parallel if c.par else K.restrict
-        restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+        if not self.restricted[k]:
+            restrict = K.restrict_parallel if c.par else K.restrict
+            restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+        self.restricted[k] = False
         add = K.add_operator_parallel if c.par else K.add_operator
         add(c.x, c.y, c.p, c.q, self.periodic, c.fx, c.fy)
 
@@ -446,7 +464,7 @@ class _FAS:
             return
         if not have_defect:
             self.smooth(lv, PRE)
-            self.defect(lv)
+            self.defect_restrict(k)
         self.to_coarse(k)
         for _ in range(self.gamma if k + 1 < len(self.levels) - 1 else 1):
             self.cycle(k + 1)
@@ -474,7 +492,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     if len(levels) == 1:  # too small to coarsen: plain Gauss–Seidel/SOR
         return (yield from _sor(state))
     # ----------------------------------------------------- full-multigrid start
-    r0 = math.sqrt(mg.defect(lv0))  # the stopping measure (see the module docstring)
+    r0 = math.sqrt(mg.defect_restrict(0))  # the stopping measure (see the module docstring)
     if r0 <= tol:
         r0 = state.residual()
     state.history.append((0, r0))
@@ -487,6 +505,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         K.sample(f.y, f.si, f.swi, f.sj, f.swj, levels[k].y)
         levels[k].fx[...] = 0.0
         levels[k].fy[...] = 0.0
+    mg.restricted[0] = False  # the r0 check's restriction was just zeroed
     top = len(levels) - 1  # the levels below ``top`` run their FMG step from Python
     if mg.kfuse < len(levels) and levels[mg.kfuse].x.size < YIELD_NODES:
         mg.fmg_fused()
@@ -514,7 +533,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     best = math.inf
     for it in range(1, cfg.max_iterations + 1):
         state.iterations = it
-        r = math.sqrt(mg.defect(lv0))
+        r = math.sqrt(mg.defect_restrict(0))
         state.history.append((it, r))
         if r <= tol and _sources_settled(state):
             state.final_residual = r
@@ -541,7 +560,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
         if state.sources is not None and state.sources.wants_update(it):
             state.sources.update(state.x, state.y, state.p, state.q, it)
             mg.restrict_sources()
-            mg.defect(lv0)
+            mg.defect_restrict(0)
         mg.cycle(0, have_defect=True)
     return False
 

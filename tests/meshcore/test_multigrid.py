@@ -220,6 +220,27 @@ def test_restriction_and_prolongation_are_the_tensor_products_of_the_tables(ni, 
     np.testing.assert_allclose(x, want, rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("ni, nj", [(40, 34), (101, 57), (64, 33)])
+def test_fused_defect_restriction_is_defect_then_restriction(ni, nj):
+    """No fine defect arrays: the same numbers bit for bit (nested and non-nested tables)."""
+    rng = np.random.default_rng(ni)
+    X, Y = np.meshgrid(np.linspace(0, 1, ni + 1), np.linspace(0, 1, nj + 1) ** 1.2, indexing="ij")
+    X = X + 1e-3 * rng.standard_normal(X.shape)
+    f, pq = 1e-4 * rng.standard_normal(X.shape), 0.1 * rng.standard_normal(X.shape)
+    ti = _mg_kernels.transfer_tables(np.arange(ni + 1.0), True, False)
+    tj = _mg_kernels.transfer_tables(np.arange(nj + 1.0), True, False)
+    shape = (ti[6].size, tj[6].size)
+    for F, P in ((E, E), (f, pq)):
+        rx, ry = np.empty_like(X), np.empty_like(X)
+        a, b = np.empty(shape), np.empty(shape)
+        m = _mg_kernels.defect(X, Y, F, F, P, P, False, rx, ry)
+        _mg_kernels.restrict(rx, ry, ti[2], ti[3], tj[2], tj[3], 16.0, a, b)
+        for fn in (_mg_kernels.defect_restrict, _mg_kernels.defect_restrict_parallel):
+            c, d = np.empty(shape), np.empty(shape)
+            assert fn(X, Y, F, F, P, P, ti[2], ti[3], tj[2], tj[3], 16.0, c, d) == m
+            assert np.array_equal(a, c) and np.array_equal(b, d)
+
+
 @pytest.mark.parametrize("periodic", [False, True])
 def test_parallel_kernels_are_bit_identical(periodic):
     rng = np.random.default_rng(6)
@@ -249,7 +270,8 @@ def test_serial_and_parallel_compilations_are_cached_under_distinct_names():
     # one Python function (serial and parallel=True) would load each other's machine code
     pairs = [(_kernels.sweep4, _kernels.sweep4_parallel)]
     pairs += [(getattr(_mg_kernels, n), getattr(_mg_kernels, n + "_parallel"))
-              for n in ("smooth", "defect", "add_operator", "restrict", "prolong_correct")]
+              for n in ("smooth", "defect", "add_operator", "restrict", "prolong_correct",
+                        "defect_restrict")]
     names = set()
     for serial, parallel in pairs:
         assert not serial.targetoptions.get("parallel") and parallel.targetoptions["parallel"]
