@@ -37,8 +37,10 @@ Gauss–Seidel sweeps before the first full sweep (so do coarse FMG levels with
 fine truncation error next to curved borders.
 The fine defect that a cycle restricts is computed first
 and its largest ``|N(u)|/(2(α+γ))`` *is* the point-Jacobi stopping measure, so
-the convergence check costs nothing extra (the same number as
-:func:`._kernels.jacobi_residual` up to rounding, ``inf`` on NaN; a test
+the convergence check costs nothing extra; on non-periodic grids the finest
+defect is restricted as it is computed (:func:`._mg_kernels.defect_restrict`,
+no fine defect arrays).  The measure is the same number as
+:func:`._kernels.jacobi_residual` up to rounding (``inf`` on NaN; a test
 holds them together).  On the finest level a cycle
 is V(0, ``POST``) after one initial pre-smoothing sweep (the same sequence of
 operations as V(1, ``POST`` − 1) repeated); coarse levels use
