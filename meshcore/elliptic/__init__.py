@@ -38,14 +38,42 @@ __all__ = [
 ]
 
 
-def warmup() -> None:
-    """Compile (or load from cache) the kernels on a tiny grid."""
+def warmup(*, multigrid: bool = True, parallel: bool = True) -> None:
+    """Compile (or load from the numba cache) the solver kernels on tiny grids.
+
+    ``multigrid`` also runs a small multigrid solve (every serial multigrid
+    kernel), ``parallel`` calls the ``parallel=True`` kernels that the
+    default ``threads=0`` uses on large grids.  Meant for a background thread
+    at start-up, so that the first real solve pays no one-time cost.
+    """
     import numpy as np
 
-    from . import _kernels
+    from . import _kernels, _mg_kernels
+    from .solver import solve
 
     x, y = np.meshgrid(np.arange(5.0), np.arange(5.0), indexing="ij")
     x, y = np.ascontiguousarray(x), np.ascontiguousarray(y)
     e = np.zeros((0, 0))
     _kernels.sweep4(x, y, e, e, 1.0, False)
     _kernels.jacobi_residual(x, y, e, e, False)
+    if multigrid:
+        from ..grid import StructuredGrid
+
+        s = np.linspace(0.0, 1.0, 33)
+        X, Y = np.meshgrid(s, s, indexing="ij")
+        X = X + 0.05 * np.sin(np.pi * X) * np.sin(np.pi * Y)
+        solve(StructuredGrid(X, Y), method="multigrid", threads=1)
+    if parallel:
+        _kernels.sweep4_parallel(x, y, e, e, 1.0, False)
+        r = np.zeros_like(x)
+        _mg_kernels.smooth_parallel(x, y, r, r, e, e, False, 1)
+        tab = _mg_kernels.transfer_tables(np.arange(5.0), True, False)
+        xc = np.zeros((tab[6].size, tab[6].size))
+        _mg_kernels.defect_parallel(x, y, e, e, e, e, False, r.copy(), r.copy())
+        _mg_kernels.defect_restrict_parallel(x, y, e, e, e, e, tab[2], tab[3], tab[2], tab[3], 1.0,
+                                             xc, xc.copy())
+        _mg_kernels.restrict_parallel(r, r, tab[2], tab[3], tab[2], tab[3], 1.0, xc, xc.copy())
+        _mg_kernels.add_operator_parallel(xc, xc.copy(), e, e, False, xc.copy(), xc.copy())
+        _mg_kernels.prolong_correct_parallel(x, y, xc, xc.copy(), xc.copy(), xc.copy(), tab[0],
+                                             tab[1], tab[0], tab[1], tab[4], tab[4], tab[5],
+                                             tab[5], False)

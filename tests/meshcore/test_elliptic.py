@@ -176,3 +176,22 @@ def test_nan_grid_is_never_converged():
     X[3, 3] = np.nan
     e = np.zeros((0, 0))
     assert _kernels.jacobi_residual(np.ascontiguousarray(X), np.ascontiguousarray(Y), e, e, False) == np.inf
+
+
+def test_warmup_loads_every_kernel_a_default_solve_uses():
+    """The app warms up in a background thread: after it, a large default solve (multigrid,
+    threads=0 → parallel kernels) dispatches to kernels that are already loaded."""
+    import subprocess
+    import sys
+
+    code = (
+        "import meshcore.elliptic as e\n"
+        "from meshcore.elliptic import _kernels as K0, _mg_kernels as K\n"
+        "e.warmup()\n"
+        "fs = [K0.sweep4, K0.sweep4_parallel, K.smooth, K.smooth_parallel, K.vcycle, K.fmg_start,\n"
+        "      K.defect_restrict, K.defect_restrict_parallel, K.prolong_correct,\n"
+        "      K.prolong_correct_parallel, K.add_operator_parallel, K.sample, K.smooth_band]\n"
+        "print(sum(1 for f in fs if not f.signatures))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "0", out.stdout + out.stderr
