@@ -375,7 +375,8 @@ def smoother_throughput(n=1025):
 def level_breakdown(g0):
     """Time per level and per operation of one multigrid solve (wrapping the _FAS methods)."""
     F = multigrid._FAS
-    orig = {k: getattr(F, k) for k in ("smooth", "defect", "to_coarse", "correct")}
+    orig = {k: getattr(F, k) for k in ("smooth", "defect", "defect_restrict", "to_coarse",
+                                       "correct")}
     acc = {}
 
     def wrap(name):
@@ -419,10 +420,13 @@ def level_breakdown(g0):
         K.vcycle = vcycle
         F._pack = pack
     shapes = multigrid.last_run["levels"]
-    rows = ["| level | nodes | smooth | defect | restrict (+N_c) | prolong | share |",
+    rows = ["| level | nodes | smooth | defect (restricted on the fly where not periodic) | "
+            "R̂, restrict (+N_c) | prolong | share |",
             "|" + "---|" * 7]
     for lvl, shp in enumerate(shapes):
-        v = [acc.get((lvl, k), 0.0) for k in ("smooth", "defect", "to_coarse", "correct")]
+        v = [acc.get((lvl, "smooth"), 0.0),
+             acc.get((lvl, "defect"), 0.0) + acc.get((lvl, "defect_restrict"), 0.0),
+             acc.get((lvl, "to_coarse"), 0.0), acc.get((lvl, "correct"), 0.0)]
         rows.append(f"| {lvl} | {shp[0]}×{shp[1]} | " + " | ".join(fmt_time(t) for t in v)
                     + f" | {100 * sum(v) / total:.0f} % |")
     if ("fused", "cycle") in acc:

@@ -1036,7 +1036,6 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         rx = _v2(fbuf, m[M_RX], n0, n1)
         ry = _v2(fbuf, m[M_RY], n0, n1)
         smooth(x, y, fx, fy, p, q, periodic, pre)
-        defect(x, y, fx, fy, p, q, periodic, rx, ry)
         c = meta[k + 1]
         c0, c1 = c[M_N0], c[M_N1]
         xc = _v2(fbuf, c[M_X], c0, c1)
@@ -1055,7 +1054,11 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         rj = _v2(ibuf, m[M_RJ], c1, m[M_WJ])
         rwi = _v2(fbuf, m[M_RWI], c0, m[M_WI])
         rwj = _v2(fbuf, m[M_RWJ], c1, m[M_WJ])
-        restrict(rx, ry, ri, rwi, rj, rwj, scale[k], fxc, fyc)
+        if periodic:
+            defect(x, y, fx, fy, p, q, periodic, rx, ry)
+            restrict(rx, ry, ri, rwi, rj, rwj, scale[k], fxc, fyc)
+        else:  # the same numbers without the fine defect arrays
+            defect_restrict(x, y, fx, fy, p, q, ri, rwi, rj, rwj, scale[k], fxc, fyc)
         add_operator(xc, yc, pc, qc, periodic, fxc, fyc)
     m = meta[nlev - 1]
     n0, n1 = m[M_N0], m[M_N1]
