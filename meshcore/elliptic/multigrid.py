@@ -112,6 +112,7 @@ YIELD_NODES = 200_000
 WORKSPACE_MAX_NODES, WORKSPACE_CACHE_SIZE = 1 << 17, 4
 
 _EMPTY = np.zeros((0, 0))
+_ZERO = np.zeros(())
 _WORKSPACES: dict = {}
 
 #: Diagnostics of the most recent multigrid solve in this process (for benchmarks):
@@ -279,10 +280,20 @@ class _FAS:
                 break
 
     def _build(self, plan: list, use_pq: bool, threads: int) -> None:
-        """Allocate the levels of ``plan`` and pack the fused ones (see :meth:`_pack`)."""
+        """Allocate the levels of ``plan``; the fused ones live in flat buffers (:meth:`_pack`)."""
         state = self.state
         lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q)
         self.levels = [lv0]
+
+        def fused(shp):  # see _pack: V-cycles fuse every serial coarse level
+            par = threads > 1 and shp[0] * shp[1] >= PARALLEL_MIN_NODES
+            return self.gamma == 1 and not par
+
+        def new(shp, fuse, zero=False):  # a fused level's arrays are placed by _pack
+            if fuse:
+                return np.broadcast_to(_ZERO, shp)
+            return np.zeros(shp) if zero else np.empty(shp)
+
         for _ci, _cj, tab_i, tab_j in plan:
             fine = self.levels[-1]
             ni, nj = fine.x.shape[0] - 1, fine.x.shape[1] - 1
@@ -294,16 +305,19 @@ class _FAS:
             fine.scale = (a * b) ** 2
             fine.pscale, fine.qscale = 1.0 / a, 1.0 / b
             if fine is not lv0 or self.periodic:  # level 0's defect is restricted on the fly
-                fine.rx = np.empty(fine.x.shape)
-                fine.ry = np.empty(fine.x.shape)
-            pc = np.empty(shp) if use_pq else _EMPTY
-            qc = np.empty(shp) if use_pq else _EMPTY
-            self.levels.append(_Level(np.empty(shp), np.empty(shp), np.zeros(shp), np.zeros(shp),
-                                      pc, qc))
+                ff = fine is not lv0 and fused(fine.x.shape)
+                fine.rx = new(fine.x.shape, ff)
+                fine.ry = new(fine.x.shape, ff)
+            fc = fused(shp)
+            pc = new(shp, fc) if use_pq else _EMPTY
+            qc = new(shp, fc) if use_pq else _EMPTY
+            self.levels.append(_Level(new(shp, fc), new(shp, fc), new(shp, fc, True),
+                                      new(shp, fc, True), pc, qc))
         last = self.levels[-1]
         if last.rx is None and len(self.levels) > 1:
-            last.rx = np.empty(last.x.shape)  # scratch for the correction to the next finer level
-            last.ry = np.empty(last.x.shape)
+            # scratch for the correction to the next finer level
+            last.rx = new(last.x.shape, fused(last.x.shape))
+            last.ry = new(last.x.shape, fused(last.x.shape))
         n = max(self.levels[-1].x.shape) - 1
         self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, COARSEST_MAX))
         for lv in self.levels:
@@ -311,13 +325,14 @@ class _FAS:
         self._pack()
 
     def _pack(self) -> None:
-        """Move the arrays of the small levels into flat buffers for :func:`K.vcycle`.
+        """Place the arrays of the small levels in flat buffers for :func:`K.vcycle`.
 
         Levels from ``kfuse`` on (all but the finest for V-cycles, or the
         serial ones with threads) run a whole V-cycle in one compiled call;
-        their arrays become views of the buffers, so the Python code paths
-        (FMG start, sources, transfers from level ``kfuse − 1``) see the same
-        data.
+        their arrays are views of the buffers (allocated here, once: the
+        levels hold shape-only placeholders until then), so the Python code
+        paths (FMG start, sources, transfers from level ``kfuse − 1``) see the
+        same data.  The transfer tables are copied in.
         """
         levels = self.levels
         nlev = len(levels)
@@ -329,46 +344,51 @@ class _FAS:
             kf += 1
         if kf >= nlev:
             return
-        fl, il = [], []
-        fpos = [0]
-        ipos = [0]
-
-        def put(arr, lst, pos):
-            off = pos[0]
-            lst.append(np.ascontiguousarray(arr).ravel())
-            pos[0] += arr.size
-            return off
-
+        fpos, ipos = 0, 0
+        fcopy, icopy = [], []  # (offset, table) to copy once the buffers exist
         meta = np.zeros((nlev - kf, K.META_COLS), dtype=np.int64)
         fnames = ("x", "y", "fx", "fy", "p", "q", "rx", "ry")
+        fcols = (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX, K.M_RY)
         for r, lv in enumerate(levels[kf:]):
             m = meta[r]
             m[K.M_N0], m[K.M_N1] = lv.x.shape
             m[K.M_PQ] = lv.p.size > 0
-            for name, col in zip(fnames, (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX,
-                                          K.M_RY), strict=True):
+            for name, col in zip(fnames, fcols, strict=True):
                 arr = getattr(lv, name)
                 if arr is not None and arr.size:
-                    m[col] = put(arr, fl, fpos)
+                    m[col] = fpos
+                    fpos += arr.size
             if lv.si is not None:
                 for name, col in (("si", K.M_SI), ("sj", K.M_SJ), ("ri", K.M_RI), ("rj", K.M_RJ),
                                   ("li", K.M_LI), ("lj", K.M_LJ)):
-                    m[col] = put(np.asarray(getattr(lv, name), dtype=np.int64), il, ipos)
+                    tab = getattr(lv, name)
+                    m[col] = ipos
+                    icopy.append((ipos, tab))
+                    ipos += tab.size
                 m[K.M_WI], m[K.M_WJ] = lv.ri.shape[1], lv.rj.shape[1]
                 for name, col in (("swi", K.M_SWI), ("swj", K.M_SWJ), ("rwi", K.M_RWI),
                                   ("rwj", K.M_RWJ), ("wli", K.M_WLI), ("wlj", K.M_WLJ)):
-                    m[col] = put(np.asarray(getattr(lv, name), dtype=np.float64), fl, fpos)
-        fbuf = np.concatenate(fl) if fl else np.zeros(0)
-        ibuf = np.concatenate(il) if il else np.zeros(0, dtype=np.int64)
+                    tab = getattr(lv, name)
+                    m[col] = fpos
+                    fcopy.append((fpos, tab))
+                    fpos += tab.size
+        fbuf = np.empty(fpos)
+        ibuf = np.empty(ipos, dtype=np.int64)
+        for off, tab in fcopy:
+            fbuf[off:off + tab.size] = np.ravel(tab)
+        for off, tab in icopy:
+            ibuf[off:off + tab.size] = np.ravel(tab)
         for r, lv in enumerate(levels[kf:]):
             m = meta[r]
             shp = lv.x.shape
             n = shp[0] * shp[1]
-            for name, col in zip(fnames, (K.M_X, K.M_Y, K.M_FX, K.M_FY, K.M_P, K.M_Q, K.M_RX,
-                                          K.M_RY), strict=True):
+            for name, col in zip(fnames, fcols, strict=True):
                 arr = getattr(lv, name)
                 if arr is not None and arr.size:
-                    setattr(lv, name, fbuf[m[col]:m[col] + n].reshape(shp))
+                    view = fbuf[m[col]:m[col] + n].reshape(shp)
+                    if name in ("fx", "fy"):
+                        view[...] = 0.0
+                    setattr(lv, name, view)
         self.kfuse = kf
         self.fbuf, self.ibuf, self.meta = fbuf, ibuf, meta
         self.fscale = np.array([lv.scale for lv in levels[kf:]])
