@@ -780,7 +780,8 @@ def _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, sca
     return m
 
 
-def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc):  # pragma: no cover
+def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc,
+                     chunks):  # pragma: no cover - compiled
     """:func:`_defect` followed by :func:`_restrict`, without the fine defect arrays.
 
     Each chunk of coarse rows computes the fine defect rows its full-weighting
@@ -788,13 +789,15 @@ def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc):  # pr
     computed by both, with the same result) and restricts them at once: the
     same numbers as ``defect`` + ``restrict`` bit for bit, without writing and
     re-reading two fine arrays (the largest memory stream of a cycle on big
-    grids).  Not periodic (the seam's stencil wraps around).  Returns the
-    largest ``(|f − N|/den)²`` as :func:`_defect`.
+    grids).  Not periodic (the seam's stencil wraps around).  ``chunks``:
+    at most this many independent chunks (1 for the serial kernel: one ring,
+    no recomputed rows).  Returns the largest ``(|f − N|/den)²`` as
+    :func:`_defect`.
     """
     use_f = fx.size > 0
     use_pq = p.size > 0
     nI = fxc.shape[0]
-    nchunks = min(nI, ROW_CHUNKS)
+    nchunks = max(1, min(nI, chunks))
     cmax = np.zeros(nchunks)
     for c in prange(nchunks):
         cmax[c] = _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, scale,
@@ -1058,7 +1061,7 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
             defect(x, y, fx, fy, p, q, periodic, rx, ry)
             restrict(rx, ry, ri, rwi, rj, rwj, scale[k], fxc, fyc)
         else:  # the same numbers without the fine defect arrays
-            defect_restrict(x, y, fx, fy, p, q, ri, rwi, rj, rwj, scale[k], fxc, fyc)
+            defect_restrict(x, y, fx, fy, p, q, ri, rwi, rj, rwj, scale[k], fxc, fyc, 1)
         add_operator(xc, yc, pc, qc, periodic, fxc, fyc)
     m = meta[nlev - 1]
     n0, n1 = m[M_N0], m[M_N1]

@@ -450,9 +450,12 @@ class _FAS:
             self.restricted[k] = False
             return self.defect(f)
         c = self.levels[k + 1]
-        fn = K.defect_restrict_parallel if f.par else K.defect_restrict
         self.restricted[k] = True
-        return fn(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+        if f.par:
+            return K.defect_restrict_parallel(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj,
+                                              f.rwj, f.scale, c.fx, c.fy, K.ROW_CHUNKS)
+        return K.defect_restrict(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj, f.rwj, f.scale,
+                                 c.fx, c.fy, 1)
 
     def to_coarse(self, k: int) -> None:
         """FAS right-hand side of level k+1 from the defect of level k."""

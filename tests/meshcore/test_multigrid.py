@@ -235,9 +235,10 @@ def test_fused_defect_restriction_is_defect_then_restriction(ni, nj):
         a, b = np.empty(shape), np.empty(shape)
         m = _mg_kernels.defect(X, Y, F, F, P, P, False, rx, ry)
         _mg_kernels.restrict(rx, ry, ti[2], ti[3], tj[2], tj[3], 16.0, a, b)
-        for fn in (_mg_kernels.defect_restrict, _mg_kernels.defect_restrict_parallel):
+        for fn, chunks in itertools.product(
+                (_mg_kernels.defect_restrict, _mg_kernels.defect_restrict_parallel), (1, 3, 16)):
             c, d = np.empty(shape), np.empty(shape)
-            assert fn(X, Y, F, F, P, P, ti[2], ti[3], tj[2], tj[3], 16.0, c, d) == m
+            assert fn(X, Y, F, F, P, P, ti[2], ti[3], tj[2], tj[3], 16.0, c, d, chunks) == m
             assert np.array_equal(a, c) and np.array_equal(b, d)
 
 
