@@ -385,10 +385,10 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
 
 @njit(cache=True, nogil=True)
 def _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, outx, outy, tx, ty, tq,
-                td):  # pragma: no cover - compiled
+                td, measure=True):  # pragma: no cover - compiled
     """Defect of row ``i`` into ``outx, outy`` (length ``nj1``, 0 at both ends); returns the
-    row's largest ``(|f − N|/den)²`` (``inf`` on NaN).  ``tx … td`` are scratch rows whose
-    end entries are 0 (fresh, so the unit-stride loop vectorises)."""
+    row's largest ``(|f − N|/den)²`` (``inf`` on NaN; 0 without ``measure``).  ``tx … td``
+    are scratch rows whose end entries are 0 (fresh, so the unit-stride loop vectorises)."""
     ie = i + 1
     for j in range(1, nj1 - 1):
         xe = x[ie, j]
@@ -425,12 +425,15 @@ def _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, outx, outy, tx, t
             dy += fy[i, j]
         tx[j] = dx
         ty[j] = dy
-        tq[j] = dx * dx + dy * dy
-        td[j] = den * den
+        if measure:
+            tq[j] = dx * dx + dy * dy
+            td[j] = den * den
     m = 0.0
     for j in range(nj1):
         outx[j] = tx[j]
         outy[j] = ty[j]
+    if not measure:
+        return m
     for j in range(nj1):
         if td[j] > 0.0 and tq[j] > m * td[j]:  # (dx² + dy²)/den² > m, divided only when true
             m = tq[j] / td[j]
@@ -503,42 +506,20 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
 
 @njit(cache=True, nogil=True)
 def _add_operator_rows(x, y, p, q, use_pq, ni, nj1, fx, fy, lo, hi):  # pragma: no cover
-    """Rows ``lo ≤ i < hi`` of :func:`_add_operator`."""
+    """Rows ``lo ≤ i < hi`` of :func:`_add_operator`: ``f −= (f = 0 defect)``, which is
+    ``f += N(u)`` exactly (IEEE negation)."""
+    tx, ty, tq, td = _scratch_rows(nj1)
+    ox = np.empty(nj1)
+    oy = np.empty(nj1)
+    e = np.zeros((0, 0))
     for i in range(lo, hi):
         iw = i - 1
         if iw < 0:
             iw = ni - 1
-        ie = i + 1
+        _defect_row(x, y, e, e, p, q, False, use_pq, i, iw, nj1, ox, oy, tx, ty, tq, td, False)
         for j in range(1, nj1 - 1):
-            xe = x[ie, j]
-            xw = x[iw, j]
-            xn = x[i, j + 1]
-            xs = x[i, j - 1]
-            ye = y[ie, j]
-            yw = y[iw, j]
-            yn = y[i, j + 1]
-            ys = y[i, j - 1]
-            xxi = 0.5 * (xe - xw)
-            yxi = 0.5 * (ye - yw)
-            xet = 0.5 * (xn - xs)
-            yet = 0.5 * (yn - ys)
-            a = xet * xet + yet * yet
-            b = xxi * xet + yxi * yet
-            g = xxi * xxi + yxi * yxi
-            den = 2.0 * (a + g)
-            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
-            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
-            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-            if use_pq:
-                d = xxi * yet - xet * yxi
-                d2 = d * d
-                pp = p[i, j]
-                qq = q[i, j]
-                sx += d2 * (pp * xxi + qq * xet)
-                sy += d2 * (pp * yxi + qq * yet)
-            fx[i, j] += den * x[i, j] - sx
-            fy[i, j] += den * y[i, j] - sy
+            fx[i, j] -= ox[j]
+            fy[i, j] -= oy[j]
 
 
 def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
