@@ -317,6 +317,15 @@ def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sw
     )
 
 
+def _raise_if_failed(res: FoldFreeResult, failed: bool) -> FoldFreeResult:
+    """``res``, or (strict mode, ``failed``) a :class:`FoldedGridError` that carries it."""
+    if failed:
+        err = FoldedGridError(res.message)
+        err.result = res  # type: ignore[attr-defined]
+        raise err
+    return res
+
+
 def _folded(x, y) -> int:
     a = (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1]) - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
     return int((a <= 0).sum())
@@ -432,40 +441,9 @@ def repair(
     else:
         bad_now = invalid_cells(x, y, ex_bits)
         msg = f"{origin}; " + _failure_message(StructuredGrid(x, y), bad_now, exempt)
-        if strict:
-            res = _result(
-                grid,
-                x,
-                y,
-                ok=False,
-                before=before,
-                folded_before=folded_before,
-                exempt=exempt,
-                ex_bits=ex_bits,
-                nodes=nfree,
-                sweeps=total,
-                t0=t0,
-                method=method,
-                msg=msg,
-            )
-            err = FoldedGridError(msg)
-            err.result = res  # type: ignore[attr-defined]
-            raise err
-    return _result(
-        grid,
-        x,
-        y,
-        ok=ok,
-        before=before,
-        folded_before=folded_before,
-        exempt=exempt,
-        ex_bits=ex_bits,
-        nodes=nfree,
-        sweeps=total,
-        t0=t0,
-        method=method,
-        msg=msg,
-    )
+    res = _result(grid, x, y, ok=ok, before=before, folded_before=folded_before, exempt=exempt,
+                  ex_bits=ex_bits, nodes=nfree, sweeps=total, t0=t0, method=method, msg=msg)
+    return _raise_if_failed(res, strict and not ok)
 
 
 def _patches(
@@ -620,39 +598,10 @@ def smooth(
     else:
         ok = False
         msg = _failure_message(StructuredGrid(x, y), invalid_cells(x, y, ex_bits), exempt)
-        if strict:
-            err = FoldedGridError(msg)
-            err.result = _result(  # type: ignore[attr-defined]
-                grid,
-                x,
-                y,
-                ok=False,
-                before=before,
-                folded_before=folded_before,
-                exempt=exempt,
-                ex_bits=ex_bits,
-                nodes=len(nodes),
-                sweeps=sw,
-                t0=t0,
-                method="foldfree",
-                msg=msg,
-            )
-            raise err
-    return _result(
-        grid,
-        x,
-        y,
-        ok=ok,
-        before=before,
-        folded_before=folded_before,
-        exempt=exempt,
-        ex_bits=ex_bits,
-        nodes=len(nodes),
-        sweeps=sw,
-        t0=t0,
-        method="foldfree",
-        msg=msg,
-    )
+    res = _result(grid, x, y, ok=ok, before=before, folded_before=folded_before, exempt=exempt,
+                  ex_bits=ex_bits, nodes=len(nodes), sweeps=sw, t0=t0, method="foldfree",
+                  msg=msg)
+    return _raise_if_failed(res, strict and not ok)
 
 
 def _median_area(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
