@@ -60,36 +60,10 @@ def _update(x, y, nb):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def table_sweep(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omega):  # pragma: no cover
-    """One SOR sweep over the regular nodes, then the irregular ones."""
-    dmax = 0.0
-    for k in range(nodes.shape[0]):
-        p = nodes[k]
-        rx, ry, den = _update(x, y, nbr[k])
-        if den <= 0.0:
-            continue
-        dx = omega * (rx / den - x[p])
-        dy = omega * (ry / den - y[p])
-        x[p] += dx
-        y[p] += dy
-        m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
-    for k in range(irr_nodes.shape[0]):
-        p = irr_nodes[k]
-        sx = 0.0
-        sy = 0.0
-        for r in range(irr_ptr[k], irr_ptr[k + 1]):
-            sx += x[irr_ring[r]]
-            sy += y[irr_ring[r]]
-        c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
-        dx = omega * (sx * c - x[p])
-        dy = omega * (sy * c - y[p])
-        x[p] += dx
-        y[p] += dy
-        m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
-    return np.sqrt(dmax)
+    """One SOR sweep over the regular nodes, then the irregular ones (:func:`table_sweep_rhs`
+    with ``f = 0``)."""
+    e = np.zeros(0)
+    return table_sweep_rhs(x, y, e, e, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omega)
 
 
 @njit(cache=True, nogil=True)
@@ -129,15 +103,21 @@ def table_residual(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring):  # pragma: n
 
 @njit(cache=True, nogil=True)
 def table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omega):  # pragma: no cover
-    """One nonlinear Gauss–Seidel/SOR sweep of ``u − T(u) = f``: ``u_p ← u_p + ω (T_p + f_p − u_p)``."""
+    """One nonlinear Gauss–Seidel/SOR sweep of ``u − T(u) = f``: ``u_p ← u_p + ω (T_p + f_p − u_p)``
+    (``fx, fy`` empty: ``f = 0``)."""
+    use_f = fx.size > 0
     dmax = 0.0
     for k in range(nodes.shape[0]):
         p = nodes[k]
         rx, ry, den = _update(x, y, nbr[k])
         if den <= 0.0:
             continue
-        dx = omega * (rx / den + fx[p] - x[p])
-        dy = omega * (ry / den + fy[p] - y[p])
+        if use_f:
+            dx = omega * (rx / den + fx[p] - x[p])
+            dy = omega * (ry / den + fy[p] - y[p])
+        else:
+            dx = omega * (rx / den - x[p])
+            dy = omega * (ry / den - y[p])
         x[p] += dx
         y[p] += dy
         m = dx * dx + dy * dy
@@ -151,8 +131,12 @@ def table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omeg
             sx += x[irr_ring[r]]
             sy += y[irr_ring[r]]
         c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
-        dx = omega * (sx * c + fx[p] - x[p])
-        dy = omega * (sy * c + fy[p] - y[p])
+        if use_f:
+            dx = omega * (sx * c + fx[p] - x[p])
+            dy = omega * (sy * c + fy[p] - y[p])
+        else:
+            dx = omega * (sx * c - x[p])
+            dy = omega * (sy * c - y[p])
         x[p] += dx
         y[p] += dy
         m = dx * dx + dy * dy
