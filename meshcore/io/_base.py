@@ -146,6 +146,25 @@ def make_polyline(name: str, pts: np.ndarray, *, closed: bool | None = None,
     return Polyline(name, p, closed=bool(closed), orientation=orientation)
 
 
+def merge_point_runs(polylines: Sequence[Polyline], name: str, where: str) -> list[Polyline]:
+    """Consecutive single-point features (points picked by hand) joined into one polyline
+    named ``name`` (a run of one point is dropped); other polylines pass through in order."""
+    merged: list[Polyline] = []
+    run: list[np.ndarray] = []
+    for pl in [*polylines, None]:
+        if pl is not None and pl.orientation == "point":
+            run.append(pl.points)
+            continue
+        if run:
+            pts = np.vstack(run)
+            if len(pts) >= 2:
+                merged.append(make_polyline(name, pts, where=where))
+            run = []
+        if pl is not None:
+            merged.append(pl)
+    return merged
+
+
 # ----------------------------------------------------------------- reading
 @contextlib.contextmanager
 def read_guard(path: Any, what: str = "file") -> Iterator[None]:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..crs import LONLAT, check_lonlat, normalize_crs
 from ..errors import InvalidInputError, ReadError
-from ._base import PointSet, Polyline, decode_text, make_polyline, read_bytes
+from ._base import PointSet, Polyline, decode_text, make_polyline, merge_point_runs, read_bytes
 
 __all__ = ["read_points_geojson"]
 
@@ -111,19 +111,7 @@ def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
         name = str(name or f.get("id") or (path.stem if len(feats) == 1 else f"feature {k + 1}"))
         _geometry(f.get("geometry"), name, f"{path}: feature {k} ({name})", out)
     # consecutive Point features form one polyline (points picked by hand)
-    merged: list[Polyline] = []
-    run: list[np.ndarray] = []
-    for pl in [*out, None]:
-        if pl is not None and pl.orientation == "point":
-            run.append(pl.points)
-            continue
-        if run:
-            pts = np.vstack(run)
-            if len(pts) >= 2:
-                merged.append(make_polyline(f"{path.stem} points", pts, where=str(path)))
-            run = []
-        if pl is not None:
-            merged.append(pl)
+    merged = merge_point_runs(out, f"{path.stem} points", str(path))
     if not merged:
         raise ReadError(f"{path}: no LineString or Polygon coordinates in {len(feats)} feature(s)")
     try:

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..crs import LONLAT, check_lonlat, normalize_crs
 from ..errors import ReadError
-from ._base import PointSet, Polyline, make_polyline, read_bytes
+from ._base import PointSet, Polyline, make_polyline, merge_point_runs, read_bytes
 
 __all__ = ["KMZ_LIMIT", "read_points_kml", "read_points_kmz"]
 
@@ -131,19 +131,7 @@ def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
         n_marks += 1
         nm = (_find_child(pm, "name") or "").strip() or f"placemark {n_marks}"
         _placemark_geoms(pm, nm, f"{where}: placemark {n_marks} ({nm})", out)
-    merged: list[Polyline] = []
-    run: list[np.ndarray] = []
-    for pl in [*out, None]:
-        if pl is not None and pl.orientation == "point":
-            run.append(pl.points)
-            continue
-        if run:
-            pts = np.vstack(run)
-            if len(pts) >= 2:
-                merged.append(make_polyline(f"{stem} points", pts, where=where))
-            run = []
-        if pl is not None:
-            merged.append(pl)
+    merged = merge_point_runs(out, f"{stem} points", where)
     if not merged:
         raise ReadError(
             f"{where}: no coordinates: none of {n_marks} placemark(s) has a LineString, "
