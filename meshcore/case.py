@@ -216,6 +216,11 @@ def _points(value: Any, base: Path | None, where: str, ctx: dict[str, Any]) -> n
         if not p.is_absolute() and base is not None:
             p = base / p
         return _read_point_file(p, where, ctx)
+    return xy_pairs(value, where)
+
+
+def xy_pairs(value: Any, where: str) -> np.ndarray:
+    """Points given inline in a case file: an ``(n, 2)`` float array, or a CaseFileError."""
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):

@@ -51,6 +51,7 @@ from ..case import (
     _check_keys,
     register_case_generator,
     register_keys,
+    xy_pairs,
 )
 from ..elliptic import EllipticConfig
 from ..errors import CaseFileError, InvalidInputError
@@ -130,13 +131,7 @@ def _read_outline(value: Any, base: Any, where: str) -> tuple[np.ndarray, Any]:
         if not ps.polylines:
             raise CaseFileError(f"{where}: {p} holds no polyline")
         return np.asarray(ps.polylines[0].points, dtype=np.float64), ps.crs
-    try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise CaseFileError(f"{where}: expected a list of [x, y] pairs or a file name") from None
-    if arr.ndim != 2 or arr.shape[1] != 2:
-        raise CaseFileError(f"{where}: expected a list of [x, y] pairs, got shape {arr.shape}")
-    return arr, None
+    return xy_pairs(value, where), None
 
 
 def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where: str,
