@@ -273,6 +273,17 @@ def resolve_threads(threads: int, nodes: int) -> int:
     return max(1, int(numba.config.NUMBA_NUM_THREADS))
 
 
+def config_with(config: EllipticConfig | None, overrides: dict[str, Any]) -> EllipticConfig:
+    """``config`` (default settings if None) with keyword ``overrides``; unknown names raise."""
+    cfg = config or EllipticConfig()
+    if overrides:
+        try:
+            cfg = cfg.replaced(**overrides)
+        except TypeError as exc:
+            raise InvalidInputError(f"unknown solver option: {exc}") from None
+    return cfg
+
+
 def _choose_method(cfg: EllipticConfig, shape: tuple[int, int]) -> str:
     m = cfg.method
     if m == "auto":
@@ -322,12 +333,7 @@ def iterate(
     StructuredGrid
         The final grid, with ``info`` (method, converged, iterations, residual).
     """
-    cfg = config or EllipticConfig()
-    if overrides:
-        try:
-            cfg = cfg.replaced(**overrides)
-        except TypeError as exc:
-            raise InvalidInputError(f"unknown solver option: {exc}") from None
+    cfg = config_with(config, overrides)
     x = np.array(initial.x, dtype=np.float64, order="C", copy=True)
     y = np.array(initial.y, dtype=np.float64, order="C", copy=True)
     if not (np.isfinite(x).all() and np.isfinite(y).all()):

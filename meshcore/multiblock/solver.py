@@ -52,7 +52,7 @@ from .._validation import validate_choice
 from ..algebraic import algebraic_grid
 from ..elliptic import EllipticConfig
 from ..elliptic import solve as solve_block
-from ..elliptic.solver import default_tolerance
+from ..elliptic.solver import config_with, default_tolerance
 from ..errors import InvalidInputError
 from ..grid import SolveInfo, StructuredGrid
 from ..quality import QualityReport, quality
@@ -306,12 +306,7 @@ def solve_multiblock(
     mode = validate_choice(mode, MODES, name="mode")
     start = validate_choice(start, ("frozen", "algebraic"), name="start")
     engine = validate_choice(engine, ENGINES, name="engine")
-    cfg = config or EllipticConfig()
-    if overrides:
-        try:
-            cfg = cfg.replaced(**overrides)
-        except TypeError as exc:
-            raise InvalidInputError(f"unknown solver option: {exc}") from None
+    cfg = config_with(config, overrides)
     m = topology.node_map
     t0 = time.perf_counter()
     grids = list(initial) if initial is not None else initial_grids(topology)
