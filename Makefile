@@ -8,4 +8,5 @@ setup:
 bench:
 	bash scripts/setup.sh && .venv/bin/python -m pip install -q -e ".[bench]" && .venv/bin/python benchmarks/run.py
 lint:
+	.venv/bin/ruff format --check meshcore app tests benchmarks tools scripts
 	.venv/bin/ruff check meshcore app tests

@@ -53,12 +53,17 @@ def split(X, Y, nb: int) -> MultiBlockTopology:
             (Interface(Side("a", "right"), Side("b", "left")),),
         )
     h, v = ni // 2, nj // 2
-    parts = {"sw": np.s_[: h + 1, : v + 1], "se": np.s_[h:, : v + 1],
-             "nw": np.s_[: h + 1, v:], "ne": np.s_[h:, v:]}
+    parts = {"sw": np.s_[: h + 1, : v + 1], "se": np.s_[h:, : v + 1], "nw": np.s_[: h + 1, v:], "ne": np.s_[h:, v:]}
     bl = tuple(Block(n, borders(X[s], Y[s])) for n, s in parts.items())
-    itf = tuple(Interface(Side(a, ba), Side(b, bb)) for a, ba, b, bb in (
-        ("sw", "right", "se", "left"), ("nw", "right", "ne", "left"),
-        ("sw", "top", "nw", "bottom"), ("se", "top", "ne", "bottom")))
+    itf = tuple(
+        Interface(Side(a, ba), Side(b, bb))
+        for a, ba, b, bb in (
+            ("sw", "right", "se", "left"),
+            ("nw", "right", "ne", "left"),
+            ("sw", "top", "nw", "bottom"),
+            ("se", "top", "ne", "bottom"),
+        )
+    )
     return MultiBlockTopology(bl, itf)
 
 
@@ -103,8 +108,10 @@ def per_sweep(repeat: int, sizes) -> None:
 
             res.append(best(run, repeat)[0] / n)
         tt, tb = res
-        print(f"| {X.shape[0]}×{X.shape[1]} = {X.size} | {t4 * 1e3:.3f} | {tt * 1e3:.3f} | "
-              f"{tb * 1e3:.3f} | {tt / t4:.2f} | {tb / t4:.2f} |")
+        print(
+            f"| {X.shape[0]}×{X.shape[1]} = {X.size} | {t4 * 1e3:.3f} | {tt * 1e3:.3f} | "
+            f"{tb * 1e3:.3f} | {tt / t4:.2f} | {tb / t4:.2f} |"
+        )
     print()
 
 
@@ -119,27 +126,32 @@ def whole_solves(repeat: int, sizes) -> None:
         t1, ref = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="sor", tolerance=tol), repeat)
         rows = [("1 block, SOR", ref.iterations, t1, 0.0)]
         if "multigrid" in METHODS:
-            tm, gm = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="multigrid", tolerance=tol),
-                          repeat)
+            tm, gm = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="multigrid", tolerance=tol), repeat)
             rows.append(("1 block, multigrid", gm.iterations, tm, float(np.abs(gm.x - ref.x).max())))
         for nb in (2, 4):
             topo = split(X, Y, nb)
-            for engine, start in (("multigrid", "algebraic"), ("blocks", "algebraic"),
-                                  ("blocks", "frozen"), ("table", "algebraic")):
-                tb, mb = best(lambda topo=topo, engine=engine, start=start, tol=tol: solve_multiblock(
-                    topo, mode="smooth", tolerance=tol, engine=engine, start=start), repeat)
+            for engine, start in (
+                ("multigrid", "algebraic"),
+                ("blocks", "algebraic"),
+                ("blocks", "frozen"),
+                ("table", "algebraic"),
+            ):
+                tb, mb = best(
+                    lambda topo=topo, engine=engine, start=start, tol=tol: solve_multiblock(
+                        topo, mode="smooth", tolerance=tol, engine=engine, start=start
+                    ),
+                    repeat,
+                )
                 xs = np.full(X.shape, np.nan)
                 ys = np.full(X.shape, np.nan)
                 h, v = ni // 2, nj // 2
-                offs = {"a": (0, 0), "b": (h, 0), "sw": (0, 0), "se": (h, 0), "nw": (0, v),
-                        "ne": (h, v)}
+                offs = {"a": (0, 0), "b": (h, 0), "sw": (0, 0), "se": (h, 0), "nw": (0, v), "ne": (h, v)}
                 for name, g in zip(mb.names, mb.grids, strict=True):
                     i0, j0 = offs[name]
-                    xs[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.x
-                    ys[i0:i0 + g.shape[0], j0:j0 + g.shape[1]] = g.y
+                    xs[i0 : i0 + g.shape[0], j0 : j0 + g.shape[1]] = g.x
+                    ys[i0 : i0 + g.shape[0], j0 : j0 + g.shape[1]] = g.y
                 dist = float(np.hypot(xs - ref.x, ys - ref.y).max()) / ref.size
-                rows.append((f"{nb} blocks smooth, {engine}, {start} start", mb.info.iterations,
-                             tb, dist))
+                rows.append((f"{nb} blocks smooth, {engine}, {start} start", mb.info.iterations, tb, dist))
         for label, it, t, d in rows:
             print(f"| {X.size} | {label} | {it} | {t:.3f} | {t / t1:.2f} | {d:.1e} |")
     print()
@@ -165,10 +177,8 @@ def lake(repeat: int, quick: bool) -> None:
         t1, one = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="sor", tolerance=tol), repeat)
         print(f"| {tag} | {X.size} | one block {ni}×{nj}, SOR | {one.iterations} | {t1:.3f} | 1.00 |")
         if "multigrid" in METHODS:
-            tm, gm = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="multigrid", tolerance=tol),
-                          repeat)
-            print(f"| {tag} | {X.size} | one block {ni}×{nj}, multigrid | {gm.iterations} | {tm:.3f} | "
-                  f"{tm / t1:.2f} |")
+            tm, gm = best(lambda g0=g0, tol=tol: meshcore.solve(g0, method="multigrid", tolerance=tol), repeat)
+            print(f"| {tag} | {X.size} | one block {ni}×{nj}, multigrid | {gm.iterations} | {tm:.3f} | {tm / t1:.2f} |")
         for label, kw in (
             ("smooth, auto (default)", {"mode": "smooth"}),
             ("smooth, multigrid only", {"mode": "smooth", "engine": "multigrid"}),
@@ -176,10 +186,11 @@ def lake(repeat: int, quick: bool) -> None:
             ("smooth, table engine (SOR)", {"mode": "smooth", "engine": "table"}),
             ("frozen (blocks solved separately)", {"mode": "frozen"}),
         ):
-            t, mb = best(lambda kw=kw, tol=tol, topo=topo: solve_multiblock(topo, tolerance=tol, **kw),
-                         repeat)
-            print(f"| {tag} | {n} | {len(topo.blocks)} blocks {label}: {mb.info.method} | "
-                  f"{mb.info.iterations} | {t:.3f} | {t / t1:.2f} |")
+            t, mb = best(lambda kw=kw, tol=tol, topo=topo: solve_multiblock(topo, tolerance=tol, **kw), repeat)
+            print(
+                f"| {tag} | {n} | {len(topo.blocks)} blocks {label}: {mb.info.method} | "
+                f"{mb.info.iterations} | {t:.3f} | {t / t1:.2f} |"
+            )
     print()
 
 

@@ -46,8 +46,7 @@ def jacobi_sweep(x: np.ndarray, y: np.ndarray) -> float:
     return d
 
 
-def solve(x0: np.ndarray, y0: np.ndarray, tol_abs: float, *, max_seconds: float = np.inf,
-          max_sweeps: int = 10_000_000):
+def solve(x0: np.ndarray, y0: np.ndarray, tol_abs: float, *, max_seconds: float = np.inf, max_sweeps: int = 10_000_000):
     """Iterate until the displacement ≤ ``tol_abs``; returns (x, y, sweeps, seconds, done)."""
     x, y = x0.copy(), y0.copy()
     t0 = time.perf_counter()

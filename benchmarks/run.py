@@ -92,8 +92,7 @@ def lake(ni=256):
     lon, lat = ll[:, 0], ll[:, 1]
     lat0 = math.radians(lat.mean())
     R = 6_371_000.0
-    pts = np.column_stack([R * np.radians(lon - lon.mean()) * math.cos(lat0),
-                           R * np.radians(lat - lat.mean())])
+    pts = np.column_stack([R * np.radians(lon - lon.mean()) * math.cos(lat0), R * np.radians(lat - lat.mean())])
     c = pts - pts.mean(axis=0)
     _, _, vt = np.linalg.svd(c, full_matrices=False)
     u, v = c @ vt[0], c @ vt[1]
@@ -141,8 +140,7 @@ def tol_abs(g):
 
 def criterion(x, y):
     e = np.zeros((0, 0))
-    return float(_kernels.jacobi_residual(np.ascontiguousarray(x), np.ascontiguousarray(y), e, e,
-                                          False))
+    return float(_kernels.jacobi_residual(np.ascontiguousarray(x), np.ascontiguousarray(y), e, e, False))
 
 
 def quality_cols(x, y, periodic=False):
@@ -180,9 +178,19 @@ def run_meshcore(g0, method, threads, repeats, report_interval):
         fse = g.iterations
         it = f"{g.iterations} sw"
     folded, orth = quality_cols(g.x, g.y, g.periodic)
-    return Row(time=med, best=best, iters=it, fse=fse, ns=med / max(fse * nodes, 1) * 1e9,
-               mem=peak / nodes, folded=folded, orth=orth,
-               res=criterion(g.x, g.y) / tol_abs(g0), conv=g.converged, method_used=g.info.method)
+    return Row(
+        time=med,
+        best=best,
+        iters=it,
+        fse=fse,
+        ns=med / max(fse * nodes, 1) * 1e9,
+        mem=peak / nodes,
+        folded=folded,
+        orth=orth,
+        res=criterion(g.x, g.y) / tol_abs(g0),
+        conv=g.converged,
+        method_used=g.info.method,
+    )
 
 
 def run_numpy(g0, quick, sweeps_model):
@@ -213,12 +221,32 @@ def run_numpy(g0, quick, sweeps_model):
     if est <= NUMPY_LIMIT:
         x, y, k, secs, done = paper_jacobi.solve(x0, y0, tol, max_seconds=2 * NUMPY_LIMIT)
         folded, orth = quality_cols(x, y)
-        return Row(time=secs, best=secs, iters=f"{k} sw", fse=k, ns=secs / max(k * nodes, 1) * 1e9,
-                   mem=peak / nodes, folded=folded, orth=orth,
-                   res=criterion(x, y) / tol, conv=done, note="run")
-    return Row(time=est, best=est, iters=f"~{sweeps} sw", fse=sweeps, ns=t_sweep / nodes * 1e9,
-               mem=peak / nodes, folded="", orth="", res=float("nan"), conv=None,
-               note=f"extrapolated: {sweeps} sweeps ({how}) × {t_sweep * 1e3:.2f} ms/sweep")
+        return Row(
+            time=secs,
+            best=secs,
+            iters=f"{k} sw",
+            fse=k,
+            ns=secs / max(k * nodes, 1) * 1e9,
+            mem=peak / nodes,
+            folded=folded,
+            orth=orth,
+            res=criterion(x, y) / tol,
+            conv=done,
+            note="run",
+        )
+    return Row(
+        time=est,
+        best=est,
+        iters=f"~{sweeps} sw",
+        fse=sweeps,
+        ns=t_sweep / nodes * 1e9,
+        mem=peak / nodes,
+        folded="",
+        orth="",
+        res=float("nan"),
+        conv=None,
+        note=f"extrapolated: {sweeps} sweeps ({how}) × {t_sweep * 1e3:.2f} ms/sweep",
+    )
 
 
 def run_gmsh(g0, repeats, budget=60.0):
@@ -234,17 +262,23 @@ def run_gmsh(g0, repeats, budget=60.0):
 
     ni, nj = g0.x.shape[0] - 1, g0.x.shape[1] - 1
     x, y = np.asarray(g0.x), np.asarray(g0.y)
-    loop = np.concatenate([
-        np.column_stack([x[:, 0], y[:, 0]]),
-        np.column_stack([x[-1, 1:], y[-1, 1:]]),
-        np.column_stack([x[-2::-1, -1], y[-2::-1, -1]]),
-        np.column_stack([x[0, -2:0:-1], y[0, -2:0:-1]]),
-    ])
+    loop = np.concatenate(
+        [
+            np.column_stack([x[:, 0], y[:, 0]]),
+            np.column_stack([x[-1, 1:], y[-1, 1:]]),
+            np.column_stack([x[-2::-1, -1], y[-2::-1, -1]]),
+            np.column_stack([x[0, -2:0:-1], y[0, -2:0:-1]]),
+        ]
+    )
     corner = [0, ni, ni + nj, 2 * ni + nj]
-    tfi = meshcore.tfi(meshcore.Borders(bottom=np.column_stack([x[:, 0], y[:, 0]]),
-                                        right=np.column_stack([x[-1], y[-1]]),
-                                        top=np.column_stack([x[:, -1], y[:, -1]]),
-                                        left=np.column_stack([x[0], y[0]])))
+    tfi = meshcore.tfi(
+        meshcore.Borders(
+            bottom=np.column_stack([x[:, 0], y[:, 0]]),
+            right=np.column_stack([x[-1], y[-1]]),
+            top=np.column_stack([x[:, -1], y[:, -1]]),
+            left=np.column_stack([x[0], y[0]]),
+        )
+    )
     inner = np.column_stack([np.ravel(tfi.x[1:-1, 1:-1]), np.ravel(tfi.y[1:-1, 1:-1])])
 
     def mesh(k):
@@ -254,8 +288,7 @@ def run_gmsh(g0, repeats, budget=60.0):
             gmsh.option.setNumber("General.Verbosity", 0)
             gmsh.model.add("block")
             pts = [gmsh.model.geo.addPoint(px, py, 0.0) for px, py in loop]
-            lines = [gmsh.model.geo.addLine(pts[m], pts[(m + 1) % len(pts)])
-                     for m in range(len(pts))]
+            lines = [gmsh.model.geo.addLine(pts[m], pts[(m + 1) % len(pts)]) for m in range(len(pts))]
             cl = gmsh.model.geo.addCurveLoop(lines)
             s = gmsh.model.geo.addPlaneSurface([cl])
             gmsh.model.geo.synchronize()
@@ -304,8 +337,18 @@ def run_gmsh(g0, repeats, budget=60.0):
     ts = [el] + [mesh(k)[0] for _ in range(max(0, min(repeats, 3) - 1)) if el < 5]
     folded, orth = quality_cols(gx, gy)
     med = statistics.median(ts)
-    return Row(time=med, best=min(ts), iters=f"{k} it", fse=k, ns=med / (k * g0.x.size) * 1e9,
-               mem=float("nan"), folded=folded, orth=orth, res=res / tol, conv=res <= tol)
+    return Row(
+        time=med,
+        best=min(ts),
+        iters=f"{k} it",
+        fse=k,
+        ns=med / (k * g0.x.size) * 1e9,
+        mem=float("nan"),
+        folded=folded,
+        orth=orth,
+        res=res / tol,
+        conv=res <= tol,
+    )
 
 
 #: MeshKernel 8.3 has no call that loads a curvilinear grid from given nodes: the nodes are
@@ -328,15 +371,19 @@ def run_meshkernel(g0, repeats):
     x, y = np.asarray(g0.x), np.asarray(g0.y)
     ni, nj = x.shape[0] - 1, x.shape[1] - 1
     if x.size > MESHKERNEL_MAX_NODES:
-        raise RuntimeError(f"meshkernel {mkp.__version__}: no bulk call to load given nodes; "
-                           f"{x.size} curvilinear_move_node calls (O(N²)) would take minutes")
+        raise RuntimeError(
+            f"meshkernel {mkp.__version__}: no bulk call to load given nodes; "
+            f"{x.size} curvilinear_move_node calls (O(N²)) would take minutes"
+        )
     off = float(ni + nj + 10) + float(np.abs(np.concatenate([x.ravel(), y.ravel()])).max())
 
     def load():
         mk = mkp.MeshKernel()
-        mk.curvilinear_compute_rectangular_grid(mkp.MakeGridParameters(
-            num_columns=ni, num_rows=nj, origin_x=0.0, origin_y=0.0, block_size_x=1.0,
-            block_size_y=1.0))
+        mk.curvilinear_compute_rectangular_grid(
+            mkp.MakeGridParameters(
+                num_columns=ni, num_rows=nj, origin_x=0.0, origin_y=0.0, block_size_x=1.0, block_size_y=1.0
+            )
+        )
         for i in range(ni + 1):
             for j in range(nj + 1):
                 mk.curvilinear_move_node(float(i), float(j), x[i, j] + off, y[i, j] + off)
@@ -363,11 +410,19 @@ def run_meshkernel(g0, repeats):
     folded, orth = quality_cols(gx, gy)
     med = statistics.median(ts)
     p = mkp.OrthogonalizationParameters()
-    return Row(time=med, best=min(ts), iters=f"{p.outer_iterations}×{p.inner_iterations} (defaults)",
-               fse=float("nan"), ns=float("nan"), mem=float("nan"), folded=folded, orth=orth,
-               res=criterion(gx, gy) / tol_abs(g0), conv=False,
-               note="meshkernel: own equations, boundary nodes slide; defaults, not iterated "
-                    "to our criterion")
+    return Row(
+        time=med,
+        best=min(ts),
+        iters=f"{p.outer_iterations}×{p.inner_iterations} (defaults)",
+        fse=float("nan"),
+        ns=float("nan"),
+        mem=float("nan"),
+        folded=folded,
+        orth=orth,
+        res=criterion(gx, gy) / tol_abs(g0),
+        conv=False,
+        note="meshkernel: own equations, boundary nodes slide; defaults, not iterated to our criterion",
+    )
 
 
 # --------------------------------------------------------------------------- report
@@ -383,8 +438,10 @@ def fmt_time(t):
     return f"{t / 3600:.1f} h"
 
 
-HEAD = ("| case | nodes | method | time (median) | best | sweeps/cycles | fine-sweep eq. | "
-        "ns/node-update | peak B/node | folded | orth. max/mean (°) | residual/tol |")
+HEAD = (
+    "| case | nodes | method | time (median) | best | sweeps/cycles | fine-sweep eq. | "
+    "ns/node-update | peak B/node | folded | orth. max/mean (°) | residual/tol |"
+)
 SEP = "|" + "---|" * 12
 
 
@@ -393,9 +450,11 @@ def line(case, nodes, name, r):
         return f"| {case} | {nodes} | {name} | skipped: {r['error']} |" + " |" * 8
     res = r["res"]
     res_s = "–" if not math.isfinite(res) else f"{res:.2f}"
-    return (f"| {case} | {nodes} | {name} | {fmt_time(r['time'])} | {fmt_time(r['best'])} | "
-            f"{r['iters']} | {r['fse']:.1f} | {r['ns']:.2f} | {r['mem']:.0f} | {r['folded']} | "
-            f"{r['orth']} | {res_s} |")
+    return (
+        f"| {case} | {nodes} | {name} | {fmt_time(r['time'])} | {fmt_time(r['best'])} | "
+        f"{r['iters']} | {r['fse']:.1f} | {r['ns']:.2f} | {r['mem']:.0f} | {r['folded']} | "
+        f"{r['orth']} | {res_s} |"
+    )
 
 
 def bandwidth():
@@ -428,20 +487,19 @@ def smoother_throughput(n=1025):
 def level_breakdown(g0):
     """Time per level and per operation of one multigrid solve (wrapping the _FAS methods)."""
     F = multigrid._FAS
-    orig = {k: getattr(F, k) for k in ("smooth", "defect", "defect_restrict", "to_coarse",
-                                       "correct")}
+    orig = {k: getattr(F, k) for k in ("smooth", "defect", "defect_restrict", "to_coarse", "correct")}
     acc = {}
 
     def wrap(name):
         f = orig[name]
 
         def w(self, arg, *a, **kw):
-            lvl = arg if isinstance(arg, int) else next(
-                k for k, lv in enumerate(self.levels) if lv is arg)
+            lvl = arg if isinstance(arg, int) else next(k for k, lv in enumerate(self.levels) if lv is arg)
             t = time.perf_counter()
             r = f(self, arg, *a, **kw)
             acc[(lvl, name)] = acc.get((lvl, name), 0.0) + time.perf_counter() - t
             return r
+
         return w
 
     K = multigrid.K
@@ -473,26 +531,38 @@ def level_breakdown(g0):
         K.vcycle = vcycle
         F._pack = pack
     shapes = multigrid.last_run["levels"]
-    rows = ["| level | nodes | smooth | defect (restricted on the fly where not periodic) | "
-            "R̂, restrict (+N_c) | prolong | share |",
-            "|" + "---|" * 7]
+    rows = [
+        "| level | nodes | smooth | defect (restricted on the fly where not periodic) | "
+        "R̂, restrict (+N_c) | prolong | share |",
+        "|" + "---|" * 7,
+    ]
     for lvl, shp in enumerate(shapes):
-        v = [acc.get((lvl, "smooth"), 0.0),
-             acc.get((lvl, "defect"), 0.0) + acc.get((lvl, "defect_restrict"), 0.0),
-             acc.get((lvl, "to_coarse"), 0.0), acc.get((lvl, "correct"), 0.0)]
-        rows.append(f"| {lvl} | {shp[0]}×{shp[1]} | " + " | ".join(fmt_time(t) for t in v)
-                    + f" | {100 * sum(v) / total:.0f} % |")
+        v = [
+            acc.get((lvl, "smooth"), 0.0),
+            acc.get((lvl, "defect"), 0.0) + acc.get((lvl, "defect_restrict"), 0.0),
+            acc.get((lvl, "to_coarse"), 0.0),
+            acc.get((lvl, "correct"), 0.0),
+        ]
+        rows.append(
+            f"| {lvl} | {shp[0]}×{shp[1]} | "
+            + " | ".join(fmt_time(t) for t in v)
+            + f" | {100 * sum(v) / total:.0f} % |"
+        )
     if ("fused", "cycle") in acc:
         kf = kfuse[-1]
         v = acc[("fused", "cycle")]
-        rows.append(f"| ≥ {kf} | {shapes[kf][0]}×{shapes[kf][1]} and coarser | whole V-cycles in "
-                    f"one numba call (`_mg_kernels.vcycle`): {fmt_time(v)} | | | | "
-                    f"{100 * v / total:.0f} % |")
+        rows.append(
+            f"| ≥ {kf} | {shapes[kf][0]}×{shapes[kf][1]} and coarser | whole V-cycles in "
+            f"one numba call (`_mg_kernels.vcycle`): {fmt_time(v)} | | | | "
+            f"{100 * v / total:.0f} % |"
+        )
     accounted = sum(acc.values())
     rest = 100 * (1 - accounted / total)
-    rows.append(f"\nTotal {fmt_time(total)} ({g.iterations} cycles incl. FMG); kernels account "
-                f"for {fmt_time(accounted)}, the rest ({rest:.0f} %) is Python dispatch, residual "
-                "checks and driver.")
+    rows.append(
+        f"\nTotal {fmt_time(total)} ({g.iterations} cycles incl. FMG); kernels account "
+        f"for {fmt_time(accounted)}, the rest ({rest:.0f} %) is Python dispatch, residual "
+        "checks and driver."
+    )
     return "\n".join(rows)
 
 
@@ -515,8 +585,9 @@ def cold_start():
     with tempfile.TemporaryDirectory() as d:
         env["NUMBA_CACHE_DIR"] = d
         for label in ("cold", "warm", "warm2"):
-            p = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
-                               text=True, timeout=600)
+            p = subprocess.run(
+                [sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=600
+            )
             out[label] = p.stdout.strip() or p.stderr.strip()[-300:]
     return out
 
@@ -534,31 +605,40 @@ def main(argv=None):
         report.append(s)
 
     emit("# Benchmark results\n")
-    emit(f"`python benchmarks/run.py{' --quick' if quick else ''}` on {platform.node()}: "
-         f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-         f"Python {platform.python_version()}, numpy {np.__version__}, "
-         f"numba {__import__('numba').__version__}, "
-         f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}. The machine is shared: timings "
-         "are noisy; compare ratios within one run and best-of-N.\n")
-    emit("Criterion for every row: largest point-Jacobi displacement of eq. 30 (P = Q = 0) ≤ "
-         "tol·L, L = bbox diagonal, tol = 1e-6·min(1, (32/(n−1))²). Times are medians after a "
-         "warm-up (JIT compiled/loaded); `best` = minimum. Multigrid: fine-sweep eq. = smoother "
-         "node updates on all levels / fine nodes; ns/node-update = total time / (fine-sweep eq. × "
-         "nodes), i.e. including residuals, transfers and Python overhead. Peak memory: "
-         "tracemalloc peak of one solve (the start grid excluded) per node.\n")
+    emit(
+        f"`python benchmarks/run.py{' --quick' if quick else ''}` on {platform.node()}: "
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"Python {platform.python_version()}, numpy {np.__version__}, "
+        f"numba {__import__('numba').__version__}, "
+        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}. The machine is shared: timings "
+        "are noisy; compare ratios within one run and best-of-N.\n"
+    )
+    emit(
+        "Criterion for every row: largest point-Jacobi displacement of eq. 30 (P = Q = 0) ≤ "
+        "tol·L, L = bbox diagonal, tol = 1e-6·min(1, (32/(n−1))²). Times are medians after a "
+        "warm-up (JIT compiled/loaded); `best` = minimum. Multigrid: fine-sweep eq. = smoother "
+        "node updates on all levels / fine nodes; ns/node-update = total time / (fine-sweep eq. × "
+        "nodes), i.e. including residuals, transfers and Python overhead. Peak memory: "
+        "tracemalloc peak of one solve (the start grid excluded) per node.\n"
+    )
 
     bw = bandwidth()
     thr = smoother_throughput(513 if quick else 1025)
-    emit(f"Memory bandwidth (numpy copy of 32 MB, read+write): {bw / 1e9:.1f} GB/s. A smoother "
-         f"node-update moves at least 32 bytes (x, y read and written) ⇒ bandwidth bound "
-         f"{32 / bw * 1e9:.2f} ns/node-update. Measured 4-colour Gauss–Seidel smoother on "
-         f"{513 if quick else 1025}²: {thr['serial']:.2f} ns/node-update serial, "
-         f"{thr['parallel']:.2f} parallel ({__import__('numba').get_num_threads()} threads, "
-         f"threading layer {_kernels.threading_layer()}).\n")
+    emit(
+        f"Memory bandwidth (numpy copy of 32 MB, read+write): {bw / 1e9:.1f} GB/s. A smoother "
+        f"node-update moves at least 32 bytes (x, y read and written) ⇒ bandwidth bound "
+        f"{32 / bw * 1e9:.2f} ns/node-update. Measured 4-colour Gauss–Seidel smoother on "
+        f"{513 if quick else 1025}²: {thr['serial']:.2f} ns/node-update serial, "
+        f"{thr['parallel']:.2f} parallel ({__import__('numba').get_num_threads()} threads, "
+        f"threading layer {_kernels.threading_layer()}).\n"
+    )
 
-    paper = [("bottle 6×15", lambda: bottle((6, 15))), ("bottle 12×30", lambda: bottle((12, 30))),
-             ("two circles 30×6", lambda: two_circles((30, 6))),
-             ("two circles 40×8", lambda: two_circles((40, 8)))]
+    paper = [
+        ("bottle 6×15", lambda: bottle((6, 15))),
+        ("bottle 12×30", lambda: bottle((12, 30))),
+        ("two circles 30×6", lambda: two_circles((30, 6))),
+        ("two circles 40×8", lambda: two_circles((40, 8))),
+    ]
     sizes = [64, 128, 256] if quick else [64, 128, 256, 512, 1024, 2048]
     cases = [*paper, ("Shasta Lake", lambda: lake(128 if quick else 256))]
     cases += [(f"wavy square {n + 1}²", (lambda n=n: wavy_square(n))) for n in sizes]
@@ -594,14 +674,11 @@ def main(argv=None):
                 counted[n] = r["fse"]
             rows.append(("NumPy Jacobi (paper)", r))
         if n <= (256 if quick else 512):
-            rows.append(("meshcore SOR", run_meshcore(g0, "sor", 1, reps if n <= 256 else 0,
-                                                      1 / 30)))
+            rows.append(("meshcore SOR", run_meshcore(g0, "sor", 1, reps if n <= 256 else 0, 1 / 30)))
         rows.append(("meshcore multigrid", run_meshcore(g0, "multigrid", 1, reps, 1 / 30)))
-        rows.append(("meshcore multigrid, 2 threads",
-                     run_meshcore(g0, "multigrid", 2, reps, 1 / 30)))
+        rows.append(("meshcore multigrid, 2 threads", run_meshcore(g0, "multigrid", 2, reps, 1 / 30)))
         if nodes <= 66_000:
-            for peer, fn in (("gmsh transfinite + smoother", run_gmsh),
-                             ("meshkernel orthogonalize", run_meshkernel)):
+            for peer, fn in (("gmsh transfinite + smoother", run_gmsh), ("meshkernel orthogonalize", run_meshkernel)):
                 try:
                     rows.append((peer, fn(g0, reps)))
                 except Exception as exc:  # optional peers: report and go on
@@ -613,21 +690,26 @@ def main(argv=None):
             if "note" in r and "extrapolated" in r["note"]:
                 emit(f"|  |  | ↳ {r['note']} |" + " |" * 9)
 
-    emit("\nMeshKernel rows: `curvilinear_orthogonalize` with its default parameters on the same "
-         "start grid (loaded node by node; skipped above "
-         f"{MESHKERNEL_MAX_NODES} nodes, where that takes minutes). It solves its own equations "
-         "(orthogonality plus smoothing) and slides boundary nodes along the boundary, so the "
-         "common criterion does not apply (residual/tol shows how far its grid is from eq. 30); "
-         "the row gives its time and the grid it makes.")
+    emit(
+        "\nMeshKernel rows: `curvilinear_orthogonalize` with its default parameters on the same "
+        "start grid (loaded node by node; skipped above "
+        f"{MESHKERNEL_MAX_NODES} nodes, where that takes minutes). It solves its own equations "
+        "(orthogonality plus smoothing) and slides boundary nodes along the boundary, so the "
+        "common criterion does not apply (residual/tol shows how far its grid is from eq. 30); "
+        "the row gives its time and the grid it makes."
+    )
 
     # ---------------------------------------------------------------- summary
     emit("\n## Targets\n")
-    tgt = {"wavy square 129²": 2.5e-3, "wavy square 513²": 40e-3, "wavy square 1025²": 0.2,
-           "wavy square 2049²": 0.9}
-    emit("Two threads is what the default `threads=0` uses on this 2-core machine for grids of "
-         "≥ 16 000 nodes (bit-identical to serial).\n")
-    emit("| case | multigrid, 1 thread | 2 threads | target | NumPy paper / multigrid "
-         "(1 thread, 2 threads) | gmsh smoother / multigrid (1 thread) |")
+    tgt = {"wavy square 129²": 2.5e-3, "wavy square 513²": 40e-3, "wavy square 1025²": 0.2, "wavy square 2049²": 0.9}
+    emit(
+        "Two threads is what the default `threads=0` uses on this 2-core machine for grids of "
+        "≥ 16 000 nodes (bit-identical to serial).\n"
+    )
+    emit(
+        "| case | multigrid, 1 thread | 2 threads | target | NumPy paper / multigrid "
+        "(1 thread, 2 threads) | gmsh smoother / multigrid (1 thread) |"
+    )
     emit("|---|---|---|---|---|---|")
     for case, t in tgt.items():
         if case in summary:
@@ -636,25 +718,33 @@ def main(argv=None):
             m2 = s["meshcore multigrid, 2 threads"]["time"]
             npx = s.get("NumPy Jacobi (paper)", {}).get("time", float("nan"))
             gm = s.get("gmsh transfinite + smoother", {}).get("time")
-            emit(f"| {case} | {fmt_time(m1)} | {fmt_time(m2)} | ≤ {fmt_time(t)} | "
-                 f"{npx / m1:.0f}×, {npx / m2:.0f}× | "
-                 f"{f'{gm / m1:.0f}×' if gm else '–'} |")
+            emit(
+                f"| {case} | {fmt_time(m1)} | {fmt_time(m2)} | ≤ {fmt_time(t)} | "
+                f"{npx / m1:.0f}×, {npx / m2:.0f}× | "
+                f"{f'{gm / m1:.0f}×' if gm else '–'} |"
+            )
     for case in [c for c, _ in paper]:
         s = summary[case]
         best = min(r["time"] for k, r in s.items() if k.startswith("meshcore") and "time" in r)
         auto = _choose_method(meshcore.EllipticConfig(), cases_shape[case])
-        emit(f"| {case} (auto → {auto}) | "
-             f"{fmt_time(best)} (best meshcore row) | | ≤ 300 µs | | |")
-    ws = [(summary[c]["meshcore multigrid"]["time"], int(c.split()[-1][:-1]) ** 2)
-          for c in summary if c.startswith("wavy") and int(c.split()[-1][:-1]) >= 129]
+        emit(f"| {case} (auto → {auto}) | {fmt_time(best)} (best meshcore row) | | ≤ 300 µs | | |")
+    ws = [
+        (summary[c]["meshcore multigrid"]["time"], int(c.split()[-1][:-1]) ** 2)
+        for c in summary
+        if c.startswith("wavy") and int(c.split()[-1][:-1]) >= 129
+    ]
     if len(ws) >= 2:
         t = np.log([w[0] for w in ws])
         nn = np.log([w[1] for w in ws])
         p = float(np.polyfit(nn, t, 1)[0])
-        emit(f"\nGrowth exponent (time ~ nodes^p, multigrid 1 thread, 129² and up): p = {p:.3f} "
-             "(target ≤ 1.05).")
-        t2 = np.log([summary[c]["meshcore multigrid, 2 threads"]["time"] for c in summary
-                     if c.startswith("wavy") and int(c.split()[-1][:-1]) >= 129])
+        emit(f"\nGrowth exponent (time ~ nodes^p, multigrid 1 thread, 129² and up): p = {p:.3f} (target ≤ 1.05).")
+        t2 = np.log(
+            [
+                summary[c]["meshcore multigrid, 2 threads"]["time"]
+                for c in summary
+                if c.startswith("wavy") and int(c.split()[-1][:-1]) >= 129
+            ]
+        )
         p2 = float(np.polyfit(nn, t2, 1)[0])
         emit(f"With 2 threads: p = {p2:.3f}.")
 
@@ -665,22 +755,23 @@ def main(argv=None):
 
     emit("\n## Snapshot overhead of the driver\n")
     g0 = cases[-1][1]()
-    _, t_def, _ = timed(lambda: meshcore.solve(g0, method="multigrid", threads=1,
-                                               report_interval=1 / 30), 3)
-    _, t_none, _ = timed(lambda: meshcore.solve(g0, method="multigrid", threads=1,
-                                                report_interval=1e9), 3)
-    emit(f"{g0.x.shape[0]}×{g0.x.shape[1]}: solve with snapshots every 1/30 s {fmt_time(t_def)}, "
-         f"without snapshots {fmt_time(t_none)}: overhead {100 * (t_def / t_none - 1):.1f} %.")
+    _, t_def, _ = timed(lambda: meshcore.solve(g0, method="multigrid", threads=1, report_interval=1 / 30), 3)
+    _, t_none, _ = timed(lambda: meshcore.solve(g0, method="multigrid", threads=1, report_interval=1e9), 3)
+    emit(
+        f"{g0.x.shape[0]}×{g0.x.shape[1]}: solve with snapshots every 1/30 s {fmt_time(t_def)}, "
+        f"without snapshots {fmt_time(t_none)}: overhead {100 * (t_def / t_none - 1):.1f} %."
+    )
 
-    emit("\n## Start-up (new process, import meshcore + generate_block 65², NUMBA_CACHE_DIR = "
-         "fresh temp dir)\n")
+    emit("\n## Start-up (new process, import meshcore + generate_block 65², NUMBA_CACHE_DIR = fresh temp dir)\n")
     cs = cold_start()
     emit("| run | import (s) | solve (s) | total (s) | method | converged |")
     emit("|---|---|---|---|---|---|")
     for k, v in cs.items():
         emit(f"| {k} cache | " + " | ".join(v.split()) + " |")
-    emit("\nThe cold row includes compiling every kernel (numba, cached on disk afterwards); "
-         "target for the warm rows: < 1.5 s.")
+    emit(
+        "\nThe cold row includes compiling every kernel (numba, cached on disk afterwards); "
+        "target for the warm rows: < 1.5 s."
+    )
 
     Path(args.out).write_text("\n".join(report) + "\n", encoding="utf-8")
     print(f"\nwritten to {args.out}")

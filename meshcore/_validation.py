@@ -20,9 +20,7 @@ __all__ = [
 ]
 
 
-def validate_points(
-    points: Any, *, name: str, min_points: int = 2, where: str = ""
-) -> np.ndarray:
+def validate_points(points: Any, *, name: str, min_points: int = 2, where: str = "") -> np.ndarray:
     """Return ``points`` as a C-contiguous float64 ``(n, 2)`` array or raise.
 
     Parameters
@@ -42,13 +40,9 @@ def validate_points(
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(f"{prefix}{name}: cannot read points as numbers ({exc})") from None
     if arr.ndim != 2 or arr.shape[1] != 2:
-        raise InvalidInputError(
-            f"{prefix}{name}: expected an (n, 2) array of x, y points, got shape {arr.shape}"
-        )
+        raise InvalidInputError(f"{prefix}{name}: expected an (n, 2) array of x, y points, got shape {arr.shape}")
     if arr.shape[0] < min_points:
-        raise InvalidInputError(
-            f"{prefix}{name}: needs at least {min_points} points, got {arr.shape[0]}"
-        )
+        raise InvalidInputError(f"{prefix}{name}: needs at least {min_points} points, got {arr.shape[0]}")
     bad = ~np.isfinite(arr).all(axis=1)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])

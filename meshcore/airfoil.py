@@ -31,11 +31,7 @@ __all__ = ["first_cell_height", "naca4", "naca4_body"]
 
 
 def _parse(code: str | int) -> tuple[float, float, float]:
-    s = (
-        f"{code}"
-        if not isinstance(code, str)
-        else code.strip().upper().removeprefix("NACA").strip()
-    )
+    s = f"{code}" if not isinstance(code, str) else code.strip().upper().removeprefix("NACA").strip()
     if len(s) != 4 or not s.isdigit():
         raise InvalidInputError(f"NACA 4-digit code must be 4 digits, e.g. '0012', got {code!r}")
     m, p, t = int(s[0]) / 100.0, int(s[1]) / 10.0, int(s[2:]) / 100.0
@@ -46,9 +42,7 @@ def _parse(code: str | int) -> tuple[float, float, float]:
     return m, p, t
 
 
-def naca4(
-    code: str | int, n: int = 64, *, closed: bool = True, chord: float = 1.0
-) -> tuple[np.ndarray, np.ndarray]:
+def naca4(code: str | int, n: int = 64, *, closed: bool = True, chord: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Upper and lower surfaces, each ``n + 1`` points from LE to TE (cosine spaced).
 
     Returns

@@ -72,17 +72,11 @@ class BorderSpec:
     name: str | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(
-            self, "distribution", validate_choice(self.distribution, DISTRIBUTIONS, name="distribution")
-        )
+        object.__setattr__(self, "distribution", validate_choice(self.distribution, DISTRIBUTIONS, name="distribution"))
         for nm in ("first", "last"):
-            object.__setattr__(
-                self, nm, validate_positive(getattr(self, nm), name=f"{nm} spacing", allow_none=True)
-            )
+            object.__setattr__(self, nm, validate_positive(getattr(self, nm), name=f"{nm} spacing", allow_none=True))
         if self.distribution != "uniform" and self.first is None and self.last is None:
-            raise InvalidInputError(
-                f"distribution {self.distribution!r} needs 'first' and/or 'last' spacing"
-            )
+            raise InvalidInputError(f"distribution {self.distribution!r} needs 'first' and/or 'last' spacing")
 
     @classmethod
     def coerce(cls, value: Any, *, border: str) -> BorderSpec:
@@ -96,9 +90,7 @@ class BorderSpec:
             valid = {"distribution", "first", "last", "name"}
             unknown = set(value) - valid
             if unknown:
-                raise InvalidInputError(
-                    f"{border} border: unknown option(s) {sorted(unknown)}; valid: {sorted(valid)}"
-                )
+                raise InvalidInputError(f"{border} border: unknown option(s) {sorted(unknown)}; valid: {sorted(valid)}")
             try:
                 return cls(**dict(value))
             except InvalidInputError as exc:
@@ -157,9 +149,7 @@ class Borders:
 
     def loop(self) -> np.ndarray:
         """The closed boundary walk bottom → right → top⁻¹ → left⁻¹ (no repeated point)."""
-        return np.vstack(
-            [self.bottom[:-1], self.right[:-1], self.top[::-1][:-1], self.left[::-1][:-1]]
-        )
+        return np.vstack([self.bottom[:-1], self.right[:-1], self.top[::-1][:-1], self.left[::-1][:-1]])
 
     def check_counts(self) -> tuple[int, int]:
         """Return ``(ni, nj)`` cells or raise :class:`BorderMismatchError`."""
@@ -200,9 +190,7 @@ class Borders:
         specs = dict(specs or {})
         unknown = set(specs) - set(BORDER_NAMES)
         if unknown:
-            raise InvalidInputError(
-                f"unknown border name(s) {sorted(unknown)}; valid: {list(BORDER_NAMES)}"
-            )
+            raise InvalidInputError(f"unknown border name(s) {sorted(unknown)}; valid: {list(BORDER_NAMES)}")
         out = {}
         for name in BORDER_NAMES:
             n = ni if name in ("bottom", "top") else nj
@@ -442,9 +430,7 @@ def borders_from_loop(
         drop = (dup + 1) % n
         bad = [k for k in drop if k in c]
         if bad:
-            raise BoundaryError(
-                f"{prefix}corner point {bad[0]} duplicates its predecessor; pick the first of the two"
-            )
+            raise BoundaryError(f"{prefix}corner point {bad[0]} duplicates its predecessor; pick the first of the two")
         warnings.warn(
             f"{prefix}boundary: dropped {dup.size} duplicate consecutive point(s) at index "
             f"{', '.join(str(int(k)) for k in drop[:5])}",
@@ -476,6 +462,4 @@ def borders_from_loop(
     right = walk(c[1], c[2])
     top = walk(c[2], c[3])[::-1].copy()
     left = walk(c[3], c[0])[::-1].copy()
-    return borders_from_polylines(
-        bottom, right, top, left, check_intersections=check_intersections, where=where
-    )
+    return borders_from_polylines(bottom, right, top, left, check_intersections=check_intersections, where=where)

@@ -80,7 +80,15 @@ __all__ = [
 TOP_KEYS = {"title", "description", "solver", "blocks", "crs"}
 CRS_KEYS = {"crs", "origin", "source_crs", "source"}
 BLOCK_KEYS = {
-    "name", "cells", "weights", "initial", "curve", "periodic", "snap_angle", "boundary", "borders",
+    "name",
+    "cells",
+    "weights",
+    "initial",
+    "curve",
+    "periodic",
+    "snap_angle",
+    "boundary",
+    "borders",
     "control",
 }
 BOUNDARY_KEYS = {"bottom", "right", "top", "left", "points", "corners"}
@@ -165,9 +173,7 @@ class Case:
 def _check_keys(table: Mapping[str, Any], valid: set[str], where: str) -> None:
     unknown = [k for k in table if k not in valid]
     if unknown:
-        raise CaseFileError(
-            f"{where}: unknown key {unknown[0]!r}; valid keys: {', '.join(sorted(valid))}"
-        )
+        raise CaseFileError(f"{where}: unknown key {unknown[0]!r}; valid keys: {', '.join(sorted(valid))}")
 
 
 def _read_point_file(path: Path, where: str, ctx: dict[str, Any]) -> np.ndarray:
@@ -245,8 +251,7 @@ def _int(v: Any) -> int:
     return v
 
 
-def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str,
-                 ctx: dict[str, Any]) -> BlockCase:
+def _parse_block(tbl: Mapping[str, Any], k: int, base: Path | None, src: str, ctx: dict[str, Any]) -> BlockCase:
     where = f"{src}: [[blocks]] #{k + 1}"
     if not isinstance(tbl, Mapping):
         raise CaseFileError(f"{where}: expected a table")
@@ -365,8 +370,7 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         solver=solver,
         repair=repair,
         path=None,
-        extra={k: data[k] for k in (_EXTRA_TOP | {"crs"}) if k in data}
-        | ({"crs": ctx["crs"]} if "crs" in ctx else {}),
+        extra={k: data[k] for k in (_EXTRA_TOP | {"crs"}) if k in data} | ({"crs": ctx["crs"]} if "crs" in ctx else {}),
     )
 
 
@@ -525,8 +529,9 @@ def register_case_generator(claims: Callable[[Case], bool], fn: Callable[..., An
     _CASE_GENERATORS.append((claims, fn))
 
 
-def generate_case(case: Case, *, callback: Callable[..., Any] | None = None,
-                  config: EllipticConfig | None = None) -> list[StructuredGrid]:
+def generate_case(
+    case: Case, *, callback: Callable[..., Any] | None = None, config: EllipticConfig | None = None
+) -> list[StructuredGrid]:
     """Generate every block of ``case`` (independently, unless a multiblock hook claims it)."""
     from .generate import generate_block
 

@@ -138,16 +138,12 @@ class Attractor:
 
     def __post_init__(self) -> None:
         if self.kind not in ("xi", "eta", "point"):
-            raise InvalidInputError(
-                f"attractor kind must be 'xi', 'eta' or 'point', got {self.kind!r}"
-            )
+            raise InvalidInputError(f"attractor kind must be 'xi', 'eta' or 'point', got {self.kind!r}")
         need = {"xi": ("xi",), "eta": ("eta",), "point": ("xi", "eta")}[self.kind]
         for nm in need:
             v = getattr(self, nm)
             if v is None or not (0.0 <= float(v) <= 1.0):
-                raise InvalidInputError(
-                    f"{self.kind} attractor: {nm} must be a fraction in [0, 1], got {v!r}"
-                )
+                raise InvalidInputError(f"{self.kind} attractor: {nm} must be a fraction in [0, 1], got {v!r}")
         if not math.isfinite(self.amplitude):
             raise InvalidInputError(f"attractor amplitude must be finite, got {self.amplitude!r}")
         if not (self.decay > 0 and math.isfinite(self.decay)):
@@ -246,15 +242,11 @@ class ControlSpec:
 
     def __post_init__(self) -> None:
         if self.kind not in BOUNDARY_KINDS:
-            raise InvalidInputError(
-                f"control kind must be one of {list(BOUNDARY_KINDS)}, got {self.kind!r}"
-            )
+            raise InvalidInputError(f"control kind must be one of {list(BOUNDARY_KINDS)}, got {self.kind!r}")
         b = {}
         for name, v in dict(self.borders).items():
             if name not in BORDER_NAMES:
-                raise InvalidInputError(
-                    f"control: unknown border {name!r}; valid: {list(BORDER_NAMES)}"
-                )
+                raise InvalidInputError(f"control: unknown border {name!r}; valid: {list(BORDER_NAMES)}")
             b[name] = _coerce(BorderControl, v, where=f"control border {name}")
         object.__setattr__(self, "borders", b)
         object.__setattr__(
@@ -265,20 +257,14 @@ class ControlSpec:
         fl = tuple(self.floating)
         for name in fl:
             if name not in BORDER_NAMES:
-                raise InvalidInputError(
-                    f"control: unknown floating border {name!r}; valid: {list(BORDER_NAMES)}"
-                )
+                raise InvalidInputError(f"control: unknown floating border {name!r}; valid: {list(BORDER_NAMES)}")
         object.__setattr__(self, "floating", fl)
         if not (0.0 < self.relaxation <= 1.0):
-            raise InvalidInputError(
-                f"control relaxation must be in (0, 1], got {self.relaxation!r}"
-            )
+            raise InvalidInputError(f"control relaxation must be in (0, 1], got {self.relaxation!r}")
         if not (0.0 <= self.feedback <= 1.0):
             raise InvalidInputError(f"control feedback must be in [0, 1], got {self.feedback!r}")
         if not (0.0 < self.float_relaxation <= 1.0):
-            raise InvalidInputError(
-                f"float_relaxation must be in (0, 1], got {self.float_relaxation!r}"
-            )
+            raise InvalidInputError(f"float_relaxation must be in (0, 1], got {self.float_relaxation!r}")
         if not self.limit > 0:
             raise InvalidInputError(f"control limit must be > 0, got {self.limit!r}")
         for nm in ("every", "float_every"):
@@ -290,9 +276,7 @@ class ControlSpec:
 
     @property
     def active(self) -> bool:
-        return bool(
-            self.borders or self.thomas_middlecoff or self.attractors or self.floating or self.wake
-        )
+        return bool(self.borders or self.thomas_middlecoff or self.attractors or self.floating or self.wake)
 
 
 def _coerce(cls, value, *, where):
@@ -302,9 +286,7 @@ def _coerce(cls, value, *, where):
         valid = set(cls.__dataclass_fields__)
         unknown = set(value) - valid
         if unknown:
-            raise InvalidInputError(
-                f"{where}: unknown key(s) {sorted(unknown)}; valid: {sorted(valid)}"
-            )
+            raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}; valid: {sorted(valid)}")
         try:
             return cls(**dict(value))
         except InvalidInputError as exc:
@@ -505,9 +487,7 @@ class _Polyline:
 
     def at(self, s: np.ndarray) -> np.ndarray:
         s = np.mod(s, self.length) if self.closed else np.clip(s, 0.0, self.length)
-        return np.column_stack(
-            [np.interp(s, self.s, self.p[:, 0]), np.interp(s, self.s, self.p[:, 1])]
-        )
+        return np.column_stack([np.interp(s, self.s, self.p[:, 0]), np.interp(s, self.s, self.p[:, 1])])
 
     def locate(self, q: np.ndarray) -> np.ndarray:
         """Arc-length parameter of the nearest point to each query (global search)."""
@@ -582,17 +562,13 @@ class ControlSources:
         Largest change of the normalised sources per update.
     """
 
-    def __init__(
-        self, spec: ControlSpec, *, periodic: bool = False, curves: Mapping[str, Any] | None = None
-    ):
+    def __init__(self, spec: ControlSpec, *, periodic: bool = False, curves: Mapping[str, Any] | None = None):
         if not isinstance(spec, ControlSpec):
             raise InvalidInputError(f"spec must be a ControlSpec, got {type(spec).__name__}")
         if periodic:
             for b in ("left", "right"):
                 if b in spec.borders or b in spec.floating:
-                    raise InvalidInputError(
-                        f"control on the {b} border of a periodic grid: the seam is not a boundary"
-                    )
+                    raise InvalidInputError(f"control on the {b} border of a periodic grid: the seam is not a boundary")
         self.spec = spec
         self.periodic = bool(periodic)
         self.curves_in = dict(curves or {})
@@ -611,14 +587,10 @@ class ControlSources:
         ni, nj = ni1 - 1, nj1 - 1
         sp = self.spec
         if sp.wake and not (0 < sp.wake < ni // 2):
-            raise InvalidInputError(
-                f"control wake={sp.wake} must be in 1 … {ni // 2 - 1} for ni={ni}"
-            )
+            raise InvalidInputError(f"control wake={sp.wake} must be in 1 … {ni // 2 - 1} for ni={ni}")
         for name in sp.borders:
             if (name in ("bottom", "top") and nj < 3) or (name in ("left", "right") and ni < 3):
-                raise InvalidInputError(
-                    f"boundary control on the {name} border needs ≥ 3 cells across it"
-                )
+                raise InvalidInputError(f"boundary control on the {name} border needs ≥ 3 cells across it")
         self.shape = x.shape
         from .elliptic.solver import default_tolerance
 
@@ -665,9 +637,7 @@ class ControlSources:
                 lo = 1 if bc.start is None else int(bc.start)
                 hi = n - 1 if bc.stop is None else int(bc.stop)
                 if not (0 <= lo < hi <= n):
-                    raise InvalidInputError(
-                        f"{name} border control: bad node range {lo}…{hi} (border has {n} nodes)"
-                    )
+                    raise InvalidInputError(f"{name} border control: bad node range {lo}…{hi} (border has {n} nodes)")
                 idx = np.arange(lo, hi)
             else:
                 idx = np.arange(0, n - 1) if per else np.arange(1, n - 1)
@@ -704,11 +674,7 @@ class ControlSources:
             closed = self.periodic and name in ("bottom", "top")
             r0 = _border_rows(x, y, name)[0]
             pts = self.curves_in.get(name)
-            pts = (
-                r0[:-1]
-                if (pts is None and closed)
-                else (r0 if pts is None else np.asarray(pts, float))
-            )
+            pts = r0[:-1] if (pts is None and closed) else (r0 if pts is None else np.asarray(pts, float))
             c = _Polyline(pts, closed)
             s = c.locate(r0)
             if closed:
@@ -956,9 +922,16 @@ def _corner_angle(x, y, name, end) -> float:
     a = r0[1] if end == 0 else r0[-2]
     # the other border leaving the same corner
     ni, nj = x.shape[0] - 1, x.shape[1] - 1
-    i, j = {("bottom", 0): (0, 0), ("bottom", 1): (ni, 0), ("top", 0): (0, nj), ("top", 1): (ni, nj),
-            ("left", 0): (0, 0), ("left", 1): (0, nj), ("right", 0): (ni, 0), ("right", 1): (ni, nj)}[
-        (name, 0 if end == 0 else 1)]
+    i, j = {
+        ("bottom", 0): (0, 0),
+        ("bottom", 1): (ni, 0),
+        ("top", 0): (0, nj),
+        ("top", 1): (ni, nj),
+        ("left", 0): (0, 0),
+        ("left", 1): (0, nj),
+        ("right", 0): (ni, 0),
+        ("right", 1): (ni, nj),
+    }[(name, 0 if end == 0 else 1)]
     if name in ("bottom", "top"):
         b = np.array([x[i, 1 if j == 0 else nj - 1], y[i, 1 if j == 0 else nj - 1]])
     else:
@@ -978,8 +951,9 @@ def _set_border(x, y, name, ks, pts):
         x[-1, ks], y[-1, ks] = pts[:, 0], pts[:, 1]
 
 
-def make_sources(control: ControlSpec | Mapping[str, Any], *, periodic: bool = False,
-                 curves: Mapping[str, Any] | None = None) -> ControlSources | None:
+def make_sources(
+    control: ControlSpec | Mapping[str, Any], *, periodic: bool = False, curves: Mapping[str, Any] | None = None
+) -> ControlSources | None:
     """A :class:`ControlSources` for ``control`` (a spec or a case-file table); None if inactive."""
     spec = control if isinstance(control, ControlSpec) else control_from_mapping(control)
     if not spec.active:

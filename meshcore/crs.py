@@ -47,9 +47,7 @@ def _pyproj():
     try:
         import pyproj
     except ImportError as exc:  # pragma: no cover - pyproj is in the io extra
-        raise InvalidInputError(
-            "map projections need pyproj (pip install 'gcmesh[io]')"
-        ) from exc
+        raise InvalidInputError("map projections need pyproj (pip install 'gcmesh[io]')") from exc
     return pyproj
 
 
@@ -132,8 +130,7 @@ def check_lonlat(points: np.ndarray, *, where: str) -> None:
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise ReadError(
-            f"{where}: point {k} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range "
-            f"[-180, 180] × [-90, 90]"
+            f"{where}: point {k} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range [-180, 180] × [-90, 90]"
         )
 
 
@@ -196,13 +193,11 @@ class Frame:
 
     def to_world(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         """Local → world (projected) coordinates."""
-        return (np.asarray(x, dtype=np.float64) + self.origin[0],
-                np.asarray(y, dtype=np.float64) + self.origin[1])
+        return (np.asarray(x, dtype=np.float64) + self.origin[0], np.asarray(y, dtype=np.float64) + self.origin[1])
 
     def to_local(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         """World (projected) → local coordinates."""
-        return (np.asarray(x, dtype=np.float64) - self.origin[0],
-                np.asarray(y, dtype=np.float64) - self.origin[1])
+        return (np.asarray(x, dtype=np.float64) - self.origin[0], np.asarray(y, dtype=np.float64) - self.origin[1])
 
     def to_lonlat(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
         """Local coordinates → WGS84 longitude, latitude (degrees)."""
@@ -238,8 +233,7 @@ def as_frame(crs: Any = None, origin: Any = None) -> Frame:
     return Frame(normalize_crs(crs), o)
 
 
-def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto",
-            source_crs: Any = None) -> tuple[Any, Frame]:
+def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_crs: Any = None) -> tuple[Any, Frame]:
     """Project a :class:`~meshcore.io.PointSet` to local metric coordinates.
 
     Parameters
@@ -302,9 +296,7 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto",
             X, Y = t.transform(pl.points[:, 0], pl.points[:, 1])
             P = np.column_stack([X, Y]).astype(np.float64)
             if not np.isfinite(P).all():
-                raise InvalidInputError(
-                    f"{pointset.source}: {pl.name}: points cannot be projected to {target}"
-                )
+                raise InvalidInputError(f"{pointset.source}: {pl.name}: points cannot be projected to {target}")
             new.append((pl, P))
     else:
         new = [(pl, pl.points) for pl in pointset.polylines]
@@ -316,9 +308,7 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto",
     else:
         o = (float(origin[0]), float(origin[1]))
     off = np.array(o)
-    polylines = [
-        Polyline(pl.name, p - off, closed=pl.closed, orientation=pl.orientation) for pl, p in new
-    ]
+    polylines = [Polyline(pl.name, p - off, closed=pl.closed, orientation=pl.orientation) for pl, p in new]
     return pointset.with_points(polylines, target), Frame(target, o, src)
 
 

@@ -68,9 +68,7 @@ class LinearSpline(Curve):
         seg = np.hypot(np.diff(p[:, 0]), np.diff(p[:, 1]))
         if np.any(seg == 0):
             k = int(np.flatnonzero(seg == 0)[0])
-            raise InvalidInputError(
-                f"curve points {k} and {k + 1} coincide; remove duplicate points"
-            )
+            raise InvalidInputError(f"curve points {k} and {k + 1} coincide; remove duplicate points")
         t = np.concatenate([[0.0], np.cumsum(seg)])
         object.__setattr__(self, "points", p)
         object.__setattr__(self, "t", t)
@@ -114,9 +112,7 @@ class SmoothCurve(Curve):
         chord = np.hypot(np.diff(p[:, 0]), np.diff(p[:, 1]))
         if np.any(chord == 0):
             k = int(np.flatnonzero(chord == 0)[0])
-            raise InvalidInputError(
-                f"curve points {k} and {k + 1} coincide; remove duplicate points"
-            )
+            raise InvalidInputError(f"curve points {k} and {k + 1} coincide; remove duplicate points")
         dt = np.sqrt(chord)  # centripetal parameter
         t = np.concatenate([[0.0], np.cumsum(dt)])
         n = len(p)
@@ -132,18 +128,14 @@ class SmoothCurve(Curve):
             m = np.empty_like(p)
             for k in range(1, n - 1):
                 h0, h1 = t[k] - t[k - 1], t[k + 1] - t[k]
-                m[k] = (
-                    (p[k] - p[k - 1]) / h0 * h1 / (h0 + h1) + (p[k + 1] - p[k]) / h1 * h0 / (h0 + h1)
-                )
+                m[k] = (p[k] - p[k - 1]) / h0 * h1 / (h0 + h1) + (p[k + 1] - p[k]) / h1 * h0 / (h0 + h1)
             m[0] = (p[1] - p[0]) / (t[1] - t[0])
             m[-1] = (p[-1] - p[-2]) / (t[-1] - t[-2])
             spline = CubicHermiteSpline(t, p, m, axis=0)
         deriv = spline.derivative()
         # Arc length table: 4 sub-intervals per knot interval, 8-point Gauss each.
         sub = 4
-        edges = np.concatenate(
-            [np.linspace(t[k], t[k + 1], sub + 1)[:-1] for k in range(n - 1)] + [[t[-1]]]
-        )
+        edges = np.concatenate([np.linspace(t[k], t[k + 1], sub + 1)[:-1] for k in range(n - 1)] + [[t[-1]]])
         a, b = edges[:-1], edges[1:]
         mid, half = 0.5 * (a + b), 0.5 * (b - a)
         tq = mid[:, None] + half[:, None] * _GL_X[None, :]

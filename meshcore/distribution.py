@@ -68,6 +68,7 @@ def tanh_one_sided(n: int, first: float, *, at_end: bool = False) -> np.ndarray:
     if n == 1:
         return np.array([0.0, 1.0])
     xi = np.linspace(0.0, 1.0, n + 1)
+
     # f(d) = first spacing for parameter d; monotone decreasing in d on (-π, ∞).
     def f(d: float) -> float:
         return float(_one_sided(np.array([1.0 / n]), d)[0])
@@ -82,16 +83,13 @@ def tanh_one_sided(n: int, first: float, *, at_end: bool = False) -> np.ndarray:
             while f(hi) > target:
                 hi *= 2.0
                 if hi > 1e4:
-                    raise InvalidInputError(
-                        f"first spacing {first:g} is too small for {n} cells"
-                    )
+                    raise InvalidInputError(f"first spacing {first:g} is too small for {n} cells")
         else:
             # tan branch: spacing grows as a → π; the largest reachable spacing
             lo, hi = -math.pi * (1 - 1e-12), 0.0
             if f(lo) < target:
                 raise InvalidInputError(
-                    f"first spacing {first:g} of the length is too large for {n} cells "
-                    f"(at most {f(lo):.4g})"
+                    f"first spacing {first:g} of the length is too large for {n} cells (at most {f(lo):.4g})"
                 )
         for _ in range(200):
             mid = 0.5 * (lo + hi)
@@ -156,14 +154,10 @@ def vinokur(n: int, first: float, last: float) -> np.ndarray:
         return np.array([0.0, 1.0])
     if n == 2:
         if abs(first + last - 1.0) > 1e-9:
-            raise InvalidInputError(
-                f"with 2 cells first + last spacing must be 1, got {first} + {last}"
-            )
+            raise InvalidInputError(f"with 2 cells first + last spacing must be 1, got {first} + {last}")
         return np.array([0.0, first, 1.0])
     if first + last >= 1.0:
-        raise InvalidInputError(
-            f"first + last spacing ({first:g} + {last:g}) must be < 1 of the border length"
-        )
+        raise InvalidInputError(f"first + last spacing ({first:g} + {last:g}) must be < 1 of the border length")
     xi = np.linspace(0.0, 1.0, n + 1)
     a0 = math.sqrt(last / first)
     b0 = 1.0 / (n * math.sqrt(first * last))
@@ -204,9 +198,7 @@ def vinokur(n: int, first: float, last: float) -> np.ndarray:
     u = _vinokur_map(xi, delta, math.exp(la))
     u[0], u[-1] = 0.0, 1.0
     if not np.all(np.diff(u) > 0):
-        raise InvalidInputError(
-            f"cannot distribute {n} cells with first spacing {first:g} and last {last:g}"
-        )
+        raise InvalidInputError(f"cannot distribute {n} cells with first spacing {first:g} and last {last:g}")
     return u
 
 

@@ -51,9 +51,7 @@ def prepare_borders(
         if any(v is not None for v in (bottom, right, top, left)):
             raise InvalidInputError("give either four borders or loop + corners, not both")
         if corners is None:
-            raise InvalidInputError(
-                'a closed loop needs four corner indices (corners=) or corners="auto"'
-            )
+            raise InvalidInputError('a closed loop needs four corner indices (corners=) or corners="auto"')
         if isinstance(corners, str) and corners == "auto":
             from .corners import choose_corners
 
@@ -201,28 +199,37 @@ def generate_block(
         # C-grid: the bottom border folds back on itself along the wake cut, so the
         # self-intersection check does not apply; the nodes are used as given
         if cells is not None or loop is not None:
-            raise InvalidInputError("a C-grid (control wake > 0) needs four borders given node by node "
-                                    "(no cells=, no loop)")
+            raise InvalidInputError(
+                "a C-grid (control wake > 0) needs four borders given node by node (no cells=, no loop)"
+            )
         b = borders_from_polylines(bottom, right, top, left, check_intersections=False)
         b.check_counts()
     else:
         b = prepare_borders(
-            bottom, right, top, left, loop=loop, corners=corners, cells=cells, borders=borders,
-            curve=curve, periodic=periodic, snap_angle=snap_angle,
+            bottom,
+            right,
+            top,
+            left,
+            loop=loop,
+            corners=corners,
+            cells=cells,
+            borders=borders,
+            curve=curve,
+            periodic=periodic,
+            snap_angle=snap_angle,
         )
-    names = {
-        k: v["name"]
-        for k, v in (borders or {}).items()
-        if isinstance(v, Mapping) and v.get("name")
-    }
+    names = {k: v["name"] for k, v in (borders or {}).items() if isinstance(v, Mapping) and v.get("name")}
     g0 = initial_grid(b, initial=initial, weights=weights, names=names)
     if not smooth:
         return g0
     repair = validate_choice(repair, ("auto", "strict", "off"), name="repair")
     foldfree = (config.method if config is not None else str(method).lower()) == "foldfree"
     cfg = config or EllipticConfig(
-        method="auto" if foldfree else method, tolerance=tolerance, max_iterations=max_iterations,
-        omega=omega, threads=threads,
+        method="auto" if foldfree else method,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        omega=omega,
+        threads=threads,
     )
     sources = None
     if control is not None:

@@ -104,9 +104,7 @@ class StructuredGrid:
         x = _frozen(self.x, "x")
         y = _frozen(self.y, "y")
         if x.ndim != 2 or x.shape != y.shape:
-            raise InvalidInputError(
-                f"grid x and y must be 2-D arrays of the same shape, got {x.shape} and {y.shape}"
-            )
+            raise InvalidInputError(f"grid x and y must be 2-D arrays of the same shape, got {x.shape} and {y.shape}")
         if x.shape[0] < 2 or x.shape[1] < 2:
             raise InvalidInputError(f"grid needs at least 2 × 2 nodes, got {x.shape}")
         object.__setattr__(self, "x", x)

@@ -22,8 +22,18 @@ from .grid import StructuredGrid
 __all__ = ["METRIC_FIELDS", "Metrics", "metrics"]
 
 METRIC_FIELDS = (
-    "x_xi", "x_eta", "y_xi", "y_eta", "jacobian", "alpha", "beta", "gamma",
-    "xi_x", "xi_y", "eta_x", "eta_y",
+    "x_xi",
+    "x_eta",
+    "y_xi",
+    "y_eta",
+    "jacobian",
+    "alpha",
+    "beta",
+    "gamma",
+    "xi_x",
+    "xi_y",
+    "eta_x",
+    "eta_y",
 )
 
 
@@ -83,7 +93,16 @@ def metrics(grid: StructuredGrid) -> Metrics:
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = np.where(d != 0, 1.0 / np.where(d != 0, d, 1.0), np.nan)
     return Metrics(
-        x_xi=x_xi, x_eta=x_eta, y_xi=y_xi, y_eta=y_eta, jacobian=d,
-        alpha=x_eta**2 + y_eta**2, beta=x_xi * x_eta + y_xi * y_eta, gamma=x_xi**2 + y_xi**2,
-        xi_x=y_eta * inv, xi_y=-x_eta * inv, eta_x=-y_xi * inv, eta_y=x_xi * inv,
+        x_xi=x_xi,
+        x_eta=x_eta,
+        y_xi=y_xi,
+        y_eta=y_eta,
+        jacobian=d,
+        alpha=x_eta**2 + y_eta**2,
+        beta=x_xi * x_eta + y_xi * y_eta,
+        gamma=x_xi**2 + y_xi**2,
+        xi_x=y_eta * inv,
+        xi_y=-x_eta * inv,
+        eta_x=-y_xi * inv,
+        eta_y=x_xi * inv,
     )

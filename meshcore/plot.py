@@ -75,7 +75,9 @@ def plot_grid(
                 ax.fill(
                     [g.x[i, j], g.x[i + 1, j], g.x[i + 1, j + 1], g.x[i, j + 1]],
                     [g.y[i, j], g.y[i + 1, j], g.y[i + 1, j + 1], g.y[i, j + 1]],
-                    color="red", alpha=0.6, lw=0,
+                    color="red",
+                    alpha=0.6,
+                    lw=0,
                 )
     if points is not None:
         for pts in points:

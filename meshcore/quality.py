@@ -54,9 +54,7 @@ def cell_quality(grid: StructuredGrid) -> dict[str, np.ndarray]:
         lengths.append(np.hypot(ax_, ay_))
     cj_arr = np.stack(cj)
     ang = np.stack(angles)
-    area = 0.5 * (
-        (p[2][0] - p[0][0]) * (p[3][1] - p[1][1]) - (p[3][0] - p[1][0]) * (p[2][1] - p[0][1])
-    )
+    area = 0.5 * ((p[2][0] - p[0][0]) * (p[3][1] - p[1][1]) - (p[3][0] - p[1][0]) * (p[2][1] - p[0][1]))
     # angles of inverted corners are negative; use |angle| for deviation measures
     absang = np.where(ang < 0, 360.0 + ang, ang)
     orth = np.max(np.abs(absang - 90.0), axis=0)
@@ -147,16 +145,21 @@ class QualityReport:
             ("non-convex cells", str(self.n_nonconvex), "a corner Jacobian ≤ 0"),
             ("cell area min / max", f"{self.min_area:.4g} / {self.max_area:.4g}", ""),
             ("min Jacobian ratio", f"{self.min_jacobian_ratio:.4f}", "min/max corner J, 1 = ideal"),
-            ("orthogonality max / mean",
-             f"{self.max_orthogonality:.2f}° / {self.mean_orthogonality:.2f}°", "deviation from 90°"),
+            (
+                "orthogonality max / mean",
+                f"{self.max_orthogonality:.2f}° / {self.mean_orthogonality:.2f}°",
+                "deviation from 90°",
+            ),
             ("skewness max / mean", f"{self.max_skewness:.4f} / {self.mean_skewness:.4f}", "equiangle, 0 = ideal"),
             ("aspect ratio max / mean", f"{self.max_aspect_ratio:.3f} / {self.mean_aspect_ratio:.3f}", ""),
             ("adjacent size ratio max / mean", f"{self.max_size_ratio:.3f} / {self.mean_size_ratio:.3f}", "≥ 1"),
         ]
         w0 = max(len(r[0]) for r in rows)
         w1 = max(len(r[1]) for r in rows)
-        lines = [f"| {'metric'.ljust(w0)} | {'value'.ljust(w1)} | note |",
-                 f"|{'-' * (w0 + 2)}|{'-' * (w1 + 2)}|------|"]
+        lines = [
+            f"| {'metric'.ljust(w0)} | {'value'.ljust(w1)} | note |",
+            f"|{'-' * (w0 + 2)}|{'-' * (w1 + 2)}|------|",
+        ]
         lines += [f"| {a.ljust(w0)} | {b.ljust(w1)} | {c} |" for a, b, c in rows]
         return "\n".join(lines)
 

@@ -66,9 +66,7 @@ def closed_curve_nodes(
     return out
 
 
-def radial_nodes(
-    a: Any, b: Any, n: int, *, first: float | None = None, last: float | None = None
-) -> np.ndarray:
+def radial_nodes(a: Any, b: Any, n: int, *, first: float | None = None, last: float | None = None) -> np.ndarray:
     """``n + 1`` nodes on the segment a → b, clustered by ``first``/``last`` spacing."""
     a = np.asarray(a, float)
     b = np.asarray(b, float)
@@ -110,9 +108,7 @@ def ogrid_borders(
         Where the cut meets the inner curve (default: its first point); the
         cut goes straight to the nearest outer node.
     """
-    ni, nj = (
-        validate_count(c, name=nm) for c, nm in zip(cells, ("cells ξ", "cells η"), strict=True)
-    )
+    ni, nj = (validate_count(c, name=nm) for c, nm in zip(cells, ("cells ξ", "cells η"), strict=True))
     bottom = closed_curve_nodes(inner, ni, start=start, name="inner curve")
     # the cut leaves the inner curve along the ray from its centroid (no twist)
     po = _closed(outer, "outer curve")
@@ -199,9 +195,7 @@ def cgrid(
     if np.hypot(*(b[0] - b[-1])) > 1e-12 * float(np.ptp(b, axis=0).max()):
         raise BoundaryError("C-grid body: first and last node must both be the trailing edge")
     if signed_area(b[:-1]) > 0:
-        raise BoundaryError(
-            "C-grid body must run clockwise (trailing edge → lower → leading edge → upper)"
-        )
+        raise BoundaryError("C-grid body must run clockwise (trailing edge → lower → leading edge → upper)")
     nw = validate_count(cells_wake, name="cells_wake")
     nj = validate_count(cells_normal, name="cells_normal")
     validate_positive(wake_length, name="wake_length")

@@ -7,4 +7,5 @@ export QT_QPA_PLATFORM=offscreen
 export OMP_WAIT_POLICY=passive
 export NUMBA_NUM_THREADS=${NUMBA_NUM_THREADS:-2}
 .venv/bin/ruff check meshcore app tests benchmarks tools scripts
+.venv/bin/ruff format --check -q meshcore app tests benchmarks tools scripts
 exec .venv/bin/python -m pytest -q -p no:cacheprovider "$@"

@@ -21,8 +21,7 @@ DATA = Path(__file__).resolve().parent / "data"
 SHARED_LAKES = ROOT.parent / "shared" / "data" / "lakes"
 
 
-def annulus_sector(ni: int, nj: int, r0: float = 1.0, r1: float = 3.0,
-                   th0: float = 0.0, th1: float = math.pi / 2):
+def annulus_sector(ni: int, nj: int, r0: float = 1.0, r1: float = 3.0, th0: float = 0.0, th1: float = math.pi / 2):
     """Exact Winslow grid of an annulus sector: i along ln r (geometric), j along θ."""
     r = r0 * (r1 / r0) ** np.linspace(0.0, 1.0, ni + 1)
     th = np.linspace(th0, th1, nj + 1)

@@ -32,8 +32,10 @@ def r(a):
 
 def rectangle_cutout():
     bottom = np.column_stack([np.linspace(0, 10, 10), np.zeros(10)])
-    top = np.array([[0, 4], [1.75, 4], [3.5, 4], [3.5, 3.25], [3.5, 2.5],
-                    [6.5, 2.5], [6.5, 3.25], [6.5, 4], [8.25, 4], [10, 4]], float)
+    top = np.array(
+        [[0, 4], [1.75, 4], [3.5, 4], [3.5, 3.25], [3.5, 2.5], [6.5, 2.5], [6.5, 3.25], [6.5, 4], [8.25, 4], [10, 4]],
+        float,
+    )
     left = np.column_stack([np.zeros(4), np.linspace(0, 4, 4)])
     right = np.column_stack([np.full(4, 10.0), np.linspace(0, 4, 4)])
     return {"bottom": r(bottom), "right": r(right), "top": r(top), "left": r(left)}
@@ -52,8 +54,20 @@ def two_circles():
 
 
 def bottle():
-    right = np.array([[3.0, 0.0], [3.2, 1.0], [3.2, 2.2], [3.1, 3.4], [2.8, 4.4],
-                      [2.1, 5.2], [1.4, 5.9], [1.0, 6.6], [1.0, 7.4], [1.1, 8.0]])
+    right = np.array(
+        [
+            [3.0, 0.0],
+            [3.2, 1.0],
+            [3.2, 2.2],
+            [3.1, 3.4],
+            [2.8, 4.4],
+            [2.1, 5.2],
+            [1.4, 5.9],
+            [1.0, 6.6],
+            [1.0, 7.4],
+            [1.1, 8.0],
+        ]
+    )
     left = right * [-1, 1]
     bottom = np.column_stack([np.linspace(-3, 3, 4), np.zeros(4)])
     top = np.column_stack([np.linspace(-1.1, 1.1, 4), np.full(4, 8.0)])
@@ -73,34 +87,73 @@ def annulus(ni=24, nj=16, r0=1.0, r1=4.0, th1=math.pi / 2):
 def main():
     OUT.mkdir(parents=True, exist_ok=True)
     cases = {
-        "rectangle-cutout-coarse": ("Rectangle with a cutout (paper Table 1, refinement 1)",
-                                    rectangle_cutout(), (15, 6), (0.1, 0.0)),
-        "rectangle-cutout-fine": ("Rectangle with a cutout (paper Table 1, refinement 2)",
-                                  rectangle_cutout(), (30, 12), (0.1, 0.0)),
-        "two-circles-coarse": ("Doubly connected region, two circles joined by a cut (paper Table 2, refinement 1)",
-                               two_circles(), (30, 6), (0.05, 0.0)),
-        "two-circles-fine": ("Doubly connected region, two circles joined by a cut (paper Table 2, refinement 2)",
-                             two_circles(), (40, 8), (0.05, 0.0)),
+        "rectangle-cutout-coarse": (
+            "Rectangle with a cutout (paper Table 1, refinement 1)",
+            rectangle_cutout(),
+            (15, 6),
+            (0.1, 0.0),
+        ),
+        "rectangle-cutout-fine": (
+            "Rectangle with a cutout (paper Table 1, refinement 2)",
+            rectangle_cutout(),
+            (30, 12),
+            (0.1, 0.0),
+        ),
+        "two-circles-coarse": (
+            "Doubly connected region, two circles joined by a cut (paper Table 2, refinement 1)",
+            two_circles(),
+            (30, 6),
+            (0.05, 0.0),
+        ),
+        "two-circles-fine": (
+            "Doubly connected region, two circles joined by a cut (paper Table 2, refinement 2)",
+            two_circles(),
+            (40, 8),
+            (0.05, 0.0),
+        ),
         "bottle-coarse": ("Bottle (paper Table 3, refinement 1)", bottle(), (6, 15), (1.0, 0.5)),
         "bottle-fine": ("Bottle (paper Table 3, refinement 2)", bottle(), (12, 30), (1.0, 0.5)),
     }
     for name, (title, b, cells, w) in cases.items():
         # The cutout's corners are kept as nodes (snap_angle); the paper's
         # uniform re-sampling would cut them off.
-        block = BlockCase(name=name.rsplit("-", 1)[0], cells=cells, weights=w, borders=b,
-                          border_specs={}, snap_angle=30.0 if "cutout" in name else None)
-        save_case(Case(blocks=(block,), title=title,
-                       description="Input points designed to match the paper's description and counts."),
-                  OUT / f"{name}.toml")
+        block = BlockCase(
+            name=name.rsplit("-", 1)[0],
+            cells=cells,
+            weights=w,
+            borders=b,
+            border_specs={},
+            snap_angle=30.0 if "cutout" in name else None,
+        )
+        save_case(
+            Case(
+                blocks=(block,),
+                title=title,
+                description="Input points designed to match the paper's description and counts.",
+            ),
+            OUT / f"{name}.toml",
+        )
     b = annulus()
-    block = BlockCase(name="annulus-sector", cells=None, weights=(0.5, 0.5), initial="tfi",
-                      borders=b, border_specs={"right": BorderSpec(name="outer"),
-                                               "left": BorderSpec(name="inner")})
-    save_case(Case(blocks=(block,), title="Annulus sector with an exact answer",
-                   description=("Radii geometric (ln r uniform), angles uniform: θ and ln r are harmonic, "
-                                "so the Winslow grid is x = r cos θ, y = r sin θ exactly; the discrete "
-                                "error falls at second order.")),
-              OUT / "annulus-sector.toml")
+    block = BlockCase(
+        name="annulus-sector",
+        cells=None,
+        weights=(0.5, 0.5),
+        initial="tfi",
+        borders=b,
+        border_specs={"right": BorderSpec(name="outer"), "left": BorderSpec(name="inner")},
+    )
+    save_case(
+        Case(
+            blocks=(block,),
+            title="Annulus sector with an exact answer",
+            description=(
+                "Radii geometric (ln r uniform), angles uniform: θ and ln r are harmonic, "
+                "so the Winslow grid is x = r cos θ, y = r sin θ exactly; the discrete "
+                "error falls at second order."
+            ),
+        ),
+        OUT / "annulus-sector.toml",
+    )
 
 
 if __name__ == "__main__":

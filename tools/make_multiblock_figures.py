@@ -35,15 +35,21 @@ def main() -> None:
         mb = res["smooth"]
         n = sum(g.cells[0] * g.cells[1] for g in mb.grids)
         plot_multiblock(
-            mb, FIG / f"shasta-multiblock-{tag}.png", outline=shore, scale=1e-3, unit="km",
+            mb,
+            FIG / f"shasta-multiblock-{tag}.png",
+            outline=shore,
+            scale=1e-3,
+            unit="km",
             title=f"Shasta Lake, {len(mb)} blocks, {n} cells, smooth interfaces ({tag})",
         )
         print(f"## {tag}\n")
         print(mb.report())
         print()
         for m, r in res.items():
-            print(f"### mode {m}: {r.info.message}, {r.info.iterations} iterations, "
-                  f"{r.info.elapsed:.3f} s, interface mismatch {r.interface_mismatch():.3g}\n")
+            print(
+                f"### mode {m}: {r.info.message}, {r.info.iterations} iterations, "
+                f"{r.info.elapsed:.3f} s, interface mismatch {r.interface_mismatch():.3g}\n"
+            )
             print(r.quality().table())
             print()
     # zoom on the main ↔ east and east ↔ arms interfaces: frozen vs smooth
@@ -58,9 +64,17 @@ def main() -> None:
     ex0, ey0, ex1, ey1 = (v * 1e-3 for v in res["smooth"]["east"].bounds())
     win = (ex0 - 4.0, ey0 - 0.6, ex1 + 1.5, ey1 + 1.2)
     for ax, m in zip(axes, ("frozen", "smooth"), strict=True):
-        plot_multiblock(res[m], ax=ax, outline=shore, scale=1e-3, unit="km", window=win,
-                        labels=True, linewidth=0.6,
-                        title=f"{m}: interface size ratio {res[m].quality().worst_interface:.2f}")
+        plot_multiblock(
+            res[m],
+            ax=ax,
+            outline=shore,
+            scale=1e-3,
+            unit="km",
+            window=win,
+            labels=True,
+            linewidth=0.6,
+            title=f"{m}: interface size ratio {res[m].quality().worst_interface:.2f}",
+        )
     fig.savefig(FIG / "shasta-multiblock-interfaces.png", dpi=140, bbox_inches="tight")
     plt.close(fig)
     # the confluence: three blocks meet at the centre (irregular corner)
@@ -69,8 +83,14 @@ def main() -> None:
     pts = np.asarray(case.extra["outline"]["points"], dtype=float)
     fig, axes = plt.subplots(1, 2, figsize=(14, 6.5))
     plot_multiblock(mb, ax=axes[0], outline=pts, labels=False, title="confluence: 6 blocks, smooth")
-    plot_multiblock(mb, ax=axes[1], outline=pts, window=(-1.8, -1.8, 1.8, 1.6), linewidth=0.7,
-                    title="junction: three blocks meet at the centre (Laplacian update there)")
+    plot_multiblock(
+        mb,
+        ax=axes[1],
+        outline=pts,
+        window=(-1.8, -1.8, 1.8, 1.6),
+        linewidth=0.7,
+        title="junction: three blocks meet at the centre (Laplacian update there)",
+    )
     fig.savefig(FIG / "multiblock-confluence.png", dpi=140, bbox_inches="tight")
     plt.close(fig)
     print("## confluence\n")

@@ -43,8 +43,10 @@ def _version() -> str:
 
     from .. import __version__
 
-    return (f"meshcore {__version__} (Python {platform.python_version()}, numpy {numpy.__version__}, "
-            f"numba {numba.__version__})")
+    return (
+        f"meshcore {__version__} (Python {platform.python_version()}, numpy {numpy.__version__}, "
+        f"numba {numba.__version__})"
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:

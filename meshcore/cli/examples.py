@@ -44,6 +44,7 @@ def _data_files(case_file: Path) -> list[str]:
     """Relative data files a case refers to (point files)."""
     data = tomllib.loads(case_file.read_text(encoding="utf-8"))
     out = []
+
     def visit(v):
         if isinstance(v, dict):
             for vv in v.values():
@@ -53,6 +54,7 @@ def _data_files(case_file: Path) -> list[str]:
                 visit(vv)
         elif isinstance(v, str) and (case_file.parent / v).is_file():
             out.append(v)
+
     visit(data)
     return sorted(set(out))
 

@@ -19,8 +19,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", help="solver method (auto, sor, multigrid, ...)")
     p.add_argument("--tolerance", type=float, help="relative tolerance of the stopping rule")
     p.add_argument("--max-iterations", type=int, help="iteration cap")
-    p.add_argument("--threads", type=int,
-                   help="solver threads: 0 = all cores on large grids (default), 1 = serial")
+    p.add_argument("--threads", type=int, help="solver threads: 0 = all cores on large grids (default), 1 = serial")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress or quality table")
 
 
@@ -39,7 +38,9 @@ class _Progress:
         print(
             f"\r  {snap.method}: iteration {snap.iteration:6d}  residual {snap.residual:.3e} "
             f"(tolerance {snap.tolerance:.1e})  {snap.elapsed:5.1f} s",
-            end="", file=sys.stderr, flush=True,
+            end="",
+            file=sys.stderr,
+            flush=True,
         )
 
     def done(self) -> None:
@@ -84,8 +85,10 @@ def run(args: argparse.Namespace) -> int:
         block_names = list(getattr(result, "names", [b.name for b in case.blocks]))
         for k, g in enumerate(blocks):
             name = block_names[k] if k < len(block_names) else ""
-            print(f"block {name!r}: {g.cells[0]}×{g.cells[1]} cells, {g.info.method}, "
-                  f"{g.info.message}, {g.iterations} iterations, residual {g.residual:.3e}")
+            print(
+                f"block {name!r}: {g.cells[0]}×{g.cells[1]} cells, {g.info.method}, "
+                f"{g.info.message}, {g.iterations} iterations, residual {g.residual:.3e}"
+            )
             print(quality(g).table())
         if hasattr(result, "report"):  # multiblock: connectivity and interface quality
             print(result.report())

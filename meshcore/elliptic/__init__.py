@@ -70,10 +70,25 @@ def warmup(*, multigrid: bool = True, parallel: bool = True) -> None:
         tab = _mg_kernels.transfer_tables(np.arange(5.0), True, False)
         xc = np.zeros((tab[6].size, tab[6].size))
         _mg_kernels.defect_parallel(x, y, e, e, e, e, False, r.copy(), r.copy())
-        _mg_kernels.defect_restrict_parallel(x, y, e, e, e, e, tab[2], tab[3], tab[2], tab[3], 1.0,
-                                             xc, xc.copy(), _mg_kernels.ROW_CHUNKS)
+        _mg_kernels.defect_restrict_parallel(
+            x, y, e, e, e, e, tab[2], tab[3], tab[2], tab[3], 1.0, xc, xc.copy(), _mg_kernels.ROW_CHUNKS
+        )
         _mg_kernels.restrict_parallel(r, r, tab[2], tab[3], tab[2], tab[3], 1.0, xc, xc.copy())
         _mg_kernels.add_operator_parallel(xc, xc.copy(), e, e, False, xc.copy(), xc.copy())
-        _mg_kernels.prolong_correct_parallel(x, y, xc, xc.copy(), xc.copy(), xc.copy(), tab[0],
-                                             tab[1], tab[0], tab[1], tab[4], tab[4], tab[5],
-                                             tab[5], False)
+        _mg_kernels.prolong_correct_parallel(
+            x,
+            y,
+            xc,
+            xc.copy(),
+            xc.copy(),
+            xc.copy(),
+            tab[0],
+            tab[1],
+            tab[0],
+            tab[1],
+            tab[4],
+            tab[4],
+            tab[5],
+            tab[5],
+            False,
+        )

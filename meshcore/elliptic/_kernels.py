@@ -113,8 +113,7 @@ def _sweep4(x, y, p, q, omega, periodic):  # pragma: no cover - compiled
 def _renamed(fn, suffix):
     """A copy of ``fn`` with its own name (see :func:`._mg_kernels._renamed`: numba's
     disk cache does not tell the serial and ``parallel=True`` compilations apart)."""
-    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__,
-                             fn.__closure__)
+    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__, fn.__closure__)
     out.__qualname__ = fn.__qualname__ + suffix
     return out
 

@@ -316,8 +316,7 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
                         _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, nj)
                     else:
                         _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, 1, width + 1)
-                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1,
-                                     nj - width, nj)
+                        _relax_range(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj - width, nj)
                 for j in range(nj1):
                     x[ni, j] = x[0, j]
                     y[ni, j] = y[0, j]
@@ -332,8 +331,7 @@ def smooth_band(x, y, fx, fy, p, q, periodic, width, sweeps):  # pragma: no cove
                 pt = ps[k] if use_pq else e
                 qt = qs[k] if use_pq else e
                 for jj in range(1, W - 1):
-                    _relax_row_vec(xt, yt, fxt, fyt, pt, qt, use_f, use_pq, jj, jj - 1, jj + 1, L,
-                                   sx, sy)
+                    _relax_row_vec(xt, yt, fxt, fyt, pt, qt, use_f, use_pq, jj, jj - 1, jj + 1, L, sx, sy)
                 _strip_out(xt, x, j0s[k], periodic)
                 _strip_out(yt, y, j0s[k], periodic)
 
@@ -367,15 +365,15 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
                     if iw < 0:
                         iw = ni - 1
                     if vec:
-                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1, tx,
-                                       ty)
+                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1, tx, ty)
                     else:
                         _relax_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, i + 1, nj1)
             if periodic:
                 if late0 and ci == 0:
                     if vec:
-                        _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1,
-                                       np.empty(nj1), np.empty(nj1))
+                        _relax_row_vec(
+                            x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1, np.empty(nj1), np.empty(nj1)
+                        )
                     else:
                         _relax_row(x, y, fx, fy, p, q, use_f, use_pq, 0, ni - 1, 1, nj1)
                 for j in range(nj1):
@@ -384,8 +382,9 @@ def _smooth(x, y, fx, fy, p, q, periodic, sweeps):  # pragma: no cover - compile
 
 
 @njit(cache=True, nogil=True)
-def _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, outx, outy, tx, ty, tq,
-                td, measure=True):  # pragma: no cover - compiled
+def _defect_row(
+    x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, outx, outy, tx, ty, tq, td, measure=True
+):  # pragma: no cover - compiled
     """Defect of row ``i`` into ``outx, outy`` (length ``nj1``, 0 at both ends); returns the
     row's largest ``(|f − N|/den)²`` (``inf`` on NaN; 0 without ``measure``).  ``tx … td``
     are scratch rows whose end entries are 0 (fresh, so the unit-stride loop vectorises)."""
@@ -459,8 +458,9 @@ def _scratch_rows(nj1):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
-                 row_max):  # pragma: no cover - compiled
+def _defect_rows(
+    x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry, row_max
+):  # pragma: no cover - compiled
     """Rows of chunk ``c`` of :func:`_defect` (a separate function, so that the
     serial and parallel compilations run the same vectorised machine code)."""
     tx, ty, tq, td = _scratch_rows(nj1)
@@ -469,8 +469,7 @@ def _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks,
         iw = i - 1
         if iw < 0:
             iw = ni - 1
-        row_max[i] = _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, rx[i], ry[i],
-                                 tx, ty, tq, td)
+        row_max[i] = _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, iw, nj1, rx[i], ry[i], tx, ty, tq, td)
 
 
 def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compiled
@@ -495,8 +494,7 @@ def _defect(x, y, fx, fy, p, q, periodic, rx, ry):  # pragma: no cover - compile
     nrows = ni - i0
     nchunks = min(nrows, ROW_CHUNKS)
     for c in prange(nchunks):
-        _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry,
-                     row_max)
+        _defect_rows(x, y, fx, fy, p, q, use_f, use_pq, i0, ni, nj1, nrows, nchunks, c, rx, ry, row_max)
     if periodic:
         for j in range(nj1):
             rx[ni, j] = rx[0, j]
@@ -531,8 +529,9 @@ def _add_operator(x, y, p, q, periodic, fx, fy):  # pragma: no cover - compiled
     nrows = ni - i0
     nchunks = min(nrows, ROW_CHUNKS)
     for c in prange(nchunks):
-        _add_operator_rows(x, y, p, q, use_pq, ni, nj1, fx, fy, i0 + c * nrows // nchunks,
-                           i0 + (c + 1) * nrows // nchunks)
+        _add_operator_rows(
+            x, y, p, q, use_pq, ni, nj1, fx, fy, i0 + c * nrows // nchunks, i0 + (c + 1) * nrows // nchunks
+        )
     if periodic:
         for j in range(nj1):
             fx[ni, j] = fx[0, j]
@@ -583,8 +582,7 @@ def _restrict(rx, ry, ii, wi, jj, wj, scale, fx, fy):  # pragma: no cover - comp
     nI = fx.shape[0]
     nchunks = min(nI, ROW_CHUNKS)
     for c in prange(nchunks):
-        _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, c * nI // nchunks,
-                       (c + 1) * nI // nchunks)
+        _restrict_rows(rx, ry, ii, wi, jj, wj, scale, fx, fy, c * nI // nchunks, (c + 1) * nI // nchunks)
 
 
 @njit(cache=True, nogil=True)
@@ -606,8 +604,7 @@ def _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, lo, hi):  # pragma: no co
             y[i, j] += vy
 
 
-def _prolong_correct(x, y, xc, yc, ex, ey, si, swi, sj, swj, li, lj, wli, wlj,
-                     periodic):  # pragma: no cover - compiled
+def _prolong_correct(x, y, xc, yc, ex, ey, si, swi, sj, swj, li, lj, wli, wlj, periodic):  # pragma: no cover - compiled
     """``u += P(u_c − R̂u)`` (``R̂`` = :func:`sample`).
 
     ``si, swi, sj, swj`` are the sampling tables of ``R̂``; ``li[i]`` is the left coarse
@@ -630,8 +627,7 @@ def _prolong_correct(x, y, xc, yc, ex, ey, si, swi, sj, swj, li, lj, wli, wlj,
     nrows = ni1 - 1 - i0
     nchunks = min(nrows, ROW_CHUNKS)
     for c in prange(nchunks):
-        _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, i0 + c * nrows // nchunks,
-                      i0 + (c + 1) * nrows // nchunks)
+        _prolong_rows(x, y, ex, ey, li, lj, wli, wlj, nj1, i0 + c * nrows // nchunks, i0 + (c + 1) * nrows // nchunks)
     if periodic:
         for j in range(nj1):
             x[ni1 - 1, j] = x[0, j]
@@ -700,8 +696,9 @@ RING = 6
 
 
 @njit(cache=True, nogil=True)
-def _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, scale, fxc, fyc,
-                          lo, hi):  # pragma: no cover - compiled
+def _defect_restrict_rows(
+    x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, scale, fxc, fyc, lo, hi
+):  # pragma: no cover - compiled
     """Coarse rows ``lo ≤ I < hi`` of :func:`_defect_restrict`; returns the largest
     ``(|f − N|/den)²`` of the fine rows it computed."""
     ni1, nj1 = x.shape
@@ -725,8 +722,9 @@ def _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, sca
                         ringx[s, j] = 0.0
                         ringy[s, j] = 0.0
                 else:
-                    mm = _defect_row(x, y, fx, fy, p, q, use_f, use_pq, i, i - 1, nj1, ringx[s],
-                                     ringy[s], tx, ty, tq, td)
+                    mm = _defect_row(
+                        x, y, fx, fy, p, q, use_f, use_pq, i, i - 1, nj1, ringx[s], ringy[s], tx, ty, tq, td
+                    )
                     if mm > m:
                         m = mm
         # the arithmetic of _restrict_rows, reading the ring instead of r
@@ -761,8 +759,7 @@ def _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, sca
     return m
 
 
-def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc,
-                     chunks):  # pragma: no cover - compiled
+def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc, chunks):  # pragma: no cover - compiled
     """:func:`_defect` followed by :func:`_restrict`, without the fine defect arrays.
 
     Each chunk of coarse rows computes the fine defect rows its full-weighting
@@ -781,8 +778,25 @@ def _defect_restrict(x, y, fx, fy, p, q, ii, wi, jj, wj, scale, fxc, fyc,
     nchunks = max(1, min(nI, chunks))
     cmax = np.zeros(nchunks)
     for c in prange(nchunks):
-        cmax[c] = _defect_restrict_rows(x, y, fx, fy, p, q, use_f, use_pq, ii, wi, jj, wj, scale,
-                                        fxc, fyc, c * nI // nchunks, (c + 1) * nI // nchunks)
+        cmax[c] = _defect_restrict_rows(
+            x,
+            y,
+            fx,
+            fy,
+            p,
+            q,
+            use_f,
+            use_pq,
+            ii,
+            wi,
+            jj,
+            wj,
+            scale,
+            fxc,
+            fyc,
+            c * nI // nchunks,
+            (c + 1) * nI // nchunks,
+        )
     return cmax.max()
 
 
@@ -794,8 +808,7 @@ def _renamed(fn, suffix):
     two compilations of one Python function would load each other's machine
     code (whichever was compiled first).  Each variant gets its own name.
     """
-    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__,
-                             fn.__closure__)
+    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__, fn.__closure__)
     out.__qualname__ = fn.__qualname__ + suffix
     out.__doc__ = fn.__doc__
     return out
@@ -977,27 +990,52 @@ def transfer_tables(pos: np.ndarray, coarsen: bool, periodic: bool):
         for a, (i, w) in enumerate(col):
             r_idx[I, a] = i
             r_w[I, a] = w
-        r_idx[I, len(col):] = col[0][0]
+        r_idx[I, len(col) :] = col[0][0]
         r_w[I] /= r_w[I].sum()
     return si, swi, r_idx, r_w, left, w_left, pos_c
 
 
 # ----------------------------------------------------------- fused coarse V-cycle
 #: Columns of the level table of :func:`vcycle` (offsets into the flat buffers).
-(M_N0, M_N1, M_X, M_Y, M_FX, M_FY, M_P, M_Q, M_RX, M_RY, M_PQ,
- M_SI, M_SJ, M_RI, M_RJ, M_LI, M_LJ, M_RWI, M_RWJ, M_WLI, M_WLJ, M_SWI, M_SWJ,
- M_WI, M_WJ) = range(25)
+(
+    M_N0,
+    M_N1,
+    M_X,
+    M_Y,
+    M_FX,
+    M_FY,
+    M_P,
+    M_Q,
+    M_RX,
+    M_RY,
+    M_PQ,
+    M_SI,
+    M_SJ,
+    M_RI,
+    M_RJ,
+    M_LI,
+    M_LJ,
+    M_RWI,
+    M_RWJ,
+    M_WLI,
+    M_WLJ,
+    M_SWI,
+    M_SWJ,
+    M_WI,
+    M_WJ,
+) = range(25)
 META_COLS = 25
 
 
 @njit(cache=True, nogil=True)
 def _v2(buf, off, n0, n1):  # pragma: no cover - compiled
-    return buf[off:off + n0 * n1].reshape((n0, n1))
+    return buf[off : off + n0 * n1].reshape((n0, n1))
 
 
 @njit(cache=True, nogil=True)
-def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sweeps,
-           periodic):  # pragma: no cover - compiled
+def vcycle(
+    fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sweeps, periodic
+):  # pragma: no cover - compiled
     """One FAS V-cycle on levels ``k0 …`` whose arrays live in flat buffers.
 
     Exactly the operations of :meth:`multigrid._FAS.cycle` (``gamma = 1``,
@@ -1028,10 +1066,10 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         fyc = _v2(fbuf, c[M_FY], c0, c1)
         pc = _v2(fbuf, c[M_P], c0, c1) if c[M_PQ] else e
         qc = _v2(fbuf, c[M_Q], c0, c1) if c[M_PQ] else e
-        si = ibuf[m[M_SI]:m[M_SI] + c0]
-        sj = ibuf[m[M_SJ]:m[M_SJ] + c1]
-        swi = fbuf[m[M_SWI]:m[M_SWI] + c0]
-        swj = fbuf[m[M_SWJ]:m[M_SWJ] + c1]
+        si = ibuf[m[M_SI] : m[M_SI] + c0]
+        sj = ibuf[m[M_SJ] : m[M_SJ] + c1]
+        swi = fbuf[m[M_SWI] : m[M_SWI] + c0]
+        swj = fbuf[m[M_SWJ] : m[M_SWJ] + c1]
         sample(x, si, swi, sj, swj, xc)
         sample(y, si, swi, sj, swj, yc)
         ri = _v2(ibuf, m[M_RI], c0, m[M_WI])
@@ -1046,9 +1084,16 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         add_operator(xc, yc, pc, qc, periodic, fxc, fyc)
     m = meta[nlev - 1]
     n0, n1 = m[M_N0], m[M_N1]
-    smooth(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), _v2(fbuf, m[M_FX], n0, n1),
-           _v2(fbuf, m[M_FY], n0, n1), _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
-           _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, coarsest)
+    smooth(
+        _v2(fbuf, m[M_X], n0, n1),
+        _v2(fbuf, m[M_Y], n0, n1),
+        _v2(fbuf, m[M_FX], n0, n1),
+        _v2(fbuf, m[M_FY], n0, n1),
+        _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+        _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e,
+        periodic,
+        coarsest,
+    )
     for k in range(nlev - 2, k0 - 1, -1):
         m = meta[k]
         n0, n1 = m[M_N0], m[M_N1]
@@ -1060,17 +1105,31 @@ def vcycle(fbuf, ibuf, meta, scale, k0, pre, post, coarsest, band_width, band_sw
         q = _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e
         c = meta[k + 1]
         c0, c1 = c[M_N0], c[M_N1]
-        si = ibuf[m[M_SI]:m[M_SI] + c0]
-        sj = ibuf[m[M_SJ]:m[M_SJ] + c1]
-        swi = fbuf[m[M_SWI]:m[M_SWI] + c0]
-        swj = fbuf[m[M_SWJ]:m[M_SWJ] + c1]
-        li = ibuf[m[M_LI]:m[M_LI] + n0]
-        lj = ibuf[m[M_LJ]:m[M_LJ] + n1]
-        wli = fbuf[m[M_WLI]:m[M_WLI] + n0]
-        wlj = fbuf[m[M_WLJ]:m[M_WLJ] + n1]
-        prolong_correct(x, y, _v2(fbuf, c[M_X], c0, c1), _v2(fbuf, c[M_Y], c0, c1),
-                        _v2(fbuf, c[M_RX], c0, c1), _v2(fbuf, c[M_RY], c0, c1),
-                        si, swi, sj, swj, li, lj, wli, wlj, periodic)
+        si = ibuf[m[M_SI] : m[M_SI] + c0]
+        sj = ibuf[m[M_SJ] : m[M_SJ] + c1]
+        swi = fbuf[m[M_SWI] : m[M_SWI] + c0]
+        swj = fbuf[m[M_SWJ] : m[M_SWJ] + c1]
+        li = ibuf[m[M_LI] : m[M_LI] + n0]
+        lj = ibuf[m[M_LJ] : m[M_LJ] + n1]
+        wli = fbuf[m[M_WLI] : m[M_WLI] + n0]
+        wlj = fbuf[m[M_WLJ] : m[M_WLJ] + n1]
+        prolong_correct(
+            x,
+            y,
+            _v2(fbuf, c[M_X], c0, c1),
+            _v2(fbuf, c[M_Y], c0, c1),
+            _v2(fbuf, c[M_RX], c0, c1),
+            _v2(fbuf, c[M_RY], c0, c1),
+            si,
+            swi,
+            sj,
+            swj,
+            li,
+            lj,
+            wli,
+            wlj,
+            periodic,
+        )
         smooth(x, y, fx, fy, p, q, periodic, post)
         if band_sweeps > 0:
             smooth_band(x, y, fx, fy, p, q, periodic, band_width, band_sweeps)
@@ -1083,18 +1142,42 @@ def _up(fbuf, ibuf, meta, k, periodic):  # pragma: no cover - compiled
     n0, n1 = m[M_N0], m[M_N1]
     c = meta[k + 1]
     c0, c1 = c[M_N0], c[M_N1]
-    prolong_correct(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1),
-                    _v2(fbuf, c[M_X], c0, c1), _v2(fbuf, c[M_Y], c0, c1),
-                    _v2(fbuf, c[M_RX], c0, c1), _v2(fbuf, c[M_RY], c0, c1),
-                    ibuf[m[M_SI]:m[M_SI] + c0], fbuf[m[M_SWI]:m[M_SWI] + c0],
-                    ibuf[m[M_SJ]:m[M_SJ] + c1], fbuf[m[M_SWJ]:m[M_SWJ] + c1],
-                    ibuf[m[M_LI]:m[M_LI] + n0], ibuf[m[M_LJ]:m[M_LJ] + n1],
-                    fbuf[m[M_WLI]:m[M_WLI] + n0], fbuf[m[M_WLJ]:m[M_WLJ] + n1], periodic)
+    prolong_correct(
+        _v2(fbuf, m[M_X], n0, n1),
+        _v2(fbuf, m[M_Y], n0, n1),
+        _v2(fbuf, c[M_X], c0, c1),
+        _v2(fbuf, c[M_Y], c0, c1),
+        _v2(fbuf, c[M_RX], c0, c1),
+        _v2(fbuf, c[M_RY], c0, c1),
+        ibuf[m[M_SI] : m[M_SI] + c0],
+        fbuf[m[M_SWI] : m[M_SWI] + c0],
+        ibuf[m[M_SJ] : m[M_SJ] + c1],
+        fbuf[m[M_SWJ] : m[M_SWJ] + c1],
+        ibuf[m[M_LI] : m[M_LI] + n0],
+        ibuf[m[M_LJ] : m[M_LJ] + n1],
+        fbuf[m[M_WLI] : m[M_WLI] + n0],
+        fbuf[m[M_WLJ] : m[M_WLJ] + n1],
+        periodic,
+    )
 
 
 @njit(cache=True, nogil=True)
-def fmg_start(fbuf, ibuf, meta, scale, pre, post, coarsest, band_width, band_sweeps, fmg_width,
-              fmg_sweeps, fmg_min_cells, fmg_cycles, periodic):  # pragma: no cover - compiled
+def fmg_start(
+    fbuf,
+    ibuf,
+    meta,
+    scale,
+    pre,
+    post,
+    coarsest,
+    band_width,
+    band_sweeps,
+    fmg_width,
+    fmg_sweeps,
+    fmg_min_cells,
+    fmg_cycles,
+    periodic,
+):  # pragma: no cover - compiled
     """The full-multigrid start on all fused levels in one compiled call.
 
     Solve the coarsest level (``coarsest`` sweeps), then for each finer fused
@@ -1107,9 +1190,16 @@ def fmg_start(fbuf, ibuf, meta, scale, pre, post, coarsest, band_width, band_swe
     e = np.zeros((0, 0))
     m = meta[nlev - 1]
     n0, n1 = m[M_N0], m[M_N1]
-    smooth(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), _v2(fbuf, m[M_FX], n0, n1),
-           _v2(fbuf, m[M_FY], n0, n1), _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
-           _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, coarsest)
+    smooth(
+        _v2(fbuf, m[M_X], n0, n1),
+        _v2(fbuf, m[M_Y], n0, n1),
+        _v2(fbuf, m[M_FX], n0, n1),
+        _v2(fbuf, m[M_FY], n0, n1),
+        _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+        _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e,
+        periodic,
+        coarsest,
+    )
     for k in range(nlev - 2, -1, -1):
         _up(fbuf, ibuf, meta, k, periodic)
         m = meta[k]
@@ -1119,10 +1209,16 @@ def fmg_start(fbuf, ibuf, meta, scale, pre, post, coarsest, band_width, band_swe
         fx[:] = 0.0
         fy[:] = 0.0
         if min(n0, n1) - 1 >= fmg_min_cells:
-            smooth_band(_v2(fbuf, m[M_X], n0, n1), _v2(fbuf, m[M_Y], n0, n1), fx, fy,
-                        _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
-                        _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e, periodic, fmg_width,
-                        fmg_sweeps)
+            smooth_band(
+                _v2(fbuf, m[M_X], n0, n1),
+                _v2(fbuf, m[M_Y], n0, n1),
+                fx,
+                fy,
+                _v2(fbuf, m[M_P], n0, n1) if m[M_PQ] else e,
+                _v2(fbuf, m[M_Q], n0, n1) if m[M_PQ] else e,
+                periodic,
+                fmg_width,
+                fmg_sweeps,
+            )
         for _ in range(fmg_cycles):
-            vcycle(fbuf, ibuf, meta, scale, k, pre, post, coarsest, band_width, band_sweeps,
-                   periodic)
+            vcycle(fbuf, ibuf, meta, scale, k, pre, post, coarsest, band_width, band_sweeps, periodic)

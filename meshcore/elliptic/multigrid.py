@@ -244,14 +244,21 @@ class _FAS:
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
         use_pq = state.p.size > 0
         plan = _plan(state.x, state.y, self.periodic)
-        self.key = (state.x.shape, self.periodic, use_pq, threads, gamma,
-                    tuple((ci, cj) for ci, cj, _, _ in plan))
+        self.key = (state.x.shape, self.periodic, use_pq, threads, gamma, tuple((ci, cj) for ci, cj, _, _ in plan))
         ws = _WORKSPACES.pop(self.key, None)
         if ws is None:
             self._build(plan, use_pq, threads)
         else:
-            (self.levels, self.kfuse, self.fbuf, self.ibuf, self.meta, self.fscale,
-             self.fused_updates, self.coarsest_sweeps) = ws
+            (
+                self.levels,
+                self.kfuse,
+                self.fbuf,
+                self.ibuf,
+                self.meta,
+                self.fscale,
+                self.fused_updates,
+                self.coarsest_sweeps,
+            ) = ws
         lv0 = self.levels[0]
         lv0.x, lv0.y, lv0.p, lv0.q = state.x, state.y, state.p, state.q
         # restricted[k]: level k+1's right-hand side holds level k's restricted defect
@@ -269,10 +276,16 @@ class _FAS:
             return
         lv0 = self.levels[0]
         lv0.x = lv0.y = lv0.p = lv0.q = _EMPTY  # no reference to the caller's arrays
-        _WORKSPACES[self.key] = (self.levels, self.kfuse, getattr(self, "fbuf", None),
-                                 getattr(self, "ibuf", None), getattr(self, "meta", None),
-                                 getattr(self, "fscale", None), getattr(self, "fused_updates", None),
-                                 self.coarsest_sweeps)
+        _WORKSPACES[self.key] = (
+            self.levels,
+            self.kfuse,
+            getattr(self, "fbuf", None),
+            getattr(self, "ibuf", None),
+            getattr(self, "meta", None),
+            getattr(self, "fscale", None),
+            getattr(self, "fused_updates", None),
+            self.coarsest_sweeps,
+        )
         while len(_WORKSPACES) > WORKSPACE_CACHE_SIZE:
             try:
                 del _WORKSPACES[next(iter(_WORKSPACES))]  # the oldest
@@ -311,8 +324,7 @@ class _FAS:
             fc = fused(shp)
             pc = new(shp, fc) if use_pq else _EMPTY
             qc = new(shp, fc) if use_pq else _EMPTY
-            self.levels.append(_Level(new(shp, fc), new(shp, fc), new(shp, fc, True),
-                                      new(shp, fc, True), pc, qc))
+            self.levels.append(_Level(new(shp, fc), new(shp, fc), new(shp, fc, True), new(shp, fc, True), pc, qc))
         last = self.levels[-1]
         if last.rx is None and len(self.levels) > 1:
             # scratch for the correction to the next finer level
@@ -359,15 +371,27 @@ class _FAS:
                     m[col] = fpos
                     fpos += arr.size
             if lv.si is not None:
-                for name, col in (("si", K.M_SI), ("sj", K.M_SJ), ("ri", K.M_RI), ("rj", K.M_RJ),
-                                  ("li", K.M_LI), ("lj", K.M_LJ)):
+                for name, col in (
+                    ("si", K.M_SI),
+                    ("sj", K.M_SJ),
+                    ("ri", K.M_RI),
+                    ("rj", K.M_RJ),
+                    ("li", K.M_LI),
+                    ("lj", K.M_LJ),
+                ):
                     tab = getattr(lv, name)
                     m[col] = ipos
                     icopy.append((ipos, tab))
                     ipos += tab.size
                 m[K.M_WI], m[K.M_WJ] = lv.ri.shape[1], lv.rj.shape[1]
-                for name, col in (("swi", K.M_SWI), ("swj", K.M_SWJ), ("rwi", K.M_RWI),
-                                  ("rwj", K.M_RWJ), ("wli", K.M_WLI), ("wlj", K.M_WLJ)):
+                for name, col in (
+                    ("swi", K.M_SWI),
+                    ("swj", K.M_SWJ),
+                    ("rwi", K.M_RWI),
+                    ("rwj", K.M_RWJ),
+                    ("wli", K.M_WLI),
+                    ("wlj", K.M_WLJ),
+                ):
                     tab = getattr(lv, name)
                     m[col] = fpos
                     fcopy.append((fpos, tab))
@@ -375,9 +399,9 @@ class _FAS:
         fbuf = np.empty(fpos)
         ibuf = np.empty(ipos, dtype=np.int64)
         for off, tab in fcopy:
-            fbuf[off:off + tab.size] = np.ravel(tab)
+            fbuf[off : off + tab.size] = np.ravel(tab)
         for off, tab in icopy:
-            ibuf[off:off + tab.size] = np.ravel(tab)
+            ibuf[off : off + tab.size] = np.ravel(tab)
         for r, lv in enumerate(levels[kf:]):
             m = meta[r]
             shp = lv.x.shape
@@ -385,7 +409,7 @@ class _FAS:
             for name, col in zip(fnames, fcols, strict=True):
                 arr = getattr(lv, name)
                 if arr is not None and arr.size:
-                    view = fbuf[m[col]:m[col] + n].reshape(shp)
+                    view = fbuf[m[col] : m[col] + n].reshape(shp)
                     if name in ("fx", "fy"):
                         view[...] = 0.0
                     setattr(lv, name, view)
@@ -419,23 +443,34 @@ class _FAS:
             fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
 
     def smooth_band(self, lv: _Level, fine: bool) -> None:
-        width, sweeps = (BAND_WIDTH, BAND_SWEEPS) if fine else (COARSE_BAND_WIDTH,
-                                                                COARSE_BAND_SWEEPS)
+        width, sweeps = (BAND_WIDTH, BAND_SWEEPS) if fine else (COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS)
         if sweeps > 0:
             K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, width, sweeps)
 
     def fmg_band(self, lv: _Level) -> None:
-        K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, FMG_BAND_WIDTH,
-                      FMG_BAND_SWEEPS)
+        K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, FMG_BAND_WIDTH, FMG_BAND_SWEEPS)
 
     def fmg_fused(self) -> None:
         """The FMG start on the fused levels in one compiled call (:func:`K.fmg_start`)."""
         kf = self.kfuse
         self.updates += self.coarsest_sweeps * self.levels[-1].x.size
         self.updates += FMG_CYCLES * sum(self.fused_updates[kf:-1])
-        K.fmg_start(self.fbuf, self.ibuf, self.meta, self.fscale, PRE, COARSE_POST,
-                    self.coarsest_sweeps, COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS, FMG_BAND_WIDTH,
-                    FMG_BAND_SWEEPS, FMG_BAND_MIN_CELLS, FMG_CYCLES, self.periodic)
+        K.fmg_start(
+            self.fbuf,
+            self.ibuf,
+            self.meta,
+            self.fscale,
+            PRE,
+            COARSE_POST,
+            self.coarsest_sweeps,
+            COARSE_BAND_WIDTH,
+            COARSE_BAND_SWEEPS,
+            FMG_BAND_WIDTH,
+            FMG_BAND_SWEEPS,
+            FMG_BAND_MIN_CELLS,
+            FMG_CYCLES,
+            self.periodic,
+        )
 
     def defect(self, lv: _Level) -> float:
         fn = K.defect_parallel if lv.par else K.defect
@@ -452,10 +487,10 @@ class _FAS:
         c = self.levels[k + 1]
         self.restricted[k] = True
         if f.par:
-            return K.defect_restrict_parallel(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj,
-                                              f.rwj, f.scale, c.fx, c.fy, K.ROW_CHUNKS)
-        return K.defect_restrict(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj, f.rwj, f.scale,
-                                 c.fx, c.fy, 1)
+            return K.defect_restrict_parallel(
+                f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy, K.ROW_CHUNKS
+            )
+        return K.defect_restrict(f.x, f.y, f.fx, f.fy, f.p, f.q, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy, 1)
 
     def to_coarse(self, k: int) -> None:
         """FAS right-hand side of level k+1 from the defect of level k."""
@@ -473,16 +508,26 @@ class _FAS:
         """``u_k += P(u_{k+1} − R̂ u_k)`` (the coarse level's scratch holds the correction)."""
         f, c = self.levels[k], self.levels[k + 1]
         fn = K.prolong_correct_parallel if f.par else K.prolong_correct
-        fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.si, f.swi, f.sj, f.swj, f.li, f.lj, f.wli, f.wlj,
-           self.periodic)
+        fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.si, f.swi, f.sj, f.swj, f.li, f.lj, f.wli, f.wlj, self.periodic)
 
     def cycle(self, k: int, *, have_defect: bool = False) -> None:
         """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
         lv = self.levels[k]
         if k >= self.kfuse:
             self.updates += self.fused_updates[k]
-            K.vcycle(self.fbuf, self.ibuf, self.meta, self.fscale, k - self.kfuse, PRE, COARSE_POST,
-                     self.coarsest_sweeps, COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS, self.periodic)
+            K.vcycle(
+                self.fbuf,
+                self.ibuf,
+                self.meta,
+                self.fscale,
+                k - self.kfuse,
+                PRE,
+                COARSE_POST,
+                self.coarsest_sweeps,
+                COARSE_BAND_WIDTH,
+                COARSE_BAND_SWEEPS,
+                self.periodic,
+            )
             return
         if k == len(self.levels) - 1:
             self.smooth(lv, self.coarsest_sweeps)

@@ -347,8 +347,16 @@ def iterate(
     tol_rel = cfg.tolerance if cfg.tolerance is not None else default_tolerance(x.shape)
     method = _choose_method(cfg, x.shape)
     state = SolverState(
-        x=x, y=y, p=pp, q=qq, periodic=initial.periodic, config=cfg,
-        tol_abs=tol_rel * length, length=length, stop_event=stop_event, sources=sources,
+        x=x,
+        y=y,
+        p=pp,
+        q=qq,
+        periodic=initial.periodic,
+        config=cfg,
+        tol_abs=tol_rel * length,
+        length=length,
+        stop_event=stop_event,
+        sources=sources,
         start=(np.asarray(initial.x, dtype=np.float64), np.asarray(initial.y, dtype=np.float64)),
     )
     if sources is not None:
@@ -358,8 +366,7 @@ def iterate(
     last = t0
     # until a snapshot has been timed: assume copying x, y of a huge grid (arrays that numpy
     # places in transparent huge pages, ≥ 4 MB) runs at SNAPSHOT_BYTES_PER_S
-    interval_floor = (SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S
-                      if x.nbytes >= 4 << 20 else 0.0)
+    interval_floor = SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S if x.nbytes >= 4 << 20 else 0.0
     gen = METHODS[method](state)
     converged = False
     stopped = False

@@ -441,8 +441,21 @@ def repair(
     else:
         bad_now = invalid_cells(x, y, ex_bits)
         msg = f"{origin}; " + _failure_message(StructuredGrid(x, y), bad_now, exempt)
-    res = _result(grid, x, y, ok=ok, before=before, folded_before=folded_before, exempt=exempt,
-                  ex_bits=ex_bits, nodes=nfree, sweeps=total, t0=t0, method=method, msg=msg)
+    res = _result(
+        grid,
+        x,
+        y,
+        ok=ok,
+        before=before,
+        folded_before=folded_before,
+        exempt=exempt,
+        ex_bits=ex_bits,
+        nodes=nfree,
+        sweeps=total,
+        t0=t0,
+        method=method,
+        msg=msg,
+    )
     return _raise_if_failed(res, strict and not ok)
 
 
@@ -598,9 +611,21 @@ def smooth(
     else:
         ok = False
         msg = _failure_message(StructuredGrid(x, y), invalid_cells(x, y, ex_bits), exempt)
-    res = _result(grid, x, y, ok=ok, before=before, folded_before=folded_before, exempt=exempt,
-                  ex_bits=ex_bits, nodes=len(nodes), sweeps=sw, t0=t0, method="foldfree",
-                  msg=msg)
+    res = _result(
+        grid,
+        x,
+        y,
+        ok=ok,
+        before=before,
+        folded_before=folded_before,
+        exempt=exempt,
+        ex_bits=ex_bits,
+        nodes=len(nodes),
+        sweeps=sw,
+        t0=t0,
+        method="foldfree",
+        msg=msg,
+    )
     return _raise_if_failed(res, strict and not ok)
 
 

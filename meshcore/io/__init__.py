@@ -97,41 +97,100 @@ def register_format(fmt: Format) -> None:
 
 
 for _f in (
-    Format("points-csv", (".csv", ".txt", ".xy", ".dat", ".tsv"),
-           "delimited x/y or lon/lat points", points_reader="points_csv:read_points_csv",
-           crs=True),
-    Format("geojson", (".geojson", ".json"), "GeoJSON lines and polygons",
-           points_reader="geojson:read_points_geojson", crs=True),
+    Format(
+        "points-csv",
+        (".csv", ".txt", ".xy", ".dat", ".tsv"),
+        "delimited x/y or lon/lat points",
+        points_reader="points_csv:read_points_csv",
+        crs=True,
+    ),
+    Format(
+        "geojson",
+        (".geojson", ".json"),
+        "GeoJSON lines and polygons",
+        points_reader="geojson:read_points_geojson",
+        crs=True,
+    ),
     Format("kml", (".kml",), "Google Earth KML", points_reader="kml:read_points_kml", crs=True),
-    Format("kmz", (".kmz",), "Google Earth KMZ (zipped KML)",
-           points_reader="kml:read_points_kmz", crs=True),
-    Format("shapefile", (".shp",), "ESRI shapefile (+ .shx, .dbf, .prj)",
-           points_reader="shp:read_points_shp", crs=True),
-    Format("dxf", (".dxf",), "AutoCAD DXF polylines and splines",
-           points_reader="dxf:read_points_dxf"),
-    Format("plot3d", (".xyz", ".x", ".p3d", ".g"), "PLOT3D 2-D grid (ASCII / binary)",
-           writer="plot3d:write_plot3d", grid_reader="plot3d:read_plot3d", multiblock=True),
-    Format("vts", (".vts",), "VTK XML StructuredGrid", writer="vtk_xml:write_vts",
-           grid_reader="vtk_xml:read_vts", crs=True),
-    Format("vtm", (".vtm",), "VTK XML MultiBlock of .vts", writer="vtk_xml:write_vtm",
-           grid_reader="vtk_xml:read_vtm", crs=True, multiblock=True),
-    Format("npz", (".npz",), "NumPy archive: coordinates, metrics, CRS",
-           writer="native:write_npz", grid_reader="native:read_npz", crs=True, multiblock=True),
-    Format("metrics-csv", (".csv",), "metrics table per node (CSV)",
-           writer="native:write_metrics_csv", grid_reader="native:read_metrics_csv", crs=True,
-           multiblock=True),
-    Format("cgns", (".cgns",), "CGNS/HDF5 structured zones", writer="cgns:write_cgns",
-           grid_reader="cgns:read_cgns", crs=True, markers=True, multiblock=True),
-    Format("gmsh", (".msh",), "Gmsh MSH 4.1 (quads + physical border lines)",
-           writer="unstructured:write_msh", markers=True, multiblock=True),
-    Format("su2", (".su2",), "SU2 mesh with markers", writer="unstructured:write_su2",
-           markers=True, multiblock=True),
-    Format("delft3d", (".grd",), "Delft3D RGFGRID grid (+ .enc enclosure)",
-           writer="delft3d:write_grd", grid_reader="delft3d:read_grd", crs=True),
-    Format("sgrid", (".nc",), "NetCDF (SGRID conventions, CF grid mapping)",
-           writer="sgrid:write_sgrid", grid_reader="sgrid:read_sgrid", crs=True),
-    Format("figure", (".png", ".svg", ".pdf"), "figure (matplotlib)",
-           writer="figure:write_figure", multiblock=True),
+    Format("kmz", (".kmz",), "Google Earth KMZ (zipped KML)", points_reader="kml:read_points_kmz", crs=True),
+    Format(
+        "shapefile", (".shp",), "ESRI shapefile (+ .shx, .dbf, .prj)", points_reader="shp:read_points_shp", crs=True
+    ),
+    Format("dxf", (".dxf",), "AutoCAD DXF polylines and splines", points_reader="dxf:read_points_dxf"),
+    Format(
+        "plot3d",
+        (".xyz", ".x", ".p3d", ".g"),
+        "PLOT3D 2-D grid (ASCII / binary)",
+        writer="plot3d:write_plot3d",
+        grid_reader="plot3d:read_plot3d",
+        multiblock=True,
+    ),
+    Format(
+        "vts", (".vts",), "VTK XML StructuredGrid", writer="vtk_xml:write_vts", grid_reader="vtk_xml:read_vts", crs=True
+    ),
+    Format(
+        "vtm",
+        (".vtm",),
+        "VTK XML MultiBlock of .vts",
+        writer="vtk_xml:write_vtm",
+        grid_reader="vtk_xml:read_vtm",
+        crs=True,
+        multiblock=True,
+    ),
+    Format(
+        "npz",
+        (".npz",),
+        "NumPy archive: coordinates, metrics, CRS",
+        writer="native:write_npz",
+        grid_reader="native:read_npz",
+        crs=True,
+        multiblock=True,
+    ),
+    Format(
+        "metrics-csv",
+        (".csv",),
+        "metrics table per node (CSV)",
+        writer="native:write_metrics_csv",
+        grid_reader="native:read_metrics_csv",
+        crs=True,
+        multiblock=True,
+    ),
+    Format(
+        "cgns",
+        (".cgns",),
+        "CGNS/HDF5 structured zones",
+        writer="cgns:write_cgns",
+        grid_reader="cgns:read_cgns",
+        crs=True,
+        markers=True,
+        multiblock=True,
+    ),
+    Format(
+        "gmsh",
+        (".msh",),
+        "Gmsh MSH 4.1 (quads + physical border lines)",
+        writer="unstructured:write_msh",
+        markers=True,
+        multiblock=True,
+    ),
+    Format("su2", (".su2",), "SU2 mesh with markers", writer="unstructured:write_su2", markers=True, multiblock=True),
+    Format(
+        "delft3d",
+        (".grd",),
+        "Delft3D RGFGRID grid (+ .enc enclosure)",
+        writer="delft3d:write_grd",
+        grid_reader="delft3d:read_grd",
+        crs=True,
+    ),
+    Format(
+        "sgrid",
+        (".nc",),
+        "NetCDF (SGRID conventions, CF grid mapping)",
+        writer="sgrid:write_sgrid",
+        grid_reader="sgrid:read_sgrid",
+        crs=True,
+    ),
+    Format("figure", (".png", ".svg", ".pdf"), "figure (matplotlib)", writer="figure:write_figure", multiblock=True),
 ):
     register_format(_f)
 
@@ -145,8 +204,13 @@ def find_format(path: Any, format: str | None = None, *, role: str) -> Format:
     attr = {"write": "writer", "grid": "grid_reader", "points": "points_reader"}[role]
     if format is not None:
         fmt = FORMATS.get(format) or next(
-            (f for f in FORMATS.values() if format.lower().lstrip(".") in
-             (s.lstrip(".") for s in f.suffixes) and getattr(f, attr)), None)
+            (
+                f
+                for f in FORMATS.values()
+                if format.lower().lstrip(".") in (s.lstrip(".") for s in f.suffixes) and getattr(f, attr)
+            ),
+            None,
+        )
         if fmt is None:
             raise (WriteError if role == "write" else ReadError)(
                 f"unknown format {format!r} (known: {', '.join(FORMATS)})"
@@ -160,14 +224,20 @@ def find_format(path: Any, format: str | None = None, *, role: str) -> Format:
     can = sorted({s for f in FORMATS.values() if getattr(f, attr) for s in f.suffixes})
     verb = {"write": "write", "grid": "read grids from", "points": "read points from"}[role]
     raise (WriteError if role == "write" else ReadError)(
-        f"{path}: cannot {verb} {suffix or 'files without a suffix'} files "
-        f"(known suffixes: {' '.join(can)})"
+        f"{path}: cannot {verb} {suffix or 'files without a suffix'} files (known suffixes: {' '.join(can)})"
     )
 
 
 # ------------------------------------------------------------------- reading
-def read_points(path: Any, *, format: str | None = None, columns: Any = None,
-                crs: Any = None, closed: bool | None = None, **options: Any) -> PointSet:
+def read_points(
+    path: Any,
+    *,
+    format: str | None = None,
+    columns: Any = None,
+    crs: Any = None,
+    closed: bool | None = None,
+    **options: Any,
+) -> PointSet:
     """Read named polylines and their CRS from a point file.
 
     Parameters
@@ -209,8 +279,9 @@ def read_points(path: Any, *, format: str | None = None, columns: Any = None,
 
 def _is_grid_suffix(p: Path) -> bool:
     s = p.suffix.lower()
-    return any(s in f.suffixes and f.grid_reader and not f.points_reader for f in FORMATS.values()) \
-        and not any(s in f.suffixes and f.points_reader for f in FORMATS.values())
+    return any(s in f.suffixes and f.grid_reader and not f.points_reader for f in FORMATS.values()) and not any(
+        s in f.suffixes and f.points_reader for f in FORMATS.values()
+    )
 
 
 def _grid_as_points(gs: GridSet, p: Path) -> PointSet:
@@ -287,9 +358,17 @@ def _is_metrics_csv(p: Path) -> bool:
 
 
 # ------------------------------------------------------------------- writing
-def write(path: Any, grid_or_blocks: Any, format: str | None = None, *, crs: Any = None,
-          origin: Any = None, block_names: Any = None, connectivity: Any = None,
-          **options: Any) -> Path:
+def write(
+    path: Any,
+    grid_or_blocks: Any,
+    format: str | None = None,
+    *,
+    crs: Any = None,
+    origin: Any = None,
+    block_names: Any = None,
+    connectivity: Any = None,
+    **options: Any,
+) -> Path:
     """Write a grid or a list of blocks; the format comes from the suffix or ``format``.
 
     Parameters
@@ -322,18 +401,21 @@ def write(path: Any, grid_or_blocks: Any, format: str | None = None, *, crs: Any
     if isinstance(grid_or_blocks, GridSet):
         gs = grid_or_blocks
         if crs is not None or origin is not None:
-            gs = GridSet(gs.blocks, as_frame(crs if crs is not None else gs.frame, origin),
-                         gs.block_names, gs.connectivity, gs.source)
+            gs = GridSet(
+                gs.blocks,
+                as_frame(crs if crs is not None else gs.frame, origin),
+                gs.block_names,
+                gs.connectivity,
+                gs.source,
+            )
     else:
         blocks = as_blocks(grid_or_blocks)
-        names = (tuple(block_names) if block_names is not None
-                 else _block_names(grid_or_blocks, len(blocks)))
+        names = tuple(block_names) if block_names is not None else _block_names(grid_or_blocks, len(blocks))
         if len(names) != len(blocks):
             raise WriteError(f"{p}: {len(names)} block names for {len(blocks)} blocks")
         if connectivity is None:
             connectivity = getattr(grid_or_blocks, "connectivity", None)
-        gs = GridSet(blocks, as_frame(crs, origin), names,
-                     coerce_interfaces(connectivity, blocks))
+        gs = GridSet(blocks, as_frame(crs, origin), names, coerce_interfaces(connectivity, blocks))
     if len(gs.blocks) > 1 and not fmt.multiblock:
         raise WriteError(f"{p}: the {fmt.name} format holds one block, got {len(gs.blocks)}")
     fmt._load(fmt.writer)(p, gs, **options)

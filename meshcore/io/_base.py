@@ -120,8 +120,7 @@ class PointSet:
         return PointSet(tuple(polylines), crs, self.source, dict(self.meta))
 
 
-def make_polyline(name: str, pts: np.ndarray, *, closed: bool | None = None,
-                  where: str = "") -> Polyline:
+def make_polyline(name: str, pts: np.ndarray, *, closed: bool | None = None, where: str = "") -> Polyline:
     """Build a :class:`Polyline`, detecting a repeated closing point.
 
     ``closed=None`` means: closed when the last point repeats the first.
@@ -193,8 +192,7 @@ def read_guard(path: Any, what: str = "file") -> Iterator[None]:
         raise ReadError(f"{path}: nesting too deep, not a valid {what}") from None
     except Exception as exc:  # the safety net (see docstring)
         msg = one_line(str(exc)) if str(exc) else type(exc).__name__
-        raise ReadError(one_line(f"{path}: not a valid {what} ({type(exc).__name__}: {msg})")) \
-            from exc
+        raise ReadError(one_line(f"{path}: not a valid {what} ({type(exc).__name__}: {msg})")) from exc
 
 
 def one_line(msg: str, limit: int = 400) -> str:
@@ -271,9 +269,7 @@ def as_blocks(obj: Any) -> tuple[StructuredGrid, ...]:
                 raise WriteError(f"block {k} is a {type(b).__name__}, not a StructuredGrid")
             out.append(g)
         return tuple(out)
-    raise WriteError(
-        f"expected a StructuredGrid, a list of them or a multiblock object, got {type(obj).__name__}"
-    )
+    raise WriteError(f"expected a StructuredGrid, a list of them or a multiblock object, got {type(obj).__name__}")
 
 
 def block_names(obj: Any, n: int) -> tuple[str, ...]:
@@ -342,9 +338,7 @@ class GridSet:
         if self.frame is None:
             object.__setattr__(self, "frame", Frame())
         if not self.block_names:
-            object.__setattr__(
-                self, "block_names", tuple(f"block{k + 1}" for k in range(len(self.blocks)))
-            )
+            object.__setattr__(self, "block_names", tuple(f"block{k + 1}" for k in range(len(self.blocks))))
 
     def __len__(self) -> int:
         return len(self.blocks)
@@ -379,7 +373,7 @@ def find_interfaces(blocks: Sequence[StructuredGrid], *, rtol: float = 1e-9) -> 
     found = []
     borders = [(k, b, g.border(b)) for k, g in enumerate(blocks) for b in BORDER_NAMES]
     for m, (ka, ba, pa) in enumerate(borders):
-        for kb, bb, pb in borders[m + 1:]:
+        for kb, bb, pb in borders[m + 1 :]:
             if kb == ka or len(pa) != len(pb):
                 continue
             if np.max(np.abs(pa - pb)) <= tol:
@@ -400,15 +394,17 @@ def coerce_interfaces(conn: Any, blocks: Sequence[StructuredGrid]) -> tuple[Inte
             continue
         get = r.get if isinstance(r, dict) else (lambda key, d=None, r=r: getattr(r, key, d))
         try:
-            it = Interface(int(get("a")), str(get("border_a")), int(get("b")),
-                           str(get("border_b")), bool(get("reversed", False)))
+            it = Interface(
+                int(get("a")), str(get("border_a")), int(get("b")), str(get("border_b")), bool(get("reversed", False))
+            )
         except (TypeError, ValueError) as exc:
             raise WriteError(
-                f"connectivity record {k} must have a, border_a, b, border_b "
-                f"(and optionally reversed): {exc}"
+                f"connectivity record {k} must have a, border_a, b, border_b (and optionally reversed): {exc}"
             ) from None
-        if it.border_a not in BORDER_NAMES or it.border_b not in BORDER_NAMES or not (
-            0 <= it.a < len(blocks) and 0 <= it.b < len(blocks)
+        if (
+            it.border_a not in BORDER_NAMES
+            or it.border_b not in BORDER_NAMES
+            or not (0 <= it.a < len(blocks) and 0 <= it.b < len(blocks))
         ):
             raise WriteError(f"connectivity record {k} names an unknown block or border: {it}")
         out.append(it)

@@ -42,9 +42,16 @@ from ._base import GridSet, Interface, atomic_path, border_names
 __all__ = ["bc_type", "read_cgns", "write_cgns"]
 
 _BC_TYPES = {
-    "inlet": "BCInflow", "inflow": "BCInflow", "outlet": "BCOutflow", "outflow": "BCOutflow",
-    "wall": "BCWall", "shore": "BCWall", "bank": "BCWall", "symmetry": "BCSymmetryPlane",
-    "farfield": "BCFarfield", "far": "BCFarfield",
+    "inlet": "BCInflow",
+    "inflow": "BCInflow",
+    "outlet": "BCOutflow",
+    "outflow": "BCOutflow",
+    "wall": "BCWall",
+    "shore": "BCWall",
+    "bank": "BCWall",
+    "symmetry": "BCSymmetryPlane",
+    "farfield": "BCFarfield",
+    "far": "BCFarfield",
 }
 
 
@@ -71,8 +78,7 @@ def _node(parent, name: str, label: str, dtype: str = "MT", data: Any = None):
         if dtype == "C1":
             arr = np.frombuffer(str(data).encode("utf-8"), dtype=np.int8)
         else:
-            arr = np.asarray(data, dtype={"I4": np.int32, "I8": np.int64, "R4": np.float32,
-                                          "R8": np.float64}[dtype])
+            arr = np.asarray(data, dtype={"I4": np.int32, "I8": np.int64, "R4": np.float32, "R8": np.float64}[dtype])
             arr = arr.T.copy() if arr.ndim > 1 else arr  # Fortran order: reversed dims
         g.create_dataset(" data", data=arr)
     return g
@@ -127,16 +133,14 @@ def write_cgns(path: Path, gs: GridSet, **_: Any) -> None:
             _node(base, "LocalOrigin", "Descriptor_t", "C1", f"{o[0]!r} {o[1]!r}")
         for k, g in enumerate(gs.blocks):
             ni, nj = g.cells
-            z = _node(base, zones[k], "Zone_t", "I4",
-                      np.array([[ni + 1, nj + 1], [ni, nj], [0, 0]]).T)
+            z = _node(base, zones[k], "Zone_t", "I4", np.array([[ni + 1, nj + 1], [ni, nj], [0, 0]]).T)
             _node(z, "ZoneType", "ZoneType_t", "C1", "Structured")
             gc = _node(z, "GridCoordinates", "GridCoordinates_t")
             X, Y = gs.world(k)
             _node(gc, "CoordinateX", "DataArray_t", "R8", X)
             _node(gc, "CoordinateY", "DataArray_t", "R8", Y)
             names = border_names(g)
-            bcs = [b for b in BORDER_NAMES if (k, b) not in iface
-                   and not (g.periodic and b in ("left", "right"))]
+            bcs = [b for b in BORDER_NAMES if (k, b) not in iface and not (g.periodic and b in ("left", "right"))]
             if bcs:
                 zbc = _node(z, "ZoneBC", "ZoneBC_t")
                 used: set[str] = set()
@@ -144,8 +148,7 @@ def write_cgns(path: Path, gs: GridSet, **_: Any) -> None:
                     nm = names[b] if names[b] not in used else f"{names[b]}_{b}"
                     used.add(nm)
                     bc = _node(zbc, nm, "BC_t", "C1", bc_type(names[b]))
-                    _node(bc, "PointRange", "IndexRange_t", "I4",
-                          np.array(_RANGES[b](ni, nj)).T)
+                    _node(bc, "PointRange", "IndexRange_t", "I4", np.array(_RANGES[b](ni, nj)).T)
                     _node(bc, "GridLocation", "GridLocation_t", "C1", "Vertex")
             conns = [(b, it, first) for b in BORDER_NAMES for it, first in iface.get((k, b), [])]
             if conns:
@@ -159,14 +162,12 @@ def write_cgns(path: Path, gs: GridSet, **_: Any) -> None:
                     if nm in zgc:
                         nm = f"{nm[:28]}_{n_c}"
                     c = _node(zgc, nm, "GridConnectivity1to1_t", "C1", zones[other])
-                    _node(c, "PointRange", "IndexRange_t", "I4",
-                          np.array(_RANGES[b](ni, nj)).T)
+                    _node(c, "PointRange", "IndexRange_t", "I4", np.array(_RANGES[b](ni, nj)).T)
                     dr = _RANGES[ob](oni, onj)
                     if it.reversed:
                         dr = [dr[1], dr[0]]
                     _node(c, "PointRangeDonor", "IndexRange_t", "I4", np.array(dr).T)
-                    _node(c, "Transform", '"int[IndexDimension]"', "I4",
-                          transform(b, ob, it.reversed))
+                    _node(c, "Transform", '"int[IndexDimension]"', "I4", transform(b, ob, it.reversed))
 
 
 def _text(node) -> str:
@@ -186,8 +187,7 @@ def read_cgns(path: Path, **_: Any) -> GridSet:
     except OSError as exc:
         raise ReadError(f"{path}: not an HDF5/CGNS file ({exc})") from None
     with f:
-        base = next((f[k] for k in f if isinstance(f[k], h5py.Group)
-                     and _label(f[k]) == "CGNSBase_t"), None)
+        base = next((f[k] for k in f if isinstance(f[k], h5py.Group) and _label(f[k]) == "CGNSBase_t"), None)
         if base is None:
             raise ReadError(f"{path}: no CGNSBase_t node")
         crs, origin = None, (0.0, 0.0)

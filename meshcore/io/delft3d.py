@@ -45,13 +45,12 @@ def _rows(name: str, a: np.ndarray) -> list[str]:
     for j in range(nmax):
         v = a[:, j]
         for s in range(0, mmax, 5):
-            vals = "".join(f"{t:25.17E}" for t in v[s:s + 5])
+            vals = "".join(f"{t:25.17E}" for t in v[s : s + 5])
             out.append((f" ETA={j + 1:5d}" if s == 0 else " " * 10) + vals)
     return out
 
 
-def write_grd(path: Path, gs: GridSet, *, lonlat: bool = False, enclosure: bool = True,
-              **_: Any) -> None:
+def write_grd(path: Path, gs: GridSet, *, lonlat: bool = False, enclosure: bool = True, **_: Any) -> None:
     """Write an RGFGRID ``.grd`` (and ``.enc``) file (see module docstring)."""
     g = gs.blocks[0]
     if lonlat:
@@ -132,7 +131,7 @@ def read_grd(path: Path, **_: Any) -> GridSet:
         raise ReadError(f"{path}: {len(vals)} coordinates, expected 2 x {mmax} x {nmax}")
     a = np.array(vals)
     X = a[: mmax * nmax].reshape((nmax, mmax)).T
-    Y = a[mmax * nmax:].reshape((nmax, mmax)).T
+    Y = a[mmax * nmax :].reshape((nmax, mmax)).T
     if np.any(missing == X) or np.any(missing == Y):
         raise ReadError(f"{path}: grid has missing (inactive) points; only full grids are read")
     frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))

@@ -20,8 +20,7 @@ from ._base import PointSet, Polyline, make_polyline
 __all__ = ["read_points_dxf"]
 
 
-def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None,
-                    **_: Any) -> PointSet:
+def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None, **_: Any) -> PointSet:
     """Read polylines and splines from the model space of a DXF file."""
     try:
         import ezdxf
@@ -48,8 +47,7 @@ def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None
         elif kind == "POLYLINE":
             if e.is_poly_face_mesh or e.is_polygon_mesh:
                 continue
-            pts = np.array([(v.dxf.location[0], v.dxf.location[1]) for v in e.vertices],
-                           dtype=np.float64)
+            pts = np.array([(v.dxf.location[0], v.dxf.location[1]) for v in e.vertices], dtype=np.float64)
             raw.append((label, pts, bool(e.is_closed) or None, where))
         elif kind == "SPLINE":
             raw.append((label, e, None, where))

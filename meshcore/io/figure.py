@@ -17,8 +17,7 @@ from ._base import GridSet, atomic_path
 __all__ = ["write_figure"]
 
 
-def write_figure(path: Path, gs: GridSet, *, dpi: int = 150, title: str | None = None,
-                 **options: Any) -> None:
+def write_figure(path: Path, gs: GridSet, *, dpi: int = 150, title: str | None = None, **options: Any) -> None:
     """Draw the blocks of ``gs`` to an image file (format from the suffix)."""
     try:
         from matplotlib.figure import Figure

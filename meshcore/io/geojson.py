@@ -25,8 +25,10 @@ def _coords(c: Any, where: str) -> np.ndarray:
         raise ReadError(f"{where}: coordinates must be a non-empty list of positions")
     dims = set()
     for k, pos in enumerate(c):
-        if not isinstance(pos, list) or len(pos) < 2 or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in pos
+        if (
+            not isinstance(pos, list)
+            or len(pos) < 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in pos)
         ):
             raise ReadError(f"{where}: position {k} is not a list of numbers: {str(pos)[:40]}")
         dims.add(len(pos))
@@ -49,15 +51,15 @@ def _geometry(geom: Any, name: str, where: str, out: list[Polyline]) -> None:
             raise ReadError(f"{where}: Polygon without rings")
         for k, ring in enumerate(c):
             nm = name if k == 0 else f"{name} hole {k}"
-            out.append(make_polyline(nm, _coords(ring, f"{where} ring {k}"), closed=True,
-                                     where=where))
+            out.append(make_polyline(nm, _coords(ring, f"{where} ring {k}"), closed=True, where=where))
     elif t in ("MultiLineString", "MultiPolygon"):
         if not isinstance(c, list):
             raise ReadError(f"{where}: {t} coordinates must be a list")
         sub = t.removeprefix("Multi")
         for k, part in enumerate(c):
-            _geometry({"type": sub, "coordinates": part},
-                      f"{name} {k + 1}" if len(c) > 1 else name, f"{where} part {k}", out)
+            _geometry(
+                {"type": sub, "coordinates": part}, f"{name} {k + 1}" if len(c) > 1 else name, f"{where} part {k}", out
+            )
     elif t == "GeometryCollection":
         for k, g in enumerate(geom.get("geometries") or []):
             _geometry(g, f"{name} {k + 1}", f"{where} geometry {k}", out)

@@ -48,8 +48,7 @@ def _parse_xml(data: bytes, where: str):
         return fromstring(data, forbid_dtd=True, forbid_entities=True, forbid_external=True)
     except (DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden) as exc:
         raise ReadError(
-            f"{where}: refused: the XML declares a DTD or entities ({type(exc).__name__}); "
-            f"KML files never need them"
+            f"{where}: refused: the XML declares a DTD or entities ({type(exc).__name__}); KML files never need them"
         ) from None
     except ParseError as exc:
         line = getattr(exc, "position", (None,))[0]
@@ -79,8 +78,7 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
         tag = _local(child.tag)
         if tag == "LineString":
             c = _find_child(child, "coordinates")
-            out.append(make_polyline(name, _coordinates(c, f"{where} LineString"),
-                                     closed=None, where=where))
+            out.append(make_polyline(name, _coordinates(c, f"{where} LineString"), closed=None, where=where))
         elif tag == "Polygon":
             k = 0
             for bnd in child:
@@ -94,12 +92,10 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
                     nm = name if btag == "outerBoundaryIs" else f"{name} hole {k + 1}"
                     if btag == "innerBoundaryIs":
                         k += 1
-                    out.append(make_polyline(nm, _coordinates(c, f"{where} {btag}"),
-                                             closed=True, where=where))
+                    out.append(make_polyline(nm, _coordinates(c, f"{where} {btag}"), closed=True, where=where))
         elif tag == "LinearRing" and not _inside_polygon(elem, child):
             c = _find_child(child, "coordinates")
-            out.append(make_polyline(name, _coordinates(c, f"{where} LinearRing"),
-                                     closed=True, where=where))
+            out.append(make_polyline(name, _coordinates(c, f"{where} LinearRing"), closed=True, where=where))
         elif tag == "Point":
             c = _find_child(child, "coordinates")
             pl = Polyline(name, _coordinates(c, f"{where} Point"))
@@ -115,8 +111,7 @@ def _find_child(elem, tag: str) -> str | None:
 
 
 def _inside_polygon(root, ring) -> bool:
-    return any(_local(poly.tag) == "Polygon" and any(r is ring for r in poly.iter())
-               for poly in root.iter())
+    return any(_local(poly.tag) == "Polygon" and any(r is ring for r in poly.iter()) for poly in root.iter())
 
 
 def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
@@ -161,10 +156,7 @@ def read_points_kmz(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
             raise ReadError(f"{path}: refused: KMZ has {len(infos)} members")
         total = sum(i.file_size for i in infos)
         if total > KMZ_LIMIT:
-            raise ReadError(
-                f"{path}: refused: KMZ would uncompress to {total} bytes "
-                f"(limit {KMZ_LIMIT})"
-            )
+            raise ReadError(f"{path}: refused: KMZ would uncompress to {total} bytes (limit {KMZ_LIMIT})")
         kmls = [i for i in infos if i.filename.lower().endswith(".kml")]
         if not kmls:
             raise ReadError(f"{path}: KMZ archive holds no .kml file")

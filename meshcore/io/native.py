@@ -64,8 +64,20 @@ COLUMNS: dict[str, str] = {
     "eta_x": "-y_xi / J",
     "eta_y": "x_xi / J",
 }
-_METRIC_KEYS = ("x_xi", "x_eta", "y_xi", "y_eta", "jacobian", "alpha", "beta", "gamma",
-                "xi_x", "xi_y", "eta_x", "eta_y")
+_METRIC_KEYS = (
+    "x_xi",
+    "x_eta",
+    "y_xi",
+    "y_eta",
+    "jacobian",
+    "alpha",
+    "beta",
+    "gamma",
+    "xi_x",
+    "xi_y",
+    "eta_x",
+    "eta_y",
+)
 
 
 def _node_table(g: StructuredGrid, frame: Frame) -> dict[str, np.ndarray]:
@@ -84,8 +96,10 @@ def write_metrics_csv(path: Path, gs: GridSet, **_: Any) -> None:
     lines.append(f"# origin: {gs.frame.origin[0]!r} {gs.frame.origin[1]!r}")
     for k, g in enumerate(gs.blocks):
         nm = border_names(g)
-        lines.append(f"# block {k} ({gs.block_names[k]}): {g.shape[0]} x {g.shape[1]} nodes; "
-                     f"borders " + ", ".join(f"{b}={n}" for b, n in nm.items()))
+        lines.append(
+            f"# block {k} ({gs.block_names[k]}): {g.shape[0]} x {g.shape[1]} nodes; "
+            f"borders " + ", ".join(f"{b}={n}" for b, n in nm.items())
+        )
     for c, d in COLUMNS.items():
         lines.append(f"# column {c}: {d}")
     lines.append(",".join(COLUMNS))

@@ -30,8 +30,16 @@ from ._base import GridSet, atomic_path, read_bytes
 __all__ = ["read_plot3d", "write_plot3d"]
 
 
-def write_plot3d(path: Path, gs: GridSet, *, mode: str = "fortran", multi: bool | None = None,
-                 precision: str = "double", byte_order: str = "little", **_: Any) -> None:
+def write_plot3d(
+    path: Path,
+    gs: GridSet,
+    *,
+    mode: str = "fortran",
+    multi: bool | None = None,
+    precision: str = "double",
+    byte_order: str = "little",
+    **_: Any,
+) -> None:
     """Write blocks as a 2-D PLOT3D grid file (see module docstring)."""
     if mode not in ("ascii", "fortran", "binary"):
         raise WriteError(f"{path}: PLOT3D mode must be ascii, fortran or binary, got {mode!r}")
@@ -52,7 +60,7 @@ def write_plot3d(path: Path, gs: GridSet, *, mode: str = "fortran", multi: bool 
                     for arr in (x, y):
                         v = arr.ravel(order="F")
                         for s in range(0, len(v), 4):
-                            f.write(" ".join(f"{t:.17g}" for t in v[s:s + 4]) + "\n")
+                            f.write(" ".join(f"{t:.17g}" for t in v[s : s + 4]) + "\n")
             return
         bo = "<" if byte_order == "little" else ">"
         ft = np.dtype(f"{bo}f8" if precision == "double" else f"{bo}f4")
@@ -79,12 +87,12 @@ def _blocks_from(values: np.ndarray, dims: list[tuple[int, ...]], path: Path) ->
     for k, d in enumerate(dims):
         n = int(np.prod(d))
         ncoord = 3 if len(d) == 3 else 2
-        chunk = values[pos:pos + ncoord * n]
+        chunk = values[pos : pos + ncoord * n]
         if len(chunk) < ncoord * n:
             raise ReadError(f"{path}: block {k + 1} is truncated ({len(chunk)} of {ncoord * n} values)")
         pos += ncoord * n
         x = chunk[:n].reshape(d, order="F")
-        y = chunk[n:2 * n].reshape(d, order="F")
+        y = chunk[n : 2 * n].reshape(d, order="F")
         if len(d) == 3:
             x, y = x[:, :, 0], y[:, :, 0]
         if not (np.isfinite(x).all() and np.isfinite(y).all()):
@@ -120,20 +128,18 @@ def _read_ascii(path: Path, text: str) -> list[StructuredGrid]:
                 if multi and (v[0] != nb or nb < 1 or nb > 100_000):
                     continue
                 off = 1 if multi else 0
-                dv = v[off:off + nd * nb]
+                dv = v[off : off + nd * nb]
                 if len(dv) < nd * nb or np.any(dv != np.round(dv)) or np.any(dv < 1):
                     continue
-                dims = [tuple(int(t) for t in dv[k * nd:(k + 1) * nd]) for k in range(nb)]
+                dims = [tuple(int(t) for t in dv[k * nd : (k + 1) * nd]) for k in range(nb)]
                 need = sum(nd * int(np.prod(d)) for d in dims)
                 if len(v) - off - nd * nb != need:
                     continue
             except (OverflowError, ValueError):
                 continue
             _check_dims(dims, path)
-            return _blocks_from(v[off + nd * nb:], dims, path)
-    raise ReadError(
-        f"{path}: not a 2-D PLOT3D grid: the {len(v)} numbers match no single- or multi-block layout"
-    )
+            return _blocks_from(v[off + nd * nb :], dims, path)
+    raise ReadError(f"{path}: not a 2-D PLOT3D grid: the {len(v)} numbers match no single- or multi-block layout")
 
 
 def _isfloat(t: str) -> bool:
@@ -158,8 +164,7 @@ def _read_binary(path: Path, data: bytes) -> list[StructuredGrid]:
                             _check_dims(dims, path)
                             return _blocks_from(values, dims, path)
     raise ReadError(
-        f"{path}: not a 2-D PLOT3D grid: no ASCII, Fortran-unformatted or plain binary "
-        f"layout matches its {size} bytes"
+        f"{path}: not a 2-D PLOT3D grid: no ASCII, Fortran-unformatted or plain binary layout matches its {size} bytes"
     )
 
 
@@ -192,7 +197,7 @@ def _try_binary(data, size, bo, i4, fortran, multi, nd, fsz):
     d = ints(nd * nb)
     if d is None or np.any(d < 1) or np.any(d > 10**8):
         return None
-    dims = [tuple(int(t) for t in d[k * nd:(k + 1) * nd]) for k in range(nb)]
+    dims = [tuple(int(t) for t in d[k * nd : (k + 1) * nd]) for k in range(nb)]
     need = [nd * int(np.prod(dd)) * fsz for dd in dims]
     expect = pos + sum(need) + (8 * nb if fortran else 0)
     if expect != size:

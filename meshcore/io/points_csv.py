@@ -53,9 +53,11 @@ def _sniff(lines: list[str]) -> tuple[str | None, bool]:
     sample = lines[:50]
     for d in ("\t", ";", "|"):
         if sample and all(d in ln for ln in sample):
-            decimal_comma = d == ";" and any(
-                re.search(r"\d,\d", ln) for ln in sample
-            ) and not any(re.search(r"\d\.\d", ln) for ln in sample)
+            decimal_comma = (
+                d == ";"
+                and any(re.search(r"\d,\d", ln) for ln in sample)
+                and not any(re.search(r"\d\.\d", ln) for ln in sample)
+            )
             return d, decimal_comma
     if sample and all("," in ln for ln in sample):
         return ",", False
@@ -68,8 +70,9 @@ def _split(line: str, delim: str | None) -> list[str]:
     return [t.strip().strip('"').strip("'") for t in line.split(delim)]
 
 
-def read_points_csv(path: Path, *, columns: Any = None, crs: Any = None,
-                    closed: bool | None = None, **_: Any) -> PointSet:
+def read_points_csv(
+    path: Path, *, columns: Any = None, crs: Any = None, closed: bool | None = None, **_: Any
+) -> PointSet:
     """Read polylines from a delimited text file (see module docstring).
 
     Parameters
@@ -121,9 +124,12 @@ def read_points_csv(path: Path, *, columns: Any = None, crs: Any = None,
             segments.append((s[1:].strip() or None, rows))
             continue
         t = tokens(s)
-        if header is None and not any(r for _, r in segments) and not all(
-            _is_number(v) for v in t if v
-        ) and not any(_is_number(v) for v in t[:2]):
+        if (
+            header is None
+            and not any(r for _, r in segments)
+            and not all(_is_number(v) for v in t if v)
+            and not any(_is_number(v) for v in t[:2])
+        ):
             header = [_clean_header(v) for v in t]
             continue
         rows.append((lineno, t))
@@ -154,17 +160,13 @@ def read_points_csv(path: Path, *, columns: Any = None, crs: Any = None,
         if ix is None or iy is None:
             numeric = [k for k, v in enumerate(first) if _is_number(v)]
             if len(numeric) < 2:
-                raise ReadError(
-                    f"{path}: line {first_line}: no numeric x/y columns (header {header})"
-                )
+                raise ReadError(f"{path}: line {first_line}: no numeric x/y columns (header {header})")
             ix, iy = numeric[0], numeric[1]
         name_col = _find(header, _NAME_NAMES)
     else:
         numeric = [k for k, v in enumerate(first) if _is_number(v)]
         if len(numeric) < 2:
-            raise ReadError(
-                f"{path}: line {first_line}: no numeric columns (need at least two: x, y)"
-            )
+            raise ReadError(f"{path}: line {first_line}: no numeric columns (need at least two: x, y)")
         ix, iy = numeric[0], numeric[1]
     if ix == iy:
         raise ReadError(f"{path}: x and y are the same column ({ix})")
@@ -177,24 +179,24 @@ def read_points_csv(path: Path, *, columns: Any = None, crs: Any = None,
         for lineno, t in seg_rows:
             if len(t) != width:
                 raise ReadError(
-                    f"{path}: line {lineno}: mixed dimensions: {len(t)} values, "
-                    f"but line {first_line} has {width}"
+                    f"{path}: line {lineno}: mixed dimensions: {len(t)} values, but line {first_line} has {width}"
                 )
             try:
                 xv = float(t[ix].replace("d", "e").replace("D", "e"))
                 yv = float(t[iy].replace("d", "e").replace("D", "e"))
             except (ValueError, IndexError):
                 raise ReadError(
-                    f"{path}: line {lineno}: not a number in column {ix + 1} or {iy + 1}: "
-                    f"{' '.join(t)[:60]!r}"
+                    f"{path}: line {lineno}: not a number in column {ix + 1} or {iy + 1}: {' '.join(t)[:60]!r}"
                 ) from None
             gname = t[name_col] if name_col is not None else None
             if not groups or groups[-1][0] != gname:
                 groups.append((gname, []))
             groups[-1][1].append((xv, yv))
         for gname, pts in groups:
-            name = gname or seg_name or (
-                base if len(segments) == 1 and len(groups) == 1 else f"{base} {len(polylines) + 1}"
+            name = (
+                gname
+                or seg_name
+                or (base if len(segments) == 1 and len(groups) == 1 else f"{base} {len(polylines) + 1}")
             )
             arr = np.array(pts, dtype=np.float64)
             if len(arr) < 2:

@@ -76,10 +76,18 @@ def write_sgrid(path: Path, gs: GridSet, *, lonlat: bool | None = None, **_: Any
         t.local_origin = np.array(gs.frame.origin, dtype=np.float64)
         proj = crs is not None and not crs.upper().startswith("EPSG:4326")
         for name, arr, std, units in (
-            ("x", X, "projection_x_coordinate" if proj else "longitude" if crs else "",
-             "m" if proj else "degrees_east" if crs else "1"),
-            ("y", Y, "projection_y_coordinate" if proj else "latitude" if crs else "",
-             "m" if proj else "degrees_north" if crs else "1"),
+            (
+                "x",
+                X,
+                "projection_x_coordinate" if proj else "longitude" if crs else "",
+                "m" if proj else "degrees_east" if crs else "1",
+            ),
+            (
+                "y",
+                Y,
+                "projection_y_coordinate" if proj else "latitude" if crs else "",
+                "m" if proj else "degrees_north" if crs else "1",
+            ),
         ):
             v = f.createVariable(name, "d", ("jnode", "inode"))
             v[:] = arr.T
@@ -92,8 +100,10 @@ def write_sgrid(path: Path, gs: GridSet, *, lonlat: bool | None = None, **_: Any
                 v.grid_mapping = "crs"
         if with_ll:
             lon, lat = gs.frame.to_lonlat(g.x, g.y)
-            for name, arr, std, units in (("lon", lon, "longitude", "degrees_east"),
-                                          ("lat", lat, "latitude", "degrees_north")):
+            for name, arr, std, units in (
+                ("lon", lon, "longitude", "degrees_east"),
+                ("lat", lat, "latitude", "degrees_north"),
+            ):
                 v = f.createVariable(name, "d", ("jnode", "inode"))
                 v[:] = arr.T
                 v.standard_name = std

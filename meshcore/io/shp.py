@@ -39,9 +39,7 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     shx, dbf = _sibling(path, ".shx"), _sibling(path, ".dbf")
     missing = [s for s, p in ((".shx", shx), (".dbf", dbf)) if p is None]
     if missing:
-        raise ReadError(
-            f"{path}: the shapefile is incomplete: missing {' and '.join(missing)} next to it"
-        )
+        raise ReadError(f"{path}: the shapefile is incomplete: missing {' and '.join(missing)} next to it")
     prj = _sibling(path, ".prj")
     declared = None
     if crs is not None:
@@ -59,13 +57,17 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
         except shapefile.ShapefileException as exc:
             raise ReadError(f"{path}: not a valid shapefile ({exc})") from None
         fields = [f[0] for f in reader.fields[1:]]
-        name_field = next(
-            (f for f in fields if f.lower() in ("name", "id", "label", "title")), None
-        )
+        name_field = next((f for f in fields if f.lower() in ("name", "id", "label", "title")), None)
         polygon_types = {shapefile.POLYGON, shapefile.POLYGONZ, shapefile.POLYGONM}
         line_types = {shapefile.POLYLINE, shapefile.POLYLINEZ, shapefile.POLYLINEM}
-        point_types = {shapefile.POINT, shapefile.POINTZ, shapefile.POINTM,
-                       shapefile.MULTIPOINT, shapefile.MULTIPOINTZ, shapefile.MULTIPOINTM}
+        point_types = {
+            shapefile.POINT,
+            shapefile.POINTZ,
+            shapefile.POINTM,
+            shapefile.MULTIPOINT,
+            shapefile.MULTIPOINTZ,
+            shapefile.MULTIPOINTM,
+        }
         out: list[Polyline] = []
         points: list[np.ndarray] = []
         n = len(reader)
@@ -75,9 +77,7 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
             nm = None
             if name_field is not None:
                 nm = rec[name_field]
-            name = str(nm).strip() if nm not in (None, "") else (
-                path.stem if n == 1 else f"{path.stem} {k + 1}"
-            )
+            name = str(nm).strip() if nm not in (None, "") else (path.stem if n == 1 else f"{path.stem} {k + 1}")
             where = f"{path}: shape {k} ({name})"
             if shp.shapeType == shapefile.NULL:
                 continue
@@ -89,12 +89,13 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
                 raise ReadError(f"{where}: unsupported shape type {shp.shapeTypeName}")
             parts = [*list(shp.parts), len(pts)]
             for p in range(len(parts) - 1):
-                seg = pts[parts[p]:parts[p + 1]]
+                seg = pts[parts[p] : parts[p + 1]]
                 if len(seg) < 2:
                     raise ReadError(f"{where}: part {p} has fewer than 2 points")
                 nmp = name if len(parts) == 2 else f"{name} part {p + 1}"
-                out.append(make_polyline(nmp, seg, closed=True if shp.shapeType in polygon_types
-                                         else None, where=where))
+                out.append(
+                    make_polyline(nmp, seg, closed=True if shp.shapeType in polygon_types else None, where=where)
+                )
         if points:
             allp = np.vstack(points)
             if len(allp) >= 2:

@@ -49,8 +49,7 @@ def to_unstructured(gs: GridSet) -> UnstructuredMesh:
     for k, g in enumerate(gs.blocks):
         idx = np.full(g.shape, -1, dtype=np.int64)
         for it in gs.connectivity:
-            for me, mb, other, ob in ((it.b, it.border_b, it.a, it.border_a),
-                                      (it.a, it.border_a, it.b, it.border_b)):
+            for me, mb, other, ob in ((it.b, it.border_b, it.a, it.border_a), (it.a, it.border_a, it.b, it.border_b)):
                 if me == k and other < k:
                     src = ids[other][border_index(gs.blocks[other].shape, ob)]
                     idx[border_index(g.shape, mb)] = src[::-1] if it.reversed else src
@@ -94,8 +93,7 @@ def write_msh(path: Path, gs: GridSet, **_: Any) -> None:
     markers = list(dict.fromkeys(b[0] for b in m.borders))
     phys1 = {nm: k + 1 for k, nm in enumerate(markers)}
     phys2 = {k: len(markers) + k + 1 for k in range(len(gs.blocks))}
-    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat", "$PhysicalNames",
-           str(len(phys1) + len(phys2))]
+    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(phys1) + len(phys2))]
     out += [f'1 {t} "{nm}"' for nm, t in phys1.items()]
     out += [f'2 {t} "{gs.block_names[k]}"' for k, t in phys2.items()]
     out.append("$EndPhysicalNames")
@@ -112,8 +110,9 @@ def write_msh(path: Path, gs: GridSet, **_: Any) -> None:
         curve_of_block.setdefault(k, []).append(c)
     for k, q in enumerate(m.quads):
         curves = curve_of_block.get(k, [])
-        out.append(f"{k + 1} {bbox(m.points[np.unique(q)])} 1 {phys2[k]} {len(curves)} "
-                   + " ".join(str(c) for c in curves))
+        out.append(
+            f"{k + 1} {bbox(m.points[np.unique(q)])} 1 {phys2[k]} {len(curves)} " + " ".join(str(c) for c in curves)
+        )
     out.append("$EndEntities")
     # nodes: each node in the surface entity of the first block that uses it
     owner = np.full(len(m.points), -1)

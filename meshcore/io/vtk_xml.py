@@ -41,8 +41,10 @@ __all__ = ["read_vtm", "read_vts", "write_vtm", "write_vts"]
 
 def _string_array(name: str, s: str) -> str:
     codes = " ".join(str(b) for b in s.encode("utf-8")) + " 0"
-    return (f'      <Array type="String" Name="{name}" NumberOfTuples="1" format="ascii">\n'
-            f"        {codes}\n      </Array>\n")
+    return (
+        f'      <Array type="String" Name="{name}" NumberOfTuples="1" format="ascii">\n'
+        f"        {codes}\n      </Array>\n"
+    )
 
 
 def _vts_bytes(g: StructuredGrid, frame: Frame, *, data: bool = True) -> bytes:
@@ -89,11 +91,10 @@ def _vts_bytes(g: StructuredGrid, frame: Frame, *, data: bool = True) -> bytes:
         '<?xml version="1.0"?>\n'
         '<VTKFile type="StructuredGrid" version="1.0" byte_order="LittleEndian" '
         'header_type="UInt64">\n'
-        f'  <StructuredGrid WholeExtent="{ext}">\n' + field
-        + f'    <Piece Extent="{ext}">\n'
-        '      <PointData>\n' + "".join(xml["PointData"]) + "      </PointData>\n"
-        '      <CellData>\n' + "".join(xml["CellData"]) + "      </CellData>\n"
-        '      <Points>\n' + "".join(xml["Points"]) + "      </Points>\n"
+        f'  <StructuredGrid WholeExtent="{ext}">\n' + field + f'    <Piece Extent="{ext}">\n'
+        "      <PointData>\n" + "".join(xml["PointData"]) + "      </PointData>\n"
+        "      <CellData>\n" + "".join(xml["CellData"]) + "      </CellData>\n"
+        "      <Points>\n" + "".join(xml["Points"]) + "      </Points>\n"
         "    </Piece>\n  </StructuredGrid>\n"
         '  <AppendedData encoding="raw">\n   _'
     )
@@ -124,14 +125,12 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
         for k, g in enumerate(gs.blocks):
             fn = f"{sub.name}_{k}.vts"
             (tmpdir / fn).write_bytes(_vts_bytes(g, gs.frame, data=data))
-            entries.append(
-                f'    <DataSet index="{k}" name="{_xml_attr(gs.block_names[k])}" '
-                f'file="{sub.name}/{fn}"/>\n'
-            )
+            entries.append(f'    <DataSet index="{k}" name="{_xml_attr(gs.block_names[k])}" file="{sub.name}/{fn}"/>\n')
         vtm = (
             '<?xml version="1.0"?>\n'
             '<VTKFile type="vtkMultiBlockDataSet" version="1.0" byte_order="LittleEndian" '
-            'header_type="UInt64">\n  <vtkMultiBlockDataSet>\n' + "".join(entries)
+            'header_type="UInt64">\n  <vtkMultiBlockDataSet>\n'
+            + "".join(entries)
             + "  </vtkMultiBlockDataSet>\n</VTKFile>\n"
         )
         os.chmod(tmpdir, 0o755)
@@ -154,15 +153,23 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
 
 
 def _xml_attr(s: str) -> str:
-    return (s.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
-            .replace(">", "&gt;"))
+    return s.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
 
 
 # ----------------------------------------------------------------- reading
 _DTYPES = {
-    "Float64": "f8", "Float32": "f4", "Int8": "i1", "UInt8": "u1", "Int16": "i2",
-    "UInt16": "u2", "Int32": "i4", "UInt32": "u4", "Int64": "i8", "UInt64": "u8",
-    "String": "u1", "Char": "i1",
+    "Float64": "f8",
+    "Float32": "f4",
+    "Int8": "i1",
+    "UInt8": "u1",
+    "Int16": "i2",
+    "UInt16": "u2",
+    "Int32": "i4",
+    "UInt32": "u4",
+    "Int64": "i8",
+    "UInt64": "u8",
+    "String": "u1",
+    "Char": "i1",
 }
 
 
@@ -178,8 +185,8 @@ def _parse(data: bytes, path: Path):
         end = data.rfind(b"</AppendedData>")
         if start < 0 or us < 0 or end < us:
             raise ReadError(f"{path}: malformed <AppendedData> section")
-        appended = data[us + 1:end]
-        data = data[:start + 1] + b"</AppendedData>" + data[end + len(b"</AppendedData>"):]
+        appended = data[us + 1 : end]
+        data = data[: start + 1] + b"</AppendedData>" + data[end + len(b"</AppendedData>") :]
     root = _parse_xml(data, str(path))
     return root, appended
 
@@ -214,32 +221,32 @@ class _Decoder:
             n0 = int(np.frombuffer(first[:hs], dtype=self.header)[0])
             if not self.compressed:
                 # VTK encodes the header and the data separately; accept both ways
-                data = base64.b64decode(buf[chars(hs): chars(hs) + chars(n0)])
+                data = base64.b64decode(buf[chars(hs) : chars(hs) + chars(n0)])
                 if len(data) >= n0:
                     return data[:n0]
                 whole = base64.b64decode(buf[: chars(hs + n0)])
                 if len(whole) < hs + n0:
                     raise ReadError(f"{self.path}: base64 data truncated")
-                return whole[hs:hs + n0]
+                return whole[hs : hs + n0]
             hlen = (3 + n0) * hs
             hdr = np.frombuffer(base64.b64decode(buf[: chars(hlen)])[:hlen], dtype=self.header)
-            total = int(hdr[3:3 + n0].astype(np.int64).sum())
-            body = base64.b64decode(buf[chars(hlen): chars(hlen) + chars(total)])
+            total = int(hdr[3 : 3 + n0].astype(np.int64).sum())
+            body = base64.b64decode(buf[chars(hlen) : chars(hlen) + chars(total)])
             return self._inflate(hdr, body)
         n0 = int(np.frombuffer(buf[:hs], dtype=self.header)[0])
         if not self.compressed:
             if len(buf) < hs + n0:
                 raise ReadError(f"{self.path}: appended data truncated")
-            return buf[hs:hs + n0]
+            return buf[hs : hs + n0]
         hdr = np.frombuffer(buf[: (3 + n0) * hs], dtype=self.header)
-        return self._inflate(hdr, buf[(3 + n0) * hs:])
+        return self._inflate(hdr, buf[(3 + n0) * hs :])
 
     def _inflate(self, hdr: np.ndarray, body: bytes) -> bytes:
         nb = int(hdr[0])
-        sizes = hdr[3:3 + nb].astype(np.int64)
+        sizes = hdr[3 : 3 + nb].astype(np.int64)
         out, pos = [], 0
         for s in sizes:
-            out.append(zlib.decompress(body[pos:pos + int(s)]))
+            out.append(zlib.decompress(body[pos : pos + int(s)]))
             pos += int(s)
         return b"".join(out)
 
@@ -258,9 +265,7 @@ class _Decoder:
             raw = self._unpack(self.appended[off:], self.app_encoding == "base64")
         else:
             raise ReadError(f"{self.path}: unknown DataArray format {fmt!r}")
-        return np.frombuffer(raw[: len(raw) // dt.itemsize * dt.itemsize], dtype=dt).astype(
-            np.float64
-        )
+        return np.frombuffer(raw[: len(raw) // dt.itemsize * dt.itemsize], dtype=dt).astype(np.float64)
 
 
 def _local(tag: str) -> str:
@@ -287,8 +292,7 @@ def read_vts(path: Path, **_: Any) -> GridSet:
     if nk != 1 or ni < 2 or nj < 2:
         raise ReadError(f"{path}: extent {ext} is not a 2-D grid of at least 2 × 2 nodes")
     pts_el = next((e for e in piece.iter() if _local(e.tag) == "Points"), None)
-    arr_el = None if pts_el is None else next(
-        (e for e in pts_el if _local(e.tag) == "DataArray"), None)
+    arr_el = None if pts_el is None else next((e for e in pts_el if _local(e.tag) == "DataArray"), None)
     if arr_el is None:
         raise ReadError(f"{path}: no <Points> DataArray")
     p = dec.array(arr_el)

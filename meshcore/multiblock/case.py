@@ -134,8 +134,7 @@ def _read_outline(value: Any, base: Any, where: str) -> tuple[np.ndarray, Any]:
     return xy_pairs(value, where), None
 
 
-def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where: str,
-                     src_crs: Any, case_frame: Any):
+def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where: str, src_crs: Any, case_frame: Any):
     """Project the outline and the extra points; return (xy, extra_xy, frame)."""
     from ..crs import LONLAT, Frame, _pyproj, project
     from ..io._base import PointSet, Polyline
@@ -177,9 +176,7 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, Any]:
         raise CaseFileError(f"{where} must be a table")
     _check_keys(tbl, OUTLINE_KEYS, where)
     if case.blocks:
-        raise CaseFileError(
-            f"{src}: an [outline] case defines its blocks in [[outline.blocks]]; remove [[blocks]]"
-        )
+        raise CaseFileError(f"{src}: an [outline] case defines its blocks in [[outline.blocks]]; remove [[blocks]]")
     for key in ("points", "cuts", "blocks"):
         if key not in tbl:
             raise CaseFileError(f"{where}: missing key {key!r}")
@@ -212,12 +209,14 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, Any]:
         corners = b["corners"]
         if not isinstance(corners, list) or len(corners) != 4:
             raise CaseFileError(f"{bw}: corners must be 4 points (sw, se, ne, nw)")
-        blocks.append({
-            "name": str(b["name"]),
-            "corners": [_outline_point(v, f"{bw}: corners") for v in corners],
-            "cells": list(b["cells"]),
-            "initial": str(b.get("initial", "tfi")),
-        })
+        blocks.append(
+            {
+                "name": str(b["name"]),
+                "corners": [_outline_point(v, f"{bw}: corners") for v in corners],
+                "cells": list(b["cells"]),
+                "initial": str(b.get("initial", "tfi")),
+            }
+        )
     from ..crs import frame_from_case, is_geographic, looks_lonlat
 
     frame = None
@@ -229,8 +228,7 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, Any]:
     if crs not in ("xy", "none") and (crs != "auto" or geographic):
         extra = [v for c in cuts for v in c if not isinstance(v, int)]
         extra += [v for b in blocks for v in b["corners"] if not isinstance(v, int)]
-        xy, ex, frame = _project_outline(pts, extra, crs, tbl.get("origin"), where, src_crs,
-                                         frame_from_case(case))
+        xy, ex, frame = _project_outline(pts, extra, crs, tbl.get("origin"), where, src_crs, frame_from_case(case))
         it = iter(ex.tolist())
         cuts = [[v if isinstance(v, int) else next(it) for v in c] for c in cuts]
         for b in blocks:
@@ -348,10 +346,16 @@ def topology_case(
     blocks = []
     for b in topology.blocks:
         specs = {n: BorderSpec(name=v) for n, v in b.names.items() if n in BORDER_NAMES and v}
-        blocks.append(BlockCase(
-            name=b.name, cells=None, weights=tuple(b.weights), initial=b.initial,
-            borders={n: np.asarray(b.borders[n]) for n in BORDER_NAMES}, border_specs=specs,
-        ))
+        blocks.append(
+            BlockCase(
+                name=b.name,
+                cells=None,
+                weights=tuple(b.weights),
+                initial=b.initial,
+                borders={n: np.asarray(b.borders[n]) for n in BORDER_NAMES},
+                border_specs=specs,
+            )
+        )
     itfs = [
         {
             "a": f"{i.a.block}.{i.a.border}[{i.a.start}:{i.a.stop}]",
@@ -361,7 +365,9 @@ def topology_case(
         for i in topology.interfaces
     ]
     return Case(
-        blocks=tuple(blocks), title=title, description=description,
+        blocks=tuple(blocks),
+        title=title,
+        description=description,
         solver=solver or EllipticConfig(),
         extra={"multiblock": {"mode": mode}, "interfaces": itfs},
     )

@@ -59,8 +59,17 @@ def plot_multiblock(
         ax.add_collection(LineCollection(segs, colors=[c], linewidths=linewidth))
         if labels:
             i, j = x.shape[0] // 2, x.shape[1] // 2
-            ax.text(x[i, j], y[i, j], name, color="k", fontsize=8, ha="center", va="center", clip_on=True,
-                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": c, "alpha": 0.85})
+            ax.text(
+                x[i, j],
+                y[i, j],
+                name,
+                color="k",
+                fontsize=8,
+                ha="center",
+                va="center",
+                clip_on=True,
+                bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": c, "alpha": 0.85},
+            )
     for itf in mb.interfaces:
         p = mb[itf.a.block].border(itf.a.border)[itf.a.start : itf.a.stop + 1] * scale
         ax.plot(p[:, 0], p[:, 1], color="k", lw=1.2, ls="--", zorder=3)

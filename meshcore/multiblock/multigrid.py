@@ -90,9 +90,7 @@ def _factors_ok(topo: MultiBlockTopology, factors: list[tuple[int, int]]) -> boo
     return True
 
 
-def coarsen(
-    topo: MultiBlockTopology, factors: list[tuple[int, int]] | None = None
-) -> MultiBlockTopology | None:
+def coarsen(topo: MultiBlockTopology, factors: list[tuple[int, int]] | None = None) -> MultiBlockTopology | None:
     """Every ``ci``-th / ``cj``-th node of every block (default: every other node), or None.
 
     ``factors[k] = (ci, cj) ∈ {1, 2}²`` per block; an interface's two sides
@@ -107,10 +105,14 @@ def coarsen(
         Block(
             b.name,
             Borders(
-                bottom=b.borders.bottom[::ci], right=b.borders.right[::cj],
-                top=b.borders.top[::ci], left=b.borders.left[::cj],
+                bottom=b.borders.bottom[::ci],
+                right=b.borders.right[::cj],
+                top=b.borders.top[::ci],
+                left=b.borders.left[::cj],
             ),
-            initial=b.initial, weights=b.weights, names=b.names,
+            initial=b.initial,
+            weights=b.weights,
+            names=b.names,
         )
         for b, (ci, cj) in zip(topo.blocks, factors, strict=True)
     )
@@ -163,13 +165,18 @@ def plan(topo: MultiBlockTopology, aspect: np.ndarray) -> list[tuple[int, int]] 
     chosen = set()
     for c in np.unique(cls):
         if want[c] >= CLASS_VOTE * total[c]:
-            trial = [(2 if cls[2 * k] == c or cls[2 * k] in chosen else 1,
-                      2 if cls[2 * k + 1] == c or cls[2 * k + 1] in chosen else 1)
-                     for k in range(len(topo.blocks))]
+            trial = [
+                (
+                    2 if cls[2 * k] == c or cls[2 * k] in chosen else 1,
+                    2 if cls[2 * k + 1] == c or cls[2 * k + 1] in chosen else 1,
+                )
+                for k in range(len(topo.blocks))
+            ]
             if _factors_ok(topo, trial):
                 chosen.add(int(c))
-    factors = [(2 if cls[2 * k] in chosen else 1, 2 if cls[2 * k + 1] in chosen else 1)
-               for k in range(len(topo.blocks))]
+    factors = [
+        (2 if cls[2 * k] in chosen else 1, 2 if cls[2 * k + 1] in chosen else 1) for k in range(len(topo.blocks))
+    ]
     if all(f == (1, 1) for f in factors):
         return None
     return factors
@@ -232,8 +239,7 @@ def _make_level(t: MultiBlockTopology, grids: list) -> _Level:
     free[m.nodes] = True
     free[m.irr_nodes] = True
     mult = np.bincount(np.concatenate([g.ravel() for g in m.ids]), minlength=m.n_nodes)
-    return _Level(t, (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring), m.n_nodes, free,
-                  mult.astype(float), grids)
+    return _Level(t, (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring), m.n_nodes, free, mult.astype(float), grids)
 
 
 def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True) -> list[_Level]:
@@ -255,8 +261,7 @@ def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True)
         tc = coarsen(t, factors)
         if tc is None:
             break
-        cgrids = [(x[::ci, ::cj], y[::ci, ::cj]) for (x, y), (ci, cj)
-                  in zip(out[-1].grids, factors, strict=True)]
+        cgrids = [(x[::ci, ::cj], y[::ci, ::cj]) for (x, y), (ci, cj) in zip(out[-1].grids, factors, strict=True)]
         lv = _make_level(tc, cgrids)
         lv.factors = factors
         out.append(lv)
@@ -266,8 +271,7 @@ def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True)
         inj = np.empty(mc.n_nodes, dtype=np.int64)
         scale = np.zeros(mc.n_nodes)
         rsum = np.zeros(mc.n_nodes)
-        for gf, gc, (ci, cj), (x, y) in zip(mf.ids, mc.ids, coarse.factors, fine.grids,
-                                             strict=True):
+        for gf, gc, (ci, cj), (x, y) in zip(mf.ids, mc.ids, coarse.factors, fine.grids, strict=True):
             inj[gc.ravel()] = gf[::ci, ::cj].ravel()
             # FAS scaling: A = −N/(2(α+γ)), N ~ (ab)², α → b²α, γ → a²γ
             gx0, gy0 = np.gradient(x, axis=0), np.gradient(y, axis=0)
@@ -286,8 +290,7 @@ def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True)
 def _restrict(fine: _Level, coarse: _Level, r: np.ndarray) -> np.ndarray:
     """``R r = D⁻¹ Pᵀ r`` (transpose of the blockwise bilinear prolongation, row-normalised)."""
     acc = np.zeros(coarse.n)
-    for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids,
-                                coarse.factors, strict=True):
+    for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids, coarse.factors, strict=True):
         np.add.at(acc, gc.ravel(), _adjoint(r[gf] / fine.mult[gf], ci, cj).ravel())
     out = acc / coarse.rsum
     out[~coarse.free] = 0.0
@@ -297,8 +300,7 @@ def _restrict(fine: _Level, coarse: _Level, r: np.ndarray) -> np.ndarray:
 def _prolong(fine: _Level, coarse: _Level, e: np.ndarray) -> np.ndarray:
     """Bilinear interpolation of the coarse correction ``e`` block by block."""
     c = np.zeros(fine.n)
-    for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids,
-                                coarse.factors, strict=True):
+    for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids, coarse.factors, strict=True):
         c[gf] = _interp(e[gc], ci, cj)
     c[~fine.free] = 0.0
     return c
@@ -339,8 +341,16 @@ def _cycle(lvs: list[_Level], k: int, x, y, fx, fy) -> None:
         _kernels.table_sweep_rhs(x, y, fx, fy, *lv.args, 1.0)
 
 
-def solve_fas(x, y, topo: MultiBlockTopology, tol: float, max_cycles: int, callback=None,
-              give_up_rate: float | None = None, lvs: list | None = None):
+def solve_fas(
+    x,
+    y,
+    topo: MultiBlockTopology,
+    tol: float,
+    max_cycles: int,
+    callback=None,
+    give_up_rate: float | None = None,
+    lvs: list | None = None,
+):
     """V-cycles on the global arrays ``x, y`` (in place) until the Jacobi residual ≤ ``tol``.
 
     ``give_up_rate``: stop with message ``"slow"`` when, from the third cycle

@@ -46,9 +46,7 @@ __all__ = ["BlockOutline", "OutlineBlocks", "from_outline", "project_lonlat"]
 EARTH_RADIUS_M = 6_371_008.8  # mean Earth radius (IUGG)
 
 
-def project_lonlat(
-    lonlat: Any, *, origin: tuple[float, float] | None = None
-) -> tuple[np.ndarray, tuple[float, float]]:
+def project_lonlat(lonlat: Any, *, origin: tuple[float, float] | None = None) -> tuple[np.ndarray, tuple[float, float]]:
     r"""Local equirectangular projection of lon/lat degrees to metres.
 
     .. math::  x = R\,(λ − λ_0)\cos φ_0,\qquad y = R\,(φ − φ_0)
@@ -92,9 +90,7 @@ class BlockOutline:
                 )
             missing = {"name", "corners", "cells"} - set(value)
             if missing:
-                raise InvalidInputError(
-                    f"outline block {value.get('name', '?')!r}: missing {sorted(missing)}"
-                )
+                raise InvalidInputError(f"outline block {value.get('name', '?')!r}: missing {sorted(missing)}")
             return cls(
                 name=str(value["name"]),
                 corners=tuple(value["corners"]),
@@ -213,13 +209,10 @@ def from_outline(
     cut_list = []
     for k, c in enumerate(cuts):
         try:
-            pts = [
-                given_ring[int(v)] if isinstance(v, (int, np.integer)) else v for v in c
-            ]
+            pts = [given_ring[int(v)] if isinstance(v, (int, np.integer)) else v for v in c]
         except (IndexError, TypeError):
             raise TopologyError(
-                f"cut {k}: points must be [x, y] pairs or outline point indices "
-                f"(0 … {len(given_ring) - 1}), got {c!r}"
+                f"cut {k}: points must be [x, y] pairs or outline point indices (0 … {len(given_ring) - 1}), got {c!r}"
             ) from None
         cut_list.append(validate_points(pts, name=f"cut {k}"))
     if not cut_list:
@@ -261,9 +254,7 @@ def from_outline(
         inner = LineString(c).intersection(LineString(np.vstack([ring, ring[:1]])))
         n_touch = len(getattr(inner, "geoms", [inner])) if not inner.is_empty else 0
         if n_touch > 2:
-            raise TopologyError(
-                f"cut {k} touches the outline {n_touch} times; a cut may meet it only at its ends"
-            )
+            raise TopologyError(f"cut {k} touches the outline {n_touch} times; a cut may meet it only at its ends")
     # --- regions
     lines = shapely.union_all([LineString(np.vstack([ring, ring[:1]])), *(LineString(c) for c in cut_list)])
     faces = [orient(f, 1.0) for f in shapely.polygonize(list(getattr(lines, "geoms", [lines]))).geoms]
@@ -271,8 +262,7 @@ def from_outline(
     area = sum(f.area for f in faces)
     if abs(area - lake.area) > 1e-6 * lake.area:
         raise TopologyError(
-            f"the cuts do not split the lake cleanly: regions cover {area:.6g} of its area "
-            f"{lake.area:.6g}"
+            f"the cuts do not split the lake cleanly: regions cover {area:.6g} of its area {lake.area:.6g}"
         )
     for f in faces:
         if f.interiors:
@@ -316,8 +306,7 @@ def from_outline(
             if isinstance(c, (int, np.integer)):
                 if not -given_n <= int(c) < given_n:
                     raise TopologyError(
-                        f"block {s.name!r}: corner {lab} index {c} is outside the outline "
-                        f"(0 … {given_n - 1})"
+                        f"block {s.name!r}: corner {lab} index {c} is outside the outline (0 … {given_n - 1})"
                     )
                 q = given_ring[int(c)]
             else:
@@ -347,14 +336,10 @@ def from_outline(
             )
         ok = [fi for fi, good in cand if good]
         if not ok:
-            raise TopologyError(
-                f"block {s.name!r}: corners must be given counter-clockwise as sw, se, ne, nw"
-            )
+            raise TopologyError(f"block {s.name!r}: corners must be given counter-clockwise as sw, se, ne, nw")
         fi = ok[0]
         if fi in face_of:
-            raise TopologyError(
-                f"blocks {face_of[fi]!r} and {s.name!r} overlap: both are the same region"
-            )
+            raise TopologyError(f"blocks {face_of[fi]!r} and {s.name!r} overlap: both are the same region")
         face_of[fi] = s.name
         block_face[s.name] = fi
         block_corners[s.name] = cs
@@ -362,9 +347,7 @@ def from_outline(
     for fi, f in enumerate(faces):
         if fi not in face_of:
             c = f.representative_point()
-            around = sorted(
-                {face_of[g] for g in face_of if faces[g].distance(f) <= 1e-9 * size}
-            )
+            around = sorted({face_of[g] for g in face_of if faces[g].distance(f) <= 1e-9 * size})
             raise TopologyError(
                 f"gap: the region near ({c.x:.6g}, {c.y:.6g}) (area {f.area:.4g}, next to "
                 f"{', '.join(repr(a) for a in around) or 'no block'}) is covered by no block; "
@@ -374,8 +357,7 @@ def from_outline(
     for s in specs:
         if s.cells[0] % multiple or s.cells[1] % multiple:
             raise TopologyError(
-                f"block {s.name!r}: cells {list(s.cells)} must be multiples of {multiple} "
-                f"(multiple = {multiple})"
+                f"block {s.name!r}: cells {list(s.cells)} must be multiples of {multiple} (multiple = {multiple})"
             )
     # --- sides → chains
     breaks = set(corner_set) | {v for v, nb in nbrs.items() if len(nb) >= 3}
@@ -387,8 +369,7 @@ def from_outline(
         n = len(r)
         pos = {_key(p): i for i, p in enumerate(r)}
         ci = [pos[c] for c in block_corners[s.name]]
-        for side, (a, b) in zip(("bottom", "right", "top", "left"), zip(ci, ci[1:] + ci[:1], strict=True),
-                                strict=True):
+        for side, (a, b) in zip(("bottom", "right", "top", "left"), zip(ci, ci[1:] + ci[:1], strict=True), strict=True):
             walk = [r[(a + k) % n] for k in range((b - a) % n + 1)]
             chains, cur = [], [walk[0]]
             for p in walk[1:]:

@@ -83,8 +83,7 @@ class MultiBlockQuality:
 
     def table(self) -> str:
         lines = [
-            "| block | cells | folded | min Jac. ratio | max orth. dev. | max skew | max aspect "
-            "| max size ratio |",
+            "| block | cells | folded | min Jac. ratio | max orth. dev. | max skew | max aspect | max size ratio |",
             "|---|---|---|---|---|---|---|---|",
         ]
         for name, r in self.blocks.items():
@@ -171,10 +170,7 @@ class MultiBlockGrid:
             x, y = _assemble(self.grids, m)
             c = m.cells
             cx, cy = x[c], y[c]
-            area = 0.5 * (
-                (cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3])
-                - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2])
-            )
+            area = 0.5 * ((cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3]) - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2]))
             e0 = c.reshape(-1)
             e1 = np.roll(c, -1, axis=1).reshape(-1)
             cid = np.repeat(np.arange(len(c)), 4)
@@ -231,8 +227,12 @@ def snapped_borders(topology: MultiBlockTopology) -> list:
     out = []
     for b, ids in zip(topology.blocks, m.ids, strict=True):
         new = {}
-        for name, sl in (("bottom", (slice(None), 0)), ("top", (slice(None), -1)),
-                         ("left", (0, slice(None))), ("right", (-1, slice(None)))):
+        for name, sl in (
+            ("bottom", (slice(None), 0)),
+            ("top", (slice(None), -1)),
+            ("left", (0, slice(None))),
+            ("right", (-1, slice(None))),
+        ):
             g = ids[sl]
             p = np.array(b.borders[name], dtype=np.float64)
             have = ~np.isnan(x[g])
@@ -243,8 +243,12 @@ def snapped_borders(topology: MultiBlockTopology) -> list:
             new[name] = p
         # the corners were written by the first border that saw them
         for name in ("bottom", "top", "left", "right"):
-            sl = {"bottom": (slice(None), 0), "top": (slice(None), -1),
-                  "left": (0, slice(None)), "right": (-1, slice(None))}[name]
+            sl = {
+                "bottom": (slice(None), 0),
+                "top": (slice(None), -1),
+                "left": (0, slice(None)),
+                "right": (-1, slice(None)),
+            }[name]
             g = ids[sl]
             new[name][:, 0] = x[g]
             new[name][:, 1] = y[g]
@@ -311,9 +315,7 @@ def solve_multiblock(
     t0 = time.perf_counter()
     grids = list(initial) if initial is not None else initial_grids(topology)
     if len(grids) != len(topology.blocks):
-        raise InvalidInputError(
-            f"initial: expected {len(topology.blocks)} grids (one per block), got {len(grids)}"
-        )
+        raise InvalidInputError(f"initial: expected {len(topology.blocks)} grids (one per block), got {len(grids)}")
     names = tuple(b.name for b in topology.blocks)
     length = topology.size or 1.0
     if mode == "frozen" or start == "frozen":
@@ -363,9 +365,11 @@ def solve_multiblock(
             message = message or f"multigrid was slow; SOR after {mg_cycles} cycles"
     conv = r <= tol * (1 + 1e-12)
     info = SolveInfo(
-        method=(f"smooth/multigrid({n_levels} levels)" if engine == "multigrid"
-                else f"smooth/{engine}-sor" + (f" after {mg_cycles} multigrid cycles"
-                                                if mg_cycles else ""))
+        method=(
+            f"smooth/multigrid({n_levels} levels)"
+            if engine == "multigrid"
+            else f"smooth/{engine}-sor" + (f" after {mg_cycles} multigrid cycles" if mg_cycles else "")
+        )
         + ("+frozen-start" if start == "frozen" else ""),
         converged=conv,
         iterations=iters,
@@ -373,8 +377,9 @@ def solve_multiblock(
         tolerance=tol_rel,
         residual_history=tuple((int(i), float(v) / length) for i, v in history),
         elapsed=time.perf_counter() - t0,
-        message=(("converged" if conv else f"not converged after {iters} iterations")
-                 + (f" ({message})" if message else "")),
+        message=(
+            ("converged" if conv else f"not converged after {iters} iterations") + (f" ({message})" if message else "")
+        ),
     )
     final = []
     for g, ids, n in zip(grids, m.ids, names, strict=True):

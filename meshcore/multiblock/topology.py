@@ -89,9 +89,7 @@ def parse_side(text: str | Side | Sequence[Any]) -> Side:
             block, border, *rng = text
             return Side(str(block), str(border), *(int(v) for v in rng))
         except (TypeError, ValueError):
-            raise TopologyError(
-                f"interface side must be 'block.border[start:stop]', got {text!r}"
-            ) from None
+            raise TopologyError(f"interface side must be 'block.border[start:stop]', got {text!r}") from None
     s = text.strip()
     rng: tuple[int, ...] = ()
     if s.endswith("]") and "[" in s:
@@ -100,13 +98,9 @@ def parse_side(text: str | Side | Sequence[Any]) -> Side:
             a, b = r.split(":")
             rng = (int(a), int(b))
         except ValueError:
-            raise TopologyError(
-                f"interface side {text!r}: the node range must be [start:stop] with integers"
-            ) from None
+            raise TopologyError(f"interface side {text!r}: the node range must be [start:stop] with integers") from None
     if "." not in s:
-        raise TopologyError(
-            f"interface side {text!r} must be written 'block.border', e.g. 'main.right'"
-        )
+        raise TopologyError(f"interface side {text!r} must be written 'block.border', e.g. 'main.right'")
     block, border = s.rsplit(".", 1)
     return Side(block, border, *rng)
 
@@ -280,9 +274,7 @@ class MultiBlockTopology:
         for b in self.blocks:
             if b.name == name:
                 return b
-        raise TopologyError(
-            f"no block named {name!r}; blocks: {', '.join(b.name for b in self.blocks)}"
-        )
+        raise TopologyError(f"no block named {name!r}; blocks: {', '.join(b.name for b in self.blocks)}")
 
     def index(self, name: str) -> int:
         return [b.name for b in self.blocks].index(name)
@@ -303,8 +295,7 @@ class MultiBlockTopology:
                 )
             if s.border not in BORDER_NAMES:
                 raise TopologyError(
-                    f"interface side {s.block}.{s.border}: border must be one of "
-                    f"{', '.join(BORDER_NAMES)}"
+                    f"interface side {s.block}.{s.border}: border must be one of {', '.join(BORDER_NAMES)}"
                 )
             n = len(by_name[s.block].borders[s.border])
             r = s.resolved(n)
@@ -366,8 +357,7 @@ class MultiBlockTopology:
             poly = Polygon(b.borders.loop())
             if not poly.is_valid:
                 raise TopologyError(
-                    f"block {b.name!r}: its four borders cross each other "
-                    f"({shapely.is_valid_reason(poly)})"
+                    f"block {b.name!r}: its four borders cross each other ({shapely.is_valid_reason(poly)})"
                 )
             polys[b.name] = poly
         declared: dict[frozenset, float] = defaultdict(float)
@@ -440,14 +430,9 @@ class MultiBlockTopology:
                 )
         # cells, CCW: (i,j) (i+1,j) (i+1,j+1) (i,j+1)
         cells = np.vstack(
-            [
-                np.stack([g[:-1, :-1], g[1:, :-1], g[1:, 1:], g[:-1, 1:]], axis=-1).reshape(-1, 4)
-                for g in ids
-            ]
+            [np.stack([g[:-1, :-1], g[1:, :-1], g[1:, 1:], g[:-1, 1:]], axis=-1).reshape(-1, 4) for g in ids]
         ).astype(np.int64)
-        cell_block = np.concatenate(
-            [np.full((a - 1) * (c - 1), k, dtype=np.int32) for k, (a, c) in enumerate(shapes)]
-        )
+        cell_block = np.concatenate([np.full((a - 1) * (c - 1), k, dtype=np.int32) for k, (a, c) in enumerate(shapes)])
         # edges: count cells per undirected edge
         e0 = cells.reshape(-1)
         e1 = np.roll(cells, -1, axis=1).reshape(-1)
@@ -486,8 +471,14 @@ class MultiBlockTopology:
             c = g[1:-1, 1:-1].ravel()
             nb = np.stack(
                 [
-                    g[2:, 1:-1], g[:-2, 1:-1], g[1:-1, 2:], g[1:-1, :-2],
-                    g[2:, 2:], g[:-2, 2:], g[2:, :-2], g[:-2, :-2],
+                    g[2:, 1:-1],
+                    g[:-2, 1:-1],
+                    g[1:-1, 2:],
+                    g[1:-1, :-2],
+                    g[2:, 2:],
+                    g[:-2, 2:],
+                    g[2:, :-2],
+                    g[:-2, :-2],
                 ],
                 axis=-1,
             ).reshape(-1, 8)
@@ -580,7 +571,10 @@ class MultiBlockTopology:
                 i, j = hit[0]
                 ni, nj = b.cells
                 for border, (bi, bj) in (
-                    ("bottom", (i, 0)), ("top", (i, nj)), ("left", (0, j)), ("right", (ni, j)),
+                    ("bottom", (i, 0)),
+                    ("top", (i, nj)),
+                    ("left", (0, j)),
+                    ("right", (ni, j)),
                 ):
                     if (i, j) == (bi, bj):
                         p = b.borders[border][i if border in ("bottom", "top") else j]

@@ -44,8 +44,7 @@ def main() -> None:
     doc = ezdxf.new("R2010")
     msp = doc.modelspace()
     msp.add_lwpolyline(np.column_stack([E, N]).tolist(), close=True, dxfattribs={"layer": "shore"})
-    msp.add_spline(np.column_stack([E[:8], N[:8], np.zeros(8)]).tolist(),
-                   dxfattribs={"layer": "inlet"})
+    msp.add_spline(np.column_stack([E[:8], N[:8], np.zeros(8)]).tolist(), dxfattribs={"layer": "inlet"})
     doc.saveas(HERE / "lake_zurich_sparse_utm32.dxf")
 
     # KMZ: the Lake Zurich KML zipped as Google Earth does (doc.kml)

@@ -16,8 +16,14 @@ from meshcore.cli import main
 from meshcore.cli.examples import example_path, list_examples
 from meshcore.errors import CaseFileError
 
-PAPER = ["rectangle-cutout-coarse", "rectangle-cutout-fine", "two-circles-coarse", "two-circles-fine",
-         "bottle-coarse", "bottle-fine"]
+PAPER = [
+    "rectangle-cutout-coarse",
+    "rectangle-cutout-fine",
+    "two-circles-coarse",
+    "two-circles-fine",
+    "bottle-coarse",
+    "bottle-fine",
+]
 
 MINI = """
 title = "mini"
@@ -111,8 +117,10 @@ def test_points_file_and_corners(tmp_path):
         (MINI + "[solver]\nomega = 2.5\n", r"\[solver\]: omega must be in \(0, 2\)"),
         (MINI + "[solver]\ntol = 1e-3\n", r"\[solver\]: unknown key 'tol'"),
         (MINI.replace("bottom = [[0, 0], [2, 0]]\n", ""), r"missing border\(s\) bottom"),
-        (MINI + "[blocks.borders.bottom]\ndistribution = 'tanh'\nfrist = 0.1\n",
-         r"borders.bottom: unknown key 'frist'"),
+        (
+            MINI + "[blocks.borders.bottom]\ndistribution = 'tanh'\nfrist = 0.1\n",
+            r"borders.bottom: unknown key 'frist'",
+        ),
         (MINI.replace("cells = [4, 3]", "cells = [4]"), r"cells: expected a pair"),
         ("[[blocks]]\nname = 'x'\n", r"missing \[blocks.boundary\]"),
         ("title = 'x'\n", r"needs at least one \[\[blocks\]\]"),
@@ -136,7 +144,9 @@ def test_cli_bad_input_exit_2_one_line_no_partial_output(tmp_path):
     out = tmp_path / "out.vts"
     proc = subprocess.run(
         [sys.executable, "-m", "meshcore", "generate", str(case), "-o", str(out)],
-        capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2],
+        capture_output=True,
+        text=True,
+        cwd=Path(__file__).resolve().parents[2],
     )
     assert proc.returncode == 2
     err = proc.stderr.strip().splitlines()
@@ -147,8 +157,19 @@ def test_cli_bad_input_exit_2_one_line_no_partial_output(tmp_path):
 
 def test_cli_not_converged_exit_3(tmp_path, capsys):
     assert main(["examples", "bottle-fine", str(tmp_path)]) == 0
-    rc = main(["generate", str(tmp_path / "bottle-fine.toml"), "--max-iterations", "2",
-               "--method", "sor", "-o", str(tmp_path / "o.npz"), "-q"])
+    rc = main(
+        [
+            "generate",
+            str(tmp_path / "bottle-fine.toml"),
+            "--max-iterations",
+            "2",
+            "--method",
+            "sor",
+            "-o",
+            str(tmp_path / "o.npz"),
+            "-q",
+        ]
+    )
     assert rc == 3
     assert (tmp_path / "o.npz").exists()  # the unconverged grid is still written, and said so
     assert "did not converge" in capsys.readouterr().err
@@ -156,8 +177,20 @@ def test_cli_not_converged_exit_3(tmp_path, capsys):
 
 def test_cli_png_and_quality(tmp_path, capsys):
     main(["examples", "two-circles-coarse", str(tmp_path)])
-    assert main(["generate", str(tmp_path / "two-circles-coarse.toml"), "-o", str(tmp_path / "g.xyz"),
-                 "--png", str(tmp_path / "g.png"), "-q"]) == 0
+    assert (
+        main(
+            [
+                "generate",
+                str(tmp_path / "two-circles-coarse.toml"),
+                "-o",
+                str(tmp_path / "g.xyz"),
+                "--png",
+                str(tmp_path / "g.png"),
+                "-q",
+            ]
+        )
+        == 0
+    )
     assert (tmp_path / "g.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     capsys.readouterr()
     assert main(["quality", str(tmp_path / "g.xyz")]) == 0
@@ -172,11 +205,14 @@ def test_examples_listing(capsys):
 
 
 def test_import_meshcore_does_not_import_qt():
-    code = ("import sys, meshcore, meshcore.case, meshcore.cli;"
-            "bad=[m for m in ('PySide6','pyqtgraph','superqt','psygnal','matplotlib') if m in sys.modules];"
-            "print(bad); sys.exit(1 if bad else 0)")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          cwd=Path(__file__).resolve().parents[2])
+    code = (
+        "import sys, meshcore, meshcore.case, meshcore.cli;"
+        "bad=[m for m in ('PySide6','pyqtgraph','superqt','psygnal','matplotlib') if m in sys.modules];"
+        "print(bad); sys.exit(1 if bad else 0)"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2]
+    )
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 

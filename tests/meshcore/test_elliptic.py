@@ -133,10 +133,13 @@ def test_solve_callback_can_stop():
         seen.append(snap.iteration)
         return "stop"
 
-    g = meshcore.generate_block(*borders_of(X, Y), method="sor", tolerance=1e-15,
-                                config=meshcore.EllipticConfig(method="sor", tolerance=1e-15,
-                                                               report_interval=1e-9),
-                                callback=cb)
+    g = meshcore.generate_block(
+        *borders_of(X, Y),
+        method="sor",
+        tolerance=1e-15,
+        config=meshcore.EllipticConfig(method="sor", tolerance=1e-15, report_interval=1e-9),
+        callback=cb,
+    )
     assert len(seen) == 1 and not g.converged
 
 
@@ -153,8 +156,7 @@ def test_source_terms_shift_lines():
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.integers(2, 9), st.integers(2, 9), st.floats(-1, 1), st.floats(-1, 1),
-       st.floats(-1, 1), st.floats(-1, 1))
+@given(st.integers(2, 9), st.integers(2, 9), st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1))
 def test_tfi_reproduces_bilinear_maps(ni, nj, a, b, c, d):
     # bilinear map of the unit square with corners perturbed (kept convex)
     c00 = np.array([0.0, 0.0])

@@ -308,9 +308,7 @@ def test_lakes_24000_nodes_fold_free(name):
 # ----------------------------------------------------------- C shape, paper-like
 def c_shape(n_side: int = 6):
     """Unit square with a deep slot from the right side (slot 0.2 wide, 0.8 deep)."""
-    return np.array(
-        [[0, 0], [1, 0], [1, 0.4], [0.2, 0.4], [0.2, 0.6], [1, 0.6], [1, 1], [0, 1]], float
-    )
+    return np.array([[0, 0], [1, 0], [1, 0.4], [0.2, 0.4], [0.2, 0.6], [1, 0.6], [1, 1], [0, 1]], float)
 
 
 def test_c_shaped_domain_has_no_nonconvex_cells():
@@ -327,8 +325,7 @@ def test_heavily_folded_c_shape_needs_and_gets_the_multilevel_start():
     # at 60 × 120 cells SOR converges to a Winslow solution that folds dozens of cells across
     # the slot (multigrid happens to find an unfolded one); local patches fail on it
     loop = c_shape()
-    w = meshcore.generate_block(loop=loop, corners=(0, 1, 6, 7), cells=(60, 120), repair="off",
-                                method="sor")
+    w = meshcore.generate_block(loop=loop, corners=(0, 1, 6, 7), cells=(60, 120), repair="off", method="sor")
     assert meshcore.quality(w).n_folded > 20
     r = repair(w)
     assert r.ok and meshcore.quality(r.grid).ok
@@ -346,7 +343,8 @@ def test_hairpin_slot_is_repaired(cells):
 
 
 EXAMPLES = sorted(
-    p for p in (Path(__file__).resolve().parents[2] / "resources" / "examples").glob("*.toml")
+    p
+    for p in (Path(__file__).resolve().parents[2] / "resources" / "examples").glob("*.toml")
     if "[multiblock]" not in p.read_text(encoding="utf-8")  # single-block cases only
 )
 

@@ -18,9 +18,24 @@ from tests.conftest import DATA, ROOT
 def test_import_generate_convert_a_lake(tmp_path, capsys):
     pytest.importorskip("pyproj")
     case = tmp_path / "zurich.toml"
-    assert main(["import", str(DATA / "lake_zurich_sparse.kmz"), "-o", str(case),
-                 "--border-name", "left=inlet", "--border-name", "right=outlet",
-                 "--cells", "30", "6"]) == 0
+    assert (
+        main(
+            [
+                "import",
+                str(DATA / "lake_zurich_sparse.kmz"),
+                "-o",
+                str(case),
+                "--border-name",
+                "left=inlet",
+                "--border-name",
+                "right=outlet",
+                "--cells",
+                "30",
+                "6",
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "EPSG:32632" in out and "zurich.toml" in out
     c = load_case(case)
@@ -37,8 +52,7 @@ def test_import_generate_convert_a_lake(tmp_path, capsys):
     # convert → CGNS → SGRID → PLOT3D: the world coordinates survive
     for suffix in (".cgns", ".nc", ".xyz", ".msh", ".su2", ".grd", ".csv", ".png"):
         target = tmp_path / f"zurich{suffix}"
-        assert main(["convert", str(vts if suffix != ".xyz" else tmp_path / "zurich.nc"),
-                     str(target)]) == 0, suffix
+        assert main(["convert", str(vts if suffix != ".xyz" else tmp_path / "zurich.nc"), str(target)]) == 0, suffix
     g0 = gs.blocks[0]
     for suffix in (".cgns", ".nc", ".grd", ".csv"):
         back = read_blocks(tmp_path / f"zurich{suffix}")
@@ -52,8 +66,12 @@ def test_import_csv_with_columns_and_no_projection(tmp_path):
     ring = np.array([[0, 0], [4, 0], [8, 0], [8, 2], [8, 4], [4, 4], [0, 4], [0, 2]], float)
     f.write_text("id;x;y\n" + "".join(f"{k};{a};{b}\n" for k, (a, b) in enumerate(ring)))
     case = tmp_path / "c.toml"
-    assert main(["import", str(f), "-o", str(case), "--crs", "none",
-                 "--columns", "x", "y", "--corners", "0", "2", "4", "6"]) == 0
+    assert (
+        main(
+            ["import", str(f), "-o", str(case), "--crs", "none", "--columns", "x", "y", "--corners", "0", "2", "4", "6"]
+        )
+        == 0
+    )
     c = load_case(case)
     np.testing.assert_array_equal(c.blocks[0].loop, ring)
     assert c.blocks[0].corners == (0, 2, 4, 6)
@@ -74,12 +92,13 @@ def test_cli_bad_input_exit_codes(tmp_path, capsys):
 
 def test_import_meshcore_stays_light():
     """``import meshcore`` (and meshcore.io) must not pull in the heavy optional readers."""
-    code = ("import sys, meshcore, meshcore.io, meshcore.crs; "
-            "heavy = {'vtk', 'gmsh', 'h5py', 'netCDF4', 'pyproj', 'ezdxf', 'shapefile', "
-            "'matplotlib', 'meshio', 'defusedxml'}; "
-            "print(sorted(heavy & set(sys.modules)))")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                       check=True)
+    code = (
+        "import sys, meshcore, meshcore.io, meshcore.crs; "
+        "heavy = {'vtk', 'gmsh', 'h5py', 'netCDF4', 'pyproj', 'ezdxf', 'shapefile', "
+        "'matplotlib', 'meshio', 'defusedxml'}; "
+        "print(sorted(heavy & set(sys.modules)))"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert r.stdout.strip() == "[]"
 
 
@@ -93,15 +112,13 @@ def test_top_level_reexports(tmp_path):
     assert meshcore.read_grid(f)[0].shape == (3, 2)
 
 
-SUFFIXES = [".xyz", ".vts", ".vtm", ".npz", ".csv", ".cgns", ".msh", ".su2", ".grd", ".nc",
-            ".png", ".svg", ".pdf"]
+SUFFIXES = [".xyz", ".vts", ".vtm", ".npz", ".csv", ".cgns", ".msh", ".su2", ".grd", ".nc", ".png", ".svg", ".pdf"]
 
 
 def test_generate_writes_every_format(tmp_path, capsys):
     pytest.importorskip("pyproj")
     case = tmp_path / "w.toml"
-    assert main(["import", str(DATA / "windermere_sparse.csv"), "-o", str(case),
-                 "--cells", "16", "4"]) == 0
+    assert main(["import", str(DATA / "windermere_sparse.csv"), "-o", str(case), "--cells", "16", "4"]) == 0
     frame = frame_from_case(load_case(case))
     for suffix in SUFFIXES:
         out = tmp_path / f"w{suffix}"

@@ -17,16 +17,25 @@ pyproj = pytest.importorskip("pyproj")
 
 @pytest.mark.parametrize(
     ("lon", "lat", "epsg"),
-    [(8.67, 47.28, 32632), (-122.27, 40.81, 32610), (-2.94, 54.35, 32630), (11.93, 42.59, 32632),
-     (151.2, -33.9, 32756), (5.3, 60.4, 32632), (15.0, 78.0, 32633), (-180.0, 0.0, 32601),
-     (180.0, 10.0, 32660)],
+    [
+        (8.67, 47.28, 32632),
+        (-122.27, 40.81, 32610),
+        (-2.94, 54.35, 32630),
+        (11.93, 42.59, 32632),
+        (151.2, -33.9, 32756),
+        (5.3, 60.4, 32632),
+        (15.0, 78.0, 32633),
+        (-180.0, 0.0, 32601),
+        (180.0, 10.0, 32660),
+    ],
 )
 def test_utm_zone(lon, lat, epsg):
     assert utm_epsg(lon, lat) == epsg
     # pyproj agrees where the zone is the plain 6° band
     if not (56 <= lat < 64 or lat >= 72 or abs(lon) == 180):
         info = pyproj.database.query_utm_crs_info(
-            datum_name="WGS 84", area_of_interest=pyproj.aoi.AreaOfInterest(lon, lat, lon, lat))
+            datum_name="WGS 84", area_of_interest=pyproj.aoi.AreaOfInterest(lon, lat, lon, lat)
+        )
         assert str(epsg) in {i.code for i in info}
 
 
@@ -64,8 +73,7 @@ def test_project_to_given_epsg_and_none():
     assert 2.68e6 < X.mean() < 2.72e6
     same, f2 = project(ps, None)  # no projection; still a local origin (0.1° steps)
     assert f2.crs == "EPSG:4326" and f2.origin == (8.7, 47.3)
-    np.testing.assert_allclose(same.polylines[0].points + f2.origin, ps.polylines[0].points,
-                               rtol=0, atol=1e-13)
+    np.testing.assert_allclose(same.polylines[0].points + f2.origin, ps.polylines[0].points, rtol=0, atol=1e-13)
     raw, f3 = project(ps, None, origin=None)
     assert f3.origin == (0.0, 0.0)
     np.testing.assert_array_equal(raw.polylines[0].points, ps.polylines[0].points)
@@ -88,8 +96,7 @@ def test_same_lake_in_lonlat_and_utm_gives_the_same_grid(tmp_path):
     # the same outline as a UTM CSV, as a GIS would export it (mm precision is plenty)
     X, Y = frame_ll.to_world(*local_ll.polylines[0].points.T)
     f = tmp_path / "bolsena_utm.csv"
-    f.write_text("easting,northing\n" + "".join(f"{a:.6f},{b:.6f}\n" for a, b in zip(X, Y,
-                                                                               strict=True)))
+    f.write_text("easting,northing\n" + "".join(f"{a:.6f},{b:.6f}\n" for a, b in zip(X, Y, strict=True)))
     ps_utm = read_points(f, crs=frame_ll.crs)
     local_utm, frame_utm = project(ps_utm)
     assert frame_utm.crs == frame_ll.crs and frame_utm.origin == frame_ll.origin

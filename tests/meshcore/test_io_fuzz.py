@@ -16,15 +16,32 @@ from meshcore.errors import ReadError
 from meshcore.io import read_blocks, read_points, write
 from tests.conftest import DATA
 
-POINT_FILES = ["lake_zurich_sparse.csv", "lake_zurich_sparse.kml", "lake_zurich_sparse.kmz",
-               "lake_zurich_sparse.geojson", "windermere_sparse.shp",
-               "lake_zurich_sparse_utm32.dxf"]
-GRID_SUFFIXES = [("g.xyz", {"mode": "ascii"}), ("f.xyz", {"mode": "fortran"}),
-                 ("b.xyz", {"mode": "binary"}), ("g.vts", {}), ("g.npz", {}), ("g.cgns", {}),
-                 ("g.grd", {}), ("g.nc", {}), ("g.csv", {})]
+POINT_FILES = [
+    "lake_zurich_sparse.csv",
+    "lake_zurich_sparse.kml",
+    "lake_zurich_sparse.kmz",
+    "lake_zurich_sparse.geojson",
+    "windermere_sparse.shp",
+    "lake_zurich_sparse_utm32.dxf",
+]
+GRID_SUFFIXES = [
+    ("g.xyz", {"mode": "ascii"}),
+    ("f.xyz", {"mode": "fortran"}),
+    ("b.xyz", {"mode": "binary"}),
+    ("g.vts", {}),
+    ("g.npz", {}),
+    ("g.cgns", {}),
+    ("g.grd", {}),
+    ("g.nc", {}),
+    ("g.csv", {}),
+]
 
-FUZZ = settings(max_examples=25, deadline=None, derandomize=True,
-                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+FUZZ = settings(
+    max_examples=25,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
 
 @st.composite
@@ -36,8 +53,7 @@ def corruption(draw, n: int):
     if kind == "insert":
         return [("insert", draw(st.integers(0, n)), draw(st.binary(min_size=1, max_size=16)))]
     k = 1 if kind == "flip" else draw(st.integers(2, 12))
-    return [("flip", draw(st.integers(0, max(0, n - 1))), draw(st.integers(0, 255)))
-            for _ in range(k)]
+    return [("flip", draw(st.integers(0, max(0, n - 1))), draw(st.integers(0, 255))) for _ in range(k)]
 
 
 def _apply(data: bytes, edits) -> bytes:
@@ -46,7 +62,7 @@ def _apply(data: bytes, edits) -> bytes:
         if e[0] == "cut":
             b = b[: e[1]]
         elif e[0] == "insert":
-            b[e[1]:e[1]] = e[2]
+            b[e[1] : e[1]] = e[2]
         elif b:
             b[e[1] % len(b)] = e[2]
     return bytes(b)
@@ -81,8 +97,10 @@ def test_point_readers_survive_corruption(name, data):
         _expect_only_read_error(read_points, target)
 
 
-@pytest.mark.parametrize("suffix", [".csv", ".kml", ".kmz", ".geojson", ".shp", ".dxf", ".xyz",
-                                    ".vts", ".vtm", ".npz", ".cgns", ".grd", ".nc"])
+@pytest.mark.parametrize(
+    "suffix",
+    [".csv", ".kml", ".kmz", ".geojson", ".shp", ".dxf", ".xyz", ".vts", ".vtm", ".npz", ".cgns", ".grd", ".nc"],
+)
 @FUZZ
 @given(blob=st.binary(max_size=600))
 def test_random_bytes(suffix, blob):
@@ -92,8 +110,7 @@ def test_random_bytes(suffix, blob):
         if suffix == ".shp":
             (Path(d) / "r.shx").write_bytes(blob[::-1])
             (Path(d) / "r.dbf").write_bytes(blob[:50])
-        fn = read_blocks if suffix in (".xyz", ".vts", ".vtm", ".npz", ".cgns", ".grd", ".nc") \
-            else read_points
+        fn = read_blocks if suffix in (".xyz", ".vts", ".vtm", ".npz", ".cgns", ".grd", ".nc") else read_points
         _expect_only_read_error(fn, f)
 
 

@@ -70,13 +70,11 @@ def test_vts_read_by_vtk(tmp_path, grid):
     np.testing.assert_array_equal(pts[:, 1], Y.ravel(order="F"))
     m = metrics(grid)
     for name in ("jacobian", "alpha", "beta", "gamma", "xi_x", "eta_y"):
-        np.testing.assert_array_equal(vtk_to_numpy(o.GetPointData().GetArray(name)),
-                                      getattr(m, name).ravel(order="F"))
+        np.testing.assert_array_equal(vtk_to_numpy(o.GetPointData().GetArray(name)), getattr(m, name).ravel(order="F"))
     cq = cell_quality(grid)
     assert o.GetNumberOfCells() == grid.cells[0] * grid.cells[1]
     for name in ("skewness", "orthogonality", "aspect_ratio", "area"):
-        np.testing.assert_array_equal(vtk_to_numpy(o.GetCellData().GetArray(name)),
-                                      cq[name].ravel(order="F"))
+        np.testing.assert_array_equal(vtk_to_numpy(o.GetCellData().GetArray(name)), cq[name].ravel(order="F"))
     fd = o.GetFieldData()
     assert fd.GetAbstractArray("crs").GetValue(0) == CRS
     assert "bottom=inlet" in fd.GetAbstractArray("border_names").GetValue(0)
@@ -199,8 +197,7 @@ def _s(a):
 def test_cgns_sids_layout_and_vtk_reader(tmp_path, blocks):
     h5py = pytest.importorskip("h5py")
     conn = find_interfaces(blocks)
-    assert [(c.a, c.border_a, c.b, c.border_b, c.reversed) for c in conn] == \
-        [(0, "right", 1, "left", False)]
+    assert [(c.a, c.border_a, c.b, c.border_b, c.reversed) for c in conn] == [(0, "right", 1, "left", False)]
     f = write(tmp_path / "m.cgns", blocks, block_names=["west", "east"], crs=CRS, origin=ORIGIN)
     with h5py.File(f, "r") as h:
         assert _s(h.attrs["label"]) == "Root Node of HDF5 File"
@@ -298,7 +295,8 @@ def test_msh_read_by_gmsh(tmp_path, blocks):
         first = qnodes[:4]
         np.testing.assert_array_equal(
             [lookup[int(t)] for t in first],
-            [[X[0, 0], Y[0, 0]], [X[1, 0], Y[1, 0]], [X[1, 1], Y[1, 1]], [X[0, 1], Y[0, 1]]])
+            [[X[0, 0], Y[0, 0]], [X[1, 0], Y[1, 0]], [X[1, 1], Y[1, 1]], [X[0, 1], Y[0, 1]]],
+        )
         _, c = gmsh.model.mesh.getNodesForPhysicalGroup(*groups["inlet"])
         np.testing.assert_array_equal(np.sort(c.reshape(-1, 3)[:, 1]), np.sort(Y[0, :]))
         bottom_nodes, _ = gmsh.model.mesh.getNodesForPhysicalGroup(*groups["bottom"])
@@ -329,8 +327,7 @@ def test_su2_read_by_meshio(tmp_path, blocks):
     np.testing.assert_array_equal(m.points[quads[0], 1], [Y[0, 0], Y[1, 0], Y[1, 1], Y[0, 1]])
     # every quad is counter-clockwise (positive shoelace area)
     p = m.points[quads][:, :, :2]
-    area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, 1) - np.roll(p[:, :, 0], -1, 1)
-                        * p[:, :, 1], axis=1)
+    area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, 1) - np.roll(p[:, :, 0], -1, 1) * p[:, :, 1], axis=1)
     assert (area > 0).all()
 
 
@@ -389,8 +386,7 @@ def test_delft3d_grd_and_enc(tmp_path, grid):
     # independent parse of the RGFGRID layout: ETA=n records, 5 values per line
     body = "\n".join(text[k:])
     recs = re.split(r"\s*ETA=\s*(\d+)", body)[1:]
-    numbers = [(int(recs[i]), np.array(recs[i + 1].split(), dtype=float))
-               for i in range(0, len(recs), 2)]
+    numbers = [(int(recs[i]), np.array(recs[i + 1].split(), dtype=float)) for i in range(0, len(recs), 2)]
     assert [n for n, _ in numbers] == list(range(1, nmax + 1)) * 2
     assert all(len(v) == mmax for _, v in numbers)
     assert all(len(ln.split()) <= 5 + 2 for ln in text[k:])
@@ -409,8 +405,7 @@ def test_delft3d_spherical(tmp_path, grid):
     f = write(tmp_path / "ll.grd", grid, crs=CRS, origin=ORIGIN, lonlat=True)
     assert "Coordinate System = Spherical" in f.read_text()
     gs = read_blocks(f)
-    lon, lat = pyproj.Transformer.from_crs(CRS, "EPSG:4326", always_xy=True).transform(
-        *_world(grid))
+    lon, lat = pyproj.Transformer.from_crs(CRS, "EPSG:4326", always_xy=True).transform(*_world(grid))
     assert gs.frame.crs == "EPSG:4326"
     np.testing.assert_allclose(gs.blocks[0].x, lon, atol=1e-13)
     np.testing.assert_allclose(gs.blocks[0].y, lat, atol=1e-13)
@@ -424,19 +419,35 @@ def test_metrics_csv_columns(tmp_path, grid):
     lines = f.read_text().splitlines()
     doc = [ln for ln in lines if ln.startswith("# column ")]
     header = next(ln for ln in lines if not ln.startswith("#")).split(",")
-    assert header == ["block", "i", "j", "x", "y", "x_xi", "x_eta", "y_xi", "y_eta", "J", "alpha",
-                      "beta", "gamma", "xi_x", "xi_y", "eta_x", "eta_y"]
+    assert header == [
+        "block",
+        "i",
+        "j",
+        "x",
+        "y",
+        "x_xi",
+        "x_eta",
+        "y_xi",
+        "y_eta",
+        "J",
+        "alpha",
+        "beta",
+        "gamma",
+        "xi_x",
+        "xi_y",
+        "eta_x",
+        "eta_y",
+    ]
     assert [d.split(":")[0].removeprefix("# column ") for d in doc] == header
     rows = list(csv.DictReader(ln for ln in lines if not ln.startswith("#")))
     assert len(rows) == grid.n_nodes
     m = metrics(grid)
     X, Y = _world(grid)
-    for r in rows[:: 7]:
+    for r in rows[::7]:
         i, j = int(r["i"]), int(r["j"])
         assert float(r["x"]) == X[i, j] and float(r["y"]) == Y[i, j]
         assert float(r["J"]) == m.jacobian[i, j]
-        for c in ("x_xi", "x_eta", "y_xi", "y_eta", "alpha", "beta", "gamma", "xi_x", "xi_y",
-                  "eta_x", "eta_y"):
+        for c in ("x_xi", "x_eta", "y_xi", "y_eta", "alpha", "beta", "gamma", "xi_x", "xi_y", "eta_x", "eta_y"):
             assert float(r[c]) == getattr(m, c)[i, j]
     # consistency of the columns themselves: ξ_x x_ξ + ξ_y y_ξ = 1
     a = np.array([[float(r[c]) for c in ("xi_x", "xi_y", "x_xi", "y_xi")] for r in rows])
@@ -528,12 +539,10 @@ def test_generate_and_rewrite_a_lake_grid(tmp_path):
 
 
 def test_explicit_connectivity_records_and_grid_borders_as_points(tmp_path, blocks):
-    f = write(tmp_path / "m.su2", blocks,
-              connectivity=[{"a": 0, "border_a": "right", "b": 1, "border_b": "left"}])
+    f = write(tmp_path / "m.su2", blocks, connectivity=[{"a": 0, "border_a": "right", "b": 1, "border_b": "left"}])
     assert "MARKER_TAG= right" not in f.read_text()
     with pytest.raises(WriteError, match="unknown block or border"):
-        write(tmp_path / "x.su2", blocks,
-              connectivity=[{"a": 0, "border_a": "east", "b": 1, "border_b": "left"}])
+        write(tmp_path / "x.su2", blocks, connectivity=[{"a": 0, "border_a": "east", "b": 1, "border_b": "left"}])
     # a grid file read as points gives its borders, named
     from meshcore.io import read_points
 

@@ -23,8 +23,7 @@ def _one_line(exc: pytest.ExceptionInfo) -> str:
 
 
 # ------------------------------------------------------------ real lake files
-@pytest.mark.parametrize("name", ["lake_zurich_sparse.kml", "lake_zurich_sparse.kmz",
-                                  "lake_zurich_sparse.geojson"])
+@pytest.mark.parametrize("name", ["lake_zurich_sparse.kml", "lake_zurich_sparse.kmz", "lake_zurich_sparse.geojson"])
 def test_zurich_ring_formats_agree_with_the_csv(name):
     ps = read_points(DATA / name)
     assert ps.crs == "EPSG:4326"
@@ -90,7 +89,9 @@ def test_kml_several_placemarks_lines_and_points(tmp_path):
         "</outerBoundaryIs><innerBoundaryIs><LinearRing><coordinates>8.552,47.252 8.553,47.253 "
         "8.553,47.252 8.552,47.252</coordinates></LinearRing></innerBoundaryIs></Polygon>"
         "</MultiGeometry></Placemark>"
-        "</Folder></Document></kml>", encoding="utf-8")
+        "</Folder></Document></kml>",
+        encoding="utf-8",
+    )
     ps = read_points(f)
     assert ps.names == ("inlet", "mixed points", "island", "island hole 1")
     assert not ps["inlet"].closed and len(ps["inlet"]) == 3
@@ -101,11 +102,13 @@ def test_kml_several_placemarks_lines_and_points(tmp_path):
 
 def test_geojson_multi_geometries(tmp_path):
     f = tmp_path / "m.geojson"
-    f.write_text('{"type": "FeatureCollection", "features": ['
-                 '{"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": '
-                 '"MultiLineString", "coordinates": [[[1, 2], [3, 4]], [[5, 6], [7, 8], [9, 9]]]}},'
-                 '{"type": "Feature", "id": "b", "properties": null, "geometry": {"type": '
-                 '"MultiPolygon", "coordinates": [[[[10, 10], [11, 10], [11, 11], [10, 10]]]]}}]}')
+    f.write_text(
+        '{"type": "FeatureCollection", "features": ['
+        '{"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": '
+        '"MultiLineString", "coordinates": [[[1, 2], [3, 4]], [[5, 6], [7, 8], [9, 9]]]}},'
+        '{"type": "Feature", "id": "b", "properties": null, "geometry": {"type": '
+        '"MultiPolygon", "coordinates": [[[[10, 10], [11, 10], [11, 11], [10, 10]]]]}}]}'
+    )
     ps = read_points(f)
     assert ps.names == ("a 1", "a 2", "b")
     assert ps["b"].closed and len(ps["b"]) == 3
@@ -115,13 +118,18 @@ def test_geojson_multi_geometries(tmp_path):
 @pytest.mark.parametrize(
     ("text", "crs", "expected"),
     [
-        ("# survey\nlat;lon\n47,30;8,50\n47,31;8,52\n47,33;8,55\n", "EPSG:4326",
-         [[8.50, 47.30], [8.52, 47.31], [8.55, 47.33]]),
+        (
+            "# survey\nlat;lon\n47,30;8,50\n47,31;8,52\n47,33;8,55\n",
+            "EPSG:4326",
+            [[8.50, 47.30], [8.52, 47.31], [8.55, 47.33]],
+        ),
         ("x\ty\tz\n1\t2\t0\n3\t4\t0\n5\t6\t0\n", None, [[1, 2], [3, 4], [5, 6]]),
-        ("% gnuplot style\n1.0 2.0\n3.0   4.0  # trailing comment\n5 6\n", None,
-         [[1, 2], [3, 4], [5, 6]]),
-        ("Easting (m),Northing (m)\n500000.5,5200000.25\n500010,5200001\n", None,
-         [[500000.5, 5200000.25], [500010, 5200001]]),
+        ("% gnuplot style\n1.0 2.0\n3.0   4.0  # trailing comment\n5 6\n", None, [[1, 2], [3, 4], [5, 6]]),
+        (
+            "Easting (m),Northing (m)\n500000.5,5200000.25\n500010,5200001\n",
+            None,
+            [[500000.5, 5200000.25], [500010, 5200001]],
+        ),
         ("1d0 2D0\n3.5E+00 4\n", None, [[1, 2], [3.5, 4]]),
     ],
 )
@@ -169,16 +177,25 @@ def _write(tmp_path, name, data):
         ("words2.txt", "foo bar\nbaz qux\n", "no numeric"),
         ("range.csv", "lon,lat\n8.5,47.3\n8.6,97.3\n", "outside the lon/lat range"),
         ("mixed.csv", "1,2\n3,4,5\n6,7\n", "line 2: mixed dimensions"),
-        ("mixed.geojson", '{"type": "LineString", "coordinates": [[1, 2], [3, 4, 5]]}',
-         "mixed dimensions"),
+        ("mixed.geojson", '{"type": "LineString", "coordinates": [[1, 2], [3, 4, 5]]}', "mixed dimensions"),
         ("bad.geojson", '{"type": "LineString", "coordinates": [[1, 2], ', "line 1"),
-        ("nocoords.kml", '<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark>'
-         "<name>x</name></Placemark></Document></kml>", "no coordinates"),
-        ("emptycoords.kml", '<kml><Placemark><LineString><coordinates> </coordinates>'
-         "</LineString></Placemark></kml>", "empty <coordinates>"),
+        (
+            "nocoords.kml",
+            '<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark>'
+            "<name>x</name></Placemark></Document></kml>",
+            "no coordinates",
+        ),
+        (
+            "emptycoords.kml",
+            "<kml><Placemark><LineString><coordinates> </coordinates></LineString></Placemark></kml>",
+            "empty <coordinates>",
+        ),
         ("notxml.kml", "<kml><Placemark>", "not well-formed"),
-        ("lonlat.kml", "<kml><Placemark><LineString><coordinates>200,10 201,11</coordinates>"
-         "</LineString></Placemark></kml>", "outside the lon/lat range"),
+        (
+            "lonlat.kml",
+            "<kml><Placemark><LineString><coordinates>200,10 201,11</coordinates></LineString></Placemark></kml>",
+            "outside the lon/lat range",
+        ),
         ("one.csv", "x,y\n1,2\n", "only 1 point"),
         ("bad.kmz", b"PK\x03\x04garbage", "corrupt KMZ"),
         ("nul.csv", b"1,2\n\x00\x00\x01", "binary"),
@@ -194,10 +211,11 @@ def test_bad_point_files(tmp_path, name, data, needle):
 
 
 def test_billion_laughs_is_refused(tmp_path):
-    lol = ('<?xml version="1.0"?>\n<!DOCTYPE lolz [\n<!ENTITY lol "lol">\n'
-           + "".join(f'<!ENTITY lol{k} "{("&lol" + (str(k - 1) if k > 1 else "") + ";") * 10}">\n'
-                     for k in range(1, 10))
-           + ']>\n<kml><Placemark><name>&lol9;</name></Placemark></kml>\n')
+    lol = (
+        '<?xml version="1.0"?>\n<!DOCTYPE lolz [\n<!ENTITY lol "lol">\n'
+        + "".join(f'<!ENTITY lol{k} "{("&lol" + (str(k - 1) if k > 1 else "") + ";") * 10}">\n' for k in range(1, 10))
+        + "]>\n<kml><Placemark><name>&lol9;</name></Placemark></kml>\n"
+    )
     f = _write(tmp_path, "lol.kml", lol)
     with pytest.raises(ReadError) as exc:
         read_points(f)
@@ -205,8 +223,10 @@ def test_billion_laughs_is_refused(tmp_path):
 
 
 def test_external_entity_is_refused(tmp_path):
-    xxe = ('<?xml version="1.0"?>\n<!DOCTYPE kml [<!ENTITY xxe SYSTEM "file:///etc/passwd">]>\n'
-           "<kml><Placemark><name>&xxe;</name></Placemark></kml>")
+    xxe = (
+        '<?xml version="1.0"?>\n<!DOCTYPE kml [<!ENTITY xxe SYSTEM "file:///etc/passwd">]>\n'
+        "<kml><Placemark><name>&xxe;</name></Placemark></kml>"
+    )
     f = _write(tmp_path, "xxe.kml", xxe)
     with pytest.raises(ReadError, match="refused"):
         read_points(f)
@@ -263,9 +283,14 @@ def test_missing_file_and_unknown_suffix(tmp_path):
     assert len(read_points(f, format="points-csv").polylines[0]) == 2
 
 
-@pytest.mark.parametrize(("name", "n", "zone"), [("lake_bolsena.kml", 102, 32632),
-                                                 ("shasta_lake_sparse.kml", 54, 32610),
-                                                 ("lake_bolsena_sparse.geojson", 40, 32632)])
+@pytest.mark.parametrize(
+    ("name", "n", "zone"),
+    [
+        ("lake_bolsena.kml", 102, 32632),
+        ("shasta_lake_sparse.kml", 54, 32610),
+        ("lake_bolsena_sparse.geojson", 40, 32632),
+    ],
+)
 def test_more_real_lakes_read_and_project(name, n, zone):
     pytest.importorskip("pyproj")
     from meshcore.crs import project

@@ -100,17 +100,20 @@ def assert_glued(mb) -> None:
 
 
 # ------------------------------------------------ equivalence with one block
-@pytest.mark.parametrize(("start", "engine"), [("algebraic", "blocks"), ("frozen", "blocks"),
-                                               ("algebraic", "table"), ("algebraic", "multigrid")])
+@pytest.mark.parametrize(
+    ("start", "engine"),
+    [("algebraic", "blocks"), ("frozen", "blocks"), ("algebraic", "table"), ("algebraic", "multigrid")],
+)
 def test_two_blocks_smooth_equals_single_block(rect, start, engine):
     X, Y, ref = rect
-    mb = solve_multiblock(two_blocks(X, Y, 10), mode="smooth", tolerance=TIGHT, start=start,
-                          engine=engine)
+    mb = solve_multiblock(two_blocks(X, Y, 10), mode="smooth", tolerance=TIGHT, start=start, engine=engine)
     assert mb.converged
     size = ref.size
     d = max(
-        np.abs(mb["a"].x - ref.x[:11]).max(), np.abs(mb["a"].y - ref.y[:11]).max(),
-        np.abs(mb["b"].x - ref.x[10:]).max(), np.abs(mb["b"].y - ref.y[10:]).max(),
+        np.abs(mb["a"].x - ref.x[:11]).max(),
+        np.abs(mb["a"].y - ref.y[:11]).max(),
+        np.abs(mb["b"].x - ref.x[10:]).max(),
+        np.abs(mb["b"].y - ref.y[10:]).max(),
     )
     assert d <= 1e-6 * size
     assert_glued(mb)
@@ -127,8 +130,7 @@ def test_four_blocks_smooth_equals_single_block(rect, engine):
     mb = solve_multiblock(topo, mode="smooth", tolerance=TIGHT, engine=engine)
     assert mb.converged
     d = 0.0
-    for name, sl in (("sw", np.s_[:15, :6]), ("se", np.s_[14:, :6]),
-                     ("nw", np.s_[:15, 5:]), ("ne", np.s_[14:, 5:])):
+    for name, sl in (("sw", np.s_[:15, :6]), ("se", np.s_[14:, :6]), ("nw", np.s_[:15, 5:]), ("ne", np.s_[14:, 5:])):
         d = max(d, np.abs(mb[name].x - ref.x[sl]).max(), np.abs(mb[name].y - ref.y[sl]).max())
     assert d <= 1e-6 * ref.size
     assert_glued(mb)
@@ -202,8 +204,10 @@ def star(k: int, n: int = 8):
         # corners: sw = centre, se = midpoint vertex v0, ne = v1, nw = v2 (CCW)
         sw, se, ne, nw = c, v0, v1, v2
         bd = Borders(
-            bottom=sw + lin * (se - sw), right=se + lin * (ne - se),
-            top=nw + lin * (ne - nw), left=sw + lin * (nw - sw),
+            bottom=sw + lin * (se - sw),
+            right=se + lin * (ne - se),
+            top=nw + lin * (ne - nw),
+            left=sw + lin * (nw - sw),
         )
         blocks.append(Block(f"q{q}", bd))
         itfs.append(Interface(Side(f"q{q}", "left"), Side(f"q{(q + 1) % k}", "bottom")))
@@ -226,8 +230,7 @@ def test_irregular_corner_of_k_blocks(k, engine):
         x, y = np.array(g.x), np.array(g.y)
         x[1:-1, 1:-1] += 0.05
         shifted.append(meshcore.StructuredGrid(x, y))
-    mb = solve_multiblock(topo, mode="smooth", tolerance=1e-11, initial=shifted, start="algebraic",
-                          engine=engine)
+    mb = solve_multiblock(topo, mode="smooth", tolerance=1e-11, initial=shifted, start="algebraic", engine=engine)
     assert mb.converged
     assert_glued(mb)
     centre = mb["q0"].x[0, 0], mb["q0"].y[0, 0]
@@ -270,9 +273,7 @@ def test_shasta_lake_quality_and_glue(shasta_topology, mode):
     assert_glued(mb)
     q = mb.quality()
     assert q.n_folded == 0
-    assert set(q.interfaces) == {
-        " ↔ ".join(sorted((i.a.block, i.b.block), key=mb.names.index)) for i in mb.interfaces
-    }
+    assert set(q.interfaces) == {" ↔ ".join(sorted((i.a.block, i.b.block), key=mb.names.index)) for i in mb.interfaces}
     if mode == "smooth":
         assert q.worst_interface <= 1.5 * q.worst_inside
 
@@ -427,8 +428,9 @@ def test_error_gap_hole_named():
         sw, se, ne, nw = (np.asarray(v, dtype=float) for v in (sw, se, ne, nw))
         ni, nj = round(se[0] - sw[0]), round(nw[1] - sw[1])
         li, lj = np.linspace(0, 1, ni + 1)[:, None], np.linspace(0, 1, nj + 1)[:, None]
-        return Borders(bottom=sw + li * (se - sw), right=se + lj * (ne - se),
-                       top=nw + li * (ne - nw), left=sw + lj * (nw - sw))
+        return Borders(
+            bottom=sw + li * (se - sw), right=se + lj * (ne - se), top=nw + li * (ne - nw), left=sw + lj * (nw - sw)
+        )
 
     bl = (
         Block("a", quad([0, 0], [2, 0], [2, 1], [0, 1])),
@@ -440,9 +442,12 @@ def test_error_gap_hole_named():
     )
     S = Side
     itf = (
-        Interface(S("a", "right"), S("b", "left")), Interface(S("e", "right"), S("f", "left")),
-        Interface(S("a", "top", 0, 1), S("c", "bottom")), Interface(S("b", "top", 1, 2), S("d", "bottom")),
-        Interface(S("c", "top"), S("e", "bottom", 0, 1)), Interface(S("d", "top"), S("f", "bottom", 1, 2)),
+        Interface(S("a", "right"), S("b", "left")),
+        Interface(S("e", "right"), S("f", "left")),
+        Interface(S("a", "top", 0, 1), S("c", "bottom")),
+        Interface(S("b", "top", 1, 2), S("d", "bottom")),
+        Interface(S("c", "top"), S("e", "bottom", 0, 1)),
+        Interface(S("d", "top"), S("f", "bottom", 1, 2)),
     )
     msg = _err(lambda: MultiBlockTopology(bl, itf))
     assert "gap" in msg and "hole" in msg
@@ -452,8 +457,10 @@ def test_error_gap_hole_named():
 def test_error_border_parts_overlap(pair):
     X, Y = pair
     a, b = block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])
-    itf = (Interface(Side("a", "right", 0, 3), Side("b", "left", 0, 3)),
-           Interface(Side("a", "right", 2, 4), Side("b", "left", 2, 4)))
+    itf = (
+        Interface(Side("a", "right", 0, 3), Side("b", "left", 0, 3)),
+        Interface(Side("a", "right", 2, 4), Side("b", "left", 2, 4)),
+    )
     msg = _err(lambda: MultiBlockTopology((a, b), itf))
     assert "a.right" in msg and "overlap" in msg
 
@@ -582,9 +589,11 @@ def test_case_outline_unknown_key_and_mode(tmp_path):
 def test_cli_generate_multiblock_case(tmp_path):
     out = tmp_path / "shasta.xyz"
     r = subprocess.run(
-        [sys.executable, "-m", "meshcore", "generate", str(EXAMPLES / "shasta-multiblock-coarse.toml"),
-         "-o", str(out)],
-        capture_output=True, text=True, cwd=ROOT, timeout=300,
+        [sys.executable, "-m", "meshcore", "generate", str(EXAMPLES / "shasta-multiblock-coarse.toml"), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
     )
     assert r.returncode == 0, r.stderr
     assert "Interfaces" in r.stdout and "main.top" in r.stdout
@@ -665,9 +674,20 @@ def test_cli_generate_vtm_with_crs(tmp_path):
     vtk = pytest.importorskip("vtkmodules.vtkIOXML")
     out = tmp_path / "lake.vtm"
     r = subprocess.run(
-        [sys.executable, "-m", "meshcore", "generate", str(EXAMPLES / "shasta-multiblock-coarse.toml"),
-         "-o", str(out), "-q"],
-        capture_output=True, text=True, cwd=ROOT, timeout=300,
+        [
+            sys.executable,
+            "-m",
+            "meshcore",
+            "generate",
+            str(EXAMPLES / "shasta-multiblock-coarse.toml"),
+            "-o",
+            str(out),
+            "-q",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
     )
     assert r.returncode == 0, r.stderr
     reader = vtk.vtkXMLMultiBlockDataReader()
@@ -711,8 +731,7 @@ def test_from_outline_cut_ending_on_another_cut():
     # the snapped end is exactly on cut 0 and is a node of all three blocks
     (t,) = [c for c in topo.node_map.corners if len(c.blocks) == 3]
     assert t.point == (2.0, 1.1) and t.valence == 4 and t.free
-    east_parts = sorted((s.start, s.stop) for i in topo.interfaces for s in (i.a, i.b)
-                        if s.block == "east")
+    east_parts = sorted((s.start, s.stop) for i in topo.interfaces for s in (i.a, i.b) if s.block == "east")
     assert east_parts == [(0, 3), (3, 6)]  # east.left is split at the T point
     mb = solve_multiblock(topo)
     assert mb.converged and mb.quality().n_folded == 0

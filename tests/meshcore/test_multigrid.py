@@ -135,8 +135,7 @@ def test_transfer_tables_interpolate_linear_functions_and_restrict_constants(n, 
 def test_smoother_is_the_4_colour_gauss_seidel_sweep():
     rng = np.random.default_rng(3)
     # (.., 200): rows long enough for the vectorised row update (VECTOR_ROW)
-    for ni, nj, periodic in [(9, 7, False), (16, 11, False), (12, 9, True), (6, 200, False),
-                             (8, 200, True)]:
+    for ni, nj, periodic in [(9, 7, False), (16, 11, False), (12, 9, True), (6, 200, False), (8, 200, True)]:
         X, Y = np.meshgrid(np.arange(ni + 1.0), np.arange(nj + 1.0), indexing="ij")
         X = X + 0.2 * rng.standard_normal(X.shape)
         Y = Y + 0.2 * rng.standard_normal(Y.shape)
@@ -215,8 +214,9 @@ def test_restriction_and_prolongation_are_the_tensor_products_of_the_tables(ni, 
     want = x + Pi @ (xc - Si @ x @ Sj.T) @ Pj.T
     want[0], want[-1], want[:, 0], want[:, -1] = x[0], x[-1], x[:, 0], x[:, -1]
     ex, ey = np.empty_like(fx), np.empty_like(fx)
-    _mg_kernels.prolong_correct(x, y, xc, xc.copy(), ex, ey, ti[0], ti[1], tj[0], tj[1], ti[4],
-                                tj[4], ti[5], tj[5], False)
+    _mg_kernels.prolong_correct(
+        x, y, xc, xc.copy(), ex, ey, ti[0], ti[1], tj[0], tj[1], ti[4], tj[4], ti[5], tj[5], False
+    )
     np.testing.assert_allclose(x, want, rtol=0, atol=1e-12)
 
 
@@ -236,7 +236,8 @@ def test_fused_defect_restriction_is_defect_then_restriction(ni, nj):
         m = _mg_kernels.defect(X, Y, F, F, P, P, False, rx, ry)
         _mg_kernels.restrict(rx, ry, ti[2], ti[3], tj[2], tj[3], 16.0, a, b)
         for fn, chunks in itertools.product(
-                (_mg_kernels.defect_restrict, _mg_kernels.defect_restrict_parallel), (1, 3, 16)):
+            (_mg_kernels.defect_restrict, _mg_kernels.defect_restrict_parallel), (1, 3, 16)
+        ):
             c, d = np.empty(shape), np.empty(shape)
             assert fn(X, Y, F, F, P, P, ti[2], ti[3], tj[2], tj[3], 16.0, c, d, chunks) == m
             assert np.array_equal(a, c) and np.array_equal(b, d)
@@ -270,9 +271,10 @@ def test_serial_and_parallel_compilations_are_cached_under_distinct_names():
     # numba's disk cache files a function by qualified name and line only: two compilations of
     # one Python function (serial and parallel=True) would load each other's machine code
     pairs = [(_kernels.sweep4, _kernels.sweep4_parallel)]
-    pairs += [(getattr(_mg_kernels, n), getattr(_mg_kernels, n + "_parallel"))
-              for n in ("smooth", "defect", "add_operator", "restrict", "prolong_correct",
-                        "defect_restrict")]
+    pairs += [
+        (getattr(_mg_kernels, n), getattr(_mg_kernels, n + "_parallel"))
+        for n in ("smooth", "defect", "add_operator", "restrict", "prolong_correct", "defect_restrict")
+    ]
     names = set()
     for serial, parallel in pairs:
         assert not serial.targetoptions.get("parallel") and parallel.targetoptions["parallel"]
@@ -384,8 +386,9 @@ def test_odd_sizes_converge_as_fast_as_even_ones(cells):
     assert g.converged and g.info.message == "converged", g.info.message
     rates = _rates(g)
     assert math.exp(np.mean(np.log(rates))) <= 0.15, rates
-    even = meshcore.solve(_curved(cells[0] + cells[0] % 2, cells[1] + cells[1] % 2),
-                          method="multigrid", tolerance=1e-12)
+    even = meshcore.solve(
+        _curved(cells[0] + cells[0] % 2, cells[1] + cells[1] % 2), method="multigrid", tolerance=1e-12
+    )
     assert g.iterations <= even.iterations + 1
 
 
@@ -492,8 +495,9 @@ def test_fallback_to_sor_starts_the_control_over_and_says_so():
     cs = load_case(Path(__file__).resolve().parents[2] / "resources/examples/naca0012-ogrid.toml")
     mg = generate_case(cs, config=dataclasses.replace(cs.solver, method="multigrid"))[0]
     sor = generate_case(cs, config=dataclasses.replace(cs.solver, method="sor"))[0]
-    assert mg.converged and mg.info.message.startswith("converged (multigrid diverged; continued "
-                                                       "with SOR"), mg.info.message
+    assert mg.converged and mg.info.message.startswith("converged (multigrid diverged; continued with SOR"), (
+        mg.info.message
+    )
     assert np.array_equal(mg.x, sor.x) and np.array_equal(mg.y, sor.y)
 
 
@@ -508,8 +512,12 @@ def test_full_ring_with_a_fixed_cut_does_not_coarsen_into_a_degenerate_ring(cell
     """The paper's doubly connected case: a ring of 2 cells is a folded coarse grid."""
     t = np.linspace(0.0, -2 * np.pi, 41)
     cut = np.column_stack([np.linspace(1.0, 3.0, 5), np.zeros(5)])
-    b = meshcore.Borders(bottom=np.column_stack([np.cos(t), np.sin(t)]), right=cut,
-                         top=np.column_stack([3 * np.cos(t), 3 * np.sin(t)]), left=cut)
+    b = meshcore.Borders(
+        bottom=np.column_stack([np.cos(t), np.sin(t)]),
+        right=cut,
+        top=np.column_stack([3 * np.cos(t), 3 * np.sin(t)]),
+        left=cut,
+    )
     g0 = meshcore.initial_grid(b.resampled(cells), weights=(0.05, 0.0))
     levels = multigrid.hierarchy(g0.x, g0.y)
     assert levels[-1][0] >= 3  # 2 cells around would be a folded coarse ring
@@ -551,9 +559,9 @@ def test_band_smoother_on_long_strips_solves_the_band_problem(periodic):
         X[-1], Y[-1] = X[0], Y[0]
     p, q = 0.3 * rng.standard_normal(X.shape), np.full(X.shape, -0.2)
     band = np.zeros(X.shape, bool)
-    band[:, 1:w + 1] = band[:, nj - w:nj] = True
+    band[:, 1 : w + 1] = band[:, nj - w : nj] = True
     if not periodic:
-        band[1:w + 1, 1:-1] = band[ni - w:ni, 1:-1] = True
+        band[1 : w + 1, 1:-1] = band[ni - w : ni, 1:-1] = True
         band[0] = band[-1] = False
     a = [X.copy(), Y.copy()]
     _mg_kernels.smooth_band(a[0], a[1], E, E, p, q, periodic, w, 300)

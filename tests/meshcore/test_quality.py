@@ -77,7 +77,10 @@ def test_folded_and_nonconvex_cells_are_found():
 
 @settings(max_examples=40, deadline=None)
 @given(
-    st.floats(-100, 100), st.floats(-100, 100), st.floats(0, 2 * math.pi), st.floats(1e-3, 1e3),
+    st.floats(-100, 100),
+    st.floats(-100, 100),
+    st.floats(0, 2 * math.pi),
+    st.floats(1e-3, 1e3),
     st.integers(0, 1000),
 )
 def test_quality_invariant_under_similarity(dx, dy, angle, scale, seed):
