@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 import threading
@@ -28,6 +29,24 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _logging() -> None:
+    """Warnings and errors to stderr; everything from INFO up, with tracebacks, to gcmesh.log."""
+    from PySide6 import QtCore
+
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    loc = QtCore.QStandardPaths.StandardLocation.AppDataLocation
+    folder = Path(QtCore.QStandardPaths.writableLocation(loc))
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        handler = logging.FileHandler(folder / "gcmesh.log", encoding="utf-8")
+    except OSError:
+        return
+    handler.setLevel(logging.INFO)
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    logging.getLogger().addHandler(handler)
+    logging.getLogger("app").setLevel(logging.INFO)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
@@ -45,16 +64,15 @@ def main(argv: list[str] | None = None) -> int:
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     app.setApplicationName("gcmesh")
     app.setOrganizationName("gcmesh")
+    _logging()
 
     from .main_window import MainWindow
 
     win = MainWindow(restore_layout=not args.screenshot)  # screenshots: the default layout
 
     def excepthook(kind, value, tb):  # a bug in a slot must not leave the user guessing
-        import traceback
-
-        traceback.print_exception(kind, value, tb)
-        win.message(f"internal error: {kind.__name__}: {value}", error=True)
+        logging.getLogger("app").critical("internal error", exc_info=(kind, value, tb))
+        win.message(f"internal error: {kind.__name__}: {value} (the traceback is in the log)", error=True)
 
     sys.excepthook = excepthook
     if args.size or args.screenshot:
@@ -67,11 +85,11 @@ def main(argv: list[str] | None = None) -> int:
     startup = time.perf_counter() - t0
     win.message(f"Ready in {startup:.2f} s. " + win._status.text())
     if not args.screenshot and not args.file and not args.example:
-        win.offer_recovery()
+        win.io.offer_recovery()
     if args.example:
-        if not win.open_example(args.example, confirm=False):
+        if not win.io.open_example(args.example, confirm=False):
             return 2
-    elif args.file and not win.open_path(Path(args.file)):
+    elif args.file and not win.io.open_path(Path(args.file)):
         return 2
     app.processEvents()
     win.canvas.fit()

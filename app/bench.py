@@ -38,11 +38,9 @@ def main() -> int:
     import meshcore.elliptic
 
     meshcore.elliptic.warmup()
-    import numpy as np
     from PySide6 import QtWidgets
 
     from app.main_window import MainWindow
-    from meshcore import StructuredGrid
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     win = MainWindow()
@@ -51,9 +49,20 @@ def main() -> int:
     win.show()
     app.processEvents()
     print(f"start-up to a shown window (warm numba cache, in-process): {time.perf_counter() - t0:.2f} s")
+    redraw_rate(win)
+    live_rate_and_stop(app, win)
+    drag_to_converged(app, win)
+    win.stack.setClean()
+    win.close()
+    return 0
 
-    # 1. raw redraw rate at 257 × 257 nodes
-    n = 257
+
+def redraw_rate(win, n: int = 257) -> None:
+    """Raw redraw rate of the grid curve at ``n`` × ``n`` nodes (setData + forced paint)."""
+    import numpy as np
+
+    from meshcore import StructuredGrid
+
     xi, eta = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n), indexing="ij")
     win.canvas.zoom_to((0, 0, 1, 1))
     times = []
@@ -64,10 +73,12 @@ def main() -> int:
         win.canvas.viewport().repaint()
         times.append(time.perf_counter() - t)
     med = statistics.median(times)
-    print(f"redraw 257x257 (setData + paint): median {med * 1000:.1f} ms = {1 / med:.1f} redraws/s")
+    print(f"redraw {n}x{n} (setData + paint): median {med * 1000:.1f} ms = {1 / med:.1f} redraws/s")
 
-    # 2. live rate during a solve at 256 × 256 cells, then Stop latency
-    win.open_example("bottle-fine", confirm=False)
+
+def live_rate_and_stop(app, win) -> None:
+    """Live redraws during a 257 × 257 solve, then the Stop latency."""
+    win.io.open_example("bottle-fine", confirm=False)
     win.editor.set_block_options(cells=(256, 256))
     win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     frames = []
@@ -89,8 +100,12 @@ def main() -> int:
         lat.append(_wait(app, lambda: not win.solver.running))
     print(f"stop latency (5 runs): median {statistics.median(lat) * 1000:.0f} ms, max {max(lat) * 1000:.0f} ms")
 
-    # 3. drag-to-converged on a ~100 x 100 grid, auto-generate on
-    win.open_example("annulus-sector", confirm=False)
+
+def drag_to_converged(app, win) -> None:
+    """Drag a corner of a ~100 × 100 grid with auto-generate on; time from release to converged."""
+    import numpy as np
+
+    win.io.open_example("annulus-sector", confirm=False)
     win.editor.set_block_options(cells=(100, 100))
     win.editor.set_solver(method="auto")
     win.a_auto.trigger()
@@ -99,7 +114,7 @@ def main() -> int:
     p = np.array(win.doc.block.points[k])
     results = []
     delta = np.array([0.15, 0.075])
-    frames.clear()
+    frames = []
     win.solver.redrawn.connect(lambda: frames.append(time.perf_counter()))
     for rep in range(6):  # drag the NE corner out and back, ~0.5 s per drag at 60 Hz
         drag = win.editor.new_drag_id()
@@ -118,9 +133,6 @@ def main() -> int:
             f"({g.info.method}, {g.iterations} it) {dt * 1000:.0f} ms after release"
         )
     print(f"drag-to-converged 101x101 nodes: median {statistics.median(results) * 1000:.0f} ms")
-    win.stack.setClean()
-    win.close()
-    return 0
 
 
 if __name__ == "__main__":

@@ -1,8 +1,10 @@
 """The document: the single source of truth the views draw (psygnal, no Qt widgets).
 
 It holds the immutable :class:`~app.project.Project`, the grids of the last
-solve (and the live preview while solving), the selection and the active
-block.  Views subscribe to its signals; edits go through undo commands
+solve (and the live preview while solving), the multiblock result with its
+connectivity, the quality report of the active block's final grid, the
+metric the cells are coloured by, the selection and the active block.  Views
+subscribe to its signals and draw it; edits go through undo commands
 (:mod:`app.commands`) that call :meth:`Document.set_project`.
 """
 
@@ -12,11 +14,22 @@ from pathlib import Path
 
 from psygnal import Signal
 
-from meshcore import StructuredGrid
+from meshcore import StructuredGrid, quality
 
 from .project import Block, Project
 
-__all__ = ["Document"]
+__all__ = ["METRICS", "Document"]
+
+#: the metrics cells can be coloured by: label → (array of the quality report, colour map)
+METRICS = {
+    "none": None,
+    "Jacobian ratio": ("jacobian_ratio", "viridis"),
+    "skewness": ("skewness", "viridis"),
+    "orthogonality (deg)": ("orthogonality", "viridis"),
+    "aspect ratio": ("aspect_ratio", "viridis"),
+    "cell area": ("area", "viridis"),
+    "size ratio": ("size_ratio", "viridis"),
+}
 
 
 class Document:
@@ -36,6 +49,12 @@ class Document:
         The file path of the project changed (None for unsaved).
     message(str)
         A human-readable status message (errors included).
+    quality_changed()
+        :attr:`quality` changed (a solve finished, started, or another block became active).
+    colour_changed(str)
+        The metric the cells are coloured by changed (a key of :data:`METRICS`).
+    opened()
+        A new project was opened (:meth:`reset`): views drop what they showed.
     """
 
     project_changed = Signal(object)
@@ -44,6 +63,9 @@ class Document:
     active_changed = Signal(int)
     path_changed = Signal(object)
     message = Signal(str)
+    quality_changed = Signal()
+    colour_changed = Signal(str)
+    opened = Signal()
 
     def __init__(self, project: Project | None = None) -> None:
         self.project: Project = project or Project()
@@ -53,6 +75,14 @@ class Document:
         self.selection: frozenset[int] = frozenset()
         self.active: int = 0
         self.path: Path | None = None
+        #: the meshcore MultiBlockGrid of the last multiblock solve (with its connectivity)
+        self.multiblock = None
+        #: the meshcore QualityReport of the active block's final grid (None while solving)
+        self.quality = None
+        self.quality_grid: StructuredGrid | None = None  # the grid ``quality`` describes
+        self.colour_by: str = "none"
+        self.solving: bool = False
+        self._final: bool = False  # the grids are the result of a finished solve
 
     # ----------------------------------------------------------- project
     @property
@@ -78,7 +108,9 @@ class Document:
             }
             self.grids = {k: g for k, g in self.grids.items() if k in keep}
             self.initial = {k: g for k, g in self.initial.items() if k in keep}
+            self.multiblock = None
             self.grids_changed.emit()
+            self._update_quality()
         if self.active >= len(project.blocks):
             self.set_active(len(project.blocks) - 1)
         n = len(self.block.points)
@@ -91,11 +123,15 @@ class Document:
         """Start over with ``project`` (open/new): grids and selection cleared."""
         self.grids = {}
         self.initial = {}
+        self.multiblock = None
+        self._final = False
         self.selection = frozenset()
         self.active = 0
         self.project = project
         self.path = Path(path) if path else None
         self.stale = True
+        self._update_quality()
+        self.opened.emit()
         self.project_changed.emit(project)
         self.grids_changed.emit()
         self.selection_changed.emit(self.selection)
@@ -109,17 +145,62 @@ class Document:
             self.stale = False
         self.grids_changed.emit()
 
-    def set_grids(self, grids: dict[int, StructuredGrid], initial: dict | None = None) -> None:
+    def set_grids(self, grids: dict[int, StructuredGrid], initial: dict | None = None, *, multiblock=None) -> None:
+        """The final grids of a solve (and, for a multiblock case, meshcore's MultiBlockGrid)."""
         self.grids = dict(grids)
         if initial is not None:
             self.initial = dict(initial)
+        self.multiblock = multiblock
         self.stale = False
+        self._final = True
         self.grids_changed.emit()
+        self._update_quality()
+
+    def set_multiblock(self, multiblock) -> None:
+        """The MultiBlockGrid (connectivity included) of the grids just set."""
+        self.multiblock = multiblock
 
     def clear_grids(self) -> None:
         self.grids = {}
         self.initial = {}
+        self.multiblock = None
+        self._final = False
         self.grids_changed.emit()
+        self._update_quality()
+
+    def set_solving(self, solving: bool) -> None:
+        """A solve started (the quality of the old grid is withdrawn) or ended."""
+        solving = bool(solving)
+        if solving == self.solving:
+            return
+        self.solving = solving
+        if solving:
+            self._final = False
+        self._update_quality()
+
+    # ----------------------------------------------------------- quality
+    def _update_quality(self) -> None:
+        g = self.grid if self._final and not self.solving else None
+        if g is self.quality_grid:
+            return
+        self.quality_grid = g
+        self.quality = quality(g) if g is not None else None
+        self.quality_changed.emit()
+
+    def set_colour_by(self, label: str) -> None:
+        """Colour the cells by the metric ``label`` (a key of :data:`METRICS`)."""
+        if label not in METRICS:
+            raise ValueError(f"unknown metric {label!r}; known: {', '.join(METRICS)}")
+        if label != self.colour_by:
+            self.colour_by = label
+            self.colour_changed.emit(label)
+
+    def colour_values(self):
+        """``(grid, values, label)`` of the cell colouring, or ``(None, None, "")`` for none."""
+        m = METRICS.get(self.colour_by)
+        if m is None or self.quality is None:
+            return None, None, ""
+        return self.quality_grid, self.quality.arrays[m[0]], self.colour_by
 
     @property
     def grid(self) -> StructuredGrid | None:
@@ -138,6 +219,7 @@ class Document:
         if index != self.active:
             self.active = index
             self.selection = frozenset()
+            self._update_quality()
             self.active_changed.emit(index)
             self.selection_changed.emit(self.selection)
 

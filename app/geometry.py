@@ -13,6 +13,10 @@ import numpy as np
 __all__ = [
     "auto_corners",
     "border_polylines",
+    "cell_at",
+    "cell_centres",
+    "compose_similarity",
+    "fit_image",
     "grid_lines",
     "nearest_point",
     "nearest_segment",
@@ -275,6 +279,65 @@ def similarity_from_pairs(uv0, xy0, uv1, xy1) -> tuple[float, float, float, floa
     m = (z1 - z0) / (w1 - w0)
     t = z0 - m * w0
     return (m.real, m.imag, t.real, t.imag)
+
+
+def compose_similarity(transform, shown, true) -> tuple[float, float, float, float]:
+    """The transform that moves two ``shown`` model points onto their ``true`` positions.
+
+    ``transform`` (``(a, b, tx, ty)``, see :func:`similarity_from_pairs`) places
+    an image in the model; the image currently shows two features at the
+    model points ``shown[0]`` and ``shown[1]`` whose real coordinates are
+    ``true[0]`` and ``true[1]``.  The result is the correction composed with
+    ``transform``: the image drawn with it shows the features at ``true``.
+
+    Raises
+    ------
+    ValueError
+        When the two shown points coincide.
+    """
+    a, b, tx, ty = similarity_from_pairs(shown[0], true[0], shown[1], true[1])
+    m_s, t_s = complex(a, b), complex(tx, ty)
+    a0, b0, tx0, ty0 = transform
+    m, t = m_s * complex(a0, b0), m_s * complex(tx0, ty0) + t_s
+    return (m.real, m.imag, t.real, t.imag)
+
+
+def fit_image(width: int, height: int, bounds) -> tuple[float, float, float, float]:
+    """A similarity transform putting a ``width`` × ``height`` pixel image over ``bounds``.
+
+    The image keeps its aspect ratio and covers the box ``(x0, y0, x1, y1)``
+    with its lower-left corner at ``(x0, y0)``; without bounds it is drawn at
+    one model unit per pixel from the origin.
+    """
+    if bounds is None:
+        return (1.0, 0.0, 0.0, 0.0)
+    x0, y0, x1, y1 = bounds
+    s = max((x1 - x0) / max(width, 1), (y1 - y0) / max(height, 1))
+    return (s if s > 0 else 1.0, 0.0, float(x0), float(y0))
+
+
+def cell_centres(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Centres (mean of the four nodes) of the cells of a grid, shape ``(ni, nj)``."""
+    cx = 0.25 * (x[:-1, :-1] + x[1:, :-1] + x[1:, 1:] + x[:-1, 1:])
+    cy = 0.25 * (y[:-1, :-1] + y[1:, :-1] + y[1:, 1:] + y[:-1, 1:])
+    return cx, cy
+
+
+def cell_at(x: np.ndarray, y: np.ndarray, px: float, py: float, centres=None) -> tuple[int, int] | None:
+    """The cell ``(i, j)`` whose centre is nearest to ``(px, py)``, or None when the point is
+    farther from that centre than the cell's diagonal (outside the grid).
+
+    ``centres`` may pass the result of :func:`cell_centres` (cached by the caller).
+    """
+    cx, cy = centres if centres is not None else cell_centres(x, y)
+    if cx.size == 0:
+        return None
+    d = np.hypot(cx - px, cy - py)
+    i, j = np.unravel_index(int(np.argmin(d)), d.shape)
+    size = math.hypot(x[i + 1, j + 1] - x[i, j], y[i + 1, j + 1] - y[i, j])
+    if d[i, j] > size:
+        return None
+    return int(i), int(j)
 
 
 def polyline_length(p: np.ndarray) -> float:

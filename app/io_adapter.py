@@ -20,6 +20,8 @@ from .project import Block, Project, SolverSettings, boundary_to_loop
 __all__ = [
     "PointData",
     "block_from_case",
+    "case_of_project",
+    "dumps_project",
     "load_project",
     "mesh_formats",
     "project_frame",
@@ -238,38 +240,49 @@ def project_from_multiblock_case(case) -> Project:
     )
 
 
-def save_project(project: Project, path) -> None:
-    """Write the project as a case file (meshcore.case.save_case).
+def case_of_project(project: Project):
+    """The :class:`meshcore.case.Case` a project is saved as.
 
-    A multiblock case is written back as read, with the app's solver settings.
+    A multiblock case is written back as read, with the app's solver settings;
+    otherwise the ready blocks (:func:`project_to_case`; ValueError when none is).
     """
     from meshcore import EllipticConfig
+
+    if project.multiblock is None:
+        return project_to_case(project)
+    s = project.solver
+    cfg = EllipticConfig(
+        method="auto" if s.method == "foldfree" else s.method,
+        tolerance=s.tolerance,
+        max_iterations=s.max_iterations,
+        omega=s.omega,
+    )
+    case = project.multiblock
+    if "outline" in case.extra:
+        # written as explicit [[blocks]] + [[interfaces]] (meshcore's dump of an [outline]
+        # case does not load back: it writes ``blocks = []``)
+        from meshcore.multiblock.case import _settings, case_topology, topology_case
+
+        mode, _start = _settings(case)
+        case = topology_case(case_topology(case), mode=mode, title=case.title, description=case.description, solver=cfg)
+        frame = project_frame(project)
+        if frame is not None:
+            case = case.replaced(extra={**dict(case.extra), "crs": frame.as_dict()})
+    return case.replaced(solver=cfg, path=None)
+
+
+def save_project(project: Project, path) -> None:
+    """Write the project as a case file (:func:`meshcore.case.save_case` of :func:`case_of_project`)."""
     from meshcore.case import save_case
 
-    if project.multiblock is not None:
-        s = project.solver
-        cfg = EllipticConfig(
-            method="auto" if s.method == "foldfree" else s.method,
-            tolerance=s.tolerance,
-            max_iterations=s.max_iterations,
-            omega=s.omega,
-        )
-        case = project.multiblock
-        if "outline" in case.extra:
-            # written as explicit [[blocks]] + [[interfaces]] (meshcore's dump of an [outline]
-            # case does not load back: it writes ``blocks = []``)
-            from meshcore.multiblock.case import _settings, case_topology, topology_case
+    save_case(case_of_project(project), path)
 
-            mode, _start = _settings(case)
-            case = topology_case(
-                case_topology(case), mode=mode, title=case.title, description=case.description, solver=cfg
-            )
-            frame = project_frame(project)
-            if frame is not None:
-                case = case.replaced(extra={**dict(case.extra), "crs": frame.as_dict()})
-        save_case(case.replaced(solver=cfg, path=None), path)
-        return
-    save_case(project_to_case(project), path)
+
+def dumps_project(project: Project) -> str:
+    """The case-file text of a project (what :func:`save_project` writes)."""
+    from meshcore.case import dumps_case
+
+    return dumps_case(case_of_project(project))
 
 
 # --------------------------------------------------------------------- mesh

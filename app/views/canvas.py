@@ -10,6 +10,8 @@ and the tool overlay (rubber band / rubber line).
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pyqtgraph as pg
 from PySide6 import QtCore, QtGui
@@ -21,6 +23,8 @@ from .. import geometry as geo
 from ..document import Document
 
 __all__ = ["BORDER_COLOURS", "Canvas"]
+
+log = logging.getLogger(__name__)
 
 BORDER_COLOURS = {
     "bottom": "#1f77b4",  # blue
@@ -94,7 +98,28 @@ class Canvas(pg.PlotWidget):
             pi.getAxis(ax).setPen(pg.mkPen("#666"))
             pi.getAxis(ax).setTextPen(pg.mkPen("#333"))
         self.setMouseTracking(True)
+        self._make_shape_items()
+        self._make_border_items()
+        self._make_point_items()
+        self._make_overlays()
+        # items are pictures only: every click goes to the ViewBox and so to the tool
+        for it in self.getPlotItem().items:
+            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+        self._label_at: dict[str, tuple[float, float, float]] = {}
+        self._vb.sigRangeChanged.connect(self._place_labels)
+        self.scene().sigMouseMoved.connect(self._on_mouse_moved)
+        doc.project_changed.connect(self.refresh_boundary)
+        doc.selection_changed.connect(lambda _: self.refresh_selection())
+        doc.active_changed.connect(lambda _: self.refresh_boundary())
+        doc.grids_changed.connect(self.refresh_grids)
+        doc.quality_changed.connect(self.refresh_quality)
+        doc.colour_changed.connect(lambda _label: self.refresh_quality())
+        doc.opened.connect(self.clear_highlight)
+        self.refresh_boundary()
 
+    # ----------------------------------------------------------- building
+    def _make_shape_items(self) -> None:
+        """Background image, quality colouring, grid, loops and cut lines."""
         self.background_item = pg.ImageItem()
         self.background_item.setZValue(-100)
         self.background_item.setOpacity(0.6)
@@ -120,6 +145,8 @@ class Canvas(pg.PlotWidget):
         self.cut_curve.setZValue(6)
         self.addItem(self.cut_curve)
 
+    def _make_border_items(self) -> None:
+        """The four coloured borders of the active block, their arrows and labels."""
         self.border_curves = {}
         self.border_arrows = {}
         self.border_labels = {}
@@ -141,6 +168,8 @@ class Canvas(pg.PlotWidget):
             self.addItem(t)
             self.border_labels[name] = t
 
+    def _make_point_items(self) -> None:
+        """Points, other blocks' points, selection, corners, folded-cell markers."""
         self.points_item = _Scatter(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
         self.points_item.setZValue(20)
         self.addItem(self.points_item)
@@ -165,7 +194,8 @@ class Canvas(pg.PlotWidget):
         self.folded_item.setZValue(30)
         self.addItem(self.folded_item)
 
-        # tool overlays
+    def _make_overlays(self) -> None:
+        """The tools' rubber line and box, and the ring around a cell picked in the quality list."""
         self.rubber_line = pg.PlotCurveItem(pen=pg.mkPen("#1f77b4", width=1, style=QtCore.Qt.PenStyle.DashLine))
         self.rubber_line.setZValue(40)
         self.addItem(self.rubber_line)
@@ -178,17 +208,6 @@ class Canvas(pg.PlotWidget):
         self.highlight_item = _Scatter(size=16, symbol="o", pen=pg.mkPen("#ff00ff", width=2), brush=None)
         self.highlight_item.setZValue(42)
         self.addItem(self.highlight_item)
-
-        # items are pictures only: every click goes to the ViewBox and so to the tool
-        for it in self.getPlotItem().items:
-            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
-        self._label_at: dict[str, tuple[float, float, float]] = {}
-        self._vb.sigRangeChanged.connect(self._place_labels)
-        self.scene().sigMouseMoved.connect(self._on_mouse_moved)
-        doc.project_changed.connect(self.refresh_boundary)
-        doc.selection_changed.connect(lambda _: self.refresh_selection())
-        doc.active_changed.connect(lambda _: self.refresh_boundary())
-        self.refresh_boundary()
 
     # ------------------------------------------------------------ helpers
     def to_model(self, scene_pos) -> tuple[float, float]:
@@ -231,39 +250,36 @@ class Canvas(pg.PlotWidget):
 
     # ------------------------------------------------------------ drawing
     def refresh_boundary(self, *_args) -> None:
+        """Draw the project's outlines: loops, the active block's borders, points, corners, cuts."""
+        self._draw_loops()
+        self._draw_borders()
+        self._draw_points()
+        _set_polylines(self.cut_curve, self.doc.project.cut_lines)
+        self.refresh_selection()
+
+    def _draw_loops(self) -> None:
+        """Other blocks' points, faint, and every block's loop as a dashed line."""
         doc = self.doc
-        block = doc.block
-        pts = block.points
-        # other blocks: their points, faint
         others = [b for k, b in enumerate(doc.project.blocks) if k != doc.active]
         multiblock = doc.project.multiblock is not None  # boundary nodes, not editable points
         op = [b.points for b in others if len(b.points)]
         if not multiblock:
             op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
-        if op:
-            a = np.vstack(op)
-            self.other_points_item.setData(a[:, 0], a[:, 1])
-        else:
-            self.other_points_item.setData([], [])
-        # loops of all blocks as a faint dashed line (NaN separated)
-        segs = []
+        _set_points(self.other_points_item, np.vstack(op) if op else None)
+        loops = []
         for b in doc.project.blocks:
-            p = (
-                b.points
-                if b.boundary is None
-                else np.vstack([b.boundary[0], b.boundary[1], b.boundary[2][::-1], b.boundary[3][::-1]])
-            )
-            if len(p) == 0:
-                continue
-            if b.closed or b.boundary is not None:
-                p = np.vstack([p, p[:1]])
-            segs += [p, np.full((1, 2), np.nan)]
-        if segs:
-            a = np.vstack(segs)
-            self.loop_curve.setData(a[:, 0], a[:, 1], connect="finite")
-        else:
-            self.loop_curve.setData([], [])
-        # borders of the active block
+            if b.boundary is not None:
+                p = np.vstack([b.boundary[0], b.boundary[1], b.boundary[2][::-1], b.boundary[3][::-1]])
+            else:
+                p = b.points
+            if len(p):
+                loops.append(np.vstack([p, p[:1]]) if b.closed or b.boundary is not None else p)
+        _set_polylines(self.loop_curve, loops)
+
+    def _draw_borders(self) -> None:
+        """The active block's four borders, each with an arrow and a label at its middle."""
+        block = self.doc.block
+        pts = block.points
         borders = None
         if block.boundary is not None:
             borders = dict(zip(("bottom", "right", "top", "left"), block.boundary, strict=True))
@@ -274,18 +290,13 @@ class Canvas(pg.PlotWidget):
                 borders = None
         for name in ("bottom", "right", "top", "left"):
             c, a, t = self.border_curves[name], self.border_arrows[name], self.border_labels[name]
-            if borders is None:
-                c.setData([], [])
-                a.hide()
-                t.setText("")
-                self._label_at.pop(name, None)
-                continue
-            p = borders[name]
+            p = borders[name] if borders is not None else np.zeros((0, 2))
             c.setData(p[:, 0], p[:, 1])
             m = geo.arrow_at_middle(p)
             if m is None:
                 a.hide()
                 t.setText("")
+                self._label_at.pop(name, None)
                 continue
             x, y, ang = m
             a.setPos(x, y)
@@ -294,14 +305,16 @@ class Canvas(pg.PlotWidget):
             t.setText(f"{name} · {block.node_count(name)}")
             self._label_at[name] = (x, y, ang)
         self._place_labels()
+
+    def _draw_points(self) -> None:
+        """The active block's points (or border nodes) and its corners."""
+        block = self.doc.block
+        pts = block.points
         if block.boundary is None:
             disp = pts
         else:
-            disp = np.zeros((0, 2)) if multiblock else np.vstack(block.boundary)
-        if len(disp):
-            self.points_item.setData(disp[:, 0], disp[:, 1])
-        else:
-            self.points_item.setData([], [])
+            disp = None if self.doc.project.multiblock is not None else np.vstack(block.boundary)
+        _set_points(self.points_item, disp)
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
             cp = pts[list(block.corners)]
             self.corner_item.setData(cp[:, 0], cp[:, 1])
@@ -312,15 +325,6 @@ class Canvas(pg.PlotWidget):
             self.corner_item.setData([], [])
             for lab in self.corner_labels:
                 lab.setText("")
-        cuts = []
-        for c in doc.project.cut_lines:
-            cuts += [c, np.full((1, 2), np.nan)]
-        if cuts:
-            a = np.vstack(cuts)
-            self.cut_curve.setData(a[:, 0], a[:, 1], connect="finite")
-        else:
-            self.cut_curve.setData([], [])
-        self.refresh_selection()
 
     def _place_labels(self, *_args) -> None:
         """Put each border label just outside the middle of its border (any orientation)."""
@@ -342,6 +346,41 @@ class Canvas(pg.PlotWidget):
             self.selected_item.setData(pts[sel, 0], pts[sel, 1])
         else:
             self.selected_item.setData([], [])
+
+    def refresh_grids(self) -> None:
+        """Draw the document's grids; while solving, the colouring of the old grid is hidden."""
+        self.set_grids(self.doc.grids)
+        if self.doc.solving and self.quality_item is not None:
+            self.set_quality(None, None)
+
+    def refresh_quality(self) -> None:
+        """Colour the cells and mark the folded ones as the document says."""
+        grid, values, label = self.doc.colour_values()
+        try:
+            self.set_quality(grid, values, label=label)
+        except Exception:  # a drawing problem must not kill the window
+            log.exception("cannot colour the cells by %s", label)
+            self.doc.message.emit(f"cannot colour cells by {label} (details in the log)")
+        r = self.doc.quality
+        self.set_folded(self.doc.quality_grid, r.folded if r is not None else None)
+        self.clear_highlight()
+
+    def zoom_to_cell(self, i: int, j: int) -> None:
+        """Zoom to cell ``(i, j)`` of the active grid and ring it."""
+        g = self.doc.grid
+        if g is None or not (0 <= i < g.cells[0] and 0 <= j < g.cells[1]):
+            return
+        ni, nj = g.cells
+        i0, i1 = max(i - 3, 0), min(i + 4, ni)
+        j0, j1 = max(j - 3, 0), min(j + 4, nj)
+        xs, ys = g.x[i0 : i1 + 1, j0 : j1 + 1], g.y[i0 : i1 + 1, j0 : j1 + 1]
+        self.zoom_to((xs.min(), ys.min(), xs.max(), ys.max()), margin=0.1)
+        cx = 0.25 * (g.x[i, j] + g.x[i + 1, j] + g.x[i + 1, j + 1] + g.x[i, j + 1])
+        cy = 0.25 * (g.y[i, j] + g.y[i + 1, j] + g.y[i + 1, j + 1] + g.y[i, j + 1])
+        self.highlight_item.setData([cx], [cy])
+
+    def clear_highlight(self) -> None:
+        self.highlight_item.setData([], [])
 
     def set_grids(self, grids: dict[int, StructuredGrid]) -> None:
         """Draw all block grids as one NaN-separated curve."""
@@ -428,7 +467,32 @@ class Canvas(pg.PlotWidget):
         """Write the canvas to PNG (raster) or SVG (vector) by the file suffix."""
         import pyqtgraph.exporters as ex
 
-        if str(path).lower().endswith(".svg"):
-            ex.SVGExporter(self.getPlotItem()).export(str(path))
-        else:
-            self.grab().save(str(path))
+        ring = self.highlight_item.isVisible()
+        self.highlight_item.hide()  # a marker of the last click, not part of the figure
+        try:
+            if str(path).lower().endswith(".svg"):
+                ex.SVGExporter(self.getPlotItem()).export(str(path))
+            elif not self.grab().save(str(path)):
+                raise OSError(f"{path}: cannot write the image")
+        finally:
+            self.highlight_item.setVisible(ring)
+
+
+def _set_points(item, points) -> None:
+    """Show ``(n, 2)`` points in a scatter item (None or empty: none)."""
+    if points is None or len(points) == 0:
+        item.setData([], [])
+    else:
+        item.setData(points[:, 0], points[:, 1])
+
+
+def _set_polylines(item, lines) -> None:
+    """Show polylines as one NaN-separated curve (``connect="finite"``)."""
+    parts = []
+    for line in lines:
+        parts += [np.asarray(line, float).reshape(-1, 2), np.full((1, 2), np.nan)]
+    if parts:
+        a = np.vstack(parts)
+        item.setData(a[:, 0], a[:, 1], connect="finite")
+    else:
+        item.setData([], [])

@@ -69,7 +69,7 @@ def test_click_a_square_pick_corners_generate(qtbot, win):
 
 
 def test_edit_tool_drag_insert_delete(qtbot, win):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     win.canvas.fit()
     qtbot.wait(50)
     b0 = win.doc.block
@@ -99,7 +99,7 @@ def test_edit_tool_drag_insert_delete(qtbot, win):
 
 
 def test_live_remesh_follows_a_drag(qtbot, win):
-    win.open_example("annulus-sector", confirm=False)
+    win.io.open_example("annulus-sector", confirm=False)
     win.a_auto.trigger()
     assert win.solver.auto
     wait_idle(qtbot, win)
@@ -120,7 +120,7 @@ def test_live_remesh_follows_a_drag(qtbot, win):
 
 
 def test_stop_during_a_long_solve(qtbot, win):
-    win.open_example("bottle-fine", confirm=False)
+    win.io.open_example("bottle-fine", confirm=False)
     b = win.doc.block
     win.editor.set_block_options(cells=(300, 300))
     win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
@@ -137,7 +137,7 @@ def test_stop_during_a_long_solve(qtbot, win):
 
 
 def test_pause_and_resume(qtbot, win):
-    win.open_example("bottle-fine", confirm=False)
+    win.io.open_example("bottle-fine", confirm=False)
     win.editor.set_block_options(cells=(200, 200))
     win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     win.generate()
@@ -161,7 +161,7 @@ def _iteration(win):
 def test_import_kml_projects_to_utm(qtbot, win):
     from pyproj import Transformer
 
-    assert win.import_points(DATA / "lake_bolsena_sparse.kml", project_lonlat=True)
+    assert win.io.import_points(DATA / "lake_bolsena_sparse.kml", project_lonlat=True)
     b = win.doc.block
     assert win.doc.project.crs == "EPSG:32632"
     assert b.closed and b.ready and len(b.points) == 40
@@ -176,12 +176,12 @@ def test_import_kml_projects_to_utm(qtbot, win):
 
 def test_export_vts_read_back_by_vtk(qtbot, win, tmp_path):
     vtk = pytest.importorskip("vtk")
-    win.open_example("rectangle-cutout-coarse", confirm=False)
+    win.io.open_example("rectangle-cutout-coarse", confirm=False)
     win.generate()
     wait_idle(qtbot, win)
     g = win.doc.grid
     out = tmp_path / "mesh.vts"
-    assert win.export_mesh(out)
+    assert win.io.export_mesh(out)
     r = vtk.vtkXMLStructuredGridReader()
     r.SetFileName(str(out))
     r.Update()
@@ -198,17 +198,17 @@ def test_export_vts_read_back_by_vtk(qtbot, win, tmp_path):
 
 
 def test_save_open_round_trip_and_recent(qtbot, win, tmp_path):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     win.editor.set_block_options(cells=(8, 20))
     assert not win.stack.isClean()
     path = tmp_path / "p.toml"
-    assert win._save_to(path)
+    assert win.io.save_to(path)
     assert win.stack.isClean() and win.windowTitle().startswith("p.toml")
     before = win.doc.project
-    win.set_project(type(before)())
-    assert win.open_path(path)
+    win.io.set_project(type(before)())
+    assert win.io.open_path(path)
     assert win.doc.project.blocks == before.blocks
-    assert win._recent()[0] == str(path)
+    assert win.io.recent()[0] == str(path)
 
 
 def test_autosave_and_recovery(qtbot, win, tmp_path, monkeypatch):
@@ -216,16 +216,16 @@ def test_autosave_and_recovery(qtbot, win, tmp_path, monkeypatch):
 
     from app.main_window import MainWindow
 
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     win.editor.set_block_options(weights=(0.3, 0.7))
-    win.autosave()
-    assert win.recovery_path.exists()
+    win.io.autosave()
+    assert win.io.recovery_path.exists()
     # a second window (as after a crash) offers the project back
-    w2 = MainWindow(settings=win.settings, recovery=win.recovery_path)
+    w2 = MainWindow(settings=win.settings, recovery=win.io.recovery_path)
     w2.quiet = True
     qtbot.addWidget(w2)
     monkeypatch.setattr(QtWidgets.QMessageBox, "question", lambda *a, **k: QtWidgets.QMessageBox.StandardButton.Yes)
-    assert w2.offer_recovery()
+    assert w2.io.offer_recovery()
     assert w2.doc.project == win.doc.project
     assert not w2.stack.isClean()  # restored work counts as unsaved
     w2.stack.setClean()
@@ -234,7 +234,7 @@ def test_autosave_and_recovery(qtbot, win, tmp_path, monkeypatch):
 def test_errors_are_messages_not_crashes(qtbot, win, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("x,y\n1,2\nfoo,bar\n")
-    assert not win.import_points(bad)
+    assert not win.io.import_points(bad)
     assert "bad.csv" in win._status.text()
     # a self-intersecting boundary: the solver reports, the window lives on
     bow = np.array([[0, 0], [2, 2], [2, 0], [0, 2.0]])
@@ -254,7 +254,6 @@ def test_quality_panel_lists_folded_cells_and_zooms(qtbot, win):
     x[2, 2], y[2, 2] = 3.6, 2.9  # pull a node across its neighbour: folded cells
     g = StructuredGrid(x, y)
     win.doc.set_grids({0: g})
-    win.quality_panel.update_grid(g)
     lst = win.quality_panel.folded
     assert lst.count() >= 1
     assert "folded" in lst.item(0).text()
@@ -267,7 +266,7 @@ def test_quality_panel_lists_folded_cells_and_zooms(qtbot, win):
 
 
 def test_parameter_validation_is_immediate(qtbot, win):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     pp = win.params_panel
     n = win.stack.count()
     pp.dist.setCurrentText("tanh")  # needs a spacing: rejected with a message, nothing applied
@@ -316,7 +315,7 @@ def test_command_line_screenshot(tmp_path):
 
 @pytest.mark.parametrize("suffix", [".png", ".svg"])
 def test_export_figure(qtbot, win, tmp_path, suffix):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     win.generate()
     wait_idle(qtbot, win)
     out = tmp_path / f"fig{suffix}"
@@ -331,20 +330,20 @@ def test_export_figure(qtbot, win, tmp_path, suffix):
 def test_lake_keeps_its_frame_through_save_and_export(qtbot, win, tmp_path):
     from meshcore.io import read_blocks
 
-    win.open_example("windermere", confirm=False)
+    win.io.open_example("windermere", confirm=False)
     p = win.doc.project
     assert p.crs == "EPSG:32630" and p.source_crs == "EPSG:4326" and p.origin != (0.0, 0.0)
     win.generate()
     wait_idle(qtbot, win)
     case = tmp_path / "lake.toml"
-    assert win._save_to(case)
-    assert win.open_path(case)
+    assert win.io.save_to(case)
+    assert win.io.open_path(case)
     q = win.doc.project
     assert (q.crs, q.origin) == (p.crs, p.origin) and q.blocks == p.blocks
     win.generate()
     wait_idle(qtbot, win)
     out = tmp_path / "lake.vts"
-    assert win.export_mesh(out)
+    assert win.io.export_mesh(out)
     gs = read_blocks(out)
     assert gs.frame.crs == p.crs
     g = win.doc.grid
@@ -375,14 +374,14 @@ def test_background_image_calibrated_by_two_points(qtbot, win, tmp_path):
     img.fill(QtGui.QColor("steelblue"))
     path = tmp_path / "bg.png"
     assert img.save(str(path))
-    win.load_background(str(path))
+    win.background.load(str(path))
     bg = win.doc.project.background
     assert bg is not None and win.canvas.background_item.isVisible()
     # pixel (u, v) = (0, 0) and (40, 0) currently shown at these model points ...
     a, b, tx, ty = bg.transform
     shown = [(tx, ty), (a * 40 + tx, b * 40 + ty)]
     # ... are really at (100, 50) and (100, 130): a 90° turn, scale 2
-    win.calibrate_background(shown, [(100.0, 50.0), (100.0, 130.0)])
+    win.background.calibrate(shown, [(100.0, 50.0), (100.0, 130.0)])
     a, b, tx, ty = win.doc.project.background.transform
     m, t = complex(a, b), complex(tx, ty)
     assert m * 0 + t == pytest.approx(complex(100, 50))
@@ -417,7 +416,7 @@ def test_box_select_and_snapping(qtbot, win):
 
 
 def test_failed_solve_greys_the_old_grid(qtbot, win):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     win.generate()
     wait_idle(qtbot, win)
     assert win.doc.grid is not None
@@ -436,14 +435,14 @@ def test_failed_solve_greys_the_old_grid(qtbot, win):
 
 
 def test_fold_free_repair_setting_round_trips_and_applies(qtbot, win, tmp_path):
-    win.open_example("windermere", confirm=False)
+    win.io.open_example("windermere", confirm=False)
     win.editor.set_solver(repair="off")
     win.generate()
     wait_idle(qtbot, win)
     raw = win.doc.grid
     path = tmp_path / "w.toml"
-    assert win._save_to(path)
-    assert win.open_path(path)
+    assert win.io.save_to(path)
+    assert win.io.open_path(path)
     assert win.doc.project.solver.repair == "off"
     win.params_panel.repair.setCurrentText("auto")
     assert win.doc.project.solver.repair == "auto"
@@ -457,7 +456,7 @@ def test_fold_free_repair_setting_round_trips_and_applies(qtbot, win, tmp_path):
 
 
 def test_border_labels_sit_outside_their_borders(qtbot, win):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     qtbot.wait(20)
     c = win.canvas
     pos = {n: c.border_labels[n].pos() for n in ("bottom", "right", "top", "left")}
@@ -470,17 +469,18 @@ def test_border_labels_sit_outside_their_borders(qtbot, win):
 def test_multiblock_case_solves_exports_and_refuses_edits(qtbot, win, tmp_path):
     from meshcore.io import read_blocks
 
-    assert win.open_example("confluence-multiblock", confirm=False)
+    assert win.io.open_example("confluence-multiblock", confirm=False)
     p = win.doc.project
     assert p.multiblock is not None and len(p.blocks) == 6
     win.generate()
     wait_idle(qtbot, win, timeout=60_000)
     assert sorted(win.doc.grids) == list(range(6))
     assert all(g.converged for g in win.doc.grids.values())
+    assert win.doc.multiblock is not None and len(win.doc.multiblock.grids) == 6  # the document owns it
     x, _y = win.conv_panel.curve.getData()
     assert x is not None and len(x) > 1  # the global residual history reached the plot
     out = tmp_path / "mb.vtm"
-    assert win.export_mesh(out)
+    assert win.io.export_mesh(out)
     assert len(read_blocks(out).blocks) == 6
     n = win.stack.count()
     win.editor.add_point((0.0, 0.0))
@@ -489,8 +489,8 @@ def test_multiblock_case_solves_exports_and_refuses_edits(qtbot, win, tmp_path):
     win.editor.set_solver(tolerance=1e-7)  # solver settings stay editable
     assert win.stack.count() == n + 1
     case = tmp_path / "mb.toml"
-    assert win._save_to(case)
-    assert win.open_path(case) and win.doc.project.multiblock is not None
+    assert win.io.save_to(case)
+    assert win.io.open_path(case) and win.doc.project.multiblock is not None
     assert win.doc.project.solver.tolerance == 1e-7
 
 
@@ -533,7 +533,7 @@ def test_cut_lines_split_a_channel_into_blocks(qtbot, win):
 def test_control_functions_from_the_panel_match_meshcore(qtbot, win):
     from meshcore import generate_block
 
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     pp = win.params_panel
     pp.ctl_spacing.setText("0.05")
     pp.ctl_borders["bottom"].setChecked(True)
@@ -567,7 +567,7 @@ def test_control_functions_from_the_panel_match_meshcore(qtbot, win):
 
 
 def test_hover_reads_the_coloured_metric(qtbot, win):
-    win.open_example("bottle-coarse", confirm=False)
+    win.io.open_example("bottle-coarse", confirm=False)
     win.generate()
     wait_idle(qtbot, win)
     win.quality_panel.metric.setCurrentText("skewness")

@@ -1,0 +1,119 @@
+"""The background image: load, place over the outline, calibrate by two known points.
+
+The maths (placing, composing the calibration) is in :mod:`app.geometry`;
+this module reads the image and asks the user for the true coordinates.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from . import geometry as geo
+from .project import Background
+
+__all__ = ["BackgroundController", "read_image"]
+
+log = logging.getLogger(__name__)
+
+
+def read_image(path: str) -> np.ndarray | None:
+    """An RGBA image as an ``(h, w, 4)`` uint8 array, row 0 the *bottom* row (None if unreadable)."""
+    img = QtGui.QImage(str(path))
+    if img.isNull():
+        return None
+    img = img.convertToFormat(QtGui.QImage.Format.Format_RGBA8888)
+    w, h = img.width(), img.height()
+    arr = np.frombuffer(img.constBits(), dtype=np.uint8, count=img.sizeInBytes())
+    arr = arr.reshape(h, img.bytesPerLine())[:, : 4 * w].reshape(h, w, 4)
+    return np.flipud(arr).copy()  # v runs upwards like y
+
+
+class BackgroundController(QtCore.QObject):
+    """Load and calibrate the background image of a window's project (undoable edits)."""
+
+    def __init__(self, window) -> None:
+        super().__init__(window)
+        self.win = window
+        self.doc = window.doc
+        self._cache: tuple[str, np.ndarray] | None = None
+        self.doc.project_changed.connect(self._show)
+
+    def image(self, path: str) -> np.ndarray | None:
+        """The image at ``path`` (cached: every edit redraws the background)."""
+        if self._cache is not None and self._cache[0] == path:
+            return self._cache[1]
+        arr = read_image(path)
+        if arr is None:
+            self.win.message(f"cannot load background image {path}", error=True)
+            return None
+        self._cache = (path, arr)
+        return arr
+
+    def _show(self, project) -> None:
+        bg = project.background
+        img = self.image(bg.path) if bg is not None else None
+        self.win.canvas.set_background(img, bg.transform if img is not None else None)
+
+    def dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self.win, "Background image", self.win.io.last_dir(), "Images (*.png *.jpg *.jpeg *.tif *.bmp)"
+        )
+        if path:
+            self.load(path)
+
+    def load(self, path: str) -> None:
+        """Show the image at ``path`` behind the outline, fitted over it."""
+        img = self.image(path)
+        if img is None:
+            return
+        h, w = img.shape[:2]
+        bounds = self.doc.project.bounds()
+        tr = geo.fit_image(w, h, bounds)
+        project = self.doc.project.replaced(background=Background(str(path), tr))
+        self.win.editor.replace_project(project, "Load background")
+        if bounds is None:
+            self.win.canvas.fit()
+        self.win.message("Background loaded: File ▸ Calibrate to place it by two known points, then trace with Draw")
+
+    def ask_true_points(self, pair) -> None:
+        """The calibration tool picked two points: ask where they really are, then calibrate."""
+        bg = self.doc.project.background
+        if bg is None:
+            self.win.message("Load a background image first")
+            self.win.set_tool("pan")
+            return
+        dlg = QtWidgets.QDialog(self.win)
+        dlg.setWindowTitle("Calibrate background")
+        form = QtWidgets.QFormLayout(dlg)
+        edits = []
+        for k, (x, y) in enumerate(pair):
+            ex, ey = QtWidgets.QLineEdit(f"{x:.6g}"), QtWidgets.QLineEdit(f"{y:.6g}")
+            row = QtWidgets.QHBoxLayout()
+            row.addWidget(ex)
+            row.addWidget(ey)
+            form.addRow(f"true x, y of point {k + 1}", row)
+            edits += [ex, ey]
+        sb = QtWidgets.QDialogButtonBox.StandardButton
+        bb = QtWidgets.QDialogButtonBox(sb.Ok | sb.Cancel)
+        bb.accepted.connect(dlg.accept)
+        bb.rejected.connect(dlg.reject)
+        form.addRow(bb)
+        if dlg.exec() != QtWidgets.QDialog.DialogCode.Accepted:
+            return
+        try:
+            vals = [float(e.text()) for e in edits]
+            self.calibrate(pair, ((vals[0], vals[1]), (vals[2], vals[3])))
+        except ValueError as exc:
+            self.win.error("Calibration", exc)
+        self.win.set_tool("draw")
+
+    def calibrate(self, shown, true) -> None:
+        """Move the background so that the two ``shown`` model points land on ``true``."""
+        bg = self.doc.project.background
+        tr = geo.compose_similarity(bg.transform, shown, true)
+        project = self.doc.project.replaced(background=Background(bg.path, tr))
+        self.win.editor.replace_project(project, "Calibrate background")
+        self.win.message("Background calibrated")

@@ -1,0 +1,378 @@
+"""Files in and out of the window: new/open/save, import, export, recent files, autosave.
+
+:class:`IOController` owns every file dialog and file operation of the window.
+Reading and writing are done by :mod:`app.io_adapter` (over ``meshcore.io``
+and ``meshcore.case``); crash recovery goes through the case format
+(:mod:`app.recovery`).  The autosave is debounced on edits: it writes
+``DEBOUNCE_MS`` after the last edit, and at least every ``MAX_DELAY_S``
+seconds while edits keep coming (a long drag), so a crash loses at most a
+couple of seconds of work.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+from PySide6 import QtCore, QtWidgets
+
+from meshcore import MeshcoreError
+
+from . import geometry as geo
+from . import io_adapter as fio
+from . import recovery
+from .examples import load_example
+from .project import Block, Project, default_cells
+
+__all__ = ["MAX_RECENT", "IOController"]
+
+log = logging.getLogger(__name__)
+
+MAX_RECENT = 8
+DEBOUNCE_MS = 1000
+MAX_DELAY_S = 2.0
+
+
+class IOController(QtCore.QObject):
+    """File operations of a :class:`~app.main_window.MainWindow`.
+
+    It talks to the window only through ``message``, ``error``, ``set_tool``,
+    ``quiet`` (no modal dialogs) and the canvas's ``fit``.
+    """
+
+    def __init__(self, window, settings: QtCore.QSettings, recovery_path: Path) -> None:
+        super().__init__(window)
+        self.win = window
+        self.doc = window.doc
+        self.stack = window.stack
+        self.editor = window.editor
+        self.settings = settings
+        self.recovery_path = Path(recovery_path)
+        self.recent_menu: QtWidgets.QMenu | None = None
+        self._autosave = QtCore.QTimer(self)
+        self._autosave.setSingleShot(True)
+        self._autosave.setInterval(DEBOUNCE_MS)
+        self._autosave.timeout.connect(self.autosave)
+        self._first_unsaved = 0.0  # when the oldest edit not yet autosaved was made
+        self.stack.indexChanged.connect(self._edited)
+        self.stack.cleanChanged.connect(self._clean_changed)
+
+    # ----------------------------------------------------------- helpers
+    @property
+    def quiet(self) -> bool:
+        return bool(getattr(self.win, "quiet", False))
+
+    def _parent(self):
+        return self.win
+
+    # ---------------------------------------------------------- project
+    def set_project(self, project: Project, path: Path | None = None) -> None:
+        """Start over with ``project`` (no undo history, nothing unsaved)."""
+        self.win.solver.stop()
+        self.stack.clear()
+        self.doc.reset(project, path)
+        self.win.canvas.fit()
+        self.stack.setClean()
+
+    def maybe_save(self) -> bool:
+        """Ask about unsaved changes; False when the user cancels."""
+        if self.stack.isClean() or self.quiet:
+            return True
+        b = QtWidgets.QMessageBox.StandardButton
+        r = QtWidgets.QMessageBox.question(
+            self._parent(),
+            "Unsaved changes",
+            "The project has unsaved changes. Save them?",
+            b.Save | b.Discard | b.Cancel,
+        )
+        if r == b.Cancel:
+            return False
+        if r == b.Save:
+            return self.save()
+        return True
+
+    def new_project(self) -> None:
+        if self.maybe_save():
+            self.set_project(Project())
+            self.win.set_tool("draw")
+
+    def open_dialog(self) -> None:
+        if not self.maybe_save():
+            return
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self._parent(), "Open project", self.last_dir(), "gcmesh case (*.toml);;All files (*)"
+        )
+        if path:
+            self.open_path(path)
+
+    def open_path(self, path) -> bool:
+        """Open a case file, or import a point file (by suffix)."""
+        path = Path(path)
+        if path.suffix.lower() != ".toml":
+            return self.import_points(path)
+        try:
+            project = fio.load_project(path)
+        except (MeshcoreError, OSError) as exc:
+            self.win.error("Cannot open project", exc)
+            return False
+        self.set_project(project, path)
+        self.add_recent(path)
+        self.win.set_tool("edit")
+        self.win.message(f"Opened {path.name}: press F5 to generate")
+        return True
+
+    def open_example(self, name: str, *, confirm: bool = True) -> bool:
+        if confirm and not self.maybe_save():
+            return False
+        try:
+            project, _path = load_example(name)
+        except (MeshcoreError, OSError, KeyError) as exc:
+            self.win.error("Cannot open example", exc)
+            return False
+        self.set_project(project, None)
+        self.win.set_tool("edit")
+        self.win.message(f"Example {name!r}: press F5 to generate; drag points to reshape")
+        return True
+
+    def save(self) -> bool:
+        if self.doc.path is None:
+            return self.save_as()
+        return self.save_to(self.doc.path)
+
+    def save_as(self) -> bool:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self._parent(), "Save project", self.last_dir(), "gcmesh case (*.toml)"
+        )
+        if not path:
+            return False
+        if not path.endswith(".toml"):
+            path += ".toml"
+        return self.save_to(Path(path))
+
+    def save_to(self, path: Path) -> bool:
+        try:
+            fio.save_project(self.doc.project, path)
+        except (MeshcoreError, OSError, ValueError) as exc:
+            self.win.error("Cannot save project", exc)
+            return False
+        self.doc.set_path(path)
+        self.stack.setClean()
+        self.add_recent(path)
+        p = self.doc.project
+        skipped = [b.name for b in p.blocks if not b.ready and (len(b.points) or b.boundary is not None)]
+        note = f" (not saved: {', '.join(skipped)} — no closed loop with corners yet)" if skipped else ""
+        self.win.message(f"Saved {path}{note}", error=bool(skipped))
+        return True
+
+    # ------------------------------------------------------------ import
+    def import_dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self._parent(), "Import boundary points", self.last_dir(), fio.POINT_FILTER
+        )
+        if path:
+            self.import_points(Path(path))
+
+    def import_points(self, path: Path, *, project_lonlat: bool | None = None) -> bool:
+        """Read points as a new closed block with automatic corners (undoable)."""
+        path = Path(path)
+        try:
+            pd = fio.read_points(path)
+        except (MeshcoreError, OSError, ValueError) as exc:
+            self.win.error("Cannot import points", exc)
+            return False
+        pts = pd.points
+        frame = fio.project_frame(self.doc.project)
+        if pd.lonlat:
+            if project_lonlat is None and not self.quiet:
+                target = frame.crs if frame is not None else "the UTM zone of the outline"
+                r = QtWidgets.QMessageBox.question(
+                    self._parent(),
+                    "Geographic coordinates",
+                    f"{path.name} holds longitude/latitude degrees.\n\nProject them to metres "
+                    f"({target}, relative to a round local origin)? Grids in degrees are distorted.",
+                )
+                project_lonlat = r == QtWidgets.QMessageBox.StandardButton.Yes
+            if project_lonlat is None or project_lonlat:
+                try:
+                    pts, frame = fio.to_local(pd, frame)
+                except (MeshcoreError, ValueError) as exc:
+                    self.win.error("Cannot project coordinates", exc)
+                    return False
+        if len(pts) < 4:
+            self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
+            return False
+        try:
+            corners = geo.auto_corners(pts)
+        except (ValueError, MeshcoreError):
+            corners = None
+        block = Block(
+            name=path.stem,
+            points=pts,
+            closed=True,
+            corners=corners,
+            cells=default_cells(pts, corners, total=40, minimum=8) if corners else (32, 16),
+        )
+        self._add_imported(block, frame, path.name)
+        self.remember_dir(path)
+        projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
+        self.win.message(
+            f"Imported {len(pts)} points from {path.name}{projected}; corners chosen "
+            f"automatically — adjust with the Corners tool, then F5"
+        )
+        return True
+
+    def _add_imported(self, block: Block, frame, name: str) -> None:
+        """Put an imported block into the first empty block (or add it), as one undo step."""
+        p = self.doc.project
+        empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
+        if empty:
+            k = empty[0]
+            after = p.with_block(k, block)
+        else:
+            after = p.replaced(blocks=(*p.blocks, block))
+            k = len(after.blocks) - 1
+        if frame is not None and frame.crs:
+            after = after.replaced(crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "")
+        self.editor.replace_project(after, f"Import {name}")
+        self.doc.set_active(k)
+        self.win.canvas.fit()
+        self.win.set_tool("edit")
+
+    # ------------------------------------------------------------ export
+    def export_dialog(self) -> None:
+        if not self.doc.grids:
+            self.win.message("Nothing to export yet: generate a grid first (F5)")
+            return
+        fmts = fio.mesh_formats()
+        filt = ";;".join(f"{d} ({p})" for d, p in fmts)
+        path, chosen = QtWidgets.QFileDialog.getSaveFileName(self._parent(), "Export mesh", self.last_dir(), filt)
+        if path:
+            if not Path(path).suffix:
+                pat = next((p for d, p in fmts if chosen.startswith(d)), "*.vts")
+                path += pat.split()[0].lstrip("*")
+            self.export_mesh(Path(path))
+
+    def export_mesh(self, path: Path) -> bool:
+        """Write the grids (a multiblock result with its connectivity) with meshcore.io."""
+        grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
+        mb = self.doc.multiblock
+        frame = fio.project_frame(self.doc.project)
+        try:
+            if mb is not None and self.doc.project.multiblock is not None and not self.doc.stale:
+                fio.write_mesh(path, mb, frame)
+            else:
+                fio.write_mesh(path, grids, frame)
+        except (MeshcoreError, OSError) as exc:
+            self.win.error("Cannot export mesh", exc)
+            return False
+        self.remember_dir(path)
+        self.win.message(f"Exported {len(grids)} block(s) to {path}")
+        return True
+
+    def figure_dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self._parent(), "Export figure", self.last_dir(), "PNG image (*.png);;SVG vector (*.svg)"
+        )
+        if path:
+            if not Path(path).suffix:
+                path += ".png"
+            self.export_figure(path)
+
+    def export_figure(self, path) -> bool:
+        try:
+            self.win.canvas.export_image(str(path))
+        except Exception as exc:  # pyqtgraph's exporters raise anything
+            log.exception("cannot export the figure %s", path)
+            self.win.error("Cannot export figure", exc)
+            return False
+        self.win.message(f"Saved figure {path}")
+        return True
+
+    # ---------------------------------------------------- recent, folders
+    def last_dir(self) -> str:
+        return str(self.settings.value("last_dir", str(Path.home())))
+
+    def remember_dir(self, path: Path) -> None:
+        self.settings.setValue("last_dir", str(Path(path).parent))
+
+    def add_recent(self, path: Path) -> None:
+        rec = [str(path)] + [p for p in self.recent() if p != str(path)]
+        self.settings.setValue("recent", rec[:MAX_RECENT])
+        self.remember_dir(path)
+        self.refresh_recent()
+
+    def recent(self) -> list[str]:
+        v = self.settings.value("recent", [])
+        if isinstance(v, str):
+            v = [v]
+        return list(v or [])
+
+    def refresh_recent(self) -> None:
+        if self.recent_menu is None:
+            return
+        self.recent_menu.clear()
+        rec = self.recent()
+        for p in rec:
+            self.recent_menu.addAction(p, lambda p=p: self.maybe_save() and self.open_path(p))
+        self.recent_menu.setEnabled(bool(rec))
+
+    # ---------------------------------------------------------- autosave
+    def _edited(self, _index: int) -> None:
+        """An edit (or undo/redo): autosave soon; at once when edits have kept coming for a while."""
+        now = time.monotonic()
+        if not self._autosave.isActive():
+            self._first_unsaved = now
+        if now - self._first_unsaved >= MAX_DELAY_S:
+            self.autosave()
+        else:
+            self._autosave.start()
+
+    def _clean_changed(self, clean: bool) -> None:
+        if clean:  # saved (or undone back to the saved state): nothing to recover
+            self._autosave.stop()
+            self.discard_recovery()
+
+    def autosave(self) -> None:
+        """Write the project to the recovery files when it has unsaved edits."""
+        self._autosave.stop()
+        if self.stack.isClean():
+            return
+        try:
+            recovery.write(self.doc.project, self.recovery_path, self.doc.path)
+        except (OSError, MeshcoreError, ValueError) as exc:
+            log.exception("autosave to %s failed", self.recovery_path)
+            self.win.message(f"autosave failed: {exc}", error=True)
+
+    def discard_recovery(self) -> None:
+        try:
+            recovery.discard(self.recovery_path)
+        except OSError:
+            log.warning("cannot remove the recovery file %s", self.recovery_path, exc_info=True)
+
+    def offer_recovery(self) -> bool:
+        """After a crash: offer the autosaved project back (True when restored)."""
+        if not recovery.exists(self.recovery_path):
+            return False
+        try:
+            project, path = recovery.read(self.recovery_path)
+        except (MeshcoreError, OSError, ValueError, KeyError, TypeError):
+            log.exception("the recovery file %s cannot be read; it is removed", self.recovery_path)
+            self.discard_recovery()
+            return False
+        r = QtWidgets.QMessageBox.question(
+            self._parent(),
+            "Recover project",
+            "gcmesh did not shut down cleanly last time. Restore the autosaved project?",
+        )
+        if r != QtWidgets.QMessageBox.StandardButton.Yes:
+            self.discard_recovery()
+            return False
+        self.set_project(project, path)
+        self.stack.resetClean()  # restored work counts as unsaved
+        return True
+
+    def shutdown(self) -> None:
+        """A clean exit: nothing to recover."""
+        self._autosave.stop()
+        self.discard_recovery()

@@ -1,0 +1,189 @@
+"""Crash recovery through the case format (no pickle, no Qt).
+
+The autosave writes two files:
+
+* ``recovery.toml`` — a case file (:func:`app.io_adapter.save_project`) with
+  every block that a case can hold (closed loops with corners, border
+  blocks, or the whole multiblock case).  It opens in the app and in
+  ``meshcore generate`` like any case.
+* ``recovery.toml.json`` — what a case file cannot hold: blocks still being
+  drawn, cut lines, the background image, the solver settings as the app
+  keeps them, and the path the project was last saved to.  It names the
+  SHA-256 of the case text it belongs to; a sidecar that does not match (a
+  crash between the two writes) is ignored and the case alone is recovered.
+
+:func:`write` and :func:`read` are inverses: ``read(write(p)) == p``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from meshcore import BorderSpec, MeshcoreError
+from meshcore.io import atomic_write_text
+
+from .project import Background, Block, Project, SolverSettings
+
+__all__ = ["discard", "exists", "read", "sidecar", "write"]
+
+FORMAT = "gcmesh-recovery"
+VERSION = 1
+
+
+def sidecar(path) -> Path:
+    """The JSON file beside the recovery case file ``path``."""
+    p = Path(path)
+    return p.with_name(p.name + ".json")
+
+
+def exists(path) -> bool:
+    return Path(path).exists() or sidecar(path).exists()
+
+
+def discard(path) -> None:
+    """Remove the recovery files (after a clean save or a clean exit)."""
+    for p in (Path(path), sidecar(path)):
+        p.unlink(missing_ok=True)
+
+
+def write(project: Project, path, saved_as: Path | None = None) -> None:
+    """Write ``project`` as the recovery case file ``path`` plus its JSON sidecar.
+
+    Raises OSError when a file cannot be written.
+    """
+    from .io_adapter import dumps_project
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    solver = project.solver
+    if solver.method == "foldfree":  # not an EllipticConfig method; the sidecar keeps it
+        project = project.replaced(solver=dataclasses.replace(solver, method="auto"))
+    try:
+        text = dumps_project(project)
+    except (MeshcoreError, ValueError):  # nothing a case can hold yet (a loop still being drawn)
+        text = None
+    state = {
+        "format": FORMAT,
+        "version": VERSION,
+        "case_sha256": _sha(text) if text is not None else None,
+        "path": str(saved_as) if saved_as else None,
+        "title": project.title,
+        "crs": project.crs,
+        "origin": list(project.origin),
+        "source_crs": project.source_crs,
+        "solver": dataclasses.asdict(solver),
+        "cut_lines": [np.asarray(c).tolist() for c in project.cut_lines],
+        "background": _background(project.background),
+        "blocks": None if project.multiblock is not None else _blocks(project),
+    }
+    if text is None:
+        path.unlink(missing_ok=True)
+    else:
+        atomic_write_text(path, text)
+    atomic_write_text(sidecar(path), json.dumps(state, indent=1))
+
+
+def read(path) -> tuple[Project, Path | None]:
+    """The recovered project and the path it was saved to (None if never saved).
+
+    Raises
+    ------
+    MeshcoreError, OSError, ValueError
+        When neither file can be read back.
+    """
+    from .io_adapter import load_project
+
+    path = Path(path)
+    case_project = load_project(path) if path.exists() else None
+    state = _state(sidecar(path), path if case_project is not None else None)
+    if state is None:
+        if case_project is None:
+            raise ValueError(f"{path}: no recovery file")
+        return case_project, None
+    base = case_project or Project()
+    if state["blocks"] is not None:
+        blocks = tuple(base.blocks[b["case"]] if "case" in b else _block_from_state(b) for b in state["blocks"]) or (
+            Block(),
+        )
+        base = base.replaced(blocks=blocks)
+    bg = state.get("background")
+    project = base.replaced(
+        title=state.get("title", ""),
+        crs=state.get("crs", ""),
+        origin=tuple(state.get("origin", (0.0, 0.0))),
+        source_crs=state.get("source_crs", ""),
+        solver=SolverSettings(**state["solver"]),
+        cut_lines=tuple(np.asarray(c, float).reshape(-1, 2) for c in state.get("cut_lines", ())),
+        background=Background(bg["path"], tuple(bg["transform"])) if bg else None,
+    )
+    return project, Path(state["path"]) if state.get("path") else None
+
+
+# ----------------------------------------------------------------- helpers
+def _sha(text: str) -> str:
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def _state(p: Path, case_path: Path | None) -> dict | None:
+    """The sidecar's state when it is readable and belongs to the case file next to it."""
+    try:
+        state = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(state, dict) or state.get("format") != FORMAT or state.get("version") != VERSION:
+        return None
+    text = case_path.read_text(encoding="utf-8") if case_path is not None else None
+    if state.get("case_sha256") != (_sha(text) if text is not None else None):
+        return None
+    return state
+
+
+def _background(bg: Background | None):
+    return None if bg is None else {"path": bg.path, "transform": list(bg.transform)}
+
+
+def _blocks(project: Project) -> list[dict]:
+    """Each block: its index among the case's blocks (the ready ones), or its full state."""
+    out, k = [], 0
+    for b in project.blocks:
+        if b.ready:
+            out.append({"case": k})
+            k += 1
+        else:
+            out.append(_block_state(b))
+    return out
+
+
+def _block_state(b: Block) -> dict:
+    control = b.control if b.control is None or isinstance(b.control, Mapping) else None
+    return {
+        "name": b.name,
+        "points": np.asarray(b.points).tolist(),
+        "closed": b.closed,
+        "corners": list(b.corners) if b.corners is not None else None,
+        "cells": list(b.cells),
+        "weights": list(b.weights),
+        "initial": b.initial,
+        "curve": b.curve,
+        "periodic": b.periodic,
+        "borders": {n: dataclasses.asdict(s) for n, s in b.borders},
+        "snap_angle": b.snap_angle,
+        "keep_nodes": b.keep_nodes,
+        "control": control,
+    }
+
+
+def _block_from_state(d: Mapping) -> Block:
+    kw = dict(d)
+    kw["points"] = np.asarray(kw["points"], float).reshape(-1, 2)
+    kw["corners"] = tuple(kw["corners"]) if kw.get("corners") is not None else None
+    kw["cells"] = tuple(kw["cells"])
+    kw["weights"] = tuple(kw["weights"])
+    kw["borders"] = tuple((n, BorderSpec(**s)) for n, s in dict(kw.get("borders", {})).items())
+    return Block(**kw)

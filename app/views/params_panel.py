@@ -1,0 +1,361 @@
+"""The parameters dock: cells, weights, initial grid, per-border distribution, solver, control.
+
+Edits become undo commands through the :class:`~app.commands.Editor`; the
+panel shows the document and never owns state.  Invalid input is shown at
+once (red field and a message under the group) and not applied.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+from PySide6 import QtCore, QtWidgets
+
+from meshcore import BORDER_NAMES, BorderSpec, InvalidInputError
+from meshcore.elliptic import METHODS
+
+from ..commands import Editor
+from ..document import Document
+from .canvas import BORDER_COLOURS
+
+__all__ = ["ParamsPanel"]
+
+_BAD = "background: #ffd6d6;"
+
+
+def _message_label() -> QtWidgets.QLabel:
+    """A red, word-wrapped label for the problems of a group."""
+    label = QtWidgets.QLabel(wordWrap=True)
+    label.setStyleSheet("color: #b00;")
+    return label
+
+
+class ParamsPanel(QtWidgets.QScrollArea):
+    """Cells, weights, initial grid, per-border distribution, solver settings."""
+
+    def __init__(self, doc: Document, editor: Editor, parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.editor = editor
+        self._updating = False
+        self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        w = QtWidgets.QWidget()
+        self.setWidget(w)
+        lay = QtWidgets.QVBoxLayout(w)
+        for group in (self._block_group(), self._border_group(), self._solver_group(), self._control_group()):
+            lay.addWidget(group)
+        lay.addStretch(1)
+        self._connect()
+        doc.project_changed.connect(lambda _p: self.refresh())
+        doc.active_changed.connect(lambda _k: self.refresh())
+        self.refresh()
+
+    # ---------------------------------------------------------- building
+    def _block_group(self) -> QtWidgets.QGroupBox:
+        g = QtWidgets.QGroupBox("Block")
+        f = QtWidgets.QFormLayout(g)
+        self.ni = QtWidgets.QSpinBox(minimum=1, maximum=4096, toolTip="cells along ξ (bottom/top)")
+        self.nj = QtWidgets.QSpinBox(minimum=1, maximum=4096, toolTip="cells along η (left/right)")
+        cells = QtWidgets.QHBoxLayout()
+        cells.addWidget(QtWidgets.QLabel("ξ"))
+        cells.addWidget(self.ni)
+        cells.addWidget(QtWidgets.QLabel("η"))
+        cells.addWidget(self.nj)
+        f.addRow("Cells", cells)
+        self.wx = QtWidgets.QDoubleSpinBox(
+            minimum=0.0,
+            maximum=1.0,
+            singleStep=0.05,
+            decimals=3,
+            toolTip="p13_x: weight of the left/right interpolation (paper eq. 34)",
+        )
+        self.wy = QtWidgets.QDoubleSpinBox(minimum=0.0, maximum=1.0, singleStep=0.05, decimals=3, toolTip="p13_y")
+        wts = QtWidgets.QHBoxLayout()
+        wts.addWidget(self.wx)
+        wts.addWidget(self.wy)
+        f.addRow("Weights p13 x/y", wts)
+        self.initial = QtWidgets.QComboBox()
+        self.initial.addItems(["weighted", "tfi"])
+        self.initial.setToolTip("algebraic start grid: paper's weighted average (eq. 34) or TFI")
+        f.addRow("Initial grid", self.initial)
+        self.curve = QtWidgets.QComboBox()
+        self.curve.addItems(["linear", "cubic", "catmull-rom"])
+        self.curve.setToolTip("curve through the boundary points used to re-sample the borders")
+        f.addRow("Boundary curve", self.curve)
+        return g
+
+    def _border_group(self) -> QtWidgets.QGroupBox:
+        g = QtWidgets.QGroupBox("Border")
+        f = QtWidgets.QFormLayout(g)
+        self.border = QtWidgets.QComboBox()
+        self.border.addItems(list(BORDER_NAMES))
+        f.addRow("Border", self.border)
+        self.dist = QtWidgets.QComboBox()
+        self.dist.addItems(["uniform", "tanh", "vinokur"])
+        self.dist.setToolTip("uniform in arc length; tanh one-sided or vinokur two-sided clustering")
+        f.addRow("Distribution", self.dist)
+        self.first = QtWidgets.QLineEdit(placeholderText="first spacing (model units)")
+        self.last = QtWidgets.QLineEdit(placeholderText="last spacing (model units)")
+        self.bname = QtWidgets.QLineEdit(placeholderText="e.g. inlet, wall, shore")
+        f.addRow("First spacing", self.first)
+        f.addRow("Last spacing", self.last)
+        f.addRow("Name", self.bname)
+        self.border_msg = _message_label()
+        f.addRow(self.border_msg)
+        return g
+
+    def _solver_group(self) -> QtWidgets.QGroupBox:
+        g = QtWidgets.QGroupBox("Solver")
+        f = QtWidgets.QFormLayout(g)
+        self.method = QtWidgets.QComboBox()
+        self.method.addItems(["auto", *sorted(METHODS), "foldfree"])
+        self.method.setToolTip(
+            "auto = multigrid when available and the grid is large enough, else SOR; "
+            "foldfree = elliptic solve, then fold-free barrier smoothing of the whole block"
+        )
+        f.addRow("Method", self.method)
+        self.repair = QtWidgets.QComboBox()
+        self.repair.addItems(["auto", "off"])
+        self.repair.setToolTip("auto: repair folded / non-convex cells after the solve (fold-free barrier method)")
+        f.addRow("Repair folds", self.repair)
+        self.tol = QtWidgets.QLineEdit(placeholderText="default (scale-aware)")
+        self.tol.setToolTip("relative tolerance: largest Jacobi update ≤ tol · bbox diagonal")
+        f.addRow("Tolerance", self.tol)
+        self.maxit = QtWidgets.QSpinBox(minimum=1, maximum=10_000_000, singleStep=1000)
+        f.addRow("Max iterations", self.maxit)
+        self.omega = QtWidgets.QLineEdit(placeholderText="auto")
+        self.omega.setToolTip("SOR relaxation factor in (0, 2); empty = automatic")
+        f.addRow("ω (SOR)", self.omega)
+        self.solver_msg = _message_label()
+        f.addRow(self.solver_msg)
+        return g
+
+    def _control_group(self) -> QtWidgets.QGroupBox:
+        g = QtWidgets.QGroupBox("Control functions (P, Q)")
+        g.setToolTip(
+            "meshcore.control: boundary orthogonality with a first-cell height (Hilgenstock–White), "
+            "interior following the boundary spacing (Thomas–Middlecoff)"
+        )
+        f = QtWidgets.QFormLayout(g)
+        self.ctl_summary = QtWidgets.QLabel(wordWrap=True)
+        f.addRow(self.ctl_summary)
+        row = QtWidgets.QGridLayout()
+        self.ctl_borders = {}
+        for k, name in enumerate(BORDER_NAMES):
+            cb = QtWidgets.QCheckBox(name)
+            cb.setStyleSheet(f"color: {BORDER_COLOURS[name]};")
+            row.addWidget(cb, k // 2, k % 2)
+            self.ctl_borders[name] = cb
+        f.addRow("Orthogonal at", row)
+        self.ctl_spacing = QtWidgets.QLineEdit(placeholderText="empty: angle only")
+        self.ctl_spacing.setToolTip("first-cell height at the orthogonal borders (model units)")
+        f.addRow("First cell", self.ctl_spacing)
+        self.ctl_tm = QtWidgets.QCheckBox("Thomas–Middlecoff")
+        self.ctl_tm.setToolTip("the interior follows the boundary point spacing")
+        f.addRow(self.ctl_tm)
+        self.ctl_msg = _message_label()
+        f.addRow(self.ctl_msg)
+        return g
+
+    def _connect(self) -> None:
+        self.ni.valueChanged.connect(lambda v: self._block(cells=(v, self.nj.value())))
+        self.nj.valueChanged.connect(lambda v: self._block(cells=(self.ni.value(), v)))
+        self.wx.valueChanged.connect(lambda v: self._block(weights=(v, self.wy.value())))
+        self.wy.valueChanged.connect(lambda v: self._block(weights=(self.wx.value(), v)))
+        self.initial.currentTextChanged.connect(lambda s: self._block(initial=s))
+        self.curve.currentTextChanged.connect(lambda s: self._block(curve=s))
+        self.border.currentTextChanged.connect(lambda _s: self.refresh())
+        self.dist.currentTextChanged.connect(lambda _s: self._border_edit())
+        for e in (self.first, self.last, self.bname):
+            e.editingFinished.connect(self._border_edit)
+        self.method.currentTextChanged.connect(lambda s: self._solver(method=s))
+        self.repair.currentTextChanged.connect(lambda s: self._solver(repair=s))
+        self.tol.editingFinished.connect(self._solver_text)
+        self.omega.editingFinished.connect(self._solver_text)
+        self.maxit.valueChanged.connect(lambda v: self._solver(max_iterations=v))
+        for cb in self.ctl_borders.values():
+            cb.toggled.connect(lambda _on: self._control_edit())
+        self.ctl_spacing.editingFinished.connect(self._control_edit)
+        self.ctl_tm.toggled.connect(lambda _on: self._control_edit())
+
+    def select_border(self, name: str) -> None:
+        self.border.setCurrentText(name)
+
+    # ---------------------------------------------------------- refresh
+    def refresh(self) -> None:
+        self._updating = True
+        try:
+            b = self.doc.block
+            self.ni.setValue(b.cells[0])
+            self.nj.setValue(b.cells[1])
+            self.wx.setValue(b.weights[0])
+            self.wy.setValue(b.weights[1])
+            self.initial.setCurrentText(b.initial)
+            self.curve.setCurrentText(b.curve)
+            s = b.spec(self.border.currentText())
+            self.dist.setCurrentText(s.distribution)
+            self.first.setText("" if s.first is None else f"{s.first:.6g}")
+            self.last.setText("" if s.last is None else f"{s.last:.6g}")
+            self.bname.setText(s.name or "")
+            for e in (self.first, self.last, self.tol, self.omega):
+                e.setStyleSheet("")
+            self.border_msg.setText("")
+            self.solver_msg.setText("")
+            self._refresh_control(b)
+            sv = self.doc.project.solver
+            self.method.setCurrentText(sv.method)
+            self.repair.setCurrentText(sv.repair)
+            self.tol.setText("" if sv.tolerance is None else f"{sv.tolerance:.6g}")
+            self.maxit.setValue(sv.max_iterations)
+            self.omega.setText("" if sv.omega is None else f"{sv.omega:.6g}")
+        finally:
+            self._updating = False
+
+    # ------------------------------------------------------------ edits
+    def _block(self, **kw) -> None:
+        if self._updating:
+            return
+        self.editor.set_block_options(merge_key="panel", **kw)
+
+    @staticmethod
+    def _number(edit: QtWidgets.QLineEdit):
+        t = edit.text().strip()
+        if not t:
+            return None
+        v = float(t)  # ValueError on garbage
+        if not math.isfinite(v):
+            raise ValueError(f"{t!r} is not a finite number")
+        return v
+
+    def _border_edit(self) -> None:
+        if self._updating:
+            return
+        for e in (self.first, self.last):
+            e.setStyleSheet("")
+        try:
+            first = self._number(self.first)
+        except ValueError:
+            self.first.setStyleSheet(_BAD)
+            self.border_msg.setText(f"first spacing: {self.first.text()!r} is not a number")
+            return
+        try:
+            last = self._number(self.last)
+        except ValueError:
+            self.last.setStyleSheet(_BAD)
+            self.border_msg.setText(f"last spacing: {self.last.text()!r} is not a number")
+            return
+        dist = self.dist.currentText()
+        if dist == "uniform":
+            first = last = None
+        try:
+            spec = BorderSpec(distribution=dist, first=first, last=last, name=self.bname.text().strip() or None)
+        except InvalidInputError as exc:
+            self.border_msg.setText(str(exc))
+            (self.first if first is None or "first" in str(exc) else self.last).setStyleSheet(_BAD)
+            return
+        self.border_msg.setText("")
+        self.editor.set_border_spec(self.border.currentText(), spec)
+
+    # ------------------------------------------------------------ control
+    def _refresh_control(self, b) -> None:
+        c = b.control
+        if c is None:
+            self.ctl_summary.setText("none")
+        elif isinstance(c, Mapping):
+            kind = c.get("kind", "hilgenstock-white")
+            parts = [
+                f"{n} ⟂" + (f" {v['spacing']:.3g}" if isinstance(v, Mapping) and v.get("spacing") else "")
+                for n, v in dict(c.get("borders", {})).items()
+            ]
+            extra = sorted(k for k in c if k not in ("kind", "borders", "thomas-middlecoff", "thomas_middlecoff"))
+            tm = c.get("thomas-middlecoff", c.get("thomas_middlecoff", False))
+            self.ctl_summary.setText(
+                f"{kind}: "
+                + (", ".join(parts) or "no borders")
+                + (" · Thomas–Middlecoff" if tm else "")
+                + (f" · also {', '.join(extra)} (from the case file)" if extra else "")
+            )
+        else:
+            self.ctl_summary.setText(f"{type(c).__name__} (set in code; not editable here)")
+        borders = dict(c.get("borders", {})) if isinstance(c, Mapping) else {}
+        for name, cb in self.ctl_borders.items():
+            cb.setChecked(name in borders)
+            cb.setEnabled(c is None or isinstance(c, Mapping))
+        sp = [v.get("spacing") for v in borders.values() if isinstance(v, Mapping) and v.get("spacing")]
+        self.ctl_spacing.setText(f"{sp[0]:.6g}" if sp else "")
+        self.ctl_spacing.setStyleSheet("")
+        tm = bool(c.get("thomas-middlecoff", c.get("thomas_middlecoff", False))) if isinstance(c, Mapping) else False
+        self.ctl_tm.setChecked(tm)
+        self.ctl_msg.setText("")
+
+    def _control_edit(self) -> None:
+        if self._updating:
+            return
+        from meshcore.control import control_from_mapping
+
+        old = self.doc.block.control
+        if old is not None and not isinstance(old, Mapping):
+            return
+        self.ctl_spacing.setStyleSheet("")
+        try:
+            spacing = self._number(self.ctl_spacing)
+            if spacing is not None and spacing <= 0:
+                raise ValueError("the first cell height must be positive")
+        except ValueError as exc:
+            self.ctl_spacing.setStyleSheet(_BAD)
+            self.ctl_msg.setText(f"first cell: {exc}")
+            return
+        new = {k: v for k, v in dict(old or {}).items() if k not in ("borders", "thomas_middlecoff")}
+        old_borders = dict((old or {}).get("borders", {}))
+        borders = {}
+        for name, cb in self.ctl_borders.items():
+            if cb.isChecked():
+                entry = dict(old_borders.get(name, {}))
+                entry["angle"] = 90.0
+                if spacing is None:
+                    entry.pop("spacing", None)
+                else:
+                    entry["spacing"] = spacing
+                borders[name] = entry
+        if borders:
+            new["borders"] = borders
+        new["thomas-middlecoff"] = self.ctl_tm.isChecked()
+        if not borders and not new["thomas-middlecoff"] and set(new) <= {"kind", "thomas-middlecoff"}:
+            control = None
+        else:
+            control = new
+            try:
+                control_from_mapping(control)
+            except InvalidInputError as exc:
+                self.ctl_msg.setText(str(exc))
+                return
+        self.ctl_msg.setText("")
+        if control != old:
+            self.editor.set_block_options(control=control)
+
+    def _solver(self, **kw) -> None:
+        if self._updating:
+            return
+        self.editor.set_solver(**kw)
+
+    def _solver_text(self) -> None:
+        if self._updating:
+            return
+        kw = {}
+        for key, e, lo, hi in (("tolerance", self.tol, 0.0, math.inf), ("omega", self.omega, 0.0, 2.0)):
+            e.setStyleSheet("")
+            try:
+                v = self._number(e)
+            except ValueError:
+                e.setStyleSheet(_BAD)
+                self.solver_msg.setText(f"{key}: {e.text()!r} is not a number")
+                return
+            if v is not None and not (lo < v < hi):
+                e.setStyleSheet(_BAD)
+                self.solver_msg.setText(f"{key} must be in ({lo:g}, {hi:g}), got {v:g}")
+                return
+            kw[key] = v
+        self.solver_msg.setText("")
+        self._solver(**kw)
