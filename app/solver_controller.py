@@ -11,6 +11,7 @@ solve (coalesced in one event-loop pass), warm-started from the last grid.
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 
@@ -24,6 +25,8 @@ from .pipeline import ResidualProgress, solve_project
 
 __all__ = ["SolverController"]
 
+log = logging.getLogger(__name__)
+
 
 def _run(run_id, project, warm, stop_event, smooth):
     """The worker body: tag every item with the run id; errors become results."""
@@ -36,8 +39,9 @@ def _run(run_id, project, warm, stop_event, smooth):
         return run_id, fin.value, None
     except MeshcoreError as exc:
         return run_id, None, str(exc)
-    except Exception as exc:  # a bug must not kill the window: report it
-        return run_id, None, f"internal error: {type(exc).__name__}: {exc}"
+    except Exception as exc:  # a bug must not kill the window: report it, and log where it happened
+        log.exception("the solver worker failed")
+        return run_id, None, f"internal error: {type(exc).__name__}: {exc} (the traceback is in the log)"
 
 
 class SolverController(QtCore.QObject):
@@ -278,6 +282,7 @@ class SolverController(QtCore.QObject):
         self._check_thread()
         self._timer.stop()
         self._worker = None
+        log.error("the solver worker failed", exc_info=exc)
         msg = f"solver failed: {exc}"
         self.last_error = msg
         self.error.emit(msg)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import subprocess
 import sys
+import traceback
 from pathlib import Path
 
 import numpy as np
@@ -97,3 +98,20 @@ def test_views_never_import_the_solver_controller():
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_a_bug_in_the_solver_is_logged_with_its_traceback(qtbot, win, caplog, monkeypatch):
+    import app.solver_controller as sc
+
+    def broken(*a, **k):
+        yield from ()
+        raise ZeroDivisionError("a bug in the pipeline")
+
+    monkeypatch.setattr(sc, "solve_project", broken)
+    win.io.open_example("bottle-coarse", confirm=False)
+    with caplog.at_level(logging.INFO, logger="app"):
+        win.generate()
+        qtbot.waitUntil(lambda: not win.solver.running, timeout=20_000)
+    rec = [r for r in caplog.records if r.exc_info and r.exc_info[0] is ZeroDivisionError]
+    assert rec and "broken" in "".join(traceback.format_tb(rec[0].exc_info[2]))
+    assert "internal error" in win._status.text() and "ZeroDivisionError" in win._status.text()
