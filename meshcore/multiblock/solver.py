@@ -55,7 +55,7 @@ from ..elliptic import solve as solve_block
 from ..elliptic.solver import config_with, default_tolerance
 from ..errors import InvalidInputError
 from ..grid import SolveInfo, StructuredGrid
-from ..quality import QualityReport, quality
+from ..quality import QualityReport, interface_pairs, quality
 from . import _kernels
 from .topology import Interface, MultiBlockTopology
 
@@ -165,28 +165,10 @@ class MultiBlockGrid:
     def quality(self) -> MultiBlockQuality:
         reports = {n: quality(g) for n, g in zip(self.names, self.grids, strict=True)}
         inter: dict[str, float] = {}
-        if self.topology is not None:
-            m = self.topology.node_map
-            x, y = _assemble(self.grids, m)
-            c = m.cells
-            cx, cy = x[c], y[c]
-            area = 0.5 * ((cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3]) - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2]))
-            e0 = c.reshape(-1)
-            e1 = np.roll(c, -1, axis=1).reshape(-1)
-            cid = np.repeat(np.arange(len(c)), 4)
-            key = np.minimum(e0, e1) * m.n_nodes + np.maximum(e0, e1)
-            order = np.argsort(key, kind="stable")
-            ks = key[order]
-            dup = np.flatnonzero(ks[1:] == ks[:-1])
-            c1, c2 = cid[order[dup]], cid[order[dup + 1]]
-            b1, b2 = m.cell_block[c1], m.cell_block[c2]
-            cross = b1 != b2
-            a1, a2 = np.abs(area[c1[cross]]), np.abs(area[c2[cross]])
-            with np.errstate(divide="ignore"):
-                ratio = np.maximum(a1 / a2, a2 / a1)
-            for p, q, r in zip(b1[cross], b2[cross], ratio, strict=True):
-                lo, hi = sorted((int(p), int(q)))
-                k = f"{self.names[lo]} ↔ {self.names[hi]}"
+        if len(self.grids) > 1:
+            pairs = interface_pairs(self.grids)  # the cross-interface ratio of meshcore.quality
+            for p, q, r in zip(pairs["cell_a"][:, 0], pairs["cell_b"][:, 0], pairs["ratio"], strict=True):
+                k = f"{self.names[min(p, q)]} ↔ {self.names[max(p, q)]}"
                 inter[k] = max(inter.get(k, 1.0), float(r))
         return MultiBlockQuality(
             blocks=reports,

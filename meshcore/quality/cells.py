@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .grid import StructuredGrid
+from ..grid import StructuredGrid
 
 __all__ = ["QualityReport", "cell_quality", "quality"]
 

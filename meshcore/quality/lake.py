@@ -1,0 +1,441 @@
+r"""Grid quality in lake modellers' terms (definitions: ``shared/design/lake-grids.md``).
+
+Per block, on the node arrays ``x, y`` of shape ``(ni + 1, nj + 1)``:
+
+* ``cos`` — node orthogonality at every **block-interior** node,
+  ``|x_ξ·x_η| / (|x_ξ||x_η|)`` with central differences
+  ``x_ξ = P[i+1, j] − P[i−1, j]``, ``x_η = P[i, j+1] − P[i, j−1]``
+  (Delft3D/RGFGRID quote ``< 0.02``);
+* ``deviation`` — ``asin(cos)`` in degrees at the same nodes (EFDC: ``< 3°``);
+* ``smoothness`` — at every node inside a grid line, ``max(l₂/l₁, l₁/l₂)`` of
+  the two consecutive edges along the line, for ξ-lines and η-lines
+  (RGFGRID: 1.1–1.2);
+* ``aspect_ratio`` — per cell, the longer over the shorter of its two edges
+  from the ``(i, j)`` corner;
+* ``folded`` — per cell, 1 when any of its four corner Jacobians is ``≤ 0``
+  relative to the block's orientation (folded or non-convex), else 0;
+* ``interface_ratio`` — for two cells of different blocks that share an edge,
+  ``max(A₁/A₂, A₂/A₁)``.  Shared edges are found from the coordinates (both
+  end nodes coincide within ``1e-7`` of the domain size), so the same code
+  serves a :class:`~meshcore.multiblock.MultiBlockGrid`, the blocks read from
+  a file and partial (T-junction) interfaces.
+
+Node-shaped arrays hold NaN where a metric is not defined (border nodes for
+``cos``; line ends for smoothness).  For an O-grid (``periodic``) the ξ seam is
+interior: nodes ``i = 0`` get central differences across it and column
+``i = ni`` (a copy of column 0) is NaN.  Every metric is invariant under
+translation, rotation and uniform scaling.  Coverage against the water
+polygon is in :mod:`.coverage`; limits and verdicts in :mod:`.presets`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidInputError
+from ..grid import StructuredGrid
+from .interfaces import interface_pairs, no_pairs, ratio, signed_area
+
+__all__ = [
+    "METRICS",
+    "BlockMetrics",
+    "LakeMetrics",
+    "Location",
+    "Samples",
+    "block_metrics",
+    "interface_pairs",
+    "lake_metrics",
+]
+
+#: metric → (what it is measured on, description, unit); "worst" is always the largest value.
+METRICS: dict[str, tuple[str, str, str]] = {
+    "cos": ("nodes", "node orthogonality |cos|", ""),
+    "deviation": ("nodes", "deviation from 90°", "°"),
+    "smoothness": ("edge pairs", "consecutive edge-length ratio", ""),
+    "aspect_ratio": ("cells", "aspect ratio", ""),
+    "folded": ("cells", "folded or non-convex (1) cells", ""),
+    "interface_ratio": ("cell pairs", "cross-interface cell-area ratio", ""),
+    "area_error": ("grid", "|grid area / polygon area − 1|", ""),
+    "shore_distance": ("grid", "Hausdorff distance grid boundary ↔ shoreline", " cells"),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Location:
+    """One value of a metric and where it is: block, ``(i, j)`` (node or cell), ``(x, y)``."""
+
+    value: float
+    block: str
+    i: int
+    j: int
+    x: float
+    y: float
+    note: str = ""  # e.g. "ξ-line", or the partner cell of an interface pair
+
+    def __str__(self) -> str:
+        where = f"{self.block}({self.i},{self.j})" if self.block else "grid"
+        extra = f" {self.note}" if self.note else ""
+        return f"{self.value:.4g} at {where}{extra} ({self.x:.8g}, {self.y:.8g})"
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Samples:
+    """The values of one metric wherever it is defined, each with its place.
+
+    ``block`` indexes :attr:`LakeMetrics.names` (``-1``: the whole grid);
+    ``i, j`` are node indices for node metrics and smoothness, cell indices
+    for cell metrics and for side *a* of an interface pair (``partner``:
+    ``(block, i, j)`` of the cell on side *b*); ``axis`` is 0 for ξ-lines and
+    1 for η-lines (smoothness only).
+    """
+
+    metric: str
+    values: np.ndarray
+    block: np.ndarray
+    i: np.ndarray
+    j: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    partner: np.ndarray | None = None
+    axis: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class BlockMetrics:
+    """Per-node and per-cell arrays of one block (see module docstring)."""
+
+    name: str
+    cos: np.ndarray  # (ni+1, nj+1), NaN off block-interior nodes
+    deviation: np.ndarray  # degrees, same shape
+    smooth_xi: np.ndarray  # (ni+1, nj+1): ratio of the two ξ-edges meeting at the node
+    smooth_eta: np.ndarray  # (ni+1, nj+1): the same along η
+    aspect_ratio: np.ndarray  # (ni, nj)
+    area: np.ndarray  # (ni, nj) signed area, positive in the block's orientation
+    folded: np.ndarray  # (ni, nj) bool: a corner Jacobian ≤ 0
+
+
+def _node_cos(x: np.ndarray, y: np.ndarray, periodic: bool) -> np.ndarray:
+    cos = np.full(x.shape, np.nan)
+    if x.shape[1] < 3 or (x.shape[0] < 3 and not periodic):
+        return cos
+    if periodic:  # core columns 0..ni-1, wrapping over the seam
+        cx, cy = x[:-1], y[:-1]
+        ax = np.roll(cx, -1, axis=0) - np.roll(cx, 1, axis=0)
+        ay = np.roll(cy, -1, axis=0) - np.roll(cy, 1, axis=0)
+        ax, ay = ax[:, 1:-1], ay[:, 1:-1]
+        bx, by = cx[:, 2:] - cx[:, :-2], cy[:, 2:] - cy[:, :-2]
+        target = (slice(0, -1), slice(1, -1))
+    else:
+        ax, ay = x[2:, 1:-1] - x[:-2, 1:-1], y[2:, 1:-1] - y[:-2, 1:-1]
+        bx, by = x[1:-1, 2:] - x[1:-1, :-2], y[1:-1, 2:] - y[1:-1, :-2]
+        target = (slice(1, -1), slice(1, -1))
+    norm = np.hypot(ax, ay) * np.hypot(bx, by)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.abs(ax * bx + ay * by) / norm
+    cos[target] = np.where(norm > 0, np.minimum(c, 1.0), 1.0)  # a collapsed node counts as worst
+    return cos
+
+
+def _smoothness(x: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
+    sxi = np.full(x.shape, np.nan)
+    seta = np.full(x.shape, np.nan)
+    lxi = np.hypot(np.diff(x, axis=0), np.diff(y, axis=0))  # (ni, nj+1): edge i from node i to i+1
+    leta = np.hypot(np.diff(x, axis=1), np.diff(y, axis=1))  # (ni+1, nj)
+    sxi[1:-1] = ratio(lxi[:-1], lxi[1:])
+    if periodic:  # node 0 (= node ni) sits between the last and the first edge
+        sxi[0] = ratio(lxi[-1], lxi[0])
+    seta[:, 1:-1] = ratio(leta[:, :-1], leta[:, 1:])
+    return sxi, seta
+
+
+def _corner_jacobians(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``(4, ni, nj)`` cross products of the two edges at each corner (CCW: 00, 10, 11, 01)."""
+    p = [(x[:-1, :-1], y[:-1, :-1]), (x[1:, :-1], y[1:, :-1]), (x[1:, 1:], y[1:, 1:]), (x[:-1, 1:], y[:-1, 1:])]
+    out = []
+    for k in range(4):
+        (px, py), (nx, ny), (bx, by) = p[k], p[(k + 1) % 4], p[(k - 1) % 4]
+        out.append((nx - px) * (by - py) - (ny - py) * (bx - px))
+    return np.stack(out)
+
+
+def block_metrics(grid: StructuredGrid, name: str = "block1") -> BlockMetrics:
+    """All per-block arrays of ``grid`` (see the module docstring for the definitions)."""
+    x, y = np.asarray(grid.x), np.asarray(grid.y)
+    cos = _node_cos(x, y, grid.periodic)
+    dev = np.degrees(np.arcsin(cos))
+    sxi, seta = _smoothness(x, y, grid.periodic)
+    lxi = np.hypot(x[1:, :-1] - x[:-1, :-1], y[1:, :-1] - y[:-1, :-1])
+    leta = np.hypot(x[:-1, 1:] - x[:-1, :-1], y[:-1, 1:] - y[:-1, :-1])
+    area = signed_area(x, y)
+    orient = -1.0 if area.sum() < 0 else 1.0  # a mirrored (clockwise) block is judged in its own sense
+    folded = (orient * _corner_jacobians(x, y) <= 0).any(axis=0)
+    return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded)
+
+
+def _names(obj: Any, n: int) -> tuple[str, ...]:
+    names = getattr(obj, "names", None)
+    if not isinstance(names, (tuple, list)):
+        names = getattr(obj, "block_names", None)
+    if isinstance(names, (tuple, list)) and len(names) == n:
+        return tuple(str(s) for s in names)
+    return tuple(f"block{k + 1}" for k in range(n))
+
+
+def as_grids(obj: Any) -> tuple[tuple[StructuredGrid, ...], tuple[str, ...]]:
+    """A grid, a sequence or ``{name: grid}`` of grids, a MultiBlockGrid or a GridSet → (grids, names)."""
+    if isinstance(obj, StructuredGrid):
+        return (obj,), (str(obj.names.get("block", "block1")),)
+    if isinstance(obj, Mapping):
+        return as_grids(list(obj.values()))[0], tuple(str(k) for k in obj)
+    seq = getattr(obj, "grids", None) or getattr(obj, "blocks", None) or obj
+    try:
+        grids = tuple(seq)
+    except TypeError:
+        raise InvalidInputError(f"expected a grid or a multiblock grid, got {type(obj).__name__}") from None
+    if not grids or not all(isinstance(g, StructuredGrid) for g in grids):
+        raise InvalidInputError(f"expected a grid or a sequence of grids, got {type(obj).__name__}")
+    return grids, _names(obj, len(grids))
+
+
+def _collect(metric: str, parts: list[tuple], axis: list | None = None) -> Samples:
+    """Stack per-block ``(k, values, x, y)`` arrays (NaN = undefined) into one :class:`Samples`."""
+    vals, blk, ii, jj, xs, ys, ax = [], [], [], [], [], [], []
+    for n, (k, arr, x, y) in enumerate(parts):
+        i, j = np.nonzero(~np.isnan(arr))  # NaN: not defined there; inf (collapsed) is kept
+        vals.append(arr[i, j])
+        blk.append(np.full(len(i), k))
+        ii.append(i)
+        jj.append(j)
+        xs.append(x[i, j])
+        ys.append(y[i, j])
+        if axis is not None:
+            ax.append(np.full(len(i), axis[n]))
+    cat = lambda a, dt=float: np.concatenate(a).astype(dt) if a else np.zeros(0, dt)  # noqa: E731
+    return Samples(
+        metric,
+        cat(vals),
+        cat(blk, np.int64),
+        cat(ii, np.int64),
+        cat(jj, np.int64),
+        cat(xs),
+        cat(ys),
+        axis=cat(ax, np.int8) if axis is not None else None,
+    )
+
+
+def _samples(grids: Sequence[StructuredGrid], bms: Sequence[BlockMetrics], pairs: dict) -> dict[str, Samples]:
+    nodes = [(k, np.asarray(g.x), np.asarray(g.y)) for k, g in enumerate(grids)]
+    cents = []
+    for k, g in enumerate(grids):
+        x, y = np.asarray(g.x), np.asarray(g.y)
+        cx = 0.25 * (x[:-1, :-1] + x[1:, :-1] + x[1:, 1:] + x[:-1, 1:])
+        cy = 0.25 * (y[:-1, :-1] + y[1:, :-1] + y[1:, 1:] + y[:-1, 1:])
+        cents.append((k, cx, cy))
+    out = {
+        "cos": _collect("cos", [(k, b.cos, x, y) for (k, x, y), b in zip(nodes, bms, strict=True)]),
+        "deviation": _collect("deviation", [(k, b.deviation, x, y) for (k, x, y), b in zip(nodes, bms, strict=True)]),
+        "smoothness": _collect(
+            "smoothness",
+            [(k, a, x, y) for (k, x, y), b in zip(nodes, bms, strict=True) for a in (b.smooth_xi, b.smooth_eta)],
+            axis=[ax for _ in bms for ax in (0, 1)],
+        ),
+        "aspect_ratio": _collect(
+            "aspect_ratio", [(k, b.aspect_ratio, cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
+        ),
+        "folded": _collect(
+            "folded", [(k, b.folded.astype(float), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
+        ),
+    }
+    ca = pairs["cell_a"]
+    out["interface_ratio"] = Samples(
+        "interface_ratio",
+        pairs["ratio"],
+        ca[:, 0],
+        ca[:, 1],
+        ca[:, 2],
+        pairs["mid"][:, 0],
+        pairs["mid"][:, 1],
+        partner=pairs["cell_b"],
+    )
+    return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LakeMetrics:
+    """The lake-grid metrics of a single- or multiblock grid (see :func:`lake_metrics`).
+
+    ``blocks`` holds the per-node/per-cell arrays of each block (for colouring
+    a figure); ``samples`` every value of every metric with its place (for
+    shares and worst places); ``coverage`` is ``None`` without a polygon.
+    """
+
+    names: tuple[str, ...]
+    blocks: tuple[BlockMetrics, ...]
+    samples: dict[str, Samples] = field(repr=False)
+    coverage: Any = None  # meshcore.quality.coverage.Coverage
+
+    def values(self, metric: str) -> np.ndarray:
+        """Every value of ``metric`` (a key of :data:`METRICS`)."""
+        if metric not in METRICS:
+            raise InvalidInputError(f"unknown metric {metric!r}; known: {', '.join(METRICS)}")
+        s = self.samples.get(metric)
+        return s.values if s is not None else np.zeros(0)
+
+    def share(self, metric: str, limit: float) -> float:
+        """Share (0…1) of the values of ``metric`` that are ``≤ limit``; NaN when there are none."""
+        v = self.values(metric)
+        return float(np.mean(v <= limit)) if len(v) else float("nan")
+
+    def mean(self, metric: str) -> float:
+        v = self.values(metric)
+        return float(np.mean(v)) if len(v) else float("nan")
+
+    def max(self, metric: str) -> float:
+        v = self.values(metric)
+        return float(np.max(v)) if len(v) else float("nan")
+
+    def worst(self, metric: str, k: int = 5, *, above: float | None = None) -> tuple[Location, ...]:
+        """The ``k`` largest values of ``metric`` (only those ``> above`` if given), worst first."""
+        v = self.values(metric)
+        s = self.samples.get(metric)
+        if s is None or not len(v):
+            return ()
+        idx = np.flatnonzero(v > above) if above is not None else np.arange(len(v))
+        if k is not None and len(idx) > k:
+            idx = idx[np.argpartition(-v[idx], k - 1)[:k]]
+        idx = idx[np.lexsort((idx, -v[idx]))]
+        return tuple(self._location(s, int(n)) for n in idx)
+
+    def _location(self, s: Samples, n: int) -> Location:
+        b = int(s.block[n])
+        note = ""
+        if s.axis is not None:
+            note = "ξ-line" if s.axis[n] == 0 else "η-line"
+        if s.partner is not None:
+            pb, pi, pj = (int(t) for t in s.partner[n])
+            note = f"| {self.names[pb]}({pi},{pj})"
+        name = self.names[b] if b >= 0 else ""
+        return Location(float(s.values[n]), name, int(s.i[n]), int(s.j[n]), float(s.x[n]), float(s.y[n]), note)
+
+    def summary(self) -> dict[str, float | None]:
+        """The headline numbers (shares in %, angles in degrees; None where undefined)."""
+        out = {
+            "blocks": len(self.blocks),
+            "cells": int(sum(b.area.size for b in self.blocks)),
+            "interior_nodes": len(self.values("cos")),
+            "mean_deviation_deg": self.mean("deviation"),
+            "max_deviation_deg": self.max("deviation"),
+            "pct_nodes_within_3deg": 100 * self.share("deviation", 3.0),
+            "pct_nodes_cos_le_0.02": 100 * self.share("cos", 0.02),
+            "pct_nodes_cos_le_0.05": 100 * self.share("cos", 0.05),
+            "pct_smoothness_le_1.2": 100 * self.share("smoothness", 1.2),
+            "max_smoothness": self.max("smoothness"),
+            "max_aspect_ratio": self.max("aspect_ratio"),
+            "mean_aspect_ratio": self.mean("aspect_ratio"),
+            "folded_cells": int(self.values("folded").sum()),
+            "interface_cell_pairs": len(self.values("interface_ratio")),
+            "max_interface_ratio": self.max("interface_ratio"),
+        }
+        if self.coverage is not None:
+            out.update(self.coverage.as_dict())
+        return {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in out.items()}
+
+    def table(self) -> str:
+        """A short Markdown table of the headline numbers with the worst places."""
+        from .presets import format_table
+
+        def w(metric: str) -> str:
+            loc = self.worst(metric, 1)
+            return str(loc[0]) if loc else "—"
+
+        n_folded = int(self.values("folded").sum())
+        rows = [
+            (
+                "blocks / cells / interior nodes",
+                f"{len(self.blocks)} / {self.summary()['cells']} / {len(self.values('cos'))}",
+                "",
+            ),
+            (
+                "deviation from 90°, mean / max",
+                f"{self.mean('deviation'):.2f}° / {self.max('deviation'):.2f}°",
+                w("deviation"),
+            ),
+            (
+                "nodes within 3° / |cos| ≤ 0.02 / ≤ 0.05",
+                f"{100 * self.share('deviation', 3.0):.1f} % / "
+                f"{100 * self.share('cos', 0.02):.1f} % / {100 * self.share('cos', 0.05):.1f} %",
+                "",
+            ),
+            (
+                "edge pairs with ratio ≤ 1.2 / max",
+                f"{100 * self.share('smoothness', 1.2):.1f} % / {self.max('smoothness'):.3g}",
+                w("smoothness"),
+            ),
+            (
+                "aspect ratio mean / max",
+                f"{self.mean('aspect_ratio'):.3g} / {self.max('aspect_ratio'):.3g}",
+                w("aspect_ratio"),
+            ),
+            ("folded or non-convex cells", str(n_folded), w("folded") if n_folded else ""),
+        ]
+        if len(self.values("interface_ratio")):
+            rows.append(("cross-interface area ratio max", f"{self.max('interface_ratio'):.3g}", w("interface_ratio")))
+        if self.coverage is not None:
+            rows += self.coverage.rows()
+        return format_table(("metric", "value", "worst at"), rows)
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def lake_metrics(
+    grid: Any,
+    *,
+    polygon: Any = None,
+    holes: Sequence[Any] = (),
+    cell_size: float | None = None,
+) -> LakeMetrics:
+    """Measure a grid the way lake modellers do (``shared/design/lake-grids.md``).
+
+    Parameters
+    ----------
+    grid : StructuredGrid, MultiBlockGrid, GridSet, sequence or ``{name: grid}`` of StructuredGrid
+    polygon : shapely Polygon/MultiPolygon or (n, 2) array, optional
+        The water polygon, in the grid's coordinates; with it the report has
+        the coverage (area ratio, Hausdorff distance of the shoreline).
+    holes : sequence of (m, 2) arrays
+        Islands, when ``polygon`` is given as the outer ring's points.
+    cell_size : float, optional
+        Unit of the shoreline distance; default ``sqrt(grid area / cells)``.
+
+    Returns
+    -------
+    LakeMetrics
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshcore import StructuredGrid
+    >>> xi, eta = np.meshgrid(np.arange(5.0), np.arange(4.0), indexing="ij")
+    >>> m = lake_metrics(StructuredGrid(xi + 0.5 * eta, eta))   # sheared: cos = 1/√5
+    >>> round(m.max("cos"), 6), m.share("deviation", 3.0), m.max("smoothness")
+    (0.447214, 0.0, 1.0)
+    """
+    grids, names = as_grids(grid)
+    bms = tuple(block_metrics(g, n) for g, n in zip(grids, names, strict=True))
+    samples = _samples(grids, bms, interface_pairs(grids) if len(grids) > 1 else no_pairs())
+    cov = None
+    if polygon is not None:
+        from .coverage import coverage
+
+        cov = coverage(grids, bms, polygon, holes=holes, cell_size=cell_size)
+        samples["area_error"] = cov.samples("area_error")
+        samples["shore_distance"] = cov.samples("shore_distance")
+    return LakeMetrics(names, bms, samples, cov)
