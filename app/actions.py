@@ -36,6 +36,7 @@ class ActionSpec:
     separator: bool = False  # a separator line before it in its menu
     toolbar: float = 0.0  # 0: not on the toolbar; else its place (the integer part groups buttons)
     checkable: bool = False
+    checked: bool = False  # the initial state of a checkable action
     enabled: bool = True
     help: str = ""  # the line in Help ▸ Keyboard shortcuts (default: the text)
 
@@ -147,6 +148,29 @@ ACTIONS: tuple[ActionSpec, ...] = (
     ),
     # View
     ActionSpec("fit", "&Fit view", "canvas.fit", ("F",), menu="&View", toolbar=5, help="fit the view"),
+    ActionSpec(
+        "grid_lines",
+        "&Grid lines",
+        "canvas.set_grid_visible",
+        ("G",),
+        "show the grid lines (they fade by themselves when the cells are only a few pixels wide)",
+        "&View",
+        separator=True,
+        checkable=True,
+        checked=True,
+        help="show / hide the grid lines",
+    ),
+    ActionSpec(
+        "markers",
+        "&Boundary points and markers",
+        "canvas.set_markers_visible",
+        ("M",),
+        "show the boundary points, corners, border arrows and labels (hide them to see a zoomed-out grid)",
+        "&View",
+        checkable=True,
+        checked=True,
+        help="show / hide the boundary points and markers",
+    ),
     ActionSpec("docks", "", "@docks", menu="&View", separator=True),
     ActionSpec("examples", "", "@examples", menu="E&xamples"),
     # Help
@@ -219,6 +243,8 @@ def _describe(a: QtGui.QAction, spec: ActionSpec) -> None:
         a.setToolTip(spec.tip)
         a.setStatusTip(spec.tip)
     a.setEnabled(spec.enabled)
+    if spec.checkable:
+        a.setChecked(spec.checked)
 
 
 def _toolbar(window, actions: dict[str, QtGui.QAction]) -> QtWidgets.QToolBar:

@@ -55,6 +55,9 @@ class Document:
         The metric the cells are coloured by changed (a key of :data:`METRICS`).
     opened()
         A new project was opened (:meth:`reset`): views drop what they showed.
+    reported(str, str)
+        A problem or a note worth keeping: level ("info", "warning", "error") and the full text
+        (the message panel lists them; the status bar shows only the latest line).
     """
 
     project_changed = Signal(object)
@@ -66,6 +69,7 @@ class Document:
     quality_changed = Signal()
     colour_changed = Signal(str)
     opened = Signal()
+    reported = Signal(str, str)
 
     def __init__(self, project: Project | None = None) -> None:
         self.project: Project = project or Project()
@@ -177,6 +181,12 @@ class Document:
         if solving:
             self._final = False
         self._update_quality()
+
+    def report(self, level: str, text: str) -> None:
+        """Add ``text`` to the message panel (``level``: "info", "warning" or "error")."""
+        if level not in ("info", "warning", "error"):
+            raise ValueError(f"unknown message level {level!r}")
+        self.reported.emit(level, str(text))
 
     # ----------------------------------------------------------- quality
     def _update_quality(self) -> None:

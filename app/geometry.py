@@ -16,13 +16,18 @@ __all__ = [
     "cell_at",
     "cell_centres",
     "compose_similarity",
+    "corner_advice",
     "fit_image",
     "grid_lines",
+    "image_bounds",
+    "line_alpha",
     "nearest_point",
     "nearest_segment",
     "points_in_box",
     "similarity_from_pairs",
     "snap",
+    "typical_cell_size",
+    "union_bounds",
 ]
 
 
@@ -162,6 +167,27 @@ def _off_reflex(p: np.ndarray, c) -> tuple[int, int, int, int]:
         if len(set(trial)) == 4 and rel[0] < rel[1] < rel[2] < rel[3]:
             c = trial
     return tuple(c)  # type: ignore[return-value]
+
+
+def corner_advice(points: np.ndarray, corners) -> list[str]:
+    """What is wrong with corners on reflex vertices, and where to move them.
+
+    One sentence per problem corner (from :func:`meshcore.corners.corner_problems`),
+    with points numbered from 1 like the rows of a point file.
+    """
+    from meshcore.corners import corner_problems
+
+    out = []
+    for prob in corner_problems(np.asarray(points, float), corners):
+        s = (
+            f"corner {prob.corner.upper()} is on point {prob.index + 1}, a reflex vertex "
+            f"(interior angle {prob.angle:.0f}° ≥ 180°): its corner cell cannot be convex; "
+            f"move corner {prob.corner.upper()} to a convex vertex"
+        )
+        if prob.suggestion is not None:
+            s += f", e.g. point {prob.suggestion + 1}"
+        out.append(s)
+    return out
 
 
 def _upright(p: np.ndarray, c) -> tuple[int, int, int, int]:
@@ -314,6 +340,62 @@ def fit_image(width: int, height: int, bounds) -> tuple[float, float, float, flo
     x0, y0, x1, y1 = bounds
     s = max((x1 - x0) / max(width, 1), (y1 - y0) / max(height, 1))
     return (s if s > 0 else 1.0, 0.0, float(x0), float(y0))
+
+
+def image_bounds(width: int, height: int, transform) -> tuple[float, float, float, float]:
+    """The model-coordinate bounding box of a ``width`` × ``height`` image placed by ``transform``."""
+    corners = [_apply(transform, u, v) for u, v in ((0, 0), (width, 0), (width, height), (0, height))]
+    xs, ys = [z.real for z in corners], [z.imag for z in corners]
+    return (min(xs), min(ys), max(xs), max(ys))
+
+
+def _apply(transform, u: float, v: float) -> complex:
+    a, b, tx, ty = transform
+    return complex(a, b) * complex(u, v) + complex(tx, ty)
+
+
+def union_bounds(*boxes) -> tuple[float, float, float, float] | None:
+    """The box around every ``(x0, y0, x1, y1)`` given (Nones skipped; None if there is none)."""
+    bb = [b for b in boxes if b is not None]
+    if not bb:
+        return None
+    a = np.asarray(bb, float)
+    return (float(a[:, 0].min()), float(a[:, 1].min()), float(a[:, 2].max()), float(a[:, 3].max()))
+
+
+def typical_cell_size(grids, sample: int = 20_000) -> float:
+    """The median length of the grid lines' segments (model units; 0 without grids).
+
+    At most about ``sample`` segments of each grid are measured (a regular
+    subset of the rows), so this stays cheap for large grids.
+    """
+    lengths = []
+    for g in grids:
+        x, y = np.asarray(g.x), np.asarray(g.y)
+        step = max(1, int(x.size // max(sample, 1)))
+        xs, ys = x[::step], y[::step]
+        if xs.shape[1] > 1:
+            lengths.append(np.hypot(np.diff(xs, axis=1), np.diff(ys, axis=1)).ravel())
+        if x.shape[0] > 1:
+            lengths.append(np.hypot(x[1::step] - x[:-1:step], y[1::step] - y[:-1:step]).ravel())
+    if not lengths:
+        return 0.0
+    a = np.concatenate(lengths)
+    a = a[np.isfinite(a)]
+    return float(np.median(a)) if a.size else 0.0
+
+
+def line_alpha(cell_pixels: float, *, full: float = 8.0, faint: float = 2.0, floor: float = 0.12) -> float:
+    """Opacity of grid lines for cells ``cell_pixels`` wide on screen (level of detail).
+
+    Opaque for cells of ``full`` pixels or more, fading linearly to ``floor``
+    at ``faint`` pixels and below: a zoomed-out fine grid reads as a light
+    texture and the cell colouring shows through, instead of a black blob.
+    """
+    if not math.isfinite(cell_pixels) or cell_pixels >= full:
+        return 1.0
+    t = (cell_pixels - faint) / (full - faint)
+    return float(floor + (1.0 - floor) * min(max(t, 0.0), 1.0))
 
 
 def cell_centres(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

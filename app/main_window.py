@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import time
 from pathlib import Path
 
 from PySide6 import QtCore, QtGui, QtWidgets
@@ -27,11 +26,12 @@ from .commands import Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
-from .pipeline import ALL_BLOCKS
 from .project import Project, boundary_to_loop
+from .solve_status import SolveStatus
 from .solver_controller import SolverController
 from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, PanTool
 from .views.canvas import Canvas
+from .views.messages import ElidedLabel, MessagePanel
 from .views.panels import BlocksPanel, ConvergencePanel, ParamsPanel, QualityPanel
 
 __all__ = ["MainWindow"]
@@ -39,6 +39,8 @@ __all__ = ["MainWindow"]
 log = logging.getLogger(__name__)
 
 APP_NAME = "gcmesh"
+DEFAULT_SIZE = (1400, 880)
+VIEW_TOGGLES = ("grid_lines", "markers")  # checkable View actions remembered between sessions
 
 
 def default_recovery_path() -> Path:
@@ -62,7 +64,7 @@ class MainWindow(QtWidgets.QMainWindow):
         icon = Path(__file__).resolve().parent.parent / "resources" / "icons" / "gcmesh.svg"
         if icon.exists():
             self.setWindowIcon(QtGui.QIcon(str(icon)))
-        self.resize(1400, 880)
+        self.resize(*DEFAULT_SIZE)
         self.setAcceptDrops(True)
         self.quiet = False  # True: no modal dialogs (tests, screenshots); errors go to the status bar
         self.settings = settings or QtCore.QSettings("gcmesh", "gcmesh")
@@ -70,16 +72,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.stack = QtGui.QUndoStack(self)
         self.editor = Editor(self.doc, self.stack)
         self.solver = SolverController(self.doc, self)
-        self._frames: list[float] = []
         self._centres = (None, None)  # (grid, its cell centres) for the hover read-out
         self.canvas = Canvas(self.doc)
+        self.canvas.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.setCentralWidget(self.canvas)
-        self._status = QtWidgets.QLabel()
+        self._status = ElidedLabel()
         self._coords = QtWidgets.QLabel()
-        self._solver_label = QtWidgets.QLabel("idle")
         self.statusBar().addWidget(self._status, 1)
-        self.statusBar().addPermanentWidget(self._solver_label)
-        self.statusBar().addPermanentWidget(self._coords)
 
         self.io = IOController(self, self.settings, recovery or default_recovery_path())
         self.background = BackgroundController(self)
@@ -88,13 +87,20 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tool_group = QtGui.QActionGroup(self)
         self.tool_actions: dict[str, QtGui.QAction] = {}
         self.actions = actions.build(self, self._placeholder)
+        self.solve_status = SolveStatus(self)
+        self.statusBar().addPermanentWidget(self.solve_status.label)
+        self.statusBar().addPermanentWidget(self._coords)
         self.io.refresh_recent()
         self._connect()
 
+        self._shown = False
+        self._corners_seen = None  # (block, points, corners) last checked for corner advice
         self.set_tool("draw")
         self._update_title()
+        self.focus_canvas()
         if restore_layout:
             self._restore_layout()
+        self.fit_to_screen()
         self.canvas.fit()
         self.message(
             "Draw a boundary (click points, double-click to close), import points (Ctrl+I) "
@@ -107,6 +113,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.params_panel = ParamsPanel(self.doc, self.editor)
         self.conv_panel = ConvergencePanel()
         self.quality_panel = QualityPanel(self.doc)
+        self.messages_panel = MessagePanel(self.doc)
         self.undo_view = QtWidgets.QUndoView(self.stack)
         self.undo_view.setEmptyLabel("<start>")
         self.docks = {}
@@ -117,6 +124,7 @@ class MainWindow(QtWidgets.QMainWindow):
             ("params", "Parameters", self.params_panel, left),
             ("quality", "Quality", self.quality_panel, right),
             ("convergence", "Convergence", self.conv_panel, right),
+            ("messages", "Messages", self.messages_panel, right),
             ("history", "Undo history", self.undo_view, right),
         ):
             d = QtWidgets.QDockWidget(title, self)
@@ -124,7 +132,8 @@ class MainWindow(QtWidgets.QMainWindow):
             d.setWidget(w)
             self.addDockWidget(area, d)
             self.docks[key] = d
-        self.tabifyDockWidget(self.docks["convergence"], self.docks["history"])
+        self.tabifyDockWidget(self.docks["convergence"], self.docks["messages"])
+        self.tabifyDockWidget(self.docks["messages"], self.docks["history"])
         self.docks["convergence"].raise_()
         vertical, horizontal = QtCore.Qt.Orientation.Vertical, QtCore.Qt.Orientation.Horizontal
         self.resizeDocks([self.docks["blocks"], self.docks["params"]], [230, 520], vertical)
@@ -183,32 +192,41 @@ class MainWindow(QtWidgets.QMainWindow):
     def _connect(self) -> None:
         self.doc.message.connect(self.message)
         self.doc.project_changed.connect(self._on_project)
-        self.doc.grids_changed.connect(lambda: self._frames.append(time.perf_counter()))
-        self.doc.active_changed.connect(lambda _k: self._on_final())
-        self.doc.opened.connect(self._on_opened)
+        self.doc.opened.connect(self.focus_canvas)
         self.doc.path_changed.connect(self._update_title)
         self.canvas.hovered.connect(self._show_coords)
         self.blocks_panel.border_selected.connect(self.params_panel.select_border)
         self.quality_panel.zoom_to_cell.connect(self.canvas.zoom_to_cell)
-        self.solver.state_changed.connect(self._on_solver_state)
-        self.solver.error.connect(self._on_solver_error)
-        self.solver.progress.connect(self._on_progress)
-        self.solver.finished.connect(self._on_finished)
+        self.params_panel.committed.connect(self.focus_canvas)
+        self.messages_panel.attention.connect(self.show_messages)
+        self.doc.project_changed.connect(self._check_corners)
         self.stack.cleanChanged.connect(self._update_title)
 
     # ------------------------------------------------------------ status
     def message(self, text: str, *, error: bool = False) -> None:
+        """One line in the status bar; errors also go to the message panel, in full."""
         self._status.setText(text)
-        self._status.setToolTip(text)
         self._status.setStyleSheet("color: #b00000; font-weight: bold;" if error else "")
+        if error:
+            self.doc.report("error", text)
 
     def error(self, title: str, exc: BaseException | str) -> None:
-        """Report a failed operation: the status bar, a dialog (unless quiet) and the log."""
+        """Report a failed operation: the status bar, the message panel, a dialog (unless quiet), the log."""
         text = str(exc)
         log.info("%s: %s", title, text, exc_info=exc if isinstance(exc, BaseException) else None)
         self.message(f"{title}: {text}", error=True)
         if not self.quiet:
             QtWidgets.QMessageBox.warning(self, title, text)
+
+    def show_messages(self) -> None:
+        """Bring the message panel to the front (a problem was reported)."""
+        dock = self.docks["messages"]
+        dock.show()
+        dock.raise_()
+
+    def focus_canvas(self) -> None:
+        """Give the keyboard to the canvas: tool keys and Ctrl+Z act on the drawing again."""
+        self.canvas.setFocus(QtCore.Qt.FocusReason.OtherFocusReason)
 
     def _show_coords(self, x: float, y: float) -> None:
         p = self.doc.project
@@ -314,8 +332,7 @@ class MainWindow(QtWidgets.QMainWindow):
                 hint = "pick four corners (Corners tool) or use Auto corners (A)"
             self.message(f"Nothing to generate yet: {hint}")
             return
-        self.conv_panel.clear_history()
-        self._frames = []
+        self.solve_status.reset()
         self.solver.start()
 
     # ---------------------------------------------------------- reactions
@@ -330,62 +347,19 @@ class MainWindow(QtWidgets.QMainWindow):
             pi.setLabel("bottom", "")
             pi.setLabel("left", "")
 
-    def _on_opened(self) -> None:
-        self.conv_panel.clear_history()
-        self.canvas.set_grid_stale(False)
-        self._solver_label.setText("idle")
-
-    def _on_progress(self, k: int, snap) -> None:
-        if k == ALL_BLOCKS:  # a multiblock solve: relative residuals of the global iteration
-            self.conv_panel.set_history(list(snap.history))
-            self._solver_label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
+    def _check_corners(self, project: Project) -> None:
+        """New corners on reflex vertices: say which, and where to move them."""
+        b = self.doc.block
+        key = (self.doc.active, b.corners)
+        if b.corners is None or b.boundary is not None or key == self._corners_seen:
             return
-        if k == self.doc.active:
-            length = max(snap.grid.size, 1e-300)  # history is absolute, residual relative
-            self.conv_panel.set_history([(i, r / length) for i, r in snap.history], snap.tolerance)
-        fr = [t for t in self._frames if t > self._frames[-1] - 1.0] if self._frames else []
-        self._solver_label.setText(
-            f"{snap.method}: iteration {snap.iteration}, residual {snap.residual:.2e} "
-            f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s"
-        )
-
-    def _on_solver_state(self, state: str) -> None:
-        running = state != "idle"
-        self.doc.set_solving(running)
-        self.a_pause.setEnabled(running)
-        self.a_stop.setEnabled(running)
-        self.a_pause.setChecked(state == "paused")
-        if state == "paused":
-            self._solver_label.setText("paused")
-
-    def _on_solver_error(self, text: str) -> None:
-        # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why
-        self.canvas.set_grid_stale(True)
-        self.message(f"Cannot generate: {text}", error=True)
-        self._solver_label.setText("error")
-
-    def _on_finished(self, result) -> None:
-        if result is not None and self.doc.project.multiblock is not None:
-            self.doc.set_multiblock(getattr(result, "multiblock", None))
-        self._on_final()
-
-    def _on_final(self) -> None:
-        g = self.doc.grid
-        if self.solver.running or self.solver.last_error:
+        self._corners_seen = key
+        try:
+            advice = geo.corner_advice(b.points, b.corners)
+        except (MeshcoreError, ValueError, IndexError):
             return
-        self.canvas.set_grid_stale(False)
-        if g is None:
-            self._solver_label.setText("idle")
-            return
-        info = g.info
-        if info.residual_history:
-            self.conv_panel.set_history(list(info.residual_history), info.tolerance)
-        r = self.doc.quality
-        dt = self.solver.t_done - self.solver.t_start
-        state = "converged" if info.converged else info.message or "not converged"
-        warn = f" — {r.n_folded} FOLDED cells (red ×)" if r is not None and r.n_folded else ""
-        self._solver_label.setText(f"{info.method}: {state}, {info.iterations} iterations, {dt * 1000:.0f} ms")
-        self.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}")
+        for text in advice:
+            self.doc.report("warning", f"{b.name}: {text}")
 
     # ------------------------------------------------------------- window
     def _update_title(self, *_a) -> None:
@@ -414,7 +388,31 @@ class MainWindow(QtWidgets.QMainWindow):
         self.io.shutdown()
         self.settings.setValue("geometry", self.saveGeometry())
         self.settings.setValue("window_state", self.saveState())
+        for key in VIEW_TOGGLES:
+            self.settings.setValue(f"view/{key}", self.actions[key].isChecked())
         ev.accept()
+
+    def showEvent(self, ev: QtGui.QShowEvent) -> None:
+        super().showEvent(ev)
+        if not self._shown:  # the window frame is known now: fit it, decoration included
+            self._shown = True
+            QtCore.QTimer.singleShot(0, self.fit_to_screen)
+
+    def fit_to_screen(self) -> None:
+        """Keep the whole window (docks and status bar included) on its screen."""
+        screen = self.screen() or QtGui.QGuiApplication.primaryScreen()
+        if screen is None:
+            return
+        avail = screen.availableGeometry()
+        frame = self.frameGeometry().size() - self.geometry().size()  # the window manager's decoration
+        w = min(self.width(), avail.width() - frame.width())
+        h = min(self.height(), avail.height() - frame.height())
+        if (w, h) != (self.width(), self.height()):
+            self.resize(w, h)
+        x = min(max(self.x(), avail.left()), avail.right() - self.frameGeometry().width() + 1)
+        y = min(max(self.y(), avail.top()), avail.bottom() - self.frameGeometry().height() + 1)
+        if (x, y) != (self.x(), self.y()):
+            self.move(max(x, avail.left()), max(y, avail.top()))
 
     def _restore_layout(self) -> None:
         """Window size and dock layout from the last session (if any)."""
@@ -425,6 +423,10 @@ class MainWindow(QtWidgets.QMainWindow):
                 self.restoreGeometry(geom)
             if state is not None:
                 self.restoreState(state)
+        for key in VIEW_TOGGLES:
+            on = self.settings.value(f"view/{key}", None)
+            if on is not None and (str(on).lower() == "true") != self.actions[key].isChecked():
+                self.actions[key].trigger()
 
     # --------------------------------------------------------------- help
     def show_shortcuts(self) -> None:

@@ -244,16 +244,8 @@ class CornersTool(Tool):
             self.picked = []
             self.doc.set_selection(())
             self.status("Corners set: bottom = SW→SE, right = SE→NE, top = NW→NE, left = SW→NW")
-            try:
-                from meshcore.corners import corner_problems
-
-                problems = corner_problems(np.asarray(b.points), self.doc.block.corners)
-            except (ImportError, ValueError):
-                problems = []
-            if problems:
-                self.status("Warning: " + problems[0].message)
-        else:
-            self.status(f"Corner {names[len(self.picked) - 1]} = point {k}; now click {names[len(self.picked)]}")
+        else:  # points are numbered from 1, like the rows of a point file
+            self.status(f"Corner {names[len(self.picked) - 1]} = point {k + 1}; now click {names[len(self.picked)]}")
         return True
 
 

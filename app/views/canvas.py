@@ -21,6 +21,7 @@ from meshcore import StructuredGrid
 
 from .. import geometry as geo
 from ..document import Document
+from .items import Scatter, ToolViewBox, set_points, set_polylines
 
 __all__ = ["BORDER_COLOURS", "Canvas"]
 
@@ -38,56 +39,13 @@ CORNER_LABELS = ("SW", "SE", "NE", "NW")
 _OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
 
 
-class _Scatter(pg.ScatterPlotItem):
-    """A scatter that is only a picture: clicks on its spots go to the ViewBox (the tool)."""
-
-    def mouseClickEvent(self, ev) -> None:
-        ev.ignore()
-
-    def hoverEvent(self, ev) -> None:
-        pass
-
-
-class _ViewBox(pg.ViewBox):
-    """A ViewBox that offers mouse events to the active tool before panning."""
-
-    def __init__(self, canvas: Canvas) -> None:
-        super().__init__(lockAspect=True, enableMenu=False)
-        self._canvas = canvas
-
-    def mouseClickEvent(self, ev) -> None:
-        tool = self._canvas.tool
-        if tool is not None and ev.button() == QtCore.Qt.MouseButton.LeftButton:
-            xy = self._canvas.to_model(ev.scenePos())
-            handled = tool.double_click(xy, ev.modifiers()) if ev.double() else tool.click(xy, ev.modifiers())
-            if handled:
-                ev.accept()
-                return
-        right = ev.button() == QtCore.Qt.MouseButton.RightButton
-        if right and tool is not None and tool.right_click(self._canvas.to_model(ev.scenePos())):
-            ev.accept()
-            return
-        super().mouseClickEvent(ev)
-
-    def mouseDragEvent(self, ev, axis=None) -> None:
-        tool = self._canvas.tool
-        if tool is not None and ev.button() == QtCore.Qt.MouseButton.LeftButton:
-            xy = self._canvas.to_model(ev.scenePos())
-            start = self._canvas.to_model(ev.buttonDownScenePos())
-            phase = "start" if ev.isStart() else "finish" if ev.isFinish() else "move"
-            if tool.drag(phase, xy, start, ev.modifiers()):
-                ev.accept()
-                return
-        super().mouseDragEvent(ev, axis)
-
-
 class Canvas(pg.PlotWidget):
     """The drawing area.  ``tool`` receives mouse events in model coordinates."""
 
     hovered = QtCore.Signal(float, float)
 
     def __init__(self, doc: Document, parent=None) -> None:
-        self._vb = _ViewBox(self)
+        self._vb = ToolViewBox(self)
         super().__init__(parent=parent, viewBox=self._vb, background="w")
         self.doc = doc
         self.tool = None
@@ -106,7 +64,10 @@ class Canvas(pg.PlotWidget):
         for it in self.getPlotItem().items:
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self._label_at: dict[str, tuple[float, float, float]] = {}
+        self.markers_visible = True
+        self._bg_transform = (1.0, 0.0, 0.0, 0.0)
         self._vb.sigRangeChanged.connect(self._place_labels)
+        self._vb.sigRangeChanged.connect(self._apply_level_of_detail)
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
         doc.project_changed.connect(self.refresh_boundary)
         doc.selection_changed.connect(lambda _: self.refresh_selection())
@@ -134,6 +95,9 @@ class Canvas(pg.PlotWidget):
         )
         self.grid_curve.setZValue(0)
         self.addItem(self.grid_curve)
+        self._grid_colour = "#303030"
+        self._cell_size = 0.0  # typical cell size of the grids (model units), for the level of detail
+        self._sized_shapes: tuple = ()
 
         self.loop_curve = pg.PlotCurveItem(pen=pg.mkPen("#888", width=1, style=QtCore.Qt.PenStyle.DashLine))
         self.loop_curve.setZValue(5)
@@ -170,16 +134,16 @@ class Canvas(pg.PlotWidget):
 
     def _make_point_items(self) -> None:
         """Points, other blocks' points, selection, corners, folded-cell markers."""
-        self.points_item = _Scatter(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
+        self.points_item = Scatter(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
         self.points_item.setZValue(20)
         self.addItem(self.points_item)
-        self.other_points_item = _Scatter(size=5, pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
+        self.other_points_item = Scatter(size=5, pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
         self.other_points_item.setZValue(19)
         self.addItem(self.other_points_item)
-        self.selected_item = _Scatter(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
+        self.selected_item = Scatter(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
         self.selected_item.setZValue(21)
         self.addItem(self.selected_item)
-        self.corner_item = _Scatter(size=13, symbol="s", pen=pg.mkPen("#000", width=2), brush=pg.mkBrush("#ffd700"))
+        self.corner_item = Scatter(size=13, symbol="s", pen=pg.mkPen("#000", width=2), brush=pg.mkBrush("#ffd700"))
         self.corner_item.setZValue(22)
         self.addItem(self.corner_item)
         self.corner_labels = []
@@ -190,7 +154,7 @@ class Canvas(pg.PlotWidget):
             self.addItem(t)
             self.corner_labels.append(t)
 
-        self.folded_item = _Scatter(size=9, symbol="x", pen=pg.mkPen("#ff0000", width=2))
+        self.folded_item = Scatter(size=9, symbol="x", pen=pg.mkPen("#ff0000", width=2))
         self.folded_item.setZValue(30)
         self.addItem(self.folded_item)
 
@@ -205,7 +169,7 @@ class Canvas(pg.PlotWidget):
         self.rubber_box.setZValue(41)
         self.rubber_box.hide()
         self.addItem(self.rubber_box)
-        self.highlight_item = _Scatter(size=16, symbol="o", pen=pg.mkPen("#ff00ff", width=2), brush=None)
+        self.highlight_item = Scatter(size=16, symbol="o", pen=pg.mkPen("#ff00ff", width=2), brush=None)
         self.highlight_item.setZValue(42)
         self.addItem(self.highlight_item)
 
@@ -239,14 +203,12 @@ class Canvas(pg.PlotWidget):
         )
 
     def fit(self) -> None:
-        b = self.doc.project.bounds()
-        if b is None and self.doc.grids:
-            gs = list(self.doc.grids.values())
-            bb = np.array([g.bounds() for g in gs])
-            b = (bb[:, 0].min(), bb[:, 1].min(), bb[:, 2].max(), bb[:, 3].max())
-        if b is None:
-            b = (0.0, 0.0, 1.0, 1.0)
-        self.zoom_to(b)
+        """Show the outline, the grids and the background image."""
+        boxes = [self.doc.project.bounds(), *(g.bounds() for g in self.doc.grids.values())]
+        if self.background_item.isVisible() and self.background_item.image is not None:
+            h, w = self.background_item.image.shape[:2]
+            boxes.append(geo.image_bounds(w, h, self._bg_transform))
+        self.zoom_to(geo.union_bounds(*boxes) or (0.0, 0.0, 1.0, 1.0))
 
     # ------------------------------------------------------------ drawing
     def refresh_boundary(self, *_args) -> None:
@@ -254,7 +216,7 @@ class Canvas(pg.PlotWidget):
         self._draw_loops()
         self._draw_borders()
         self._draw_points()
-        _set_polylines(self.cut_curve, self.doc.project.cut_lines)
+        set_polylines(self.cut_curve, self.doc.project.cut_lines)
         self.refresh_selection()
 
     def _draw_loops(self) -> None:
@@ -265,7 +227,7 @@ class Canvas(pg.PlotWidget):
         op = [b.points for b in others if len(b.points)]
         if not multiblock:
             op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
-        _set_points(self.other_points_item, np.vstack(op) if op else None)
+        set_points(self.other_points_item, np.vstack(op) if op else None)
         loops = []
         for b in doc.project.blocks:
             if b.boundary is not None:
@@ -274,7 +236,7 @@ class Canvas(pg.PlotWidget):
                 p = b.points
             if len(p):
                 loops.append(np.vstack([p, p[:1]]) if b.closed or b.boundary is not None else p)
-        _set_polylines(self.loop_curve, loops)
+        set_polylines(self.loop_curve, loops)
 
     def _draw_borders(self) -> None:
         """The active block's four borders, each with an arrow and a label at its middle."""
@@ -301,7 +263,7 @@ class Canvas(pg.PlotWidget):
             x, y, ang = m
             a.setPos(x, y)
             a.setStyle(angle=180.0 - ang)  # ArrowItem points along −x at angle 0, y down in screen
-            a.show()
+            a.setVisible(self.markers_visible)
             t.setText(f"{name} · {block.node_count(name)}")
             self._label_at[name] = (x, y, ang)
         self._place_labels()
@@ -314,7 +276,7 @@ class Canvas(pg.PlotWidget):
             disp = pts
         else:
             disp = None if self.doc.project.multiblock is not None else np.vstack(block.boundary)
-        _set_points(self.points_item, disp)
+        set_points(self.points_item, disp)
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
             cp = pts[list(block.corners)]
             self.corner_item.setData(cp[:, 0], cp[:, 1])
@@ -386,6 +348,7 @@ class Canvas(pg.PlotWidget):
         """Draw all block grids as one NaN-separated curve."""
         if not grids:
             self.grid_curve.setData([], [])
+            self._cell_size, self._sized_shapes = 0.0, ()
             return
         xs, ys = [], []
         for g in grids.values():
@@ -395,11 +358,37 @@ class Canvas(pg.PlotWidget):
         X = np.concatenate(xs) if len(xs) > 1 else xs[0]
         Y = np.concatenate(ys) if len(ys) > 1 else ys[0]
         self.grid_curve.setData(X, Y, connect="finite", skipFiniteCheck=True)
+        shapes = tuple(g.shape for g in grids.values())
+        if shapes != self._sized_shapes:  # the cell size only moves with the shape (cheap enough anyway)
+            self._sized_shapes = shapes
+            self._cell_size = geo.typical_cell_size(grids.values())
+            self._apply_level_of_detail()
 
     def set_grid_stale(self, stale: bool) -> None:
         """Grey the grid when it no longer matches the boundary (the last solve failed)."""
-        col = "#b0b0b0" if stale else "#303030"
-        self.grid_curve.setPen(pg.mkPen(col, width=1, cosmetic=True))
+        self._grid_colour = "#b0b0b0" if stale else "#303030"
+        self._apply_level_of_detail()
+
+    def _apply_level_of_detail(self, *_args) -> None:
+        """Fade the grid lines when the cells are only a few pixels wide on screen."""
+        alpha = geo.line_alpha(self._cell_size / self.pixel()) if self._cell_size > 0 else 1.0
+        colour = QtGui.QColor(self._grid_colour)
+        colour.setAlphaF(alpha)
+        if self.grid_curve.opts["pen"].color() != colour:
+            self.grid_curve.setPen(pg.mkPen(colour, width=1, cosmetic=True))
+
+    def set_grid_visible(self, on: bool) -> None:
+        """Show or hide the grid lines (View ▸ Grid lines)."""
+        self.grid_curve.setVisible(bool(on))
+
+    def set_markers_visible(self, on: bool) -> None:
+        """Show or hide the boundary points, corners, arrows and labels (View ▸ Boundary markers)."""
+        on = bool(on)
+        self.markers_visible = on
+        items = [self.points_item, self.other_points_item, self.corner_item, self.selected_item]
+        items += [*self.corner_labels, *self.border_arrows.values(), *self.border_labels.values()]
+        for it in items:
+            it.setVisible(on)
 
     def set_folded(self, grid: StructuredGrid | None, cells: np.ndarray | None) -> None:
         if grid is None or cells is None or len(cells) == 0:
@@ -449,7 +438,7 @@ class Canvas(pg.PlotWidget):
             self.colorbar.setColorMap(cm)
             self.colorbar.setLevels(levels)
             self.colorbar.setImageItem(item)
-            self.colorbar.getAxis("right").setLabel(label) if hasattr(self.colorbar, "getAxis") else None
+            self.colorbar.getAxis("left").setLabel(label)  # where ColorBarItem puts the label of a vertical bar
             self.colorbar.show()
 
     def set_background(self, image: np.ndarray | None, transform=None) -> None:
@@ -458,6 +447,7 @@ class Canvas(pg.PlotWidget):
             self.background_item.hide()
             return
         a, b, tx, ty = transform or (1.0, 0.0, 0.0, 0.0)
+        self._bg_transform = (a, b, tx, ty)
         self.background_item.setImage(image, axisOrder="row-major")
         tr = QtGui.QTransform(a, b, -b, a, tx, ty)  # pixel (u, v), v up → (a u − b v + tx, b u + a v + ty)
         self.background_item.setTransform(tr)
@@ -476,23 +466,3 @@ class Canvas(pg.PlotWidget):
                 raise OSError(f"{path}: cannot write the image")
         finally:
             self.highlight_item.setVisible(ring)
-
-
-def _set_points(item, points) -> None:
-    """Show ``(n, 2)`` points in a scatter item (None or empty: none)."""
-    if points is None or len(points) == 0:
-        item.setData([], [])
-    else:
-        item.setData(points[:, 0], points[:, 1])
-
-
-def _set_polylines(item, lines) -> None:
-    """Show polylines as one NaN-separated curve (``connect="finite"``)."""
-    parts = []
-    for line in lines:
-        parts += [np.asarray(line, float).reshape(-1, 2), np.full((1, 2), np.nan)]
-    if parts:
-        a = np.vstack(parts)
-        item.setData(a[:, 0], a[:, 1], connect="finite")
-    else:
-        item.setData([], [])

@@ -32,7 +32,16 @@ def _message_label() -> QtWidgets.QLabel:
 
 
 class ParamsPanel(QtWidgets.QScrollArea):
-    """Cells, weights, initial grid, per-border distribution, solver settings."""
+    """Cells, weights, initial grid, per-border distribution, solver settings.
+
+    Signals
+    -------
+    committed()
+        An edit was committed with Enter, a pick from a list or a click (not by
+        moving on to another field): the window gives the keyboard back to the canvas.
+    """
+
+    committed = QtCore.Signal()
 
     def __init__(self, doc: Document, editor: Editor, parent=None) -> None:
         super().__init__(parent)
@@ -56,8 +65,12 @@ class ParamsPanel(QtWidgets.QScrollArea):
     def _block_group(self) -> QtWidgets.QGroupBox:
         g = QtWidgets.QGroupBox("Block")
         f = QtWidgets.QFormLayout(g)
-        self.ni = QtWidgets.QSpinBox(minimum=1, maximum=4096, toolTip="cells along ξ (bottom/top)")
-        self.nj = QtWidgets.QSpinBox(minimum=1, maximum=4096, toolTip="cells along η (left/right)")
+        # the range lets a wrong count (0, −5) be typed so that it can be refused visibly, not
+        # corrected silently; values apply on Enter, focus change or the arrows (no keyboard tracking)
+        self.ni = QtWidgets.QSpinBox(minimum=-9999, maximum=4096, toolTip="cells along ξ (bottom/top)")
+        self.nj = QtWidgets.QSpinBox(minimum=-9999, maximum=4096, toolTip="cells along η (left/right)")
+        for box in (self.ni, self.nj):
+            box.setKeyboardTracking(False)
         cells = QtWidgets.QHBoxLayout()
         cells.addWidget(QtWidgets.QLabel("ξ"))
         cells.addWidget(self.ni)
@@ -84,6 +97,8 @@ class ParamsPanel(QtWidgets.QScrollArea):
         self.curve.addItems(["linear", "cubic", "catmull-rom"])
         self.curve.setToolTip("curve through the boundary points used to re-sample the borders")
         f.addRow("Boundary curve", self.curve)
+        self.block_msg = _message_label()
+        f.addRow(self.block_msg)
         return g
 
     def _border_group(self) -> QtWidgets.QGroupBox:
@@ -160,8 +175,8 @@ class ParamsPanel(QtWidgets.QScrollArea):
         return g
 
     def _connect(self) -> None:
-        self.ni.valueChanged.connect(lambda v: self._block(cells=(v, self.nj.value())))
-        self.nj.valueChanged.connect(lambda v: self._block(cells=(self.ni.value(), v)))
+        self.ni.valueChanged.connect(lambda _v: self._cells())
+        self.nj.valueChanged.connect(lambda _v: self._cells())
         self.wx.valueChanged.connect(lambda v: self._block(weights=(v, self.wy.value())))
         self.wy.valueChanged.connect(lambda v: self._block(weights=(self.wx.value(), v)))
         self.initial.currentTextChanged.connect(lambda s: self._block(initial=s))
@@ -179,6 +194,26 @@ class ParamsPanel(QtWidgets.QScrollArea):
             cb.toggled.connect(lambda _on: self._control_edit())
         self.ctl_spacing.editingFinished.connect(self._control_edit)
         self.ctl_tm.toggled.connect(lambda _on: self._control_edit())
+        self._watch_commits()
+
+    def _watch_commits(self) -> None:
+        for box in (self.ni, self.nj, self.wx, self.wy, self.maxit):
+            box.editingFinished.connect(lambda w=box: self._commit_from(w))
+        for e in (self.first, self.last, self.bname, self.tol, self.omega, self.ctl_spacing):
+            e.returnPressed.connect(lambda w=e: self._commit_from(w))
+        for c in (self.initial, self.curve, self.border, self.dist, self.method, self.repair):
+            c.activated.connect(lambda _i, w=c: self._commit_from(w))
+        for cb in (*self.ctl_borders.values(), self.ctl_tm):
+            cb.clicked.connect(lambda _on=False, w=cb: self._commit_from(w))
+
+    def _commit_from(self, widget: QtWidgets.QWidget) -> None:
+        # after the edit has been applied (the same event), and only if the keyboard is still
+        # there: Tab to the next field is not a reason to leave the panel
+        QtCore.QTimer.singleShot(0, lambda: self._committed(widget))
+
+    def _committed(self, widget: QtWidgets.QWidget) -> None:
+        if widget.hasFocus() and not widget.styleSheet():  # a refused value keeps the focus for fixing
+            self.committed.emit()
 
     def select_border(self, name: str) -> None:
         self.border.setCurrentText(name)
@@ -199,8 +234,9 @@ class ParamsPanel(QtWidgets.QScrollArea):
             self.first.setText("" if s.first is None else f"{s.first:.6g}")
             self.last.setText("" if s.last is None else f"{s.last:.6g}")
             self.bname.setText(s.name or "")
-            for e in (self.first, self.last, self.tol, self.omega):
+            for e in (self.first, self.last, self.tol, self.omega, self.ni, self.nj):
                 e.setStyleSheet("")
+            self.block_msg.setText("")
             self.border_msg.setText("")
             self.solver_msg.setText("")
             self._refresh_control(b)
@@ -218,6 +254,29 @@ class ParamsPanel(QtWidgets.QScrollArea):
         if self._updating:
             return
         self.editor.set_block_options(merge_key="panel", **kw)
+
+    def _cells(self) -> None:
+        """Apply the typed cell counts, or refuse them with a message (never corrected silently)."""
+        if self._updating:
+            return
+        for box in (self.ni, self.nj):
+            box.setStyleSheet("")
+        for box, name in ((self.ni, "ξ"), (self.nj, "η")):
+            if box.value() < 1:
+                self._refuse(box, self.block_msg, f"cells {name} must be at least 1, got {box.value()}: not applied")
+                return
+        self.block_msg.setText("")
+        self._block(cells=(self.ni.value(), self.nj.value()))
+
+    def _refuse(self, field, label: QtWidgets.QLabel, text: str) -> None:
+        """Show why an input is not applied: red field, the text under its group, the message panel."""
+        if field is not None:
+            field.setStyleSheet(_BAD)
+        label.setText(text)
+        self.ensureWidgetVisible(label)  # never below the fold of the scroll area
+        if field is not None:
+            self.ensureWidgetVisible(field)
+        self.doc.report("warning", text)
 
     @staticmethod
     def _number(edit: QtWidgets.QLineEdit):
@@ -237,14 +296,12 @@ class ParamsPanel(QtWidgets.QScrollArea):
         try:
             first = self._number(self.first)
         except ValueError:
-            self.first.setStyleSheet(_BAD)
-            self.border_msg.setText(f"first spacing: {self.first.text()!r} is not a number")
+            self._refuse(self.first, self.border_msg, f"first spacing: {self.first.text()!r} is not a number")
             return
         try:
             last = self._number(self.last)
         except ValueError:
-            self.last.setStyleSheet(_BAD)
-            self.border_msg.setText(f"last spacing: {self.last.text()!r} is not a number")
+            self._refuse(self.last, self.border_msg, f"last spacing: {self.last.text()!r} is not a number")
             return
         dist = self.dist.currentText()
         if dist == "uniform":
@@ -252,8 +309,8 @@ class ParamsPanel(QtWidgets.QScrollArea):
         try:
             spec = BorderSpec(distribution=dist, first=first, last=last, name=self.bname.text().strip() or None)
         except InvalidInputError as exc:
-            self.border_msg.setText(str(exc))
-            (self.first if first is None or "first" in str(exc) else self.last).setStyleSheet(_BAD)
+            field = self.first if first is None or "first" in str(exc) else self.last
+            self._refuse(field, self.border_msg, f"{self.border.currentText()} border: {exc}")
             return
         self.border_msg.setText("")
         self.editor.set_border_spec(self.border.currentText(), spec)
@@ -304,8 +361,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
             if spacing is not None and spacing <= 0:
                 raise ValueError("the first cell height must be positive")
         except ValueError as exc:
-            self.ctl_spacing.setStyleSheet(_BAD)
-            self.ctl_msg.setText(f"first cell: {exc}")
+            self._refuse(self.ctl_spacing, self.ctl_msg, f"first cell: {exc}")
             return
         new = {k: v for k, v in dict(old or {}).items() if k not in ("borders", "thomas_middlecoff")}
         old_borders = dict((old or {}).get("borders", {}))
@@ -329,7 +385,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
             try:
                 control_from_mapping(control)
             except InvalidInputError as exc:
-                self.ctl_msg.setText(str(exc))
+                self._refuse(None, self.ctl_msg, f"control functions: {exc}")
                 return
         self.ctl_msg.setText("")
         if control != old:
@@ -349,12 +405,10 @@ class ParamsPanel(QtWidgets.QScrollArea):
             try:
                 v = self._number(e)
             except ValueError:
-                e.setStyleSheet(_BAD)
-                self.solver_msg.setText(f"{key}: {e.text()!r} is not a number")
+                self._refuse(e, self.solver_msg, f"{key}: {e.text()!r} is not a number")
                 return
             if v is not None and not (lo < v < hi):
-                e.setStyleSheet(_BAD)
-                self.solver_msg.setText(f"{key} must be in ({lo:g}, {hi:g}), got {v:g}")
+                self._refuse(e, self.solver_msg, f"{key} must be in ({lo:g}, {hi:g}), got {v:g}: not applied")
                 return
             kw[key] = v
         self.solver_msg.setText("")

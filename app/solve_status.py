@@ -1,0 +1,113 @@
+"""What the window shows about solving: the convergence plot, the solver label, notes.
+
+:class:`SolveStatus` listens to the solver controller and the document and
+updates the convergence plot, the solver label in the status bar, the
+Pause/Stop actions and the status line; it reports the solver's notes
+(repairs, corner advice) in full to the message panel.
+"""
+
+from __future__ import annotations
+
+import time
+
+from PySide6 import QtCore, QtWidgets
+
+from .pipeline import ALL_BLOCKS
+
+__all__ = ["SolveStatus"]
+
+
+class SolveStatus(QtCore.QObject):
+    """The solving part of a :class:`~app.main_window.MainWindow` (label: ``self.label``)."""
+
+    def __init__(self, window) -> None:
+        super().__init__(window)
+        self.win = window
+        self.doc = window.doc
+        self.solver = window.solver
+        self.conv = window.conv_panel
+        self.label = QtWidgets.QLabel("idle")
+        self.frames: list[float] = []  # times of the last redraws (for the redraws/s read-out)
+        self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
+        self.doc.active_changed.connect(lambda _k: self.on_final())
+        self.doc.opened.connect(self.on_opened)
+        self.solver.state_changed.connect(self.on_state)
+        self.solver.error.connect(self.on_error)
+        self.solver.progress.connect(self.on_progress)
+        self.solver.finished.connect(self.on_finished)
+
+    def reset(self) -> None:
+        """A solve is about to start."""
+        self.conv.clear_history()
+        self.frames = []
+
+    def on_opened(self) -> None:
+        self.conv.clear_history()
+        self.win.canvas.set_grid_stale(False)
+        self.label.setText("idle")
+
+    def on_progress(self, k: int, snap) -> None:
+        if k == ALL_BLOCKS:  # a multiblock solve: relative residuals of the global iteration
+            self.conv.set_history(list(snap.history))
+            self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
+            return
+        if k == self.doc.active:
+            length = max(snap.grid.size, 1e-300)  # history is absolute, residual relative
+            self.conv.set_history([(i, r / length) for i, r in snap.history], snap.tolerance)
+        fr = [t for t in self.frames if t > self.frames[-1] - 1.0] if self.frames else []
+        self.label.setText(
+            f"{snap.method}: iteration {snap.iteration}, residual {snap.residual:.2e} "
+            f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s"
+        )
+
+    def on_state(self, state: str) -> None:
+        running = state != "idle"
+        self.doc.set_solving(running)
+        self.win.a_pause.setEnabled(running)
+        self.win.a_stop.setEnabled(running)
+        self.win.a_pause.setChecked(state == "paused")
+        if state == "paused":
+            self.label.setText("paused")
+
+    def on_error(self, text: str) -> None:
+        # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why
+        self.win.canvas.set_grid_stale(True)
+        self.win.message(f"Cannot generate: {text}", error=True)
+        self.label.setText("error")
+
+    def on_finished(self, result) -> None:
+        if result is not None and self.doc.project.multiblock is not None:
+            self.doc.set_multiblock(getattr(result, "multiblock", None))
+        self.on_final()
+        if result is not None and not self.solver.last_error:
+            self.report_notes()
+
+    def on_final(self) -> None:
+        """The solve ended (or another block became active): the summary of the active grid."""
+        g = self.doc.grid
+        if self.solver.running or self.solver.last_error:
+            return
+        self.win.canvas.set_grid_stale(False)
+        if g is None:
+            self.label.setText("idle")
+            return
+        info = g.info
+        if info.residual_history:
+            self.conv.set_history(list(info.residual_history), info.tolerance)
+        r = self.doc.quality
+        dt = self.solver.t_done - self.solver.t_start
+        state = "converged" if info.converged else info.message or "not converged"
+        warn = f" — {r.n_folded} FOLDED cells (red ×)" if r is not None and r.n_folded else ""
+        self.label.setText(f"{info.method}: {state}, {info.iterations} iterations, {dt * 1000:.0f} ms")
+        self.win.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}")
+
+    def report_notes(self) -> None:
+        """Repairs, corner advice and other notes of the solver, in full, in the message panel."""
+        blocks = self.doc.project.blocks
+        for k, g in sorted(self.doc.grids.items()):
+            note = (g.info.message or "").strip()
+            if not note or note in ("converged", "stopped"):
+                continue
+            name = blocks[k].name if k < len(blocks) else f"block {k + 1}"
+            bad = "move corner" in note or "cannot" in note or not g.converged
+            self.doc.report("warning" if bad else "info", f"{name}: {note}")

@@ -1,0 +1,122 @@
+"""The message panel and the status-bar label: problems in full, never cut off.
+
+:class:`MessagePanel` lists what the document reports (:meth:`Document.report`):
+solver errors, repairs of folded cells, corner advice, refused inputs — each
+in full, word-wrapped, newest first.  :class:`ElidedLabel` shows one line in
+the status bar, shortened with "…" to fit, the whole text in its tooltip.
+"""
+
+from __future__ import annotations
+
+import time
+
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from ..document import Document
+
+__all__ = ["ElidedLabel", "MessagePanel"]
+
+_COLOURS = {"info": "#333333", "warning": "#a05a00", "error": "#b00000"}
+_SIGNS = {"info": "ℹ", "warning": "⚠", "error": "✖"}
+
+
+class MessagePanel(QtWidgets.QWidget):
+    """Every reported problem and note, in full (newest first), with a Clear button.
+
+    Signals
+    -------
+    attention()
+        A warning or an error arrived: the window raises the dock.
+    """
+
+    attention = QtCore.Signal()
+    MAX_ITEMS = 200
+
+    def __init__(self, doc: Document, parent=None) -> None:
+        super().__init__(parent)
+        lay = QtWidgets.QVBoxLayout(self)
+        lay.setContentsMargins(2, 2, 2, 2)
+        self.list = QtWidgets.QListWidget()
+        self.list.setWordWrap(True)
+        self.list.setTextElideMode(QtCore.Qt.TextElideMode.ElideNone)
+        self.list.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.list.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.ExtendedSelection)
+        self.list.setMinimumHeight(60)
+        lay.addWidget(self.list, 1)
+        row = QtWidgets.QHBoxLayout()
+        self.count = QtWidgets.QLabel()
+        row.addWidget(self.count, 1)
+        copy = QtWidgets.QPushButton("Copy")
+        copy.setToolTip("copy the selected messages (all when none is selected)")
+        copy.clicked.connect(self.copy)
+        clear = QtWidgets.QPushButton("Clear")
+        clear.clicked.connect(self.clear)
+        row.addWidget(copy)
+        row.addWidget(clear)
+        lay.addLayout(row)
+        doc.reported.connect(self.add)
+        self._update_count()
+
+    def add(self, level: str, text: str) -> None:
+        """List ``text`` (newest first; the same message again only refreshes its time)."""
+        if self.list.count() and self.list.item(0).data(QtCore.Qt.ItemDataRole.UserRole) == (level, text):
+            self.list.takeItem(0)
+        it = QtWidgets.QListWidgetItem(f"{_SIGNS.get(level, '')} {time.strftime('%H:%M:%S')}  {text}")
+        it.setForeground(QtGui.QBrush(QtGui.QColor(_COLOURS.get(level, "#333333"))))
+        it.setToolTip(text)
+        it.setData(QtCore.Qt.ItemDataRole.UserRole, (level, text))
+        self.list.insertItem(0, it)
+        while self.list.count() > self.MAX_ITEMS:
+            self.list.takeItem(self.list.count() - 1)
+        self._update_count()
+        if level != "info":
+            self.attention.emit()
+
+    def messages(self) -> list[tuple[str, str]]:
+        """``(level, text)`` of every listed message, newest first."""
+        return [self.list.item(k).data(QtCore.Qt.ItemDataRole.UserRole) for k in range(self.list.count())]
+
+    def clear(self) -> None:
+        self.list.clear()
+        self._update_count()
+
+    def copy(self) -> None:
+        items = self.list.selectedItems() or [self.list.item(k) for k in range(self.list.count())]
+        QtWidgets.QApplication.clipboard().setText("\n".join(it.text() for it in items))
+
+    def _update_count(self) -> None:
+        levels = [lv for lv, _t in self.messages()]
+        n_err, n_warn = levels.count("error"), levels.count("warning")
+        self.count.setText(f"{n_err} error(s), {n_warn} warning(s)" if levels else "no messages")
+
+
+class ElidedLabel(QtWidgets.QLabel):
+    """A one-line label that shortens its text with "…" to fit (full text in the tooltip).
+
+    A long message neither widens the window nor disappears past its edge.
+    """
+
+    def __init__(self, text: str = "", parent=None) -> None:
+        super().__init__(parent)
+        self._full = ""
+        self.setSizePolicy(QtWidgets.QSizePolicy.Policy.Ignored, QtWidgets.QSizePolicy.Policy.Preferred)
+        self.setMinimumWidth(40)
+        self.setText(text)
+
+    def setText(self, text: str) -> None:
+        self._full = str(text)
+        self.setToolTip(self._full)
+        self._elide()
+
+    def text(self) -> str:
+        """The full text (not the shortened one shown)."""
+        return self._full
+
+    def resizeEvent(self, ev: QtGui.QResizeEvent) -> None:
+        super().resizeEvent(ev)
+        self._elide()
+
+    def _elide(self) -> None:
+        line = self._full.replace("\n", "  ")
+        shown = self.fontMetrics().elidedText(line, QtCore.Qt.TextElideMode.ElideRight, max(self.width(), 40))
+        super().setText(shown)

@@ -1,0 +1,222 @@
+"""The app as a lake modeller found it (issue 13): one test per problem fixed."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from PySide6 import QtCore, QtWidgets
+from PySide6.QtTest import QTest
+
+from app import geometry as geo
+
+pytestmark = pytest.mark.gui
+
+
+def wait_idle(qtbot, win, timeout=30_000):
+    qtbot.waitUntil(lambda: not win.solver.running and not win.solver._debounce.isActive(), timeout=timeout)
+
+
+def solved(qtbot, win, name="bottle-coarse"):
+    win.io.open_example(name, confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    return win.doc.grid
+
+
+def _labels(colorbar):
+    return [
+        colorbar.getAxis(k).labelText
+        for k in ("left", "right", "top", "bottom")
+        if colorbar.getAxis(k).label.isVisible() and colorbar.getAxis(k).labelText
+    ]
+
+
+# ------------------------------------------------------------------ display
+def test_one_colour_bar_label_after_a_re_solve(qtbot, win):
+    solved(qtbot, win)
+    win.quality_panel.metric.setCurrentText("skewness")
+    win.generate()
+    wait_idle(qtbot, win)
+    win.quality_panel.metric.setCurrentText("aspect ratio")
+    assert _labels(win.canvas.colorbar) == ["aspect ratio"]
+
+
+def test_no_stale_ring_after_new_open_or_in_figures(qtbot, win, tmp_path):
+    x, y = np.meshgrid(np.arange(6.0), np.arange(5.0), indexing="ij")
+    x[2, 2], y[2, 2] = 3.6, 2.9
+    from meshcore import StructuredGrid
+
+    win.doc.set_grids({0: StructuredGrid(x, y)})
+    win.quality_panel._folded_clicked(win.quality_panel.folded.item(0))
+    ring = win.canvas.highlight_item
+    assert len(ring.data) == 1
+    seen = []
+    real = win.canvas.grab
+
+    def grab(*a):
+        seen.append(ring.isVisible())
+        return real(*a)
+
+    win.canvas.grab = grab
+    assert win.io.export_figure(tmp_path / "f.png")
+    assert seen == [False] and ring.isVisible()  # not in the figure, still on screen
+    win.io.new_project()
+    assert len(ring.data) == 0
+
+
+def test_quality_table_is_cleared_while_a_new_solve_runs(qtbot, win):
+    solved(qtbot, win, "bottle-fine")
+    assert win.quality_panel.table.rowCount() > 0
+    win.editor.set_block_options(cells=(200, 200))
+    win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
+    win.generate()
+    qtbot.waitUntil(lambda: win.solver.state == "running", timeout=10_000)
+    assert win.quality_panel.table.rowCount() == 0 and win.doc.quality is None
+    win.solver.stop()
+    wait_idle(qtbot, win)
+
+
+def test_grid_lines_fade_when_cells_are_a_few_pixels(qtbot, win):
+    assert geo.line_alpha(20.0) == 1.0 and geo.line_alpha(1.0) == pytest.approx(0.12)
+    a = [geo.line_alpha(px) for px in np.linspace(0.5, 12, 30)]
+    assert all(p <= q for p, q in itertools.pairwise(a))  # more pixels, more ink
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.editor.set_block_options(cells=(300, 300))
+    win.editor.set_solver(max_iterations=3)
+    win.generate()
+    wait_idle(qtbot, win)
+    win.canvas.fit()
+    qtbot.wait(20)
+    far = win.canvas.grid_curve.opts["pen"].color().alphaF()
+    g = win.doc.grid
+    win.canvas.zoom_to((g.x[150, 150], g.y[150, 150], g.x[153, 153], g.y[153, 153]), margin=0)
+    qtbot.wait(20)
+    near = win.canvas.grid_curve.opts["pen"].color().alphaF()
+    assert far < 0.5 and near == 1.0
+
+
+def test_markers_and_grid_lines_can_be_hidden(qtbot, win):
+    solved(qtbot, win)
+    c = win.canvas
+    assert c.points_item.isVisible() and c.corner_item.isVisible()
+    win.a_markers.trigger()
+    assert not c.points_item.isVisible() and not c.corner_item.isVisible()
+    assert not any(a.isVisible() for a in c.border_arrows.values())
+    win.editor.set_block_options(weights=(0.4, 0.6))  # a redraw does not bring them back
+    assert not any(a.isVisible() for a in c.border_arrows.values())
+    win.a_grid_lines.trigger()
+    assert not c.grid_curve.isVisible()
+    win.a_markers.trigger()
+    win.a_grid_lines.trigger()
+    assert c.points_item.isVisible() and c.grid_curve.isVisible()
+
+
+def test_the_window_fits_its_screen_and_remembers_its_size(qtbot, tmp_path):
+    from app.main_window import MainWindow
+
+    settings = QtCore.QSettings(str(tmp_path / "s.ini"), QtCore.QSettings.Format.IniFormat)
+    w = MainWindow(settings=settings, recovery=tmp_path / "r.toml")
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: w._shown, timeout=5_000)
+    qtbot.wait(20)
+    avail = w.screen().availableGeometry()
+    assert avail.contains(w.frameGeometry()), (avail, w.frameGeometry())
+    assert w.minimumSizeHint().width() <= 1066 and w.minimumSizeHint().height() <= 666  # 1600×1000 at 150 %
+    w.resize(700, 600)
+    w.close()
+    w2 = MainWindow(settings=settings, recovery=tmp_path / "r.toml")
+    qtbot.addWidget(w2)
+    assert (w2.width(), w2.height()) == (700, 600)
+
+
+# --------------------------------------------------------------- keyboard
+def test_focus_returns_to_the_canvas_after_an_edit(qtbot, win):
+    win.io.open_example("bottle-coarse", confirm=False)
+    assert win.focusWidget() is win.canvas  # opening a project does not focus ξ
+    pp = win.params_panel
+    pp.ni.setFocus()
+    pp.ni.lineEdit().selectAll()
+    QTest.keyClicks(pp.ni, "9")
+    QTest.keyClick(pp.ni, QtCore.Qt.Key.Key_Return)
+    qtbot.waitUntil(lambda: win.focusWidget() is win.canvas, timeout=2_000)
+    assert win.doc.block.cells[0] == 9
+    # moving on with Tab keeps the keyboard in the panel
+    pp.ni.setFocus()
+    pp.ni.lineEdit().selectAll()
+    QTest.keyClicks(pp.ni, "11")
+    QTest.keyClick(pp.ni, QtCore.Qt.Key.Key_Tab)
+    qtbot.wait(20)
+    assert win.doc.block.cells[0] == 11 and win.focusWidget() is not win.canvas
+    # a pick from a list gives the keyboard back too
+    pp.initial.setFocus()
+    pp.initial.setCurrentText("tfi")
+    pp.initial.activated.emit(pp.initial.currentIndex())
+    qtbot.waitUntil(lambda: win.focusWidget() is win.canvas, timeout=2_000)
+
+
+# -------------------------------------------------------------- messages
+def test_wrong_cell_counts_are_refused_visibly(qtbot, win):
+    win.io.open_example("bottle-coarse", confirm=False)
+    pp = win.params_panel
+    before = win.doc.block.cells
+    for typed in ("0", "-5"):
+        pp.nj.setFocus()
+        pp.nj.lineEdit().selectAll()
+        QTest.keyClicks(pp.nj, typed)
+        QTest.keyClick(pp.nj, QtCore.Qt.Key.Key_Return)
+        assert win.doc.block.cells == before
+        assert pp.nj.value() == int(typed) and pp.nj.styleSheet()  # still shown, in red
+        assert "at least 1" in pp.block_msg.text() and typed in pp.block_msg.text()
+        assert any("at least 1" in t for _lv, t in win.messages_panel.messages())
+    assert win.focusWidget() is not win.canvas  # the keyboard stays there to fix it
+
+
+def test_a_tolerance_error_is_in_view_and_in_the_message_panel(qtbot, win):
+    win.io.open_example("bottle-coarse", confirm=False)
+    pp = win.params_panel
+    pp.resize(pp.width(), 200)  # a short dock: the solver group is below the fold
+    pp.verticalScrollBar().setValue(0)
+    pp.tol.setText("-1")
+    pp.tol.editingFinished.emit()
+    qtbot.wait(20)
+    assert not pp.solver_msg.visibleRegion().isEmpty()
+    assert win.doc.project.solver.tolerance is None
+    assert ("warning", pp.solver_msg.text()) in win.messages_panel.messages()
+    assert win.docks["messages"].isVisible()
+
+
+def test_long_messages_are_kept_whole(qtbot, win):
+    text = "Cannot generate: " + "a very long explanation " * 40
+    win.message(text, error=True)
+    assert win._status.text() == text  # the full text (and tooltip) ...
+    assert QtWidgets.QLabel.text(win._status).endswith("…")  # ... shown shortened to fit
+    assert win.statusBar().width() <= win.width()
+    assert ("error", text) in win.messages_panel.messages()
+
+
+def test_repairs_and_corner_advice_reach_the_message_panel(qtbot, win):
+    solved(qtbot, win, "windermere")
+    notes = " ".join(t for _lv, t in win.messages_panel.messages())
+    assert "repaired" in notes  # Windermere's south arm: the fold-free repair says what it did
+    # a corner on a reflex vertex: which point (counted from 1) and where to move it
+    ring = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2.0]])  # an L: point 4 is reflex
+    for xy in ring:
+        win.editor.add_point(tuple(xy))
+    win.editor.close_loop()
+    win.editor.set_corners((0, 1, 3, 5))
+    advice = [t for lv, t in win.messages_panel.messages() if lv == "warning" and "reflex" in t]
+    assert advice and "point 4" in advice[0] and "corner NE" in advice[0]
+
+
+def test_corner_tool_counts_points_from_one(qtbot, win):
+    for xy in [(0, 0), (1, 0), (1, 1), (0, 1)]:
+        win.editor.add_point(xy)
+    win.editor.close_loop()
+    win.set_tool("corners")
+    win.canvas.zoom_to((0, 0, 1, 1))
+    qtbot.wait(20)
+    win.canvas.tool.click((0.0, 0.0))
+    assert "= point 1;" in win._status.text()
