@@ -11,7 +11,10 @@ import logging
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from meshcore import MeshcoreError
+
 from . import geometry as geo
+from . import io_adapter as fio
 from .project import Background
 
 __all__ = ["BackgroundController", "read_image"]
@@ -85,35 +88,72 @@ class BackgroundController(QtCore.QObject):
             self.win.message("Load a background image first")
             self.win.set_tool("pan")
             return
-        dlg = QtWidgets.QDialog(self.win)
-        dlg.setWindowTitle("Calibrate background")
-        form = QtWidgets.QFormLayout(dlg)
-        edits = []
+        answer = _TrueCoordinatesDialog(self.win, pair, self.doc.project.crs).ask()
+        if answer is not None:
+            true, lonlat = answer
+            try:
+                self.calibrate(pair, true, lonlat=lonlat)
+            except (ValueError, MeshcoreError) as exc:
+                self.win.error("Calibration", exc)
+        self.win.set_tool("draw")
+
+    def calibrate(self, shown, true, *, lonlat: bool = False) -> None:
+        """Move the background so that the two ``shown`` model points land on ``true``.
+
+        With ``lonlat`` the true points are longitude/latitude degrees: they are
+        projected to the project's CRS, or, when it has none yet, to the UTM zone
+        of the points, which the project then adopts (one undo step).
+        """
+        project = self.doc.project
+        bg = project.background
+        if lonlat:
+            local, frame = fio.lonlat_to_local(true, fio.project_frame(project))
+            true = [tuple(p) for p in local]
+            if not project.crs and frame.crs:
+                # a project without a CRS adopts the frame of the calibration points
+                project = project.replaced(
+                    crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "EPSG:4326"
+                )
+        tr = geo.compose_similarity(bg.transform, shown, true)
+        self.win.editor.replace_project(project.replaced(background=Background(bg.path, tr)), "Calibrate background")
+        self.win.canvas.fit()  # the image moved to its true place: show it there
+        where = f" ({project.crs}, local origin {project.origin[0]:.0f}, {project.origin[1]:.0f})" if lonlat else ""
+        self.win.message(f"Background calibrated{where}; trace the outline with Draw")
+
+
+class _TrueCoordinatesDialog(QtWidgets.QDialog):
+    """Asks for the true coordinates of two picked points: model x, y or longitude, latitude."""
+
+    def __init__(self, parent, pair, crs: str) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Calibrate background")
+        form = QtWidgets.QFormLayout(self)
+        self.lonlat = QtWidgets.QCheckBox("longitude, latitude (degrees)")
+        self.lonlat.setToolTip(
+            f"projected to the project's {crs}" if crs else "projected to the UTM zone of the two points"
+        )
+        form.addRow("Coordinates are", self.lonlat)
+        self.edits = []
         for k, (x, y) in enumerate(pair):
             ex, ey = QtWidgets.QLineEdit(f"{x:.6g}"), QtWidgets.QLineEdit(f"{y:.6g}")
             row = QtWidgets.QHBoxLayout()
             row.addWidget(ex)
             row.addWidget(ey)
-            form.addRow(f"true x, y of point {k + 1}", row)
-            edits += [ex, ey]
+            form.addRow(f"point {k + 1}: x, y / lon, lat", row)
+            self.edits += [ex, ey]
         sb = QtWidgets.QDialogButtonBox.StandardButton
         bb = QtWidgets.QDialogButtonBox(sb.Ok | sb.Cancel)
-        bb.accepted.connect(dlg.accept)
-        bb.rejected.connect(dlg.reject)
+        bb.accepted.connect(self.accept)
+        bb.rejected.connect(self.reject)
         form.addRow(bb)
-        if dlg.exec() != QtWidgets.QDialog.DialogCode.Accepted:
-            return
-        try:
-            vals = [float(e.text()) for e in edits]
-            self.calibrate(pair, ((vals[0], vals[1]), (vals[2], vals[3])))
-        except ValueError as exc:
-            self.win.error("Calibration", exc)
-        self.win.set_tool("draw")
 
-    def calibrate(self, shown, true) -> None:
-        """Move the background so that the two ``shown`` model points land on ``true``."""
-        bg = self.doc.project.background
-        tr = geo.compose_similarity(bg.transform, shown, true)
-        project = self.doc.project.replaced(background=Background(bg.path, tr))
-        self.win.editor.replace_project(project, "Calibrate background")
-        self.win.message("Background calibrated")
+    def ask(self):
+        """``(((x0, y0), (x1, y1)), lonlat)``, or None when cancelled or not numbers."""
+        if self.exec() != QtWidgets.QDialog.DialogCode.Accepted:
+            return None
+        try:
+            v = [float(e.text()) for e in self.edits]
+        except ValueError as exc:
+            self.parent().error("Calibration", exc)
+            return None
+        return ((v[0], v[1]), (v[2], v[3])), self.lonlat.isChecked()

@@ -23,6 +23,7 @@ __all__ = [
     "case_of_project",
     "dumps_project",
     "load_project",
+    "lonlat_to_local",
     "mesh_formats",
     "project_frame",
     "read_points",
@@ -80,6 +81,24 @@ def to_local(pd: PointData, frame=None) -> tuple[np.ndarray, object]:
     else:
         local, fr = mcrs.project(ps, "auto", source_crs=src)
     return _drop_closing(np.asarray(local.polylines[0].points, float)), fr
+
+
+def lonlat_to_local(points, frame=None) -> tuple[np.ndarray, object]:
+    """Longitude/latitude degrees (``(n, 2)``) to the project's local metric coordinates.
+
+    With ``frame`` (the project's :class:`meshcore.crs.Frame`) the points go to
+    its CRS minus its origin; without, to the UTM zone of their centroid with a
+    round origin (the frame is returned so the project can adopt it).
+    """
+    from meshcore import crs as mcrs
+    from meshcore.io import PointSet, Polyline
+
+    ps = PointSet((Polyline("points", np.asarray(points, float).reshape(-1, 2), closed=False),), mcrs.LONLAT, "")
+    if frame is not None and frame.crs:
+        local, fr = mcrs.project(ps, frame.crs, origin=frame.origin)
+    else:
+        local, fr = mcrs.project(ps, "auto")
+    return np.asarray(local.polylines[0].points, float), fr
 
 
 def _drop_closing(p: np.ndarray) -> np.ndarray:

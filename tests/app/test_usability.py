@@ -220,3 +220,54 @@ def test_corner_tool_counts_points_from_one(qtbot, win):
     qtbot.wait(20)
     win.canvas.tool.click((0.0, 0.0))
     assert "= point 1;" in win._status.text()
+
+
+# ------------------------------------------------------------- background
+def _image(tmp_path, w=40, h=20):
+    from PySide6 import QtGui
+
+    img = QtGui.QImage(w, h, QtGui.QImage.Format.Format_RGB32)
+    img.fill(QtGui.QColor("steelblue"))
+    path = tmp_path / "bg.png"
+    assert img.save(str(path))
+    return path
+
+
+def _in_view(win, box):
+    (x0, x1), (y0, y1) = win.canvas.getPlotItem().getViewBox().viewRange()
+    return x0 <= box[0] and box[2] <= x1 and y0 <= box[1] and box[3] <= y1
+
+
+def test_a_background_is_in_view_after_loading_fitting_and_calibrating(qtbot, win, tmp_path):
+    win.background.load(str(_image(tmp_path)))
+    assert _in_view(win, (0, 0, 40, 20))  # no outline yet: one unit per pixel, and shown
+    win.canvas.zoom_to((500, 500, 510, 510))
+    win.canvas.fit()
+    assert _in_view(win, (0, 0, 40, 20))  # Fit view counts the image
+    win.background.calibrate([(0.0, 0.0), (40.0, 0.0)], [(1000.0, 5000.0), (1400.0, 5000.0)])
+    assert _in_view(win, (1000, 5000, 1400, 5200))  # the view follows it to its true place
+
+
+@pytest.mark.parametrize("with_crs", [True, False])
+def test_calibration_by_longitude_and_latitude(qtbot, win, tmp_path, with_crs):
+    from pyproj import Transformer
+
+    from app.project import Project
+
+    if with_crs:
+        win.io.set_project(Project(crs="EPSG:32632", origin=(700000.0, 4700000.0), source_crs="EPSG:4326"))
+    win.background.load(str(_image(tmp_path)))
+    lonlat = [(11.90, 42.55), (11.99, 42.62)]
+    a, b, tx, ty = win.doc.project.background.transform
+    shown = [(tx, ty), (a * 40 + tx, b * 40 + ty)]  # pixels (0, 0) and (40, 0) as drawn now
+    win.background.calibrate(shown, lonlat, lonlat=True)
+    p = win.doc.project
+    assert p.crs == "EPSG:32632"  # the project's, or the UTM zone of the points
+    tr = Transformer.from_crs("EPSG:4326", p.crs, always_xy=True)
+    a, b, tx, ty = p.background.transform
+    for (u, v), (lon, lat) in zip([(0, 0), (40, 0)], lonlat, strict=True):
+        e, n = tr.transform(lon, lat)
+        z = complex(a, b) * complex(u, v) + complex(tx, ty)
+        assert (z.real + p.origin[0], z.imag + p.origin[1]) == pytest.approx((e, n), abs=1e-6)
+    win.stack.undo()  # one step: the image and the frame it brought
+    assert win.doc.project.crs == ("EPSG:32632" if with_crs else "")
