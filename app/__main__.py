@@ -78,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.size or args.screenshot:
         w, h = (int(v) for v in (args.size or "1400x880").lower().split("x"))
         win.resize(w, h)
+        win.fit_on_show = False
     if args.screenshot:
         win.quiet = True
     win.show()

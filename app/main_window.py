@@ -94,6 +94,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._connect()
 
         self._shown = False
+        self.fit_on_show = True  # False: a size asked for explicitly (``--size``) is kept as it is
         self._corners_seen = None  # (block, points, corners) last checked for corner advice
         self.set_tool("draw")
         self._update_title()
@@ -396,7 +397,8 @@ class MainWindow(QtWidgets.QMainWindow):
         super().showEvent(ev)
         if not self._shown:  # the window frame is known now: fit it, decoration included
             self._shown = True
-            QtCore.QTimer.singleShot(0, self.fit_to_screen)
+            if self.fit_on_show:
+                QtCore.QTimer.singleShot(0, self.fit_to_screen)
 
     def fit_to_screen(self) -> None:
         """Keep the whole window (docks and status bar included) on its screen."""
