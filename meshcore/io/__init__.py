@@ -183,6 +183,15 @@ for _f in (
         crs=True,
     ),
     Format(
+        "delft3d-dd",
+        (".ddb",),
+        "Delft3D-FLOW domain decomposition (.grd + .enc per block, .ddb couplings)",
+        writer="delft3d_dd:write_ddb",
+        grid_reader="delft3d_dd:read_ddb",
+        crs=True,
+        multiblock=True,
+    ),
+    Format(
         "sgrid",
         (".nc",),
         "NetCDF (SGRID conventions, CF grid mapping)",
