@@ -1,9 +1,25 @@
-"""Small validators used at the public edge; every message names the argument."""
+"""Small validators used at the public edge; every message names the argument.
+
+Limits
+------
+What an input may make meshcore allocate is checked *before* allocating, with
+an error that says what the request would need:
+
+* :func:`max_nodes` — nodes of one grid (generated, or read from a file):
+  ``2**24`` (16 777 216, a 4097 × 4097 grid), ``MESHCORE_MAX_NODES`` overrides;
+* :func:`max_points` — points (or lines) of one point file: 5 000 000,
+  ``MESHCORE_MAX_POINTS`` overrides;
+* :func:`max_bytes` — bytes of one input file, and bytes one compressed array
+  may inflate to: 512 MiB, ``MESHCORE_MAX_BYTES`` overrides;
+* :data:`MAX_COORDINATE` — coordinates must be finite and at most ``1e150``
+  in magnitude (squares and products of them stay finite).
+"""
 
 from __future__ import annotations
 
 import enum
 import math
+import os
 from collections.abc import Iterable
 from typing import Any
 
@@ -12,12 +28,88 @@ import numpy as np
 from .errors import InvalidInputError
 
 __all__ = [
+    "MAX_COORDINATE",
+    "check_allocation",
+    "check_grid_size",
+    "max_bytes",
+    "max_nodes",
+    "max_points",
     "validate_choice",
     "validate_count",
     "validate_fraction",
     "validate_points",
     "validate_positive",
 ]
+
+
+#: Largest coordinate magnitude accepted (its square, and products of two, stay finite).
+MAX_COORDINATE = 1e150
+
+#: Bytes per node a solve needs at most (coordinates, solver work arrays, quality and output arrays).
+BYTES_PER_NODE = 200
+
+
+def _env_limit(name: str, default: int) -> int:
+    raw = os.environ.get(name, "").strip()
+    if not raw:
+        return default
+    try:
+        v = int(raw.replace("_", ""))
+    except ValueError:
+        raise InvalidInputError(f"environment variable {name} must be a positive integer, got {raw!r}") from None
+    if v < 1:
+        raise InvalidInputError(f"environment variable {name} must be a positive integer, got {raw!r}")
+    return v
+
+
+def max_nodes() -> int:
+    """Largest number of nodes in one grid (``MESHCORE_MAX_NODES``, default ``2**24``)."""
+    return _env_limit("MESHCORE_MAX_NODES", 2**24)
+
+
+def max_points() -> int:
+    """Largest number of points (or text lines) in one point file (``MESHCORE_MAX_POINTS``, default 5 000 000)."""
+    return _env_limit("MESHCORE_MAX_POINTS", 5_000_000)
+
+
+def max_bytes() -> int:
+    """Largest input file, and largest inflated array, in bytes (``MESHCORE_MAX_BYTES``, default 512 MiB)."""
+    return _env_limit("MESHCORE_MAX_BYTES", 512 * 2**20)
+
+
+def _size(nbytes: int) -> str:
+    for unit, f in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if nbytes >= f:
+            return f"{nbytes / f:.3g} {unit}"
+    return f"{nbytes} bytes"
+
+
+def check_allocation(
+    count: int, limit: int, *, what: str, env: str, error: type[Exception] = InvalidInputError
+) -> None:
+    """Raise ``error`` when ``count`` (of ``what``) exceeds ``limit`` (raised by the variable ``env``)."""
+    if int(count) > int(limit):
+        raise error(f"{what}: {int(count):,} is more than the limit of {int(limit):,} (set {env} to raise it)")
+
+
+def check_grid_size(
+    n_i: Any, n_j: Any, *, what: str = "grid", error: type[Exception] = InvalidInputError, nodes: bool = False
+) -> None:
+    """Refuse a grid of ``n_i × n_j`` cells (``nodes=True``: nodes) above :func:`max_nodes`.
+
+    Works on Python integers, so absurd counts (``2**63 - 1``) give the same
+    clear message instead of an overflow.
+    """
+    a, b = int(n_i), int(n_j)
+    ni, nj = (a, b) if nodes else (a + 1, b + 1)
+    n = ni * nj
+    limit = max_nodes()
+    if n > limit:
+        shown = f"{a} × {b} {'nodes' if nodes else 'cells'}"
+        raise error(
+            f"{what}: {shown} make {n:,} nodes (about {_size(n * BYTES_PER_NODE)} of memory to solve); "
+            f"the limit is {limit:,} nodes (set MESHCORE_MAX_NODES to raise it)"
+        )
 
 
 def validate_points(points: Any, *, name: str, min_points: int = 2, where: str = "") -> np.ndarray:
@@ -49,6 +141,13 @@ def validate_points(points: Any, *, name: str, min_points: int = 2, where: str =
         raise InvalidInputError(
             f"{prefix}{name}: point {k} is not finite ({arr[k, 0]!r}, {arr[k, 1]!r})"
             + (f" and {int(bad.sum()) - 1} more" if bad.sum() > 1 else "")
+        )
+    huge = (np.abs(arr) > MAX_COORDINATE).any(axis=1)
+    if huge.any():
+        k = int(np.flatnonzero(huge)[0])
+        raise InvalidInputError(
+            f"{prefix}{name}: point {k} ({arr[k, 0]:.6g}, {arr[k, 1]:.6g}) is beyond ±{MAX_COORDINATE:g}; "
+            f"scale the coordinates (or move them to a local origin)"
         )
     return np.ascontiguousarray(arr)
 

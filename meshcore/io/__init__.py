@@ -422,9 +422,13 @@ def write(
         names = tuple(block_names) if block_names is not None else _block_names(grid_or_blocks, len(blocks))
         if len(names) != len(blocks):
             raise WriteError(f"{p}: {len(names)} block names for {len(blocks)} blocks")
+        conn_names = names
         if connectivity is None:
             connectivity = getattr(grid_or_blocks, "connectivity", None)
-        gs = GridSet(blocks, as_frame(crs, origin), names, coerce_interfaces(connectivity, blocks))
+        if connectivity is None and hasattr(grid_or_blocks, "interfaces"):  # a MultiBlockGrid: declared parts
+            connectivity = grid_or_blocks.interfaces
+            conn_names = tuple(getattr(grid_or_blocks, "names", names))
+        gs = GridSet(blocks, as_frame(crs, origin), names, coerce_interfaces(connectivity, blocks, conn_names))
     if len(gs.blocks) > 1 and not fmt.multiblock:
         raise WriteError(f"{p}: the {fmt.name} format holds one block, got {len(gs.blocks)}")
     fmt._load(fmt.writer)(p, gs, **options)

@@ -9,8 +9,6 @@ leaves nothing behind.
 from __future__ import annotations
 
 import contextlib
-import os
-import tempfile
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,8 +16,24 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import MAX_COORDINATE, check_allocation, check_grid_size, max_bytes
 from ..errors import MeshcoreError, ReadError, WriteError
 from ..grid import BORDER_NAMES, StructuredGrid
+from ._atomic import (  # noqa: F401 - re-exported: the writers import them from here
+    STALE_AGE,
+    atomic_path,
+    atomic_paths,
+    clean_stale_temporaries,
+    one_line,
+    temp_prefix,
+)
+from ._connectivity import (  # noqa: F401 - re-exported
+    Interface,
+    border_ij,
+    check_interface,
+    coerce_interfaces,
+    find_interfaces,
+)
 
 __all__ = [
     "PointSet",
@@ -195,63 +209,110 @@ def read_guard(path: Any, what: str = "file") -> Iterator[None]:
         raise ReadError(one_line(f"{path}: not a valid {what} ({type(exc).__name__}: {msg})")) from exc
 
 
-def one_line(msg: str, limit: int = 400) -> str:
-    """Collapse line breaks (a third-party message may hold some) and cap the length."""
-    import re
+def parse_xml(data: bytes, where: str, *, kind: str):
+    """Parse XML with :mod:`defusedxml` (DTDs, entities and external references refused).
 
-    s = re.sub(r"\s*[\r\n]+\s*", " ", msg).strip()
-    return s if len(s) <= limit else s[: limit - 1] + "…"
+    ``kind`` names the format in messages (``"KML"``, ``"VTK"``).
+    """
+    try:
+        from defusedxml import DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden
+        from defusedxml.ElementTree import ParseError, fromstring
+    except ImportError as exc:  # pragma: no cover - defusedxml is a dependency
+        raise ReadError(f"{where}: reading {kind} files needs defusedxml (pip install defusedxml)") from exc
+    if not data.strip():
+        raise ReadError(f"{where}: file is empty")
+    try:
+        return fromstring(data, forbid_dtd=True, forbid_entities=True, forbid_external=True)
+    except (DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden) as exc:
+        raise ReadError(
+            f"{where}: refused: the XML declares a DTD or entities ({type(exc).__name__}); {kind} files never need them"
+        ) from None
+    except ParseError as exc:
+        line = getattr(exc, "position", (None,))[0]
+        raise ReadError(one_line(f"{where}: line {line}: not well-formed XML ({exc})")) from None
 
 
-def read_bytes(path: Path, *, limit: int = 512 * 2**20) -> bytes:
-    """Read a whole file, refusing absurdly large ones."""
+def read_bytes(path: Path, *, limit: int | None = None) -> bytes:
+    """Read a whole file, refusing one larger than ``limit`` (default :func:`max_bytes`)."""
     size = path.stat().st_size
-    if size > limit:
-        raise ReadError(f"{path}: file is {size} bytes, more than the limit of {limit}")
+    if limit is None:
+        what = f"{path}: file size in bytes"
+        check_allocation(size, max_bytes(), what=what, env="MESHCORE_MAX_BYTES", error=ReadError)
+    elif size > limit:
+        raise ReadError(f"{path}: file is {size:,} bytes, more than the limit of {limit:,}")
     return path.read_bytes()
 
 
+def check_nodes(shape: Sequence[int], path: Any, what: str = "grid") -> None:
+    """Refuse (ReadError) a grid whose node count exceeds :func:`max_nodes`, before allocating it."""
+    ni, nj = (int(v) for v in shape[:2])
+    if ni < 2 or nj < 2:
+        raise ReadError(f"{path}: {what} has {ni} × {nj} nodes, at least 2 × 2 are needed")
+    check_grid_size(ni, nj, what=f"{path}: {what}", error=ReadError, nodes=True)
+
+
+def grid_from_world(
+    X: Any, Y: Any, origin: Sequence[float], path: Any, what: str = "grid", names: dict | None = None
+) -> StructuredGrid:
+    """A grid in local coordinates (world − origin), refusing non-finite or huge values.
+
+    Every grid reader builds its grids here, so a NaN, an infinity or a
+    coordinate beyond :data:`~meshcore._validation.MAX_COORDINATE` (in the file
+    or in its origin) is a :class:`ReadError` naming the node, never a grid.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    Y = np.asarray(Y, dtype=np.float64)
+    if X.ndim != 2 or X.shape != Y.shape:
+        raise ReadError(f"{path}: {what}: coordinates are not two 2-D arrays of one shape ({X.shape}, {Y.shape})")
+    check_nodes(X.shape, path, what)
+    o = np.asarray(origin, dtype=np.float64).reshape(-1)
+    if o.size != 2 or not np.isfinite(o).all() or (np.abs(o) > MAX_COORDINATE).any():
+        raise ReadError(f"{path}: the local origin {o.tolist()} is not two finite numbers")
+    for axis, A in (("x", X), ("y", Y)):
+        bad = ~np.isfinite(A) | (np.abs(A) > MAX_COORDINATE)
+        if bad.any():
+            i, j = (int(v) for v in np.argwhere(bad)[0])
+            kind = "not finite" if not np.isfinite(A[i, j]) else f"beyond ±{MAX_COORDINATE:g}"
+            raise ReadError(
+                f"{path}: {what}: {axis} of node (i={i}, j={j}) is {kind} ({A[i, j]!r})"
+                + (f", {int(bad.sum()) - 1} more such values" if bad.sum() > 1 else "")
+            )
+    return StructuredGrid(X - o[0], Y - o[1], names=dict(names or {}))
+
+
 def decode_text(path: Path, data: bytes) -> str:
-    """Decode text as UTF-8 (with or without BOM), falling back to Latin-1."""
+    """Decode text: UTF-16 (with a byte-order mark, or plain ASCII-range UTF-16), else UTF-8
+    (with or without BOM), falling back to Latin-1."""
     if not data.strip():
         raise ReadError(f"{path}: file is empty")
-    if b"\x00" in data[:4096]:
-        raise ReadError(f"{path}: binary data (NUL bytes) in a text file")
+    head = data[:4096]
+    encoding = None
+    if head[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        encoding = "utf-16"
+    elif len(head) >= 4 and b"\x00" in head:
+        even, odd = head[0::2], head[1::2]
+        if not odd.strip(b"\x00") and b"\x00" not in even:
+            encoding = "utf-16-le"
+        elif not even.strip(b"\x00") and b"\x00" not in odd:
+            encoding = "utf-16-be"
+        else:
+            k = head.index(b"\x00")
+            raise ReadError(
+                f"{path}: not a text file: NUL byte at offset {k} (binary data, or a text encoding other "
+                f"than UTF-8, Latin-1 or UTF-16)"
+            )
+    if encoding is not None:
+        try:
+            text = data.decode(encoding)
+        except UnicodeDecodeError as exc:
+            raise ReadError(f"{path}: the text encoding looks like UTF-16 but byte {exc.start} is not") from None
+        if not text.strip():
+            raise ReadError(f"{path}: file is empty")
+        return text.lstrip("\ufeff")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:
         return data.decode("latin-1")
-
-
-# ----------------------------------------------------------------- writing
-@contextlib.contextmanager
-def atomic_path(path: Any, *, binary: bool = True) -> Iterator[Path]:
-    """Yield a temporary path next to ``path``; rename it over ``path`` on success.
-
-    On any error the temporary file is removed and a
-    :class:`~meshcore.errors.WriteError` naming ``path`` is raised, so nothing
-    partial is ever left at ``path``.
-    """
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise WriteError(f"{target}: cannot write here ({exc.strerror or exc})") from None
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        yield tmp_path
-        os.chmod(tmp_path, 0o644)
-        os.replace(tmp_path, target)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            tmp_path.unlink()
-        if isinstance(exc, MeshcoreError) or not isinstance(exc, Exception):
-            raise
-        if isinstance(exc, OSError):
-            raise WriteError(f"{target}: cannot write ({exc.strerror or exc})") from exc
-        raise WriteError(f"{target}: cannot write ({type(exc).__name__}: {exc})") from exc
 
 
 def as_blocks(obj: Any) -> tuple[StructuredGrid, ...]:
@@ -347,65 +408,3 @@ class GridSet:
         """World coordinates of block ``k`` (local + origin)."""
         g = self.blocks[k]
         return self.frame.to_world(g.x, g.y)
-
-
-@dataclass(frozen=True, slots=True)
-class Interface:
-    """A 1-to-1 connection: ``border_a`` of block ``a`` coincides node by node
-    with ``border_b`` of block ``b`` (``reversed``: the node order runs the other way)."""
-
-    a: int
-    border_a: str
-    b: int
-    border_b: str
-    reversed: bool = False
-
-
-def find_interfaces(blocks: Sequence[StructuredGrid], *, rtol: float = 1e-9) -> tuple[Interface, ...]:
-    """Whole-border 1-to-1 interfaces between blocks, found by coordinates.
-
-    Two borders connect when they have the same node count and every node
-    coincides (to ``rtol`` times the largest block size), in the same or the
-    reverse order.
-    """
-    size = max((g.size for g in blocks), default=1.0) or 1.0
-    tol = rtol * size
-    found = []
-    borders = [(k, b, g.border(b)) for k, g in enumerate(blocks) for b in BORDER_NAMES]
-    for m, (ka, ba, pa) in enumerate(borders):
-        for kb, bb, pb in borders[m + 1 :]:
-            if kb == ka or len(pa) != len(pb):
-                continue
-            if np.max(np.abs(pa - pb)) <= tol:
-                found.append(Interface(ka, ba, kb, bb, False))
-            elif np.max(np.abs(pa - pb[::-1])) <= tol:
-                found.append(Interface(ka, ba, kb, bb, True))
-    return tuple(found)
-
-
-def coerce_interfaces(conn: Any, blocks: Sequence[StructuredGrid]) -> tuple[Interface, ...]:
-    """Interfaces from records (Interface, dicts or objects with a/border_a/b/border_b)."""
-    if conn is None:
-        return find_interfaces(blocks) if len(blocks) > 1 else ()
-    out = []
-    for k, r in enumerate(conn):
-        if isinstance(r, Interface):
-            out.append(r)
-            continue
-        get = r.get if isinstance(r, dict) else (lambda key, d=None, r=r: getattr(r, key, d))
-        try:
-            it = Interface(
-                int(get("a")), str(get("border_a")), int(get("b")), str(get("border_b")), bool(get("reversed", False))
-            )
-        except (TypeError, ValueError) as exc:
-            raise WriteError(
-                f"connectivity record {k} must have a, border_a, b, border_b (and optionally reversed): {exc}"
-            ) from None
-        if (
-            it.border_a not in BORDER_NAMES
-            or it.border_b not in BORDER_NAMES
-            or not (0 <= it.a < len(blocks) and 0 <= it.b < len(blocks))
-        ):
-            raise WriteError(f"connectivity record {k} names an unknown block or border: {it}")
-        out.append(it)
-    return tuple(out)

@@ -31,8 +31,7 @@ import numpy as np
 
 from ..crs import Frame, normalize_crs
 from ..errors import ReadError
-from ..grid import StructuredGrid
-from ._base import GridSet, atomic_path, read_bytes
+from ._base import GridSet, atomic_path, atomic_paths, check_nodes, grid_from_world, read_bytes
 
 __all__ = ["read_grd", "write_grd"]
 
@@ -50,13 +49,13 @@ def _rows(name: str, a: np.ndarray) -> list[str]:
     return out
 
 
-def write_grd(path: Path, gs: GridSet, *, lonlat: bool = False, enclosure: bool = True, **_: Any) -> None:
-    """Write an RGFGRID ``.grd`` (and ``.enc``) file (see module docstring)."""
-    g = gs.blocks[0]
+def _grd_text(gs: GridSet, k: int = 0, *, lonlat: bool = False) -> tuple[str, int, int]:
+    """The ``.grd`` text of block ``k`` and its node counts (MMAX, NMAX)."""
+    g = gs.blocks[k]
     if lonlat:
         X, Y = gs.frame.to_lonlat(g.x, g.y)
     else:
-        X, Y = gs.world(0)
+        X, Y = gs.world(k)
     mmax, nmax = X.shape
     head = ["* Deltares, Delft3D-RGFGRID grid written by meshcore (gcmesh)"]
     if gs.frame.crs and not lonlat:
@@ -67,22 +66,39 @@ def write_grd(path: Path, gs: GridSet, *, lonlat: bool = False, enclosure: bool 
         f"{mmax:8d}{nmax:8d}",
         " 0 0 0",
     ]
-    text = "\n".join(head + _rows("x", X) + _rows("y", Y)) + "\n"
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="ascii")
-    if enclosure:
-        enc = [(1, 1), (mmax + 1, 1), (mmax + 1, nmax + 1), (1, nmax + 1), (1, 1)]
-        with atomic_path(Path(path).with_suffix(".enc")) as tmp:
-            tmp.write_text("".join(f"{m:6d}{n:6d}\n" for m, n in enc), encoding="ascii")
+    return "\n".join(head + _rows("x", X) + _rows("y", Y)) + "\n", mmax, nmax
+
+
+def _enc_text(mmax: int, nmax: int) -> str:
+    """The enclosure of a fully active grid of MMAX × NMAX points."""
+    enc = [(1, 1), (mmax + 1, 1), (mmax + 1, nmax + 1), (1, nmax + 1), (1, 1)]
+    return "".join(f"{m:6d}{n:6d}\n" for m, n in enc)
+
+
+def write_grd(path: Path, gs: GridSet, *, lonlat: bool = False, enclosure: bool = True, **_: Any) -> None:
+    """Write an RGFGRID ``.grd`` (and ``.enc``) file (see module docstring).
+
+    The two files are written as a set: both are complete before either
+    replaces an old one, so a failure (disk full) leaves the old pair intact.
+    """
+    text, mmax, nmax = _grd_text(gs, 0, lonlat=lonlat)
+    path = Path(path)
+    if not enclosure:
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="ascii")
+        return
+    # the .enc is renamed first: a crash between the two renames leaves a new .enc that
+    # read_grd finds inconsistent with the old .grd (when the sizes differ) and says so
+    with atomic_paths([path.with_suffix(".enc"), path]) as (tmp_enc, tmp_grd):
+        tmp_grd.write_text(text, encoding="ascii")
+        tmp_enc.write_text(_enc_text(mmax, nmax), encoding="ascii")
 
 
 _KV = re.compile(r"^\s*([A-Za-z ]+?)\s*=\s*(.*)$")
 
 
-def read_grd(path: Path, **_: Any) -> GridSet:
-    """Read an RGFGRID ``.grd`` file (Cartesian or Spherical)."""
-    text = read_bytes(path).decode("latin-1")
-    lines = text.splitlines()
+def _header(path: Path, lines: list[str]) -> tuple[int, str | None, bool, float]:
+    """Skip comments and ``key = value`` lines; return (index of the dimensions line, crs, spherical, missing)."""
     k = 0
     crs: str | None = None
     spherical = False
@@ -103,36 +119,75 @@ def read_grd(path: Path, **_: Any) -> GridSet:
                 try:
                     missing = float(val.replace("D", "E"))
                 except ValueError:
-                    raise ReadError(f"{path}: line {k + 1}: bad Missing Value {val!r}") from None
+                    raise ReadError(f"{path}: line {k + 1}: bad Missing Value {val[:40]!r}") from None
         k += 1
+    return k, crs, spherical, missing
+
+
+def read_grd(path: Path, **_: Any) -> GridSet:
+    """Read an RGFGRID ``.grd`` file (Cartesian or Spherical).
+
+    The grid size is checked against the node limit before the values are
+    read (one pass, into an array of that size); every coordinate must be a
+    finite number; a ``.enc`` next to the file that does not fit the grid (a
+    pair written by two different runs) is reported.
+    """
+    text = read_bytes(path).decode("latin-1")
+    lines = text.splitlines()
+    k, crs, spherical, missing = _header(path, lines)
     if k >= len(lines):
         raise ReadError(f"{path}: no grid dimensions line")
     try:
         mmax, nmax = (int(v) for v in lines[k].split()[:2])
     except ValueError:
         raise ReadError(f"{path}: line {k + 1}: expected 'MMAX NMAX', got {lines[k][:40]!r}") from None
-    if mmax < 2 or nmax < 2 or mmax * nmax > 10**8:
+    if mmax < 2 or nmax < 2:
         raise ReadError(f"{path}: line {k + 1}: invalid grid size {mmax} x {nmax}")
-    k += 2  # skip "0 0 0"
-    vals: list[float] = []
-    for ln_no in range(k, len(lines)):
+    check_nodes((mmax, nmax), path)
+    need = 2 * mmax * nmax
+    a = np.empty(need)
+    n = 0
+    for ln_no in range(k + 2, len(lines)):  # k + 1 is "0 0 0"
         ln = lines[ln_no]
-        if not ln.strip():
-            continue
         s = ln.split("=", 1)[1] if "ETA=" in ln else ln
         toks = s.split()
         if "ETA=" in ln:
             toks = toks[1:]
+        if not toks:
+            continue
+        if n + len(toks) > need:
+            raise ReadError(f"{path}: line {ln_no + 1}: more coordinates than 2 x {mmax} x {nmax}")
         try:
-            vals.extend(float(t.replace("D", "E")) for t in toks)
+            a[n : n + len(toks)] = [float(t.replace("D", "E")) for t in toks]
         except ValueError:
             raise ReadError(f"{path}: line {ln_no + 1}: not a number in {ln.strip()[:40]!r}") from None
-    if len(vals) != 2 * mmax * nmax:
-        raise ReadError(f"{path}: {len(vals)} coordinates, expected 2 x {mmax} x {nmax}")
-    a = np.array(vals)
+        n += len(toks)
+    if n != need:
+        raise ReadError(f"{path}: {n} coordinates, expected 2 x {mmax} x {nmax}")
     X = a[: mmax * nmax].reshape((nmax, mmax)).T
     Y = a[mmax * nmax :].reshape((nmax, mmax)).T
     if np.any(missing == X) or np.any(missing == Y):
         raise ReadError(f"{path}: grid has missing (inactive) points; only full grids are read")
+    _check_enclosure(path, mmax, nmax)
     frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
-    return GridSet((StructuredGrid(X, Y),), frame, source=str(path))
+    return GridSet((grid_from_world(X, Y, (0.0, 0.0), path),), frame, source=str(path))
+
+
+def _check_enclosure(path: Path, mmax: int, nmax: int) -> None:
+    """A sibling ``.enc`` must stay within the grid's MMAX+1 × NMAX+1 water-level points."""
+    enc = Path(path).with_suffix(".enc")
+    try:
+        if not enc.is_file() or enc.stat().st_size > 2**20:
+            return
+        text = enc.read_text(encoding="latin-1")
+    except OSError:
+        return
+    for no, ln in enumerate(text.splitlines(), 1):
+        v = ln.split()
+        if len(v) >= 2 and v[0].lstrip("-").isdigit() and v[1].lstrip("-").isdigit():
+            m, nn = int(v[0]), int(v[1])
+            if not (0 <= m <= mmax + 1 and 0 <= nn <= nmax + 1):
+                raise ReadError(
+                    f"{path}: the enclosure {enc.name} (line {no}: {m} {nn}) does not fit this "
+                    f"{mmax} x {nmax} grid: the two files come from different writes"
+                )

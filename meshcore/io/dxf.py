@@ -2,22 +2,29 @@
 
 Each entity of the model space becomes a polyline named ``"<layer> <handle>"``;
 splines are flattened to within ``sagitta`` drawing units (default 1e-3 of the
-drawing's extent).  DXF carries no CRS, so the CRS is unknown (None) unless
+drawing's extent, control and fit points included), at most
+:data:`SPLINE_MAX_POINTS` points per spline.  DXF carries no CRS, so the CRS is unknown (None) unless
 given.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._validation import check_allocation, max_bytes, max_points, validate_positive
 from ..crs import normalize_crs
 from ..errors import ReadError
 from ._base import PointSet, Polyline, make_polyline
 
-__all__ = ["read_points_dxf"]
+__all__ = ["SPLINE_MAX_POINTS", "read_points_dxf"]
+
+#: Most points one spline may flatten to (a larger ``sagitta`` gives fewer).
+SPLINE_MAX_POINTS = 200_000
 
 
 def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None, **_: Any) -> PointSet:
@@ -31,6 +38,9 @@ def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None
         raise ReadError(f"{path}: no such file")
     if path.stat().st_size == 0:
         raise ReadError(f"{path}: file is empty")
+    check_allocation(
+        path.stat().st_size, max_bytes(), what=f"{path}: file size in bytes", env="MESHCORE_MAX_BYTES", error=ReadError
+    )
     try:
         doc = ezdxf.readfile(str(path))
     except (DXFError, OSError, UnicodeDecodeError, ValueError) as exc:
@@ -53,28 +63,42 @@ def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None
             raw.append((label, e, None, where))
     if not raw:
         raise ReadError(f"{path}: no LWPOLYLINE, POLYLINE or SPLINE entities in the model space")
-    # flatten splines with a tolerance relative to the extent of everything
+    # flatten splines with a tolerance relative to the extent of everything (control
+    # points and fit points included: a spline given by fit points alone has no control points)
     fixed = [r[1] for r in raw if isinstance(r[1], np.ndarray) and len(r[1])]
-    ctrl = []
     for r in raw:
         if not isinstance(r[1], np.ndarray):
-            cps = np.array([(p[0], p[1]) for p in r[1].control_points], dtype=np.float64)
-            if len(cps):
-                ctrl.append(cps)
-    allp = np.vstack(fixed + ctrl) if fixed or ctrl else np.zeros((1, 2))
-    ext = float(np.hypot(*(allp.max(axis=0) - allp.min(axis=0)))) or 1.0
-    tol = sagitta if sagitta is not None else 1e-3 * ext
+            for pts in (r[1].control_points, r[1].fit_points):
+                cps = np.array([(p[0], p[1]) for p in pts], dtype=np.float64).reshape(-1, 2)
+                if len(cps):
+                    fixed.append(cps)
+    allp = np.vstack(fixed) if fixed else np.zeros((1, 2))
+    finite = allp[np.isfinite(allp).all(axis=1)]
+    ext = float(np.hypot(*(finite.max(axis=0) - finite.min(axis=0)))) if len(finite) else 1.0
+    ext = ext if math.isfinite(ext) and ext > 0 else 1.0
+    tol = validate_positive(sagitta, name="sagitta") if sagitta is not None else 1e-3 * ext
+    tol = max(tol, 1e-9 * ext)
+    cap = min(max_points(), SPLINE_MAX_POINTS)
     out: list[Polyline] = []
+    total = 0
     for label, obj, closed, where in raw:
         if isinstance(obj, np.ndarray):
             pts = obj
         else:
             try:
-                pts = np.array([(v[0], v[1]) for v in obj.flattening(tol)], dtype=np.float64)
-            except (DXFError, ValueError, ZeroDivisionError, IndexError) as exc:
+                flat = list(itertools.islice(obj.flattening(tol), cap + 1))
+            except (DXFError, ValueError, ZeroDivisionError, IndexError, ArithmeticError) as exc:
                 raise ReadError(f"{where}: cannot evaluate the spline ({exc})") from None
+            if len(flat) > cap:
+                raise ReadError(
+                    f"{where}: the spline flattens to more than {cap:,} points at a sagitta of {tol:.3g} "
+                    f"drawing units; give a larger sagitta"
+                )
+            pts = np.array([(v[0], v[1]) for v in flat], dtype=np.float64).reshape(-1, 2)
             closed = bool(obj.closed) or None
         if len(pts) < 2:
             raise ReadError(f"{where}: fewer than 2 points")
+        total += len(pts)
+        check_allocation(total, max_points(), what=f"{path}: points", env="MESHCORE_MAX_POINTS", error=ReadError)
         out.append(make_polyline(label, pts, closed=closed, where=where))
     return PointSet(tuple(out), normalize_crs(crs) if crs is not None else None, str(path))

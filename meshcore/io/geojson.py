@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import check_allocation, max_points
 from ..crs import LONLAT, check_lonlat, normalize_crs
 from ..errors import InvalidInputError, ReadError
 from ._base import PointSet, Polyline, decode_text, make_polyline, merge_point_runs, read_bytes
@@ -73,7 +74,12 @@ def _geometry(geom: Any, name: str, where: str, out: list[Polyline]) -> None:
 
 def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     """Read the line and polygon geometries of a GeoJSON file."""
-    text = decode_text(path, read_bytes(path))
+    data = read_bytes(path)
+    # every position opens a "[": an upper bound on the points, counted before parsing
+    check_allocation(
+        data.count(b"["), max_points(), what=f"{path}: positions", env="MESHCORE_MAX_POINTS", error=ReadError
+    )
+    text = decode_text(path, data)
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:

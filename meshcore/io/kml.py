@@ -14,15 +14,17 @@ anything is decompressed, and the KML member is read with the same cap.
 from __future__ import annotations
 
 import re
+import warnings
 import zipfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._validation import check_allocation, max_points
 from ..crs import LONLAT, check_lonlat, normalize_crs
 from ..errors import ReadError
-from ._base import PointSet, Polyline, make_polyline, merge_point_runs, read_bytes
+from ._base import PointSet, Polyline, make_polyline, merge_point_runs, parse_xml, read_bytes
 
 __all__ = ["KMZ_LIMIT", "read_points_kml", "read_points_kmz"]
 
@@ -37,44 +39,51 @@ def _local(tag: Any) -> str:
 
 
 def _parse_xml(data: bytes, where: str):
-    try:
-        from defusedxml import DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden
-        from defusedxml.ElementTree import ParseError, fromstring
-    except ImportError as exc:  # pragma: no cover
-        raise ReadError(f"{where}: reading KML needs defusedxml (pip install 'gcmesh[io]')") from exc
-    if not data.strip():
-        raise ReadError(f"{where}: file is empty")
-    try:
-        return fromstring(data, forbid_dtd=True, forbid_entities=True, forbid_external=True)
-    except (DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden) as exc:
-        raise ReadError(
-            f"{where}: refused: the XML declares a DTD or entities ({type(exc).__name__}); KML files never need them"
-        ) from None
-    except ParseError as exc:
-        line = getattr(exc, "position", (None,))[0]
-        raise ReadError(f"{where}: line {line}: not well-formed XML ({exc})") from None
+    return parse_xml(data, where, kind="KML")
 
 
 _SPLIT = re.compile(r"\s+")
 
 
 def _coordinates(text: str | None, where: str) -> np.ndarray:
+    """``lon,lat[,alt]`` tuples → ``(n, 2)``: one C pass; the slow loop runs only to name a bad tuple."""
     if text is None or not text.strip():
         raise ReadError(f"{where}: empty <coordinates>")
-    pts = []
+    commas = text.count(",")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            v = np.fromstring(text.replace(",", " "), dtype=np.float64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        v = None
+    if v is not None and v.size == 2 * commas and v.size:
+        return v.reshape(-1, 2)
+    if v is not None and 2 * v.size == 3 * commas and v.size:
+        return v.reshape(-1, 3)[:, :2].copy()
+    pts = []  # tuples that mix lon,lat and lon,lat,alt, or a bad one to name
     for k, tup in enumerate(_SPLIT.split(text.strip())):
         vals = tup.split(",")
         if len(vals) not in (2, 3):
             raise ReadError(f"{where}: coordinate tuple {k} {tup[:40]!r} is not lon,lat[,alt]")
         try:
             pts.append((float(vals[0]), float(vals[1])))
+            if len(vals) == 3:
+                float(vals[2])
         except ValueError:
             raise ReadError(f"{where}: coordinate tuple {k} {tup[:40]!r} is not numeric") from None
     return np.array(pts, dtype=np.float64)
 
 
 def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
-    for child in elem.iter():
+    """Every geometry of one placemark, in document order.
+
+    One walk that does not descend into a geometry once it is read (nor into a
+    nested placemark, which is read on its own), so the work is linear in the
+    size of the placemark whatever the nesting.
+    """
+    stack = list(reversed(list(elem)))
+    while stack:
+        child = stack.pop()
         tag = _local(child.tag)
         if tag == "LineString":
             c = _find_child(child, "coordinates")
@@ -93,7 +102,7 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
                     if btag == "innerBoundaryIs":
                         k += 1
                     out.append(make_polyline(nm, _coordinates(c, f"{where} {btag}"), closed=True, where=where))
-        elif tag == "LinearRing" and not _inside_polygon(elem, child):
+        elif tag == "LinearRing":
             c = _find_child(child, "coordinates")
             out.append(make_polyline(name, _coordinates(c, f"{where} LinearRing"), closed=True, where=where))
         elif tag == "Point":
@@ -101,6 +110,8 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
             pl = Polyline(name, _coordinates(c, f"{where} Point"))
             object.__setattr__(pl, "orientation", "point")
             out.append(pl)
+        elif tag != "Placemark":
+            stack.extend(reversed(list(child)))
 
 
 def _find_child(elem, tag: str) -> str | None:
@@ -110,11 +121,15 @@ def _find_child(elem, tag: str) -> str | None:
     return None
 
 
-def _inside_polygon(root, ring) -> bool:
-    return any(_local(poly.tag) == "Polygon" and any(r is ring for r in poly.iter()) for poly in root.iter())
-
-
 def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
+    # every coordinate tuple holds a comma: an upper bound on the points, counted before parsing
+    check_allocation(
+        data.count(b","),
+        max_points(),
+        what=f"{where}: commas (coordinate tuples)",
+        env="MESHCORE_MAX_POINTS",
+        error=ReadError,
+    )
     root = _parse_xml(data, where)
     if _local(root.tag) != "kml":
         raise ReadError(f"{where}: root element is <{_local(root.tag)}>, not <kml>")

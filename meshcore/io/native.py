@@ -36,11 +36,12 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import check_allocation, max_nodes
 from ..crs import Frame
 from ..errors import ReadError
-from ..grid import StructuredGrid
+from ..grid import BORDER_NAMES, StructuredGrid
 from ..metrics import metrics
-from ._base import GridSet, atomic_path, border_names, read_bytes
+from ._base import GridSet, atomic_path, border_names, grid_from_world, read_bytes
 
 __all__ = ["COLUMNS", "read_metrics_csv", "read_npz", "write_metrics_csv", "write_npz"]
 
@@ -100,6 +101,9 @@ def write_metrics_csv(path: Path, gs: GridSet, **_: Any) -> None:
             f"# block {k} ({gs.block_names[k]}): {g.shape[0]} x {g.shape[1]} nodes; "
             f"borders " + ", ".join(f"{b}={n}" for b, n in nm.items())
         )
+    # the names once more, machine-readable (any characters survive): read back by read_metrics_csv
+    lines.append("# block_names: " + json.dumps(list(gs.block_names), ensure_ascii=True))
+    lines.append("# border_names: " + json.dumps([dict(g.names) for g in gs.blocks], ensure_ascii=True))
     for c, d in COLUMNS.items():
         lines.append(f"# column {c}: {d}")
     lines.append(",".join(COLUMNS))
@@ -118,52 +122,93 @@ def write_metrics_csv(path: Path, gs: GridSet, **_: Any) -> None:
         tmp.write_text(buf.getvalue(), encoding="utf-8")
 
 
+def _json_comment(path: Path, lineno: int, text: str, kind: type) -> Any:
+    try:
+        v = json.loads(text)
+    except (json.JSONDecodeError, RecursionError):
+        raise ReadError(f"{path}: line {lineno}: not a JSON list ({text[:40]!r})") from None
+    if not isinstance(v, list) or not all(isinstance(t, kind) for t in v):
+        raise ReadError(f"{path}: line {lineno}: expected a JSON list of {kind.__name__}")
+    return v
+
+
 def read_metrics_csv(path: Path, **_: Any) -> GridSet:
-    """Read the grid back from a metrics CSV (coordinates only; metrics are recomputed)."""
+    """Read the grid back from a metrics CSV (coordinates, CRS, origin, block and border names).
+
+    One pass over the lines into preallocated arrays (the number of data lines
+    is checked against the node limit first); metrics are not read (they are
+    recomputed from the coordinates).
+    """
     from ..crs import normalize_crs
 
     text = read_bytes(path).decode("utf-8", errors="replace")
+    check_allocation(
+        text.count("\n"), max_nodes(), what=f"{path}: lines (one per node)", env="MESHCORE_MAX_NODES", error=ReadError
+    )
     crs, origin = None, (0.0, 0.0)
-    rows = []
+    block_names: list = []
+    bnames: list = []
     header = None
-    for lineno, ln in enumerate(text.splitlines(), 1):
-        if ln.startswith("# crs:"):
-            v = ln[6:].strip()
-            crs = None if v == "unknown" else normalize_crs(v)
-        elif ln.startswith("# origin:"):
-            o = ln[9:].split()
-            origin = (float(o[0]), float(o[1]))
-        elif ln.startswith("#") or not ln.strip():
+    n_rows = 0
+    ints = np.empty((text.count("\n") + 1, 3), dtype=np.int64)
+    xy = np.empty((len(ints), 2))
+    for lineno, ln in enumerate(io.StringIO(text), 1):
+        if ln.startswith("#"):
+            if ln.startswith("# crs:"):
+                v = ln[6:].strip()
+                crs = None if v == "unknown" else normalize_crs(v)
+            elif ln.startswith("# origin:"):
+                try:
+                    o = ln[9:].split()
+                    origin = (float(o[0]), float(o[1]))
+                except (IndexError, ValueError):
+                    raise ReadError(f"{path}: line {lineno}: the origin is not two numbers") from None
+            elif ln.startswith("# block_names:"):
+                block_names = _json_comment(path, lineno, ln[14:], str)
+            elif ln.startswith("# border_names:"):
+                bnames = _json_comment(path, lineno, ln[15:], dict)
             continue
-        elif header is None:
+        if not ln.strip():
+            continue
+        if header is None:
             header = [h.strip() for h in ln.split(",")]
             if header[:5] != ["block", "i", "j", "x", "y"]:
                 raise ReadError(f"{path}: line {lineno}: not a meshcore metrics CSV header")
-        else:
-            v = ln.split(",")
-            if len(v) != len(header):
-                raise ReadError(f"{path}: line {lineno}: {len(v)} values, header has {len(header)}")
-            try:
-                rows.append((int(v[0]), int(v[1]), int(v[2]), float(v[3]), float(v[4])))
-            except ValueError:
-                raise ReadError(f"{path}: line {lineno}: not a number") from None
-    if not rows:
+            continue
+        v = ln.split(",", 5)
+        if len(v) < 5 or (len(header) > 5 and len(v) != 6) or (len(v) == 6 and v[5].count(",") != len(header) - 6):
+            raise ReadError(f"{path}: line {lineno}: {ln.count(',') + 1} values, header has {len(header)}")
+        try:
+            ints[n_rows] = (int(v[0]), int(v[1]), int(v[2]))
+            xy[n_rows] = (float(v[3]), float(v[4]))
+        except (ValueError, OverflowError):
+            raise ReadError(f"{path}: line {lineno}: not a number") from None
+        n_rows += 1
+    if not n_rows:
         raise ReadError(f"{path}: no data rows")
-    a = np.array(rows)
+    ints, xy = ints[:n_rows], xy[:n_rows]
+    if (ints < 0).any():
+        raise ReadError(f"{path}: line of row {int(np.argmax((ints < 0).any(axis=1))) + 1}: negative block/i/j")
     blocks = []
-    for b in np.unique(a[:, 0]).astype(int):
-        r = a[a[:, 0] == b]
+    for b in np.unique(ints[:, 0]).tolist():
+        sel = ints[:, 0] == b
+        r, c = ints[sel], xy[sel]
         ni, nj = int(r[:, 1].max()) + 1, int(r[:, 2].max()) + 1
         if len(r) != ni * nj:
             raise ReadError(f"{path}: block {b} has {len(r)} rows, expected {ni} x {nj}")
         X = np.full((ni, nj), np.nan)
         Y = np.full((ni, nj), np.nan)
-        X[r[:, 1].astype(int), r[:, 2].astype(int)] = r[:, 3]
-        Y[r[:, 1].astype(int), r[:, 2].astype(int)] = r[:, 4]
-        if np.isnan(X).any():
-            raise ReadError(f"{path}: block {b} has missing nodes")
-        blocks.append(StructuredGrid(X - origin[0], Y - origin[1]))
-    return GridSet(tuple(blocks), Frame(crs, origin), source=str(path))
+        X[r[:, 1], r[:, 2]] = c[:, 0]
+        Y[r[:, 1], r[:, 2]] = c[:, 1]
+        seen = np.zeros((ni, nj), dtype=bool)
+        seen[r[:, 1], r[:, 2]] = True
+        if not seen.all():
+            raise ReadError(f"{path}: block {b} has missing nodes (repeated i, j rows)")
+        names = bnames[len(blocks)] if len(blocks) < len(bnames) else {}
+        names = {k: str(v) for k, v in names.items() if k in BORDER_NAMES}
+        blocks.append(grid_from_world(X, Y, origin, path, f"block {b}", names))
+    names_t = tuple(block_names) if len(block_names) == len(blocks) else ()
+    return GridSet(tuple(blocks), Frame(crs, origin), names_t, source=str(path))
 
 
 def write_npz(path: Path, gs: GridSet, **_: Any) -> None:
@@ -189,7 +234,11 @@ def read_npz(path: Path, **_: Any) -> GridSet:
         raise ReadError(f"{path}: not a valid .npz ({exc})") from None
     with z:
         keys = set(z.files)
-        origin = tuple(float(v) for v in z["origin"]) if "origin" in keys else (0.0, 0.0)
+        inflated = {i.filename.removesuffix(".npy"): i.file_size for i in z.zip.infolist()}
+        for key in keys:
+            if key not in ("x", "y") and not (key.startswith("b") and key[1:2].isdigit()) and inflated[key] > 2**20:
+                raise ReadError(f"{path}: refused: the entry {key!r} inflates to more than 1 MiB")
+        origin = tuple(float(v) for v in np.asarray(z["origin"]).reshape(-1)[:2]) if "origin" in keys else (0.0, 0.0)
         crs = str(z["crs"]) if "crs" in keys and str(z["crs"]) else None
         if "x" in keys and "y" in keys:
             pairs = [("x", "y")]
@@ -200,24 +249,38 @@ def read_npz(path: Path, **_: Any) -> GridSet:
             pairs = [(f"b{k}_x", f"b{k}_y") for k in range(n)]
         if not pairs:
             raise ReadError(f"{path}: no x/y arrays (keys: {sorted(keys)[:10]})")
-        bnames = [{} for _ in pairs]
+        bnames: Any = [{} for _ in pairs]
         if "border_names" in keys:
             try:
                 bnames = json.loads(str(z["border_names"]))
-            except json.JSONDecodeError:
+            except (json.JSONDecodeError, RecursionError):
                 raise ReadError(f"{path}: border_names is not JSON") from None
-        names = ()
+        if not isinstance(bnames, list):
+            bnames = []
+        names: tuple = ()
         if "block_names" in keys:
             try:
-                names = tuple(json.loads(str(z["block_names"])))
-            except json.JSONDecodeError:
+                names = json.loads(str(z["block_names"]))
+            except (json.JSONDecodeError, RecursionError):
                 raise ReadError(f"{path}: block_names is not JSON") from None
+            names = tuple(names) if isinstance(names, list) and all(isinstance(t, str) for t in names) else ()
         blocks = []
+        total = 0
         for k, (kx, ky) in enumerate(pairs):
+            for key in (kx, ky):  # the inflated size, from the zip directory, before inflating
+                total += inflated[key]
+            check_allocation(
+                total,
+                16 * max_nodes() + 4096 * len(pairs),
+                what=f"{path}: inflated bytes of x/y",
+                env="MESHCORE_MAX_NODES",
+                error=ReadError,
+            )
             X = np.asarray(z[kx], dtype=np.float64)
             Y = np.asarray(z[ky], dtype=np.float64)
             bn = bnames[k] if k < len(bnames) and isinstance(bnames[k], dict) else {}
-            blocks.append(StructuredGrid(X - origin[0], Y - origin[1], names=bn))
+            bn = {b: str(v) for b, v in bn.items() if b in BORDER_NAMES}
+            blocks.append(grid_from_world(X, Y, origin, path, f"block {k}", bn))
     if len(names) != len(blocks):
         names = ()
     return GridSet(tuple(blocks), Frame(crs, origin), names, source=str(path))

@@ -17,7 +17,9 @@ files with ``nk = 1``.  PLOT3D carries no CRS: world coordinates are written.
 
 from __future__ import annotations
 
+import io
 import struct
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +27,7 @@ import numpy as np
 
 from ..errors import ReadError, WriteError
 from ..grid import StructuredGrid
-from ._base import GridSet, atomic_path, read_bytes
+from ._base import GridSet, atomic_path, check_nodes, grid_from_world, read_bytes
 
 __all__ = ["read_plot3d", "write_plot3d"]
 
@@ -95,9 +97,7 @@ def _blocks_from(values: np.ndarray, dims: list[tuple[int, ...]], path: Path) ->
         y = chunk[n : 2 * n].reshape(d, order="F")
         if len(d) == 3:
             x, y = x[:, :, 0], y[:, :, 0]
-        if not (np.isfinite(x).all() and np.isfinite(y).all()):
-            raise ReadError(f"{path}: block {k + 1} has non-finite coordinates")
-        out.append(StructuredGrid(x, y))
+        out.append(grid_from_world(x, y, (0.0, 0.0), path, f"block {k + 1}"))
     return out
 
 
@@ -107,19 +107,29 @@ def _check_dims(dims: list[tuple[int, ...]], path: Path) -> None:
             raise ReadError(f"{path}: block {k + 1} has invalid dimensions {d} (2-D grids only)")
         if d[0] < 2 or d[1] < 2:
             raise ReadError(f"{path}: block {k + 1} has {d} nodes, at least 2 × 2 are needed")
+        check_nodes(d, path, f"block {k + 1}")
+
+
+def _numbers(path: Path, text: str) -> np.ndarray:
+    """All white-space separated numbers of ``text`` (Fortran ``D`` exponents too), in one C pass."""
+    text = text.replace("d", "e").replace("D", "e")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            return np.fromstring(text, dtype=np.float64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        pass
+    for lineno, ln in enumerate(io.StringIO(text), 1):  # find the culprit (only on error)
+        for t in ln.split():
+            if not _isfloat(t):
+                raise ReadError(f"{path}: line {lineno}: {t[:30]!r} is not a number") from None
+    raise ReadError(f"{path}: not a list of numbers")
 
 
 def _read_ascii(path: Path, text: str) -> list[StructuredGrid]:
-    toks = text.split()
-    try:
-        vals = [float(t.replace("d", "e").replace("D", "e")) for t in toks]
-    except ValueError:
-        bad = next(t for t in toks if not _isfloat(t))
-        line = next(k for k, ln in enumerate(text.splitlines(), 1) if bad in ln.split())
-        raise ReadError(f"{path}: line {line}: {bad[:30]!r} is not a number") from None
-    if not vals:
+    v = _numbers(path, text)
+    if not v.size:
         raise ReadError(f"{path}: file is empty")
-    v = np.array(vals)
     # hypotheses: multi/single × 2-D/3-D; pick the one whose count matches
     for multi in (True, False):
         for nd in (2, 3):

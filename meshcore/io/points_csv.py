@@ -18,11 +18,14 @@ point dropped.
 from __future__ import annotations
 
 import re
+from array import array
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._validation import check_allocation, max_points
 from ..crs import LONLAT, check_lonlat, normalize_crs
 from ..errors import ReadError
 from ._base import PointSet, decode_text, make_polyline, read_bytes
@@ -48,20 +51,35 @@ def _clean_header(tok: str) -> str:
     return t.replace(" ", "_")
 
 
-def _sniff(lines: list[str]) -> tuple[str | None, bool]:
-    """Return (delimiter or None for white space, decimal_comma)."""
-    sample = lines[:50]
-    for d in ("\t", ";", "|"):
-        if sample and all(d in ln for ln in sample):
-            decimal_comma = (
-                d == ";"
-                and any(re.search(r"\d,\d", ln) for ln in sample)
-                and not any(re.search(r"\d\.\d", ln) for ln in sample)
-            )
-            return d, decimal_comma
-    if sample and all("," in ln for ln in sample):
-        return ",", False
-    return None, False
+def _show(s: str, limit: int = 40) -> str:
+    """A short, printable rendering of file text for messages."""
+    t = "".join(c if c.isprintable() else "?" for c in s.strip())
+    return repr(t if len(t) <= limit else t[: limit - 1] + "…")
+
+
+_DELIMS = ("\t", ";", "|", ",")
+
+
+def _sniff(sample: list[str]) -> tuple[str | None, bool]:
+    """Return (delimiter or None for white space, decimal_comma).
+
+    The delimiter is the one found on most sample lines (at least half of
+    them), so one stray character on a later line is reported on that line
+    instead of changing how the whole file is read.
+    """
+    best, best_n = None, 0
+    for d in _DELIMS:
+        n = sum(d in ln for ln in sample)
+        if n > best_n:
+            best, best_n = d, n
+    if best is None or 2 * best_n < len(sample):
+        return None, False
+    decimal_comma = (
+        best == ";"
+        and any(re.search(r"\d,\d", ln) for ln in sample)
+        and not any(re.search(r"\d\.\d", ln) for ln in sample)
+    )
+    return best, decimal_comma
 
 
 def _split(line: str, delim: str | None) -> list[str]:
@@ -70,10 +88,109 @@ def _split(line: str, delim: str | None) -> list[str]:
     return [t.strip().strip('"').strip("'") for t in line.split(delim)]
 
 
+def _lines(text: str) -> Iterator[tuple[int, str]]:
+    """``(line number, content)``: comments cut, white space stripped; one pass, no copies of the text."""
+    if "\n" not in text and "\r" in text:
+        text = text.replace("\r", "\n")  # old Mac line ends
+    start, n, lineno = 0, len(text), 0
+    while start < n:
+        end = text.find("\n", start)
+        if end < 0:
+            end = n
+        lineno += 1
+        s = text[start:end].strip()
+        start = end + 1
+        if s.startswith(_COMMENT):
+            yield lineno, ""
+            continue
+        if "#" in s:
+            s = s[: s.index("#")].rstrip()
+        yield lineno, s
+
+
+class _Layout:
+    """How the rows of one file are read: delimiter, header, x/y (and name) columns."""
+
+    def __init__(self, path: Path, text: str, columns: Any) -> None:
+        sample: list[tuple[int, str]] = []
+        for lineno, s in _lines(text):
+            if s and not s.startswith(">"):
+                sample.append((lineno, s))
+                if len(sample) > 50:
+                    break
+        if not sample:
+            raise ReadError(f"{path}: no data lines (only comments or blank lines)")
+        body = [s for _, s in sample[1:]] or [sample[0][1]]
+        self.delim, self.decimal_comma = _sniff(body)
+        first_no, first = sample[0]
+        t = self.tokens(first)
+        self.header: list[str] | None = None
+        self.header_line = 0
+        if not all(_is_number(v) for v in t if v) and not any(_is_number(v) for v in t[:2]):
+            self.header = [_clean_header(v) for v in t]
+            self.header_line = first_no
+            if len(sample) < 2:
+                raise ReadError(f"{path}: no data rows after the header")
+            first_no, first = sample[1]
+            t = self.tokens(first)
+        self.first_line, self.width = first_no, len(t)
+        self.lonlat = False
+        self.name_col: int | None = None
+        self.ix, self.iy = self._columns(path, columns, t)
+        if self.ix == self.iy:
+            raise ReadError(f"{path}: x and y are the same column ({self.ix})")
+        if max(self.ix, self.iy) >= self.width:
+            raise ReadError(
+                f"{path}: line {self.first_line}: column {max(self.ix, self.iy) + 1} asked for, "
+                f"but the line has {self.width} values"
+            )
+
+    def tokens(self, s: str) -> list[str]:
+        t = _split(s, self.delim)
+        if self.decimal_comma:
+            t = [v.replace(",", ".") for v in t]
+        return t
+
+    def _columns(self, path: Path, columns: Any, first: list[str]) -> tuple[int, int]:
+        header = self.header
+        if columns is not None:
+            try:
+                cx, cy = columns
+            except (TypeError, ValueError):
+                raise ReadError(f"{path}: columns must be (x, y), got {columns!r}") from None
+            ix, iy = (_col_index(c, header, path) for c in (cx, cy))
+            if header is not None and max(ix, iy) < len(header):
+                self.lonlat = header[ix] in _LON_NAMES and header[iy] in _LAT_NAMES
+            return ix, iy
+        if header is not None:
+            self.name_col = _find(header, _NAME_NAMES)
+            ix, iy = _find(header, _LON_NAMES), _find(header, _LAT_NAMES)
+            if ix is not None and iy is not None:
+                self.lonlat = True
+                return ix, iy
+            ix, iy = _find(header, _X_NAMES), _find(header, _Y_NAMES)
+            if ix is not None and iy is not None:
+                return ix, iy
+        numeric = [k for k, v in enumerate(first) if _is_number(v)]
+        if len(numeric) < 2:
+            what = "no numeric x/y columns" if header is not None else "no numeric columns (need at least two: x, y)"
+            sep = {None: "white space", "\t": "tabs"}.get(self.delim, repr(self.delim))
+            raise ReadError(
+                f"{path}: line {self.first_line}: {what}: {_show(' '.join(first))} split at {sep} "
+                f"has {len(numeric)} number(s)"
+                + (f" (the header {_show(' '.join(header))} names no x/y or lon/lat columns)" if header else "")
+            )
+        return numeric[0], numeric[1]
+
+
 def read_points_csv(
     path: Path, *, columns: Any = None, crs: Any = None, closed: bool | None = None, **_: Any
 ) -> PointSet:
     """Read polylines from a delimited text file (see module docstring).
+
+    One pass over the text into two float arrays (about 16 bytes per point);
+    the number of lines is checked against
+    :func:`~meshcore._validation.max_points` before parsing.
 
     Parameters
     ----------
@@ -88,122 +205,55 @@ def read_points_csv(
         the last point repeats the first.
     """
     text = decode_text(path, read_bytes(path))
-    raw = text.splitlines()
-    # strip comments, remember line numbers (1-based)
-    entries: list[tuple[int, str]] = []
-    for k, ln in enumerate(raw, 1):
-        s = ln.strip()
-        if s.startswith(_COMMENT):
-            entries.append((k, ""))
-            continue
-        if "#" in s:
-            s = s[: s.index("#")].rstrip()
-        entries.append((k, s))
-    content = [s for _, s in entries if s and not s.startswith(">")]
-    if not content:
-        raise ReadError(f"{path}: no data lines (only comments or blank lines)")
-    delim, decimal_comma = _sniff(content[1:] if len(content) > 1 else content)
-
-    def tokens(s: str) -> list[str]:
-        t = _split(s, delim)
-        if decimal_comma:
-            t = [v.replace(",", ".") for v in t]
-        return t
-
-    header: list[str] | None = None
-    rows: list[tuple[int, list[str]]] = []
-    segments: list[tuple[str | None, list[tuple[int, list[str]]]]] = [(None, rows)]
-    for lineno, s in entries:
+    check_allocation(
+        text.count("\n") + 1, max_points(), what=f"{path}: lines", env="MESHCORE_MAX_POINTS", error=ReadError
+    )
+    lay = _Layout(path, text, columns)
+    xs, ys = array("d"), array("d")
+    # (first point index, group name, segment name, line) of each run of points
+    groups: list[tuple[int, str | None, str | None, int]] = []
+    seg_name: str | None = None
+    new_segment = True
+    sep = {None: "white space", "\t": "tabs"}.get(lay.delim, repr(lay.delim))
+    ix, iy, nc, width = lay.ix, lay.iy, lay.name_col, lay.width
+    for lineno, s in _lines(text):
         if not s:
-            if rows:
-                rows = []
-                segments.append((None, rows))
+            new_segment = True
             continue
         if s.startswith(">"):
-            rows = []
-            segments.append((s[1:].strip() or None, rows))
+            seg_name, new_segment = s[1:].strip() or None, True
             continue
-        t = tokens(s)
-        if (
-            header is None
-            and not any(r for _, r in segments)
-            and not all(_is_number(v) for v in t if v)
-            and not any(_is_number(v) for v in t[:2])
-        ):
-            header = [_clean_header(v) for v in t]
+        if lineno == lay.header_line:
             continue
-        rows.append((lineno, t))
-    segments = [(nm, r) for nm, r in segments if r]
-    if not segments:
-        raise ReadError(f"{path}: no data rows after the header")
-
-    # ------------------------------------------------------------ columns
-    first_line, first = segments[0][1][0]
-    width = len(first)
-    lonlat = False
-    name_col: int | None = None
-    if columns is not None:
-        try:
-            cx, cy = columns
-        except (TypeError, ValueError):
-            raise ReadError(f"{path}: columns must be (x, y), got {columns!r}") from None
-        ix, iy = (_col_index(c, header, path) for c in (cx, cy))
-        if header is not None:
-            lonlat = header[ix] in _LON_NAMES and header[iy] in _LAT_NAMES
-    elif header is not None:
-        ix = _find(header, _LON_NAMES)
-        iy = _find(header, _LAT_NAMES)
-        if ix is not None and iy is not None:
-            lonlat = True
-        else:
-            ix, iy = _find(header, _X_NAMES), _find(header, _Y_NAMES)
-        if ix is None or iy is None:
-            numeric = [k for k, v in enumerate(first) if _is_number(v)]
-            if len(numeric) < 2:
-                raise ReadError(f"{path}: line {first_line}: no numeric x/y columns (header {header})")
-            ix, iy = numeric[0], numeric[1]
-        name_col = _find(header, _NAME_NAMES)
-    else:
-        numeric = [k for k, v in enumerate(first) if _is_number(v)]
-        if len(numeric) < 2:
-            raise ReadError(f"{path}: line {first_line}: no numeric columns (need at least two: x, y)")
-        ix, iy = numeric[0], numeric[1]
-    if ix == iy:
-        raise ReadError(f"{path}: x and y are the same column ({ix})")
-
-    # ------------------------------------------------------------- values
-    polylines = []
-    base = path.stem
-    for seg_no, (seg_name, seg_rows) in enumerate(segments):
-        groups: list[tuple[str | None, list[tuple[float, float]]]] = []
-        for lineno, t in seg_rows:
-            if len(t) != width:
-                raise ReadError(
-                    f"{path}: line {lineno}: mixed dimensions: {len(t)} values, but line {first_line} has {width}"
-                )
-            try:
-                xv = float(t[ix].replace("d", "e").replace("D", "e"))
-                yv = float(t[iy].replace("d", "e").replace("D", "e"))
-            except (ValueError, IndexError):
-                raise ReadError(
-                    f"{path}: line {lineno}: not a number in column {ix + 1} or {iy + 1}: {' '.join(t)[:60]!r}"
-                ) from None
-            gname = t[name_col] if name_col is not None else None
-            if not groups or groups[-1][0] != gname:
-                groups.append((gname, []))
-            groups[-1][1].append((xv, yv))
-        for gname, pts in groups:
-            name = (
-                gname
-                or seg_name
-                or (base if len(segments) == 1 and len(groups) == 1 else f"{base} {len(polylines) + 1}")
+        t = lay.tokens(s)
+        if len(t) != width:
+            raise ReadError(
+                f"{path}: line {lineno}: mixed dimensions: {len(t)} values separated by {sep}, but line "
+                f"{lay.first_line} has {width}: {_show(s)}"
             )
-            arr = np.array(pts, dtype=np.float64)
-            if len(arr) < 2:
-                raise ReadError(f"{path}: polyline {name!r} has only {len(arr)} point")
-            polylines.append(make_polyline(name, arr, closed=closed, where=str(path)))
-        del seg_no
-    declared = normalize_crs(crs) if crs is not None else (LONLAT if lonlat else None)
+        try:
+            xs.append(float(t[ix].replace("d", "e").replace("D", "e")))
+            ys.append(float(t[iy].replace("d", "e").replace("D", "e")))
+        except ValueError:
+            raise ReadError(
+                f"{path}: line {lineno}: not a number in column {ix + 1} or {iy + 1}: {_show(s, 60)}"
+            ) from None
+        gname = t[nc] if nc is not None else None
+        if new_segment or gname != groups[-1][1]:
+            groups.append((len(xs) - 1, gname, seg_name, lineno))
+            new_segment = False
+    if not groups:
+        raise ReadError(f"{path}: no data rows after the header")
+    pts = np.column_stack([np.frombuffer(xs, dtype=np.float64), np.frombuffer(ys, dtype=np.float64)])
+    base = path.stem
+    polylines = []
+    ends = [g[0] for g in groups[1:]] + [len(pts)]
+    for (start, gname, sname, lineno), end in zip(groups, ends, strict=True):
+        name = gname or sname or (base if len(groups) == 1 else f"{base} {len(polylines) + 1}")
+        if end - start < 2:
+            raise ReadError(f"{path}: polyline {name!r} (line {lineno}) has only {end - start} point")
+        polylines.append(make_polyline(name, pts[start:end], closed=closed, where=str(path)))
+    declared = normalize_crs(crs) if crs is not None else (LONLAT if lay.lonlat else None)
     if declared == LONLAT:
         for pl in polylines:
             check_lonlat(pl.points, where=f"{path}: {pl.name}")
@@ -218,7 +268,9 @@ def _find(header: list[str], names: set[str]) -> int | None:
 
 
 def _col_index(c: Any, header: list[str] | None, path: Path) -> int:
-    if isinstance(c, (int, np.integer)):
+    if isinstance(c, (int, np.integer)) and not isinstance(c, bool):
+        if int(c) < 0:
+            raise ReadError(f"{path}: column index {int(c)} is negative (columns count from 0)")
         return int(c)
     if isinstance(c, str) and c.isdigit():
         return int(c)
@@ -226,5 +278,5 @@ def _col_index(c: Any, header: list[str] | None, path: Path) -> int:
         raise ReadError(f"{path}: column {c!r} given by name but the file has no header")
     key = _clean_header(str(c))
     if key not in header:
-        raise ReadError(f"{path}: no column {c!r} in the header {header}")
+        raise ReadError(f"{path}: no column {c!r} in the header {_show(' '.join(header))}")
     return header.index(key)

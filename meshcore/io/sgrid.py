@@ -25,8 +25,8 @@ import numpy as np
 
 from ..crs import Frame, normalize_crs
 from ..errors import ReadError
-from ..grid import BORDER_NAMES, StructuredGrid
-from ._base import GridSet, atomic_path, border_names, read_bytes
+from ..grid import BORDER_NAMES
+from ._base import GridSet, atomic_path, border_names, check_nodes, grid_from_world, read_bytes
 
 __all__ = ["read_sgrid", "write_sgrid"]
 
@@ -72,7 +72,8 @@ def write_sgrid(path: Path, gs: GridSet, *, lonlat: bool | None = None, **_: Any
         t.node_coordinates = "x y" + (" lon lat" if with_ll else "")
         names = border_names(g)
         for b in BORDER_NAMES:
-            setattr(t, f"border_{b}", names[b])
+            # NetCDF-3 text attributes are bytes: names are stored as UTF-8 (any language)
+            setattr(t, f"border_{b}", names[b].encode("utf-8"))
         t.local_origin = np.array(gs.frame.origin, dtype=np.float64)
         proj = crs is not None and not crs.upper().startswith("EPSG:4326")
         for name, arr, std, units in (
@@ -120,7 +121,7 @@ def write_sgrid(path: Path, gs: GridSet, *, lonlat: bool | None = None, **_: Any
             c = f.createVariable("crs", "i", ())
             for k, val in _cf_attrs(crs).items():
                 setattr(c, k, val)
-            c.crs_authority = crs
+            c.crs_authority = crs.encode("utf-8")
         f.flush()
         data = buf.getvalue()
     with atomic_path(path) as tmp:
@@ -160,12 +161,18 @@ def _from_vars(path: Path, variables) -> GridSet:
     coords = str(_attr(topo, "node_coordinates", "")).split()
     if len(coords) < 2 or coords[0] not in variables or coords[1] not in variables:
         raise ReadError(f"{path}: node_coordinates {coords} not found")
-    X = np.array(variables[coords[0]][:], dtype=np.float64).T
-    Y = np.array(variables[coords[1]][:], dtype=np.float64).T
-    if X.ndim != 2 or X.shape != Y.shape:
+    vx, vy = variables[coords[0]], variables[coords[1]]
+    shape = tuple(getattr(vx, "shape", ()))
+    if len(shape) != 2 or tuple(getattr(vy, "shape", ())) != shape:
         raise ReadError(f"{path}: node coordinates are not 2-D arrays of one shape")
+    check_nodes(shape[::-1], path)
+    X = np.array(vx[:], dtype=np.float64).T
+    Y = np.array(vy[:], dtype=np.float64).T
     o = _attr(topo, "local_origin", None)
-    origin = (float(o[0]), float(o[1])) if o is not None and len(o) >= 2 else (0.0, 0.0)
+    try:
+        origin = (float(o[0]), float(o[1])) if o is not None and len(o) >= 2 else (0.0, 0.0)
+    except (TypeError, ValueError):
+        raise ReadError(f"{path}: local_origin {str(o)[:40]!r} is not two numbers") from None
     names = {}
     for b in BORDER_NAMES:
         nm = _attr(topo, f"border_{b}")
@@ -177,5 +184,5 @@ def _from_vars(path: Path, variables) -> GridSet:
         auth = _attr(variables[gm], "crs_authority")
         wkt = _attr(variables[gm], "crs_wkt")
         crs = normalize_crs(auth or wkt) if (auth or wkt) else None
-    g = StructuredGrid(X - origin[0], Y - origin[1], names=names)
+    g = grid_from_world(X, Y, origin, path, names=names)
     return GridSet((g,), Frame(crs, origin), source=str(path))

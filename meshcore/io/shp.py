@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import check_allocation, max_bytes, max_points
 from ..crs import LONLAT, check_lonlat, is_geographic, normalize_crs
 from ..errors import InvalidInputError, ReadError
 from ._base import PointSet, Polyline, make_polyline
@@ -40,11 +41,25 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     missing = [s for s, p in ((".shx", shx), (".dbf", dbf)) if p is None]
     if missing:
         raise ReadError(f"{path}: the shapefile is incomplete: missing {' and '.join(missing)} next to it")
+    for part in (path, shx, dbf):
+        check_allocation(
+            part.stat().st_size,
+            max_bytes(),
+            what=f"{part}: file size in bytes",
+            env="MESHCORE_MAX_BYTES",
+            error=ReadError,
+        )
+    # a point takes 16 bytes in the .shp: an upper bound on the points, known before reading
+    check_allocation(
+        path.stat().st_size // 16, max_points(), what=f"{path}: points", env="MESHCORE_MAX_POINTS", error=ReadError
+    )
     prj = _sibling(path, ".prj")
     declared = None
     if crs is not None:
         declared = normalize_crs(crs)
     elif prj is not None:
+        if prj.stat().st_size > 2**20:
+            raise ReadError(f"{prj}: {prj.stat().st_size} bytes is not a projection file")
         wkt = prj.read_text(errors="replace").strip()
         if wkt:
             try:

@@ -2,10 +2,11 @@ r"""Unstructured solver formats built from structured blocks: Gmsh ``.msh`` 4.1 
 
 Every cell becomes a quadrilateral with nodes ``(i, j), (i+1, j), (i+1, j+1),
 (i, j+1)`` (counter-clockwise for a valid grid).  Nodes shared by blocks (1-to-1
-interfaces) and the seam of a periodic block are merged, so the mesh is
-conforming.  Every border that is not an interface becomes line elements in a
-marker named after it (``grid.names``, default ``bottom/right/top/left``);
-borders with the same name across blocks share one marker.
+interfaces, also those that cover only part of a border) and the seam of a
+periodic block are merged, so the mesh is conforming.  Every border edge that
+no other cell shares becomes a line element in a marker named after its
+border (``grid.names``, default ``bottom/right/top/left``); borders with the
+same name across blocks share one marker.  Names are written as UTF-8.
 
 * Gmsh: ASCII MSH 4.1; one surface entity per block (physical group of
   dimension 2 named after the block), one curve entity per boundary border,
@@ -38,48 +39,64 @@ class UnstructuredMesh:
 
 
 def to_unstructured(gs: GridSet) -> UnstructuredMesh:
-    """Merge the blocks of ``gs`` into one conforming quad mesh (see module docstring)."""
-    ids: list[np.ndarray] = []
-    coords: list[np.ndarray] = []
-    n = 0
-    shared: set[tuple[int, str]] = set()
+    """Merge the blocks of ``gs`` into one conforming quad mesh (see module docstring).
+
+    Nodes paired by an interface (whole border or part of one) and the seam
+    of a periodic block become one node; node ids follow the first block
+    (then the first node, i-major) that holds them.  A border edge is a
+    boundary element only when no other cell shares it, so interfaces —
+    however they cut the borders — never appear in a marker.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    blocks = gs.blocks
+    shapes = [g.shape for g in blocks]
+    offsets = np.cumsum([0] + [a * b for a, b in shapes])
+    total = int(offsets[-1])
+    us, vs = [], []
     for it in gs.connectivity:
-        shared.add((it.a, it.border_a))
-        shared.add((it.b, it.border_b))
-    for k, g in enumerate(gs.blocks):
-        idx = np.full(g.shape, -1, dtype=np.int64)
-        for it in gs.connectivity:
-            for me, mb, other, ob in ((it.b, it.border_b, it.a, it.border_a), (it.a, it.border_a, it.b, it.border_b)):
-                if me == k and other < k:
-                    src = ids[other][border_index(gs.blocks[other].shape, ob)]
-                    idx[border_index(g.shape, mb)] = src[::-1] if it.reversed else src
-        free = idx < 0
-        if g.periodic:
-            free[-1, :] = False  # the seam column repeats column 0
-        cnt = int(free.sum())
-        idx[free] = np.arange(n, n + cnt)
-        if g.periodic:
-            idx[-1, :] = idx[0, :]
-        X, Y = gs.world(k)
-        pts = np.zeros((cnt, 2))
-        pts[:, 0] = X[free]
-        pts[:, 1] = Y[free]
-        coords.append(pts)
-        n += cnt
-        ids.append(idx)
-    points = np.vstack(coords)
+        ia, ja, ib, jb = it.node_pairs(blocks)
+        us.append(offsets[it.a] + ia * shapes[it.a][1] + ja)
+        vs.append(offsets[it.b] + ib * shapes[it.b][1] + jb)
+    for k, g in enumerate(blocks):
+        if g.periodic:  # the seam column ni repeats column 0
+            j = np.arange(shapes[k][1])
+            us.append(offsets[k] + (shapes[k][0] - 1) * shapes[k][1] + j)
+            vs.append(offsets[k] + j)
+    u = np.concatenate(us) if us else np.zeros(0, dtype=np.int64)
+    v = np.concatenate(vs) if vs else np.zeros(0, dtype=np.int64)
+    graph = coo_matrix((np.ones(len(u), dtype=np.int8), (u, v)), shape=(total, total))
+    _, label = connected_components(graph, directed=False)
+    # number the merged nodes in order of their first occurrence
+    _, first = np.unique(label, return_index=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))
+    gid = rank[label]
+    ids = [gid[offsets[k] : offsets[k + 1]].reshape(shapes[k]) for k in range(len(blocks))]
+    world = [gs.world(k) for k in range(len(blocks))]
+    X = np.concatenate([w[0].ravel() for w in world])
+    Y = np.concatenate([w[1].ravel() for w in world])
+    points = np.column_stack([X[np.sort(first)], Y[np.sort(first)]])
     quads = []
     for idx in ids:
         q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1)
         quads.append(q.reshape(-1, 4))
+    allq = np.vstack(quads)
+    n = len(points)
+    e0, e1 = allq.reshape(-1), np.roll(allq, -1, axis=1).reshape(-1)
+    ukey, cnt = np.unique(np.minimum(e0, e1) * n + np.maximum(e0, e1), return_counts=True)
     borders = []
-    for k, g in enumerate(gs.blocks):
+    for k, g in enumerate(blocks):
         names = border_names(g)
         for b in BORDER_NAMES:
-            if (k, b) in shared or (g.periodic and b in ("left", "right")):
-                continue
             line = ids[k][border_index(g.shape, b)]
-            borders.append((names[b], k, b, np.column_stack([line[:-1], line[1:]])))
+            seg = np.column_stack([line[:-1], line[1:]])
+            key = np.minimum(seg[:, 0], seg[:, 1]) * n + np.maximum(seg[:, 0], seg[:, 1])
+            pos = np.searchsorted(ukey, key)
+            keep = (seg[:, 0] != seg[:, 1]) & (cnt[np.minimum(pos, len(cnt) - 1)] == 1)
+            if keep.any():
+                borders.append((names[b], k, b, seg[keep]))
     return UnstructuredMesh(points, tuple(quads), tuple(borders))
 
 
@@ -141,7 +158,7 @@ def write_msh(path: Path, gs: GridSet, **_: Any) -> None:
             tag += 1
     out.append("$EndElements")
     with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(out) + "\n", encoding="ascii")
+        tmp.write_text("\n".join(out) + "\n", encoding="utf-8")
 
 
 def write_su2(path: Path, gs: GridSet, **_: Any) -> None:
@@ -164,4 +181,4 @@ def write_su2(path: Path, gs: GridSet, **_: Any) -> None:
         out += [f"MARKER_TAG= {nm}", f"MARKER_ELEMS= {len(lines)}"]
         out += [f"3 {a} {b}" for a, b in lines]
     with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(out) + "\n", encoding="ascii")
+        tmp.write_text("\n".join(out) + "\n", encoding="utf-8")

@@ -11,7 +11,9 @@ float64), readable by VTK/ParaView.  Contents of each ``.vts``:
   ``jacobian_ratio``, ``orthogonality``, ``skewness``, ``aspect_ratio``,
   ``size_ratio``; ``min_corner_jacobian``);
 * ``FieldData`` — ``crs`` (authority string or WKT), ``origin`` (x0, y0) and
-  ``border_names`` (``"bottom=inlet;right=right;…"``).
+  ``border_names`` (JSON: ``{"bottom": "inlet", "right": "right", …}``); a
+  block of a ``.vtm`` also ``write_id`` and ``connectivity`` (JSON list of
+  ``[a, border_a, b, border_b, reversed, range_a, range_b]``).
 
 A ``.vtm`` lists one ``.vts`` per block, stored in a directory named after the
 ``.vtm`` stem next to it.  The reader accepts ASCII, inline base64 and
@@ -21,10 +23,12 @@ appended (raw or base64) data, UInt32/UInt64 headers and zlib compression.
 from __future__ import annotations
 
 import base64
+import json
 import os
 import shutil
 import struct
 import tempfile
+import uuid
 import zlib
 from pathlib import Path
 from typing import Any
@@ -34,7 +38,20 @@ import numpy as np
 from ..crs import Frame
 from ..errors import ReadError, WriteError
 from ..grid import BORDER_NAMES, StructuredGrid
-from ._base import GridSet, atomic_path, border_names, read_bytes
+from ._base import (
+    GridSet,
+    Interface,
+    atomic_path,
+    border_names,
+    check_interface,
+    check_nodes,
+    clean_stale_temporaries,
+    grid_from_world,
+    one_line,
+    parse_xml,
+    read_bytes,
+    temp_prefix,
+)
 
 __all__ = ["read_vtm", "read_vts", "write_vtm", "write_vts"]
 
@@ -47,7 +64,7 @@ def _string_array(name: str, s: str) -> str:
     )
 
 
-def _vts_bytes(g: StructuredGrid, frame: Frame, *, data: bool = True) -> bytes:
+def _vts_bytes(g: StructuredGrid, frame: Frame, *, data: bool = True, extra: dict[str, str] | None = None) -> bytes:
     from ..metrics import metrics
     from ..quality import cell_quality
 
@@ -83,7 +100,8 @@ def _vts_bytes(g: StructuredGrid, frame: Frame, *, data: bool = True) -> bytes:
         + (_string_array("crs", frame.crs) if frame.crs else "")
         + '      <Array type="Float64" Name="origin" NumberOfTuples="1" NumberOfComponents="2" '
         f'format="ascii">{frame.origin[0]!r} {frame.origin[1]!r}</Array>\n'
-        + _string_array("border_names", ";".join(f"{b}={names[b]}" for b in BORDER_NAMES))
+        + _string_array("border_names", json.dumps({b: names[b] for b in BORDER_NAMES}))
+        + "".join(_string_array(k, v) for k, v in (extra or {}).items())
         + "    </FieldData>\n"
     )
     ext = f"0 {ni} 0 {nj} 0 0"
@@ -110,26 +128,42 @@ def write_vts(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
         tmp.write_bytes(blob)
 
 
+def _connectivity_json(gs: GridSet) -> str:
+    return json.dumps(
+        [[it.a, it.border_a, it.b, it.border_b, it.reversed, it.range_a, it.range_b] for it in gs.connectivity]
+    )
+
+
 def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
-    """Write blocks as a ``.vtm`` plus a directory of ``.vts`` files."""
+    """Write blocks as a ``.vtm`` plus a directory (named after its stem) of ``.vts`` files.
+
+    Every ``.vts`` holds the block connectivity (``connectivity``, JSON) and
+    the id of this write (``write_id``), which the ``.vtm`` holds too: a
+    ``.vtm`` and a block folder from two different writes (a crash between
+    the two renames that replace them) are refused by :func:`read_vtm`
+    instead of read.  The new folder is complete before either rename.
+    """
     path = Path(path)
     sub = path.with_suffix("")
     parent = path.parent if str(path.parent) else Path(".")
+    write_id = uuid.uuid4().hex
+    clean_stale_temporaries(path)
     try:
-        tmpdir = Path(tempfile.mkdtemp(prefix=f".{sub.name}.", dir=parent))
+        tmpdir = Path(tempfile.mkdtemp(prefix=temp_prefix(path), suffix=".tmpdir", dir=parent))
     except OSError as exc:
-        raise WriteError(f"{path}: cannot write here ({exc.strerror or exc})") from None
+        raise WriteError(one_line(f"{path}: cannot write here ({exc.strerror or exc})")) from None
     old = None
     try:
         entries = []
+        extra = {"write_id": write_id, "connectivity": _connectivity_json(gs)}
         for k, g in enumerate(gs.blocks):
             fn = f"{sub.name}_{k}.vts"
-            (tmpdir / fn).write_bytes(_vts_bytes(g, gs.frame, data=data))
+            (tmpdir / fn).write_bytes(_vts_bytes(g, gs.frame, data=data, extra=extra))
             entries.append(f'    <DataSet index="{k}" name="{_xml_attr(gs.block_names[k])}" file="{sub.name}/{fn}"/>\n')
         vtm = (
             '<?xml version="1.0"?>\n'
             '<VTKFile type="vtkMultiBlockDataSet" version="1.0" byte_order="LittleEndian" '
-            'header_type="UInt64">\n  <vtkMultiBlockDataSet>\n'
+            f'header_type="UInt64" meshcore_write_id="{write_id}">\n  <vtkMultiBlockDataSet>\n'
             + "".join(entries)
             + "  </vtkMultiBlockDataSet>\n</VTKFile>\n"
         )
@@ -137,7 +171,7 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
         with atomic_path(path) as tmp:
             tmp.write_text(vtm, encoding="utf-8")
             if sub.exists():
-                old = Path(tempfile.mkdtemp(prefix=f".{sub.name}.old.", dir=parent))
+                old = Path(tempfile.mkdtemp(prefix=temp_prefix(path), suffix=".tmpdir", dir=parent))
                 os.replace(sub, old / "d")
             os.replace(tmpdir, sub)
     except BaseException as exc:
@@ -145,7 +179,7 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
         if old is not None and (old / "d").exists() and not sub.exists():
             os.replace(old / "d", sub)
         if isinstance(exc, OSError) and not isinstance(exc, WriteError):
-            raise WriteError(f"{path}: cannot write ({exc.strerror or exc})") from exc
+            raise WriteError(one_line(f"{path}: cannot write ({exc.strerror or exc})")) from exc
         raise
     finally:
         if old is not None:
@@ -174,8 +208,6 @@ _DTYPES = {
 
 
 def _parse(data: bytes, path: Path):
-    from .kml import _parse_xml
-
     # cut the raw appended section before XML parsing
     marker = data.find(b"<AppendedData")
     appended = b""
@@ -187,7 +219,7 @@ def _parse(data: bytes, path: Path):
             raise ReadError(f"{path}: malformed <AppendedData> section")
         appended = data[us + 1 : end]
         data = data[: start + 1] + b"</AppendedData>" + data[end + len(b"</AppendedData>") :]
-    root = _parse_xml(data, str(path))
+    root = parse_xml(data, str(path), kind="VTK")
     return root, appended
 
 
@@ -209,7 +241,8 @@ class _Decoder:
             # the appended data may end with white space before </AppendedData>
             self.appended = appended
 
-    def _unpack(self, buf: bytes, b64: bool) -> bytes:
+    def _unpack(self, buf: bytes, b64: bool, limit: int) -> bytes:
+        """The bytes of one array (at most ``limit``: checked from the headers before inflating)."""
         hs = self.header.itemsize
 
         def chars(nbytes: int) -> int:
@@ -218,8 +251,11 @@ class _Decoder:
         if b64:
             buf = buf.lstrip()
             first = base64.b64decode(buf[: chars(hs)])
+            if len(first) < hs:
+                raise ReadError(f"{self.path}: base64 data truncated")
             n0 = int(np.frombuffer(first[:hs], dtype=self.header)[0])
             if not self.compressed:
+                self._check_size(n0, limit)
                 # VTK encodes the header and the data separately; accept both ways
                 data = base64.b64decode(buf[chars(hs) : chars(hs) + chars(n0)])
                 if len(data) >= n0:
@@ -228,29 +264,60 @@ class _Decoder:
                 if len(whole) < hs + n0:
                     raise ReadError(f"{self.path}: base64 data truncated")
                 return whole[hs : hs + n0]
+            if n0 > len(buf):  # more blocks than characters: a corrupt header
+                raise ReadError(f"{self.path}: compressed array header claims {n0} blocks")
             hlen = (3 + n0) * hs
             hdr = np.frombuffer(base64.b64decode(buf[: chars(hlen)])[:hlen], dtype=self.header)
+            if len(hdr) < 3 + n0:
+                raise ReadError(f"{self.path}: compressed array header truncated")
             total = int(hdr[3 : 3 + n0].astype(np.int64).sum())
+            if total > len(buf):
+                raise ReadError(f"{self.path}: compressed array larger than the file")
             body = base64.b64decode(buf[chars(hlen) : chars(hlen) + chars(total)])
-            return self._inflate(hdr, body)
+            return self._inflate(hdr, body, limit)
+        if len(buf) < hs:
+            raise ReadError(f"{self.path}: appended data truncated")
         n0 = int(np.frombuffer(buf[:hs], dtype=self.header)[0])
         if not self.compressed:
             if len(buf) < hs + n0:
                 raise ReadError(f"{self.path}: appended data truncated")
+            self._check_size(n0, limit)
             return buf[hs : hs + n0]
+        if n0 > len(buf):
+            raise ReadError(f"{self.path}: compressed array header claims {n0} blocks")
         hdr = np.frombuffer(buf[: (3 + n0) * hs], dtype=self.header)
-        return self._inflate(hdr, buf[(3 + n0) * hs :])
+        if len(hdr) < 3 + n0:
+            raise ReadError(f"{self.path}: compressed array header truncated")
+        return self._inflate(hdr, buf[(3 + n0) * hs :], limit)
 
-    def _inflate(self, hdr: np.ndarray, body: bytes) -> bytes:
-        nb = int(hdr[0])
+    def _check_size(self, nbytes: int, limit: int) -> None:
+        if nbytes > limit:
+            raise ReadError(
+                f"{self.path}: refused: an array would inflate to {nbytes:,} bytes, more than the "
+                f"{limit:,} its grid size allows"
+            )
+
+    def _inflate(self, hdr: np.ndarray, body: bytes, limit: int) -> bytes:
+        """zlib blocks of a VTK compressed array; sizes from the header, each block capped while inflating."""
+        nb, block, last = int(hdr[0]), int(hdr[1]), int(hdr[2])
+        if nb == 0:
+            return b""
+        full = (nb - 1) * block + (last if last else block)
+        self._check_size(full, limit)
         sizes = hdr[3 : 3 + nb].astype(np.int64)
         out, pos = [], 0
-        for s in sizes:
-            out.append(zlib.decompress(body[pos : pos + int(s)]))
+        for k, s in enumerate(sizes):
+            want = block if (k < nb - 1 or not last) else last
+            d = zlib.decompressobj()
+            chunk = d.decompress(body[pos : pos + int(s)], want)
+            if d.unconsumed_tail or len(chunk) != want:
+                raise ReadError(f"{self.path}: compressed block {k} does not inflate to its declared {want} bytes")
+            out.append(chunk)
             pos += int(s)
         return b"".join(out)
 
-    def array(self, e) -> np.ndarray:
+    def array(self, e, limit: int) -> np.ndarray:
+        """The values of a DataArray as float64 (at most ``limit`` bytes of raw data)."""
         typ = e.get("type", "Float64")
         if typ not in _DTYPES:
             raise ReadError(f"{self.path}: DataArray {e.get('Name')!r} has unknown type {typ!r}")
@@ -259,21 +326,30 @@ class _Decoder:
         if fmt == "ascii":
             return np.array((e.text or "").split(), dtype=np.float64)
         if fmt == "binary":
-            raw = self._unpack((e.text or "").encode("ascii"), True)
+            raw = self._unpack((e.text or "").encode("ascii"), True, limit)
         elif fmt == "appended":
-            off = int(e.get("offset", "0"))
-            raw = self._unpack(self.appended[off:], self.app_encoding == "base64")
+            try:
+                off = int(e.get("offset", "0"))
+            except ValueError:
+                raise ReadError(f"{self.path}: DataArray offset {e.get('offset')[:20]!r} is not an integer") from None
+            if not 0 <= off < len(self.appended):
+                raise ReadError(f"{self.path}: DataArray offset {off} is outside the appended data")
+            raw = self._unpack(self.appended[off:], self.app_encoding == "base64", limit)
         else:
-            raise ReadError(f"{self.path}: unknown DataArray format {fmt!r}")
+            raise ReadError(f"{self.path}: unknown DataArray format {fmt[:20]!r}")
         return np.frombuffer(raw[: len(raw) // dt.itemsize * dt.itemsize], dtype=dt).astype(np.float64)
+
+
+#: Largest string array (CRS WKT, border names) read from a .vts.
+_STRING_LIMIT = 2**20
 
 
 def _local(tag: str) -> str:
     return tag.rsplit("}", 1)[-1]
 
 
-def read_vts(path: Path, **_: Any) -> GridSet:
-    """Read a ``.vts`` file (2-D: one k layer) with its CRS, origin and border names."""
+def _read_vts(path: Path) -> tuple[StructuredGrid, Frame, dict[str, str]]:
+    """The grid, frame and meshcore string fields (``write_id``, ``connectivity``) of a ``.vts``."""
     root, appended = _parse(read_bytes(path), path)
     if _local(root.tag) != "VTKFile" or root.get("type") != "StructuredGrid":
         raise ReadError(f"{path}: not a VTK StructuredGrid file")
@@ -291,17 +367,19 @@ def read_vts(path: Path, **_: Any) -> GridSet:
     ni, nj, nk = ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1
     if nk != 1 or ni < 2 or nj < 2:
         raise ReadError(f"{path}: extent {ext} is not a 2-D grid of at least 2 × 2 nodes")
+    check_nodes((ni, nj), path)
     pts_el = next((e for e in piece.iter() if _local(e.tag) == "Points"), None)
     arr_el = None if pts_el is None else next((e for e in pts_el if _local(e.tag) == "DataArray"), None)
     if arr_el is None:
         raise ReadError(f"{path}: no <Points> DataArray")
-    p = dec.array(arr_el)
+    p = dec.array(arr_el, 3 * ni * nj * 8)
     if p.size != 3 * ni * nj:
         raise ReadError(f"{path}: Points has {p.size} values, expected {3 * ni * nj}")
     p = p.reshape(-1, 3)
     X = p[:, 0].reshape((ni, nj), order="F")
     Y = p[:, 1].reshape((ni, nj), order="F")
     crs, origin, names = None, (0.0, 0.0), {}
+    fields: dict[str, str] = {}
     for e in root.iter():
         if _local(e.tag) != "Array" and _local(e.tag) != "DataArray":
             continue
@@ -311,39 +389,63 @@ def read_vts(path: Path, **_: Any) -> GridSet:
             crs = _decode_string(e, dec)
             parent_is_field = True
         elif name == "origin" and e.get("format", "ascii") == "ascii":
-            o = [float(v) for v in (e.text or "").split()]
+            try:
+                o = [float(v) for v in (e.text or "").split()[:2]]
+            except ValueError:
+                raise ReadError(f"{path}: the origin field {(e.text or '').strip()[:40]!r} is not numbers") from None
             if len(o) >= 2:
                 origin = (o[0], o[1])
         elif name == "border_names" and e.get("type") == "String":
-            s = _decode_string(e, dec)
-            for item in s.split(";"):
-                if "=" in item:
-                    b, n = item.split("=", 1)
-                    if b in BORDER_NAMES and n != b:
-                        names[b] = n
+            names = _border_names(_decode_string(e, dec))
+        elif name in ("write_id", "connectivity") and e.get("type") == "String":
+            fields[name] = _decode_string(e, dec)
         del parent_is_field
-    if not (np.isfinite(X).all() and np.isfinite(Y).all()):
-        raise ReadError(f"{path}: non-finite coordinates")
-    g = StructuredGrid(X - origin[0], Y - origin[1], names=names)
-    return GridSet((g,), Frame(crs, origin), source=str(path))
+    return grid_from_world(X, Y, origin, path, names=names), Frame(crs, origin), fields
+
+
+def read_vts(path: Path, **_: Any) -> GridSet:
+    """Read a ``.vts`` file (2-D: one k layer) with its CRS, origin and border names."""
+    g, frame, _fields = _read_vts(path)
+    return GridSet((g,), frame, source=str(path))
+
+
+def _border_names(s: str) -> dict[str, str]:
+    """``{"bottom": "inlet", …}`` (JSON) or the older ``bottom=inlet;right=right;…``; defaults dropped."""
+    items: dict[str, Any] = {}
+    if s.lstrip().startswith("{"):
+        try:
+            v = json.loads(s)
+        except (json.JSONDecodeError, RecursionError):
+            v = None
+        items = v if isinstance(v, dict) else {}
+    else:
+        items = dict(item.split("=", 1) for item in s.split(";") if "=" in item)
+    return {b: str(n) for b, n in items.items() if b in BORDER_NAMES and str(n) != b}
 
 
 def _decode_string(e, dec: _Decoder) -> str:
     if e.get("format", "ascii") == "ascii":
-        codes = [int(v) for v in (e.text or "").split()]
+        try:
+            codes = [int(v) for v in (e.text or "").split()[:_STRING_LIMIT]]
+        except ValueError:
+            raise ReadError(f"{dec.path}: string array {e.get('Name')!r} holds a non-integer code") from None
     else:
-        codes = [int(v) for v in dec.array(e)]
-    return bytes(c for c in codes if c != 0).decode("utf-8", errors="replace")
+        codes = [int(v) for v in dec.array(e, _STRING_LIMIT)]
+    return bytes(c for c in codes if 0 < c < 256).decode("utf-8", errors="replace")
 
 
 def read_vtm(path: Path, **_: Any) -> GridSet:
-    """Read a ``.vtm`` whose blocks are ``.vts`` files."""
-    from .kml import _parse_xml
+    """Read a ``.vtm`` whose blocks are ``.vts`` files.
 
-    root = _parse_xml(read_bytes(path), str(path))
+    Checks that the blocks come from the same write as the ``.vtm`` (when it
+    says so) and that the nodes of every stored interface coincide (the
+    shared-node check).
+    """
+    root = parse_xml(read_bytes(path), str(path), kind="VTK")
     if _local(root.tag) != "VTKFile" or root.get("type") != "vtkMultiBlockDataSet":
         raise ReadError(f"{path}: not a VTK MultiBlock file")
-    blocks, names, frame = [], [], None
+    write_id = root.get("meshcore_write_id")
+    blocks, names, frame, conn = [], [], None, None
     for e in root.iter():
         if _local(e.tag) != "DataSet":
             continue
@@ -352,13 +454,42 @@ def read_vtm(path: Path, **_: Any) -> GridSet:
             continue
         sub = (path.parent / fn).resolve()
         if not str(sub).endswith(".vts"):
-            raise ReadError(f"{path}: block file {fn!r} is not a .vts")
+            raise ReadError(f"{path}: block file {fn[:60]!r} is not a .vts")
         if not sub.is_file():
-            raise ReadError(f"{path}: block file {fn!r} not found")
-        gs = read_vts(sub)
-        blocks.append(gs.blocks[0])
+            raise ReadError(f"{path}: block file {fn[:60]!r} not found")
+        g, f, fields = _read_vts(sub)
+        if write_id is not None and fields.get("write_id") != write_id:
+            raise ReadError(
+                f"{path}: block file {fn[:60]!r} does not belong to this .vtm (written by another run: "
+                f"an interrupted write?); write the grid again"
+            )
+        blocks.append(g)
         names.append(e.get("name") or f"block{len(names) + 1}")
-        frame = frame or gs.frame
+        frame = frame or f
+        conn = conn if conn is not None else fields.get("connectivity")
     if not blocks:
         raise ReadError(f"{path}: no .vts blocks listed")
-    return GridSet(tuple(blocks), frame, tuple(names), source=str(path))
+    interfaces = _interfaces(path, conn, blocks)
+    return GridSet(tuple(blocks), frame, tuple(names), interfaces, source=str(path))
+
+
+def _interfaces(path: Path, text: str | None, blocks: list[StructuredGrid]) -> tuple[Interface, ...]:
+    if not text:
+        return ()
+    try:
+        recs = json.loads(text)
+        out = tuple(
+            Interface(int(a), str(ba), int(b), str(bb), bool(r), _pair(ra), _pair(rb))
+            for a, ba, b, bb, r, ra, rb in recs
+        )
+    except (json.JSONDecodeError, RecursionError, TypeError, ValueError):
+        raise ReadError(f"{path}: the connectivity field is not a list of interfaces") from None
+    for k, it in enumerate(out):
+        if not (0 <= it.a < len(blocks) and 0 <= it.b < len(blocks)) or {it.border_a, it.border_b} - set(BORDER_NAMES):
+            raise ReadError(f"{path}: interface {k} names an unknown block or border")
+        check_interface(it, blocks, f"{path}: interface {k}", ReadError)
+    return out
+
+
+def _pair(v: Any) -> tuple[int, int] | None:
+    return None if v is None else (int(v[0]), int(v[1]))
