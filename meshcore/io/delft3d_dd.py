@@ -372,13 +372,14 @@ def read_dd(path: Any) -> DomainDecomposition:
                 f"across a coupling is not supported"
             )
         itfs.append(MBInterface(Side(name_of[fa], ba, sa, ta), Side(name_of[fb], bb, sb, tb), da != db))
-        if sa == 0 and sb == 0 and ta == len(ga.border(ba)) - 1 and tb == len(gb.border(bb)) - 1:
-            conn.append(Interface(files.index(fa), ba, files.index(fb), bb, da != db))
+        whole = sa == 0 and sb == 0 and ta == len(ga.border(ba)) - 1 and tb == len(gb.border(bb)) - 1
+        ranges = (None, None) if whole else ((sa, ta), (sb, tb))
+        conn.append(Interface(files.index(fa), ba, files.index(fb), bb, da != db, *ranges))
     frame = grids[files[0]].frame
     gs = GridSet(tuple(grids[f].blocks[0] for f in files), frame, names, tuple(conn), str(path))
     return DomainDecomposition(gs, tuple(files), tuple(itfs))
 
 
 def read_ddb(path: Path, **_: Any) -> GridSet:
-    """The blocks of a ``.ddb`` (whole-border couplings as ``connectivity``); see :func:`read_dd`."""
+    """The blocks of a ``.ddb`` (every coupling, parts of borders too, as ``connectivity``); see :func:`read_dd`."""
     return read_dd(path).blocks

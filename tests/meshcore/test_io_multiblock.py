@@ -160,6 +160,15 @@ def test_cgns_one_to_one_with_node_ranges_read_by_h5py(tmp_path, tee):
     _assert_conforming(m.points, m.get_cells_type("quad"), m.get_cells_type("line"), tee)
 
 
+def test_ddb_couplings_become_connectivity(tmp_path, tee):
+    """Delft3D domain decomposition → SU2: the partial couplings keep the mesh conforming."""
+    meshio = pytest.importorskip("meshio")
+    gs = read_blocks(write(tmp_path / "t.ddb", tee))
+    assert len(gs.connectivity) == 3
+    m = meshio.read(write(tmp_path / "t.su2", gs))
+    assert len(m.points) == _distinct(m.points) == tee.n_nodes
+
+
 def test_cgns_read_by_vtk(tmp_path, tee):
     vtk = pytest.importorskip("vtk")
     f = write(tmp_path / "t.cgns", tee)
