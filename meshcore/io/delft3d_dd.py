@@ -269,8 +269,9 @@ def _staged(path: Path):
     except BaseException as exc:
         for final, old in reversed(moved):
             with contextlib.suppress(OSError):
-                final.unlink()
-                if old is not None:
+                final.unlink()  # absent when this very move failed
+            if old is not None:
+                with contextlib.suppress(OSError):
                     os.replace(old, final)
         if isinstance(exc, MeshcoreError) or not isinstance(exc, Exception):
             raise

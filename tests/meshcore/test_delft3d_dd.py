@@ -204,16 +204,18 @@ def test_failure_while_moving_into_place_restores_the_previous_set(tmp_path, mon
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     real, n = os.replace, []
 
-    def failing(src, dst):
-        n.append(dst)
-        if len(n) == 7:
-            raise OSError(28, "No space left on device")
+    def failing(src, dst):  # the third move from the staging folder into place fails
+        if Path(dst).parent == tmp_path and Path(src).parent.name.startswith(".s.ddb."):
+            n.append(dst)
+            if len(n) == 3:
+                raise OSError(28, "No space left on device")
         return real(src, dst)
 
     monkeypatch.setattr(dd.os, "replace", failing)
     with pytest.raises(WriteError, match="No space left"):
         write(tmp_path / "s.ddb", star(4, n=6))
     monkeypatch.setattr(dd.os, "replace", real)
+    assert len(n) == 3  # two files were in place already and were rolled back
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
