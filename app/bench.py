@@ -115,7 +115,15 @@ def drag_to_converged(app, win) -> None:
     results = []
     delta = np.array([0.15, 0.075])
     frames = []
-    win.solver.redrawn.connect(lambda: frames.append(time.perf_counter()))
+    start_frames = []  # redraws that showed an algebraic start grid (the flicker of issue 13)
+
+    def redrawn() -> None:
+        frames.append(time.perf_counter())
+        doc = win.doc
+        if any(_is_start(g, doc.initial.get(k)) for k, g in doc.grids.items()):
+            start_frames.append(frames[-1])
+
+    win.solver.redrawn.connect(redrawn)
     for rep in range(6):  # drag the NE corner out and back, ~0.5 s per drag at 60 Hz
         drag = win.editor.new_drag_id()
         t_drag = time.perf_counter()
@@ -128,11 +136,23 @@ def drag_to_converged(app, win) -> None:
         g = win.doc.grid
         results.append(dt)
         previews = [t for t in frames if t_drag <= t <= t_release]
+        starts = [t for t in start_frames if t >= t_drag]
         print(
-            f"  drag {rep}: {len(previews)} preview redraws while dragging; converged={g.converged} "
-            f"({g.info.method}, {g.iterations} it) {dt * 1000:.0f} ms after release"
+            f"  drag {rep}: {len(previews)} preview redraws while dragging, {len(starts)} of them "
+            f"showed a start grid; converged={g.converged} ({g.info.method}, {g.iterations} it) "
+            f"{dt * 1000:.0f} ms after release"
         )
     print(f"drag-to-converged 101x101 nodes: median {statistics.median(results) * 1000:.0f} ms")
+    print(f"redraws showing an algebraic start grid during the drags: {len(start_frames)} of {len(frames)}")
+
+
+def _is_start(grid, algebraic) -> bool:
+    """True when ``grid`` is the algebraic start grid (the raw TFI / weighted average, unsmoothed)."""
+    import numpy as np
+
+    if algebraic is None or grid.shape != algebraic.shape:
+        return False
+    return grid is algebraic or (np.array_equal(grid.x, algebraic.x) and np.array_equal(grid.y, algebraic.y))
 
 
 if __name__ == "__main__":

@@ -98,6 +98,8 @@ class SolveStatus(QtCore.QObject):
         dt = self.solver.t_done - self.solver.t_start
         state = "converged" if info.converged else info.message or "not converged"
         warn = f" — {r.n_folded} FOLDED cells (red ×)" if r is not None and r.n_folded else ""
+        if info.method.endswith("+foldfree") and info.message:
+            warn += " — invalid cells repaired (what was done: View ▸ Messages)"
         self.label.setText(f"{info.method}: {state}, {info.iterations} iterations, {dt * 1000:.0f} ms")
         self.win.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}")
 

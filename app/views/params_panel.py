@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
-from PySide6 import QtCore, QtWidgets
+from PySide6 import QtCore, QtGui, QtWidgets
 
 from meshcore import BORDER_NAMES, BorderSpec, InvalidInputError
 from meshcore.elliptic import METHODS
@@ -21,13 +21,26 @@ from .canvas import BORDER_COLOURS
 
 __all__ = ["ParamsPanel"]
 
-_BAD = "background: #ffd6d6;"
+_BAD = QtGui.QColor("#ffd6d6")
+
+
+def _mark(field: QtWidgets.QWidget, bad: bool) -> None:
+    """Colour a field whose value was refused (the palette, not a style sheet: same size)."""
+    field.setProperty("refused", bool(bad))
+    pal = field.palette()
+    pal.setColor(
+        QtGui.QPalette.ColorRole.Base,
+        _BAD if bad else QtWidgets.QApplication.palette().color(QtGui.QPalette.ColorRole.Base),
+    )
+    field.setPalette(pal)
 
 
 def _message_label() -> QtWidgets.QLabel:
     """A red, word-wrapped label for the problems of a group."""
     label = QtWidgets.QLabel(wordWrap=True)
     label.setStyleSheet("color: #b00;")
+    # wrap to the width the panel has; never widen the panel (its fields would go off the edge)
+    label.setSizePolicy(QtWidgets.QSizePolicy.Policy.Ignored, QtWidgets.QSizePolicy.Policy.Preferred)
     return label
 
 
@@ -212,7 +225,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         QtCore.QTimer.singleShot(0, lambda: self._committed(widget))
 
     def _committed(self, widget: QtWidgets.QWidget) -> None:
-        if widget.hasFocus() and not widget.styleSheet():  # a refused value keeps the focus for fixing
+        if widget.hasFocus() and not widget.property("refused"):  # a refused value keeps the focus for fixing
             self.committed.emit()
 
     def select_border(self, name: str) -> None:
@@ -235,7 +248,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
             self.last.setText("" if s.last is None else f"{s.last:.6g}")
             self.bname.setText(s.name or "")
             for e in (self.first, self.last, self.tol, self.omega, self.ni, self.nj):
-                e.setStyleSheet("")
+                _mark(e, False)
             self.block_msg.setText("")
             self.border_msg.setText("")
             self.solver_msg.setText("")
@@ -260,7 +273,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         if self._updating:
             return
         for box in (self.ni, self.nj):
-            box.setStyleSheet("")
+            _mark(box, False)
         for box, name in ((self.ni, "ξ"), (self.nj, "η")):
             if box.value() < 1:
                 self._refuse(box, self.block_msg, f"cells {name} must be at least 1, got {box.value()}: not applied")
@@ -271,7 +284,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
     def _refuse(self, field, label: QtWidgets.QLabel, text: str) -> None:
         """Show why an input is not applied: red field, the text under its group, the message panel."""
         if field is not None:
-            field.setStyleSheet(_BAD)
+            _mark(field, True)
         label.setText(text)
         self.ensureWidgetVisible(label)  # never below the fold of the scroll area
         if field is not None:
@@ -292,7 +305,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         if self._updating:
             return
         for e in (self.first, self.last):
-            e.setStyleSheet("")
+            _mark(e, False)
         try:
             first = self._number(self.first)
         except ValueError:
@@ -342,7 +355,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
             cb.setEnabled(c is None or isinstance(c, Mapping))
         sp = [v.get("spacing") for v in borders.values() if isinstance(v, Mapping) and v.get("spacing")]
         self.ctl_spacing.setText(f"{sp[0]:.6g}" if sp else "")
-        self.ctl_spacing.setStyleSheet("")
+        _mark(self.ctl_spacing, False)
         tm = bool(c.get("thomas-middlecoff", c.get("thomas_middlecoff", False))) if isinstance(c, Mapping) else False
         self.ctl_tm.setChecked(tm)
         self.ctl_msg.setText("")
@@ -355,7 +368,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
         old = self.doc.block.control
         if old is not None and not isinstance(old, Mapping):
             return
-        self.ctl_spacing.setStyleSheet("")
+        _mark(self.ctl_spacing, False)
         try:
             spacing = self._number(self.ctl_spacing)
             if spacing is not None and spacing <= 0:
@@ -401,7 +414,7 @@ class ParamsPanel(QtWidgets.QScrollArea):
             return
         kw = {}
         for key, e, lo, hi in (("tolerance", self.tol, 0.0, math.inf), ("omega", self.omega, 0.0, 2.0)):
-            e.setStyleSheet("")
+            _mark(e, False)
             try:
                 v = self._number(e)
             except ValueError:

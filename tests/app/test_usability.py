@@ -168,7 +168,8 @@ def test_wrong_cell_counts_are_refused_visibly(qtbot, win):
         QTest.keyClicks(pp.nj, typed)
         QTest.keyClick(pp.nj, QtCore.Qt.Key.Key_Return)
         assert win.doc.block.cells == before
-        assert pp.nj.value() == int(typed) and pp.nj.styleSheet()  # still shown, in red
+        assert pp.nj.value() == int(typed) and pp.nj.property("refused")  # still shown, in red
+        assert pp.nj.palette().color(pp.nj.palette().ColorRole.Base).name() == "#ffd6d6"
         assert "at least 1" in pp.block_msg.text() and typed in pp.block_msg.text()
         assert any("at least 1" in t for _lv, t in win.messages_panel.messages())
     assert win.focusWidget() is not win.canvas  # the keyboard stays there to fix it
