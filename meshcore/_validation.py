@@ -11,7 +11,7 @@ an error that says what the request would need:
   ``MESHCORE_MAX_POINTS`` overrides;
 * :func:`max_bytes` — bytes of one input file, and bytes one compressed array
   may inflate to: 512 MiB, ``MESHCORE_MAX_BYTES`` overrides;
-* :data:`MAX_COORDINATE` — coordinates must be finite and at most ``1e150``
+* :data:`MAX_COORDINATE` — coordinates must be finite and at most ``1e100``
   in magnitude (squares and products of them stay finite).
 """
 
@@ -25,11 +25,13 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InvalidInputError
+from .errors import BoundaryError, InvalidInputError
 
 __all__ = [
     "MAX_COORDINATE",
+    "MIN_EXTENT",
     "check_allocation",
+    "check_extent",
     "check_grid_size",
     "max_bytes",
     "max_nodes",
@@ -43,7 +45,10 @@ __all__ = [
 
 
 #: Largest coordinate magnitude accepted (its square, and products of two, stay finite).
-MAX_COORDINATE = 1e150
+MAX_COORDINATE = 1e100
+
+#: Smallest extent of a boundary (cubes of cell sizes must stay above the float64 underflow).
+MIN_EXTENT = 1e-100
 
 #: Bytes per node a solve needs at most (coordinates, solver work arrays, quality and output arrays).
 BYTES_PER_NODE = 200
@@ -150,6 +155,27 @@ def validate_points(points: Any, *, name: str, min_points: int = 2, where: str =
             f"scale the coordinates (or move them to a local origin)"
         )
     return np.ascontiguousarray(arr)
+
+
+def check_extent(points: np.ndarray, *, name: str) -> float:
+    """The extent (bounding-box diagonal) of ``points``; refuse a boundary too small to grid.
+
+    Too small is below :data:`MIN_EXTENT`, or below 1e-12 of the largest
+    coordinate (then float64 resolves fewer than four digits across it).
+    """
+    p = np.asarray(points, dtype=np.float64)
+    size = float(np.hypot(*(p.max(axis=0) - p.min(axis=0))))
+    big = float(np.abs(p).max())
+    if size == 0:
+        raise BoundaryError(f"{name}: all points coincide")
+    if size < MIN_EXTENT:
+        raise BoundaryError(f"{name}: the points span only {size:.3g} (less than {MIN_EXTENT:g}); scale them up")
+    if size <= 1e-12 * big:
+        raise BoundaryError(
+            f"{name}: the points span only {size:.3g} at coordinates up to {big:.3g}, too little to grid in "
+            f"double precision; move them to a local origin (subtract a point near them)"
+        )
+    return size
 
 
 def validate_count(value: Any, *, name: str, minimum: int = 1) -> int:

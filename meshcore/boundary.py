@@ -30,7 +30,14 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import validate_choice, validate_count, validate_points, validate_positive
+from ._validation import (
+    check_extent,
+    check_grid_size,
+    validate_choice,
+    validate_count,
+    validate_points,
+    validate_positive,
+)
 from .curves import CURVE_KINDS, make_curve
 from .distribution import DISTRIBUTIONS, distribute
 from .errors import BorderMismatchError, BoundaryError, InvalidInputError, MeshcoreWarning
@@ -47,9 +54,26 @@ __all__ = [
 
 
 def signed_area(points: np.ndarray) -> float:
-    """Signed area of a closed polygon (positive when counter-clockwise)."""
-    x, y = points[:, 0], points[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    """Signed area of a closed polygon (positive when counter-clockwise).
+
+    Computed about the first vertex and in units of the polygon's extent, so
+    the sign does not depend on where the polygon lies (a 1e-3 circle at
+    (1e5, 1e5)) or on its scale (a loop scaled by 1e-300).  The value is
+    the area times the square of the extent; it underflows to 0 only below
+    the scales meshcore refuses anyway (:func:`~meshcore._validation.check_extent`).
+    """
+    p = np.asarray(points, dtype=np.float64)
+    if len(p) < 3:
+        return 0.0
+    d = p - p[0]
+    s = float(np.abs(d).max())
+    if not s > 0 or not math.isfinite(s):
+        return 0.0
+    d = d / s
+    x, y = d[:, 0], d[:, 1]
+    a = 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    area = a * s * s
+    return area if area != 0 or a == 0 else math.copysign(math.ulp(0.0), a)  # keep the sign of an underflow
 
 
 @dataclass(frozen=True, slots=True)
@@ -186,6 +210,7 @@ class Borders:
         """
         ni = validate_count(cells[0], name="cells ξ (ni)")
         nj = validate_count(cells[1], name="cells η (nj)")
+        check_grid_size(ni, nj, what="cells")  # before a node is allocated
         curve = validate_choice(curve, CURVE_KINDS, name="curve")
         specs = dict(specs or {})
         unknown = set(specs) - set(BORDER_NAMES)
@@ -325,9 +350,7 @@ def borders_from_polylines(
         # a private copy: corners are snapped in place below, never in the caller's arrays
         raw[name] = validate_points(pts, name=f"{prefix}{name} border", min_points=2).copy()
     allp = np.vstack(list(raw.values()))
-    size = float(math.hypot(*(allp.max(axis=0) - allp.min(axis=0))))
-    if size == 0:
-        raise BoundaryError(f"{prefix}all boundary points coincide")
+    size = check_extent(allp, name=f"{prefix}boundary points")
     tol = 1e-9 * size
     for name in BORDER_NAMES:
         raw[name] = _drop_duplicates(raw[name], name=f"{prefix}{name} border", tol=tol)
@@ -402,9 +425,7 @@ def borders_from_loop(
     prefix = f"{where}: " if where else ""
     p = validate_points(points, name=f"{prefix}boundary points", min_points=4)
     n_given = len(p)
-    size = float(math.hypot(*(p.max(axis=0) - p.min(axis=0))))
-    if size == 0:
-        raise BoundaryError(f"{prefix}all boundary points coincide")
+    size = check_extent(p, name=f"{prefix}boundary points")
     closed_repeat = bool(np.hypot(*(p[0] - p[-1])) <= 1e-12 * size)
     try:
         c = [int(v) for v in corners]

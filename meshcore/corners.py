@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import validate_choice, validate_points
+from ._validation import check_extent, validate_choice, validate_points
 from .errors import BoundaryError
 
 __all__ = ["CORNER_NAMES", "CornerProblem", "choose_corners", "corner_problems", "interior_angles"]
@@ -50,17 +50,16 @@ CORNER_NAMES: tuple[str, ...] = ("sw", "se", "ne", "nw")
 def _loop(points: Any, name: str) -> tuple[np.ndarray, int]:
     p = validate_points(points, name=name, min_points=4)
     n = len(p)
-    size = float(math.hypot(*(p.max(axis=0) - p.min(axis=0))))
-    if size == 0:
-        raise BoundaryError(f"{name}: all points coincide")
+    size = check_extent(p, name=name)
     if math.hypot(*(p[0] - p[-1])) <= 1e-12 * size:
         n -= 1
     return p[:n], n
 
 
 def _signed_area(p: np.ndarray) -> float:
-    x, y = p[:, 0], p[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    from .boundary import signed_area  # translation- and scale-invariant sign
+
+    return signed_area(p)
 
 
 def interior_angles(points: Any) -> np.ndarray:
@@ -70,15 +69,17 @@ def interior_angles(points: Any) -> np.ndarray:
     enclosed region.  A vertex with angle > 180° is *reflex*.
     """
     p, _ = _loop(points, "boundary points")
-    if _signed_area(p) < 0:
-        return interior_angles(p[::-1])[::-1]
+    flip = _signed_area(p) < 0
+    if flip:  # measure on the counter-clockwise loop (no recursion: rounding cannot ping-pong)
+        p = p[::-1]
     d_in = p - np.roll(p, 1, axis=0)
     d_out = np.roll(p, -1, axis=0) - p
     turn = np.arctan2(
         d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0],
         (d_in * d_out).sum(axis=1),
     )
-    return 180.0 - np.degrees(turn)
+    ang = 180.0 - np.degrees(turn)
+    return ang[::-1].copy() if flip else ang
 
 
 def _principal_frame(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

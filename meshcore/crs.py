@@ -20,6 +20,7 @@ pyproj is imported lazily, inside the functions that need it.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -47,7 +48,7 @@ def _pyproj():
     try:
         import pyproj
     except ImportError as exc:  # pragma: no cover - pyproj is in the io extra
-        raise InvalidInputError("map projections need pyproj (pip install 'gcmesh[io]')") from exc
+        raise InvalidInputError("map projections need pyproj: pip install pyproj") from exc
     return pyproj
 
 
@@ -55,32 +56,62 @@ def normalize_crs(crs: Any) -> str | None:
     """An authority string (``"EPSG:32632"``) for ``crs``, or its WKT, or None.
 
     Accepts an int EPSG code, ``"EPSG:nnnn"``, ``"epsg:nnnn"``, a WKT / PROJ
-    string or a ``pyproj.CRS``.
+    string or a ``pyproj.CRS``.  A CRS that PROJ does not know (``EPSG:999999``)
+    is an :class:`~meshcore.errors.InvalidInputError`, never written into a file.
     """
     if crs is None:
         return None
+    if isinstance(crs, bool):
+        raise InvalidInputError(f"crs: expected an EPSG code or a CRS string, got {crs!r}")
     if isinstance(crs, (int, np.integer)):
-        return f"EPSG:{int(crs)}"
-    if isinstance(crs, str):
+        s = f"EPSG:{int(crs)}"
+    elif isinstance(crs, str):
         s = crs.strip()
         if not s or s.lower() in {"none", "local"}:
             return None
-        if s.upper() in _GEOGRAPHIC_ALIASES:
-            return LONLAT
-        if s.isdigit():
-            return f"EPSG:{s}"
-        if s.upper().startswith("EPSG:") and s[5:].isdigit():
+    elif getattr(crs, "to_wkt", None) is not None:
+        s = crs.to_wkt()
+    else:
+        raise InvalidInputError(f"crs: expected an EPSG code or a CRS string, got {type(crs).__name__}")
+    if s.upper() in _GEOGRAPHIC_ALIASES:
+        return LONLAT
+    if s.isdigit():
+        s = f"EPSG:{s}"
+    return _checked_crs(s)
+
+
+@functools.lru_cache(maxsize=256)
+def _checked_crs(s: str) -> str:
+    """``s`` checked against the PROJ database: ``EPSG:n`` as given, anything else as authority or WKT."""
+    epsg = s.upper().startswith("EPSG:") and s[5:].isdigit()
+    try:
+        pyproj = _pyproj()
+    except InvalidInputError:
+        if epsg:  # without pyproj an EPSG code can only be taken on trust
             return f"EPSG:{s[5:]}"
-        try:
-            c = _pyproj().CRS.from_user_input(s)
-        except Exception as exc:
-            raise InvalidInputError(f"crs: cannot understand {s[:60]!r} ({exc})") from None
-        auth = c.to_authority(min_confidence=90)
-        return f"{auth[0]}:{auth[1]}" if auth else c.to_wkt()
-    to_wkt = getattr(crs, "to_wkt", None)
-    if to_wkt is not None:
-        return normalize_crs(to_wkt())
-    raise InvalidInputError(f"crs: expected an EPSG code or a CRS string, got {type(crs).__name__}")
+        raise
+    shown = s if len(s) <= 60 else s[:59] + "…"
+    try:
+        c = pyproj.CRS.from_user_input(s)
+    except Exception as exc:
+        why = "no such code in the PROJ database" if epsg else " ".join(str(exc).split())[:120]
+        raise InvalidInputError(f"crs: unknown CRS {shown!r} ({why})") from None
+    if epsg:
+        return f"EPSG:{int(s[5:])}"
+    auth = c.to_authority(min_confidence=90)
+    return f"{auth[0]}:{auth[1]}" if auth else c.to_wkt()
+
+
+def _transformer(src: str, dst: str, where: str):
+    """A pyproj transformer ``src → dst`` (x = east/lon first), or an error naming both."""
+    try:
+        return _pyproj().Transformer.from_crs(src, dst, always_xy=True)
+    except InvalidInputError:
+        raise
+    except Exception as exc:
+        raise InvalidInputError(
+            f"{where}: cannot transform {src} to {dst} ({' '.join(str(exc).split())[:120]})"
+        ) from None
 
 
 def is_geographic(crs: str | None) -> bool:
@@ -89,14 +120,23 @@ def is_geographic(crs: str | None) -> bool:
         return False
     if crs.upper() in _GEOGRAPHIC_ALIASES:
         return True
-    return bool(_pyproj().CRS.from_user_input(crs).is_geographic)
+    return bool(_crs_object(crs).is_geographic)
 
 
 def crs_wkt(crs: str | None) -> str | None:
     """WKT2 of ``crs`` (None for an unknown CRS)."""
     if crs is None:
         return None
-    return _pyproj().CRS.from_user_input(crs).to_wkt()
+    return _crs_object(crs).to_wkt()
+
+
+def _crs_object(crs: str):
+    try:
+        return _pyproj().CRS.from_user_input(crs)
+    except InvalidInputError:
+        raise
+    except Exception as exc:
+        raise InvalidInputError(f"crs: unknown CRS {crs[:60]!r} ({' '.join(str(exc).split())[:120]})") from None
 
 
 def looks_lonlat(points: Any) -> bool:
@@ -206,7 +246,7 @@ class Frame:
         X, Y = self.to_world(x, y)
         if is_geographic(self.crs):
             return X, Y
-        t = _pyproj().Transformer.from_crs(self.crs, LONLAT, always_xy=True)
+        t = _transformer(self.crs, LONLAT, "lon/lat")
         lon, lat = t.transform(X, Y)
         return np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64)
 
@@ -290,7 +330,7 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_cr
     if src is not None and is_geographic(src):
         check_lonlat(pts, where=pointset.source or "points")
     if target is not None and src is not None and target != src:
-        t = _pyproj().Transformer.from_crs(src, target, always_xy=True)
+        t = _transformer(src, target, pointset.source or "points")
         new = []
         for pl in pointset.polylines:
             X, Y = t.transform(pl.points[:, 0], pl.points[:, 1])
@@ -314,7 +354,7 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_cr
 
 def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
     if src != LONLAT:
-        t = _pyproj().Transformer.from_crs(src, LONLAT, always_xy=True)
+        t = _transformer(src, LONLAT, "centroid")
         lon, lat = t.transform(pts[:, 0], pts[:, 1])
         pts = np.column_stack([lon, lat])
     lo, hi = pts.min(axis=0), pts.max(axis=0)

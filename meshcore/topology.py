@@ -23,7 +23,14 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import validate_count, validate_points, validate_positive
+from ._validation import (
+    check_allocation,
+    check_grid_size,
+    max_nodes,
+    validate_count,
+    validate_points,
+    validate_positive,
+)
 from .algebraic import algebraic_grid
 from .boundary import Borders, signed_area
 from .distribution import distribute
@@ -54,6 +61,7 @@ def closed_curve_nodes(
     """
     p = _closed(points, name)
     n = validate_count(n, name=f"{name} cells")
+    check_allocation(n, max_nodes(), what=f"{name} cells", env="MESHCORE_MAX_NODES")
     if (signed_area(p) < 0) != clockwise:
         p = p[::-1]
     k0 = 0 if start is None else int(np.argmin(np.hypot(*(p - np.asarray(start, float)).T)))
@@ -109,6 +117,7 @@ def ogrid_borders(
         cut goes straight to the nearest outer node.
     """
     ni, nj = (validate_count(c, name=nm) for c, nm in zip(cells, ("cells ξ", "cells η"), strict=True))
+    check_grid_size(ni, nj, what="cells")
     bottom = closed_curve_nodes(inner, ni, start=start, name="inner curve")
     # the cut leaves the inner curve along the ray from its centroid (no twist)
     po = _closed(outer, "outer curve")

@@ -1,8 +1,14 @@
-"""``meshcore generate CASE -o OUT [--png FIG]``."""
+"""``meshcore generate CASE -o OUT [--png FIG]``.
+
+Every output path is checked before the solve (a format that can be written,
+its optional dependency installed, an existing writable folder), so a bad
+``--png`` never leaves a fresh ``-o`` file behind after an exit 2.
+"""
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -49,12 +55,53 @@ class _Progress:
             self.shown = False
 
 
+def check_output(path: str, option: str, *, blocks: int = 1, figure: bool = False) -> Path:
+    """Refuse an output path that cannot be written, before any work is done.
+
+    Checks the suffix (a format meshcore writes; ``figure``: an image), the
+    format's optional dependency, the number of blocks it holds, and that the
+    folder exists and is writable.  Raises :class:`InvalidInputError` naming
+    ``option`` and the path.
+    """
+    from ..errors import WriteError
+    from ..io import find_format
+
+    p = Path(path)
+    if p.is_dir():
+        raise InvalidInputError(f"{option} {p}: is a folder, not a file")
+    try:
+        fmt = find_format(p, None, role="write")
+    except WriteError as exc:
+        raise InvalidInputError(f"{option} {exc}") from None
+    if figure and fmt.name != "figure":
+        raise InvalidInputError(f"{option} {p}: expected a figure file (.png, .svg or .pdf)")
+    missing = fmt.missing()
+    if missing:
+        raise InvalidInputError(f"{option} {p}: {missing}")
+    if blocks > 1 and not fmt.multiblock:
+        raise InvalidInputError(
+            f"{option} {p}: the {fmt.name} format holds one block and this case has {blocks}; "
+            f"write .vtm, .cgns, .su2, .msh, .xyz, .npz or .csv"
+        )
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise InvalidInputError(f"{option} {p}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InvalidInputError(f"{option} {p}: cannot write in the folder {folder} (permission denied)")
+    return p
+
+
 def run(args: argparse.Namespace) -> int:
     from ..crs import frame_from_case  # also registers the case file's top-level `crs` key
     from ..io import write
     from ..quality import quality
 
     case = load_case(args.case)
+    n_blocks = len(getattr(case, "blocks", ()) or ())
+    if args.output:
+        check_output(args.output, "-o", blocks=n_blocks)
+    if args.png:
+        check_output(args.png, "--png", figure=True)
     frame = frame_from_case(case)
     overrides = {}
     if args.method:

@@ -6,6 +6,11 @@ code, moves the points to a local origin, picks the outline (the longest ring,
 or ``--polyline NAME``), four corners (``--corners`` or a guess along the
 principal axes) and cell counts (``--cells`` or roughly square cells), and
 writes a case file whose top-level ``crs`` table records the CRS and origin.
+
+Input is refused where it is typed: corner indices out of range, repeated or
+not in cyclic order, cell counts below 1 or beyond the node limit, an unknown
+CRS; an outline with islands inside it is refused unless ``--ignore-islands``
+(one structured block cannot leave an island out).
 """
 
 from __future__ import annotations
@@ -47,10 +52,54 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="name a border, e.g. bottom=inlet (repeatable)",
     )
     p.add_argument("--title", help="case title")
+    p.add_argument(
+        "--ignore-islands",
+        action="store_true",
+        help="grid over islands (inner rings) of the outline instead of refusing them",
+    )
+
+
+def _cells(values: list[int] | None) -> tuple[int, int] | None:
+    """``--cells NI NJ``, refused where typed: counts ≥ 1 and a grid within the node limit."""
+    from .._validation import check_grid_size, validate_count
+
+    if values is None:
+        return None
+    ni, nj = (validate_count(v, name=f"--cells {nm}") for v, nm in zip(values, ("NI", "NJ"), strict=True))
+    check_grid_size(ni, nj, what="--cells")
+    return ni, nj
+
+
+def _islands(outline, polylines) -> list:
+    """Closed rings lying inside ``outline`` (islands of a lake; holes of a polygon)."""
+    import shapely
+
+    poly = shapely.Polygon(outline.points)
+    if not poly.is_valid:
+        poly = poly.buffer(0)
+    out = []
+    for pl in polylines:
+        if pl is outline or not pl.closed or len(pl) < 3:
+            continue
+        if poly.contains(shapely.Point(*pl.points[0])) and shapely.Polygon(pl.points).area < poly.area:
+            out.append(pl)
+    return out
+
+
+def _corners(args: argparse.Namespace, loop, where: str) -> tuple[int, int, int, int]:
+    """``--corners`` checked where typed (in range, distinct, in cyclic order), or guessed."""
+    from ..boundary import borders_from_loop
+    from ..io.outline import guess_corners
+
+    if not args.corners:
+        return guess_corners(loop)
+    borders_from_loop(loop, args.corners, check_intersections=False, where=f"{where}: --corners")
+    return tuple(int(c) % len(loop) for c in args.corners)  # type: ignore[return-value]
 
 
 def run(args: argparse.Namespace) -> int:
     import re
+    import sys
     from pathlib import Path
 
     from ..boundary import BorderSpec
@@ -59,8 +108,15 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import InvalidInputError
     from ..grid import BORDER_NAMES
     from ..io import read_points
-    from ..io.outline import guess_cells, guess_corners
+    from ..io.outline import guess_cells
 
+    cells = _cells(args.cells)
+    specs = {}
+    for item in args.border_name:
+        b, _, nm = item.partition("=")
+        if b not in BORDER_NAMES or not nm:
+            raise InvalidInputError(f"--border-name expects BORDER=NAME with BORDER in {BORDER_NAMES}, got {item!r}")
+        specs[b] = BorderSpec(name=nm)
     ps = read_points(args.points, columns=args.columns)
     local, frame = project(ps, None if args.crs.lower() == "none" else args.crs, source_crs=args.source_crs)
     if args.polyline:
@@ -70,15 +126,26 @@ def run(args: argparse.Namespace) -> int:
     else:
         rings = [p for p in local.polylines if p.closed]
         pl = max(rings or list(local.polylines), key=len)
+    where = f"{args.points}: {pl.name!r}"
+    islands = _islands(pl, local.polylines) if pl.closed else []
+    if islands:
+        listed = ", ".join(repr(p.name) for p in islands[:3]) + (" …" if len(islands) > 3 else "")
+        if not args.ignore_islands:
+            raise InvalidInputError(
+                f"{where} has {len(islands)} island(s) inside it ({listed}); one structured block cannot "
+                f"leave them out: pass --ignore-islands to grid over them, or split the lake into blocks "
+                f"around them (a multiblock case)"
+            )
+        print(
+            f"meshcore import: warning: {where}: the grid covers {len(islands)} island(s) ({listed})", file=sys.stderr
+        )
     loop = pl.points
-    corners = tuple(args.corners) if args.corners else guess_corners(loop)
-    cells = tuple(args.cells) if args.cells else guess_cells(loop, corners)
-    specs = {}
-    for item in args.border_name:
-        b, _, nm = item.partition("=")
-        if b not in BORDER_NAMES or not nm:
-            raise InvalidInputError(f"--border-name expects BORDER=NAME with BORDER in {BORDER_NAMES}, got {item!r}")
-        specs[b] = BorderSpec(name=nm)
+    try:
+        corners = _corners(args, loop, where)
+        cells = cells or guess_cells(loop, corners)
+    except InvalidInputError as exc:
+        msg = str(exc)
+        raise type(exc)(msg if msg.startswith(where) else f"{where}: {msg}") from None
     name = args.name or re.sub(r"[^\w-]+", "_", pl.name).strip("_") or "lake"
     crs_tbl = frame.as_dict()
     crs_tbl["source"] = str(Path(args.points).name)

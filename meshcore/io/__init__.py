@@ -82,6 +82,19 @@ class Format:
     crs: bool = False
     markers: bool = False
     multiblock: bool = False
+    #: ``(module, extra)`` of an optional dependency the format needs, e.g. ``("h5py", "io")``
+    requires: tuple[str, str] | None = None
+
+    def missing(self) -> str | None:
+        """``None`` when the format can be used, else one line naming the extra to install."""
+        if self.requires is None:
+            return None
+        import importlib.util
+
+        module, extra = self.requires
+        if importlib.util.find_spec(module) is not None:
+            return None
+        return f"{self.name} files need {module}: pip install 'gcmesh[{extra}]'"
 
     def _load(self, spec: str):
         mod, fn = spec.split(":")
@@ -164,6 +177,7 @@ for _f in (
         crs=True,
         markers=True,
         multiblock=True,
+        requires=("h5py", "io"),
     ),
     Format(
         "gmsh",
@@ -199,7 +213,14 @@ for _f in (
         grid_reader="sgrid:read_sgrid",
         crs=True,
     ),
-    Format("figure", (".png", ".svg", ".pdf"), "figure (matplotlib)", writer="figure:write_figure", multiblock=True),
+    Format(
+        "figure",
+        (".png", ".svg", ".pdf"),
+        "figure (matplotlib)",
+        writer="figure:write_figure",
+        multiblock=True,
+        requires=("matplotlib", "plot"),
+    ),
 ):
     register_format(_f)
 
@@ -317,6 +338,9 @@ def read_blocks(path: Any, *, format: str | None = None, **options: Any) -> Grid
             raise ReadError(f"{p}: no such file")
         if p.is_dir():
             raise ReadError(f"{p}: is a directory, not a {fmt.name} file")
+        missing = fmt.missing()
+        if missing:
+            raise ReadError(f"{p}: {missing}")
         return fmt._load(fmt.grid_reader)(p, **options)
 
 
@@ -431,6 +455,9 @@ def write(
         gs = GridSet(blocks, as_frame(crs, origin), names, coerce_interfaces(connectivity, blocks, conn_names))
     if len(gs.blocks) > 1 and not fmt.multiblock:
         raise WriteError(f"{p}: the {fmt.name} format holds one block, got {len(gs.blocks)}")
+    missing = fmt.missing()
+    if missing:
+        raise WriteError(f"{p}: {missing}")
     fmt._load(fmt.writer)(p, gs, **options)
     return p
 

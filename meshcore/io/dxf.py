@@ -33,7 +33,7 @@ def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None
         import ezdxf
         from ezdxf.lldxf.const import DXFError
     except ImportError as exc:  # pragma: no cover
-        raise ReadError(f"{path}: reading DXF needs ezdxf (pip install 'gcmesh[io]')") from exc
+        raise ReadError(f"{path}: reading DXF needs ezdxf (pip install ezdxf)") from exc
     if not path.exists():
         raise ReadError(f"{path}: no such file")
     if path.stat().st_size == 0:

@@ -22,7 +22,7 @@ def write_figure(path: Path, gs: GridSet, *, dpi: int = 150, title: str | None =
     try:
         from matplotlib.figure import Figure
     except ImportError as exc:  # pragma: no cover
-        raise WriteError(f"{path}: figures need matplotlib (pip install 'gcmesh[plot]')") from exc
+        raise WriteError(f"{path}: figures need matplotlib: pip install 'gcmesh[plot]'") from exc
     fmt = Path(path).suffix.lower().lstrip(".")
     fig = Figure(figsize=options.pop("figsize", (7, 6)))
     ax = fig.add_subplot()

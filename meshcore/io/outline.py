@@ -33,8 +33,9 @@ def outline_loop(pointset: Any, name: str | None = None) -> np.ndarray:
 
 
 def _ccw(loop: np.ndarray) -> bool:
-    c = loop - loop.mean(axis=0)
-    return float(np.sum(c[:, 0] * np.roll(c[:, 1], -1) - np.roll(c[:, 0], -1) * c[:, 1])) > 0
+    from ..boundary import signed_area
+
+    return signed_area(loop) > 0
 
 
 def guess_corners(loop: Any) -> tuple[int, int, int, int]:
@@ -59,12 +60,17 @@ def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, ni: int = 40) 
 
     def length(a: int, b: int) -> float:
         k, tot = a, 0.0
-        while k != b:
+        for _ in range(n):  # at most once around the loop
+            if k == b:
+                break
             tot += seg[k] if ccw else seg[(k - 1) % n]
             k = (k + 1) % n if ccw else (k - 1) % n
         return tot
 
-    sw, se, ne, nw = corners
+    try:
+        sw, se, ne, nw = (int(c) % n for c in corners)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"corners must be 4 integer point indices, got {corners!r}") from None
     bt = 0.5 * (length(sw, se) + length(ne, nw))
     lr = 0.5 * (length(se, ne) + length(nw, sw))
     nj = max(2, round(ni * lr / bt)) if bt > 0 else ni

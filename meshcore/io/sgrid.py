@@ -140,7 +140,7 @@ def read_sgrid(path: Path, **_: Any) -> GridSet:
         try:
             import netCDF4
         except ImportError as exc:  # pragma: no cover
-            raise ReadError(f"{path}: NetCDF-4 files need netCDF4") from exc
+            raise ReadError(f"{path}: NetCDF-4 files need netCDF4: pip install 'gcmesh[io]'") from exc
         with netCDF4.Dataset(str(path)) as f:
             f.set_auto_mask(False)
             return _from_vars(path, f.variables)

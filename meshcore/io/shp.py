@@ -34,7 +34,7 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     try:
         import shapefile  # pyshp
     except ImportError as exc:  # pragma: no cover
-        raise ReadError(f"{path}: reading shapefiles needs pyshp (pip install 'gcmesh[io]')") from exc
+        raise ReadError(f"{path}: reading shapefiles needs pyshp (pip install pyshp)") from exc
     if not path.exists():
         raise ReadError(f"{path}: no such file")
     shx, dbf = _sibling(path, ".shx"), _sibling(path, ".dbf")

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import validate_count, validate_points
+from .._validation import check_allocation, max_nodes, validate_count, validate_points
 from ..boundary import Borders, signed_area
 from ..errors import InvalidInputError, TopologyError
 from .topology import Block, Interface, MultiBlockTopology, Side
@@ -292,6 +292,7 @@ def from_outline(
     block_corners: dict[str, list[tuple[float, float]]] = {}
     block_face: dict[str, int] = {}
     corner_set: set = set()
+    total_nodes = 0
     for s in specs:
         if len(s.corners) != 4:
             raise TopologyError(f"block {s.name!r}: needs 4 corners (sw, se, ne, nw), got {len(s.corners)}")
@@ -300,7 +301,10 @@ def from_outline(
             nj = validate_count(s.cells[1], name=f"block {s.name!r} cells nj")
         except (IndexError, TypeError):
             raise TopologyError(f"block {s.name!r}: cells must be [ni, nj], got {s.cells!r}") from None
-        del ni, nj
+        total_nodes += (ni + 1) * (nj + 1)
+        check_allocation(
+            total_nodes, max_nodes(), what=f"nodes of the blocks up to {s.name!r}", env="MESHCORE_MAX_NODES"
+        )
         cs = []
         for lab, c in zip(("sw", "se", "ne", "nw"), s.corners, strict=True):
             if isinstance(c, (int, np.integer)):

@@ -205,3 +205,21 @@ def test_bad_limit_variable_is_one_clear_error(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("MESHCORE_MAX_NODES", "lots")
     assert main(["quality", str(f)]) == 2
     assert "MESHCORE_MAX_NODES must be a positive integer" in capsys.readouterr().err
+
+
+def test_readme_promises_the_limits_the_code_has(monkeypatch):
+    from meshcore import _validation as v
+    from tests.conftest import ROOT
+
+    for name in ("MESHCORE_MAX_NODES", "MESHCORE_MAX_POINTS", "MESHCORE_MAX_BYTES"):
+        monkeypatch.delenv(name, raising=False)
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    promise = text[text.index("## What we promise") :]
+    assert v.max_nodes() == 2**24 and "2²⁴ = 16 777 216" in promise
+    assert v.max_points() == 5_000_000 and "| 5 000 000 |" in promise
+    assert v.max_bytes() == 512 * 2**20 and "512 MiB" in promise
+    assert v.MAX_COORDINATE == 1e100 and "≤ 1e100" in promise and f"≥ {v.MIN_EXTENT:g}" in promise
+    from meshcore.io import dxf, kml
+
+    assert dxf.SPLINE_MAX_POINTS == 200_000 and "| 200 000 (a larger" in promise
+    assert kml.KMZ_LIMIT == 64 * 2**20 and "KMZ: 64 MiB" in promise
