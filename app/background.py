@@ -89,13 +89,13 @@ class BackgroundController(QtCore.QObject):
             self.win.set_tool("pan")
             return
         answer = _TrueCoordinatesDialog(self.win, pair, self.doc.project.crs).ask()
+        self.win.set_tool("draw")  # first: its tip would hide the outcome in the status bar
         if answer is not None:
             true, lonlat = answer
             try:
                 self.calibrate(pair, true, lonlat=lonlat)
             except (ValueError, MeshcoreError) as exc:
                 self.win.error("Calibration", exc)
-        self.win.set_tool("draw")
 
     def calibrate(self, shown, true, *, lonlat: bool = False) -> None:
         """Move the background so that the two ``shown`` model points land on ``true``.
