@@ -195,11 +195,20 @@ class Editor:
         )
 
     def set_corners(self, corners) -> None:
+        """Set the corners; the first corners of a block still at the default cell counts give it
+        counts in proportion to its borders (said in the status bar), typed counts are kept."""
         b = self.doc.block
         cells = b.cells
-        if corners is not None and b.corners is None and b.boundary is None:
+        if corners is not None and b.corners is None and b.boundary is None and b.cells == Block().cells:
             cells = pj.default_cells(b.points, tuple(corners), total=max(b.cells))
         self._edit_block(SetCorners, lambda bb: pj.with_corners(bb, corners).replaced(cells=cells), "Set corners")
+        if cells != b.cells and self.doc.block.cells == cells:
+            text = (
+                f"Cells {cells[0]}×{cells[1]} in proportion to the borders (were {b.cells[0]}×{b.cells[1]}); "
+                "type other counts in Parameters — typed counts are kept"
+            )
+            self.doc.message.emit(text)
+            self.doc.report("info", f"{b.name}: {text}")
 
     # ---------------------------------------------------------- options
     def set_block_options(self, merge_key=None, index: int | None = None, **kw) -> None:

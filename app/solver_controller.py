@@ -62,6 +62,7 @@ class SolverController(QtCore.QObject):
         self._run = 0
         self._stop_event: threading.Event | None = None
         self._latest: dict[int, tuple[object, StructuredGrid]] = {}
+        self._smoothed: set[int] = set()
         self._dirty = False
         self.state = "idle"
         self.t_start = 0.0
@@ -123,6 +124,7 @@ class SolverController(QtCore.QObject):
         ev = threading.Event()
         self._stop_event = ev
         self._latest = {}
+        self._smoothed = set()  # blocks whose snapshots of this run are on screen
         worker = create_worker(_run, self._run, project, warm, ev, self.smooth, _start_thread=False)
         worker.yielded.connect(self._on_yielded)
         worker.returned.connect(self._on_returned)
@@ -223,12 +225,20 @@ class SolverController(QtCore.QObject):
                 self.progress.emit(k, item)
                 continue
             grid = item.grid if isinstance(item, SolverProgress) else item
+            if not isinstance(item, SolverProgress) and self._showing(k, grid):
+                continue  # a start grid never replaces a smoothed grid on screen (no flicker in a drag)
             self.doc.grids[k] = grid
             self.doc.initial[k] = g0
             if isinstance(item, SolverProgress):
+                self._smoothed.add(k)
                 self.progress.emit(k, item)
         self.doc.grids_changed.emit()
         self.redrawn.emit()
+
+    def _showing(self, k: int, grid: StructuredGrid) -> bool:
+        """True when block ``k`` already shows a grid of this shape (from an earlier solve)."""
+        old = self.doc.grids.get(k)
+        return old is not None and old.shape == grid.shape
 
     @QtCore.Slot(object)
     def _on_returned(self, value) -> None:
@@ -243,7 +253,9 @@ class SolverController(QtCore.QObject):
             # an edit arrived while solving: keep this iterate as the warm start, go again
             if result is not None:
                 for k, g in result.grids.items():
-                    if k in result.initial:
+                    # only an iterate that was already on screen: one stopped right after its start
+                    # is close to the algebraic grid, and the shown (A, G) pair stays the warm start
+                    if k in result.initial and (k in self._smoothed or k not in self.doc.grids):
                         self.doc.grids[k] = g
                         self.doc.initial[k] = result.initial[k]
                 self.doc.grids_changed.emit()

@@ -272,3 +272,46 @@ def test_calibration_by_longitude_and_latitude(qtbot, win, tmp_path, with_crs):
         assert (z.real + p.origin[0], z.imag + p.origin[1]) == pytest.approx((e, n), abs=1e-6)
     win.stack.undo()  # one step: the image and the frame it brought
     assert win.doc.project.crs == ("EPSG:32632" if with_crs else "")
+
+
+# ------------------------------------------------------------------ flicker
+def test_a_drag_with_auto_generate_never_shows_the_start_grid(qtbot, win):
+    from app.bench import _is_start
+
+    win.io.open_example("annulus-sector", confirm=False)
+    win.a_auto.trigger()
+    wait_idle(qtbot, win)
+    assert win.doc.grid is not None
+    frames = []
+    win.doc.grids_changed.connect(lambda: frames.append(_is_start(win.doc.grids.get(0), win.doc.initial.get(0))))
+    k = int(win.doc.block.corners[2])
+    p = np.array(win.doc.block.points[k])
+    drag = win.editor.new_drag_id()
+    for t in np.linspace(0, 1, 8)[1:]:
+        win.doc.initial.pop(0, None)  # as when the warm start is refused: each solve starts cold
+        win.editor.set_points([k], [p + t * np.array([0.2, 0.1])], drag_id=drag)
+        qtbot.wait(30)
+    wait_idle(qtbot, win)
+    assert frames and not any(frames)  # redraws happened, none of them the algebraic grid
+    assert win.doc.grid.converged
+
+
+def test_typed_cells_survive_setting_corners(qtbot, win):
+    square = [(0, 0), (4, 0), (8, 0), (8, 2), (4, 2), (0, 2.0)]
+    for xy in square:
+        win.editor.add_point(xy)
+    win.editor.close_loop()
+    win.params_panel.ni.setValue(20)
+    win.params_panel.nj.setValue(6)
+    win.editor.set_corners((0, 2, 3, 5))
+    assert win.doc.block.cells == (20, 6)  # what the user typed
+    # a block nobody typed counts for gets counts in proportion to its borders, and is told so
+    win.editor.add_block()
+    for xy in square:
+        win.editor.add_point(xy)
+    win.editor.close_loop()
+    before = win.doc.block.cells
+    win.editor.set_corners((0, 2, 3, 5))
+    ni, nj = win.doc.block.cells
+    assert (ni, nj) != before and ni > nj  # 8 long, 2 wide
+    assert f"Cells {ni}×{nj}" in win._status.text()
