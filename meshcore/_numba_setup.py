@@ -1,19 +1,53 @@
-"""Make numba's on-disk cache work in read-only installs.
+"""Where numba caches meshcore's compiled kernels, and keeping that cache consistent.
 
-numba caches compiled kernels next to the source (``__pycache__``).  When the
-package directory is not writable numba falls back to ``$HOME/.cache/numba``;
-when neither is writable, ``@njit(cache=True)`` makes the *import* fail
-("no locator available").  Before any kernel module is imported we therefore
-check, and if needed point ``NUMBA_CACHE_DIR`` at a writable directory
-(``$XDG_CACHE_HOME/gcmesh-numba``, ``~/.cache/gcmesh-numba`` or the system temp
-directory).  A user-set ``NUMBA_CACHE_DIR`` is always respected.
+numba caches compiled kernels on disk: next to the source
+(``meshcore/<package>/__pycache__/*.nbi, *.nbc``) or, when ``NUMBA_CACHE_DIR``
+is set, in ``$NUMBA_CACHE_DIR/<package>_<hash of its path>/``.  This module
+runs before any kernel module is imported and does two things:
+
+* **Read-only installs.**  When the package directory is not writable numba
+  falls back to ``$HOME/.cache/numba``; when neither is writable,
+  ``@njit(cache=True)`` makes the *import* fail ("no locator available").  We
+  therefore check, and if needed point ``NUMBA_CACHE_DIR`` at a writable
+  directory (``$XDG_CACHE_HOME/gcmesh-numba``, ``~/.cache/gcmesh-numba`` or the
+  system temp directory).  A user-set ``NUMBA_CACHE_DIR`` is always respected.
+* **Stale kernels.**  numba keys each cached function on its *own* source
+  file only, but meshcore's kernels inline functions from other files (the
+  one Winslow stencil, :mod:`meshcore.elliptic._stencil`).  After an edit of
+  such a file numba would load kernels compiled with the old code.  The stamp
+  (modification time and size) of every kernel module is recorded next to the
+  cache (``gcmesh-kernels.stamp``); when it changes, the cached kernels of all
+  of them are removed and compile again on first use.
+
+``scripts/setup.sh`` compiles every kernel once (:func:`meshcore.elliptic.warmup`),
+so that the first solve in a new environment loads them instead of compiling.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import tempfile
 from pathlib import Path
+
+__all__ = ["KERNEL_MODULES", "cache_dir", "cache_dirs"]
+
+_ROOT = Path(__file__).parent
+
+#: Every module with numba kernels (relative to the package): they call each other.
+KERNEL_MODULES = (
+    "elliptic/_stencil.py",
+    "elliptic/_compile.py",
+    "elliptic/_kernels.py",
+    "elliptic/_mg_relax.py",
+    "elliptic/_mg_defect.py",
+    "elliptic/_mg_transfer.py",
+    "elliptic/_mg_fused.py",
+    "elliptic/_mg_lines.py",
+    "multiblock/_kernels.py",
+    "foldfree/_kernels.py",
+)
+STAMP_NAME = "gcmesh-kernels.stamp"
 
 
 def _writable(d: Path) -> bool:
@@ -28,17 +62,61 @@ def _writable(d: Path) -> bool:
 
 
 def cache_dir() -> str:
-    """The directory numba uses for meshcore's compiled kernels."""
-    env = os.environ.get("NUMBA_CACHE_DIR")
-    if env:
-        return env
-    return str(Path(__file__).parent / "elliptic" / "__pycache__")
+    """The directory numba uses for the single-block solver's compiled kernels."""
+    return str(cache_dirs()[0])
+
+
+def cache_dirs() -> list[Path]:
+    """The cache directory of each package with kernels (numba's own rule, see above)."""
+    base = os.environ.get("NUMBA_CACHE_DIR")
+    out = []
+    for pkg in sorted({Path(m).parent.name for m in KERNEL_MODULES}, key=lambda p: p != "elliptic"):
+        src = _ROOT / pkg
+        if base:
+            path = os.path.abspath(src)
+            out.append(Path(base) / f"{src.name}_{hashlib.sha1(path.encode()).hexdigest()}")
+        else:
+            out.append(src / "__pycache__")
+    return out
+
+
+def _stamp() -> str:
+    parts = []
+    for rel in KERNEL_MODULES:
+        try:
+            st = (_ROOT / rel).stat()
+        except OSError:
+            continue
+        parts.append(f"{rel}:{st.st_mtime_ns}:{st.st_size}")
+    return hashlib.sha1("|".join(parts).encode()).hexdigest()
+
+
+def _purge_stale() -> None:
+    """Remove cached kernels compiled from other versions of the kernel modules."""
+    stamp = _stamp()
+    stems = {Path(m).stem for m in KERNEL_MODULES}
+    for d in cache_dirs():
+        marker = d / STAMP_NAME
+        try:
+            if marker.read_text() == stamp:
+                continue
+        except OSError:
+            pass
+        if not d.is_dir():
+            continue
+        try:
+            for f in d.iterdir():
+                if f.suffix in (".nbi", ".nbc") and f.name.split(".", 1)[0] in stems:
+                    f.unlink(missing_ok=True)
+            marker.write_text(stamp)
+        except OSError:  # read-only cache: numba recompiles in memory if needed
+            pass
 
 
 def _configure() -> None:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    if _writable(Path(__file__).parent / "elliptic" / "__pycache__"):
+    if _writable(_ROOT / "elliptic" / "__pycache__"):
         return
     candidates = []
     if os.environ.get("XDG_CACHE_HOME"):
@@ -60,3 +138,4 @@ def _configure() -> None:
 
 
 _configure()
+_purge_stale()

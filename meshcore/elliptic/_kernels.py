@@ -1,8 +1,8 @@
 r"""numba kernels for the elliptic grid equations (functions only, no state).
 
-Discrete equations (paper eq. 30 with the errata in NOTES.md), at an interior
-node P with neighbours E = (i+1, j), W = (i−1, j), N = (i, j+1), S = (i, j−1)
-and Δξ = Δη = 1:
+Discrete equations (paper eq. 30 with the errata in NOTES.md, written once in
+:func:`._stencil.winslow`), at an interior node P with neighbours
+E = (i+1, j), W = (i−1, j), N = (i, j+1), S = (i, j−1) and Δξ = Δη = 1:
 
 .. math::
 
@@ -34,11 +34,12 @@ column 0 is column ``ni − 1`` and after each colour column ``ni`` is refreshed
 
 from __future__ import annotations
 
-import types
-
 import numba
 import numpy as np
 from numba import njit, prange
+
+from ._compile import parallel, serial
+from ._stencil import winslow_at, with_sources
 
 __all__ = ["jacobi_residual", "sweep4", "sweep4_parallel"]
 
@@ -63,35 +64,11 @@ def _sweep4(x, y, p, q, omega, periodic):  # pragma: no cover - compiled
                 ie = i + 1
                 rmax = 0.0
                 for j in range(1 + cj, nj1 - 1, 2):
-                    xe = x[ie, j]
-                    xw = x[iw, j]
-                    xn = x[i, j + 1]
-                    xs = x[i, j - 1]
-                    ye = y[ie, j]
-                    yw = y[iw, j]
-                    yn = y[i, j + 1]
-                    ys = y[i, j - 1]
-                    xxi = 0.5 * (xe - xw)
-                    yxi = 0.5 * (ye - yw)
-                    xet = 0.5 * (xn - xs)
-                    yet = 0.5 * (yn - ys)
-                    a = xet * xet + yet * yet
-                    b = xxi * xet + yxi * yet
-                    g = xxi * xxi + yxi * yxi
-                    den = 2.0 * (a + g)
+                    rx, ry, den, xxi, yxi, xet, yet = winslow_at(x, y, i, iw, ie, j)
+                    if use_pq:
+                        rx, ry = with_sources(rx, ry, xxi, yxi, xet, yet, p[i, j], q[i, j])
                     if den <= 0.0:
                         continue
-                    cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
-                    cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
-                    rx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-                    ry = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-                    if use_pq:
-                        d = xxi * yet - xet * yxi
-                        d2 = d * d
-                        pp = p[i, j]
-                        qq = q[i, j]
-                        rx += d2 * (pp * xxi + qq * xet)
-                        ry += d2 * (pp * yxi + qq * yet)
                     dx = omega * (rx / den - x[i, j])
                     dy = omega * (ry / den - y[i, j])
                     x[i, j] += dx
@@ -110,16 +87,8 @@ def _sweep4(x, y, p, q, omega, periodic):  # pragma: no cover - compiled
     return np.sqrt(dmax)
 
 
-def _renamed(fn, suffix):
-    """A copy of ``fn`` with its own name (see :func:`._mg_kernels._renamed`: numba's
-    disk cache does not tell the serial and ``parallel=True`` compilations apart)."""
-    out = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + suffix, fn.__defaults__, fn.__closure__)
-    out.__qualname__ = fn.__qualname__ + suffix
-    return out
-
-
-sweep4 = njit(cache=True, nogil=True)(_renamed(_sweep4, "_serial"))
-sweep4_parallel = njit(cache=True, nogil=True, parallel=True)(_renamed(_sweep4, "_parallel"))
+sweep4 = serial(_sweep4)
+sweep4_parallel = parallel(_sweep4)
 
 
 @njit(cache=True, nogil=True)
@@ -140,35 +109,13 @@ def jacobi_residual(x, y, p, q, periodic):  # pragma: no cover - compiled
             iw = ni1 - 2
         ie = i + 1
         for j in range(1, nj1 - 1):
-            xe = x[ie, j]
-            xw = x[iw, j]
-            xn = x[i, j + 1]
-            xs = x[i, j - 1]
-            ye = y[ie, j]
-            yw = y[iw, j]
-            yn = y[i, j + 1]
-            ys = y[i, j - 1]
-            xxi = 0.5 * (xe - xw)
-            yxi = 0.5 * (ye - yw)
-            xet = 0.5 * (xn - xs)
-            yet = 0.5 * (yn - ys)
-            a = xet * xet + yet * yet
-            b = xxi * xet + yxi * yet
-            g = xxi * xxi + yxi * yxi
-            den = 2.0 * (a + g)
+            rx, ry, den, xxi, yxi, xet, yet = winslow_at(x, y, i, iw, ie, j)
+            if use_pq:
+                rx, ry = with_sources(rx, ry, xxi, yxi, xet, yet, p[i, j], q[i, j])
             if not den > 0.0:
                 if den != den:
                     return np.inf
                 continue
-            cx = x[ie, j + 1] - x[iw, j + 1] - x[ie, j - 1] + x[iw, j - 1]
-            cy = y[ie, j + 1] - y[iw, j + 1] - y[ie, j - 1] + y[iw, j - 1]
-            rx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-            ry = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-            if use_pq:
-                d = xxi * yet - xet * yxi
-                d2 = d * d
-                rx += d2 * (p[i, j] * xxi + q[i, j] * xet)
-                ry += d2 * (p[i, j] * yxi + q[i, j] * yet)
             dx = rx / den - x[i, j]
             dy = ry / den - y[i, j]
             m = dx * dx + dy * dy

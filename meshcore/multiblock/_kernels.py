@@ -4,7 +4,7 @@ All blocks are assembled into one node array ``x, y`` (each shared node stored
 once).  A free *regular* node ``n = nodes[k]`` has exactly four cells around
 it; ``nbr[k] = (E, W, N, S, NE, NW, SE, SW)`` are its eight neighbours in a
 local frame taken from its ring of cells (see :mod:`.topology`).  Its update is
-the single-block Winslow stencil of :mod:`meshcore.elliptic._kernels` with
+the single-block Winslow stencil (:func:`meshcore.elliptic._stencil.winslow`) with
 P = Q = 0:
 
 .. math::
@@ -29,33 +29,20 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..elliptic._stencil import winslow
+
 __all__ = ["table_defect", "table_residual", "table_sweep", "table_sweep_rhs"]
 
 
 @njit(cache=True, nogil=True)
 def _update(x, y, nb):  # pragma: no cover - compiled
+    """:func:`~meshcore.elliptic._stencil.winslow` at a regular node with neighbours ``nb``."""
     e, w, n, s, ne, nw, se, sw = nb[0], nb[1], nb[2], nb[3], nb[4], nb[5], nb[6], nb[7]
-    xe = x[e]
-    xw = x[w]
-    xn = x[n]
-    xs = x[s]
-    ye = y[e]
-    yw = y[w]
-    yn = y[n]
-    ys = y[s]
-    xxi = 0.5 * (xe - xw)
-    yxi = 0.5 * (ye - yw)
-    xet = 0.5 * (xn - xs)
-    yet = 0.5 * (yn - ys)
-    a = xet * xet + yet * yet
-    b = xxi * xet + yxi * yet
-    g = xxi * xxi + yxi * yxi
-    den = 2.0 * (a + g)
-    cx = x[ne] - x[nw] - x[se] + x[sw]
-    cy = y[ne] - y[nw] - y[se] + y[sw]
-    rx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * cx
-    ry = a * (ye + yw) + g * (yn + ys) - 0.5 * b * cy
-    return rx, ry, den
+    sx, sy, den, _, _, _, _ = winslow(
+        x[e], x[w], x[n], x[s], x[ne], x[nw], x[se], x[sw],
+        y[e], y[w], y[n], y[s], y[ne], y[nw], y[se], y[sw],
+    )  # fmt: skip
+    return sx, sy, den
 
 
 @njit(cache=True, nogil=True)

@@ -56,6 +56,7 @@ def _random_grid(rng, ni, nj, periodic=False):
     return np.ascontiguousarray(X), np.ascontiguousarray(Y)
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize("periodic", [False, True])
 @pytest.mark.parametrize("with_pq", [False, True])
 def test_kernel_matches_numpy_reference(periodic, with_pq):

@@ -69,6 +69,7 @@ def random_grid(ni=7, nj=5, amp=0.15, seed=0):
 
 
 # ---------------------------------------------------------------- kernels vs oracle
+@pytest.mark.kernel
 @pytest.mark.parametrize("eps", [0.0, 1e-3, 0.05])
 def test_node_gradient_matches_reference(eps):
     x, y = random_grid(seed=3)
@@ -160,6 +161,7 @@ def o_grid(ni=48, nj=12):
     return X, Y
 
 
+@pytest.mark.kernel
 def test_periodic_seam_gradient_matches_reference():
     x, y = o_grid()
     x[0, 5] += 0.05

@@ -158,6 +158,7 @@ def test_single_block_topology_matches_block_solver(rect):
 
 
 # ---------------------------------------------------------------- kernels
+@pytest.mark.kernel
 def test_table_kernel_matches_numpy_reference_and_block_kernel(rect):
     X, Y, _ = rect
     topo = four_blocks(X, Y, 14, 5)
@@ -779,6 +780,7 @@ def test_multigrid_hierarchy_and_convergence(rect):
         assert np.abs(g.x - k.x).max() < 1e-7 * ref.size
 
 
+@pytest.mark.kernel
 def test_multigrid_kernels_match_reference():
     """table_defect with f = 0 equals the NumPy Jacobi targets minus u."""
     topo = star(5)

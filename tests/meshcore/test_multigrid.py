@@ -132,6 +132,7 @@ def test_transfer_tables_interpolate_linear_functions_and_restrict_constants(n, 
 
 
 # -------------------------------------------------------------- kernels
+@pytest.mark.kernel
 def test_smoother_is_the_4_colour_gauss_seidel_sweep():
     rng = np.random.default_rng(3)
     # (.., 200): rows long enough for the vectorised row update (VECTOR_ROW)
@@ -151,6 +152,7 @@ def test_smoother_is_the_4_colour_gauss_seidel_sweep():
         np.testing.assert_allclose(a[1], b[1], rtol=0, atol=1e-12)
 
 
+@pytest.mark.kernel
 def test_defect_is_the_jacobi_displacement_times_the_diagonal_and_rhs_shifts_it():
     rng = np.random.default_rng(4)
     X, Y = np.meshgrid(np.arange(14.0), np.arange(9.0), indexing="ij")
@@ -180,6 +182,7 @@ def test_defect_is_the_jacobi_displacement_times_the_diagonal_and_rhs_shifts_it(
     np.testing.assert_allclose(fy2, -ry, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.kernel
 def test_defect_measure_is_infinite_when_any_node_is_nan():
     X, Y = np.meshgrid(np.arange(60.0), np.arange(50.0), indexing="ij")
     rx, ry = np.empty_like(X), np.empty_like(X)
@@ -191,6 +194,7 @@ def test_defect_measure_is_infinite_when_any_node_is_nan():
         assert _kernels.jacobi_residual(Xn, Y, E, E, False) == np.inf
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize("ni, nj", [(11, 8), (12, 8), (13, 9)])
 def test_restriction_and_prolongation_are_the_tensor_products_of_the_tables(ni, nj):
     rng = np.random.default_rng(5)
@@ -220,6 +224,7 @@ def test_restriction_and_prolongation_are_the_tensor_products_of_the_tables(ni, 
     np.testing.assert_allclose(x, want, rtol=0, atol=1e-12)
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize("ni, nj", [(40, 34), (101, 57), (64, 33)])
 def test_fused_defect_restriction_is_defect_then_restriction(ni, nj):
     """No fine defect arrays: the same numbers bit for bit (nested and non-nested tables)."""
@@ -524,6 +529,7 @@ def test_full_ring_with_a_fixed_cut_does_not_coarsen_into_a_degenerate_ring(cell
     _compare_with_sor(g0)
 
 
+@pytest.mark.kernel
 def test_band_smoother_is_gauss_seidel_restricted_to_the_border_band():
     rng = np.random.default_rng(8)
     X, Y = np.meshgrid(np.arange(31.0), np.arange(27.0), indexing="ij")
