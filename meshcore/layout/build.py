@@ -1,0 +1,176 @@
+r"""The layout pipeline: a water polygon and a cell size in, four-cornered pieces out.
+
+1. :func:`~.skeleton.skeleton` — the pruned medial axis: arms, junctions, rings round islands;
+2. :func:`~.chords.place_chords` — cuts across the arms at right angles to the banks;
+3. :func:`~.regions.partition` — the regions between shore and cuts (islands cut free);
+4. :func:`~.split.best_split` — regions that are not four-sided are split at their reflex
+   corners (T, L, X shapes) or by a star from their junction (Y shapes);
+5. :func:`~.corners.choose_corners` — four corners per piece;
+6. :func:`~.blocks.conform` — every vertex inserted into the rings it lies on, so neighbours
+   share their common edges vertex for vertex (T-junctions explicit).
+
+Every length is relative to the cell size ``h`` (sampling ``h/2``, shortest cut ``2h``,
+narrowest piece ``3h``, corners read at the scale ``1.5h``) or to the local channel width;
+nothing depends on the units or on a particular lake.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .blocks import Piece, conform
+from .chords import Chord, place_chords
+from .corners import choose_corners
+from .regions import partition
+from .skeleton import Skeleton, skeleton
+from .split import _GOOD, best_split, forced_indices
+
+__all__ = ["layout_pieces"]
+
+
+def _densify(line: np.ndarray, step: float) -> np.ndarray:
+    import shapely
+
+    return np.asarray(shapely.segmentize(shapely.LineString(line), step).coords)
+
+
+def _insert_mid(r: np.ndarray) -> np.ndarray:
+    """Insert the midpoint of the longest edge (a triangle gets a fourth vertex)."""
+    L = np.hypot(*(np.roll(r, -1, axis=0) - r).T)
+    k = int(np.argmax(L))
+    return np.insert(r, k + 1, 0.5 * (r[k] + r[(k + 1) % len(r)]), axis=0)
+
+
+def _key(p) -> tuple[float, float]:
+    return (float(p[0]), float(p[1]))
+
+
+def _merged(a: np.ndarray, b: np.ndarray):
+    """The ring of ``a ∪ b`` when they share one contiguous run of edges, else None."""
+    na, nb = len(a), len(b)
+    pos_b = {_key(p): i for i, p in enumerate(b)}
+    shared = [
+        i
+        for i in range(na)
+        if _key(a[i]) in pos_b
+        and _key(a[(i + 1) % na]) in pos_b
+        and (pos_b[_key(a[i])] - pos_b[_key(a[(i + 1) % na])]) % nb == 1
+    ]
+    if not shared or len(shared) >= na - 1:
+        return None
+    # the shared run in a: edges i, i+1, …, j (cyclic, contiguous)
+    s = set(shared)
+    start = next(i for i in shared if (i - 1) % na not in s)
+    run = [start]
+    while (run[-1] + 1) % na in s:
+        run.append((run[-1] + 1) % na)
+    if len(run) != len(shared):
+        return None  # two separate contacts: the union would have a hole
+    p0, pk = start, (run[-1] + 1) % na  # a[p0] … a[pk] is the shared path
+    out = [a[(pk + t) % na] for t in range((p0 - pk) % na + 1)]  # a from pk round to p0
+    j0 = pos_b[_key(a[p0])]
+    jk = pos_b[_key(a[pk])]
+    out += [b[(j0 + t) % nb] for t in range(1, (jk - j0) % nb)]  # b from p0 round to pk
+    r = np.array(out)
+    return r if len(r) >= 4 else None
+
+
+def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
+    """Join neighbouring pieces whose union is a good four-sided block and no worse than the
+    two (a straight or gently curved arm cut by chords becomes one block again)."""
+    from .corners import choose_corners
+
+    rings, forced = list(rings), list(forced)
+    cost = [choose_corners(r, sigma)[1] for r in rings]
+    changed = True
+    while changed:
+        changed = False
+        for i in range(len(rings)):
+            for j in range(i + 1, len(rings)):
+                if forced[i] or forced[j]:
+                    continue
+                m = _merged(rings[i], rings[j])
+                if m is None:
+                    continue
+                c = choose_corners(m, sigma)[1]
+                if c <= min(cost[i] + cost[j], _GOOD) + 1e-9:
+                    rings[i], cost[i] = m, c
+                    del rings[j], cost[j], forced[j]
+                    changed = True
+                    break
+            if changed:
+                break
+    return rings, forced
+
+
+def layout_pieces(
+    poly, h: float, *, regular: bool = False
+) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
+    """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
+    (``regular``: only nodes where four blocks meet, see :func:`~.split.best_split`)."""
+    import shapely
+    from shapely.geometry import Point, Polygon
+
+    sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
+    chords = place_chords(poly, sk, min_length=2 * h)
+    dense = shapely.segmentize(poly, h)
+    regions, cuts = partition(dense, [_densify(c.points, h) for c in chords])
+    junctions = sk.nodes[sk.degree() >= 3]
+    sigma = 1.5 * h
+    rings: list[np.ndarray] = []
+    forced: list[tuple] = []
+    for r in regions:
+        P = Polygon(r)
+        inside = [j for j in junctions if P.contains(Point(j))]
+        centre = np.mean(inside, axis=0) if inside else None
+        pieces, new_cuts, _ = best_split(r, sigma=sigma, min_width=3 * h, center=centre, regular=regular)
+        rings += [p for p, _ in pieces]
+        forced += [f for _, f in pieces]
+        cuts += new_cuts
+    rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
+    rings, forced = _merge_strips(rings, forced, sigma)
+    corner_pts = []
+    for r, f in zip(rings, forced, strict=True):
+        c, _ = choose_corners(r, sigma, forced=forced_indices(r, f))
+        corner_pts.append([r[i] for i in c])
+    size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
+    rings = conform(rings, 1e-9 * size)
+    pieces = []
+    for r, cs in zip(rings, corner_pts, strict=True):
+        idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
+        pieces.append(Piece(r, idx))
+    pieces, cuts = _make_countable(pieces, cuts, h, size)
+    pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
+    return sk, chords, cuts, pieces
+
+
+def _countable(pieces: list[Piece], h: float) -> bool:
+    from ..errors import TopologyError
+    from .blocks import build_topology
+
+    try:
+        build_topology(pieces, h)
+    except TopologyError:
+        return False
+    return True
+
+
+def _make_countable(pieces: list[Piece], cuts: list, h: float, size: float):
+    """Continue T-junctions across their blocks while no integer cell counts exist."""
+    from .tjunction import extend_t_junctions
+
+    for _ in range(4 * len(pieces) + 4):
+        if _countable(pieces, h):
+            return pieces, cuts
+        new, new_cuts = extend_t_junctions(pieces)
+        if not new_cuts:
+            break
+        cuts = cuts + new_cuts
+        rings = conform([p.ring for p in new], 1e-9 * size)
+        pieces = [
+            Piece(r, tuple(sorted(int(np.argmin(np.hypot(*(r - p.ring[c]).T))) for c in p.corners)))
+            for r, p in zip(rings, new, strict=True)
+        ]
+    return pieces, cuts

@@ -1,0 +1,177 @@
+r"""Four corners for a region: where its boundary turns, measured at the scale of its cells.
+
+A block is four-sided: walking round it counter-clockwise the boundary turns by 360° in all,
+ideally 90° at each of its four corners and not at all in between.  For any region (a simple
+polygon) we choose the four corner vertices from the **cumulative turning** ``θ(s)``: the
+corners are where ``θ`` first reaches ``φ + 45° + 90° k`` (k = 0 … 3).  A rectangle's corners
+are found for every phase ``φ``; a rounded end is split evenly (its corners at 45° and 135° of
+its turn); the phase with the smallest cost is kept.
+
+The **cost** of a choice is what the grid pays for it: ``Σ (t − 90)²`` over the corners,
+``Σ t²`` over the other vertices whose turning is large (sharp bends left inside a side), with
+``t`` the turning at a vertex measured over a window of ``± sigma`` of arc length (so jagged
+shores are read at the scale of the cells, not of their vertices), plus a term for opposite
+sides of different lengths (:func:`side_cost`): the same number of cells on both.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["choose_corners", "corner_cost", "turning"]
+
+#: A vertex turning more than this (degrees, at scale) counts as a sharp feature.
+SHARP = 30.0
+
+
+def _arclength_closed(ring: np.ndarray) -> tuple[np.ndarray, float]:
+    seg = np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)
+    s = np.concatenate([[0.0], np.cumsum(seg[:-1])])
+    return s, float(seg.sum())
+
+
+def turning(ring: np.ndarray, sigma: float) -> np.ndarray:
+    """Turning angle (degrees, left = positive) at every vertex of a closed ring, at scale.
+
+    The direction before a vertex is that of the chord from the point ``sigma`` behind it
+    (along the ring) to the vertex, after it the chord to the point ``sigma`` ahead.
+    """
+    s, total = _arclength_closed(ring)
+    sigma = min(sigma, 0.25 * total)
+    xs = np.concatenate([s - total, s, s + total])
+    xp = np.vstack([ring, ring, ring])
+
+    def at(q):
+        return np.column_stack([np.interp(q, xs, xp[:, 0]), np.interp(q, xs, xp[:, 1])])
+
+    back = at(s - sigma)
+    ahead = at(s + sigma)
+    a = ring - back
+    b = ahead - ring
+    ang = np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
+    return ang
+
+
+def _raw_turning(ring: np.ndarray) -> np.ndarray:
+    a = ring - np.roll(ring, 1, axis=0)
+    b = np.roll(ring, -1, axis=0) - ring
+    return np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
+
+
+def corner_cost(t: np.ndarray, corners, near=None) -> float:
+    """Cost of taking ``corners`` (indices) as the corners, given turning ``t`` at every vertex.
+
+    ``(t − 90)²`` per corner, made steeper below 60° of turning (an angle above 120°): an
+    orthogonal grid squeezes its cells to nothing at a block corner on a nearly straight shore,
+    which is far worse than the angle alone says.  ``near`` (a mask) marks the vertices that
+    are close to a corner: they are not counted as bends of the sides.
+    """
+    mask = np.zeros(len(t), dtype=bool)
+    mask[list(corners)] = True
+    tc = t[mask]
+    flat = 1.0 + 2.0 * np.clip(60.0 - tc, 0.0, 60.0) / 60.0
+    # vertices within the window of a corner see part of its turn: not a bend of their own
+    side = t[~(mask | near)] if near is not None else t[~mask]
+    return float(((tc - 90.0) ** 2 * flat).sum() + (side[np.abs(side) > SHARP] ** 2).sum())
+
+
+#: Cost of opposite sides whose lengths differ by a factor e (a block whose sides differ a lot
+#: squeezes its cells on one side and stretches them on the other); 2× costs about as much as
+#: a corner 30° off.
+SIDE_WEIGHT = 2000.0
+
+
+def side_cost(s: np.ndarray, total: float, corners) -> float:
+    """``SIDE_WEIGHT × (log² (bottom/top) + log² (left/right))`` for corners at arc lengths."""
+    c = sorted(corners)
+    pos = [s[i] for i in c]
+    L = [(pos[(k + 1) % 4] - pos[k]) % total for k in range(4)]
+    if min(L) <= 0:
+        return math.inf
+    return SIDE_WEIGHT * (math.log(L[0] / L[2]) ** 2 + math.log(L[1] / L[3]) ** 2)
+
+
+def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float) -> list[int]:
+    """Vertices turning more than ``limit`` that are the largest within ``± sigma`` of arc length."""
+    order = np.argsort(-t)
+    taken: list[int] = []
+    for i in order:
+        if t[i] < limit:
+            break
+        if all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in taken):
+            taken.append(int(i))
+    return taken
+
+
+def _smooth_corners(raw: np.ndarray, a: int, b: int, m: int) -> list[int]:
+    """``m`` corners on the stretch of vertices strictly between ``a`` and ``b`` (cyclic), at the
+    quantiles ``(k + ½) / m`` of its total turning (a rounded end gets its corners at 45° and
+    135° of a 180° turn)."""
+    n = len(raw)
+    idx = [(a + k) % n for k in range(1, (b - a) % n if (b - a) % n else n)]
+    if len(idx) < m:
+        return []
+    cum = np.cumsum(np.maximum(raw[idx], 0.0))
+    total = cum[-1] if len(cum) else 0.0
+    out = []
+    for k in range(m):
+        level = (k + 0.5) / m * total
+        j = int(np.searchsorted(cum, level)) if total > 0 else int((k + 0.5) / m * len(idx))
+        j = min(max(j, 0), len(idx) - 1)
+        while idx[j] in out and j + 1 < len(idx):
+            j += 1
+        out.append(idx[j])
+    return out
+
+
+def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
+    """The four corner indices (increasing, counter-clockwise) of a CCW ring, and their cost.
+
+    Sharp corners (turning ≥ 45° at scale ``sigma``, at most one within ``± sigma``) are
+    taken first, the most turning first; ``forced`` vertices always count as sharp.  Missing
+    corners are placed on the smooth convex stretches in between, in proportion to how much
+    each stretch turns, at the quantiles of its turning.  Returns ``(None, inf)`` when the ring
+    has fewer than four vertices.
+    """
+    n = len(ring)
+    if n < 4:
+        return None, math.inf
+    t = turning(ring, sigma)
+    raw = _raw_turning(ring)
+    s, total = _arclength_closed(ring)
+    forced = sorted({int(f) for f in forced})
+    tt = t.copy()
+    tt[forced] = 1e9  # forced first
+    picks = _sharp_peaks(tt, s, total, min(sigma, 0.1 * total), 45.0)[:4]
+    if len(picks) < 4:
+        picks = sorted(picks)
+        missing = 4 - len(picks)
+        if not picks:
+            # a smooth oval: corners at the quantiles of the whole turn
+            picks = _smooth_corners(raw, 0, 0, 4)
+        else:
+            stretches = [(a, b) for a, b in zip(picks, picks[1:] + picks[:1], strict=True)]
+            turn = np.array(
+                [np.maximum(raw[[(a + k) % n for k in range(1, (b - a) % n or n)]], 0).sum() for a, b in stretches]
+            )
+            share = np.zeros(len(stretches), dtype=int)
+            for _ in range(missing):  # largest remaining turn per corner gets the next one
+                share[int(np.argmax(turn / (share + 1)))] += 1
+            extra = []
+            for (a, b), m in zip(stretches, share, strict=True):
+                if m:
+                    extra += _smooth_corners(raw, a, b, int(m))
+            picks = picks + extra
+    picks = sorted(set(picks))
+    if len(picks) != 4:
+        order = [int(i) for i in np.argsort(-t) if int(i) not in picks]
+        picks = sorted(set(picks + order[: 4 - len(picks)]))[:4]
+    if len(picks) != 4:
+        return None, math.inf
+    near = np.zeros(n, dtype=bool)
+    for c in picks:
+        d = np.abs(s - s[c])
+        near |= np.minimum(d, total - d) < sigma
+    return tuple(picks), corner_cost(t, picks, near) + side_cost(s, total, picks)

@@ -1,0 +1,150 @@
+r"""The water polygon: an outline and its islands, checked and cleaned once.
+
+Rules (every violation is an :class:`~meshcore.errors.InvalidInputError` naming the ring and
+the place):
+
+* rings need at least three distinct, finite points; a repeated closing point is dropped;
+* the outline must not cross itself; islands must lie inside it and must not cross or touch
+  it (an island touching the shore at a point is a peninsula: join it to the outline); islands
+  that touch each other are joined into one;
+* orientation is free: the outline is made counter-clockwise and islands clockwise;
+* islands smaller than ``drop_islands_below`` across (a few cells) are removed, with a note:
+  no grid of that cell size could go round them.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidInputError
+
+__all__ = ["water_polygon"]
+
+
+def _ring(points: Any, what: str) -> np.ndarray:
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{what}: expected (x, y) points, got {type(points).__name__}") from None
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise InvalidInputError(f"{what}: expected an (n, 2) array of points, got shape {p.shape}")
+    bad = np.flatnonzero(~np.isfinite(p).all(axis=1))
+    if len(bad):
+        raise InvalidInputError(f"{what}: point {bad[0] + 1} is not finite ({p[bad[0]].tolist()})")
+    if len(p) > 1 and np.array_equal(p[0], p[-1]):
+        p = p[:-1]
+    keep = np.concatenate([[True], np.any(np.diff(p, axis=0) != 0, axis=1)])
+    p = p[keep]
+    if len(p) < 3:
+        raise InvalidInputError(f"{what}: needs at least 3 distinct points, got {len(p)}")
+    return p
+
+
+def _crossing(ring: np.ndarray, what: str) -> None:
+    """Raise when the closed ring crosses itself, naming two crossing segments (from 1)."""
+    import shapely
+    from shapely.geometry import LinearRing
+
+    if LinearRing(ring).is_simple:
+        return
+    n = len(ring)
+    segs = shapely.linestrings(np.stack([ring, np.roll(ring, -1, axis=0)], axis=1))
+    tree = shapely.STRtree(segs)
+    i_idx, j_idx = tree.query(segs, predicate="intersects")
+    for i, j in zip(i_idx.tolist(), j_idx.tolist(), strict=True):
+        if j <= i or j == i + 1 or (i == 0 and j == n - 1):
+            continue
+        x = shapely.intersection(segs[i], segs[j]).representative_point()
+        raise InvalidInputError(
+            f"{what} crosses itself: the edge from point {i + 1} to {i % n + 2 if i + 1 < n else 1} "
+            f"meets the edge from point {j + 1} near ({x.x:.6g}, {x.y:.6g})"
+        )
+    raise InvalidInputError(f"{what} crosses itself ({shapely.is_valid_reason(shapely.Polygon(ring))})")
+
+
+def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 0.0):
+    """A valid shapely Polygon of the water and a list of notes about what was changed."""
+    from shapely.geometry import Polygon
+    from shapely.geometry.polygon import orient
+
+    notes: list[str] = []
+    if hasattr(outline, "exterior"):  # a shapely Polygon
+        if len(holes):
+            raise InvalidInputError("give the islands either as the polygon's holes or as holes=, not both")
+        holes = [np.asarray(h.coords) for h in outline.interiors]
+        outline = np.asarray(outline.exterior.coords)
+    outer = _ring(outline, "outline")
+    _crossing(outer, "the outline")
+    shell = Polygon(outer)
+    size = math.hypot(*(outer.max(axis=0) - outer.min(axis=0)))
+    rings = []
+    for k, h in enumerate(holes):
+        r = _ring(h, f"island {k + 1}")
+        _crossing(r, f"island {k + 1}")
+        isl = Polygon(r)
+        if not shell.contains(isl):
+            c = isl.representative_point()
+            raise InvalidInputError(
+                f"island {k + 1} (near {c.x:.6g}, {c.y:.6g}) is not inside the outline or touches it"
+            )
+        for j, other in enumerate(rings):
+            if Polygon(other).intersects(isl):  # touching islands are one island
+                merged = Polygon(other).union(isl)
+                if merged.geom_type != "Polygon":  # touching at points: close the pinch
+                    merged = merged.buffer(1e-7 * size, join_style="mitre").buffer(-0.5e-7 * size, join_style="mitre")
+                if merged.geom_type != "Polygon":
+                    raise InvalidInputError(f"islands {j + 1} and {k + 1} overlap in more than one place")
+                notes.append(f"islands {j + 1} and {k + 1} touch: joined into one")
+                rings[j] = np.asarray(merged.exterior.coords)[:-1]
+                isl = None
+                break
+        if isl is None:
+            continue
+        if drop_islands_below > 0:
+            width = 2.0 * isl.area / max(isl.length, 1e-300) * 2.0  # ≈ diameter of a round island
+            if width < drop_islands_below:
+                c = isl.representative_point()
+                notes.append(
+                    f"island {k + 1} near ({c.x:.6g}, {c.y:.6g}) is about {width:.3g} across, less than "
+                    f"{drop_islands_below:.3g} (two cells): too small for the grid to go round it; ignored"
+                )
+                continue
+        rings.append(r)
+    poly = orient(Polygon(outer, rings), 1.0)
+    if not poly.is_valid or poly.area <= 1e-12 * size * size:
+        import shapely
+
+        raise InvalidInputError(f"the water polygon is not valid ({shapely.is_valid_reason(poly)})")
+    return poly, notes
+
+
+def water_from_points(pointset: Any):
+    """Outline and islands from the polylines of a point file (projected already).
+
+    The ring with the largest area is the shore; every other ring must lie inside it (an
+    island).  Returns ``(outline, islands)`` as arrays.
+    """
+    from shapely.geometry import Polygon
+
+    rings = []
+    for k, pl in enumerate(pointset.polylines):
+        name = pl.name or f"polyline {k + 1}"
+        p = _ring(pl.points, f"{pointset.source or 'points'}: {name}")
+        rings.append((abs(Polygon(p).area), name, p))
+    if not rings:
+        raise InvalidInputError(f"{pointset.source or 'points'}: no outline")
+    rings.sort(key=lambda t: -t[0])
+    _, oname, outer = rings[0]
+    shell = Polygon(outer).buffer(0)
+    islands = []
+    for _, name, p in rings[1:]:
+        if not shell.contains(Polygon(p).representative_point()):
+            raise InvalidInputError(
+                f"{pointset.source or 'points'}: {name!r} lies outside the outline {oname!r} — one lake per "
+                f"file (islands are rings inside the shore)"
+            )
+        islands.append(p)
+    return outer, islands

@@ -1,0 +1,342 @@
+r"""Splitting a region that is not four-sided: cuts from reflex corners, or a star.
+
+A region whose boundary has more than four sharp turns (a junction of arms, an L, a bay)
+cannot be one block.  Two kinds of split are tried and the cheapest result is kept (cost:
+:func:`~.corners.choose_corners`, summed over the pieces):
+
+* **motorcycle cuts** — from a reflex corner (the shore turns right, into the water) a straight
+  cut continues one of the two shore lines that meet there, until it meets the other side of
+  the region; where it lands near another reflex corner it ends there.  This is how a T
+  junction becomes a through channel plus a side arm, an L two rectangles, an X a cross;
+* **a star** — from one interior point (the skeleton's junction) a straight spoke to each of
+  three to five reflex corners.  This is the symmetric Y: three blocks meeting at a point of
+  valence three.
+
+Splits are applied greedily (the best cut first, then the pieces again) while they lower the
+cost; a piece narrower than ``min_width`` is never made.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from .corners import SHARP, choose_corners, turning
+
+__all__ = ["best_split", "region_cost"]
+
+
+def _width(ring: np.ndarray) -> float:
+    """A width scale of a region: twice its area over its perimeter (exact for long strips)."""
+    from shapely.geometry import Polygon
+
+    p = Polygon(ring)
+    return 2.0 * p.area / max(p.length, 1e-300)
+
+
+def region_cost(ring: np.ndarray, sigma: float, forced=()) -> float:
+    """The corner cost of ``ring`` (``forced``: points that must be corners)."""
+    return choose_corners(ring, sigma, forced=forced_indices(ring, forced))[1]
+
+
+def forced_indices(ring: np.ndarray, points) -> list[int]:
+    """Indices of the ring vertices equal to ``points``."""
+    if not len(points):
+        return []
+    keys = {(float(p[0]), float(p[1])) for p in points}
+    return [i for i, q in enumerate(ring) if (float(q[0]), float(q[1])) in keys]
+
+
+def _ray_to_boundary(ring: np.ndarray, v: int, d: np.ndarray):
+    """First crossing of the ray from vertex ``v`` along ``d`` with the ring's other edges."""
+    n = len(ring)
+    c = ring[v]
+    a = ring
+    b = np.roll(ring, -1, axis=0)
+    e = b - a
+    den = d[0] * e[:, 1] - d[1] * e[:, 0]
+    w = a - c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (w[:, 0] * e[:, 1] - w[:, 1] * e[:, 0]) / den
+        u = (w[:, 0] * d[1] - w[:, 1] * d[0]) / den
+    ok = (np.abs(den) > 1e-300) & (t > 1e-9) & (u >= 0) & (u <= 1)
+    ok[v] = False
+    ok[(v - 1) % n] = False
+    if not ok.any():
+        return None
+    t = np.where(ok, t, np.inf)
+    k = int(np.argmin(t))
+    return k, float(u[k]), c + t[k] * d
+
+
+def _split_ring(ring: np.ndarray, i: int, k: int, u: float, q: np.ndarray):
+    """Split a ring by the segment from vertex ``i`` to point ``q`` on edge ``k`` (at ``u``)."""
+    n = len(ring)
+    # insert q after vertex k (unless it is a vertex)
+    if u <= 1e-9:
+        j = k
+        r = ring
+    elif u >= 1 - 1e-9:
+        j = (k + 1) % n
+        r = ring
+    else:
+        r = np.insert(ring, k + 1, q, axis=0)
+        j = k + 1
+        if i > k:
+            i += 1
+    m = len(r)
+    if i == j:
+        return None
+    a = [r[(i + s) % m] for s in range((j - i) % m + 1)]
+    b = [r[(j + s) % m] for s in range((i - j) % m + 1)]
+    if len(a) < 3 or len(b) < 3:
+        return None
+    return np.array(a), np.array(b), r[j].copy()
+
+
+def _snap_to_reflex(ring: np.ndarray, t: np.ndarray, k: int, u: float, q: np.ndarray, tol: float):
+    """Move a cut's end ``q`` onto a reflex vertex within ``tol`` of it, if there is one."""
+    n = len(ring)
+    cand = [j for j in (k, (k + 1) % n) if t[j] < -SHARP]
+    d = [(math.hypot(*(ring[j] - q)), j) for j in cand]
+    d = [x for x in d if x[0] <= tol]
+    if not d:
+        return k, u, q
+    _, j = min(d)
+    return j, 0.0, ring[j].copy()
+
+
+def _motorcycle_cuts(ring: np.ndarray, sigma: float):
+    """Candidate cuts ``(piece_a, piece_b, segment)`` from every reflex vertex, both directions."""
+    t = turning(ring, sigma)
+    w = _width(ring)
+    out = []
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
+    total = s[-1] + math.hypot(*(ring[0] - ring[-1]))
+    for v in _reflex_peaks(t, s, total, sigma):
+        back = _point_along(ring, s, total, s[v] - sigma)
+        ahead = _point_along(ring, s, total, s[v] + sigma)
+        for d in (ring[v] - back, ring[v] - ahead):
+            nd = math.hypot(*d)
+            if nd == 0:
+                continue
+            hit = _ray_to_boundary(ring, v, d / nd)
+            if hit is None:
+                continue
+            k, u, q = hit
+            k, u, q = _snap_to_reflex(ring, t, k, u, q, 0.5 * w)
+            res = _split_ring(ring, v, k, u, q)
+            if res is None:
+                continue
+            a, b, q = res
+            out.append((a, b, np.array([ring[v], q])))
+    return out
+
+
+def _reflex_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float) -> list[int]:
+    """Reflex vertices (turning < −45° at scale), the sharpest within ``± sigma`` only."""
+    taken: list[int] = []
+    for i in np.argsort(t):
+        if t[i] >= -45.0:
+            break
+        if all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in taken):
+            taken.append(int(i))
+    return taken
+
+
+def _point_along(ring, s, total, at):
+    at = at % total
+    xs = np.concatenate([s, [total]])
+    xp = np.vstack([ring, ring[:1]])
+    return np.array([np.interp(at, xs, xp[:, 0]), np.interp(at, xs, xp[:, 1])])
+
+
+def _orient(r: np.ndarray) -> np.ndarray:
+    x, y = r[:, 0], r[:, 1]
+    a = 0.5 * (np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    return r if a > 0 else r[::-1].copy()
+
+
+def best_split(
+    ring: np.ndarray, *, sigma: float, min_width: float, center=None, depth: int = 4, forced=(), regular: bool = False
+):
+    """Pieces and cuts (segments) of a greedy split of ``ring`` (maybe none).
+
+    Returns ``(pieces, cuts, cost)`` with ``pieces`` a list of ``(ring, corners)``: a CCW ring
+    and the points that must be among its corners (a butterfly's), usually none.  The cut (or
+    star, or butterfly) whose pieces are cheapest is applied if it lowers the cost, then the
+    pieces are split again, at most ``depth`` levels deep.  ``regular``: no star and no
+    butterfly, so no node where three or five blocks meet (Delft3D's domain decomposition
+    couples grid lines of the same direction only).
+    """
+    base = region_cost(ring, sigma, forced)
+    if depth <= 0 or base <= _GOOD:
+        return [(ring, tuple(forced))], [], base
+    options = []
+    if not len(forced):
+        for a, b, seg in _motorcycle_cuts(ring, sigma):
+            a, b = _orient(a), _orient(b)
+            if min(_width(a), _width(b)) < min_width:
+                continue
+            options.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
+        if center is not None and not regular:
+            star = _star(ring, np.asarray(center, float), sigma, min_width)
+            if star is not None:
+                options.append(([(p, ()) for p in star[0]], star[1], star[2]))
+        fly = None if regular else _butterfly(ring, sigma, min_width)
+        if fly is not None:
+            options.append(fly)
+    if not options:
+        return [(ring, tuple(forced))], [], base
+    pieces, cuts, cost = min(options, key=lambda o: o[2])
+    if cost >= base - _GOOD:
+        return [(ring, tuple(forced))], [], base
+    out_p, out_c, total = [], list(cuts), 0.0
+    for pc, fc in pieces:
+        pp, cc, c = best_split(pc, sigma=sigma, min_width=min_width, depth=depth - 1, forced=fc, regular=regular)
+        out_p += pp
+        out_c += cc
+        total += c
+    return out_p, out_c, total
+
+
+#: A region whose corner cost is below this (four corners within ~20° of a right angle, no
+#: sharp bend left on a side) is not split further.
+_GOOD = 4 * 20.0**2
+
+
+def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
+    """Spokes from ``center`` to 3–5 reflex vertices: the cheapest admissible star.
+
+    A spoke reaches its reflex corner along the continuation of the shore that arrives there
+    (walking the region counter-clockwise): the piece on that side sees a straight side, the
+    other piece a corner — no piece is left with a half-way angle, and a symmetric junction
+    gets a symmetric star (the rule turns with the junction).
+    """
+    from shapely.geometry import LineString, Point, Polygon
+
+    t = turning(ring, sigma)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
+    total = s[-1] + math.hypot(*(ring[0] - ring[-1]))
+    reflex = sorted(_reflex_peaks(t, s, total, sigma)[:7])
+    poly = Polygon(ring)
+    if not poly.contains(Point(center)):
+        return None
+    room = poly.buffer(1e-9 * math.sqrt(poly.area))
+    spoke_of = {}
+    for v in reflex:
+        back = _point_along(ring, s, total, s[v] - sigma)
+        u = ring[v] - back
+        nu = math.hypot(*u)
+        d = math.hypot(*(center - ring[v]))
+        if nu == 0 or d == 0:
+            continue
+        knee = ring[v] + u / nu * 0.5 * d
+        # a quadratic Bézier from the centre that arrives along the continued shore
+        tt = np.linspace(0.0, 1.0, max(3, int(np.ceil(d / sigma)) + 2))[:, None]
+        sp = (1 - tt) ** 2 * center + 2 * (1 - tt) * tt * knee + tt**2 * ring[v]
+        sp[0], sp[-1] = center, ring[v]
+        if room.covers(LineString(sp)):
+            spoke_of[v] = sp
+    reflex = [v for v in reflex if v in spoke_of]
+    best = None
+    for k in (3, 4, 5):
+        for combo in itertools.combinations(reflex, k):
+            spokes = [LineString(spoke_of[v]) for v in combo]
+            if any(spokes[i].crosses(spokes[j]) for i in range(k) for j in range(i + 1, k)):
+                continue
+            pieces = []
+            for v0, v1 in zip(combo, combo[1:] + combo[:1], strict=True):
+                arc = [ring[(v0 + q) % len(ring)] for q in range((v1 - v0) % len(ring) + 1)]
+                pieces.append(_orient(np.array([*spoke_of[v0][:-1], *arc, *spoke_of[v1][-2:0:-1]])))
+            if min(_width(p) for p in pieces) < min_width:
+                continue
+            if not all(Polygon(p).is_valid for p in pieces):
+                continue
+            cost = sum(region_cost(p, sigma) for p in pieces)
+            if best is None or cost < best[2]:
+                best = (pieces, [spoke_of[v] for v in combo], cost)
+    return best
+
+
+def _butterfly(ring: np.ndarray, sigma: float, min_width: float):
+    """An inner rectangle and four pieces round it (the "butterfly" or O-grid of a basin).
+
+    A wide basin whose shore has no right-angled corners would get its four block corners on a
+    smooth shore, where an orthogonal grid squeezes its cells to nothing.  Here the shore has
+    no corner at all: the rectangle sits at the basin's widest point, along its principal axes,
+    and from each of its corners a spoke runs to the nearest shore point in its quadrant (so it
+    meets the shore at a right angle).
+    """
+    from shapely.geometry import LineString, Point, Polygon
+    from shapely.ops import polylabel
+
+    poly = Polygon(ring)
+    if not poly.is_valid:
+        return None
+    c = np.asarray(polylabel(poly, tolerance=0.05 * math.sqrt(poly.area)).coords[0])
+    r = poly.exterior.distance(Point(c))
+    if r < 1.5 * min_width:
+        return None
+    P = ring - c
+    _, v = np.linalg.eigh(P.T @ P)
+    axes = v[:, ::-1].T  # major axis first
+    ext = [np.abs(P @ a).max() for a in axes]
+    half = [0.45 * r * min(2.0, ext[0] / max(ext[1], 1e-300)) ** 0.5, 0.45 * r]
+    corners = [c + sx * half[0] * axes[0] + sy * half[1] * axes[1] for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    inner = np.array(corners)
+    if not poly.contains(Polygon(inner)):
+        return None
+    boundary = np.vstack([ring, ring[:1]])
+    room = poly.buffer(1e-9 * math.sqrt(poly.area))
+    spokes, ends = [], []
+    for q in inner:
+        d = q - c
+        # the nearest shore point within ±40° of the diagonal
+        vec = ring - q
+        ang = np.degrees(np.arccos(np.clip((vec @ d) / np.maximum(np.hypot(*vec.T) * math.hypot(*d), 1e-300), -1, 1)))
+        ok = np.flatnonzero(ang <= 40.0)
+        if not len(ok):
+            return None
+        k = int(ok[np.argmin(np.hypot(*vec[ok].T))])
+        seg = np.array([q, ring[k]])
+        if not room.covers(LineString(seg)):
+            return None
+        spokes.append(seg)
+        ends.append(k)
+    if len(set(ends)) != 4 or (ends != sorted(ends) and not _cyclic(ends)):
+        return None
+    pieces = [(_orient(inner.copy()), tuple(inner))]
+    for j in range(4):
+        a, b = ends[j], ends[(j + 1) % 4]
+        arc = [ring[(a + t) % len(ring)] for t in range((b - a) % len(ring) + 1)]
+        corners = (inner[j], ring[a], ring[b], inner[(j + 1) % 4])
+        pieces.append((_orient(np.array([inner[j], *arc, inner[(j + 1) % 4]])), corners))
+    del boundary
+    if not all(Polygon(pc).is_valid for pc, _ in pieces) or min(_width(pc) for pc, _ in pieces) < min_width:
+        return None
+    sides = [np.array([inner[j], inner[(j + 1) % 4]]) for j in range(4)]
+    # the rectangle's corners are nodes where three blocks meet: the smoother gives each cell
+    # about 120° there (the interfaces move), not the 90° / 135° of the drawing
+    cost = sum(region_cost(pc, sigma, fc) for pc, fc in pieces)
+    cost -= sum(_corner_term(pc, sigma, inner) for pc, _ in pieces[1:])
+    cost += 8 * (120.0 - 90.0) ** 2
+    return pieces, spokes + sides, cost
+
+
+def _corner_term(ring: np.ndarray, sigma: float, points) -> float:
+    """The part of the corner cost that the vertices at ``points`` contribute as corners."""
+    from .corners import corner_cost
+
+    idx = forced_indices(ring, points)
+    t = turning(ring, sigma)[idx]
+    return corner_cost(t, range(len(idx)))
+
+
+def _cyclic(idx: list[int]) -> bool:
+    """True when the indices increase round the ring from their smallest (any rotation)."""
+    k = idx.index(min(idx))
+    rot = idx[k:] + idx[:k]
+    return rot == sorted(rot)

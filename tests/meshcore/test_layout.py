@@ -1,0 +1,154 @@
+"""Automatic block layout: the textbook cases and validity on many random water bodies."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from meshcore import testing
+from meshcore.errors import InvalidInputError, TopologyError
+from meshcore.layout import auto_layout
+from meshcore.layout.counts import solve_counts
+
+
+def _check_valid(lay, *, count_ratio: bool = True) -> None:
+    """Blocks four-sided, interfaces matching, union = polygon, no overlaps."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    poly = lay.polygon
+    polys = [Polygon(p.ring) for p in lay.pieces]
+    assert all(p.is_valid and p.area > 0 for p in polys)
+    total = sum(p.area for p in polys)
+    assert total == pytest.approx(poly.area, rel=1e-9)
+    union = shapely.union_all(polys)
+    assert union.symmetric_difference(poly).area <= 1e-9 * poly.area  # no overlaps, no gaps
+    for pc in lay.pieces:
+        assert len(set(pc.corners)) == 4
+        assert list(pc.corners) == sorted(pc.corners)  # counter-clockwise sw, se, ne, nw
+    topo = lay.topology()  # validates every interface (counts, coincident nodes, orientation)
+    assert len(topo.blocks) == len(lay.blocks)
+    for b in topo.blocks:
+        assert min(b.cells) >= 3
+    cells = sum(b.cells[0] * b.cells[1] for b in topo.blocks)
+    ratio = cells * lay.cell_size**2 / poly.area
+    # the issue's target (0.5–2×) is measured on lakes by benchmarks/lake_grids.py; here: sane
+    assert 0.25 <= ratio <= 4.0 or not count_ratio
+
+
+def test_a_straight_channel_is_one_block():
+    lay = auto_layout(testing.straight_channel(10.0, 1.0), cell_size=0.1)
+    assert len(lay.blocks) == 1
+    (b,) = lay.blocks
+    assert sorted(b.cells) == [10, 100]
+    _check_valid(lay)
+
+
+def test_a_rectangle_with_a_hole_gives_a_ring_of_blocks():
+    poly = testing.rectangle_with_hole(6.0, 4.0, 1.5)
+    lay = auto_layout(poly, cell_size=0.1)
+    _check_valid(lay)
+    assert len(lay.blocks) >= 4
+    # every block touches the island, and the island's whole shore is block border
+    from shapely.geometry import LineString, Polygon
+
+    island = LineString(poly.interiors[0].coords)
+    touching = [Polygon(p.ring).boundary.intersection(island).length for p in lay.pieces]
+    assert sum(touching) == pytest.approx(island.length, rel=1e-9)
+    assert sum(t > 0 for t in touching) >= 2
+
+
+def _rotate(p, k: int):
+    c, s = math.cos(2 * math.pi * k / 3), math.sin(2 * math.pi * k / 3)
+    return p @ np.array([[c, s], [-s, c]])
+
+
+def test_a_symmetric_y_gives_a_layout_symmetric_under_rotations():
+    from scipy.spatial import cKDTree
+
+    lay = auto_layout(testing.y_junction(arm=6.0, width=1.0), cell_size=0.085)
+    _check_valid(lay)
+    assert len(lay.blocks) % 3 == 0
+    # the medial axis is sampled, so the layout is symmetric to a fraction of a cell, and the
+    # integer counts (rounded from lengths equal to that precision) to one cell
+    tol = 0.25 * lay.cell_size
+    blocks = [(np.asarray(b.corners), np.array(sorted(b.cells))) for b in lay.blocks]
+    for k in (1, 2):
+        # every block, turned by 120° or 240°, is a block of the same layout, alike in cells
+        for corners, cells in blocks:
+            turned = _rotate(corners, k)
+            match = [oc for other, oc in blocks if cKDTree(other).query(turned)[0].max() <= tol]
+            assert len(match) == 1, f"block with corners {np.round(corners, 3).tolist()} has no image"
+            assert np.abs(match[0] - cells).max() <= 1
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), branches=st.integers(2, 7), rough=st.sampled_from([0.0, 0.1]))
+def test_every_layout_of_a_channel_network_is_valid(seed, branches, rough):
+    poly = testing.channel_network(seed, n_branches=branches, roughness=rough)
+    lay = auto_layout(poly, target_cells=3000)
+    _check_valid(lay)
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), islands=st.integers(1, 3), near=st.booleans())
+def test_every_layout_of_a_lake_with_islands_is_valid(seed, islands, near):
+    poly = testing.lake_with_islands(seed, n_islands=islands, near_shore=near)
+    lay = auto_layout(poly, target_cells=3000)
+    _check_valid(lay)
+    for hole in lay.polygon.interiors:  # no block holds an island inside it
+        from shapely.geometry import Polygon
+
+        assert all(not Polygon(p.ring).contains(Polygon(hole)) for p in lay.pieces)
+
+
+def test_spiral_and_narrow_arm():
+    _check_valid(auto_layout(testing.spiral(turns=1.5), target_cells=3000))
+    # arms narrower than two cells still get blocks of three cells across
+    narrow = testing.channel_network(7, n_branches=4, width=(0.2, 0.3))
+    lay = auto_layout(narrow, cell_size=0.12)
+    _check_valid(lay, count_ratio=False)  # three cells across an arm of two need more cells
+
+
+def test_bad_outlines_are_clear_errors():
+    with pytest.raises(InvalidInputError, match=r"crosses itself: the edge from point 1 to 2"):
+        auto_layout([[0, 0], [1, 1], [1, 0], [0, 1]], cell_size=0.1)
+    with pytest.raises(InvalidInputError, match="at least 3 distinct points"):
+        auto_layout([[0, 0], [1, 1], [0, 0]], cell_size=0.1)
+    with pytest.raises(InvalidInputError, match="point 2 is not finite"):
+        auto_layout([[0, 0], [np.nan, 1], [1, 0], [1, 1]], cell_size=0.1)
+    with pytest.raises(InvalidInputError, match=r"island 1 .* not inside"):
+        auto_layout([[0, 0], [4, 0], [4, 4], [0, 4]], holes=[[[5, 5], [6, 5], [6, 6]]], cell_size=0.1)
+
+
+def test_small_islands_are_dropped_with_a_note():
+    outer = [[0, 0], [10, 0], [10, 6], [0, 6]]
+    tiny = [[5, 3], [5.05, 3], [5.05, 3.05], [5, 3.05]]
+    lay = auto_layout(outer, holes=[tiny], cell_size=0.2)
+    assert not lay.polygon.interiors
+    assert any("island 1" in n and "ignored" in n for n in lay.notes)
+
+
+def test_counts_agree_and_respect_fixed_values():
+    # two blocks side by side sharing chain 1; block A: bottom 0, right 1, top 2, left 3;
+    # block B: bottom 4, right 5, top 6, left 1 (the shared one)
+    sides = [([0], [1], [2], [3]), ([4], [5], [6], [1])]
+    n = solve_counts([10.2, 5.1, 9.8, 4.9, 7.0, 5.0, 7.2], sides)
+    assert n[0] == n[2] and n[1] == n[3] and n[4] == n[6] and n[1] == n[5]
+    assert (n >= 1).all()
+    n2 = solve_counts([10.2, 5.1, 9.8, 4.9, 7.0, 5.0, 7.2], sides, fixed={5: 8}, multiple=2)
+    assert n2[1] == 8 and n2[3] == 8 and (n2 % 2 == 0).all()
+    with pytest.raises(TopologyError, match="no integer cell counts"):
+        solve_counts([10, 5, 10, 5, 7, 5, 7], sides, fixed={1: 4, 5: 6})
+
+
+def test_regular_layouts_have_only_four_block_corners():
+    lay = auto_layout(testing.y_junction(arm=6.0, width=1.0), cell_size=0.085, regular=True)
+    _check_valid(lay)
+    m = lay.topology().node_map
+    assert all(c.valence == 4 for c in m.corners if c.free)
+    assert len(m.irr_nodes) == 0
