@@ -1,0 +1,5 @@
+"""Orthogonal grids with shore nodes that slide (see :mod:`.driver`)."""
+
+from .driver import OrthoResult, orthogonalize
+
+__all__ = ["OrthoResult", "orthogonalize"]

@@ -1,0 +1,312 @@
+r"""Numba kernels of the orthogonal smoother (the formulas, once; NumPy oracle in ``_reference``).
+
+Interior node ``P`` with neighbours ``E, W, N, S`` (and diagonals) in its local frame moves
+towards the solution of the Ryskin–Leal equations with the distortion function read off the
+current grid (the "weak constraint"):
+
+.. math::
+    x_P = \frac{a_E x_E + a_W x_W + b_N x_N + b_S x_S}{a_E + a_W + b_N + b_S},\quad
+    a_E = \frac{\bar h_\eta(PE)}{|E - P|},\ b_N = \frac{\bar h_\xi(PN)}{|N - P|},
+
+``h̄_η(PE)`` the mean length of the four η-edges that touch ``P`` or ``E`` (and likewise for
+``h̄_ξ``).  Any orthogonal grid is a fixed point (for a rectangular grid of spacing ``dx, dy``
+the update returns ``P``); with boundary nodes free to slide, the iteration drives the grid to
+an orthogonal one of the same topology.  Nodes where three or five cells meet move to the
+mean of their edge neighbours.  Shore nodes slide along the shore to the foot of the
+perpendicular from their inward neighbour (the grid line leaving the shore meets it at a right
+angle).  Every move is checked against the cells around the node: a move that would make a
+corner Jacobian of one of them fall below a small positive floor (``jmin``, per node) is
+halved, up to four times, and otherwise not made, so a valid grid stays valid.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["jacobi_targets", "shore_sweep", "sweep"]
+
+
+@njit(cache=True, inline="always")
+def _dist(X, Y, a, b):
+    return math.hypot(X[b] - X[a], Y[b] - Y[a])
+
+
+@njit(cache=True)
+def _worst(X, Y, cptr, cells, node, out):
+    """The smallest corner Jacobian of each cell around ``node``, into ``out``."""
+    for q in range(cptr[node], cptr[node + 1]):
+        w = 1e300
+        for k in range(4):
+            p = cells[q, k]
+            n = cells[q, (k + 1) % 4]
+            m = cells[q, (k + 3) % 4]
+            j = (X[n] - X[p]) * (Y[m] - Y[p]) - (Y[n] - Y[p]) * (X[m] - X[p])
+            w = min(w, j)
+        out[q - cptr[node]] = w
+
+
+@njit(cache=True)
+def _all_above(X, Y, cptr, cells, node, floor):
+    """True when every corner Jacobian of the cells around ``node`` exceeds ``floor``."""
+    for q in range(cptr[node], cptr[node + 1]):
+        for k in range(4):
+            p = cells[q, k]
+            n = cells[q, (k + 1) % 4]
+            m = cells[q, (k + 3) % 4]
+            if (X[n] - X[p]) * (Y[m] - Y[p]) - (Y[n] - Y[p]) * (X[m] - X[p]) <= floor:
+                return False
+    return True
+
+
+@njit(cache=True)
+def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after):
+    """Move ``node`` towards ``(nx, ny)``, halving the step up to four times, so that every
+    cell around it keeps its smallest corner Jacobian above ``jmin[node]`` — or, for a cell
+    that was already below, at least where it was (an invalid cell may only get better)."""
+    ox, oy = X[node], Y[node]
+    dx, dy = nx - ox, ny - oy
+    X[node], Y[node] = nx, ny
+    if _all_above(X, Y, cptr, cells, node, jmin[node]):  # the usual case: one check
+        return math.hypot(dx, dy)
+    X[node], Y[node] = ox, oy
+    _worst(X, Y, cptr, cells, node, before)
+    nc = cptr[node + 1] - cptr[node]
+    for _ in range(5):
+        X[node], Y[node] = ox + dx, oy + dy
+        _worst(X, Y, cptr, cells, node, after)
+        ok = True
+        for q in range(nc):
+            if after[q] <= jmin[node] and after[q] < before[q]:
+                ok = False
+                break
+        if ok:
+            return math.hypot(dx, dy)
+        dx *= 0.5
+        dy *= 0.5
+    X[node], Y[node] = ox, oy
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth):
+    """The Ryskin–Leal position of node ``p`` (weights blended ``smooth`` towards their means);
+    ``(nan, nan)`` when an edge at ``p`` has zero length."""
+    he = _dist(X, Y, p, e)
+    hw = _dist(X, Y, w, p)
+    hn = _dist(X, Y, p, n)
+    hs = _dist(X, Y, s, p)
+    if he <= 0.0 or hw <= 0.0 or hn <= 0.0 or hs <= 0.0:
+        return np.nan, np.nan
+    eta_e = 0.25 * (hn + hs + _dist(X, Y, e, ne) + _dist(X, Y, se, e))
+    eta_w = 0.25 * (hn + hs + _dist(X, Y, w, nw) + _dist(X, Y, sw, w))
+    xi_n = 0.25 * (he + hw + _dist(X, Y, n, ne) + _dist(X, Y, nw, n))
+    xi_s = 0.25 * (he + hw + _dist(X, Y, s, se) + _dist(X, Y, sw, s))
+    ae, aw, bn, bs = eta_e / he, eta_w / hw, xi_n / hn, xi_s / hs
+    # blend with the symmetrised weights (equal spacing along each line: smoothness)
+    am, bm = 0.5 * (ae + aw), 0.5 * (bn + bs)
+    ae += smooth * (am - ae)
+    aw += smooth * (am - aw)
+    bn += smooth * (bm - bn)
+    bs += smooth * (bm - bs)
+    den = ae + aw + bn + bs
+    return (
+        (ae * X[e] + aw * X[w] + bn * X[n] + bs * X[s]) / den,
+        (ae * Y[e] + aw * Y[w] + bn * Y[n] + bs * Y[s]) / den,
+    )
+
+
+@njit(cache=True)
+def jacobi_targets(X, Y, nodes, nbr, smooth, tx, ty):
+    """The update of every regular node from the same old positions (test oracle's twin)."""
+    for k in range(len(nodes)):
+        tx[k], ty[k] = _target(
+            X,
+            Y,
+            nodes[k],
+            nbr[k, 0],
+            nbr[k, 1],
+            nbr[k, 2],
+            nbr[k, 3],
+            nbr[k, 4],
+            nbr[k, 5],
+            nbr[k, 6],
+            nbr[k, 7],
+            smooth,
+        )
+
+
+@njit(cache=True)
+def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, jmin):
+    """One Gauss–Seidel sweep over the free interior nodes; returns the largest move."""
+    big = 0.0
+    before = np.empty(16)
+    after = np.empty(16)
+    for k in range(len(nodes)):
+        p = nodes[k]
+        tx, ty = _target(
+            X, Y, p, nbr[k, 0], nbr[k, 1], nbr[k, 2], nbr[k, 3], nbr[k, 4], nbr[k, 5], nbr[k, 6], nbr[k, 7], smooth
+        )
+        if tx != tx:
+            continue
+        nx = X[p] + omega * (tx - X[p])
+        ny = Y[p] + omega * (ty - Y[p])
+        d = _try_move(X, Y, p, nx, ny, cptr, cells, jmin, before, after)
+        big = max(big, d)
+    for k in range(len(irr_nodes)):
+        p = irr_nodes[k]
+        sx, sy = 0.0, 0.0
+        cnt = irr_ptr[k + 1] - irr_ptr[k]
+        for q in range(irr_ptr[k], irr_ptr[k + 1]):
+            sx += X[irr_ring[q]]
+            sy += Y[irr_ring[q]]
+        d = _try_move(X, Y, p, sx / cnt, sy / cnt, cptr, cells, jmin, before, after)
+        big = max(big, d)
+    return big
+
+
+@njit(cache=True)
+def _segment(S, s0, n, u):
+    """Index ``k`` (0 ≤ k < n) of the ring segment holding arc length ``u`` (0 ≤ u < total)."""
+    a, b = 0, n
+    while b - a > 1:
+        m = (a + b) // 2
+        if S[s0 + m] <= u:
+            a = m
+        else:
+            b = m
+    return a
+
+
+@njit(cache=True)
+def _ring_point(R, S, r0, s0, n, s):
+    """Point at arc length ``s`` (any real: the ring is closed) of ring ``R[r0:r0+n]``."""
+    total = S[s0 + n]
+    u = s % total
+    k = _segment(S, s0, n, u)
+    k1 = (k + 1) % n
+    L = S[s0 + k + 1] - S[s0 + k]
+    t = (u - S[s0 + k]) / L if L > 0 else 0.0
+    return (
+        R[r0 + k, 0] + t * (R[r0 + k1, 0] - R[r0 + k, 0]),
+        R[r0 + k, 1] + t * (R[r0 + k1, 1] - R[r0 + k, 1]),
+    )
+
+
+@njit(cache=True)
+def _foot(R, S, r0, s0, n, qx, qy, sa, sb):
+    """Arc length (unwrapped, in ``[sa, sb]``) of the ring point nearest to ``q``."""
+    total = S[s0 + n]
+    base = math.floor(sa / total) * total
+    k = _segment(S, s0, n, sa - base)
+    best_d, best_s = 1e300, sa
+    for _ in range(n + 1):
+        lo = base + S[s0 + k]
+        hi = base + S[s0 + k + 1]
+        if lo > sb:
+            break
+        ax, ay = R[r0 + k, 0], R[r0 + k, 1]
+        k1 = k + 1 if k + 1 < n else 0
+        dx, dy = R[r0 + k1, 0] - ax, R[r0 + k1, 1] - ay
+        L2 = dx * dx + dy * dy
+        t = ((qx - ax) * dx + (qy - ay) * dy) / L2 if L2 > 0 else 0.0
+        t = min(max(t, 0.0), 1.0)
+        st = lo + t * (hi - lo)
+        if st < sa:
+            st = sa
+        elif st > sb:
+            st = sb
+        # the point at st on this segment (st within [lo, hi] unless clamped to the window)
+        u = (st - lo) / (hi - lo) if hi > lo else 0.0
+        u = min(max(u, 0.0), 1.0)
+        px, py = ax + u * dx, ay + u * dy
+        d = (px - qx) ** 2 + (py - qy) ** 2
+        if d < best_d:
+            best_d, best_s = d, st
+        k += 1
+        if k == n:
+            k = 0
+            base += total
+    return best_s
+
+
+#: Largest ratio of the shore's arc length between two neighbouring shore nodes to the
+#: straight edge between them (1.2: a corner cut off by at most ~0.2 cell sizes).
+STRAIGHT = 1.2
+
+
+@njit(cache=True, inline="always")
+def _bend(ax, ay, bx, by, cx, cy, arc_ab, arc_bc):
+    """How far the shore arcs a→b and b→c exceed ``STRAIGHT`` × their chords (≤ 0: fine)."""
+    d1 = arc_ab - STRAIGHT * math.hypot(bx - ax, by - ay)
+    d2 = arc_bc - STRAIGHT * math.hypot(cx - bx, cy - by)
+    return max(d1, d2)
+
+
+@njit(cache=True)
+def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, jmin):
+    """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
+    the perpendicular from their inward neighbour, between their two shore neighbours;
+    returns the largest move."""
+    big = 0.0
+    before = np.empty(16)
+    after = np.empty(16)
+    for f in range(len(free)):
+        k = free[f]
+        p = bnode[k]
+        r = bring[k]
+        r0 = roff[r]
+        n = roff[r + 1] - r0
+        s0 = r0 + r
+        total = S[s0 + n]
+        s = bs[k]
+        sp = bs[bprev[k]]
+        sn = bs[bnext[k]]
+        while sp > s:
+            sp -= total
+        while sp <= s - total:
+            sp += total
+        while sn < s:
+            sn += total
+        while sn >= s + total:
+            sn -= total
+        gap = 0.1 * (sn - sp)
+        q = binner[k]
+        sf = _foot(R, S, r0, s0, n, X[q], Y[q], sp + gap, sn - gap)
+        sf = (1.0 - mu) * sf + mu * 0.5 * (sp + sn)  # a little pull to the middle keeps the spacing
+        # the shore between a node and its neighbours must stay close to the straight edge
+        # between them (arc ≤ ``straight`` × chord): a node may not slide past a bay or a point
+        ppx, ppy = _ring_point(R, S, r0, s0, n, sp)
+        pnx, pny = _ring_point(R, S, r0, s0, n, sn)
+        bad0 = _bend(ppx, ppy, X[p], Y[p], pnx, pny, s - sp, sn - s)
+        ox, oy = X[p], Y[p]
+        step = omega * (sf - s)
+        moved = False
+        for _ in range(5):
+            snew = s + step
+            nx, ny = _ring_point(R, S, r0, s0, n, snew)
+            bad = _bend(ppx, ppy, nx, ny, pnx, pny, snew - sp, sn - snew)
+            if bad <= max(bad0, 0.0):
+                X[p], Y[p] = nx, ny
+                ok = _all_above(X, Y, cptr, cells, p, jmin[p])
+                if not ok:
+                    X[p], Y[p] = ox, oy
+                    _worst(X, Y, cptr, cells, p, before)
+                    X[p], Y[p] = nx, ny
+                    _worst(X, Y, cptr, cells, p, after)
+                    ok = True
+                    for qq in range(cptr[p + 1] - cptr[p]):
+                        if after[qq] <= jmin[p] and after[qq] < before[qq]:
+                            ok = False
+                if ok:
+                    bs[k] = snew % total
+                    big = max(big, math.hypot(nx - ox, ny - oy))
+                    moved = True
+                    break
+                X[p], Y[p] = ox, oy
+            step *= 0.5
+        if not moved:
+            X[p], Y[p] = ox, oy
+    return big

@@ -1,0 +1,226 @@
+r"""Orthogonal grids: the smoother that lake models need, over one block or many.
+
+:func:`orthogonalize` takes a multiblock grid (a start grid without folds: algebraic or the
+elliptic solution) and the shore it lies on, and iterates
+
+1. a Gauss–Seidel sweep of the Ryskin–Leal weak-constraint update over every free node —
+   block interiors, interface nodes (so cut lines move, along and across), corners where 3 or
+   5 blocks meet (see :mod:`._kernels`);
+2. a sweep that slides every shore node with two cells around it along the shore, to the foot
+   of the perpendicular from its inward neighbour.  Nodes with one cell (convex block corners)
+   or three (reflex corners) stay where the layout put them;
+
+until the largest move is below ``tol`` × the median edge length.  Every move is guarded: no
+cell around a moving node may lose its positive corner Jacobians, so a grid without folds
+stays without folds.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _kernels
+
+__all__ = ["OrthoResult", "orthogonalize"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class OrthoResult:
+    grids: tuple
+    sweeps: int
+    converged: bool
+    elapsed: float
+    history: tuple[float, ...]
+
+
+def _assemble(grids, m):
+    X = np.zeros(m.n_nodes)
+    Y = np.zeros(m.n_nodes)
+    for g, ids in zip(grids, m.ids, strict=True):
+        X[ids] = g.x
+        Y[ids] = g.y
+    return X, Y
+
+
+def _node_cells(cells: np.ndarray, n_nodes: int):
+    flat = cells.reshape(-1)
+    order = np.argsort(flat, kind="stable")
+    cnt = np.bincount(flat, minlength=n_nodes)
+    ptr = np.concatenate([[0], np.cumsum(cnt)]).astype(np.int64)
+    return ptr, cells[order // 4].astype(np.int64), cnt
+
+
+def _shore_data(X, Y, m, cells, cnt, rings):
+    """Arrays describing every shore node: inward neighbour, shore neighbours, ring and s."""
+    n = m.n_nodes
+    e0 = cells.reshape(-1)
+    e1 = np.roll(cells, -1, axis=1).reshape(-1)
+    key = np.minimum(e0, e1) * n + np.maximum(e0, e1)
+    ukey, ecnt = np.unique(key, return_counts=True)
+    a, b = np.divmod(ukey, n)
+    bnd_edge = ecnt == 1
+    nodes = np.flatnonzero(m.boundary)
+    pos = -np.ones(n, dtype=np.int64)
+    pos[nodes] = np.arange(len(nodes))
+    nbrs = [[] for _ in nodes]
+    for u, v in zip(a[bnd_edge], b[bnd_edge], strict=True):
+        nbrs[pos[u]].append(int(v))
+        nbrs[pos[v]].append(int(u))
+    inner = -np.ones(len(nodes), dtype=np.int64)
+    for u, v in zip(a[~bnd_edge], b[~bnd_edge], strict=True):
+        if m.boundary[u] and not m.boundary[v]:
+            inner[pos[u]] = v
+        elif m.boundary[v] and not m.boundary[u]:
+            inner[pos[v]] = u
+        elif m.boundary[u] and m.boundary[v]:  # an interior edge between two shore nodes
+            if cnt[u] == 2:
+                inner[pos[u]] = v
+            if cnt[v] == 2:
+                inner[pos[v]] = u
+    # ring and arc length of every shore node (nearest point of the nearest ring)
+    P = np.column_stack([X[nodes], Y[nodes]])
+    best_d = np.full(len(nodes), np.inf)
+    ring_of = np.zeros(len(nodes), dtype=np.int64)
+    s_of = np.zeros(len(nodes))
+    for k, r in enumerate(rings):
+        A = r
+        B = np.roll(r, -1, axis=0)
+        D = B - A
+        L2 = np.maximum((D * D).sum(axis=1), 1e-300)
+        cum = np.concatenate([[0.0], np.cumsum(np.sqrt(L2))])
+        for i in range(len(nodes)):
+            t = np.clip(((P[i] - A) * D).sum(axis=1) / L2, 0.0, 1.0)
+            foot = A + t[:, None] * D
+            d = np.hypot(*(foot - P[i]).T)
+            j = int(np.argmin(d))
+            if d[j] < best_d[i]:
+                best_d[i] = d[j]
+                ring_of[i] = k
+                s_of[i] = cum[j] + t[j] * math.sqrt(L2[j])
+    prev = -np.ones(len(nodes), dtype=np.int64)
+    nxt = -np.ones(len(nodes), dtype=np.int64)
+    per = [float(np.hypot(*(np.roll(r, -1, axis=0) - r).T).sum()) for r in rings]
+    for i in range(len(nodes)):
+        if len(nbrs[i]) != 2 or not rings:
+            continue
+        total = per[ring_of[i]]
+        j0, j1 = pos[nbrs[i][0]], pos[nbrs[i][1]]
+        d0 = (s_of[j0] - s_of[i]) % total
+        d1 = (s_of[j1] - s_of[i]) % total
+        if d0 < d1:
+            nxt[i], prev[i] = j0, j1
+        else:
+            nxt[i], prev[i] = j1, j0
+    free = (cnt[nodes] == 2) & (inner >= 0) & (prev >= 0) & bool(rings)
+    return nodes, inner, prev, nxt, ring_of, s_of, free
+
+
+def _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, h: float, angle: float) -> int:
+    """Put a shore node on every sharp bend of the shore and keep it there.
+
+    A sliding node would leave a sharp point of the shore (a headland, the end of a bay)
+    between two nodes and the grid would cut it off; so each ring vertex that turns by more
+    than ``angle`` degrees at the scale ``h`` (the largest turn within ``± h``) takes the free
+    node nearest to it along the shore, unless that node's neighbours are closer to another
+    feature.  Returns how many nodes were pinned.
+    """
+    from ..layout.corners import turning
+
+    pinned = 0
+    for r, ring in enumerate(rings):
+        seg = np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)
+        cum = np.concatenate([[0.0], np.cumsum(seg)])
+        total = cum[-1]
+        t = np.abs(turning(ring, h))
+        cand = [int(i) for i in np.argsort(-t) if t[i] > angle]
+        on = np.flatnonzero((bring == r) & free)
+        if not len(on) or not cand:
+            continue
+        taken_s: list[float] = []
+        for v in cand:
+            sv = cum[v]
+            if any(min(abs(sv - q), total - abs(sv - q)) < h for q in taken_s):
+                continue
+            d = np.abs((bs[on] - sv + 0.5 * total) % total - 0.5 * total)
+            k = on[int(np.argmin(d))]
+            if not free[k]:
+                continue
+            # only when the vertex lies between the node's two shore neighbours
+            sp, sn = bs[bprev[k]], bs[bnext[k]]
+            lo = (sv - sp) % total
+            hi = (sn - sp) % total
+            if not (0 < lo < hi):
+                continue
+            X[bn[k]], Y[bn[k]] = ring[v]
+            bs[k] = sv
+            free[k] = False
+            taken_s.append(sv)
+            pinned += 1
+    return pinned
+
+
+def _ring_tables(rings):
+    """Points of all rings in one array (ring k: ``R[roff[k]:roff[k+1]]``) and their cumulative
+    arc lengths (ring k: ``S[roff[k]+k : roff[k+1]+k+1]``, from 0 to the perimeter)."""
+    parts, off = [], [0]
+    for r in rings:
+        seg = np.hypot(*(np.roll(r, -1, axis=0) - r).T)
+        parts.append(np.concatenate([[0.0], np.cumsum(seg)]))
+        off.append(off[-1] + len(r))
+    return np.vstack(rings).astype(np.float64), np.concatenate(parts), np.array(off, dtype=np.int64)
+
+
+def orthogonalize(
+    topology,
+    grids,
+    rings,
+    *,
+    tol: float = 1e-4,
+    max_sweeps: int = 20_000,
+    omega: float = 1.0,
+    smooth: float = 0.1,
+    pin_angle: float | None = None,
+    shore_smooth: float = 0.15,
+    callback=None,
+):
+    """Orthogonalise ``grids`` (one per block of ``topology``) with shore nodes sliding on ``rings``."""
+    t0 = time.perf_counter()
+    m = topology.node_map
+    X, Y = _assemble(grids, m)
+    cells = m.cells.astype(np.int64)
+    cptr, ncells, cnt = _node_cells(cells, m.n_nodes)
+    # guard floor: a thousandth of the mean area of the cells around each node
+    cx, cy = X[cells], Y[cells]
+    area = 0.5 * ((cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3]) - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2]))
+    mean_area = np.bincount(cells.reshape(-1), weights=np.repeat(np.abs(area), 4), minlength=m.n_nodes)
+    jmin = 1e-3 * mean_area / np.maximum(cnt, 1)
+    rings = [np.asarray(r, dtype=np.float64) for r in rings]
+    bn, binner, bprev, bnext, bring, bs, free = _shore_data(X, Y, m, cells, cnt, rings)
+    edge0 = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
+    if pin_angle is not None:
+        _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, float(np.median(edge0)), pin_angle)
+    R, S, roff = _ring_tables(rings) if rings else (np.zeros((1, 2)), np.zeros(2), np.zeros(2, dtype=np.int64))
+    fidx = np.flatnonzero(free).astype(np.int64)
+    edge = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
+    h = float(np.median(edge))
+    hist = []
+    it = 0
+    converged = False
+    for it in range(1, max_sweeps + 1):
+        d1 = _kernels.sweep(X, Y, m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring, cptr, ncells, omega, smooth, jmin)
+        d2 = _kernels.shore_sweep(
+            X, Y, fidx, bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells, 1.0, shore_smooth, jmin
+        )
+        d = max(d1, d2) / h
+        hist.append(d)
+        if callback is not None and it % 50 == 0:
+            callback(it, d)
+        if d < tol:
+            converged = True
+            break
+    out = [g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True)]
+    return OrthoResult(tuple(out), it, converged, time.perf_counter() - t0, tuple(hist))

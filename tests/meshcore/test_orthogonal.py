@@ -1,0 +1,125 @@
+"""The orthogonal smoother: its formula against the NumPy oracle, fixed points, sliding shores,
+no folds, and the whole lake pipeline on synthetic water bodies."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from meshcore import StructuredGrid, testing
+from meshcore.boundary import Borders
+from meshcore.multiblock.topology import Block, MultiBlockTopology
+from meshcore.orthogonal import _kernels, orthogonalize
+from meshcore.orthogonal._reference import ortho_targets
+from meshcore.orthogonal.levels import coarsen_topology, refine
+from meshcore.quality import lake_metrics
+
+
+def _one_block(x, y):
+    bd = Borders(
+        bottom=np.c_[x[:, 0], y[:, 0]], right=np.c_[x[-1], y[-1]], top=np.c_[x[:, -1], y[:, -1]], left=np.c_[x[0], y[0]]
+    )
+    topo = MultiBlockTopology((Block("a", bd),), (), check_geometry=False)
+    return topo, StructuredGrid(x, y)
+
+
+@pytest.mark.parametrize("smooth", [0.0, 0.3, 1.0])
+def test_the_kernel_update_is_the_numpy_oracle(smooth):
+    rng = np.random.default_rng(1)
+    xi, eta = np.meshgrid(np.linspace(0, 3, 13), np.linspace(0, 1, 7), indexing="ij")
+    x = xi + 0.05 * rng.standard_normal(xi.shape) + 0.2 * eta**2
+    y = eta + 0.05 * rng.standard_normal(xi.shape) + 0.1 * np.sin(xi)
+    topo, _ = _one_block(x, y)
+    m = topo.node_map
+    X, Y = x.ravel().copy(), y.ravel().copy()
+    ids = m.ids[0].ravel()
+    gx, gy = np.empty(m.n_nodes), np.empty(m.n_nodes)
+    gx[ids], gy[ids] = X, Y
+    tx, ty = np.empty(len(m.nodes)), np.empty(len(m.nodes))
+    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, tx, ty)
+    rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth)
+    np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
+
+
+def test_an_orthogonal_grid_is_a_fixed_point():
+    # a stretched rectangular grid (unequal spacing) and a polar sector are orthogonal
+    xs = np.cumsum(np.r_[0, np.linspace(1, 2, 12)])
+    ys = np.cumsum(np.r_[0, np.linspace(0.5, 0.2, 8)])
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    topo, g = _one_block(X, Y)
+    res = orthogonalize(topo, [g], [], max_sweeps=5, smooth=0.0)
+    np.testing.assert_allclose(res.grids[0].x, X, atol=1e-12)
+    np.testing.assert_allclose(res.grids[0].y, Y, atol=1e-12)
+
+
+def test_a_distorted_channel_becomes_orthogonal_with_sliding_shores():
+    # a curved channel (annulus sector) with its nodes shuffled along both banks and inside
+    r = np.linspace(2.0, 3.0, 9)
+    th = np.linspace(0.0, math.pi / 2, 33)
+    R, T = np.meshgrid(r, th, indexing="ij")
+    T = T + 0.15 * np.sin(3 * T) * (R - 2.0) * (3.0 - R) + 0.04 * np.sin(5 * T)
+    T[:, 0], T[:, -1] = 0.0, math.pi / 2
+    x, y = R * np.cos(T), R * np.sin(T)
+    x, y = x.T[::-1].copy(), y.T[::-1].copy()  # i along the channel (clockwise), j outwards
+    topo, g = _one_block(x, y)
+    before = lake_metrics(g)
+    t = np.linspace(0, math.pi / 2, 400)
+    ring = np.vstack([np.c_[2 * np.cos(t), 2 * np.sin(t)], np.c_[3 * np.cos(t[::-1]), 3 * np.sin(t[::-1])]])
+    res = orthogonalize(topo, [g], [ring], max_sweeps=3000, omega=1.5, smooth=0.2)
+    after = lake_metrics(res.grids[0])
+    assert before.mean("deviation") > 3.0
+    assert after.mean("deviation") < 0.3
+    assert after.share("deviation", 1.0) > 0.95
+    # the shore nodes stayed on the shore
+    gx, gy = res.grids[0].x, res.grids[0].y
+    np.testing.assert_allclose(np.hypot(gx[:, 0], gy[:, 0]), 2.0, atol=2e-5)  # on the 400-edge polyline
+    np.testing.assert_allclose(np.hypot(gx[:, -1], gy[:, -1]), 3.0, atol=3e-5)
+
+
+def test_refine_and_coarsen_keep_interfaces_shared():
+    lay_poly = testing.y_junction(arm=4.0, width=1.0)
+    from meshcore.layout import auto_layout
+
+    lay = auto_layout(lay_poly, cell_size=0.1, multiple=4)
+    topo = lay.topology()
+    coarse = coarsen_topology(topo, 4)
+    from meshcore.multiblock import initial_grids
+
+    fine = refine(refine(initial_grids(coarse)))
+    for g, b in zip(fine, topo.blocks, strict=True):
+        assert g.cells == b.cells
+    # every interface pair of nodes coincides after refinement
+    from meshcore.multiblock import MultiBlockGrid
+
+    mb = MultiBlockGrid(tuple(fine), tuple(b.name for b in topo.blocks), topo.interfaces, topology=topo)
+    assert mb.interface_mismatch() == 0.0
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: testing.y_junction(),
+        pytest.param(
+            lambda: testing.channel_network(4, n_branches=5),
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="known limit: round bulges on the outside of a hairpin bend are left "
+                "outside the grid (1.8 % of the area; the layout has no block for them)",
+            ),
+        ),
+        lambda: testing.channel_network(2, n_branches=4),
+    ],
+)
+def test_lake_grids_have_no_folds_and_are_orthogonal(make):
+    from meshcore.lakegrid import mesh_outline
+
+    poly = make()
+    mb = mesh_outline(poly, target_cells=3000)
+    m = lake_metrics(mb, polygon=poly)
+    assert m.values("folded").sum() == 0
+    assert mb.interface_mismatch() == 0.0
+    assert m.share("deviation", 3.0) >= 0.85
+    assert m.coverage.area_error < 0.01
