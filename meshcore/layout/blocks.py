@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..boundary import Borders
+from ..errors import TopologyError
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
 from .counts import solve_counts
 
@@ -152,5 +153,8 @@ def build_topology(pieces: list[Piece], cell_size: float, *, min_cells: int = 3,
             b0, b1 = offsets[(pb, sb, key)]
             interfaces.append(Interface(Side(blocks[pa].name, sa, a0, a1), Side(blocks[pb].name, sb, b0, b1), None))
         elif len(users) > 2:
-            raise ValueError(f"a chain is shared by {len(users)} blocks")
+            c = np.asarray(key).mean(axis=0)
+            raise TopologyError(
+                f"blocks overlap: an edge near ({c[0]:.6g}, {c[1]:.6g}) is shared by {len(users)} blocks"
+            )
     return MultiBlockTopology(tuple(blocks), tuple(interfaces), check_geometry=False), counts

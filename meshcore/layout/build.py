@@ -74,7 +74,9 @@ def _merged(a: np.ndarray, b: np.ndarray):
     jk = pos_b[_key(a[pk])]
     out += [b[(j0 + t) % nb] for t in range(1, (jk - j0) % nb)]  # b from p0 round to pk
     r = np.array(out)
-    return r if len(r) >= 4 else None
+    from shapely.geometry import Polygon
+
+    return r if len(r) >= 4 and Polygon(r).is_valid else None
 
 
 def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
@@ -141,9 +143,32 @@ def layout_pieces(
     for r, cs in zip(rings, corner_pts, strict=True):
         idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
         pieces.append(Piece(r, idx))
+    _check_pieces(poly, pieces)
     pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
     return sk, chords, cuts, pieces
+
+
+def _check_pieces(poly, pieces: list[Piece]) -> None:
+    """Every piece a valid polygon, and together exactly the water: else a clear error."""
+    from shapely.geometry import Polygon
+
+    from ..errors import TopologyError
+
+    for pc in pieces:
+        P = Polygon(pc.ring)
+        if not P.is_valid:
+            c = P.representative_point()
+            raise TopologyError(
+                f"automatic layout: a block near ({c.x:.6g}, {c.y:.6g}) came out self-intersecting; "
+                f"add cut lines there by hand (a [outline] case) or try another cell size"
+            )
+    total = sum(Polygon(pc.ring).area for pc in pieces)
+    if abs(total - poly.area) > 1e-6 * poly.area:
+        raise TopologyError(
+            f"automatic layout: the blocks cover {total:.6g} of the water's {poly.area:.6g}; "
+            f"add cut lines by hand (a [outline] case) or try another cell size"
+        )
 
 
 def _countable(pieces: list[Piece], h: float) -> bool:
@@ -173,4 +198,13 @@ def _make_countable(pieces: list[Piece], cuts: list, h: float, size: float):
             Piece(r, tuple(sorted(int(np.argmin(np.hypot(*(r - p.ring[c]).T))) for c in p.corners)))
             for r, p in zip(rings, new, strict=True)
         ]
-    return pieces, cuts
+    if _countable(pieces, h):
+        return pieces, cuts
+    from ..errors import TopologyError
+    from .tjunction import t_junctions
+
+    where = [pieces[i].ring[v] for i, v in t_junctions(pieces)] or [pieces[0].ring[0]]
+    raise TopologyError(
+        f"automatic layout: no cell counts agree round the blocks near ({where[0][0]:.6g}, {where[0][1]:.6g}); "
+        f"add cut lines there by hand (a [outline] case) or try another cell size"
+    )

@@ -153,6 +153,12 @@ def _point_along(ring, s, total, at):
     return np.array([np.interp(at, xs, xp[:, 0]), np.interp(at, xs, xp[:, 1])])
 
 
+def _valid(r: np.ndarray) -> bool:
+    from shapely.geometry import Polygon
+
+    return len(r) >= 3 and Polygon(r).is_valid
+
+
 def _orient(r: np.ndarray) -> np.ndarray:
     x, y = r[:, 0], r[:, 1]
     a = 0.5 * (np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
@@ -178,7 +184,7 @@ def best_split(
     if not len(forced):
         for a, b, seg in _motorcycle_cuts(ring, sigma):
             a, b = _orient(a), _orient(b)
-            if min(_width(a), _width(b)) < min_width:
+            if min(_width(a), _width(b)) < min_width or not (_valid(a) and _valid(b)):
                 continue
             options.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
         if center is not None and not regular:
