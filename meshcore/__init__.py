@@ -67,6 +67,7 @@ __all__ = [
     "WriteError",
     "__version__",
     "algebraic_grid",
+    "auto_layout",
     "borders_from_loop",
     "borders_from_polylines",
     "cell_quality",
@@ -77,6 +78,7 @@ __all__ = [
     "iterate",
     "make_curve",
     "make_sources",
+    "mesh_outline",
     "metrics",
     "prepare_borders",
     "quality",
@@ -89,6 +91,8 @@ __all__ = [
 # Readers/writers are re-exported lazily so that ``import meshcore`` stays light
 # (meshcore.io imports nothing heavy either, but keeps optional readers out).
 _LAZY_IO = {"read_points", "read_grid", "read_blocks", "write", "PointSet", "GridSet"}
+# The lake pipeline (shapely, scipy, the layout MILP) is loaded on first use as well.
+_LAZY = {"auto_layout": "layout", "mesh_outline": "lakegrid"}
 
 
 def __getattr__(name: str):
@@ -96,4 +100,8 @@ def __getattr__(name: str):
         from . import io as _io
 
         return getattr(_io, name)
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module 'meshcore' has no attribute {name!r}")

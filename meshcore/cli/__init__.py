@@ -28,6 +28,7 @@ SUBCOMMANDS: list[tuple[str, str, str]] = [
     ("examples", "examples", "list bundled example cases, or copy one to a folder"),
     ("convert", "convert", "convert a grid file to another format (PLOT3D, VTK, CGNS, ...)"),
     ("import", "import_", "make a case file from a shoreline point file (KML, GeoJSON, CSV, ...)"),
+    ("mesh", "mesh", "a lake outline (islands included) in, an orthogonal multiblock grid out"),
 ]
 
 

@@ -1,0 +1,384 @@
+"""``meshcore mesh OUTLINE -o OUT`` — a lake outline in, a model-ready multiblock grid out.
+
+The whole of :func:`meshcore.mesh_outline` from the command line::
+
+    meshcore mesh lake.geojson -o lake.vtm -o lake.ddb --png lake.png --preset delft3d
+
+1. **read** OUTLINE (any point file: CSV/TXT, KML/KMZ, GeoJSON, shapefile, DXF).  The ring
+   with the largest area is the shore; every other ring must lie inside it and is an island
+   (GeoJSON interior rings, KML ``innerBoundaryIs``, shapefile holes, extra CSV rings).
+   Lon/lat is projected to the UTM zone of the centroid, or to ``--crs``; the grid is made
+   and written in that CRS's world coordinates (metres, no local offset).
+2. **layout** — :func:`meshcore.layout.auto_layout` at the cell size ``--cell-size`` (default
+   ``sqrt(water area / 10 000)``, or ``/ --cells``); a ``.ddb`` output asks for a layout
+   without 3- or 5-block corners (``--regular``), the only kind Delft3D can couple.
+3. **grid** — :func:`meshcore.lakegrid.mesh_layout`, coarse to fine over three levels.
+4. **quality** — :func:`meshcore.quality.lake_metrics` against the water polygon, and the
+   verdict of each ``--preset``.
+
+Every output is checked before any work (a format meshcore writes, its optional dependency,
+an existing writable folder, no path given twice) and again against the layout's block count
+before the solve, so an exit 2 leaves no file behind.  Progress goes to stderr; the quality
+table and the verdicts to stdout.  Exit codes: 0 a grid without folded cells, 2 bad input
+(one line naming the file and the place), 3 a grid was written but has folded cells or did
+not converge, 1 an internal error of the pipeline (one line; please report it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import io
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidInputError, MeshcoreError
+
+#: Cells of the default grid (``cell size = sqrt(water area / DEFAULT_CELLS)``).
+DEFAULT_CELLS = 10_000
+#: Coarse levels of the grid sequencing (cell counts are multiples of ``2**LEVELS``).
+LEVELS = 2
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    from ..quality import PRESETS
+
+    p.add_argument("outline", help="lake outline (.csv .txt .kml .kmz .geojson .shp .dxf); inner rings are islands")
+    size = p.add_mutually_exclusive_group()
+    size.add_argument("--cell-size", type=float, metavar="H", help="cell size in the grid's CRS units (metres)")
+    size.add_argument(
+        "--cells", type=int, metavar="N", help=f"about N cells: H = sqrt(water area / N) (default {DEFAULT_CELLS})"
+    )
+    p.add_argument(
+        "--crs", default="auto", help="CRS of the grid: auto (UTM zone of the centroid for lon/lat) or EPSG:nnnn"
+    )
+    p.add_argument("--source-crs", help="CRS of the outline when the file does not say (e.g. a DXF)")
+    p.add_argument(
+        "--columns", nargs=2, metavar=("X", "Y"), help="CSV: x and y (or lon and lat) column names or 0-based indices"
+    )
+    p.add_argument(
+        "--preset",
+        action="append",
+        choices=sorted(PRESETS),
+        help="print the verdict against a model's limits (repeatable)",
+    )
+    p.add_argument(
+        "--regular",
+        action="store_true",
+        help="no corner where 3 or 5 blocks meet (what Delft3D domain decomposition couples; implied by .ddb)",
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        action="append",
+        required=True,
+        metavar="OUT",
+        help="grid file, repeatable: .vtm .cgns .xyz (PLOT3D) .ddb (Delft3D DD) .npz .su2 .msh .csv",
+    )
+    p.add_argument("--png", metavar="FIG", help="also draw the grid to this figure (.png .svg .pdf)")
+    p.add_argument(
+        "--colour",
+        "--color",
+        dest="colour",
+        choices=("blocks", "deviation"),
+        default="blocks",
+        help="figure: one colour per block (default) or cells coloured by deviation from 90°",
+    )
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress and no quality table")
+
+
+class _Say:
+    """Progress lines on stderr (nothing with ``-q``)."""
+
+    def __init__(self, quiet: bool) -> None:
+        self.quiet = quiet
+        self.t0 = time.perf_counter()
+
+    def __call__(self, msg: str) -> None:
+        if not self.quiet:
+            print(msg, file=sys.stderr, flush=True)
+
+    def lap(self) -> float:
+        t, self.t0 = self.t0, time.perf_counter()
+        return self.t0 - t
+
+
+# ------------------------------------------------------------------ checks before any work
+def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
+    """Every ``-o`` and ``--png`` checked (format, dependency, folder, not given twice)."""
+    from ..io import find_format
+    from .generate import check_output
+
+    seen: dict[Path, str] = {}
+    out = []
+    for opt, path in [("-o", o) for o in args.output] + ([("--png", args.png)] if args.png else []):
+        p = check_output(path, opt, figure=opt == "--png")
+        key = p.resolve()
+        if key in seen:
+            raise InvalidInputError(f"{opt} {p}: the same file as {seen[key]}")
+        seen[key] = f"{opt} {p}"
+        if opt == "-o":
+            out.append((p, find_format(p, None, role="write")))
+    return out
+
+
+def _check_sizes(args: argparse.Namespace) -> None:
+    from .._validation import validate_count, validate_positive
+
+    if args.cell_size is not None:
+        validate_positive(args.cell_size, name="--cell-size")
+    if args.cells is not None:
+        validate_count(args.cells, name="--cells", minimum=16)
+
+
+def _check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
+    """Refuse, before the solve, an output that cannot hold this layout.
+
+    A ``.ddb`` is written once, from the algebraic grids of the layout's blocks, into a
+    temporary folder: the couplings (and whether Delft3D can orient them) depend on the
+    layout only, so the real write after the solve cannot fail on them.
+    """
+    n_blocks = len(lay.blocks)
+    for p, fmt in outputs:
+        if n_blocks > 1 and not fmt.multiblock:
+            raise InvalidInputError(
+                f"-o {p}: the {fmt.name} format holds one block and the layout has {n_blocks}; "
+                f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh"
+            )
+        if fmt.name == "delft3d-dd":
+            if n_blocks < 2:
+                raise InvalidInputError(f"-o {p}: the layout is one block; write it as .grd, not as a .ddb")
+            _dry_run_ddb(p, lay)
+
+
+def _dry_run_ddb(p: Path, lay: Any) -> None:
+    import tempfile
+
+    from ..algebraic import tfi
+    from ..errors import WriteError
+    from ..io import write
+
+    topo = lay.topology()
+    grids = [tfi(b.borders) for b in topo.blocks]
+    with tempfile.TemporaryDirectory(prefix="meshcore-mesh-") as d:
+        trial = Path(d) / p.name
+        try:
+            write(trial, grids, block_names=[b.name for b in topo.blocks])
+        except WriteError as exc:
+            msg = str(exc).replace(f"{trial}: ", "").replace(str(trial), str(p))
+            raise InvalidInputError(f"-o {p}: {msg} (write .vtm, .cgns or .xyz instead)") from None
+
+
+# ------------------------------------------------------------------ stages
+def _crs_label(crs: str | None) -> str:
+    if crs is None:
+        return "no CRS: the grid keeps the file's coordinates"
+    try:
+        import pyproj
+
+        name = f" ({pyproj.CRS.from_user_input(crs).name})"
+    except Exception:  # a label only: the CRS itself was checked by meshcore.crs
+        name = ""
+    return f"grid CRS {crs}{name}"
+
+
+def _read(args: argparse.Namespace, say: _Say):
+    """The water polygon in world coordinates of the grid's CRS, and its frame."""
+    from ..crs import is_geographic, normalize_crs, project
+    from ..io import read_points
+    from ..layout.polygon import water_from_points, water_polygon
+
+    target = args.crs
+    if target.strip().lower() not in ("auto", "none", "local"):
+        target = normalize_crs(target)
+        if target is not None and is_geographic(target):
+            raise InvalidInputError(f"--crs {args.crs}: a geographic CRS (degrees); give a projected one (metres)")
+    ps = read_points(args.outline, columns=args.columns)
+    local, frame = project(ps, target, origin=None, source_crs=args.source_crs)
+    if frame.crs is not None and is_geographic(frame.crs):
+        raise InvalidInputError(
+            f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
+        )
+    outer, islands = water_from_points(local)
+    try:
+        poly, notes = water_polygon(outer, holes=islands)
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{args.outline}: {exc}") from None
+    n_isl = len(islands)
+    where = f" from {frame.source_crs}" if frame.source_crs and frame.source_crs != frame.crs else ""
+    isl = f"{n_isl} island{'s' * (n_isl != 1)} ({sum(len(r) for r in islands)} points)" if n_isl else "no islands"
+    say(f"read {args.outline}: shore of {len(outer)} points, {isl}; {_crs_label(frame.crs)}{where}")
+    _notes(notes)
+    return poly, frame
+
+
+def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:
+    """The cell size and how it was chosen; refused when the grid would pass the node limit."""
+    from .._validation import max_nodes
+
+    area = float(poly.area)
+    if args.cell_size is not None:
+        h, why = float(args.cell_size), "--cell-size"
+    else:
+        n = args.cells or DEFAULT_CELLS
+        h = math.sqrt(area / n)
+        why = f"sqrt(water area / {n})"
+    est = area / (h * h)
+    if est > max_nodes():
+        raise InvalidInputError(
+            f"{args.outline}: {why} {h:.4g}{unit} gives about {est:,.0f} cells; the limit is "
+            f"{max_nodes():,} nodes (set MESHCORE_MAX_NODES to raise it)"
+        )
+    return h, f"cell size {h:.4g}{unit} ({why}, about {est:,.0f} cells)"
+
+
+def _notes(notes: Any) -> None:
+    """What the pipeline changed in the water (islands joined or too small): shown even with -q."""
+    for n in notes:
+        print(f"meshcore mesh: note: {n}", file=sys.stderr)
+
+
+def _layout(args, poly, h: float, regular: bool, say: _Say):
+    from ..layout import auto_layout
+
+    try:
+        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular)
+    except InvalidInputError as exc:
+        msg = str(exc)
+        raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None
+    n = len(lay.blocks)
+    say(
+        f"layout: {n} block{'s' * (n != 1)}, {lay.n_cells:,} cells"
+        f"{' (regular: no 3- or 5-block corners)' if regular else ''}, {say.lap():.1f} s"
+    )
+    _notes(lay.notes)
+    return lay
+
+
+def _grid(lay, say: _Say):
+    from ..lakegrid import mesh_layout
+
+    n_levels = LEVELS + 1
+
+    def level(kind: str, value: Any) -> None:
+        if kind != "level":
+            return
+        lev, res = value
+        f = 2 ** (LEVELS - lev)
+        cells = sum(g.cells[0] * g.cells[1] for g in res.grids)
+        scale = f"cells ÷ {f}" if f > 1 else "full"
+        say(f"grid level {lev + 1}/{n_levels} ({scale}, {cells:,} cells): {res.sweeps} sweeps, {say.lap():.1f} s")
+
+    return mesh_layout(lay, levels=LEVELS, callback=level)
+
+
+# ------------------------------------------------------------------ figure
+def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any) -> None:
+    """One colour per block, or cells coloured by the largest deviation from 90° at their nodes."""
+    import matplotlib
+    from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
+
+    from ..grid import BORDER_NAMES
+    from ..io import atomic_write_bytes
+
+    xs = np.concatenate([np.ravel(g.x) for g in mb.grids])
+    ys = np.concatenate([np.ravel(g.y) for g in mb.grids])
+    w, h = float(np.ptp(xs)) or 1.0, float(np.ptp(ys)) or 1.0
+    s = 8.0 / max(w, h)
+    fig = Figure(figsize=(max(4.0, w * s + 1.5), max(4.0, h * s + 0.8)))
+    ax = fig.add_subplot()
+    blocks = matplotlib.colormaps["tab10"].colors
+    mesh = None
+    for k, g in enumerate(mb.grids):
+        x, y = np.asarray(g.x), np.asarray(g.y)
+        if colour == "deviation":
+            d = metrics.blocks[k].deviation
+            corners = np.stack([d[:-1, :-1], d[1:, :-1], d[1:, 1:], d[:-1, 1:]])
+            with np.errstate(all="ignore"):
+                c = np.where(np.isnan(corners).all(axis=0), np.nan, np.nanmax(corners, axis=0))
+            mesh = ax.pcolormesh(x, y, c, cmap="magma_r", vmin=0.0, vmax=10.0, shading="flat")
+            line = "0.35"
+        else:
+            line = blocks[k % len(blocks)]
+        segs = [np.column_stack([x[i], y[i]]) for i in range(x.shape[0])]
+        segs += [np.column_stack([x[:, j], y[:, j]]) for j in range(x.shape[1])]
+        ax.add_collection(LineCollection(segs, colors=[line], linewidths=0.3))
+        ax.add_collection(LineCollection([g.border(b) for b in BORDER_NAMES], colors=[line], linewidths=0.9))
+    for ring in [poly.exterior, *poly.interiors]:
+        r = np.asarray(ring.coords)
+        ax.plot(r[:, 0], r[:, 1], color="k", lw=0.8)
+    if mesh is not None:
+        fig.colorbar(mesh, ax=ax, extend="max", shrink=0.8, label="deviation from 90° at the cell's nodes [°]")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.ticklabel_format(useOffset=False, style="plain")
+    unit = f" [m, {frame.crs}]" if frame.crs else ""
+    ax.set_xlabel(f"x{unit}")
+    ax.set_ylabel(f"y{unit}")
+    n_cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
+    ax.set_title(f"{len(mb.grids)} blocks, {n_cells:,} cells", fontsize=10)
+    buf = io.BytesIO()
+    fig.savefig(buf, format=path.suffix.lower().lstrip("."), dpi=150, bbox_inches="tight")
+    atomic_write_bytes(path, buf.getvalue())
+
+
+# ------------------------------------------------------------------ the command
+def run(args: argparse.Namespace) -> int:
+    from ..crs import normalize_crs
+    from ..io import write
+    from ..quality import check, lake_metrics
+
+    t_start = time.perf_counter()
+    say = _Say(args.quiet)
+    _check_sizes(args)
+    if args.crs.strip().lower() not in ("auto", "none", "local"):
+        normalize_crs(args.crs)  # an unknown CRS is refused before the file is read
+    outputs = _check_outputs(args)
+    ddb = [p for p, fmt in outputs if fmt.name == "delft3d-dd"]
+    regular = bool(args.regular or ddb)
+    if ddb and not args.regular:
+        say(f"{ddb[0]}: Delft3D domain decomposition couples no 3- or 5-block corners: using --regular")
+    poly, frame = _read(args, say)
+    unit = " m" if frame.crs else ""
+    h, how = _cell_size(args, poly, unit)
+    say(f"water area {poly.area / 1e6:.4g} km², {how}" if frame.crs else f"water area {poly.area:.6g}, {how}")
+    say.lap()
+    try:
+        lay = _layout(args, poly, h, regular, say)
+        _check_blocks(outputs, lay)
+        mb = _grid(lay, say)
+    except MeshcoreError:
+        raise
+    except Exception as exc:  # a bug of the pipeline, not bad input: one line, exit 1
+        print(
+            f"meshcore mesh: internal error while making the grid of {args.outline} "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); please report it with the file",
+            file=sys.stderr,
+        )
+        return 1
+    mb = dataclasses.replace(mb, frame=frame)
+    m = lake_metrics(mb, polygon=poly, cell_size=h)
+    n_folded = int(m.values("folded").sum())
+    say(f"quality: {n_folded} folded cells, mean deviation from 90° {m.mean('deviation'):.2f}°, {say.lap():.1f} s")
+    for p, _ in outputs:
+        write(p, mb, crs=frame)
+        say(f"wrote {p}")
+    if args.png:
+        _figure(Path(args.png), mb, poly, frame, args.colour, m)
+        say(f"wrote {args.png}")
+    if not args.quiet:
+        print(m.table())
+        for name in dict.fromkeys(args.preset or ()):
+            print("\n" + check(m, name).table())
+        print(f"\n{len(mb.grids)} blocks, {m.summary()['cells']:,} cells in {time.perf_counter() - t_start:.1f} s")
+    if n_folded or not mb.converged:
+        why = f"{n_folded} folded or non-convex cells" if n_folded else "the solver did not converge"
+        print(f"meshcore mesh: warning: {why} (exit code 3)", file=sys.stderr)
+        return 3
+    return 0

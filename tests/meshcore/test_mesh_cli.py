@@ -1,0 +1,496 @@
+"""``meshcore mesh``: a lake outline in, a multiblock grid out — end to end.
+
+Each output is read back by an independent reader (VTK, h5py, a Fortran-record parser, the
+Delft3D parsers of ``test_delft3d_dd``) and by meshcore's own, and its world coordinates are
+checked against the input outline projected here with pyproj directly.  Exit codes: 0, 2
+(bad input: one line, nothing written), 3 (a grid with folded cells, written), 1 (a bug).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import io
+import json
+import math
+import os
+import xml.etree.ElementTree as ET
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from meshcore.cli import main
+from meshcore.io import read_blocks
+from tests.conftest import ROOT
+from tests.meshcore.test_delft3d_dd import parse_ddb, parse_grd, segment
+
+LAKES = ROOT / "benchmarks" / "lakes"
+shapely = pytest.importorskip("shapely")
+pyproj = pytest.importorskip("pyproj")
+
+
+@dataclasses.dataclass
+class Run:
+    rc: int
+    out: str
+    err: str
+
+
+def mesh(*argv) -> Run:
+    """``meshcore mesh ARGV`` in this process (the compiled kernels stay loaded)."""
+    o, e = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
+        rc = main(["mesh", *map(str, argv)])
+    return Run(rc, o.getvalue(), e.getvalue())
+
+
+# ------------------------------------------------------------------ independent geometry
+def geojson_rings(path: Path) -> list[np.ndarray]:
+    d = json.loads(path.read_text())
+    geom = d["features"][0]["geometry"] if "features" in d else d.get("geometry", d)
+    return [np.asarray(r, float)[:, :2] for r in geom["coordinates"]]
+
+
+def kml_rings(path: Path) -> list[np.ndarray]:
+    ns = {"k": "http://www.opengis.net/kml/2.2"}
+    poly = ET.parse(path).getroot().find(".//k:Polygon", ns)
+    rings = poly.findall("k:outerBoundaryIs//k:coordinates", ns) + poly.findall("k:innerBoundaryIs//k:coordinates", ns)
+    return [np.array([[float(v) for v in t.split(",")[:2]] for t in r.text.split()]) for r in rings]
+
+
+def projected(rings: list[np.ndarray], crs: str):
+    t = pyproj.Transformer.from_crs("EPSG:4326", crs, always_xy=True)
+    xy = [np.column_stack(t.transform(r[:, 0], r[:, 1])) for r in rings]
+    return shapely.Polygon(xy[0], xy[1:])
+
+
+def blocks_of(gs) -> list[tuple[np.ndarray, np.ndarray]]:
+    return [gs.world(k) for k in range(len(gs.blocks))]
+
+
+def check_covers_the_water(blocks, water) -> None:
+    """Grid nodes in the water, shore nodes on the shore, no cell on an island, about the water's area.
+
+    The node checks (to 1e-7 of the lake's size) pin the coordinates down: a grid in another
+    CRS, shifted by an origin or scaled, fails them.  The area is a sanity check only (10 %);
+    the pipeline's own tests hold the coverage targets.
+    """
+    size = math.sqrt(water.area)
+    tol = 1e-7 * size
+    nodes = np.vstack([np.column_stack([x.ravel(), y.ravel()]) for x, y in blocks])
+    assert np.abs(nodes).max() > 0
+    assert shapely.distance(water, shapely.points(nodes)).max() <= tol
+    # a border node of one block only lies on the shore (or an island's); shared ones are interfaces
+    owners: Counter = Counter()
+    border = {}
+    for x, y in blocks:
+        sides = ((x[:, 0], y[:, 0]), (x[-1], y[-1]), (x[:, -1], y[:, -1]), (x[0], y[0]))
+        ring = np.concatenate([np.column_stack(side) for side in sides])
+        keys = {tuple(k): p for k, p in zip(np.round(ring / tol).astype(np.int64).tolist(), ring, strict=True)}
+        owners.update(keys.keys())
+        border.update(keys)
+    shore = np.array([border[k] for k, n in owners.items() if n == 1])
+    assert shapely.distance(water.boundary, shapely.points(shore)).max() <= tol
+    quads = []
+    for x, y in blocks:
+        c = [(x[:-1, :-1], y[:-1, :-1]), (x[1:, :-1], y[1:, :-1]), (x[1:, 1:], y[1:, 1:]), (x[:-1, 1:], y[:-1, 1:])]
+        quads.append(np.stack([np.column_stack([a.ravel(), b.ravel()]) for a, b in c], axis=1))
+    cells = shapely.polygons(np.concatenate(quads))
+    assert abs(shapely.area(cells).sum() / water.area - 1.0) <= 0.1
+    for hole in water.interiors:
+        island = shapely.Polygon(hole)
+        assert not shapely.contains(island, shapely.centroid(cells)).any()  # no cell over the island
+        # ... and the grid goes round it: its shore nodes follow the island's whole ring
+        on = shore[shapely.distance(island.exterior, shapely.points(shore)) <= tol]
+        along = shapely.line_locate_point(island.exterior, shapely.points(on))
+        assert len(on) >= 8 and shapely.Polygon(on[np.argsort(along)]).area > 0.8 * island.area
+
+
+# ------------------------------------------------------------------ independent readers
+def vtm_blocks(path: Path) -> list[tuple[np.ndarray, np.ndarray]]:
+    vtk = pytest.importorskip("vtk")
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    r = vtk.vtkXMLMultiBlockDataReader()
+    r.SetFileName(str(path))
+    r.Update()
+    mb = r.GetOutput()
+    out = []
+    for k in range(mb.GetNumberOfBlocks()):
+        b = mb.GetBlock(k)
+        e = b.GetExtent()
+        shape = (e[1] - e[0] + 1, e[3] - e[2] + 1)
+        pts = vtk_to_numpy(b.GetPoints().GetData())
+        out.append((pts[:, 0].reshape(shape, order="F"), pts[:, 1].reshape(shape, order="F")))
+    return out
+
+
+def plot3d_blocks(path: Path) -> list[tuple[np.ndarray, np.ndarray]]:
+    """A multi-grid 2-D PLOT3D file in Fortran records (little-endian, double)."""
+    raw, pos, recs = path.read_bytes(), 0, []
+    while pos < len(raw):
+        n = int(np.frombuffer(raw, "<i4", 1, pos)[0])
+        assert int(np.frombuffer(raw, "<i4", 1, pos + 4 + n)[0]) == n
+        recs.append(raw[pos + 4 : pos + 4 + n])
+        pos += n + 8
+    nb = int(np.frombuffer(recs[0], "<i4")[0])
+    dims = np.frombuffer(recs[1], "<i4").reshape(nb, 2)
+    assert len(recs) == 2 + nb
+    out = []
+    for (ni, nj), rec in zip(dims, recs[2:], strict=True):
+        xy = np.frombuffer(rec, "<f8").reshape(2, nj, ni)
+        out.append((xy[0].T, xy[1].T))
+    return out
+
+
+def cgns_blocks(path: Path) -> tuple[str, list[tuple[np.ndarray, np.ndarray]]]:
+    h5py = pytest.importorskip("h5py")
+    with h5py.File(path, "r") as h:
+        (base,) = (h[k] for k in h if not k.startswith(" ") and k != "CGNSLibraryVersion")
+        crs = bytes(base["CRS"][" data"][:].astype(np.uint8)).decode()
+        zones = [base[k] for k in base if bytes(np.asarray(base[k].attrs.get("label", b""))).startswith(b"Zone_t")]
+        out = [
+            (z["GridCoordinates/CoordinateX/ data"][:].T, z["GridCoordinates/CoordinateY/ data"][:].T) for z in zones
+        ]
+    return crs, out
+
+
+def node_set(blocks) -> set:
+    return {tuple(p) for x, y in blocks for p in np.round(np.column_stack([x.ravel(), y.ravel()]), 3).tolist()}
+
+
+# ------------------------------------------------------------------ a real lake, every format
+@pytest.fixture(scope="module")
+def ness(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ness")
+    src = LAKES / "loch_ness_sparse.geojson"
+    outs = [d / f"ness.{s}" for s in ("vtm", "ddb", "cgns", "xyz", "npz")]
+    run = mesh(
+        src,
+        "--cells",
+        1500,
+        *[a for o in outs for a in ("-o", o)],
+        "--png",
+        d / "ness.png",
+        "--preset",
+        "delft3d",
+        "--preset",
+        "efdc",
+    )
+    water = projected(geojson_rings(src), "EPSG:32630")  # Loch Ness: 4.5° W, UTM zone 30 N
+    return run, d, water
+
+
+def test_ness_runs_with_progress_summary_and_verdicts(ness):
+    run, d, _ = ness
+    assert run.rc == 0, run.err
+    gs = read_blocks(d / "ness.npz")
+    n = len(gs.blocks)
+    assert n >= 2
+    err = run.err.splitlines()
+    stages = [
+        "read ",
+        "water area",
+        f"layout: {n} blocks",
+        "grid level 1/3",
+        "grid level 2/3",
+        "grid level 3/3",
+        "quality:",
+    ]
+    starts = [next(k for k, ln in enumerate(err) if s in ln) for s in stages]
+    assert starts == sorted(starts)
+    assert "EPSG:32630" in err[starts[0]] and "no islands" in err[starts[0]]
+    assert any("ness.ddb" in ln and "--regular" in ln for ln in err)  # said, not silently done
+    for s in ("vtm", "ddb", "cgns", "xyz", "npz", "png"):
+        assert f"wrote {d / f'ness.{s}'}" in run.err
+    cells = sum(g.cells[0] * g.cells[1] for g in gs.blocks)
+    assert 750 <= cells <= 3000  # --cells 1500: within 0.5-2×
+    assert "| blocks / cells / interior nodes" in run.out and f"{n} / {cells} /" in run.out
+    assert "delft3d: " in run.out and "efdc: " in run.out and run.out.count("verdict: ") == 2
+    assert f"{n} blocks, {cells:,} cells in" in run.out
+
+
+def test_ness_world_coordinates_are_the_projected_outline(ness):
+    _, d, water = ness
+    gs = read_blocks(d / "ness.npz")
+    assert gs.frame.crs == "EPSG:32630" and gs.frame.origin == (0.0, 0.0)
+    check_covers_the_water(blocks_of(gs), water)
+
+
+def test_ness_vtm_cgns_plot3d_read_back_by_independent_readers(ness):
+    _, d, _ = ness
+    ref = blocks_of(read_blocks(d / "ness.npz"))
+    crs, cg = cgns_blocks(d / "ness.cgns")
+    assert crs == "EPSG:32630"
+    for got in (vtm_blocks(d / "ness.vtm"), cg, plot3d_blocks(d / "ness.xyz")):
+        assert len(got) == len(ref)
+        for (x, y), (X, Y) in zip(got, ref, strict=True):
+            np.testing.assert_array_equal(x, X)
+            np.testing.assert_array_equal(y, Y)
+    for f in ("ness.vtm", "ness.cgns", "ness.xyz"):  # and by meshcore's readers, with the CRS where stored
+        gs = read_blocks(d / f)
+        assert gs.frame.origin == (0.0, 0.0) and gs.frame.crs == (None if f.endswith("xyz") else "EPSG:32630")
+        for (x, y), (X, Y) in zip(blocks_of(gs), ref, strict=True):
+            np.testing.assert_array_equal(x, X)
+            np.testing.assert_array_equal(y, Y)
+
+
+def test_ness_delft3d_domain_decomposition_reads_back(ness):
+    _, d, _ = ness
+    ref = blocks_of(read_blocks(d / "ness.npz"))
+    lines = parse_ddb(d / "ness.ddb")
+    files = sorted({ln[0] for ln in lines} | {ln[2] for ln in lines})
+    assert len(files) == len(ref)  # every block coupled
+    grd = {f: parse_grd(d / f) for f in files}
+    assert node_set(grd.values()) == node_set(ref)  # the same nodes, in world coordinates
+    for f in files:
+        assert any(ln.startswith("* Projection: EPSG:32630") for ln in (d / f).read_text().splitlines())
+    for fa, mna, fb, mnb in lines:  # each coupling joins coinciding grid points
+        np.testing.assert_allclose(segment(*grd[fa], mna), segment(*grd[fb], mnb), atol=1e-6)
+    assert len(read_blocks(d / "ness.ddb").blocks) == len(ref)
+
+
+def test_ness_figure_is_an_image(ness):
+    _, d, _ = ness
+    assert (d / "ness.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# ------------------------------------------------------------------ islands
+def test_kml_islands_are_left_out_of_the_grid(tmp_path):
+    src = LAKES / "quabbin_sparse.kml"  # one island (innerBoundaryIs)
+    run = mesh(src, "--cells", 1500, "-o", tmp_path / "q.vtm", "--png", tmp_path / "q.png", "--colour", "deviation")
+    assert run.rc == 0, run.err
+    assert "1 island" in run.err
+    water = projected(kml_rings(src), "EPSG:32618")  # 72.3° W: UTM zone 18 N
+    assert len(water.interiors) == 1
+    check_covers_the_water(vtm_blocks(tmp_path / "q.vtm"), water)
+    assert (tmp_path / "q.png").stat().st_size > 10_000
+
+
+def _synthetic_rings(x0: float = 500_000.0, y0: float = 5_200_000.0):
+    """An elliptic lake (6 × 3.6 km) with a round island (1 km) off its centre, in metres."""
+    t = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    s = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    shore = np.column_stack([x0 + 3000 * np.cos(t), y0 + 1800 * np.sin(t)])
+    island = np.column_stack([x0 + 800 + 500 * np.cos(s), y0 + 200 + 500 * np.sin(-s)])
+    return shore, island
+
+
+@pytest.fixture
+def synthetic_csv(tmp_path):
+    """The synthetic lake as ``x,y,ring`` rows in metres, no CRS (an extra ring = an island)."""
+    f = tmp_path / "lake.csv"
+    shore, island = _synthetic_rings()
+    rows = [f"{x:.3f},{y:.3f},shore" for x, y in shore] + [f"{x:.3f},{y:.3f},island" for x, y in island]
+    f.write_text("x,y,ring\n" + "\n".join(rows) + "\n")
+    return f
+
+
+def test_csv_rings_without_a_crs_keep_the_file_coordinates(tmp_path, synthetic_csv):
+    run = mesh(synthetic_csv, "--cell-size", 150, "-o", tmp_path / "s.vtm", "-o", tmp_path / "s.npz")
+    assert run.rc == 0, run.err
+    assert (
+        "1 island" in run.err
+        and "no CRS: the grid keeps the file's coordinates" in run.err
+        and "cell size 150 (--cell-size" in run.err
+    )
+    gs = read_blocks(tmp_path / "s.npz")
+    assert gs.frame.crs is None and gs.frame.origin == (0.0, 0.0)
+    shore, island = (np.round(r, 3) for r in _synthetic_rings())
+    water = shapely.Polygon(shore, [island])
+    check_covers_the_water(vtm_blocks(tmp_path / "s.vtm"), water)
+    cells = sum(g.cells[0] * g.cells[1] for g in gs.blocks)
+    assert 0.5 <= cells / (water.area / 150**2) <= 2.0
+
+
+def test_geojson_interior_ring_in_lon_lat_to_a_given_crs(tmp_path):
+    """Lon/lat in, ``--crs EPSG:3035`` (ETRS89-LAEA) out: coordinates and CRS are that CRS's."""
+    to_ll = pyproj.Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True)
+    rings = [np.column_stack(to_ll.transform(r[:, 0], r[:, 1])) for r in _synthetic_rings()]
+    f = tmp_path / "lake.geojson"
+    coords = [[[round(a, 7), round(b, 7)] for a, b in [*r, r[0]]] for r in rings]
+    f.write_text(
+        json.dumps({"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": coords}})
+    )
+    run = mesh(f, "--cells", 600, "--crs", "EPSG:3035", "-o", tmp_path / "s.cgns", "-q")
+    assert run.rc == 0 and run.out == "" and run.err == "", run.err
+    crs, blocks = cgns_blocks(tmp_path / "s.cgns")
+    assert crs == "EPSG:3035"
+    check_covers_the_water(blocks, projected(geojson_rings(f), "EPSG:3035"))
+
+
+def test_shapefile_hole_is_an_island(tmp_path):
+    shp = pytest.importorskip("shapefile")
+    shore, island = _synthetic_rings()
+    with shp.Writer(str(tmp_path / "lake"), shapeType=shp.POLYGON) as w:
+        w.field("name", "C")
+        w.poly(
+            [shore[::-1].tolist(), island[::-1].tolist()]
+        )  # shapefile: outer ring clockwise, holes counter-clockwise
+        w.record("lake")
+    run = mesh(tmp_path / "lake.shp", "--cells", 400, "-o", tmp_path / "s.vtm")
+    assert run.rc == 0, run.err
+    assert "1 island" in run.err
+    check_covers_the_water(vtm_blocks(tmp_path / "s.vtm"), shapely.Polygon(shore, [island]))
+
+
+def test_the_command_is_mesh_outline(tmp_path, synthetic_csv):
+    """The grid written is the one ``meshcore.mesh_outline`` returns for the same outline."""
+    import meshcore
+    from meshcore import lakegrid, layout
+
+    assert meshcore.mesh_outline is lakegrid.mesh_outline and meshcore.auto_layout is layout.auto_layout
+    assert mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "s.npz", "-q").rc == 0
+    shore, island = (np.round(r, 3) for r in _synthetic_rings())
+    water = shapely.Polygon(shore, [island])
+    mb = meshcore.mesh_outline(shore, holes=[island], cell_size=math.sqrt(water.area / 400))
+    got = read_blocks(tmp_path / "s.npz").blocks
+    assert len(got) == len(mb.grids) == len(meshcore.auto_layout(water, cell_size=math.sqrt(water.area / 400)).blocks)
+    for a, b in zip(got, mb.grids, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.y, b.y)
+
+
+# ------------------------------------------------------------------ exit code 2: nothing written
+def _refused(run: Run, folder: Path, *needles: str, before: set | None = None) -> None:
+    assert run.rc == 2, (run.rc, run.err)
+    assert run.err.count("\n") == 1 and "Traceback" not in run.err, run.err
+    for n in needles:
+        assert n in run.err, (n, run.err)
+    assert set(os.listdir(folder)) == (before or set()), "an output was written"
+
+
+def test_default_cell_size_and_a_one_block_format_refused_before_the_solve(tmp_path, synthetic_csv):
+    """Without --cell-size: about 10 000 cells; a .vts cannot hold them: refused after the layout."""
+    out = tmp_path / "out"
+    out.mkdir()
+    run = mesh(synthetic_csv, "-o", out / "s.vtm", "-o", out / "s.vts")
+    assert run.rc == 2 and "Traceback" not in run.err
+    assert "sqrt(water area / 10000), about 10,000 cells" in run.err
+    assert "grid level" not in run.err  # refused before the solve
+    layout_cells = int(next(ln for ln in run.err.splitlines() if ln.startswith("layout:")).split()[3].replace(",", ""))
+    assert 5_000 <= layout_cells <= 20_000
+    assert "-o" in run.err.splitlines()[-1] and "s.vts" in run.err.splitlines()[-1] and "holds one block" in run.err
+    assert os.listdir(out) == []
+
+
+@pytest.mark.parametrize(
+    ("text", "needles"),
+    [
+        ("x,y\n0,0\n4000,0\nabc,2000\n0,2000\n", ("bad.csv", "line 4")),
+        ("x,y\n0,0\n4000,2000\n4000,0\n0,2000\n", ("bad.csv", "crosses itself", "point")),  # a bow tie
+        (
+            "x,y,ring\n0,0,shore\n4000,0,shore\n4000,2000,shore\n0,2000,shore\n"
+            "5000,0,other\n6000,0,other\n6000,1000,other\n",
+            ("bad.csv", "'other'", "outside the outline"),
+        ),
+    ],
+    ids=["not-a-number", "bow-tie", "second-lake"],
+)
+def test_bad_outline_file(tmp_path, text, needles):
+    f = tmp_path / "bad.csv"
+    f.write_text(text)
+    out = tmp_path / "out"
+    out.mkdir()
+    _refused(mesh(f, "-o", out / "s.vtm", "--png", out / "s.png"), out, *needles)
+
+
+def test_missing_file_and_unknown_crs(tmp_path, synthetic_csv):
+    out = tmp_path / "out"
+    out.mkdir()
+    _refused(mesh(tmp_path / "nope.kml", "-o", out / "s.vtm"), out, "nope.kml", "no such file")
+    src = LAKES / "loch_ness_sparse.kml"
+    _refused(mesh(src, "--crs", "EPSG:999999", "-o", out / "s.vtm"), out, "unknown CRS 'EPSG:999999'")
+    _refused(mesh(src, "--crs", "EPSG:4326", "-o", out / "s.vtm"), out, "--crs", "projected")
+
+
+@pytest.mark.parametrize(
+    ("outputs", "needles"),
+    [
+        (["-o", "{out}/missing/s.vtm"], ("-o", "missing", "does not exist")),
+        (["-o", "{out}/s.vtm", "-o", "{out}/s.foo"], ("-o", "s.foo", "cannot write .foo")),
+        (["-o", "{out}/s.vtm", "--png", "{out}/s.vtm"], ("--png", "figure")),
+        (["-o", "{out}/s.vtm", "-o", "{out}/s.vtm"], ("-o", "the same file")),
+        (["-o", "{out}"], ("-o", "is a folder")),
+    ],
+    ids=["no-folder", "unknown-format", "png-not-a-figure", "twice", "a-folder"],
+)
+def test_unwritable_output_refused_before_reading(tmp_path, synthetic_csv, outputs, needles):
+    out = tmp_path / "out"
+    out.mkdir()
+    argv = [a.format(out=out) for a in outputs]
+    _refused(mesh(synthetic_csv, *argv), out, *needles)
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="needs a folder the user cannot write")
+def test_read_only_folder_refused(tmp_path, synthetic_csv):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o500)
+    try:
+        _refused(mesh(synthetic_csv, "-o", ro / "s.vtm"), ro, "permission denied")
+    finally:
+        ro.chmod(0o700)
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["--cells", "0"], "--cells must be >= 16"),
+        (["--cell-size", "-5"], "--cell-size must be a positive"),
+        (["--cell-size", "nan"], "--cell-size must be a positive"),
+        (["--cell-size", "0.01"], "--cell-size 0.01 gives about 161,508,"),
+    ],
+)
+def test_bad_sizes(tmp_path, synthetic_csv, argv, needle):
+    out = tmp_path / "out"
+    out.mkdir()
+    _refused(mesh(synthetic_csv, *argv, "-o", out / "s.vtm", "-q"), out, needle)
+
+
+# ------------------------------------------------------------------ exit code 3 and 1
+def _spoiled(fold: bool):
+    from meshcore import lakegrid
+
+    real = lakegrid.mesh_layout
+
+    def spoiled(lay, **kw):
+        mb = real(lay, **kw)
+        if not fold:
+            return dataclasses.replace(mb, info=dataclasses.replace(mb.info, converged=False))
+        g = mb.grids[0]
+        x = np.array(g.x)
+        x[1, 1], x[2, 1] = x[2, 1], x[1, 1]  # two interior nodes swapped: cells folded
+        return dataclasses.replace(mb, grids=(g.replaced(x=x), *mb.grids[1:]))
+
+    return spoiled
+
+
+@pytest.mark.parametrize(("fold", "needle"), [(True, "folded or non-convex cells"), (False, "did not converge")])
+def test_a_grid_with_folds_or_not_converged_is_written_and_exits_3(tmp_path, synthetic_csv, monkeypatch, fold, needle):
+    from meshcore import lakegrid
+
+    monkeypatch.setattr(lakegrid, "mesh_layout", _spoiled(fold))
+    run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "s.vtm")
+    assert run.rc == 3, run.err
+    assert needle in run.err.splitlines()[-1] and "exit code 3" in run.err
+    assert len(read_blocks(tmp_path / "s.vtm").blocks) >= 1
+    quality = next(ln for ln in run.err.splitlines() if ln.startswith("quality:"))
+    assert (int(quality.split()[1]) > 0) == fold
+
+
+def test_a_bug_in_the_pipeline_is_one_line_and_exit_1(tmp_path, synthetic_csv, monkeypatch):
+    from meshcore import lakegrid
+
+    def broken(lay, **kw):
+        raise IndexError("index 7 is out of bounds")
+
+    monkeypatch.setattr(lakegrid, "mesh_layout", broken)
+    out = tmp_path / "out"
+    out.mkdir()
+    run = mesh(synthetic_csv, "--cells", 400, "-o", out / "s.vtm", "-q")
+    assert run.rc == 1 and run.err.count("\n") == 1 and "Traceback" not in run.err
+    assert "internal error" in run.err and "IndexError: index 7" in run.err and "lake.csv" in run.err
+    assert os.listdir(out) == []
