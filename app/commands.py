@@ -17,7 +17,7 @@ from meshcore import BorderSpec
 
 from . import project as pj
 from .document import Document
-from .project import Block, Project, SolverSettings
+from .project import Block, Project
 
 __all__ = [
     "AddBlock",
@@ -200,7 +200,7 @@ class Editor:
         b = self.doc.block
         cells = b.cells
         if corners is not None and b.corners is None and b.boundary is None and b.cells == Block().cells:
-            cells = pj.default_cells(b.points, tuple(corners), total=max(b.cells))
+            cells = pj.default_cells(b.points, tuple(corners), total=max(b.cells or (32, 16)))
         self._edit_block(SetCorners, lambda bb: pj.with_corners(bb, corners).replaced(cells=cells), "Set corners")
         if cells != b.cells and self.doc.block.cells == cells:
             text = (
@@ -213,8 +213,6 @@ class Editor:
     # ---------------------------------------------------------- options
     def set_block_options(self, merge_key=None, index: int | None = None, **kw) -> None:
         names = ", ".join(kw)
-        if "cells" in kw:
-            kw["keep_nodes"] = False
         self._edit_block(
             SetBlockOptions,
             lambda b: b.replaced(**kw),
@@ -230,9 +228,7 @@ class Editor:
 
     def set_solver(self, merge_key=None, **kw) -> None:
         p = self.doc.project
-        s = SolverSettings(
-            **{**{f: getattr(p.solver, f) for f in ("method", "tolerance", "max_iterations", "omega", "repair")}, **kw}
-        )
+        s = p.solver.replaced(**kw)
         self._push(
             SetSolver,
             p.replaced(solver=s),

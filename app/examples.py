@@ -1,8 +1,8 @@
 """The Examples menu: the paper's cases (``resources/examples/*.toml``) and real lakes.
 
 Lakes (``app/resources/*.csv``, lon/lat) are projected to UTM metres, given
-corners by :func:`app.geometry.auto_corners` and cell counts proportional to
-their shape.
+corners and cell counts by :func:`app.project.block_from_points` (the choice
+of ``meshcore import``).
 """
 
 from __future__ import annotations
@@ -10,9 +10,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from . import geometry as geo
 from .io_adapter import load_project, read_points, to_local
-from .project import Block, Project, default_cells
+from .project import Project, block_from_points
 
 __all__ = ["EXAMPLE_DIRS", "LAKES", "example_names", "load_example"]
 
@@ -51,9 +50,7 @@ def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
         crs, origin, src = frame.crs or "", frame.origin, frame.source_crs or ""
     else:
         pts, crs, origin, src = pd.points, "", (0.0, 0.0), ""
-    corners = geo.auto_corners(pts)
-    ni, nj = default_cells(pts, corners, total=cells, minimum=12)  # a dozen cells across narrow lakes
-    block = Block(name=csv_path.stem, points=pts, closed=True, corners=corners, cells=(ni, nj))
+    block = block_from_points(pts, csv_path.stem, total=cells, minimum=12)  # a dozen cells across narrow lakes
     return Project(blocks=(block,), crs=crs, origin=origin, source_crs=src, title=title)
 
 

@@ -15,11 +15,10 @@ import numpy as np
 
 from meshcore import BORDER_NAMES, BorderSpec, ReadError
 
-from .project import Block, Project, SolverSettings, boundary_to_loop
+from .project import Block, Project, boundary_to_loop
 
 __all__ = [
     "PointData",
-    "block_from_case",
     "case_of_project",
     "dumps_project",
     "load_project",
@@ -117,99 +116,45 @@ def project_frame(project: Project):
 
 
 # ------------------------------------------------------------------ project
-def block_from_case(bc) -> Block:
-    """A :class:`Block` from a :class:`meshcore.case.BlockCase`."""
-    specs = tuple(dict(bc.border_specs).items())
-    common = {
-        "name": bc.name,
-        "weights": tuple(bc.weights),
-        "initial": bc.initial,
-        "curve": bc.curve,
-        "periodic": bool(bc.periodic),
-        "borders": specs,
-        "snap_angle": bc.snap_angle,
-        "keep_nodes": bc.cells is None,
-        "control": getattr(bc, "control", None),
-    }
-    if bc.loop is not None:
-        pts = np.asarray(bc.loop, float)
-        if len(pts) > 3 and np.allclose(pts[0], pts[-1]):
-            pts = pts[:-1]
-        corners = tuple(int(c) % len(pts) for c in bc.corners)
-        cells = bc.cells
-        if cells is None:
-            n = len(pts)
-            sw, se, ne, _nw = corners
-            cells = ((se - sw) % n, (ne - se) % n)
-        return Block(points=pts, closed=True, corners=corners, cells=cells, **common)
-    bd = tuple(np.asarray(bc.borders[n], float) for n in BORDER_NAMES)
-    cells = bc.cells or (len(bd[0]) - 1, len(bd[3]) - 1)
-    block = Block(boundary=bd, cells=cells, **common)
-    # four separate borders become an editable loop unless left and right coincide (a cut/seam)
-    # or the block is a C-grid (its bottom folds back along the wake cut)
-    cut = bd[1].shape == bd[3].shape and np.allclose(bd[1], bd[3])
-    ctl = getattr(bc, "control", None)
-    wake = (ctl.get("wake", 0) if isinstance(ctl, dict) else getattr(ctl, "wake", 0)) if ctl else 0
-    return block if (cut or bc.periodic or wake) else boundary_to_loop(block)
+def _editable(spec) -> Block:
+    """A case block as an editable block: four separate borders become a loop + corners,
+    unless left and right coincide (a cut/seam) or the block is a C-grid (its bottom folds
+    back along the wake cut)."""
+    block = Block.of(spec)
+    if spec.boundary is None:
+        return block
+    _b, r, _t, l = spec.boundary
+    cut = r.shape == l.shape and np.allclose(r, l)
+    return block if (cut or spec.periodic or spec.wake) else boundary_to_loop(block)
 
 
-def block_to_case(b: Block):
-    from meshcore.case import BlockCase
-
-    kw = {
-        "name": b.name,
-        "cells": None if b.keep_nodes else tuple(b.cells),
-        "weights": tuple(b.weights),
-        "initial": b.initial,
-        "curve": b.curve,
-        "periodic": b.periodic,
-        "snap_angle": b.snap_angle,
-        "border_specs": dict(b.borders),
-    }
-    if b.control is not None:
-        kw["control"] = b.control
-    if b.boundary is not None:
-        return BlockCase(borders={n: np.asarray(p) for n, p in zip(BORDER_NAMES, b.boundary, strict=True)}, **kw)
-    return BlockCase(loop=np.asarray(b.points), corners=tuple(b.corners), **kw)
+def _frame_fields(frame) -> dict:
+    if frame is None:
+        return {}
+    return {"crs": frame.crs or "", "origin": tuple(frame.origin), "source_crs": frame.source_crs or ""}
 
 
 def project_from_case(case) -> Project:
-    s = case.solver
-    repair = str(getattr(case, "repair", "auto"))  # "strict" has no meaning in the app: auto
-    solver = SolverSettings(
-        method=s.method,
-        tolerance=s.tolerance,
-        max_iterations=s.max_iterations,
-        omega=s.omega,
-        repair="off" if repair == "off" else "auto",
-    )
-    frame = dict(case.extra).get("crs") or {}
-    origin = frame.get("origin", (0.0, 0.0))
+    from meshcore.crs import frame_from_case
+
     return Project(
-        blocks=tuple(block_from_case(b) for b in case.blocks),
-        solver=solver,
+        blocks=tuple(_editable(b) for b in case.blocks),
+        solver=case.solver,
         title=case.title,
-        crs=str(frame.get("crs", "") or ""),
-        origin=(float(origin[0]), float(origin[1])),
-        source_crs=str(frame.get("source_crs", "") or ""),
+        **_frame_fields(frame_from_case(case)),
     )
 
 
 def project_to_case(project: Project):
     """The :class:`meshcore.case.Case` of the ready blocks (raises ValueError when none is)."""
-    from meshcore import EllipticConfig
     from meshcore.case import Case
 
-    blocks = tuple(block_to_case(b) for b in project.blocks if b.ready)
+    blocks = tuple(b for b in project.blocks if b.ready)
     if not blocks:
         raise ValueError("nothing to save yet: no block has a closed boundary with four corners")
-    s = project.solver
-    solver = EllipticConfig(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega)
-    extra = {}
     frame = project_frame(project)
-    if frame is not None:
-        extra["crs"] = frame.as_dict()
-    return Case(blocks=blocks, title=project.title, solver=solver, extra=extra, repair=s.repair)
+    crs = frame.as_dict() if frame is not None else None
+    return Case(blocks=blocks, title=project.title, solver=project.solver, crs=crs)
 
 
 def load_project(path) -> Project:
@@ -217,45 +162,35 @@ def load_project(path) -> Project:
     from meshcore.case import load_case
 
     case = load_case(path)
-    try:
-        from meshcore.multiblock.case import is_multiblock_case
-    except ImportError:  # older meshcore
-        return project_from_case(case)
-    if is_multiblock_case(case):
+    if case.is_multiblock:
         return project_from_multiblock_case(case)
     return project_from_case(case)
 
 
 def project_from_multiblock_case(case) -> Project:
     """A project showing a multiblock case: one boundary block per topology block."""
-    from meshcore.multiblock.case import case_frame, case_topology
+    from meshcore.case import case_frame, case_topology
 
     topo = case_topology(case)
     blocks = []
     for b in topo.blocks:
-        bd = tuple(np.asarray(b.borders[n], float) for n in BORDER_NAMES)
         names = {n: BorderSpec(name=v) for n, v in dict(b.names).items() if n in BORDER_NAMES and v}
         blocks.append(
             Block(
                 name=b.name,
-                boundary=bd,
-                cells=(len(bd[0]) - 1, len(bd[3]) - 1),
-                keep_nodes=True,
+                boundary=tuple(b.borders[n] for n in BORDER_NAMES),
+                cells=None,
                 weights=tuple(b.weights),
                 initial=b.initial,
-                borders=tuple(names.items()),
+                borders=names,
             )
         )
-    s = case.solver
-    frame = case_frame(case)
     return Project(
         blocks=tuple(blocks),
-        solver=SolverSettings(method=s.method, tolerance=s.tolerance, max_iterations=s.max_iterations, omega=s.omega),
+        solver=case.solver,
         title=case.title,
-        crs=(frame.crs or "") if frame is not None else "",
-        origin=tuple(frame.origin) if frame is not None else (0.0, 0.0),
-        source_crs=(frame.source_crs or "") if frame is not None else "",
         multiblock=case,
+        **_frame_fields(case_frame(case)),
     )
 
 
@@ -265,29 +200,21 @@ def case_of_project(project: Project):
     A multiblock case is written back as read, with the app's solver settings;
     otherwise the ready blocks (:func:`project_to_case`; ValueError when none is).
     """
-    from meshcore import EllipticConfig
-
     if project.multiblock is None:
         return project_to_case(project)
-    s = project.solver
-    cfg = EllipticConfig(
-        method="auto" if s.method == "foldfree" else s.method,
-        tolerance=s.tolerance,
-        max_iterations=s.max_iterations,
-        omega=s.omega,
-    )
     case = project.multiblock
-    if "outline" in case.extra:
-        # written as explicit [[blocks]] + [[interfaces]] (meshcore's dump of an [outline]
-        # case does not load back: it writes ``blocks = []``)
-        from meshcore.multiblock.case import _settings, case_topology, topology_case
+    if case.outline is not None:
+        # written as explicit [[blocks]] + [[interfaces]]: the outline's point file is
+        # relative to the case file it came from
+        from meshcore.case import case_topology, topology_case
 
-        mode, _start = _settings(case)
-        case = topology_case(case_topology(case), mode=mode, title=case.title, description=case.description, solver=cfg)
+        case = topology_case(
+            case_topology(case), mode=case.settings.mode, title=case.title, description=case.description
+        )
         frame = project_frame(project)
         if frame is not None:
-            case = case.replaced(extra={**dict(case.extra), "crs": frame.as_dict()})
-    return case.replaced(solver=cfg, path=None)
+            case = case.replaced(crs=frame.as_dict())
+    return case.replaced(solver=project.solver, path=None)
 
 
 def save_project(project: Project, path) -> None:

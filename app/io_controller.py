@@ -19,11 +19,10 @@ from PySide6 import QtCore, QtWidgets
 
 from meshcore import MeshcoreError
 
-from . import geometry as geo
 from . import io_adapter as fio
 from . import recovery
 from .examples import load_example
-from .project import Block, Project, default_cells
+from .project import Block, Project, block_from_points
 
 __all__ = ["MAX_RECENT", "IOController"]
 
@@ -202,17 +201,7 @@ class IOController(QtCore.QObject):
         if len(pts) < 4:
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
-        try:
-            corners = geo.auto_corners(pts)
-        except (ValueError, MeshcoreError):
-            corners = None
-        block = Block(
-            name=path.stem,
-            points=pts,
-            closed=True,
-            corners=corners,
-            cells=default_cells(pts, corners, total=40, minimum=8) if corners else (32, 16),
-        )
+        block = block_from_points(pts, path.stem)
         self._add_imported(block, frame, path.name)
         self.remember_dir(path)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""

@@ -17,6 +17,7 @@ from pathlib import Path
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from meshcore import MeshcoreError
+from meshcore.io.outline import guess_corners
 
 from . import actions
 from . import geometry as geo
@@ -279,7 +280,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.message("Auto corners needs a closed loop of at least 4 points")
             return
         try:
-            c = geo.auto_corners(b.points)
+            c = guess_corners(b.points)
         except (ValueError, MeshcoreError) as exc:
             self.error("Auto corners", exc)
             return
@@ -306,7 +307,9 @@ class MainWindow(QtWidgets.QMainWindow):
             self.message("Split needs a closed loop of points (draw or import one) and cut lines across it")
             return False
         try:
-            d = case_dict_from_cuts(b.points, list(p.cut_lines), cells_across=b.cells[1], title=p.title)
+            d = case_dict_from_cuts(
+                b.points, list(p.cut_lines), cells_across=(b.cell_counts or (32, 16))[1], title=p.title
+            )
             case = loads_case(tomli_w.dumps(d), source="cut lines")
             after = fio.project_from_multiblock_case(case)
         except (MeshcoreError, ValueError) as exc:
@@ -317,7 +320,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.doc.set_active(0)
         self.set_tool("pan")
         self.message(
-            f"Split into {len(after.blocks)} blocks (η cells {b.cells[1]} across every block); "
+            f"Split into {len(after.blocks)} blocks (η cells {(b.cell_counts or (32, 16))[1]} across every block); "
             "F5 solves them together — Ctrl+Z undoes the split"
         )
         return True

@@ -20,13 +20,13 @@ Blocks come in two forms, both accepted by :func:`meshcore.generate_block`:
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from meshcore import BORDER_NAMES, BorderSpec, EllipticConfig
+from meshcore import BORDER_NAMES, BlockSpec, BorderSpec, MeshcoreError, SolverSpec
+from meshcore.io.outline import guess_cells, guess_corners
 
 __all__ = [
     "Background",
@@ -35,6 +35,9 @@ __all__ = [
     "SolverSettings",
     "frozen_points",
 ]
+
+#: The solver part of a project: meshcore's :class:`~meshcore.SolverSpec` itself.
+SolverSettings = SolverSpec
 
 
 def frozen_points(points: Any) -> np.ndarray:
@@ -51,68 +54,31 @@ def _eq_arrays(a: np.ndarray | None, b: np.ndarray | None) -> bool:
     return a.shape == b.shape and bool(np.array_equal(a, b))
 
 
-@dataclass(frozen=True, slots=True)
-class SolverSettings:
-    """The solver part of a project (mirrors :class:`meshcore.EllipticConfig`)."""
-
-    method: str = "auto"
-    tolerance: float | None = None
-    max_iterations: int = 50_000
-    omega: float | None = None
-    repair: str = "auto"  # "auto": fold-free repair of invalid cells after the solve; or "off"
-
-    def config(self, **kw: Any) -> EllipticConfig:
-        """The :class:`EllipticConfig` (raises InvalidInputError when invalid).
-
-        ``method="foldfree"`` solves with ``"auto"`` first; the pipeline then
-        minimises the barrier functional (as :func:`meshcore.generate_block` does).
-        """
-        method = "auto" if self.method == "foldfree" else self.method
-        return EllipticConfig(
-            method=method,
-            tolerance=self.tolerance,
-            max_iterations=self.max_iterations,
-            omega=self.omega,
-            **kw,
-        )
-
-
 @dataclass(frozen=True, slots=True, eq=False)
-class Block:
-    """One block of the project.
+class Block(BlockSpec):
+    """One block of the project: a :class:`meshcore.BlockSpec` plus the drawing state.
 
     ``points`` is the closed loop (first point not repeated) when ``closed``;
     while the user is still drawing it is an open polyline.  ``corners`` are
     four indices into ``points`` (sw, se, ne, nw) or None.  ``boundary``
     (four polylines) replaces points/corners for blocks given by borders.
+    ``cells=None`` keeps the given points as the boundary nodes.
     """
 
-    name: str = "block"
-    points: np.ndarray = field(default_factory=lambda: frozen_points(None))
+    cells: tuple[int, int] | None = (32, 16)
     closed: bool = False
-    corners: tuple[int, int, int, int] | None = None
-    boundary: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
-    cells: tuple[int, int] = (32, 16)
-    weights: tuple[float, float] = (0.5, 0.5)
-    initial: str = "weighted"
-    curve: str = "linear"
-    periodic: bool = False
-    borders: tuple[tuple[str, BorderSpec], ...] = ()
-    snap_angle: float | None = None
-    keep_nodes: bool = False  # True: the given border points are the nodes (no re-sampling)
-    control: Any = None  # grid control: a [blocks.control] mapping or a meshcore.control.ControlSpec
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "points", frozen_points(self.points))
-        if self.boundary is not None:
-            object.__setattr__(self, "boundary", tuple(frozen_points(b) for b in self.boundary))
-        if self.corners is not None:
-            object.__setattr__(self, "corners", tuple(int(c) for c in self.corners))
-        object.__setattr__(self, "cells", (int(self.cells[0]), int(self.cells[1])))
-        object.__setattr__(self, "weights", (float(self.weights[0]), float(self.weights[1])))
-        object.__setattr__(
-            self, "borders", tuple(sorted((n, BorderSpec.coerce(s, border=n)) for n, s in dict(self.borders).items()))
-        )
+    @classmethod
+    def of(cls, spec: BlockSpec, **changes: Any) -> Block:
+        """The editable block of a :class:`meshcore.BlockSpec` (a loop is closed, its repeated point dropped)."""
+        kw = {f.name: getattr(spec, f.name) for f in dataclasses.fields(BlockSpec)}
+        pts = np.asarray(spec.points)
+        if len(pts) > 3 and np.allclose(pts[0], pts[-1]):
+            kw["points"] = pts[:-1]
+            if isinstance(spec.corners, tuple):
+                kw["corners"] = tuple(int(c) % (len(pts) - 1) for c in spec.corners)
+        kw["closed"] = len(pts) > 0
+        return cls(**(kw | changes))
 
     # ------------------------------------------------------------ queries
     @property
@@ -122,61 +88,9 @@ class Block:
             return True
         return self.closed and self.corners is not None and len(self.points) >= 4
 
-    def spec(self, border: str) -> BorderSpec:
-        """The :class:`BorderSpec` of ``border`` (uniform by default)."""
-        return dict(self.borders).get(border, BorderSpec())
-
-    def border_specs(self) -> dict[str, BorderSpec]:
-        return dict(self.borders)
-
     def node_count(self, border: str) -> int:
-        ni, nj = self.cells
+        ni, nj = self.cell_counts or (0, 0)
         return (ni if border in ("bottom", "top") else nj) + 1
-
-    def replaced(self, **kw: Any) -> Block:
-        return dataclasses.replace(self, **kw)
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Block):
-            return NotImplemented
-        if self.boundary is None or other.boundary is None:
-            same_boundary = self.boundary is None and other.boundary is None
-        else:
-            same_boundary = all(_eq_arrays(a, b) for a, b in zip(self.boundary, other.boundary, strict=True))
-        return (
-            _eq_arrays(self.points, other.points)
-            and same_boundary
-            and (
-                self.name,
-                self.closed,
-                self.corners,
-                self.cells,
-                self.weights,
-                self.initial,
-                self.curve,
-                self.periodic,
-                self.borders,
-                self.snap_angle,
-                self.keep_nodes,
-                self.control,
-            )
-            == (
-                other.name,
-                other.closed,
-                other.corners,
-                other.cells,
-                other.weights,
-                other.initial,
-                other.curve,
-                other.periodic,
-                other.borders,
-                other.snap_angle,
-                other.keep_nodes,
-                other.control,
-            )
-        )
-
-    __hash__ = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -202,7 +116,7 @@ class Project:
     """Everything the user edits (immutable; edits return new projects)."""
 
     blocks: tuple[Block, ...] = (Block(name="block"),)
-    solver: SolverSettings = SolverSettings()
+    solver: SolverSpec = field(default_factory=SolverSpec)
     cut_lines: tuple[np.ndarray, ...] = ()
     background: Background | None = None
     crs: str = ""  # metric CRS of the world coordinates, e.g. "EPSG:32632"
@@ -347,22 +261,22 @@ def next_block_name(project: Project) -> str:
 def default_cells(
     points: np.ndarray, corners: tuple[int, int, int, int], total: int = 40, minimum: int = 2
 ) -> tuple[int, int]:
-    """Cell counts proportional to the mean lengths of opposite borders.
+    """Cell counts proportional to the mean lengths of opposite borders (:func:`meshcore.io.outline.guess_cells`).
 
     About ``total`` cells along the longer direction, at least ``minimum`` along either.
     """
-    n = len(points)
+    return guess_cells(points, corners, total=total, minimum=minimum)
 
-    def arc(a: int, b: int) -> float:
-        idx = [(a + k) % n for k in range((b - a) % n + 1)]
-        seg = np.diff(points[idx], axis=0)
-        return float(np.hypot(seg[:, 0], seg[:, 1]).sum())
 
-    sw, se, ne, nw = corners
-    lxi = 0.5 * (arc(sw, se) + arc(ne, nw))
-    leta = 0.5 * (arc(se, ne) + arc(nw, sw))
-    if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
-        return (total, total)
-    if lxi >= leta:
-        return (total, max(minimum, round(total * leta / lxi)))
-    return (max(minimum, round(total * lxi / leta)), total)
+def block_from_points(points: Any, name: str, *, total: int = 40, minimum: int = 8) -> Block:
+    """A closed block from imported boundary points, with the corners and cells ``meshcore import`` chooses.
+
+    (:func:`meshcore.io.outline.guess_corners`, :func:`~meshcore.io.outline.guess_cells`):
+    the same point file gives the same grid in the app and on the command line.
+    """
+    try:
+        corners = guess_corners(points)
+    except MeshcoreError:
+        return Block(name=name, points=points, closed=True)
+    cells = guess_cells(points, corners, total=total, minimum=minimum)
+    return Block(name=name, points=points, closed=True, corners=corners, cells=cells)

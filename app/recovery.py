@@ -167,14 +167,13 @@ def _block_state(b: Block) -> dict:
         "points": np.asarray(b.points).tolist(),
         "closed": b.closed,
         "corners": list(b.corners) if b.corners is not None else None,
-        "cells": list(b.cells),
+        "cells": list(b.cells) if b.cells is not None else None,
         "weights": list(b.weights),
         "initial": b.initial,
         "curve": b.curve,
         "periodic": b.periodic,
         "borders": {n: dataclasses.asdict(s) for n, s in b.borders},
         "snap_angle": b.snap_angle,
-        "keep_nodes": b.keep_nodes,
         "control": control,
     }
 
@@ -183,7 +182,7 @@ def _block_from_state(d: Mapping) -> Block:
     kw = dict(d)
     kw["points"] = np.asarray(kw["points"], float).reshape(-1, 2)
     kw["corners"] = tuple(kw["corners"]) if kw.get("corners") is not None else None
-    kw["cells"] = tuple(kw["cells"])
+    kw["cells"] = tuple(kw["cells"]) if kw.get("cells") is not None else None
     kw["weights"] = tuple(kw["weights"])
     kw["borders"] = tuple((n, BorderSpec(**s)) for n, s in dict(kw.get("borders", {})).items())
     return Block(**kw)

@@ -1,7 +1,8 @@
 """Runs the solver in a worker thread and feeds the document at a bounded rate.
 
 The worker (superqt ``GeneratorWorker``) iterates :func:`app.pipeline.solve_project`
-and only emits signals; the slots here run in the GUI thread.  Snapshots are
+(meshcore's typed events per block) and only emits signals; the slots here run
+in the GUI thread.  Snapshots are
 kept as the *latest* one per block and pushed to the document by a ~30 Hz
 timer, so stale frames are dropped, never queued.  Stop sets a
 ``threading.Event`` checked by meshcore after every sweep/cycle, so it takes
@@ -18,7 +19,7 @@ import time
 from PySide6 import QtCore
 from superqt.utils import create_worker
 
-from meshcore import MeshcoreError, SolverProgress, StructuredGrid
+from meshcore import Done, MeshcoreError, Repaired, SolverProgress, StartGrid, StructuredGrid
 
 from .document import Document
 from .pipeline import ResidualProgress, solve_project
@@ -33,8 +34,8 @@ def _run(run_id, project, warm, stop_event, smooth):
     gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth)
     try:
         while True:
-            k, item, g0 = next(gen)
-            yield run_id, k, item, g0
+            k, event = next(gen)
+            yield run_id, k, event
     except StopIteration as fin:
         return run_id, fin.value, None
     except MeshcoreError as exc:
@@ -61,7 +62,8 @@ class SolverController(QtCore.QObject):
         self._worker = None
         self._run = 0
         self._stop_event: threading.Event | None = None
-        self._latest: dict[int, tuple[object, StructuredGrid]] = {}
+        self._latest: dict[int, object] = {}  # the latest event per block
+        self._algebraic: dict[int, StructuredGrid] = {}  # the algebraic grid per block (warm starts)
         self._smoothed: set[int] = set()
         self._dirty = False
         self.state = "idle"
@@ -124,6 +126,7 @@ class SolverController(QtCore.QObject):
         ev = threading.Event()
         self._stop_event = ev
         self._latest = {}
+        self._algebraic = {}
         self._smoothed = set()  # blocks whose snapshots of this run are on screen
         worker = create_worker(_run, self._run, project, warm, ev, self.smooth, _start_thread=False)
         worker.yielded.connect(self._on_yielded)
@@ -204,10 +207,12 @@ class SolverController(QtCore.QObject):
     @QtCore.Slot(object)
     def _on_yielded(self, value) -> None:
         self._check_thread()
-        run, k, item, g0 = value
+        run, k, event = value
         if run != self._run:
             return
-        self._latest[k] = (item, g0)
+        if isinstance(event, StartGrid):
+            self._algebraic[k] = event.algebraic
+        self._latest[k] = event
         self._dirty = True
         wait = self._last_flush + self.frame_interval - time.perf_counter()
         if wait <= 0:
@@ -220,18 +225,20 @@ class SolverController(QtCore.QObject):
             return
         self._dirty = False
         self._last_flush = time.perf_counter()
-        for k, (item, g0) in self._latest.items():
-            if isinstance(item, ResidualProgress):  # all blocks at once, no grid snapshot
-                self.progress.emit(k, item)
+        for k, event in self._latest.items():
+            if isinstance(event, ResidualProgress):  # all blocks at once, no grid snapshot
+                self.progress.emit(k, event)
                 continue
-            grid = item.grid if isinstance(item, SolverProgress) else item
-            if not isinstance(item, SolverProgress) and self._showing(k, grid):
+            if not isinstance(event, (StartGrid, SolverProgress, Repaired, Done)):
+                continue
+            if isinstance(event, StartGrid) and self._showing(k, event.grid):
                 continue  # a start grid never replaces a smoothed grid on screen (no flicker in a drag)
-            self.doc.grids[k] = grid
-            self.doc.initial[k] = g0
-            if isinstance(item, SolverProgress):
+            self.doc.grids[k] = event.grid
+            if k in self._algebraic:
+                self.doc.initial[k] = self._algebraic[k]
+            if isinstance(event, SolverProgress):
                 self._smoothed.add(k)
-                self.progress.emit(k, item)
+                self.progress.emit(k, event)
         self.doc.grids_changed.emit()
         self.redrawn.emit()
 
@@ -277,6 +284,8 @@ class SolverController(QtCore.QObject):
         grids = {k: g for k, g in grids.items() if k in ready}
         self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready})
         self.last_result = result
+        for w in result.warnings:  # what meshcore warned about (e.g. dropped duplicate points)
+            self.doc.report("warning", w)
         self._set_state("idle")
         self.finished.emit(result)
 

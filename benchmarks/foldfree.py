@@ -158,19 +158,12 @@ def shapes(repeat: int) -> None:
     root = Path(__file__).resolve().parent.parent / "resources" / "examples"
     for path in sorted(root.glob("*.toml")):
         case = load_case(path)
-        if not case.blocks or "multiblock" in case.extra:  # single-block cases only
+        if not case.blocks or case.is_multiblock:  # single-block cases only
             continue
-        kw = dict(case.blocks[0].generate_kwargs())
-        kw["config"] = case.solver
-        cases.append((path.stem, (), kw))
+        cases.append((path.stem, case.blocks[0], case.solver))
     for cells in [(20, 40), (30, 60), (60, 120)]:
-        cases.append(
-            (
-                "C (square, slot 0.2 × 0.8)",
-                (),
-                {"loop": c_shape(), "corners": (0, 1, 6, 7), "cells": cells},
-            )
-        )
+        spec = meshcore.BlockSpec(points=c_shape(), corners=(0, 1, 6, 7), cells=cells)
+        cases.append(("C (square, slot 0.2 × 0.8)", spec, meshcore.SolverSpec()))
     print()
     print(
         "| case | cells | Winslow folded/non-convex | auto: method, folded/non-convex | "
@@ -178,15 +171,10 @@ def shapes(repeat: int) -> None:
         "min Jacobian ratio W / auto / foldfree | Winslow s | auto s | foldfree s |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for name, bs, kw in cases:
-        gen = partial(meshcore.generate_block, *bs, **kw)
-        tw, w = best_of(repeat, partial(gen, repair="off"))
-        tg, g = best_of(repeat, gen)
-        if "config" in kw:
-            ff = partial(gen, config=kw["config"].replaced(method="foldfree"))
-        else:
-            ff = partial(gen, method="foldfree")
-        tf, f = best_of(repeat, ff)
+    for name, spec, solver in cases:
+        tw, w = best_of(repeat, partial(meshcore.generate_block, spec, solver.replaced(repair="off")))
+        tg, g = best_of(repeat, partial(meshcore.generate_block, spec, solver))
+        tf, f = best_of(repeat, partial(meshcore.generate_block, spec, solver.replaced(method="foldfree")))
         qw, qg, qf = meshcore.quality(w), meshcore.quality(g), meshcore.quality(f)
         h = float(np.median(np.hypot(np.diff(w.x, axis=0), np.diff(w.y, axis=0))))
         d = float(np.hypot(f.x - w.x, f.y - w.y).max()) / h

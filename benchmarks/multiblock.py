@@ -158,8 +158,7 @@ def whole_solves(repeat: int, sizes) -> None:
 
 
 def lake(repeat: int, quick: bool) -> None:
-    from meshcore.case import load_case
-    from meshcore.multiblock.case import case_topology
+    from meshcore.case import case_topology, load_case
 
     print("## 3. Shasta Lake vs one block with the same node count\n")
     print("| case | nodes | solver | iterations | time (s) | × one block (same nodes, same tolerance) |")

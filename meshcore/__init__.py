@@ -34,21 +34,24 @@ from .errors import (
     TopologyError,
     WriteError,
 )
-from .generate import generate_block, initial_grid, prepare_borders
+from .generate import Done, Repaired, StartGrid, generate_block, initial_grid, prepare_borders, run_block
 from .grid import BORDER_NAMES, SolveInfo, StructuredGrid
 from .metrics import Metrics, metrics
 from .quality import QualityReport, cell_quality, quality
+from .spec import BlockSpec, SolverSpec
 
 __version__ = "0.1.0"
 
 __all__ = [
     "BORDER_NAMES",
+    "BlockSpec",
     "BorderMismatchError",
     "BorderSpec",
     "Borders",
     "BoundaryError",
     "CaseFileError",
     "ControlSpec",
+    "Done",
     "EllipticConfig",
     "FoldedGridError",
     "InvalidInputError",
@@ -58,10 +61,13 @@ __all__ = [
     "Metrics",
     "QualityReport",
     "ReadError",
+    "Repaired",
     "SmoothCurve",
     "SolveInfo",
     "SolverError",
     "SolverProgress",
+    "SolverSpec",
+    "StartGrid",
     "StructuredGrid",
     "TopologyError",
     "WriteError",
@@ -82,6 +88,7 @@ __all__ = [
     "metrics",
     "prepare_borders",
     "quality",
+    "run_block",
     "solve",
     "tfi",
     "weighted_average",

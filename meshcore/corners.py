@@ -20,9 +20,24 @@ outline alone:
     reflex, and they appear along the loop in the same cyclic order as their
     directions, so they are always a valid (sw, se, ne, nw).
 
-Both methods fall back to ``"hull"`` when the ``"bbox"`` picks coincide or are
-not in counter-clockwise cyclic order, and then to convex vertices near the
-quarter points of the perimeter measured from the ``sw`` pick.
+``"outline"``
+    For shorelines and rivers: a long, narrow, curved outline
+    (``4·area / perimeter² < 0.12``, i.e. width ≲ length / 8, filling less
+    than 70 % of its principal box) gets two corners beside each tip — the
+    first vertices, walking both ways from the extreme vertices along the long
+    axis, at least half a mean width (``area / half-perimeter``) of arc away —
+    so the tips become the short left/right borders; any other outline gets
+    the ``"bbox"`` corners.
+
+All methods fall back to ``"hull"`` when their picks coincide or are not in
+counter-clockwise cyclic order, and then to convex vertices near the quarter
+points of the perimeter measured from the ``sw`` pick.  ``upright=True``
+renames the corners (a cyclic shift, the same grid up to a renaming of the
+borders) so that SW → SE points most nearly along +x: "bottom" stays at the
+bottom of the screen.
+
+:func:`meshcore.io.outline.guess_corners` (``meshcore import``) and the app
+both use ``method="outline", upright=True``.
 
 A corner on a reflex vertex makes its corner cell non-convex whatever the
 interior nodes do (the corner Jacobian of that cell depends on the three
@@ -104,15 +119,17 @@ def _cyclic_ok(c: list[int], n: int) -> bool:
     return rel[0] < rel[1] < rel[2] < rel[3]
 
 
-def choose_corners(points: Any, *, method: str = "bbox") -> tuple[int, int, int, int]:
+def choose_corners(points: Any, *, method: str = "bbox", upright: bool = False) -> tuple[int, int, int, int]:
     """Pick four corner indices ``(sw, se, ne, nw)`` on a closed loop.
 
     Parameters
     ----------
     points : (n, 2) array_like
         The loop, either orientation, optionally closed (first point repeated).
-    method : {"bbox", "hull"}
+    method : {"bbox", "hull", "outline"}
         See the module docstring.
+    upright : bool
+        Rename the corners so that SW → SE points most nearly along +x.
 
     Returns
     -------
@@ -126,34 +143,19 @@ def choose_corners(points: Any, *, method: str = "bbox") -> tuple[int, int, int,
     >>> choose_corners(sq)
     (0, 2, 3, 5)
     """
-    method = validate_choice(method, ("bbox", "hull"), name="corner method")
+    method = validate_choice(method, ("bbox", "hull", "outline"), name="corner method")
     p, n = _loop(points, "boundary points")
     ccw = _signed_area(p) >= 0
     q = p if ccw else p[::-1]
     c0, rot = _principal_frame(q)
     st = (q - c0) @ rot.T
-    lo, hi = st.min(axis=0), st.max(axis=0)
-    box = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
     picks: list[int] = []
-    if method == "bbox":
-        ang = interior_angles(q)
-        convex = ang < 180.0 - 1e-9
-        for b in box:
-            d2 = ((st - b) ** 2).sum(axis=1)
-            k = int(np.argmin(d2))
-            if not convex[k] and convex.any():
-                k = int(np.argmin(np.where(convex, d2, np.inf)))
-            picks.append(k)
-    if method == "hull" or not _cyclic_ok(picks, n):
-        half = 0.5 * (hi - lo)
-        half = np.where(half > 0, half, 1.0)
-        picks = []
-        for b in box:
-            direction = (b - 0.5 * (lo + hi)) / half**2
-            proj = st @ direction
-            # ties (a straight hull edge): take the vertex nearest the box corner
-            cand = np.flatnonzero(proj >= proj.max() - 1e-12 * max(1.0, abs(proj.max())))
-            picks.append(int(cand[np.argmin(((st[cand] - b) ** 2).sum(axis=1))]))
+    if method == "outline" and _elongated(q, st):
+        picks = _tip_corners(q, st[:, 0])  # [] when the tips give no four corners: the box
+    if not picks and method in ("bbox", "outline"):
+        picks = _box_corners(q, st)
+    if not _cyclic_ok(picks, n):
+        picks = _hull_corners(st)
         if not _cyclic_ok(picks, n):
             picks = _by_arc_length(q, picks[0])
         if not _cyclic_ok(picks, n):
@@ -161,9 +163,96 @@ def choose_corners(points: Any, *, method: str = "bbox") -> tuple[int, int, int,
                 "could not find four distinct corners in counter-clockwise order on the "
                 f"loop of {n} points (picked {picks}); give corners= explicitly"
             )
+    if upright:
+        picks = _upright(q, picks)
     if not ccw:
         picks = [n - 1 - k for k in picks]
     return tuple(int(k) for k in picks)  # type: ignore[return-value]
+
+
+def _box(st: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    lo, hi = st.min(axis=0), st.max(axis=0)
+    return np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]]), lo, hi
+
+
+def _box_corners(q: np.ndarray, st: np.ndarray) -> list[int]:
+    """The vertices nearest the principal box's corners (the nearest convex one for a reflex pick)."""
+    box, _, _ = _box(st)
+    convex = interior_angles(q) < 180.0 - 1e-9
+    picks = []
+    for b in box:
+        d2 = ((st - b) ** 2).sum(axis=1)
+        k = int(np.argmin(d2))
+        if not convex[k] and convex.any():
+            k = int(np.argmin(np.where(convex, d2, np.inf)))
+        picks.append(k)
+    return picks
+
+
+def _hull_corners(st: np.ndarray) -> list[int]:
+    """The support vertices in the four box-diagonal directions (hull vertices, never reflex)."""
+    box, lo, hi = _box(st)
+    half = 0.5 * (hi - lo)
+    half = np.where(half > 0, half, 1.0)
+    picks = []
+    for b in box:
+        direction = (b - 0.5 * (lo + hi)) / half**2
+        proj = st @ direction
+        # ties (a straight hull edge): take the vertex nearest the box corner
+        cand = np.flatnonzero(proj >= proj.max() - 1e-12 * max(1.0, abs(proj.max())))
+        picks.append(int(cand[np.argmin(((st[cand] - b) ** 2).sum(axis=1))]))
+    return picks
+
+
+def _elongated(q: np.ndarray, st: np.ndarray) -> bool:
+    """Long, narrow and curved: ``4·area / perimeter² < 0.12`` and filling < 70 % of the box."""
+    area = abs(_signed_area(q))
+    perimeter = float(np.hypot(*(np.roll(q, -1, axis=0) - q).T).sum())
+    extent = st.max(axis=0) - st.min(axis=0)
+    fill = area / max(float(extent[0] * extent[1]), 1e-300)
+    return 4.0 * area / max(perimeter**2, 1e-300) < 0.12 and fill < 0.7
+
+
+def _tip_corners(q: np.ndarray, u: np.ndarray) -> list[int]:
+    """Two corners beside each tip of a long loop (counter-clockwise ``q``; ``u``: long-axis coordinate)."""
+    n = len(q)
+    seg = np.hypot(*(np.roll(q, -1, axis=0) - q).T)
+    width = 2.0 * abs(_signed_area(q)) / seg.sum()
+    a, b = int(np.argmin(u)), int(np.argmax(u))
+
+    def walk(tip: int, step: int) -> int:
+        """The first vertex at least half a mean width of arc away from the tip."""
+        arc, k = 0.0, tip
+        for _ in range(n // 4):
+            nxt = (k + step) % n
+            arc += float(np.hypot(*(q[nxt] - q[k])))
+            k = nxt
+            if arc >= 0.5 * width:
+                break
+        return k
+
+    c = [walk(a, 1), walk(b, -1), walk(b, 1), walk(a, -1)]  # sw, se, ne, nw walking CCW
+    if not _cyclic_ok(c, n):
+        return []
+    ang = interior_angles(q)
+    for prob in corner_problems(q, c):  # off reflex vertices, keeping the order
+        if prob.suggestion is not None:
+            trial = c.copy()
+            trial[CORNER_NAMES.index(prob.corner)] = prob.suggestion
+            if _cyclic_ok(trial, n) and ang[prob.suggestion] < 180.0:
+                c = trial
+    return c
+
+
+def _upright(q: np.ndarray, c: list[int]) -> list[int]:
+    """Rotate the corner roles so that SW → SE points most nearly along +x."""
+    best, best_cos = 0, -2.0
+    for k in range(4):
+        d = q[c[(k + 1) % 4]] - q[c[k]]
+        cos = float(d[0] / max(math.hypot(*d), 1e-300))
+        if cos > best_cos + 1e-12:
+            best, best_cos = k, cos
+    return [c[(best + j) % 4] for j in range(4)]
 
 
 def _by_arc_length(q: np.ndarray, start: int) -> list[int]:

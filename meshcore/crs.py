@@ -33,9 +33,12 @@ __all__ = [
     "LONLAT",
     "Frame",
     "crs_wkt",
+    "frame_from_case",
+    "frame_from_table",
     "is_geographic",
     "looks_lonlat",
     "project",
+    "project_arrays",
     "utm_epsg",
 ]
 
@@ -305,10 +308,33 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_cr
     >>> frame.crs, frame.origin
     ('EPSG:32632', (470000.0, 5240000.0))
     """
-    from .io._base import Polyline
+    import dataclasses
 
     src = normalize_crs(source_crs) if source_crs is not None else pointset.crs
-    pts = pointset.all_points()
+    arrays = [pl.points for pl in pointset.polylines]
+    names = [pl.name for pl in pointset.polylines]
+    local, frame = project_arrays(arrays, crs, source_crs=src, origin=origin, where=pointset.source, names=names)
+    polylines = [dataclasses.replace(pl, points=p) for pl, p in zip(pointset.polylines, local, strict=True)]
+    return pointset.with_points(polylines, frame.crs), frame
+
+
+def project_arrays(
+    arrays: list[np.ndarray],
+    crs: Any = "auto",
+    *,
+    source_crs: Any = None,
+    origin: Any = "auto",
+    where: str = "",
+    names: list[str] | None = None,
+) -> tuple[list[np.ndarray], Frame]:
+    """Project ``(n, 2)`` point arrays together (the core of :func:`project`).
+
+    ``source_crs`` is the CRS of the points (None: unknown; unlabelled lon/lat
+    is recognised by :func:`looks_lonlat`).  Returns the local arrays and the
+    :class:`Frame` that maps them back.
+    """
+    src = normalize_crs(source_crs) if source_crs is not None else None
+    pts = np.vstack([np.asarray(a, dtype=np.float64).reshape(-1, 2) for a in arrays]) if arrays else np.zeros((0, 2))
     target_in = crs.strip().lower() if isinstance(crs, str) else crs
     if src is None and target_in not in (None, "none", "local") and looks_lonlat(pts):
         src = LONLAT
@@ -324,23 +350,23 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_cr
         target = normalize_crs(crs)
         if src is None:
             raise InvalidInputError(
-                f"{pointset.source}: cannot project to {target}: the points' CRS is unknown "
-                f"(give source_crs / --source-crs)"
+                f"{where}: cannot project to {target}: the points' CRS is unknown (give source_crs / --source-crs)"
             )
     if src is not None and is_geographic(src):
-        check_lonlat(pts, where=pointset.source or "points")
+        check_lonlat(pts, where=where or "points")
+    new = [np.asarray(a, dtype=np.float64).reshape(-1, 2) for a in arrays]
     if target is not None and src is not None and target != src:
-        t = _transformer(src, target, pointset.source or "points")
-        new = []
-        for pl in pointset.polylines:
-            X, Y = t.transform(pl.points[:, 0], pl.points[:, 1])
+        t = _transformer(src, target, where or "points")
+        for k, a in enumerate(new):
+            if len(a) == 0:
+                continue
+            X, Y = t.transform(a[:, 0], a[:, 1])
             P = np.column_stack([X, Y]).astype(np.float64)
             if not np.isfinite(P).all():
-                raise InvalidInputError(f"{pointset.source}: {pl.name}: points cannot be projected to {target}")
-            new.append((pl, P))
-    else:
-        new = [(pl, pl.points) for pl in pointset.polylines]
-    allp = np.vstack([p for _, p in new]) if new else np.zeros((0, 2))
+                label = f"{names[k]}: " if names else ""
+                raise InvalidInputError(f"{where}: {label}points cannot be projected to {target}")
+            new[k] = P
+    allp = np.vstack(new) if new else np.zeros((0, 2))
     if isinstance(origin, str) and origin == "auto":
         o = _nice_origin(allp)
     elif origin is None:
@@ -348,8 +374,7 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_cr
     else:
         o = (float(origin[0]), float(origin[1]))
     off = np.array(o)
-    polylines = [Polyline(pl.name, p - off, closed=pl.closed, orientation=pl.orientation) for pl, p in new]
-    return pointset.with_points(polylines, target), Frame(target, o, src)
+    return [a - off for a in new], Frame(target, o, src)
 
 
 def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
@@ -362,20 +387,24 @@ def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
 
 
 # ------------------------------------------------------------ case files
-def frame_from_case(case: Any) -> Frame | None:
-    """The :class:`Frame` stored in a case's top-level ``crs`` table, or None.
+def frame_from_table(table: Any) -> Frame | None:
+    """The :class:`Frame` of a case file's top-level ``crs`` table (None without one).
 
     The table (written by ``meshcore import``) reads::
 
         crs = { crs = "EPSG:32632", origin = [480000.0, 5240000.0],
                 source_crs = "EPSG:4326" }
     """
-    t = (getattr(case, "extra", None) or {}).get("crs")
-    if not isinstance(t, dict):
+    if not isinstance(table, dict):
         return None
-    o = t.get("origin", [0.0, 0.0])
+    o = table.get("origin", [0.0, 0.0])
     try:
         origin = (float(o[0]), float(o[1]))
     except (TypeError, ValueError, IndexError):
         raise InvalidInputError(f"case crs.origin must be [x0, y0], got {o!r}") from None
-    return Frame(normalize_crs(t.get("crs")), origin, normalize_crs(t.get("source_crs")))
+    return Frame(normalize_crs(table.get("crs")), origin, normalize_crs(table.get("source_crs")))
+
+
+def frame_from_case(case: Any) -> Frame | None:
+    """The :class:`Frame` stored in a :class:`meshcore.case.Case`'s ``crs`` table, or None."""
+    return frame_from_table(getattr(case, "crs", None))

@@ -1,79 +1,132 @@
-"""From boundary points to a smooth grid: the block pipeline.
+"""From a block spec to a smooth grid: the block pipeline, written once.
 
-``borders → (re-sample by curve + distribution) → algebraic grid → elliptic solve``.
+``borders → (re-sample by curve + distribution) → algebraic grid → elliptic
+solve → fold-free step``.  :func:`run_block` is the pipeline as a generator
+of typed events; :func:`generate_block` (the library call, case files, the
+CLI) drains it and the app's solver worker iterates it.
+
+Events, in order::
+
+    StartGrid(grid, algebraic)        the start grid (after the caller's warm start)
+    SolverProgress(...)               snapshots of the elliptic solve (0 or more)
+    Repaired(grid, before, result)    the fold-free step changed the grid (0 or 1)
+    Done(grid, algebraic, warnings)   the final grid and the warnings of the run
+
+Rules that live here only: a C-grid (``control.wake > 0``) takes its four
+borders node by node; grid control slides floating nodes on the *input*
+polylines; ``method="foldfree"`` minimises the barrier functional after the
+solve; otherwise ``repair`` decides what happens to folded cells; a stopped
+solve is returned as it is.
 """
 
 from __future__ import annotations
 
+import contextlib
+import threading
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Generator, Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ._validation import validate_choice, validate_count
 from .algebraic import algebraic_grid
 from .boundary import Borders, borders_from_loop, borders_from_polylines
-from .elliptic import EllipticConfig, SolverProgress, iterate, solve
-from .errors import InvalidInputError, MeshcoreError, MeshcoreWarning
+from .elliptic import EllipticConfig, SolverProgress, iterate
+from .errors import InvalidInputError, MeshcoreWarning
 from .grid import BORDER_NAMES, StructuredGrid
+from .spec import BlockSpec, SolverSpec
 
-__all__ = ["generate_block", "initial_grid", "prepare_borders"]
+__all__ = [
+    "BlockEvent",
+    "Done",
+    "Repaired",
+    "StartGrid",
+    "block_borders",
+    "generate_block",
+    "initial_grid",
+    "prepare_borders",
+    "run_block",
+]
 
 
-def _cells(cells: Any) -> tuple[int, int] | None:
-    if cells is None:
-        return None
-    try:
-        ni, nj = cells
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"cells must be a pair (ni, nj), got {cells!r}") from None
-    return validate_count(ni, name="cells ξ (ni)"), validate_count(nj, name="cells η (nj)")
+@dataclass(frozen=True, slots=True, eq=False)
+class StartGrid:
+    """The grid the solve starts from, and the block's algebraic grid."""
+
+    grid: StructuredGrid
+    algebraic: StructuredGrid
 
 
-def prepare_borders(
-    bottom: Any = None,
-    right: Any = None,
-    top: Any = None,
-    left: Any = None,
-    *,
-    loop: Any = None,
-    corners: Any = None,
-    cells: Any = None,
-    borders: Mapping[str, Any] | None = None,
-    curve: str = "linear",
-    periodic: bool = False,
-    snap_angle: float | None = None,
-    where: str = "",
-) -> Borders:
-    """Validate the boundary and re-sample it (or use the given nodes when ``cells`` is None)."""
-    if loop is not None:
-        if any(v is not None for v in (bottom, right, top, left)):
+@dataclass(frozen=True, slots=True, eq=False)
+class Repaired:
+    """The fold-free step changed the grid (``result``: a :class:`meshcore.foldfree.FoldFreeResult`)."""
+
+    grid: StructuredGrid
+    before: StructuredGrid
+    result: Any
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Done:
+    """The final grid, the algebraic grid and the warnings of the run (messages)."""
+
+    grid: StructuredGrid
+    algebraic: StructuredGrid
+    warnings: tuple[str, ...] = ()
+
+
+BlockEvent = StartGrid | SolverProgress | Repaired | Done
+
+
+# ------------------------------------------------------------------ borders
+def _raw_borders(spec: BlockSpec, where: str) -> Borders:
+    """The boundary as given (validated, corners snapped), before any re-sampling."""
+    if spec.boundary is not None:
+        if len(spec.points):
             raise InvalidInputError("give either four borders or loop + corners, not both")
-        if corners is None:
-            raise InvalidInputError('a closed loop needs four corner indices (corners=) or corners="auto"')
-        if isinstance(corners, str) and corners == "auto":
-            from .corners import choose_corners
+        if spec.wake:
+            # C-grid: the bottom border folds back on itself along the wake cut, so the
+            # self-intersection check does not apply; the nodes are used as given
+            if spec.cells is not None:
+                raise InvalidInputError(
+                    "a C-grid (control wake > 0) needs four borders given node by node (no cells=, no loop)"
+                )
+            return borders_from_polylines(*spec.boundary, check_intersections=False)
+        return borders_from_polylines(*spec.boundary, periodic=spec.periodic, where=where)
+    if spec.wake:
+        raise InvalidInputError(
+            "a C-grid (control wake > 0) needs four borders given node by node (no cells=, no loop)"
+        )
+    if spec.corners is None:
+        raise InvalidInputError('a closed loop needs four corner indices (corners=) or corners="auto"')
+    corners = spec.corners
+    if isinstance(corners, str) and corners == "auto":
+        from .corners import choose_corners
 
-            corners = choose_corners(loop)
-        b = borders_from_loop(loop, corners, where=where)
-        if periodic:
-            raise InvalidInputError("periodic=True needs four borders (left = right is the seam)")
-    else:
-        missing = [n for n, v in zip(BORDER_NAMES, (bottom, right, top, left), strict=True) if v is None]
-        if missing:
-            raise InvalidInputError(f"missing border(s): {', '.join(missing)}")
-        b = borders_from_polylines(bottom, right, top, left, periodic=periodic, where=where)
-    c = _cells(cells)
-    if c is None:
-        if borders and any(
-            (v or {}).get("distribution", "uniform") != "uniform" if isinstance(v, Mapping) else False
-            for v in borders.values()
-        ):
+        corners = choose_corners(spec.points)
+    b = borders_from_loop(spec.points, corners, where=where)
+    if spec.periodic:
+        raise InvalidInputError("periodic=True needs four borders (left = right is the seam)")
+    return b
+
+
+def block_borders(spec: BlockSpec, *, where: str = "") -> tuple[Borders, Borders]:
+    """The block's boundary nodes and its input borders: ``(nodes, given)``.
+
+    ``nodes`` are re-sampled to ``spec.cells`` (or are the given points when
+    ``cells`` is None); ``given`` are the validated input polylines (floating
+    nodes of grid control slide on them).  Raises a MeshcoreError naming the
+    problem.
+    """
+    raw = _raw_borders(spec, where)
+    if spec.cells is None:
+        if any(s.distribution != "uniform" for _, s in spec.borders):
             raise InvalidInputError("border distributions need cells= (the borders are re-sampled)")
-        b.check_counts()
-        return b
-    return b.resampled(c, specs=borders, curve=curve, snap_angle=snap_angle)
+        raw.check_counts()
+        return raw, raw
+    nodes = raw.resampled(spec.cells, specs=spec.border_specs(), curve=spec.curve, snap_angle=spec.snap_angle)
+    return nodes, raw
 
 
 def initial_grid(
@@ -92,6 +145,145 @@ def initial_grid(
         raise InvalidInputError(f"weights must be a pair (p13_x, p13_y), got {weights!r}")
     g = algebraic_grid(borders, initial, weights=w)  # type: ignore[arg-type]
     return g.replaced(names=dict(names or {}))
+
+
+# ----------------------------------------------------------------- pipeline
+@contextlib.contextmanager
+def _recorded(into: list[str]) -> Iterator[None]:
+    """Collect the :class:`MeshcoreWarning` messages of a block of code; pass others on.
+
+    (``warnings.catch_warnings`` is process-wide: keep the block short.)
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        if issubclass(w.category, MeshcoreWarning):
+            if str(w.message) not in into:
+                into.append(str(w.message))
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def run_block(
+    spec: BlockSpec,
+    solver: SolverSpec | None = None,
+    *,
+    start: Callable[[StructuredGrid], StructuredGrid] | None = None,
+    stop_event: threading.Event | None = None,
+    smooth: bool = True,
+    where: str | None = None,
+) -> Generator[BlockEvent, Any, StructuredGrid]:
+    """Generate one block, yielding typed events; returns the final grid.
+
+    Parameters
+    ----------
+    spec : BlockSpec
+        The block.
+    solver : SolverSpec, optional
+        The solve (default settings when None).
+    start : callable, optional
+        ``start(algebraic) -> grid``: the grid to start the solve from (a warm
+        start); the algebraic grid by default.
+    stop_event : threading.Event, optional
+        Cooperative stop (checked every sweep/cycle); ``gen.send("stop")`` too.
+    smooth : bool
+        ``False``: stop after the algebraic grid.
+    where : str, optional
+        Prefix of boundary error messages (default: the block name).
+
+    Yields
+    ------
+    StartGrid, SolverProgress, Repaired, Done
+        See the module docstring.  Values sent to the generator go to
+        :func:`meshcore.elliptic.iterate` (``"stop"``, a new ``EllipticConfig``).
+    """
+    solver = solver or SolverSpec()
+    notes: list[str] = []
+    with _recorded(notes):
+        nodes, given = block_borders(spec, where=spec.name if where is None else where)
+        g0 = initial_grid(nodes, initial=spec.initial, weights=spec.weights, names=spec.border_names())
+        sources = None
+        if smooth and spec.control is not None:
+            from .control import make_sources
+
+            sources = make_sources(spec.control, periodic=spec.periodic, curves={n: given[n] for n in BORDER_NAMES})
+    g = start(g0) if start is not None and smooth else g0
+    yield StartGrid(g, g0)
+    if smooth:
+        g = yield from iterate(g, solver.config(), p=spec.p, q=spec.q, sources=sources, stop_event=stop_event)
+        stopped = g.info.message == "stopped"
+        if not stopped and (solver.foldfree or solver.repair != "off"):
+            with _recorded(notes):
+                fixed = _fold_free(g, spec, solver)
+            if fixed.grid is not g:
+                yield Repaired(fixed.grid, g, fixed)
+                g = fixed.grid
+    yield Done(g, g0, tuple(notes))
+    return g
+
+
+def _fold_free(grid: StructuredGrid, spec: BlockSpec, solver: SolverSpec) -> Any:
+    """The fold-free step: :func:`meshcore.foldfree.smooth` or :func:`~meshcore.foldfree.repair`."""
+    from . import foldfree
+
+    strict = solver.repair == "strict"
+    if solver.foldfree:
+        if spec.p is not None or spec.q is not None:
+            warnings.warn(
+                'method="foldfree": the source terms P, Q shape only the elliptic start grid; '
+                "the fold-free minimisation has none (the default method keeps them and "
+                "repairs only the invalid cells)",
+                MeshcoreWarning,
+                stacklevel=2,
+            )
+        return foldfree.smooth(grid, strict=strict)
+    return foldfree.repair(grid, strict=strict)
+
+
+# ----------------------------------------------------------- keyword API
+def _spec_from_keywords(bottom: Any, right: Any, top: Any, left: Any, loop: Any, corners: Any, **kw: Any) -> BlockSpec:
+    given = [bottom, right, top, left]
+    if loop is not None:
+        if any(v is not None for v in given):
+            raise InvalidInputError("give either four borders or loop + corners, not both")
+        return BlockSpec(points=loop, corners=corners, **kw)
+    missing = [n for n, v in zip(BORDER_NAMES, given, strict=True) if v is None]
+    if missing:
+        raise InvalidInputError(f"missing border(s): {', '.join(missing)}")
+    return BlockSpec(boundary=tuple(given), **kw)  # type: ignore[arg-type]
+
+
+def prepare_borders(
+    bottom: Any = None,
+    right: Any = None,
+    top: Any = None,
+    left: Any = None,
+    *,
+    loop: Any = None,
+    corners: Any = None,
+    cells: Any = None,
+    borders: Mapping[str, Any] | None = None,
+    curve: str = "linear",
+    periodic: bool = False,
+    snap_angle: float | None = None,
+    where: str = "",
+) -> Borders:
+    """Validate the boundary and re-sample it (or use the given nodes when ``cells`` is None)."""
+    spec = _spec_from_keywords(
+        bottom,
+        right,
+        top,
+        left,
+        loop,
+        corners,
+        cells=cells,
+        borders=borders or {},
+        curve=curve,
+        periodic=periodic,
+        snap_angle=snap_angle,
+    )
+    return block_borders(spec, where=where)[0]
 
 
 def generate_block(
@@ -121,8 +313,14 @@ def generate_block(
     repair: str = "auto",
     snap_angle: float | None = None,
     control: Any = None,
+    solver: SolverSpec | None = None,
 ) -> StructuredGrid:
     """Generate one block's grid from its boundary.
+
+    Either keywords (below), or the specs themselves:
+    ``generate_block(spec, solver)`` with a :class:`~meshcore.BlockSpec` and a
+    :class:`~meshcore.SolverSpec` (then only ``callback`` and ``smooth`` may be
+    given too).  Drains :func:`run_block` and re-emits its warnings.
 
     Parameters
     ----------
@@ -153,7 +351,7 @@ def generate_block(
         Source terms P, Q of the node shape (zero by default).
     callback : callable, optional
         Called with each :class:`~meshcore.elliptic.SolverProgress`; return
-        ``"stop"`` to stop early.
+        ``"stop"`` to stop early (the grid is then returned as it is).
     smooth : bool
         ``False`` returns the algebraic grid without the elliptic solve.
     periodic : bool
@@ -179,6 +377,8 @@ def generate_block(
         first-cell spacing, Thomas–Middlecoff, attraction, floating nodes
         (which slide on the given border polylines), e.g.
         ``{"borders": {"bottom": {"spacing": 0.01}}}``.
+    solver : SolverSpec, optional
+        All solver settings at once (instead of ``method`` … ``repair``).
 
     Returns
     -------
@@ -194,91 +394,57 @@ def generate_block(
     >>> g.shape, g.converged
     ((5, 3), True)
     """
-    wake = _wake_cells(control)
-    if wake:
-        # C-grid: the bottom border folds back on itself along the wake cut, so the
-        # self-intersection check does not apply; the nodes are used as given
-        if cells is not None or loop is not None:
-            raise InvalidInputError(
-                "a C-grid (control wake > 0) needs four borders given node by node (no cells=, no loop)"
-            )
-        b = borders_from_polylines(bottom, right, top, left, check_intersections=False)
-        b.check_counts()
+    if isinstance(bottom, BlockSpec):
+        spec = bottom
+        if isinstance(right, SolverSpec):
+            solver = right
     else:
-        b = prepare_borders(
+        spec = _spec_from_keywords(
             bottom,
             right,
             top,
             left,
-            loop=loop,
-            corners=corners,
+            loop,
+            corners,
             cells=cells,
-            borders=borders,
+            weights=weights,
+            initial=initial,
             curve=curve,
+            borders=borders or {},
             periodic=periodic,
             snap_angle=snap_angle,
+            control=control,
+            p=p,
+            q=q,
         )
-    names = {k: v["name"] for k, v in (borders or {}).items() if isinstance(v, Mapping) and v.get("name")}
-    g0 = initial_grid(b, initial=initial, weights=weights, names=names)
-    if not smooth:
-        return g0
-    repair = validate_choice(repair, ("auto", "strict", "off"), name="repair")
-    foldfree = (config.method if config is not None else str(method).lower()) == "foldfree"
-    cfg = config or EllipticConfig(
-        method="auto" if foldfree else method,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        omega=omega,
-        threads=threads,
-    )
-    sources = None
-    if control is not None:
-        from .control import make_sources
-
-        curves = {n: b[n] for n in ("bottom", "right", "top", "left")}
-        if cells is not None:  # slide on the input polylines, not on the re-sampled nodes
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")  # already reported by prepare_borders
-                    if loop is not None:
-                        raw = borders_from_loop(loop, corners)
-                    else:
-                        raw = borders_from_polylines(bottom, right, top, left, periodic=periodic)
-                curves = {n: raw[n] for n in curves}
-            except MeshcoreError:  # e.g. corners="auto": slide on the re-sampled nodes
-                pass
-        sources = make_sources(control, periodic=periodic, curves=curves)
-    if foldfree and cfg.method == "foldfree":
-        cfg = cfg.replaced(method="auto")
-    g = solve(g0, cfg, callback=callback, p=p, q=q, sources=sources)
-    if foldfree:
-        from .foldfree import smooth as _ff_smooth
-
-        if p is not None or q is not None:
-            warnings.warn(
-                'method="foldfree": the source terms P, Q shape only the elliptic start grid; '
-                "the fold-free minimisation has none (the default method keeps them and "
-                "repairs only the invalid cells)",
-                MeshcoreWarning,
-                stacklevel=2,
+    if solver is None:
+        if config is not None:
+            solver = SolverSpec.from_config(config, repair=repair)
+        else:
+            solver = SolverSpec(
+                method=method,
+                tolerance=tolerance,
+                max_iterations=max_iterations,
+                omega=omega,
+                threads=threads,
+                repair=repair,
             )
-
-        return _ff_smooth(g, strict=repair == "strict").grid
-    if repair == "off":
-        return g
-    from .foldfree import repair as _ff_repair
-
-    return _ff_repair(g, strict=repair == "strict").grid
+    return _drain(run_block(spec, solver, smooth=smooth, where=""), callback)
 
 
-def _wake_cells(control: Any) -> int:
-    if control is None:
-        return 0
-    w = getattr(control, "wake", None)
-    if w is None and isinstance(control, Mapping):
-        w = control.get("wake", 0)
-    return int(w or 0)
-
-
-# Re-export for convenience
-iterate = iterate
+def _drain(
+    gen: Generator[BlockEvent, Any, StructuredGrid], callback: Callable[[SolverProgress], Any] | None = None
+) -> StructuredGrid:
+    """Run :func:`run_block` to the end; ``callback`` sees the progress; warnings are re-emitted."""
+    try:
+        event = next(gen)
+        while True:
+            cmd = None
+            if isinstance(event, SolverProgress) and callback is not None:
+                cmd = callback(event)
+            elif isinstance(event, Done):
+                for msg in event.warnings:
+                    warnings.warn(msg, MeshcoreWarning, stacklevel=3)
+            event = gen.send("stop" if cmd in ("stop", False) else None)
+    except StopIteration as fin:
+        return fin.value

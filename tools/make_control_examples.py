@@ -23,8 +23,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from meshcore.airfoil import first_cell_height, naca4_body
 from meshcore.boundary import BorderSpec
-from meshcore.case import BlockCase, Case, save_case
-from meshcore.elliptic import EllipticConfig
+from meshcore.case import Case, save_case
+from meshcore.spec import BlockSpec, SolverSpec
 from meshcore.topology import cgrid, radial_nodes
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -39,7 +39,7 @@ def r(a):
 
 
 def main():
-    sor = EllipticConfig(method="sor", max_iterations=100_000)
+    sor = SolverSpec(method="sor", max_iterations=100_000)
     cases = {}
     sp = 0.05
     cases["bottle-orthogonal"] = Case(
@@ -47,12 +47,12 @@ def main():
         description="Hilgenstock-White boundary control on all four walls; borders clustered to the same spacing.",
         solver=sor,
         blocks=(
-            BlockCase(
+            BlockSpec(
                 name="bottle",
                 cells=(12, 30),
                 weights=(1.0, 0.5),
-                borders=bottle(),
-                border_specs={n: BorderSpec(distribution="vinokur", first=sp, last=sp) for n in WALLS},
+                boundary=bottle(),
+                borders={n: BorderSpec(distribution="vinokur", first=sp, last=sp) for n in WALLS},
                 control={"kind": "hilgenstock-white", "borders": {n: {"spacing": sp} for n in WALLS}},
             ),
         ),
@@ -66,12 +66,12 @@ def main():
         ),
         solver=sor,
         blocks=(
-            BlockCase(
+            BlockSpec(
                 name="two-circles",
                 cells=(40, 8),
                 weights=(0.05, 0.0),
-                borders=tc,
-                border_specs={n: BorderSpec(distribution="vinokur", first=0.05, last=0.05) for n in ("left", "right")},
+                boundary=tc,
+                borders={n: BorderSpec(distribution="vinokur", first=0.05, last=0.05) for n in ("left", "right")},
                 control={"borders": {"bottom": {"spacing": 0.05}, "top": {"spacing": 0.05}}},
             ),
         ),
@@ -81,11 +81,11 @@ def main():
         description="left = right is the seam, solved like the interior.",
         solver=sor,
         blocks=(
-            BlockCase(
+            BlockSpec(
                 name="two-circles",
                 cells=(40, 8),
                 initial="tfi",
-                borders=tc,
+                boundary=tc,
                 periodic=True,
                 control={"borders": {"bottom": {"spacing": 0.05}, "top": {"spacing": 0.05}}},
             ),
@@ -103,13 +103,13 @@ def main():
         description=f"Nodes given; wall first cell {dy:.3e} chords, orthogonal; Thomas-Middlecoff interior.",
         solver=sor,
         blocks=(
-            BlockCase(
+            BlockSpec(
                 name="naca0012",
                 cells=None,
                 initial="tfi",
                 periodic=True,
-                borders={"bottom": r(body), "right": r(cut), "top": r(top), "left": r(cut)},
-                border_specs={"bottom": BorderSpec(name="wall"), "top": BorderSpec(name="farfield")},
+                boundary={"bottom": r(body), "right": r(cut), "top": r(top), "left": r(cut)},
+                borders={"bottom": BorderSpec(name="wall"), "top": BorderSpec(name="farfield")},
                 control={"thomas-middlecoff": True, "borders": {"bottom": {"spacing": float(f"{dy:.4e}")}}},
             ),
         ),
@@ -130,12 +130,12 @@ def main():
         ),
         solver=sor,
         blocks=(
-            BlockCase(
+            BlockSpec(
                 name="naca0012",
                 cells=None,
                 initial="tfi",
-                borders={k: r(v) for k, v in bd.items()},
-                border_specs={
+                boundary={k: r(v) for k, v in bd.items()},
+                borders={
                     "top": BorderSpec(name="farfield"),
                     "left": BorderSpec(name="outflow"),
                     "right": BorderSpec(name="outflow"),

@@ -21,7 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from meshcore.boundary import BorderSpec
-from meshcore.case import BlockCase, Case, save_case
+from meshcore.case import Case, save_case
+from meshcore.spec import BlockSpec
 
 OUT = Path(__file__).resolve().parent.parent / "resources" / "examples"
 
@@ -117,12 +118,12 @@ def main():
     for name, (title, b, cells, w) in cases.items():
         # The cutout's corners are kept as nodes (snap_angle); the paper's
         # uniform re-sampling would cut them off.
-        block = BlockCase(
+        block = BlockSpec(
             name=name.rsplit("-", 1)[0],
             cells=cells,
             weights=w,
-            borders=b,
-            border_specs={},
+            boundary=b,
+            borders={},
             snap_angle=30.0 if "cutout" in name else None,
         )
         save_case(
@@ -134,13 +135,13 @@ def main():
             OUT / f"{name}.toml",
         )
     b = annulus()
-    block = BlockCase(
+    block = BlockSpec(
         name="annulus-sector",
         cells=None,
         weights=(0.5, 0.5),
         initial="tfi",
-        borders=b,
-        border_specs={"right": BorderSpec(name="outer"), "left": BorderSpec(name="inner")},
+        boundary=b,
+        borders={"right": BorderSpec(name="outer"), "left": BorderSpec(name="inner")},
     )
     save_case(
         Case(

@@ -13,11 +13,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-import numpy as np  # noqa: E402
 
-from meshcore.case import load_case  # noqa: E402
+from meshcore.case import case_topology, load_case, outline_points  # noqa: E402
 from meshcore.multiblock import solve_multiblock  # noqa: E402
-from meshcore.multiblock.case import case_topology, outline_points  # noqa: E402
 from meshcore.multiblock.figure import plot_multiblock  # noqa: E402
 
 FIG = ROOT / "docs" / "figures"
@@ -80,7 +78,7 @@ def main() -> None:
     # the confluence: three blocks meet at the centre (irregular corner)
     case = load_case(EX / "confluence-multiblock.toml")
     mb = solve_multiblock(case_topology(case))
-    pts = np.asarray(case.extra["outline"]["points"], dtype=float)
+    pts = outline_points(case)
     fig, axes = plt.subplots(1, 2, figsize=(14, 6.5))
     plot_multiblock(mb, ax=axes[0], outline=pts, labels=False, title="confluence: 6 blocks, smooth")
     plot_multiblock(

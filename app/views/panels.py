@@ -43,7 +43,8 @@ class BlocksPanel(QtWidgets.QTreeWidget):
         self.clear()
         for k, b in enumerate(self.doc.project.blocks):
             status = "ready" if b.ready else "closed, needs corners" if b.closed else f"{len(b.points)} points, open"
-            it = QtWidgets.QTreeWidgetItem([b.name, f"{b.cells[0] + 1}×{b.cells[1] + 1}", status])
+            ni, nj = b.cell_counts or (0, 0)
+            it = QtWidgets.QTreeWidgetItem([b.name, f"{ni + 1}×{nj + 1}", status])
             it.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("block", k))
             f = it.font(0)
             f.setBold(k == self.doc.active)

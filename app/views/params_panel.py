@@ -145,8 +145,11 @@ class ParamsPanel(QtWidgets.QScrollArea):
         )
         f.addRow("Method", self.method)
         self.repair = QtWidgets.QComboBox()
-        self.repair.addItems(["auto", "off"])
-        self.repair.setToolTip("auto: repair folded / non-convex cells after the solve (fold-free barrier method)")
+        self.repair.addItems(["auto", "strict", "off"])
+        self.repair.setToolTip(
+            "auto: repair folded / non-convex cells after the solve (fold-free barrier method); "
+            "strict: an error when no fold-free grid exists; off: keep the elliptic grid"
+        )
         f.addRow("Repair folds", self.repair)
         self.tol = QtWidgets.QLineEdit(placeholderText="default (scale-aware)")
         self.tol.setToolTip("relative tolerance: largest Jacobi update ≤ tol · bbox diagonal")
@@ -236,8 +239,9 @@ class ParamsPanel(QtWidgets.QScrollArea):
         self._updating = True
         try:
             b = self.doc.block
-            self.ni.setValue(b.cells[0])
-            self.nj.setValue(b.cells[1])
+            ni, nj = b.cell_counts or (32, 16)
+            self.ni.setValue(ni)
+            self.nj.setValue(nj)
             self.wx.setValue(b.weights[0])
             self.wy.setValue(b.weights[1])
             self.initial.setCurrentText(b.initial)

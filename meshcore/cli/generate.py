@@ -92,7 +92,7 @@ def check_output(path: str, option: str, *, blocks: int = 1, figure: bool = Fals
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..crs import frame_from_case  # also registers the case file's top-level `crs` key
+    from ..crs import frame_from_case
     from ..io import write
     from ..quality import quality
 
@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidInputError(f"{args.case}: {exc}") from None
     prog = _Progress(args.quiet)
     t0 = time.perf_counter()
-    result = generate_case(case, callback=prog, config=cfg)
+    result = generate_case(case, callback=prog, solver=cfg)
     prog.done()
     elapsed = time.perf_counter() - t0
     blocks = list(getattr(result, "blocks", result))

@@ -103,12 +103,13 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from ..boundary import BorderSpec
-    from ..case import BlockCase, Case, save_case
+    from ..case import Case, save_case
     from ..crs import project
     from ..errors import InvalidInputError
     from ..grid import BORDER_NAMES
     from ..io import read_points
     from ..io.outline import guess_cells
+    from ..spec import BlockSpec
 
     cells = _cells(args.cells)
     specs = {}
@@ -150,9 +151,9 @@ def run(args: argparse.Namespace) -> int:
     crs_tbl = frame.as_dict()
     crs_tbl["source"] = str(Path(args.points).name)
     case = Case(
-        blocks=(BlockCase(name=name, cells=cells, loop=loop, corners=corners, border_specs=specs),),
+        blocks=(BlockSpec(name=name, cells=cells, points=loop, corners=corners, borders=specs),),
         title=args.title or f"{pl.name} (imported from {Path(args.points).name})",
-        extra={"crs": crs_tbl},
+        crs=crs_tbl,
     )
     out = save_case(case, args.output)
     print(

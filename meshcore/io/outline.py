@@ -1,16 +1,14 @@
 r"""From a point file's outline to a block boundary: pick the loop and four corners.
 
 A lake shoreline is one closed ring; a structured block needs four corners
-``(sw, se, ne, nw)`` on it.  :func:`guess_corners` picks them in the frame of
-the outline's principal axes ``(u, v)`` (u along the longest extent): the
-points extreme in the four diagonal directions ``−u−v, +u−v, +u+v, −u+v``.
-For an elongated lake this puts two corners at each end, so the long sides
-become bottom and top.  If those four are not distinct or not in
-counter-clockwise order, corners at quarter arc lengths are used instead.
+``(sw, se, ne, nw)`` on it and cell counts.  :func:`guess_corners` and
+:func:`guess_cells` are the one choice that ``meshcore import`` and the app
+both make, so a point file gives the same grid in both.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -39,23 +37,25 @@ def _ccw(loop: np.ndarray) -> bool:
 
 
 def guess_corners(loop: Any) -> tuple[int, int, int, int]:
-    """Four corner indices ``(sw, se, ne, nw)`` on a closed loop.
+    """Four corner indices ``(sw, se, ne, nw)`` on a closed loop: the choice of ``meshcore import`` and the app.
 
-    The same choice as :func:`meshcore.corners.choose_corners` (vertices nearest the
-    corners of the principal-axis bounding box, moved off reflex vertices).
+    :func:`meshcore.corners.choose_corners` with ``method="outline"`` (tip caps
+    for long narrow outlines, else the principal box) and ``upright=True``.
     """
     from ..corners import choose_corners
 
-    return choose_corners(loop)
+    return choose_corners(loop, method="outline", upright=True)
 
 
-def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, ni: int = 40) -> tuple[int, int]:
-    """Cell counts ``(ni, nj)`` with ``nj/ni`` ≈ (mean of left/right length) /
-    (mean of bottom/top length), so cells are roughly square."""
+def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, total: int = 40, minimum: int = 8) -> tuple[int, int]:
+    """Cell counts proportional to the mean lengths of opposite borders.
+
+    About ``total`` cells along the longer direction, at least ``minimum``
+    along either, so cells are roughly square.
+    """
     p = np.asarray(loop, dtype=np.float64)
     n = len(p)
     seg = np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T)
-
     ccw = _ccw(p)
 
     def length(a: int, b: int) -> float:
@@ -71,7 +71,10 @@ def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, ni: int = 40) 
         sw, se, ne, nw = (int(c) % n for c in corners)
     except (TypeError, ValueError):
         raise InvalidInputError(f"corners must be 4 integer point indices, got {corners!r}") from None
-    bt = 0.5 * (length(sw, se) + length(ne, nw))
-    lr = 0.5 * (length(se, ne) + length(nw, sw))
-    nj = max(2, round(ni * lr / bt)) if bt > 0 else ni
-    return (ni, int(nj))
+    lxi = 0.5 * (length(sw, se) + length(ne, nw))
+    leta = 0.5 * (length(se, ne) + length(nw, sw))
+    if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
+        return (total, total)
+    if lxi >= leta:
+        return (total, max(minimum, round(total * leta / lxi)))
+    return (max(minimum, round(total * lxi / leta)), total)

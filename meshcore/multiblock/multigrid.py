@@ -248,7 +248,7 @@ def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True)
     ``semi=True`` chooses per level which axes to coarsen (:func:`plan`);
     ``semi=False`` coarsens both axes of every block while possible.
     """
-    from .solver import initial_grids
+    from .start import initial_grids
 
     grids = [(np.asarray(g.x), np.asarray(g.y)) for g in initial_grids(topo)]
     out = [_make_level(topo, grids)]

@@ -49,7 +49,6 @@ from typing import Any
 import numpy as np
 
 from .._validation import validate_choice
-from ..algebraic import algebraic_grid
 from ..elliptic import EllipticConfig
 from ..elliptic import solve as solve_block
 from ..elliptic.solver import config_with, default_tolerance
@@ -57,6 +56,7 @@ from ..errors import InvalidInputError
 from ..grid import SolveInfo, StructuredGrid
 from ..quality import QualityReport, interface_pairs, quality
 from . import _kernels
+from .start import initial_grids
 from .topology import Interface, MultiBlockTopology
 
 __all__ = ["MODES", "MultiBlockGrid", "MultiBlockQuality", "solve_multiblock"]
@@ -197,54 +197,6 @@ def _assemble(grids, m) -> tuple[np.ndarray, np.ndarray]:
         x[ids.ravel()] = np.asarray(g.x).ravel()
         y[ids.ravel()] = np.asarray(g.y).ravel()
     return x, y
-
-
-def snapped_borders(topology: MultiBlockTopology) -> list:
-    """Each block's borders with every shared node set to one value (bit-identical copies)."""
-    from ..boundary import Borders
-
-    m = topology.node_map
-    x = np.full(m.n_nodes, np.nan)
-    y = np.full(m.n_nodes, np.nan)
-    out = []
-    for b, ids in zip(topology.blocks, m.ids, strict=True):
-        new = {}
-        for name, sl in (
-            ("bottom", (slice(None), 0)),
-            ("top", (slice(None), -1)),
-            ("left", (0, slice(None))),
-            ("right", (-1, slice(None))),
-        ):
-            g = ids[sl]
-            p = np.array(b.borders[name], dtype=np.float64)
-            have = ~np.isnan(x[g])
-            p[have, 0] = x[g[have]]
-            p[have, 1] = y[g[have]]
-            x[g[~have]] = p[~have, 0]
-            y[g[~have]] = p[~have, 1]
-            new[name] = p
-        # the corners were written by the first border that saw them
-        for name in ("bottom", "top", "left", "right"):
-            sl = {
-                "bottom": (slice(None), 0),
-                "top": (slice(None), -1),
-                "left": (0, slice(None)),
-                "right": (-1, slice(None)),
-            }[name]
-            g = ids[sl]
-            new[name][:, 0] = x[g]
-            new[name][:, 1] = y[g]
-        out.append(Borders(**new, periodic=False))
-    return out
-
-
-def initial_grids(topology: MultiBlockTopology) -> list[StructuredGrid]:
-    """Algebraic start grid of each block from its (snapped) borders."""
-    out = []
-    for b, bd in zip(topology.blocks, snapped_borders(topology), strict=True):
-        g = algebraic_grid(bd, b.initial, weights=b.weights)
-        out.append(g.replaced(names=dict(b.names)))
-    return out
 
 
 def solve_multiblock(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -12,6 +14,7 @@ from app.document import Document
 from app.pipeline import block_initial_grid, solve_project
 from app.project import Block, Project
 from meshcore import BorderSpec, borders_from_loop
+from meshcore.io.outline import guess_corners
 
 
 def square_block(n=4, cells=(8, 8)):
@@ -53,7 +56,7 @@ def test_auto_corners_of_rotated_rectangle_loop(reverse):
     pts = pts @ rot.T
     if reverse:
         pts = pts[::-1].copy()
-    c = geo.auto_corners(pts)
+    c = guess_corners(pts)
     # the chosen points are the rectangle's four vertices
     verts = np.array([[0, 0], [3, 0], [3, 1], [0, 1]]) @ rot.T
     assert sorted(map(tuple, np.round(pts[list(c)], 9))) == sorted(map(tuple, np.round(verts, 9)))
@@ -148,7 +151,8 @@ def test_solve_project_generator_returns_grids_and_warm_start_helps():
         res = fin.value
     g = res.grids[0]
     assert g.cells == (16, 16) and g.converged
-    assert seen[0][0] == 0 and seen[0][1] == res.initial[0] == seen[0][2]
+    k, start = seen[0]
+    assert k == 0 and start.grid == res.initial[0] == start.algebraic
     # warm start after a small boundary move converges in fewer iterations
     p2 = p.copy()
     p2[2] += (0.0, 0.02)
@@ -210,7 +214,7 @@ def test_auto_corners_cap_the_tips_of_a_curved_channel():
     outer = np.c_[10 * np.cos(th_in), 10 * np.sin(th_in)]
     inner = np.c_[9 * np.cos(th_in[::-1]), 9 * np.sin(th_in[::-1])]
     loop = np.vstack([outer, inner])[::-1].copy()  # counter-clockwise
-    c = geo.auto_corners(loop)
+    c = guess_corners(loop)
     ends = loop[list(c)]
     # two corners at each end of the band (y ≈ 0, x ≈ ±9..10)
     assert np.all(np.abs(ends[:, 1]) < 1.0)
@@ -226,7 +230,7 @@ def test_auto_corners_keep_bottom_at_the_bottom(angle):
     pts = np.array(b.points) * [2.0, 1.0]
     rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     pts = pts @ rot.T
-    sw, se, ne, nw = geo.auto_corners(pts)
+    sw, se, ne, nw = guess_corners(pts)
     d = [pts[c1] - pts[c0] for c0, c1 in ((sw, se), (se, ne), (ne, nw), (nw, sw))]
     cos = [v[0] / np.hypot(*v) for v in d]
     assert cos[0] == max(cos)
@@ -261,3 +265,30 @@ def test_cut_ends_snap_onto_the_outline_as_vertices():
     assert any(np.array_equal(v, [1.1, 1.0]) for v in new)
     with pytest.raises(TopologyError, match="cut 1"):
         snap_cuts_to_outline(ring, [np.array([[1.0, -0.5], [1.0, 1.0]])], snap=0.1)
+
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+LAKES = sorted((Path(__file__).resolve().parents[2] / "app" / "resources").glob("*.csv"))
+
+
+@pytest.mark.parametrize("path", [*LAKES, DATA / "lake_zurich_sparse.kml"], ids=lambda p: p.name)
+def test_a_point_file_gives_the_same_grid_in_the_app_and_on_the_command_line(tmp_path, path):
+    """The app's imported block (corners, cells, grid) = ``meshcore import`` + ``meshcore generate``."""
+    from app.io_adapter import read_points, to_local
+    from app.project import block_from_points
+    from meshcore.case import generate_case, load_case
+    from meshcore.cli import main
+
+    pd = read_points(path)
+    pts, _frame = to_local(pd)
+    block = block_from_points(pts, path.stem)
+    case_path = tmp_path / "lake.toml"
+    assert main(["import", str(path), "-o", str(case_path)]) == 0
+    case = load_case(case_path)
+    (cb,) = case.blocks
+    assert cb.corners == block.corners and cb.cells == block.cells
+    mine = _drain(solve_project(Project(blocks=(block,)))).grids[0]
+    (theirs,) = generate_case(case)
+    assert mine.converged and theirs.converged
+    np.testing.assert_array_equal(mine.x, theirs.x)
+    np.testing.assert_array_equal(mine.y, theirs.y)

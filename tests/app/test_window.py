@@ -154,8 +154,7 @@ def test_pause_and_resume(qtbot, win):
 
 
 def _iteration(win):
-    item = win.solver._latest.get(0, (None,))[0]
-    return getattr(item, "iteration", -1)
+    return getattr(win.solver._latest.get(0), "iteration", -1)
 
 
 def test_import_kml_projects_to_utm(qtbot, win):
@@ -512,7 +511,7 @@ def test_cut_lines_split_a_channel_into_blocks(qtbot, win):
     assert win.split_by_cuts()
     p = win.doc.project
     assert p.multiblock is not None and len(p.blocks) == 3
-    assert all(b.cells[1] == 8 for b in p.blocks)  # the η count is shared along the chain
+    assert all(b.cell_counts[1] == 8 for b in p.blocks)  # the η count is shared along the chain
     win.generate()
     wait_idle(qtbot, win, timeout=60_000)
     g = [win.doc.grids[k] for k in range(3)]

@@ -64,13 +64,13 @@ def test_paper_cases_match_the_tables():
     assert cells["two-circles-coarse"] == (30, 6) and cells["two-circles-fine"] == (40, 8)
     assert cells["bottle-coarse"] == (6, 15) and cells["bottle-fine"] == (12, 30)
     b = load_case(example_path("bottle-coarse")).blocks[0]
-    assert (len(b.borders["bottom"]), len(b.borders["left"])) == (4, 10)
+    assert (len(b.boundary[0]), len(b.boundary[3])) == (4, 10)
     assert b.weights == (1.0, 0.5)
     rc = load_case(example_path("rectangle-cutout-coarse")).blocks[0]
-    assert (len(rc.borders["bottom"]), len(rc.borders["left"])) == (10, 4)
+    assert (len(rc.boundary[0]), len(rc.boundary[3])) == (10, 4)
     assert rc.weights == (pytest.approx(0.1), 0.0)  # p24 = (0.9, 1.0)
     tc = load_case(example_path("two-circles-coarse")).blocks[0]
-    assert (len(tc.borders["bottom"]), len(tc.borders["left"])) == (20, 4)
+    assert (len(tc.boundary[0]), len(tc.boundary[3])) == (20, 4)
 
 
 def test_annulus_example_is_close_to_exact():
@@ -92,8 +92,8 @@ def test_case_round_trip(tmp_path):
     c2 = load_case(p)
     assert c2.blocks[0].cells == c.blocks[0].cells
     assert c2.blocks[0].weights == c.blocks[0].weights
-    for n in meshcore.BORDER_NAMES:
-        np.testing.assert_array_equal(c2.blocks[0].borders[n], c.blocks[0].borders[n])
+    for k in range(4):
+        np.testing.assert_array_equal(c2.blocks[0].boundary[k], c.blocks[0].boundary[k])
     g1, g2 = generate_case(c)[0], generate_case(c2)[0]
     np.testing.assert_array_equal(g1.x, g2.x)
     assert tomllib.loads(dumps_case(c2))["blocks"][0]["name"] == "bottle"
@@ -227,14 +227,14 @@ def test_lonlat_point_file_in_a_case_is_projected(tmp_path):
         '[[blocks]]\ncells = [40, 6]\n[blocks.boundary]\npoints = "lake.csv"\ncorners = [0, 10, 20, 30]\n'
     )
     case = load_case(tmp_path / "c.toml")
-    assert case.extra["crs"]["crs"] == "EPSG:32630"  # Windermere is in UTM zone 30N
-    loop = case.blocks[0].loop
+    assert case.crs["crs"] == "EPSG:32630"  # Windermere is in UTM zone 30N
+    loop = case.blocks[0].points
     assert 10_000 < np.ptp(loop[:, 1]) < 20_000  # ~14 km long, in metres, not degrees
     assert np.abs(loop).max() < 1e5  # relative to a local origin
     # saved and re-loaded, the case keeps its frame and gives the same grid
     p = save_case(case, tmp_path / "saved.toml")
     again = load_case(p)
-    assert again.extra["crs"]["origin"] == case.extra["crs"]["origin"]
+    assert again.crs["origin"] == case.crs["origin"]
     g1, g2 = generate_case(case)[0], generate_case(again)[0]
     np.testing.assert_allclose(g1.x, g2.x, atol=1e-6)
 
@@ -244,7 +244,7 @@ def test_solver_repair_key(tmp_path):
     c = loads_case(text, source="t.toml")
     assert c.repair == "off"
     off = generate_case(c)[0]
-    on = generate_case(c.replaced(repair="auto"))[0]
+    on = generate_case(c.replaced(solver=c.solver.replaced(repair="auto")))[0]
     assert meshcore.quality(off).n_nonconvex > 0  # Winslow leaves non-convex cells at the cutout
     assert meshcore.quality(on).n_nonconvex == 0 and "foldfree" in on.info.method
     assert loads_case(dumps_case(c), source="t2").repair == "off"

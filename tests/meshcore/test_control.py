@@ -327,7 +327,7 @@ def test_cgrid_example_loads_and_starts_unfolded():
 
     block = load_case(EXAMPLES / "naca0012-cgrid.toml").blocks[0]
     wake = block.control["wake"]
-    g0 = generate_block(**block.generate_kwargs(), smooth=False)
+    g0 = generate_block(block, smooth=False)
     ni = g0.shape[0] - 1
     k = np.arange(wake + 1)
     assert np.allclose(g0.x[k, 0], g0.x[ni - k, 0]) and np.allclose(g0.y[k, 0], g0.y[ni - k, 0])

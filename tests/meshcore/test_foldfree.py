@@ -361,8 +361,7 @@ def test_paper_cases_fold_free_and_close_to_valid_winslow(path):
     from meshcore.case import generate_case, load_case
 
     case = load_case(path)
-    kw = case.blocks[0].generate_kwargs()
-    w = meshcore.generate_block(**kw, config=case.solver, repair="off")
+    w = meshcore.generate_block(case.blocks[0], case.solver.replaced(repair="off"))
     g = generate_case(case)[0]
     qw, qg = meshcore.quality(w), meshcore.quality(g)
     assert qg.ok and g.converged, g.info.message
@@ -372,7 +371,7 @@ def test_paper_cases_fold_free_and_close_to_valid_winslow(path):
     else:  # ... an invalid one is repaired, and the message says so
         assert g.method.endswith("+foldfree")
         assert f"{qw.n_nonconvex} non-convex cell(s)" in g.info.message
-    f = meshcore.generate_block(**kw, config=case.solver.replaced(method="foldfree"))
+    f = meshcore.generate_block(case.blocks[0], case.solver.replaced(method="foldfree"))
     assert f.method == "foldfree" and f.converged and meshcore.quality(f).ok
     # the whole-block barrier minimiser stays close to a valid Winslow grid (it has no
     # grid control, so controlled examples are not compared)

@@ -41,8 +41,8 @@ def test_import_generate_convert_a_lake(tmp_path, capsys):
     c = load_case(case)
     frame = frame_from_case(c)
     assert frame.crs == "EPSG:32632" and frame.source_crs == "EPSG:4326"
-    assert c.blocks[0].cells == (30, 6) and len(c.blocks[0].loop) == 40
-    assert np.abs(c.blocks[0].loop).max() < 2e4  # local coordinates
+    assert c.blocks[0].cells == (30, 6) and len(c.blocks[0].points) == 40
+    assert np.abs(c.blocks[0].points).max() < 2e4  # local coordinates
     # generate → .vts keeps the CRS and the origin
     vts = tmp_path / "zurich.vts"
     assert main(["generate", str(case), "-o", str(vts), "-q"]) == 0
@@ -73,7 +73,7 @@ def test_import_csv_with_columns_and_no_projection(tmp_path):
         == 0
     )
     c = load_case(case)
-    np.testing.assert_array_equal(c.blocks[0].loop, ring)
+    np.testing.assert_array_equal(c.blocks[0].points, ring)
     assert c.blocks[0].corners == (0, 2, 4, 6)
     assert frame_from_case(c).crs is None
 

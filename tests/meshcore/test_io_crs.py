@@ -102,7 +102,7 @@ def test_same_lake_in_lonlat_and_utm_gives_the_same_grid(tmp_path):
     assert frame_utm.crs == frame_ll.crs and frame_utm.origin == frame_ll.origin
     loop_ll, loop_utm = local_ll.polylines[0].points, local_utm.polylines[0].points
     corners = guess_corners(loop_ll)
-    cells = guess_cells(loop_ll, corners, ni=24)
+    cells = guess_cells(loop_ll, corners, total=24)
     g1 = meshcore.generate_block(loop=loop_ll, corners=corners, cells=cells)
     g2 = meshcore.generate_block(loop=loop_utm, corners=corners, cells=cells)
     assert g1.converged and g2.converged

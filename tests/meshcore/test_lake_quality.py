@@ -152,9 +152,8 @@ def test_partial_interface_t_junction_and_reversed_orientation():
 
 
 def test_interface_pairs_match_the_topology_of_the_shasta_case():
-    from meshcore.case import load_case
+    from meshcore.case import case_topology, load_case
     from meshcore.multiblock import initial_grids
-    from meshcore.multiblock.case import case_topology
 
     topo = case_topology(load_case(EXAMPLES / "shasta-multiblock-coarse.toml"))
     grids = initial_grids(topo)

@@ -1,0 +1,197 @@
+"""What a case file holds: :class:`Case` and its multiblock sections (frozen, no I/O)."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._validation import validate_count
+from ..errors import InvalidInputError
+from ..multiblock.outline import BlockOutline
+from ..multiblock.solver import MODES
+from ..spec import BlockSpec, SolverSpec
+
+__all__ = [
+    "OUTLINE_CRS",
+    "START_CHOICES",
+    "Case",
+    "InterfaceEntry",
+    "MultiblockSection",
+    "OutlineSection",
+    "outline_point",
+]
+
+#: ``[multiblock] start``: smooth mode starts from the algebraic grids or the frozen solution.
+START_CHOICES = ("algebraic", "frozen")
+#: ``crs`` of an outline: no projection, local equirectangular, UTM of the centroid (pyproj);
+#: any other value is a target CRS for pyproj (``"EPSG:32610"``, ``32610``).
+OUTLINE_CRS = ("xy", "none", "lonlat", "utm", "auto")
+
+
+@dataclass(frozen=True, slots=True)
+class MultiblockSection:
+    """``[multiblock]``: how the blocks are solved together.
+
+    ``mode``: ``"smooth"`` (interfaces solved) or ``"frozen"`` (the paper:
+    interfaces fixed); ``start``: smooth mode starts from the ``"algebraic"``
+    grids or from the ``"frozen"`` solution.
+    """
+
+    mode: str = "smooth"
+    start: str = "algebraic"
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise InvalidInputError(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
+        if self.start not in START_CHOICES:
+            raise InvalidInputError(f"start must be frozen or algebraic, got {self.start!r}")
+
+
+@dataclass(frozen=True, slots=True)
+class InterfaceEntry:
+    """``[[interfaces]]``: two block sides glued together.
+
+    ``a``, ``b``: ``"block.border"``, optionally with a node range
+    (``"main.top[4:12]"``); ``reversed``: orientation (None = from the coordinates).
+    """
+
+    a: str
+    b: str
+    reversed: bool | None = None
+
+    def __post_init__(self) -> None:
+        if self.reversed is not None and not isinstance(self.reversed, bool):
+            raise InvalidInputError("reversed must be true or false")
+
+
+def outline_point(v: Any) -> int | tuple[float, float]:
+    if isinstance(v, (int, np.integer)) and not isinstance(v, bool):
+        return int(v)
+    if (
+        isinstance(v, (list, tuple, np.ndarray))
+        and len(v) == 2
+        and all(isinstance(e, (int, float, np.number)) and not isinstance(e, bool) for e in v)
+    ):
+        return (float(v[0]), float(v[1]))
+    raise InvalidInputError(f"expected an outline point index or an [x, y] pair, got {v!r}")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class OutlineSection:
+    """``[outline]``: one closed outline split by cut lines into ``[[outline.blocks]]``.
+
+    ``points`` is a point-file name (relative to the case file) or ``(n, 2)``
+    points; cut and corner points are outline indices or ``(x, y)`` pairs.
+    See :func:`meshcore.multiblock.from_outline` and ``crs`` in :data:`OUTLINE_CRS`.
+    """
+
+    points: str | np.ndarray
+    cuts: tuple[tuple[int | tuple[float, float], ...], ...]
+    blocks: tuple[BlockOutline, ...]
+    crs: str | int = "auto"
+    origin: tuple[float, float] | None = None
+    snap: float | None = None
+    multiple: int = 1
+
+    def __post_init__(self) -> None:
+        put = object.__setattr__
+        if not isinstance(self.points, str):
+            a = np.array(self.points, dtype=np.float64)
+            if a.ndim != 2 or a.shape[1] != 2:
+                raise InvalidInputError(f"points: expected a list of [x, y] pairs, got shape {a.shape}")
+            a.setflags(write=False)
+            put(self, "points", a)
+        if isinstance(self.crs, bool) or not isinstance(self.crs, (str, int)):
+            raise InvalidInputError(f"crs must be a string or an EPSG code, got {self.crs!r}")
+        if isinstance(self.crs, str):
+            c = self.crs.strip()
+            put(self, "crs", c.lower() if c.lower() in OUTLINE_CRS else c)
+        if not isinstance(self.cuts, (list, tuple)) or not self.cuts:
+            raise InvalidInputError("cuts must be a list of polylines")
+        cuts = []
+        for k, c in enumerate(self.cuts):
+            if not isinstance(c, (list, tuple)) or len(c) < 2:
+                raise InvalidInputError(f"cut {k} must list at least two points")
+            try:
+                cuts.append(tuple(outline_point(v) for v in c))
+            except InvalidInputError as exc:
+                raise InvalidInputError(f"cut {k}: {exc}") from None
+        put(self, "cuts", tuple(cuts))
+        if not isinstance(self.blocks, (list, tuple)) or not self.blocks:
+            raise InvalidInputError("needs [[outline.blocks]] tables")
+        put(self, "blocks", tuple(self.blocks))
+        if self.origin is not None:
+            put(self, "origin", (float(self.origin[0]), float(self.origin[1])))
+        if self.snap is not None:
+            put(self, "snap", float(self.snap))
+        if isinstance(self.multiple, bool) or not isinstance(self.multiple, int) or self.multiple < 1:
+            raise InvalidInputError("multiple must be a positive integer")
+        validate_count(self.multiple, name="multiple")
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, OutlineSection):
+            return NotImplemented
+        same_points = (
+            self.points == other.points
+            if isinstance(self.points, str) or isinstance(other.points, str)
+            else np.array_equal(self.points, other.points)
+        )
+        return same_points and all(
+            getattr(self, f.name) == getattr(other, f.name) for f in dataclasses.fields(self) if f.name != "points"
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, eq=False)
+class Case:
+    """A whole case: blocks, solver settings and the optional multiblock sections.
+
+    ``crs`` is the top-level ``crs`` table (``crs``, ``origin``, ``source_crs``,
+    ``source``; :func:`meshcore.crs.frame_from_case`).  A case is *multiblock*
+    when it has a ``[multiblock]`` table, ``[[interfaces]]`` or an ``[outline]``.
+    """
+
+    blocks: tuple[BlockSpec, ...] = ()
+    title: str = ""
+    description: str = ""
+    solver: SolverSpec = field(default_factory=SolverSpec)
+    crs: Mapping[str, Any] | None = None
+    multiblock: MultiblockSection | None = None
+    interfaces: tuple[InterfaceEntry, ...] = ()
+    outline: OutlineSection | None = None
+    path: Path | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "blocks", tuple(self.blocks))
+        object.__setattr__(self, "interfaces", tuple(self.interfaces))
+        if self.crs is not None:
+            object.__setattr__(self, "crs", dict(self.crs))
+
+    @property
+    def is_multiblock(self) -> bool:
+        """True when the blocks are solved together (``[multiblock]``, ``[[interfaces]]``, ``[outline]``)."""
+        return self.multiblock is not None or bool(self.interfaces) or self.outline is not None
+
+    @property
+    def settings(self) -> MultiblockSection:
+        """The ``[multiblock]`` settings (defaults when the table is absent)."""
+        return self.multiblock or MultiblockSection()
+
+    @property
+    def repair(self) -> str:
+        """``solver.repair``."""
+        return self.solver.repair
+
+    @property
+    def source(self) -> str:
+        """The case file's name for messages (``<case>`` when it was not read from a file)."""
+        return str(self.path) if self.path else "<case>"
+
+    def replaced(self, **changes: Any) -> Case:
+        return dataclasses.replace(self, **changes)

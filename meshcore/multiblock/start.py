@@ -1,0 +1,58 @@
+"""The start of a multiblock solve: every block's borders with shared nodes made identical, and its algebraic grid."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..algebraic import algebraic_grid
+from ..boundary import Borders
+from ..grid import StructuredGrid
+from .topology import MultiBlockTopology
+
+__all__ = ["initial_grids", "snapped_borders"]
+
+
+def snapped_borders(topology: MultiBlockTopology) -> list:
+    """Each block's borders with every shared node set to one value (bit-identical copies)."""
+    m = topology.node_map
+    x = np.full(m.n_nodes, np.nan)
+    y = np.full(m.n_nodes, np.nan)
+    out = []
+    for b, ids in zip(topology.blocks, m.ids, strict=True):
+        new = {}
+        for name, sl in (
+            ("bottom", (slice(None), 0)),
+            ("top", (slice(None), -1)),
+            ("left", (0, slice(None))),
+            ("right", (-1, slice(None))),
+        ):
+            g = ids[sl]
+            p = np.array(b.borders[name], dtype=np.float64)
+            have = ~np.isnan(x[g])
+            p[have, 0] = x[g[have]]
+            p[have, 1] = y[g[have]]
+            x[g[~have]] = p[~have, 0]
+            y[g[~have]] = p[~have, 1]
+            new[name] = p
+        # the corners were written by the first border that saw them
+        for name in ("bottom", "top", "left", "right"):
+            sl = {
+                "bottom": (slice(None), 0),
+                "top": (slice(None), -1),
+                "left": (0, slice(None)),
+                "right": (-1, slice(None)),
+            }[name]
+            g = ids[sl]
+            new[name][:, 0] = x[g]
+            new[name][:, 1] = y[g]
+        out.append(Borders(**new, periodic=False))
+    return out
+
+
+def initial_grids(topology: MultiBlockTopology) -> list[StructuredGrid]:
+    """Algebraic start grid of each block from its (snapped) borders."""
+    out = []
+    for b, bd in zip(topology.blocks, snapped_borders(topology), strict=True):
+        g = algebraic_grid(bd, b.initial, weights=b.weights)
+        out.append(g.replaced(names=dict(b.names)))
+    return out
