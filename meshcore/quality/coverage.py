@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..grid import StructuredGrid
+from .samples import Samples
 
 __all__ = ["Coverage", "as_polygon", "coverage"]
 
@@ -74,8 +75,6 @@ class Coverage:
         ]
 
     def samples(self, metric: str) -> Any:
-        from .lake import Samples
-
         v = self.area_error if metric == "area_error" else self.hausdorff_cells
         x, y = (math.nan, math.nan) if metric == "area_error" else self.where
         one = lambda a, dt=float: np.array([a], dtype=dt)  # noqa: E731

@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..grid import StructuredGrid
 from .interfaces import interface_pairs, no_pairs, ratio, signed_area
+from .samples import Samples, format_table
 
 __all__ = [
     "METRICS",
@@ -80,31 +81,6 @@ class Location:
         where = f"{self.block}({self.i},{self.j})" if self.block else "grid"
         extra = f" {self.note}" if self.note else ""
         return f"{self.value:.4g} at {where}{extra} ({self.x:.8g}, {self.y:.8g})"
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Samples:
-    """The values of one metric wherever it is defined, each with its place.
-
-    ``block`` indexes :attr:`LakeMetrics.names` (``-1``: the whole grid);
-    ``i, j`` are node indices for node metrics and smoothness, cell indices
-    for cell metrics and for side *a* of an interface pair (``partner``:
-    ``(block, i, j)`` of the cell on side *b*); ``axis`` is 0 for ξ-lines and
-    1 for η-lines (smoothness only).
-    """
-
-    metric: str
-    values: np.ndarray
-    block: np.ndarray
-    i: np.ndarray
-    j: np.ndarray
-    x: np.ndarray
-    y: np.ndarray
-    partner: np.ndarray | None = None
-    axis: np.ndarray | None = None
-
-    def __len__(self) -> int:
-        return len(self.values)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -349,7 +325,6 @@ class LakeMetrics:
 
     def table(self) -> str:
         """A short Markdown table of the headline numbers with the worst places."""
-        from .presets import format_table
 
         def w(metric: str) -> str:
             loc = self.worst(metric, 1)

@@ -30,6 +30,7 @@ import numpy as np
 from .._validation import validate_choice
 from ..errors import InvalidInputError
 from .lake import METRICS, LakeMetrics, Location, lake_metrics
+from .samples import format_table
 
 __all__ = ["PRESETS", "Limit", "LimitResult", "Preset", "Verdict", "check", "format_table"]
 
@@ -239,11 +240,3 @@ def check(
         preset = PRESETS[preset]
     m = grid if isinstance(grid, LakeMetrics) else lake_metrics(grid, polygon=polygon, holes=holes)
     return Verdict(preset, tuple(_result(m, lim, worst) for lim in preset.limits), m)
-
-
-def format_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    """A Markdown table with padded columns."""
-    rows = [[str(v).replace("|", "\\|") for v in r] for r in [head, *rows]]  # a | inside a cell is escaped
-    w = [max(len(r[c]) for r in rows) for c in range(len(head))]
-    line = lambda r: "| " + " | ".join(v.ljust(w[c]) for c, v in enumerate(r)) + " |"  # noqa: E731
-    return "\n".join([line(rows[0]), "|" + "|".join("-" * (n + 2) for n in w) + "|"] + [line(r) for r in rows[1:]])
