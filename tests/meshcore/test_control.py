@@ -77,9 +77,9 @@ def test_control_from_mapping_and_unknown_keys():
     )
     assert spec.thomas_middlecoff and spec.borders["bottom"].angle == 80
     assert spec.attractors[0].xi == 0.5 and spec.floating == ("top",)
-    with pytest.raises(InvalidInputError, match=r"valid:.*relaxation"):
+    with pytest.raises(InvalidInputError, match=r"valid keys:.*relaxation"):
         control_from_mapping({"relax": 0.1})
-    with pytest.raises(InvalidInputError, match=r"valid:.*spacing"):
+    with pytest.raises(InvalidInputError, match=r"valid keys:.*spacing"):
         control_from_mapping({"borders": {"bottom": {"spcing": 0.1}}})
     with pytest.raises(InvalidInputError, match="border 'middle'"):
         control_from_mapping({"borders": {"middle": {"spacing": 0.1}}})
