@@ -89,6 +89,27 @@ def snap(xy, points: np.ndarray, tol: float, *, exclude=()) -> tuple[float, floa
     return float(xy[0]), float(xy[1])
 
 
+def corner_advice(points: np.ndarray, corners) -> list[str]:
+    """What is wrong with corners on reflex vertices, and where to move them.
+
+    One sentence per problem corner (from :func:`meshcore.corners.corner_problems`),
+    with points numbered from 1 like the rows of a point file.
+    """
+    from meshcore.corners import corner_problems
+
+    out = []
+    for prob in corner_problems(np.asarray(points, float), corners):
+        s = (
+            f"corner {prob.corner.upper()} is on point {prob.index + 1}, a reflex vertex "
+            f"(interior angle {prob.angle:.0f}° ≥ 180°): its corner cell cannot be convex; "
+            f"move corner {prob.corner.upper()} to a convex vertex"
+        )
+        if prob.suggestion is not None:
+            s += f", e.g. point {prob.suggestion + 1}"
+        out.append(s)
+    return out
+
+
 def _signed_area(p: np.ndarray) -> float:
     x, y = p[:, 0], p[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))

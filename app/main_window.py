@@ -295,11 +295,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def split_by_cuts(self) -> bool:
         """Turn the active loop + the drawn cut lines into a multiblock case (undoable)."""
-        import tomli_w
-
-        from meshcore.case import loads_case
-
-        from .cutsplit import case_dict_from_cuts
+        from meshcore.case import cut_case
 
         p = self.doc.project
         b = self.doc.block
@@ -307,10 +303,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.message("Split needs a closed loop of points (draw or import one) and cut lines across it")
             return False
         try:
-            d = case_dict_from_cuts(
-                b.points, list(p.cut_lines), cells_across=(b.cell_counts or (32, 16))[1], title=p.title
-            )
-            case = loads_case(tomli_w.dumps(d), source="cut lines")
+            case = cut_case(b.points, list(p.cut_lines), cells_across=(b.cell_counts or (32, 16))[1], title=p.title)
             after = fio.project_from_multiblock_case(case)
         except (MeshcoreError, ValueError) as exc:
             self.error("Cannot split by cut lines", exc)

@@ -3,7 +3,9 @@
 :func:`solve_project` runs meshcore's block pipeline (:func:`meshcore.run_block`)
 on every ready block and yields ``(block_index, event)`` pairs — meshcore's
 typed events (``StartGrid``, ``SolverProgress``, ``Repaired``, ``Done``) —
-and returns a :class:`BlockResult`.  What is the app's own is the warm start:
+and returns a :class:`BlockResult`.  A multiblock case yields
+``(ALL_BLOCKS, SolverProgress)`` with every block's grid (one generator, no
+second thread).  What is the app's own is the warm start:
 
 Warm start (live remesh): when the previous grid of a block has the same
 shape, the candidate start grid is ``A_new + (G_old − A_old)`` — the new
@@ -29,7 +31,6 @@ from .project import Block, Project
 __all__ = [
     "ALL_BLOCKS",
     "BlockResult",
-    "ResidualProgress",
     "block_initial_grid",
     "solve_project",
     "warm_start",
@@ -38,20 +39,6 @@ __all__ = [
 
 #: block index of progress items that concern all blocks at once
 ALL_BLOCKS = -1
-
-
-@dataclass(frozen=True, slots=True)
-class ResidualProgress:
-    """Progress of a solve that has no grid snapshots (multiblock): relative residuals only.
-
-    Yielded as ``(ALL_BLOCKS, progress)``.
-    """
-
-    iteration: int
-    residual: float
-    history: tuple[tuple[int, float], ...]
-    method: str = "multiblock"
-    tolerance: float = float("nan")
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,49 +117,28 @@ def solve_project(
 
 
 def _solve_multiblock(project: Project, solver, stop_event):
-    """A multiblock case: all blocks solved together by :func:`meshcore.multiblock.solve_multiblock`.
+    """A multiblock case: all blocks solved together (:func:`meshcore.case.iterate_multiblock_case`).
 
-    Yields the algebraic start grids (for display), then runs the global
-    solve, whose callback honours ``stop_event``; returns every block's grid.
+    Yields the algebraic start grids, then ``(ALL_BLOCKS, SolverProgress)``
+    with every block's current grid; returns every block's grid.
     """
-    from meshcore.case import case_topology
-    from meshcore.multiblock import initial_grids, solve_multiblock
+    from meshcore.case import case_topology, iterate_multiblock_case
+    from meshcore.multiblock import initial_grids
 
     case = project.multiblock
-    s = case.settings
     topo = case_topology(case)
     starts = dict(enumerate(initial_grids(topo)))
     for k, g in starts.items():
         yield k, StartGrid(g, g)
-
-    history: list[tuple[int, float]] = []
-    out: dict = {}
-    cfg = solver.config()
-
-    def callback(iteration, rel_residual):
-        history.append((int(iteration), float(rel_residual)))
-        return "stop" if stop_event is not None and stop_event.is_set() else None
-
-    def run() -> None:  # the global solve reports only through its callback: run it aside
-        try:
-            out["mb"] = solve_multiblock(topo, mode=s.mode, start=s.start, config=cfg, callback=callback)
-        except BaseException as exc:  # handed back to the worker below
-            out["error"] = exc
-
-    th = threading.Thread(target=run, name="multiblock-solve", daemon=True)
-    th.start()
-    seen = 0
-    while th.is_alive():
-        th.join(cfg.report_interval)
-        if len(history) > seen:
-            seen = len(history)
-            it, r = history[-1]
-            yield ALL_BLOCKS, ResidualProgress(it, r, tuple(history))
-    if "error" in out:
-        raise out["error"]
-    mb = out["mb"]
-    grids = dict(enumerate(mb.grids))
-    return BlockResult(grids=grids, initial=starts, multiblock=mb)
+    gen = iterate_multiblock_case(case, solver, topology=topo, initial=list(starts.values()), stop_event=stop_event)
+    try:
+        snap = next(gen)
+        while True:
+            cmd = yield ALL_BLOCKS, snap
+            snap = gen.send(cmd)
+    except StopIteration as fin:
+        mb = fin.value
+    return BlockResult(grids=dict(enumerate(mb.grids)), initial=starts, multiblock=mb)
 
 
 def folded_cells(grid: StructuredGrid) -> np.ndarray:

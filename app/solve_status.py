@@ -47,13 +47,12 @@ class SolveStatus(QtCore.QObject):
         self.label.setText("idle")
 
     def on_progress(self, k: int, snap) -> None:
-        if k == ALL_BLOCKS:  # a multiblock solve: relative residuals of the global iteration
-            self.conv.set_history(list(snap.history))
+        if k == ALL_BLOCKS:  # a multiblock solve: every block at once
+            self.conv.set_history(list(snap.history), snap.tolerance)
             self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
             return
-        if k == self.doc.active:
-            length = max(snap.grid.size, 1e-300)  # history is absolute, residual relative
-            self.conv.set_history([(i, r / length) for i, r in snap.history], snap.tolerance)
+        if k == self.doc.active:  # history and residual are relative to the grid size
+            self.conv.set_history(list(snap.history), snap.tolerance)
         fr = [t for t in self.frames if t > self.frames[-1] - 1.0] if self.frames else []
         self.label.setText(
             f"{snap.method}: iteration {snap.iteration}, residual {snap.residual:.2e} "

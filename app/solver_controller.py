@@ -22,7 +22,7 @@ from superqt.utils import create_worker
 from meshcore import Done, MeshcoreError, Repaired, SolverProgress, StartGrid, StructuredGrid
 
 from .document import Document
-from .pipeline import ResidualProgress, solve_project
+from .pipeline import ALL_BLOCKS, solve_project
 
 __all__ = ["SolverController"]
 
@@ -226,7 +226,9 @@ class SolverController(QtCore.QObject):
         self._dirty = False
         self._last_flush = time.perf_counter()
         for k, event in self._latest.items():
-            if isinstance(event, ResidualProgress):  # all blocks at once, no grid snapshot
+            if k == ALL_BLOCKS and isinstance(event, SolverProgress):  # a multiblock solve: every block
+                for i, g in enumerate(event.grids):
+                    self.doc.grids[i] = g
                 self.progress.emit(k, event)
                 continue
             if not isinstance(event, (StartGrid, SolverProgress, Repaired, Done)):

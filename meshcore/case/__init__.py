@@ -57,9 +57,9 @@ settings :class:`meshcore.SolverSpec`.
 """
 
 from .model import Case, InterfaceEntry, MultiblockSection, OutlineSection
-from .multiblock import case_frame, case_topology, outline_points, topology_case
+from .multiblock import case_frame, case_topology, cut_case, outline_points, topology_case
 from .parse import load_case, loads_case, xy_pairs
-from .run import case_solver, generate_case
+from .run import case_solver, generate_case, iterate_multiblock_case
 from .write import case_to_dict, dumps_case, save_case
 
 __all__ = [
@@ -71,8 +71,10 @@ __all__ = [
     "case_solver",
     "case_to_dict",
     "case_topology",
+    "cut_case",
     "dumps_case",
     "generate_case",
+    "iterate_multiblock_case",
     "load_case",
     "loads_case",
     "outline_points",

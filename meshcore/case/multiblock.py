@@ -50,7 +50,7 @@ from ..spec import BlockSpec, SolverSpec
 from .model import Case, InterfaceEntry, MultiblockSection, OutlineSection
 from .parse import read_point_file
 
-__all__ = ["case_frame", "case_topology", "outline_points", "topology_case"]
+__all__ = ["case_frame", "case_topology", "cut_case", "outline_points", "topology_case"]
 
 
 def _read_outline(outline: OutlineSection, base: Path | None, where: str) -> tuple[np.ndarray, Any]:
@@ -218,3 +218,23 @@ def topology_case(
         multiblock=MultiblockSection(mode=mode),
         interfaces=tuple(itfs),
     )
+
+
+def cut_case(
+    outline: Any, cuts: list[Any], *, cells_across: int = 12, snap: float | None = None, title: str = ""
+) -> Case:
+    """An ``[outline]`` case splitting ``outline`` by ``cuts`` into a chain of blocks.
+
+    See :func:`meshcore.multiblock.cutsplit.chain_blocks` (``cells_across`` η
+    cells in every block); the outline is in model units (``crs = "xy"``).
+    """
+    from ..multiblock.cutsplit import chain_blocks
+
+    ring, cut_lines, blocks = chain_blocks(outline, cuts, cells_across=cells_across, snap=snap)
+    section = OutlineSection(
+        points=ring,
+        cuts=tuple(tuple((float(x), float(y)) for x, y in c) for c in cut_lines),
+        blocks=tuple(blocks),
+        crs="xy",
+    )
+    return Case(title=title or "split by cut lines", multiblock=MultiblockSection(mode="smooth"), outline=section)

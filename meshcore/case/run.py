@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Generator
 from typing import Any
 
 from ..elliptic import EllipticConfig, SolverProgress
@@ -14,7 +15,7 @@ from ..spec import SolverSpec
 from .model import Case
 from .multiblock import case_frame, case_topology
 
-__all__ = ["case_solver", "generate_case"]
+__all__ = ["case_solver", "generate_case", "iterate_multiblock_case"]
 
 
 def case_solver(case: Case, solver: SolverSpec | EllipticConfig | None = None) -> SolverSpec:
@@ -43,7 +44,7 @@ def generate_case(
     """
     spec = case_solver(case, solver if solver is not None else config)
     if case.is_multiblock:
-        return _generate_multiblock(case, spec, callback)
+        return _drain(iterate_multiblock_case(case, spec), callback)
     grids: list[StructuredGrid] = []
     for b in case.blocks:
         try:
@@ -55,10 +56,39 @@ def generate_case(
     return grids
 
 
-def _generate_multiblock(case: Case, solver: SolverSpec, callback: Any) -> Any:
-    from ..multiblock.solver import solve_multiblock
+def iterate_multiblock_case(
+    case: Case,
+    solver: SolverSpec | EllipticConfig | None = None,
+    *,
+    topology: Any = None,
+    initial: Any = None,
+    stop_event: threading.Event | None = None,
+) -> Generator[SolverProgress, Any, Any]:
+    """A multiblock case's solve as a generator of :class:`SolverProgress` (``grids`` per block).
 
-    del callback  # progress snapshots are per block; the multiblock solve reports at the end
+    Returns the :class:`~meshcore.multiblock.MultiBlockGrid` with the case's
+    frame.  ``topology`` (:func:`case_topology`) and ``initial`` grids may be
+    given when the caller has them already.
+    """
+    from ..multiblock.solver import iterate_multiblock
+
     s = case.settings
-    mb = solve_multiblock(case_topology(case), mode=s.mode, start=s.start, config=solver.config())
+    mb = yield from iterate_multiblock(
+        topology if topology is not None else case_topology(case),
+        mode=s.mode,
+        start=s.start,
+        config=case_solver(case, solver).config(),
+        initial=initial,
+        stop_event=stop_event,
+    )
     return dataclasses.replace(mb, frame=case_frame(case))
+
+
+def _drain(gen: Generator[SolverProgress, Any, Any], callback: Callable[[SolverProgress], Any] | None) -> Any:
+    try:
+        snap = next(gen)
+        while True:
+            cmd = callback(snap) if callback is not None else None
+            snap = gen.send("stop" if cmd in ("stop", False) else None)
+    except StopIteration as fin:
+        return fin.value

@@ -126,15 +126,22 @@ class EllipticConfig:
 
 @dataclass(frozen=True, slots=True)
 class SolverProgress:
-    """A progress snapshot; ``grid`` is a copy, safe to read from another thread."""
+    """A progress snapshot; ``grid`` is a copy, safe to read from another thread.
+
+    ``residual`` and ``history`` (``(iteration, residual)`` pairs) are relative to
+    the grid size, like ``tolerance``.  A multiblock solve
+    (:func:`meshcore.multiblock.iterate_multiblock`) has ``grid=None`` and every
+    block's current grid in ``grids``.
+    """
 
     iteration: int
     residual: float
     tolerance: float
-    grid: StructuredGrid
+    grid: StructuredGrid | None
     elapsed: float
     method: str
     history: tuple[tuple[int, float], ...] = field(default=(), repr=False)
+    grids: tuple[StructuredGrid, ...] = field(default=(), repr=False)
 
     @property
     def relative_residual(self) -> float:
@@ -386,7 +393,7 @@ def iterate(
                     grid=StructuredGrid(x, y, periodic=initial.periodic, names=initial.names),
                     elapsed=now - t0,
                     method=method,
-                    history=tuple(state.history),
+                    history=tuple((i, v / length) for i, v in state.history),
                 )
                 last = time.perf_counter()
                 # a snapshot copies x, y: keep that below ~5 % of the solve on huge grids

@@ -3,9 +3,12 @@
 * :mod:`.topology` — blocks, interfaces (border parts with orientation),
   global node numbering, corners where 3/4/5 blocks meet, validation.
 * :mod:`.outline` — one closed shoreline + corner points + cut lines → blocks.
-* :mod:`.solver` — ``frozen`` and ``smooth`` interface modes; :class:`MultiBlockGrid`.
-* :mod:`.multigrid` — nonlinear multigrid (FAS) over all blocks (smooth mode).
-* :mod:`.case` — ``[multiblock]``, ``[[interfaces]]``, ``[outline]`` in case files.
+* :mod:`.start` — shared border nodes made identical; the algebraic start grids.
+* :mod:`.solver` — ``frozen`` and ``smooth`` interface modes: :func:`iterate_multiblock`
+  yields progress like the single-block solver, :func:`solve_multiblock` drains it.
+* :mod:`.sor`, :mod:`.multigrid` — SOR and nonlinear multigrid (FAS) over all blocks.
+* :mod:`.result` — :class:`MultiBlockGrid` and its quality across interfaces.
+* Case files (``[multiblock]``, ``[[interfaces]]``, ``[outline]``): :mod:`meshcore.case`.
 * :mod:`.export`, :mod:`.figure` — connectivity report, one-colour-per-block figures.
 
 Example
@@ -22,14 +25,9 @@ Example
 """
 
 from .outline import BlockOutline, OutlineBlocks, from_outline, project_lonlat
-from .solver import (
-    ENGINES,
-    MODES,
-    MultiBlockGrid,
-    MultiBlockQuality,
-    initial_grids,
-    solve_multiblock,
-)
+from .result import MultiBlockGrid, MultiBlockQuality
+from .solver import ENGINES, MODES, iterate_multiblock, solve_multiblock
+from .start import initial_grids
 from .topology import Block, Corner, Interface, MultiBlockTopology, NodeMap, Side, parse_side
 
 __all__ = [
@@ -47,6 +45,7 @@ __all__ = [
     "Side",
     "from_outline",
     "initial_grids",
+    "iterate_multiblock",
     "parse_side",
     "project_lonlat",
     "solve_multiblock",

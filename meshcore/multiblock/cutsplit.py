@@ -1,4 +1,4 @@
-"""Cut lines → a multiblock case (no Qt): the app's "Split into blocks by cut lines".
+"""Cut lines → a chain of blocks: the app's "Split into blocks by cut lines".
 
 The user draws cut lines across a closed outline (a lake, a river).  Each
 region between the cuts becomes one block whose cut sides are its left/right
@@ -11,9 +11,10 @@ its neighbours — a *chain* of blocks, the common river/lake case:
 * a region bordered by **two** cuts takes the four cut ends as corners.
 
 Cut ends are moved onto the outline (and inserted as outline vertices) when
-they are within ``snap`` of it.  The result is an ``[outline]`` multiblock case
-for :mod:`meshcore.multiblock` (which re-samples shared chains once, so
-interface nodes are identical).  Regions bordered by three or more cuts, or
+they are within ``snap`` of it.  The result (outline, cuts, blocks) is what
+:func:`meshcore.multiblock.from_outline` takes — :func:`meshcore.case.cut_case`
+makes it an ``[outline]`` case; shared chains are re-sampled once, so
+interface nodes are identical.  Regions bordered by three or more cuts, or
 cuts that meet each other, need hand-picked corners (not supported here).
 """
 
@@ -24,14 +25,11 @@ from typing import Any
 
 import numpy as np
 
-from meshcore.errors import TopologyError
+from ..boundary import signed_area as _signed_area
+from ..errors import TopologyError
+from .outline import BlockOutline, _insert, _project_on
 
-__all__ = ["case_dict_from_cuts", "snap_cuts_to_outline"]
-
-
-def _signed_area(p: np.ndarray) -> float:
-    x, y = p[:, 0], p[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+__all__ = ["chain_blocks", "snap_cuts_to_outline"]
 
 
 def snap_cuts_to_outline(outline: np.ndarray, cuts: list[np.ndarray], snap: float):
@@ -42,32 +40,19 @@ def snap_cuts_to_outline(outline: np.ndarray, cuts: list[np.ndarray], snap: floa
     """
     ring = np.asarray(outline, float).copy()
     out_cuts = []
-    for k, c in enumerate(cuts):
+    for k_cut, c in enumerate(cuts):
         c = np.asarray(c, float).copy()
         if len(c) < 2:
-            raise TopologyError(f"cut {k + 1} needs at least two points")
+            raise TopologyError(f"cut {k_cut + 1} needs at least two points")
         for end in (0, -1):
-            q = c[end]
-            a, b = ring, np.roll(ring, -1, axis=0)
-            d = b - a
-            L2 = np.einsum("ij,ij->i", d, d)
-            t = np.clip(np.einsum("ij,ij->i", q - a, d) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
-            foot = a + t[:, None] * d
-            dist = np.hypot(*(foot - q).T)
-            s = int(np.argmin(dist))
-            if dist[s] > snap:
+            dist, k, t = _project_on(ring, c[end], True)
+            if dist > snap:
                 raise TopologyError(
-                    f"cut {k + 1}: its {'first' if end == 0 else 'last'} point is {dist[s]:.3g} from the "
+                    f"cut {k_cut + 1}: its {'first' if end == 0 else 'last'} point is {dist:.3g} from the "
                     f"outline; both ends of a cut must lie on the outline (within {snap:.3g})"
                 )
-            f = foot[s]
-            if t[s] <= 1e-9:
-                f = ring[s]
-            elif t[s] >= 1 - 1e-9:
-                f = ring[(s + 1) % len(ring)]
-            else:
-                ring = np.insert(ring, s + 1, f, axis=0)
-            c[end] = f
+            seg = float(np.hypot(*(ring[(k + 1) % len(ring)] - ring[k])))
+            ring, c[end] = _insert(ring, k, t, True, 1e-9 * seg)
         out_cuts.append(c)
     return ring, out_cuts
 
@@ -92,15 +77,14 @@ def _walk(q: np.ndarray, start: int, step: int, length: float, stop: int) -> int
             return k
 
 
-def case_dict_from_cuts(
+def chain_blocks(
     outline: Any,
     cuts: list[Any],
     *,
     cells_across: int = 12,
     snap: float | None = None,
-    title: str = "",
-) -> dict:
-    """An ``[outline]`` multiblock case (as a TOML-ready dict) from an outline and cuts.
+) -> tuple[np.ndarray, list[np.ndarray], list[BlockOutline]]:
+    """A chain of blocks from an outline and cuts: ``(outline, cuts, blocks)`` for :func:`from_outline`.
 
     ``cells_across`` is the η count shared by all blocks; each block's ξ
     count follows from its length at the same cell size (rounded to even, so
@@ -168,20 +152,6 @@ def case_dict_from_cuts(
                 f"(a chain of blocks) can be split automatically"
             )
         ni = max(2, 2 * round(0.5 * (0.5 * (bottom + top)) / h))
-        blocks.append(
-            {
-                "name": f"block{r + 1}",
-                "corners": [[float(q[c][0]), float(q[c][1])] for c in corners],
-                "cells": [int(ni), int(cells_across)],
-            }
-        )
-    return {
-        "title": title or "split by cut lines",
-        "multiblock": {"mode": "smooth"},
-        "outline": {
-            "crs": "xy",
-            "points": ring.tolist(),
-            "cuts": [c.tolist() for c in cuts],
-            "blocks": blocks,
-        },
-    }
+        xy = tuple((float(q[c][0]), float(q[c][1])) for c in corners)
+        blocks.append(BlockOutline(f"block{r + 1}", xy, (int(ni), int(cells_across))))
+    return ring, cuts, blocks

@@ -50,7 +50,7 @@ from ..boundary import Borders
 from . import _kernels
 from .topology import Block, Interface, MultiBlockTopology, Side
 
-__all__ = ["MIN_CELLS", "coarsen", "levels", "solve_fas"]
+__all__ = ["MIN_CELLS", "coarsen", "iterate_fas", "levels"]
 
 #: A block side keeps at least this many cells on the coarsest level.
 MIN_CELLS = 2
@@ -341,21 +341,22 @@ def _cycle(lvs: list[_Level], k: int, x, y, fx, fy) -> None:
         _kernels.table_sweep_rhs(x, y, fx, fy, *lv.args, 1.0)
 
 
-def solve_fas(
+def iterate_fas(
     x,
     y,
     topo: MultiBlockTopology,
     tol: float,
     max_cycles: int,
-    callback=None,
     give_up_rate: float | None = None,
     lvs: list | None = None,
 ):
     """V-cycles on the global arrays ``x, y`` (in place) until the Jacobi residual ≤ ``tol``.
 
-    ``give_up_rate``: stop with message ``"slow"`` when, from the third cycle
-    on, the defect falls by less than this factor per cycle (geometric mean of
-    the last two cycles) — the caller then continues with SOR.
+    A generator: yields ``(cycle, residual)`` after every cycle (send
+    ``"stop"`` to stop).  ``give_up_rate``: stop with message ``"slow"`` when,
+    from the third cycle on, the defect falls by less than this factor per
+    cycle (geometric mean of the last two cycles) — the caller then continues
+    with SOR.
 
     Returns ``(cycles, residual, history, message, n_levels)``.
     """
@@ -372,7 +373,7 @@ def solve_fas(
         _cycle(lvs, 0, x, y, zero, zero)
         r = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
         history.append((it, r))
-        if callback is not None and callback(it, r) == "stop":
+        if (yield it, r) == "stop":
             return it, r, history, "stopped", len(lvs)
         if not math.isfinite(r) or r > 1e3 * best:
             x[...] = saved[0]

@@ -255,8 +255,8 @@ def test_add_and_delete_blocks_are_undoable():
 
 
 def test_cut_ends_snap_onto_the_outline_as_vertices():
-    from app.cutsplit import snap_cuts_to_outline
     from meshcore.errors import TopologyError
+    from meshcore.multiblock.cutsplit import snap_cuts_to_outline
 
     ring = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [0.0, 1.0]])
     new, cuts = snap_cuts_to_outline(ring, [np.array([[1.0, -0.05], [1.1, 1.04]])], snap=0.1)
@@ -292,3 +292,28 @@ def test_a_point_file_gives_the_same_grid_in_the_app_and_on_the_command_line(tmp
     assert mine.converged and theirs.converged
     np.testing.assert_array_equal(mine.x, theirs.x)
     np.testing.assert_array_equal(mine.y, theirs.y)
+
+
+def test_a_multiblock_project_yields_live_grids_in_one_thread():
+    """The multiblock solve runs in the worker's own thread and shows every block's grid as it goes."""
+    import threading
+
+    from app.io_adapter import load_project
+    from app.pipeline import ALL_BLOCKS
+
+    project = load_project(
+        Path(__file__).resolve().parents[2] / "resources" / "examples" / "confluence-multiblock.toml"
+    )
+    gen = solve_project(project, report_interval=1e-9)
+    threads = threading.active_count()
+    items = []
+    try:
+        while True:
+            items.append(next(gen))
+            assert threading.active_count() == threads  # no second thread inside the worker
+    except StopIteration as fin:
+        res = fin.value
+    live = [e for k, e in items if k == ALL_BLOCKS]
+    assert live and all(len(e.grids) == len(project.blocks) and e.grid is None for e in live)
+    assert res.multiblock is not None and res.multiblock.converged
+    assert all(np.array_equal(res.grids[k].x, g.x) for k, g in enumerate(res.multiblock.grids))

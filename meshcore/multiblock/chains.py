@@ -1,0 +1,198 @@
+"""Shared border chains of an outline split into blocks: cell counts, nodes, interfaces.
+
+Each block side (walked counter-clockwise on its region) is split into
+**chains** at block corners and at points where three or more lines meet.  A
+chain shared by two blocks is re-sampled once (uniformly in arc length, the
+paper's linear spline) and used by both, so interface nodes are identical by
+construction.  A side's chains must add up to its block's ``ni`` (bottom, top)
+or ``nj`` (left, right): counts fixed by another block are taken from there,
+the remaining cells of a side are shared among its free chains by arc length.
+Used by :func:`meshcore.multiblock.from_outline`.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from typing import Any
+
+import numpy as np
+
+from ..boundary import Borders
+from ..errors import TopologyError
+from .topology import Block, Interface, MultiBlockTopology, Side
+
+__all__ = ["chain_topology"]
+
+SIDES = ("bottom", "right", "top", "left")
+
+Key = tuple  # a chain: its vertices as (x, y) tuples, in the smaller of its two directions
+
+
+def _key(p: np.ndarray) -> tuple[float, float]:
+    return (float(p[0]), float(p[1]))
+
+
+def _resample(chain: np.ndarray, n_cells: int) -> np.ndarray:
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(chain, axis=0).T))])
+    u = np.linspace(0.0, s[-1], n_cells + 1)
+    out = np.column_stack([np.interp(u, s, chain[:, 0]), np.interp(u, s, chain[:, 1])])
+    out[0], out[-1] = chain[0], chain[-1]
+    return out
+
+
+def _side_chains(specs: list, rings: dict[str, np.ndarray], corners: dict[str, list], breaks: set) -> tuple:
+    """``(side → chain keys, chain key → points, chain key → [(block, side)])``."""
+    side_chains: dict[tuple[str, str], list[Key]] = {}
+    chain_pts: dict[Key, np.ndarray] = {}
+    chain_users: dict[Key, list[tuple[str, str]]] = defaultdict(list)
+    for s in specs:
+        r = rings[s.name]
+        n = len(r)
+        pos = {_key(p): i for i, p in enumerate(r)}
+        ci = [pos[c] for c in corners[s.name]]
+        for side, (a, b) in zip(SIDES, zip(ci, ci[1:] + ci[:1], strict=True), strict=True):
+            walk = [r[(a + k) % n] for k in range((b - a) % n + 1)]
+            chains, cur = [], [walk[0]]
+            for p in walk[1:]:
+                cur.append(p)
+                if _key(p) in breaks:
+                    chains.append(np.array(cur))
+                    cur = [p]
+            keys = []
+            for ch in chains:
+                fwd = tuple(_key(p) for p in ch)
+                key = min(fwd, fwd[::-1])
+                chain_pts.setdefault(key, np.array(key))
+                keys.append(key)
+                chain_users[key].append((s.name, side))
+            side_chains[(s.name, side)] = keys
+    return side_chains, chain_pts, chain_users
+
+
+class _Counts:
+    """Cells per chain, so that every side adds up to its block's count."""
+
+    def __init__(self, specs: list, side_chains: dict, chain_pts: dict, chain_users: dict, multiple: int) -> None:
+        self.side_chains, self.chain_pts, self.chain_users = side_chains, chain_pts, chain_users
+        self.multiple = multiple
+        self.need = {
+            (s.name, side): int(s.cells[0] if side in ("bottom", "top") else s.cells[1])
+            for s in specs
+            for side in SIDES
+        }
+        self.count: dict[Key, int] = {}
+
+    def arclen(self, key: Key) -> float:
+        return float(np.hypot(*np.diff(self.chain_pts[key], axis=0).T).sum())
+
+    def describe(self, bs: tuple[str, str]) -> str:
+        parts = []
+        for key in self.side_chains[bs]:
+            other = [u for u in self.chain_users[key] if u != bs]
+            who = f"shared with {other[0][0]}.{other[0][1]}" if other else "shore"
+            parts.append(f"{self.count.get(key, '?')} ({who})")
+        return " + ".join(parts)
+
+    def propagate(self) -> None:
+        """Sides with one unknown chain: it gets the rest of the side."""
+        changed = True
+        while changed:
+            changed = False
+            for bs, keys in self.side_chains.items():
+                unknown = [k for k in keys if k not in self.count]
+                if len(unknown) == 1:
+                    rest = self.need[bs] - sum(self.count[k] for k in keys if k in self.count)
+                    if rest < 1:
+                        raise TopologyError(
+                            f"cell counts disagree at block {bs[0]!r} {bs[1]} border: it has "
+                            f"{self.need[bs]} cells but its parts already need {self.describe(bs)}"
+                        )
+                    self.count[unknown[0]] = rest
+                    changed = True
+
+    def share(self, bs: tuple[str, str], keys: list[Key]) -> None:
+        """The free chains of one side share its remaining cells by arc length (in units of ``multiple``)."""
+        unknown = [k for k in keys if k not in self.count]
+        rest = self.need[bs] - sum(self.count[k] for k in keys if k in self.count)
+        if rest < len(unknown) * self.multiple:
+            raise TopologyError(
+                f"cell counts disagree at block {bs[0]!r} {bs[1]} border: {self.need[bs]} cells cannot "
+                f"hold its parts {self.describe(bs)} with at least {self.multiple} cell(s) each"
+            )
+        units = rest // self.multiple
+        w = np.array([self.arclen(k) for k in unknown])
+        share = 1 + (units - len(unknown)) * w / w.sum()
+        base = np.floor(share).astype(int)
+        for k in np.argsort(-(share - base))[: units - int(base.sum())]:
+            base[k] += 1
+        for k, c in zip(unknown, base.tolist(), strict=True):
+            self.count[k] = int(c) * self.multiple
+
+    def solve(self) -> dict[Key, int]:
+        while True:
+            self.propagate()
+            open_sides = [(bs, keys) for bs, keys in self.side_chains.items() if any(k not in self.count for k in keys)]
+            if not open_sides:
+                break
+            self.share(*open_sides[0])
+        for bs, keys in self.side_chains.items():
+            if sum(self.count[k] for k in keys) != self.need[bs]:
+                raise TopologyError(
+                    f"cell counts disagree across an interface: block {bs[0]!r} {bs[1]} border needs "
+                    f"{self.need[bs]} cells but its parts have {self.describe(bs)} = "
+                    f"{sum(self.count[k] for k in keys)}; change the cells of {bs[0]!r} or of its neighbours"
+                )
+        return self.count
+
+
+def _block(s: Any, side_chains: dict, nodes: dict, corners: list, offsets: dict) -> Block:
+    """One block's borders from its chains' nodes; records each chain's node range in ``offsets``."""
+    sides = {}
+    for side in SIDES:
+        pieces: list[np.ndarray] = []
+        at = 0
+        for key in side_chains[(s.name, side)]:
+            p = nodes[key]
+            if pieces:
+                if not np.array_equal(p[0], pieces[-1][-1]):
+                    p = p[::-1]
+            elif _key(p[0]) != corners[SIDES.index(side)]:
+                p = p[::-1]
+            offsets[(s.name, side, key)] = (at, at + len(p) - 1)
+            at += len(p) - 1
+            pieces.append(p)
+        sides[side] = np.vstack([pieces[0]] + [q[1:] for q in pieces[1:]])
+    # walked CCW: bottom sw→se, right se→ne, top ne→nw, left nw→sw; top and left run the other way
+    for side in ("top", "left"):
+        n = len(sides[side]) - 1
+        sides[side] = sides[side][::-1].copy()
+        for key in side_chains[(s.name, side)]:
+            a, b = offsets[(s.name, side, key)]
+            offsets[(s.name, side, key)] = (n - b, n - a)
+    bd = Borders(bottom=sides["bottom"], right=sides["right"], top=sides["top"], left=sides["left"])
+    return Block(s.name, bd, initial=s.initial)
+
+
+def chain_topology(
+    specs: list, rings: dict[str, np.ndarray], corners: dict[str, list], breaks: set, multiple: int
+) -> MultiBlockTopology:
+    """The topology of blocks on regions.
+
+    ``specs``: the :class:`~.outline.BlockOutline` of each block; ``rings``: its
+    region (counter-clockwise vertex ring); ``corners``: its four corner
+    vertices (``(x, y)`` tuples, sw, se, ne, nw); ``breaks``: vertices where
+    chains end (corners and junctions of three or more lines).
+    """
+    side_chains, chain_pts, chain_users = _side_chains(specs, rings, corners, breaks)
+    count = _Counts(specs, side_chains, chain_pts, chain_users, multiple).solve()
+    nodes = {key: _resample(chain_pts[key], count[key]) for key in chain_pts}
+    offsets: dict[tuple[str, str, Key], tuple[int, int]] = {}
+    blocks = [_block(s, side_chains, nodes, corners[s.name], offsets) for s in specs]
+    interfaces = []
+    for key, users in chain_users.items():
+        if len(users) == 2:
+            (ba, sa), (bb, sb) = users
+            a0, a1 = offsets[(ba, sa, key)]
+            b0, b1 = offsets[(bb, sb, key)]
+            interfaces.append(Interface(Side(ba, sa, a0, a1), Side(bb, sb, b0, b1), None))
+    return MultiBlockTopology(tuple(blocks), tuple(interfaces))
