@@ -338,6 +338,7 @@ def project_arrays(
     target_in = crs.strip().lower() if isinstance(crs, str) else crs
     if src is None and target_in not in (None, "none", "local") and looks_lonlat(pts):
         src = LONLAT
+    target: str | None
     if target_in == "auto":
         if src is not None and is_geographic(src):
             lon, lat = _lonlat_centroid(pts, src)

@@ -59,7 +59,7 @@ def tanh_one_sided(n: int, first: float, *, at_end: bool = False) -> np.ndarray:
     ``at_end=True`` clusters at ``u = 1`` instead (``first`` is then the last spacing).
 
     >>> u = tanh_one_sided(10, 0.01)
-    >>> round(float(u[1]), 12), u[0], u[-1]
+    >>> round(float(u[1]), 12), float(u[0]), float(u[-1])
     (0.01, 0.0, 1.0)
     """
     n = validate_count(n, name="cells")

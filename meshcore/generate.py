@@ -121,7 +121,7 @@ def block_borders(spec: BlockSpec, *, where: str = "") -> tuple[Borders, Borders
     """
     raw = _raw_borders(spec, where)
     if spec.cells is None:
-        if any(s.distribution != "uniform" for _, s in spec.borders):
+        if any(s.distribution != "uniform" for s in spec.border_specs().values()):
             raise InvalidInputError("border distributions need cells= (the borders are re-sampled)")
         raw.check_counts()
         return raw, raw

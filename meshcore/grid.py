@@ -63,7 +63,7 @@ class SolveInfo:
     iterations: int = 0
     residual: float = 0.0
     tolerance: float = 0.0
-    residual_history: tuple[float, ...] = ()
+    residual_history: tuple[tuple[int, float], ...] = ()
     elapsed: float = 0.0
     message: str = ""
 

@@ -112,9 +112,9 @@ class BlockSpec:
     name: str = "block"
     points: np.ndarray = field(default_factory=lambda: _frozen_points(None, "", 0))
     corners: tuple[int, int, int, int] | str | None = None
-    boundary: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+    boundary: tuple[np.ndarray, ...] | Mapping[str, Any] | None = None
     cells: tuple[int, int] | None = None
-    borders: tuple[tuple[str, BorderSpec], ...] = ()
+    borders: tuple[tuple[str, BorderSpec], ...] | Mapping[str, Any] = ()
     weights: tuple[float, float] = (0.5, 0.5)
     initial: str = "weighted"
     curve: str = "linear"
@@ -156,7 +156,7 @@ class BlockSpec:
             raise InvalidInputError(f"weights must be a pair (p13_x, p13_y), got {self.weights!r}") from None
         if len(w) != 2:
             raise InvalidInputError(f"weights must be a pair (p13_x, p13_y), got {self.weights!r}")
-        put(self, "weights", w)
+        put(self, "weights", (w[0], w[1]))
         put(self, "initial", str(self.initial))
         put(self, "curve", str(self.curve))
         put(self, "periodic", bool(self.periodic))
@@ -188,7 +188,8 @@ class BlockSpec:
         if self.cells is not None:
             return self.cells
         if self.boundary is not None:
-            return (len(self.boundary[0]) - 1, len(self.boundary[3]) - 1)
+            bottom, _right, _top, left = self.boundary
+            return (len(bottom) - 1, len(left) - 1)
         if isinstance(self.corners, tuple) and len(self.points) >= 4:
             n = len(self.points)
             if np.array_equal(self.points[0], self.points[-1]):
@@ -209,7 +210,7 @@ class BlockSpec:
 
     def border_names(self) -> dict[str, str]:
         """Boundary-condition names of the borders that have one."""
-        return {n: s.name for n, s in self.borders if s.name}
+        return {n: s.name for n, s in self.border_specs().items() if s.name}
 
     def replaced(self, **changes: Any) -> BlockSpec:
         return dataclasses.replace(self, **changes)

@@ -109,11 +109,11 @@ class OutlineSection:
         if isinstance(self.crs, bool) or not isinstance(self.crs, (str, int)):
             raise InvalidInputError(f"crs must be a string or an EPSG code, got {self.crs!r}")
         if isinstance(self.crs, str):
-            c = self.crs.strip()
-            put(self, "crs", c.lower() if c.lower() in OUTLINE_CRS else c)
+            crs = self.crs.strip()
+            put(self, "crs", crs.lower() if crs.lower() in OUTLINE_CRS else crs)
         if not isinstance(self.cuts, (list, tuple)) or not self.cuts:
             raise InvalidInputError("cuts must be a list of polylines")
-        cuts = []
+        cuts: list[tuple[int | tuple[float, float], ...]] = []
         for k, c in enumerate(self.cuts):
             if not isinstance(c, (list, tuple)) or len(c) < 2:
                 raise InvalidInputError(f"cut {k} must list at least two points")

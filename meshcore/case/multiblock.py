@@ -196,7 +196,7 @@ def topology_case(
         blocks.append(
             BlockSpec(
                 name=b.name,
-                weights=tuple(b.weights),
+                weights=b.weights,
                 initial=b.initial,
                 boundary=tuple(np.asarray(b.borders[n]) for n in BORDER_NAMES),
                 borders=specs,

@@ -199,7 +199,7 @@ def _parse_block(tbl: Any, k: int, base: Path | None, src: str, ctx: dict[str, A
     geometry = _boundary(tbl.get("boundary"), base, where, ctx)
     return from_table(
         BlockSpec,
-        tbl | {"name": name},
+        {**tbl, "name": name},
         where=where,
         error=CaseFileError,
         convert=_BLOCK_CONVERT,

@@ -67,7 +67,7 @@ def _block_table(b: BlockSpec) -> dict[str, Any]:
             corners = choose_corners(b.points)
         t["boundary"] = {"points": b.points, "corners": list(corners or ())}
     if b.borders:
-        t["borders"] = {n: dataclasses.asdict(s) for n, s in b.borders}
+        t["borders"] = {n: dataclasses.asdict(s) for n, s in b.border_specs().items()}
     if b.control is not None:
         c = b.control
         t["control"] = dict(c) if isinstance(c, Mapping) else dataclasses.asdict(c)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -36,10 +36,10 @@ class _BorderState:
     spacing_eff: np.ndarray
     angle_eff: np.ndarray  # radians
     weight: np.ndarray  # decay field (full node shape)
-    ss_t: np.ndarray = None  # Steger–Sorenson part
-    ss_n: np.ndarray = None
-    hw_t: np.ndarray = None  # Hilgenstock–White integrators
-    hw_n: np.ndarray = None
+    ss_t: np.ndarray = field(init=False)  # Steger–Sorenson part
+    ss_n: np.ndarray = field(init=False)
+    hw_t: np.ndarray = field(init=False)  # Hilgenstock–White integrators
+    hw_n: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         n = len(self.s_t)

@@ -85,7 +85,11 @@ class _Reporter:
     stopped: bool = False
 
     def run(
-        self, inner: Generator, method: str, grids: Callable[[], list[StructuredGrid]], offset: int = 0
+        self,
+        inner: Generator[tuple[int, float], Any, Any],
+        method: str,
+        grids: Callable[[], list[StructuredGrid]],
+        offset: int = 0,
     ) -> Generator[SolverProgress, Any, Any]:
         """Drive ``inner`` (which yields ``(iteration, absolute residual)``); return its value."""
         history: list[tuple[int, float]] = []
@@ -175,7 +179,8 @@ def _smooth(
     def shown(xx: np.ndarray, yy: np.ndarray) -> Callable[[], list[StructuredGrid]]:
         return lambda: [StructuredGrid(xx[ids], yy[ids]) for ids in m.ids]
 
-    n_levels, mg_cycles, mg_history = 1, 0, []
+    n_levels, mg_cycles = 1, 0
+    mg_history: list[tuple[int, float]] = []
     if engine in ("auto", "multigrid"):
         from .multigrid import AUTO_GIVE_UP_RATE, iterate_fas, levels
 
@@ -194,7 +199,7 @@ def _smooth(
         eng = sor_engine(x, y, m, engine)
         sor = iterate_sor(eng, m, cfg, tol)
         iters, r, history, message = yield from rep.run(
-            sor, f"smooth/{engine}-sor", lambda: [StructuredGrid(a, b) for a, b in eng.grids(m.ids)], mg_cycles
+            sor, f"smooth/{engine}-sor", lambda: [StructuredGrid(a, b) for a, b in eng.grids(list(m.ids))], mg_cycles
         )
         if mg_cycles:
             history = mg_history + [(mg_cycles + i, v) for i, v in history[1:]]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..algebraic import algebraic_grid
@@ -12,6 +14,15 @@ from .topology import MultiBlockTopology
 __all__ = ["initial_grids", "snapped_borders"]
 
 
+#: Each border's nodes in a block's node-index array.
+_SIDES: dict[str, tuple[Any, Any]] = {
+    "bottom": (slice(None), 0),
+    "top": (slice(None), -1),
+    "left": (0, slice(None)),
+    "right": (-1, slice(None)),
+}
+
+
 def snapped_borders(topology: MultiBlockTopology) -> list:
     """Each block's borders with every shared node set to one value (bit-identical copies)."""
     m = topology.node_map
@@ -20,12 +31,7 @@ def snapped_borders(topology: MultiBlockTopology) -> list:
     out = []
     for b, ids in zip(topology.blocks, m.ids, strict=True):
         new = {}
-        for name, sl in (
-            ("bottom", (slice(None), 0)),
-            ("top", (slice(None), -1)),
-            ("left", (0, slice(None))),
-            ("right", (-1, slice(None))),
-        ):
+        for name, sl in _SIDES.items():
             g = ids[sl]
             p = np.array(b.borders[name], dtype=np.float64)
             have = ~np.isnan(x[g])
@@ -35,13 +41,7 @@ def snapped_borders(topology: MultiBlockTopology) -> list:
             y[g[~have]] = p[~have, 1]
             new[name] = p
         # the corners were written by the first border that saw them
-        for name in ("bottom", "top", "left", "right"):
-            sl = {
-                "bottom": (slice(None), 0),
-                "top": (slice(None), -1),
-                "left": (0, slice(None)),
-                "right": (-1, slice(None)),
-            }[name]
+        for name, sl in _SIDES.items():
             g = ids[sl]
             new[name][:, 0] = x[g]
             new[name][:, 1] = y[g]
