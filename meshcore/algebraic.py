@@ -3,7 +3,7 @@ r"""Algebraic grids: the paper's weighted average (eq. 34) and transfinite inter
 Both fill the interior of a block from its four re-sampled borders; boundary
 nodes are copied from the borders unchanged.
 
-Weighted average (paper eqs. 34a/b, with the errata of NOTES.md)::
+Weighted average (paper eqs. 34a/b, with the errata in docs/errata.md)::
 
     x_ij = p13_x (x_0j + i Δxξ_j) + (1 − p13_x) (x_i0 + j Δxη_i)
     Δxξ_j = (x_Nj − x_0j) / N      (straight line between left and right of row j)

@@ -2,7 +2,7 @@
 
 Items (created once): background image, quality colouring (PColorMeshItem),
 the grid as ONE NaN-separated PlotCurveItem (width-1 cosmetic pen,
-``connect="finite"``, ``skipFiniteCheck=True``; environment.md §3), the
+``connect="finite"``, ``skipFiniteCheck=True``; docs/environment.md), the
 boundary loop, four coloured border curves with direction arrows and node
 counts, the points, the selection, corner labels, cut lines, folded cells,
 and the tool overlay (rubber band / rubber line).

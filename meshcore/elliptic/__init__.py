@@ -9,7 +9,7 @@ Symbols used throughout:
 * ``p, q``: control functions P, Q;
 * ``omega``: the SOR relaxation factor.
 
-Equations (paper eqs. 25/26, errata applied):
+Equations (paper eqs. 25/26, errata applied: docs/errata.md):
 α x_ξξ − 2β x_ξη + γ x_ηη + D² (P x_ξ + Q x_η) = 0, same for y.
 """
 

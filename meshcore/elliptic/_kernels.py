@@ -1,6 +1,6 @@
 r"""numba kernels for the elliptic grid equations (functions only, no state).
 
-Discrete equations (paper eq. 30 with the errata in NOTES.md, written once in
+Discrete equations (paper eq. 30 with the errata in docs/errata.md, written once in
 :func:`._stencil.winslow`), at an interior node P with neighbours
 E = (i+1, j), W = (i−1, j), N = (i, j+1), S = (i, j−1) and Δξ = Δη = 1:
 
