@@ -315,70 +315,39 @@ def generate_block(
     control: Any = None,
     solver: SolverSpec | None = None,
 ) -> StructuredGrid:
-    """Generate one block's grid from its boundary.
+    """Generate one block's grid from its boundary (drains :func:`run_block`).
 
-    Either keywords (below), or the specs themselves:
-    ``generate_block(spec, solver)`` with a :class:`~meshcore.BlockSpec` and a
-    :class:`~meshcore.SolverSpec` (then only ``callback`` and ``smooth`` may be
-    given too).  Drains :func:`run_block` and re-emits its warnings.
+    Either keywords or the specs themselves: ``generate_block(spec, solver)``
+    with a :class:`~meshcore.BlockSpec` and a :class:`~meshcore.SolverSpec`
+    (then only ``callback`` and ``smooth`` count).  Warnings of the run are
+    re-emitted as :class:`~meshcore.errors.MeshcoreWarning`.
 
     Parameters
     ----------
     bottom, right, top, left : (k, 2) array_like
         Border polylines in the orientation of :mod:`meshcore.grid` (bottom/top
-        left→right, left/right bottom→top).  Alternatively ``loop`` + ``corners``.
-    loop : (n, 2) array_like, optional
-        A closed boundary loop; ``corners = (sw, se, ne, nw)`` point indices,
-        or ``corners="auto"`` (:func:`meshcore.corners.choose_corners`).
-    cells : (ni, nj), optional
-        Re-sample each border by the paper's linear spline (or ``curve``),
-        uniformly in arc length unless ``borders`` says otherwise.  With
-        ``None`` the given points are the boundary nodes.
-    weights : (p13_x, p13_y)
-        Weights of the left/right interpolation in the paper's eq. 34.
-    initial : {"weighted", "tfi"}
-        Algebraic start grid.
-    curve : {"linear", "cubic", "catmull-rom"}
-        Boundary curve used for re-sampling.
-    borders : dict, optional
-        Per-border :class:`~meshcore.boundary.BorderSpec` (distribution, first,
-        last, name), e.g. ``{"bottom": {"distribution": "tanh", "first": 0.01}}``.
-    method, tolerance, max_iterations, omega, threads, config
-        Solver settings (see :class:`~meshcore.elliptic.EllipticConfig`);
-        ``threads``: 0 (default) = all cores on large grids, 1 = serial, ``n`` = ``n``
-        threads; every choice gives the same grid bit for bit.
-    p, q : array_like, optional
-        Source terms P, Q of the node shape (zero by default).
+        left→right, left/right bottom→top): ``BlockSpec.boundary``.
+    loop, corners : optional
+        Or a closed loop and ``(sw, se, ne, nw)`` indices / ``"auto"``:
+        ``BlockSpec.points``, ``BlockSpec.corners``.
+    cells, weights, initial, curve, borders, periodic, snap_angle, control, p, q
+        As the fields of :class:`~meshcore.BlockSpec` (``cells=None``: the given
+        points are the nodes; ``borders``: per-border distributions, e.g.
+        ``{"bottom": {"distribution": "tanh", "first": 0.01}}``).
+    method, tolerance, max_iterations, omega, threads, repair
+        As the fields of :class:`~meshcore.SolverSpec` (``repair="auto"``:
+        folded or non-convex cells are repaired by the fold-free barrier
+        method; ``"strict"`` raises :class:`~meshcore.errors.FoldedGridError`
+        when no fold-free grid exists; ``"off"`` keeps the elliptic grid).
+    config : EllipticConfig, optional
+        Solver settings as an :class:`~meshcore.elliptic.EllipticConfig` (``repair`` still counts).
     callback : callable, optional
         Called with each :class:`~meshcore.elliptic.SolverProgress`; return
         ``"stop"`` to stop early (the grid is then returned as it is).
     smooth : bool
         ``False`` returns the algebraic grid without the elliptic solve.
-    periodic : bool
-        Periodic ξ direction (O-grid): left and right borders coincide and the
-        seam nodes are solved like interior nodes.
-    repair : {"auto", "strict", "off"}
-        What to do when the elliptic result has folded or non-convex cells
-        (a corner Jacobian ≤ 0): ``"auto"`` repairs them with the fold-free
-        barrier method (:func:`meshcore.foldfree.repair`; ``info.method``
-        becomes e.g. ``"multigrid+foldfree"`` and ``info.message`` says why)
-        and, if no fold-free grid exists for these boundary nodes, returns the
-        best grid with ``converged=False`` and a message naming the cells and
-        the fix; ``"strict"`` raises :class:`~meshcore.errors.FoldedGridError`
-        instead; ``"off"`` returns the elliptic result as it is.
-        ``method="foldfree"`` minimises the barrier functional over the whole
-        block after the elliptic solve (:func:`meshcore.foldfree.smooth`).
-    snap_angle : float, optional
-        When re-sampling, input vertices where a border turns by more than this
-        many degrees get a node exactly (keeps the corners of a cutout);
-        ``None`` = pure distribution (the paper).
-    control : ControlSpec or mapping, optional
-        Grid control (:mod:`meshcore.control`): boundary orthogonality and
-        first-cell spacing, Thomas–Middlecoff, attraction, floating nodes
-        (which slide on the given border polylines), e.g.
-        ``{"borders": {"bottom": {"spacing": 0.01}}}``.
     solver : SolverSpec, optional
-        All solver settings at once (instead of ``method`` … ``repair``).
+        All solver settings at once.
 
     Returns
     -------

@@ -101,12 +101,16 @@ class BlockSpec:
     periodic : bool
         Periodic ξ (O-grid): left and right coincide (four borders only).
     snap_angle : float, optional
-        Input vertices where a border turns by more than this many degrees get
-        a node exactly.
+        When re-sampling, input vertices where a border turns by more than this
+        many degrees get a node exactly (keeps the corners of a cutout);
+        ``None`` = pure distribution (the paper).
     control : ControlSpec or mapping, optional
-        Grid control (:mod:`meshcore.control`), kept as given.
+        Grid control (:mod:`meshcore.control`), kept as given: boundary
+        orthogonality and first-cell spacing, Thomas–Middlecoff, attraction,
+        floating nodes (which slide on the given border polylines), a C-grid
+        wake cut; e.g. ``{"borders": {"bottom": {"spacing": 0.01}}}``.
     p, q : array_like, optional
-        Fixed source terms P, Q of the node shape.
+        Fixed source terms P, Q of the node shape (zero by default).
     """
 
     name: str = "block"
@@ -247,7 +251,8 @@ class SolverSpec:
         ``"foldfree"``: the default elliptic solve, then the barrier functional
         minimised over the whole block (:func:`meshcore.foldfree.smooth`).
     tolerance, max_iterations, omega, report_interval, threads
-        As in :class:`~meshcore.elliptic.EllipticConfig`.
+        As in :class:`~meshcore.elliptic.EllipticConfig` (``threads``: 0 = all
+        cores on large grids, 1 = serial; every choice gives the same grid).
     repair : {"auto", "strict", "off"}
         Folded or non-convex cells after the solve: ``"auto"`` repairs them
         (:func:`meshcore.foldfree.repair`) and returns the best grid with

@@ -48,7 +48,6 @@ converged.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
@@ -56,7 +55,18 @@ import numpy as np
 
 from ..errors import FoldedGridError
 from ..grid import SolveInfo, StructuredGrid
-from . import _kernels
+from .cells import (
+    BoundaryCorner,
+    _exempt_bits,
+    _failure_message,
+    _folded,
+    _median_edge,
+    _nodes_of,
+    _touched_cells,
+    block_corner_problems,
+    invalid_cells,
+)
+from .minimise import minimise, patches
 
 __all__ = [
     "BoundaryCorner",
@@ -66,24 +76,6 @@ __all__ = [
     "repair",
     "smooth",
 ]
-
-
-@dataclass(frozen=True, slots=True)
-class BoundaryCorner:
-    """A block corner whose boundary angle is ≥ 180° (its corner cell cannot be convex)."""
-
-    corner: str
-    cell: tuple[int, int]
-    point: tuple[float, float]
-    angle: float
-
-    @property
-    def message(self) -> str:
-        return (
-            f"block corner {self.corner} at ({self.point[0]:.6g}, {self.point[1]:.6g}) has a "
-            f"boundary angle of {self.angle:.1f}° ≥ 180°, so its corner cell {self.cell} cannot be "
-            f"convex; move corner {self.corner} to a convex boundary vertex"
-        )
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -101,191 +93,6 @@ class FoldFreeResult:
     elapsed: float
     message: str
     bad_cells: np.ndarray = field(repr=False)
-
-
-def block_corner_problems(grid: StructuredGrid) -> list[BoundaryCorner]:
-    """Block corners with a boundary angle ≥ 180° (corner Jacobian ≤ 0 from boundary nodes)."""
-    if grid.periodic:
-        return []
-    x, y = grid.x, grid.y
-    ni, nj = grid.cells
-    # (name, cell, corner index m of that cell): corners c0..c3 = 00, 10, 11, 01
-    table = (
-        ("sw", (0, 0), 0),
-        ("se", (ni - 1, 0), 1),
-        ("ne", (ni - 1, nj - 1), 2),
-        ("nw", (0, nj - 1), 3),
-    )
-    out = []
-    for name, (ci, cj), m in table:
-        cx = [x[ci, cj], x[ci + 1, cj], x[ci + 1, cj + 1], x[ci, cj + 1]]
-        cy = [y[ci, cj], y[ci + 1, cj], y[ci + 1, cj + 1], y[ci, cj + 1]]
-        ax, ay = cx[(m + 1) % 4] - cx[m], cy[(m + 1) % 4] - cy[m]
-        bx, by = cx[(m + 3) % 4] - cx[m], cy[(m + 3) % 4] - cy[m]
-        cross = ax * by - ay * bx
-        if cross <= 0.0:
-            ang = math.degrees(math.atan2(cross, ax * bx + ay * by)) % 360.0
-            out.append(BoundaryCorner(name, (ci, cj), (float(cx[m]), float(cy[m])), ang))
-    return out
-
-
-def _exempt_bits(grid: StructuredGrid, corners: list[BoundaryCorner]) -> np.ndarray:
-    ex = np.zeros(grid.cells, dtype=np.uint8)
-    m_of = {"sw": 0, "se": 1, "ne": 2, "nw": 3}
-    for c in corners:
-        ex[c.cell] |= np.uint8(1 << m_of[c.corner])
-    return ex
-
-
-def invalid_cells(x: np.ndarray, y: np.ndarray, exempt: np.ndarray | None = None) -> np.ndarray:
-    """Boolean ``(ni, nj)`` mask of cells with a corner Jacobian ≤ 0 (exempt corners ignored)."""
-    cj = _kernels.corner_jacobians(np.ascontiguousarray(x), np.ascontiguousarray(y))
-    bad = cj <= 0.0
-    if exempt is not None:
-        for m in range(4):
-            bad[m] &= ((exempt >> m) & 1) == 0
-    return bad.any(axis=0)
-
-
-def _nodes_of(cells_mask: np.ndarray, periodic: bool) -> np.ndarray:
-    """Free nodes (interior nodes of the masked cells), int32 (k, 2), in 4-colour order."""
-    ni, nj = cells_mask.shape
-    nm = np.zeros((ni + 1, nj + 1), dtype=bool)
-    nm[:-1, :-1] |= cells_mask
-    nm[1:, :-1] |= cells_mask
-    nm[1:, 1:] |= cells_mask
-    nm[:-1, 1:] |= cells_mask
-    if periodic:  # column ni repeats column 0: a seam node is listed once, as column 0
-        nm[0, :] |= nm[-1, :]
-    else:
-        nm[0, :] = False
-    nm[-1, :] = False
-    nm[:, 0] = False
-    nm[:, -1] = False
-    idx = np.argwhere(nm).astype(np.int32)
-    colour = (idx[:, 0] % 2) * 2 + (idx[:, 1] % 2)
-    return np.ascontiguousarray(idx[np.argsort(colour, kind="stable")])
-
-
-def _touched_cells(nodes: np.ndarray, shape: tuple[int, int], periodic: bool = False) -> np.ndarray:
-    ni, nj = shape
-    m = np.zeros((ni, nj), dtype=bool)
-    for di in (0, 1):
-        for dj in (0, 1):
-            ci = nodes[:, 0] - di
-            if periodic:
-                ci = ci % ni
-            cj = nodes[:, 1] - dj
-            ok = (ci >= 0) & (cj >= 0) & (ci < ni) & (cj < nj)
-            m[ci[ok], cj[ok]] = True
-    return np.ascontiguousarray(np.argwhere(m).astype(np.int32))
-
-
-def _dilate(mask: np.ndarray, r: int, periodic: bool = False) -> np.ndarray:
-    out = mask.copy()
-    for _ in range(r):
-        if periodic:  # wrap across the seam in ξ
-            out = out | np.roll(out, 1, axis=0) | np.roll(out, -1, axis=0)
-        m = out.copy()
-        m[1:, :] |= out[:-1, :]
-        m[:-1, :] |= out[1:, :]
-        m[:, 1:] |= out[:, :-1]
-        m[:, :-1] |= out[:, 1:]
-        m[1:, 1:] |= out[:-1, :-1]
-        m[:-1, :-1] |= out[1:, 1:]
-        m[1:, :-1] |= out[:-1, 1:]
-        m[:-1, 1:] |= out[1:, :-1]
-        out = m
-    return out
-
-
-#: Most sweeps per ε in the untangling stage (fewer when the energy stalls); one is fastest
-#: on lakes, slots and C shapes (measured 1–40); the whole-block last resort uses 20.
-_INNER = 1
-
-
-def _minimise(
-    x: np.ndarray,
-    y: np.ndarray,
-    nodes: np.ndarray,
-    cells: np.ndarray,
-    exempt: np.ndarray,
-    *,
-    tol: float,
-    max_sweeps: int,
-    max_outer: int = 500,
-    inner: int | None = None,
-    omega: float = 1.9,
-    periodic: bool = False,
-) -> tuple[bool, int]:
-    """Untangle (if needed) then minimise the barrier energy over ``nodes`` in place.
-
-    Returns ``(valid, sweeps)``.
-    """
-    inner = _INNER if inner is None else inner
-    sweeps = 0
-    step = np.inf
-    _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
-    if dmin <= 0.0:
-        eps_floor = 1e-12 * _median_area(x, y, cells)
-        eps = max(math.sqrt(0.04 * dmin * dmin), eps_floor)
-        e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
-        for _outer in range(max_outer):
-            # minimise at this ε until the energy stalls (≤ inner sweeps)
-            e_in = e_prev
-            for _ in range(inner):
-                d = _kernels.sweep(x, y, nodes, eps, step, 1.0, periodic)
-                sweeps += 1
-                e, dmin = _kernels.patch_stats(x, y, cells, eps, exempt)
-                if d <= tol or dmin > 0.0 or e_in - e <= 1e-3 * e:
-                    break
-                e_in = e
-            if dmin > 0.0:
-                break
-            sigma = max(1.0 - e / e_prev, 0.1)
-            chi = 0.5 * (dmin + math.sqrt(eps * eps + dmin * dmin))
-            mu = (1.0 - sigma) * chi
-            eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
-            eps = max(eps, eps_floor)
-            if eps < 1e-4 * abs(dmin):
-                break  # stagnated: ε has vanished next to the worst inverted corner
-            e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
-        if dmin <= 0.0:
-            return False, sweeps
-    for _ in range(max_sweeps):
-        d = _kernels.sweep(x, y, nodes, 0.0, step, omega, periodic)
-        sweeps += 1
-        if d <= tol:
-            break
-    _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
-    return dmin > 0.0, sweeps
-
-
-def _failure_message(grid: StructuredGrid, bad: np.ndarray, exempt: list[BoundaryCorner]) -> str:
-    x, y = grid.x, grid.y
-    ni, nj = grid.cells
-    idx = np.argwhere(bad)
-    parts = []
-    for ci, cj in idx[:6]:
-        cx = 0.25 * (x[ci, cj] + x[ci + 1, cj] + x[ci + 1, cj + 1] + x[ci, cj + 1])
-        cy = 0.25 * (y[ci, cj] + y[ci + 1, cj] + y[ci + 1, cj + 1] + y[ci, cj + 1])
-        parts.append(f"({ci}, {cj}) at ({cx:.6g}, {cy:.6g})")
-    more = f" and {len(idx) - 6} more" if len(idx) > 6 else ""
-    # which borders are nearest to the bad cells (index-space distance)
-    near = {"bottom": 0, "top": 0, "left": 0, "right": 0}
-    for ci, cj in idx:
-        d = {"bottom": cj, "top": nj - 1 - cj, "left": ci, "right": ni - 1 - ci}
-        near[min(d, key=d.get)] += 1
-    border = max(near, key=near.get)
-    msg = (
-        f"no fold-free grid found for these boundary nodes: {len(idx)} cell(s) stay folded or "
-        f"non-convex: {', '.join(parts)}{more}. Fix: put more nodes on the {border} border "
-        f"(raise cells in {'ξ' if border in ('bottom', 'top') else 'η'}) or a finer distribution "
-        f"there, choose other corners, or split the region into blocks"
-    )
-    if exempt:
-        msg += "; also: " + "; ".join(c.message for c in exempt)
-    return msg
 
 
 def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg):
@@ -324,11 +131,6 @@ def _raise_if_failed(res: FoldFreeResult, failed: bool) -> FoldFreeResult:
         err.result = res  # type: ignore[attr-defined]
         raise err
     return res
-
-
-def _folded(x, y) -> int:
-    a = (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1]) - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
-    return int((a <= 0).sum())
 
 
 def repair(
@@ -372,65 +174,28 @@ def repair(
     before = int(bad.sum())
     folded_before = _folded(x, y)
     exempt_note = ("; " + "; ".join(c.message for c in exempt)) if exempt else ""
+    common = {"folded_before": folded_before, "exempt": exempt, "ex_bits": ex_bits, "t0": t0}
     if before == 0:
-        return _result(
-            grid,
-            x,
-            y,
-            ok=True,
-            before=0,
-            folded_before=folded_before,
-            exempt=exempt,
-            ex_bits=ex_bits,
-            nodes=0,
-            sweeps=0,
-            t0=t0,
-            method=grid.info.method,
-            msg=grid.info.message + exempt_note,
-        )
-    ni, nj = grid.cells
+        msg = grid.info.message + exempt_note
+        return _result(grid, x, y, ok=True, before=0, nodes=0, sweeps=0, method=grid.info.method, msg=msg, **common)
     opts = {"tolerance": tolerance, "max_sweeps": max_sweeps, "periodic": grid.periodic}
     x0, y0 = x.copy(), y.copy()
-    ok, nfree, total = _patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, **opts)
+    ok, nfree, total = patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, **opts)
     how = ""
     start = None
     if not ok:
         x[...], y[...] = x0, y0
-        start = _coarse_start(grid) if min(ni, nj) >= 8 else None
-        if start is not None:
-            x2, y2 = start
-            bad2 = invalid_cells(x2, y2, ex_bits)
-            ok2, sw2 = True, 0
-            if bad2.any():
-                ok2, _, sw2 = _patches(x2, y2, bad2, ex_bits, radius=radius, max_fraction=0.3, **opts)
-            total += sw2
-            if ok2:
-                # the prolonged grid is piecewise bilinear: relax it on the whole block
-                nodes = _nodes_of(np.ones_like(bad), grid.periodic)
-                cells = _touched_cells(nodes, (ni, nj), grid.periodic)
-                h = _median_edge(x2, y2, cells)
-                _, sw3 = _minimise(
-                    x2,
-                    y2,
-                    nodes,
-                    cells,
-                    ex_bits,
-                    tol=tolerance * h,
-                    max_sweeps=max_sweeps,
-                    periodic=grid.periodic,
-                )
-                total += sw3
-                x[...], y[...] = x2, y2
-                ok, nfree, how = True, len(nodes), " after a coarse-grid (multilevel) start"
+        ok, nfree, total, start = _multilevel(grid, x, y, ex_bits, radius, opts, nfree, total)
+        how = " after a coarse-grid (multilevel) start" if ok else ""
     if not ok:
         # last resort: the whole block, a full minimisation per ε, from the start with fewer bad cells
         x[...], y[...] = x0, y0
         if start is not None and invalid_cells(start[0], start[1], ex_bits).sum() < before:
             x[...], y[...] = start
             bad = invalid_cells(x, y, ex_bits)
-        ok, nfree, sw = _patches(x, y, bad, ex_bits, radius=max(ni, nj), max_fraction=1.0, inner=20, **opts)
+        n = max(grid.cells)
+        ok, nfree, sw = patches(x, y, bad, ex_bits, radius=n, max_fraction=1.0, inner=20, **opts)
         total += sw
-    method = f"{grid.info.method}+foldfree"
     origin = f"{grid.info.method} {grid.info.message}".strip()
     if ok:
         msg = (
@@ -439,81 +204,43 @@ def repair(
             f"{exempt_note}"
         )
     else:
-        bad_now = invalid_cells(x, y, ex_bits)
-        msg = f"{origin}; " + _failure_message(StructuredGrid(x, y), bad_now, exempt)
-    res = _result(
-        grid,
-        x,
-        y,
-        ok=ok,
-        before=before,
-        folded_before=folded_before,
-        exempt=exempt,
-        ex_bits=ex_bits,
-        nodes=nfree,
-        sweeps=total,
-        t0=t0,
-        method=method,
-        msg=msg,
-    )
+        msg = f"{origin}; " + _failure_message(StructuredGrid(x, y), invalid_cells(x, y, ex_bits), exempt)
+    method = f"{grid.info.method}+foldfree"
+    res = _result(grid, x, y, ok=ok, before=before, nodes=nfree, sweeps=total, method=method, msg=msg, **common)
     return _raise_if_failed(res, strict and not ok)
 
 
-def _patches(
+def _multilevel(
+    grid: StructuredGrid,
     x: np.ndarray,
     y: np.ndarray,
-    bad: np.ndarray,
     ex_bits: np.ndarray,
-    *,
     radius: int,
-    max_fraction: float,
-    tolerance: float,
-    max_sweeps: int,
-    inner: int | None = None,
-    periodic: bool = False,
-) -> tuple[bool, int, int]:
-    """Barrier minimisation on patches around ``bad``; the radius doubles on failure.
-
-    Stops when the patch covers more than ``max_fraction`` of the cells (the
-    whole block is always allowed when ``max_fraction ≥ 1``).  On failure the
-    nodes are left as they were.  Returns ``(ok, free nodes, sweeps)``.
-    """
-    ni, nj = bad.shape
-    r = max(1, int(radius))
-    total = 0
-    nfree = 0
-    while True:
-        patch = _dilate(bad, r, periodic) if r < max(ni, nj) else np.ones_like(bad)
-        if patch.mean() > max_fraction and max_fraction < 1.0:
-            return False, nfree, total
-        nodes = _nodes_of(patch, periodic)
-        if nodes.size == 0:
-            return False, 0, total
-        cells = _touched_cells(nodes, (ni, nj), periodic)
-        h = _median_edge(x, y, cells)
-        xs, ys = x.copy(), y.copy()
-        ok, sw = _minimise(
-            x,
-            y,
-            nodes,
-            cells,
-            ex_bits,
-            tol=tolerance * h,
-            max_sweeps=max_sweeps,
-            inner=inner,
-            periodic=periodic,
-        )
-        total += sw
-        nfree = len(nodes)
-        if ok:
-            bad_now = invalid_cells(x, y, ex_bits)
-            if not bad_now.any():
-                return True, nfree, total
-            bad = bad | bad_now
-        x[...], y[...] = xs, ys
-        if patch.all():
-            return False, nfree, total
-        r *= 2
+    opts: dict,
+    nfree: int,
+    total: int,
+) -> tuple[bool, int, int, tuple[np.ndarray, np.ndarray] | None]:
+    """The multilevel stage of :func:`repair`: ``(ok, free nodes, sweeps, coarse start)``; on success in ``x, y``."""
+    ni, nj = grid.cells
+    start = _coarse_start(grid) if min(ni, nj) >= 8 else None
+    if start is None:
+        return False, nfree, total, None
+    x2, y2 = start
+    bad2 = invalid_cells(x2, y2, ex_bits)
+    ok2, sw2 = True, 0
+    if bad2.any():
+        ok2, _, sw2 = patches(x2, y2, bad2, ex_bits, radius=radius, max_fraction=0.3, **opts)
+    total += sw2
+    if not ok2:
+        return False, nfree, total, start
+    # the prolonged grid is piecewise bilinear: relax it on the whole block
+    nodes = _nodes_of(np.ones((ni, nj), dtype=bool), grid.periodic)
+    cells = _touched_cells(nodes, (ni, nj), grid.periodic)
+    h = _median_edge(x2, y2, cells)
+    tol = opts["tolerance"] * h
+    _, sw3 = minimise(x2, y2, nodes, cells, ex_bits, tol=tol, max_sweeps=opts["max_sweeps"], periodic=grid.periodic)
+    x[...], y[...] = x2, y2
+    return True, len(nodes), total + sw3, start
 
 
 def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
@@ -591,7 +318,7 @@ def smooth(
         if ok:
             x[...], y[...] = fixed.grid.x, fixed.grid.y
     if ok and nodes.size:
-        ok, sw2 = _minimise(
+        ok, sw2 = minimise(
             x,
             y,
             nodes,
@@ -627,18 +354,3 @@ def smooth(
         msg=msg,
     )
     return _raise_if_failed(res, strict and not ok)
-
-
-def _median_area(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
-    ci, cj = cells[:, 0], cells[:, 1]
-    a = (x[ci + 1, cj + 1] - x[ci, cj]) * (y[ci, cj + 1] - y[ci + 1, cj]) - (x[ci, cj + 1] - x[ci + 1, cj]) * (
-        y[ci + 1, cj + 1] - y[ci, cj]
-    )
-    return float(np.median(np.abs(0.5 * a)))
-
-
-def _median_edge(x: np.ndarray, y: np.ndarray, cells: np.ndarray) -> float:
-    ci, cj = cells[:, 0], cells[:, 1]
-    e1 = np.hypot(x[ci + 1, cj] - x[ci, cj], y[ci + 1, cj] - y[ci, cj])
-    e2 = np.hypot(x[ci, cj + 1] - x[ci, cj], y[ci, cj + 1] - y[ci, cj])
-    return float(np.median(np.concatenate([e1, e2])))

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -49,6 +49,7 @@ import numpy as np
 from ..boundary import Borders
 from ..errors import TopologyError
 from ..grid import BORDER_NAMES
+from .nodemap import Corner, NodeMap, build_node_map
 
 __all__ = [
     "Block",
@@ -148,78 +149,6 @@ class Block:
         return self.borders[border]
 
 
-@dataclass(frozen=True, slots=True)
-class Corner:
-    """A node shared by three or more blocks (or an irregular interior node)."""
-
-    node: int
-    point: tuple[float, float]
-    blocks: tuple[str, ...]  # "name(i,j)" labels of the block corners/nodes meeting here
-    valence: int  # number of cells around the node
-    free: bool  # solved (interior) or fixed (on the outer boundary)
-
-    @property
-    def handling(self) -> str:
-        if not self.free:
-            return "fixed (on the outer boundary)"
-        if self.valence == 4:
-            return "regular 9-point stencil from the ring of 4 cells"
-        return f"irregular: Laplacian update over its {self.valence} edge neighbours"
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class NodeMap:
-    """Global node numbering and the solver tables of a topology."""
-
-    n_nodes: int
-    ids: tuple[np.ndarray, ...]  # per block, (ni+1, nj+1) global ids
-    boundary: np.ndarray  # bool (n_nodes,): on the outer boundary (fixed)
-    shared: np.ndarray  # bool (n_nodes,): in more than one block
-    nodes: np.ndarray  # int64 (m,): free regular nodes in sweep order (block interiors first)
-    nbr: np.ndarray  # int64 (m, 8): E, W, N, S, NE, NW, SE, SW
-    irr_nodes: np.ndarray
-    irr_ptr: np.ndarray
-    irr_ring: np.ndarray
-    corners: tuple[Corner, ...]
-    cells: np.ndarray  # int64 (n_cells, 4) CCW corner ids
-    cell_block: np.ndarray  # int32 (n_cells,): block index of each cell
-    n_interior: int = 0  # nodes[:n_interior] are block-interior nodes, the rest lie on borders
-
-
-def _union_find(n: int) -> tuple[np.ndarray, Any, Any]:
-    parent = np.arange(n)
-
-    def find(a: int) -> int:
-        root = a
-        while parent[root] != root:
-            root = parent[root]
-        while parent[a] != root:
-            parent[a], a = root, parent[a]
-        return int(root)
-
-    def union(a: int, b: int) -> None:
-        ra, rb = find(a), find(b)
-        if ra != rb:
-            if ra < rb:
-                parent[rb] = ra
-            else:
-                parent[ra] = rb
-
-    return parent, find, union
-
-
-def _border_index(shape: tuple[int, int], border: str) -> tuple[np.ndarray, np.ndarray]:
-    """(i, j) index arrays of a border's nodes in its own direction."""
-    n1, m1 = shape
-    if border == "bottom":
-        return np.arange(n1), np.zeros(n1, dtype=int)
-    if border == "top":
-        return np.arange(n1), np.full(n1, m1 - 1)
-    if border == "left":
-        return np.zeros(m1, dtype=int), np.arange(m1)
-    return np.full(m1, n1 - 1), np.arange(m1)
-
-
 @dataclass(frozen=True, slots=True, eq=False)
 class MultiBlockTopology:
     """Blocks and the interfaces that glue them (validated on construction).
@@ -262,7 +191,7 @@ class MultiBlockTopology:
         self._check_overlapping_parts()
         if self.check_geometry:
             self._check_geometry()
-        self._map.append(self._build_map())
+        self._map.append(build_node_map(self.blocks, self.interfaces))
 
     # ------------------------------------------------------------ basics
     @property
@@ -400,186 +329,6 @@ class MultiBlockTopology:
                     f"gap between blocks {', '.join(repr(n) for n in around)}: a hole of area "
                     f"{hp.area:.4g} near ({c.x:.6g}, {c.y:.6g}) is covered by no block"
                 )
-
-    # ------------------------------------------------------ numbering
-    def _build_map(self) -> NodeMap:
-        shapes = [(b.cells[0] + 1, b.cells[1] + 1) for b in self.blocks]
-        offsets = np.cumsum([0] + [a * c for a, c in shapes])
-        local = [offsets[k] + np.arange(a * c).reshape(a, c) for k, (a, c) in enumerate(shapes)]
-        _, find, union = _union_find(int(offsets[-1]))
-        idx = {b.name: k for k, b in enumerate(self.blocks)}
-        for itf in self.interfaces:
-            ka, kb = idx[itf.a.block], idx[itf.b.block]
-            ia, ja = _border_index(shapes[ka], itf.a.border)
-            ib, jb = _border_index(shapes[kb], itf.b.border)
-            ga = local[ka][ia, ja][itf.a.start : itf.a.stop + 1]
-            gb = local[kb][ib, jb][itf.b.start : itf.b.stop + 1]
-            if itf.reversed:
-                gb = gb[::-1]
-            for u, v in zip(ga.tolist(), gb.tolist(), strict=True):
-                union(u, v)
-        roots = np.array([find(k) for k in range(int(offsets[-1]))])
-        uniq, compact = np.unique(roots, return_inverse=True)
-        n_nodes = len(uniq)
-        ids = tuple(compact[loc].reshape(loc.shape) for loc in local)
-        for k, g in enumerate(ids):
-            if len(np.unique(g)) != g.size:
-                raise TopologyError(
-                    f"block {self.blocks[k].name!r}: interfaces glue two nodes of the same block "
-                    f"together (a border is joined to itself or to a neighbour's border twice)"
-                )
-        # cells, CCW: (i,j) (i+1,j) (i+1,j+1) (i,j+1)
-        cells = np.vstack(
-            [np.stack([g[:-1, :-1], g[1:, :-1], g[1:, 1:], g[:-1, 1:]], axis=-1).reshape(-1, 4) for g in ids]
-        ).astype(np.int64)
-        cell_block = np.concatenate([np.full((a - 1) * (c - 1), k, dtype=np.int32) for k, (a, c) in enumerate(shapes)])
-        # edges: count cells per undirected edge
-        e0 = cells.reshape(-1)
-        e1 = np.roll(cells, -1, axis=1).reshape(-1)
-        key = np.minimum(e0, e1) * n_nodes + np.maximum(e0, e1)
-        ukey, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
-        if (cnt > 2).any():
-            bad = int(ukey[np.argmax(cnt > 2)])
-            u, v = divmod(bad, n_nodes)
-            hit = np.flatnonzero(key == bad)
-            blocks = sorted({self.blocks[cell_block[c // 4]].name for c in hit})
-            raise TopologyError(
-                f"an edge is shared by more than two cells (blocks {', '.join(blocks)}): "
-                f"interfaces of these blocks overlap"
-            )
-        # directed-edge check: a shared edge must be walked in opposite directions
-        dkey = e0 * n_nodes + e1
-        _, dcnt = np.unique(dkey, return_counts=True)
-        if (dcnt > 1).any():
-            raise TopologyError(
-                "two blocks meet with opposite orientations (a mirrored block): every block must "
-                "run bottom → right → top → left counter-clockwise"
-            )
-        on_bnd_edge = cnt[inv] == 1
-        boundary = np.zeros(n_nodes, dtype=bool)
-        boundary[e0[on_bnd_edge]] = True
-        boundary[e1[on_bnd_edge]] = True
-        count = np.bincount(cells.reshape(-1), minlength=n_nodes)  # cells per node
-        occ = np.bincount(np.concatenate([np.unique(g) for g in ids]), minlength=n_nodes)
-        shared = occ > 1
-
-        # --- regular interior nodes of each block: direct frame
-        nodes_l, nbr_l = [], []
-        for g in ids:
-            if g.shape[0] < 3 or g.shape[1] < 3:
-                continue
-            c = g[1:-1, 1:-1].ravel()
-            nb = np.stack(
-                [
-                    g[2:, 1:-1],
-                    g[:-2, 1:-1],
-                    g[1:-1, 2:],
-                    g[1:-1, :-2],
-                    g[2:, 2:],
-                    g[:-2, 2:],
-                    g[2:, :-2],
-                    g[:-2, :-2],
-                ],
-                axis=-1,
-            ).reshape(-1, 8)
-            nodes_l.append(c)
-            nbr_l.append(nb)
-        # --- free nodes on block borders: frame from the ring of cells
-        border_free = np.flatnonzero(~boundary & shared)
-        inc = defaultdict(list)
-        sel = np.isin(cells, border_free)
-        for cidx, pos in zip(*np.nonzero(sel), strict=True):
-            inc[int(cells[cidx, pos])].append((int(cidx), int(pos)))
-        reg_n, reg_nb, irr_n, irr_ptr, irr_ring = [], [], [], [0], []
-        corners = []
-        for n in border_free.tolist():
-            lst = inc[n]
-            nxt = {}
-            for cidx, pos in lst:
-                c = cells[cidx]
-                e_next, diag, e_prev = (int(c[(pos + k) % 4]) for k in (1, 2, 3))
-                nxt[e_next] = (e_next, diag, e_prev)
-            ring = []
-            cur = next(iter(nxt.values()))
-            for _ in range(len(lst)):
-                ring.append(cur)
-                cur = nxt.get(cur[2])
-                if cur is None:
-                    break
-            if len(ring) != len(lst) or cur != ring[0]:
-                raise TopologyError(
-                    f"the cells around node {self._node_label(n, ids)} do not close into a ring: "
-                    f"interfaces there are inconsistent"
-                )
-            if len(ring) == 4:
-                e = [r[0] for r in ring]
-                d = [r[1] for r in ring]
-                # E, W, N, S, NE, NW, SE, SW  with E=e0, N=e1, W=e2, S=e3
-                reg_n.append(n)
-                reg_nb.append([e[0], e[2], e[1], e[3], d[0], d[1], d[3], d[2]])
-            else:
-                irr_n.append(n)
-                irr_ring.extend(r[0] for r in ring)
-                irr_ptr.append(len(irr_ring))
-        # corner records: nodes in ≥ 3 blocks, or irregular
-        for n in np.flatnonzero(occ >= 3).tolist() + [m for m in irr_n if occ[m] < 3]:
-            corners.append(
-                Corner(
-                    node=n,
-                    point=self._node_xy(n, ids),
-                    blocks=self._node_owners(n, ids),
-                    valence=int(count[n]),
-                    free=not bool(boundary[n]),
-                )
-            )
-        n_interior = int(sum(len(c) for c in nodes_l))
-        if reg_n:
-            nodes_l.append(np.array(reg_n, dtype=np.int64))
-            nbr_l.append(np.array(reg_nb, dtype=np.int64))
-        nodes = np.concatenate(nodes_l).astype(np.int64) if nodes_l else np.zeros(0, np.int64)
-        nbr = np.vstack(nbr_l).astype(np.int64) if nbr_l else np.zeros((0, 8), np.int64)
-        return NodeMap(
-            n_nodes=n_nodes,
-            ids=ids,
-            boundary=boundary,
-            shared=shared,
-            nodes=np.ascontiguousarray(nodes),
-            nbr=np.ascontiguousarray(nbr),
-            irr_nodes=np.array(irr_n, dtype=np.int64),
-            irr_ptr=np.array(irr_ptr, dtype=np.int64),
-            irr_ring=np.array(irr_ring, dtype=np.int64),
-            corners=tuple(sorted(corners, key=lambda c: c.node)),
-            cells=cells,
-            cell_block=cell_block,
-            n_interior=n_interior,
-        )
-
-    def _node_owners(self, n: int, ids: Iterable[np.ndarray]) -> tuple[str, ...]:
-        out = []
-        for b, g in zip(self.blocks, ids, strict=True):
-            for i, j in np.argwhere(g == n):
-                out.append(f"{b.name}({int(i)},{int(j)})")
-        return tuple(out)
-
-    def _node_label(self, n: int, ids: Iterable[np.ndarray]) -> str:
-        return " = ".join(self._node_owners(n, ids))
-
-    def _node_xy(self, n: int, ids: Iterable[np.ndarray]) -> tuple[float, float]:
-        for b, g in zip(self.blocks, ids, strict=True):
-            hit = np.argwhere(g == n)
-            if len(hit):
-                i, j = hit[0]
-                ni, nj = b.cells
-                for border, (bi, bj) in (
-                    ("bottom", (i, 0)),
-                    ("top", (i, nj)),
-                    ("left", (0, j)),
-                    ("right", (ni, j)),
-                ):
-                    if (i, j) == (bi, bj):
-                        p = b.borders[border][i if border in ("bottom", "top") else j]
-                        return (float(p[0]), float(p[1]))
-        return (math.nan, math.nan)
 
     # --------------------------------------------------------- report
     def connectivity_report(self) -> str:

@@ -1,0 +1,284 @@
+"""Global node numbering of a multiblock topology and the solver's tables.
+
+Every block node gets an id; the ids of paired interface nodes are merged
+(union–find), so a shared node — including a corner where 3, 4 or 5 blocks
+meet — is stored once.  From the cells of all blocks (corners in
+counter-clockwise order): boundary nodes (on an edge of one cell only), regular
+free nodes (four cells around: a 9-point stencil read off the ring of cells)
+and irregular free nodes (``k ≠ 4`` cells: a Laplacian over the ring).  See
+:mod:`.topology`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import TopologyError
+
+__all__ = ["Corner", "NodeMap", "border_index", "build_node_map"]
+
+
+@dataclass(frozen=True, slots=True)
+class Corner:
+    """A node shared by three or more blocks (or an irregular interior node)."""
+
+    node: int
+    point: tuple[float, float]
+    blocks: tuple[str, ...]  # "name(i,j)" labels of the block corners/nodes meeting here
+    valence: int  # number of cells around the node
+    free: bool  # solved (interior) or fixed (on the outer boundary)
+
+    @property
+    def handling(self) -> str:
+        if not self.free:
+            return "fixed (on the outer boundary)"
+        if self.valence == 4:
+            return "regular 9-point stencil from the ring of 4 cells"
+        return f"irregular: Laplacian update over its {self.valence} edge neighbours"
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class NodeMap:
+    """Global node numbering and the solver tables of a topology."""
+
+    n_nodes: int
+    ids: tuple[np.ndarray, ...]  # per block, (ni+1, nj+1) global ids
+    boundary: np.ndarray  # bool (n_nodes,): on the outer boundary (fixed)
+    shared: np.ndarray  # bool (n_nodes,): in more than one block
+    nodes: np.ndarray  # int64 (m,): free regular nodes in sweep order (block interiors first)
+    nbr: np.ndarray  # int64 (m, 8): E, W, N, S, NE, NW, SE, SW
+    irr_nodes: np.ndarray
+    irr_ptr: np.ndarray
+    irr_ring: np.ndarray
+    corners: tuple[Corner, ...]
+    cells: np.ndarray  # int64 (n_cells, 4) CCW corner ids
+    cell_block: np.ndarray  # int32 (n_cells,): block index of each cell
+    n_interior: int = 0  # nodes[:n_interior] are block-interior nodes, the rest lie on borders
+
+
+def _union_find(n: int) -> tuple[np.ndarray, Any, Any]:
+    parent = np.arange(n)
+
+    def find(a: int) -> int:
+        root = a
+        while parent[root] != root:
+            root = parent[root]
+        while parent[a] != root:
+            parent[a], a = root, parent[a]
+        return int(root)
+
+    def union(a: int, b: int) -> None:
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            if ra < rb:
+                parent[rb] = ra
+            else:
+                parent[ra] = rb
+
+    return parent, find, union
+
+
+def border_index(shape: tuple[int, int], border: str) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j) index arrays of a border's nodes in its own direction."""
+    n1, m1 = shape
+    if border == "bottom":
+        return np.arange(n1), np.zeros(n1, dtype=int)
+    if border == "top":
+        return np.arange(n1), np.full(n1, m1 - 1)
+    if border == "left":
+        return np.zeros(m1, dtype=int), np.arange(m1)
+    return np.full(m1, n1 - 1), np.arange(m1)
+
+
+def _global_ids(blocks: Sequence[Any], interfaces: Sequence[Any]) -> tuple[int, tuple[np.ndarray, ...]]:
+    """``(n_nodes, ids)``: every block node's global id, paired interface nodes merged."""
+    shapes = [(b.cells[0] + 1, b.cells[1] + 1) for b in blocks]
+    offsets = np.cumsum([0] + [a * c for a, c in shapes])
+    local = [offsets[k] + np.arange(a * c).reshape(a, c) for k, (a, c) in enumerate(shapes)]
+    _, find, union = _union_find(int(offsets[-1]))
+    idx = {b.name: k for k, b in enumerate(blocks)}
+    for itf in interfaces:
+        ka, kb = idx[itf.a.block], idx[itf.b.block]
+        ia, ja = border_index(shapes[ka], itf.a.border)
+        ib, jb = border_index(shapes[kb], itf.b.border)
+        ga = local[ka][ia, ja][itf.a.start : itf.a.stop + 1]
+        gb = local[kb][ib, jb][itf.b.start : itf.b.stop + 1]
+        if itf.reversed:
+            gb = gb[::-1]
+        for u, v in zip(ga.tolist(), gb.tolist(), strict=True):
+            union(u, v)
+    roots = np.array([find(k) for k in range(int(offsets[-1]))])
+    uniq, compact = np.unique(roots, return_inverse=True)
+    ids = tuple(compact[loc].reshape(loc.shape) for loc in local)
+    for k, g in enumerate(ids):
+        if len(np.unique(g)) != g.size:
+            raise TopologyError(
+                f"block {blocks[k].name!r}: interfaces glue two nodes of the same block "
+                f"together (a border is joined to itself or to a neighbour's border twice)"
+            )
+    return len(uniq), ids
+
+
+def _cells(
+    blocks: Sequence[Any], ids: tuple[np.ndarray, ...], n_nodes: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(cells, cell_block, boundary)``: CCW cells of all blocks, their block, nodes on the outer boundary."""
+    # cells, CCW: (i,j) (i+1,j) (i+1,j+1) (i,j+1)
+    cells = np.vstack(
+        [np.stack([g[:-1, :-1], g[1:, :-1], g[1:, 1:], g[:-1, 1:]], axis=-1).reshape(-1, 4) for g in ids]
+    ).astype(np.int64)
+    cell_block = np.concatenate(
+        [np.full((g.shape[0] - 1) * (g.shape[1] - 1), k, dtype=np.int32) for k, g in enumerate(ids)]
+    )
+    # edges: count cells per undirected edge
+    e0 = cells.reshape(-1)
+    e1 = np.roll(cells, -1, axis=1).reshape(-1)
+    key = np.minimum(e0, e1) * n_nodes + np.maximum(e0, e1)
+    ukey, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
+    if (cnt > 2).any():
+        bad = int(ukey[np.argmax(cnt > 2)])
+        hit = np.flatnonzero(key == bad)
+        names = sorted({blocks[cell_block[c // 4]].name for c in hit})
+        raise TopologyError(
+            f"an edge is shared by more than two cells (blocks {', '.join(names)}): interfaces of these blocks overlap"
+        )
+    # directed-edge check: a shared edge must be walked in opposite directions
+    _, dcnt = np.unique(e0 * n_nodes + e1, return_counts=True)
+    if (dcnt > 1).any():
+        raise TopologyError(
+            "two blocks meet with opposite orientations (a mirrored block): every block must "
+            "run bottom → right → top → left counter-clockwise"
+        )
+    on_bnd_edge = cnt[inv] == 1
+    boundary = np.zeros(n_nodes, dtype=bool)
+    boundary[e0[on_bnd_edge]] = True
+    boundary[e1[on_bnd_edge]] = True
+    return cells, cell_block, boundary
+
+
+def _interior_stencils(ids: tuple[np.ndarray, ...]) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Regular interior nodes of each block and their 8 neighbours (E, W, N, S, NE, NW, SE, SW)."""
+    nodes_l, nbr_l = [], []
+    for g in ids:
+        if g.shape[0] < 3 or g.shape[1] < 3:
+            continue
+        nb = [g[2:, 1:-1], g[:-2, 1:-1], g[1:-1, 2:], g[1:-1, :-2], g[2:, 2:], g[:-2, 2:], g[2:, :-2], g[:-2, :-2]]
+        nodes_l.append(g[1:-1, 1:-1].ravel())
+        nbr_l.append(np.stack(nb, axis=-1).reshape(-1, 8))
+    return nodes_l, nbr_l
+
+
+def _border_stencils(cells: np.ndarray, border_free: np.ndarray, label: Any) -> tuple[list, list, list, list, list]:
+    """Free nodes on block borders: ``(regular, their neighbours, irregular, ring pointers, rings)``.
+
+    The local frame of a node is read off the ring of cells around it; ``label(n)``
+    names a node in messages.
+    """
+    inc = defaultdict(list)
+    sel = np.isin(cells, border_free)
+    for cidx, pos in zip(*np.nonzero(sel), strict=True):
+        inc[int(cells[cidx, pos])].append((int(cidx), int(pos)))
+    reg_n, reg_nb, irr_n, irr_ptr, irr_ring = [], [], [], [0], []
+    for n in border_free.tolist():
+        lst = inc[n]
+        nxt = {}
+        for cidx, pos in lst:
+            c = cells[cidx]
+            e_next, diag, e_prev = (int(c[(pos + k) % 4]) for k in (1, 2, 3))
+            nxt[e_next] = (e_next, diag, e_prev)
+        ring = []
+        cur = next(iter(nxt.values()))
+        for _ in range(len(lst)):
+            ring.append(cur)
+            cur = nxt.get(cur[2])
+            if cur is None:
+                break
+        if len(ring) != len(lst) or cur != ring[0]:
+            raise TopologyError(
+                f"the cells around node {label(n)} do not close into a ring: interfaces there are inconsistent"
+            )
+        if len(ring) == 4:
+            e = [r[0] for r in ring]
+            d = [r[1] for r in ring]
+            # E, W, N, S, NE, NW, SE, SW  with E=e0, N=e1, W=e2, S=e3
+            reg_n.append(n)
+            reg_nb.append([e[0], e[2], e[1], e[3], d[0], d[1], d[3], d[2]])
+        else:
+            irr_n.append(n)
+            irr_ring.extend(r[0] for r in ring)
+            irr_ptr.append(len(irr_ring))
+    return reg_n, reg_nb, irr_n, irr_ptr, irr_ring
+
+
+def node_owners(blocks: Sequence[Any], ids: Sequence[np.ndarray], n: int) -> tuple[str, ...]:
+    """``"name(i,j)"`` of every block node that is global node ``n``."""
+    out = []
+    for b, g in zip(blocks, ids, strict=True):
+        for i, j in np.argwhere(g == n):
+            out.append(f"{b.name}({int(i)},{int(j)})")
+    return tuple(out)
+
+
+def node_xy(blocks: Sequence[Any], ids: Sequence[np.ndarray], n: int) -> tuple[float, float]:
+    """The coordinates of a global border node (NaN when it is on no border)."""
+    for b, g in zip(blocks, ids, strict=True):
+        hit = np.argwhere(g == n)
+        if len(hit):
+            i, j = hit[0]
+            ni, nj = b.cells
+            for border, (bi, bj) in (("bottom", (i, 0)), ("top", (i, nj)), ("left", (0, j)), ("right", (ni, j))):
+                if (i, j) == (bi, bj):
+                    p = b.borders[border][i if border in ("bottom", "top") else j]
+                    return (float(p[0]), float(p[1]))
+    return (math.nan, math.nan)
+
+
+def build_node_map(blocks: Sequence[Any], interfaces: Sequence[Any]) -> NodeMap:
+    """The global numbering and solver tables of blocks glued by (resolved) interfaces."""
+    n_nodes, ids = _global_ids(blocks, interfaces)
+    cells, cell_block, boundary = _cells(blocks, ids, n_nodes)
+    count = np.bincount(cells.reshape(-1), minlength=n_nodes)  # cells per node
+    occ = np.bincount(np.concatenate([np.unique(g) for g in ids]), minlength=n_nodes)
+    shared = occ > 1
+    nodes_l, nbr_l = _interior_stencils(ids)
+    border_free = np.flatnonzero(~boundary & shared)
+    label = lambda n: " = ".join(node_owners(blocks, ids, n))  # noqa: E731
+    reg_n, reg_nb, irr_n, irr_ptr, irr_ring = _border_stencils(cells, border_free, label)
+    # corner records: nodes in ≥ 3 blocks, or irregular
+    corners = [
+        Corner(
+            node=n,
+            point=node_xy(blocks, ids, n),
+            blocks=node_owners(blocks, ids, n),
+            valence=int(count[n]),
+            free=not bool(boundary[n]),
+        )
+        for n in np.flatnonzero(occ >= 3).tolist() + [m for m in irr_n if occ[m] < 3]
+    ]
+    n_interior = int(sum(len(c) for c in nodes_l))
+    if reg_n:
+        nodes_l.append(np.array(reg_n, dtype=np.int64))
+        nbr_l.append(np.array(reg_nb, dtype=np.int64))
+    nodes = np.concatenate(nodes_l).astype(np.int64) if nodes_l else np.zeros(0, np.int64)
+    nbr = np.vstack(nbr_l).astype(np.int64) if nbr_l else np.zeros((0, 8), np.int64)
+    return NodeMap(
+        n_nodes=n_nodes,
+        ids=ids,
+        boundary=boundary,
+        shared=shared,
+        nodes=np.ascontiguousarray(nodes),
+        nbr=np.ascontiguousarray(nbr),
+        irr_nodes=np.array(irr_n, dtype=np.int64),
+        irr_ptr=np.array(irr_ptr, dtype=np.int64),
+        irr_ring=np.array(irr_ring, dtype=np.int64),
+        corners=tuple(sorted(corners, key=lambda c: c.node)),
+        cells=cells,
+        cell_block=cell_block,
+        n_interior=n_interior,
+    )
