@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from ._generators import drain
 from .algebraic import algebraic_grid
 from .boundary import Borders, borders_from_loop, borders_from_polylines
 from .elliptic import EllipticConfig, SolverProgress, iterate
@@ -405,15 +406,13 @@ def _drain(
     gen: Generator[BlockEvent, Any, StructuredGrid], callback: Callable[[SolverProgress], Any] | None = None
 ) -> StructuredGrid:
     """Run :func:`run_block` to the end; ``callback`` sees the progress; warnings are re-emitted."""
-    try:
-        event = next(gen)
-        while True:
-            cmd = None
-            if isinstance(event, SolverProgress) and callback is not None:
-                cmd = callback(event)
-            elif isinstance(event, Done):
-                for msg in event.warnings:
-                    warnings.warn(msg, MeshcoreWarning, stacklevel=3)
-            event = gen.send("stop" if cmd in ("stop", False) else None)
-    except StopIteration as fin:
-        return fin.value
+
+    def on_event(event: BlockEvent) -> Any:
+        if isinstance(event, Done):
+            for msg in event.warnings:
+                warnings.warn(msg, MeshcoreWarning, stacklevel=5)  # at generate_block's caller
+        elif isinstance(event, SolverProgress) and callback is not None:
+            return callback(event)
+        return None
+
+    return drain(gen, on_event)

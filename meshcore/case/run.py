@@ -7,6 +7,7 @@ import threading
 from collections.abc import Callable, Generator
 from typing import Any
 
+from .._generators import drain
 from ..elliptic import EllipticConfig, SolverProgress
 from ..errors import CaseFileError, InvalidInputError
 from ..generate import generate_block
@@ -44,7 +45,7 @@ def generate_case(
     """
     spec = case_solver(case, solver if solver is not None else config)
     if case.is_multiblock:
-        return _drain(iterate_multiblock_case(case, spec), callback)
+        return drain(iterate_multiblock_case(case, spec), callback)
     grids: list[StructuredGrid] = []
     for b in case.blocks:
         try:
@@ -82,13 +83,3 @@ def iterate_multiblock_case(
         stop_event=stop_event,
     )
     return dataclasses.replace(mb, frame=case_frame(case))
-
-
-def _drain(gen: Generator[SolverProgress, Any, Any], callback: Callable[[SolverProgress], Any] | None) -> Any:
-    try:
-        snap = next(gen)
-        while True:
-            cmd = callback(snap) if callback is not None else None
-            snap = gen.send("stop" if cmd in ("stop", False) else None)
-    except StopIteration as fin:
-        return fin.value

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from .._generators import drain
 from .._validation import validate_choice, validate_count, validate_positive
 from ..errors import InvalidInputError
 from ..grid import SolveInfo, StructuredGrid
@@ -443,11 +444,4 @@ def solve(
 
     If the callback returns ``"stop"`` (or ``False``) the solve stops early.
     """
-    gen = iterate(initial, config, **kwargs)
-    try:
-        snap = next(gen)
-        while True:
-            cmd = callback(snap) if callback is not None else None
-            snap = gen.send("stop" if cmd in ("stop", False) else None)
-    except StopIteration as fin:
-        return fin.value
+    return drain(iterate(initial, config, **kwargs), callback)

@@ -95,6 +95,15 @@ class FoldFreeResult:
     bad_cells: np.ndarray = field(repr=False)
 
 
+def _prepare(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[BoundaryCorner], np.ndarray]:
+    """``(x, y, invalid cells, exempt corners, their bits)``: the working copy of a grid to repair."""
+    exempt = block_corner_problems(grid)
+    ex_bits = _exempt_bits(grid, exempt)
+    x = np.array(grid.x, dtype=np.float64, order="C")
+    y = np.array(grid.y, dtype=np.float64, order="C")
+    return x, y, invalid_cells(x, y, ex_bits), exempt, ex_bits
+
+
 def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg):
     bad = invalid_cells(x, y, ex_bits)
     ok = ok and not bad.any()
@@ -166,13 +175,8 @@ def repair(
         ``+foldfree`` when nodes moved, ``info.message`` says why).
     """
     t0 = time.perf_counter()
-    exempt = block_corner_problems(grid)
-    ex_bits = _exempt_bits(grid, exempt)
-    x = np.array(grid.x, dtype=np.float64, order="C")
-    y = np.array(grid.y, dtype=np.float64, order="C")
-    bad = invalid_cells(x, y, ex_bits)
-    before = int(bad.sum())
-    folded_before = _folded(x, y)
+    x, y, bad, exempt, ex_bits = _prepare(grid)
+    before, folded_before = int(bad.sum()), _folded(x, y)
     exempt_note = ("; " + "; ".join(c.message for c in exempt)) if exempt else ""
     common = {"folded_before": folded_before, "exempt": exempt, "ex_bits": ex_bits, "t0": t0}
     if before == 0:
@@ -298,13 +302,8 @@ def smooth(
     as in :func:`repair`; ``tolerance`` is relative to the median edge length.
     """
     t0 = time.perf_counter()
-    exempt = block_corner_problems(grid)
-    ex_bits = _exempt_bits(grid, exempt)
-    x = np.array(grid.x, dtype=np.float64, order="C")
-    y = np.array(grid.y, dtype=np.float64, order="C")
-    bad = invalid_cells(x, y, ex_bits)
-    before = int(bad.sum())
-    folded_before = _folded(x, y)
+    x, y, bad, exempt, ex_bits = _prepare(grid)
+    before, folded_before = int(bad.sum()), _folded(x, y)
     nodes = _nodes_of(np.ones(grid.cells, dtype=bool), grid.periodic)
     cells = _touched_cells(nodes, grid.cells, grid.periodic) if nodes.size else np.zeros((0, 2), np.int32)
     h = _median_edge(x, y, cells) if nodes.size else 0.0

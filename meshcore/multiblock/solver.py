@@ -54,6 +54,7 @@ from typing import Any
 
 import numpy as np
 
+from .._generators import drain
 from .._validation import validate_choice
 from ..elliptic import EllipticConfig, SolverProgress
 from ..elliptic import iterate as iterate_block
@@ -316,11 +317,4 @@ def solve_multiblock(
     --------
     See :mod:`meshcore.multiblock`.
     """
-    gen = iterate_multiblock(topology, **kwargs)
-    try:
-        snap = next(gen)
-        while True:
-            cmd = callback(snap) if callback is not None else None
-            snap = gen.send("stop" if cmd in ("stop", False) else None)
-    except StopIteration as fin:
-        return fin.value
+    return drain(iterate_multiblock(topology, **kwargs), callback)
