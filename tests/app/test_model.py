@@ -317,3 +317,41 @@ def test_a_multiblock_project_yields_live_grids_in_one_thread():
     assert live and all(len(e.grids) == len(project.blocks) and e.grid is None for e in live)
     assert res.multiblock is not None and res.multiblock.converged
     assert all(np.array_equal(res.grids[k].x, g.x) for k, g in enumerate(res.multiblock.grids))
+
+
+def test_the_app_pipeline_honours_strict_repair_and_keeps_warnings():
+    """The drifts of the old app pipeline, fixed: repair="strict" raises, warnings reach the result."""
+    from meshcore import FoldedGridError
+
+    strip = Block(  # one row of cells whose top dips: no fold-free grid exists (as in test_foldfree)
+        boundary=(
+            np.array([[0, 0], [1, 0], [2, 0]], float),
+            np.array([[2, 0], [2, 1]], float),
+            np.array([[0, 1], [0.3, 0.1], [2, 1]], float),
+            np.array([[0, 0], [0, 1]], float),
+        ),
+        cells=None,
+    )
+    project = Project(blocks=(strip,))
+    auto = _drain(solve_project(project)).grids[0]
+    assert not auto.converged and "no fold-free grid" in auto.info.message
+    with pytest.raises(FoldedGridError, match="no fold-free grid"):
+        _drain(solve_project(project.replaced(solver=project.solver.replaced(repair="strict"))))
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])  # a repeated point
+    res = _drain(solve_project(Project(blocks=(Block(name="sq", points=sq, closed=True, corners=(0, 1, 3, 4)),))))
+    assert any("duplicate" in w and w.startswith("sq:") for w in res.warnings)
+
+
+def test_solver_settings_survive_a_save_from_the_app(tmp_path):
+    """repair = "strict" and threads are kept when the app loads and saves a case."""
+    from app.io_adapter import load_project, save_project
+    from meshcore.case import load_case
+
+    src = Path(__file__).resolve().parents[2] / "resources" / "examples" / "bottle-coarse.toml"
+    case = tmp_path / "in.toml"
+    case.write_text(src.read_text() + '\n[solver]\nrepair = "strict"\nthreads = 2\n')
+    project = load_project(case)
+    assert project.solver.repair == "strict" and project.solver.threads == 2
+    save_project(project, tmp_path / "out.toml")
+    again = load_case(tmp_path / "out.toml").solver
+    assert again.repair == "strict" and again.threads == 2
