@@ -213,7 +213,7 @@ def run_block(
     yield StartGrid(g, g0)
     if smooth:
         g = yield from iterate(g, solver.config(), p=spec.p, q=spec.q, sources=sources, stop_event=stop_event)
-        stopped = g.info.message == "stopped"
+        stopped = g.info.message == "stopped" or (stop_event is not None and stop_event.is_set())
         if not stopped and (solver.foldfree or solver.repair != "off"):
             with _recorded(notes):
                 fixed = _fold_free(g, spec, solver)

@@ -105,7 +105,7 @@ def test_import_does_not_drop_islands_silently(tmp_path, capsys):
     assert main(["import", str(lake), "-o", str(out), "--ignore-islands"]) == 0
     err = capsys.readouterr().err
     assert "warning" in err and "island" in err
-    assert len(load_case(out).blocks[0].loop) == 4
+    assert len(load_case(out).blocks[0].points) == 4
 
 
 def test_import_too_few_points_names_the_file(tmp_path, capsys):
