@@ -42,7 +42,7 @@ def main() -> None:
         grid = generate_case(case)[0]
         dt = time.perf_counter() - t0
         blk = case.blocks[0]
-        pts = [blk.borders[k] for k in meshcore.BORDER_NAMES] if blk.borders else [blk.loop]
+        pts = list(blk.boundary) if blk.boundary is not None else [blk.points]
         plot_grid(
             grid, figs / f"{name}.png", title=f"{case.title}\n{grid.cells[0]} × {grid.cells[1]} cells", points=pts
         )

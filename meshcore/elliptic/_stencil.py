@@ -1,7 +1,7 @@
 r"""The Winslow/TTM stencil at one node: the single place the discrete equations are written.
 
 At an interior node P with neighbours E, W, N, S and NE, NW, SE, SW (Δξ = Δη = 1;
-paper eq. 30 with the errata in NOTES.md):
+paper eq. 30 with the errata in docs/errata.md):
 
 .. math::
 
