@@ -376,6 +376,7 @@ def iterate(
     # places in transparent huge pages, ≥ 4 MB) runs at SNAPSHOT_BYTES_PER_S
     interval_floor = SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S if x.nbytes >= 4 << 20 else 0.0
     gen = METHODS[method](state)
+    rel: list[tuple[int, float]] = []  # the relative history so far (extended, not rebuilt, per snapshot)
     converged = False
     stopped = False
     try:
@@ -394,7 +395,7 @@ def iterate(
                     grid=StructuredGrid(x, y, periodic=initial.periodic, names=initial.names),
                     elapsed=now - t0,
                     method=method,
-                    history=tuple((i, v / length) for i, v in state.history),
+                    history=_relative(state.history, rel, length),
                 )
                 last = time.perf_counter()
                 # a snapshot copies x, y: keep that below ~5 % of the solve on huge grids
@@ -431,6 +432,14 @@ def iterate(
         message=msg,
     )
     return StructuredGrid(x, y, info=info, names=initial.names, periodic=initial.periodic)
+
+
+def _relative(history: list, rel: list, length: float) -> tuple[tuple[int, float], ...]:
+    """``history`` relative to ``length``, extending ``rel`` by the new entries only."""
+    if len(history) < len(rel) or (rel and history and history[len(rel) - 1][0] != rel[-1][0]):
+        rel.clear()  # a method restarted its history (multigrid falling back to SOR)
+    rel.extend((i, v / length) for i, v in history[len(rel) :])
+    return tuple(rel)
 
 
 def solve(
