@@ -184,17 +184,22 @@ def _border_stencils(cells: np.ndarray, border_free: np.ndarray, label: Any) -> 
     sel = np.isin(cells, border_free)
     for cidx, pos in zip(*np.nonzero(sel), strict=True):
         inc[int(cells[cidx, pos])].append((int(cidx), int(pos)))
-    reg_n, reg_nb, irr_n, irr_ptr, irr_ring = [], [], [], [0], []
+    reg_n: list[int] = []
+    reg_nb: list[list[int]] = []
+    irr_n: list[int] = []
+    irr_ptr: list[int] = [0]
+    irr_ring: list[int] = []
     for n in border_free.tolist():
         lst = inc[n]
-        nxt = {}
+        nxt: dict[int, tuple[int, int, int]] = {}
         for cidx, pos in lst:
             c = cells[cidx]
             e_next, diag, e_prev = (int(c[(pos + k) % 4]) for k in (1, 2, 3))
             nxt[e_next] = (e_next, diag, e_prev)
         ring = []
-        cur = next(iter(nxt.values()))
+        cur: tuple[int, int, int] | None = next(iter(nxt.values()))
         for _ in range(len(lst)):
+            assert cur is not None
             ring.append(cur)
             cur = nxt.get(cur[2])
             if cur is None:
