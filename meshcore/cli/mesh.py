@@ -41,6 +41,8 @@ from ..errors import InvalidInputError, MeshcoreError
 
 #: Cells of the default grid (``cell size = sqrt(water area / DEFAULT_CELLS)``).
 DEFAULT_CELLS = 10_000
+#: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
+MIN_CELLS = 16
 #: Coarse levels of the grid sequencing (cell counts are multiples of ``2**LEVELS``).
 LEVELS = 2
 
@@ -133,7 +135,7 @@ def _check_sizes(args: argparse.Namespace) -> None:
     if args.cell_size is not None:
         validate_positive(args.cell_size, name="--cell-size")
     if args.cells is not None:
-        validate_count(args.cells, name="--cells", minimum=16)
+        validate_count(args.cells, name="--cells", minimum=MIN_CELLS)
 
 
 def _check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
@@ -204,7 +206,7 @@ def _read(args: argparse.Namespace, say: _Say):
         raise InvalidInputError(
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
         )
-    outer, islands = water_from_points(local)
+    outer, islands = water_from_points(_without_lines_on_the_shore(local))
     try:
         poly, notes = water_polygon(outer, holes=islands)
     except InvalidInputError as exc:
@@ -215,6 +217,29 @@ def _read(args: argparse.Namespace, say: _Say):
     say(f"read {args.outline}: shore of {len(outer)} points, {isl}; {_crs_label(frame.crs)}{where}")
     _notes(notes)
     return poly, frame
+
+
+def _without_lines_on_the_shore(ps: Any) -> Any:
+    """Drop open polylines that touch the shore (an inlet or a cut drawn on it), with a note.
+
+    The shore is the ring of largest area, as :func:`~meshcore.layout.polygon.water_from_points`
+    picks it; an open line that meets it cannot be an island.
+    """
+    import shapely
+
+    if len(ps.polylines) < 2 or any(len(pl.points) < 3 for pl in ps.polylines):
+        return ps  # water_from_points names the short ring
+    shore = max(ps.polylines, key=lambda pl: abs(shapely.Polygon(pl.points).area))
+    ring = shapely.LinearRing(shore.points)
+    keep, dropped = [], []
+    for pl in ps.polylines:
+        line = pl is not shore and not pl.closed and shapely.LineString(pl.points).intersects(ring)
+        (dropped if line else keep).append(pl)
+    if dropped:
+        names = ", ".join(repr(pl.name) for pl in dropped)
+        what = "an open line" if len(dropped) == 1 else "open lines"
+        _notes([f"{names}: {what} touching the shore, not an island: ignored"])
+    return ps.with_points(keep, ps.crs)
 
 
 def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:
@@ -228,11 +253,17 @@ def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, s
         n = args.cells or DEFAULT_CELLS
         h = math.sqrt(area / n)
         why = f"sqrt(water area / {n})"
-    est = area / (h * h)
+    est = area / h / h  # not area / h², which underflows to 0 for h ≈ 1e-200
     if est > max_nodes():
         raise InvalidInputError(
             f"{args.outline}: {why} {h:.4g}{unit} gives about {est:,.0f} cells; the limit is "
             f"{max_nodes():,} nodes (set MESHCORE_MAX_NODES to raise it)"
+        )
+    if est < MIN_CELLS:
+        raise InvalidInputError(
+            f"{args.outline}: {why} {h:.4g}{unit} gives about {est:.2g} cells for a water area of "
+            f"{area:.4g}{unit + '²' if unit else ''}; give a cell size of at most "
+            f"{math.sqrt(area / MIN_CELLS):.4g}{unit}"
         )
     return h, f"cell size {h:.4g}{unit} ({why}, about {est:,.0f} cells)"
 

@@ -336,6 +336,20 @@ def test_shapefile_hole_is_an_island(tmp_path):
     check_covers_the_water(vtm_blocks(tmp_path / "s.vtm"), shapely.Polygon(shore, [island]))
 
 
+def test_dxf_shore_with_an_inlet_line_in_utm(tmp_path):
+    """A DXF (no CRS in the file) in UTM metres: --source-crs names it; the open inlet line drawn
+    from the shore is not an island."""
+    ezdxf = pytest.importorskip("ezdxf")
+    src = ROOT / "tests" / "data" / "lake_zurich_sparse_utm32.dxf"
+    run = mesh(src, "--source-crs", "EPSG:32632", "--cells", 600, "-o", tmp_path / "z.vtm")
+    assert run.rc == 0, run.err
+    assert "'inlet" in run.err and "not an island: ignored" in run.err and "no islands" in run.err
+    (shore,) = ezdxf.readfile(src).modelspace().query("LWPOLYLINE")
+    gs = read_blocks(tmp_path / "z.vtm")
+    assert gs.frame.crs == "EPSG:32632"
+    check_covers_the_water(blocks_of(gs), shapely.Polygon(np.array(shore.get_points("xy"))))
+
+
 def test_the_command_is_mesh_outline(tmp_path, synthetic_csv):
     """The grid written is the one ``meshcore.mesh_outline`` returns for the same outline."""
     import meshcore
@@ -442,6 +456,8 @@ def test_read_only_folder_refused(tmp_path, synthetic_csv):
         (["--cell-size", "-5"], "--cell-size must be a positive"),
         (["--cell-size", "nan"], "--cell-size must be a positive"),
         (["--cell-size", "0.01"], "--cell-size 0.01 gives about 161,508,"),
+        (["--cell-size", "1e-300"], "gives about inf cells"),
+        (["--cell-size", "5000"], "give a cell size of at most 1005"),
     ],
 )
 def test_bad_sizes(tmp_path, synthetic_csv, argv, needle):
