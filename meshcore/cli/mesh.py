@@ -231,7 +231,8 @@ def _without_lines_on_the_shore(ps: Any) -> Any:
         return ps  # water_from_points names the short ring
     shore = max(ps.polylines, key=lambda pl: abs(shapely.Polygon(pl.points).area))
     ring = shapely.LinearRing(shore.points)
-    keep, dropped = [], []
+    keep: list[Any] = []
+    dropped: list[Any] = []
     for pl in ps.polylines:
         line = pl is not shore and not pl.closed and shapely.LineString(pl.points).intersects(ring)
         (dropped if line else keep).append(pl)
