@@ -176,12 +176,19 @@ class SolverController(QtCore.QObject):
                 return False
         return True
 
-    def shutdown(self) -> None:
-        """Stop and wait for every worker (window close)."""
+    def shutdown(self, msecs: int = 2000) -> bool:
+        """Stop and wait up to ``msecs`` for every worker (window close); False if one is still busy.
+
+        A worker still in its sweep after the wait has been told to stop and ends by itself.
+        """
         self._abandon()
         from superqt.utils._qthreading import WorkerBase
 
-        WorkerBase.await_workers(msecs=2000)
+        try:
+            WorkerBase.await_workers(msecs=msecs)
+        except RuntimeError:  # superqt: "Workers did not quit gracefully in the time allotted"
+            return False
+        return True
 
     def _abandon(self) -> None:
         if self._stop_event is not None:

@@ -143,9 +143,10 @@ def test_pause_and_resume(qtbot, win):
     win.generate()
     qtbot.waitUntil(lambda: win.solver.state == "running" and bool(win.solver._latest), timeout=10_000)
     win.solver.pause()
-    qtbot.wait(150)
-    it = _iteration(win)
-    qtbot.wait(300)
+    # progress already queued when the worker paused may still arrive (a busy machine delays it):
+    # wait until the iteration stands still, then check that it stays still
+    it = _settled_iteration(qtbot, win)
+    qtbot.wait(500)
     assert _iteration(win) == it  # nothing moves while paused
     win.solver.resume()
     qtbot.waitUntil(lambda: _iteration(win) > it, timeout=5_000)
@@ -155,6 +156,18 @@ def test_pause_and_resume(qtbot, win):
 
 def _iteration(win):
     return getattr(win.solver._latest.get(0), "iteration", -1)
+
+
+def _settled_iteration(qtbot, win, timeout_s: float = 60.0) -> int:
+    """The iteration once two readings 300 ms apart agree (fails if it never settles)."""
+    last = _iteration(win)
+    for _ in range(int(timeout_s / 0.3)):
+        qtbot.wait(300)
+        now = _iteration(win)
+        if now == last:
+            return now
+        last = now
+    raise AssertionError("the solver kept iterating after pause()")
 
 
 def test_import_kml_projects_to_utm(qtbot, win):
