@@ -109,6 +109,32 @@ ACTIONS: tuple[ActionSpec, ...] = (
         "&Block",
         separator=True,
     ),
+    # Lake
+    ActionSpec(
+        "auto_layout",
+        "&Auto layout",
+        "lake_ctl.auto_layout",
+        ("Ctrl+L",),
+        "split the lake into four-sided blocks that follow its arms (cell size in the Lake panel), then generate",
+        "&Lake",
+        toolbar=3.5,
+        help="auto layout of a lake",
+    ),
+    ActionSpec(
+        "auto_layout_regular",
+        "Auto layout, &regular (Delft3D DD)",
+        "auto_layout_regular",
+        tip="a layout without corners where 3 or 5 blocks meet: what Delft3D domain decomposition can couple",
+        menu="&Lake",
+    ),
+    ActionSpec(
+        "clear_layout",
+        "&Clear layout",
+        "editor.clear_layout",
+        tip="back to the shore as one editable block",
+        menu="&Lake",
+    ),
+    ActionSpec("lake_panel", "Lake &panel", "show_lake", menu="&Lake", separator=True),
     # Generate
     ActionSpec(
         "generate", "&Generate", "generate", ("F5",), "build the algebraic grid and solve", "&Generate", toolbar=4.1

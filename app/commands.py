@@ -32,6 +32,7 @@ __all__ = [
     "SetBlockOptions",
     "SetBorderSpec",
     "SetCorners",
+    "SetLake",
     "SetSolver",
 ]
 
@@ -110,6 +111,10 @@ class AddCutLine(ProjectCommand):
     """Add a cut line (multiblock)."""
 
 
+class SetLake(ProjectCommand):
+    """The lake's settings or its block layout (Auto layout, a layout edit, Clear layout)."""
+
+
 _drag_ids = itertools.count(1)
 
 
@@ -134,6 +139,12 @@ class Editor:
             self.doc.message.emit(
                 "This is a multiblock case: its blocks and interfaces come from the case file and "
                 "cannot be edited here (solver settings can); edit the case file, or start a new project"
+            )
+            return True
+        if self.doc.project.layout is not None:
+            self.doc.message.emit(
+                "These blocks are the lake's layout: change it in the Lake panel (cell size, Auto layout), "
+                "or Clear layout (Lake menu) to edit the shore"
             )
             return True
         return False
@@ -258,6 +269,23 @@ class Editor:
             return
         p = self.doc.project
         self._push(AddCutLine, p.replaced(cut_lines=(*p.cut_lines, pj.frozen_points(points))), "Add cut line")
+
+    def set_lake(self, lake, text: str, merge_key=None) -> None:
+        """Set the project's lake (with a layout: its blocks become the project's blocks)."""
+        from .lake import with_layout
+
+        p = self.doc.project
+        self._push(SetLake, with_layout(p, lake), text, merge_key)
+
+    def clear_layout(self) -> None:
+        """Back to the lake's shore as one editable block (the layout is dropped; undoable)."""
+        from .project import block_from_points
+
+        p = self.doc.project
+        if p.layout is None:
+            return
+        block = block_from_points(p.lake.outline, p.title or "lake")
+        self._push(SetLake, p.replaced(lake=p.lake.replaced(layout=None), blocks=(block,)), "Clear layout")
 
     def replace_project(self, after: Project, text: str) -> None:
         self._push(ProjectCommand, after, text)

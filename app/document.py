@@ -20,6 +20,12 @@ from .project import Block, Project
 
 __all__ = ["METRICS", "Document"]
 
+
+def _layout_shape(layout) -> tuple | None:
+    """What a lake layout's grids depend on in shape: the blocks' names and cells."""
+    return None if layout is None else tuple((b.name, tuple(b.cells)) for b in layout.blocks)
+
+
 #: the metrics cells can be coloured by: label → (array of the quality report, colour map)
 METRICS = {
     "none": None,
@@ -87,6 +93,8 @@ class Document:
         self.colour_by: str = "none"
         self.solving: bool = False
         self._final: bool = False  # the grids are the result of a finished solve
+        #: meshcore LakeMetrics of a lake layout's finished grid (None otherwise)
+        self.lake_metrics = None
 
     # ----------------------------------------------------------- project
     @property
@@ -100,13 +108,15 @@ class Document:
             return
         old = self.project
         self.project = project
-        if project.multiblock is not old.multiblock or len(project.blocks) != len(old.blocks):
+        relaid = project.layout is not old.layout and _layout_shape(project.layout) != _layout_shape(old.layout)
+        if relaid or project.multiblock is not old.multiblock or len(project.blocks) != len(old.blocks):
             # a different block structure (split by cuts, undo of it, add/delete block): keep
             # only the grids of blocks that are still there, unchanged, at the same index
             keep = {
                 k
                 for k in self.grids
                 if project.multiblock is old.multiblock
+                and not relaid
                 and k < min(len(project.blocks), len(old.blocks))
                 and project.blocks[k] is old.blocks[k]
             }
@@ -195,7 +205,18 @@ class Document:
             return
         self.quality_grid = g
         self.quality = quality(g) if g is not None else None
+        self.lake_metrics = self._lake_metrics() if g is not None else None
         self.quality_changed.emit()
+
+    def _lake_metrics(self):
+        """The lake modellers' metrics of a lake layout's grid, against the water polygon."""
+        lay = self.project.layout
+        mb = self.multiblock
+        if lay is None or mb is None or len(mb.grids) != len(lay.blocks):
+            return None
+        from meshcore.quality import lake_metrics
+
+        return lake_metrics(mb, polygon=lay.polygon, cell_size=lay.cell_size)
 
     def set_colour_by(self, label: str) -> None:
         """Colour the cells by the metric ``label`` (a key of :data:`METRICS`)."""

@@ -200,6 +200,8 @@ def case_of_project(project: Project):
     A multiblock case is written back as read, with the app's solver settings;
     otherwise the ready blocks (:func:`project_to_case`; ValueError when none is).
     """
+    if project.layout is not None:
+        return _layout_case(project)
     if project.multiblock is None:
         return project_to_case(project)
     case = project.multiblock
@@ -215,6 +217,28 @@ def case_of_project(project: Project):
         if frame is not None:
             case = case.replaced(crs=frame.as_dict())
     return case.replaced(solver=project.solver, path=None)
+
+
+def _layout_case(project: Project):
+    """A lake layout as a case: meshcore's ``layout_case`` when it exists, else its blocks and interfaces.
+
+    Seam: without :func:`meshcore.layout.layout_case` the case holds the layout's blocks and
+    interfaces (``meshcore generate`` solves them as a smooth multiblock grid); the cut lines
+    and the orthogonal mode come back only with it.
+    """
+    import meshcore.layout as ml
+    from meshcore.case import topology_case
+
+    layout = project.layout
+    make = getattr(ml, "layout_case", None)
+    if make is not None:
+        case = make(layout)
+    else:
+        case = topology_case(layout.topology(), mode="smooth", title=project.title)
+    frame = project_frame(project)
+    if frame is not None:
+        case = case.replaced(crs=frame.as_dict())
+    return case.replaced(solver=project.solver, title=project.title or case.title, path=None)
 
 
 def save_project(project: Project, path) -> None:

@@ -22,6 +22,7 @@ from meshcore import MeshcoreError
 from . import io_adapter as fio
 from . import recovery
 from .examples import load_example
+from .lake import Lake, looks_branched, read_lake
 from .project import Block, Project, block_from_points
 
 __all__ = ["MAX_RECENT", "IOController"]
@@ -198,20 +199,39 @@ class IOController(QtCore.QObject):
                 except (MeshcoreError, ValueError) as exc:
                     self.win.error("Cannot project coordinates", exc)
                     return False
+        lake = self._read_lake(pd, frame, lonlat=bool(pd.lonlat and project_lonlat is not False))
+        if lake is not None:
+            pts = lake.outline
         if len(pts) < 4:
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
         block = block_from_points(pts, path.stem)
-        self._add_imported(block, frame, path.name)
+        self._add_imported(block, frame, path.name, lake=lake)
         self.remember_dir(path)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
+        isl = f" and {len(lake.holes)} island(s)" if lake is not None and lake.holes else ""
         self.win.message(
-            f"Imported {len(pts)} points from {path.name}{projected}; corners chosen "
-            f"automatically — adjust with the Corners tool, then F5"
+            f"Imported {len(pts)} points{isl} from {path.name}{projected}; corners chosen "
+            f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
         )
+        if lake is not None and looks_branched(lake.outline, lake.holes):
+            why = f"{len(lake.holes)} island(s)" if lake.holes else "the water has arms or bends"
+            self.win.show_lake()
+            self.win.lake_ctl.offer(path.name, why)
         return True
 
-    def _add_imported(self, block: Block, frame, name: str) -> None:
+    def _read_lake(self, pd, frame, *, lonlat: bool):
+        """The lake (shore and islands) of the file's rings, in the frame of the imported block; None if none."""
+        if pd.pointset is None:
+            return None
+        try:
+            outer, islands, _fr = read_lake(pd.pointset, frame, lonlat=lonlat)
+        except (MeshcoreError, ValueError) as exc:
+            log.info("%s: not read as a lake (%s)", pd.path, exc)
+            return None
+        return Lake(outline=outer, holes=tuple(islands))
+
+    def _add_imported(self, block: Block, frame, name: str, *, lake=None) -> None:
         """Put an imported block into the first empty block (or add it), as one undo step."""
         p = self.doc.project
         empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
@@ -223,6 +243,8 @@ class IOController(QtCore.QObject):
             k = len(after.blocks) - 1
         if frame is not None and frame.crs:
             after = after.replaced(crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "")
+        if lake is not None and k == 0 and after.layout is None:
+            after = after.replaced(lake=lake)
         self.editor.replace_project(after, f"Import {name}")
         self.doc.set_active(k)
         self.win.canvas.fit()
@@ -246,17 +268,58 @@ class IOController(QtCore.QObject):
         """Write the grids (a multiblock result with its connectivity) with meshcore.io."""
         grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
         mb = self.doc.multiblock
-        frame = fio.project_frame(self.doc.project)
+        p = self.doc.project
+        frame = fio.project_frame(p)
+        if p.layout is not None and (mb is None or self.doc.stale or self.doc.solving):
+            self.win.message("The lake grid is not finished: generate it (F5) and export when it is done", error=True)
+            return False
+        if not self._folds_confirmed():
+            return False
         try:
-            if mb is not None and self.doc.project.multiblock is not None and not self.doc.stale:
+            if mb is not None and (p.multiblock is not None or p.layout is not None) and not self.doc.stale:
                 fio.write_mesh(path, mb, frame)
             else:
                 fio.write_mesh(path, grids, frame)
         except (MeshcoreError, OSError) as exc:
+            if self._offer_regular(path, exc):
+                return False
             self.win.error("Cannot export mesh", exc)
             return False
         self.remember_dir(path)
         self.win.message(f"Exported {len(grids)} block(s) to {path}")
+        return True
+
+    def _folds_confirmed(self) -> bool:
+        """A lake grid with folded cells: warn (and ask, unless quiet) before writing it."""
+        m = self.doc.lake_metrics
+        n = int(m.values("folded").sum()) if m is not None else 0
+        if not n:
+            return True
+        text = f"The grid has {n} folded or non-convex cell(s); a model may refuse it"
+        self.doc.report("warning", text)
+        if self.quiet:
+            return True
+        b = QtWidgets.QMessageBox.StandardButton
+        r = QtWidgets.QMessageBox.question(self._parent(), "Folded cells", f"{text}.\n\nExport anyway?", b.Yes | b.No)
+        return r == b.Yes
+
+    def _offer_regular(self, path: Path, exc: BaseException) -> bool:
+        """A .ddb that Delft3D cannot couple (3- or 5-block corners): offer a regular layout instead."""
+        lay = self.doc.project.layout
+        if lay is None or Path(path).suffix.lower() != ".ddb" or self.doc.project.lake.regular:
+            return False
+        text = (
+            f"Cannot export {Path(path).name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
+            "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"
+        )
+        self.win.message(text, error=True)
+        if not self.quiet:
+            b = QtWidgets.QMessageBox.StandardButton
+            r = QtWidgets.QMessageBox.question(
+                self._parent(), "Delft3D domain decomposition", f"{text}.\n\nMake a regular layout now?", b.Yes | b.No
+            )
+            if r == b.Yes:
+                self.win.lake_ctl.auto_layout(regular=True)
         return True
 
     def figure_dialog(self) -> None:

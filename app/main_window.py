@@ -27,11 +27,13 @@ from .commands import Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
+from .lake_controller import LakeController
 from .project import Project, boundary_to_loop
 from .solve_status import SolveStatus
 from .solver_controller import SolverController
 from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, PanTool
 from .views.canvas import Canvas
+from .views.lake_panel import LakePanel, LakeQualityBox
 from .views.messages import ElidedLabel, MessagePanel
 from .views.panels import BlocksPanel, ConvergencePanel, ParamsPanel, QualityPanel
 
@@ -73,6 +75,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.stack = QtGui.QUndoStack(self)
         self.editor = Editor(self.doc, self.stack)
         self.solver = SolverController(self.doc, self)
+        self.lake_ctl = LakeController(self)
         self._centres = (None, None)  # (grid, its cell centres) for the hover read-out
         self.canvas = Canvas(self.doc)
         self.canvas.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
@@ -116,6 +119,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.conv_panel = ConvergencePanel()
         self.quality_panel = QualityPanel(self.doc)
         self.messages_panel = MessagePanel(self.doc)
+        self.lake_panel = LakePanel(self.doc, self.lake_ctl)
+        self.lake_quality = LakeQualityBox(self.doc)
+        self.quality_panel.layout().addWidget(self.lake_quality)
         self.undo_view = QtWidgets.QUndoView(self.stack)
         self.undo_view.setEmptyLabel("<start>")
         self.docks = {}
@@ -124,6 +130,7 @@ class MainWindow(QtWidgets.QMainWindow):
         for key, title, w, area in (
             ("blocks", "Blocks and borders", self.blocks_panel, left),
             ("params", "Parameters", self.params_panel, left),
+            ("lake", "Lake", self.lake_panel, left),
             ("quality", "Quality", self.quality_panel, right),
             ("convergence", "Convergence", self.conv_panel, right),
             ("messages", "Messages", self.messages_panel, right),
@@ -134,6 +141,8 @@ class MainWindow(QtWidgets.QMainWindow):
             d.setWidget(w)
             self.addDockWidget(area, d)
             self.docks[key] = d
+        self.tabifyDockWidget(self.docks["params"], self.docks["lake"])
+        self.docks["params"].raise_()
         self.tabifyDockWidget(self.docks["convergence"], self.docks["messages"])
         self.tabifyDockWidget(self.docks["messages"], self.docks["history"])
         self.docks["convergence"].raise_()
@@ -200,6 +209,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.blocks_panel.border_selected.connect(self.params_panel.select_border)
         self.quality_panel.zoom_to_cell.connect(self.canvas.zoom_to_cell)
         self.params_panel.committed.connect(self.focus_canvas)
+        self.lake_panel.committed.connect(self.focus_canvas)
+        self.lake_quality.misses.connect(self.canvas.lake_items.set_misses)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
         self.stack.cleanChanged.connect(self._update_title)
@@ -317,6 +328,15 @@ class MainWindow(QtWidgets.QMainWindow):
             "F5 solves them together — Ctrl+Z undoes the split"
         )
         return True
+
+    def auto_layout_regular(self) -> None:
+        """Auto layout without 3- or 5-block corners (what Delft3D domain decomposition couples)."""
+        self.lake_ctl.auto_layout(regular=True)
+
+    def show_lake(self) -> None:
+        """Bring the Lake dock to the front."""
+        self.docks["lake"].show()
+        self.docks["lake"].raise_()
 
     def generate(self) -> None:
         if not any(b.ready for b in self.doc.project.blocks):

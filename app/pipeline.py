@@ -5,7 +5,8 @@ on every ready block and yields ``(block_index, event)`` pairs — meshcore's
 typed events (``StartGrid``, ``SolverProgress``, ``Repaired``, ``Done``) —
 and returns a :class:`BlockResult`.  A multiblock case yields
 ``(ALL_BLOCKS, SolverProgress)`` with every block's grid (one generator, no
-second thread).  What is the app's own is the warm start:
+second thread); a lake layout (:mod:`app.lake_solve`) likewise.  What is the app's own is
+the warm start:
 
 Warm start (live remesh): when the previous grid of a block has the same
 shape, the candidate start grid is ``A_new + (G_old − A_old)`` — the new
@@ -90,6 +91,10 @@ def solve_project(
     solver = project.solver.replaced(report_interval=report_interval)
     if project.multiblock is not None:
         return (yield from _solve_multiblock(project, solver, stop_event))
+    if project.layout is not None:  # a lake layout: one orthogonal grid over all its blocks
+        from .lake_solve import solve_layout
+
+        return (yield from solve_layout(project.lake, warm=warm, stop_event=stop_event))
     grids: dict[int, StructuredGrid] = {}
     starts: dict[int, StructuredGrid] = {}
     notes: list[str] = []

@@ -126,6 +126,9 @@ class Project:
     #: a multiblock case (meshcore.case.Case with [multiblock]/[outline]/[[interfaces]]):
     #: its blocks are shown and solved together by meshcore.multiblock; not editable in the app
     multiblock: Any = None
+    #: a lake (:class:`app.lake.Lake`): shore, islands, cell size and the block layout; with a
+    #: layout the blocks are the layout's, solved together as one orthogonal grid
+    lake: Any = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "blocks", tuple(self.blocks))
@@ -133,6 +136,11 @@ class Project:
 
     def replaced(self, **kw: Any) -> Project:
         return dataclasses.replace(self, **kw)
+
+    @property
+    def layout(self) -> Any:
+        """The lake's block layout (a :class:`meshcore.layout.Layout`), or None."""
+        return self.lake.layout if self.lake is not None else None
 
     def with_block(self, index: int, block: Block) -> Project:
         blocks = list(self.blocks)
@@ -150,6 +158,7 @@ class Project:
             and self.background == other.background
             and self.crs == other.crs
             and self.title == other.title
+            and (self.lake is other.lake or self.lake == other.lake)
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -158,6 +167,8 @@ class Project:
         """Bounding box of all points (None when empty)."""
         pts = [b.points for b in self.blocks if len(b.points)]
         pts += [np.vstack(b.boundary) for b in self.blocks if b.boundary is not None]
+        if self.lake is not None:
+            pts.append(self.lake.outline)
         if not pts:
             return None
         a = np.vstack(pts)

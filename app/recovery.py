@@ -8,7 +8,8 @@ The autosave writes two files:
   ``meshcore generate`` like any case.
 * ``recovery.toml.json`` — what a case file cannot hold: blocks still being
   drawn, cut lines, the background image, the solver settings as the app
-  keeps them, and the path the project was last saved to.  It names the
+  keeps them, a lake's water and layout settings (its layout is made again
+  from them), and the path the project was last saved to.  It names the
   SHA-256 of the case text it belongs to; a sidecar that does not match (a
   crash between the two writes) is ignored and the case alone is recovered.
 
@@ -65,7 +66,8 @@ def write(project: Project, path, saved_as: Path | None = None) -> None:
     if solver.method == "foldfree":  # not an EllipticConfig method; the sidecar keeps it
         project = project.replaced(solver=dataclasses.replace(solver, method="auto"))
     try:
-        text = dumps_project(project)
+        # a lake layout is made again from the sidecar's lake (a case cannot hold its islands yet)
+        text = dumps_project(project) if project.layout is None else None
     except (MeshcoreError, ValueError):  # nothing a case can hold yet (a loop still being drawn)
         text = None
     state = {
@@ -80,7 +82,8 @@ def write(project: Project, path, saved_as: Path | None = None) -> None:
         "solver": dataclasses.asdict(solver),
         "cut_lines": [np.asarray(c).tolist() for c in project.cut_lines],
         "background": _background(project.background),
-        "blocks": None if project.multiblock is not None else _blocks(project),
+        "blocks": None if project.multiblock is not None or project.layout is not None else _blocks(project),
+        "lake": _lake_state(project.lake),
     }
     if text is None:
         path.unlink(missing_ok=True)
@@ -122,6 +125,8 @@ def read(path) -> tuple[Project, Path | None]:
         cut_lines=tuple(np.asarray(c, float).reshape(-1, 2) for c in state.get("cut_lines", ())),
         background=Background(bg["path"], tuple(bg["transform"])) if bg else None,
     )
+    if state.get("lake"):
+        project = _with_lake(project, state["lake"])
     return project, Path(state["path"]) if state.get("path") else None
 
 
@@ -146,6 +151,35 @@ def _state(p: Path, case_path: Path | None) -> dict | None:
 
 def _background(bg: Background | None):
     return None if bg is None else {"path": bg.path, "transform": list(bg.transform)}
+
+
+def _lake_state(lake) -> dict | None:
+    """The lake's water and settings; its layout is remade from them (auto layout is deterministic)."""
+    if lake is None:
+        return None
+    return {
+        "outline": np.asarray(lake.outline).tolist(),
+        "holes": [np.asarray(h).tolist() for h in lake.holes],
+        "cell_size": lake.cell_size,
+        "target_cells": lake.target_cells,
+        "regular": lake.regular,
+        "layout": lake.layout is not None,
+    }
+
+
+def _with_lake(project: Project, d: Mapping) -> Project:
+    from .lake import Lake, compute_layout, with_layout
+
+    lake = Lake(
+        outline=np.asarray(d["outline"], float).reshape(-1, 2),
+        holes=tuple(np.asarray(h, float).reshape(-1, 2) for h in d.get("holes", ())),
+        cell_size=d.get("cell_size"),
+        target_cells=int(d.get("target_cells", 10_000)),
+        regular=bool(d.get("regular", False)),
+    )
+    if d.get("layout"):
+        lake = lake.replaced(layout=compute_layout(lake))
+    return with_layout(project, lake)
 
 
 def _blocks(project: Project) -> list[dict]:

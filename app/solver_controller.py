@@ -235,7 +235,10 @@ class SolverController(QtCore.QObject):
         for k, event in self._latest.items():
             if k == ALL_BLOCKS and isinstance(event, SolverProgress):  # a multiblock solve: every block
                 for i, g in enumerate(event.grids):
-                    self.doc.grids[i] = g
+                    # a coarse level of a lake grid never replaces an earlier solve's grid on screen
+                    if i in self._smoothed or not self._showing_other(i, g):
+                        self.doc.grids[i] = g
+                        self._smoothed.add(i)
                 self.progress.emit(k, event)
                 continue
             if not isinstance(event, (StartGrid, SolverProgress, Repaired, Done)):
@@ -255,6 +258,11 @@ class SolverController(QtCore.QObject):
         """True when block ``k`` already shows a grid of this shape (from an earlier solve)."""
         old = self.doc.grids.get(k)
         return old is not None and old.shape == grid.shape
+
+    def _showing_other(self, k: int, grid: StructuredGrid) -> bool:
+        """True when block ``k`` shows a grid of another shape (from an earlier solve)."""
+        old = self.doc.grids.get(k)
+        return old is not None and old.shape != grid.shape
 
     @QtCore.Slot(object)
     def _on_returned(self, value) -> None:
@@ -291,7 +299,8 @@ class SolverController(QtCore.QObject):
         initial.update(result.initial)
         ready = {k for k, b in enumerate(self.doc.project.blocks) if b.ready}
         grids = {k: g for k, g in grids.items() if k in ready}
-        self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready})
+        mb = getattr(result, "multiblock", None)
+        self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready}, multiblock=mb)
         self.last_result = result
         for w in result.warnings:  # what meshcore warned about (e.g. dropped duplicate points)
             self.doc.report("warning", w)

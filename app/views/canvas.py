@@ -22,6 +22,7 @@ from meshcore import StructuredGrid
 from .. import geometry as geo
 from ..document import Document
 from .items import Scatter, ToolViewBox, set_points, set_polylines
+from .lake_items import LakeOverlay
 
 __all__ = ["BORDER_COLOURS", "Canvas"]
 
@@ -60,6 +61,7 @@ class Canvas(pg.PlotWidget):
         self._make_border_items()
         self._make_point_items()
         self._make_overlays()
+        self.lake_items = LakeOverlay(self)
         # items are pictures only: every click goes to the ViewBox and so to the tool
         for it in self.getPlotItem().items:
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
@@ -70,6 +72,8 @@ class Canvas(pg.PlotWidget):
         self._vb.sigRangeChanged.connect(self._apply_level_of_detail)
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
         doc.project_changed.connect(self.refresh_boundary)
+        doc.project_changed.connect(self.lake_items.refresh)
+        doc.opened.connect(lambda: self.lake_items.set_misses(None))
         doc.selection_changed.connect(lambda _: self.refresh_selection())
         doc.active_changed.connect(lambda _: self.refresh_boundary())
         doc.grids_changed.connect(self.refresh_grids)
@@ -223,7 +227,8 @@ class Canvas(pg.PlotWidget):
         """Other blocks' points, faint, and every block's loop as a dashed line."""
         doc = self.doc
         others = [b for k, b in enumerate(doc.project.blocks) if k != doc.active]
-        multiblock = doc.project.multiblock is not None  # boundary nodes, not editable points
+        # boundary nodes of a multiblock case or a lake layout, not editable points
+        multiblock = doc.project.multiblock is not None or doc.project.layout is not None
         op = [b.points for b in others if len(b.points)]
         if not multiblock:
             op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
@@ -275,7 +280,8 @@ class Canvas(pg.PlotWidget):
         if block.boundary is None:
             disp = pts
         else:
-            disp = None if self.doc.project.multiblock is not None else np.vstack(block.boundary)
+            solved_together = self.doc.project.multiblock is not None or self.doc.project.layout is not None
+            disp = None if solved_together else np.vstack(block.boundary)
         set_points(self.points_item, disp)
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
             cp = pts[list(block.corners)]
@@ -389,6 +395,7 @@ class Canvas(pg.PlotWidget):
         items += [*self.corner_labels, *self.border_arrows.values(), *self.border_labels.values()]
         for it in items:
             it.setVisible(on)
+        self.lake_items.set_markers_visible(on)
 
     def set_folded(self, grid: StructuredGrid | None, cells: np.ndarray | None) -> None:
         if grid is None or cells is None or len(cells) == 0:

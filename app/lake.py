@@ -1,0 +1,197 @@
+"""Lakes in the app: the water (shore + islands), its block layout, and the layout's grid (no Qt).
+
+The same functions as ``meshcore mesh`` (:mod:`meshcore.cli.mesh`) so that the same file
+gives the same layout in the app and on the command line:
+
+* the water: every ring of the point file, projected like the rest of the project
+  (:func:`meshcore.crs.project`), split into shore and islands by
+  :func:`meshcore.layout.polygon.water_from_points`;
+* the layout: :func:`meshcore.layout.auto_layout` at the cell size the user set, or at
+  ``sqrt(water area / 10 000)`` (:data:`meshcore.cli.mesh.DEFAULT_CELLS`), with cell counts
+  that are multiples of ``2**LEVELS`` (the grid sequencing of :func:`meshcore.lakegrid.mesh_layout`);
+* the grid: :func:`meshcore.lakegrid.mesh_layout` (see :func:`app.pipeline.solve_project`).
+
+A :class:`Lake` is part of the immutable :class:`~app.project.Project`; with a layout, the
+project's blocks are the layout's blocks (:func:`with_layout`) and are solved together.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from meshcore import MeshcoreError
+
+__all__ = [
+    "BRANCHED_FILL",
+    "Lake",
+    "cell_size_of",
+    "compute_layout",
+    "default_cell_size",
+    "layout_blocks",
+    "looks_branched",
+    "read_lake",
+    "water",
+    "with_layout",
+]
+
+#: an outline whose water fills less than this share of its convex hull is "branched":
+#: one block would be poor, the app offers Auto layout on import
+BRANCHED_FILL = 0.5
+
+
+def _frozen(a: Any) -> np.ndarray:
+    out = np.array(a, dtype=np.float64).reshape(-1, 2)
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Lake:
+    """The water of a lake project and its block layout.
+
+    ``outline`` is the shore and ``holes`` the islands (local model coordinates);
+    ``cell_size`` the wanted cell size (None: about :data:`target_cells` cells);
+    ``regular`` asks for a layout without 3- or 5-block corners (Delft3D DD);
+    ``layout`` is the :class:`meshcore.layout.Layout` (None until Auto layout).
+    """
+
+    outline: np.ndarray
+    holes: tuple[np.ndarray, ...] = ()
+    cell_size: float | None = None
+    target_cells: int = 10_000
+    regular: bool = False
+    layout: Any = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "outline", _frozen(self.outline))
+        object.__setattr__(self, "holes", tuple(_frozen(h) for h in self.holes))
+
+    def replaced(self, **kw: Any) -> Lake:
+        return replace(self, **kw)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Lake):
+            return NotImplemented
+        return (
+            np.array_equal(self.outline, other.outline)
+            and len(self.holes) == len(other.holes)
+            and all(np.array_equal(a, b) for a, b in zip(self.holes, other.holes, strict=True))
+            and self._settings() == other._settings()
+            and self.layout is other.layout
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def _settings(self) -> tuple:
+        return (self.cell_size, self.target_cells, self.regular)
+
+
+# ------------------------------------------------------------------ reading
+def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tuple[np.ndarray, list, Any]:
+    """Shore, islands and frame of a point file's rings (lon/lat projected as the CLI does).
+
+    ``pointset`` is the :class:`meshcore.io.PointSet` read from the file; with ``lonlat``
+    its degrees go to ``frame`` (the project's) or to the UTM zone of the centroid with a
+    round local origin.  Raises :class:`~meshcore.MeshcoreError` when the rings are not
+    one lake (an island outside the shore, a ring of fewer than three points).
+    """
+    from meshcore import crs as mcrs
+    from meshcore.layout.polygon import water_from_points
+
+    ps = pointset
+    if lonlat:
+        src = mcrs.LONLAT if ps.crs is None else None
+        if frame is not None and frame.crs:
+            ps, frame = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)
+        else:
+            ps, frame = mcrs.project(ps, "auto", source_crs=src)
+    outer, islands = water_from_points(ps)
+    return np.asarray(outer, float), [np.asarray(r, float) for r in islands], frame
+
+
+def water(outline: Any, holes: Any = ()) -> Any:
+    """The water polygon (shapely, islands as holes, cleaned as meshcore cleans it) and its notes."""
+    from meshcore.layout.polygon import water_polygon
+
+    return water_polygon(np.asarray(outline, float), holes=[np.asarray(h, float) for h in holes])
+
+
+def looks_branched(outline: Any, holes: Any = ()) -> bool:
+    """True for water that one block grids poorly: islands, or a shape far from convex (arms)."""
+    if len(holes):
+        return True
+    try:
+        poly, _ = water(outline)
+    except MeshcoreError:
+        return False
+    hull = poly.convex_hull.area
+    return hull > 0 and poly.area / hull < BRANCHED_FILL
+
+
+# ------------------------------------------------------------------ layout
+def default_cell_size(area: float, target_cells: int | None = None) -> float:
+    """``sqrt(water area / cells)``: the cell size ``meshcore mesh`` chooses by default."""
+    from meshcore.cli.mesh import DEFAULT_CELLS
+
+    return math.sqrt(float(area) / float(target_cells or DEFAULT_CELLS))
+
+
+def cell_size_of(lake: Lake) -> float:
+    """The cell size a layout of ``lake`` uses (the set one, or the default)."""
+    if lake.cell_size is not None:
+        return float(lake.cell_size)
+    poly, _ = water(lake.outline, lake.holes)
+    return default_cell_size(poly.area, lake.target_cells)
+
+
+def compute_layout(lake: Lake) -> Any:
+    """The :class:`meshcore.layout.Layout` of ``lake`` (what ``meshcore mesh`` would make).
+
+    Runs :func:`meshcore.layout.auto_layout` (seconds on a 10 000-cell lake: call it off the
+    GUI thread).  Raises :class:`~meshcore.MeshcoreError` naming the problem.
+    """
+    from meshcore.cli.mesh import LEVELS, MIN_CELLS
+    from meshcore.errors import InvalidInputError
+    from meshcore.layout import auto_layout
+
+    poly, _ = water(lake.outline, lake.holes)
+    h = cell_size_of(lake)
+    if not (h > 0 and math.isfinite(h)):
+        raise InvalidInputError(f"cell size must be positive, got {h}")
+    est = poly.area / h / h
+    if est < MIN_CELLS:
+        raise InvalidInputError(
+            f"a cell size of {h:.4g} gives about {est:.2g} cells; give at most {math.sqrt(poly.area / MIN_CELLS):.4g}"
+        )
+    return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular)
+
+
+def layout_blocks(layout: Any) -> tuple:
+    """One :class:`~app.project.Block` per layout block: its four borders (read-only) and cells."""
+    from meshcore import BORDER_NAMES
+
+    from .project import Block
+
+    topo = layout.topology()
+    out = []
+    for lb, b in zip(layout.blocks, topo.blocks, strict=True):
+        out.append(
+            Block(
+                name=lb.name,
+                boundary=tuple(np.asarray(b.borders[n], float) for n in BORDER_NAMES),
+                cells=None,
+                closed=True,
+            )
+        )
+    return tuple(out)
+
+
+def with_layout(project: Any, lake: Lake) -> Any:
+    """The project with ``lake`` (and, when it has a layout, the layout's blocks)."""
+    if lake.layout is None:
+        return project.replaced(lake=lake)
+    return project.replaced(lake=lake, blocks=layout_blocks(lake.layout), multiblock=None)

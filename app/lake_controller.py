@@ -1,0 +1,160 @@
+"""Lake actions of the window: Auto layout in a worker thread, the layout settings, the import offer.
+
+:class:`LakeController` computes :func:`app.lake.compute_layout` off the GUI thread (a
+superqt function worker), then sets the layout by one undoable command
+(:meth:`app.commands.Editor.set_lake`) and starts the grid.  Settings (cell size, regular)
+are undoable edits of the project's :class:`~app.lake.Lake`.  After importing a branched
+outline it offers Auto layout in a non-modal box (never shown with ``window.quiet``).
+"""
+
+from __future__ import annotations
+
+import logging
+
+from PySide6 import QtCore, QtWidgets
+from superqt.utils import create_worker
+
+from meshcore import MeshcoreError
+
+from .lake import Lake, compute_layout
+
+__all__ = ["LakeController"]
+
+log = logging.getLogger(__name__)
+
+
+def _layout_job(lake: Lake):
+    """The worker body: the layout, or the message of why there is none."""
+    try:
+        return lake, compute_layout(lake), None
+    except MeshcoreError as exc:
+        return lake, None, str(exc)
+    except Exception as exc:  # a bug must not kill the window: report it, log where it happened
+        log.exception("the layout worker failed")
+        return lake, None, f"internal error: {type(exc).__name__}: {exc} (the traceback is in the log)"
+
+
+class LakeController(QtCore.QObject):
+    """Auto layout and the lake settings of a :class:`~app.main_window.MainWindow`."""
+
+    layout_done = QtCore.Signal(object)  # the Layout, or None when it failed
+    busy_changed = QtCore.Signal(bool)
+
+    def __init__(self, window) -> None:
+        super().__init__(window)
+        self.win = window
+        self.doc = window.doc
+        self.editor = window.editor
+        self._worker = None
+        self.generate_after = True  # start the grid when a layout is set
+        self.prompt: QtWidgets.QMessageBox | None = None  # the offer after importing a branched lake
+        self.last_error: str | None = None
+
+    @property
+    def busy(self) -> bool:
+        return self._worker is not None
+
+    # ------------------------------------------------------------ the lake
+    def lake(self) -> Lake | None:
+        """The lake to lay out: the project's, with the shore as edited (the active loop), or the loop."""
+        p = self.doc.project
+        if p.lake is not None and p.layout is not None:
+            return p.lake
+        b = self.doc.block
+        loop = b.points if b.closed and b.boundary is None and len(b.points) >= 3 else None
+        if p.lake is not None:
+            return p.lake if loop is None or len(p.blocks) > 1 else p.lake.replaced(outline=loop)
+        return None if loop is None else Lake(outline=loop)
+
+    # ---------------------------------------------------------- settings
+    def set_cell_size(self, h: float | None) -> None:
+        """The wanted cell size (None: about 10 000 cells), an undoable edit."""
+        lake = self.lake()
+        if lake is None:
+            self.win.message("Import or draw a lake outline first")
+            return
+        h = None if h is None or h <= 0 else float(h)
+        if h != lake.cell_size:
+            self.editor.set_lake(lake.replaced(cell_size=h), "Set cell size", merge_key=("lake", "h"))
+
+    def set_regular(self, on: bool) -> None:
+        lake = self.lake()
+        if lake is not None and bool(on) != lake.regular:
+            self.editor.set_lake(lake.replaced(regular=bool(on)), "Regular layout" if on else "Any layout")
+
+    # ------------------------------------------------------- auto layout
+    def auto_layout(self, *, regular: bool | None = None) -> bool:
+        """Compute the layout of the lake in a worker; it is set (undoable) and gridded when done."""
+        lake = self.lake()
+        if lake is None:
+            self.win.message("Auto layout needs a lake: import an outline (Ctrl+I) or draw and close a loop")
+            return False
+        if self.busy:
+            return False
+        if regular is not None:
+            lake = lake.replaced(regular=bool(regular))
+        self.close_prompt()
+        self.win.solver.stop()
+        self.last_error = None
+        worker = create_worker(_layout_job, lake.replaced(layout=None), _start_thread=False)
+        worker.returned.connect(self._on_returned)
+        worker.errored.connect(self._on_errored)
+        self._worker = worker
+        self.busy_changed.emit(True)
+        kind = "regular layout (no 3- or 5-block corners)" if lake.regular else "layout"
+        self.win.message(f"Computing the block {kind} of the lake…")
+        worker.start()
+        return True
+
+    def _on_returned(self, value) -> None:
+        lake, layout, err = value
+        self._worker = None
+        self.busy_changed.emit(False)
+        if layout is None:
+            self.last_error = err
+            self.win.error("Cannot lay out the lake", err)
+            self.layout_done.emit(None)
+            return
+        self.editor.set_lake(lake.replaced(layout=layout), "Auto layout")
+        for note in layout.notes:
+            self.doc.report("info", f"layout: {note}")
+        n = len(layout.blocks)
+        self.win.message(
+            f"Layout: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells at {layout.cell_size:.4g} m — "
+            "generating the orthogonal grid (Ctrl+Z undoes the layout)"
+        )
+        self.layout_done.emit(layout)
+        if self.generate_after:
+            self.win.generate()
+
+    def _on_errored(self, exc) -> None:
+        self._worker = None
+        self.busy_changed.emit(False)
+        log.error("the layout worker failed", exc_info=exc)
+        self.last_error = str(exc)
+        self.win.error("Cannot lay out the lake", exc)
+        self.layout_done.emit(None)
+
+    # ------------------------------------------------------------- offer
+    def offer(self, name: str, why: str) -> None:
+        """After importing a branched lake: say why one block is poor, offer Auto layout (non-modal)."""
+        text = f"{name}: {why}. One block would give a poor grid; Auto layout splits the lake into blocks."
+        self.doc.report("info", text)
+        box = QtWidgets.QMessageBox(self.win)
+        box.setWindowTitle("A branched lake")
+        box.setIcon(QtWidgets.QMessageBox.Icon.Question)
+        box.setText(text)
+        box.setModal(False)
+        go = box.addButton("Auto layout", QtWidgets.QMessageBox.ButtonRole.AcceptRole)
+        box.addButton("Not now", QtWidgets.QMessageBox.ButtonRole.RejectRole)
+        go.clicked.connect(lambda: self.auto_layout())
+        self.close_prompt()
+        self.prompt = box
+        if not getattr(self.win, "quiet", False):
+            box.show()
+
+    def close_prompt(self) -> None:
+        if self.prompt is not None:
+            self.prompt.close()
+            self.prompt.deleteLater()
+            self.prompt = None

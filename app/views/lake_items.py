@@ -1,0 +1,111 @@
+"""What the canvas draws of a lake: shore and islands, the layout's cut lines, block corners and
+per-block cell counts, and the places that miss a quality preset.
+
+:class:`LakeOverlay` owns its pyqtgraph items (made once, updated with ``setData``); the
+canvas calls :meth:`LakeOverlay.refresh` when the project changes and
+:meth:`LakeOverlay.set_misses` when the quality verdict changes.  It only draws the document.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6 import QtCore, QtGui
+
+from .items import Scatter, set_points, set_polylines
+
+__all__ = ["LakeOverlay", "block_label_points"]
+
+CUT_COLOUR = "#9467bd"
+SHORE_COLOUR = "#1f5fa8"
+MISS_COLOUR = "#ff7f0e"
+
+
+def block_label_points(layout) -> np.ndarray:
+    """A point inside each layout block (where its cell count is written)."""
+    from shapely.geometry import Polygon
+
+    out = []
+    for pc in layout.pieces:
+        p = Polygon(np.asarray(pc.ring, float)).representative_point()
+        out.append((p.x, p.y))
+    return np.asarray(out, float).reshape(-1, 2)
+
+
+class LakeOverlay:
+    """The lake's items on a canvas (a :class:`pyqtgraph.PlotWidget`)."""
+
+    def __init__(self, canvas) -> None:
+        self.canvas = canvas
+        self.shore = pg.PlotCurveItem(pen=pg.mkPen(SHORE_COLOUR, width=1.5), connect="finite")
+        self.shore.setZValue(4)
+        self.cuts = pg.PlotCurveItem(pen=pg.mkPen(CUT_COLOUR, width=2.5), connect="finite")
+        self.cuts.setZValue(7)
+        self.cut_ends = Scatter(size=9, symbol="o", pen=pg.mkPen(CUT_COLOUR, width=1.5), brush=pg.mkBrush("#fff"))
+        self.cut_ends.setZValue(24)
+        self.corners = Scatter(size=8, symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush("#ffd700"))
+        self.corners.setZValue(23)
+        self.misses = Scatter(size=7, symbol="o", pen=pg.mkPen(MISS_COLOUR, width=1.5), brush=None)
+        self.misses.setZValue(31)
+        for it in (self.shore, self.cuts, self.cut_ends, self.corners, self.misses):
+            canvas.addItem(it)
+            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+        self.labels: list[pg.TextItem] = []
+        self.markers_visible = True
+        self.shown_labels: list[str] = []  # the texts on screen (tests read them)
+
+    # ------------------------------------------------------------ drawing
+    def refresh(self, project) -> None:
+        """Draw the project's lake (nothing when it has none)."""
+        lake = project.lake
+        if lake is None:
+            set_polylines(self.shore, [])
+            self._draw_layout(None)
+            return
+        rings = [lake.outline, *lake.holes]
+        set_polylines(self.shore, [np.vstack([r, r[:1]]) for r in rings if len(r)])
+        self._draw_layout(lake.layout)
+
+    def _draw_layout(self, layout) -> None:
+        if layout is None:
+            set_polylines(self.cuts, [])
+            set_points(self.cut_ends, None)
+            set_points(self.corners, None)
+            self._set_labels([], np.zeros((0, 2)))
+            return
+        cuts = [np.asarray(c, float) for c in layout.cuts]
+        set_polylines(self.cuts, cuts)
+        ends = [c[[0, -1]] for c in cuts if len(c) >= 2]
+        set_points(self.cut_ends, np.vstack(ends) if ends else None)
+        corners = np.array([p for b in layout.blocks for p in b.corners], float).reshape(-1, 2)
+        set_points(self.corners, np.unique(corners, axis=0) if len(corners) else None)
+        texts = [f"{b.name}\n{b.cells[0]}×{b.cells[1]}" for b in layout.blocks]
+        self._set_labels(texts, block_label_points(layout))
+
+    def _set_labels(self, texts: list[str], at: np.ndarray) -> None:
+        font = QtGui.QFont()
+        font.setPointSize(8)
+        while len(self.labels) < len(texts):
+            t = pg.TextItem("", color="#3a1f5c", anchor=(0.5, 0.5), fill=pg.mkBrush(255, 255, 255, 170))
+            t.setFont(font)
+            t.setZValue(25)
+            t.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+            self.canvas.addItem(t)
+            self.labels.append(t)
+        for k, t in enumerate(self.labels):
+            if k < len(texts):
+                t.setText(texts[k])
+                t.setPos(float(at[k, 0]), float(at[k, 1]))
+                t.setVisible(self.markers_visible)
+            else:
+                t.setText("")
+        self.shown_labels = list(texts)
+
+    def set_misses(self, points: np.ndarray | None) -> None:
+        """Ring the places that miss the chosen quality preset (None: none)."""
+        set_points(self.misses, points)
+
+    def set_markers_visible(self, on: bool) -> None:
+        self.markers_visible = bool(on)
+        for it in (self.cut_ends, self.corners, *self.labels):
+            it.setVisible(self.markers_visible)

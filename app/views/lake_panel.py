@@ -1,0 +1,187 @@
+"""The Lake dock: cell size, regular layout, Auto layout, and the layout's blocks with their cells;
+and the lake-grid quality box (presets with pass/fail) of the Quality dock.
+
+Both draw the document; edits go through the lake controller (:mod:`app.lake_controller`),
+whose settings are undoable commands.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from ..document import Document
+
+__all__ = ["LakePanel", "LakeQualityBox", "miss_points"]
+
+AUTO_TEXT = "auto (≈10 000 cells)"
+
+
+class LakePanel(QtWidgets.QWidget):
+    """Settings and result of the lake's block layout."""
+
+    committed = QtCore.Signal()  # an edit was made: the keyboard goes back to the canvas
+
+    def __init__(self, doc: Document, controller, parent=None) -> None:
+        super().__init__(parent)
+        self.doc = doc
+        self.ctl = controller
+        form = QtWidgets.QFormLayout()
+        self.cell_size = QtWidgets.QDoubleSpinBox()
+        self.cell_size.setRange(0.0, 1e7)
+        self.cell_size.setDecimals(1)
+        self.cell_size.setSingleStep(10.0)
+        self.cell_size.setSuffix(" m")
+        self.cell_size.setSpecialValueText(AUTO_TEXT)
+        self.cell_size.setKeyboardTracking(False)
+        self.cell_size.setToolTip("the size of the cells; 0 = sqrt(water area / 10 000), as meshcore mesh")
+        form.addRow("Cell size", self.cell_size)
+        self.regular = QtWidgets.QCheckBox("regular: no 3- or 5-block corners (Delft3D DD)")
+        form.addRow(self.regular)
+        self.button = QtWidgets.QPushButton("Auto layout")
+        self.button.setToolTip("split the lake into four-sided blocks that follow its arms, then generate (Ctrl+L)")
+        form.addRow(self.button)
+        self.summary = QtWidgets.QLabel()
+        self.summary.setWordWrap(True)
+        form.addRow(self.summary)
+        lay = QtWidgets.QVBoxLayout(self)
+        lay.addLayout(form)
+        self.table = QtWidgets.QTableWidget(0, 2)
+        self.table.setHorizontalHeaderLabels(["block", "cells ξ × η"])
+        self.table.horizontalHeader().setStretchLastSection(True)
+        self.table.verticalHeader().hide()
+        self.table.verticalHeader().setDefaultSectionSize(20)
+        self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.itemClicked.connect(lambda it: self.doc.set_active(it.row()))
+        lay.addWidget(self.table, 1)
+        self.cell_size.editingFinished.connect(self._cell_size_edited)
+        self.regular.toggled.connect(self._regular_toggled)
+        self.button.clicked.connect(lambda: self.ctl.auto_layout())
+        controller.busy_changed.connect(self._busy)
+        doc.project_changed.connect(lambda _p: self.refresh())
+        self.refresh()
+
+    def refresh(self) -> None:
+        lake = self.ctl.lake()
+        p = self.doc.project
+        for w in (self.cell_size, self.regular):
+            w.blockSignals(True)
+        self.cell_size.setValue((lake.cell_size or 0.0) if lake is not None else 0.0)
+        self.regular.setChecked(bool(lake is not None and lake.regular))
+        for w in (self.cell_size, self.regular):
+            w.blockSignals(False)
+        self.setEnabled(lake is not None)
+        lay = p.layout
+        if lay is None:
+            self.summary.setText(
+                "No layout yet: Auto layout splits the lake into blocks."
+                if lake is not None
+                else "Import a lake outline (Ctrl+I) or draw and close a loop."
+            )
+            self.table.setRowCount(0)
+            return
+        n = len(lay.blocks)
+        self.summary.setText(f"{n} block{'s' * (n != 1)}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m")
+        self.table.setRowCount(n)
+        for k, b in enumerate(lay.blocks):
+            self.table.setItem(k, 0, QtWidgets.QTableWidgetItem(b.name))
+            self.table.setItem(k, 1, QtWidgets.QTableWidgetItem(f"{b.cells[0]} × {b.cells[1]}"))
+
+    def _cell_size_edited(self) -> None:
+        v = float(self.cell_size.value())
+        self.ctl.set_cell_size(v if v > 0 else None)
+        self.committed.emit()
+
+    def _regular_toggled(self, on: bool) -> None:
+        self.ctl.set_regular(on)
+        self.committed.emit()
+
+    def _busy(self, busy: bool) -> None:
+        self.button.setEnabled(not busy)
+        self.button.setText("Computing the layout…" if busy else "Auto layout")
+
+
+def miss_points(verdict) -> np.ndarray:
+    """``(k, 2)`` places (nodes, cells, edge pairs) that miss a limit the verdict failed."""
+    m = verdict.metrics
+    out = []
+    for r in verdict.failed:
+        s = m.samples.get(r.limit.metric)
+        if s is None or not len(s) or r.limit.statistic != "each":
+            continue
+        bad = ~(s.values <= r.limit.max)
+        out.append(np.column_stack([s.x[bad], s.y[bad]]))
+    return np.vstack(out) if out else np.zeros((0, 2))
+
+
+class LakeQualityBox(QtWidgets.QGroupBox):
+    """A model's limits (Delft3D, EFDC, …) against the lake grid: pass/fail per limit.
+
+    ``misses`` carries the places that miss a failed limit (the canvas rings them).
+    """
+
+    misses = QtCore.Signal(object)
+
+    def __init__(self, doc: Document, parent=None) -> None:
+        super().__init__("Lake grid against a model's limits", parent)
+        from meshcore.quality import PRESETS
+
+        self.doc = doc
+        self.verdict = None
+        lay = QtWidgets.QVBoxLayout(self)
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(QtWidgets.QLabel("Preset"))
+        self.preset = QtWidgets.QComboBox()
+        self.preset.addItems(list(PRESETS))
+        row.addWidget(self.preset, 1)
+        lay.addLayout(row)
+        self.headline = QtWidgets.QLabel()
+        self.headline.setWordWrap(True)
+        lay.addWidget(self.headline)
+        self.table = QtWidgets.QTableWidget(0, 3)
+        self.table.setHorizontalHeaderLabels(["limit", "verdict", "miss"])
+        self.table.horizontalHeader().setStretchLastSection(True)
+        self.table.verticalHeader().hide()
+        self.table.verticalHeader().setDefaultSectionSize(20)
+        self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.setMinimumHeight(90)
+        lay.addWidget(self.table)
+        self.preset.currentTextChanged.connect(lambda _t: self.refresh())
+        doc.quality_changed.connect(self.refresh)
+        self.refresh()
+
+    def refresh(self) -> None:
+        from meshcore.quality import check
+
+        m = self.doc.lake_metrics
+        self.setVisible(self.doc.project.layout is not None)
+        if m is None:
+            self.verdict = None
+            self.headline.setText("No lake grid yet (Auto layout, then it generates).")
+            self.table.setRowCount(0)
+            self.misses.emit(None)
+            return
+        v = check(m, self.preset.currentText())
+        self.verdict = v
+        s = m.summary()
+        n_fail = len(v.failed)
+        word = "PASS" if v.passed else f"FAIL ({n_fail} of {len(v.results)} limits missed)"
+        self.headline.setText(
+            f"<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
+            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded; places that miss are ringed in orange"
+        )
+        self.table.setRowCount(len(v.results))
+        for k, r in enumerate(v.results):
+            if r.passed is None:
+                text, colour = "not checked", "#666"
+            else:
+                stat = f"mean {r.value:.3g}" if r.limit.statistic == "mean" else f"{100 * r.value:.1f} % ok"
+                text, colour = (f"pass ({stat})", "#070") if r.passed else (f"FAIL ({stat})", "#c00")
+            cells = [r.limit.label, text, str(r.n_failed)]
+            for c, t in enumerate(cells):
+                it = QtWidgets.QTableWidgetItem(t)
+                if c == 1:
+                    it.setForeground(QtGui.QBrush(QtGui.QColor(colour)))
+                self.table.setItem(k, c, it)
+        self.table.resizeColumnToContents(0)
+        self.misses.emit(miss_points(v))

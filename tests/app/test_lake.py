@@ -1,0 +1,195 @@
+"""A lake in the app: import with islands, Auto layout, the orthogonal grid, presets, export, undo."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.gui
+
+LAKES = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
+ISEO = LAKES / "lake_iseo_sparse.geojson"  # one island (Monte Isola)
+COMO = LAKES / "lake_como.geojson"  # Y-shaped, three arms
+
+
+def wait_idle(qtbot, win, timeout=120_000):
+    """Until neither the layout nor the grid is being computed (a busy machine may take long)."""
+    qtbot.waitUntil(
+        lambda: not win.lake_ctl.busy and not win.solver.running and not win.solver._debounce.isActive(),
+        timeout=timeout,
+    )
+
+
+def lay_out(qtbot, win, path, cell_size=None):
+    """Import ``path`` and run Auto layout as a user does (panel, then the toolbar action)."""
+    assert win.io.import_points(path, project_lonlat=True)
+    if cell_size is not None:
+        win.lake_panel.cell_size.setValue(cell_size)
+        win.lake_panel.cell_size.editingFinished.emit()
+    win.a_auto_layout.trigger()
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None or win.lake_ctl.last_error, timeout=120_000)
+    assert win.lake_ctl.last_error is None
+    wait_idle(qtbot, win)
+    return win.doc.project.layout
+
+
+def test_import_reads_islands_and_offers_auto_layout(qtbot, win):
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    p = win.doc.project
+    assert p.lake is not None and len(p.lake.holes) == 1  # Monte Isola
+    np.testing.assert_array_equal(win.doc.block.points, p.lake.outline)  # the shore is the editable block
+    assert p.crs.startswith("EPSG:326")
+    prompt = win.lake_ctl.prompt
+    assert prompt is not None and not prompt.isVisible()  # quiet: offered, not shown
+    assert "island" in prompt.text()
+    assert win.docks["lake"].isVisible()
+    # the island is drawn (shore and island rings)
+    x, _y = win.canvas.lake_items.shore.getData()
+    assert np.isnan(x).sum() == 2
+    # the offer's button runs Auto layout, and the grid follows
+    go = next(b for b in prompt.buttons() if b.text() == "Auto layout")
+    win.lake_panel.cell_size.setValue(300.0)
+    win.lake_panel.cell_size.editingFinished.emit()
+    go.click()
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    wait_idle(qtbot, win)
+    lay = win.doc.project.layout
+    assert lay.cell_size == 300.0 and len(lay.polygon.interiors) == 1
+    assert win.lake_ctl.prompt is None
+
+
+def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
+    lay = lay_out(qtbot, win, ISEO, cell_size=300.0)
+    n = len(lay.blocks)
+    doc = win.doc
+    assert len(doc.project.blocks) == n and n > 1
+    # the canvas: cut lines, block corners and one "name / ni×nj" label per block
+    items = win.canvas.lake_items
+    assert items.shown_labels == [f"{b.name}\n{b.cells[0]}×{b.cells[1]}" for b in lay.blocks]
+    assert len(items.cuts.getData()[0]) > 0 and len(items.corners.getData()[0]) >= 4
+    # the panel lists the blocks and their cells
+    assert win.lake_panel.table.rowCount() == n
+    assert win.lake_panel.table.item(0, 1).text() == f"{lay.blocks[0].cells[0]} × {lay.blocks[0].cells[1]}"
+    # every block gridded with its layout cells, as one orthogonal multiblock grid
+    assert sorted(doc.grids) == list(range(n))
+    assert [doc.grids[k].cells for k in range(n)] == [tuple(b.cells) for b in lay.blocks]
+    assert doc.multiblock is not None and doc.multiblock.mode == "orthogonal"
+    # the quality dock: lake metrics against a preset, pass/fail per limit, misses ringed
+    box = win.lake_quality
+    assert box.isVisible() and doc.lake_metrics is not None
+    assert doc.lake_metrics.summary()["folded_cells"] == 0
+    for preset in ("delft3d", "efdc"):
+        box.preset.setCurrentText(preset)
+        v = box.verdict
+        assert v is not None and v.preset.name == preset
+        assert box.table.rowCount() == len(v.results)
+        words = {box.table.item(k, 1).text().split()[0] for k in range(box.table.rowCount())}
+        assert words <= {"pass", "FAIL", "not"}
+        misses = win.canvas.lake_items.misses.getData()[0]
+        assert (len(misses) > 0) == any(r.limit.statistic == "each" for r in v.failed)
+
+
+def test_the_same_layout_as_meshcore_mesh(qtbot, win):
+    """The app's layout of a file is the CLI's: same water, cell size, multiple, blocks, cells."""
+    from meshcore.cli.mesh import LEVELS
+    from meshcore.crs import project
+    from meshcore.io import read_points
+    from meshcore.layout import auto_layout
+    from meshcore.layout.polygon import water_from_points, water_polygon
+
+    win.lake_ctl.generate_after = False
+    assert win.io.import_points(COMO, project_lonlat=True)
+    win.a_auto_layout.trigger()
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    app = win.doc.project.layout
+    local, _frame = project(read_points(COMO), "auto", origin=None)  # as `meshcore mesh` reads it
+    outer, islands = water_from_points(local)
+    poly, _ = water_polygon(outer, holes=islands)
+    h = math.sqrt(poly.area / 10_000)  # the CLI's default cell size
+    cli = auto_layout(poly, cell_size=h, multiple=2**LEVELS)
+    assert app.cell_size == pytest.approx(h, rel=1e-9)
+    assert [b.cells for b in app.blocks] == [b.cells for b in cli.blocks]
+    assert app.n_cells == cli.n_cells and 8_000 < app.n_cells < 12_000
+
+
+def test_layout_undo_redo_and_clear(qtbot, win):
+    win.lake_ctl.generate_after = False
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    shore = win.doc.project
+    win.lake_ctl.set_cell_size(300.0)
+    win.a_auto_layout.trigger()
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    laid = win.doc.project
+    # the block points are not editable in a layout: a clear message instead
+    win.editor.move_points([0], (10.0, 0.0))
+    assert win.doc.project is laid and "Lake panel" in win._status.text()
+    win.stack.undo()
+    assert win.doc.project.layout is None and len(win.doc.project.blocks) == 1
+    assert win.canvas.lake_items.shown_labels == []
+    win.stack.undo()  # the cell size
+    assert win.doc.project.lake.cell_size is None
+    win.stack.redo()
+    win.stack.redo()
+    assert win.doc.project is laid
+    win.a_clear_layout.trigger()
+    p = win.doc.project
+    assert p.layout is None and p.lake.cell_size == 300.0 and len(p.blocks) == 1
+    np.testing.assert_array_equal(p.blocks[0].points, shore.lake.outline)
+
+
+def test_export_como_to_delft3d_dd_and_vtm(qtbot, win, tmp_path):
+    """The issue's target: Como in, Auto layout, generate, a Delft3D DD file out."""
+    from meshcore.io import read
+
+    lay = lay_out(qtbot, win, COMO)
+    assert 8_000 < lay.n_cells < 12_000
+    assert win.doc.lake_metrics.summary()["folded_cells"] == 0
+    out = tmp_path / "como.ddb"
+    assert win.io.export_mesh(out), win._status.text()
+    back = read(out)
+    assert len(back.blocks) == len(lay.blocks)
+    assert sum(g.cells[0] * g.cells[1] for g in back.blocks) == lay.n_cells
+    assert win.io.export_mesh(tmp_path / "como.vtm")
+    assert (tmp_path / "como.vtm").exists()
+
+
+def test_a_ddb_that_delft3d_cannot_couple_says_what_to_do(qtbot, win, tmp_path):
+    lay_out(qtbot, win, LAKES / "lake_como_sparse.geojson", cell_size=300.0)
+    out = tmp_path / "x.ddb"
+    if win.io.export_mesh(out):
+        pytest.skip("this layout can be coupled by Delft3D")  # meshcore's layout improved
+    assert not out.exists()
+    assert "regular" in win._status.text()
+    win.a_auto_layout_regular.trigger()
+    qtbot.waitUntil(lambda: win.doc.project.lake.regular and win.doc.project.layout is not None, timeout=120_000)
+    wait_idle(qtbot, win)
+    if not win.io.export_mesh(out):
+        assert "Cannot export" in win._status.text() and not out.exists()
+
+
+def test_save_and_recover_a_lake_layout(qtbot, win, tmp_path):
+    from app import recovery
+
+    lay = lay_out(qtbot, win, ISEO, cell_size=300.0)
+    path = tmp_path / "iseo.toml"
+    assert win.io.save_to(path)
+    assert path.exists()
+    # the autosave keeps the lake: the recovered project has the same layout
+    recovery.write(win.doc.project, tmp_path / "rec.toml")
+    back, _ = recovery.read(tmp_path / "rec.toml")
+    got = back.layout
+    assert got is not None and back.lake.cell_size == 300.0
+    assert [b.cells for b in got.blocks] == [b.cells for b in lay.blocks]
+    assert len(back.blocks) == len(lay.blocks)
+
+
+def test_a_lake_refused_is_a_message(qtbot, win):
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    win.lake_ctl.set_cell_size(1e6)  # a few cells for the whole lake
+    win.a_auto_layout.trigger()
+    qtbot.waitUntil(lambda: not win.lake_ctl.busy, timeout=60_000)
+    assert win.doc.project.layout is None
+    assert "Cannot lay out the lake" in win._status.text() and "cell size" in win._status.text()
