@@ -1,7 +1,7 @@
 """The orthogonal multiblock grid of a lake layout, as a generator the solver worker runs (no Qt).
 
 :func:`solve_layout` yields ``(ALL_BLOCKS, SolverProgress)`` items with every block's grid and
-returns a :class:`~app.pipeline.BlockResult` carrying the
+returns a :class:`~app.results.BlockResult` carrying the
 :class:`~meshcore.multiblock.MultiBlockGrid`.  Two ways, one result:
 
 * **cold** (a new layout, or blocks whose cell counts changed):
@@ -29,7 +29,7 @@ import numpy as np
 
 from meshcore import SolverProgress, StructuredGrid
 
-from .pipeline import ALL_BLOCKS, BlockResult
+from .results import ALL_BLOCKS, BlockResult
 
 __all__ = ["TOLERANCE", "solve_layout"]
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable, Generator, Mapping
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from meshcore import Done, StartGrid, StructuredGrid, run_block
 from meshcore.elliptic import residual
 
 from .project import Block, Project
+from .results import ALL_BLOCKS, BlockResult
 
 __all__ = [
     "ALL_BLOCKS",
@@ -37,19 +37,6 @@ __all__ = [
     "warm_start",
     "warmup",
 ]
-
-#: block index of progress items that concern all blocks at once
-ALL_BLOCKS = -1
-
-
-@dataclass(frozen=True, slots=True)
-class BlockResult:
-    """What the worker returns: final grids and algebraic grids per block, and the warnings."""
-
-    grids: dict
-    initial: dict
-    multiblock: object = None  # the meshcore MultiBlockGrid of a multiblock case (connectivity)
-    warnings: tuple[str, ...] = field(default=())
 
 
 def warm_start(previous: tuple[StructuredGrid, StructuredGrid]) -> Callable[[StructuredGrid], StructuredGrid]:

@@ -91,6 +91,10 @@ class SolveStatus(QtCore.QObject):
             self.label.setText("idle")
             return
         info = g.info
+        mb = self.doc.multiblock
+        if self.doc.project.layout is not None and mb is not None:  # a lake grid: what was done to all blocks
+            self._lake_final(mb)
+            return
         if info.residual_history:
             self.conv.set_history(list(info.residual_history), info.tolerance)
         r = self.doc.quality
@@ -102,9 +106,24 @@ class SolveStatus(QtCore.QObject):
         self.label.setText(f"{info.method}: {state}, {info.iterations} iterations, {dt * 1000:.0f} ms")
         self.win.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}")
 
+    def _lake_final(self, mb) -> None:
+        info = mb.info
+        m = self.doc.lake_metrics
+        dt = self.solver.t_done - self.solver.t_start
+        cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
+        self.label.setText(f"orthogonal: {info.iterations} sweeps, {dt:.1f} s")
+        folded = int(m.values("folded").sum()) if m is not None else 0
+        warn = f" — {folded} FOLDED or non-convex cells" if folded else ""
+        mean = f", mean deviation from 90° {m.mean('deviation'):.2f}°" if m is not None else ""
+        self.win.message(f"Lake grid: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
+
     def report_notes(self) -> None:
         """Repairs, corner advice and other notes of the solver, in full, in the message panel."""
         blocks = self.doc.project.blocks
+        mb = self.doc.multiblock
+        if self.doc.project.layout is not None and mb is not None:
+            self.doc.report("info", f"lake grid: {mb.info.message}")
+            return
         for k, g in sorted(self.doc.grids.items()):
             note = (g.info.message or "").strip()
             if not note or note in ("converged", "stopped"):

@@ -45,9 +45,11 @@ class LakeOverlay:
         self.cut_ends.setZValue(24)
         self.corners = Scatter(size=8, symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush("#ffd700"))
         self.corners.setZValue(23)
-        self.misses = Scatter(size=7, symbol="o", pen=pg.mkPen(MISS_COLOUR, width=1.5), brush=None)
+        self.misses = Scatter(size=5, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 170))
         self.misses.setZValue(31)
-        for it in (self.shore, self.cuts, self.cut_ends, self.corners, self.misses):
+        self.drag_point = Scatter(size=13, symbol="o", pen=pg.mkPen("#d62728", width=2), brush=None)
+        self.drag_point.setZValue(43)
+        for it in (self.shore, self.cuts, self.cut_ends, self.corners, self.misses, self.drag_point):
             canvas.addItem(it)
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.labels: list[pg.TextItem] = []
@@ -104,6 +106,10 @@ class LakeOverlay:
     def set_misses(self, points: np.ndarray | None) -> None:
         """Ring the places that miss the chosen quality preset (None: none)."""
         set_points(self.misses, points)
+
+    def set_drag_point(self, xy) -> None:
+        """Ring the handle being dragged where it will go (None: no drag)."""
+        set_points(self.drag_point, None if xy is None else np.asarray(xy, float).reshape(1, 2))
 
     def set_markers_visible(self, on: bool) -> None:
         self.markers_visible = bool(on)
