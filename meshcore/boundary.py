@@ -53,6 +53,17 @@ __all__ = [
 ]
 
 
+def check_encloses_area(points: np.ndarray, *, name: str) -> float:
+    """The signed area of a closed loop; refuse one that encloses (almost) no area (points on a line)."""
+    p = np.asarray(points, dtype=np.float64)
+    a = signed_area(p)
+    d = p - p[0]
+    s = float(np.abs(d).max()) if len(p) else 0.0
+    if s > 0 and abs(signed_area(d / s)) <= 1e-12:
+        raise BoundaryError(f"{name}: the outline encloses no area (its points lie on a line)")
+    return a
+
+
 def signed_area(points: np.ndarray) -> float:
     """Signed area of a closed polygon (positive when counter-clockwise).
 
@@ -395,7 +406,7 @@ def borders_from_polylines(
             )
         except BoundaryError as exc:
             raise BoundaryError(f"{prefix}{exc}") from None
-        if signed_area(borders.loop()) <= 0 and not is_cut:
+        if not is_cut and check_encloses_area(borders.loop(), name=f"{prefix}borders") <= 0:
             raise BoundaryError(
                 f"{prefix}the borders run clockwise (bottom → right → top → left must go "
                 f"counter-clockwise): reverse their order or swap left/right"
@@ -464,7 +475,7 @@ def borders_from_loop(
         c = [int(newidx[ci]) for ci in c]
         loop = loop[keep]
         n = len(loop)
-    if signed_area(loop) < 0:
+    if check_encloses_area(loop, name=f"{prefix}boundary points") < 0:
         loop = loop[::-1].copy()
         c = [n - 1 - ci for ci in c]
     # the corners must be in cyclic CCW order sw → se → ne → nw

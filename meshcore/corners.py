@@ -84,6 +84,12 @@ def interior_angles(points: Any) -> np.ndarray:
     enclosed region.  A vertex with angle > 180° is *reflex*.
     """
     p, _ = _loop(points, "boundary points")
+    return _angles(p)
+
+
+def _angles(p: np.ndarray) -> np.ndarray:
+    """Interior angles of the loop ``p`` exactly as given (no closing point dropped: a loop whose
+    last point repeats its first after a run of repeated points keeps its length)."""
     flip = _signed_area(p) < 0
     if flip:  # measure on the counter-clockwise loop (no recursion: rounding cannot ping-pong)
         p = p[::-1]
@@ -145,7 +151,9 @@ def choose_corners(points: Any, *, method: str = "bbox", upright: bool = False) 
     """
     method = validate_choice(method, ("bbox", "hull", "outline"), name="corner method")
     p, n = _loop(points, "boundary points")
-    ccw = _signed_area(p) >= 0
+    from .boundary import check_encloses_area  # points on a line: one clear error, not a NaN box
+
+    ccw = check_encloses_area(p, name="boundary points") >= 0
     q = p if ccw else p[::-1]
     c0, rot = _principal_frame(q)
     st = (q - c0) @ rot.T
@@ -178,7 +186,7 @@ def _box(st: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def _box_corners(q: np.ndarray, st: np.ndarray) -> list[int]:
     """The vertices nearest the principal box's corners (the nearest convex one for a reflex pick)."""
     box, _, _ = _box(st)
-    convex = interior_angles(q) < 180.0 - 1e-9
+    convex = _angles(q) < 180.0 - 1e-9
     picks = []
     for b in box:
         d2 = ((st - b) ** 2).sum(axis=1)
@@ -234,7 +242,7 @@ def _tip_corners(q: np.ndarray, u: np.ndarray) -> list[int]:
     c = [walk(a, 1), walk(b, -1), walk(b, 1), walk(a, -1)]  # sw, se, ne, nw walking CCW
     if not _cyclic_ok(c, n):
         return []
-    ang = interior_angles(q)
+    ang = _angles(q)
     for prob in corner_problems(q, c):  # off reflex vertices, keeping the order
         if prob.suggestion is not None:
             trial = c.copy()
@@ -262,7 +270,7 @@ def _by_arc_length(q: np.ndarray, start: int) -> list[int]:
     seg = np.hypot(*(np.roll(q, -1, axis=0) - q).T)
     s = np.concatenate([[0.0], np.cumsum(seg[order][:-1])])
     per = float(seg.sum())
-    convex = interior_angles(q)[order] < 180.0
+    convex = _angles(q)[order] < 180.0
     picks = [0]
     for k in (1, 2, 3):
         lo = picks[-1] + 1
@@ -301,7 +309,7 @@ class CornerProblem:
 def corner_problems(points: Any, corners: Any) -> list[CornerProblem]:
     """Corners (``sw, se, ne, nw`` indices into ``points``) that sit on reflex vertices."""
     p, n = _loop(points, "boundary points")
-    ang = interior_angles(p)
+    ang = _angles(p)
     convex = np.flatnonzero(ang < 180.0)
     out = []
     for name, k in zip(CORNER_NAMES, corners, strict=True):

@@ -2,22 +2,27 @@
 
 Subcommands live in one module each with ``add_args(parser)`` and
 ``run(args) -> int``.  Exit codes: 0 success/converged, 2 bad input (one line
-on stderr, no traceback, no partial output), 3 solved but not converged.
+on stderr, no traceback, no partial output), 3 solved but not converged, 1 an
+internal error (a bug; one line too, ``MESHCORE_DEBUG=1`` shows the traceback),
+130 interrupted.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import platform
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from ..errors import MeshcoreError
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_CONVERGED", "EXIT_OK", "main"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_INTERNAL", "EXIT_NOT_CONVERGED", "EXIT_OK", "main"]
 
 EXIT_OK = 0
+EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
 
@@ -50,13 +55,21 @@ def _version() -> str:
     )
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with the promised error format: one line on stderr, exit code 2."""
+
+    def error(self, message: str) -> NoReturn:
+        line = " ".join(message.split())
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {line} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="meshcore",
         description="Structured boundary-fitted 2-D grids in generalized coordinates.",
     )
     parser.add_argument("--version", action="version", version=_version())
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, mod, help_ in SUBCOMMANDS:
         m = importlib.import_module(f"{__name__}.{mod}")
         p = sub.add_parser(name, help=help_, description=help_)
@@ -66,19 +79,38 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit code (see the module docstring)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a usage error (already printed as one line)
+        return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
     if not getattr(args, "_run", None):
         parser.print_help(sys.stderr)
         return EXIT_BAD_INPUT
     try:
         return int(args._run(args))
     except MeshcoreError as exc:
-        print(f"meshcore {args.command}: error: {exc}", file=sys.stderr)
+        print(f"meshcore {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print(f"meshcore {args.command}: interrupted", file=sys.stderr)
         return 130
     except (OSError, ValueError) as exc:  # anything else a user can cause (paths, numbers)
-        print(f"meshcore {args.command}: error: {exc}", file=sys.stderr)
+        print(f"meshcore {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except Exception as exc:  # a bug: still one line, with the way to the traceback
+        if os.environ.get("MESHCORE_DEBUG"):
+            raise
+        print(
+            f"meshcore {args.command}: internal error: {type(exc).__name__}: {_one_line(exc)} "
+            f"(a bug: please report it; MESHCORE_DEBUG=1 shows the traceback)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL
+
+
+def _one_line(exc: BaseException) -> str:
+    from ..io._atomic import one_line
+
+    return one_line(str(exc)) or type(exc).__name__

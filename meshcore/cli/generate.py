@@ -128,6 +128,8 @@ def run(args: argparse.Namespace) -> int:
     if args.png:
         write(Path(args.png), result, crs=frame)
     converged = all(g.converged for g in blocks)
+    reports = [quality(g) for g in blocks]
+    folded = sum(r.n_folded for r in reports)
     if not args.quiet:
         block_names = list(getattr(result, "names", [b.name for b in case.blocks]))
         for k, g in enumerate(blocks):
@@ -136,12 +138,15 @@ def run(args: argparse.Namespace) -> int:
                 f"block {name!r}: {g.cells[0]}×{g.cells[1]} cells, {g.info.method}, "
                 f"{g.info.message}, {g.iterations} iterations, residual {g.residual:.3e}"
             )
-            print(quality(g).table())
+            print(reports[k].table())
         if hasattr(result, "report"):  # multiblock: connectivity and interface quality
             print(result.report())
             print(result.quality().table())
         print(f"done in {elapsed:.3f} s" + (f"; wrote {args.output}" if args.output else ""))
     if not converged:
         print("meshcore generate: warning: the solver did not converge (exit code 3)", file=sys.stderr)
+        return 3
+    if folded:  # a folded grid is never reported as a success (e.g. repair = "off" in the case)
+        print(f"meshcore generate: warning: the grid has {folded} folded cell(s) (exit code 3)", file=sys.stderr)
         return 3
     return 0

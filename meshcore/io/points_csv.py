@@ -18,6 +18,7 @@ point dropped.
 from __future__ import annotations
 
 import re
+import warnings
 from array import array
 from collections.abc import Iterator
 from pathlib import Path
@@ -183,34 +184,40 @@ class _Layout:
         return numeric[0], numeric[1]
 
 
-def read_points_csv(
-    path: Path, *, columns: Any = None, crs: Any = None, closed: bool | None = None, **_: Any
-) -> PointSet:
-    """Read polylines from a delimited text file (see module docstring).
+def _fast_points(text: str, lay: _Layout) -> np.ndarray | None:
+    """Every row in one C pass, when the file is one plain block of numbers after its header
+    (no comments, segments, names, quotes or blank lines); None otherwise (then the line loop
+    runs, and names the line of any problem)."""
+    if lay.name_col is not None or lay.decimal_comma:
+        return None
+    start = 0
+    for _ in range(lay.header_line):  # skip the header line (and anything before it)
+        start = text.find("\n", start) + 1
+        if start == 0:
+            return None
+    body = text[start:].replace("\r", "").strip()
+    if not body or any(c in body for c in "#>%!\"'/") or re.search(r"\n[ \t]*\n", body):
+        return None
+    flat = body.replace(lay.delim, " ") if lay.delim else body
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            vals = np.fromstring(flat, dtype=np.float64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        return None
+    rows = body.count("\n") + 1
+    if vals.size != rows * lay.width:
+        return None
+    v = vals.reshape(rows, lay.width)
+    return np.column_stack([v[:, lay.ix], v[:, lay.iy]])
 
-    One pass over the text into two float arrays (about 16 bytes per point);
-    the number of lines is checked against
-    :func:`~meshcore._validation.max_points` before parsing.
 
-    Parameters
-    ----------
-    path : Path
-    columns : (x, y), optional
-        Column names (as in the header) or 0-based indices of x and y
-        (or of lon and lat).
-    crs : optional
-        Declared CRS of the points (overrides what the header suggests).
-    closed : bool, optional
-        Force rings (True) or open polylines (False); default: closed when
-        the last point repeats the first.
-    """
-    text = decode_text(path, read_bytes(path))
-    check_allocation(
-        text.count("\n") + 1, max_points(), what=f"{path}: lines", env="MESHCORE_MAX_POINTS", error=ReadError
-    )
-    lay = _Layout(path, text, columns)
+def _rows(path: Path, text: str, lay: _Layout) -> tuple[np.ndarray, list[tuple[int, str | None, str | None, int]]]:
+    """All points, and ``(first point, group name, segment name, line)`` of each polyline's run."""
+    fast = _fast_points(text, lay)
+    if fast is not None:
+        return fast, [(0, None, None, lay.first_line)]
     xs, ys = array("d"), array("d")
-    # (first point index, group name, segment name, line) of each run of points
     groups: list[tuple[int, str | None, str | None, int]] = []
     seg_name: str | None = None
     new_segment = True
@@ -242,9 +249,42 @@ def read_points_csv(
         if new_segment or gname != groups[-1][1]:
             groups.append((len(xs) - 1, gname, seg_name, lineno))
             new_segment = False
+    pts = np.column_stack([np.frombuffer(xs, dtype=np.float64), np.frombuffer(ys, dtype=np.float64)])
+    return pts, groups
+
+
+def read_points_csv(
+    path: Path, *, columns: Any = None, crs: Any = None, closed: bool | None = None, **_: Any
+) -> PointSet:
+    """Read polylines from a delimited text file (see module docstring).
+
+    Linear in the file, about 16 bytes per point beyond the text itself (a
+    plain block of numbers is parsed in one C pass, anything else line by
+    line); the number of lines is checked against
+    :func:`~meshcore._validation.max_points` before parsing.
+
+    Parameters
+    ----------
+    path : Path
+    columns : (x, y), optional
+        Column names (as in the header) or 0-based indices of x and y
+        (or of lon and lat).
+    crs : optional
+        Declared CRS of the points (overrides what the header suggests).
+    closed : bool, optional
+        Force rings (True) or open polylines (False); default: closed when
+        the last point repeats the first.
+    """
+    data = read_bytes(path)
+    check_allocation(
+        data.count(b"\n") + 1, max_points(), what=f"{path}: lines", env="MESHCORE_MAX_POINTS", error=ReadError
+    )
+    text = decode_text(path, data)
+    del data
+    lay = _Layout(path, text, columns)
+    pts, groups = _rows(path, text, lay)
     if not groups:
         raise ReadError(f"{path}: no data rows after the header")
-    pts = np.column_stack([np.frombuffer(xs, dtype=np.float64), np.frombuffer(ys, dtype=np.float64)])
     base = path.stem
     polylines = []
     ends = [g[0] for g in groups[1:]] + [len(pts)]

@@ -187,3 +187,46 @@ print("ok")
     with tempfile.TemporaryDirectory() as d:
         r = subprocess.run([sys.executable, "-c", code, d], capture_output=True, text=True, cwd=ROOT, timeout=600)
     assert r.returncode == 0 and r.stdout.strip().endswith("ok"), r.stderr[-3000:]
+
+
+def test_a_folded_grid_is_never_exit_0(tmp_path, capsys):
+    """With repair = "off" the elliptic grid keeps its folded cell: written, but exit 3 and said so."""
+    pts = [[0.848, 0.088], [0.196, 0.051], [-0.11, 0.879], [-0.218, -0.061], [-0.614, -0.487]]
+    pts += [[-0.222, -0.258], [-0.114, -0.883], [0.245, -0.584], [0.375, -0.229], [0.494, -0.214]]
+    case = tmp_path / "fold.toml"
+    case.write_text(
+        f"[[blocks]]\nname = 'f'\ncells = [12, 12]\n[blocks.boundary]\npoints = {pts}\ncorners = [0, 1, 2, 8]\n"
+        "[solver]\nrepair = 'off'\n"
+    )
+    out = tmp_path / "f.vts"
+    assert main(["generate", str(case), "-o", str(out), "-q"]) == 3
+    assert "1 folded cell(s)" in capsys.readouterr().err
+    assert out.exists()
+    case.write_text(case.read_text().replace("repair = 'off'", "repair = 'auto'"))
+    assert main(["generate", str(case), "-o", str(out), "-q"]) == 0
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["generate"], ["import", "x.kml", "--corners", "1", "2"], ["bogus"], ["generate", "c.toml", "--threads", "x"]],
+)
+def test_usage_errors_are_one_line_exit_2(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ": error: " in err and "--help" in err
+
+
+def test_an_internal_error_is_one_line_exit_1(capsys, monkeypatch, tmp_path):
+    from meshcore.cli import quality
+
+    def boom(args):
+        raise TypeError("unexpected")
+
+    monkeypatch.setattr(quality, "run", boom)
+    assert main(["quality", str(tmp_path / "g.vts")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error: TypeError: unexpected" in err and "MESHCORE_DEBUG" in err
+    monkeypatch.setenv("MESHCORE_DEBUG", "1")
+    with pytest.raises(TypeError):
+        main(["quality", str(tmp_path / "g.vts")])
