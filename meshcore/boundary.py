@@ -54,14 +54,16 @@ __all__ = [
 
 
 def check_encloses_area(points: np.ndarray, *, name: str) -> float:
-    """The signed area of a closed loop; refuse one that encloses (almost) no area (points on a line)."""
+    """The signed area of a closed loop; refuse a loop whose points lie on a line (no area at all).
+
+    A loop that crosses itself so that its areas cancel is not refused here
+    (the self-intersection check names the crossing).
+    """
     p = np.asarray(points, dtype=np.float64)
-    a = signed_area(p)
-    d = p - p[0]
-    s = float(np.abs(d).max()) if len(p) else 0.0
-    if s > 0 and abs(signed_area(d / s)) <= 1e-12:
+    sv = np.linalg.svd(p - p.mean(axis=0), compute_uv=False) if len(p) >= 2 else np.zeros(1)
+    if len(sv) < 2 or not sv[1] > 1e-12 * sv[0]:
         raise BoundaryError(f"{name}: the outline encloses no area (its points lie on a line)")
-    return a
+    return signed_area(p)
 
 
 def signed_area(points: np.ndarray) -> float:

@@ -107,6 +107,13 @@ def _prepare(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
 def _result(grid, x, y, *, ok, before, folded_before, exempt, ex_bits, nodes, sweeps, t0, method, msg):
     bad = invalid_cells(x, y, ex_bits)
     ok = ok and not bad.any()
+    flat = _folded(x, y)
+    if flat and ok:  # an exempt corner excuses a corner angle, never a cell without area
+        ok = False
+        msg = (
+            f"{msg}; {flat} cell(s) have no area (area ≤ 0): the block's corners leave them no room "
+            f"(choose other corners or more cells)"
+        )
     info = SolveInfo(
         method=method,
         converged=grid.info.converged and ok,
@@ -181,7 +188,8 @@ def repair(
     common = {"folded_before": folded_before, "exempt": exempt, "ex_bits": ex_bits, "t0": t0}
     if before == 0:
         msg = grid.info.message + exempt_note
-        return _result(grid, x, y, ok=True, before=0, nodes=0, sweeps=0, method=grid.info.method, msg=msg, **common)
+        res = _result(grid, x, y, ok=True, before=0, nodes=0, sweeps=0, method=grid.info.method, msg=msg, **common)
+        return _raise_if_failed(res, strict and not res.ok)
     opts = {"tolerance": tolerance, "max_sweeps": max_sweeps, "periodic": grid.periodic}
     x0, y0 = x.copy(), y.copy()
     ok, nfree, total = patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, **opts)
@@ -211,7 +219,7 @@ def repair(
         msg = f"{origin}; " + _failure_message(StructuredGrid(x, y), invalid_cells(x, y, ex_bits), exempt)
     method = f"{grid.info.method}+foldfree"
     res = _result(grid, x, y, ok=ok, before=before, nodes=nfree, sweeps=total, method=method, msg=msg, **common)
-    return _raise_if_failed(res, strict and not ok)
+    return _raise_if_failed(res, strict and not res.ok)
 
 
 def _multilevel(
@@ -352,4 +360,4 @@ def smooth(
         method="foldfree",
         msg=msg,
     )
-    return _raise_if_failed(res, strict and not ok)
+    return _raise_if_failed(res, strict and not res.ok)

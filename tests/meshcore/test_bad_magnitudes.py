@@ -100,3 +100,16 @@ def test_multiblock_total_node_limit(monkeypatch, capsys):
     assert main(["generate", str(case), "-q"]) == 2
     err = capsys.readouterr().err
     assert "MESHCORE_MAX_NODES" in err and err.count("\n") == 1
+
+
+def test_a_cell_without_area_is_never_converged():
+    """Found by the property test: corners 0-3 of a 12-point square put all four block corners on one
+    side, so the 1 × 1 grid's cell has no area; every corner is 'exempt' (0° or 180°), yet the grid
+    must not be reported as converged."""
+    s = np.linspace(0, 1, 4)[:-1]
+    sq = np.vstack([np.c_[s, 0 * s], np.c_[1 + 0 * s, s], np.c_[1 - s, 1 + 0 * s], np.c_[0 * s, 1 - s]])
+    g = meshcore.generate_block(loop=sq, corners=[0, 1, 2, 3], cells=(1, 1))
+    assert meshcore.quality(g).n_folded == 1
+    assert not g.converged and "no area" in g.info.message
+    with pytest.raises(MeshcoreError):
+        meshcore.generate_block(loop=sq, corners=[0, 1, 2, 3], cells=(1, 1), repair="strict")
