@@ -184,10 +184,47 @@ class _Layout:
         return numeric[0], numeric[1]
 
 
+_CHUNK = 1 << 18  # characters per block of the one-pass parser (its temporaries stay ~ 4 MB)
+
+
+def _plain_block(chunk: str, delim: str | None, width: int) -> np.ndarray | None:
+    """The numbers of ``chunk`` as (rows, width) when every line holds exactly ``width`` values
+    split by ``delim`` (or by blanks), else None: a line of another width never shifts the
+    columns of the lines after it."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            vals = np.fromstring(chunk.replace(delim, " ") if delim else chunk, dtype=np.float64, sep=" ")
+    except (ValueError, DeprecationWarning):
+        return None
+    rows = chunk.count("\n") + 1
+    if vals.size != rows * width:
+        return None
+    lut = np.zeros(256, dtype=np.int8)  # 0 part of a number, 1 blank, 2 delimiter, 3 line end
+    lut[[ord(c) for c in " \t\v\f"]] = 1
+    if delim:
+        lut[ord(delim)] = 2
+    lut[ord("\n")] = 3
+    cls = lut[np.frombuffer(chunk.encode("ascii"), dtype=np.uint8)]
+    value = np.zeros(len(cls) + 2, dtype=bool)
+    value[1:-1] = cls == 0
+    edge = np.flatnonzero(value[1:] != value[:-1])
+    starts, ends = edge[0::2], edge[1::2]  # one run of number characters per value
+    if len(starts) != vals.size or starts[0] != 0 or ends[-1] != len(cls):
+        return None
+    line_end = (np.arange(1, vals.size) % width == 0).astype(np.intp)  # between value k-1 and k
+    wanted = [(3, line_end)] + ([(2, 1 - line_end)] if delim else [])  # no delimiter bytes without one
+    for c, want in wanted:
+        seen = np.cumsum(cls == c, dtype=np.int32)  # line ends / delimiters up to each character
+        if not np.array_equal(seen[starts[1:] - 1] - seen[ends[:-1] - 1], want):
+            return None
+    return vals.reshape(rows, width)
+
+
 def _fast_points(text: str, lay: _Layout) -> np.ndarray | None:
-    """Every row in one C pass, when the file is one plain block of numbers after its header
-    (no comments, segments, names, quotes or blank lines); None otherwise (then the line loop
-    runs, and names the line of any problem)."""
+    """Every row in one C pass (block by block), when the file is one plain block of numbers
+    after its header (no comments, segments, names, quotes, blank lines or lines of another
+    width); None otherwise (then the line loop runs, and names the line of any problem)."""
     if lay.name_col is not None or lay.decimal_comma:
         return None
     start = 0
@@ -195,21 +232,19 @@ def _fast_points(text: str, lay: _Layout) -> np.ndarray | None:
         start = text.find("\n", start) + 1
         if start == 0:
             return None
-    body = text[start:].replace("\r", "").strip()
-    if not body or any(c in body for c in "#>%!\"'/") or re.search(r"\n[ \t]*\n", body):
+    body = text[start:].replace("\r\n", "\n").replace("\r", "\n").strip()
+    if not body or not body.isascii() or any(c in body for c in "#>%!\"'/") or "\n\n" in body:
         return None
-    flat = body.replace(lay.delim, " ") if lay.delim else body
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            vals = np.fromstring(flat, dtype=np.float64, sep=" ")
-    except (ValueError, DeprecationWarning):
-        return None
-    rows = body.count("\n") + 1
-    if vals.size != rows * lay.width:
-        return None
-    v = vals.reshape(rows, lay.width)
-    return np.column_stack([v[:, lay.ix], v[:, lay.iy]])
+    blocks, a = [], 0
+    while a < len(body):
+        b = body.find("\n", a + _CHUNK)
+        b = len(body) if b < 0 else b
+        block = _plain_block(body[a:b].strip(" \t"), lay.delim, lay.width)
+        if block is None:
+            return None
+        blocks.append(block[:, [lay.ix, lay.iy]])
+        a = b + 1
+    return np.concatenate(blocks)
 
 
 def _rows(path: Path, text: str, lay: _Layout) -> tuple[np.ndarray, list[tuple[int, str | None, str | None, int]]]:

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import shutil
+import tempfile
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from meshcore.errors import ReadError
 from meshcore.io import read_points
@@ -302,3 +306,58 @@ def test_more_real_lakes_read_and_project(name, n, zone):
     assert frame.crs == f"EPSG:{zone}"
     lon, lat = frame.to_lonlat(*local.polylines[0].points.T)
     np.testing.assert_allclose(np.column_stack([lon, lat]), pl.points, rtol=0, atol=1e-9)
+
+
+# ------------------------------------------------- the one-pass parser of plain blocks
+@pytest.mark.parametrize(
+    ("data", "needle"),
+    [
+        ("1,2\n3,4,5\n6\n7,8\n", "line 2: mixed dimensions"),  # as many numbers as rows × 2, in the wrong rows
+        ("x y\n1 2\n3 4 5\n6\n7 8\n", "line 3: mixed dimensions"),
+        ("x,y\n1 2,\n5,6\n7,8\n", "line 2: not a number"),  # a space inside a field, an empty field
+        ("1,2,3\n4,,5 6\n7,8,9\n", "line 2: not a number"),
+    ],
+)
+def test_a_line_of_another_width_is_refused_in_a_plain_block(tmp_path, data, needle):
+    f = _write(tmp_path, "p.csv", data)
+    with pytest.raises(ReadError) as exc:
+        read_points(f)
+    assert needle in _one_line(exc)
+
+
+_FIELDS = st.sampled_from(["1", "-2.5", "3e2", ".5", "+7.", "0", "1 2", "", "x", "1e400"])
+
+
+@settings(max_examples=150, derandomize=True, deadline=None, database=None)
+@given(
+    rows=st.lists(st.lists(_FIELDS, min_size=2, max_size=4), min_size=2, max_size=6),
+    delim=st.sampled_from([",", ";", "\t", " ", "|", ", ", " ; "]),
+    pad=st.sampled_from(["", " ", "\t"]),
+    header=st.booleans(),
+    crlf=st.booleans(),
+    chunk=st.sampled_from([8, 40, 1 << 18]),
+)
+def test_plain_blocks_read_as_the_line_loop_reads_them(rows, delim, pad, header, crlf, chunk):
+    """The one-pass parser is a shortcut: every file reads (or fails) exactly as line by line
+    (also when it is cut into blocks of a few characters)."""
+    from unittest import mock
+
+    from meshcore.io import points_csv
+
+    lines = (["x" + delim + "y"] if header else []) + [pad + delim.join(r) + pad for r in rows]
+    text = ("\r\n" if crlf else "\n").join(lines) + "\n"
+
+    def outcome(fast: bool):
+        with tempfile.TemporaryDirectory() as d:
+            f = _write(Path(d), "p.csv", text)
+            fast_points = points_csv._fast_points if fast else (lambda *a: None)
+            with (
+                mock.patch.object(points_csv, "_fast_points", fast_points),
+                mock.patch.object(points_csv, "_CHUNK", chunk),
+            ):
+                try:
+                    return [pl.points.tolist() for pl in read_points(f).polylines]
+                except ReadError as exc:
+                    return str(exc).replace(d, "")
+
+    assert outcome(True) == outcome(False)
