@@ -144,7 +144,7 @@ def validate_points(points: Any, *, name: str, min_points: int = 2, where: str =
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise InvalidInputError(
-            f"{prefix}{name}: point {k} is not finite ({arr[k, 0]!r}, {arr[k, 1]!r})"
+            f"{prefix}{name}: point {k} is not finite ({float(arr[k, 0])!r}, {float(arr[k, 1])!r})"
             + (f" and {int(bad.sum()) - 1} more" if bad.sum() > 1 else "")
         )
     huge = (np.abs(arr) > MAX_COORDINATE).any(axis=1)

@@ -274,7 +274,7 @@ def grid_from_world(
             i, j = (int(v) for v in np.argwhere(bad)[0])
             kind = "not finite" if not np.isfinite(A[i, j]) else f"beyond ±{MAX_COORDINATE:g}"
             raise ReadError(
-                f"{path}: {what}: {axis} of node (i={i}, j={j}) is {kind} ({A[i, j]!r})"
+                f"{path}: {what}: {axis} of node (i={i}, j={j}) is {kind} ({float(A[i, j])!r})"
                 + (f", {int(bad.sum()) - 1} more such values" if bad.sum() > 1 else "")
             )
     return StructuredGrid(X - o[0], Y - o[1], names=dict(names or {}))
