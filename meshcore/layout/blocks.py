@@ -41,23 +41,29 @@ def _key(p) -> tuple[float, float]:
 
 def conform(rings: list[np.ndarray], eps: float) -> list[np.ndarray]:
     """Insert every ring vertex that lies on another ring's edge into that edge (T-junctions)."""
+    from scipy.spatial import cKDTree
+
     allv = np.unique(np.vstack(rings), axis=0)
+    tree = cKDTree(allv)
     out = []
     for r in rings:
-        pts = [r[0]]
-        n = len(r)
-        for k in range(n):
-            a, b = r[k], r[(k + 1) % n]
-            d = b - a
-            L2 = float(d @ d)
-            if L2 > 0:
-                t = ((allv - a) @ d) / L2
-                foot = a + np.outer(t, d)
-                on = (t > 1e-9) & (t < 1 - 1e-9) & (np.hypot(*(allv - foot).T) <= eps)
-                for j in np.argsort(t[on]):
-                    pts.append(allv[on][j])
-            if k + 1 < n:
-                pts.append(b)
+        a, b = r, np.roll(r, -1, axis=0)
+        d = b - a
+        L = np.hypot(*d.T)
+        # candidate vertices: within half an edge (plus eps) of the edge's midpoint
+        cand = tree.query_ball_point(0.5 * (a + b), 0.5 * L + eps)
+        pts = []
+        for k in range(len(r)):
+            pts.append(r[k])
+            idx = np.asarray(cand[k], dtype=int)
+            if len(idx) <= 2 or L[k] == 0:
+                continue
+            v = allv[idx]
+            t = ((v - a[k]) @ d[k]) / (L[k] * L[k])
+            foot = a[k] + np.outer(t, d[k])
+            on = (t > 1e-9) & (t < 1 - 1e-9) & (np.hypot(*(v - foot).T) <= eps)
+            for j in np.argsort(t[on]):
+                pts.append(v[on][j])
         out.append(np.array(pts))
     return out
 

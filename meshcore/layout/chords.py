@@ -62,7 +62,7 @@ def _tangent(br: Branch, s_all: np.ndarray, s: float, window: float) -> np.ndarr
     return t / n
 
 
-def _candidates(poly, br: Branch, s_all: np.ndarray, step: float, min_length: float):
+def _candidates(poly, room, br: Branch, s_all: np.ndarray, step: float, min_length: float):
     """Chords normal to the branch at regularly spaced arc lengths, with their bank angles.
 
     Returns ``(s, segments (m, 2, 2), error (m,))``: ``error`` is the larger deviation (degrees)
@@ -85,10 +85,11 @@ def _candidates(poly, br: Branch, s_all: np.ndarray, step: float, min_length: fl
     rings = [np.asarray(poly.exterior.coords), *(np.asarray(h.coords) for h in poly.interiors)]
     seg_a = np.vstack([rg[:-1] for rg in rings])
     seg_b = np.vstack([rg[1:] for rg in rings])
+
     ends = np.full((m, 2, 2), np.nan)
     err = np.zeros(m)
     for side, sign in ((1, 1.0), (0, -1.0)):
-        p, q = _ray_hits(c, sign * n, seg_a, seg_b, 4.0 * r)
+        p, q = _local_hits(c, sign * n, seg_a, seg_b, 4.0 * r)
         ends[:, side] = p
         tb = q / np.maximum(np.hypot(*q.T), 1e-300)[:, None]
         dev = np.degrees(np.arcsin(np.clip(np.abs((tb * n).sum(axis=1)), 0.0, 1.0)))
@@ -99,9 +100,24 @@ def _candidates(poly, br: Branch, s_all: np.ndarray, step: float, min_length: fl
     ok = np.flatnonzero(np.isfinite(err))
     if len(ok):
         lines = shapely.linestrings(ends[ok])
-        inside = shapely.covered_by(lines, poly.buffer(1e-9 * float(np.nanmax(length[ok]))))
+        inside = shapely.covered_by(lines, room)
         err[ok[~inside]] = np.inf
     return s, ends, err
+
+
+def _local_hits(c, d, seg_a, seg_b, reach, group: int = 48):
+    """:func:`_ray_hits` for consecutive groups of rays, each against the shore within reach."""
+    hit = np.full((len(c), 2), np.nan)
+    tan = np.full((len(c), 2), np.nan)
+    smin, smax = np.minimum(seg_a, seg_b), np.maximum(seg_a, seg_b)
+    for lo in range(0, len(c), group):
+        sl = slice(lo, lo + group)
+        rr = float(reach[sl].max())
+        a, b = c[sl].min(axis=0) - rr, c[sl].max(axis=0) + rr
+        near = ~((smax[:, 0] < a[0]) | (smin[:, 0] > b[0]) | (smax[:, 1] < a[1]) | (smin[:, 1] > b[1]))
+        if near.any():
+            hit[sl], tan[sl] = _ray_hits(c[sl], d[sl], seg_a[near], seg_b[near], reach[sl])
+    return hit, tan
 
 
 def _ray_hits(c, d, seg_a, seg_b, reach):
@@ -167,17 +183,20 @@ def place_chords(
     deviation from a right angle where a chord meets a bank.  A tip zone is kept at least
     ``min_length`` long.
     """
+    import shapely
     from shapely.geometry import LineString
 
     degree = sk.degree()
     chords: list[Chord] = []
+    room = poly.buffer(1e-9 * math.sqrt(poly.area))  # the water, a hair wider (cuts end on the shore)
+    shapely.prepare(room)
     for k, br in enumerate(sk.branches):
         s_all = _arclength(br.points)
         L = s_all[-1]
         if L <= 0:
             continue
         step = 0.25 * float(np.min(br.radius[br.radius > 0], initial=L))
-        s, ends, err = _candidates(poly, br, s_all, step, min_length)
+        s, ends, err = _candidates(poly, room, br, s_all, step, min_length)
         w = 2.0 * np.maximum(br.radius, 1e-12)
         u_all = np.concatenate([[0.0], np.cumsum(np.diff(s_all) / (0.5 * (w[1:] + w[:-1])))])
         u = np.interp(s, s_all, u_all)

@@ -17,13 +17,13 @@ stays without folds.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _kernels
+from .shore import project_to_rings
 
 __all__ = ["OrthoResult", "orthogonalize"]
 
@@ -82,25 +82,11 @@ def _shore_data(X, Y, m, cells, cnt, rings):
             if cnt[v] == 2:
                 inner[pos[v]] = u
     # ring and arc length of every shore node (nearest point of the nearest ring)
-    P = np.column_stack([X[nodes], Y[nodes]])
-    best_d = np.full(len(nodes), np.inf)
-    ring_of = np.zeros(len(nodes), dtype=np.int64)
-    s_of = np.zeros(len(nodes))
-    for k, r in enumerate(rings):
-        A = r
-        B = np.roll(r, -1, axis=0)
-        D = B - A
-        L2 = np.maximum((D * D).sum(axis=1), 1e-300)
-        cum = np.concatenate([[0.0], np.cumsum(np.sqrt(L2))])
-        for i in range(len(nodes)):
-            t = np.clip(((P[i] - A) * D).sum(axis=1) / L2, 0.0, 1.0)
-            foot = A + t[:, None] * D
-            d = np.hypot(*(foot - P[i]).T)
-            j = int(np.argmin(d))
-            if d[j] < best_d[i]:
-                best_d[i] = d[j]
-                ring_of[i] = k
-                s_of[i] = cum[j] + t[j] * math.sqrt(L2[j])
+    if rings:
+        ring_of, s_of, _ = project_to_rings(rings, np.column_stack([X[nodes], Y[nodes]]))
+        ring_of = ring_of.astype(np.int64)
+    else:
+        ring_of, s_of = np.zeros(len(nodes), dtype=np.int64), np.zeros(len(nodes))
     prev = -np.ones(len(nodes), dtype=np.int64)
     nxt = -np.ones(len(nodes), dtype=np.int64)
     per = [float(np.hypot(*(np.roll(r, -1, axis=0) - r).T).sum()) for r in rings]

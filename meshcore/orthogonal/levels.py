@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
+from .shore import project_to_rings, ring_point
 
 __all__ = ["coarsen_topology", "refine"]
 
@@ -60,37 +61,6 @@ def coarsen_topology(topology: MultiBlockTopology, factor: int) -> MultiBlockTop
     return MultiBlockTopology(tuple(blocks), tuple(itfs), check_geometry=False)
 
 
-def _project(rings: list[np.ndarray], pts: np.ndarray):
-    """Ring index, arc length and perimeter of the nearest ring point to every point."""
-    best = np.full(len(pts), np.inf)
-    ring_of = np.zeros(len(pts), dtype=int)
-    s_of = np.zeros(len(pts))
-    for k, r in enumerate(rings):
-        a, b = r, np.roll(r, -1, axis=0)
-        d = b - a
-        L = np.hypot(*d.T)
-        cum = np.concatenate([[0.0], np.cumsum(L)])
-        for lo in range(0, len(pts), 256):
-            q = pts[lo : lo + 256, None, :]
-            t = np.clip(((q - a) * d).sum(-1) / np.maximum(L * L, 1e-300), 0.0, 1.0)
-            dist = np.hypot(*(a + t[..., None] * d - q).transpose(2, 0, 1))
-            j = np.argmin(dist, axis=1)
-            dj = dist[np.arange(len(j)), j]
-            better = dj < best[lo : lo + 256]
-            idx = np.arange(lo, lo + len(j))[better]
-            best[idx] = dj[better]
-            ring_of[idx] = k
-            s_of[idx] = cum[j[better]] + t[np.arange(len(j)), j][better] * L[j[better]]
-    return ring_of, s_of
-
-
-def _ring_point(ring: np.ndarray, s: np.ndarray) -> np.ndarray:
-    closed = np.vstack([ring, ring[:1]])
-    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(closed, axis=0).T))])
-    s = np.mod(s, cum[-1])
-    return np.column_stack([np.interp(s, cum, closed[:, 0]), np.interp(s, cum, closed[:, 1])])
-
-
 def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -> list:
     """After :func:`refine`, put every new shore node on the shore, halfway along it between
     its two neighbours (the straight midpoint would cut across every bay the coarse edge
@@ -99,32 +69,30 @@ def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -
         return list(grids)
     m = topology.node_map
     per = [float(np.hypot(*(np.roll(r, -1, axis=0) - r).T).sum()) for r in rings]
-    out = []
-    for g, ids in zip(grids, m.ids, strict=True):
-        x, y = np.array(g.x), np.array(g.y)
-        trip = []
-        for sl in ((slice(None), 0), (slice(None), -1), (0, slice(None)), (-1, slice(None))):
-            bid = ids[sl]
-            idx = np.arange(x.shape[0]) if isinstance(sl[0], slice) else np.arange(x.shape[1])
-            for j in range(1, len(bid) - 1, 2):
-                if m.boundary[bid[j - 1]] and m.boundary[bid[j]] and m.boundary[bid[j + 1]]:
-                    trip.append((sl, idx[j - 1], idx[j], idx[j + 1]))
-        if trip:
-
-            def at(sl, j):
-                return (j, sl[1]) if isinstance(sl[0], slice) else (sl[0], j)
-
-            ends = np.array([[x[at(sl, a)], y[at(sl, a)], x[at(sl, b)], y[at(sl, b)]] for sl, a, _, b in trip])
-            ra, sa = _project(rings, ends[:, :2])
-            rb, sb = _project(rings, ends[:, 2:])
-            for (sl, _, j, _), r1, s1, r2, s2 in zip(trip, ra, sa, rb, sb, strict=True):
-                if r1 != r2:
-                    continue
-                total = per[r1]
-                d = (s2 - s1) % total
-                if d > total / 2:  # the short way round
-                    d -= total
-                p = _ring_point(rings[r1], np.array([s1 + d / 2]))[0]
-                x[at(sl, j)], y[at(sl, j)] = p
-        out.append(g.replaced(x=x, y=y))
-    return out
+    xs = [np.array(g.x) for g in grids]
+    ys = [np.array(g.y) for g in grids]
+    where, ends = [], []  # (block, index of the new node), coordinates of its two neighbours
+    for b, ids in enumerate(m.ids):
+        n1, m1 = ids.shape
+        for fixed_i, fixed_j in ((None, 0), (None, m1 - 1), (0, None), (n1 - 1, None)):
+            count = n1 if fixed_i is None else m1
+            for k in range(1, count - 1, 2):
+                idx = [(t, fixed_j) if fixed_i is None else (fixed_i, t) for t in (k - 1, k, k + 1)]
+                if all(m.boundary[ids[ij]] for ij in idx):
+                    where.append((b, idx[1]))
+                    ends.append([xs[b][idx[0]], ys[b][idx[0]], xs[b][idx[2]], ys[b][idx[2]]])
+    if not where:
+        return list(grids)
+    ends_a = np.asarray(ends)
+    ra, sa, _ = project_to_rings(rings, ends_a[:, :2])
+    rb, sb, _ = project_to_rings(rings, ends_a[:, 2:])
+    for (b, ij), r1, s1, r2, s2 in zip(where, ra, sa, rb, sb, strict=True):
+        if r1 != r2:
+            continue
+        total = per[r1]
+        d = (s2 - s1) % total
+        if d > total / 2:  # the short way round
+            d -= total
+        p = ring_point(rings[r1], np.array([s1 + d / 2]))[0]
+        xs[b][ij], ys[b][ij] = p
+    return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)]

@@ -1,0 +1,45 @@
+"""Points on the shore: nearest-point projection onto the shore rings, and back.
+
+The shore is a list of closed rings (outline and islands, densified).  A shore node is kept
+as ``(ring, s)``: which ring and the arc length along it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["project_to_rings", "ring_point"]
+
+
+def _segments(rings: list[np.ndarray]):
+    a = np.vstack(rings)
+    b = np.vstack([np.roll(r, -1, axis=0) for r in rings])
+    ring = np.concatenate([np.full(len(r), k) for k, r in enumerate(rings)])
+    L = np.hypot(*(b - a).T)
+    start = np.concatenate(
+        [np.concatenate([[0.0], np.cumsum(np.hypot(*(np.roll(r, -1, axis=0) - r).T))[:-1]]) for r in rings]
+    )
+    return a, b, ring, L, start
+
+
+def project_to_rings(rings: list[np.ndarray], pts: np.ndarray):
+    """For every point: the index of the nearest ring, the arc length of its nearest point on
+    that ring, and the distance (an STR-tree nearest-segment query, then the exact foot)."""
+    import shapely
+
+    pts = np.asarray(pts, dtype=float).reshape(-1, 2)
+    a, b, ring, L, start = _segments(rings)
+    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+    seg = tree.query_nearest(shapely.points(pts), return_distance=False, all_matches=False)[1]
+    d = b[seg] - a[seg]
+    t = np.clip(((pts - a[seg]) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-300), 0.0, 1.0)
+    foot = a[seg] + t[:, None] * d
+    return ring[seg], start[seg] + t * L[seg], np.hypot(*(foot - pts).T)
+
+
+def ring_point(ring: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Points at arc lengths ``s`` (any real: the ring is closed) of one ring."""
+    closed = np.vstack([ring, ring[:1]])
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(closed, axis=0).T))])
+    s = np.mod(s, cum[-1])
+    return np.column_stack([np.interp(s, cum, closed[:, 0]), np.interp(s, cum, closed[:, 1])])
