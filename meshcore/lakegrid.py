@@ -53,9 +53,23 @@ def _repair_folds(grids: list) -> tuple[list, int]:
     return out, fixed
 
 
+def _start(topo, how: str):
+    """A start grid on the coarsest level: the algebraic (TFI) grids relaxed as one grid."""
+    from .multiblock import initial_grids, solve_multiblock
+    from .orthogonal import orthogonalize
+
+    if how == "winslow":
+        mb = solve_multiblock(topo)
+        return list(mb.grids), f"multiblock Winslow ({mb.info.message})"
+    g0 = initial_grids(topo)
+    res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4)
+    return list(res.grids), f"algebraic grids relaxed as one grid ({res.sweeps} sweeps)"
+
+
 def mesh_layout(
     layout,
     *,
+    start: str = "winslow",
     levels: int | None = None,
     sweeps: tuple[int, ...] = (400, 150, 80),
     smooth: float = 0.2,
@@ -65,7 +79,7 @@ def mesh_layout(
     callback: Callable[[str, Any], Any] | None = None,
 ):
     """The orthogonal multiblock grid of a :class:`~meshcore.layout.Layout`."""
-    from .multiblock import MultiBlockGrid, solve_multiblock
+    from .multiblock import MultiBlockGrid
     from .orthogonal import orthogonalize
     from .orthogonal.levels import coarsen_topology, refine, refine_shore
 
@@ -75,8 +89,8 @@ def mesh_layout(
         levels = max(0, int(np.log2(layout.multiple))) if layout.multiple > 1 else 0
     factor = 2**levels
     tops = [coarsen_topology(topo, 2**k) if k else topo for k in range(levels, -1, -1)]
-    start = solve_multiblock(tops[0])
-    grids, repaired = _repair_folds(list(start.grids))
+    grids, how = _start(tops[0], start)
+    grids, repaired = _repair_folds(grids)
     rings = _shore_rings(layout.polygon, layout.cell_size / 4)
     total = 0
     converged = True
@@ -99,10 +113,7 @@ def mesh_layout(
         if callback is not None:
             callback("level", (lev, res))
     elapsed = time.perf_counter() - t0
-    msg = (
-        f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; "
-        f"start: multiblock Winslow ({start.info.message})"
-    )
+    msg = f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; start: {how}"
     if repaired:
         msg += f"; {repaired} coarse block(s) repaired by the fold-free method"
     info = SolveInfo(method="orthogonal", converged=converged, iterations=total, elapsed=elapsed, message=msg)

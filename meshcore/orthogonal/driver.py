@@ -171,6 +171,7 @@ def orthogonalize(
     smooth: float = 0.1,
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
+    guard: bool = True,
     callback=None,
 ):
     """Orthogonalise ``grids`` (one per block of ``topology``) with shore nodes sliding on ``rings``."""
@@ -183,7 +184,7 @@ def orthogonalize(
     cx, cy = X[cells], Y[cells]
     area = 0.5 * ((cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3]) - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2]))
     mean_area = np.bincount(cells.reshape(-1), weights=np.repeat(np.abs(area), 4), minlength=m.n_nodes)
-    jmin = 1e-3 * mean_area / np.maximum(cnt, 1)
+    jmin = 1e-3 * mean_area / np.maximum(cnt, 1) if guard else np.full(m.n_nodes, -np.inf)
     rings = [np.asarray(r, dtype=np.float64) for r in rings]
     bn, binner, bprev, bnext, bring, bs, free = _shore_data(X, Y, m, cells, cnt, rings)
     edge0 = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
