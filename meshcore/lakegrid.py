@@ -53,6 +53,13 @@ def _repair_folds(grids: list) -> tuple[list, int]:
     return out, fixed
 
 
+def _per_level(value, lev: int) -> float:
+    """A number, or one per level (coarse first; the last one repeats)."""
+    if isinstance(value, (int, float)):
+        return float(value)
+    return float(value[min(lev, len(value) - 1)])
+
+
 def _start(topo, how: str):
     """A start grid on the coarsest level: the algebraic (TFI) grids relaxed as one grid."""
     from .multiblock import initial_grids, solve_multiblock
@@ -72,7 +79,7 @@ def mesh_layout(
     start: str = "winslow",
     levels: int | None = None,
     sweeps: tuple[int, ...] = (400, 150, 80),
-    smooth: float = 0.2,
+    smooth: float | tuple[float, ...] = 0.05,
     omega: float = 1.8,
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
@@ -103,7 +110,7 @@ def mesh_layout(
             rings,
             tol=1e-5,
             max_sweeps=sweeps[min(lev, len(sweeps) - 1)],
-            smooth=smooth,
+            smooth=_per_level(smooth, lev),
             omega=omega,
             pin_angle=pin_angle,
             shore_smooth=shore_smooth,

@@ -232,21 +232,44 @@ def _foot(R, S, r0, s0, n, qx, qy, sa, sb):
     return best_s
 
 
-#: Largest ratio of the shore's arc length between two neighbouring shore nodes to the
-#: straight edge between them (1.2: a corner cut off by at most ~0.2 cell sizes).
-STRAIGHT = 1.2
-
-
-@njit(cache=True, inline="always")
-def _bend(ax, ay, bx, by, cx, cy, arc_ab, arc_bc):
-    """How far the shore arcs a→b and b→c exceed ``STRAIGHT`` × their chords (≤ 0: fine)."""
-    d1 = arc_ab - STRAIGHT * math.hypot(bx - ax, by - ay)
-    d2 = arc_bc - STRAIGHT * math.hypot(cx - bx, cy - by)
-    return max(d1, d2)
+@njit(cache=True)
+def _gap(R, S, r0, s0, n, sa, sb, ax, ay, bx, by):
+    """How far the shore between arc lengths ``sa < sb`` strays from the straight edge a–b:
+    the largest distance of a shore vertex in between from that segment."""
+    total = S[s0 + n]
+    dx, dy = bx - ax, by - ay
+    L2 = dx * dx + dy * dy
+    worst = 0.0
+    base = math.floor(sa / total) * total
+    k = _segment(S, s0, n, sa - base) + 1
+    for _ in range(n + 1):
+        if k >= n:
+            k -= n
+            base += total
+        sv = base + S[s0 + k]
+        if sv >= sb:
+            break
+        px, py = R[r0 + k, 0], R[r0 + k, 1]
+        t = ((px - ax) * dx + (py - ay) * dy) / L2 if L2 > 0 else 0.0
+        t = min(max(t, 0.0), 1.0)
+        d = math.hypot(px - ax - t * dx, py - ay - t * dy)
+        if d > worst:
+            worst = d
+        k += 1
+    return worst
 
 
 @njit(cache=True)
-def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, jmin):
+def _bend(R, S, r0, s0, n, sp, s, sn, px, py, x, y, qx, qy, limit):
+    """How far the shore next to a node strays from its two grid edges beyond ``limit``
+    (≤ 0: both edges follow the shore closely enough)."""
+    g1 = _gap(R, S, r0, s0, n, sp, s, px, py, x, y)
+    g2 = _gap(R, S, r0, s0, n, s, sn, x, y, qx, qy)
+    return max(g1, g2) - limit
+
+
+@njit(cache=True)
+def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, gap, jmin):
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours;
     returns the largest move."""
@@ -272,22 +295,24 @@ def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, 
             sn += total
         while sn >= s + total:
             sn -= total
-        gap = 0.1 * (sn - sp)
+        margin = 0.1 * (sn - sp)
         q = binner[k]
-        sf = _foot(R, S, r0, s0, n, X[q], Y[q], sp + gap, sn - gap)
+        sf = _foot(R, S, r0, s0, n, X[q], Y[q], sp + margin, sn - margin)
         sf = (1.0 - mu) * sf + mu * 0.5 * (sp + sn)  # a little pull to the middle keeps the spacing
-        # the shore between a node and its neighbours must stay close to the straight edge
-        # between them (arc ≤ ``straight`` × chord): a node may not slide past a bay or a point
+        # the shore between a node and its neighbours must stay within ``gap`` of the straight
+        # edges between them: a node may not slide past a bay or a point
         ppx, ppy = _ring_point(R, S, r0, s0, n, sp)
         pnx, pny = _ring_point(R, S, r0, s0, n, sn)
-        bad0 = _bend(ppx, ppy, X[p], Y[p], pnx, pny, s - sp, sn - s)
+        bad0 = _bend(R, S, r0, s0, n, sp, s, sn, ppx, ppy, X[p], Y[p], pnx, pny, gap)
+        if bad0 > 0.0:  # already too far from the shore: head for the middle of the arc
+            sf = 0.5 * (sp + sn)
         ox, oy = X[p], Y[p]
         step = omega * (sf - s)
         moved = False
         for _ in range(5):
             snew = s + step
             nx, ny = _ring_point(R, S, r0, s0, n, snew)
-            bad = _bend(ppx, ppy, nx, ny, pnx, pny, snew - sp, sn - snew)
+            bad = _bend(R, S, r0, s0, n, sp, snew, sn, ppx, ppy, nx, ny, pnx, pny, gap)
             if bad <= max(bad0, 0.0):
                 X[p], Y[p] = nx, ny
                 ok = _all_above(X, Y, cptr, cells, p, jmin[p])

@@ -172,6 +172,7 @@ def orthogonalize(
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
     guard: bool = True,
+    shore_gap: float = 0.25,
     callback=None,
 ):
     """Orthogonalise ``grids`` (one per block of ``topology``) with shore nodes sliding on ``rings``."""
@@ -200,7 +201,24 @@ def orthogonalize(
     for it in range(1, max_sweeps + 1):
         d1 = _kernels.sweep(X, Y, m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring, cptr, ncells, omega, smooth, jmin)
         d2 = _kernels.shore_sweep(
-            X, Y, fidx, bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells, 1.0, shore_smooth, jmin
+            X,
+            Y,
+            fidx,
+            bn,
+            binner,
+            bprev,
+            bnext,
+            bring,
+            bs,
+            R,
+            S,
+            roff,
+            cptr,
+            ncells,
+            1.0,
+            shore_smooth,
+            shore_gap * h,
+            jmin,
         )
         d = max(d1, d2) / h
         hist.append(d)
