@@ -8,8 +8,11 @@ count ``n_c`` is one unknown.  A block needs equal counts on opposite sides:
            \sum_{c \in \text{left}} n_c = \sum_{c \in \text{right}} n_c .
 
 We look for integers ``n_c ≥ 1`` (every side ≥ ``min_cells``) closest to the wanted counts
-``L_c / h`` (``L_c`` the chain's length, ``h`` the cell size) in the weighted L¹ sense
-``Σ |n_c − L_c/h|``
+in the L¹ sense: first every block's count in each direction against the mean of its two
+opposite sides' lengths over ``h`` (cells of the asked size in both directions, so
+neighbouring blocks' cells are alike across their interface), then — with a quarter of the
+weight — every chain against ``L_c / h`` (``L_c`` its length), which shares a side's cells
+among the chains of a T-junction,
 with :func:`scipy.optimize.milp` (HiGHS).  Each block side's constraint couples only the
 chains around it, so the programs are tiny (tens to hundreds of unknowns) and solve in
 milliseconds.  Optionally every count is a multiple of ``multiple`` (2**k lets a multigrid
@@ -59,44 +62,44 @@ def solve_counts(
 
     t = np.asarray(targets, dtype=float)
     n = len(t)
+    nb = len(sides)
     m = int(multiple)
-    # unknowns: k_c (n_c = m k_c), e_c ≥ |m k_c − t_c| and the shortfall u_c ≥ t_c / 3 − m k_c
-    # (a chain with far fewer cells than its length asks for would cut across the water it
-    # should follow: below a third of it, a missing cell costs double)
-    nv = 3 * n
-    w = np.ones(n)
-    # a tiny premium on larger counts breaks ties (opposite sides of different lengths) towards
-    # cells no larger than asked for
-    cost = np.concatenate([np.full(n, -1e-3 * m), w, 2.0 * w])
+    # unknowns: k_c (n_c = m k_c); e_c ≥ |n_c − t_c| per chain; f_bd ≥ |N_bd − T_bd| per block and
+    # direction, with N_bd the count across the block in that direction and T_bd the mean of its
+    # two opposite sides' targets: every block's cells close to the asked size in both directions
+    # (so neighbours' cells are alike across interfaces), chains close to theirs within a side
+    nv = 2 * n + 2 * nb
+    cost = np.concatenate([np.full(n, -1e-3 * m), np.full(n, 0.25), np.ones(2 * nb)])
     rows, lo, hi = [], [], []
 
     def row() -> np.ndarray:
         return np.zeros(nv)
 
-    for c in range(n):  # e_c − m k_c ≥ −t_c ;  e_c + m k_c ≥ t_c ;  u_c + m k_c ≥ t_c / 3
-        r = row()
-        r[n + c], r[c] = 1.0, -m
-        rows.append(r), lo.append(-t[c]), hi.append(np.inf)
-        r = row()
-        r[n + c], r[c] = 1.0, m
-        rows.append(r), lo.append(t[c]), hi.append(np.inf)
-        r = row()
-        r[2 * n + c], r[c] = 1.0, m
-        rows.append(r), lo.append(t[c] / 3.0), hi.append(np.inf)
-    for bottom, right, top, left in sides:
-        for a, b in ((bottom, top), (left, right)):
+    def absdev(dev_index: int, chains, target: float) -> None:
+        for sign in (1.0, -1.0):  # dev ± Σ m k ≥ ± target
+            r = row()
+            r[dev_index] = 1.0
+            for c in chains:
+                r[c] += sign * m
+            rows.append(r), lo.append(sign * target), hi.append(np.inf)
+
+    for c in range(n):
+        absdev(n + c, [c], t[c])
+    for bi, (bottom, right, top, left) in enumerate(sides):
+        for d, (a, b) in enumerate(((bottom, top), (left, right))):
             r = row()
             for c in a:
                 r[c] += m
             for c in b:
                 r[c] -= m
             rows.append(r), lo.append(0.0), hi.append(0.0)
+            absdev(2 * n + 2 * bi + d, list(a), 0.5 * (t[list(a)].sum() + t[list(b)].sum()))
         for side in (bottom, right, top, left):
             r = row()
             for c in side:
                 r[c] += m
             rows.append(r), lo.append(float(min_cells)), hi.append(np.inf)
-    lb = np.concatenate([np.ones(n), np.zeros(2 * n)])
+    lb = np.concatenate([np.ones(n), np.zeros(n + 2 * nb)])
     ub = np.full(nv, np.inf)
     for c, v in (fixed or {}).items():
         if v % m:
@@ -107,7 +110,7 @@ def solve_counts(
     res = milp(
         cost,
         constraints=LinearConstraint(np.array(rows), lo, hi),
-        integrality=np.concatenate([np.ones(n), np.zeros(2 * n)]),
+        integrality=np.concatenate([np.ones(n), np.zeros(n + 2 * nb)]),
         bounds=Bounds(lb, ub),
         options={"time_limit": 20.0, "mip_rel_gap": 0.0},
     )
