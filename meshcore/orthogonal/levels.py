@@ -94,5 +94,33 @@ def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -
         if d > total / 2:  # the short way round
             d -= total
         p = ring_point(rings[r1], np.array([s1 + d / 2]))[0]
-        xs[b][ij], ys[b][ij] = p
+        _move_if_valid(xs[b], ys[b], ij, p)
     return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)]
+
+
+def _convex_around(x: np.ndarray, y: np.ndarray, ij) -> bool:
+    """True when every cell of the block that has node ``ij`` as a corner is convex."""
+    i, j = ij
+    n1, m1 = x.shape
+    for ci in (i - 1, i):
+        for cj in (j - 1, j):
+            if not (0 <= ci < n1 - 1 and 0 <= cj < m1 - 1):
+                continue
+            px = [x[ci, cj], x[ci + 1, cj], x[ci + 1, cj + 1], x[ci, cj + 1]]
+            py = [y[ci, cj], y[ci + 1, cj], y[ci + 1, cj + 1], y[ci, cj + 1]]
+            for k in range(4):
+                ax, ay = px[(k + 1) % 4] - px[k], py[(k + 1) % 4] - py[k]
+                bx, by = px[(k + 3) % 4] - px[k], py[(k + 3) % 4] - py[k]
+                if ax * by - ay * bx <= 0.0:
+                    return False
+    return True
+
+
+def _move_if_valid(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> None:
+    """Move node ``ij`` to ``p``, or as far towards it as keeps its cells convex."""
+    ox, oy = x[ij], y[ij]
+    for f in (1.0, 0.5, 0.25):
+        x[ij], y[ij] = ox + f * (p[0] - ox), oy + f * (p[1] - oy)
+        if _convex_around(x, y, ij):
+            return
+    x[ij], y[ij] = ox, oy
