@@ -477,9 +477,9 @@ def _spoiled(fold: bool):
         if not fold:
             return dataclasses.replace(mb, info=dataclasses.replace(mb.info, converged=False))
         g = mb.grids[0]
-        x = np.array(g.x)
-        x[1, 1], x[2, 1] = x[2, 1], x[1, 1]  # two interior nodes swapped: cells folded
-        return dataclasses.replace(mb, grids=(g.replaced(x=x), *mb.grids[1:]))
+        x, y = np.array(g.x), np.array(g.y)
+        x[1, 1], y[1, 1] = x[-2, -2], y[-2, -2]  # an interior node thrown across its block: folds
+        return dataclasses.replace(mb, grids=(g.replaced(x=x, y=y), *mb.grids[1:]))
 
     return spoiled
 
