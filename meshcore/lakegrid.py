@@ -18,15 +18,18 @@ The result is a :class:`~meshcore.multiblock.MultiBlockGrid` (``mode="orthogonal
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Generator
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .errors import FoldedGridError
 from .grid import SolveInfo
 
-__all__ = ["mesh_layout", "mesh_outline"]
+if TYPE_CHECKING:
+    from .elliptic import SolverProgress
+
+__all__ = ["iterate_layout", "mesh_layout", "mesh_outline"]
 
 
 def _shore_rings(poly, step: float) -> list[np.ndarray]:
@@ -73,7 +76,18 @@ def _start(topo, how: str):
     return list(res.grids), f"algebraic grids relaxed as one grid ({res.sweeps} sweeps)"
 
 
-def mesh_layout(
+def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **options: Any):
+    """The orthogonal multiblock grid of a :class:`~meshcore.layout.Layout`.
+
+    The options are those of :func:`iterate_layout`; ``callback("level", (level, result))``
+    is called after each level (coarse first).
+    """
+    from ._generators import drain
+
+    return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
+
+
+def iterate_layout(
     layout,
     *,
     start: str = "winslow",
@@ -83,14 +97,24 @@ def mesh_layout(
     omega: float = 1.8,
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
-    callback: Callable[[str, Any], Any] | None = None,
-):
-    """The orthogonal multiblock grid of a :class:`~meshcore.layout.Layout`."""
+    every: int | None = 25,
+    level_callback: Callable[[str, Any], Any] | None = None,
+    stop_event: Any = None,
+) -> Generator[SolverProgress, Any, Any]:
+    """:func:`mesh_layout` as a generator of :class:`~meshcore.elliptic.SolverProgress`.
+
+    Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
+    coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
+    solve with the grids as they are (``info.converged`` False, message "stopped").  Returns
+    the :class:`~meshcore.multiblock.MultiBlockGrid` (``mode="orthogonal"``).
+    """
+    from .elliptic import SolverProgress
     from .multiblock import MultiBlockGrid
-    from .orthogonal import orthogonalize
+    from .orthogonal import iterate_orthogonalize
     from .orthogonal.levels import coarsen_topology, refine, refine_shore
 
     t0 = time.perf_counter()
+    tol = 1e-5
     topo = layout.topology()
     if levels is None:
         levels = max(0, int(np.log2(layout.multiple))) if layout.multiple > 1 else 0
@@ -100,32 +124,51 @@ def mesh_layout(
     grids, repaired = _repair_folds(grids)
     rings = _shore_rings(layout.polygon, layout.cell_size / 4)
     total = 0
-    converged = True
+    history: list[tuple[int, float]] = []
+    stopped = False
     for lev, tp in enumerate(tops):
         if lev:
             grids = refine_shore(refine(grids), tp, rings)
-        res = orthogonalize(
+        gen = iterate_orthogonalize(
             tp,
             grids,
             rings,
-            tol=1e-5,
+            every=every,
+            tol=tol,
             max_sweeps=sweeps[min(lev, len(sweeps) - 1)],
             smooth=_per_level(smooth, lev),
             omega=omega,
             pin_angle=pin_angle,
             shore_smooth=shore_smooth,
         )
+        try:
+            it, d, snap = next(gen)
+            while True:
+                history.append((total + it, d))
+                cmd = yield SolverProgress(
+                    total + it, d, tol, None, time.perf_counter() - t0, "orthogonal", tuple(history), snap
+                )
+                stopped = stopped or cmd == "stop" or (stop_event is not None and stop_event.is_set())
+                it, d, snap = gen.send("stop" if stopped else None)
+        except StopIteration as fin:
+            res = fin.value
         grids = list(res.grids)
         total += res.sweeps
-        if callback is not None:
-            callback("level", (lev, res))
+        if level_callback is not None:
+            level_callback("level", (lev, res))
+        if stopped:
+            break
     elapsed = time.perf_counter() - t0
-    msg = f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; start: {how}"
-    if repaired:
-        msg += f"; {repaired} coarse block(s) repaired by the fold-free method"
-    info = SolveInfo(method="orthogonal", converged=converged, iterations=total, elapsed=elapsed, message=msg)
+    if stopped:
+        msg = "stopped"
+    else:
+        msg = f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; start: {how}"
+        if repaired:
+            msg += f"; {repaired} coarse block(s) repaired by the fold-free method"
+    info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
-    return MultiBlockGrid(tuple(grids), names, topo.interfaces, "orthogonal", info, topo)
+    # stopped on a coarse level: the grid of that level, with its topology
+    return MultiBlockGrid(tuple(grids), names, tp.interfaces, "orthogonal", info, tp)
 
 
 def mesh_outline(

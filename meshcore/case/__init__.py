@@ -57,7 +57,7 @@ settings :class:`meshcore.SolverSpec`.
 """
 
 from .model import Case, InterfaceEntry, MultiblockSection, OutlineSection
-from .multiblock import case_frame, case_topology, cut_case, outline_points, topology_case
+from .multiblock import case_frame, case_layout, case_topology, cut_case, layout_case, outline_points, topology_case
 from .parse import load_case, loads_case, xy_pairs
 from .run import case_solver, generate_case, iterate_multiblock_case
 from .write import case_to_dict, dumps_case, save_case
@@ -68,6 +68,7 @@ __all__ = [
     "MultiblockSection",
     "OutlineSection",
     "case_frame",
+    "case_layout",
     "case_solver",
     "case_to_dict",
     "case_topology",
@@ -75,6 +76,7 @@ __all__ = [
     "dumps_case",
     "generate_case",
     "iterate_multiblock_case",
+    "layout_case",
     "load_case",
     "loads_case",
     "outline_points",

@@ -17,6 +17,7 @@ from ..multiblock.solver import MODES
 from ..spec import BlockSpec, SolverSpec
 
 __all__ = [
+    "CASE_MODES",
     "OUTLINE_CRS",
     "START_CHOICES",
     "Case",
@@ -26,6 +27,9 @@ __all__ = [
     "outline_point",
 ]
 
+#: ``[multiblock] mode``: the multiblock solver's modes, and ``orthogonal`` (an ``[outline]`` case
+#: solved by :func:`meshcore.lakegrid.iterate_layout`: shore nodes slide, grid lines orthogonal).
+CASE_MODES = (*MODES, "orthogonal")
 #: ``[multiblock] start``: smooth mode starts from the algebraic grids or the frozen solution.
 START_CHOICES = ("algebraic", "frozen")
 #: ``crs`` of an outline: no projection, local equirectangular, UTM of the centroid (pyproj);
@@ -37,8 +41,9 @@ OUTLINE_CRS = ("xy", "none", "lonlat", "utm", "auto")
 class MultiblockSection:
     """``[multiblock]``: how the blocks are solved together.
 
-    ``mode``: ``"smooth"`` (interfaces solved) or ``"frozen"`` (the paper:
-    interfaces fixed); ``start``: smooth mode starts from the ``"algebraic"``
+    ``mode``: ``"smooth"`` (interfaces solved), ``"frozen"`` (the paper:
+    interfaces fixed) or ``"orthogonal"`` (an ``[outline]`` case: orthogonal lake grid, shore
+    nodes sliding); ``start``: smooth mode starts from the ``"algebraic"``
     grids or from the ``"frozen"`` solution.
     """
 
@@ -46,8 +51,8 @@ class MultiblockSection:
     start: str = "algebraic"
 
     def __post_init__(self) -> None:
-        if self.mode not in MODES:
-            raise InvalidInputError(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
+        if self.mode not in CASE_MODES:
+            raise InvalidInputError(f"mode must be one of {', '.join(CASE_MODES)}, got {self.mode!r}")
         if self.start not in START_CHOICES:
             raise InvalidInputError(f"start must be frozen or algebraic, got {self.start!r}")
 
@@ -86,8 +91,10 @@ class OutlineSection:
     """``[outline]``: one closed outline split by cut lines into ``[[outline.blocks]]``.
 
     ``points`` is a point-file name (relative to the case file) or ``(n, 2)``
-    points; cut and corner points are outline indices or ``(x, y)`` pairs.
-    See :func:`meshcore.multiblock.from_outline` and ``crs`` in :data:`OUTLINE_CRS`.
+    points; cut and corner points are outline indices or ``(x, y)`` pairs.  ``holes``: islands,
+    inline rings of ``(x, y)`` points (cuts may end on them); ``cell_size``: the cell size the
+    layout was made for (shares a side's cells among its parts; the orthogonal mode's shore
+    sampling).  See :func:`meshcore.multiblock.from_outline` and ``crs`` in :data:`OUTLINE_CRS`.
     """
 
     points: str | np.ndarray
@@ -97,9 +104,24 @@ class OutlineSection:
     origin: tuple[float, float] | None = None
     snap: float | None = None
     multiple: int = 1
+    holes: tuple[np.ndarray, ...] = ()
+    cell_size: float | None = None
 
     def __post_init__(self) -> None:
         put = object.__setattr__
+        holes = []
+        for k, h in enumerate(self.holes):
+            a = np.array(h, dtype=np.float64)
+            if a.ndim != 2 or a.shape[1] != 2 or len(a) < 3:
+                raise InvalidInputError(f"holes[{k}]: expected a ring of at least 3 [x, y] pairs, got shape {a.shape}")
+            a.setflags(write=False)
+            holes.append(a)
+        put(self, "holes", tuple(holes))
+        if self.cell_size is not None:
+            size = float(self.cell_size)
+            if not (np.isfinite(size) and size > 0):
+                raise InvalidInputError(f"cell_size must be a positive number, got {self.cell_size!r}")
+            put(self, "cell_size", size)
         if not isinstance(self.points, str):
             a = np.array(self.points, dtype=np.float64)
             if a.ndim != 2 or a.shape[1] != 2:
@@ -111,7 +133,7 @@ class OutlineSection:
         if isinstance(self.crs, str):
             crs = self.crs.strip()
             put(self, "crs", crs.lower() if crs.lower() in OUTLINE_CRS else crs)
-        if not isinstance(self.cuts, (list, tuple)) or not self.cuts:
+        if not isinstance(self.cuts, (list, tuple)):
             raise InvalidInputError("cuts must be a list of polylines")
         cuts: list[tuple[int | tuple[float, float], ...]] = []
         for k, c in enumerate(self.cuts):
@@ -141,8 +163,17 @@ class OutlineSection:
             if isinstance(self.points, str) or isinstance(other.points, str)
             else np.array_equal(self.points, other.points)
         )
-        return same_points and all(
-            getattr(self, f.name) == getattr(other, f.name) for f in dataclasses.fields(self) if f.name != "points"
+        same_holes = len(self.holes) == len(other.holes) and all(
+            np.array_equal(a, b) for a, b in zip(self.holes, other.holes, strict=True)
+        )
+        return (
+            same_points
+            and same_holes
+            and all(
+                getattr(self, f.name) == getattr(other, f.name)
+                for f in dataclasses.fields(self)
+                if f.name not in ("points", "holes")
+            )
         )
 
     __hash__ = None  # type: ignore[assignment]

@@ -43,14 +43,14 @@ from ..boundary import BorderSpec
 from ..errors import CaseFileError, InvalidInputError
 from ..generate import block_borders
 from ..grid import BORDER_NAMES
-from ..multiblock.outline import from_outline, project_lonlat
+from ..multiblock.outline import BlockOutline, from_outline, project_lonlat
 from ..multiblock.solver import MODES
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, parse_side
 from ..spec import BlockSpec, SolverSpec
 from .model import Case, InterfaceEntry, MultiblockSection, OutlineSection
 from .parse import read_point_file
 
-__all__ = ["case_frame", "case_topology", "cut_case", "outline_points", "topology_case"]
+__all__ = ["case_frame", "case_layout", "case_topology", "cut_case", "layout_case", "outline_points", "topology_case"]
 
 
 def _read_outline(outline: OutlineSection, base: Path | None, where: str) -> tuple[np.ndarray, Any]:
@@ -90,8 +90,8 @@ def _project_outline(pts: np.ndarray, extra: list, crs: Any, origin: Any, where:
     return xy, ex, frame
 
 
-def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any]:
-    """(outline xy, cuts, blocks, frame) of an ``[outline]`` case, in model units."""
+def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any, list]:
+    """(outline xy, cuts, blocks, frame, island rings) of an ``[outline]`` case, in model units."""
     from ..crs import frame_from_case, is_geographic, looks_lonlat
 
     outline = case.outline
@@ -100,6 +100,7 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any]:
     pts, src_crs = _read_outline(outline, case.path.parent if case.path else None, f"{where} points")
     cuts = [list(c) for c in outline.cuts]
     blocks = list(outline.blocks)
+    holes = [np.asarray(h, dtype=np.float64) for h in outline.holes]
     crs = outline.crs
     frame = None
     # like [[blocks]] point files: a lon/lat *file* is projected by default; inline points
@@ -108,14 +109,16 @@ def _outline_geometry(case: Case) -> tuple[np.ndarray, list, list, Any]:
         (src_crs is not None and is_geographic(src_crs)) or (src_crs is None and looks_lonlat(pts))
     )
     if crs in ("xy", "none") or (crs == "auto" and not geographic):
-        return pts, cuts, blocks, None
+        return pts, cuts, blocks, None, holes
     extra = [v for c in cuts for v in c if not isinstance(v, int)]
     extra += [v for b in blocks for v in b.corners if not isinstance(v, int)]
+    extra += [v for h in holes for v in h.tolist()]
     xy, ex, frame = _project_outline(pts, extra, crs, outline.origin, where, src_crs, frame_from_case(case))
     it = iter(ex.tolist())
     cuts = [[v if isinstance(v, int) else next(it) for v in c] for c in cuts]
     blocks = [replace(b, corners=tuple(v if isinstance(v, int) else next(it) for v in b.corners)) for b in blocks]
-    return xy, cuts, blocks, frame
+    holes = [np.array([next(it) for _ in range(len(h))]) for h in holes]
+    return xy, cuts, blocks, frame, holes
 
 
 def outline_points(case: Case) -> np.ndarray:
@@ -136,11 +139,28 @@ def case_frame(case: Case) -> Any:
 
 def _outline_topology(case: Case) -> MultiBlockTopology:
     assert case.outline is not None
-    xy, cuts, blocks, _ = _outline_geometry(case)
+    xy, cuts, blocks, _, holes = _outline_geometry(case)
+    o = case.outline
     try:
         return from_outline(
-            xy, cuts=cuts, blocks=blocks, snap=case.outline.snap, multiple=case.outline.multiple
+            xy, cuts=cuts, blocks=blocks, holes=holes, snap=o.snap, multiple=o.multiple, cell_size=o.cell_size
         ).topology
+    except InvalidInputError as exc:
+        raise type(exc)(f"{case.source}: {exc}") from None
+
+
+def case_layout(case: Case) -> Any:
+    """The :class:`~meshcore.layout.Layout` of an ``[outline]`` case (for ``mode = "orthogonal"``)."""
+    from ..layout import layout_from_outline
+
+    if case.outline is None:
+        raise CaseFileError(f'{case.source}: [multiblock] mode = "orthogonal" needs an [outline] section')
+    xy, cuts, blocks, _, holes = _outline_geometry(case)
+    o = case.outline
+    try:
+        return layout_from_outline(
+            xy, cuts=cuts, blocks=blocks, holes=holes, cell_size=o.cell_size, multiple=o.multiple
+        )
     except InvalidInputError as exc:
         raise type(exc)(f"{case.source}: {exc}") from None
 
@@ -238,3 +258,40 @@ def cut_case(
         crs="xy",
     )
     return Case(title=title or "split by cut lines", multiblock=MultiblockSection(mode="smooth"), outline=section)
+
+
+def layout_case(layout: Any, *, title: str = "", description: str = "", crs: Any = None) -> Case:
+    """An ``[outline]`` case of a :class:`~meshcore.layout.Layout` with ``[multiblock] mode =
+    "orthogonal"``: the shore, the islands, every cut and each block's corners and cells, inline
+    in the layout's coordinates.  ``meshcore generate`` of it gives the grid of
+    :func:`meshcore.lakegrid.mesh_layout`; edit it (move a corner, change cells) and generate again.
+
+    ``crs`` (a :class:`meshcore.crs.Frame` or ``None``) is written as the case's ``[crs]`` table,
+    so the grid files say which CRS the coordinates are in.
+    """
+    from ..layout.outline import outline_parts
+
+    parts = outline_parts(layout)
+    section = OutlineSection(
+        points=parts["outline"],
+        cuts=tuple(tuple((float(x), float(y)) for x, y in c) for c in parts["cuts"]),
+        blocks=tuple(
+            BlockOutline(b["name"], tuple(tuple(c) for c in b["corners"]), tuple(b["cells"])) for b in parts["blocks"]
+        ),
+        crs="xy",
+        multiple=layout.multiple,
+        holes=tuple(parts["holes"]),
+        cell_size=float(layout.cell_size),
+    )
+    table = None
+    if crs is not None and getattr(crs, "crs", None) is not None:
+        table = {"crs": str(crs.crs), "origin": [float(v) for v in crs.origin]}
+        if crs.source_crs is not None:
+            table["source_crs"] = str(crs.source_crs)
+    return Case(
+        title=title or f"automatic layout: {len(layout.blocks)} blocks",
+        description=description,
+        multiblock=MultiblockSection(mode="orthogonal"),
+        outline=section,
+        crs=table,
+    )

@@ -286,6 +286,12 @@ def _corners(value: Any, where: str) -> tuple:
         raise CaseFileError(f"{where}: {exc}") from None
 
 
+def _holes(value: Any, where: str) -> tuple:
+    if not isinstance(value, list):
+        raise CaseFileError(f"{where} holes must be a list of rings (lists of [x, y] points)")
+    return tuple(xy_pairs(r, f"{where} holes[{k}]") for k, r in enumerate(value))
+
+
 def parse_outline(tbl: Any, src: str) -> OutlineSection:
     """The ``[outline]`` table (its point file is read when the blocks are built)."""
     where = f"{src}: [outline]"
@@ -300,6 +306,7 @@ def parse_outline(tbl: Any, src: str) -> OutlineSection:
         convert={
             "points": lambda v, w: v if isinstance(v, str) else xy_pairs(v, f"{where} points"),
             "blocks": lambda v, w: _outline_blocks(v, src),
+            "holes": lambda v, w: _holes(v, where),
         },
     )
 
@@ -336,6 +343,8 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         interfaces=parse_interfaces(data.get("interfaces", []), source),
         outline=parse_outline(data["outline"], source) if "outline" in data else None,
     )
+    if case.settings.mode == "orthogonal" and case.outline is None:
+        raise CaseFileError(f'{source}: [multiblock] mode = "orthogonal" needs an [outline] section (the shore)')
     if case.outline is not None and case.blocks:
         raise CaseFileError(f"{source}: an [outline] case defines its blocks in [[outline.blocks]]; remove [[blocks]]")
     return case

@@ -14,7 +14,7 @@ from ..generate import generate_block
 from ..grid import StructuredGrid
 from ..spec import SolverSpec
 from .model import Case
-from .multiblock import case_frame, case_topology
+from .multiblock import case_frame, case_layout, case_topology
 
 __all__ = ["case_solver", "generate_case", "iterate_multiblock_case"]
 
@@ -74,6 +74,11 @@ def iterate_multiblock_case(
     from ..multiblock.solver import iterate_multiblock
 
     s = case.settings
+    if s.mode == "orthogonal":  # an [outline] lake case: the orthogonal lake grid
+        from ..lakegrid import iterate_layout
+
+        mb = yield from iterate_layout(case_layout(case), stop_event=stop_event)
+        return dataclasses.replace(mb, frame=case_frame(case))
     mb = yield from iterate_multiblock(
         topology if topology is not None else case_topology(case),
         mode=s.mode,

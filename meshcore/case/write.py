@@ -83,6 +83,10 @@ def _outline_table(o: OutlineSection) -> dict[str, Any]:
         t["snap"] = o.snap
     if o.multiple != 1:
         t["multiple"] = o.multiple
+    if o.cell_size is not None:
+        t["cell_size"] = o.cell_size
+    if o.holes:
+        t["holes"] = [np.asarray(h).tolist() for h in o.holes]
     t["blocks"] = [
         {"name": b.name, "corners": list(b.corners), "cells": list(b.cells), "initial": b.initial} for b in o.blocks
     ]

@@ -84,6 +84,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--png", metavar="FIG", help="also draw the grid to this figure (.png .svg .pdf)")
     p.add_argument(
+        "--case",
+        metavar="LAYOUT.toml",
+        help="also write the layout as a case file (shore, islands, cuts, blocks): edit it and "
+        "'meshcore generate' it again (same grid without edits)",
+    )
+    p.add_argument(
         "--colour",
         "--color",
         dest="colour",
@@ -126,6 +132,14 @@ def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
         seen[key] = f"{opt} {p}"
         if opt == "-o":
             out.append((p, find_format(p, None, role="write")))
+    if args.case:
+        p = Path(args.case)
+        if p.suffix.lower() != ".toml":
+            raise InvalidInputError(f"--case {p}: a case file ends in .toml")
+        if p.is_dir() or not p.resolve().parent.is_dir():
+            raise InvalidInputError(f"--case {p}: {'is a folder' if p.is_dir() else 'its folder does not exist'}")
+        if p.resolve() in seen:
+            raise InvalidInputError(f"--case {p}: the same file as {seen[p.resolve()]}")
     return out
 
 
@@ -395,6 +409,11 @@ def run(args: argparse.Namespace) -> int:
         )
         return 1
     mb = dataclasses.replace(mb, frame=frame)
+    if args.case:
+        from ..case import layout_case, save_case
+
+        save_case(layout_case(lay, crs=frame, description=f"made by meshcore mesh from {args.outline}"), args.case)
+        say(f"wrote {args.case} (the layout: edit it and run 'meshcore generate {args.case}')")
     m = lake_metrics(mb, polygon=poly, cell_size=h)
     n_folded = int(m.values("folded").sum())
     say(f"quality: {n_folded} folded cells, mean deviation from 90° {m.mean('deviation'):.2f}°, {say.lap():.1f} s")

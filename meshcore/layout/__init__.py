@@ -15,59 +15,25 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 * :mod:`.corners` — four corners per piece, where the boundary turns at the cells' scale;
 * :mod:`.counts` — integer cell counts that agree across every interface (a small MILP);
 * :mod:`.blocks` — the pieces as a :class:`~meshcore.multiblock.MultiBlockTopology`;
-* :mod:`.build` — the pipeline.
+* :mod:`.build` — the pipeline;
+* :mod:`.model` — :class:`Layout`; :mod:`.outline` — a layout as shore, islands, cuts and
+  blocks (the ``[outline]`` case); :mod:`.edit` — layouts from hand-made cuts and corners.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .blocks import Piece, build_topology
+from .blocks import build_topology
 from .build import layout_pieces
+from .edit import layout_from_cuts, layout_from_outline, with_cells
+from .model import Layout, LayoutBlock
+from .outline import interior_cuts
 from .polygon import water_polygon
 
-__all__ = ["Layout", "LayoutBlock", "auto_layout"]
-
-
-@dataclass(frozen=True, slots=True)
-class LayoutBlock:
-    """A block of a layout: its name, corners ``(sw, se, ne, nw)`` as points and its cells."""
-
-    name: str
-    corners: tuple[tuple[float, float], ...]
-    cells: tuple[int, int]
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Layout:
-    """The result of :func:`auto_layout`.
-
-    ``polygon`` is the water (a shapely Polygon, islands as holes, after cleaning),
-    ``cuts`` the cut lines (chords across arms and the splits inside junctions), ``pieces``
-    the regions with their corners, ``blocks`` their names, corners and cell counts.
-    """
-
-    polygon: Any
-    cell_size: float
-    cuts: tuple[np.ndarray, ...]
-    pieces: tuple[Piece, ...]
-    blocks: tuple[LayoutBlock, ...]
-    multiple: int = 1
-    skeleton: Any = field(default=None, repr=False)
-    chords: tuple = field(default=(), repr=False)
-    notes: tuple[str, ...] = ()
-
-    @property
-    def n_cells(self) -> int:
-        return sum(b.cells[0] * b.cells[1] for b in self.blocks)
-
-    def topology(self):
-        """The :class:`~meshcore.multiblock.MultiBlockTopology` (re-sampled borders, interfaces)."""
-        topo, _ = build_topology(list(self.pieces), self.cell_size, multiple=self.multiple)
-        return topo
+__all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
 
 
 def auto_layout(
@@ -111,7 +77,7 @@ def auto_layout(
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else float(np.sqrt(poly.area / target_cells))
     poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
-    sk, chords, cuts, pieces = layout_pieces(poly, h, regular=regular)
+    sk, chords, _, pieces = layout_pieces(poly, h, regular=regular)
     topo, _ = build_topology(pieces, h, multiple=multiple)
     blocks = tuple(
         LayoutBlock(
@@ -124,7 +90,7 @@ def auto_layout(
     return Layout(
         polygon=poly,
         cell_size=h,
-        cuts=tuple(cuts),
+        cuts=tuple(interior_cuts(pieces)),  # the lines between blocks (merged strips lose theirs)
         pieces=tuple(pieces),
         blocks=blocks,
         multiple=multiple,

@@ -4,7 +4,7 @@ The pieces are counter-clockwise rings that share their common edges vertex for 
 (:func:`conform` inserts every vertex into every ring whose edge it lies on, so T-junctions
 are explicit).  Each ring has four corner indices.  The boundary of each piece is cut into
 **chains** at its corners and wherever the neighbour across changes; a chain is shared by at
-most two pieces.  Counts come from :func:`~.counts.solve_counts`; each chain is re-sampled
+most two pieces.  Counts come from :func:`~meshcore.multiblock.counts.solve_counts`; each chain is re-sampled
 once (uniformly in arc length) and used by both neighbours, so interface nodes coincide by
 construction.
 """
@@ -18,8 +18,8 @@ import numpy as np
 
 from ..boundary import Borders
 from ..errors import TopologyError
+from ..multiblock.counts import solve_counts
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
-from .counts import solve_counts
 
 __all__ = ["Piece", "build_topology", "conform"]
 
@@ -116,14 +116,22 @@ def _resample(chain: np.ndarray, n_cells: int) -> np.ndarray:
     return out
 
 
-def build_topology(pieces: list[Piece], cell_size: float, *, min_cells: int = 3, multiple: int = 1):
-    """The :class:`MultiBlockTopology` of ``pieces`` with counts for ``cell_size``."""
+def build_topology(
+    pieces: list[Piece],
+    cell_size: float,
+    *,
+    min_cells: int = 3,
+    multiple: int = 1,
+    block_cells: dict[int, tuple[int, int]] | None = None,
+):
+    """The :class:`MultiBlockTopology` of ``pieces`` with counts for ``cell_size``
+    (``block_cells``: pieces whose cells ``(ni, nj)`` are given)."""
     side_chains, chain_pts, chain_users = _chains_of(pieces)
     keys = list(chain_pts)
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
-    counts = solve_counts(length / cell_size, sides, min_cells=min_cells, multiple=multiple)
+    counts = solve_counts(length / cell_size, sides, min_cells=min_cells, multiple=multiple, block_cells=block_cells)
     nodes = {k: _resample(chain_pts[k], int(counts[index[k]])) for k in keys}
     blocks, offsets = [], {}
     for pi, pc in enumerate(pieces):

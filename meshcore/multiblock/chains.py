@@ -145,6 +145,40 @@ class _Counts:
         return self.count
 
 
+def _chain_counts(
+    specs: list, side_chains: dict, chain_pts: dict, chain_users: dict, multiple: int, cell_size: float | None
+) -> dict[Key, int]:
+    """Cells per chain: the integer program of :func:`~.counts.solve_counts` with every block's cells
+    given; when it has no solution, the step-by-step count names the block and border at fault."""
+    from .counts import solve_counts
+
+    keys = list(chain_pts)
+    index = {k: i for i, k in enumerate(keys)}
+    length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
+    if cell_size is None:  # each chain at the cell size of the sides it lies on
+        scale = np.zeros(len(keys))
+        users = np.zeros(len(keys))
+        for s in specs:
+            for side in SIDES:
+                ks = side_chains[(s.name, side)]
+                need = s.cells[0] if side in ("bottom", "top") else s.cells[1]
+                total = sum(length[index[k]] for k in ks)
+                for k in ks:
+                    scale[index[k]] += need / total if total > 0 else 0.0
+                    users[index[k]] += 1
+        targets = length * scale / np.maximum(users, 1)
+    else:
+        targets = length / float(cell_size)
+    sides = [tuple([index[k] for k in side_chains[(s.name, side)]] for side in SIDES) for s in specs]
+    cells = {bi: (int(s.cells[0]), int(s.cells[1])) for bi, s in enumerate(specs)}
+    try:
+        n = solve_counts(targets, sides, min_cells=1, multiple=multiple, block_cells=cells)
+    except TopologyError:
+        _Counts(specs, side_chains, chain_pts, chain_users, multiple).solve()  # names the conflict
+        raise
+    return {k: int(n[index[k]]) for k in keys}
+
+
 def _block(s: Any, side_chains: dict, nodes: dict, corners: list, offsets: dict) -> Block:
     """One block's borders from its chains' nodes; records each chain's node range in ``offsets``."""
     sides = {}
@@ -174,17 +208,28 @@ def _block(s: Any, side_chains: dict, nodes: dict, corners: list, offsets: dict)
 
 
 def chain_topology(
-    specs: list, rings: dict[str, np.ndarray], corners: dict[str, list], breaks: set, multiple: int
+    specs: list,
+    rings: dict[str, np.ndarray],
+    corners: dict[str, list],
+    breaks: set,
+    multiple: int,
+    *,
+    check_geometry: bool = True,
+    cell_size: float | None = None,
 ) -> MultiBlockTopology:
     """The topology of blocks on regions.
 
     ``specs``: the :class:`~.outline.BlockOutline` of each block; ``rings``: its
     region (counter-clockwise vertex ring); ``corners``: its four corner
     vertices (``(x, y)`` tuples, sw, se, ne, nw); ``breaks``: vertices where
-    chains end (corners and junctions of three or more lines).
+    chains end (corners and junctions of three or more lines).  ``check_geometry=False``
+    skips the topology's shapely checks (islands are holes the blocks do not cover).
+    Where a side has several chains, its cells are shared among them as
+    :func:`~.counts.solve_counts` does: closest to ``length / cell_size`` (default: each
+    side's own cell size), integer and consistent round every block.
     """
     side_chains, chain_pts, chain_users = _side_chains(specs, rings, corners, breaks)
-    count = _Counts(specs, side_chains, chain_pts, chain_users, multiple).solve()
+    count = _chain_counts(specs, side_chains, chain_pts, chain_users, multiple, cell_size)
     nodes = {key: _resample(chain_pts[key], count[key]) for key in chain_pts}
     offsets: dict[tuple[str, str, Key], tuple[int, int]] = {}
     blocks = [_block(s, side_chains, nodes, corners[s.name], offsets) for s in specs]
@@ -195,4 +240,4 @@ def chain_topology(
             a0, a1 = offsets[(ba, sa, key)]
             b0, b1 = offsets[(bb, sb, key)]
             interfaces.append(Interface(Side(ba, sa, a0, a1), Side(bb, sb, b0, b1), None))
-    return MultiBlockTopology(tuple(blocks), tuple(interfaces))
+    return MultiBlockTopology(tuple(blocks), tuple(interfaces), check_geometry=check_geometry)

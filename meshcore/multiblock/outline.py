@@ -108,6 +108,7 @@ class OutlineBlocks:
     outline: np.ndarray
     cuts: tuple[np.ndarray, ...]
     regions: tuple[np.ndarray, ...]  # CCW vertex rings of the regions
+    islands: tuple[np.ndarray, ...] = ()  # clockwise rings of the islands (cut ends inserted)
 
 
 def _project_on(poly: np.ndarray, q: np.ndarray, closed: bool) -> tuple[float, int, float]:
@@ -153,17 +154,17 @@ def _resolve_cuts(given_ring: np.ndarray, cuts: Sequence[Any]) -> list[np.ndarra
                 f"cut {k}: points must be [x, y] pairs or outline point indices (0 … {len(given_ring) - 1}), got {c!r}"
             ) from None
         cut_list.append(validate_points(pts, name=f"cut {k}"))
-    if not cut_list:
-        raise TopologyError("from_outline needs at least one cut line (one block needs no multiblock)")
     return cut_list
 
 
-def _snap_cut_ends(ring: np.ndarray, cut_list: list[np.ndarray], snap: float, eps: float) -> np.ndarray:
-    """Move every cut end onto the outline or another cut, inserting the point there; returns the ring."""
+def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: float, eps: float) -> list[np.ndarray]:
+    """Move every cut end onto the outline, an island or another cut, inserting the point there;
+    returns the shore rings (outline first, then the islands)."""
+    rings = list(rings)
     for k in range(len(cut_list)):
         for end in (0, -1):
             q = cut_list[k][end]
-            best = (_project_on(ring, q, True), "outline", -1)
+            best = min(((_project_on(r, q, True), "outline", ri) for ri, r in enumerate(rings)), key=lambda b: b[0][0])
             for m, other in enumerate(cut_list):
                 if m == k:
                     continue
@@ -174,22 +175,23 @@ def _snap_cut_ends(ring: np.ndarray, cut_list: list[np.ndarray], snap: float, ep
             if dist > snap:
                 raise TopologyError(
                     f"cut {k}: its {'first' if end == 0 else 'last'} point ({q[0]:.6g}, {q[1]:.6g}) "
-                    f"is {dist:.4g} from the outline and from every other cut (snap distance "
-                    f"{snap:.4g}); cuts must end on the outline or on another cut"
+                    f"is {dist:.4g} from the shore and from every other cut (snap distance "
+                    f"{snap:.4g}); cuts must end on the outline, an island or another cut"
                 )
             if kind == "outline":
-                ring, p = _insert(ring, seg, t, True, eps)
+                rings[m], p = _insert(rings[m], seg, t, True, eps)
             else:
                 cut_list[m], p = _insert(cut_list[m], seg, t, False, eps)
             cut_list[k][end] = p
-    return ring
+    return rings
 
 
-def _check_cuts(ring: np.ndarray, cut_list: list[np.ndarray], snap: float) -> None:
-    """Every cut runs inside the outline and meets it only at its ends."""
-    from shapely.geometry import LineString, Polygon
+def _check_cuts(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: float) -> None:
+    """Every cut runs inside the water and meets the shore only at its ends."""
+    from shapely.geometry import LineString, MultiLineString, Polygon
 
-    inside = Polygon(ring).buffer(snap)
+    inside = Polygon(rings[0], rings[1:]).buffer(snap)
+    shore = MultiLineString([np.vstack([r, r[:1]]) for r in rings])
     for k, c in enumerate(cut_list):
         ls = LineString(c)
         if not inside.contains(ls):
@@ -199,22 +201,24 @@ def _check_cuts(ring: np.ndarray, cut_list: list[np.ndarray], snap: float) -> No
                 f"cut {k} leaves the water near ({pt.x:.6g}, {pt.y:.6g}); cut lines must run "
                 f"across the inside of the outline"
             )
-        inner = LineString(c).intersection(LineString(np.vstack([ring, ring[:1]])))
+        inner = LineString(c).intersection(shore)
         n_touch = len(getattr(inner, "geoms", [inner])) if not inner.is_empty else 0
         if n_touch > 2:
-            raise TopologyError(f"cut {k} touches the outline {n_touch} times; a cut may meet it only at its ends")
+            raise TopologyError(f"cut {k} touches the shore {n_touch} times; a cut may meet it only at its ends")
 
 
-def _regions(ring: np.ndarray, cut_list: list[np.ndarray], size: float) -> list[Any]:
-    """The faces (CCW polygons) into which the outline and the cuts split the water."""
+def _regions(rings: list[np.ndarray], cut_list: list[np.ndarray], size: float) -> list[Any]:
+    """The faces (CCW polygons) into which the shore (outline and islands) and the cuts split the water."""
     import shapely
     from shapely.geometry import LineString, Polygon
     from shapely.geometry.polygon import orient
 
-    lake = Polygon(ring)
-    lines = shapely.union_all([LineString(np.vstack([ring, ring[:1]])), *(LineString(c) for c in cut_list)])
+    lake = Polygon(rings[0], rings[1:])
+    lines = shapely.union_all([LineString(np.vstack([r, r[:1]])) for r in rings] + [LineString(c) for c in cut_list])
     faces = [orient(f, 1.0) for f in shapely.polygonize(list(getattr(lines, "geoms", [lines]))).geoms]
     faces = [f for f in faces if f.area > 1e-12 * size * size]
+    islands = [Polygon(r) for r in rings[1:]]
+    faces = [f for f in faces if not any(i.contains(f.representative_point()) for i in islands)]
     area = sum(f.area for f in faces)
     if abs(area - lake.area) > 1e-6 * lake.area:
         raise TopologyError(
@@ -222,10 +226,10 @@ def _regions(ring: np.ndarray, cut_list: list[np.ndarray], size: float) -> list[
         )
     for f in faces:
         if f.interiors:
-            c = f.representative_point()
+            c = f.interiors[0].coords[0]
             raise TopologyError(
-                f"the region near ({c.x:.6g}, {c.y:.6g}) encloses another region (a closed cut "
-                f"loop); connect it with a cut to the outline"
+                f"the region round ({c[0]:.6g}, {c[1]:.6g}) encloses an island or another region (a "
+                f"closed cut loop); connect it with cuts to the shore on two sides"
             )
     return faces
 
@@ -342,13 +346,37 @@ def _place_blocks(
     return block_corners, block_face
 
 
+def _islands(holes: Sequence[Any], lake: Any) -> list[np.ndarray]:
+    """The island rings, clockwise (as holes), each checked to be a simple ring inside the lake."""
+    from shapely.geometry import Polygon
+
+    out: list[np.ndarray] = []
+    for k, h in enumerate(holes):
+        r = validate_points(h, name=f"island {k}", min_points=3)
+        if np.hypot(*(r[0] - r[-1])) <= 1e-12 * float(np.ptp(r, axis=0).max()):
+            r = r[:-1]
+        isl = Polygon(r)
+        if not isl.is_valid or isl.area <= 0:
+            raise TopologyError(f"island {k} is not a simple ring with an area")
+        if not lake.contains(isl):
+            c = isl.representative_point()
+            raise TopologyError(f"island {k} (near ({c.x:.6g}, {c.y:.6g})) is not inside the outline")
+        for j, other in enumerate(out):
+            if isl.intersects(Polygon(other)):
+                raise TopologyError(f"islands {j} and {k} overlap or touch")
+        out.append(r[::-1].copy() if signed_area(r) > 0 else r)
+    return out
+
+
 def from_outline(
     outline: Any,
     *,
     cuts: Sequence[Any],
     blocks: Sequence[Any],
+    holes: Sequence[Any] = (),
     snap: float | None = None,
     multiple: int = 1,
+    cell_size: float | None = None,
 ) -> OutlineBlocks:
     """Split a closed outline by cut lines into four-sided blocks glued by interfaces.
 
@@ -358,6 +386,9 @@ def from_outline(
         Closed shoreline (first point not repeated, or repeated; either orientation).
     cuts : sequence of (k, 2) array_like
         Polylines across the water; each end on the outline or on another cut.
+    holes : sequence of (k, 2) array_like
+        Islands: closed rings inside the outline.  Cuts may end on them; every
+        region must be simply connected (an island needs cuts to the shore).
     blocks : sequence of BlockOutline or mappings
         ``{"name", "corners": [sw, se, ne, nw], "cells": [ni, nj]}``; a corner is
         an ``[x, y]`` point (snapped to the nearest outline/cut vertex) or an
@@ -366,6 +397,9 @@ def from_outline(
         Every chain gets a multiple of this many cells (all block cells must be
         multiples of it): ``2**k`` lets the multigrid coarsen the blocks ``k``
         times.
+    cell_size : float, optional
+        Where a block side has several parts (a T-junction), its cells are shared among
+        them closest to ``length / cell_size`` (default: that side's own cell size).
     snap : float, optional
         Distance within which cut ends and corners are snapped
         (default ``1e-3 ×`` the outline's bounding-box diagonal).
@@ -396,10 +430,11 @@ def from_outline(
     lake = Polygon(ring)
     if not lake.is_valid:
         raise TopologyError(f"the outline crosses itself ({shapely.is_valid_reason(lake)})")
+    islands = _islands(holes, lake)
     cut_list = _resolve_cuts(given_ring, cuts)
-    ring = _snap_cut_ends(ring, cut_list, snap, 1e-12 * size)
-    _check_cuts(ring, cut_list, snap)
-    faces = _regions(ring, cut_list, size)
+    ring, *islands = _snap_cut_ends([ring, *islands], cut_list, snap, 1e-12 * size)
+    _check_cuts([ring, *islands], cut_list, snap)
+    faces = _regions([ring, *islands], cut_list, size)
     rings = [np.asarray(f.exterior.coords)[:-1] for f in faces]
     nbrs = _neighbours(rings)
     specs = [BlockOutline.coerce(b) for b in blocks]
@@ -412,5 +447,11 @@ def from_outline(
             )
     breaks = {c for cs in block_corners.values() for c in cs} | {v for v, nb in nbrs.items() if len(nb) >= 3}
     sides = {s.name: rings[block_face[s.name]] for s in specs}
-    topo = chain_topology(specs, sides, block_corners, breaks, multiple)
-    return OutlineBlocks(topology=topo, outline=ring, cuts=tuple(cut_list), regions=tuple(rings))
+    # with islands the blocks leave holes by design; the regions were checked above (they are the
+    # water exactly, each is one block)
+    topo = chain_topology(
+        specs, sides, block_corners, breaks, multiple, check_geometry=not islands, cell_size=cell_size
+    )
+    return OutlineBlocks(
+        topology=topo, outline=ring, cuts=tuple(cut_list), regions=tuple(rings), islands=tuple(islands)
+    )

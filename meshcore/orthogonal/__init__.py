@@ -1,5 +1,5 @@
 """Orthogonal grids with shore nodes that slide (see :mod:`.driver`)."""
 
-from .driver import OrthoResult, orthogonalize
+from .driver import OrthoResult, iterate_orthogonalize, orthogonalize
 
-__all__ = ["OrthoResult", "orthogonalize"]
+__all__ = ["OrthoResult", "iterate_orthogonalize", "orthogonalize"]

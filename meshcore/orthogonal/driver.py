@@ -25,7 +25,7 @@ import numpy as np
 from . import _kernels
 from .shore import project_to_rings
 
-__all__ = ["OrthoResult", "orthogonalize"]
+__all__ = ["OrthoResult", "iterate_orthogonalize", "orthogonalize"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -160,11 +160,22 @@ def _ring_tables(rings):
     return np.vstack(rings).astype(np.float64), np.concatenate(parts), np.array(off, dtype=np.int64)
 
 
-def orthogonalize(
+def orthogonalize(topology, grids, rings, **options):
+    """Orthogonalise ``grids`` (one per block of ``topology``) with shore nodes sliding on ``rings``.
+
+    The options are those of :func:`iterate_orthogonalize`; returns its :class:`OrthoResult`.
+    """
+    from .._generators import drain
+
+    return drain(iterate_orthogonalize(topology, grids, rings, every=None, **options))
+
+
+def iterate_orthogonalize(
     topology,
     grids,
     rings,
     *,
+    every: int | None = 25,
     tol: float = 1e-4,
     max_sweeps: int = 20_000,
     omega: float = 1.0,
@@ -175,7 +186,9 @@ def orthogonalize(
     shore_gap: float = 0.25,
     callback=None,
 ):
-    """Orthogonalise ``grids`` (one per block of ``topology``) with shore nodes sliding on ``rings``."""
+    """:func:`orthogonalize` as a generator: every ``every`` sweeps it yields
+    ``(sweep, change, grids)`` (the change per sweep relative to the median edge, the current
+    grids); ``"stop"`` sent to it ends the sweeps.  Returns the :class:`OrthoResult`."""
     t0 = time.perf_counter()
     m = topology.node_map
     X, Y = _assemble(grids, m)
@@ -227,5 +240,9 @@ def orthogonalize(
         if d < tol:
             converged = True
             break
+        if every and it % every == 0:
+            snap = tuple(g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True))
+            if (yield (it, d, snap)) == "stop":
+                break
     out = [g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True)]
     return OrthoResult(tuple(out), it, converged, time.perf_counter() - t0, tuple(hist))

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from meshcore import testing
 from meshcore.errors import InvalidInputError, TopologyError
 from meshcore.layout import auto_layout
-from meshcore.layout.counts import solve_counts
+from meshcore.multiblock.counts import solve_counts
 
 
 def _check_valid(lay, *, count_ratio: bool = True) -> None:

@@ -510,3 +510,30 @@ def test_a_bug_in_the_pipeline_is_one_line_and_exit_1(tmp_path, synthetic_csv, m
     assert run.rc == 1 and run.err.count("\n") == 1 and "Traceback" not in run.err
     assert "internal error" in run.err and "IndexError: index 7" in run.err and "lake.csv" in run.err
     assert os.listdir(out) == []
+
+
+# ------------------------------------------------------------------ the layout as a case file
+def test_case_file_of_the_layout_generates_the_same_grid_and_can_be_edited(tmp_path, synthetic_csv):
+    """``--case`` writes the layout; ``meshcore generate`` of it gives the grid ``mesh`` wrote."""
+    from meshcore.case import load_case
+
+    run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "m.npz", "--case", tmp_path / "lay.toml", "-q")
+    assert run.rc == 0, run.err
+    case = load_case(tmp_path / "lay.toml")
+    assert case.settings.mode == "orthogonal" and len(case.outline.holes) == 1  # the island
+    o, e = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
+        rc = main(["generate", str(tmp_path / "lay.toml"), "-o", str(tmp_path / "g.npz")])
+    assert rc == 0, e.getvalue()
+    a, b = read_blocks(tmp_path / "m.npz").blocks, read_blocks(tmp_path / "g.npz").blocks
+    assert len(a) == len(b) == len(case.outline.blocks)
+    for ga, gb in zip(a, b, strict=True):
+        np.testing.assert_allclose(ga.x, gb.x, rtol=0, atol=1e-6)  # metres
+        np.testing.assert_allclose(ga.y, gb.y, rtol=0, atol=1e-6)
+
+
+def test_case_option_refused_before_the_work(tmp_path, synthetic_csv):
+    run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "m.npz", "--case", tmp_path / "lay.txt")
+    _refused(run, tmp_path, "--case", ".toml", before={"lake.csv"})
+    run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "m.npz", "--case", tmp_path / "no" / "lay.toml")
+    _refused(run, tmp_path, "--case", "folder", before={"lake.csv"})

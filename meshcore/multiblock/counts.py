@@ -31,12 +31,13 @@ __all__ = ["solve_counts"]
 
 
 def solve_counts(
-    targets: Sequence[float],
-    sides: Sequence[tuple[Sequence[int], Sequence[int], Sequence[int], Sequence[int]]],
+    targets: Sequence[float] | np.ndarray,
+    sides: Sequence[Sequence[Sequence[int]]],
     *,
     min_cells: int = 3,
     multiple: int = 1,
     fixed: dict[int, int] | None = None,
+    block_cells: dict[int, tuple[int, int]] | None = None,
 ) -> np.ndarray:
     """Integer counts per chain.
 
@@ -52,6 +53,10 @@ def solve_counts(
         Every chain count is a multiple of this.
     fixed : dict, optional
         Chains whose count is given (e.g. typed by the user).
+    block_cells : dict, optional
+        Blocks whose cells ``(ni, nj)`` are given: their bottom (and top) chains add up to
+        ``ni``, their left (and right) chains to ``nj``.  With every block given, the program
+        only shares each side's cells among its chains (closest to ``targets``).
 
     Raises
     ------
@@ -99,6 +104,12 @@ def solve_counts(
             for c in side:
                 r[c] += m
             rows.append(r), lo.append(float(min_cells)), hi.append(np.inf)
+        if block_cells and bi in block_cells:
+            for side, want in ((bottom, block_cells[bi][0]), (left, block_cells[bi][1])):
+                r = row()
+                for c in side:
+                    r[c] += m
+                rows.append(r), lo.append(float(want)), hi.append(float(want))
     lb = np.concatenate([np.ones(n), np.zeros(n + 2 * nb)])
     ub = np.full(nv, np.inf)
     for c, v in (fixed or {}).items():

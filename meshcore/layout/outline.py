@@ -1,0 +1,111 @@
+r"""A layout as the ``[outline]`` description: shore, islands, cut lines, blocks with cells.
+
+An automatic layout and a hand-edited one meet here.  :func:`outline_parts` writes a
+:class:`~meshcore.layout.Layout` as the inputs of :func:`meshcore.multiblock.from_outline`
+(the shore densified to the cell size, the islands, every line between two blocks as a cut,
+each block's four corners and cells); :func:`~.edit.layout_from_outline` reads them back.
+:meth:`Layout.topology` always goes through :func:`~meshcore.multiblock.from_outline`, so a
+layout saved as a case and generated again gives the same grid.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .blocks import Piece
+
+__all__ = ["interior_cuts", "outline_blocks", "outline_parts", "shore_rings"]
+
+
+def _key(p) -> tuple[float, float]:
+    return (float(p[0]), float(p[1]))
+
+
+def shore_rings(polygon: Any, cell_size: float) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The shore as the layout cut it: the outline and the islands with points every ``cell_size``."""
+    import shapely
+
+    dense = shapely.segmentize(polygon, cell_size)
+    return np.asarray(dense.exterior.coords)[:-1], [np.asarray(h.coords)[:-1] for h in dense.interiors]
+
+
+def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
+    """Every line between two pieces, as polylines that end where three or more lines meet.
+
+    The edges used by two pieces form a graph; its paths between vertices of degree other
+    than two (or where a shore is reached) are the cuts.
+    """
+    users: dict[frozenset, int] = {}
+    for pc in pieces:
+        r = pc.ring
+        for a, b in zip(r, np.roll(r, -1, axis=0), strict=True):
+            e = frozenset((_key(a), _key(b)))
+            users[e] = users.get(e, 0) + 1
+    inner = [tuple(e) for e, n in users.items() if n >= 2 and len(e) == 2]
+    on_shore = {v for e, n in users.items() if n == 1 for v in e}
+    adj: dict[tuple, list[tuple]] = {}
+    for a, b in inner:
+        adj.setdefault(a, []).append(b)
+        adj.setdefault(b, []).append(a)
+    stop = {v for v, nb in adj.items() if len(nb) != 2 or v in on_shore}
+    seen: set[frozenset] = set()
+    cuts = []
+    for start in sorted(adj):
+        if start not in stop:
+            continue
+        for nxt in adj[start]:
+            if frozenset((start, nxt)) in seen:
+                continue
+            path = [start, nxt]
+            seen.add(frozenset((start, nxt)))
+            while path[-1] not in stop:
+                a, b = path[-2], path[-1]
+                c = next(v for v in adj[b] if v != a)
+                seen.add(frozenset((b, c)))
+                path.append(c)
+            cuts.append(np.array(path))
+    for a, b in inner:  # closed loops without a stop vertex (a cut round an island touching nothing)
+        if frozenset((a, b)) not in seen:
+            path = [a, b]
+            seen.add(frozenset((a, b)))
+            while path[-1] != a:
+                c = next(v for v in adj[path[-1]] if frozenset((path[-1], v)) not in seen or v == a)
+                seen.add(frozenset((path[-1], c)))
+                path.append(c)
+            cuts.append(np.array(path))
+    return cuts
+
+
+def outline_parts(layout: Any) -> dict[str, Any]:
+    """The :func:`~meshcore.multiblock.from_outline` inputs of a layout.
+
+    Returns ``{"outline", "holes", "cuts", "blocks"}``: the densified shore ring, the island
+    rings, the cut polylines and ``{"name", "corners", "cells"}`` per block.
+    """
+    outline, holes = shore_rings(layout.polygon, layout.cell_size)
+    blocks = [{"name": b.name, "corners": [list(c) for c in b.corners], "cells": list(b.cells)} for b in layout.blocks]
+    return {"outline": outline, "holes": holes, "cuts": interior_cuts(list(layout.pieces)), "blocks": blocks}
+
+
+def outline_blocks(layout: Any):
+    """:func:`~meshcore.multiblock.from_outline` of a layout (its topology, regions, cuts)."""
+    from ..multiblock.outline import from_outline
+
+    parts = outline_parts(layout)
+    return from_outline(
+        parts["outline"],
+        holes=parts["holes"],
+        cuts=parts["cuts"],
+        blocks=parts["blocks"],
+        multiple=layout.multiple,
+        snap=1e-6 * _size(layout.polygon),
+        cell_size=layout.cell_size,
+    )
+
+
+def _size(polygon: Any) -> float:
+    x0, y0, x1, y1 = polygon.bounds
+    return math.hypot(x1 - x0, y1 - y0)
