@@ -220,21 +220,11 @@ def case_of_project(project: Project):
 
 
 def _layout_case(project: Project):
-    """A lake layout as a case: meshcore's ``layout_case`` when it exists, else its blocks and interfaces.
+    """A lake layout as a case: :func:`meshcore.case.layout_case` (shore, islands, cut lines, blocks
+    with corners and cells, ``mode = "orthogonal"``), which ``meshcore generate`` solves again."""
+    from meshcore.case import layout_case
 
-    Seam: without :func:`meshcore.layout.layout_case` the case holds the layout's blocks and
-    interfaces (``meshcore generate`` solves them as a smooth multiblock grid); the cut lines
-    and the orthogonal mode come back only with it.
-    """
-    import meshcore.layout as ml
-    from meshcore.case import topology_case
-
-    layout = project.layout
-    make = getattr(ml, "layout_case", None)
-    if make is not None:
-        case = make(layout)
-    else:
-        case = topology_case(layout.topology(), mode="smooth", title=project.title)
+    case = layout_case(project.layout)
     frame = project_frame(project)
     if frame is not None:
         case = case.replaced(crs=frame.as_dict())
