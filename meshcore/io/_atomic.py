@@ -96,9 +96,18 @@ def clean_stale_temporaries(target: Path) -> list[Path]:
 
 
 def _write_error(target: Any, exc: BaseException) -> WriteError:
-    if isinstance(exc, OSError):
-        return WriteError(one_line(f"{target}: cannot write ({exc.strerror or exc})"))
-    return WriteError(one_line(f"{target}: cannot write ({type(exc).__name__}: {exc})"))
+    """One line naming the target and the reason (the system's, when a library buries it in a long
+    message: HDF5 reports a full disk as ``… errno = 28, error message = '…' …``)."""
+    import re
+
+    errno = re.search(r"\berrno = (\d+)", str(exc))
+    if isinstance(exc, OSError) and exc.strerror:
+        reason = exc.strerror
+    elif errno:
+        reason = os.strerror(int(errno.group(1)))
+    else:
+        reason = str(exc) if isinstance(exc, OSError) else f"{type(exc).__name__}: {exc}"
+    return WriteError(one_line(f"{target}: cannot write ({reason})"))
 
 
 @contextlib.contextmanager

@@ -29,6 +29,7 @@ connectivity instead of boundary conditions.
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 from typing import Any
 
@@ -209,8 +210,22 @@ def _zone_connectivity(z, gs: GridSet, k: int, conns: list[tuple[Interface, bool
 
 
 def write_cgns(path: Path, gs: GridSet, **_: Any) -> None:
-    """Write blocks as CGNS structured zones (see module docstring)."""
+    """Write blocks as CGNS structured zones (see module docstring).
+
+    The file is built in memory and written in one piece: a full disk is one
+    clean ``OSError`` (HDF5 failing in the middle of a file raised again while
+    its objects were freed, and could crash the interpreter's exit).
+    """
     h5py = _h5py(path, WriteError)
+    with atomic_path(path) as tmp:
+        image = io.BytesIO()
+        with h5py.File(image, "w", track_order=True) as f:
+            _write_tree(f, gs, h5py)
+        tmp.write_bytes(image.getbuffer())
+
+
+def _write_tree(f: Any, gs: GridSet, h5py: Any) -> None:
+    """The CGNS node tree of ``gs`` in the open HDF5 file ``f``."""
     zones = list(gs.block_names)
     iface: dict[int, list[tuple[Interface, bool]]] = {}
     spans: dict[int, dict[str, list[tuple[int, int]]]] = {}
@@ -218,32 +233,31 @@ def write_cgns(path: Path, gs: GridSet, **_: Any) -> None:
         for side, k, b in (("a", it.a, it.border_a), ("b", it.b, it.border_b)):
             iface.setdefault(k, []).append((it, side == "a"))
             spans.setdefault(k, {}).setdefault(b, []).append(it.span(side, gs.blocks))
-    with atomic_path(path) as tmp, h5py.File(tmp, "w", track_order=True) as f:
-        f.attrs.create("name", np.array(b"HDF5 MotherNode", dtype="S33"))
-        f.attrs.create("label", np.array(b"Root Node of HDF5 File", dtype="S33"))
-        f.attrs.create("type", np.array(b"MT", dtype="S3"))
-        f.create_dataset(" format", data=np.frombuffer(b"IEEE_LITTLE_64\x00", dtype=np.int8))
-        ver = f"HDF5 Version {h5py.version.hdf5_version}".encode().ljust(33, b"\x00")
-        f.create_dataset(" hdf5version", data=np.frombuffer(ver, dtype=np.int8))
-        _node(f, "CGNSLibraryVersion", "CGNSLibraryVersion_t", "R4", [4.2])
-        base = _node(f, "Base", "CGNSBase_t", "I4", [2, 2])
-        if gs.frame.crs:
-            _node(base, "CRS", "Descriptor_t", "C1", gs.frame.crs)
-        o = gs.frame.origin
-        if o != (0.0, 0.0):
-            _node(base, "LocalOrigin", "Descriptor_t", "C1", f"{o[0]!r} {o[1]!r}")
-        for k, g in enumerate(gs.blocks):
-            ni, nj = g.cells
-            z = _node(base, zones[k], "Zone_t", "I4", np.array([[ni + 1, nj + 1], [ni, nj], [0, 0]]).T)
-            _node(z, "ZoneType", "ZoneType_t", "C1", "Structured")
-            gc = _node(z, "GridCoordinates", "GridCoordinates_t")
-            X, Y = gs.world(k)
-            _node(gc, "CoordinateX", "DataArray_t", "R8", X)
-            _node(gc, "CoordinateY", "DataArray_t", "R8", Y)
-            _zone_bcs(z, gs, k, spans.get(k, {}))
-            conns = sorted(iface.get(k, []), key=lambda c: BORDER_NAMES.index(c[0].border_a if c[1] else c[0].border_b))
-            if conns:
-                _zone_connectivity(z, gs, k, conns, zones)
+    f.attrs.create("name", np.array(b"HDF5 MotherNode", dtype="S33"))
+    f.attrs.create("label", np.array(b"Root Node of HDF5 File", dtype="S33"))
+    f.attrs.create("type", np.array(b"MT", dtype="S3"))
+    f.create_dataset(" format", data=np.frombuffer(b"IEEE_LITTLE_64\x00", dtype=np.int8))
+    ver = f"HDF5 Version {h5py.version.hdf5_version}".encode().ljust(33, b"\x00")
+    f.create_dataset(" hdf5version", data=np.frombuffer(ver, dtype=np.int8))
+    _node(f, "CGNSLibraryVersion", "CGNSLibraryVersion_t", "R4", [4.2])
+    base = _node(f, "Base", "CGNSBase_t", "I4", [2, 2])
+    if gs.frame.crs:
+        _node(base, "CRS", "Descriptor_t", "C1", gs.frame.crs)
+    o = gs.frame.origin
+    if o != (0.0, 0.0):
+        _node(base, "LocalOrigin", "Descriptor_t", "C1", f"{o[0]!r} {o[1]!r}")
+    for k, g in enumerate(gs.blocks):
+        ni, nj = g.cells
+        z = _node(base, zones[k], "Zone_t", "I4", np.array([[ni + 1, nj + 1], [ni, nj], [0, 0]]).T)
+        _node(z, "ZoneType", "ZoneType_t", "C1", "Structured")
+        gc = _node(z, "GridCoordinates", "GridCoordinates_t")
+        X, Y = gs.world(k)
+        _node(gc, "CoordinateX", "DataArray_t", "R8", X)
+        _node(gc, "CoordinateY", "DataArray_t", "R8", Y)
+        _zone_bcs(z, gs, k, spans.get(k, {}))
+        conns = sorted(iface.get(k, []), key=lambda c: BORDER_NAMES.index(c[0].border_a if c[1] else c[0].border_b))
+        if conns:
+            _zone_connectivity(z, gs, k, conns, zones)
 
 
 #: Longest text node read (a CRS WKT is a few kB).
