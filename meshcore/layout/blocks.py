@@ -4,22 +4,20 @@ The pieces are counter-clockwise rings that share their common edges vertex for 
 (:func:`conform` inserts every vertex into every ring whose edge it lies on, so T-junctions
 are explicit).  Each ring has four corner indices.  The boundary of each piece is cut into
 **chains** at its corners and wherever the neighbour across changes; a chain is shared by at
-most two pieces.  Counts come from :func:`~meshcore.multiblock.counts.solve_counts`; each chain is re-sampled
-once (uniformly in arc length) and used by both neighbours, so interface nodes coincide by
-construction.
+most two pieces.  Counts come from :func:`~meshcore.multiblock.counts.solve_counts`; the chains,
+their nodes (each re-sampled once, uniformly in arc length, and used by both neighbours) and the
+interfaces from :mod:`meshcore.multiblock.chains`, the code of
+:func:`~meshcore.multiblock.from_outline`.
 """
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..boundary import Borders
 from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
-from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
 
 __all__ = ["Piece", "build_topology", "conform"]
 
@@ -68,52 +66,35 @@ def conform(rings: list[np.ndarray], eps: float) -> list[np.ndarray]:
     return out
 
 
+def _line_work(pieces: list[Piece]):
+    """Names, rings, corners and chain breaks of the pieces, as :mod:`meshcore.multiblock.chains` takes them.
+
+    Chains break at block corners and where three or more lines meet (a T-junction or a cut
+    ending on the shore), exactly where the neighbour across a side changes.
+    """
+    names = [pc.name or f"b{k}" for k, pc in enumerate(pieces)]
+    rings = dict(zip(names, (pc.ring for pc in pieces), strict=True))
+    corners = {n: [_key(pc.ring[c]) for c in pc.corners] for n, pc in zip(names, pieces, strict=True)}
+    nbrs: dict = {}
+    for pc in pieces:
+        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
+            nbrs.setdefault(_key(a), set()).add(_key(b))
+            nbrs.setdefault(_key(b), set()).add(_key(a))
+    breaks = {c for cs in corners.values() for c in cs} | {v for v, nb in nbrs.items() if len(nb) >= 3}
+    return names, rings, corners, breaks
+
+
 def _chains_of(pieces: list[Piece]):
-    """Per piece and side, the chain keys; the chain polylines; the users of each chain."""
-    edge_users: dict = {}
-    for pi, pc in enumerate(pieces):
-        r = pc.ring
-        n = len(r)
-        for k in range(n):
-            e = (_key(r[k]), _key(r[(k + 1) % n]))
-            edge_users.setdefault(frozenset(e), []).append(pi)
-    corner_keys = {_key(pc.ring[c]) for pc in pieces for c in pc.corners}
-    side_chains = {}
-    chain_pts: dict = {}
-    chain_users: dict = {}
-    for pi, pc in enumerate(pieces):
-        r = pc.ring
-        n = len(r)
-        cs = list(pc.corners)
-        for side, (a, b) in zip(BORDERS, zip(cs, cs[1:] + cs[:1], strict=True), strict=True):
-            walk = [r[(a + s) % n] for s in range((b - a) % n + 1)]
-            chains, cur = [], [walk[0]]
-            prev_users = None
-            for p, q in itertools.pairwise(walk):
-                users = tuple(sorted(edge_users[frozenset((_key(p), _key(q)))]))
-                if prev_users is not None and (users != prev_users or _key(p) in corner_keys):
-                    chains.append(np.array(cur))
-                    cur = [p]
-                cur.append(q)
-                prev_users = users
-            chains.append(np.array(cur))
-            keys = []
-            for ch in chains:
-                fwd = tuple(_key(p) for p in ch)
-                key = min(fwd, fwd[::-1])
-                chain_pts.setdefault(key, np.array(key))
-                chain_users.setdefault(key, []).append((pi, side))
-                keys.append(key)
-            side_chains[(pi, side)] = keys
-    return side_chains, chain_pts, chain_users
+    """Per ``(piece index, side)`` the chain keys; the chain polylines; the users of each chain."""
+    from types import SimpleNamespace
 
+    from ..multiblock.chains import side_chains
 
-def _resample(chain: np.ndarray, n_cells: int) -> np.ndarray:
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(chain, axis=0).T))])
-    u = np.linspace(0.0, s[-1], n_cells + 1)
-    out = np.column_stack([np.interp(u, s, chain[:, 0]), np.interp(u, s, chain[:, 1])])
-    out[0], out[-1] = chain[0], chain[-1]
-    return out
+    names, rings, corners, breaks = _line_work(pieces)
+    by_name, chain_pts, users = side_chains([SimpleNamespace(name=n) for n in names], rings, corners, breaks)
+    index = {n: k for k, n in enumerate(names)}
+    sides = {(index[n], side): keys for (n, side), keys in by_name.items()}
+    return sides, chain_pts, {k: [(index[n], s) for n, s in u] for k, u in users.items()}
 
 
 def build_topology(
@@ -125,50 +106,31 @@ def build_topology(
     block_cells: dict[int, tuple[int, int]] | None = None,
 ):
     """The :class:`MultiBlockTopology` of ``pieces`` with counts for ``cell_size``
-    (``block_cells``: pieces whose cells ``(ni, nj)`` are given)."""
+    (``block_cells``: pieces whose cells ``(ni, nj)`` are given); returns it and the chain counts.
+
+    The counts come from :func:`~meshcore.multiblock.counts.solve_counts`; the blocks, their
+    shared chains and interfaces from :func:`~meshcore.multiblock.chains.chain_topology`, as
+    :func:`~meshcore.multiblock.from_outline` makes them.
+    """
+    from ..multiblock.chains import chain_topology
+    from ..multiblock.outline import BlockOutline
+
     side_chains, chain_pts, chain_users = _chains_of(pieces)
+    for key, users in chain_users.items():
+        if len(users) > 2:
+            c = np.asarray(key).mean(axis=0)
+            raise TopologyError(
+                f"blocks overlap: an edge near ({c[0]:.6g}, {c[1]:.6g}) is shared by {len(users)} blocks"
+            )
     keys = list(chain_pts)
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
     counts = solve_counts(length / cell_size, sides, min_cells=min_cells, multiple=multiple, block_cells=block_cells)
-    nodes = {k: _resample(chain_pts[k], int(counts[index[k]])) for k in keys}
-    blocks, offsets = [], {}
-    for pi, pc in enumerate(pieces):
-        walked = {}
-        for si, side in enumerate(BORDERS):
-            pieces_xy, at = [], 0
-            start = _key(pc.ring[pc.corners[si]])
-            for key in side_chains[(pi, side)]:
-                p = nodes[key]
-                if pieces_xy:
-                    if not np.array_equal(p[0], pieces_xy[-1][-1]):
-                        p = p[::-1]
-                elif _key(p[0]) != start:
-                    p = p[::-1]
-                offsets[(pi, side, key)] = (at, at + len(p) - 1)
-                at += len(p) - 1
-                pieces_xy.append(p)
-            walked[side] = np.vstack([pieces_xy[0]] + [q[1:] for q in pieces_xy[1:]])
-        # walked counter-clockwise: top and left run backwards
-        for side in ("top", "left"):
-            n_side = len(walked[side]) - 1
-            walked[side] = walked[side][::-1].copy()
-            for key in side_chains[(pi, side)]:
-                a, b = offsets[(pi, side, key)]
-                offsets[(pi, side, key)] = (n_side - b, n_side - a)
-        bd = Borders(bottom=walked["bottom"], right=walked["right"], top=walked["top"], left=walked["left"])
-        blocks.append(Block(pc.name or f"b{pi}", bd, initial="tfi"))
-    interfaces = []
-    for key, users in chain_users.items():
-        if len(users) == 2:
-            (pa, sa), (pb, sb) = users
-            a0, a1 = offsets[(pa, sa, key)]
-            b0, b1 = offsets[(pb, sb, key)]
-            interfaces.append(Interface(Side(blocks[pa].name, sa, a0, a1), Side(blocks[pb].name, sb, b0, b1), None))
-        elif len(users) > 2:
-            c = np.asarray(key).mean(axis=0)
-            raise TopologyError(
-                f"blocks overlap: an edge near ({c[0]:.6g}, {c[1]:.6g}) is shared by {len(users)} blocks"
-            )
-    return MultiBlockTopology(tuple(blocks), tuple(interfaces), check_geometry=False), counts
+    names, rings, corners, breaks = _line_work(pieces)
+    specs = [
+        BlockOutline(n, tuple(corners[n]), (int(counts[s[0]].sum()), int(counts[s[3]].sum())))
+        for n, s in zip(names, sides, strict=True)
+    ]
+    topo = chain_topology(specs, rings, corners, breaks, multiple, check_geometry=False, cell_size=cell_size)
+    return topo, counts

@@ -21,7 +21,7 @@ from ..boundary import Borders
 from ..errors import TopologyError
 from .topology import Block, Interface, MultiBlockTopology, Side
 
-__all__ = ["chain_topology"]
+__all__ = ["chain_topology", "side_chains"]
 
 SIDES = ("bottom", "right", "top", "left")
 
@@ -40,7 +40,7 @@ def _resample(chain: np.ndarray, n_cells: int) -> np.ndarray:
     return out
 
 
-def _side_chains(specs: list, rings: dict[str, np.ndarray], corners: dict[str, list], breaks: set) -> tuple:
+def side_chains(specs: list, rings: dict[str, np.ndarray], corners: dict[str, list], breaks: set) -> tuple:
     """``(side → chain keys, chain key → points, chain key → [(block, side)])``."""
     side_chains: dict[tuple[str, str], list[Key]] = {}
     chain_pts: dict[Key, np.ndarray] = {}
@@ -228,11 +228,11 @@ def chain_topology(
     :func:`~.counts.solve_counts` does: closest to ``length / cell_size`` (default: each
     side's own cell size), integer and consistent round every block.
     """
-    side_chains, chain_pts, chain_users = _side_chains(specs, rings, corners, breaks)
-    count = _chain_counts(specs, side_chains, chain_pts, chain_users, multiple, cell_size)
+    sides, chain_pts, chain_users = side_chains(specs, rings, corners, breaks)
+    count = _chain_counts(specs, sides, chain_pts, chain_users, multiple, cell_size)
     nodes = {key: _resample(chain_pts[key], count[key]) for key in chain_pts}
     offsets: dict[tuple[str, str, Key], tuple[int, int]] = {}
-    blocks = [_block(s, side_chains, nodes, corners[s.name], offsets) for s in specs]
+    blocks = [_block(s, sides, nodes, corners[s.name], offsets) for s in specs]
     interfaces = []
     for key, users in chain_users.items():
         if len(users) == 2:
