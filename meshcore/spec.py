@@ -274,7 +274,9 @@ class SolverSpec:
             raise InvalidInputError(f"method must be a string, got {self.method!r}")
         object.__setattr__(self, "method", self.method.lower())
         object.__setattr__(self, "repair", validate_choice(self.repair, REPAIR_CHOICES, name="repair"))
-        self.config()  # validates the solver fields
+        cfg = self.config()  # validates the solver fields
+        for name in ("max_iterations", "threads"):  # whole numbers kept as ints (a TOML 1e4 is a float)
+            object.__setattr__(self, name, getattr(cfg, name))
 
     @property
     def foldfree(self) -> bool:

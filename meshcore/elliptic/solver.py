@@ -115,11 +115,12 @@ class EllipticConfig:
         object.__setattr__(self, "method", self.method.lower())
         if self.tolerance is not None:
             validate_positive(self.tolerance, name="tolerance")
-        validate_count(self.max_iterations, name="max_iterations", minimum=1)
+        # stored as ints: a TOML/JSON 1e9 or 2.0 is a whole number, but range() needs an int
+        object.__setattr__(self, "max_iterations", validate_count(self.max_iterations, name="max_iterations"))
         if self.omega is not None and not (0.0 < float(self.omega) < 2.0):
             raise InvalidInputError(f"omega must be in (0, 2), got {self.omega}")
         validate_positive(self.report_interval, name="report_interval")
-        validate_count(self.threads, name="threads", minimum=0)
+        object.__setattr__(self, "threads", validate_count(self.threads, name="threads", minimum=0))
 
     def replaced(self, **kw: Any) -> EllipticConfig:
         return dataclasses.replace(self, **kw)

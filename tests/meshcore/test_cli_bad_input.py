@@ -9,6 +9,7 @@ import sys
 import numpy as np
 import pytest
 
+import meshcore
 from meshcore.case import load_case
 from meshcore.cli import main
 from tests.conftest import DATA, ROOT
@@ -230,3 +231,17 @@ def test_an_internal_error_is_one_line_exit_1(capsys, monkeypatch, tmp_path):
     monkeypatch.setenv("MESHCORE_DEBUG", "1")
     with pytest.raises(TypeError):
         main(["quality", str(tmp_path / "g.vts")])
+
+
+def test_whole_numbers_written_as_floats_are_counts(tmp_path, capsys):
+    """`max_iterations = 1e3` in a case file (TOML reads a float) was an internal error (exit 1)
+    in the solver's loop; a whole number is a count, a fraction is one clear error."""
+    case = ROOT / "resources" / "examples" / "bottle-coarse.toml"
+    text = case.read_text().replace("[[blocks]]", "[solver]\nmax_iterations = 1e3\nthreads = 1.0\n[[blocks]]", 1)
+    (tmp_path / "c.toml").write_text(text)
+    assert main(["generate", str(tmp_path / "c.toml"), "-o", str(tmp_path / "c.vts"), "-q"]) in (0, 3)
+    spec = meshcore.SolverSpec(max_iterations=1e3, threads=1.0)
+    assert (spec.max_iterations, spec.threads) == (1000, 1) and type(spec.config().max_iterations) is int
+    (tmp_path / "c.toml").write_text(text.replace("1e3", "10.5"))
+    assert main(["generate", str(tmp_path / "c.toml"), "-q"]) == 2
+    assert "max_iterations must be an integer, got 10.5" in capsys.readouterr().err
