@@ -39,6 +39,7 @@ __all__ = [
     "validate_choice",
     "validate_count",
     "validate_fraction",
+    "validate_indices",
     "validate_points",
     "validate_positive",
 ]
@@ -134,7 +135,7 @@ def validate_points(points: Any, *, name: str, min_points: int = 2, where: str =
     prefix = f"{where}: " if where else ""
     try:
         arr = np.asarray(points, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:  # OverflowError: an int beyond any float
         raise InvalidInputError(f"{prefix}{name}: cannot read points as numbers ({exc})") from None
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidInputError(f"{prefix}{name}: expected an (n, 2) array of x, y points, got shape {arr.shape}")
@@ -188,6 +189,24 @@ def validate_count(value: Any, *, name: str, minimum: int = 1) -> int:
     if value < minimum:
         raise InvalidInputError(f"{name} must be >= {minimum}, got {value}")
     return int(value)
+
+
+def validate_indices(values: Any, *, name: str) -> tuple[int, ...]:
+    """Return point indices as ints (negative ones count from the end) or raise.
+
+    A whole number written as a float (``3.0``, from a JSON or TOML file) is an
+    index; ``2.5``, ``True``, ``"3"`` or something that is not a sequence is an
+    error, never silently truncated.
+    """
+    try:
+        items = list(values)
+    except TypeError:
+        raise InvalidInputError(f"{name} must be integer point indices, got {values!r}") from None
+    for v in items:
+        whole = isinstance(v, (float, np.floating)) and float(v).is_integer()
+        if not whole and (isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer))):
+            raise InvalidInputError(f"{name} must be integer point indices, got {v!r} in {values!r}")
+    return tuple(int(v) for v in items)
 
 
 def validate_fraction(value: Any, *, name: str) -> float:

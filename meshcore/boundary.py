@@ -35,6 +35,7 @@ from ._validation import (
     check_grid_size,
     validate_choice,
     validate_count,
+    validate_indices,
     validate_points,
     validate_positive,
 )
@@ -440,10 +441,9 @@ def borders_from_loop(
     n_given = len(p)
     size = check_extent(p, name=f"{prefix}boundary points")
     closed_repeat = bool(np.hypot(*(p[0] - p[-1])) <= 1e-12 * size)
-    try:
-        c = [int(v) for v in corners]
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"{prefix}corners must be 4 integer point indices, got {corners!r}") from None
+    if isinstance(corners, str):
+        raise InvalidInputError(f"{prefix}corners must be 4 integer point indices, got {corners!r}")
+    c = list(validate_indices(corners, name=f"{prefix}corners"))
     if len(c) != 4:
         raise InvalidInputError(f"{prefix}corners must be 4 point indices (sw, se, ne, nw), got {len(c)}")
     n = n_given - 1 if closed_repeat else n_given

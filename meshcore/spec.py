@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import validate_choice, validate_count, validate_points
+from ._validation import validate_choice, validate_count, validate_indices, validate_points
 from .boundary import BorderSpec, signed_area
 from .elliptic import EllipticConfig
 from .errors import InvalidInputError
@@ -146,7 +146,7 @@ class BlockSpec:
                 tuple(_frozen_points(b, f"{n} border", 2) for n, b in zip(BORDER_NAMES, self.boundary, strict=True)),
             )
         if self.corners is not None and not isinstance(self.corners, str):
-            put(self, "corners", tuple(int(c) for c in self.corners))
+            put(self, "corners", validate_indices(self.corners, name="corners"))
         if self.cells is not None:
             try:
                 ni, nj = self.cells

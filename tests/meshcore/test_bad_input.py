@@ -118,3 +118,26 @@ def test_inputs_are_not_modified_and_read_only_inputs_work():
     assert g.converged
     for a, a0 in zip((b, r, t, l), before, strict=True):
         np.testing.assert_array_equal(a, a0)
+
+
+_RING = np.c_[
+    np.cos(np.linspace(0, 2 * np.pi, 30, endpoint=False)), np.sin(np.linspace(0, 2 * np.pi, 30, endpoint=False))
+]
+
+
+@pytest.mark.parametrize("corners", [[0.5, 7, 15, 22], {"a": 1}, [True, 7, 15, 22], ["0", 7, 15, 22], 5])
+def test_corner_indices_are_whole_numbers_never_truncated(corners):
+    """0.5 was silently read as corner 0, and a dict of corners was a bare ValueError."""
+    with pytest.raises(InvalidInputError, match="corners must be"):
+        meshcore.generate_block(loop=_RING, corners=corners, cells=(4, 4))
+
+
+def test_corner_indices_written_as_floats_are_indices():
+    a = meshcore.generate_block(loop=_RING, corners=[0, 7, 15, 22], cells=(4, 4))
+    b = meshcore.generate_block(loop=_RING, corners=[0.0, 7.0, np.int64(15), -8.0], cells=(4, 4))
+    np.testing.assert_array_equal(a.x, b.x)
+
+
+def test_an_integer_beyond_any_float_is_one_clear_error():
+    with pytest.raises(InvalidInputError, match="cannot read points as numbers"):
+        meshcore.generate_block(loop=[[0, 0], [10**400, 0], [10, 10], [0, 10]], corners=[0, 1, 2, 3], cells=(3, 3))
