@@ -30,7 +30,7 @@ LAKES = {
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", help="comma-separated names of " + ", ".join(LAKES))
-    ap.add_argument("--cells", type=int, default=6000, help="cells per lake (legible at page width)")
+    ap.add_argument("--cells", type=int, default=15000, help="cells per lake (those of benchmarks/lake_grids.py)")
     ap.add_argument("--out", default=str(ROOT / "docs" / "figures"))
     a = ap.parse_args(argv)
     names = a.only.split(",") if a.only else list(LAKES)
