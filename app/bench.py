@@ -1,9 +1,12 @@
-"""Measure the app's interactive numbers: ``python -m app.bench`` (offscreen is fine).
+"""Measure the app's interactive numbers: ``python -m app.bench [lake]`` (offscreen is fine).
 
 * redraws/s of the grid curve at 257×257 nodes (setData + forced paint), and
   the live rate the window reaches during a solve at that size;
 * Stop latency during a long solve;
 * drag-to-converged latency with auto-generate on a ~100×100 grid;
+* Lake Como (~10 000 cells): import → Auto layout → orthogonal grid → Delft3D DD export, the
+  computing time of each step; then a cut line's end dragged along the shore with
+  auto-generate on: redraws/s while dragging and the frames that showed a start grid (0);
 * start-up time of the main window (see also ``python -m app --screenshot``).
 """
 
@@ -49,9 +52,11 @@ def main() -> int:
     win.show()
     app.processEvents()
     print(f"start-up to a shown window (warm numba cache, in-process): {time.perf_counter() - t0:.2f} s")
-    redraw_rate(win)
-    live_rate_and_stop(app, win)
-    drag_to_converged(app, win)
+    if sys.argv[1:] != ["lake"]:  # ``python -m app.bench lake``: the lake rows only
+        redraw_rate(win)
+        live_rate_and_stop(app, win)
+        drag_to_converged(app, win)
+    lake_como(app, win)
     win.stack.setClean()
     win.close()
     return 0
@@ -144,6 +149,73 @@ def drag_to_converged(app, win) -> None:
         )
     print(f"drag-to-converged 101x101 nodes: median {statistics.median(results) * 1000:.0f} ms")
     print(f"redraws showing an algebraic start grid during the drags: {len(start_frames)} of {len(frames)}")
+
+
+def lake_como(app, win) -> None:
+    """Como in, layout out, grid, .ddb; then a cut line's end dragged along the shore (auto-generate)."""
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+
+    from app.layout_edit import handles, place
+
+    como = Path(__file__).resolve().parent.parent / "benchmarks" / "lakes" / "lake_como.geojson"
+    if win.solver.auto:
+        win.a_auto.trigger()
+    t = time.perf_counter()
+    win.io.import_points(como, project_lonlat=True)
+    t_import = time.perf_counter() - t
+    t = time.perf_counter()
+    win.lake_ctl.auto_layout()
+    _wait(app, lambda: not win.lake_ctl.busy, timeout=300)
+    t_layout = time.perf_counter() - t
+    t = time.perf_counter()
+    _wait(app, lambda: not win.solver.running and not win.solver._debounce.isActive(), timeout=600)
+    t_grid = time.perf_counter() - t
+    lay = win.doc.project.layout
+    with tempfile.TemporaryDirectory() as d:
+        t = time.perf_counter()
+        ok = win.io.export_mesh(Path(d) / "como.ddb")
+        t_ddb = time.perf_counter() - t
+    m = win.doc.lake_metrics
+    print(
+        f"Como: import {t_import:.1f} s, auto layout {t_layout:.1f} s ({len(lay.blocks)} blocks, {lay.n_cells} cells), "
+        f"orthogonal grid {t_grid:.1f} s ({m.summary()['folded_cells']} folded, mean deviation "
+        f"{m.mean('deviation'):.2f}°), Delft3D DD {'written' if ok else 'REFUSED'} in {t_ddb:.1f} s; "
+        f"computing total {t_import + t_layout + t_grid + t_ddb:.1f} s"
+    )
+    win.a_auto.trigger()  # auto-generate on: the grid follows the layout
+    win.set_tool("layout")
+    end = next(h for h in handles(lay) if h.kind == "end")
+    tool = win.tools["layout"]
+    frames: list[float] = []
+    starts: list[float] = []
+
+    def redrawn() -> None:
+        frames.append(time.perf_counter())
+        doc = win.doc
+        if any(_is_start(g, doc.initial.get(k)) for k, g in doc.grids.items()):
+            starts.append(frames[-1])
+
+    win.solver.redrawn.connect(redrawn)
+    h = lay.cell_size
+    t_drag = time.perf_counter()
+    tool.drag("start", end.xy, end.xy)
+    for s in np.linspace(0, 1, 180)[1:]:  # 3 s at 60 Hz: three cells along the shore and back
+        f = 3 * h * np.sin(np.pi * s)
+        tool.drag("move", place(lay, end, (end.xy[0] + f, end.xy[1] + f)), end.xy)
+        _sleep(app, 1 / 60)
+    tool.drag("finish", place(lay, end, (end.xy[0] + h, end.xy[1] + h)), end.xy)
+    t_release = time.perf_counter()
+    dt = _wait(app, lambda: not win.lake_ctl.editing and not win.solver.running, timeout=600)
+    during = [f for f in frames if t_drag <= f <= t_release]
+    print(
+        f"drag a cut end on Como ({lay.n_cells} cells, auto-generate): {len(during) / (t_release - t_drag):.1f} "
+        f"redraws/s while dragging, {len(starts)} of {len(frames)} redraws showed a start grid, "
+        f"done {dt:.1f} s after release ({win.stack.undoText()!r}, {win.lake_ctl.edit_error or 'no error'})"
+    )
+    win.solver.redrawn.disconnect(redrawn)
 
 
 def _is_start(grid, algebraic) -> bool:

@@ -162,6 +162,8 @@ def load_project(path) -> Project:
     from meshcore.case import load_case
 
     case = load_case(path)
+    if case.outline is not None and case.multiblock is not None and case.multiblock.mode == "orthogonal":
+        return project_from_layout_case(case)
     if case.is_multiblock:
         return project_from_multiblock_case(case)
     return project_from_case(case)
@@ -220,15 +222,33 @@ def case_of_project(project: Project):
 
 
 def _layout_case(project: Project):
-    """A lake layout as a case: :func:`meshcore.case.layout_case` (shore, islands, cut lines, blocks
-    with corners and cells, ``mode = "orthogonal"``), which ``meshcore generate`` solves again."""
+    """A lake layout as an ``[outline]`` case with ``mode = "orthogonal"`` (:func:`meshcore.case.layout_case`).
+
+    The shore, the islands, every cut line and each block's corners and cells: it opens again
+    as the same layout, and ``meshcore generate`` makes its grid.
+    """
     from meshcore.case import layout_case
 
-    case = layout_case(project.layout)
-    frame = project_frame(project)
-    if frame is not None:
-        case = case.replaced(crs=frame.as_dict())
-    return case.replaced(solver=project.solver, title=project.title or case.title, path=None)
+    case = layout_case(project.layout, title=project.title, crs=project_frame(project))
+    return case.replaced(solver=project.solver, path=None)
+
+
+def project_from_layout_case(case) -> Project:
+    """A project of an orthogonal ``[outline]`` case: the lake (shore, islands, layout) and its blocks."""
+    from meshcore.case import case_frame, case_layout
+
+    from .lake import Lake, with_layout
+
+    layout = case_layout(case)
+    poly = layout.polygon
+    lake = Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        cell_size=float(layout.cell_size),
+        layout=layout,
+    )
+    base = Project(solver=case.solver, title=case.title, **_frame_fields(case_frame(case)))
+    return with_layout(base, lake)
 
 
 def save_project(project: Project, path) -> None:

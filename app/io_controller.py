@@ -234,6 +234,8 @@ class IOController(QtCore.QObject):
     def _add_imported(self, block: Block, frame, name: str, *, lake=None) -> None:
         """Put an imported block into the first empty block (or add it), as one undo step."""
         p = self.doc.project
+        if p.layout is not None:  # a new outline replaces the laid-out lake (undo brings it back)
+            p = p.replaced(blocks=(Block(name="block"),), lake=None)
         empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
         if empty:
             k = empty[0]

@@ -17,6 +17,7 @@ from superqt.utils import create_worker
 from meshcore import MeshcoreError
 
 from .lake import Lake, compute_layout
+from .lake_solve import layout_topology
 
 __all__ = ["LakeController"]
 
@@ -26,12 +27,27 @@ log = logging.getLogger(__name__)
 def _layout_job(lake: Lake):
     """The worker body: the layout, or the message of why there is none."""
     try:
-        return lake, compute_layout(lake), None
+        layout = compute_layout(lake)
+        layout_topology(layout)
+        return lake, layout, None
     except MeshcoreError as exc:
         return lake, None, str(exc)
     except Exception as exc:  # a bug must not kill the window: report it, log where it happened
         log.exception("the layout worker failed")
         return lake, None, f"internal error: {type(exc).__name__}: {exc} (the traceback is in the log)"
+
+
+def _edit_job(make):
+    """The worker body of a layout edit: the new layout, or why there is none."""
+    try:
+        layout = make()
+        layout_topology(layout)  # here, off the GUI thread: the solve that follows finds it ready
+        return layout, None
+    except MeshcoreError as exc:
+        return None, str(exc)
+    except Exception as exc:  # a bug must not kill the window
+        log.exception("a layout edit failed")
+        return None, f"internal error: {type(exc).__name__}: {exc} (the traceback is in the log)"
 
 
 class LakeController(QtCore.QObject):
@@ -49,6 +65,9 @@ class LakeController(QtCore.QObject):
         self.generate_after = True  # start the grid when a layout is set
         self.prompt: QtWidgets.QMessageBox | None = None  # the offer after importing a branched lake
         self.last_error: str | None = None
+        self._edit_worker = None
+        self._pending = None  # (make, text, merge key) of the newest layout edit not yet computed
+        self.edit_error: str | None = None
 
     @property
     def busy(self) -> bool:
@@ -124,6 +143,7 @@ class LakeController(QtCore.QObject):
             "generating the orthogonal grid (Ctrl+Z undoes the layout)"
         )
         self.layout_done.emit(layout)
+        self.win.set_tool("layout")
         if self.generate_after:
             self.win.generate()
 
@@ -134,6 +154,67 @@ class LakeController(QtCore.QObject):
         self.last_error = str(exc)
         self.win.error("Cannot lay out the lake", exc)
         self.layout_done.emit(None)
+
+    # ------------------------------------------------------ layout edits
+    def edit_layout(self, make, text: str, merge_key=None) -> None:
+        """Make a new layout with ``make()`` in a worker and set it (undoable); the newest request wins.
+
+        ``make`` builds the layout from immutable inputs (e.g. the parts of the layout at the
+        start of a drag with one point moved); while one is computed, later requests replace
+        each other and only the last one runs next.  Each result is shown when it arrives (a
+        drag's steps merge into one undo step by ``merge_key``); a refusal is reported only
+        when no newer request waits.
+        """
+        self._pending = (make, text, merge_key)
+        if self._edit_worker is None:
+            self._next_edit()
+
+    def _next_edit(self) -> None:
+        if self._pending is None:
+            return
+        make, text, key = self._pending
+        self._pending = None
+        worker = create_worker(_edit_job, make, _start_thread=False)
+        worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key))
+        worker.errored.connect(lambda exc: self._edited((None, f"internal error: {exc}"), text, key))
+        self._edit_worker = worker
+        worker.start()
+
+    def _edited(self, value, text: str, key) -> None:
+        self._edit_worker = None
+        layout, err = value
+        lake = self.doc.project.lake
+        if layout is not None and lake is not None:  # newer than what is shown: show it, even mid-drag
+            self.edit_error = None
+            self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
+            self.layout_done.emit(layout)
+        elif layout is None and self._pending is None:  # a refusal only counts for the last request
+            self.edit_error = err
+            self.win.message(f"Cannot change the layout: {err}", error=True)
+            self.layout_done.emit(None)
+        self._next_edit()
+
+    def set_block_cells(self, index: int, cells: tuple[int, int]) -> None:
+        """Give block ``index`` of the layout ``cells``; the blocks sharing its sides follow (undoable)."""
+        lay = self.doc.project.layout
+        if lay is None or not 0 <= index < len(lay.blocks):
+            return
+        name = lay.blocks[index].name
+        cells = (int(cells[0]), int(cells[1]))
+        if cells == tuple(lay.blocks[index].cells):
+            return
+
+        def make():
+            from meshcore.layout import with_cells
+
+            return with_cells(lay, name, cells)
+
+        self.edit_layout(make, f"Cells of {name}: {cells[0]}×{cells[1]}")
+
+    @property
+    def editing(self) -> bool:
+        """True while a layout edit is being computed or waits to be."""
+        return self._edit_worker is not None or self._pending is not None
 
     # ------------------------------------------------------------- offer
     def offer(self, name: str, why: str) -> None:

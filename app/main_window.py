@@ -31,7 +31,7 @@ from .lake_controller import LakeController
 from .project import Project, boundary_to_loop
 from .solve_status import SolveStatus
 from .solver_controller import SolverController
-from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, PanTool
+from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, LayoutTool, PanTool
 from .views.canvas import Canvas
 from .views.lake_panel import LakePanel, LakeQualityBox
 from .views.messages import ElidedLabel, MessagePanel
@@ -121,7 +121,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.messages_panel = MessagePanel(self.doc)
         self.lake_panel = LakePanel(self.doc, self.lake_ctl)
         self.lake_quality = LakeQualityBox(self.doc)
-        self.quality_panel.layout().addWidget(self.lake_quality)
+        self.quality_panel.layout().insertWidget(0, self.lake_quality)  # for a lake, the verdict comes first
         self.undo_view = QtWidgets.QUndoView(self.stack)
         self.undo_view.setEmptyLabel("<start>")
         self.docks = {}
@@ -159,9 +159,11 @@ class MainWindow(QtWidgets.QMainWindow):
             "edit": EditTool(*ctx),
             "corners": CornersTool(*ctx),
             "cut": CutTool(*ctx),
+            "layout": LayoutTool(*ctx),
             "calibrate": CalibrateTool(*ctx, on_pair=self.background.ask_true_points),
         }
         self.tools["draw"].on_closed = lambda: self.set_tool("corners")
+        self.tools["layout"].controller = self.lake_ctl
 
     def _placeholder(self, name: str, menu: QtWidgets.QMenu, spec: actions.ActionSpec):
         """Fill the ``@name`` rows of the action table (see :func:`app.actions.build`)."""

@@ -143,7 +143,7 @@ def folded_cells(grid: StructuredGrid) -> np.ndarray:
 
 
 def warmup() -> None:
-    """Load the numba kernels and shapely and run the whole pipeline once on a tiny square.
+    """Load the numba kernels and shapely and run the whole pipeline once on a tiny square and strip.
 
     Run in a background thread at start-up so that the first real solve (and
     the first drag with auto-generate) pays no one-time costs.
@@ -155,3 +155,9 @@ def warmup() -> None:
     project = Project(blocks=(Block(points=sq, closed=True, corners=(0, 1, 2, 3), cells=(4, 4)),))
     for _ in solve_project(project):
         pass
+    # the lake grid's kernels and the layout's libraries (the first Auto layout pays nothing either)
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout import auto_layout
+
+    strip = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [0.0, 1.0]])
+    mesh_layout(auto_layout(strip, cell_size=0.25, multiple=2), levels=1)

@@ -8,8 +8,8 @@ The autosave writes two files:
   ``meshcore generate`` like any case.
 * ``recovery.toml.json`` — what a case file cannot hold: blocks still being
   drawn, cut lines, the background image, the solver settings as the app
-  keeps them, a lake's water and layout settings (its layout is made again
-  from them), and the path the project was last saved to.  It names the
+  keeps them, a lake's water and layout settings (a layout itself is in
+  the case file), and the path the project was last saved to.  It names the
   SHA-256 of the case text it belongs to; a sidecar that does not match (a
   crash between the two writes) is ignored and the case alone is recovered.
 
@@ -66,8 +66,7 @@ def write(project: Project, path, saved_as: Path | None = None) -> None:
     if solver.method == "foldfree":  # not an EllipticConfig method; the sidecar keeps it
         project = project.replaced(solver=dataclasses.replace(solver, method="auto"))
     try:
-        # a lake layout is made again from the sidecar's lake (a case cannot hold its islands yet)
-        text = dumps_project(project) if project.layout is None else None
+        text = dumps_project(project)
     except (MeshcoreError, ValueError):  # nothing a case can hold yet (a loop still being drawn)
         text = None
     state = {
@@ -154,7 +153,7 @@ def _background(bg: Background | None):
 
 
 def _lake_state(lake) -> dict | None:
-    """The lake's water and settings; its layout is remade from them (auto layout is deterministic)."""
+    """The lake's water and settings (a layout itself is in the case file, hand edits included)."""
     if lake is None:
         return None
     return {
@@ -163,23 +162,25 @@ def _lake_state(lake) -> dict | None:
         "cell_size": lake.cell_size,
         "target_cells": lake.target_cells,
         "regular": lake.regular,
-        "layout": lake.layout is not None,
     }
 
 
 def _with_lake(project: Project, d: Mapping) -> Project:
-    from .lake import Lake, compute_layout, with_layout
+    from .lake import Lake
 
+    settings = {
+        "cell_size": d.get("cell_size"),
+        "target_cells": int(d.get("target_cells", 10_000)),
+        "regular": bool(d.get("regular", False)),
+    }
+    if project.lake is not None:  # the case held the layout: only the settings come from here
+        return project.replaced(lake=project.lake.replaced(**settings))
     lake = Lake(
         outline=np.asarray(d["outline"], float).reshape(-1, 2),
         holes=tuple(np.asarray(h, float).reshape(-1, 2) for h in d.get("holes", ())),
-        cell_size=d.get("cell_size"),
-        target_cells=int(d.get("target_cells", 10_000)),
-        regular=bool(d.get("regular", False)),
+        **settings,
     )
-    if d.get("layout"):
-        lake = lake.replaced(layout=compute_layout(lake))
-    return with_layout(project, lake)
+    return project.replaced(lake=lake)
 
 
 def _blocks(project: Project) -> list[dict]:

@@ -15,7 +15,7 @@ from PySide6 import QtCore
 
 from . import geometry as geo
 
-__all__ = ["TOOLS", "CornersTool", "CutTool", "DrawTool", "EditTool", "PanTool", "Tool"]
+__all__ = ["TOOLS", "CornersTool", "CutTool", "DrawTool", "EditTool", "LayoutTool", "PanTool", "Tool"]
 
 SHIFT = QtCore.Qt.KeyboardModifier.ShiftModifier
 CTRL = QtCore.Qt.KeyboardModifier.ControlModifier
@@ -332,4 +332,82 @@ class CalibrateTool(Tool):
         return True
 
 
-TOOLS = (PanTool, DrawTool, EditTool, CornersTool, CutTool)
+class LayoutTool(Tool):
+    """Drag the lake layout's handles: cut ends along the shore, junctions and cut points, block corners."""
+
+    name = "layout"
+    label = "Layout"
+    shortcut = "Y"
+    tip = (
+        "Layout: drag a cut line's end along the shore, a cut's point, a junction or a block corner; "
+        "the layout follows (cells kept) and, with auto-generate, the grid"
+    )
+    controller = None  # the window's LakeController (it computes new layouts off the GUI thread)
+
+    def __init__(self, *a, **kw) -> None:
+        super().__init__(*a, **kw)
+        self._handle = None
+        self._base = None
+        self._parts: dict | None = None
+        self._drag = None
+
+    def activate(self) -> None:
+        if self.doc.project.layout is None:
+            self.status("Layout: no layout yet — Lake ▸ Auto layout (Ctrl+L) first")
+        else:
+            super().activate()
+
+    def drag(self, phase: str, xy, start, modifiers=None) -> bool:
+        from .layout_edit import handles, nearest_handle
+
+        lay = self.doc.project.layout
+        if phase == "start":
+            self._handle = None
+            if lay is None or self.controller is None:
+                return False
+            h = nearest_handle(handles(lay), start, self.tol())
+            if h is None:
+                return False
+            from meshcore.layout.outline import outline_parts
+
+            self._handle, self._base, self._parts = h, lay, outline_parts(lay)
+            self._drag = self.editor.new_drag_id()
+        if self._handle is None:
+            return False
+        if phase != "start":
+            self._move(xy)
+        if phase == "finish":
+            self._handle = None
+            if self.canvas is not None:
+                self.canvas.lake_items.set_drag_point(None)
+        return True
+
+    def _move(self, xy) -> None:
+        from .layout_edit import moved_parts, place
+
+        base, h = self._base, self._handle
+        q = place(base, h, xy)
+        if self.canvas is not None:
+            self.canvas.lake_items.set_drag_point(q)
+        if q == h.xy:
+            return
+        tol = 1e-9 * max(1.0, float(np.sqrt(base.polygon.area)))
+        parts = moved_parts(self._parts, h.xy, q, tol)
+
+        def make():
+            from meshcore.layout import layout_from_outline
+
+            return layout_from_outline(
+                parts["outline"],
+                holes=parts["holes"],
+                cuts=parts["cuts"],
+                blocks=parts["blocks"],
+                cell_size=base.cell_size,
+                multiple=base.multiple,
+            )
+
+        what = {"end": "cut end", "junction": "junction", "cut": "cut point", "corner": "block corner"}[h.kind]
+        self.controller.edit_layout(make, f"Move {what}", merge_key=("layout", self._drag))
+
+
+TOOLS = (PanTool, DrawTool, EditTool, CornersTool, CutTool, LayoutTool)

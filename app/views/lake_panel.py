@@ -54,6 +54,21 @@ class LakePanel(QtWidgets.QWidget):
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.itemClicked.connect(lambda it: self.doc.set_active(it.row()))
         lay.addWidget(self.table, 1)
+        row = QtWidgets.QHBoxLayout()
+        self.block_label = QtWidgets.QLabel("cells")
+        row.addWidget(self.block_label)
+        self.ni = QtWidgets.QSpinBox()
+        self.nj = QtWidgets.QSpinBox()
+        for w, tip in ((self.ni, "cells along ξ"), (self.nj, "cells along η")):
+            w.setRange(1, 100_000)
+            w.setToolTip(f"{tip} of the selected block; its neighbours follow")
+            row.addWidget(w, 1)
+        self.set_cells = QtWidgets.QPushButton("Set")
+        self.set_cells.setToolTip("give the selected block these cells; the blocks that share its sides follow")
+        row.addWidget(self.set_cells)
+        lay.addLayout(row)
+        self.set_cells.clicked.connect(self._set_cells)
+        doc.active_changed.connect(lambda _k: self._show_active())
         self.cell_size.editingFinished.connect(self._cell_size_edited)
         self.regular.toggled.connect(self._regular_toggled)
         self.button.clicked.connect(lambda: self.ctl.auto_layout())
@@ -86,6 +101,26 @@ class LakePanel(QtWidgets.QWidget):
         for k, b in enumerate(lay.blocks):
             self.table.setItem(k, 0, QtWidgets.QTableWidgetItem(b.name))
             self.table.setItem(k, 1, QtWidgets.QTableWidgetItem(f"{b.cells[0]} × {b.cells[1]}"))
+        self._show_active()
+
+    def _show_active(self) -> None:
+        """The selected (active) block's cells in the spin boxes, in steps of the layout's multiple."""
+        lay = self.doc.project.layout
+        on = lay is not None and self.doc.active < len(lay.blocks)
+        for w in (self.ni, self.nj, self.set_cells):
+            w.setEnabled(on)
+        if not on:
+            self.block_label.setText("cells")
+            return
+        b = lay.blocks[self.doc.active]
+        self.block_label.setText(f"{b.name}:")
+        for w, v in ((self.ni, b.cells[0]), (self.nj, b.cells[1])):
+            w.setSingleStep(lay.multiple)
+            w.setValue(int(v))
+
+    def _set_cells(self) -> None:
+        self.ctl.set_block_cells(self.doc.active, (self.ni.value(), self.nj.value()))
+        self.committed.emit()
 
     def _cell_size_edited(self) -> None:
         v = float(self.cell_size.value())
@@ -101,11 +136,14 @@ class LakePanel(QtWidgets.QWidget):
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
 
-def miss_points(verdict) -> np.ndarray:
-    """``(k, 2)`` places (nodes, cells, edge pairs) that miss a limit the verdict failed."""
+def miss_points(verdict, row: int | None = None) -> np.ndarray:
+    """``(k, 2)`` places (nodes, cells, edge pairs) that miss a failed limit (only limit ``row`` if given)."""
     m = verdict.metrics
     out = []
-    for r in verdict.failed:
+    results = verdict.results if row is None else verdict.results[row : row + 1]
+    for r in results:
+        if r.passed is not False:
+            continue
         s = m.samples.get(r.limit.metric)
         if s is None or not len(s) or r.limit.statistic != "each":
             continue
@@ -117,7 +155,8 @@ def miss_points(verdict) -> np.ndarray:
 class LakeQualityBox(QtWidgets.QGroupBox):
     """A model's limits (Delft3D, EFDC, …) against the lake grid: pass/fail per limit.
 
-    ``misses`` carries the places that miss a failed limit (the canvas rings them).
+    ``misses`` carries the places that miss the selected limit (the canvas rings them); a new
+    verdict selects its first failed limit.
     """
 
     misses = QtCore.Signal(object)
@@ -139,13 +178,16 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.headline.setWordWrap(True)
         lay.addWidget(self.headline)
         self.table = QtWidgets.QTableWidget(0, 3)
-        self.table.setHorizontalHeaderLabels(["limit", "verdict", "miss"])
+        self.table.setHorizontalHeaderLabels(["verdict", "miss", "limit"])
         self.table.horizontalHeader().setStretchLastSection(True)
         self.table.verticalHeader().hide()
         self.table.verticalHeader().setDefaultSectionSize(20)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
-        self.table.setMinimumHeight(90)
+        self.table.setToolTip("select a limit: the places that miss it are marked by orange dots on the canvas")
         lay.addWidget(self.table)
+        self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)
+        self.table.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.SingleSelection)
+        self.table.itemSelectionChanged.connect(self._row_selected)
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)
         self.refresh()
@@ -168,7 +210,7 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         word = "PASS" if v.passed else f"FAIL ({n_fail} of {len(v.results)} limits missed)"
         self.headline.setText(
             f"<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
-            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded; places that miss are ringed in orange"
+            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded"
         )
         self.table.setRowCount(len(v.results))
         for k, r in enumerate(v.results):
@@ -177,11 +219,24 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             else:
                 stat = f"mean {r.value:.3g}" if r.limit.statistic == "mean" else f"{100 * r.value:.1f} % ok"
                 text, colour = (f"pass ({stat})", "#070") if r.passed else (f"FAIL ({stat})", "#c00")
-            cells = [r.limit.label, text, str(r.n_failed)]
+            cells = [text, str(r.n_failed), r.limit.label]
             for c, t in enumerate(cells):
                 it = QtWidgets.QTableWidgetItem(t)
-                if c == 1:
+                it.setToolTip(f"{r.limit.label}: {text}, {r.n_failed} miss")
+                if c == 0:
                     it.setForeground(QtGui.QBrush(QtGui.QColor(colour)))
                 self.table.setItem(k, c, it)
         self.table.resizeColumnToContents(0)
-        self.misses.emit(miss_points(v))
+        self.table.resizeColumnToContents(1)
+        self.table.setFixedHeight(self.table.horizontalHeader().height() + 21 * len(v.results) + 4)
+        first = next((k for k, r in enumerate(v.results) if r.passed is False), None)
+        if first is None:
+            self.table.clearSelection()
+            self.misses.emit(None)
+        else:
+            self.table.selectRow(first)
+            self._row_selected()
+
+    def _row_selected(self) -> None:
+        rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []
+        self.misses.emit(miss_points(self.verdict, rows[0].row()) if rows else None)

@@ -86,7 +86,7 @@ def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
         v = box.verdict
         assert v is not None and v.preset.name == preset
         assert box.table.rowCount() == len(v.results)
-        words = {box.table.item(k, 1).text().split()[0] for k in range(box.table.rowCount())}
+        words = {box.table.item(k, 0).text().split()[0] for k in range(box.table.rowCount())}
         assert words <= {"pass", "FAIL", "not"}
         misses = win.canvas.lake_items.misses.getData()[0]
         assert (len(misses) > 0) == any(r.limit.statistic == "each" for r in v.failed)
@@ -138,6 +138,14 @@ def test_layout_undo_redo_and_clear(qtbot, win):
     p = win.doc.project
     assert p.layout is None and p.lake.cell_size == 300.0 and len(p.blocks) == 1
     np.testing.assert_array_equal(p.blocks[0].points, shore.lake.outline)
+    # another lake imported over a laid-out one replaces it (one undo step brings it back)
+    win.stack.undo()
+    assert win.doc.project is laid
+    assert win.io.import_points(COMO, project_lonlat=True)
+    p = win.doc.project
+    assert p.layout is None and len(p.blocks) == 1 and p.lake.holes == () and len(p.lake.outline) > 300
+    win.stack.undo()
+    assert win.doc.project is laid
 
 
 def test_export_como_to_delft3d_dd_and_vtm(qtbot, win, tmp_path):
@@ -176,14 +184,27 @@ def test_save_and_recover_a_lake_layout(qtbot, win, tmp_path):
     lay = lay_out(qtbot, win, ISEO, cell_size=300.0)
     path = tmp_path / "iseo.toml"
     assert win.io.save_to(path)
-    assert path.exists()
-    # the autosave keeps the lake: the recovered project has the same layout
+    # the case file holds the layout: it opens as the same lake layout (shore, island, cuts, cells)
+    assert win.io.open_path(path)
+    opened = win.doc.project.layout
+    assert opened is not None and len(opened.polygon.interiors) == 1
+    assert [(b.name, b.cells) for b in opened.blocks] == [(b.name, b.cells) for b in lay.blocks]
+    assert win.doc.project.crs and opened.cell_size == pytest.approx(lay.cell_size)
+    win.generate()
+    wait_idle(qtbot, win)
+    assert win.doc.multiblock is not None and len(win.doc.multiblock.grids) == len(lay.blocks)
+    # the autosave keeps the lake: the recovered project has the same layout and settings
     recovery.write(win.doc.project, tmp_path / "rec.toml")
     back, _ = recovery.read(tmp_path / "rec.toml")
     got = back.layout
     assert got is not None and back.lake.cell_size == 300.0
     assert [b.cells for b in got.blocks] == [b.cells for b in lay.blocks]
     assert len(back.blocks) == len(lay.blocks)
+    # a lake not laid out yet: its shore, islands and settings
+    win.a_clear_layout.trigger()
+    recovery.write(win.doc.project, tmp_path / "rec2.toml")
+    back, _ = recovery.read(tmp_path / "rec2.toml")
+    assert back.layout is None and len(back.lake.holes) == 1 and back.lake.cell_size == 300.0
 
 
 def test_a_lake_refused_is_a_message(qtbot, win):

@@ -38,7 +38,7 @@ def test_every_action_comes_from_the_table(qtbot, win):
             seen[s.toString()] = spec.key
         if spec.toolbar:
             assert a in win.findChild(QtWidgets.QToolBar, "main-toolbar").actions()
-    assert set(win.tool_actions) == {"pan", "draw", "edit", "corners", "cut"}
+    assert set(win.tool_actions) == {"pan", "draw", "edit", "corners", "cut", "layout"}
     help_keys = " ".join(k for k, _ in actions.shortcut_rows())
     assert "Ctrl+Y" in help_keys and "F5" in help_keys
 

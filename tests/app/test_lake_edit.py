@@ -1,0 +1,120 @@
+"""Editing a lake layout in the app: drag cut ends and corners, set a block's cells; the grid follows."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.gui
+
+LAKES = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
+ISEO = LAKES / "lake_iseo_sparse.geojson"
+
+
+def wait_idle(qtbot, win, timeout=120_000):
+    qtbot.waitUntil(
+        lambda: (
+            not win.lake_ctl.busy
+            and not win.lake_ctl.editing
+            and not win.solver.running
+            and not win.solver._debounce.isActive()
+        ),
+        timeout=timeout,
+    )
+
+
+@pytest.fixture
+def laid(qtbot, win):
+    """Iseo laid out at 300 m and gridded, the Layout tool active, auto-generate on."""
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    win.lake_ctl.set_cell_size(300.0)
+    win.a_auto_layout.trigger()
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    wait_idle(qtbot, win)
+    assert win.canvas.tool is win.tools["layout"]  # Auto layout leads on to editing it
+    win.a_auto.trigger()
+    assert win.solver.auto
+    return win
+
+
+def _is_start(grid, algebraic) -> bool:
+    return algebraic is not None and grid.shape == algebraic.shape and np.array_equal(grid.x, algebraic.x)
+
+
+def test_drag_a_cut_end_along_the_shore_and_the_grid_follows(qtbot, laid):
+    from app.layout_edit import handles
+
+    win = laid
+    lay0 = win.doc.project.layout
+    grids0 = dict(win.doc.grids)
+    shown_start = []
+    win.solver.redrawn.connect(
+        lambda: shown_start.extend(k for k, g in win.doc.grids.items() if _is_start(g, win.doc.initial.get(k)))
+    )
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    tool = win.canvas.tool
+    n = win.stack.count()
+    h = lay0.cell_size
+    path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, 1.5, 6)]
+    assert tool.drag("start", tuple(path[0]), end.xy)
+    for p in path[1:]:
+        tool.drag("move", tuple(p), end.xy)
+        qtbot.wait(30)
+    tool.drag("finish", tuple(path[-1]), end.xy)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert lay1 is not lay0 and win.lake_ctl.edit_error is None
+    assert win.stack.count() == n + 1 and win.stack.undoText().startswith("Move cut end")  # one undo step
+    assert [b.cells for b in lay1.blocks] == [b.cells for b in lay0.blocks]  # cells kept
+    ends0 = {tuple(np.round(c[k], 6)) for c in lay0.cuts for k in (0, -1)}
+    ends1 = {tuple(np.round(c[k], 6)) for c in lay1.cuts for k in (0, -1)}
+    moved = ends1 - ends0
+    assert len(moved) == 1
+    q = np.array(next(iter(moved)))
+    assert lay1.polygon.boundary.distance(__import__("shapely").Point(q)) < 1e-6 * h  # on the shore
+    # the grid re-solved from the previous one: same shapes, new nodes, never the start grid on screen
+    assert sorted(win.doc.grids) == sorted(grids0)
+    assert all(win.doc.grids[k].shape == g.shape for k, g in grids0.items())
+    assert any(not np.array_equal(win.doc.grids[k].x, g.x) for k, g in grids0.items())
+    assert shown_start == []
+    assert win.doc.lake_metrics is not None and win.doc.lake_metrics.summary()["folded_cells"] == 0
+    win.stack.undo()
+    assert win.doc.project.layout is lay0
+
+
+def test_set_one_blocks_cells_and_its_neighbours_follow(qtbot, laid):
+    win = laid
+    lay0 = win.doc.project.layout
+    win.lake_panel.table.item(0, 0).setSelected(True)
+    win.doc.set_active(0)
+    b0 = lay0.blocks[0]
+    m = lay0.multiple
+    assert win.lake_panel.ni.value() == b0.cells[0] and win.lake_panel.ni.singleStep() == m
+    win.lake_panel.ni.setValue(b0.cells[0] + 2 * m)
+    win.lake_panel.set_cells.click()
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert lay1.blocks[0].cells == (b0.cells[0] + 2 * m, b0.cells[1])
+    assert win.stack.undoText().startswith(f"Cells of {b0.name}")
+    # the grid was made again with the new counts (auto-generate), every block as its layout says
+    assert [win.doc.grids[k].cells for k in range(len(lay1.blocks))] == [tuple(b.cells) for b in lay1.blocks]
+    assert win.lake_panel.table.item(0, 1).text() == f"{b0.cells[0] + 2 * m} × {b0.cells[1]}"
+
+
+def test_an_impossible_layout_is_a_message_and_nothing_changes(qtbot, laid):
+    from app.layout_edit import handles
+
+    win = laid
+    lay0 = win.doc.project.layout
+    inner = next(h for h in handles(lay0) if h.kind == "cut")
+    x0, y0, x1, y1 = lay0.polygon.bounds
+    outside = (x1 + (x1 - x0), y1 + (y1 - y0))  # a cut point dragged far out of the water
+    tool = win.canvas.tool
+    assert tool.drag("start", inner.xy, inner.xy)
+    tool.drag("finish", outside, inner.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0
+    assert win.lake_ctl.edit_error and "Cannot change the layout" in win._status.text()
+    assert win.docks["messages"].isVisible()

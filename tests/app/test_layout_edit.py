@@ -1,0 +1,82 @@
+"""The layout handles a user drags and what moving one does (no Qt)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from shapely.geometry import Point
+
+from app.layout_edit import Handle, handles, moved_parts, nearest_handle, place
+
+
+@pytest.fixture(scope="module")
+def layout():
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+
+    poly = testing.y_junction()
+    return auto_layout(poly, cell_size=float(np.sqrt(poly.area / 600)), multiple=4)
+
+
+def test_every_cut_end_and_corner_is_a_handle_once(layout):
+    hs = handles(layout)
+    ends = [h for h in hs if h.kind == "end"]
+    assert len({h.xy for h in hs}) == len(hs)
+    boundary = layout.polygon.boundary
+    for h in ends:
+        assert boundary.distance(Point(h.xy)) < 1e-9  # cut ends lie on the shore
+    corners = {tuple(map(float, p)) for b in layout.blocks for p in b.corners}
+    assert corners <= {h.xy for h in hs}
+    interior = [h for h in hs if h.kind == "cut"]
+    assert len(interior) == sum(max(len(c) - 2, 0) for c in layout.cuts)
+    ends = {tuple(map(float, p)) for c in layout.cuts for p in (c[0], c[-1])}
+    assert ends == {h.xy for h in hs if h.kind in ("end", "junction")}
+
+
+def test_nearest_handle_prefers_a_cut_end(layout):
+    hs = handles(layout)
+    end = next(h for h in hs if h.kind == "end")
+    twin = Handle("corner", end.xy, block=0)
+    got = nearest_handle([twin, *hs], end.xy, tol=1e-3)
+    assert got.kind == "end" and got.xy == end.xy
+    assert nearest_handle(hs, (1e3, 1e3), tol=1e-3) is None
+
+
+def test_a_dragged_end_slides_on_the_shore_and_a_corner_on_its_block(layout):
+    hs = handles(layout)
+    end = next(h for h in hs if h.kind == "end")
+    far = (end.xy[0] + 0.3, end.xy[1] + 0.4)
+    q = place(layout, end, far)
+    assert layout.polygon.boundary.distance(Point(q)) < 1e-9
+    assert np.hypot(q[0] - far[0], q[1] - far[1]) <= np.hypot(end.xy[0] - far[0], end.xy[1] - far[1]) + 1e-12
+    inner = next(h for h in hs if h.kind == "cut")
+    assert place(layout, inner, (0.25, 0.5)) == (0.25, 0.5)
+
+
+def test_a_move_takes_every_coinciding_point_along(layout):
+    end = next(h for h in handles(layout) if h.kind == "end")
+    parts = {
+        "cuts": [np.asarray(c) for c in layout.cuts],
+        "blocks": [{"name": b.name, "corners": list(b.corners), "cells": b.cells} for b in layout.blocks],
+    }
+    new = (end.xy[0] + 0.01, end.xy[1])
+    out = moved_parts(parts, end.xy, new, tol=1e-9)
+    n_before = sum(1 for c in parts["cuts"] for p in c if np.allclose(p, end.xy))
+    n_before += sum(1 for b in parts["blocks"] for p in b["corners"] if np.allclose(p, end.xy))
+    n_after = sum(1 for c in out["cuts"] for p in c if np.allclose(p, new))
+    n_after += sum(1 for b in out["blocks"] for p in b["corners"] if np.allclose(p, new))
+    assert n_before >= 1 and n_after == n_before
+    assert not any(np.allclose(p, end.xy) for c in out["cuts"] for p in c)
+    assert [b["cells"] for b in out["blocks"]] == [b.cells for b in layout.blocks]  # cells kept
+
+
+def test_a_cut_bends_smoothly_and_keeps_its_far_end(layout):
+    c = np.asarray(max(layout.cuts, key=len), float)
+    parts = {"cuts": [c], "blocks": []}
+    d = np.array([0.02, -0.01])
+    for k in (0, len(c) // 2):
+        out = np.asarray(moved_parts(parts, c[k], c[k] + d, tol=1e-12)["cuts"][0])
+        shift = np.hypot(*(out - c).T)
+        np.testing.assert_allclose(out[k], c[k] + d)
+        assert shift[-1] == 0 and (k == 0 or shift[0] == 0)  # the far end(s) stay
+        assert np.all(np.diff(shift[k:]) <= 1e-15)  # less and less towards the far end
