@@ -31,7 +31,7 @@ from .build import layout_pieces
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .model import Layout, LayoutBlock
 from .outline import interior_cuts
-from .polygon import water_polygon
+from .polygon import water_polygon, without_slivers
 
 __all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
 
@@ -77,6 +77,8 @@ def auto_layout(
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else float(np.sqrt(poly.area / target_cells))
     poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
+    poly, slivers = without_slivers(poly, 0.5 * h)
+    more = more + slivers
     sk, chords, _, pieces = layout_pieces(poly, h, regular=regular)
     topo, _ = build_topology(pieces, h, multiple=multiple)
     blocks = tuple(

@@ -167,3 +167,34 @@ def test_regular_layouts_have_only_four_block_corners():
     m = lay.topology().node_map
     assert all(c.valence == 4 for c in m.corners if c.free)
     assert len(m.irr_nodes) == 0
+
+
+def test_a_spike_narrower_than_half_a_cell_is_smoothed_out_with_a_note():
+    """A needle of water thinner than half a cell (a digitising spike) cannot hold grid lines."""
+    from shapely.geometry import Polygon
+
+    from meshcore.layout.polygon import without_slivers
+    from meshcore.quality.lake import block_metrics
+
+    # a 10 × 4 basin with a needle inlet 0.04 wide and 1.2 long into its top shore
+    ring = [(0, 0), (10, 0), (10, 4), (6.02, 4), (6.02, 5.2), (5.98, 5.2), (5.98, 4), (0, 4)]
+    poly = Polygon(ring)
+    clean, notes = without_slivers(poly, 0.125)
+    assert notes and "spikes" in notes[0]
+    assert clean.area == pytest.approx(40.0, rel=1e-6) and clean.bounds[3] == pytest.approx(4.0)
+    lay = auto_layout(poly, cell_size=0.25)
+    assert any("spikes" in n for n in lay.notes)
+    from meshcore.lakegrid import mesh_layout
+
+    mb = mesh_layout(lay)
+    assert not any(block_metrics(g).folded.any() for g in mb.grids)
+    # a narrow channel that joins two basins is water the grid needs: left alone
+    two = Polygon(
+        [(0, 0), (4, 0), (4, 1.98), (6, 1.98), (6, 0), (10, 0), (10, 4), (6, 4), (6, 2.02), (4, 2.02), (4, 4), (0, 4)]
+    )
+    same, notes = without_slivers(two, 0.125)
+    assert same is two and not notes
+    # an island close to the shore stays an island
+    isl = Polygon([(0, 0), (10, 0), (10, 4), (0, 4)], [[(4, 3.95), (6, 3.95), (6, 3.0), (4, 3.0)]])
+    same, notes = without_slivers(isl, 0.125)
+    assert same is isl and not notes
