@@ -98,6 +98,36 @@ def check_allocation(
         raise error(f"{what}: {int(count):,} is more than the limit of {int(limit):,} (set {env} to raise it)")
 
 
+def read_file_bytes(path: Any, *, error: type[Exception], limit: int | None = None) -> bytes:
+    """The bytes of the regular file ``path``, refusing (``error``) more than ``limit`` bytes
+    (default :func:`max_bytes`) — by its size before reading, and while reading (a file that
+    grows) — and a device, pipe or socket, which could be read for ever (``/dev/zero``, a fifo).
+    A missing file or a directory raises ``FileNotFoundError`` / ``IsADirectoryError``."""
+    import stat
+
+    st = os.stat(path)
+    if stat.S_ISDIR(st.st_mode):
+        raise IsADirectoryError(21, "Is a directory", str(path))
+    if not stat.S_ISREG(st.st_mode):
+        raise error(f"{path}: not a regular file (a device, pipe or socket): give the path of a file")
+    cap = max_bytes() if limit is None else int(limit)
+    if limit is None:
+        check_allocation(st.st_size, cap, what=f"{path}: file size in bytes", env="MESHCORE_MAX_BYTES", error=error)
+    elif st.st_size > cap:
+        raise error(f"{path}: file is {st.st_size:,} bytes, more than the limit of {cap:,}")
+    with open(path, "rb") as fh:
+        data = fh.read(min(cap, st.st_size) + 1)  # read(n) reserves n bytes: the size it has, not the cap
+        if len(data) > st.st_size:  # a file that grows while it is read (or a /proc file of size 0)
+            parts, n = [data], len(data)
+            while n <= cap and (chunk := fh.read(1 << 20)):
+                parts.append(chunk)
+                n += len(chunk)
+            data = b"".join(parts)
+    if len(data) > cap:
+        raise error(f"{path}: the file grew beyond the limit of {cap:,} bytes while it was read")
+    return data
+
+
 def check_grid_size(
     n_i: Any, n_j: Any, *, what: str = "grid", error: type[Exception] = InvalidInputError, nodes: bool = False
 ) -> None:

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .._tables import check_keys, from_table, table_keys
+from .._validation import read_file_bytes
 from ..boundary import BorderSpec
 from ..errors import CaseFileError, InvalidInputError, MeshcoreError
 from ..grid import BORDER_NAMES
@@ -360,8 +361,8 @@ def load_case(path: str | Path) -> Case:
         the file, the block and the key).
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
+    try:  # a regular file of at most MESHCORE_MAX_BYTES (a fifo or /dev/zero would be read for ever)
+        text = read_file_bytes(p, error=CaseFileError).decode("utf-8")
     except FileNotFoundError:
         raise CaseFileError(f"{p}: case file not found") from None
     except (OSError, UnicodeDecodeError) as exc:

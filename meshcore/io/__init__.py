@@ -299,12 +299,21 @@ def read_points(
     with read_guard(p, "point file"):
         if fmt is None:  # a grid file: its borders
             return _grid_as_points(read_blocks(p), p)
-        if not p.exists():
-            raise ReadError(f"{p}: no such file")
-        if p.is_dir():
-            raise ReadError(f"{p}: is a directory, not a point file")
+        _check_file(p, "point file")
         fn = fmt._load(fmt.points_reader)
         return fn(p, columns=columns, crs=crs, closed=closed, **options)
+
+
+def _check_file(p: Path, what: str) -> None:
+    """A regular file, or one clear ReadError (a device or a pipe could be read for ever, by any reader)."""
+    import stat
+
+    if not p.exists():
+        raise ReadError(f"{p}: no such file")
+    if p.is_dir():
+        raise ReadError(f"{p}: is a directory, not a {what}")
+    if not stat.S_ISREG(p.stat().st_mode):
+        raise ReadError(f"{p}: not a regular file (a device, pipe or socket): give the path of a {what}")
 
 
 def _is_grid_suffix(p: Path) -> bool:
@@ -334,10 +343,7 @@ def read_blocks(path: Any, *, format: str | None = None, **options: Any) -> Grid
     p = Path(path)
     fmt = find_format(p, format, role="grid")
     with read_guard(p, f"{fmt.name} file"):
-        if not p.exists():
-            raise ReadError(f"{p}: no such file")
-        if p.is_dir():
-            raise ReadError(f"{p}: is a directory, not a {fmt.name} file")
+        _check_file(p, f"{fmt.name} file")
         missing = fmt.missing()
         if missing:
             raise ReadError(f"{p}: {missing}")

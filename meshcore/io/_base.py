@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import MAX_COORDINATE, check_allocation, check_grid_size, max_bytes
+from .._validation import MAX_COORDINATE, check_grid_size, read_file_bytes
 from ..errors import MeshcoreError, ReadError, WriteError
 from ..grid import BORDER_NAMES, StructuredGrid
 from ._atomic import (  # noqa: F401 - re-exported: the writers import them from here
@@ -233,14 +233,9 @@ def parse_xml(data: bytes, where: str, *, kind: str):
 
 
 def read_bytes(path: Path, *, limit: int | None = None) -> bytes:
-    """Read a whole file, refusing one larger than ``limit`` (default :func:`max_bytes`)."""
-    size = path.stat().st_size
-    if limit is None:
-        what = f"{path}: file size in bytes"
-        check_allocation(size, max_bytes(), what=what, env="MESHCORE_MAX_BYTES", error=ReadError)
-    elif size > limit:
-        raise ReadError(f"{path}: file is {size:,} bytes, more than the limit of {limit:,}")
-    return path.read_bytes()
+    """Read a whole regular file, refusing one larger than ``limit`` (default :func:`max_bytes`)
+    and devices or pipes (see :func:`~meshcore._validation.read_file_bytes`)."""
+    return read_file_bytes(path, error=ReadError, limit=limit)
 
 
 def check_nodes(shape: Sequence[int], path: Any, what: str = "grid") -> None:

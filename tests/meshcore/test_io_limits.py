@@ -8,9 +8,11 @@ are linear in their input.
 
 from __future__ import annotations
 
+import os
 import struct
 import tracemalloc
 import zlib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -224,3 +226,35 @@ def test_readme_promises_the_limits_the_code_has(monkeypatch):
 
     assert dxf.SPLINE_MAX_POINTS == 200_000 and "| 200 000 (a larger" in promise
     assert kml.KMZ_LIMIT == 64 * 2**20 and "KMZ: 64 MiB" in promise
+
+
+def _limit_memory():  # in the child: a reader of /dev/zero fails on memory, not on the machine
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (3 * 2**30, 3 * 2**30))
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo") or not os.path.exists("/dev/zero"), reason="POSIX fifos and devices")
+@pytest.mark.parametrize(
+    ("argv", "target", "kind"),
+    [
+        (["import", "{f}", "-o", "{d}/o.toml"], "lake.csv", "fifo"),
+        (["generate", "{f}", "-o", "{d}/o.vts"], "case.toml", "fifo"),
+        (["quality", "{f}"], "grid.vts", "device"),
+    ],
+)
+def test_a_pipe_or_a_device_is_refused_not_read_for_ever(tmp_path, argv, target, kind):
+    """A fifo without a writer blocked every reader; /dev/zero was read until memory ran out."""
+    import subprocess
+    import sys
+
+    f = tmp_path / target
+    if kind == "fifo":
+        os.mkfifo(f)
+    else:
+        f.symlink_to("/dev/zero")
+    env = dict(os.environ, PYTHONPATH=str(Path(meshcore.__file__).parents[1]))
+    cmd = [sys.executable, "-m", "meshcore"] + [a.format(f=f, d=tmp_path) for a in argv]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=120, preexec_fn=_limit_memory)
+    assert r.returncode == 2, r.stderr[-2000:]
+    assert r.stderr.count("\n") == 1 and f"{f}: not a regular file" in r.stderr
