@@ -84,7 +84,7 @@ def test_grid_lines_fade_when_cells_are_a_few_pixels(qtbot, win):
     assert all(p <= q for p, q in itertools.pairwise(a))  # more pixels, more ink
     win.io.open_example("bottle-coarse", confirm=False)
     win.editor.set_block_options(cells=(300, 300))
-    win.editor.set_solver(max_iterations=3, repair="off")  # any grid of small cells will do
+    win.editor.set_solver(max_iterations=3, repair="off", threads=1)  # any grid of small cells will do
     win.generate()
     wait_idle(qtbot, win, timeout=120_000)  # a busy machine is slow; the test is about drawing
 
