@@ -95,6 +95,7 @@ class Document:
         self._final: bool = False  # the grids are the result of a finished solve
         #: meshcore LakeMetrics of a lake layout's finished grid (None otherwise)
         self.lake_metrics = None
+        self._given_metrics = None  # (MultiBlockGrid, LakeMetrics) measured by the solver worker
 
     # ----------------------------------------------------------- project
     @property
@@ -159,8 +160,12 @@ class Document:
             self.stale = False
         self.grids_changed.emit()
 
-    def set_grids(self, grids: dict[int, StructuredGrid], initial: dict | None = None, *, multiblock=None) -> None:
-        """The final grids of a solve (and, for a multiblock case, meshcore's MultiBlockGrid)."""
+    def set_grids(
+        self, grids: dict[int, StructuredGrid], initial: dict | None = None, *, multiblock=None, metrics=None
+    ) -> None:
+        """The final grids of a solve (and, for a multiblock case, meshcore's MultiBlockGrid; for a lake,
+        its LakeMetrics if the worker measured them)."""
+        self._given_metrics = (multiblock, metrics) if metrics is not None else None
         self.grids = dict(grids)
         if initial is not None:
             self.initial = dict(initial)
@@ -214,6 +219,9 @@ class Document:
         mb = self.multiblock
         if lay is None or mb is None or len(mb.grids) != len(lay.blocks):
             return None
+        given = self._given_metrics
+        if given is not None and given[0] is mb:
+            return given[1]
         from meshcore.quality import lake_metrics
 
         return lake_metrics(mb, polygon=lay.polygon, cell_size=lay.cell_size)

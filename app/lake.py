@@ -174,9 +174,10 @@ def layout_blocks(layout: Any) -> tuple:
     """One :class:`~app.project.Block` per layout block: its four borders (read-only) and cells."""
     from meshcore import BORDER_NAMES
 
+    from .lake_solve import layout_topology
     from .project import Block
 
-    topo = layout.topology()
+    topo = layout_topology(layout)  # made by the worker that made the layout, as a rule
     out = []
     for lb, b in zip(layout.blocks, topo.blocks, strict=True):
         out.append(

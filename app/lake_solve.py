@@ -2,7 +2,7 @@
 
 :func:`solve_layout` yields ``(ALL_BLOCKS, SolverProgress)`` items with every block's grid and
 returns a :class:`~app.results.BlockResult` carrying the
-:class:`~meshcore.multiblock.MultiBlockGrid`.  Two ways, one result:
+:class:`~meshcore.multiblock.MultiBlockGrid` and its lake metrics.  Two ways, one result:
 
 * **cold** (a new layout, or blocks whose cell counts changed):
   :func:`meshcore.lakegrid.iterate_layout`, coarse to fine, as ``meshcore mesh`` makes it;
@@ -103,7 +103,7 @@ def _cold(layout, stop_event):
     if not full:  # stopped on a coarse level
         return BlockResult(grids={}, initial={})
     starts = dict(enumerate(initial_grids(mb.topology)))
-    return BlockResult(grids=dict(enumerate(mb.grids)), initial=starts, multiblock=mb)
+    return BlockResult(grids=dict(enumerate(mb.grids)), initial=starts, multiblock=mb, metrics=_metrics(layout, mb))
 
 
 def _warm(layout, warm, stop_event):
@@ -136,4 +136,11 @@ def _warm(layout, warm, stop_event):
     info = SolveInfo(method="orthogonal", converged=True, iterations=res.sweeps, elapsed=res.elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
     mb = MultiBlockGrid(tuple(res.grids), names, topo.interfaces, "orthogonal", info, topo)
-    return BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb)
+    return BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb, metrics=_metrics(layout, mb))
+
+
+def _metrics(layout, mb):
+    """The lake metrics of the grid, measured here in the worker (they take a while on a big lake)."""
+    from meshcore.quality import lake_metrics
+
+    return lake_metrics(mb, polygon=layout.polygon, cell_size=layout.cell_size)

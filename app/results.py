@@ -22,3 +22,4 @@ class BlockResult:
     initial: dict
     multiblock: object = None  # the meshcore MultiBlockGrid of a multiblock case or a lake (connectivity)
     warnings: tuple[str, ...] = field(default=())
+    metrics: object = None  # a lake grid's meshcore LakeMetrics, measured in the worker

@@ -300,7 +300,8 @@ class SolverController(QtCore.QObject):
         ready = {k for k, b in enumerate(self.doc.project.blocks) if b.ready}
         grids = {k: g for k, g in grids.items() if k in ready}
         mb = getattr(result, "multiblock", None)
-        self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready}, multiblock=mb)
+        metrics = getattr(result, "metrics", None)
+        self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready}, multiblock=mb, metrics=metrics)
         self.last_result = result
         for w in result.warnings:  # what meshcore warned about (e.g. dropped duplicate points)
             self.doc.report("warning", w)

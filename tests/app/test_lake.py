@@ -81,6 +81,7 @@ def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
     box = win.lake_quality
     assert box.isVisible() and doc.lake_metrics is not None
     assert doc.lake_metrics.summary()["folded_cells"] == 0
+    assert doc.lake_metrics is win.solver.last_result.metrics  # measured in the worker, not the GUI thread
     for preset in ("delft3d", "efdc"):
         box.preset.setCurrentText(preset)
         v = box.verdict
