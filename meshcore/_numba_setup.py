@@ -19,6 +19,15 @@ runs before any kernel module is imported and does two things:
   cache (``gcmesh-kernels.stamp``); when it changes, the cached kernels of all
   of them are removed and compile again on first use.
 
+* **Threads on a busy machine.**  numba's OpenMP threads spin while they wait
+  at the end of a parallel loop (libgomp's default); when another process
+  wants a core, the spinning thread and the one it waits for share it, and a
+  solve with two threads took 9–14× as long as with one (measured: 257² with
+  two threads under load).  Unless the user set ``OMP_WAIT_POLICY`` or
+  ``GOMP_SPINCOUNT``, waiting threads sleep (``OMP_WAIT_POLICY=passive``,
+  read when numba first loads its OpenMP layer): under load two threads then
+  cost about as much as one, and on an idle machine they still gain.
+
 ``scripts/setup.sh`` compiles every kernel once (:func:`meshcore.elliptic.warmup`),
 so that the first solve in a new environment loads them instead of compiling.
 """
@@ -30,7 +39,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["KERNEL_MODULES", "cache_dir", "cache_dirs"]
+__all__ = ["KERNEL_MODULES", "cache_dir", "cache_dirs", "compile_all"]
 
 _ROOT = Path(__file__).parent
 
@@ -102,9 +111,8 @@ def _purge_stale() -> None:
                 continue
         except OSError:
             pass
-        if not d.is_dir():
-            continue
         try:
+            d.mkdir(parents=True, exist_ok=True)  # numba fills it with kernels of these sources
             for f in d.iterdir():
                 if f.suffix in (".nbi", ".nbc") and f.name.split(".", 1)[0] in stems:
                     f.unlink(missing_ok=True)
@@ -137,5 +145,60 @@ def _configure() -> None:
             return
 
 
+def _wait_policy() -> None:
+    if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
+        os.environ["OMP_WAIT_POLICY"] = "passive"
+
+
+def compile_all() -> float:
+    """Compile (or load from the cache) every numba kernel once; returns the seconds taken.
+
+    ``scripts/setup.sh`` runs this, so that the
+    first solve in a new environment loads compiled kernels instead of compiling
+    them (about 20 s on a 2-core machine).
+    """
+    import time
+
+    import numpy as np
+
+    t0 = time.perf_counter()
+    from .elliptic import warmup
+    from .foldfree import repair, smooth
+    from .grid import StructuredGrid
+    from .multiblock import solve_multiblock
+    from .multiblock.topology import Block, Interface, MultiBlockTopology, Side
+
+    warmup(multigrid=True, parallel=True)
+    s = np.linspace(0.0, 1.0, 9)
+    X, Y = np.meshgrid(2.0 * s, s, indexing="ij")
+    Y = Y + 0.05 * np.sin(np.pi * X) * np.sin(np.pi * Y)
+    folded = X.copy()
+    folded[4, 4] = X[6, 4]  # one node pushed past its neighbour: folded cells
+    g = StructuredGrid(folded, Y)
+    repair(g, strict=False)
+    smooth(g, strict=False, max_sweeps=20)
+
+    def block(name, a, b):
+        from .boundary import Borders
+
+        return Block(name, Borders(bottom=np.c_[a[:, 0], b[:, 0]], right=np.c_[a[-1], b[-1]],
+                                   top=np.c_[a[:, -1], b[:, -1]], left=np.c_[a[0], b[0]]))  # fmt: skip
+
+    topo = MultiBlockTopology(
+        (block("a", X[:5], Y[:5]), block("b", X[4:], Y[4:])), (Interface(Side("a", "right"), Side("b", "left")),)
+    )
+    for engine in ("multigrid", "blocks", "table"):
+        solve_multiblock(topo, engine=engine, max_iterations=3)
+    try:  # three blocks meeting at a node (the irregular-node kernels)
+        from .case import generate_case, load_case
+        from .cli.examples import example_path
+
+        generate_case(load_case(example_path("confluence-multiblock")))
+    except Exception:  # pragma: no cover - examples not installed
+        pass
+    return time.perf_counter() - t0
+
+
 _configure()
 _purge_stale()
+_wait_policy()

@@ -13,7 +13,7 @@ Equations (paper eqs. 25/26, errata applied: docs/errata.md):
 α x_ξξ − 2β x_ξη + γ x_ηη + D² (P x_ξ + Q x_η) = 0, same for y.
 """
 
-from . import multigrid as _multigrid  # noqa: F401  (registers "multigrid")
+from . import multigrid as _multigrid  # registers "multigrid"
 from .solver import (
     METHODS,
     EllipticConfig,
@@ -67,7 +67,7 @@ def warmup(*, multigrid: bool = True, parallel: bool = True) -> None:
         _kernels.sweep4_parallel(x, y, e, e, 1.0, False)
         r = np.zeros_like(x)
         _mg_kernels.smooth_parallel(x, y, r, r, e, e, False, 1)
-        tab = _mg_kernels.transfer_tables(np.arange(5.0), True, False)
+        tab = _multigrid._tables(np.arange(5.0), True, False)  # read-only, as in a solve
         xc = np.zeros((tab[6].size, tab[6].size))
         _mg_kernels.defect_parallel(x, y, e, e, e, e, False, r.copy(), r.copy())
         _mg_kernels.defect_restrict_parallel(

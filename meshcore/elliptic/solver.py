@@ -192,8 +192,9 @@ def _pq(p, q, shape):
     if p is None and q is None:
         e = np.zeros((0, 0))
         return e, e
-    pp = np.zeros(shape) if p is None else np.ascontiguousarray(np.broadcast_to(p, shape), dtype=np.float64)
-    qq = np.zeros(shape) if q is None else np.ascontiguousarray(np.broadcast_to(q, shape), dtype=np.float64)
+    # own writable copies (a broadcast view is read-only: a distinct array type for numba)
+    pp = np.zeros(shape) if p is None else np.array(np.broadcast_to(p, shape), dtype=np.float64, order="C")
+    qq = np.zeros(shape) if q is None else np.array(np.broadcast_to(q, shape), dtype=np.float64, order="C")
     for nm, arr in (("P", pp), ("Q", qq)):
         if not np.isfinite(arr).all():
             raise InvalidInputError(f"source term {nm} contains NaN or inf")
