@@ -55,6 +55,7 @@ KERNEL_MODULES = (
     "elliptic/_mg_lines.py",
     "multiblock/_kernels.py",
     "foldfree/_kernels.py",
+    "orthogonal/_kernels.py",
 )
 STAMP_NAME = "gcmesh-kernels.stamp"
 
@@ -196,6 +197,9 @@ def compile_all() -> float:
         generate_case(load_case(example_path("confluence-multiblock")))
     except Exception:  # pragma: no cover - examples not installed
         pass
+    from .lakegrid import mesh_outline  # the orthogonal smoother of `meshcore mesh`
+
+    mesh_outline([(0.0, 0.0), (6.0, 0.0), (6.0, 2.0), (2.0, 2.0), (2.0, 5.0), (0.0, 5.0)], target_cells=200)
     return time.perf_counter() - t0
 
 

@@ -68,7 +68,7 @@ def test_the_stamp_covers_every_module_with_kernels():
 @pytest.mark.slow
 def test_after_compile_all_a_new_process_compiles_nothing(tmp_path):
     """The set-up step compiles every kernel the solvers use: in a new process (same cache)
-    single-block (serial, parallel, periodic, P/Q, SOR), multiblock and fold-free solves
+    single-block (serial, parallel, periodic, P/Q, SOR), multiblock, fold-free and lake-grid solves
     load every kernel from the cache (numba counts a compilation as a cache miss)."""
     env = {"NUMBA_CACHE_DIR": str(tmp_path)}
     _run("from meshcore._numba_setup import compile_all; compile_all()", timeout=1800, **env)
@@ -92,6 +92,8 @@ def test_after_compile_all_a_new_process_compiles_nothing(tmp_path):
         "repair(meshcore.StructuredGrid(X, Y), strict=False)\n"
         "from meshcore.case import load_case, generate_case\n"
         "generate_case(load_case(s._ROOT.parent / 'resources/examples/confluence-multiblock.toml'))\n"
+        "from meshcore.lakegrid import mesh_outline\n"
+        "mesh_outline([(0, 0), (9, 0), (9, 3), (3, 3), (3, 8), (0, 8)], target_cells=300)\n"
         "missed = []\n"
         "for rel in s.KERNEL_MODULES:\n"
         "    name = 'meshcore.' + rel[:-3].replace('/', '.')\n"
