@@ -21,7 +21,8 @@ neighbours (a Laplacian update over its ring, ``irr_ring[irr_ptr[k]:irr_ptr[k+1]
 which for a symmetric star of ``k`` equal cells is the symmetric position.
 
 Sweeps are Gauss–Seidel/SOR in table order (block by block, lexicographic),
-serial.  Each function returns the largest displacement (a length).
+serial.  Each function returns the largest displacement (a length), ``inf`` if a
+node is NaN (a NaN grid must never pass the stopping test).
 """
 
 from __future__ import annotations
@@ -65,8 +66,8 @@ def table_residual(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring):  # pragma: n
         dx = rx / den - x[p]
         dy = ry / den - y[p]
         m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
+        if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
+            dmax = m if m == m else np.inf
     for k in range(irr_nodes.shape[0]):
         p = irr_nodes[k]
         sx = 0.0
@@ -78,8 +79,8 @@ def table_residual(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring):  # pragma: n
         dx = sx * c - x[p]
         dy = sy * c - y[p]
         m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
+        if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
+            dmax = m if m == m else np.inf
     return np.sqrt(dmax)
 
 
@@ -108,8 +109,8 @@ def table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omeg
         x[p] += dx
         y[p] += dy
         m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
+        if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
+            dmax = m if m == m else np.inf
     for k in range(irr_nodes.shape[0]):
         p = irr_nodes[k]
         sx = 0.0
@@ -127,8 +128,8 @@ def table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omeg
         x[p] += dx
         y[p] += dy
         m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
+        if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
+            dmax = m if m == m else np.inf
     return np.sqrt(dmax)
 
 
@@ -148,8 +149,8 @@ def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out,
         rx_out[p] = dx
         ry_out[p] = dy
         m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
+        if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
+            dmax = m if m == m else np.inf
     for k in range(irr_nodes.shape[0]):
         p = irr_nodes[k]
         sx = 0.0
@@ -163,6 +164,6 @@ def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out,
         rx_out[p] = dx
         ry_out[p] = dy
         m = dx * dx + dy * dy
-        if m > dmax:
-            dmax = m
+        if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
+            dmax = m if m == m else np.inf
     return np.sqrt(dmax)

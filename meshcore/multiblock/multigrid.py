@@ -33,9 +33,18 @@ coarsening factors ``a, b``, so ``s = (ab)²(α+γ)/(b²α + a²γ)`` (4 for ful
 coarsening), evaluated on the start grid.  The stopping rule is the shared
 one: the finest-level defect with ``f = 0`` is the point-Jacobi displacement.
 
-Limitation (measured on the Shasta Lake examples): with strongly varying
-cell shapes inside a block the point smoother converges slowly (≈ 0.35 per
-cycle at first, 0.5–0.6 later); ``engine="auto"`` then switches to SOR.
+Transfers are sparse matrices over the global node array (built once per
+hierarchy, :func:`_transfers`): one product per transfer, not a Python loop
+over tens of blocks (:func:`restrict_reference`, :func:`prolong_reference`
+are the blockwise NumPy reference).
+
+Limitation (measured on the Shasta Lake examples and the automatic lake
+layouts of ``benchmarks/robust.py``): with strongly varying cell shapes
+inside a block the point smoother converges slowly (≈ 0.35 per cycle at
+first, 0.5–0.6 later); ``engine="auto"`` then switches to SOR.  Axis classes
+that join many blocks rarely all allow coarsening, so the coarsest level of a
+lake layout keeps ~40 % of the nodes; and the table kernels cost several
+times the single-block smoother per node update.
 """
 
 from __future__ import annotations
@@ -43,8 +52,10 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..boundary import Borders
 from . import _kernels
@@ -67,10 +78,12 @@ AUTO_GIVE_UP_RATE = 0.5
 #: Gauss–Seidel sweeps before / after the coarse-grid correction.
 PRE, POST = 2, 2
 #: Sweeps on the coarsest level: at least COARSEST_SWEEPS, then until the defect fell by
-#: COARSEST_REDUCTION, at most COARSEST_MAX_SWEEPS.
+#: COARSEST_REDUCTION, at most COARSEST_MAX_SWEEPS (where the coarsening stops early, e.g. the
+#: lake layouts, the coarsest level is large and its SOR does not reach the reduction: 2000
+#: sweeps made a cycle cost ~10× more and, on Shasta's automatic layout, diverged; measured).
 COARSEST_SWEEPS = 20
 COARSEST_REDUCTION = 1e-3
-COARSEST_MAX_SWEEPS = 2000
+COARSEST_MAX_SWEEPS = 100
 
 
 _ALONG = {"bottom": 0, "top": 0, "left": 1, "right": 1}
@@ -194,6 +207,8 @@ class _Level:
     inj: np.ndarray | None = None  # coarse node → fine node
     scale: np.ndarray | None = None  # FAS defect scaling per coarse node
     rsum: np.ndarray | None = None  # row sums of Pᵀ (restriction normalisation)
+    P: Any = None  # prolongation from this (coarse) level to the finer one (sparse)
+    R: Any = None  # restriction D⁻¹ Pᵀ from the finer level to this one (sparse)
 
 
 def _aspect(grids: list) -> np.ndarray:
@@ -233,6 +248,49 @@ def _interp(E: np.ndarray, ci: int, cj: int) -> np.ndarray:
     return F
 
 
+def _interp_1d(n_fine: int, c: int) -> sp.csr_matrix:
+    """Linear interpolation from every ``c``-th node to all ``n_fine`` nodes of a line."""
+    if c == 1:
+        return sp.identity(n_fine, format="csr")
+    nc = (n_fine - 1) // 2 + 1
+    rows = np.concatenate([np.arange(0, n_fine, 2), np.arange(1, n_fine, 2), np.arange(1, n_fine, 2)])
+    cols = np.concatenate([np.arange(nc), np.arange(nc - 1), np.arange(1, nc)])
+    vals = np.concatenate([np.ones(nc), np.full(nc - 1, 0.5), np.full(nc - 1, 0.5)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, nc))
+
+
+def _transfers(fine: _Level, coarse: _Level) -> tuple[Any, Any, np.ndarray]:
+    """``(P, R, rsum)``: blockwise bilinear prolongation and its normalised transpose as sparse
+    matrices over the global node arrays (one product per transfer instead of a Python loop over
+    the blocks; :func:`_interp` and :func:`_adjoint` are the blockwise reference).
+
+    ``P`` takes a shared fine node's row from the first block that has it (every block that
+    has it gives the same row: interface values come from interface values only);
+    ``Pᵀ`` sums every block's contribution weighted by ``1/mult`` (a node shared by ``m``
+    blocks counts once), ``R = D⁻¹ Pᵀ`` with ``D`` its row sums.
+    """
+    pr, pc, pv, rr, rc, rv = [], [], [], [], [], []
+    seen = np.zeros(fine.n, dtype=bool)
+    for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids, coarse.factors, strict=True):
+        blk = sp.kron(_interp_1d(gf.shape[0], ci), _interp_1d(gf.shape[1], cj), format="coo")
+        rows, cols = gf.ravel()[blk.row], gc.ravel()[blk.col]
+        rr.append(cols)
+        rc.append(rows)
+        rv.append(blk.data / fine.mult[rows])
+        new = ~seen[rows]
+        pr.append(rows[new])
+        pc.append(cols[new])
+        pv.append(blk.data[new])
+        seen[gf.ravel()] = True
+    P = sp.csr_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(fine.n, coarse.n))
+    Pt = sp.csr_matrix((np.concatenate(rv), (np.concatenate(rr), np.concatenate(rc))), shape=(coarse.n, fine.n))
+    rsum = np.asarray(Pt.sum(axis=1)).ravel()
+    R = sp.diags(1.0 / np.where(rsum > 0, rsum, 1.0)) @ Pt
+    R = sp.diags(coarse.free.astype(float)) @ R
+    P = sp.diags(fine.free.astype(float)) @ P
+    return P.tocsr(), R.tocsr(), rsum
+
+
 def _make_level(t: MultiBlockTopology, grids: list) -> _Level:
     m = t.node_map
     free = np.zeros(m.n_nodes, dtype=bool)
@@ -270,7 +328,6 @@ def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True)
         mf, mc = fine.topo.node_map, coarse.topo.node_map
         inj = np.empty(mc.n_nodes, dtype=np.int64)
         scale = np.zeros(mc.n_nodes)
-        rsum = np.zeros(mc.n_nodes)
         for gf, gc, (ci, cj), (x, y) in zip(mf.ids, mc.ids, coarse.factors, fine.grids, strict=True):
             inj[gc.ravel()] = gf[::ci, ::cj].ravel()
             # FAS scaling: A = −N/(2(α+γ)), N ~ (ab)², α → b²α, γ → a²γ
@@ -280,25 +337,26 @@ def levels(topo: MultiBlockTopology, max_levels: int = 16, *, semi: bool = True)
             a2, b2 = ci * ci, cj * cj
             s = a2 * b2 * (al + ga) / np.maximum(b2 * al + a2 * ga, 1e-300)
             scale[gc.ravel()] = s[::ci, ::cj].ravel()
-            np.add.at(rsum, gc.ravel(), _adjoint(1.0 / fine.mult[gf], ci, cj).ravel())
         coarse.inj = inj
         coarse.scale = scale
-        coarse.rsum = rsum
+        coarse.P, coarse.R, coarse.rsum = _transfers(fine, coarse)
     return out
 
 
-def _restrict(fine: _Level, coarse: _Level, r: np.ndarray) -> np.ndarray:
-    """``R r = D⁻¹ Pᵀ r`` (transpose of the blockwise bilinear prolongation, row-normalised)."""
+def restrict_reference(fine: _Level, coarse: _Level, r: np.ndarray) -> np.ndarray:
+    """``R r = D⁻¹ Pᵀ r`` block by block (NumPy reference of ``coarse.R``)."""
     acc = np.zeros(coarse.n)
+    rsum = np.zeros(coarse.n)
     for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids, coarse.factors, strict=True):
         np.add.at(acc, gc.ravel(), _adjoint(r[gf] / fine.mult[gf], ci, cj).ravel())
-    out = acc / coarse.rsum
+        np.add.at(rsum, gc.ravel(), _adjoint(1.0 / fine.mult[gf], ci, cj).ravel())
+    out = acc / rsum
     out[~coarse.free] = 0.0
     return out
 
 
-def _prolong(fine: _Level, coarse: _Level, e: np.ndarray) -> np.ndarray:
-    """Bilinear interpolation of the coarse correction ``e`` block by block."""
+def prolong_reference(fine: _Level, coarse: _Level, e: np.ndarray) -> np.ndarray:
+    """Bilinear interpolation of the coarse correction ``e`` block by block (reference of ``coarse.P``)."""
     c = np.zeros(fine.n)
     for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids, coarse.factors, strict=True):
         c[gf] = _interp(e[gc], ci, cj)
@@ -329,14 +387,14 @@ def _cycle(lvs: list[_Level], k: int, x, y, fx, fy) -> None:
     zero = np.zeros(co.n)
     dx, dy = np.zeros(co.n), np.zeros(co.n)
     _kernels.table_defect(vx, vy, zero, zero, *co.args, dx, dy)  # d = T(v) − v = −A_H(v)
-    fcx = -dx + co.scale * _restrict(lv, co, rx)
-    fcy = -dy + co.scale * _restrict(lv, co, ry)
+    fcx = -dx + co.scale * (co.R @ rx)
+    fcy = -dy + co.scale * (co.R @ ry)
     fcx[~co.free] = 0.0
     fcy[~co.free] = 0.0
     ux, uy = vx.copy(), vy.copy()
     _cycle(lvs, k + 1, ux, uy, fcx, fcy)
-    x += _prolong(lv, co, ux - vx)
-    y += _prolong(lv, co, uy - vy)
+    x += co.P @ (ux - vx)
+    y += co.P @ (uy - vy)
     for _ in range(POST):
         _kernels.table_sweep_rhs(x, y, fx, fy, *lv.args, 1.0)
 

@@ -282,6 +282,8 @@ def iterate_multiblock(
         raise InvalidInputError("initial grids contain NaN or inf coordinates")
     tol = tol_rel * length
     iters, r, history, message, method = yield from _smooth(x, y, topology, cfg, tol, engine, rep)
+    if not (np.isfinite(x).all() and np.isfinite(y).all()):  # never report a NaN grid converged
+        r, message = np.inf, (message + "; " if message else "") + "NaN or inf coordinates (a degenerate block?)"
     conv = r <= tol * (1 + 1e-12) and message != "stopped"
     info = SolveInfo(
         method=method + ("+frozen-start" if start == "frozen" else ""),

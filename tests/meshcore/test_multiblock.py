@@ -801,6 +801,81 @@ def test_multigrid_kernels_match_reference():
     assert np.array_equal(x2[m.boundary], x[m.boundary])
 
 
+@pytest.mark.parametrize("make", ["star5", "four_blocks", "semi"])
+def test_sparse_transfers_match_the_blockwise_reference(make, rect):
+    """The global sparse P and R equal the block-by-block interpolation and its normalised
+    transpose (shared interface nodes, a node where five blocks meet, semi-coarsening)."""
+    from meshcore.multiblock.multigrid import levels, prolong_reference, restrict_reference
+
+    X, Y, _ = rect
+    if make == "star5":
+        topo = star(5)
+    elif make == "four_blocks":
+        topo = four_blocks(X, Y, 12, 6)
+    else:
+        topo = two_blocks(*curved_rectangle(128, 16), 64)
+    lvs = levels(topo)
+    assert len(lvs) >= 2
+    rng = np.random.default_rng(5)
+    for fine, coarse in itertools.pairwise(lvs):
+        r = rng.standard_normal(fine.n)
+        e = rng.standard_normal(coarse.n)
+        assert np.allclose(coarse.R @ r, restrict_reference(fine, coarse, r), rtol=0, atol=1e-13)
+        assert np.allclose(coarse.P @ e, prolong_reference(fine, coarse, e), rtol=0, atol=1e-13)
+        # P reproduces constants away from the fixed boundary; R of a constant is the constant
+        one = np.ones(coarse.n)
+        assert np.allclose((coarse.P @ one)[fine.free], 1.0)
+        assert np.allclose((coarse.R @ np.ones(fine.n))[coarse.free], 1.0)
+
+
+@pytest.mark.kernel
+def test_a_nan_node_makes_every_measure_infinite():
+    """The table kernels' largest displacement is inf when a node is NaN (max() ignored it)."""
+    topo = star(5)
+    m = topo.node_map
+    x = np.empty(m.n_nodes)
+    y = np.empty(m.n_nodes)
+    for g, ids in zip(meshcore.multiblock.initial_grids(topo), m.ids, strict=True):
+        x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
+    x[m.nodes[len(m.nodes) // 2]] = np.nan
+    args = (m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring)
+    z = np.zeros(m.n_nodes)
+    assert _kernels.table_residual(x, y, *args) == np.inf
+    assert _kernels.table_defect(x, y, z, z, *args, z.copy(), z.copy()) == np.inf
+    assert _kernels.table_sweep_rhs(x.copy(), y.copy(), z, z, *args, 1.0) == np.inf
+
+
+def test_a_nan_grid_is_never_reported_converged(rect, monkeypatch):
+    """A cycle that leaves NaN in the grid (as a degenerate block did) counts as diverged: the
+    solve continues with SOR from the last finite grid and ends finite, or is not converged."""
+    from meshcore.multiblock import multigrid
+
+    X, Y, _ = rect
+    topo = four_blocks(X, Y, 12, 6)
+    node = int(topo.node_map.nodes[3])
+    real = multigrid._cycle
+
+    def poisoned(lvs, k, x, y, fx, fy):
+        real(lvs, k, x, y, fx, fy)
+        if k == 0:
+            x[node] = np.nan
+
+    monkeypatch.setattr(multigrid, "_cycle", poisoned)
+    mb = solve_multiblock(topo, engine="multigrid", tolerance=1e-8)
+    finite = all(np.isfinite(g.x).all() and np.isfinite(g.y).all() for g in mb)
+    assert finite and mb.converged and "sor" in mb.info.method
+    # and if the grid itself stays NaN, the result says so
+    monkeypatch.setattr(multigrid, "iterate_fas", _nan_fas)
+    mb = solve_multiblock(topo, engine="multigrid", tolerance=1e-8, max_iterations=3)
+    assert not mb.converged and "NaN" in mb.info.message
+
+
+def _nan_fas(x, y, topo, tol, max_cycles, give_up_rate=None, lvs=None):
+    x[topo.node_map.nodes] = np.nan
+    yield 1, 0.0
+    return 1, 0.0, [(0, 1.0), (1, 0.0)], "", 2
+
+
 def test_outline_multiple_gives_coarsenable_blocks():
     from meshcore.multiblock.multigrid import levels
 
