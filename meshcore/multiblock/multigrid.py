@@ -248,15 +248,27 @@ def _interp(E: np.ndarray, ci: int, cj: int) -> np.ndarray:
     return F
 
 
-def _interp_1d(n_fine: int, c: int) -> sp.csr_matrix:
-    """Linear interpolation from every ``c``-th node to all ``n_fine`` nodes of a line."""
+def _interp_1d(n_fine: int, c: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(cols, weights)``, each ``(n_fine, 2)``: linear interpolation of every node of a line
+    from every ``c``-th node (``c`` = 1: the node itself; a second weight 0)."""
+    i = np.arange(n_fine)
     if c == 1:
-        return sp.identity(n_fine, format="csr")
-    nc = (n_fine - 1) // 2 + 1
-    rows = np.concatenate([np.arange(0, n_fine, 2), np.arange(1, n_fine, 2), np.arange(1, n_fine, 2)])
-    cols = np.concatenate([np.arange(nc), np.arange(nc - 1), np.arange(1, nc)])
-    vals = np.concatenate([np.ones(nc), np.full(nc - 1, 0.5), np.full(nc - 1, 0.5)])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n_fine, nc))
+        return np.stack([i, i], axis=1), np.stack([np.ones(n_fine), np.zeros(n_fine)], axis=1)
+    odd = (i % 2).astype(float)
+    cols = np.stack([i // 2, np.minimum(i // 2 + 1, (n_fine - 1) // 2)], axis=1)
+    return cols, np.stack([1.0 - 0.5 * odd, 0.5 * odd], axis=1)
+
+
+def _block_interp(shape: tuple[int, int], ci: int, cj: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """COO ``(fine, coarse, weight)`` (local flat indices) of the bilinear interpolation of a block."""
+    (ni, nj), ncj = shape, (shape[1] - 1) // cj + 1
+    ki, wi = _interp_1d(ni, ci)
+    kj, wj = _interp_1d(nj, cj)
+    fine = np.broadcast_to(np.arange(ni * nj).reshape(ni, nj, 1, 1), (ni, nj, 2, 2))
+    coarse = ki[:, None, :, None] * ncj + kj[None, :, None, :]
+    w = wi[:, None, :, None] * wj[None, :, None, :]
+    keep = w.ravel() != 0.0
+    return fine.ravel()[keep], coarse.ravel()[keep], w.ravel()[keep]
 
 
 def _transfers(fine: _Level, coarse: _Level) -> tuple[Any, Any, np.ndarray]:
@@ -272,15 +284,15 @@ def _transfers(fine: _Level, coarse: _Level) -> tuple[Any, Any, np.ndarray]:
     pr, pc, pv, rr, rc, rv = [], [], [], [], [], []
     seen = np.zeros(fine.n, dtype=bool)
     for gf, gc, (ci, cj) in zip(fine.topo.node_map.ids, coarse.topo.node_map.ids, coarse.factors, strict=True):
-        blk = sp.kron(_interp_1d(gf.shape[0], ci), _interp_1d(gf.shape[1], cj), format="coo")
-        rows, cols = gf.ravel()[blk.row], gc.ravel()[blk.col]
+        lf, lc, w = _block_interp(gf.shape, ci, cj)
+        rows, cols = gf.ravel()[lf], gc.ravel()[lc]
         rr.append(cols)
         rc.append(rows)
-        rv.append(blk.data / fine.mult[rows])
+        rv.append(w / fine.mult[rows])
         new = ~seen[rows]
         pr.append(rows[new])
         pc.append(cols[new])
-        pv.append(blk.data[new])
+        pv.append(w[new])
         seen[gf.ravel()] = True
     P = sp.csr_matrix((np.concatenate(pv), (np.concatenate(pr), np.concatenate(pc))), shape=(fine.n, coarse.n))
     Pt = sp.csr_matrix((np.concatenate(rv), (np.concatenate(rr), np.concatenate(rc))), shape=(coarse.n, fine.n))

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from ..errors import TopologyError
 
@@ -62,28 +64,6 @@ class NodeMap:
     n_interior: int = 0  # nodes[:n_interior] are block-interior nodes, the rest lie on borders
 
 
-def _union_find(n: int) -> tuple[np.ndarray, Any, Any]:
-    parent = np.arange(n)
-
-    def find(a: int) -> int:
-        root = a
-        while parent[root] != root:
-            root = parent[root]
-        while parent[a] != root:
-            parent[a], a = root, parent[a]
-        return int(root)
-
-    def union(a: int, b: int) -> None:
-        ra, rb = find(a), find(b)
-        if ra != rb:
-            if ra < rb:
-                parent[rb] = ra
-            else:
-                parent[ra] = rb
-
-    return parent, find, union
-
-
 def border_index(shape: tuple[int, int], border: str) -> tuple[np.ndarray, np.ndarray]:
     """(i, j) index arrays of a border's nodes in its own direction."""
     n1, m1 = shape
@@ -101,8 +81,8 @@ def _global_ids(blocks: Sequence[Any], interfaces: Sequence[Any]) -> tuple[int, 
     shapes = [(b.cells[0] + 1, b.cells[1] + 1) for b in blocks]
     offsets = np.cumsum([0] + [a * c for a, c in shapes])
     local = [offsets[k] + np.arange(a * c).reshape(a, c) for k, (a, c) in enumerate(shapes)]
-    _, find, union = _union_find(int(offsets[-1]))
     idx = {b.name: k for k, b in enumerate(blocks)}
+    pa, pb = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
     for itf in interfaces:
         ka, kb = idx[itf.a.block], idx[itf.b.block]
         ia, ja = border_index(shapes[ka], itf.a.border)
@@ -111,18 +91,24 @@ def _global_ids(blocks: Sequence[Any], interfaces: Sequence[Any]) -> tuple[int, 
         gb = local[kb][ib, jb][itf.b.start : itf.b.stop + 1]
         if itf.reversed:
             gb = gb[::-1]
-        for u, v in zip(ga.tolist(), gb.tolist(), strict=True):
-            union(u, v)
-    roots = np.array([find(k) for k in range(int(offsets[-1]))])
-    uniq, compact = np.unique(roots, return_inverse=True)
-    ids = tuple(compact[loc].reshape(loc.shape) for loc in local)
+        if len(ga) != len(gb):
+            raise ValueError("interface sides of different lengths")
+        pa.append(ga)
+        pb.append(gb)
+    # paired nodes are one node: connected components, numbered in the order of their smallest
+    # member (as a union-find that keeps the smallest root, then np.unique of the roots)
+    n = int(offsets[-1])
+    a, b = np.concatenate(pa), np.concatenate(pb)
+    graph = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(n, n))
+    n_nodes, compact = connected_components(graph, directed=False)
+    ids = tuple(compact[loc].reshape(loc.shape).astype(np.int64) for loc in local)
     for k, g in enumerate(ids):
         if len(np.unique(g)) != g.size:
             raise TopologyError(
                 f"block {blocks[k].name!r}: interfaces glue two nodes of the same block "
                 f"together (a border is joined to itself or to a neighbour's border twice)"
             )
-    return len(uniq), ids
+    return int(n_nodes), ids
 
 
 def _cells(
