@@ -156,7 +156,7 @@ def compile_all() -> float:
 
     ``scripts/setup.sh`` runs this, so that the
     first solve in a new environment loads compiled kernels instead of compiling
-    them (about 20 s on a 2-core machine).
+    them (110 s of CPU, measured on a 2-core machine).
     """
     import time
 
