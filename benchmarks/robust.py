@@ -107,7 +107,7 @@ def lakes(quick: bool, emit) -> dict:
     nodes = 24_000
     reps = 3 if quick else 5
     emit(
-        f"\n## Real lakes as one block (~{nodes} nodes, 1 thread)\n\n"
+        f"\n### Real lakes as one block (~{nodes} nodes, 1 thread)\n\n"
         "Corners and cell ratio as `meshcore import` chooses them; Winslow = `generate_block(..., "
         'repair="off", threads=1)`, default = the same with the fold-free repair (`repair="auto"`). '
         "Square = the wavy square of the scale series with the same node count, solved the same "
@@ -185,7 +185,7 @@ def busy(quick: bool, emit) -> dict:
     env["PYTHONPATH"] = str(ROOT)
     code = _BUSY_CODE.format(here=str(HERE), n=n)
     emit(
-        f"\n## Busy machine ({n + 1}², default `threads=0` = {os.cpu_count()} threads here, against "
+        f"\n### Busy machine ({n + 1}², default `threads=0` = {os.cpu_count()} threads here, against "
         "`threads=1`)\n\nA new process with a user's environment (no `OMP_WAIT_POLICY`); "
         "'busy' = one other process spinning in a Python loop meanwhile.\n"
     )
@@ -230,7 +230,7 @@ def startup(quick: bool, emit) -> dict:
     """A new environment: the set-up compile, then the first solve of a new process."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     emit(
-        "\n## First solve in a new environment\n\nAn empty `NUMBA_CACHE_DIR`; `set-up` = the compile "
+        "\n### First solve in a new environment\n\nAn empty `NUMBA_CACHE_DIR`; `set-up` = the compile "
         "step of `scripts/setup.sh` (`compile_all()`); then new processes: import meshcore + "
         "`generate_block` 65² (default settings), and `meshcore generate` of the bottle example "
         "(whole CLI run).\n"
@@ -268,7 +268,7 @@ def naca(quick: bool, emit) -> dict:
     """The NACA 0012 O- and C-grid examples with wall control: method, cycles, time."""
     from meshcore.case import generate_case, load_case
 
-    emit("\n## Wall control: NACA 0012 examples (1 thread)\n")
+    emit("\n### Wall control: NACA 0012 examples (1 thread)\n")
     emit("| case | nodes | method | iterations | converged | time |")
     emit("|---|---|---|---|---|---|")
     out = {}
@@ -289,7 +289,7 @@ def multiblock(quick: bool, emit) -> dict:
     the same node count."""
     from meshcore.case import generate_case, load_case
 
-    emit("\n## Multiblock against one block of the same node count (1 thread)\n")
+    emit("\n### Multiblock against one block of the same node count (1 thread)\n")
     emit("| case | blocks | nodes | multiblock | method | one block (square) | ratio |")
     emit("|---|---|---|---|---|---|---|")
     out = {}
@@ -383,7 +383,7 @@ def _targets(res: dict, emit) -> None:
         )
     if not rows:
         return
-    emit("\n## Issue 15 targets in this run\n")
+    emit("\n### Issue 15 targets in this run\n")
     emit("| target | wanted | measured |")
     emit("|---|---|---|")
     for r in rows:
