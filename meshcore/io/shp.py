@@ -8,6 +8,7 @@ when the ``.dbf`` has one.  The CRS is the ``.prj`` WKT (None without it).
 
 from __future__ import annotations
 
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +42,9 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     missing = [s for s, p in ((".shx", shx), (".dbf", dbf)) if p is None]
     if missing:
         raise ReadError(f"{path}: the shapefile is incomplete: missing {' and '.join(missing)} next to it")
+    for part in (path, shx, dbf, _sibling(path, ".prj")):
+        if part is not None and not stat.S_ISREG(part.stat().st_mode):  # a fifo would block the read for ever
+            raise ReadError(f"{part}: not a regular file (a device, pipe or socket): give the path of a file")
     for part in (path, shx, dbf):
         check_allocation(
             part.stat().st_size,

@@ -258,3 +258,16 @@ def test_a_pipe_or_a_device_is_refused_not_read_for_ever(tmp_path, argv, target,
     r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=120, preexec_fn=_limit_memory)
     assert r.returncode == 2, r.stderr[-2000:]
     assert r.stderr.count("\n") == 1 and f"{f}: not a regular file" in r.stderr
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="POSIX fifos")
+@pytest.mark.parametrize("part", [".shx", ".dbf", ".prj"])
+def test_a_shapefile_part_that_is_a_pipe_is_refused(tmp_path, part):
+    from tests.conftest import DATA
+
+    for ext in (".shp", ".shx", ".dbf", ".prj"):
+        if ext != part:
+            (tmp_path / f"w{ext}").write_bytes((DATA / f"windermere_sparse{ext}").read_bytes())
+    os.mkfifo(tmp_path / f"w{part}")  # opening it would wait for a writer for ever
+    with pytest.raises(ReadError, match=rf"w\{part}: not a regular file"):
+        read_points(tmp_path / "w.shp")
