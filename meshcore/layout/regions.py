@@ -76,16 +76,24 @@ def partition(poly, cuts: list[np.ndarray]) -> tuple[list[np.ndarray], list[np.n
     outer ring at the nearest points on either side (so every region is simply connected);
     returns the rings and the final list of cuts.
     """
+    from ..errors import TopologyError
+
     cuts = list(cuts)
-    for _ in range(len(poly.interiors) + 1):
+    for _ in range(2 * len(poly.interiors) + 2):  # each round joins an island to another ring
         faces, cuts = _faces(poly, cuts)
         holed = [f for f in faces if f.interiors]
         if not holed:
             break
-        for f in holed:
-            cuts += _island_cuts(f)
-    else:
-        raise RuntimeError("could not cut every island free")  # pragma: no cover (bounded loop)
+        new = [c for f in holed for c in _island_cuts(f)]
+        if not new:
+            break
+        cuts += new
+    if holed:
+        c = holed[0].interiors[0].centroid
+        raise TopologyError(
+            f"automatic layout: no cut from the island near ({c.x:.6g}, {c.y:.6g}) to the shore stays in "
+            f"the water; add cut lines there by hand (a [outline] case) or try another cell size"
+        )
     return [np.asarray(f.exterior.coords)[:-1] for f in faces], cuts
 
 
@@ -136,6 +144,16 @@ def _island_cuts(face) -> list[np.ndarray]:
                 seg = LineString([p.coords[0], q.coords[0]])
                 if seg.length > 0 and room.covers(seg) and not any(seg.crosses(LineString(c)) for c in cuts):
                     cand.append((seg.length, np.asarray(seg.coords)))
+        if not cand:  # round a bend: the nearest points are not in sight; try the other rings' vertices
+            for p in starts:
+                for j, other in enumerate(rings):
+                    if j == k:
+                        continue
+                    verts = np.asarray(other.coords)[:-1]
+                    for v in verts[:: max(1, len(verts) // 64)]:
+                        seg = LineString([p.coords[0], tuple(v)])
+                        if seg.length > 0 and room.covers(seg):
+                            cand.append((seg.length, np.asarray(seg.coords)))
         if not cand:
             continue
         cand.sort(key=lambda t: t[0])
@@ -149,6 +167,8 @@ def _island_cuts(face) -> list[np.ndarray]:
             if float(np.dot(seg[0] - c, d)) < 0 and not LineString(seg).intersects(Point(first[1]))
         ]
         far = [seg for seg in far if not LineString(seg).crosses(LineString(first))]
+        if not far:  # no cut on the far side: any other that leaves the first cut alone
+            far = [seg for _, seg in cand if not LineString(seg).intersects(LineString(first))]
         if far:
             cuts.append(far[0])
     return cuts
