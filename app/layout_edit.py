@@ -96,15 +96,42 @@ def _project(rings: list[np.ndarray], xy: Any) -> tuple[float, float]:
     return best[1]
 
 
-def place(layout: Any, handle: Handle, xy: Any) -> tuple[float, float]:
-    """Where ``handle`` goes when dragged to ``xy``: a cut end onto the shore, a corner onto its block."""
+def place(layout: Any, handle: Handle, xy: Any, parts: dict | None = None) -> tuple[float, float]:
+    """Where ``handle`` goes when dragged to ``xy``: a cut end onto the shore, a corner onto its block.
+
+    A block corner must sit on a vertex of the shore or of a cut: with ``parts`` (the
+    ``[outline]`` form the layout is remade from) it goes to the vertex of its block's boundary
+    nearest to where it was dragged.
+    """
     if handle.kind == "end":
         poly = layout.polygon
         rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
         return _project(rings, xy)
     if handle.kind == "corner":
-        return _project([np.asarray(layout.pieces[handle.block].ring, float)], xy)
+        ring = np.asarray(layout.pieces[handle.block].ring, float)
+        q = _project([ring], xy)
+        if parts is None:
+            return q
+        return _nearest_vertex_on(ring, parts, q)
     return (float(xy[0]), float(xy[1]))
+
+
+def _nearest_vertex_on(ring: np.ndarray, parts: dict, q) -> tuple[float, float]:
+    """The vertex of the shore, the islands or the cuts on the closed ``ring`` nearest to ``q``."""
+    from shapely.geometry import LinearRing, MultiPoint
+
+    pts = np.vstack([np.asarray(parts["outline"], float).reshape(-1, 2)])
+    more = [np.asarray(h, float).reshape(-1, 2) for h in parts.get("holes", ())]
+    more += [np.asarray(c, float).reshape(-1, 2) for c in parts.get("cuts", ())]
+    pts = np.vstack([pts, *more]) if more else pts
+    r = LinearRing(ring)
+    size = float(np.hypot(*np.ptp(ring, axis=0)))
+    d_ring = np.asarray(r.distance(MultiPoint(pts).geoms), float)
+    on = pts[d_ring <= 1e-7 * size]
+    if not len(on):
+        return (float(q[0]), float(q[1]))
+    k = int(np.argmin(np.hypot(on[:, 0] - q[0], on[:, 1] - q[1])))
+    return (float(on[k, 0]), float(on[k, 1]))
 
 
 def _weights(c: np.ndarray, k: int) -> np.ndarray:

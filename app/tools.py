@@ -386,7 +386,7 @@ class LayoutTool(Tool):
         from .layout_edit import moved_parts, place
 
         base, h = self._base, self._handle
-        q = place(base, h, xy)
+        q = place(base, h, xy, self._parts)
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(q)
         if q == h.xy:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import shapely
 
 pytestmark = pytest.mark.gui
 
@@ -73,7 +74,7 @@ def test_drag_a_cut_end_along_the_shore_and_the_grid_follows(qtbot, laid):
     moved = ends1 - ends0
     assert len(moved) == 1
     q = np.array(next(iter(moved)))
-    assert lay1.polygon.boundary.distance(__import__("shapely").Point(q)) < 1e-6 * h  # on the shore
+    assert lay1.polygon.boundary.distance(shapely.Point(q)) < 1e-6 * h  # on the shore
     # the grid re-solved from the previous one: same shapes, new nodes, never the start grid on screen
     assert sorted(win.doc.grids) == sorted(grids0)
     assert all(win.doc.grids[k].shape == g.shape for k, g in grids0.items())
@@ -118,3 +119,27 @@ def test_an_impossible_layout_is_a_message_and_nothing_changes(qtbot, laid):
     assert win.doc.project.layout is lay0
     assert win.lake_ctl.edit_error and "Cannot change the layout" in win._status.text()
     assert win.docks["messages"].isVisible()
+
+
+def test_drag_a_block_corner_to_another_vertex_of_its_block(qtbot, laid):
+    from app.layout_edit import handles
+
+    win = laid
+    lay0 = win.doc.project.layout
+    corner = next(h for h in handles(lay0) if h.kind == "corner")
+    b = lay0.blocks[corner.block]
+    h = lay0.cell_size
+    target = (corner.xy[0] + 2 * h, corner.xy[1] + 2 * h)
+    tool = win.canvas.tool
+    assert tool.drag("start", corner.xy, corner.xy)
+    tool.drag("finish", target, corner.xy)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert win.lake_ctl.edit_error is None, win.lake_ctl.edit_error
+    assert lay1 is not lay0 and win.stack.undoText().startswith("Move block corner")
+    new = next(x for x in lay1.blocks if x.name == b.name).corners
+    assert corner.xy not in new  # the corner left its place …
+    ring = shapely.LinearRing(lay0.pieces[corner.block].ring)
+    moved = [p for p in new if p not in b.corners]
+    assert moved and all(ring.distance(shapely.Point(p)) < 1e-6 * h for p in moved)  # … along its block
+    assert [x.cells for x in lay1.blocks] == [x.cells for x in lay0.blocks]

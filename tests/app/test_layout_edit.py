@@ -80,3 +80,18 @@ def test_a_cut_bends_smoothly_and_keeps_its_far_end(layout):
         np.testing.assert_allclose(out[k], c[k] + d)
         assert shift[-1] == 0 and (k == 0 or shift[0] == 0)  # the far end(s) stay
         assert np.all(np.diff(shift[k:]) <= 1e-15)  # less and less towards the far end
+
+
+def test_a_dragged_corner_lands_on_a_vertex_of_its_block(layout):
+    from shapely.geometry import LinearRing
+
+    from meshcore.layout.outline import outline_parts
+
+    parts = outline_parts(layout)
+    vertices = {tuple(map(float, p)) for key in ("outline",) for p in parts[key]}
+    vertices |= {tuple(map(float, p)) for c in parts["cuts"] for p in c}
+    vertices |= {tuple(map(float, p)) for r in parts["holes"] for p in r}
+    for h in (h for h in handles(layout) if h.kind == "corner"):
+        q = place(layout, h, (h.xy[0] + 0.3, h.xy[1] - 0.2), parts)
+        assert q in vertices
+        assert LinearRing(layout.pieces[h.block].ring).distance(Point(q)) < 1e-9
