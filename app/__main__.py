@@ -55,7 +55,8 @@ def main(argv: list[str] | None = None) -> int:
     # load the numba kernels (warm cache: well under a second) and shapely while Qt starts
     from .pipeline import warmup
 
-    threading.Thread(target=warmup, name="gcmesh-warmup", daemon=True).start()
+    warm = threading.Thread(target=warmup, name="gcmesh-warmup", daemon=True)
+    warm.start()
 
     import pyqtgraph as pg
     from PySide6 import QtCore, QtWidgets
@@ -109,8 +110,11 @@ def main(argv: list[str] | None = None) -> int:
         ok = win.grab().save(args.screenshot)
         win.stack.setClean()
         win.close()
+        warm.join(timeout=60)  # a process that ends inside a compiled kernel aborts
         return 0 if ok else 1
-    return app.exec()
+    code = app.exec()
+    warm.join(timeout=60)
+    return code
 
 
 if __name__ == "__main__":
