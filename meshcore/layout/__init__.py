@@ -89,7 +89,7 @@ def auto_layout(
         )
         for pc, b in zip(pieces, topo.blocks, strict=True)
     )
-    return Layout(
+    lay = Layout(
         polygon=poly,
         cell_size=h,
         cuts=tuple(interior_cuts(pieces)),  # the lines between blocks (merged strips lose theirs)
@@ -100,3 +100,30 @@ def auto_layout(
         chords=tuple(chords),
         notes=tuple(notes) + tuple(more),
     )
+    _check_case(lay)
+    return lay
+
+
+def _check_case(lay: Layout) -> None:
+    """The layout read back as its ``[outline]`` case must give its blocks: else a clear error
+    naming the place (a degenerate piece the steps above let through), not a layout that fails
+    later in :meth:`Layout.topology`."""
+    from ..errors import TopologyError
+
+    try:
+        lay.topology()
+    except TopologyError as exc:
+        import re
+
+        from shapely.geometry import Polygon
+
+        where = str(exc)
+        if "near (" not in where:
+            named = re.search(r"block '([^']+)'", where)
+            piece = next((p for p in lay.pieces if named and p.name == named.group(1)), None)
+            c = (Polygon(piece.ring) if piece is not None else lay.polygon).representative_point()
+            where += f" (near ({c.x:.6g}, {c.y:.6g}))"
+        raise TopologyError(
+            f"automatic layout: its blocks do not form a valid case: {where}; "
+            f"add cut lines by hand (a [outline] case) or try another cell size"
+        ) from None

@@ -39,6 +39,7 @@ class Layout:
     skeleton: Any = field(default=None, repr=False)
     chords: tuple = field(default=(), repr=False)
     notes: tuple[str, ...] = ()
+    _topology: Any = field(default=None, init=False, repr=False, compare=False)  # made once
 
     @property
     def n_cells(self) -> int:
@@ -52,4 +53,6 @@ class Layout:
         """
         from .outline import outline_blocks
 
-        return outline_blocks(self).topology
+        if self._topology is None:
+            object.__setattr__(self, "_topology", outline_blocks(self).topology)
+        return self._topology

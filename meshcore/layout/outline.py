@@ -79,13 +79,40 @@ def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
     return cuts
 
 
+def _shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The shore as the pieces have it (every vertex a piece has on it): the edges that only one
+    piece uses, joined into rings; the ring of largest area is the outline, the others islands."""
+    count: dict[frozenset, int] = {}
+    for pc in pieces:
+        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
+            e = frozenset((_key(a), _key(b)))
+            count[e] = count.get(e, 0) + 1
+    nxt: dict[tuple, tuple] = {}
+    for pc in pieces:  # walked in each piece's own (counter-clockwise) direction
+        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
+            if count[frozenset((_key(a), _key(b)))] == 1:
+                nxt[_key(a)] = _key(b)
+    rings = []
+    while nxt:
+        start, ring = next(iter(nxt)), []
+        v = start
+        while v in nxt:
+            ring.append(v)
+            v = nxt.pop(v)
+        rings.append(np.array(ring))
+    area = [abs(0.5 * float(np.sum(r[:, 0] * np.roll(r[:, 1], -1) - np.roll(r[:, 0], -1) * r[:, 1]))) for r in rings]
+    k = int(np.argmax(area))
+    return rings[k], [r for i, r in enumerate(rings) if i != k]
+
+
 def outline_parts(layout: Any) -> dict[str, Any]:
     """The :func:`~meshcore.multiblock.from_outline` inputs of a layout.
 
-    Returns ``{"outline", "holes", "cuts", "blocks"}``: the densified shore ring, the island
-    rings, the cut polylines and ``{"name", "corners", "cells"}`` per block.
+    Returns ``{"outline", "holes", "cuts", "blocks"}``: the shore ring and the island rings with
+    every vertex the blocks have on them, the cut polylines and ``{"name", "corners", "cells"}``
+    per block.
     """
-    outline, holes = shore_rings(layout.polygon, layout.cell_size)
+    outline, holes = _shore_of(list(layout.pieces))
     blocks = [{"name": b.name, "corners": [list(c) for c in b.corners], "cells": list(b.cells)} for b in layout.blocks]
     return {"outline": outline, "holes": holes, "cuts": interior_cuts(list(layout.pieces)), "blocks": blocks}
 
