@@ -17,19 +17,21 @@ import numpy as np
 
 from .blocks import Piece
 
-__all__ = ["interior_cuts", "outline_blocks", "outline_parts", "shore_rings"]
+__all__ = ["interior_cuts", "outline_blocks", "outline_parts"]
 
 
 def _key(p) -> tuple[float, float]:
     return (float(p[0]), float(p[1]))
 
 
-def shore_rings(polygon: Any, cell_size: float) -> tuple[np.ndarray, list[np.ndarray]]:
-    """The shore as the layout cut it: the outline and the islands with points every ``cell_size``."""
-    import shapely
-
-    dense = shapely.segmentize(polygon, cell_size)
-    return np.asarray(dense.exterior.coords)[:-1], [np.asarray(h.coords)[:-1] for h in dense.interiors]
+def _edge_use(pieces: list[Piece]) -> dict[frozenset, int]:
+    """How many pieces use each edge: 1 on the shore, 2 between two blocks."""
+    count: dict[frozenset, int] = {}
+    for pc in pieces:
+        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
+            e = frozenset((_key(a), _key(b)))
+            count[e] = count.get(e, 0) + 1
+    return count
 
 
 def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
@@ -38,12 +40,7 @@ def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
     The edges used by two pieces form a graph; its paths between vertices of degree other
     than two (or where a shore is reached) are the cuts.
     """
-    users: dict[frozenset, int] = {}
-    for pc in pieces:
-        r = pc.ring
-        for a, b in zip(r, np.roll(r, -1, axis=0), strict=True):
-            e = frozenset((_key(a), _key(b)))
-            users[e] = users.get(e, 0) + 1
+    users = _edge_use(pieces)
     inner = [tuple(e) for e, n in users.items() if n >= 2 and len(e) == 2]
     on_shore = {v for e, n in users.items() if n == 1 for v in e}
     adj: dict[tuple, list[tuple]] = {}
@@ -82,11 +79,7 @@ def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
 def _shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
     """The shore as the pieces have it (every vertex a piece has on it): the edges that only one
     piece uses, joined into rings; the ring of largest area is the outline, the others islands."""
-    count: dict[frozenset, int] = {}
-    for pc in pieces:
-        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
-            e = frozenset((_key(a), _key(b)))
-            count[e] = count.get(e, 0) + 1
+    count = _edge_use(pieces)
     nxt: dict[tuple, tuple] = {}
     for pc in pieces:  # walked in each piece's own (counter-clockwise) direction
         for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
