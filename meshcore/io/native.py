@@ -40,7 +40,7 @@ from .._validation import check_allocation, max_nodes
 from ..crs import Frame
 from ..errors import ReadError
 from ..grid import BORDER_NAMES, StructuredGrid
-from ..metrics import metrics
+from ..metrics import METRIC_FIELDS, metrics
 from ._base import GridSet, atomic_path, border_names, grid_from_world, read_bytes
 
 __all__ = ["COLUMNS", "read_metrics_csv", "read_npz", "write_metrics_csv", "write_npz"]
@@ -65,27 +65,13 @@ COLUMNS: dict[str, str] = {
     "eta_x": "-y_xi / J",
     "eta_y": "x_xi / J",
 }
-_METRIC_KEYS = (
-    "x_xi",
-    "x_eta",
-    "y_xi",
-    "y_eta",
-    "jacobian",
-    "alpha",
-    "beta",
-    "gamma",
-    "xi_x",
-    "xi_y",
-    "eta_x",
-    "eta_y",
-)
 
 
 def _node_table(g: StructuredGrid, frame: Frame) -> dict[str, np.ndarray]:
     m = metrics(g).as_dict()
     X, Y = frame.to_world(g.x, g.y)
     out = {"x": X, "y": Y}
-    for k in _METRIC_KEYS:
+    for k in METRIC_FIELDS:
         out["J" if k == "jacobian" else k] = m[k]
     return out
 
