@@ -32,7 +32,7 @@ from numba import njit
 
 from ..elliptic._stencil import winslow
 
-__all__ = ["table_defect", "table_residual", "table_sweep", "table_sweep_rhs"]
+__all__ = ["line_sweep_rhs", "table_defect", "table_residual", "table_sweep", "table_sweep_rhs"]
 
 
 @njit(cache=True, nogil=True)
@@ -166,4 +166,78 @@ def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out,
         m = dx * dx + dy * dy
         if not m <= dmax:  # a NaN makes the measure inf (never 'converged')
             dmax = m if m == m else np.inf
+    return np.sqrt(dmax)
+
+
+@njit(cache=True, nogil=True)
+def line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, ptr, axis):  # pragma: no cover - compiled
+    """Line Gauss–Seidel sweep of ``u − T(u) = f`` over block lines (``fx, fy`` empty: ``f = 0``).
+
+    Line ``L`` is the table rows ``rows[ptr[L]:ptr[L + 1]]`` in order along its block axis
+    ``axis[L]`` (0: W → E, 1: S → N); its end neighbours stay fixed.  The coefficients α, β, γ
+    are frozen at the current values and the tridiagonal system
+    ``u_t − c_t (u_{t−1} + u_{t+1}) = f_t + T_t − c_t (u_{t−1} + u_{t+1})|current``
+    (``c = α/den`` along ξ, ``γ/den`` along η) is solved exactly (Thomas algorithm), for x and y.
+    Returns the largest displacement (``inf`` if a node is NaN).
+    """
+    use_f = fx.size > 0
+    m_max = 0
+    for L in range(ptr.shape[0] - 1):
+        m_max = max(m_max, ptr[L + 1] - ptr[L])
+    c = np.empty(m_max)
+    bx = np.empty(m_max)
+    by = np.empty(m_max)
+    cp = np.empty(m_max)
+    dmax = 0.0
+    for L in range(ptr.shape[0] - 1):
+        lo_k, hi_k = (1, 0) if axis[L] == 0 else (3, 2)
+        m = ptr[L + 1] - ptr[L]
+        for t in range(m):
+            k = rows[ptr[L] + t]
+            p = nodes[k]
+            nb = nbr[k]
+            sx, sy, den, xxi, yxi, xet, yet = winslow(
+                x[nb[0]], x[nb[1]], x[nb[2]], x[nb[3]], x[nb[4]], x[nb[5]], x[nb[6]], x[nb[7]],
+                y[nb[0]], y[nb[1]], y[nb[2]], y[nb[3]], y[nb[4]], y[nb[5]], y[nb[6]], y[nb[7]],
+            )  # fmt: skip
+            lo, hi = nb[lo_k], nb[hi_k]
+            if den <= 0.0:
+                c[t] = 0.0
+                bx[t] = x[p]
+                by[t] = y[p]
+                continue
+            w = (xet * xet + yet * yet) if axis[L] == 0 else (xxi * xxi + yxi * yxi)
+            ct = w / den
+            c[t] = ct
+            bx[t] = sx / den - ct * (x[lo] + x[hi])
+            by[t] = sy / den - ct * (y[lo] + y[hi])
+            if use_f:
+                bx[t] += fx[p]
+                by[t] += fy[p]
+            if t == 0:
+                bx[t] += ct * x[lo]
+                by[t] += ct * y[lo]
+            if t == m - 1:
+                bx[t] += ct * x[hi]
+                by[t] += ct * y[hi]
+        # Thomas: rows (−c_t, 1, −c_t); forward elimination then back substitution
+        piv = 1.0
+        for t in range(m):
+            if t > 0:
+                piv = 1.0 - c[t] * cp[t - 1]
+                bx[t] = (bx[t] + c[t] * bx[t - 1]) / piv
+                by[t] = (by[t] + c[t] * by[t - 1]) / piv
+            cp[t] = c[t] / piv
+        for t in range(m - 2, -1, -1):
+            bx[t] += cp[t] * bx[t + 1]
+            by[t] += cp[t] * by[t + 1]
+        for t in range(m):
+            p = nodes[rows[ptr[L] + t]]
+            dx = bx[t] - x[p]
+            dy = by[t] - y[p]
+            x[p] = bx[t]
+            y[p] = by[t]
+            d = dx * dx + dy * dy
+            if not d <= dmax:  # a NaN makes the measure inf (never 'converged')
+                dmax = d if d == d else np.inf
     return np.sqrt(dmax)

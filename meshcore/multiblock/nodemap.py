@@ -112,7 +112,7 @@ def _global_ids(blocks: Sequence[Any], interfaces: Sequence[Any]) -> tuple[int, 
 
 
 def _cells(
-    blocks: Sequence[Any], ids: tuple[np.ndarray, ...], n_nodes: int
+    names: Sequence[str], ids: tuple[np.ndarray, ...], n_nodes: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(cells, cell_block, boundary)``: CCW cells of all blocks, their block, nodes on the outer boundary."""
     # cells, CCW: (i,j) (i+1,j) (i+1,j+1) (i,j+1)
@@ -130,9 +130,9 @@ def _cells(
     if (cnt > 2).any():
         bad = int(ukey[np.argmax(cnt > 2)])
         hit = np.flatnonzero(key == bad)
-        names = sorted({blocks[cell_block[c // 4]].name for c in hit})
+        which = ", ".join(sorted({names[cell_block[c // 4]] for c in hit}))
         raise TopologyError(
-            f"an edge is shared by more than two cells (blocks {', '.join(names)}): interfaces of these blocks overlap"
+            f"an edge is shared by more than two cells (blocks {which}): interfaces of these blocks overlap"
         )
     # directed-edge check: a shared edge must be walked in opposite directions
     _, dcnt = np.unique(e0 * n_nodes + e1, return_counts=True)
@@ -160,12 +160,49 @@ def _interior_stencils(ids: tuple[np.ndarray, ...]) -> tuple[list[np.ndarray], l
     return nodes_l, nbr_l
 
 
+def _regular_rings(cells: np.ndarray, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(nbr, ok)``: the 8 neighbours of nodes with four cells around them, read off the ring
+    of cells as :func:`_ring_stencils` does (vectorised; ``ok`` False where the ring does not
+    close, left to :func:`_ring_stencils`)."""
+    m = len(nodes)
+    flat = cells.ravel()
+    idx = np.flatnonzero(np.isin(flat, nodes))  # cell-major: ascending cell index per node
+    idx = idx[np.argsort(flat[idx], kind="stable")]
+    cidx, pos = idx // 4, idx % 4
+    c = cells[cidx]
+    row = np.arange(len(idx))
+    en, dg, ep = (c[row, (pos + k) % 4].reshape(m, 4) for k in (1, 2, 3))
+    match = ep[:, :, None] == en[:, None, :]  # cell b follows cell a: e_next(b) = e_prev(a)
+    nxt = match.argmax(axis=2)
+    r = np.arange(m)
+    o1 = nxt[:, 0]
+    o2 = nxt[r, o1]
+    o3 = nxt[r, o2]
+    ring = np.stack([np.zeros(m, dtype=np.int64), o1, o2, o3], axis=1)
+    ok = (match.sum(axis=2) == 1).all(axis=1) & (nxt[r, o3] == 0) & (np.sort(ring, axis=1) == np.arange(4)).all(axis=1)
+    e, d = en[r[:, None], ring], dg[r[:, None], ring]
+    # E, W, N, S, NE, NW, SE, SW  with E=e0, N=e1, W=e2, S=e3
+    nbr = np.stack([e[:, 0], e[:, 2], e[:, 1], e[:, 3], d[:, 0], d[:, 1], d[:, 3], d[:, 2]], axis=1)
+    return nbr, ok
+
+
 def _border_stencils(cells: np.ndarray, border_free: np.ndarray, label: Any) -> tuple[list, list, list, list, list]:
     """Free nodes on block borders: ``(regular, their neighbours, irregular, ring pointers, rings)``.
 
     The local frame of a node is read off the ring of cells around it; ``label(n)``
-    names a node in messages.
+    names a node in messages.  Nodes with four cells: :func:`_regular_rings`; the others
+    (and any ring that does not close: the error names it) :func:`_ring_stencils`.
     """
+    count = np.bincount(cells.ravel(), minlength=int(border_free.max(initial=-1)) + 1)
+    four = border_free[count[border_free] == 4]
+    nbr, ok = _regular_rings(cells, four)
+    rest = np.sort(np.concatenate([border_free[count[border_free] != 4], four[~ok]]))
+    reg_n, reg_nb, irr_n, irr_ptr, irr_ring = _ring_stencils(cells, rest, label)
+    return four[ok].tolist() + reg_n, nbr[ok].tolist() + reg_nb, irr_n, irr_ptr, irr_ring
+
+
+def _ring_stencils(cells: np.ndarray, border_free: np.ndarray, label: Any) -> tuple[list, list, list, list, list]:
+    """:func:`_border_stencils` node by node (reference; irregular nodes and the errors)."""
     inc = defaultdict(list)
     sel = np.isin(cells, border_free)
     for cidx, pos in zip(*np.nonzero(sel), strict=True):
@@ -230,10 +267,36 @@ def node_xy(blocks: Sequence[Any], ids: Sequence[np.ndarray], n: int) -> tuple[f
     return (math.nan, math.nan)
 
 
+def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
+    """``(args, n_interior)``: the table arguments ``(nodes, nbr, irr_nodes, irr_ptr, irr_ring)`` of
+    blocks given only by their global ids (a multigrid coarse level); ``nodes[:n_interior]`` are
+    block-interior nodes."""
+    ids = tuple(ids)
+    cells, _, boundary = _cells([f"#{k}" for k in range(len(ids))], ids, n_nodes)
+    occ = np.bincount(np.concatenate([np.unique(g) for g in ids]), minlength=n_nodes)
+    nodes_l, nbr_l = _interior_stencils(ids)
+    border_free = np.flatnonzero(~boundary & (occ > 1))
+    reg_n, reg_nb, irr_n, irr_ptr, irr_ring = _border_stencils(cells, border_free, str)
+    n_interior = int(sum(len(c) for c in nodes_l))
+    if reg_n:
+        nodes_l.append(np.array(reg_n, dtype=np.int64))
+        nbr_l.append(np.array(reg_nb, dtype=np.int64).reshape(-1, 8))
+    nodes = np.concatenate(nodes_l).astype(np.int64) if nodes_l else np.zeros(0, np.int64)
+    nbr = np.vstack(nbr_l).astype(np.int64) if nbr_l else np.zeros((0, 8), np.int64)
+    args = (
+        np.ascontiguousarray(nodes),
+        np.ascontiguousarray(nbr),
+        np.array(irr_n, dtype=np.int64),
+        np.array(irr_ptr, dtype=np.int64),
+        np.array(irr_ring, dtype=np.int64),
+    )
+    return args, n_interior
+
+
 def build_node_map(blocks: Sequence[Any], interfaces: Sequence[Any]) -> NodeMap:
     """The global numbering and solver tables of blocks glued by (resolved) interfaces."""
     n_nodes, ids = _global_ids(blocks, interfaces)
-    cells, cell_block, boundary = _cells(blocks, ids, n_nodes)
+    cells, cell_block, boundary = _cells([b.name for b in blocks], ids, n_nodes)
     count = np.bincount(cells.reshape(-1), minlength=n_nodes)  # cells per node
     occ = np.bincount(np.concatenate([np.unique(g) for g in ids]), minlength=n_nodes)
     shared = occ > 1
