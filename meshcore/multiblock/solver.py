@@ -22,10 +22,12 @@ r"""Solve a multiblock grid: ``frozen`` or ``smooth`` interfaces.
     ``engine="table"`` sweeps every node through the neighbour table (about
     2× slower per sweep, measured in ``benchmarks/multiblock.py``).
 
-    ``engine="multigrid"`` (chosen by ``"auto"`` whenever every block and
-    interface range has even cell counts) runs a nonlinear FAS multigrid over
-    the whole topology with the table kernels as smoother
-    (:mod:`.multigrid`): 4–5 V-cycles instead of hundreds of SOR sweeps.
+    ``engine="multigrid"`` (chosen by ``"auto"`` whenever the blocks coarsen at
+    all, odd cell counts included) runs a nonlinear FAS multigrid over the
+    whole topology with point, line and border Gauss–Seidel as smoother
+    (:mod:`.multigrid`): 4–9 V-cycles instead of hundreds of SOR sweeps; its
+    hierarchy is cached per block structure, so a re-solve after an edit
+    skips the set-up.
 
     The iteration starts from the algebraic grids (``start="algebraic"``,
     default) or from the ``frozen`` solution (``start="frozen"``: the blocks
@@ -69,7 +71,7 @@ from .topology import MultiBlockTopology
 __all__ = ["ENGINES", "MODES", "MultiBlockGrid", "MultiBlockQuality", "iterate_multiblock", "solve_multiblock"]
 
 MODES = ("smooth", "frozen")
-#: Smooth-mode iterations: "auto" = multigrid when the blocks coarsen, else "blocks".
+#: Smooth-mode iterations: "auto" = multigrid when the blocks coarsen (odd counts too), else "blocks".
 ENGINES = ("auto", "multigrid", "blocks", "table")
 
 
@@ -243,7 +245,7 @@ def iterate_multiblock(
         grids or from the frozen solution.
     engine : {"auto", "multigrid", "blocks", "table"}
         ``smooth`` mode only: nonlinear multigrid over all blocks
-        (:mod:`.multigrid`; needs even cell counts and interface ranges),
+        (:mod:`.multigrid`; any cell counts),
         SOR with block sweeps and border exchange, or SOR over the global
         neighbour table.  ``auto``: multigrid when the blocks coarsen, else
         ``blocks``.

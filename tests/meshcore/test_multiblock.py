@@ -774,6 +774,9 @@ def test_multigrid_hierarchy_and_convergence(rect):
     sor = solve_multiblock(four_blocks(X2, Y2, 32, 16), tolerance=1e-10, engine="blocks")
     for g, k in zip(mb, sor, strict=True):
         assert np.abs(g.x - k.x).max() < 1e-7 * ref.size
+    # serial = parallel (the smooth iteration is serial whatever ``threads`` says)
+    two = solve_multiblock(four_blocks(X2, Y2, 32, 16), tolerance=1e-10, engine="multigrid", threads=2)
+    assert all(np.array_equal(g.x, k.x) and np.array_equal(g.y, k.y) for g, k in zip(mb, two, strict=True))
 
 
 def test_coarse_levels_keep_the_blocks_glued():
