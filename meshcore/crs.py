@@ -15,13 +15,19 @@ of ten of the outline's size (an exactly representable integer of metres).
 :class:`Frame` carries the CRS and the origin to every writer, which adds the
 origin back (``to_world``) or returns to lon/lat (``to_lonlat``).
 
-pyproj is imported lazily, inside the functions that need it.
+pyproj is imported lazily, inside the functions that need it, and every PROJ call runs on
+one long-lived thread of meshcore's (:func:`proj_call`): pyproj keeps a PROJ context per
+thread, and a pool that re-uses an operating-system thread under a new Python thread state
+(Qt's ``QThreadPool``, where the app solves) handed PROJ a freed context — the app's second
+solve of a lon/lat case crashed the process inside ``proj_create``.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+import threading
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,6 +38,7 @@ from .errors import InvalidInputError, ReadError
 __all__ = [
     "LONLAT",
     "Frame",
+    "crs_name",
     "crs_wkt",
     "frame_from_case",
     "frame_from_table",
@@ -53,6 +60,26 @@ def _pyproj():
     except ImportError as exc:  # pragma: no cover - pyproj is in the io extra
         raise InvalidInputError("map projections need pyproj: pip install pyproj") from exc
     return pyproj
+
+
+_PROJ_POOL: ThreadPoolExecutor | None = None
+_PROJ_LOCK = threading.Lock()
+
+
+def proj_call(fn, *args, **kwargs):
+    """``fn(*args, **kwargs)`` run on meshcore's one PROJ thread (see the module docstring).
+
+    Every use of pyproj objects goes through here, so no CRS or transformer
+    object ever meets a second thread's PROJ context; exceptions reach the caller.
+    """
+    global _PROJ_POOL
+    if threading.current_thread().name.startswith("meshcore-proj"):
+        return fn(*args, **kwargs)
+    with _PROJ_LOCK:
+        if _PROJ_POOL is None:
+            _PROJ_POOL = ThreadPoolExecutor(max_workers=1, thread_name_prefix="meshcore-proj")
+        pool = _PROJ_POOL
+    return pool.submit(fn, *args, **kwargs).result()
 
 
 def normalize_crs(crs: Any) -> str | None:
@@ -88,33 +115,48 @@ def _checked_crs(s: str) -> str:
     """``s`` checked against the PROJ database: ``EPSG:n`` as given, anything else as authority or WKT."""
     epsg = s.upper().startswith("EPSG:") and s[5:].isdigit()
     try:
-        pyproj = _pyproj()
+        _pyproj()
     except InvalidInputError:
         if epsg:  # without pyproj an EPSG code can only be taken on trust
             return f"EPSG:{s[5:]}"
         raise
     shown = s if len(s) <= 60 else s[:59] + "…"
     try:
-        c = pyproj.CRS.from_user_input(s)
+        auth = proj_call(_authority, s, epsg)
     except Exception as exc:
         why = "no such code in the PROJ database" if epsg else " ".join(str(exc).split())[:120]
         raise InvalidInputError(f"crs: unknown CRS {shown!r} ({why})") from None
     if epsg:
         return f"EPSG:{int(s[5:])}"
+    return auth
+
+
+def _authority(s: str, epsg: bool) -> str:
+    """``AUTH:code`` of the CRS ``s`` (its WKT when PROJ knows no authority for it; "" for an
+    EPSG code, which is only checked); PROJ thread."""
+    c = _pyproj().CRS.from_user_input(s)
+    if epsg:
+        return ""
     auth = c.to_authority(min_confidence=90)
     return f"{auth[0]}:{auth[1]}" if auth else c.to_wkt()
 
 
-def _transformer(src: str, dst: str, where: str):
-    """A pyproj transformer ``src → dst`` (x = east/lon first), or an error naming both."""
+def transform(src: str, dst: str, x: Any, y: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """Coordinates ``(x, y)`` in ``src`` → ``dst`` (x = east/lon first), or an error naming both."""
+
+    def run():
+        t = _pyproj().Transformer.from_crs(src, dst, always_xy=True)
+        return t.transform(np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64))
+
     try:
-        return _pyproj().Transformer.from_crs(src, dst, always_xy=True)
+        X, Y = proj_call(run)
     except InvalidInputError:
         raise
     except Exception as exc:
         raise InvalidInputError(
             f"{where}: cannot transform {src} to {dst} ({' '.join(str(exc).split())[:120]})"
         ) from None
+    return np.asarray(X, dtype=np.float64), np.asarray(Y, dtype=np.float64)
 
 
 def is_geographic(crs: str | None) -> bool:
@@ -123,19 +165,30 @@ def is_geographic(crs: str | None) -> bool:
         return False
     if crs.upper() in _GEOGRAPHIC_ALIASES:
         return True
-    return bool(_crs_object(crs).is_geographic)
+    return bool(_crs_attribute(crs, lambda c: c.is_geographic))
 
 
 def crs_wkt(crs: str | None) -> str | None:
     """WKT2 of ``crs`` (None for an unknown CRS)."""
     if crs is None:
         return None
-    return _crs_object(crs).to_wkt()
+    return _crs_attribute(crs, lambda c: c.to_wkt())
 
 
-def _crs_object(crs: str):
+def crs_name(crs: str) -> str:
+    """PROJ's name of ``crs`` (``"WGS 84 / UTM zone 32N"``)."""
+    return _crs_attribute(crs, lambda c: c.name)
+
+
+def crs_cf(crs: str) -> dict[str, Any]:
+    """The CF grid-mapping attributes of ``crs`` (``pyproj.CRS.to_cf()``)."""
+    return _crs_attribute(crs, lambda c: c.to_cf())
+
+
+def _crs_attribute(crs: str, get):
+    """``get(pyproj.CRS(crs))`` computed on the PROJ thread, or an error naming the CRS."""
     try:
-        return _pyproj().CRS.from_user_input(crs)
+        return proj_call(lambda: get(_pyproj().CRS.from_user_input(crs)))
     except InvalidInputError:
         raise
     except Exception as exc:
@@ -249,9 +302,7 @@ class Frame:
         X, Y = self.to_world(x, y)
         if is_geographic(self.crs):
             return X, Y
-        t = _transformer(self.crs, LONLAT, "lon/lat")
-        lon, lat = t.transform(X, Y)
-        return np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64)
+        return transform(self.crs, LONLAT, X, Y, "lon/lat")
 
     @property
     def wkt(self) -> str | None:
@@ -357,11 +408,10 @@ def project_arrays(
         check_lonlat(pts, where=where or "points")
     new = [np.asarray(a, dtype=np.float64).reshape(-1, 2) for a in arrays]
     if target is not None and src is not None and target != src:
-        t = _transformer(src, target, where or "points")
         for k, a in enumerate(new):
             if len(a) == 0:
                 continue
-            X, Y = t.transform(a[:, 0], a[:, 1])
+            X, Y = transform(src, target, a[:, 0], a[:, 1], where or "points")
             P = np.column_stack([X, Y]).astype(np.float64)
             if not np.isfinite(P).all():
                 label = f"{names[k]}: " if names else ""
@@ -380,8 +430,7 @@ def project_arrays(
 
 def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
     if src != LONLAT:
-        t = _transformer(src, LONLAT, "centroid")
-        lon, lat = t.transform(pts[:, 0], pts[:, 1])
+        lon, lat = transform(src, LONLAT, pts[:, 0], pts[:, 1], "centroid")
         pts = np.column_stack([lon, lat])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     return float(0.5 * (lo[0] + hi[0])), float(0.5 * (lo[1] + hi[1]))

@@ -194,10 +194,10 @@ def _dry_run_ddb(p: Path, lay: Any) -> None:
 def _crs_label(crs: str | None) -> str:
     if crs is None:
         return "no CRS: the grid keeps the file's coordinates"
-    try:
-        import pyproj
+    from ..crs import crs_name
 
-        name = f" ({pyproj.CRS.from_user_input(crs).name})"
+    try:
+        name = f" ({crs_name(crs)})"
     except Exception:  # a label only: the CRS itself was checked by meshcore.crs
         name = ""
     return f"grid CRS {crs}{name}"

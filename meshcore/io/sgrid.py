@@ -32,10 +32,10 @@ __all__ = ["read_sgrid", "write_sgrid"]
 
 
 def _cf_attrs(crs: str) -> dict[str, Any]:
-    import pyproj
+    from ..crs import crs_cf
 
     out = {}
-    for k, v in pyproj.CRS.from_user_input(crs).to_cf().items():
+    for k, v in crs_cf(crs).items():
         if isinstance(v, str):
             # NetCDF-3 text attributes are ASCII; WKT area names may hold "°"
             out[k] = v.replace("°", " deg").encode("ascii", "replace").decode("ascii")
