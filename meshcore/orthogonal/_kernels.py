@@ -34,7 +34,7 @@ def _dist(X, Y, a, b):
     return math.hypot(X[b] - X[a], Y[b] - Y[a])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _worst(X, Y, cptr, cells, node, out):
     """The smallest corner Jacobian of each cell around ``node``, into ``out``."""
     for q in range(cptr[node], cptr[node + 1]):
@@ -48,7 +48,7 @@ def _worst(X, Y, cptr, cells, node, out):
         out[q - cptr[node]] = w
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _all_above(X, Y, cptr, cells, node, floor):
     """True when every corner Jacobian of the cells around ``node`` exceeds ``floor``."""
     for q in range(cptr[node], cptr[node + 1]):
@@ -61,7 +61,7 @@ def _all_above(X, Y, cptr, cells, node, floor):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after):
     """Move ``node`` towards ``(nx, ny)``, halving the step up to four times, so that every
     cell around it keeps its smallest corner Jacobian above ``jmin[node]`` — or, for a cell
@@ -118,7 +118,7 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def jacobi_targets(X, Y, nodes, nbr, smooth, tx, ty):
     """The update of every regular node from the same old positions (test oracle's twin)."""
     for k in range(len(nodes)):
@@ -138,7 +138,7 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, tx, ty):
         )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, jmin):
     """One Gauss–Seidel sweep over the free interior nodes; returns the largest move."""
     big = 0.0
@@ -167,7 +167,7 @@ def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, sm
     return big
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _segment(S, s0, n, u):
     """Index ``k`` (0 ≤ k < n) of the ring segment holding arc length ``u`` (0 ≤ u < total)."""
     a, b = 0, n
@@ -180,7 +180,7 @@ def _segment(S, s0, n, u):
     return a
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _ring_point(R, S, r0, s0, n, s):
     """Point at arc length ``s`` (any real: the ring is closed) of ring ``R[r0:r0+n]``."""
     total = S[s0 + n]
@@ -195,7 +195,7 @@ def _ring_point(R, S, r0, s0, n, s):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _foot(R, S, r0, s0, n, qx, qy, sa, sb):
     """Arc length (unwrapped, in ``[sa, sb]``) of the ring point nearest to ``q``."""
     total = S[s0 + n]
@@ -232,7 +232,7 @@ def _foot(R, S, r0, s0, n, qx, qy, sa, sb):
     return best_s
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _gap(R, S, r0, s0, n, sa, sb, ax, ay, bx, by):
     """How far the shore between arc lengths ``sa < sb`` strays from the straight edge a–b:
     the largest distance of a shore vertex in between from that segment."""
@@ -259,7 +259,7 @@ def _gap(R, S, r0, s0, n, sa, sb, ax, ay, bx, by):
     return worst
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _bend(R, S, r0, s0, n, sp, s, sn, px, py, x, y, qx, qy, limit):
     """How far the shore next to a node strays from its two grid edges beyond ``limit``
     (≤ 0: both edges follow the shore closely enough)."""
@@ -268,7 +268,7 @@ def _bend(R, S, r0, s0, n, sp, s, sn, px, py, x, y, qx, qy, limit):
     return max(g1, g2) - limit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, gap, jmin):
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours;
