@@ -4,7 +4,11 @@ The worker (superqt ``GeneratorWorker``) iterates :func:`app.pipeline.solve_proj
 (meshcore's typed events per block) and only emits signals; the slots here run
 in the GUI thread.  Snapshots are
 kept as the *latest* one per block and pushed to the document by a ~30 Hz
-timer, so stale frames are dropped, never queued.  Stop sets a
+timer, so stale frames are dropped, never queued.  A solve started by *Generate* keeps the
+GUI thread's share of the time small (:data:`DRAW_BUDGET` of a core for live redraws, the
+frame gap grows while drawing costs more): on a busy two-core machine 40 redraws/s of a large
+grid had made the app's solve 2–3× as long as the CLI's.  Edits with auto-generate keep the
+full frame rate (the grid follows the hand).  Stop sets a
 ``threading.Event`` checked by meshcore after every sweep/cycle, so it takes
 effect within one sweep.  With ``auto`` on, every project edit restarts the
 solve (coalesced in one event-loop pass), warm-started from the last grid.
@@ -27,6 +31,11 @@ from .pipeline import ALL_BLOCKS, solve_project
 __all__ = ["SolverController"]
 
 log = logging.getLogger(__name__)
+
+#: Share of one core the GUI thread may spend drawing live frames of a solve started by Generate.
+DRAW_BUDGET = 0.15
+#: The longest gap between two live frames of such a solve (seconds).
+MAX_FRAME_GAP = 1.0
 
 
 def _run(run_id, project, warm, stop_event, smooth):
@@ -77,7 +86,9 @@ class SolverController(QtCore.QObject):
         # leading-edge throttle: draw a snapshot at once unless the last frame was
         # less than `frame_interval_ms` ago; then draw the latest one when the gap is over
         self.frame_interval = frame_interval_ms / 1000.0
+        self._gap = self.frame_interval  # the current frame gap (paced, see _pace)
         self._last_flush = 0.0
+        self._gui_cpu = 0.0  # GUI thread CPU time at the last frame
         self._timer = QtCore.QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(self._flush)
@@ -135,6 +146,8 @@ class SolverController(QtCore.QObject):
         worker.finished.connect(self._on_finished)
         self._worker = worker
         self.t_start = time.perf_counter()
+        self._gap = self.frame_interval
+        self._last_flush, self._gui_cpu = self.t_start - self._gap, time.thread_time()  # 1st frame at once
         self._set_state("running")
         worker.start()
         return True
@@ -221,7 +234,7 @@ class SolverController(QtCore.QObject):
             self._algebraic[k] = event.algebraic
         self._latest[k] = event
         self._dirty = True
-        wait = self._last_flush + self.frame_interval - time.perf_counter()
+        wait = self._last_flush + self._gap - time.perf_counter()
         if wait <= 0:
             self._flush()
         elif not self._timer.isActive():
@@ -231,7 +244,7 @@ class SolverController(QtCore.QObject):
         if not self._dirty:
             return
         self._dirty = False
-        self._last_flush = time.perf_counter()
+        self._pace()
         for k, event in self._latest.items():
             if k == ALL_BLOCKS and isinstance(event, SolverProgress):  # a multiblock solve: every block
                 for i, g in enumerate(event.grids):
@@ -253,6 +266,19 @@ class SolverController(QtCore.QObject):
                 self.progress.emit(k, event)
         self.doc.grids_changed.emit()
         self.redrawn.emit()
+
+    def _pace(self) -> None:
+        """Start a frame: widen the gap to the next one while the GUI thread's CPU share since the
+        last frame (its drawing included) is over :data:`DRAW_BUDGET`, narrow it when well under."""
+        now, cpu = time.perf_counter(), time.thread_time()
+        share = (cpu - self._gui_cpu) / max(now - self._last_flush, 1e-6)
+        self._last_flush, self._gui_cpu = now, cpu
+        if self.auto:  # live editing: every frame the machine can draw
+            self._gap = self.frame_interval
+        elif share > DRAW_BUDGET:
+            self._gap = min(MAX_FRAME_GAP, self._gap * 2.0)
+        elif share < 0.5 * DRAW_BUDGET:
+            self._gap = max(self.frame_interval, self._gap / 1.5)
 
     def _showing(self, k: int, grid: StructuredGrid) -> bool:
         """True when block ``k`` already shows a grid of this shape (from an earlier solve)."""
