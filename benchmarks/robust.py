@@ -1,9 +1,10 @@
 """Benchmarks of the solver on the grids users make (issue 15): real lakes, a busy machine,
-first start, wall control, multiblock.
+first start, wall control, multiblock, the app against the CLI.
 
 Run from the repository root::
 
-    python benchmarks/robust.py [--quick] [--section lakes busy startup naca multiblock] [--out benchmarks/RESULTS.md]
+    python benchmarks/robust.py [--quick] [--section lakes busy startup naca multiblock app]
+        [--out benchmarks/RESULTS.md]
 
 Every ratio compares two timings of the same run (medians; the machine is shared).
 """
@@ -384,6 +385,34 @@ def _refined(case, k: int):
     return case.replaced(outline=dataclasses.replace(ol, blocks=blocks))
 
 
+# ------------------------------------------------------------------------------- app
+def app(quick: bool, emit) -> dict:
+    """The app's solve of a case against the CLI's (``benchmarks/app_vs_cli.py``, a new process)."""
+    emit(
+        "\n### The app against the CLI (same case, same run)\n\nCLI = `generate_case(load_case(CASE))` "
+        "(what `meshcore generate` runs); app = the main window (offscreen) opens the case, Generate, "
+        "until the solver controller reports the grid, live redraws included. Medians of 3 after a "
+        "warm-up. CPU = the CLI's thread against the app's solver thread.\n"
+    )
+    cmd = [sys.executable, str(HERE / "app_vs_cli.py"), "--repeats", "1" if quick else "3"]
+    env = dict(os.environ, PYTHONPATH=str(ROOT), QT_QPA_PLATFORM="offscreen")
+    r = subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True, timeout=3600)
+    emit("| case | CLI | app | app ÷ CLI | CLI CPU | app solver CPU | CPU ratio |")
+    emit("|---|---|---|---|---|---|---|")
+    out = {}
+    for line in r.stdout.splitlines():
+        name, *v = line.split("\t")
+        cli, gui, cli_cpu, gui_cpu = map(float, v)
+        emit(
+            f"| {name} | {fmt(cli)} | {fmt(gui)} | {gui / cli:.2f} | {fmt(cli_cpu)} | {fmt(gui_cpu)} | "
+            f"{gui_cpu / cli_cpu:.2f} |"
+        )
+        out[name] = gui / cli
+    if r.returncode != 0:
+        emit(f"\n(app_vs_cli.py failed: {r.stderr.strip().splitlines()[-1] if r.stderr.strip() else r.returncode})")
+    return out
+
+
 def _targets(res: dict) -> list[str]:
     """Issue 15's target rows of this run (worst case of each group), as table lines."""
     rows = []
@@ -413,6 +442,9 @@ def _targets(res: dict) -> list[str]:
     if res.get("naca"):
         for k, v in res["naca"].items():
             rows.append((f"{k} (wall control, multigrid)", "≤ 1 s", fmt(v)))
+    if res.get("app"):
+        for k, v in res["app"].items():
+            rows.append((f"app ÷ CLI, {k}", "≤ 1.2", f"{v:.2f}"))
     if res.get("startup"):
         rows.append(
             (
@@ -426,7 +458,7 @@ def _targets(res: dict) -> list[str]:
 
 #: Everything after this line of RESULTS.md is this script's report (``--out``); run.py keeps it.
 MARKER = "<!-- benchmarks/robust.py: everything below is its report -->"
-SECTIONS = {"lakes": lakes, "busy": busy, "startup": startup, "naca": naca, "multiblock": multiblock}
+SECTIONS = {"lakes": lakes, "busy": busy, "startup": startup, "naca": naca, "multiblock": multiblock, "app": app}
 
 
 #: The heading that starts each section's report, and the first cell of its target rows: a run
@@ -437,6 +469,7 @@ HEADINGS = {
     "startup": ("### First solve in a new environment", "| first solve"),
     "naca": ("### Wall control", "| naca0012"),
     "multiblock": ("### Multiblock against one block", "| multiblock"),
+    "app": ("### The app against the CLI", "| app ÷ CLI"),
 }
 TARGETS = "### Issue 15 targets in this run"
 _TARGET_HEAD = ["| target | wanted | measured |", "|---|---|---|"]
