@@ -192,3 +192,60 @@ def spiral(turns: float = 1.5, width: float = 1.0, gap: float = 1.5):
     r = pitch * (1.0 + t / (2 * math.pi))
     line = LineString(np.column_stack([r * np.cos(t), r * np.sin(t)]))
     return _clean(line.buffer(width / 2, cap_style="flat", quad_segs=4))
+
+
+def round_lake(seed: int, *, radius: float = 10.0, kind: str = "blob", n_islands: int | None = None):
+    """A round water body with 1–4 random islands, of one of four kinds.
+
+    ``kind``: ``"disc"`` (a circle), ``"blob"`` (a smoothly lobed circle), ``"ring"`` (a disc
+    with one large island: a ring of water of random width) or ``"arms"`` (a blob with two or
+    three arms narrower than a tenth of the radius).  Islands are smooth random blobs of 4–25 %
+    of the radius, some within a few percent of the radius from the shore or from each other.
+    """
+    from shapely.geometry import LineString, Point, Polygon
+
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 2 * math.pi, 360, endpoint=False)
+    r = np.ones_like(t)
+    if kind != "disc" and kind != "ring":
+        for k in range(2, 6):
+            r += rng.uniform(0.0, 0.25 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
+    r *= radius / r.max()
+    outer = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    if kind == "arms":
+        arms = []
+        for _ in range(int(rng.integers(2, 4))):
+            a = rng.uniform(0, 2 * math.pi)
+            d = np.array([math.cos(a), math.sin(a)])
+            bend = np.array([-d[1], d[0]]) * rng.uniform(-0.3, 0.3) * radius
+            line = LineString([0.7 * radius * d, 1.3 * radius * d + 0.5 * bend, 1.7 * radius * d + bend])
+            arms.append(line.buffer(rng.uniform(0.04, 0.1) * radius, quad_segs=4))
+        import shapely
+
+        outer = shapely.union_all([outer, *arms])
+        outer = Polygon(outer.exterior)
+    holes: list[Polygon] = []
+    if kind == "ring":
+        inner_r = rng.uniform(0.3, 0.7) * radius
+        off = rng.uniform(-1, 1, 2) * 0.15 * (radius - inner_r)
+        holes.append(Point(*off).buffer(inner_r, quad_segs=32))
+        n_islands = 1 if n_islands is None else n_islands
+    want = int(rng.integers(1, 5)) if n_islands is None else n_islands
+    body = outer.buffer(-0.03 * radius)
+    tries = 0
+    while len(holes) < want and tries < 1000:
+        tries += 1
+        size = rng.uniform(0.04, 0.25) * radius
+        c = rng.uniform(-radius, radius, 2)
+        ang = np.linspace(0, 2 * math.pi, 48, endpoint=False)
+        rr = np.ones_like(ang)
+        for k in range(2, 4):
+            rr += rng.uniform(0.0, 0.25) * np.cos(k * ang + rng.uniform(0, 2 * math.pi))
+        rr *= size / rr.max()
+        isl = Polygon(c + np.column_stack([rr * np.cos(ang), rr * np.sin(ang)]))
+        if not isl.is_valid or not body.contains(isl):
+            continue
+        if any(isl.distance(h) < 0.03 * radius for h in holes):
+            continue
+        holes.append(isl)
+    return _clean(Polygon(outer.exterior, [h.exterior for h in holes]))

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
 
-__all__ = ["Piece", "build_topology", "conform"]
+__all__ = ["Piece", "build_topology", "conform", "weld"]
 
 BORDERS = ("bottom", "right", "top", "left")
 
@@ -35,6 +35,51 @@ class Piece:
 
 def _key(p) -> tuple[float, float]:
     return (float(p[0]), float(p[1]))
+
+
+def weld(rings: list[np.ndarray], eps: float) -> list[np.ndarray]:
+    """The rings with every cluster of vertices closer than ``eps`` made one point.
+
+    A cut end computed twice (as the end of a ray and as a point inserted into a shore edge)
+    can differ in the last bit; two such points would be two corners of a block 1e-16 apart.
+    Each cluster takes its lexicographically smallest point; a ring then drops repeated
+    consecutive points, and a ring left with fewer than three points (no area) is dropped.
+    """
+    from scipy.spatial import cKDTree
+
+    if not rings:
+        return []
+    allv = np.vstack(rings)
+    pairs = cKDTree(allv).query_pairs(eps, output_type="ndarray")
+    if not len(pairs):
+        return [np.asarray(r) for r in rings]
+    parent = np.arange(len(allv))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return int(i)
+
+    for i, j in pairs:
+        a, b = root(int(i)), root(int(j))
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    roots = np.array([root(i) for i in range(len(allv))])
+    best: dict[int, int] = {}
+    for i, r in enumerate(roots):  # the lexicographically smallest point of each cluster
+        k = best.get(int(r))
+        if k is None or tuple(allv[i]) < tuple(allv[k]):
+            best[int(r)] = i
+    rep = allv[[best[int(r)] for r in roots]]
+    out, lo = [], 0
+    for r in rings:
+        q = rep[lo : lo + len(r)]
+        lo += len(r)
+        keep = np.any(q != np.roll(q, 1, axis=0), axis=1)
+        if keep.sum() >= 3:
+            out.append(q[keep].copy())
+    return out
 
 
 def conform(rings: list[np.ndarray], eps: float) -> list[np.ndarray]:

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from .blocks import Piece, conform
+from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners
 from .regions import partition
@@ -131,13 +131,14 @@ def layout_pieces(
         rings += [p for p, _ in pieces]
         forced += [f for _, f in pieces]
         cuts += new_cuts
+    size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
+    rings, forced = _welded(rings, forced, 1e-9 * size)
     rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
     rings, forced = _merge_strips(rings, forced, sigma)
     corner_pts = []
     for r, f in zip(rings, forced, strict=True):
         c, _ = choose_corners(r, sigma, forced=forced_indices(r, f))
         corner_pts.append([r[i] for i in c])
-    size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
     rings = conform(rings, 1e-9 * size)
     pieces = []
     for r, cs in zip(rings, corner_pts, strict=True):
@@ -147,6 +148,30 @@ def layout_pieces(
     pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
     return sk, chords, cuts, pieces
+
+
+def _welded(rings: list[np.ndarray], forced: list[tuple], eps: float):
+    """:func:`~.blocks.weld` on the rings, keeping each ring's forced corners (moved with their
+    vertices; a ring that loses its area is dropped with them)."""
+    from scipy.spatial import cKDTree
+
+    out_r, out_f = [], []
+    for r, f in zip(rings, forced, strict=True):
+        w = weld([r], eps)  # the ring alone first: drops its own repeated points
+        if not w:
+            continue
+        out_r.append(w[0])
+        out_f.append(f)
+    allw = weld(out_r, eps)
+    if len(allw) != len(out_r):  # a ring collapsed only against the others: keep them as they are
+        return out_r, out_f
+    fixed = []
+    for r, f in zip(allw, out_f, strict=True):
+        if len(f):
+            _, k = cKDTree(r).query(np.asarray(f, dtype=float))
+            f = tuple(tuple(r[i]) for i in np.atleast_1d(k))
+        fixed.append(f)
+    return allw, fixed
 
 
 def _check_pieces(poly, pieces: list[Piece]) -> None:
