@@ -218,7 +218,7 @@ def round_lake(seed: int, *, radius: float = 10.0, kind: str = "blob", n_islands
             a = rng.uniform(0, 2 * math.pi)
             d = np.array([math.cos(a), math.sin(a)])
             bend = np.array([-d[1], d[0]]) * rng.uniform(-0.3, 0.3) * radius
-            line = LineString([0.7 * radius * d, 1.3 * radius * d + 0.5 * bend, 1.7 * radius * d + bend])
+            line = LineString([0.0 * d, 1.3 * radius * d + 0.5 * bend, 1.7 * radius * d + bend])  # from the centre
             arms.append(line.buffer(rng.uniform(0.04, 0.1) * radius, quad_segs=4))
         import shapely
 
