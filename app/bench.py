@@ -1,4 +1,4 @@
-"""Measure the app's interactive numbers: ``python -m app.bench [lake]`` (offscreen is fine).
+"""Measure the app's interactive numbers: ``python -m app.bench [lake] [--profile FILE]`` (offscreen is fine).
 
 * redraws/s of the grid curve at 257×257 nodes (setData + forced paint), and
   the live rate the window reaches during a solve at that size;
@@ -52,11 +52,13 @@ def main() -> int:
     win.show()
     app.processEvents()
     print(f"start-up to a shown window (warm numba cache, in-process): {time.perf_counter() - t0:.2f} s")
-    if sys.argv[1:] != ["lake"]:  # ``python -m app.bench lake``: the lake rows only
+    args = sys.argv[1:]
+    profile = args[args.index("--profile") + 1] if "--profile" in args else None
+    if "lake" not in args:  # ``python -m app.bench lake``: the lake rows only
         redraw_rate(win)
         live_rate_and_stop(app, win)
         drag_to_converged(app, win)
-    lake_como(app, win)
+    lake_como(app, win, profile=profile)
     win.stack.setClean()
     win.close()
     return 0
@@ -151,8 +153,11 @@ def drag_to_converged(app, win) -> None:
     print(f"redraws showing an algebraic start grid during the drags: {len(start_frames)} of {len(frames)}")
 
 
-def lake_como(app, win) -> None:
-    """Como in, layout out, grid, .ddb; then a cut line's end dragged along the shore (auto-generate)."""
+def lake_como(app, win, profile: str | None = None) -> None:
+    """Como in, layout out, grid, .ddb; then a cut line's end dragged along the shore (auto-generate).
+
+    ``profile``: a file for the cProfile statistics of the drag (the GUI thread only).
+    """
     import tempfile
     from pathlib import Path
 
@@ -200,6 +205,12 @@ def lake_como(app, win) -> None:
 
     win.solver.redrawn.connect(redrawn)
     h = lay.cell_size
+    prof = None
+    if profile:
+        import cProfile
+
+        prof = cProfile.Profile()
+        prof.enable()
     t_drag = time.perf_counter()
     tool.drag("start", end.xy, end.xy)
     for s in np.linspace(0, 1, 180)[1:]:  # 3 s at 60 Hz: three cells along the shore and back
@@ -208,6 +219,9 @@ def lake_como(app, win) -> None:
         _sleep(app, 1 / 60)
     tool.drag("finish", place(lay, end, (end.xy[0] + h, end.xy[1] + h)), end.xy)
     t_release = time.perf_counter()
+    if prof is not None:
+        prof.disable()
+        prof.dump_stats(profile)
     dt = _wait(app, lambda: not win.lake_ctl.editing and not win.solver.running, timeout=600)
     during = [f for f in frames if t_drag <= f <= t_release]
     print(

@@ -137,6 +137,27 @@ def grid_lines(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([a.ravel(), b.ravel()]), np.concatenate([c.ravel(), d.ravel()])
 
 
+def grid_segments(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every cell edge of a grid once, as start/end pairs (for ``connect="pairs"``).
+
+    The edges along j (``(i, j)–(i, j+1)``) and then along i (``(i, j)–(i+1, j)``); returns
+    flat ``(X, Y)`` of length ``2·(ni1·(nj1−1) + (ni1−1)·nj1)``.  Drawn as line segments,
+    they paint faster than the polylines of :func:`grid_lines` and need no NaN checks.
+    """
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    out = []
+    for a in (x, y):
+        along_j = np.empty(a.shape[:1] + (a.shape[1] - 1, 2))
+        along_j[..., 0] = a[:, :-1]
+        along_j[..., 1] = a[:, 1:]
+        along_i = np.empty((a.shape[0] - 1,) + a.shape[1:] + (2,))
+        along_i[..., 0] = a[:-1, :]
+        along_i[..., 1] = a[1:, :]
+        out.append(np.concatenate([along_j.ravel(), along_i.ravel()]))
+    return out[0], out[1]
+
+
 def border_polylines(points: np.ndarray, corners) -> dict[str, np.ndarray]:
     """The four borders of a loop in the grid convention, for drawing.
 

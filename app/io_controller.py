@@ -373,14 +373,24 @@ class IOController(QtCore.QObject):
 
     # ---------------------------------------------------------- autosave
     def _edited(self, _index: int) -> None:
-        """An edit (or undo/redo): autosave soon; at once when edits have kept coming for a while."""
+        """An edit (or undo/redo): autosave soon; at once when edits have kept coming for a while.
+
+        Not during a drag: its steps merge into one undo step and writing the project (a second
+        on a big lake) would stall the drag; the drag's last step is saved ``DEBOUNCE_MS`` after it.
+        """
         now = time.monotonic()
         if not self._autosave.isActive():
             self._first_unsaved = now
-        if now - self._first_unsaved >= MAX_DELAY_S:
+        if now - self._first_unsaved >= MAX_DELAY_S and not self._dragging():
             self.autosave()
         else:
             self._autosave.start()
+
+    def _dragging(self) -> bool:
+        """True while the user drags a point or a layout handle (or its edit is being computed)."""
+        tool = getattr(getattr(self.win, "canvas", None), "tool", None)
+        lake = getattr(self.win, "lake_ctl", None)
+        return bool(getattr(tool, "dragging", False)) or bool(lake is not None and lake.editing)
 
     def _clean_changed(self, clean: bool) -> None:
         if clean:  # saved (or undone back to the saved state): nothing to recover
@@ -388,9 +398,12 @@ class IOController(QtCore.QObject):
             self.discard_recovery()
 
     def autosave(self) -> None:
-        """Write the project to the recovery files when it has unsaved edits."""
+        """Write the project to the recovery files when it has unsaved edits (after a drag ends)."""
         self._autosave.stop()
         if self.stack.isClean():
+            return
+        if self._dragging():
+            self._autosave.start()
             return
         try:
             recovery.write(self.doc.project, self.recovery_path, self.doc.path)

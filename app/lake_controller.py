@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 
+import numpy as np
 from PySide6 import QtCore, QtWidgets
 from superqt.utils import create_worker
 
@@ -156,36 +157,41 @@ class LakeController(QtCore.QObject):
         self.layout_done.emit(None)
 
     # ------------------------------------------------------ layout edits
-    def edit_layout(self, make, text: str, merge_key=None) -> None:
+    def edit_layout(self, make, text: str, merge_key=None, *, shore: bool = False) -> None:
         """Make a new layout with ``make()`` in a worker and set it (undoable); the newest request wins.
 
         ``make`` builds the layout from immutable inputs (e.g. the parts of the layout at the
         start of a drag with one point moved); while one is computed, later requests replace
         each other and only the last one runs next.  Each result is shown when it arrives (a
         drag's steps merge into one undo step by ``merge_key``); a refusal is reported only
-        when no newer request waits.
+        when no newer request waits.  ``shore``: the edit moves the shore (the lake's outline
+        and islands become those of the new layout).
         """
-        self._pending = (make, text, merge_key)
+        self._pending = (make, text, merge_key, shore)
         if self._edit_worker is None:
             self._next_edit()
 
     def _next_edit(self) -> None:
         if self._pending is None:
             return
-        make, text, key = self._pending
+        make, text, key, shore = self._pending
         self._pending = None
         worker = create_worker(_edit_job, make, _start_thread=False)
-        worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key))
-        worker.errored.connect(lambda exc: self._edited((None, f"internal error: {exc}"), text, key))
+        worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key, shore))
+        worker.errored.connect(lambda exc: self._edited((None, f"internal error: {exc}"), text, key, shore))
         self._edit_worker = worker
         worker.start()
 
-    def _edited(self, value, text: str, key) -> None:
+    def _edited(self, value, text: str, key, shore: bool = False) -> None:
         self._edit_worker = None
         layout, err = value
         lake = self.doc.project.lake
         if layout is not None and lake is not None:  # newer than what is shown: show it, even mid-drag
             self.edit_error = None
+            if shore:  # the lake's shore is the layout's now (Clear layout keeps the edit)
+                poly = layout.polygon
+                rings = tuple(np.asarray(r.coords)[:-1] for r in poly.interiors)
+                lake = lake.replaced(outline=np.asarray(poly.exterior.coords)[:-1], holes=rings)
             self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
             self.layout_done.emit(layout)
         elif layout is None and self._pending is None:  # a refusal only counts for the last request
@@ -205,9 +211,15 @@ class LakeController(QtCore.QObject):
             return
 
         def make():
+            from meshcore.errors import TopologyError
             from meshcore.layout import with_cells
 
-            return with_cells(lay, name, cells)
+            out = with_cells(lay, name, cells)
+            try:
+                out.topology()
+            except TopologyError as exc:  # the counts agree on the blocks' pieces but not on the case's borders
+                raise TopologyError(f"block {name} cannot have {cells[0]}×{cells[1]} cells: {exc}") from None
+            return out
 
         self.edit_layout(make, f"Cells of {name}: {cells[0]}×{cells[1]}")
 

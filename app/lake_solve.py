@@ -119,6 +119,12 @@ def _warm(layout, warm, stop_event):
         grids.append(a.replaced(x=a.x + (g_old.x - a_old.x), y=a.y + (g_old.y - a_old.y)))
     t0 = time.perf_counter()
     history: list[tuple[int, float]] = []
+    # the moved grid is shown at once (never the start grid): a drag's redraw does not wait for sweeps
+    first = SolverProgress(0, float("nan"), TOLERANCE, None, 0.0, "orthogonal", (), tuple(grids))
+    cmd = yield ALL_BLOCKS, first
+    stopped = cmd == "stop" or (stop_event is not None and stop_event.is_set())
+    if stopped:  # a newer edit is waiting: the moved grid is the result (no metrics: nobody reads them)
+        return BlockResult(grids=dict(enumerate(grids)), initial=starts)
     gen = iterate_orthogonalize(topo, grids, _rings(layout), every=WARM_EVERY, tol=TOLERANCE, **_options())
     try:
         it, d, snap = next(gen)
@@ -128,15 +134,19 @@ def _warm(layout, warm, stop_event):
                 it, float(d), TOLERANCE, None, time.perf_counter() - t0, "orthogonal", tuple(history), snap
             )
             cmd = yield ALL_BLOCKS, progress
-            stop = cmd == "stop" or (stop_event is not None and stop_event.is_set())
-            it, d, snap = gen.send("stop" if stop else None)
+            stopped = cmd == "stop" or (stop_event is not None and stop_event.is_set())
+            it, d, snap = gen.send("stop" if stopped else None)
     except StopIteration as fin:
         res = fin.value
     msg = f"orthogonal grid from the previous one (full level only), {res.sweeps} sweeps"
     info = SolveInfo(method="orthogonal", converged=True, iterations=res.sweeps, elapsed=res.elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
     mb = MultiBlockGrid(tuple(res.grids), names, topo.interfaces, "orthogonal", info, topo)
-    return BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb, metrics=_metrics(layout, mb))
+    # stopped for a newer edit: its metrics (a while on a big lake) would only delay the next solve;
+    # the document measures a grid it keeps without them
+    stopped = stop_event is not None and stop_event.is_set()
+    metrics = None if stopped else _metrics(layout, mb)
+    return BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb, metrics=metrics)
 
 
 def _metrics(layout, mb):

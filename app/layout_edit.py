@@ -6,13 +6,16 @@ the shore, the islands, the cut lines, each block's corners and cells).  The han
 * the **ends** of the cut lines — on the shore (or an island) they stay on it: a dragged end
   slides along it; where cut lines meet inside the water (a junction) they move freely;
 * the **interior points** of the cut lines — free;
-* the **corners** of the blocks that are not cut ends — they stay on their block's boundary.
+* the **corners** of the blocks that are not cut ends — they stay on their block's boundary;
+* the **shore points** (the vertices of the shore and the islands) — free: the shore between
+  the point and its neighbouring vertices follows, with the cut ends and corners on it.
 
 A move puts the handle at the new place; the cuts through it bend smoothly to follow (their
 far ends stay) and the block corners on them move along (a cut's end and the corners of the
 blocks that meet there move together); it keeps the cell counts (so the grid re-solves from
-the previous one), and the new layout is made by :func:`meshcore.layout.layout_from_outline`,
-whose checks name the block or cut that cannot be four-sided.
+the previous one), and the new layout is made by :func:`moved_layout`
+(:func:`meshcore.layout.layout_from_outline`, whose checks name the block or cut that cannot be
+four-sided); a move that would change the blocks (a cut dragged across another) is refused.
 """
 
 from __future__ import annotations
@@ -22,15 +25,23 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Handle", "handles", "moved_parts", "nearest_handle", "place"]
+__all__ = ["KIND_NAMES", "Handle", "handles", "moved_layout", "moved_parts", "nearest_handle", "place", "shore_points"]
 
 #: the order in which coinciding handles are picked
-_PRIORITY = {"end": 0, "junction": 0, "corner": 1, "cut": 2}
+_PRIORITY = {"end": 0, "junction": 0, "corner": 1, "cut": 2, "shore": 3}
+#: what a handle is called in messages and undo texts
+KIND_NAMES = {
+    "end": "cut end",
+    "junction": "junction",
+    "cut": "cut point",
+    "corner": "block corner",
+    "shore": "shore point",
+}
 
 
 @dataclass(frozen=True, slots=True)
 class Handle:
-    """A point of the layout a user can drag: ``kind`` "end", "junction", "cut" or "corner", at ``xy``."""
+    """A point of the layout a user can drag: ``kind`` "end", "junction", "cut", "corner" or "shore", at ``xy``."""
 
     kind: str
     xy: tuple[float, float]
@@ -43,7 +54,7 @@ def _same(a, b, tol: float) -> bool:
 
 
 def handles(layout: Any) -> list[Handle]:
-    """Every handle of ``layout`` (cut ends, interior cut points, block corners), no two at one place."""
+    """Every handle of ``layout`` (cut ends, interior cut points, block corners, shore points), no two at one place."""
     tol = 1e-9 * max(1.0, float(np.sqrt(layout.polygon.area)))
     out: list[Handle] = []
 
@@ -65,7 +76,16 @@ def handles(layout: Any) -> list[Handle]:
     for k, c in enumerate(layout.cuts):
         for p in np.asarray(c, float)[1:-1]:
             add(Handle("cut", (float(p[0]), float(p[1])), cut=k))
+    for p in shore_points(layout):
+        add(Handle("shore", (float(p[0]), float(p[1]))))
     return out
+
+
+def shore_points(layout: Any) -> np.ndarray:
+    """The vertices of the shore and the islands of ``layout`` (its water polygon), ``(n, 2)``."""
+    poly = layout.polygon
+    rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
+    return np.vstack(rings) if rings else np.zeros((0, 2))
 
 
 def nearest_handle(hs: list[Handle], xy: Any, tol: float) -> Handle | None:
@@ -107,6 +127,8 @@ def place(layout: Any, handle: Handle, xy: Any, parts: dict | None = None) -> tu
         poly = layout.polygon
         rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
         return _project(rings, xy)
+    if handle.kind == "shore":
+        return (float(xy[0]), float(xy[1]))
     if handle.kind == "corner":
         ring = np.asarray(layout.pieces[handle.block].ring, float)
         q = _project([ring], xy)
@@ -150,25 +172,48 @@ def _weights(c: np.ndarray, k: int) -> np.ndarray:
     return w
 
 
-def moved_parts(parts: dict, old: Any, new: Any, tol: float) -> dict:
+def moved_parts(parts: dict, old: Any, new: Any, tol: float, shore: Any = None) -> dict:
     """``parts`` (the ``[outline]`` form) with the handle at ``old`` put at ``new``.
 
     Every cut through ``old`` bends smoothly to follow it (:func:`_weights`; the cut's far ends
     stay), and every block corner on a moved cut point moves with it; the cells are kept.
+    ``shore`` (a shore point is dragged): the shore's vertices, ``(n, 2)``; the shore's sampling
+    points between ``old`` and its neighbouring vertices follow it (:func:`_moved_ring`), with
+    the cut ends and corners on them.
     """
     old = np.asarray(old, float)
     d = np.asarray(new, float) - old
     moves: dict[tuple[float, float], tuple[float, float]] = {}
+    rings: dict = {}
+    ring_moves: list = []
+    if shore is not None:
+        stops = np.asarray(shore, float).reshape(-1, 2)
+        outline, ring_moves = _moved_ring(np.asarray(parts["outline"], float), old, d, stops, tol)
+        holes = []
+        for hole in parts.get("holes", ()):
+            hole, more = _moved_ring(np.asarray(hole, float), old, d, stops, tol)
+            holes.append(hole)
+            ring_moves += more
+        rings = {"outline": outline, "holes": holes}
     cuts = []
     for c in parts["cuts"]:
         c = np.asarray(c, float)
         hit = np.flatnonzero(np.all(np.abs(c - old) <= tol, axis=1))
         if len(hit):
             moved = c + _weights(c, int(hit[0]))[:, None] * d
+        else:  # a cut whose end sits on a moved piece of shore bends with it
+            moved = c.copy()
+            for a, b in ring_moves:
+                for k in (0, len(c) - 1):
+                    if _same(c[k], a, tol):
+                        moved = moved + _weights(c, k)[:, None] * (np.asarray(b) - np.asarray(a))
+        if len(hit) or not np.array_equal(moved, c):
             for a, b in zip(c, moved, strict=True):
                 moves[(float(a[0]), float(a[1]))] = (float(b[0]), float(b[1]))
             c = moved
         cuts.append([(float(p[0]), float(p[1])) for p in c])
+    for a, b in ring_moves:
+        moves.setdefault((float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
 
     def move(p):
         p = (float(p[0]), float(p[1]))
@@ -177,4 +222,73 @@ def moved_parts(parts: dict, old: Any, new: Any, tol: float) -> dict:
         return next((q for a, q in moves.items() if _same(p, a, tol)), p)
 
     blocks = [dict(b, corners=[move(p) for p in b["corners"]]) for b in parts["blocks"]]
-    return dict(parts, cuts=cuts, blocks=blocks)
+    return dict(parts, **rings, cuts=cuts, blocks=blocks)
+
+
+def _moved_ring(ring: np.ndarray, old: np.ndarray, d: np.ndarray, stops: np.ndarray, tol: float):
+    """``ring`` with its vertex at ``old`` moved by ``d``; the points between it and the next of the
+    ``stops`` (the shore's own vertices) or turn on either side (the sampling points the layout
+    put on the shore's straight edges) follow linearly.
+
+    Returns the new ring and the ``(old point, new point)`` pairs of every point that moved.
+    """
+    hit = np.flatnonzero(np.all(np.abs(ring - old) <= tol, axis=1))
+    if not len(hit) or not np.any(d):
+        return ring, []
+    n, i = len(ring), int(hit[0])
+    out = ring.copy()
+    out[i] = ring[i] + d
+    moved = [(ring[i], out[i])]
+    for step in (1, -1):
+        run = []  # the points on the straight edge from vertex i to the next turn
+        k = (i + step) % n
+        while k != i and len(run) < n - 2 and _straight(ring[(k - 1) % n], ring[k], ring[(k + 1) % n], tol):
+            if np.any(np.all(np.abs(stops - ring[k]) <= tol, axis=1)):
+                break
+            run.append(k)
+            k = (k + step) % n
+        pts = [i, *run, k]  # k: the turn that stays
+        s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring[pts], axis=0).T))])
+        for j, sj in zip(run, s[1:-1], strict=True):
+            out[j] = ring[j] + (1.0 - sj / s[-1]) * d
+            moved.append((ring[j], out[j]))
+    return out, moved
+
+
+def _straight(a, b, c, tol: float) -> bool:
+    """True when ``b`` lies on the segment from ``a`` to ``c`` (a sampling point, not a turn)."""
+    ab, ac = np.asarray(b) - np.asarray(a), np.asarray(c) - np.asarray(a)
+    cross = abs(float(ab[0] * ac[1] - ab[1] * ac[0]))
+    return cross <= 1e-9 * float(np.dot(ac, ac)) + tol * tol
+
+
+def moved_layout(base: Any, parts: dict) -> Any:
+    """The layout of ``parts`` (a move of :func:`moved_parts` on ``base``), with ``base``'s blocks.
+
+    Raises :class:`~meshcore.errors.TopologyError` naming the problem when the parts give no
+    layout, or when they give other blocks (a cut dragged across another cut or an island):
+    a drag keeps the blocks and their cells, so that the grid re-solves from the previous one.
+    """
+    from meshcore.errors import TopologyError
+    from meshcore.layout import layout_from_outline
+
+    lay = layout_from_outline(
+        parts["outline"],
+        holes=parts["holes"],
+        cuts=parts["cuts"],
+        blocks=parts["blocks"],
+        cell_size=base.cell_size,
+        multiple=base.multiple,
+    )
+    before = [(b.name, tuple(b.cells)) for b in base.blocks]
+    after = [(b.name, tuple(b.cells)) for b in lay.blocks]
+    if len(after) != len(before):
+        raise TopologyError(
+            f"the move would make {len(after)} blocks of the {len(before)} (a cut line crossing another "
+            f"or the shore); drag it back, or use Auto layout for a new one"
+        )
+    if after != before:
+        changed = next(f"{a[0]} ({a[1][0]}×{a[1][1]})" for a, b in zip(after, before, strict=True) if a != b)
+        raise TopologyError(f"the move would change block {changed}; a drag keeps every block and its cells")
+    lay.topology()  # here (in the worker): a layout whose blocks cannot be made is refused now
+    return lay

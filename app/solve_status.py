@@ -16,6 +16,9 @@ from .pipeline import ALL_BLOCKS
 
 __all__ = ["SolveStatus"]
 
+#: seconds between two updates of the convergence plot during a multiblock or lake solve
+HISTORY_EVERY = 1.0
+
 
 class SolveStatus(QtCore.QObject):
     """The solving part of a :class:`~app.main_window.MainWindow` (label: ``self.label``)."""
@@ -28,6 +31,8 @@ class SolveStatus(QtCore.QObject):
         self.conv = window.conv_panel
         self.label = QtWidgets.QLabel("idle")
         self.frames: list[float] = []  # times of the last redraws (for the redraws/s read-out)
+        self._history_at = 0.0  # when the convergence plot was last drawn
+        self._last_history: tuple | None = None  # (history, tolerance) of the last multiblock snapshot
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
         self.doc.opened.connect(self.on_opened)
@@ -39,6 +44,7 @@ class SolveStatus(QtCore.QObject):
     def reset(self) -> None:
         """A solve is about to start."""
         self.conv.clear_history()
+        self._last_history = None
         self.frames = []
 
     def on_opened(self) -> None:
@@ -48,7 +54,13 @@ class SolveStatus(QtCore.QObject):
 
     def on_progress(self, k: int, snap) -> None:
         if k == ALL_BLOCKS:  # a multiblock solve: every block at once
-            self.conv.set_history(list(snap.history), snap.tolerance)
+            now = time.perf_counter()
+            # the plot at most every HISTORY_EVERY s: it repaints its axes (costly in a drag's redraws)
+            if snap.history:
+                self._last_history = (snap.history, snap.tolerance)
+            if snap.history and now - self._history_at >= HISTORY_EVERY:
+                self._history_at = now
+                self.conv.set_history(list(snap.history), snap.tolerance)
             self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
             return
         if k == self.doc.active:  # history and residual are relative to the grid size
@@ -108,6 +120,8 @@ class SolveStatus(QtCore.QObject):
 
     def _lake_final(self, mb) -> None:
         info = mb.info
+        if self._last_history is not None:  # the whole history (the plot is throttled while solving)
+            self.conv.set_history(list(self._last_history[0]), self._last_history[1])
         m = self.doc.lake_metrics
         dt = self.solver.t_done - self.solver.t_start
         cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)

@@ -64,6 +64,11 @@ class Tool:
     def key(self, key: int) -> bool:
         return False
 
+    @property
+    def dragging(self) -> bool:
+        """True while a drag of this tool edits the project (the autosave waits for its end)."""
+        return False
+
 
 class PanTool(Tool):
     pass
@@ -205,6 +210,10 @@ class EditTool(Tool):
             self._drag = None
         return True
 
+    @property
+    def dragging(self) -> bool:
+        return self._drag is not None and self._drag[0] == "move"
+
     def key(self, key: int) -> bool:
         if key in (QtCore.Qt.Key.Key_Delete, QtCore.Qt.Key.Key_Backspace):
             self.editor.delete_points(self.doc.selection)
@@ -339,7 +348,7 @@ class LayoutTool(Tool):
     label = "Layout"
     shortcut = "Y"
     tip = (
-        "Layout: drag a cut line's end along the shore, a cut's point, a junction or a block corner; "
+        "Layout: drag a cut line's end along the shore, a cut's point, a junction, a block corner or a shore point; "
         "the layout follows (cells kept) and, with auto-generate, the grid"
     )
     controller = None  # the window's LakeController (it computes new layouts off the GUI thread)
@@ -350,6 +359,7 @@ class LayoutTool(Tool):
         self._base = None
         self._parts: dict | None = None
         self._drag = None
+        self._cache: tuple | None = None  # (layout, its handles)
 
     def activate(self) -> None:
         if self.doc.project.layout is None:
@@ -357,21 +367,50 @@ class LayoutTool(Tool):
         else:
             super().activate()
 
+    @property
+    def dragging(self) -> bool:
+        return self._handle is not None
+
+    def _handles(self, lay) -> list:
+        """The handles of ``lay`` (remembered for the last layout: hovering asks often)."""
+        from .layout_edit import handles
+
+        if self._cache is None or self._cache[0] is not lay:
+            self._cache = (lay, handles(lay))
+        return self._cache[1]
+
+    def hover(self, xy) -> None:
+        """Ring the handle a drag would take (shore points are not drawn: this shows them)."""
+        from .layout_edit import nearest_handle
+
+        lay = self.doc.project.layout
+        if self.canvas is None or self._handle is not None:
+            return
+        h = nearest_handle(self._handles(lay), xy, self.tol()) if lay is not None else None
+        self.canvas.lake_items.set_drag_point(None if h is None else h.xy)
+
+    def deactivate(self) -> None:
+        super().deactivate()
+        if self.canvas is not None:
+            self.canvas.lake_items.set_drag_point(None)
+
     def drag(self, phase: str, xy, start, modifiers=None) -> bool:
-        from .layout_edit import handles, nearest_handle
+        from .layout_edit import nearest_handle
 
         lay = self.doc.project.layout
         if phase == "start":
             self._handle = None
             if lay is None or self.controller is None:
                 return False
-            h = nearest_handle(handles(lay), start, self.tol())
+            h = nearest_handle(self._handles(lay), start, self.tol())
             if h is None:
                 return False
             from meshcore.layout.outline import outline_parts
 
             self._handle, self._base, self._parts = h, lay, outline_parts(lay)
             self._drag = self.editor.new_drag_id()
+            if self.canvas is not None:  # the cell counts stay; they need not repaint with every grid
+                self.canvas.lake_items.set_labels_visible(False)
         if self._handle is None:
             return False
         if phase != "start":
@@ -380,10 +419,11 @@ class LayoutTool(Tool):
             self._handle = None
             if self.canvas is not None:
                 self.canvas.lake_items.set_drag_point(None)
+                self.canvas.lake_items.set_labels_visible(True)
         return True
 
     def _move(self, xy) -> None:
-        from .layout_edit import moved_parts, place
+        from .layout_edit import KIND_NAMES, moved_layout, moved_parts, place, shore_points
 
         base, h = self._base, self._handle
         q = place(base, h, xy, self._parts)
@@ -392,22 +432,22 @@ class LayoutTool(Tool):
         if q == h.xy:
             return
         tol = 1e-9 * max(1.0, float(np.sqrt(base.polygon.area)))
-        parts = moved_parts(self._parts, h.xy, q, tol)
+        parts = moved_parts(self._parts, h.xy, q, tol, shore=shore_points(base) if h.kind == "shore" else None)
+        if h.kind == "shore" and not _shore_moved(self._parts, parts):
+            self.controller.win.message("This shore point is not on the layout's shore: it cannot be dragged")
+            return
 
         def make():
-            from meshcore.layout import layout_from_outline
+            return moved_layout(base, parts)
 
-            return layout_from_outline(
-                parts["outline"],
-                holes=parts["holes"],
-                cuts=parts["cuts"],
-                blocks=parts["blocks"],
-                cell_size=base.cell_size,
-                multiple=base.multiple,
-            )
+        what = KIND_NAMES[h.kind]
+        self.controller.edit_layout(make, f"Move {what}", merge_key=("layout", self._drag), shore=h.kind == "shore")
 
-        what = {"end": "cut end", "junction": "junction", "cut": "cut point", "corner": "block corner"}[h.kind]
-        self.controller.edit_layout(make, f"Move {what}", merge_key=("layout", self._drag))
+
+def _shore_moved(before: dict, after: dict) -> bool:
+    """True when the shore or an island of the ``[outline]`` parts moved."""
+    rings = [(before["outline"], after["outline"]), *zip(before["holes"], after["holes"], strict=True)]
+    return any(not np.array_equal(a, b) for a, b in rings)
 
 
 TOOLS = (PanTool, DrawTool, EditTool, CornersTool, CutTool, LayoutTool)

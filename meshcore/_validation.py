@@ -175,14 +175,14 @@ def validate_points(points: Any, *, name: str, min_points: int = 2, where: str =
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise InvalidInputError(
-            f"{prefix}{name}: point {k} is not finite ({float(arr[k, 0])!r}, {float(arr[k, 1])!r})"
+            f"{prefix}{name}: point {k + 1} is not finite ({float(arr[k, 0])!r}, {float(arr[k, 1])!r})"
             + (f" and {int(bad.sum()) - 1} more" if bad.sum() > 1 else "")
         )
     huge = (np.abs(arr) > MAX_COORDINATE).any(axis=1)
     if huge.any():
         k = int(np.flatnonzero(huge)[0])
         raise InvalidInputError(
-            f"{prefix}{name}: point {k} ({arr[k, 0]:.6g}, {arr[k, 1]:.6g}) is beyond ±{MAX_COORDINATE:g}; "
+            f"{prefix}{name}: point {k + 1} ({arr[k, 0]:.6g}, {arr[k, 1]:.6g}) is beyond ±{MAX_COORDINATE:g}; "
             f"scale the coordinates (or move them to a local origin)"
         )
     return np.ascontiguousarray(arr)

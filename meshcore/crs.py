@@ -226,7 +226,7 @@ def check_lonlat(points: np.ndarray, *, where: str) -> None:
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise ReadError(
-            f"{where}: point {k} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range [-180, 180] × [-90, 90]"
+            f"{where}: point {k + 1} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range [-180, 180] × [-90, 90]"
         )
 
 

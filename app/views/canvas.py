@@ -1,8 +1,8 @@
 """The pyqtgraph canvas: fixed items updated with ``setData``; mouse → active tool.
 
 Items (created once): background image, quality colouring (PColorMeshItem),
-the grid as ONE NaN-separated PlotCurveItem (width-1 cosmetic pen,
-``connect="finite"``, ``skipFiniteCheck=True``; docs/environment.md), the
+the grid as ONE PlotCurveItem of line segments (width-1 cosmetic pen,
+``connect="pairs"``, segmented line mode, ``skipFiniteCheck=True``), the
 boundary loop, four coloured border curves with direction arrows and node
 counts, the points, the selection, corner labels, cut lines, folded cells,
 and the tool overlay (rubber band / rubber line).
@@ -53,6 +53,7 @@ class Canvas(pg.PlotWidget):
         self.setAntialiasing(False)
         pi = self.getPlotItem()
         pi.showGrid(x=True, y=True, alpha=0.15)
+        self._background_grid = True
         for ax in ("left", "bottom"):
             pi.getAxis(ax).setPen(pg.mkPen("#666"))
             pi.getAxis(ax).setTextPen(pg.mkPen("#333"))
@@ -94,10 +95,13 @@ class Canvas(pg.PlotWidget):
         self.quality_item: pg.PColorMeshItem | None = None
         self.colorbar: pg.ColorBarItem | None = None
 
+        # every cell edge once, drawn as line segments (faster to paint than polylines)
         self.grid_curve = pg.PlotCurveItem(
-            pen=pg.mkPen("#303030", width=1, cosmetic=True), connect="finite", skipFiniteCheck=True
+            pen=pg.mkPen("#303030", width=1, cosmetic=True), connect="pairs", skipFiniteCheck=True
         )
+        self.grid_curve.setSegmentedLineMode("on")
         self.grid_curve.setZValue(0)
+        self._segments: dict[int, tuple] = {}  # block -> (grid, X, Y): the segments of grids still shown
         self.addItem(self.grid_curve)
         self._grid_colour = "#303030"
         self._cell_size = 0.0  # typical cell size of the grids (model units), for the level of detail
@@ -320,6 +324,7 @@ class Canvas(pg.PlotWidget):
         self.set_grids(self.doc.grids)
         if self.doc.solving and self.quality_item is not None:
             self.set_quality(None, None)
+        self.lake_items.set_solving(self.doc.solving)
 
     def refresh_quality(self) -> None:
         """Colour the cells and mark the folded ones as the document says."""
@@ -351,24 +356,39 @@ class Canvas(pg.PlotWidget):
         self.highlight_item.setData([], [])
 
     def set_grids(self, grids: dict[int, StructuredGrid]) -> None:
-        """Draw all block grids as one NaN-separated curve."""
+        """Draw all block grids as one curve of line segments (a block's grid unchanged: its segments kept)."""
+        self._show_background_grid(not grids)
         if not grids:
             self.grid_curve.setData([], [])
+            self._segments = {}
             self._cell_size, self._sized_shapes = 0.0, ()
             return
         xs, ys = [], []
-        for g in grids.values():
-            X, Y = geo.grid_lines(g.x, g.y)
-            xs.append(X)
-            ys.append(Y)
+        segments = {}
+        for k, g in grids.items():
+            old = self._segments.get(k)
+            if old is not None and old[0] is g:
+                segments[k] = old
+            else:
+                segments[k] = (g, *geo.grid_segments(g.x, g.y))
+            xs.append(segments[k][1])
+            ys.append(segments[k][2])
+        self._segments = segments
         X = np.concatenate(xs) if len(xs) > 1 else xs[0]
         Y = np.concatenate(ys) if len(ys) > 1 else ys[0]
-        self.grid_curve.setData(X, Y, connect="finite", skipFiniteCheck=True)
+        self.grid_curve.setData(X, Y, connect="pairs", skipFiniteCheck=True)
         shapes = tuple(g.shape for g in grids.values())
         if shapes != self._sized_shapes:  # the cell size only moves with the shape (cheap enough anyway)
             self._sized_shapes = shapes
             self._cell_size = geo.typical_cell_size(grids.values())
             self._apply_level_of_detail()
+
+    def _show_background_grid(self, on: bool) -> None:
+        """The faint coordinate grid behind an outline; off under a grid (its axes would then repaint,
+        and regenerate their ticks, with every redraw of the grid: the costliest part of a frame)."""
+        if on != self._background_grid:
+            self._background_grid = on
+            self.getPlotItem().showGrid(x=on, y=on, alpha=0.15)
 
     def set_grid_stale(self, stale: bool) -> None:
         """Grey the grid when it no longer matches the boundary (the last solve failed)."""

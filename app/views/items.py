@@ -10,7 +10,20 @@ __all__ = ["Scatter", "ToolViewBox", "set_points", "set_polylines"]
 
 
 class Scatter(pg.ScatterPlotItem):
-    """A scatter that is only a picture: clicks on its spots go to the ViewBox (the tool)."""
+    """A scatter that is only a picture: clicks on its spots go to the ViewBox (the tool).
+
+    Without points it has no extent and paints nothing (an empty pyqtgraph scatter is still
+    painted, at the origin, every frame: a few ms each while the grid redraws).
+    """
+
+    def boundingRect(self) -> QtCore.QRectF:
+        if self.data is None or len(self.data) == 0:
+            return QtCore.QRectF()
+        return super().boundingRect()
+
+    def paint(self, p, *args) -> None:
+        if self.data is not None and len(self.data):
+            super().paint(p, *args)
 
     def mouseClickEvent(self, ev) -> None:
         ev.ignore()

@@ -37,7 +37,8 @@ class LakeOverlay:
 
     def __init__(self, canvas) -> None:
         self.canvas = canvas
-        self.shore = pg.PlotCurveItem(pen=pg.mkPen(SHORE_COLOUR, width=1.5), connect="finite")
+        # width 1: a wider pen is several times slower to paint, and the shore repaints with every grid
+        self.shore = pg.PlotCurveItem(pen=pg.mkPen(SHORE_COLOUR, width=1), connect="finite")
         self.shore.setZValue(4)
         self.cuts = pg.PlotCurveItem(pen=pg.mkPen(CUT_COLOUR, width=2.5), connect="finite")
         self.cuts.setZValue(7)
@@ -54,6 +55,7 @@ class LakeOverlay:
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.labels: list[pg.TextItem] = []
         self.markers_visible = True
+        self.labels_on = True  # False during a drag
         self.shown_labels: list[str] = []  # the texts on screen (tests read them)
 
     # ------------------------------------------------------------ drawing
@@ -98,7 +100,7 @@ class LakeOverlay:
             if k < len(texts):
                 t.setText(texts[k])
                 t.setPos(float(at[k, 0]), float(at[k, 1]))
-                t.setVisible(self.markers_visible)
+                t.setVisible(self.markers_visible and self.labels_on)
             else:
                 t.setText("")
         self.shown_labels = list(texts)
@@ -113,5 +115,17 @@ class LakeOverlay:
 
     def set_markers_visible(self, on: bool) -> None:
         self.markers_visible = bool(on)
-        for it in (self.cut_ends, self.corners, *self.labels):
+        for it in (self.cut_ends, self.corners):
             it.setVisible(self.markers_visible)
+        for t in self.labels:
+            t.setVisible(self.markers_visible and self.labels_on)
+
+    def set_labels_visible(self, on: bool) -> None:
+        """Show or hide the blocks' cell counts (hidden during a drag: they repaint with every grid)."""
+        self.labels_on = bool(on)
+        for t in self.labels:
+            t.setVisible(self.labels_on and self.markers_visible)
+
+    def set_solving(self, solving: bool) -> None:
+        """The places that miss a preset belong to the last grid: hidden while a new one is made."""
+        self.misses.setVisible(not solving)

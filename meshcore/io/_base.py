@@ -145,7 +145,7 @@ def make_polyline(name: str, pts: np.ndarray, *, closed: bool | None = None, whe
         raise ReadError(f"{where}: {name}: expected x, y pairs, got shape {p.shape}")
     if not np.isfinite(p).all():
         k = int(np.flatnonzero(~np.isfinite(p).all(axis=1))[0])
-        raise ReadError(f"{where}: {name}: point {k} is not a finite number")
+        raise ReadError(f"{where}: {name}: point {k + 1} is not a finite number")
     repeated = len(p) > 2 and bool(np.array_equal(p[0], p[-1]))
     if closed is None:
         closed = repeated

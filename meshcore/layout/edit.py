@@ -26,7 +26,9 @@ def _pieces_of_regions(rings: list[np.ndarray], corner_points: list[list], names
     rings = conform([np.asarray(r, dtype=float) for r in rings], 1e-9 * size)
     pieces = []
     for r, cs, name in zip(rings, corner_points, names, strict=True):
-        idx = sorted(int(np.argmin(np.hypot(*(r - np.asarray(c)).T))) for c in cs)
+        named = [int(np.argmin(np.hypot(*(r - np.asarray(c)).T))) for c in cs]
+        idx = sorted(named)  # counter-clockwise along the ring, from the first corner given (sw):
+        idx = idx[idx.index(named[0]) :] + idx[: idx.index(named[0])]  # the piece's sides are the block's
         pieces.append(Piece(r, (idx[0], idx[1], idx[2], idx[3]), name))
     return pieces
 

@@ -151,9 +151,10 @@ def _resolve_cuts(given_ring: np.ndarray, cuts: Sequence[Any]) -> list[np.ndarra
             pts = [given_ring[int(v)] if isinstance(v, (int, np.integer)) else v for v in c]
         except (IndexError, TypeError):
             raise TopologyError(
-                f"cut {k}: points must be [x, y] pairs or outline point indices (0 … {len(given_ring) - 1}), got {c!r}"
+                f"cut {k + 1}: points must be [x, y] pairs or outline point indices "
+                f"(0 … {len(given_ring) - 1}), got {c!r}"
             ) from None
-        cut_list.append(validate_points(pts, name=f"cut {k}"))
+        cut_list.append(validate_points(pts, name=f"cut {k + 1}"))
     return cut_list
 
 
@@ -174,7 +175,7 @@ def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: fl
             (dist, seg, t), kind, m = best
             if dist > snap:
                 raise TopologyError(
-                    f"cut {k}: its {'first' if end == 0 else 'last'} point ({q[0]:.6g}, {q[1]:.6g}) "
+                    f"cut {k + 1}: its {'first' if end == 0 else 'last'} point ({q[0]:.6g}, {q[1]:.6g}) "
                     f"is {dist:.4g} from the shore and from every other cut (snap distance "
                     f"{snap:.4g}); cuts must end on the outline, an island or another cut"
                 )
@@ -198,13 +199,13 @@ def _check_cuts(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: float
             bad = ls.difference(inside)
             pt = bad.representative_point() if not bad.is_empty else ls.representative_point()
             raise TopologyError(
-                f"cut {k} leaves the water near ({pt.x:.6g}, {pt.y:.6g}); cut lines must run "
+                f"cut {k + 1} leaves the water near ({pt.x:.6g}, {pt.y:.6g}); cut lines must run "
                 f"across the inside of the outline"
             )
         inner = LineString(c).intersection(shore)
         n_touch = len(getattr(inner, "geoms", [inner])) if not inner.is_empty else 0
         if n_touch > 2:
-            raise TopologyError(f"cut {k} touches the shore {n_touch} times; a cut may meet it only at its ends")
+            raise TopologyError(f"cut {k + 1} touches the shore {n_touch} times; a cut may meet it only at its ends")
 
 
 def _regions(rings: list[np.ndarray], cut_list: list[np.ndarray], size: float) -> list[Any]:

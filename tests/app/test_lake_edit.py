@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 import shapely
+
+from app import io_controller
 
 pytestmark = pytest.mark.gui
 
@@ -143,3 +146,90 @@ def test_drag_a_block_corner_to_another_vertex_of_its_block(qtbot, laid):
     moved = [p for p in new if p not in b.corners]
     assert moved and all(ring.distance(shapely.Point(p)) < 1e-6 * h for p in moved)  # … along its block
     assert [x.cells for x in lay1.blocks] == [x.cells for x in lay0.blocks]
+
+
+def test_drag_a_shore_point_and_the_layout_and_grid_follow(qtbot, laid):
+    from app.layout_edit import handles
+
+    win = laid
+    lay0 = win.doc.project.layout
+    outline0 = win.doc.project.lake.outline.copy()
+    grids0 = dict(win.doc.grids)
+    h = lay0.cell_size
+    shore = [x for x in handles(lay0) if x.kind == "shore"]
+    assert shore  # the shore's own points can be taken
+    # one well inside a block's shore: pushed out of the water by half a cell (the lake grows)
+    far = max(shore, key=lambda x: min(np.hypot(*np.subtract(x.xy, c[k])) for c in lay0.cuts for k in (0, -1)))
+    c = np.asarray(lay0.polygon.centroid.coords[0])
+    out = np.asarray(far.xy) + 0.5 * h * (np.asarray(far.xy) - c) / np.hypot(*(np.asarray(far.xy) - c))
+    tool = win.canvas.tool
+    tool.hover(far.xy)  # the handle a drag would take is ringed
+    assert win.canvas.lake_items.drag_point.data["x"].tolist() == [far.xy[0]]
+    n = win.stack.count()
+    assert tool.drag("start", far.xy, far.xy)
+    tool.drag("finish", tuple(out), far.xy)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert win.lake_ctl.edit_error is None, win.lake_ctl.edit_error
+    assert win.stack.count() == n + 1 and win.stack.undoText() == "Move shore point"
+    assert lay1.polygon.area > lay0.polygon.area
+    assert lay1.polygon.boundary.distance(shapely.Point(out)) < 1e-6 * h  # the point is where it was dropped
+    assert [(b.name, b.cells) for b in lay1.blocks] == [(b.name, b.cells) for b in lay0.blocks]
+    # the lake's shore is the layout's: Clear layout keeps the edit
+    assert any(np.allclose(p, out) for p in win.doc.project.lake.outline)
+    # the grid re-solved from the previous one (same shapes, new nodes), measured on the new shore
+    assert all(win.doc.grids[k].shape == g.shape for k, g in grids0.items())
+    assert any(not np.array_equal(win.doc.grids[k].x, g.x) for k, g in grids0.items())
+    assert win.solver.last_result.metrics is win.doc.lake_metrics
+    assert win.doc.lake_metrics.summary()["folded_cells"] == 0
+    win.stack.undo()
+    assert win.doc.project.layout is lay0 and np.array_equal(win.doc.project.lake.outline, outline0)
+
+
+def test_cells_of_a_block_after_a_drag_keep_the_layout_consistent(qtbot, laid):
+    from app.layout_edit import handles
+
+    win = laid
+    lay0 = win.doc.project.layout
+    inner = next(x for x in handles(lay0) if x.kind == "cut")
+    tool = win.canvas.tool
+    assert tool.drag("start", inner.xy, inner.xy)
+    tool.drag("finish", (inner.xy[0] + 0.3 * lay0.cell_size, inner.xy[1]), inner.xy)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert lay1 is not lay0 and win.lake_ctl.edit_error is None
+    m = lay1.multiple
+    for k, b in enumerate(lay1.blocks):  # every block: its cells set, the neighbours follow
+        win.lake_ctl.set_block_cells(k, (b.cells[0] + m, b.cells[1]))
+        wait_idle(qtbot, win)
+        assert win.lake_ctl.edit_error is None, win.lake_ctl.edit_error
+        lay = win.doc.project.layout
+        assert lay.blocks[k].cells == (b.cells[0] + m, b.cells[1])
+        lay.topology()
+        win.stack.undo()
+        wait_idle(qtbot, win)
+        assert win.doc.project.layout is lay1
+
+
+def test_the_autosave_waits_for_the_end_of_a_drag(qtbot, laid, monkeypatch):
+    from app import recovery
+    from app.layout_edit import handles
+
+    win = laid
+    writes = []
+    monkeypatch.setattr(recovery, "write", lambda *a, **k: writes.append(time.monotonic()))
+    lay0 = win.doc.project.layout
+    end = next(x for x in handles(lay0) if x.kind == "end")
+    tool = win.canvas.tool
+    h = lay0.cell_size
+    assert tool.drag("start", end.xy, end.xy)
+    t_end = time.monotonic() + 1.5 * io_controller.MAX_DELAY_S  # longer than the autosave's longest wait
+    k = 0
+    while time.monotonic() < t_end:
+        k += 1
+        tool.drag("move", (end.xy[0] + 0.1 * h * (k % 5), end.xy[1]), end.xy)
+        qtbot.wait(50)
+    assert writes == []  # nothing written while the drag lasts
+    tool.drag("finish", (end.xy[0] + 0.2 * h, end.xy[1]), end.xy)
+    wait_idle(qtbot, win)
+    qtbot.waitUntil(lambda: len(writes) == 1, timeout=10 * io_controller.DEBOUNCE_MS)

@@ -95,3 +95,71 @@ def test_a_dragged_corner_lands_on_a_vertex_of_its_block(layout):
         q = place(layout, h, (h.xy[0] + 0.3, h.xy[1] - 0.2), parts)
         assert q in vertices
         assert LinearRing(layout.pieces[h.block].ring).distance(Point(q)) < 1e-9
+
+
+# --------------------------------------------------------------- a three-block strip
+def _strip():
+    """A 10 × 2 strip sampled at every unit, cut at x = 3 and x = 6 into blocks a, b, c."""
+    from meshcore.layout import layout_from_outline
+
+    outline = [(float(x), 0.0) for x in range(11)] + [(float(x), 2.0) for x in range(10, -1, -1)]
+    cuts = [[(3.0, 0.0), (3.0, 2.0)], [(6.0, 0.0), (6.0, 2.0)]]
+    blocks = [
+        {"name": "a", "corners": [(0, 0), (3, 0), (3, 2), (0, 2)], "cells": [6, 4]},
+        {"name": "b", "corners": [(3, 0), (6, 0), (6, 2), (3, 2)], "cells": [6, 4]},
+        {"name": "c", "corners": [(6, 0), (10, 0), (10, 2), (6, 2)], "cells": [8, 4]},
+    ]
+    return layout_from_outline(outline, cuts=cuts, blocks=blocks, cell_size=0.5, multiple=2)
+
+
+def test_shore_points_are_handles_after_the_layouts_own_points():
+    from app.layout_edit import shore_points
+
+    lay = _strip()
+    hs = handles(lay)
+    shore = [h for h in hs if h.kind == "shore"]
+    # every vertex of the water polygon is a handle; where a cut end or a corner sits, that one
+    assert {h.xy for h in hs} >= {tuple(map(float, p)) for p in shore_points(lay)}
+    assert (1.0, 0.0) in {h.xy for h in shore} and (3.0, 0.0) not in {h.xy for h in shore}
+    assert nearest_handle(hs, (3.01, 0.0), tol=0.1).kind == "end"
+
+
+def test_a_dragged_shore_point_takes_the_shore_and_keeps_the_blocks():
+    from app.layout_edit import moved_layout, shore_points
+    from meshcore.layout.outline import outline_parts
+
+    lay = _strip()
+    parts = outline_parts(lay)
+    parts2 = moved_parts(parts, (4.0, 2.0), (4.0, 2.5), 1e-9, shore=shore_points(lay))
+    moved = {tuple(a) for a in np.asarray(parts["outline"])} ^ {tuple(b) for b in np.asarray(parts2["outline"])}
+    assert moved == {(4.0, 2.0), (4.0, 2.5)}  # only that vertex: its neighbours are shore points too
+    lay2 = moved_layout(lay, parts2)
+    assert lay2.polygon.area == pytest.approx(lay.polygon.area + 0.5 * 2 * 0.5)  # a triangle 2 wide, 0.5 high
+    assert [(b.name, b.cells) for b in lay2.blocks] == [(b.name, b.cells) for b in lay.blocks]
+    assert lay2.topology() is not None
+
+
+def test_a_shore_drag_moves_the_layouts_sampling_points_between_two_shore_points():
+    from app.layout_edit import _moved_ring
+
+    ring = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0], [4.0, 1.0], [0.0, 1.0]])
+    stops = ring[[0, 2, 4, 5, 6]]  # 1 and 3 are sampling points the layout added
+    out, moved = _moved_ring(ring, ring[2], np.array([0.0, -1.0]), stops, 1e-12)
+    assert out[2].tolist() == [2.0, -1.0]
+    assert out[1].tolist() == [1.0, -0.5] and out[3].tolist() == [3.0, -0.5]  # half way: half the move
+    assert np.array_equal(out[[0, 4, 5, 6]], ring[[0, 4, 5, 6]]) and len(moved) == 3
+
+
+def test_a_cut_end_dragged_across_another_cut_is_refused():
+    from app.layout_edit import moved_layout
+    from meshcore.errors import TopologyError
+    from meshcore.layout.outline import outline_parts
+
+    lay = _strip()
+    parts = outline_parts(lay)
+    end = next(h for h in handles(lay) if h.xy == (3.0, 2.0))
+    ok = moved_layout(lay, moved_parts(parts, end.xy, place(lay, end, (4.0, 2.0), parts), 1e-9))
+    assert [b.cells for b in ok.blocks] == [b.cells for b in lay.blocks]
+    across = moved_parts(parts, end.xy, place(lay, end, (8.0, 2.0), parts), 1e-9)  # past the cut at x = 6
+    with pytest.raises(TopologyError, match="block 'a'"):
+        moved_layout(lay, across)

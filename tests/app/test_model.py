@@ -355,3 +355,20 @@ def test_solver_settings_survive_a_save_from_the_app(tmp_path):
     save_project(project, tmp_path / "out.toml")
     again = load_case(tmp_path / "out.toml").solver
     assert again.repair == "strict" and again.threads == 2
+
+
+def test_grid_segments_are_every_cell_edge_once():
+    rng = np.random.default_rng(3)
+    x, y = np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij")
+    x, y = x + 0.1 * rng.random(x.shape), y + 0.1 * rng.random(y.shape)
+    X, Y = geo.grid_segments(x, y)
+    assert X.shape == Y.shape == (2 * (4 * 2 + 3 * 3),)
+    got = {frozenset({(X[k], Y[k]), (X[k + 1], Y[k + 1])}) for k in range(0, len(X), 2)}
+    want = set()
+    for i in range(4):
+        for j in range(3):
+            if j + 1 < 3:
+                want.add(frozenset({(x[i, j], y[i, j]), (x[i, j + 1], y[i, j + 1])}))
+            if i + 1 < 4:
+                want.add(frozenset({(x[i, j], y[i, j]), (x[i + 1, j], y[i + 1, j])}))
+    assert got == want

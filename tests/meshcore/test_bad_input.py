@@ -25,7 +25,7 @@ def test_too_few_points():
 def test_non_finite_point_named(bad):
     r = R.copy()
     r[1, 1] = bad
-    with pytest.raises(InvalidInputError, match=r"right border: point 1 is not finite") as exc:
+    with pytest.raises(InvalidInputError, match=r"right border: point 2 is not finite") as exc:
         gen(r=r)
     assert f"({float(r[1, 0])!r}, {bad!r})" in str(exc.value)  # as a user writes them, not np.float64(nan)
 

@@ -63,7 +63,7 @@ def test_from_outline_with_an_island_gives_a_ring_of_blocks_that_solves():
     ("cuts", "blocks", "holes", "needle"),
     [
         (RING_CUTS[:1], RING_BLOCKS[:1], [ISLAND], "encloses an island"),
-        ([[[0, 0], [4, 4]]], RING_BLOCKS, [ISLAND], "cut 0 leaves the water"),
+        ([[[0, 0], [4, 4]]], RING_BLOCKS, [ISLAND], "cut 1 leaves the water"),
         (RING_CUTS, RING_BLOCKS, [ISLAND + 10], "island 0"),
         (RING_CUTS, RING_BLOCKS, [ISLAND, ISLAND + 0.2], "islands 0 and 1 overlap"),
     ],
@@ -128,6 +128,23 @@ def test_with_cells_moves_the_neighbours_and_keeps_every_interface_consistent():
         with_cells(lay, b.name, (b.cells[0] + 1, b.cells[1]))  # not a multiple of 2
     with pytest.raises(TopologyError, match="no block 'nope'"):
         with_cells(lay, "nope", (4, 4))
+
+
+def test_with_cells_on_a_layout_read_from_outline_parts_sets_that_blocks_sides():
+    # the pieces of a layout made from [outline] parts start at each block's sw corner: block
+    # cells (ni along bottom/top) go to the sides they name, whatever vertex a region ring starts at
+    lay = auto_layout(testing.y_junction(), target_cells=1500, multiple=2)
+    p = outline_parts(lay)
+    back = layout_from_outline(
+        p["outline"], holes=p["holes"], cuts=p["cuts"], blocks=p["blocks"], cell_size=lay.cell_size, multiple=2
+    )
+    for pc, b in zip(back.pieces, back.blocks, strict=True):
+        assert tuple(map(float, pc.ring[pc.corners[0]])) == pytest.approx(b.corners[0])
+        assert tuple(map(float, pc.ring[pc.corners[1]])) == pytest.approx(b.corners[1])
+    for b in back.blocks:
+        new = with_cells(back, b.name, (b.cells[0] + 2, b.cells[1]))
+        assert {x.name: x.cells for x in new.blocks}[b.name] == (b.cells[0] + 2, b.cells[1])
+        new.topology()  # every interface agrees
 
 
 # ------------------------------------------------------------------ case file round trip

@@ -469,7 +469,7 @@ def test_outline_error_cut_not_ending_on_outline():
     ring, cuts, blocks = outline_case()
     cuts = [[[1, 0.3], [1, 1.2]], cuts[1]]
     msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
-    assert "cut 0" in msg and "first point" in msg
+    assert "cut 1" in msg and "first point" in msg
 
 
 def test_outline_error_block_not_four_sided():
@@ -511,7 +511,7 @@ def test_outline_error_cut_leaves_the_water():
     ring, cuts, blocks = outline_case()
     cuts = [[[1, 0], [1.5, -0.5], [1, 1.2]], cuts[1]]
     msg = _err(lambda: from_outline(ring, cuts=cuts, blocks=blocks))
-    assert "cut 0" in msg and ("leaves" in msg or "touches" in msg)
+    assert "cut 1" in msg and ("leaves" in msg or "touches" in msg)
 
 
 # -------------------------------------------------------------- case files
