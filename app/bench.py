@@ -204,6 +204,8 @@ def lake_como(app, win, profile: str | None = None) -> None:
             starts.append(frames[-1])
 
     win.solver.redrawn.connect(redrawn)
+    layouts: list[float] = []  # the layouts shown while dragging (each restarts the solve)
+    win.lake_ctl.layout_done.connect(lambda lay: layouts.append(time.perf_counter()) if lay is not None else None)
     h = lay.cell_size
     prof = None
     if profile:
@@ -224,9 +226,11 @@ def lake_como(app, win, profile: str | None = None) -> None:
         prof.dump_stats(profile)
     dt = _wait(app, lambda: not win.lake_ctl.editing and not win.solver.running, timeout=600)
     during = [f for f in frames if t_drag <= f <= t_release]
+    n_lay = len([t for t in layouts if t <= t_release])
     print(
         f"drag a cut end on Como ({lay.n_cells} cells, auto-generate): {len(during) / (t_release - t_drag):.1f} "
-        f"redraws/s while dragging, {len(starts)} of {len(frames)} redraws showed a start grid, "
+        f"redraws/s while dragging ({len(during)} in {t_release - t_drag:.1f} s for 3 s of mouse moves, "
+        f"{n_lay} layouts), {len(starts)} of {len(frames)} redraws showed a start grid, "
         f"done {dt:.1f} s after release ({win.stack.undoText()!r}, {win.lake_ctl.edit_error or 'no error'})"
     )
     win.solver.redrawn.disconnect(redrawn)

@@ -10,6 +10,7 @@ outline it offers Auto layout in a non-modal box (never shown with ``window.quie
 from __future__ import annotations
 
 import logging
+import time
 
 import numpy as np
 from PySide6 import QtCore, QtWidgets
@@ -20,7 +21,10 @@ from meshcore import MeshcoreError
 from .lake import Lake, compute_layout
 from .lake_solve import layout_topology
 
-__all__ = ["LakeController"]
+__all__ = ["EDIT_GAP_S", "LakeController"]
+
+#: seconds between two layouts of a drag (the grid re-solves from each; see LakeController.edit_layout)
+EDIT_GAP_S = 0.25
 
 log = logging.getLogger(__name__)
 
@@ -67,7 +71,13 @@ class LakeController(QtCore.QObject):
         self.prompt: QtWidgets.QMessageBox | None = None  # the offer after importing a branched lake
         self.last_error: str | None = None
         self._edit_worker = None
-        self._pending = None  # (make, text, merge key) of the newest layout edit not yet computed
+        self._pending = None  # (make, text, merge key, shore) of the newest layout edit not yet computed
+        # a drag's next layout waits EDIT_GAP_S after the last one was shown: each new layout restarts
+        # the grid's solve, which needs that long to set up and redraw a few smoothed grids
+        self._edit_timer = QtCore.QTimer(self)
+        self._edit_timer.setSingleShot(True)
+        self._edit_timer.timeout.connect(self._next_edit)
+        self._edit_shown = 0.0  # when the last layout edit was shown
         self.edit_error: str | None = None
 
     @property
@@ -172,9 +182,14 @@ class LakeController(QtCore.QObject):
             self._next_edit()
 
     def _next_edit(self) -> None:
-        if self._pending is None:
+        if self._pending is None or self._edit_worker is not None:
             return
         make, text, key, shore = self._pending
+        wait = self._edit_shown + EDIT_GAP_S - time.perf_counter()
+        if key is not None and wait > 0:  # a drag's step: later (the newest step then)
+            if not self._edit_timer.isActive():
+                self._edit_timer.start(max(1, int(1000 * wait)))
+            return
         self._pending = None
         worker = create_worker(_edit_job, make, _start_thread=False)
         worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key, shore))
@@ -193,6 +208,7 @@ class LakeController(QtCore.QObject):
                 rings = tuple(np.asarray(r.coords)[:-1] for r in poly.interiors)
                 lake = lake.replaced(outline=np.asarray(poly.exterior.coords)[:-1], holes=rings)
             self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
+            self._edit_shown = time.perf_counter()
             self.layout_done.emit(layout)
         elif layout is None and self._pending is None:  # a refusal only counts for the last request
             self.edit_error = err
