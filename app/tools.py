@@ -376,8 +376,15 @@ class LayoutTool(Tool):
         from .layout_edit import handles
 
         if self._cache is None or self._cache[0] is not lay:
-            self._cache = (lay, handles(lay))
+            hs = handles(lay)
+            self._cache = (lay, hs, np.array([h.xy for h in hs], float).reshape(-1, 2))
         return self._cache[1]
+
+    def _near(self, lay, xy) -> list:
+        """The handles of ``lay`` within the pick tolerance of ``xy`` (a hover asks with every mouse move)."""
+        hs = self._handles(lay)
+        d = np.hypot(*(self._cache[2] - np.asarray(xy, float)).T)
+        return [hs[k] for k in np.flatnonzero(d <= self.tol())]
 
     def hover(self, xy) -> None:
         """Ring the handle a drag would take (shore points are not drawn: this shows them)."""
@@ -386,7 +393,7 @@ class LayoutTool(Tool):
         lay = self.doc.project.layout
         if self.canvas is None or self._handle is not None:
             return
-        h = nearest_handle(self._handles(lay), xy, self.tol()) if lay is not None else None
+        h = nearest_handle(self._near(lay, xy), xy, self.tol()) if lay is not None else None
         self.canvas.lake_items.set_drag_point(None if h is None else h.xy)
 
     def deactivate(self) -> None:
@@ -402,7 +409,7 @@ class LayoutTool(Tool):
             self._handle = None
             if lay is None or self.controller is None:
                 return False
-            h = nearest_handle(self._handles(lay), start, self.tol())
+            h = nearest_handle(self._near(lay, start), start, self.tol())
             if h is None:
                 return False
             from meshcore.layout.outline import outline_parts
