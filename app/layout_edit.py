@@ -215,11 +215,15 @@ def moved_parts(parts: dict, old: Any, new: Any, tol: float, shore: Any = None) 
     for a, b in ring_moves:
         moves.setdefault((float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
 
+    src = np.array(list(moves), float).reshape(-1, 2)
+    dst = list(moves.values())
+
     def move(p):
         p = (float(p[0]), float(p[1]))
         if _same(p, old, tol):
             return (float(old[0] + d[0]), float(old[1] + d[1]))
-        return next((q for a, q in moves.items() if _same(p, a, tol)), p)
+        hit = np.flatnonzero(np.all(np.abs(src - p) <= tol, axis=1))
+        return dst[int(hit[0])] if len(hit) else p
 
     blocks = [dict(b, corners=[move(p) for p in b["corners"]]) for b in parts["blocks"]]
     return dict(parts, **rings, cuts=cuts, blocks=blocks)
