@@ -63,6 +63,12 @@ class ControlSources:
     ----------
     history : list of (iteration, change)
         Largest change of the normalised sources per update.
+    metric_scaled : bool
+        True: ``P, Q`` are written as ``(α/D², γ/D²)`` times normalised sources, so a
+        solver may re-apply them with the current metric between updates (the
+        multigrid does, see :mod:`meshcore.elliptic._mg_control`).  False with a
+        C-grid wake cut: its nodes move once per update, which the multigrid does
+        not converge (measured: a residual plateau), so it runs as before.
     """
 
     def __init__(self, spec: ControlSpec, *, periodic: bool = False, curves: Mapping[str, Any] | None = None):
@@ -169,6 +175,10 @@ class ControlSources:
             if closed:
                 s = np.unwrap(s, period=c.length)
         return c, s
+
+    @property
+    def metric_scaled(self) -> bool:
+        return not self.spec.wake
 
     def wants_update(self, it: int) -> bool:
         return it % self.spec.every == 0 or (bool(self.spec.wake))

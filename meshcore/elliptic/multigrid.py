@@ -65,6 +65,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from . import _mg_control as C
 from . import _mg_kernels as K
 from .solver import SolverState, _sor, _sources_settled, register_method
 
@@ -145,14 +146,16 @@ def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) ->
     return ci, cj
 
 
-def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list:
+def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | None = None) -> list:
     """The coarsenings of the grid ``(x, y)``: ``(ci, cj, tables_i, tables_j)`` per level.
 
     Each direction is coarsened as :func:`coarsening` says; a coarse level
     (injected nodes) must still represent the shape: a level with (many) more
     folded cells than its parent, a ring cut into two cells say, is a
     degenerate grid whose FAS correction is noise, so coarsening stops
-    before it.
+    before it.  With normalised control sources ``norm = (φ, ψ)`` it also
+    stops before a level whose scaled sources lose monotonicity
+    (:func:`._mg_control.coarse_ok`).
     """
     out = []
     pos_i = np.arange(x.shape[0])
@@ -171,10 +174,33 @@ def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list:
         cstats = K.cell_stats(xc, yc, _stride(xc))
         if not cstats[1] <= stats[1] + MAX_NEW_FOLDED:
             return out
+        if norm is not None:
+            norm = _coarse_norm(norm, tab_i[0], tab_i[1], tab_j[0], tab_j[1], xc.shape, clip=False)
+            if not C.coarse_ok(*norm):
+                return out
         out.append((ci, cj, tab_i, tab_j))
         stats = cstats
         x, y = xc, yc
         pos_i, pos_j = tab_i[6], tab_j[6]
+
+
+def _coarse_norm(norm: tuple, si, swi, sj, swj, shape: tuple, clip: bool = True) -> tuple:
+    """Normalised sources ``(φ, ψ)`` sampled to a coarse level and scaled by its coarsening
+    factors (``φ → aφ``, ``ψ → bψ``); clipped to ``±PECLET_MAX`` if ``clip``."""
+    out = []
+    for arr, fac in zip(norm, _factors(norm[0].shape, shape), strict=True):
+        c = np.empty(shape)
+        K.sample(arr, si, swi, sj, swj, c)
+        c *= fac
+        if clip:
+            np.clip(c, -C.PECLET_MAX, C.PECLET_MAX, out=c)
+        out.append(c)
+    return tuple(out)
+
+
+def _factors(fine: tuple, coarse: tuple) -> tuple[float, float]:
+    """Coarsening factors ``(a, b)``: fine cells per coarse cell in ξ and η."""
+    return (fine[0] - 1) / (coarse[0] - 1), (fine[1] - 1) / (coarse[1] - 1)
 
 
 def hierarchy(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> list[tuple[int, int]]:
@@ -243,8 +269,20 @@ class _FAS:
         if threads > 1:
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
         use_pq = state.p.size > 0
-        plan = _plan(state.x, state.y, self.periodic)
-        self.key = (state.x.shape, self.periodic, use_pq, threads, gamma, tuple((ci, cj) for ci, cj, _, _ in plan))
+        # a control updater whose P, Q are metric-scaled normalised sources (see _mg_control)
+        self.controlled = use_pq and bool(getattr(state.sources, "metric_scaled", False))
+        self.norm: list = []
+        norm = C.normalised(state.x, state.y, state.p, state.q, self.periodic) if self.controlled else None
+        plan = _plan(state.x, state.y, self.periodic, norm)
+        self.key = (
+            state.x.shape,
+            self.periodic,
+            use_pq,
+            threads,
+            gamma,
+            self.controlled,
+            tuple((ci, cj) for ci, cj, _, _ in plan),
+        )
         ws = _WORKSPACES.pop(self.key, None)
         if ws is None:
             self._build(plan, use_pq, threads)
@@ -300,7 +338,7 @@ class _FAS:
 
         def fused(shp):  # see _pack: V-cycles fuse every serial coarse level
             par = threads > 1 and shp[0] * shp[1] >= PARALLEL_MIN_NODES
-            return self.gamma == 1 and not par
+            return self.gamma == 1 and not par and not self.controlled
 
         def new(shp, fuse, zero=False):  # a fused level's arrays are placed by _pack
             if fuse:
@@ -349,7 +387,7 @@ class _FAS:
         levels = self.levels
         nlev = len(levels)
         self.kfuse = nlev  # no fused levels
-        if self.gamma != 1 or nlev < 2:
+        if self.gamma != 1 or nlev < 2 or self.controlled:
             return
         kf = 1
         while kf < nlev and levels[kf].par:
@@ -425,7 +463,18 @@ class _FAS:
 
     # ------------------------------------------------------------------ pieces
     def restrict_sources(self) -> None:
-        """Carry P, Q to the coarse levels (sampled, scaled by 1/a, 1/b)."""
+        """Carry P, Q to the coarse levels (sampled, scaled by 1/a, 1/b).
+
+        Controlled solves carry the normalised sources instead (each level
+        applies them with its own metric, see :meth:`follow`).
+        """
+        if self.controlled:
+            lv0 = self.levels[0]
+            self.norm = [C.normalised(lv0.x, lv0.y, lv0.p, lv0.q, self.periodic)]
+            for k in range(1, len(self.levels)):
+                f, c = self.levels[k - 1], self.levels[k]
+                self.norm.append(_coarse_norm(self.norm[-1], f.si, f.swi, f.sj, f.swj, c.x.shape))
+            return
         for k in range(1, len(self.levels)):
             f, c = self.levels[k - 1], self.levels[k]
             if c.p.size:
@@ -436,7 +485,14 @@ class _FAS:
                 if f.qscale != 1.0:
                     c.q *= f.qscale
 
+    def follow(self, lv: _Level) -> None:
+        """Controlled solves: P, Q of level ``lv`` from its normalised sources and current metric."""
+        if self.controlled:
+            ph, qh = self.norm[next(k for k, m in enumerate(self.levels) if m is lv)]
+            C.apply(lv.x, lv.y, ph, qh, self.periodic, lv.p, lv.q)
+
     def smooth(self, lv: _Level, sweeps: int) -> None:
+        self.follow(lv)
         if sweeps > 0:
             self.updates += sweeps * lv.x.size
             fn = K.smooth_parallel if lv.par else K.smooth
@@ -444,7 +500,11 @@ class _FAS:
 
     def smooth_band(self, lv: _Level, fine: bool) -> None:
         width, sweeps = (BAND_WIDTH, BAND_SWEEPS) if fine else (COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS)
-        if sweeps > 0:
+        if self.controlled:  # the sources follow the grid sweep by sweep
+            for _ in range(sweeps):
+                self.follow(lv)
+                K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, width, 1)
+        elif sweeps > 0:
             K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, width, sweeps)
 
     def fmg_band(self, lv: _Level) -> None:
@@ -501,6 +561,7 @@ class _FAS:
             restrict = K.restrict_parallel if c.par else K.restrict
             restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
         self.restricted[k] = False
+        self.follow(c)
         add = K.add_operator_parallel if c.par else K.add_operator
         add(c.x, c.y, c.p, c.q, self.periodic, c.fx, c.fy)
 
@@ -508,7 +569,11 @@ class _FAS:
         """``u_k += P(u_{k+1} − R̂ u_k)`` (the coarse level's scratch holds the correction)."""
         f, c = self.levels[k], self.levels[k + 1]
         fn = K.prolong_correct_parallel if f.par else K.prolong_correct
+        if self.controlled:  # never let the correction collapse a thin cell (see _mg_control)
+            x0, y0 = f.x.copy(), f.y.copy()
         fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.si, f.swi, f.sj, f.swj, f.li, f.lj, f.wli, f.wlj, self.periodic)
+        if self.controlled:
+            C.safe_step(f.x, f.y, x0, y0)
 
     def cycle(self, k: int, *, have_defect: bool = False) -> None:
         """One V (gamma = 1) or W (gamma = 2) cycle on level k."""
@@ -555,7 +620,6 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
 
 
 def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
-    cfg = state.config
     tol = state.tol_abs
     levels = mg.levels
     lv0 = levels[0]
@@ -569,6 +633,9 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     if r0 <= tol:
         state.final_residual = r0
         return True
+    if mg.controlled:  # no FMG start: coarse solutions do not hold the wall spacing
+        mg.smooth(lv0, PRE)
+        return (yield from _cycles(state, mg, r0))
     for k in range(1, len(levels)):
         f = levels[k - 1]
         K.sample(f.x, f.si, f.swi, f.sj, f.swj, levels[k].x)
@@ -598,7 +665,13 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     # nodes next to the borders first (it takes one or two cycles off).
     mg.fmg_band(lv0)
     mg.smooth(lv0, PRE)
-    # ------------------------------------------------------------------ cycles
+    return (yield from _cycles(state, mg, r0))
+
+
+def _cycles(state: SolverState, mg: _FAS, r0: float) -> Generator[str, None, bool]:
+    """V (W) cycles from the current fine grid until the stopping rule holds (or fallback)."""
+    cfg = state.config
+    tol = state.tol_abs
     # ``it`` counts finished fine-level cycles; the FMG start counts as the first.
     best = math.inf
     for it in range(1, cfg.max_iterations + 1):
@@ -619,7 +692,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
             state.iterations = 0
             return (yield from _sor(state))
         best = min(best, r)
-        if it >= STALL_START and r > STALL_FACTOR * state.history[-1 - STALL_WINDOW][1]:
+        if _stalled(state.history, it, tol, mg.controlled and not _sources_settled(state)):
             state.message = f"multigrid stalled after {it} cycles; continued with SOR"
             state.history.clear()
             state.iterations = 0
@@ -633,6 +706,18 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
             mg.defect_restrict(0)
         mg.cycle(0, have_defect=True)
     return False
+
+
+def _stalled(history: list, it: int, tol: float, moving: bool) -> bool:
+    """The stall rule: less than ``1 − STALL_FACTOR`` gained in the last ``STALL_WINDOW`` cycles.
+
+    ``moving``: a control whose sources are still moving (not settled) sets the
+    pace; the residual then follows the source updates (a plateau, bumps), so
+    it is no stall.  SOR would need the same updates, one per sweep.
+    """
+    if moving or it < STALL_START or history[-1][1] <= tol:
+        return False
+    return history[-1][1] > STALL_FACTOR * history[-1 - STALL_WINDOW][1]
 
 
 def multigrid(state: SolverState) -> Generator[str, None, bool]:

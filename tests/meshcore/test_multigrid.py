@@ -488,24 +488,6 @@ def test_fused_fmg_start_is_the_level_by_level_one(monkeypatch, periodic):
     assert a.iterations == b.iterations and ua == multigrid.last_run["node_updates"]
 
 
-def test_fallback_to_sor_starts_the_control_over_and_says_so():
-    """Multigrid diverges on the wall-controlled NACA O-grid (y+ spacing, coarse levels cannot
-    hold it): SOR then starts from the start grid *and* the control's start state, so the
-    result is the SOR grid bit for bit, and the message keeps why SOR ran."""
-    import dataclasses
-    from pathlib import Path
-
-    from meshcore.case import generate_case, load_case
-
-    cs = load_case(Path(__file__).resolve().parents[2] / "resources/examples/naca0012-ogrid.toml")
-    mg = generate_case(cs, config=dataclasses.replace(cs.solver, method="multigrid"))[0]
-    sor = generate_case(cs, config=dataclasses.replace(cs.solver, method="sor"))[0]
-    assert mg.converged and mg.info.message.startswith("converged (multigrid diverged; continued with SOR"), (
-        mg.info.message
-    )
-    assert np.array_equal(mg.x, sor.x) and np.array_equal(mg.y, sor.y)
-
-
 def test_max_iterations_caps_the_cycles():
     X, Y = annulus_sector(64, 64)
     g = meshcore.solve(_start(X, Y), method="multigrid", tolerance=1e-15, max_iterations=2)
