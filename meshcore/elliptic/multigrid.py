@@ -53,7 +53,12 @@ the nonlinearity next to curved borders is strongest; O(n) work).
 If the iteration diverges (a residual that grows 1000-fold or is not finite),
 the solver restores the start grid and falls back to SOR; if it stalls (less
 than 10 % in 6 cycles, see ``STALL_*``) SOR continues from the current
-grid.  Either way ``info.message`` of the result says so.
+grid.  Either way ``info.message`` of the result says so.  With a control
+updater whose sources are metric-scaled (wall control, Thomas–Middlecoff) a
+diverged or stalled solve first starts over with the sources following the
+grid on every level, a hierarchy whose coarse sources stay monotone and
+fold-safe corrections (:mod:`._mg_control`: what makes wall-controlled grids
+converge); SOR takes over only if that fails too.
 """
 
 from __future__ import annotations
@@ -117,7 +122,8 @@ _ZERO = np.zeros(())
 _WORKSPACES: dict = {}
 
 #: Diagnostics of the most recent multigrid solve in this process (for benchmarks):
-#: ``levels`` (node shapes), ``node_updates`` (smoother node updates, all levels).
+#: ``levels`` (node shapes), ``node_updates`` (smoother node updates, all levels),
+#: ``sources_follow_grid`` (the solve that ran had the sources follow the grid).
 last_run: dict = {}
 
 
@@ -260,7 +266,7 @@ def _tables(pos: np.ndarray, coarsen: bool, periodic: bool):
 class _FAS:
     """Working storage and cycles of one solve."""
 
-    def __init__(self, state: SolverState, gamma: int):
+    def __init__(self, state: SolverState, gamma: int, controlled: bool = False):
         self.state = state
         self.gamma = gamma
         self.updates = 0
@@ -269,8 +275,8 @@ class _FAS:
         if threads > 1:
             numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
         use_pq = state.p.size > 0
-        # a control updater whose P, Q are metric-scaled normalised sources (see _mg_control)
-        self.controlled = use_pq and bool(getattr(state.sources, "metric_scaled", False))
+        # sources that follow the grid (a control updater's metric-scaled sources, _mg_control)
+        self.controlled = use_pq and controlled
         self.norm: list = []
         norm = C.normalised(state.x, state.y, state.p, state.q, self.periodic) if self.controlled else None
         plan = _plan(state.x, state.y, self.periodic, norm)
@@ -609,17 +615,45 @@ class _FAS:
 
 
 def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
-    mg = _FAS(state, gamma)
-    last_run.clear()
-    last_run["levels"] = [lv.x.shape for lv in mg.levels]
-    try:
-        return (yield from _fas_run(state, mg))
-    finally:
-        last_run["node_updates"] = mg.updates
-        mg.release()
+    """The FAS solve; if it diverges or stalls, with a control whose sources are metric-scaled
+    it starts over with the sources following the grid (see :mod:`._mg_control`), else (and
+    if that fails too) SOR takes over."""
+    retry = state.p.size > 0 and bool(getattr(state.sources, "metric_scaled", False))
+    for controlled in (False, True) if retry else (False,):
+        mg = _FAS(state, gamma, controlled)
+        last_run.clear()
+        last_run["levels"] = [lv.x.shape for lv in mg.levels]
+        last_run["sources_follow_grid"] = mg.controlled
+        try:
+            out = yield from _fas_run(state, mg)
+        finally:
+            last_run["node_updates"] = mg.updates
+            mg.release()
+        if not isinstance(out, str):
+            return out
+        if controlled or not retry:
+            break
+        _restart(state)  # the sources-following cycles start over from the start grid
+        state.history.clear()
+        state.iterations = 0
+    if out.startswith("diverged"):
+        _restart(state)
+    state.message = f"multigrid {out}; continued with SOR"
+    state.history.clear()
+    state.iterations = 0
+    return (yield from _sor(state))
 
 
-def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
+def _restart(state: SolverState) -> None:
+    """The start grid back, and the control (if any) started over with it."""
+    state.x[...] = state.start[0]
+    state.y[...] = state.start[1]
+    if state.sources is not None:
+        state.p[...], state.q[...] = state.pq_given
+        state.sources.initialize(state.x, state.y, state.p, state.q)
+
+
+def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool | str]:
     tol = state.tol_abs
     levels = mg.levels
     lv0 = levels[0]
@@ -668,8 +702,10 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool]:
     return (yield from _cycles(state, mg, r0))
 
 
-def _cycles(state: SolverState, mg: _FAS, r0: float) -> Generator[str, None, bool]:
-    """V (W) cycles from the current fine grid until the stopping rule holds (or fallback)."""
+def _cycles(state: SolverState, mg: _FAS, r0: float) -> Generator[str, None, bool | str]:
+    """V (W) cycles from the current fine grid until the stopping rule holds: True, False
+    (not converged within ``max_iterations``) or why they gave up (``"diverged"``,
+    ``"stalled after n cycles"``)."""
     cfg = state.config
     tol = state.tol_abs
     # ``it`` counts finished fine-level cycles; the FMG start counts as the first.
@@ -682,21 +718,10 @@ def _cycles(state: SolverState, mg: _FAS, r0: float) -> Generator[str, None, boo
             state.final_residual = r
             return True
         if not math.isfinite(r) or r > 1e3 * max(min(best, r0), tol if state.sources is not None else 0.0):
-            state.x[...] = state.start[0]
-            state.y[...] = state.start[1]
-            if state.sources is not None:  # the control starts over with the start grid
-                state.p[...], state.q[...] = state.pq_given
-                state.sources.initialize(state.x, state.y, state.p, state.q)
-            state.message = "multigrid diverged; continued with SOR"
-            state.history.clear()
-            state.iterations = 0
-            return (yield from _sor(state))
+            return "diverged"  # the control (if any) starts over with the start grid
         best = min(best, r)
         if _stalled(state.history, it, tol, mg.controlled and not _sources_settled(state)):
-            state.message = f"multigrid stalled after {it} cycles; continued with SOR"
-            state.history.clear()
-            state.iterations = 0
-            return (yield from _sor(state))
+            return f"stalled after {it} cycles"
         yield "tick"
         if it == cfg.max_iterations:
             break

@@ -111,6 +111,7 @@ def test_wall_controlled_ogrid_converges_by_multigrid_in_a_size_independent_numb
     sweeps grow with the size (2004 at 128×48, 7718 at 256×96 for b = 0.3)."""
     small, h = _controlled(64, 24, "multigrid", b)
     large, h2 = _controlled(128, 48, "multigrid", b)
+    assert multigrid.last_run["sources_follow_grid"] is True  # the second try
     for g, hh in ((small, h), (large, h2)):
         assert g.converged and g.info.message == "converged" and _no_fallback(g), g.info.message
         assert meshcore.quality(g).n_folded == 0
@@ -145,6 +146,20 @@ def test_naca_ogrid_example_converges_by_multigrid_to_the_sor_grid():
     assert mg.converged and mg.info.message == "converged" and _no_fallback(mg), mg.info.message
     d = float(np.hypot(mg.x - sor.x, mg.y - sor.y).max())
     assert d <= 1e-4 * mg.size, d
+
+
+def test_controlled_solves_that_converged_before_run_as_before():
+    """Thomas–Middlecoff alone converges with the plain cycles (FMG start, fused coarse
+    levels): the sources-following cycles are only the second try, so nothing changes."""
+    s = np.linspace(0.0, 1.0, 65)
+    bottom = np.column_stack([s, 0.08 * np.sin(2 * np.pi * s)])
+    top = np.column_stack([s, 1.0 + 0.06 * np.sin(3 * np.pi * s)])
+    left = np.column_stack([0 * s, s])
+    right = np.column_stack([1.0 + 0.1 * np.sin(np.pi * s), s])
+    g0 = meshcore.initial_grid(meshcore.prepare_borders(bottom, right, top, left))
+    g = meshcore.solve(g0, method="multigrid", sources=make_sources({"thomas-middlecoff": True}))
+    assert g.converged and g.info.message == "converged" and _no_fallback(g)
+    assert multigrid.last_run["sources_follow_grid"] is False
 
 
 def test_fallback_to_sor_starts_the_control_over_and_says_so(monkeypatch):
