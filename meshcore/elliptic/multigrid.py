@@ -619,6 +619,7 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
     it starts over with the sources following the grid (see :mod:`._mg_control`), else (and
     if that fails too) SOR takes over."""
     retry = state.p.size > 0 and bool(getattr(state.sources, "metric_scaled", False))
+    why = ""
     for controlled in (False, True) if retry else (False,):
         mg = _FAS(state, gamma, controlled)
         last_run.clear()
@@ -631,14 +632,15 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
             mg.release()
         if not isinstance(out, str):
             return out
+        why = out
         if controlled or not retry:
             break
         _restart(state)  # the sources-following cycles start over from the start grid
         state.history.clear()
         state.iterations = 0
-    if out.startswith("diverged"):
+    if why.startswith("diverged"):
         _restart(state)
-    state.message = f"multigrid {out}; continued with SOR"
+    state.message = f"multigrid {why}; continued with SOR"
     state.history.clear()
     state.iterations = 0
     return (yield from _sor(state))
