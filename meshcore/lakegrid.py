@@ -72,7 +72,7 @@ def _start(topo, how: str):
         mb = solve_multiblock(topo)
         return list(mb.grids), f"multiblock Winslow ({mb.info.message})"
     g0 = initial_grids(topo)
-    res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4)
+    res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4, size_ratio=None)
     return list(res.grids), f"algebraic grids relaxed as one grid ({res.sweeps} sweeps)"
 
 
@@ -93,10 +93,11 @@ def iterate_layout(
     start: str = "winslow",
     levels: int | None = None,
     sweeps: tuple[int, ...] = (400, 150, 80),
-    smooth: float | tuple[float, ...] = 0.05,
+    smooth: float | tuple[float, ...] = 0.02,
     omega: float = 1.8,
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
+    size_ratio: tuple[float, float] | None = (1.2, 2.0),
     every: int | None = 25,
     level_callback: Callable[[str, Any], Any] | None = None,
     stop_event: Any = None,
@@ -140,6 +141,7 @@ def iterate_layout(
             omega=omega,
             pin_angle=pin_angle,
             shore_smooth=shore_smooth,
+            size_ratio=size_ratio,
         )
         try:
             it, d, snap = next(gen)

@@ -91,15 +91,31 @@ def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after):
 
 
 @njit(cache=True, inline="always")
-def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth):
-    """The Ryskin–Leal position of node ``p`` (weights blended ``smooth`` towards their means);
-    ``(nan, nan)`` when an edge at ``p`` has zero length."""
+def _ramp(h1, h2, lo, hi):
+    """0 while two consecutive edges ``h1, h2`` differ by a ratio up to ``lo``, rising
+    linearly to 1 at the ratio ``hi``."""
+    r = max(h1, h2) / min(h1, h2)
+    if r <= lo:
+        return 0.0
+    return min(1.0, (r - lo) / (hi - lo))
+
+
+@njit(cache=True, inline="always")
+def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax):
+    """The Ryskin–Leal position of node ``p``, its weights along each grid line blended
+    ``smooth`` towards their mean — and further, up to the full mean, where the line's two
+    edges at ``p`` differ by a ratio above ``lo`` (:func:`_ramp`).
+
+    The extra blend of each line is the node's state ``bx, by`` moved ``relax`` of the way
+    to the current ramp value (``relax = 1``: the ramp itself); a relaxed state keeps a node
+    from cycling between the orthogonal and the smoothing position.  Returns the position and
+    the new states; ``(nan, nan, bx, by)`` when an edge at ``p`` has zero length."""
     he = _dist(X, Y, p, e)
     hw = _dist(X, Y, w, p)
     hn = _dist(X, Y, p, n)
     hs = _dist(X, Y, s, p)
     if he <= 0.0 or hw <= 0.0 or hn <= 0.0 or hs <= 0.0:
-        return np.nan, np.nan
+        return np.nan, np.nan, bx, by
     eta_e = 0.25 * (hn + hs + _dist(X, Y, e, ne) + _dist(X, Y, se, e))
     eta_w = 0.25 * (hn + hs + _dist(X, Y, w, nw) + _dist(X, Y, sw, w))
     xi_n = 0.25 * (he + hw + _dist(X, Y, n, ne) + _dist(X, Y, nw, n))
@@ -107,22 +123,28 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth):
     ae, aw, bn, bs = eta_e / he, eta_w / hw, xi_n / hn, xi_s / hs
     # blend with the symmetrised weights (equal spacing along each line: smoothness)
     am, bm = 0.5 * (ae + aw), 0.5 * (bn + bs)
-    ae += smooth * (am - ae)
-    aw += smooth * (am - aw)
-    bn += smooth * (bm - bn)
-    bs += smooth * (bm - bs)
+    rx = bx + relax * (_ramp(he, hw, lo, hi) - bx)
+    ry = by + relax * (_ramp(hn, hs, lo, hi) - by)
+    sx = smooth + (1.0 - smooth) * rx
+    sy = smooth + (1.0 - smooth) * ry
+    ae += sx * (am - ae)
+    aw += sx * (am - aw)
+    bn += sy * (bm - bn)
+    bs += sy * (bm - bs)
     den = ae + aw + bn + bs
     return (
         (ae * X[e] + aw * X[w] + bn * X[n] + bs * X[s]) / den,
         (ae * Y[e] + aw * Y[w] + bn * Y[n] + bs * Y[s]) / den,
+        rx,
+        ry,
     )
 
 
 @njit(cache=True, nogil=True)
-def jacobi_targets(X, Y, nodes, nbr, smooth, tx, ty):
+def jacobi_targets(X, Y, nodes, nbr, smooth, lo, hi, tx, ty):
     """The update of every regular node from the same old positions (test oracle's twin)."""
     for k in range(len(nodes)):
-        tx[k], ty[k] = _target(
+        tx[k], ty[k], _, _ = _target(
             X,
             Y,
             nodes[k],
@@ -135,24 +157,50 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, tx, ty):
             nbr[k, 6],
             nbr[k, 7],
             smooth,
+            lo,
+            hi,
+            0.0,
+            0.0,
+            1.0,
         )
 
 
 @njit(cache=True, nogil=True)
-def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, jmin):
-    """One Gauss–Seidel sweep over the free interior nodes; returns the largest move."""
+def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lo, hi, bx, by, relax, jmin):
+    """One Gauss–Seidel sweep over the free interior nodes (``bx, by``: the size-blend state
+    of every regular node, updated; see :func:`_target`); returns the largest move."""
     big = 0.0
     before = np.empty(16)
     after = np.empty(16)
     for k in range(len(nodes)):
         p = nodes[k]
-        tx, ty = _target(
-            X, Y, p, nbr[k, 0], nbr[k, 1], nbr[k, 2], nbr[k, 3], nbr[k, 4], nbr[k, 5], nbr[k, 6], nbr[k, 7], smooth
+        tx, ty, bx[k], by[k] = _target(
+            X,
+            Y,
+            p,
+            nbr[k, 0],
+            nbr[k, 1],
+            nbr[k, 2],
+            nbr[k, 3],
+            nbr[k, 4],
+            nbr[k, 5],
+            nbr[k, 6],
+            nbr[k, 7],
+            smooth,
+            lo,
+            hi,
+            bx[k],
+            by[k],
+            relax,
         )
+        t = max(bx[k], by[k])
         if tx != tx:
             continue
-        nx = X[p] + omega * (tx - X[p])
-        ny = Y[p] + omega * (ty - Y[p])
+        # where the size blend acts, no over-relaxation: the blended update is not the
+        # linear one SOR's factor was chosen for, and over-relaxed it can oscillate
+        w = omega - (omega - 1.0) * t if omega > 1.0 else omega
+        nx = X[p] + w * (tx - X[p])
+        ny = Y[p] + w * (ty - Y[p])
         d = _try_move(X, Y, p, nx, ny, cptr, cells, jmin, before, after)
         big = max(big, d)
     for k in range(len(irr_nodes)):
@@ -269,10 +317,13 @@ def _bend(R, S, r0, s0, n, sp, s, sn, px, py, x, y, qx, qy, limit):
 
 
 @njit(cache=True, nogil=True)
-def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, gap, jmin):
+def shore_sweep(
+    X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, gap, jmin, lo, hi, bz, relax
+):
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
-    the perpendicular from their inward neighbour, between their two shore neighbours;
-    returns the largest move."""
+    the perpendicular from their inward neighbour, between their two shore neighbours, pulled
+    ``mu`` towards the middle of the two — more where the two arcs differ by a ratio above
+    ``lo`` (state ``bz`` per free node, as in :func:`_target`); returns the largest move."""
     big = 0.0
     before = np.empty(16)
     after = np.empty(16)
@@ -298,7 +349,12 @@ def shore_sweep(X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, 
         margin = 0.1 * (sn - sp)
         q = binner[k]
         sf = _foot(R, S, r0, s0, n, X[q], Y[q], sp + margin, sn - margin)
-        sf = (1.0 - mu) * sf + mu * 0.5 * (sp + sn)  # a little pull to the middle keeps the spacing
+        # a pull to the middle keeps the spacing: a little, more where the spacing jumps
+        a1, a2 = s - sp, sn - s
+        if a1 > 0.0 and a2 > 0.0:
+            bz[f] += relax * (_ramp(a1, a2, lo, hi) - bz[f])
+        m = mu + (1.0 - mu) * bz[f]
+        sf = (1.0 - m) * sf + m * 0.5 * (sp + sn)
         # the shore between a node and its neighbours must stay within ``gap`` of the straight
         # edges between them: a node may not slide past a bay or a point
         ppx, ppy = _ring_point(R, S, r0, s0, n, sp)

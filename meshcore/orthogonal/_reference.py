@@ -7,7 +7,25 @@ import numpy as np
 __all__ = ["ortho_targets"]
 
 
-def ortho_targets(x: np.ndarray, y: np.ndarray, nodes: np.ndarray, nbr: np.ndarray, smooth: float):
+def blend(smooth: float, h1: np.ndarray, h2: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """The share of the symmetric weights along a grid line whose two edges at the node are
+    ``h1, h2``: ``smooth`` up to the ratio ``lo``, rising linearly to 1 at ``hi``."""
+    r = np.maximum(h1, h2) / np.minimum(h1, h2)
+    if not np.isfinite(lo):
+        return np.full_like(r, smooth)
+    t = np.clip((r - lo) / (hi - lo), 0.0, 1.0)
+    return smooth + (1.0 - smooth) * t
+
+
+def ortho_targets(
+    x: np.ndarray,
+    y: np.ndarray,
+    nodes: np.ndarray,
+    nbr: np.ndarray,
+    smooth: float,
+    lo: float = np.inf,
+    hi: float = np.inf,
+):
     """Where one point-Jacobi step of the Ryskin–Leal update moves every regular node.
 
     ``nbr`` holds ``E, W, N, S, NE, NW, SE, SW`` per node.  See :mod:`._kernels` for the
@@ -26,7 +44,8 @@ def ortho_targets(x: np.ndarray, y: np.ndarray, nodes: np.ndarray, nbr: np.ndarr
     xi_s = 0.25 * (he + hw + d(s, se) + d(sw, s))
     a = np.stack([eta_e / he, eta_w / hw, xi_n / hn, xi_s / hs])
     mean = np.stack([(a[0] + a[1]) / 2, (a[0] + a[1]) / 2, (a[2] + a[3]) / 2, (a[2] + a[3]) / 2])
-    a = a + smooth * (mean - a)
+    sx, sy = blend(smooth, he, hw, lo, hi), blend(smooth, hn, hs, lo, hi)
+    a = a + np.stack([sx, sx, sy, sy]) * (mean - a)
     den = a.sum(axis=0)
     tx = (a[0] * x[e] + a[1] * x[w] + a[2] * x[n] + a[3] * x[s]) / den
     ty = (a[0] * y[e] + a[1] * y[w] + a[2] * y[n] + a[3] * y[s]) / den

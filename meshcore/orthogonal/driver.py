@@ -10,7 +10,16 @@ elliptic solution) and the shore it lies on, and iterates
    of the perpendicular from its inward neighbour.  Nodes with one cell (convex block corners)
    or three (reflex corners) stay where the layout put them;
 
-until the largest move is below ``tol`` × the median edge length.  Every move is guarded: no
+until the largest move is below ``tol`` × the median edge length.
+
+The weak constraint accepts any orthogonal grid, also one whose cells grow tenfold from one
+to the next (a polar fan into a block corner, a jump across a cut line).  A blend towards
+the Laplace weights (``smooth``) damps that everywhere; ``size_ratio = (lo, hi)`` adds more
+of it only where two consecutive edges along a grid line differ by more than ``lo``, up to
+the full Laplace weights at ``hi`` (default 1.2 and 2: the modellers' limits for consecutive
+edges and for cells across an interface).  That blend is a state per node, moved
+``size_relax`` of the way to its current value each sweep: switched on and off at once, a
+node next to a shore node can cycle between the orthogonal and the smooth position for ever.  Every move is guarded: no
 cell around a moving node may lose its positive corner Jacobians, so a grid without folds
 stays without folds.
 """
@@ -184,12 +193,16 @@ def iterate_orthogonalize(
     shore_smooth: float = 0.15,
     guard: bool = True,
     shore_gap: float = 0.25,
+    size_ratio: tuple[float, float] | None = (1.2, 2.0),
+    size_relax: float = 0.05,
     callback=None,
 ):
     """:func:`orthogonalize` as a generator: every ``every`` sweeps it yields
     ``(sweep, change, grids)`` (the change per sweep relative to the median edge, the current
     grids); ``"stop"`` sent to it ends the sweeps.  Returns the :class:`OrthoResult`."""
     t0 = time.perf_counter()
+    lo, hi = size_ratio if size_ratio is not None else (np.inf, np.inf)
+    bx, by = np.zeros(len(topology.node_map.nodes)), np.zeros(len(topology.node_map.nodes))
     m = topology.node_map
     X, Y = _assemble(grids, m)
     cells = m.cells.astype(np.int64)
@@ -206,13 +219,32 @@ def iterate_orthogonalize(
         _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, float(np.median(edge0)), pin_angle)
     R, S, roff = _ring_tables(rings) if rings else (np.zeros((1, 2)), np.zeros(2), np.zeros(2, dtype=np.int64))
     fidx = np.flatnonzero(free).astype(np.int64)
+    bz = np.zeros(len(fidx))
     edge = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
     h = float(np.median(edge))
     hist = []
     it = 0
     converged = False
     for it in range(1, max_sweeps + 1):
-        d1 = _kernels.sweep(X, Y, m.nodes, m.nbr, m.irr_nodes, m.irr_ptr, m.irr_ring, cptr, ncells, omega, smooth, jmin)
+        d1 = _kernels.sweep(
+            X,
+            Y,
+            m.nodes,
+            m.nbr,
+            m.irr_nodes,
+            m.irr_ptr,
+            m.irr_ring,
+            cptr,
+            ncells,
+            omega,
+            smooth,
+            lo,
+            hi,
+            bx,
+            by,
+            size_relax,
+            jmin,
+        )
         d2 = _kernels.shore_sweep(
             X,
             Y,
@@ -232,6 +264,10 @@ def iterate_orthogonalize(
             shore_smooth,
             shore_gap * h,
             jmin,
+            lo,
+            hi,
+            bz,
+            size_relax,
         )
         d = max(d1, d2) / h
         hist.append(d)

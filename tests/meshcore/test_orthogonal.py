@@ -25,8 +25,10 @@ def _one_block(x, y):
     return topo, StructuredGrid(x, y)
 
 
-@pytest.mark.parametrize("smooth", [0.0, 0.3, 1.0])
-def test_the_kernel_update_is_the_numpy_oracle(smooth):
+@pytest.mark.parametrize(
+    ("smooth", "lo", "hi"), [(0.0, np.inf, np.inf), (0.3, np.inf, np.inf), (1.0, 1.2, 2.0), (0.05, 1.05, 1.5)]
+)
+def test_the_kernel_update_is_the_numpy_oracle(smooth, lo, hi):
     rng = np.random.default_rng(1)
     xi, eta = np.meshgrid(np.linspace(0, 3, 13), np.linspace(0, 1, 7), indexing="ij")
     x = xi + 0.05 * rng.standard_normal(xi.shape) + 0.2 * eta**2
@@ -38,8 +40,8 @@ def test_the_kernel_update_is_the_numpy_oracle(smooth):
     gx, gy = np.empty(m.n_nodes), np.empty(m.n_nodes)
     gx[ids], gy[ids] = X, Y
     tx, ty = np.empty(len(m.nodes)), np.empty(len(m.nodes))
-    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, tx, ty)
-    rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth)
+    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi, tx, ty)
+    rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi)
     np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
     np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
 
@@ -50,7 +52,7 @@ def test_an_orthogonal_grid_is_a_fixed_point():
     ys = np.cumsum(np.r_[0, np.linspace(0.5, 0.2, 8)])
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     topo, g = _one_block(X, Y)
-    res = orthogonalize(topo, [g], [], max_sweeps=5, smooth=0.0)
+    res = orthogonalize(topo, [g], [], max_sweeps=5, smooth=0.0, size_ratio=None)
     np.testing.assert_allclose(res.grids[0].x, X, atol=1e-12)
     np.testing.assert_allclose(res.grids[0].y, Y, atol=1e-12)
 
@@ -116,3 +118,33 @@ def test_lake_grids_have_no_folds_and_are_orthogonal(make):
     assert mb.interface_mismatch() == 0.0
     assert m.share("deviation", 3.0) >= 0.85
     assert m.coverage.area_error < 0.01
+
+
+@pytest.mark.parametrize("jump", [2.0, 4.0])
+@pytest.mark.parametrize("lo_hi", [(1.1, 1.5), (1.2, 2.0)])
+def test_the_size_blend_evens_out_a_jump_in_spacing(jump, lo_hi):
+    # a rectangle whose columns jump from width 1 to ``jump`` halfway: orthogonal, so a fixed
+    # point of the plain update; with the size blend (shore nodes sliding) the jump spreads
+    # out over several columns and the grid stays orthogonal
+    w = np.r_[np.ones(10), np.full(10, jump)]
+    xs = np.cumsum(np.r_[0.0, w])
+    xs *= 20.0 / xs[-1]
+    X, Y = np.meshgrid(xs, np.linspace(0.0, 4.0, 9), indexing="ij")
+    topo, g = _one_block(X, Y)
+    ring = np.array([[0.0, 0.0], [20.0, 0.0], [20.0, 4.0], [0.0, 4.0]])
+    ring = np.vstack(
+        [ring[k] + np.linspace(0, 1, 80, endpoint=False)[:, None] * (ring[(k + 1) % 4] - ring[k]) for k in range(4)]
+    )
+
+    def worst_ratio(x):
+        d = np.diff(x[:, 4])
+        return float(np.max(np.maximum(d[1:] / d[:-1], d[:-1] / d[1:])))
+
+    plain = orthogonalize(topo, [g], [ring], max_sweeps=200, smooth=0.0, shore_smooth=0.0, size_ratio=None)
+    np.testing.assert_allclose(plain.grids[0].x, X, atol=1e-9)
+    res = orthogonalize(topo, [g], [ring], max_sweeps=3000, smooth=0.0, shore_smooth=0.0, size_ratio=lo_hi)
+    x, y = res.grids[0].x, res.grids[0].y
+    assert worst_ratio(X) == pytest.approx(jump)
+    assert worst_ratio(x) < 0.5 * (lo_hi[0] + lo_hi[1])
+    assert lake_metrics(res.grids[0]).max("deviation") < 0.5
+    assert np.all(np.diff(x, axis=0) > 0) and np.all(np.diff(y, axis=1) > 0)
