@@ -38,7 +38,7 @@ def _d_eta(a: np.ndarray) -> np.ndarray:
     return _d_xi(a.T, False).T
 
 
-def _scale_factors(x: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
+def scale_factors(x: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
     """``α/D²`` and ``γ/D²`` at every node (conversion normalised → kernel sources)."""
     xx, yx = _d_xi(x, periodic), _d_xi(y, periodic)
     xe, ye = _d_eta(x), _d_eta(y)

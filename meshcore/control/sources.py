@@ -17,9 +17,9 @@ from .geometry import (
     _d_xi,
     _Polyline,
     _rot,
-    _scale_factors,
     _set_border,
     _tangent,
+    scale_factors,
 )
 from .spec import BorderControl, ControlSpec, control_from_mapping
 
@@ -298,7 +298,7 @@ class ControlSources:
                 st, sn = bs.s_t[None, :], bs.s_n[None, :]
                 qh += st * bs.weight
                 ph += sn * bs.weight
-        fa, fg = _scale_factors(x, y, self.periodic)
+        fa, fg = scale_factors(x, y, self.periodic)
         with np.errstate(all="ignore"):
             pp = self.p0 + fa * ph
             qq = self.q0 + fg * qh

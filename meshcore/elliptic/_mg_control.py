@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..control.geometry import scale_factors
+
 __all__ = [
     "MAX_AREA_LOSS",
     "PECLET_MAX",
@@ -38,7 +40,6 @@ __all__ = [
     "apply_reference",
     "cell_areas",
     "coarse_ok",
-    "metric_factors",
     "normalised",
     "safe_step",
 ]
@@ -54,40 +55,10 @@ MAX_AREA_LOSS = 0.75
 MAX_HALVINGS = 10
 
 
-def _d_xi(a: np.ndarray, periodic: bool) -> np.ndarray:
-    d = np.empty_like(a)
-    d[1:-1] = 0.5 * (a[2:] - a[:-2])
-    if periodic:  # column ni repeats column 0
-        d[0] = d[-1] = 0.5 * (a[1] - a[-2])
-    else:
-        d[0] = a[1] - a[0]
-        d[-1] = a[-1] - a[-2]
-    return d
-
-
-def _d_eta(a: np.ndarray) -> np.ndarray:
-    d = np.empty_like(a)
-    d[:, 1:-1] = 0.5 * (a[:, 2:] - a[:, :-2])
-    d[:, 0] = a[:, 1] - a[:, 0]
-    d[:, -1] = a[:, -1] - a[:, -2]
-    return d
-
-
-def metric_factors(x: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
-    """``(α/D², γ/D²)`` at every node, ``D²`` bounded below by ``10⁻³ αγ`` (degenerate cells)."""
-    xx, yx = _d_xi(x, periodic), _d_xi(y, periodic)
-    xe, ye = _d_eta(x), _d_eta(y)
-    a = xe * xe + ye * ye
-    g = xx * xx + yx * yx
-    d = xx * ye - xe * yx
-    d2 = np.maximum(np.maximum(d * d, 1e-3 * a * g), 1e-300)
-    return a / d2, g / d2
-
-
 def normalised(x, y, p, q, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
     """The normalised sources ``(φ, ψ)`` behind the kernel sources ``P, Q`` on the grid ``(x, y)``."""
     with np.errstate(all="ignore"):
-        fa, fg = metric_factors(x, y, periodic)
+        fa, fg = scale_factors(x, y, periodic)
         ph = np.where(fa > 0, p / fa, 0.0)
         qh = np.where(fg > 0, q / fg, 0.0)
     return np.nan_to_num(ph, posinf=0.0, neginf=0.0), np.nan_to_num(qh, posinf=0.0, neginf=0.0)
@@ -96,7 +67,7 @@ def normalised(x, y, p, q, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
 def apply_reference(x, y, ph, qh, periodic: bool, p: np.ndarray, q: np.ndarray) -> None:
     """``p, q ← (α/D², γ/D²)·(φ, ψ)`` with the metric of the grid ``(x, y)`` now (NumPy;
     the oracle of :func:`apply`)."""
-    fa, fg = metric_factors(x, y, periodic)
+    fa, fg = scale_factors(x, y, periodic)
     np.multiply(fa, ph, out=p)
     np.multiply(fg, qh, out=q)
 
