@@ -2,7 +2,23 @@
 
 from __future__ import annotations
 
+import gc
+
 import pytest
+
+
+@pytest.fixture(autouse=True)
+def _qt_garbage_collected_in_the_gui_thread():
+    """Collect each test's garbage here, in the GUI thread, after its windows closed.
+
+    A window dropped by a test sits in reference cycles (psygnal connections to its methods)
+    until Python's cyclic collector runs — in whatever thread allocates at that moment.  When
+    that was the next test's layout worker (scipy's Voronoi allocating), ``QObject::~QObject``
+    of the old window's objects ran there and deadlocked with the GUI thread's paint: the suite
+    hung in ``test_lake.py`` (py-spy: the worker in ``Shiboken::GilState::acquire``).
+    """
+    yield
+    gc.collect()
 
 
 @pytest.fixture
