@@ -31,6 +31,9 @@ sys.path.insert(0, str(ROOT))
 
 import meshcore  # noqa: E402
 
+sys.path.insert(0, str(HERE))
+from run import wavy_square  # noqa: E402  (the scale-series square, written once)
+
 #: (label, file): real lakes nobody on the project drew or tuned on (GSHHG outlines, see
 #: benchmarks/lakes/README.md and benchmarks/data/README.md for sources and licences).
 LAKES = [
@@ -79,16 +82,6 @@ def outline(path: Path) -> np.ndarray:
     local, _ = project(read_points(path), "auto")
     rings = [p for p in local.polylines if p.closed]
     return max(rings or list(local.polylines), key=len).points
-
-
-def wavy_square(n: int) -> meshcore.StructuredGrid:
-    """The scale-series square of ``run.py`` (a smooth domain), ``(n + 1)²`` nodes."""
-    s = np.linspace(0.0, 1.0, n + 1)
-    bottom = np.column_stack([s, 0.08 * np.sin(2 * np.pi * s)])
-    top = np.column_stack([s, 1.0 + 0.06 * np.sin(3 * np.pi * s)])
-    left = np.column_stack([np.zeros_like(s), s])
-    right = np.column_stack([1.0 + 0.1 * np.sin(np.pi * s), s])
-    return meshcore.initial_grid(meshcore.prepare_borders(bottom, right, top, left))
 
 
 def lake_block(path: Path, nodes: int = 24_000):
