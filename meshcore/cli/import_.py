@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         if b not in BORDER_NAMES or not nm:
             raise InvalidInputError(f"--border-name expects BORDER=NAME with BORDER in {BORDER_NAMES}, got {item!r}")
         specs[b] = BorderSpec(name=nm)
-    ps = read_points(args.points, columns=args.columns)
+    ps = read_points(args.points, columns=args.columns, crs=args.source_crs)
     local, frame = project(ps, None if args.crs.lower() == "none" else args.crs, source_crs=args.source_crs)
     if args.polyline:
         pl = local[args.polyline] if args.polyline in local.names else None

@@ -214,7 +214,7 @@ def _read(args: argparse.Namespace, say: _Say):
         target = normalize_crs(target)
         if target is not None and is_geographic(target):
             raise InvalidInputError(f"--crs {args.crs}: a geographic CRS (degrees); give a projected one (metres)")
-    ps = read_points(args.outline, columns=args.columns)
+    ps = read_points(args.outline, columns=args.columns, crs=args.source_crs)
     local, frame = project(ps, target, origin=None, source_crs=args.source_crs)
     if frame.crs is not None and is_geographic(frame.crs):
         raise InvalidInputError(

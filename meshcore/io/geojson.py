@@ -126,6 +126,7 @@ def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
         if declared == LONLAT:
             for pl in merged:
                 check_lonlat(pl.points, where=f"{path}: {pl.name}")
-    except InvalidInputError as exc:
-        raise ReadError(str(exc)) from None
+    except (InvalidInputError, ReadError) as exc:
+        hint = "GeoJSON positions are lon/lat; for projected coordinates give their CRS: --source-crs EPSG:nnnn"
+        raise ReadError(f"{exc} — {hint}") from None
     return PointSet(tuple(merged), declared, str(path))

@@ -321,6 +321,23 @@ def test_geojson_interior_ring_in_lon_lat_to_a_given_crs(tmp_path):
     check_covers_the_water(blocks, projected(geojson_rings(f), "EPSG:3035"))
 
 
+def test_geojson_in_projected_metres_needs_and_takes_source_crs(tmp_path):
+    """GeoJSON is lon/lat by its spec; a file in UTM metres is refused with the way out named,
+    and ``--source-crs`` reads it as such (the grid stays in those metres)."""
+    f = tmp_path / "utm.geojson"
+    coords = [[[round(a, 3), round(b, 3)] for a, b in [*r, r[0]]] for r in _synthetic_rings()]
+    f.write_text(json.dumps({"type": "Polygon", "coordinates": coords}))
+    run = mesh(f, "--cells", 600, "-o", tmp_path / "s.cgns", "-q")
+    assert run.rc == 2 and "outside the lon/lat range" in run.err and "--source-crs" in run.err, run.err
+    assert not (tmp_path / "s.cgns").exists()
+    run = mesh(f, "--cells", 600, "--source-crs", "EPSG:32633", "-o", tmp_path / "s.cgns", "-q")
+    assert run.rc == 0, run.err
+    crs, blocks = cgns_blocks(tmp_path / "s.cgns")
+    assert crs == "EPSG:32633"
+    shore, island = (np.round(r, 3) for r in _synthetic_rings())
+    check_covers_the_water(blocks, shapely.Polygon(shore, [island]))
+
+
 def test_shapefile_hole_is_an_island(tmp_path):
     shp = pytest.importorskip("shapefile")
     shore, island = _synthetic_rings()
