@@ -96,8 +96,7 @@ def main(argv: list[str] | None = None) -> int:
     app.processEvents()
     win.canvas.fit()
     if args.solve:
-        win.generate()
-        win.solver.wait(timeout_s=120)
+        solve_as_opened(app, win)
         app.processEvents()
         if args.quality:
             i = win.quality_panel.metric.findText(args.quality, QtCore.Qt.MatchFlag.MatchStartsWith)
@@ -115,6 +114,25 @@ def main(argv: list[str] | None = None) -> int:
     code = app.exec()
     warm.join(timeout=60)
     return code
+
+
+def solve_as_opened(app, win, timeout_s: float = 120.0) -> None:
+    """``--solve``: the grid of what was opened, until it is done.
+
+    A lake whose import offered Auto layout (arms or islands) is laid out first, as the offer's
+    button does; one block over such a lake would be a poor grid, or cover its islands.
+    """
+    if win.lake_ctl.prompt is not None:
+        done: list = []
+        win.lake_ctl.layout_done.connect(done.append)
+        if win.lake_ctl.auto_layout():  # the grid starts when the layout is set
+            t_end = time.perf_counter() + timeout_s
+            while not done and time.perf_counter() < t_end:
+                app.processEvents()
+                time.sleep(0.01)
+    else:
+        win.generate()
+    win.solver.wait(timeout_s=timeout_s)
 
 
 if __name__ == "__main__":

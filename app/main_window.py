@@ -351,6 +351,14 @@ class MainWindow(QtWidgets.QMainWindow):
                 hint = "pick four corners (Corners tool) or use Auto corners (A)"
             self.message(f"Nothing to generate yet: {hint}")
             return
+        lake = self.doc.project.lake
+        if lake is not None and lake.holes and lake.layout is None and len(self.doc.project.blocks) == 1:
+            n = len(lake.holes)
+            self.doc.report(
+                "warning",
+                f"one block over a lake with {n} island{'s' * (n != 1)}: the grid covers "
+                f"{'them' if n != 1 else 'it'} — Lake ▸ Auto layout puts blocks around islands",
+            )
         self.solve_status.reset()
         self.solver.start()
 

@@ -61,6 +61,27 @@ def test_import_reads_islands_and_offers_auto_layout(qtbot, win):
     assert win.lake_ctl.prompt is None
 
 
+def test_one_block_over_islands_warns_and_the_command_line_lays_out(qtbot, win):
+    """Generate on the imported shore alone covers the island: a warning says so; ``--solve``
+    on a lake file does what the import offer proposes (Auto layout, then the grid)."""
+    from PySide6 import QtWidgets
+
+    from app.__main__ import solve_as_opened
+
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    win.generate()
+    wait_idle(qtbot, win)
+    warned = [t for lv, t in win.messages_panel.messages() if lv == "warning" and "island" in t]
+    assert warned and "Auto layout" in warned[0]
+    win.lake_panel.cell_size.setValue(600.0)
+    win.lake_panel.cell_size.editingFinished.emit()
+    solve_as_opened(QtWidgets.QApplication.instance(), win)
+    wait_idle(qtbot, win)
+    lay = win.doc.project.layout
+    assert lay is not None and len(lay.blocks) > 1 and len(lay.polygon.interiors) == 1
+    assert len(win.doc.project.blocks) == len(lay.blocks)
+
+
 def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
     lay = lay_out(qtbot, win, ISEO, cell_size=300.0)
     n = len(lay.blocks)
