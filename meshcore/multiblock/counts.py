@@ -13,6 +13,11 @@ opposite sides' lengths over ``h`` (cells of the asked size in both directions, 
 neighbouring blocks' cells are alike across their interface), then — with a quarter of the
 weight — every chain against ``L_c / h`` (``L_c`` its length), which shares a side's cells
 among the chains of a T-junction,
+and — what the cells across a cut line see — every pair of spacings that meet (two chains in
+a row along a block side; the two blocks beside a shared chain, across it) pays for the
+cells by which one density exceeds :data:`JUMP` times the other (:func:`_jump_pairs`):
+without it, a block side made of a short cut and a long shore could get 28 cells on the cut
+and 4 on the shore (a Y junction's star), a tenfold jump no smoother removes;
 with :func:`scipy.optimize.milp` (HiGHS).  Each block side's constraint couples only the
 chains around it, so the programs are tiny (tens to hundreds of unknowns) and solve in
 milliseconds.  Optionally every count is a multiple of ``multiple`` (2**k lets a multigrid
@@ -21,6 +26,7 @@ coarsen k times).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 
 import numpy as np
@@ -28,6 +34,43 @@ import numpy as np
 from ..errors import TopologyError
 
 __all__ = ["solve_counts"]
+
+#: Spacings that meet (two chains in a row along a block side, two blocks across their
+#: interface) may differ by this factor before the program pays for it ...
+JUMP = 1.5
+#: ... and it pays this much per cell of the excess (a deviation from the cell size costs 1).
+JUMP_WEIGHT = 1.0
+
+
+def _jump_pairs(t: np.ndarray, sides, least: float = 1.0) -> list[tuple[list[int], float, list[int], float]]:
+    """Pairs of cell densities (chains, target cells) whose ratio should stay near 1.
+
+    * two chains in a row on one block side (they meet at a T-junction or where a cut ends on
+      the side): the spacing along the side jumps there;
+    * the two blocks beside a shared chain, across it: each block's count in the direction
+      crossing the chain against the mean of that direction's two sides — the cells on the two
+      sides of a cut line are as long, across it, as these say.
+    """
+    out: list[tuple[list[int], float, list[int], float]] = []
+    across: dict[int, list[tuple[list[int], float]]] = {}
+    for bottom, right, top, left in sides:
+        for side in (bottom, right, top, left):
+            for c1, c2 in itertools.pairwise(side):
+                if t[c1] >= least and t[c2] >= least:
+                    out.append(([c1], float(t[c1]), [c2], float(t[c2])))
+        cross = {
+            0: (list(left), 0.5 * (t[list(left)].sum() + t[list(right)].sum())),
+            1: (list(bottom), 0.5 * (t[list(bottom)].sum() + t[list(top)].sum())),
+        }
+        for d, pair in enumerate(((bottom, top), (left, right))):
+            for side in pair:
+                for c in side:
+                    across.setdefault(int(c), []).append(cross[d])
+    for users in across.values():
+        if len(users) == 2 and min(users[0][1], users[1][1]) >= least:
+            (a, ta), (b, tb) = users
+            out.append((a, float(ta), b, float(tb)))
+    return out
 
 
 def solve_counts(
@@ -69,16 +112,24 @@ def solve_counts(
     n = len(t)
     nb = len(sides)
     m = int(multiple)
+    jumps = _jump_pairs(t, sides, least=float(max(m, 1)))
     # unknowns: k_c (n_c = m k_c); e_c ≥ |n_c − t_c| per chain; f_bd ≥ |N_bd − T_bd| per block and
     # direction, with N_bd the count across the block in that direction and T_bd the mean of its
     # two opposite sides' targets: every block's cells close to the asked size in both directions
-    # (so neighbours' cells are alike across interfaces), chains close to theirs within a side
-    nv = 2 * n + 2 * nb
-    cost = np.concatenate([np.full(n, -1e-3 * m), np.full(n, 0.25), np.ones(2 * nb)])
+    # (so neighbours' cells are alike across interfaces), chains close to theirs within a side;
+    # g_p ≥ 0 per pair of spacings that meet (see _jump_pairs), the cells by which one exceeds
+    # JUMP times the other
+    nv = 2 * n + 2 * nb + len(jumps)
+    cost = np.concatenate([np.full(n, -1e-3 * m), np.full(n, 0.25), np.ones(2 * nb), np.full(len(jumps), JUMP_WEIGHT)])
     rows, lo, hi = [], [], []
 
     def row() -> np.ndarray:
         return np.zeros(nv)
+
+    def add(r: np.ndarray, low: float, high: float) -> None:
+        rows.append(r)
+        lo.append(low)
+        hi.append(high)
 
     def absdev(dev_index: int, chains, target: float) -> None:
         for sign in (1.0, -1.0):  # dev ± Σ m k ≥ ± target
@@ -86,7 +137,7 @@ def solve_counts(
             r[dev_index] = 1.0
             for c in chains:
                 r[c] += sign * m
-            rows.append(r), lo.append(sign * target), hi.append(np.inf)
+            add(r, sign * target, np.inf)
 
     for c in range(n):
         absdev(n + c, [c], t[c])
@@ -97,20 +148,30 @@ def solve_counts(
                 r[c] += m
             for c in b:
                 r[c] -= m
-            rows.append(r), lo.append(0.0), hi.append(0.0)
+            add(r, 0.0, 0.0)
             absdev(2 * n + 2 * bi + d, list(a), 0.5 * (t[list(a)].sum() + t[list(b)].sum()))
         for side in (bottom, right, top, left):
             r = row()
             for c in side:
                 r[c] += m
-            rows.append(r), lo.append(float(min_cells)), hi.append(np.inf)
+            add(r, float(min_cells), np.inf)
         if block_cells and bi in block_cells:
             for side, want in ((bottom, block_cells[bi][0]), (left, block_cells[bi][1])):
                 r = row()
                 for c in side:
                     r[c] += m
-                rows.append(r), lo.append(float(want)), hi.append(float(want))
-    lb = np.concatenate([np.ones(n), np.zeros(n + 2 * nb)])
+                add(r, float(want), float(want))
+    for p, (ca, ta, cb, tb) in enumerate(jumps):
+        w = min(ta, tb)
+        for (c1, t1), (c2, t2) in (((ca, ta), (cb, tb)), ((cb, tb), (ca, ta))):
+            r = row()  # g ≥ w (N1/T1 − JUMP N2/T2)
+            r[2 * n + 2 * nb + p] = 1.0
+            for c in c1:
+                r[c] -= w * m / t1
+            for c in c2:
+                r[c] += JUMP * w * m / t2
+            add(r, 0.0, np.inf)
+    lb = np.concatenate([np.ones(n), np.zeros(n + 2 * nb + len(jumps))])
     ub = np.full(nv, np.inf)
     for c, v in (fixed or {}).items():
         if v % m:
@@ -121,7 +182,7 @@ def solve_counts(
     res = milp(
         cost,
         constraints=LinearConstraint(np.array(rows), lo, hi),
-        integrality=np.concatenate([np.ones(n), np.zeros(n + 2 * nb)]),
+        integrality=np.concatenate([np.ones(n), np.zeros(n + 2 * nb + len(jumps))]),
         bounds=Bounds(lb, ub),
         options={"time_limit": 20.0, "mip_rel_gap": 0.0},
     )
