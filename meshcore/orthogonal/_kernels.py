@@ -323,7 +323,8 @@ def shore_sweep(
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours, pulled
     ``mu`` towards the middle of the two — more where the two arcs differ by a ratio above
-    ``lo`` (state ``bz`` per free node, as in :func:`_target`); returns the largest move."""
+    ``lo`` (state ``bz`` per free node, as in :func:`_target`) — and never so far that they
+    differ by more than ``lo``; returns the largest move."""
     big = 0.0
     before = np.empty(16)
     after = np.empty(16)
@@ -346,7 +347,10 @@ def shore_sweep(
             sn += total
         while sn >= s + total:
             sn -= total
-        margin = 0.1 * (sn - sp)
+        # the node stays far enough from both neighbours that its two arcs differ by at most
+        # ``lo`` (the smoothness limit): sliding to the foot of the perpendicular, shore nodes
+        # next to an obtuse block corner otherwise crowd into it, each arc 1.7 times the next
+        margin = (sn - sp) * max(0.1, 1.0 / (1.0 + lo))
         q = binner[k]
         sf = _foot(R, S, r0, s0, n, X[q], Y[q], sp + margin, sn - margin)
         # a pull to the middle keeps the spacing: a little, more where the spacing jumps

@@ -58,3 +58,33 @@ def test_y_junction_borders_have_no_spacing_jump(cell_size, angle0):
     differed 5-10 times, 28 cells on the cut against 4 on the shore beside it)."""
     lay = auto_layout(testing.y_junction(angle0=angle0), cell_size=cell_size)
     assert _border_jump(lay) <= 2.0
+
+
+def test_shore_nodes_do_not_crowd_into_an_obtuse_block_corner():
+    """A block whose corner on the shore is obtuse (127° here): sliding each shore node to the
+    foot of the perpendicular from its inward neighbour crowds them into the corner, each edge
+    1.5-1.7 times the next (the polar fan that makes a 20-40x jump across a cut line ending
+    there).  The slide stops where a node's two shore edges differ by the smoothness limit."""
+    from meshcore.algebraic import tfi
+    from meshcore.boundary import Borders
+    from meshcore.multiblock.topology import Block, MultiBlockTopology
+    from meshcore.orthogonal import orthogonalize
+    from meshcore.quality import lake_metrics
+
+    def line(a, b, n):
+        return np.asarray(a) + np.linspace(0, 1, n + 1)[:, None] * (np.asarray(b) - np.asarray(a))
+
+    sw, se, ne, nw = (0.0, 0.0), (5.0, 0.0), (5.0, 2.0), (-1.5, 2.0)
+    bd = Borders(bottom=line(sw, se, 20), right=line(se, ne, 8), top=line(nw, ne, 20), left=line(sw, nw, 8))
+    topo = MultiBlockTopology((Block("a", bd),), (), check_geometry=False)
+    corners = np.array([sw, se, ne, nw])
+    ring = np.vstack([line(corners[k], corners[(k + 1) % 4], 100)[:-1] for k in range(4)])
+    lo = 1.2
+    res = orthogonalize(topo, [tfi(bd)], [ring], max_sweeps=3000, smooth=0.02, omega=1.8, size_ratio=(lo, 2.0))
+    x, y = res.grids[0].x, res.grids[0].y
+    for px, py in ((x[:, 0], y[:, 0]), (x[0], y[0]), (x[:, -1], y[:, -1]), (x[-1], y[-1])):
+        e = np.hypot(np.diff(px), np.diff(py))
+        assert np.max(np.maximum(e[1:] / e[:-1], e[:-1] / e[1:])) <= lo * 1.05
+    m = lake_metrics(res.grids[0])
+    assert m.values("folded").sum() == 0
+    assert m.share("deviation", 3.0) >= 0.9  # orthogonal but at the obtuse corner
