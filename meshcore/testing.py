@@ -6,6 +6,8 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
 
 * :func:`channel_network` — a random tree of channel segments buffered to a width (branched
   reservoirs, Y and T junctions, zig-zags), optionally with jagged shores;
+* :func:`jagged_cells` — any of them with shores jagged at the scale of the cells (the
+  outlines traced from aerial images);
 * :func:`lake_with_islands` — a lobed lake with islands, some close to the shore;
 * :func:`spiral` — a channel wound round more than once;
 * :func:`y_junction`, :func:`straight_channel`, :func:`rectangle_with_hole` — the textbook cases.
@@ -25,6 +27,7 @@ import numpy as np
 __all__ = [
     "channel_network",
     "jagged",
+    "jagged_cells",
     "lake_with_islands",
     "rectangle_with_hole",
     "spiral",
@@ -45,7 +48,10 @@ def _clean(poly, min_hole_area: float = 0.0):
         raise ValueError("empty shape")
     p = max(parts, key=lambda g: g.area)
     holes = [h for h in p.interiors if Polygon(h).area > min_hole_area]
-    return orient(Polygon(p.exterior, holes), 1.0)
+    out = Polygon(p.exterior, holes)
+    if not out.is_valid:  # an island left touching the shore: joined to it
+        out = max(getattr(g := out.buffer(0), "geoms", [g]), key=lambda g: g.area)
+    return orient(out, 1.0)
 
 
 def straight_channel(length: float = 10.0, width: float = 1.0):
@@ -80,8 +86,10 @@ def y_junction(arm: float = 6.0, width: float = 1.0, angle0: float = 90.0, resol
     return _clean(shapely.union_all(arms).simplify(1e-9 * arm))
 
 
-def jagged(poly, amplitude: float, seed: int = 0, spacing: float | None = None):
-    """Shores made rough: every ring densified to ``spacing`` and moved by ±``amplitude`` along its normal."""
+def jagged(poly, amplitude: float, seed: int = 0, spacing: float | None = None, *, raw: bool = False):
+    """Shores made rough: every ring densified to ``spacing`` and moved by ±``amplitude`` along its normal
+    (``raw``: independent uniform offsets per point; otherwise each offset averaged with its
+    neighbours' by weights ¼, ½, ¼)."""
     from shapely.geometry import Polygon
 
     rng = np.random.default_rng(seed)
@@ -95,12 +103,27 @@ def jagged(poly, amplitude: float, seed: int = 0, spacing: float | None = None):
         t = np.roll(pts, -1, axis=0) - np.roll(pts, 1, axis=0)
         nrm = np.column_stack([t[:, 1], -t[:, 0]]) / np.maximum(np.hypot(*t.T), 1e-300)[:, None]
         noise = rng.uniform(-1.0, 1.0, len(pts))
-        noise = 0.5 * noise + 0.25 * (np.roll(noise, 1) + np.roll(noise, -1))
+        if not raw:
+            noise = 0.5 * noise + 0.25 * (np.roll(noise, 1) + np.roll(noise, -1))
         return pts + sign * amplitude * noise[:, None] * nrm
 
     outer = rough(poly.exterior, 1.0)
     holes = [rough(h, 1.0) for h in poly.interiors]
     return _clean(Polygon(outer, holes))
+
+
+def jagged_cells(poly, cells: float, seed: int = 0, *, target_cells: int = 10_000, spacing: float = 0.86):
+    """A shore jagged at the scale of the grid, as traced from aerial images: every ring
+    densified to ``spacing`` cells and each point moved along the normal by an independent
+    uniform offset of at most ``± cells / 2`` cells (``cells`` from tooth to tooth), the cell
+    size being that of ``target_cells`` cells over the water, ``sqrt(area / target_cells)``.
+
+    >>> from meshcore.testing import jagged_cells, straight_channel
+    >>> jagged_cells(straight_channel(50.0, 1.0), 1.4, seed=2).is_valid
+    True
+    """
+    h = math.sqrt(poly.area / target_cells)
+    return jagged(poly, 0.5 * cells * h, seed=seed, spacing=spacing * h, raw=True)
 
 
 def channel_network(

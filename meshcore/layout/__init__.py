@@ -32,6 +32,7 @@ from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .model import Layout, LayoutBlock
 from .outline import interior_cuts
 from .polygon import water_polygon, without_slivers
+from .shore import shore_at_scale, transfer
 
 __all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
 
@@ -79,7 +80,15 @@ def auto_layout(
     poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
     poly, slivers = without_slivers(poly, 0.5 * h)
     more = more + slivers
-    sk, chords, _, pieces = layout_pieces(poly, h, regular=regular)
+    shores = shore_at_scale(poly, h)
+    if shores.change is not None:
+        more.append(shores.change.note())
+    poly = shores.grid
+    sk, chords, _, pieces = layout_pieces(shores.layout, h, regular=regular)
+    moved = transfer(pieces, shores)
+    if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
+        sk, chords, _, moved = layout_pieces(poly, h, regular=regular)
+    pieces = moved
     topo, _ = build_topology(pieces, h, multiple=multiple)
     blocks = tuple(
         LayoutBlock(

@@ -1,0 +1,372 @@
+r"""The shore at the scale of the cells: detail the grid cannot resolve smoothed out.
+
+Lake outlines traced from aerial images are jagged at the scale of a few metres, far below a
+cell.  A grid line cannot follow a shore that zig-zags between two of its nodes (its cells
+fold or shear), and the layout would read every tooth as a corner: a straight channel with a
+rough shore became dozens of blocks.  So the layout and the grid both work on the shore as a
+grid of cell size ``h`` can see it:
+
+* every ring is sampled at ``h / 4`` (its own vertices kept) and, where it **wiggles** at the
+  cell scale, smoothed by a Gaussian along its arc length;
+* the wiggle at a point is the turning the shore takes back within ``± 2h``:
+  ``(∫|τ| − |∫τ|) / h`` over that window, with ``τ`` the turning between chords of length
+  ``h`` (:func:`wiggle`).  A straight or curved shore, and a sharp corner, turn one way only
+  (wiggle 0); a zig-zag turns left and right by the same amount;
+* the Gaussian's width grows in steps (``h/2, h, 1.5h, 2h, 3h``) until the wiggle of the
+  smoothed shore is below ``WIGGLE`` degrees, point by point; the width then varies gently
+  along the ring, so a smooth shore stays exactly where it was and a jagged stretch is
+  replaced by its mean line (the area of the water is kept: a Gaussian moves a zig-zag's
+  teeth towards their middle from both sides);
+* a ring whose smoothing would make it cross itself or another ring, or an island that would
+  lose its area, keeps a smaller width (down to none).
+
+:func:`shore_at_scale` returns the smoothed water polygon and what moved (the Hausdorff
+distance to the original shore in cells and the area between the two shores), for the notes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["ShoreChange", "shore_at_scale", "wiggle"]
+
+#: Largest wiggle (degrees of turning taken back within ± 2 cells) a shore keeps unsmoothed.
+WIGGLE = 30.0
+#: Half the length (in cells) over which a turn taken back counts as a wiggle.
+WINDOW = 1.0
+#: The layout's shore is smoothed more within this many cells of a shore jagged at the grid's scale.
+GATE = 8.0
+#: Gaussian widths tried, in cells.
+WIDTHS = (0.5, 1.0, 1.5, 2.0, 3.0)
+
+
+@dataclass(frozen=True, slots=True)
+class ShoreChange:
+    """What :func:`shore_at_scale` did: the largest distance between the two shores (Hausdorff,
+    in cells), the area between them (share of the water) and where it moved most."""
+
+    hausdorff_cells: float
+    moved_share: float
+    where: tuple[float, float]
+    widths: tuple[float, ...]  # the largest Gaussian width per ring, in cells (0: unchanged)
+
+    def note(self) -> str:
+        x, y = self.where
+        return (
+            f"shore jagged below the cell size smoothed along its length (Gaussian of up to "
+            f"{max(self.widths):.2g} cells): the grid's shore is at most {self.hausdorff_cells:.2g} cells from the "
+            f"outline (Hausdorff distance), {100 * self.moved_share:.2g} % of the water area lies between the two "
+            f"(farthest near ({x:.6g}, {y:.6g}))"
+        )
+
+
+def _arc(ring: np.ndarray) -> tuple[np.ndarray, float]:
+    seg = np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)
+    return np.concatenate([[0.0], np.cumsum(seg[:-1])]), float(seg.sum())
+
+
+def _periodic(s: np.ndarray, total: float, values: np.ndarray, q: np.ndarray) -> np.ndarray:
+    xs = np.concatenate([s - total, s, s + total])
+    vs = np.concatenate([values, values, values])
+    return np.interp(q, xs, vs)
+
+
+def wiggle(ring: np.ndarray, h: float, chord: float = 0.5, window: float = 1.0) -> np.ndarray:
+    """The turning (degrees) a closed ring takes back within ``± window·h`` of every vertex.
+
+    ``τ`` at a vertex is the angle between the chords from ``chord·h`` behind it and to
+    ``chord·h`` ahead (with ``chord = ½``, the turn between two consecutive cells); the wiggle
+    is ``(∫|τ| − |∫τ|) ds / h`` over the window.  Zero on a shore that turns one way only (a
+    bend, a corner).
+    """
+    s, total = _arc(ring)
+    if total <= 4 * window * h:
+        return np.zeros(len(ring))
+    c = chord * h
+    back = np.column_stack([_periodic(s, total, ring[:, k], s - c) for k in (0, 1)])
+    ahead = np.column_stack([_periodic(s, total, ring[:, k], s + c) for k in (0, 1)])
+    a = ring - back
+    b = ahead - ring
+    tau = np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
+    ds = 0.5 * (np.roll(np.diff(np.append(s, total)), 1) + np.diff(np.append(s, total)))
+    # running integrals of |τ| ds and τ ds, read over the window (periodic)
+    grid = np.append(s, total)
+    lo, hi = s - window * h, s + window * h
+
+    def over_window(f):
+        F = np.concatenate([[0.0], np.cumsum(f * ds)])
+        return _cum(grid, F, F[-1], total, hi) - _cum(grid, F, F[-1], total, lo)
+
+    return (over_window(np.abs(tau)) - np.abs(over_window(tau))) / (chord * 2 * h)
+
+
+def _cum(grid: np.ndarray, F: np.ndarray, period: float, total: float, q: np.ndarray) -> np.ndarray:
+    """The running integral ``F`` (on ``grid`` over one turn) continued periodically to ``q``."""
+    k = np.floor(q / total)
+    return np.interp(q - k * total, grid, F) + k * period
+
+
+def _sampled(ring: np.ndarray, step: float) -> np.ndarray:
+    import shapely
+
+    closed = np.vstack([ring, ring[:1]])
+    return np.asarray(shapely.segmentize(shapely.LineString(closed), step).coords)[:-1]
+
+
+def _gauss(ring: np.ndarray, s: np.ndarray, total: float, sigma: np.ndarray) -> np.ndarray:
+    """Every vertex moved to the Gaussian mean (width ``sigma[i]`` of arc length) of the ring
+    round it, weighted by arc length (the ring's vertices need not be evenly spaced)."""
+    n = len(ring)
+    ds = 0.5 * (np.diff(np.append(s, total)) + np.roll(np.diff(np.append(s, total)), 1))
+    smax = float(sigma.max())
+    if smax <= 0:
+        return ring.copy()
+    step = float(np.min(ds[ds > 0], initial=total / n))
+    k = min(n // 2, math.ceil(3.0 * smax / max(step, 1e-300)) + 1)
+    num = np.zeros_like(ring)
+    den = np.zeros(n)
+    sig = np.where(sigma > 0, sigma, 1.0)
+    for o in range(-k, k + 1):
+        idx = np.arange(n) + o
+        j = idx % n
+        d = s[j] + total * (idx // n) - s  # arc length from vertex i to vertex i + o
+        w = np.exp(-0.5 * (d / sig) ** 2) * ds[j]
+        w = np.where(sigma > 0, w, 1.0 if o == 0 else 0.0)
+        num += w[:, None] * ring[j]
+        den += w
+    return num / den[:, None]
+
+
+@dataclass(frozen=True, slots=True)
+class _Scale:
+    """What counts as a wiggle: turning between chords of ``chord`` cells, taken back within
+    ``± window`` cells, of more than ``limit`` degrees."""
+
+    chord: float
+    window: float
+    limit: float
+
+    def wiggles(self, ring: np.ndarray, h: float) -> np.ndarray:
+        return wiggle(ring, h, self.chord, self.window) > self.limit
+
+
+#: The grid's scale: no zig-zag between two consecutive shore nodes.
+GRID = _Scale(0.5, 1.0, WIGGLE)
+#: The layout's scale: no bend of the shore read as a block corner (at 1.5 cells, as
+#: :func:`~.corners.choose_corners` reads them) that the shore takes back nearby.
+LAYOUT = _Scale(1.5, 3.0, 15.0)
+
+
+def _needed(p: np.ndarray, s: np.ndarray, total: float, h: float, scale: _Scale, limit: float) -> np.ndarray:
+    """The Gaussian width (in cells) each vertex of the sampled ring ``p`` needs at ``scale``."""
+    need = np.zeros(len(p))
+    todo = scale.wiggles(p, h)
+    for width in WIDTHS:
+        if width > limit or not todo.any():
+            break
+        q = _gauss(p, s, total, np.full(len(p), width * h))
+        need[todo] = width
+        todo &= scale.wiggles(q, h)
+    if todo.any():
+        need[todo] = min(limit, WIDTHS[-1])
+    # the width varies gently: each point takes the largest need within ± 3 widths, then a
+    # running mean over the same distance
+    return _spread(s, total, need, 3.0 * float(need.max()) * h)
+
+
+def _smooth_ring(ring: np.ndarray, h: float, limit: float, layout: bool):
+    """The ring for the grid and the ring for the layout (the same vertices, each moved by its
+    own Gaussian), and the largest width of each (in cells); ``ring`` itself where no
+    smoothing is needed."""
+    if not (GRID.wiggles(ring, h).any() or (layout and LAYOUT.wiggles(ring, h).any())):
+        return ring, ring, 0.0, 0.0
+    p = _sampled(ring, 0.25 * h)
+    s, total = _arc(p)
+    g = _needed(p, s, total, h, GRID, limit)
+    # the layout reads the shore smoothed more only where it is jagged at the grid's scale
+    # (a clean shore's bends are the lake's own: its bays and points)
+    # (within ``GATE`` cells of it)
+    if layout:
+        jagged = _spread(s, total, (g > 0).astype(float), GATE * h, mean=False) > 0
+        lay = np.where(jagged, np.maximum(g, _needed(p, s, total, h, LAYOUT, limit)), g)
+    else:
+        lay = g
+    grid_ring = _gauss(p, s, total, g * h)
+    if not (layout and np.any(lay != g)):
+        grid_ring = grid_ring[_kept(grid_ring, 0.01 * h)]
+        return grid_ring, grid_ring, float(g.max()), float(lay.max())
+    layout_ring = _gauss(p, s, total, lay * h)
+    keep = np.union1d(_kept(grid_ring, 0.01 * h), _kept(layout_ring, 0.01 * h))
+    return grid_ring[keep], layout_ring[keep], float(g.max()), float(lay.max())
+
+
+def _kept(ring: np.ndarray, tol: float) -> np.ndarray:
+    """Indices of the vertices a Douglas–Peucker simplification to ``tol`` keeps."""
+    import shapely
+
+    q = np.asarray(shapely.simplify(shapely.LinearRing(ring), tol, preserve_topology=False).coords)[:-1]
+    index = {(float(x), float(y)): i for i, (x, y) in enumerate(ring)}
+    kept = sorted({index[(float(x), float(y))] for x, y in q if (float(x), float(y)) in index})
+    return np.asarray(kept if len(kept) >= 4 else range(len(ring)), dtype=int)
+
+
+def _spread(s: np.ndarray, total: float, need: np.ndarray, reach: float, mean: bool = True) -> np.ndarray:
+    """The largest ``need`` within ``± reach`` of every point, then (``mean``) averaged over ``± reach``."""
+    if reach <= 0 or not need.any():
+        return need
+    from scipy.ndimage import maximum_filter1d, uniform_filter1d
+
+    step = total / len(s)
+    k = max(1, round(reach / step))
+    if 2 * k + 1 >= len(s):
+        return np.full(len(s), float(need.max()))
+    m = maximum_filter1d(need, 2 * k + 1, mode="wrap")
+    return uniform_filter1d(m, 2 * k + 1, mode="wrap") if mean else m
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Shores:
+    """The water as the grid follows it (``grid``) and as the layout reads it (``layout``,
+    smoothed more where the shore bends back and forth at the scale of block corners).  Their
+    rings have the same vertices in the same order (``layout is grid`` when they are equal)."""
+
+    grid: Any
+    layout: Any
+    change: ShoreChange | None
+
+
+def _ring_pairs(poly, h: float, layout: bool):
+    from shapely.geometry import LinearRing, Polygon
+
+    rings = _rings(poly)
+    out = []
+    for k, r in enumerate(rings):
+        limit = WIDTHS[-1]
+        if k:  # an island keeps its size: a width of at most a fifth of its radius-like size
+            limit = min(limit, 0.2 * math.sqrt(abs(Polygon(r).area) / math.pi) / h)
+        while True:
+            g, lay, wg, wl = _smooth_ring(r, h, limit, layout) if limit >= WIDTHS[0] else (r, r, 0.0, 0.0)
+            if (wg == 0 and wl == 0) or (LinearRing(g).is_simple and LinearRing(lay).is_simple):
+                break
+            limit = max(wg, wl) / 2  # smoothed into itself: less
+        out.append((r, g, lay, wg, wl))
+    return out
+
+
+def shore_at_scale(poly: Any, h: float, *, layout: bool = True) -> Shores:
+    """``poly`` with every ring smoothed where it wiggles at the scale of cells of size ``h``.
+
+    Returns :class:`Shores` (``poly`` itself for both and no change when no ring wiggles).  A
+    ring whose smoothing would leave the polygon invalid (rings crossing or touching, an island
+    lost) is smoothed less, down to not at all.
+    """
+    from shapely.geometry import Polygon
+    from shapely.geometry.polygon import orient
+
+    pairs = _ring_pairs(poly, h, layout)
+    if not any(wg or wl for *_, wg, wl in pairs):
+        return Shores(poly, poly, None)
+
+    def build(which: int):
+        return Polygon(pairs[0][which], [p[which] for p in pairs[1:]])
+
+    grid, lay = build(1), build(2)
+    if not (grid.is_valid and lay.is_valid) or len(lay.interiors) != len(poly.interiors):
+        # rings that now touch: the islands as they were, then nothing
+        pairs = pairs[:1] + [(r, r, r, 0.0, 0.0) for r, *_ in pairs[1:]]
+        grid, lay = build(1), build(2)
+        if not (grid.is_valid and lay.is_valid):
+            return Shores(poly, poly, None)
+    grid = orient(grid, 1.0)
+    lay = grid if all(p[1] is p[2] for p in pairs) else orient(lay, 1.0)
+    return Shores(grid, lay, _change(poly, grid, h, tuple(max(wg, wl) for *_, wg, wl in pairs)))
+
+
+def _change(poly, new, h: float, widths: tuple[float, ...]) -> ShoreChange:
+    """How far ``new`` is from ``poly`` (Hausdorff, where) and the area between them."""
+    import shapely
+    from scipy.spatial import cKDTree
+
+    worst, where = 0.0, (0.0, 0.0)
+    for a, b in zip([poly.exterior, *poly.interiors], [new.exterior, *new.interiors], strict=True):
+        for one, other in ((a, b), (b, a)):
+            # both lines sampled at h/8: the distance is exact to h/16
+            pts = np.asarray(shapely.segmentize(one, 0.125 * h).coords)
+            d, _ = cKDTree(np.asarray(shapely.segmentize(other, 0.125 * h).coords)).query(pts)
+            k = int(np.argmax(d))
+            if d[k] > worst:
+                worst, where = float(d[k]), (float(pts[k, 0]), float(pts[k, 1]))
+    moved = poly.symmetric_difference(new).area
+    return ShoreChange(worst / h, moved / poly.area, where, widths)
+
+
+def transfer(pieces: list, shores: Shores) -> list | None:
+    """The pieces of a layout made on ``shores.layout`` with their shore on ``shores.grid``.
+
+    Every piece vertex on a ring of the layout's shore moves to the same place (vertex, or
+    point of an edge) of the grid's ring; the vertices inside the water (cut lines) stay.
+    The corners stay the same vertices.  None when a moved piece is not a valid polygon or
+    the pieces no longer cover the grid's water exactly (then the layout is made on the
+    grid's shore itself).
+    """
+    import shapely
+    from shapely.geometry import Polygon
+
+    from .blocks import Piece
+
+    if shores.layout is shores.grid:
+        return pieces
+    src, dst = _rings(shores.layout), _rings(shores.grid)
+    if any(len(a) != len(b) for a, b in zip(src, dst, strict=True)):
+        return None
+    at = {(float(p[0]), float(p[1])): dst[k][i] for k, r in enumerate(src) for i, p in enumerate(r)}
+    x0, y0, x1, y1 = shores.layout.bounds
+    eps = 1e-7 * math.hypot(x1 - x0, y1 - y0)
+    boundary = shores.layout.boundary
+    out = []
+    for pc in pieces:
+        ring = np.array(pc.ring, dtype=float)
+        todo = [i for i, p in enumerate(ring) if (float(p[0]), float(p[1])) not in at]
+        for i, p in enumerate(ring):
+            q = at.get((float(p[0]), float(p[1])))
+            if q is not None:
+                ring[i] = q
+        if todo:
+            d = shapely.distance(shapely.points(ring[todo]), boundary)
+            for i in np.asarray(todo)[d <= eps]:
+                ring[i] = _moved(pc.ring[i], src, dst)
+        out.append(Piece(ring, pc.corners, pc.name))
+    polys = [Polygon(p.ring) for p in out]
+    if not all(p.is_valid for p in polys):
+        return None
+    area = shores.grid.area
+    if abs(sum(p.area for p in polys) - area) > 1e-6 * area:
+        return None
+    if shapely.union_all(polys).symmetric_difference(shores.grid).area > 1e-6 * area:
+        return None
+    return out
+
+
+def _rings(poly) -> list[np.ndarray]:
+    return [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
+
+
+def _moved(q: np.ndarray, src: list[np.ndarray], dst: list[np.ndarray]) -> np.ndarray:
+    """A point on an edge of one of the rings ``src``: the same point of the edge in ``dst``."""
+    best: tuple[float, int, int, float] = (math.inf, 0, 0, 0.0)
+    for k, r in enumerate(src):
+        a, b = r, np.roll(r, -1, axis=0)
+        d = b - a
+        L2 = np.maximum((d * d).sum(axis=1), 1e-300)
+        t = np.clip(((q - a) * d).sum(axis=1) / L2, 0.0, 1.0)
+        dist = np.hypot(*(a + t[:, None] * d - q).T)
+        i = int(np.argmin(dist))
+        if dist[i] < best[0]:
+            best = (float(dist[i]), k, i, float(t[i]))
+    _, k, i, u = best
+    r = dst[k]
+    return r[i] + u * (r[(i + 1) % len(r)] - r[i])

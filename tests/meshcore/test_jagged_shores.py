@@ -1,0 +1,125 @@
+"""Shores jagged below the cell size: the layout and the grid follow the shore the grid can see.
+
+:mod:`meshcore.layout.shore` smooths a shore where it zig-zags at the scale of the cells; the
+layout reads it smoothed more where it bends back and forth at the scale of block corners.
+Tested on :func:`meshcore.testing.jagged_cells` (random teeth of a given size in cells) of
+the textbook shapes, over seeds: the blocks do not multiply, no cell folds, the grid stays
+orthogonal, and the notes say how far the grid's shore is from the outline.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from shapely.geometry import Point, Polygon, box
+
+from meshcore import testing
+from meshcore.layout import auto_layout
+from meshcore.layout.shore import shore_at_scale, wiggle
+
+
+def _channel(cells: float, seed: int):
+    return testing.jagged_cells(testing.straight_channel(50.0, 1.0), cells, seed)
+
+
+# ------------------------------------------------------------------ the wiggle
+def test_wiggle_is_zero_where_the_shore_turns_one_way():
+    circle = np.asarray(Point(0, 0).buffer(10.0, quad_segs=64).exterior.coords)[:-1]
+    square = np.asarray(box(0, 0, 10, 10).exterior.coords)[:-1]
+    for ring in (circle, square):
+        assert wiggle(ring, 0.5).max() < 1.0
+
+
+def test_wiggle_measures_a_zig_zag():
+    # teeth 0.6 cells apart and 0.3 cells high on a straight line: turns of about ±90° that
+    # are taken back within a cell
+    x = np.arange(0.0, 40.0, 0.3)
+    y = np.where(np.arange(len(x)) % 2, 0.15, -0.15)
+    ring = np.vstack([np.column_stack([x, y]), [[40.0, 10.0], [0.0, 10.0]]])
+    w = wiggle(ring, 0.5)
+    assert np.median(w[5 : len(x) - 5]) > 60.0
+
+
+# ------------------------------------------------------------------ the smoothed shore
+def test_a_clean_shore_is_left_alone():
+    for poly in (testing.straight_channel(), testing.y_junction(), testing.rectangle_with_hole()):
+        h = math.sqrt(poly.area / 10_000)
+        sh = shore_at_scale(poly, h)
+        assert sh.grid is poly and sh.layout is poly and sh.change is None
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_jagged_shore_is_smoothed_to_its_mean_line(seed):
+    clean = testing.straight_channel(50.0, 1.0)
+    poly = testing.jagged_cells(clean, 1.4, seed)
+    h = math.sqrt(poly.area / 10_000)
+    sh = shore_at_scale(poly, h)
+    assert sh.change is not None
+    for p in (sh.grid, sh.layout):
+        assert p.is_valid
+        assert abs(p.area - poly.area) < 0.01 * poly.area  # the teeth are cut from both sides
+        assert wiggle(np.asarray(p.exterior.coords)[:-1], h).max() < 60.0
+    # the grid's shore runs through the teeth: on the whole closer to the clean shore than
+    # the jagged one is (the area between them is smaller)
+    assert sh.grid.symmetric_difference(clean).area < 0.8 * poly.symmetric_difference(clean).area
+    # the reported distance is the distance to the outline as given
+    assert sh.change.hausdorff_cells == pytest.approx(sh.grid.exterior.hausdorff_distance(poly.exterior) / h, abs=0.1)
+    # both shores have the same vertices, in the same order
+    assert len(sh.grid.exterior.coords) == len(sh.layout.exterior.coords)
+
+
+def test_islands_are_smoothed_and_kept():
+    outer = testing.straight_channel(40.0, 10.0)
+    islands = [Point(10, 5).buffer(2.0), Point(28, 5).buffer(1.0)]
+    poly = testing.jagged_cells(Polygon(outer.exterior, [i.exterior for i in islands]), 1.0, 3)
+    h = math.sqrt(poly.area / 10_000)
+    sh = shore_at_scale(poly, h)
+    assert len(sh.grid.interiors) == len(sh.layout.interiors) == 2
+    for a, b in zip(poly.interiors, sh.grid.interiors, strict=True):
+        assert abs(Polygon(b).area - Polygon(a).area) < 0.1 * Polygon(a).area
+
+
+# ------------------------------------------------------------------ layouts
+@pytest.mark.parametrize("cells", [0.7, 1.4, 2.8])
+@pytest.mark.parametrize("seed", range(3))
+def test_a_jagged_straight_channel_stays_a_few_blocks(cells, seed):
+    poly = _channel(cells, seed)
+    lay = auto_layout(poly)
+    assert len(lay.blocks) <= 3
+    assert all(min(b.cells) >= 3 for b in lay.blocks)
+    note = [n for n in lay.notes if "Hausdorff" in n]
+    assert len(note) == 1 and "cells from the outline" in note[0]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_jagged_branched_lakes_keep_their_layout_size(seed):
+    for clean in (testing.y_junction(), testing.channel_network(seed + 1, n_branches=5)):
+        n_clean = len(auto_layout(clean).blocks)
+        lay = auto_layout(testing.jagged_cells(clean, 1.4, seed))
+        assert len(lay.blocks) <= n_clean + 3, (n_clean, len(lay.blocks))
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_jagged_round_lake_with_an_island(seed):
+    clean = testing.round_lake(seed + 5, kind="blob", n_islands=1)
+    poly = testing.jagged_cells(clean, 1.4, seed)
+    lay = auto_layout(poly)
+    assert len(lay.polygon.interiors) == len(poly.interiors)
+    assert len(lay.blocks) <= len(auto_layout(clean).blocks) + 3
+
+
+# ------------------------------------------------------------------ grids
+@pytest.mark.parametrize(("cells", "seed"), [(0.7, 0), (1.4, 1), (2.8, 2)])
+def test_grids_of_a_jagged_channel_are_orthogonal_and_unfolded(cells, seed):
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.quality import lake_metrics
+
+    poly = _channel(cells, seed)
+    mb = mesh_outline(poly)
+    m = lake_metrics(mb, polygon=poly)
+    assert int(m.values("folded").sum()) == 0
+    assert m.share("deviation", 3.0) >= 0.9
+    s = m.summary()
+    assert abs(s["area_ratio"] - 1.0) < 0.01
