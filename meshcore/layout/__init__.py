@@ -32,7 +32,7 @@ from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .model import Layout, LayoutBlock
 from .outline import interior_cuts
 from .polygon import water_polygon, without_slivers
-from .shore import shore_at_scale, transfer
+from .shore import shore_at_scale, transfer, without_narrow_arms
 
 __all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
 
@@ -79,7 +79,8 @@ def auto_layout(
     h = float(cell_size) if cell_size is not None else float(np.sqrt(poly.area / target_cells))
     poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
     poly, slivers = without_slivers(poly, 0.5 * h)
-    more = more + slivers
+    poly, arms = without_narrow_arms(poly, h)
+    more = more + slivers + arms
     shores = shore_at_scale(poly, h)
     if shores.change is not None:
         more.append(shores.change.note())

@@ -40,6 +40,10 @@ WIGGLE = 30.0
 WINDOW = 1.0
 #: The layout's shore is smoothed more within this many cells of a shore jagged at the grid's scale.
 GATE = 8.0
+#: A ring is jagged when this share of its length (and ``GATE`` cells of it at least) wiggles at
+#: the grid's scale (traced outlines: 5-50 %; clean outlines with a few spikes below the cell
+#: size: under 1 %).
+JAGGED_SHARE = 0.03
 #: Gaussian widths tried, in cells.
 WIDTHS = (0.5, 1.0, 1.5, 2.0, 3.0)
 
@@ -182,14 +186,18 @@ def _smooth_ring(ring: np.ndarray, h: float, limit: float, layout: bool):
     """The ring for the grid and the ring for the layout (the same vertices, each moved by its
     own Gaussian), and the largest width of each (in cells); ``ring`` itself where no
     smoothing is needed."""
-    if not (GRID.wiggles(ring, h).any() or (layout and LAYOUT.wiggles(ring, h).any())):
+    if not GRID.wiggles(ring, h).any():
         return ring, ring, 0.0, 0.0
     p = _sampled(ring, 0.25 * h)
     s, total = _arc(p)
+    # only a ring jagged along a good part of its length (a traced outline) is smoothed: a
+    # clean outline's few spikes below the cell size are left to :func:`~.polygon.without_slivers`
+    jag = GRID.wiggles(p, h)
+    if float(np.mean(jag)) < JAGGED_SHARE or jag.sum() * 0.25 < GATE:
+        return ring, ring, 0.0, 0.0
     g = _needed(p, s, total, h, GRID, limit)
-    # the layout reads the shore smoothed more only where it is jagged at the grid's scale
-    # (a clean shore's bends are the lake's own: its bays and points)
-    # (within ``GATE`` cells of it)
+    # the layout reads the shore smoothed more where it is jagged at the grid's scale (within
+    # ``GATE`` cells of it)
     if layout:
         jagged = _spread(s, total, (g > 0).astype(float), GATE * h, mean=False) > 0
         lay = np.where(jagged, np.maximum(g, _needed(p, s, total, h, LAYOUT, limit)), g)
@@ -370,3 +378,48 @@ def _moved(q: np.ndarray, src: list[np.ndarray], dst: list[np.ndarray]) -> np.nd
     _, k, i, u = best
     r = dst[k]
     return r[i] + u * (r[(i + 1) % len(r)] - r[i])
+
+
+def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
+    """The water without its dead-end arms narrower than two cells, and a note naming each.
+
+    An arm narrower than ``2h`` gets fewer than two cells across: as part of the block it
+    leaves, its cells are slivers hundreds of times longer than wide, bent round its walls.
+    No structured grid of cell size ``h`` represents it, so it is cut off where it leaves the
+    water a disc of radius ``h`` can reach (a morphological opening); the note says where, how
+    much water that is, and which cell size would keep it.  Passages between two parts of the
+    lake, or between an island and the shore, are kept (cutting them would change the lake),
+    and so are bits smaller than four cells or shorter than three cells (corners, teeth).
+    """
+    import shapely
+    from shapely.geometry.polygon import orient
+
+    opts = {"join_style": "mitre", "mitre_limit": 10.0}
+    core = poly.buffer(-h, **opts).buffer(h, **opts)
+    if core.is_empty:
+        return poly, []
+    rest = poly.difference(core.buffer(1e-9 * h))
+    parts = [g for g in getattr(rest, "geoms", [rest]) if g.geom_type == "Polygon"]
+    notes = []
+    out = poly
+    for part in sorted(parts, key=lambda g: -g.area):
+        if part.area < 4 * h * h:
+            continue
+        width = 2.0 * part.area / max(part.length, 1e-300)  # a strip's: its area over half its perimeter
+        length = part.area / max(width, 1e-300)
+        if length < 3 * h or width >= 2 * h:
+            continue
+        cut = out.difference(part.buffer(1e-7 * h))
+        cut = shapely.make_valid(cut) if not cut.is_valid else cut
+        if cut.geom_type != "Polygon" or len(cut.interiors) != len(out.interiors):
+            continue  # a passage: the water would fall apart or an island join the shore
+        c = part.representative_point()
+        notes.append(
+            f"an arm about {width / h:.2g} cells wide near ({c.x:.6g}, {c.y:.6g}) is narrower than two cells: "
+            f"left out of the grid ({100 * part.area / poly.area:.2g} % of the water); a cell size of at most "
+            f"{width / 3:.3g} would give it three cells across"
+        )
+        out = cut
+    if out is poly:
+        return poly, []
+    return orient(out.simplify(1e-6 * h), 1.0), notes

@@ -111,6 +111,7 @@ def test_a_jagged_round_lake_with_an_island(seed):
 
 
 # ------------------------------------------------------------------ grids
+@pytest.mark.slow
 @pytest.mark.parametrize(("cells", "seed"), [(0.7, 0), (1.4, 1), (2.8, 2)])
 def test_grids_of_a_jagged_channel_are_orthogonal_and_unfolded(cells, seed):
     from meshcore.lakegrid import mesh_outline
@@ -123,3 +124,55 @@ def test_grids_of_a_jagged_channel_are_orthogonal_and_unfolded(cells, seed):
     assert m.share("deviation", 3.0) >= 0.9
     s = m.summary()
     assert abs(s["area_ratio"] - 1.0) < 0.01
+
+
+# ------------------------------------------------------------------ arms narrower than two cells
+def _basin_with_arm(width: float, h: float = 0.3):
+    import shapely
+    from shapely.geometry import LineString
+
+    arm = LineString([(30 - 1e-9, 15), (36, 15), (40, 18)]).buffer(width / 2, cap_style="flat", quad_segs=4)
+    return shapely.union_all([box(0, 0, 30, 30), arm]).simplify(1e-9)
+
+
+@pytest.mark.parametrize("cells", [0.6, 1.2, 1.8])
+def test_an_arm_narrower_than_two_cells_is_left_out_with_a_note(cells):
+    h = 0.3
+    poly = _basin_with_arm(cells * h, h)
+    lay = auto_layout(poly, cell_size=h)
+    note = [n for n in lay.notes if "narrower than two cells" in n]
+    assert len(note) == 1
+    assert "near (3" in note[0] and "% of the water" in note[0]  # names the place (x ≈ 38)
+    assert not lay.polygon.buffer(1e-9).contains(Point(39.0, 17.25))  # the arm's far end
+    assert lay.polygon.area == pytest.approx(900.0, rel=1e-3)  # the basin is all there
+
+
+@pytest.mark.parametrize("cells", [2.2, 3.0])
+def test_an_arm_two_cells_wide_or_more_is_kept(cells):
+    h = 0.3
+    poly = _basin_with_arm(cells * h, h)
+    lay = auto_layout(poly, cell_size=h)
+    assert not [n for n in lay.notes if "narrower" in n]
+    assert lay.polygon.area == pytest.approx(poly.area, rel=1e-6)
+
+
+def test_a_narrow_passage_between_two_basins_is_kept():
+    import shapely
+
+    from meshcore.layout.shore import without_narrow_arms
+
+    poly = shapely.union_all([box(0, 0, 10, 10), box(15, 0, 25, 10), box(9, 4.8, 16, 5.2)])
+    out, notes = without_narrow_arms(poly, 0.3)
+    assert out is poly and notes == []
+
+
+@pytest.mark.slow
+def test_the_grid_of_a_basin_with_a_narrow_arm_has_no_folds():
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.quality import lake_metrics
+
+    poly = _basin_with_arm(1.2 * 0.3)
+    mb = mesh_outline(poly, cell_size=0.3)
+    m = lake_metrics(mb, polygon=poly)
+    assert int(m.values("folded").sum()) == 0
+    assert m.share("deviation", 3.0) >= 0.9
