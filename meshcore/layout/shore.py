@@ -389,7 +389,8 @@ def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
     water a disc of radius ``h`` can reach (a morphological opening); the note says where, how
     much water that is, and which cell size would keep it.  Passages between two parts of the
     lake, or between an island and the shore, are kept (cutting them would change the lake),
-    and so are bits smaller than four cells or shorter than three cells (corners, teeth).
+    and so are bits smaller than four cells or shorter than three cells (corners, teeth), and
+    the narrow end of a lake that tapers into it (its block's cells narrow with it).
     """
     import shapely
     from shapely.geometry.polygon import orient
@@ -409,6 +410,8 @@ def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
         length = part.area / max(width, 1e-300)
         if length < 3 * h or width >= 2 * h:
             continue
+        if _tapering(core, part, h):
+            continue
         cut = out.difference(part.buffer(1e-7 * h))
         cut = shapely.make_valid(cut) if not cut.is_valid else cut
         if cut.geom_type != "Polygon" or len(cut.interiors) != len(out.interiors):
@@ -423,3 +426,21 @@ def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
     if out is poly:
         return poly, []
     return orient(out.simplify(1e-6 * h), 1.0), notes
+
+
+def _tapering(core: Any, part: Any, h: float) -> bool:
+    """True when ``part`` continues a narrow end of ``core`` (the water a disc of radius ``h``
+    reaches): within four cells of the mouth the core holds no disc of radius 1.75 cells, so
+    the lake narrows into the arm and the block there narrows with it; a side arm leaving a
+    wider channel or a basin is False."""
+    from shapely.ops import polylabel
+
+    mouth = part.buffer(1e-6 * h).intersection(core.boundary)
+    if mouth.is_empty:
+        return False
+    near = core.intersection(mouth.centroid.buffer(4.0 * h))
+    pieces = [g for g in getattr(near, "geoms", [near]) if g.geom_type == "Polygon" and not g.is_empty]
+    if not pieces:
+        return False
+    room = max(pieces, key=lambda g: g.area)
+    return room.exterior.distance(polylabel(room, tolerance=0.05 * h)) < 1.75 * h

@@ -166,6 +166,16 @@ def test_a_narrow_passage_between_two_basins_is_kept():
     assert out is poly and notes == []
 
 
+def test_a_lake_that_tapers_into_a_narrow_end_keeps_it():
+    from meshcore.layout.shore import without_narrow_arms
+
+    h = 0.3
+    # 3 cells wide for 10 cells, narrowing over 6 cells to a tail 0.5 cells wide and 12 long
+    lake = Polygon([(0, 0), (3, 0), (4.8, 0.375), (8.4, 0.375), (8.4, 0.525), (4.8, 0.525), (3, 0.9), (0, 0.9)])
+    out, notes = without_narrow_arms(lake, h)
+    assert out is lake and notes == []
+
+
 @pytest.mark.slow
 def test_the_grid_of_a_basin_with_a_narrow_arm_has_no_folds():
     from meshcore.lakegrid import mesh_outline
