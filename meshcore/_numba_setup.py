@@ -54,6 +54,7 @@ KERNEL_MODULES = (
     "elliptic/_mg_fused.py",
     "elliptic/_mg_lines.py",
     "elliptic/_mg_control.py",
+    "elliptic/_mg_wake.py",
     "multiblock/_kernels.py",
     "foldfree/_kernels.py",
     "orthogonal/_kernels.py",

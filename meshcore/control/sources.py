@@ -40,10 +40,14 @@ class _BorderState:
     ss_n: np.ndarray = field(init=False)
     hw_t: np.ndarray = field(init=False)  # Hilgenstock–White integrators
     hw_n: np.ndarray = field(init=False)
+    gain: np.ndarray = field(init=False)  # adaptive gain multipliers (height, angle) and last error signs
+    sign: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         n = len(self.s_t)
         self.ss_t, self.ss_n, self.hw_t, self.hw_n = (np.zeros(n) for _ in range(4))
+        self.gain = np.ones((2, n))
+        self.sign = np.zeros((2, n))
 
 
 class ControlSources:
@@ -66,9 +70,10 @@ class ControlSources:
     metric_scaled : bool
         True: ``P, Q`` are written as ``(α/D², γ/D²)`` times normalised sources, so a
         solver may re-apply them with the current metric between updates (the
-        multigrid does, see :mod:`meshcore.elliptic._mg_control`).  False with a
-        C-grid wake cut: its nodes move once per update, which the multigrid does
-        not converge (measured: a residual plateau), so it runs as before.
+        multigrid does, see :mod:`meshcore.elliptic._mg_control`).
+    wake_by_solver : bool
+        Set by a solver that relaxes the C-grid wake-cut nodes as unknowns (the
+        multigrid): the updater then leaves them alone.
     """
 
     def __init__(self, spec: ControlSpec, *, periodic: bool = False, curves: Mapping[str, Any] | None = None):
@@ -86,6 +91,12 @@ class ControlSources:
         self._moved = math.inf if spec.floating else 0.0
         self._wake_move = math.inf
         self._initialized = False
+        #: Set by a solver that relaxes the wake-cut nodes itself (the multigrid, see
+        #: :mod:`meshcore.elliptic._mg_wake`): :meth:`update` then leaves them alone.
+        self.wake_by_solver = False
+        #: Set by a solver that converges the grid between updates (the multigrid): the
+        #: feedback gain then adapts per node (see :func:`_adapt`).
+        self.adaptive_gain = False
 
     # -- protocol ---------------------------------------------------------
     def initialize(self, x: np.ndarray, y: np.ndarray, p: np.ndarray, q: np.ndarray) -> None:
@@ -178,15 +189,20 @@ class ControlSources:
 
     @property
     def metric_scaled(self) -> bool:
-        return not self.spec.wake
+        return True
+
+    @property
+    def wake(self) -> int:
+        """Cells of the C-grid wake cut (0: none)."""
+        return self.spec.wake
 
     def wants_update(self, it: int) -> bool:
-        return it % self.spec.every == 0 or (bool(self.spec.wake))
+        return it % self.spec.every == 0 or (bool(self.spec.wake) and not self.wake_by_solver)
 
     def update(self, x: np.ndarray, y: np.ndarray, p: np.ndarray, q: np.ndarray, it: int) -> None:
         """Advance the controls one step and rewrite ``p, q`` (and floating/wake nodes)."""
         sp = self.spec
-        if sp.wake:
+        if sp.wake and not self.wake_by_solver:
             self._wake_move = self._wake_step(x, y) / self.L
             if it % sp.every:
                 return
@@ -203,7 +219,7 @@ class ControlSources:
 
     def settled(self, tol: float = 1e-4) -> bool:
         """True when the last update changed the sources (and nodes) by less than ``tol``."""
-        if self.spec.wake and self._wake_move > self._wake_tol:
+        if self.spec.wake and not self.wake_by_solver and self._wake_move > self._wake_tol:
             return False  # the cut nodes are not in the solver's residual
         if not (self._bstate or self.spec.floating):
             return True
@@ -262,7 +278,7 @@ class ControlSources:
         else:
             g = w
         if g > 0:  # Hilgenstock–White: integral feedback on the measured first cell
-            _feedback(bs, s1[k], ang1[k], lt[k], req_a, g, lim)
+            _feedback(bs, s1[k], ang1[k], lt[k], req_a, g, lim, self.adaptive_gain)
         if not per and len(bs.hw_n) > 5:
             # Next to a corner of angle θc ≠ 90° the first cell cannot be both
             # orthogonal to the two walls and of the requested height (h = d·tan(θc/2)
@@ -403,19 +419,46 @@ def _steger_sorenson(bs: _BorderState, rows: tuple, rt, rtt, lt, per: bool, w: f
     bs.ss_n[k] += w * (np.clip(tgt_n[k], -lim, lim) - bs.ss_n[k])
 
 
-def _feedback(bs: _BorderState, s1, ang1, lt, req_a, g: float, lim: float) -> None:
-    """Hilgenstock–White: integrate the error of the measured first cell (height, angle) at the controlled nodes."""
+#: Adaptive feedback gain: ×GAIN_UP per update while a node's error keeps its sign,
+#: ×GAIN_DOWN (not below 1) when it flips, at most GAIN_MAX.
+GAIN_UP, GAIN_DOWN, GAIN_MAX = 1.25, 0.5, 8.0
+
+
+def _adapt(bs: _BorderState, row: int, e: np.ndarray) -> np.ndarray:
+    """``e`` times the adaptive gain of its nodes (updated from the sign of ``e``).
+
+    With a solver that converges the grid between updates (the multigrid) the
+    first cell responds to the sources at once: an integral feedback then
+    creeps towards the request at a rate set by the gain (measured on the NACA
+    O-grid: 0.98 per update in the tail, 275 updates).  A node whose error keeps
+    its sign gets a larger gain, one that overshoots a smaller one (the rule of
+    resilient back-propagation): same fixed point, fewer updates.
+    """
+    k = bs.idx
+    sg = np.sign(e)
+    prod = sg * bs.sign[row, k]
+    gk = bs.gain[row, k]
+    gk = np.where(prod > 0, np.minimum(gk * GAIN_UP, GAIN_MAX), gk)
+    gk = np.where(prod < 0, np.maximum(gk * GAIN_DOWN, 1.0), gk)
+    bs.gain[row, k] = gk
+    bs.sign[row, k] = sg
+    return e * gk
+
+
+def _feedback(bs: _BorderState, s1, ang1, lt, req_a, g: float, lim: float, adaptive: bool = False) -> None:
+    """Hilgenstock–White: integrate the error of the measured first cell (height, angle) at the controlled
+    nodes (with per-node adaptive gains if ``adaptive``, see :func:`_adapt`)."""
     sigma, rho, along = _FRAME[bs.name]
     k = bs.idx
     req_s = bs.spec.spacing
     if req_s is not None:
         e = np.clip(np.log(np.maximum(s1, 1e-300) / req_s), -1.0, 1.0)
-        bs.hw_n[k] -= sigma * g * e
+        bs.hw_n[k] -= sigma * g * (_adapt(bs, 0, e) if adaptive else e)
     if req_a is not None:
         ar = np.minimum(lt / np.maximum(s1, 1e-300), 50.0)
         err = np.clip(np.angle(np.exp(1j * (req_a - ang1))), -0.5, 0.5)
         sgn = -rho * sigma * (1 if along == "xi" else -1)
-        bs.hw_t[k] += sgn * g * 2.0 * ar * err
+        bs.hw_t[k] += sgn * g * 2.0 * ar * (_adapt(bs, 1, err) if adaptive else err)
     bs.hw_t[k] = np.clip(bs.hw_t[k], -lim, lim)
     bs.hw_n[k] = np.clip(bs.hw_n[k], -lim, lim)
 

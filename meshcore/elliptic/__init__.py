@@ -63,6 +63,11 @@ def warmup(*, multigrid: bool = True, parallel: bool = True) -> None:
         X, Y = np.meshgrid(s, s, indexing="ij")
         X = X + 0.05 * np.sin(np.pi * X) * np.sin(np.pi * Y)
         solve(StructuredGrid(X, Y), method="multigrid", threads=1)
+        from . import _mg_wake  # the C-grid wake cut (x, y copies: the rows of a 5×5 square)
+
+        r = np.zeros(5)
+        _mg_wake.cut_defect(x.copy(), y.copy(), e, e, 2, r, r.copy())
+        _mg_wake.relax_cut(x.copy(), y.copy(), e, e, 2, 1)
     if parallel:
         _kernels.sweep4_parallel(x, y, e, e, 1.0, False)
         r = np.zeros_like(x)

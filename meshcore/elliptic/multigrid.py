@@ -58,7 +58,12 @@ updater whose sources are metric-scaled (wall control, Thomas–Middlecoff) a
 diverged or stalled solve first starts over with the sources following the
 grid on every level, a hierarchy whose coarse sources stay monotone and
 fold-safe corrections (:mod:`._mg_control`: what makes wall-controlled grids
-converge); SOR takes over only if that fails too.
+converge); SOR takes over only if that fails too.  Once a cycle leaves the grid
+converged for the current sources, the control's feedback adapts its gains
+(``adaptive_gain``, see :func:`meshcore.control.sources._adapt`): 117 instead of
+275 updates on the NACA O-grid.  A C-grid wake cut (``control.wake``) is solved
+by the multigrid itself: its nodes are unknowns on every level
+(:mod:`._mg_wake`), not moved once per cycle by the updater.
 """
 
 from __future__ import annotations
@@ -72,6 +77,7 @@ import numpy as np
 
 from . import _mg_control as C
 from . import _mg_kernels as K
+from . import _mg_wake as W
 from .solver import SolverState, _sor, _sources_settled, register_method
 
 __all__ = ["MIN_COARSEN_CELLS", "coarsening", "hierarchy", "multigrid", "multigrid_w"]
@@ -152,7 +158,7 @@ def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) ->
     return ci, cj
 
 
-def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | None = None) -> list:
+def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | None = None, wake: int = 0) -> list:
     """The coarsenings of the grid ``(x, y)``: ``(ci, cj, tables_i, tables_j)`` per level.
 
     Each direction is coarsened as :func:`coarsening` says; a coarse level
@@ -161,7 +167,8 @@ def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | No
     degenerate grid whose FAS correction is noise, so coarsening stops
     before it.  With normalised control sources ``norm = (φ, ψ)`` it also
     stops before a level whose scaled sources lose monotonicity
-    (:func:`._mg_control.coarse_ok`).
+    (:func:`._mg_control.coarse_ok`).  A C-grid wake cut of ``wake`` cells stays
+    nested (:func:`._mg_wake.coarsen_xi_ok`).
     """
     out = []
     pos_i = np.arange(x.shape[0])
@@ -169,6 +176,8 @@ def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | No
     stats = K.cell_stats(x, y, _stride(x))  # (log aspect, folded fraction)
     while True:
         ci, cj = coarsening((x.shape[0] - 1, x.shape[1] - 1), float(np.exp(stats[0])), periodic)
+        if wake and ci and not W.coarsen_xi_ok(x.shape[0] - 1, wake):
+            ci = False
         if not (ci or cj):
             return out
         tab_i = _tables(pos_i, ci, periodic)
@@ -185,6 +194,8 @@ def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | No
             if not C.coarse_ok(*norm):
                 return out
         out.append((ci, cj, tab_i, tab_j))
+        if ci:
+            wake //= 2
         stats = cstats
         x, y = xc, yc
         pos_i, pos_j = tab_i[6], tab_j[6]
@@ -244,6 +255,10 @@ class _Level:
     scale: float = 1.0
     pscale: float = 1.0
     qscale: float = 1.0
+    # C-grid wake cut (see _mg_wake): its cells on this level, the cut defects
+    wake: int = 0
+    rcx: np.ndarray | None = None
+    rcy: np.ndarray | None = None
 
 
 _TABLES: dict = {}
@@ -279,7 +294,9 @@ class _FAS:
         self.controlled = use_pq and controlled
         self.norm: list = []
         norm = C.normalised(state.x, state.y, state.p, state.q, self.periodic) if self.controlled else None
-        plan = _plan(state.x, state.y, self.periodic, norm)
+        # a C-grid wake cut: the multigrid relaxes its nodes on every level (see _mg_wake)
+        self.wake = int(getattr(state.sources, "wake", 0) or 0) if not self.periodic else 0
+        plan = _plan(state.x, state.y, self.periodic, norm, self.wake)
         self.key = (
             state.x.shape,
             self.periodic,
@@ -287,6 +304,7 @@ class _FAS:
             threads,
             gamma,
             self.controlled,
+            self.wake,
             tuple((ci, cj) for ci, cj, _, _ in plan),
         )
         ws = _WORKSPACES.pop(self.key, None)
@@ -339,12 +357,12 @@ class _FAS:
     def _build(self, plan: list, use_pq: bool, threads: int) -> None:
         """Allocate the levels of ``plan``; the fused ones live in flat buffers (:meth:`_pack`)."""
         state = self.state
-        lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q)
+        lv0 = _Level(state.x, state.y, _EMPTY, _EMPTY, state.p, state.q, wake=self.wake)
         self.levels = [lv0]
 
         def fused(shp):  # see _pack: V-cycles fuse every serial coarse level
             par = threads > 1 and shp[0] * shp[1] >= PARALLEL_MIN_NODES
-            return self.gamma == 1 and not par and not self.controlled
+            return self.gamma == 1 and not par and not self.controlled and not self.wake
 
         def new(shp, fuse, zero=False):  # a fused level's arrays are placed by _pack
             if fuse:
@@ -361,14 +379,16 @@ class _FAS:
             b = nj / (shp[1] - 1)
             fine.scale = (a * b) ** 2
             fine.pscale, fine.qscale = 1.0 / a, 1.0 / b
-            if fine is not lv0 or self.periodic:  # level 0's defect is restricted on the fly
+            if fine is not lv0 or self.periodic or self.wake:  # else level 0's defect is restricted on the fly
                 ff = fine is not lv0 and fused(fine.x.shape)
                 fine.rx = new(fine.x.shape, ff)
                 fine.ry = new(fine.x.shape, ff)
             fc = fused(shp)
             pc = new(shp, fc) if use_pq else _EMPTY
             qc = new(shp, fc) if use_pq else _EMPTY
-            self.levels.append(_Level(new(shp, fc), new(shp, fc), new(shp, fc, True), new(shp, fc, True), pc, qc))
+            lv = _Level(new(shp, fc), new(shp, fc), new(shp, fc, True), new(shp, fc, True), pc, qc)
+            lv.wake = fine.wake // 2 if shp[0] < fine.x.shape[0] else fine.wake
+            self.levels.append(lv)
         last = self.levels[-1]
         if last.rx is None and len(self.levels) > 1:
             # scratch for the correction to the next finer level
@@ -378,6 +398,8 @@ class _FAS:
         self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, COARSEST_MAX))
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
+            if lv.wake:
+                lv.rcx, lv.rcy = np.zeros(lv.x.shape[0]), np.zeros(lv.x.shape[0])
         self._pack()
 
     def _pack(self) -> None:
@@ -393,7 +415,7 @@ class _FAS:
         levels = self.levels
         nlev = len(levels)
         self.kfuse = nlev  # no fused levels
-        if self.gamma != 1 or nlev < 2 or self.controlled:
+        if self.gamma != 1 or nlev < 2 or self.controlled or self.wake:
             return
         kf = 1
         while kf < nlev and levels[kf].par:
@@ -502,14 +524,21 @@ class _FAS:
         if sweeps > 0:
             self.updates += sweeps * lv.x.size
             fn = K.smooth_parallel if lv.par else K.smooth
-            fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
+            if not lv.wake:
+                fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)
+                return
+            for _ in range(sweeps):  # the cut nodes after each sweep of the others
+                fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, 1)
+                W.relax_cut(lv.x, lv.y, lv.fx, lv.fy, lv.wake, 1)
 
     def smooth_band(self, lv: _Level, fine: bool) -> None:
         width, sweeps = (BAND_WIDTH, BAND_SWEEPS) if fine else (COARSE_BAND_WIDTH, COARSE_BAND_SWEEPS)
-        if self.controlled:  # the sources follow the grid sweep by sweep
+        if self.controlled or lv.wake:  # the sources follow the grid, the cut relaxes, sweep by sweep
             for _ in range(sweeps):
                 self.follow(lv)
                 K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, width, 1)
+                if lv.wake:
+                    W.relax_cut(lv.x, lv.y, lv.fx, lv.fy, lv.wake, 1)
         elif sweeps > 0:
             K.smooth_band(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, width, sweeps)
 
@@ -540,14 +569,17 @@ class _FAS:
 
     def defect(self, lv: _Level) -> float:
         fn = K.defect_parallel if lv.par else K.defect
-        return fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
+        m = fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, lv.rx, lv.ry)
+        if lv.wake:  # the cut nodes are unknowns too
+            m = max(m, W.cut_defect(lv.x, lv.y, lv.fx, lv.fy, lv.wake, lv.rcx, lv.rcy))
+        return m
 
     def defect_restrict(self, k: int) -> float:
         """Level k's defect measure (largest ``(|f − N|/den)²``), its restriction already in
         level k+1's right-hand side unless periodic (:func:`K.defect_restrict`: no fine
         defect arrays); :meth:`to_coarse` then only adds ``N_c``."""
         f = self.levels[k]
-        if self.periodic:
+        if self.periodic or f.wake:
             self.restricted[k] = False
             return self.defect(f)
         c = self.levels[k + 1]
@@ -566,10 +598,15 @@ class _FAS:
         if not self.restricted[k]:
             restrict = K.restrict_parallel if c.par else K.restrict
             restrict(f.rx, f.ry, f.ri, f.rwi, f.rj, f.rwj, f.scale, c.fx, c.fy)
+            if c.wake:
+                eta = c.x.shape[1] < f.x.shape[1]
+                W.restrict_cut(f.rcx, f.rcy, f.rx, f.ry, f.ri, f.rwi, eta, f.scale, c.wake, c.fx, c.fy)
         self.restricted[k] = False
         self.follow(c)
         add = K.add_operator_parallel if c.par else K.add_operator
         add(c.x, c.y, c.p, c.q, self.periodic, c.fx, c.fy)
+        if c.wake:
+            W.add_cut_operator(c.x, c.y, c.wake, c.fx, c.fy, c.rcx, c.rcy)
 
     def correct(self, k: int) -> None:
         """``u_k += P(u_{k+1} − R̂ u_k)`` (the coarse level's scratch holds the correction)."""
@@ -578,6 +615,8 @@ class _FAS:
         if self.controlled:  # never let the correction collapse a thin cell (see _mg_control)
             x0, y0 = f.x.copy(), f.y.copy()
         fn(f.x, f.y, c.x, c.y, c.rx, c.ry, f.si, f.swi, f.sj, f.swj, f.li, f.lj, f.wli, f.wlj, self.periodic)
+        if f.wake:
+            W.prolong_cut(f.x, f.y, c.rx, c.ry, f.li, f.wli, f.wake)
         if self.controlled:
             C.safe_step(f.x, f.y, x0, y0)
 
@@ -622,6 +661,8 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
     why = ""
     for controlled in (False, True) if retry else (False,):
         mg = _FAS(state, gamma, controlled)
+        if mg.wake:  # the cut nodes are the multigrid's unknowns now, not the updater's
+            state.sources.wake_by_solver = len(mg.levels) > 1
         last_run.clear()
         last_run["levels"] = [lv.x.shape for lv in mg.levels]
         last_run["sources_follow_grid"] = mg.controlled
@@ -638,6 +679,9 @@ def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
         _restart(state)  # the sources-following cycles start over from the start grid
         state.history.clear()
         state.iterations = 0
+    if state.sources is not None:  # SOR leaves the cut to the updater, with fixed gains
+        state.sources.wake_by_solver = False
+        state.sources.adaptive_gain = False
     if why.startswith("diverged"):
         _restart(state)
     state.message = f"multigrid {why}; continued with SOR"
@@ -669,7 +713,7 @@ def _fas_run(state: SolverState, mg: _FAS) -> Generator[str, None, bool | str]:
     if r0 <= tol:
         state.final_residual = r0
         return True
-    if mg.controlled:  # no FMG start: coarse solutions do not hold the wall spacing
+    if mg.controlled or mg.wake:  # no FMG start: coarse solutions do not hold the wall spacing
         mg.smooth(lv0, PRE)
         return (yield from _cycles(state, mg, r0))
     for k in range(1, len(levels)):
@@ -728,6 +772,9 @@ def _cycles(state: SolverState, mg: _FAS, r0: float) -> Generator[str, None, boo
         if it == cfg.max_iterations:
             break
         if state.sources is not None and state.sources.wants_update(it):
+            # a grid converged for the current sources responds to the next update at once:
+            # the feedback may then adapt its gains (see meshcore.control.sources._adapt)
+            state.sources.adaptive_gain = mg.controlled and r <= tol
             state.sources.update(state.x, state.y, state.p, state.q, it)
             mg.restrict_sources()
             mg.defect_restrict(0)
