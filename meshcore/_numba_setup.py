@@ -56,6 +56,8 @@ KERNEL_MODULES = (
     "elliptic/_mg_control.py",
     "elliptic/_mg_wake.py",
     "multiblock/_kernels.py",
+    "multiblock/_mg_fused.py",
+    "multiblock/_hier_kernels.py",
     "foldfree/_kernels.py",
     "orthogonal/_kernels.py",
 )

@@ -43,8 +43,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from . import _hier_kernels as _typed_hk
 from .nodemap import solver_tables
 from .topology import MultiBlockTopology
+
+#: The numba kernels (``Any``: mypy's numba stubs reject some calls).
+_hk: Any = _typed_hk
 
 __all__ = ["MIN_CELLS", "Level", "levels", "prolong_reference", "restrict_reference", "select"]
 
@@ -78,6 +82,7 @@ class Level:
     rsum: np.ndarray | None = None  # row sums of Pᵀ (restriction normalisation)
     P: Any = None  # prolongation from this (coarse) level to the finer one (sparse)
     R: Any = None  # restriction D⁻¹ Pᵀ from the finer level to this one (sparse)
+    packed: Any = None  # finest level: the hierarchy in the flat buffers of the fused cycle
 
     @property
     def shapes(self) -> list[tuple[int, int]]:
@@ -123,11 +128,25 @@ def _positions(ids: tuple[np.ndarray, ...]) -> tuple[list[np.ndarray], np.ndarra
         lines += [ei, ej]
         gid += [g[:, 0], g[:, -1], g[0, :], g[-1, :]]
         el += [ei, ei, ej, ej]
+    gid_a, el_a = np.concatenate(gid).astype(np.int64), np.concatenate(el).astype(np.int64)
+    return lines, _hk.position_classes(el_a, gid_a, total, int(gid_a.max()) + 1)
+
+
+def positions_reference(ids: tuple[np.ndarray, ...]) -> np.ndarray:
+    """The classes of :func:`_positions` as connected components of a graph (reference; the
+    numbering may differ)."""
+    gid, el = [], []
+    total = 0
+    for g in ids:
+        ni, nj = g.shape
+        ei, ej = total + np.arange(ni), total + ni + np.arange(nj)
+        total += ni + nj
+        gid += [g[:, 0], g[:, -1], g[0, :], g[-1, :]]
+        el += [ei, ei, ej, ej]
     gid_a, el_a = np.concatenate(gid), np.concatenate(el)
     n = total + int(gid_a.max()) + 1
     graph = sp.coo_matrix((np.ones(len(el_a), dtype=np.int8), (el_a, total + gid_a)), shape=(n, n))
-    _, comp = connected_components(graph, directed=False)
-    return lines, comp[:total]
+    return connected_components(graph, directed=False)[1][:total]
 
 
 def select(ids: tuple[np.ndarray, ...]) -> list | None:
@@ -145,16 +164,23 @@ def select(ids: tuple[np.ndarray, ...]) -> list | None:
     a = np.concatenate([c[:-1] for c in cl])
     b = np.concatenate([c[1:] for c in cl])
     adj = sp.csr_matrix((np.ones(2 * len(a)), (np.r_[a, b], np.r_[b, a])), shape=(nc, nc))
+    state = np.where(forced, 1, 0).astype(np.int64)  # 0 undecided, 1 kept, 2 dropped
+    line_ptr = np.concatenate([[0], np.cumsum([len(c) for c in cl])]).astype(np.int64)
+    _hk.greedy_drop(np.concatenate(cl).astype(np.int64), line_ptr, adj.indptr.astype(np.int64),
+                    adj.indices.astype(np.int64), state)  # fmt: skip
+    kept = state != 2
+    if kept.all():
+        return None
+    return [(np.flatnonzero(kept[cl[2 * k]]), np.flatnonzero(kept[cl[2 * k + 1]])) for k in range(len(ids))]
+
+
+def greedy_reference(cl: list[np.ndarray], adj: Any, state: np.ndarray) -> None:
+    """The greedy choice of :func:`select` in Python (reference of :func:`._hier_kernels.greedy_drop`)."""
     ptr, nbr = adj.indptr.tolist(), adj.indices.tolist()
-    state = np.where(forced, 1, 0).tolist()  # 0 undecided, 1 kept, 2 dropped
     for c in cl:
         for q in c[1:-1].tolist():
             if state[q] == 0:
                 state[q] = 1 if any(state[v] == 2 for v in nbr[ptr[q] : ptr[q + 1]]) else 2
-    kept = np.asarray(state) != 2
-    if kept.all():
-        return None
-    return [(np.flatnonzero(kept[cl[2 * k]]), np.flatnonzero(kept[cl[2 * k + 1]])) for k in range(len(ids))]
 
 
 def _interp_1d(n_fine: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -187,14 +213,20 @@ def _transfers(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarray]:
     interface values only), so summing each block's rows weighted by ``1/mult`` gives that row
     once: ``P``; the restriction is its transpose normalised by the row sums.
     """
-    rows, cols, vals = [], [], []
-    for gf, gc, (si, sj) in zip(fine.ids, coarse.ids, coarse.sel, strict=True):
-        lf, lc, w = _block_interp(gf.shape, si, sj)
-        r = gf.ravel()[lf]
-        rows.append(r)
-        cols.append(gc.ravel()[lc])
-        vals.append(w / fine.mult[r])
-    r, c, v = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    off = lambda parts: np.concatenate([[0], np.cumsum([len(p) for p in parts])]).astype(np.int64)  # noqa: E731
+    si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
+    r, c, v = _hk.interp_coo(
+        np.concatenate([g.ravel() for g in fine.ids]),
+        off([g.ravel() for g in fine.ids]),
+        np.array([g.shape for g in fine.ids], dtype=np.int64),
+        np.concatenate([g.ravel() for g in coarse.ids]),
+        off([g.ravel() for g in coarse.ids]),
+        np.concatenate(si).astype(np.int64),
+        off(si),
+        np.concatenate(sj).astype(np.int64),
+        off(sj),
+        fine.mult,
+    )
     P = sp.csr_matrix((v, (r, c)), shape=(fine.n, coarse.n))
     Pt = P.T.tocsr()
     rsum = np.asarray(Pt.sum(axis=1)).ravel()
@@ -226,7 +258,7 @@ def _coarser(lv: Level) -> Level | None:
         return None
     cuts = np.cumsum([s.size for s in sub])[:-1]
     ids = tuple(part.reshape(s.shape).astype(np.int64) for part, s in zip(np.split(inv, cuts), sub, strict=True))
-    args, n_interior = solver_tables(ids, len(inj))
+    args, n_interior = solver_tables(ids, len(inj), ~lv.free[inj])
     co = _level(ids, len(inj), args, n_interior)
     co.sel, co.inj = tuple(sel), inj.astype(np.int64)
     co.scale = _scale(co)

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from . import _kernels as _typed_kernels
+from . import _mg_fused as _typed_fused
 from .hierarchy import Level, levels
 from .topology import MultiBlockTopology
 
@@ -54,6 +55,7 @@ __all__ = ["iterate_fas", "levels"]
 
 #: The numba kernels (``Any``: mypy's numba stubs reject calls with ``*args``).
 _kernels: Any = _typed_kernels
+_fused: Any = _typed_fused
 
 #: ``engine="auto"`` leaves multigrid for SOR when a cycle reduces the defect by less than
 #: this (SOR reduces by ≈ 0.96 per sweep on the lake examples, 0.96¹⁶ ≈ 0.5, and a cycle costs
@@ -83,7 +85,8 @@ def _smooth(lv: Level, x, y, fx, fy, steps: int) -> None:
             _kernels.table_sweep_rhs(x, y, fx, fy, *lv.border, 1.0)
 
 
-def _cycle(lvs: list[Level], k: int, x, y, fx, fy) -> None:
+def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy) -> None:
+    """One V-cycle from level ``k``, kernel by kernel (the reference of :func:`_cycle`)."""
     lv = lvs[k]
     if k == len(lvs) - 1:
         # SOR until the defect dropped by COARSEST_REDUCTION (checked every 10 sweeps)
@@ -110,10 +113,71 @@ def _cycle(lvs: list[Level], k: int, x, y, fx, fy) -> None:
     fcx[~co.free] = 0.0
     fcy[~co.free] = 0.0
     ux, uy = vx.copy(), vy.copy()
-    _cycle(lvs, k + 1, ux, uy, fcx, fcy)
+    _cycle_reference(lvs, k + 1, ux, uy, fcx, fcy)
     x += co.P @ (ux - vx)
     y += co.P @ (uy - vy)
     _smooth(lv, x, y, fx, fy, POST)
+
+
+def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(fb, ib, meta)``: the levels in the flat buffers of :mod:`._mg_fused` (node values zero)."""
+    F = _typed_fused
+    meta = np.zeros((len(lvs), F.META_COLS), dtype=np.int64)
+    ints: list[np.ndarray] = []
+    floats: list[np.ndarray] = []
+    sizes = [0, 0]
+
+    def put(col: int, a: np.ndarray, is_float: bool = False) -> None:
+        buf = floats if is_float else ints
+        meta[k, col] = sizes[is_float]
+        buf.append(np.ascontiguousarray(a, dtype=np.float64 if is_float else np.int64).ravel())
+        sizes[is_float] += buf[-1].size
+
+    for k, lv in enumerate(lvs):
+        nodes, nbr, irr_n, irr_p, ring = lv.args
+        (rx, px, ax), (ry, py, ay) = lv.lines
+        meta[k, [F.C_N, F.C_NREG, F.C_NINT, F.C_NIRR, F.C_NRING]] = (
+            lv.n,
+            len(nodes),
+            len(nodes) - len(lv.border[0]),
+            len(irr_n),
+            len(ring),
+        )
+        meta[k, [F.C_NROWS, F.C_NL0, F.C_NL]] = len(rx) + len(ry), len(px) - 1, len(px) + len(py) - 2
+        for col, a in ((F.C_NODES, nodes), (F.C_NBR, nbr), (F.C_IRRN, irr_n), (F.C_IRRP, irr_p), (F.C_RING, ring)):
+            put(col, a)
+        put(F.C_ROWS, np.concatenate([rx, ry]))
+        put(F.C_LPTR, np.concatenate([px, py[1:] + len(rx)]))
+        put(F.C_LAXIS, np.concatenate([ax, ay]))
+        for col in (F.C_X, F.C_Y, F.C_FX, F.C_FY, F.C_RX, F.C_RY, F.C_VX, F.C_VY):
+            put(col, np.zeros(lv.n), True)
+        if k == 0:
+            continue
+        assert lv.inj is not None and lv.scale is not None
+        P, R = lv.P, lv.R
+        meta[k, [F.C_PNZ, F.C_RNZ]] = P.nnz, R.nnz
+        for col, a in ((F.C_INJ, lv.inj), (F.C_FREE, lv.free), (F.C_PPTR, P.indptr), (F.C_PIDX, P.indices)):
+            put(col, a)
+        put(F.C_RPTR, R.indptr)
+        put(F.C_RIDX, R.indices)
+        for col, a in ((F.C_SCALE, lv.scale), (F.C_PVAL, P.data), (F.C_RVAL, R.data)):
+            put(col, a, True)
+    return np.concatenate(floats), np.concatenate(ints), meta
+
+
+def _cycle(lvs: list[Level], k: int, x, y, fx, fy) -> None:
+    """One V-cycle from level ``k`` in one compiled call (:func:`._mg_fused.vcycle`)."""
+    lv0 = lvs[0]
+    if lv0.packed is None:
+        lv0.packed = pack(lvs)
+    fb, ib, meta = lv0.packed
+    m, n = meta[k], lvs[k].n
+    F = _typed_fused
+    for col, a in ((F.C_X, x), (F.C_Y, y), (F.C_FX, fx), (F.C_FY, fy)):
+        fb[m[col] : m[col] + n] = a
+    _fused.vcycle(fb, ib, meta, k, PRE, POST, BORDER_SWEEPS, COARSEST_SWEEPS, COARSEST_REDUCTION, COARSEST_MAX_SWEEPS)
+    x[:] = fb[m[F.C_X] : m[F.C_X] + n]
+    y[:] = fb[m[F.C_Y] : m[F.C_Y] + n]
 
 
 def iterate_fas(

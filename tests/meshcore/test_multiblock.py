@@ -846,6 +846,76 @@ def test_multigrid_kernels_match_reference():
     assert np.array_equal(x2[m.boundary], x[m.boundary])
 
 
+@pytest.mark.kernel
+@pytest.mark.parametrize("make", ["star5", "four_blocks", "odd"])
+def test_setup_kernels_match_their_references(make, rect):
+    """The position classes (union–find) are the graph's connected components, and the greedy
+    choice of kept classes equals the Python loop, on every level."""
+    import scipy.sparse as sp
+
+    from meshcore.multiblock import _hier_kernels, hierarchy
+
+    if make == "star5":
+        topo = star(5, 9)
+    elif make == "four_blocks":
+        topo = four_blocks(*curved_rectangle(56, 20), 30, 10)
+    else:
+        topo = two_blocks(*curved_rectangle(45, 13), 17)
+    lvs = hierarchy.levels(topo)
+    assert len(lvs) >= 2
+    for lv in lvs:
+        lines, comp = hierarchy._positions(lv.ids)
+        ref = hierarchy.positions_reference(lv.ids)
+        pairs = np.unique(np.c_[comp, ref], axis=0)  # one-to-one: the same partition
+        assert len(pairs) == len(np.unique(comp)) == len(np.unique(ref))
+        cl = [comp[e] for e in lines]
+        nc = int(comp.max()) + 1
+        a = np.concatenate([c[:-1] for c in cl])
+        b = np.concatenate([c[1:] for c in cl])
+        adj = sp.csr_matrix((np.ones(2 * len(a)), (np.r_[a, b], np.r_[b, a])), shape=(nc, nc))
+        state = np.zeros(nc, dtype=np.int64)
+        state[[c[0] for c in cl] + [c[-1] for c in cl]] = 1
+        expect = state.copy()
+        hierarchy.greedy_reference(cl, adj, expect)
+        ptr = np.concatenate([[0], np.cumsum([len(c) for c in cl])]).astype(np.int64)
+        _hier_kernels.greedy_drop(
+            np.concatenate(cl), ptr, adj.indptr.astype(np.int64), adj.indices.astype(np.int64), state
+        )
+        assert np.array_equal(state, expect) and (state == 2).any() and (state == 1).any()
+
+
+@pytest.mark.kernel
+@pytest.mark.parametrize("make", ["star5", "four_blocks", "stretched"])
+def test_fused_cycle_equals_the_kernel_by_kernel_cycle(make, rect):
+    """The V-cycle in one compiled call gives the iterates of the Python driver (same kernels,
+    same order): every level, irregular corners, odd counts, clustered rows."""
+    from meshcore.multiblock import multigrid
+    from meshcore.multiblock.hierarchy import levels
+
+    if make == "star5":
+        topo = star(5, 9)
+    elif make == "four_blocks":
+        topo = four_blocks(*curved_rectangle(56, 20), 30, 10)
+    else:
+        X, Y = _stretched(60, 12, 30.0)
+        topo = two_blocks(X, Y, 23)
+    lvs = levels(topo)
+    assert len(lvs) >= 3
+    m = topo.node_map
+    x = np.empty(m.n_nodes)
+    y = np.empty(m.n_nodes)
+    for g, ids in zip(meshcore.multiblock.initial_grids(topo), m.ids, strict=True):
+        x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
+    z = np.zeros(m.n_nodes)
+    xr, yr = x.copy(), y.copy()
+    x0 = x.copy()
+    for _ in range(3):
+        multigrid._cycle(lvs, 0, x, y, z, z)
+        multigrid._cycle_reference(lvs, 0, xr, yr, z, z)
+        assert np.abs(x - xr).max() <= 1e-12 * topo.size and np.abs(y - yr).max() <= 1e-12 * topo.size
+    assert np.abs(x - x0).max() > 1e-3 * topo.size  # the cycles moved the grid
+
+
 @pytest.mark.parametrize("make", ["star5", "four_blocks", "odd"])
 def test_sparse_transfers_match_the_blockwise_reference(make, rect):
     """The global sparse P and R equal the block-by-block interpolation and its normalised
