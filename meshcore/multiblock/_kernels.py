@@ -184,55 +184,60 @@ def line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, ptr, axis):  # pragma: no cov
     m_max = 0
     for L in range(ptr.shape[0] - 1):
         m_max = max(m_max, ptr[L + 1] - ptr[L])
-    c = np.empty(m_max)
+    cp = np.empty(m_max)
     bx = np.empty(m_max)
     by = np.empty(m_max)
-    cp = np.empty(m_max)
+    pp = np.empty(m_max, dtype=np.int64)
     dmax = 0.0
     for L in range(ptr.shape[0] - 1):
-        lo_k, hi_k = (1, 0) if axis[L] == 0 else (3, 2)
+        along_xi = axis[L] == 0
+        lo_k, hi_k = (1, 0) if along_xi else (3, 2)
         m = ptr[L + 1] - ptr[L]
+        # one pass: the frozen coefficients at t and the forward elimination (rows (−c_t, 1, −c_t))
         for t in range(m):
             k = rows[ptr[L] + t]
             p = nodes[k]
+            pp[t] = p
             nb = nbr[k]
             sx, sy, den, xxi, yxi, xet, yet = winslow(
                 x[nb[0]], x[nb[1]], x[nb[2]], x[nb[3]], x[nb[4]], x[nb[5]], x[nb[6]], x[nb[7]],
                 y[nb[0]], y[nb[1]], y[nb[2]], y[nb[3]], y[nb[4]], y[nb[5]], y[nb[6]], y[nb[7]],
             )  # fmt: skip
-            lo, hi = nb[lo_k], nb[hi_k]
             if den <= 0.0:
-                c[t] = 0.0
-                bx[t] = x[p]
-                by[t] = y[p]
-                continue
-            w = (xet * xet + yet * yet) if axis[L] == 0 else (xxi * xxi + yxi * yxi)
-            ct = w / den
-            c[t] = ct
-            bx[t] = sx / den - ct * (x[lo] + x[hi])
-            by[t] = sy / den - ct * (y[lo] + y[hi])
-            if use_f:
-                bx[t] += fx[p]
-                by[t] += fy[p]
+                ct = 0.0
+                b_x = x[p]
+                b_y = y[p]
+            else:
+                lo, hi = nb[lo_k], nb[hi_k]
+                w = (xet * xet + yet * yet) if along_xi else (xxi * xxi + yxi * yxi)
+                inv_den = 1.0 / den
+                ct = w * inv_den
+                b_x = sx * inv_den - ct * (x[lo] + x[hi])
+                b_y = sy * inv_den - ct * (y[lo] + y[hi])
+                if use_f:
+                    b_x += fx[p]
+                    b_y += fy[p]
+                if t == 0:
+                    b_x += ct * x[lo]
+                    b_y += ct * y[lo]
+                if t == m - 1:
+                    b_x += ct * x[hi]
+                    b_y += ct * y[hi]
             if t == 0:
-                bx[t] += ct * x[lo]
-                by[t] += ct * y[lo]
-            if t == m - 1:
-                bx[t] += ct * x[hi]
-                by[t] += ct * y[hi]
-        # Thomas: rows (−c_t, 1, −c_t); forward elimination then back substitution
-        piv = 1.0
-        for t in range(m):
-            if t > 0:
-                piv = 1.0 - c[t] * cp[t - 1]
-                bx[t] = (bx[t] + c[t] * bx[t - 1]) / piv
-                by[t] = (by[t] + c[t] * by[t - 1]) / piv
-            cp[t] = c[t] / piv
-        for t in range(m - 2, -1, -1):
-            bx[t] += cp[t] * bx[t + 1]
-            by[t] += cp[t] * by[t + 1]
-        for t in range(m):
-            p = nodes[rows[ptr[L] + t]]
+                cp[t] = ct
+                bx[t] = b_x
+                by[t] = b_y
+            else:
+                inv = 1.0 / (1.0 - ct * cp[t - 1])
+                cp[t] = ct * inv
+                bx[t] = (b_x + ct * bx[t - 1]) * inv
+                by[t] = (b_y + ct * by[t - 1]) * inv
+        # back substitution, written back as it goes
+        for t in range(m - 1, -1, -1):
+            if t < m - 1:
+                bx[t] += cp[t] * bx[t + 1]
+                by[t] += cp[t] * by[t + 1]
+            p = pp[t]
             dx = bx[t] - x[p]
             dy = by[t] - y[p]
             x[p] = bx[t]
