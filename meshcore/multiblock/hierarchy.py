@@ -258,7 +258,7 @@ def _coarser(lv: Level) -> Level | None:
         return None
     cuts = np.cumsum([s.size for s in sub])[:-1]
     ids = tuple(part.reshape(s.shape).astype(np.int64) for part, s in zip(np.split(inv, cuts), sub, strict=True))
-    args, n_interior = solver_tables(ids, len(inj), ~lv.free[inj])
+    args, n_interior = solver_tables(ids, len(inj))
     co = _level(ids, len(inj), args, n_interior)
     co.sel, co.inj = tuple(sel), inj.astype(np.int64)
     co.scale = _scale(co)

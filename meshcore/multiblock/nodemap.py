@@ -267,18 +267,12 @@ def node_xy(blocks: Sequence[Any], ids: Sequence[np.ndarray], n: int) -> tuple[f
     return (math.nan, math.nan)
 
 
-def solver_tables(ids: Sequence[np.ndarray], n_nodes: int, boundary: np.ndarray | None = None) -> tuple[tuple, int]:
+def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
     """``(args, n_interior)``: the table arguments ``(nodes, nbr, irr_nodes, irr_ptr, irr_ring)`` of
     blocks given only by their global ids (a multigrid coarse level); ``nodes[:n_interior]`` are
-    block-interior nodes.  ``boundary`` (bool per node), when known, skips finding it from the
-    cells and checking them (a coarse level: its fine level was checked)."""
+    block-interior nodes."""
     ids = tuple(ids)
-    if boundary is None:
-        cells, _, boundary = _cells([f"#{k}" for k in range(len(ids))], ids, n_nodes)
-    else:
-        cells = np.vstack(
-            [np.stack([g[:-1, :-1], g[1:, :-1], g[1:, 1:], g[:-1, 1:]], axis=-1).reshape(-1, 4) for g in ids]
-        ).astype(np.int64)
+    cells, _, boundary = _cells([f"#{k}" for k in range(len(ids))], ids, n_nodes)
     occ = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n_nodes)  # a block's ids are unique
     nodes_l, nbr_l = _interior_stencils(ids)
     border_free = np.flatnonzero(~boundary & (occ > 1))
