@@ -40,6 +40,7 @@ __all__ = ["META_COLS", "vcycle"]
     C_NL,  # all lines (ξ then η)
     C_PNZ,  # nonzeros of P (coarse levels)
     C_RNZ,  # nonzeros of R (coarse levels)
+    C_NBAND,  # regular nodes near the fixed boundary
     C_NODES,  # ib offsets from here on
     C_NBR,
     C_IRRN,
@@ -54,6 +55,8 @@ __all__ = ["META_COLS", "vcycle"]
     C_PIDX,
     C_RPTR,
     C_RIDX,
+    C_BNODES,
+    C_BNBR,
     C_X,  # fb offsets from here on
     C_Y,
     C_FX,
@@ -65,8 +68,8 @@ __all__ = ["META_COLS", "vcycle"]
     C_SCALE,
     C_PVAL,
     C_RVAL,
-) = range(35)
-META_COLS = 35
+) = range(38)
+META_COLS = 38
 
 
 @njit(cache=True, nogil=True)
@@ -76,8 +79,9 @@ def _f(fb, m, col):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _smooth(fb, ib, m, steps, border_sweeps):  # pragma: no cover - compiled
-    """``steps`` smoothing steps on one level: point sweep, lines along ξ, along η, border sweeps."""
+def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover - compiled
+    """``steps`` smoothing steps on one level: point sweep, lines along ξ, along η, border sweeps,
+    sweeps over the band next to the fixed boundary."""
     x, y, fx, fy = _f(fb, m, C_X), _f(fb, m, C_Y), _f(fb, m, C_FX), _f(fb, m, C_FY)
     nodes = ib[m[C_NODES] : m[C_NODES] + m[C_NREG]]
     nbr = ib[m[C_NBR] : m[C_NBR] + 8 * m[C_NREG]].reshape((m[C_NREG], 8))
@@ -88,12 +92,17 @@ def _smooth(fb, ib, m, steps, border_sweeps):  # pragma: no cover - compiled
     lptr = ib[m[C_LPTR] : m[C_LPTR] + m[C_NL] + 1]
     axis = ib[m[C_LAXIS] : m[C_LAXIS] + m[C_NL]]
     nl0, nint = m[C_NL0], m[C_NINT]
+    band = ib[m[C_BNODES] : m[C_BNODES] + m[C_NBAND]]
+    band_nbr = ib[m[C_BNBR] : m[C_BNBR] + 8 * m[C_NBAND]].reshape((m[C_NBAND], 8))
+    no_irr = irr_p[:1]
     for _ in range(steps):
         table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_n, irr_p, ring, 1.0)
         line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[: nl0 + 1], axis[:nl0])
         line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[nl0:], axis[nl0:])
         for _ in range(border_sweeps):
             table_sweep_rhs(x, y, fx, fy, nodes[nint:], nbr[nint:], irr_n, irr_p, ring, 1.0)
+        for _ in range(band_sweeps):
+            table_sweep_rhs(x, y, fx, fy, band, band_nbr, irr_n[:0], no_irr, ring[:0], 1.0)
 
 
 @njit(cache=True, nogil=True)
@@ -192,12 +201,12 @@ def _correct(fb, ib, fine, co):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def vcycle(fb, ib, meta, k0, pre, post, border_sweeps, c_min, c_reduction, c_max):  # pragma: no cover
+def vcycle(fb, ib, meta, k0, pre, post, border_sweeps, band_sweeps, c_min, c_reduction, c_max):  # pragma: no cover
     """One FAS V(``pre``, ``post``) cycle from level ``k0`` (its ``x, y, f`` set in ``fb``)."""
     last = meta.shape[0] - 1
     for k in range(k0, last):
         m = meta[k]
-        _smooth(fb, ib, m, pre, border_sweeps)
+        _smooth(fb, ib, m, pre, border_sweeps, band_sweeps)
         rx, ry = _f(fb, m, C_RX), _f(fb, m, C_RY)
         rx[:] = 0.0
         ry[:] = 0.0
@@ -206,4 +215,4 @@ def vcycle(fb, ib, meta, k0, pre, post, border_sweeps, c_min, c_reduction, c_max
     _coarsest(fb, ib, meta[last], c_min, c_reduction, c_max)
     for k in range(last - 1, k0 - 1, -1):
         _correct(fb, ib, meta[k], meta[k + 1])
-        _smooth(fb, ib, meta[k], post, border_sweeps)
+        _smooth(fb, ib, meta[k], post, border_sweeps, band_sweeps)

@@ -884,6 +884,25 @@ def test_setup_kernels_match_their_references(make, rect):
         assert np.array_equal(state, expect) and (state == 2).any() and (state == 1).any()
 
 
+def test_band_is_the_nodes_two_stencil_steps_from_the_boundary():
+    """The smoother's boundary band holds exactly the regular free nodes whose 8-point stencil
+    reaches a fixed node within BAND_WIDTH steps (breadth-first search over the stencils)."""
+    from meshcore.multiblock import hierarchy
+
+    for lv in hierarchy.levels(star(5, 9))[:2]:
+        nodes, nbr = lv.args[0], lv.args[1]
+        stencil = {int(p): {int(q) for q in row} for p, row in zip(nodes, nbr, strict=True)}
+        dist = {int(p): 0 for p in np.flatnonzero(~lv.free)}
+        for d in range(1, hierarchy.BAND_WIDTH + 1):
+            for p, row in stencil.items():
+                if p not in dist and any(dist.get(q) == d - 1 for q in row):
+                    dist[p] = d
+        expect = sorted(p for p in stencil if p in dist)
+        assert sorted(lv.band[0].tolist()) == expect
+        assert 0 < len(expect) < len(nodes)
+        assert np.array_equal(lv.band[1], nbr[np.isin(nodes, lv.band[0])])
+
+
 @pytest.mark.kernel
 @pytest.mark.parametrize("make", ["star5", "four_blocks", "stretched"])
 def test_fused_cycle_equals_the_kernel_by_kernel_cycle(make, rect):
