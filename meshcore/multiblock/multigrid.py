@@ -37,9 +37,10 @@ Each smoothing step ends with :data:`BAND_SWEEPS` point sweeps over the nodes
 next to the fixed boundary (:func:`.hierarchy._band`), where the error a cycle
 leaves is largest on the lake layouts.
 
-Measured (``benchmarks/robust.py``, Shasta examples and automatic lake
-layouts): 4–6 V(2, 2) cycles with rates 0.05–0.26 per cycle (4–9 cycles, rates
-up to 0.36 without the band sweeps), where the point smoother with
+The first cycle is a full-multigrid start (:func:`_fmg`).  Measured
+(``benchmarks/robust.py``, Shasta examples and automatic lake layouts): 3–6
+cycles with rates 0.05–0.26 per cycle (4–9 V(2, 2) cycles, rates up to 0.36,
+without the band sweeps and the full-multigrid start), where the point smoother with
 semi-coarsening reduced by 0.5–0.8 per cycle and ``engine="auto"`` switched to
 SOR.  The cycle runs in one compiled call (:mod:`._mg_fused`); :func:`_cycle_reference`
 is the same cycle kernel by kernel (the test oracle).

@@ -25,7 +25,7 @@ r"""Solve a multiblock grid: ``frozen`` or ``smooth`` interfaces.
     ``engine="multigrid"`` (chosen by ``"auto"`` whenever the blocks coarsen at
     all, odd cell counts included) runs a nonlinear FAS multigrid over the
     whole topology with point, line and border Gauss–Seidel as smoother
-    (:mod:`.multigrid`): 4–9 V-cycles instead of hundreds of SOR sweeps; its
+    (:mod:`.multigrid`): 3–6 cycles instead of hundreds of SOR sweeps; its
     hierarchy is cached per block structure, so a re-solve after an edit
     skips the set-up.
 
