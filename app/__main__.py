@@ -20,7 +20,8 @@ def _parser() -> argparse.ArgumentParser:
         "--quality",
         metavar="METRIC",
         default=None,
-        help="colour cells by a quality metric after solving (e.g. skewness)",
+        help="colour cells by a quality metric after solving (e.g. skewness, deviation); the start of "
+        "its name in the Quality panel",
     )
     p.add_argument(
         "--screenshot", metavar="OUT.png", help="render (off screen if there is no display), save a screenshot and exit"
@@ -47,8 +48,32 @@ def _logging() -> None:
     logging.getLogger("app").setLevel(logging.INFO)
 
 
+def quality_label(text: str) -> str:
+    """The colouring metric (a label of :data:`app.document.METRICS`) that ``text`` names.
+
+    Case-insensitive; the start of a label ("deviation", "skew") or of one of its words
+    ("ratio" is ambiguous).  Raises ValueError naming the known labels.
+    """
+    from .document import METRICS
+
+    t = " ".join(text.lower().split())
+    for rule in (lambda lab: lab == t, lambda lab: lab.startswith(t), lambda lab: f" {t}" in f" {lab}"):
+        hits = [lab for lab in METRICS if rule(lab.lower())]
+        if len(hits) == 1:
+            return hits[0]
+        if len(hits) > 1:
+            raise ValueError(f"--quality {text!r} names {len(hits)} metrics: {', '.join(hits)}")
+    raise ValueError(f"--quality {text!r}: no such metric; known: {', '.join(METRICS)}")
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.quality:
+        try:
+            args.quality = quality_label(args.quality)
+        except ValueError as exc:
+            parser.error(str(exc))
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     t0 = time.perf_counter()
@@ -59,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
     warm.start()
 
     import pyqtgraph as pg
-    from PySide6 import QtCore, QtWidgets
+    from PySide6 import QtWidgets
 
     pg.setConfigOptions(antialias=False, background="w", foreground="k")
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
@@ -99,9 +124,7 @@ def main(argv: list[str] | None = None) -> int:
         solve_as_opened(app, win)
         app.processEvents()
         if args.quality:
-            i = win.quality_panel.metric.findText(args.quality, QtCore.Qt.MatchFlag.MatchStartsWith)
-            if i >= 0:
-                win.quality_panel.metric.setCurrentIndex(i)
+            win.quality_panel.metric.setCurrentText(args.quality)
     if args.screenshot:
         for _ in range(5):
             app.processEvents()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from psygnal import Signal
 
 from meshcore import StructuredGrid, quality
@@ -27,6 +28,7 @@ def _layout_shape(layout) -> tuple | None:
 
 
 #: the metrics cells can be coloured by: label → (array of the quality report, colour map)
+DEVIATION = "deviation from 90° (deg)"
 METRICS = {
     "none": None,
     "Jacobian ratio": ("jacobian_ratio", "viridis"),
@@ -35,7 +37,12 @@ METRICS = {
     "aspect ratio": ("aspect_ratio", "viridis"),
     "cell area": ("area", "viridis"),
     "size ratio": ("size_ratio", "viridis"),
+    # the lake modellers' measure (EFDC: < 3°): the largest deviation from 90° at a cell's four nodes,
+    # over every block of a lake grid (as ``meshcore mesh --colour deviation`` draws it)
+    DEVIATION: ("deviation", "magma_r"),
 }
+#: the colour range of :data:`DEVIATION` (degrees; above it, the top colour)
+DEVIATION_LEVELS = (0.0, 10.0)
 
 
 class Document:
@@ -235,11 +242,35 @@ class Document:
             self.colour_changed.emit(label)
 
     def colour_values(self):
-        """``(grid, values, label)`` of the cell colouring, or ``(None, None, "")`` for none."""
+        """``(grid, values, label)`` of the cell colouring of the active block, or ``(None, None, "")``."""
         m = METRICS.get(self.colour_by)
         if m is None or self.quality is None:
             return None, None, ""
+        if self.colour_by == DEVIATION:
+            layers = self.colour_layers()
+            return (*layers[0], self.colour_by) if layers else (None, None, "")
         return self.quality_grid, self.quality.arrays[m[0]], self.colour_by
+
+    def colour_layers(self) -> list:
+        """``[(grid, values), …]`` of the cell colouring: the active block first, then the lake's other blocks.
+
+        A metric of the block quality colours the active block; :data:`DEVIATION` colours every
+        block of a lake grid (its lake metrics), or the active block's grid otherwise.
+        """
+        m = METRICS.get(self.colour_by)
+        if m is None or self.quality is None:
+            return []
+        if self.colour_by != DEVIATION:
+            return [(self.quality_grid, self.quality.arrays[m[0]])]
+        lm, mb = self.lake_metrics, self.multiblock
+        if lm is not None and mb is not None and len(lm.blocks) == len(mb.grids):
+            pairs = [(g, _cell_max(b.deviation)) for g, b in zip(mb.grids, lm.blocks, strict=True)]
+            k = self.active if 0 <= self.active < len(pairs) else 0
+            return [pairs[k], *pairs[:k], *pairs[k + 1 :]]
+        from meshcore.quality.lake import block_metrics
+
+        g = self.quality_grid
+        return [(g, _cell_max(block_metrics(g).deviation))]
 
     @property
     def grid(self) -> StructuredGrid | None:
@@ -265,3 +296,13 @@ class Document:
     def set_path(self, path) -> None:
         self.path = Path(path) if path else None
         self.path_changed.emit(self.path)
+
+
+def _cell_max(nodes: np.ndarray) -> np.ndarray:
+    """Per cell, the largest of a node value at its four corners (NaN where all four are NaN)."""
+    d = np.asarray(nodes, dtype=float)
+    corners = np.stack([d[:-1, :-1], d[1:, :-1], d[1:, 1:], d[:-1, 1:]])
+    out = np.full(corners.shape[1:], np.nan)
+    some = ~np.isnan(corners).all(axis=0)
+    out[some] = np.nanmax(corners[:, some], axis=0)
+    return out

@@ -100,6 +100,7 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
     one lake (an island outside the shore, a ring of fewer than three points).
     """
     from meshcore import crs as mcrs
+    from meshcore.cli.mesh import local_frame
     from meshcore.layout.polygon import water_from_points
 
     ps = pointset
@@ -107,8 +108,8 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
         src = mcrs.LONLAT if ps.crs is None else None
         if frame is not None and frame.crs:
             ps, frame = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)
-        else:
-            ps, frame = mcrs.project(ps, "auto", source_crs=src)
+        else:  # the rule of ``meshcore mesh``: the same local numbers, the same layout and grid
+            ps, frame = local_frame(ps, "auto", source_crs=src)
     outer, islands = water_from_points(ps)
     return np.asarray(outer, float), [np.asarray(r, float) for r in islands], frame
 

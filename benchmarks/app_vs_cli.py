@@ -8,11 +8,21 @@ CLI = what ``meshcore generate CASE`` does after reading its arguments:
 ``generate_case(load_case(CASE))``, timed in this process after one warm-up call.
 App = the main window (offscreen) opens the case, *Generate* is pressed and the clock stops
 when the solver controller reports the grid (every live redraw of the solve included).
-Both use the case's own solver settings.  CPU seconds are counted too (the CLI's thread; the
+Both use the case's own solver settings.
+
+A lake outline (``.kml``, ``.geojson``, ``.csv``…, e.g. ``benchmarks/lakes/taal_lake.kml``) is
+compared the same way on its automatic layout: CLI = the grid and quality stages of ``meshcore
+mesh FILE`` (:func:`meshcore.lakegrid.mesh_layout` of the layout the command makes, then
+:func:`meshcore.quality.lake_metrics`, which the app measures before it shows the grid); app = the window imports
+the file, *Auto layout* runs (not timed), then *Generate* is timed as above.  The run stops with
+an error when the two layouts differ (blocks or cells) or the grids' nodes are not identical.
+
+CPU seconds are counted too (the CLI's thread; the
 app's solver thread): on a loaded machine the two threads of the app wait for each other's
 turn on the GIL and the CPU, so the wall-clock ratio grows with the load while the CPU ratio
 says whether the app does more work.  The lines printed are
-``name<TAB>cli_s<TAB>app_s<TAB>cli_cpu_s<TAB>app_cpu_s`` (medians), for
+``name<TAB>cli_s<TAB>app_s<TAB>cli_cpu_s<TAB>app_cpu_s<TAB>app_process_cpu_s`` (medians; the last
+is every thread of the app during the solve: the solver's, the drawing's), for
 ``benchmarks/robust.py --section app`` to read.
 """
 
@@ -31,7 +41,39 @@ sys.path.insert(0, str(ROOT))
 
 #: Cases of resources/examples: a 7-block lake (multiblock Winslow), a single block with wall
 #: control and an orthogonal-mode multiblock case.
-DEFAULT_CASES = ("shasta-multiblock-fine", "naca0012-ogrid", "bottle-orthogonal")
+DEFAULT_CASES = ("shasta-multiblock-fine", "naca0012-ogrid", "bottle-orthogonal", "taal_lake.kml")
+#: Suffixes read as lake outlines (the rest are case files).
+OUTLINES = (".kml", ".kmz", ".geojson", ".json", ".csv", ".txt", ".shp", ".dxf")
+
+
+def _cli_lake_layout(path: Path):
+    """The layout ``meshcore mesh FILE`` makes (its own reading, projection and cell size)."""
+    import argparse
+
+    from meshcore.cli import mesh
+
+    ns = argparse.Namespace(outline=str(path), crs="auto", source_crs=None, columns=None, cell_size=None, cells=None)
+    say = mesh._Say(quiet=True)
+    poly, _frame = mesh._read(ns, say)
+    h, _ = mesh._cell_size(ns, poly, "")
+    return mesh._layout(ns, poly, h, False, say)
+
+
+def cli_lake_seconds(path: Path, repeats: int):
+    from meshcore.cli.mesh import LEVELS
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
+
+    lay = _cli_lake_layout(path)
+    mesh_layout(lay, levels=LEVELS)  # warm-up
+    ts, cs = [], []
+    for _ in range(repeats):
+        t, c = time.perf_counter(), time.thread_time()
+        mb = mesh_layout(lay, levels=LEVELS)
+        lake_metrics(mb, polygon=lay.polygon, cell_size=lay.cell_size)  # the CLI's quality stage, as the app's
+        ts.append(time.perf_counter() - t)
+        cs.append(time.thread_time() - c)
+    return statistics.median(ts), statistics.median(cs), lay, mb
 
 
 def cli_seconds(path: Path, repeats: int) -> tuple[float, float]:
@@ -47,7 +89,26 @@ def cli_seconds(path: Path, repeats: int) -> tuple[float, float]:
     return statistics.median(ts), statistics.median(cs)
 
 
-def app_seconds(path: Path, repeats: int) -> tuple[float, float]:
+def _lake_layout_in(app, win, path: Path):
+    """Import a lake outline into the window and set its automatic layout (no grid yet)."""
+    from PySide6 import QtCore
+
+    if not win.io.open_path(path):
+        raise SystemExit(f"the app could not open {path}")
+    win.lake_ctl.generate_after = False
+    loop = QtCore.QEventLoop()
+    done: list = []
+    win.lake_ctl.layout_done.connect(lambda lay: (done.append(lay), loop.quit()))
+    if not win.lake_ctl.auto_layout():
+        raise SystemExit(f"the app could not lay out {path}")
+    if not done:
+        loop.exec()
+    if done[-1] is None:
+        raise SystemExit(f"the app's layout of {path} failed: {win.lake_ctl.last_error}")
+    return done[-1]
+
+
+def app_seconds(path: Path, repeats: int, lake: bool = False) -> tuple[float, float, object]:
     from PySide6 import QtCore, QtWidgets
 
     import app.solver_controller as controller
@@ -71,22 +132,43 @@ def app_seconds(path: Path, repeats: int) -> tuple[float, float]:
     win.show()
     loop = QtCore.QEventLoop()  # the app's own event loop waits (no polling that eats a core)
     win.solver.finished.connect(lambda _result: loop.quit())
-    ts = []
+    ts, proc = [], []
     for k in range(repeats + 1):  # the first run warms up like the CLI's
-        if not win.io.open_path(path):
+        if lake:
+            _lake_layout_in(app, win, path)
+        elif not win.io.open_path(path):
             raise SystemExit(f"the app could not open {path}")
         app.processEvents()
-        t = time.perf_counter()
+        t, pc = time.perf_counter(), time.process_time()
         win.generate()
         loop.exec()
+        if k:
+            proc.append(time.process_time() - pc)
         if not win.doc.grids:
             raise SystemExit(f"the app's solve of {path.name} gave no grid ({win.solver.last_error})")
         if k:
             ts.append(time.perf_counter() - t)
     controller.solve_project = solve
+    mb = win.doc.multiblock if lake else None
     win.stack.setClean()
     win.close()
-    return statistics.median(ts), statistics.median(cpu[1:])
+    return statistics.median(ts), statistics.median(cpu[1:]), mb, statistics.median(proc)
+
+
+def same_lake_grid(path: Path, cli_layout, cli_mb, app_mb) -> None:
+    """Stop unless the app made the CLI's layout and grid (nodes equal up to the local origin)."""
+    import numpy as np
+
+    if app_mb is None:
+        raise SystemExit(f"{path.name}: the app kept no multiblock grid")
+    a = [g.cells for g in cli_mb.grids]
+    b = [g.cells for g in app_mb.grids]
+    if a != b:
+        raise SystemExit(f"{path.name}: the layouts differ: CLI {len(a)} blocks {a}, app {len(b)} blocks {b}")
+    for k, (g, h) in enumerate(zip(cli_mb.grids, app_mb.grids, strict=True)):
+        if not (np.array_equal(g.x, h.x) and np.array_equal(g.y, h.y)):
+            d = max(np.abs(g.x - h.x).max(), np.abs(g.y - h.y).max())
+            raise SystemExit(f"{path.name}: block {k}: the grids differ (largest node distance {d:.3g})")
 
 
 def main(argv=None) -> int:
@@ -98,9 +180,16 @@ def main(argv=None) -> int:
         path = Path(name)
         if not path.suffix:
             path = ROOT / "resources" / "examples" / f"{name}.toml"
-        cli, cli_cpu = cli_seconds(path, args.repeats)
-        gui, gui_cpu = app_seconds(path, args.repeats)
-        print(f"{path.stem}\t{cli:.4f}\t{gui:.4f}\t{cli_cpu:.4f}\t{gui_cpu:.4f}", flush=True)
+        if path.suffix.lower() in OUTLINES:
+            if not path.exists():
+                path = ROOT / "benchmarks" / "lakes" / path.name
+            cli, cli_cpu, lay, cli_mb = cli_lake_seconds(path, args.repeats)
+            gui, gui_cpu, app_mb, gui_proc = app_seconds(path, args.repeats, lake=True)
+            same_lake_grid(path, lay, cli_mb, app_mb)
+        else:
+            cli, cli_cpu = cli_seconds(path, args.repeats)
+            gui, gui_cpu, _, gui_proc = app_seconds(path, args.repeats)
+        print(f"{path.stem}\t{cli:.4f}\t{gui:.4f}\t{cli_cpu:.4f}\t{gui_cpu:.4f}\t{gui_proc:.4f}", flush=True)
     return 0
 
 

@@ -92,7 +92,8 @@ class Canvas(pg.PlotWidget):
         self.background_item.hide()
         self.addItem(self.background_item)
 
-        self.quality_item: pg.PColorMeshItem | None = None
+        self.quality_item: pg.PColorMeshItem | None = None  # the active block's colouring
+        self.quality_items: list[pg.PColorMeshItem] = []  # the other blocks' (a lake coloured by deviation)
         self.colorbar: pg.ColorBarItem | None = None
 
         # every cell edge once, drawn as line segments (faster to paint than polylines)
@@ -328,9 +329,14 @@ class Canvas(pg.PlotWidget):
 
     def refresh_quality(self) -> None:
         """Colour the cells and mark the folded ones as the document says."""
-        grid, values, label = self.doc.colour_values()
+        from ..document import DEVIATION, DEVIATION_LEVELS
+
+        layers = self.doc.colour_layers()
+        label = self.doc.colour_by if layers else ""
+        grid, values = layers[0] if layers else (None, None)
+        kw = {"levels": DEVIATION_LEVELS, "cmap": "magma_r"} if label == DEVIATION else {}
         try:
-            self.set_quality(grid, values, label=label)
+            self.set_quality(grid, values, label=label, more=layers[1:], **kw)
         except Exception:  # a drawing problem must not kill the window
             log.exception("cannot colour the cells by %s", label)
             self.doc.message.emit(f"cannot colour cells by {label} (details in the log)")
@@ -435,30 +441,42 @@ class Canvas(pg.PlotWidget):
         levels=None,
         cmap: str = "viridis",
         label: str = "",
+        more=(),
     ) -> None:
-        """Colour the cells of ``grid`` by ``values`` (shape (ni, nj)); None hides it."""
-        if self.quality_item is not None:
-            self.removeItem(self.quality_item)
-            self.quality_item = None
+        """Colour the cells of ``grid`` by ``values`` (shape (ni, nj)); None hides it.
+
+        ``more``: further ``(grid, values)`` pairs coloured on the same scale (the other blocks).
+        """
+        for old in ([self.quality_item] if self.quality_item is not None else []) + self.quality_items:
+            self.removeItem(old)
+        self.quality_item, self.quality_items = None, []
         if grid is None or values is None:
             if self.colorbar is not None:
                 self.colorbar.hide()
             return
         v = np.where(np.isfinite(values), values, np.nan)
         if levels is None:
-            finite = v[np.isfinite(v)]
+            finite = np.concatenate([v[np.isfinite(v)]] + [np.ravel(w)[np.isfinite(np.ravel(w))] for _g, w in more])
             levels = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
             if levels[0] == levels[1]:
                 levels = (levels[0] - 0.5, levels[1] + 0.5)
-        v = np.nan_to_num(v, nan=levels[1])
-        cm = pg.colormap.get(cmap)
-        item = pg.PColorMeshItem(
-            grid.x, grid.y, v, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
-        )
-        item.setZValue(-10)
-        item.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
-        self.addItem(item)
+        cm = pg.colormap.get(cmap.removesuffix("_r"))
+        if cmap.endswith("_r"):
+            cm.reverse()
+
+        def mesh(g, w):
+            w = np.nan_to_num(np.where(np.isfinite(w), w, np.nan), nan=levels[1])
+            it = pg.PColorMeshItem(
+                g.x, g.y, w, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
+            )
+            it.setZValue(-10)
+            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+            self.addItem(it)
+            return it
+
+        item = mesh(grid, v)
         self.quality_item = item
+        self.quality_items = [mesh(g, w) for g, w in more]
         if self.colorbar is None:
             self.colorbar = pg.ColorBarItem(values=levels, colorMap=cm, interactive=False, width=15, label=label)
             self.colorbar.setImageItem(item, insert_in=self.getPlotItem())

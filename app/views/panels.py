@@ -212,7 +212,10 @@ class QualityPanel(QtWidgets.QWidget):
             return
         m = METRICS.get(self.doc.colour_by)
         key, label = (m[0], self.doc.colour_by) if m is not None else ("skewness", "skewness")
-        a = np.asarray(r.arrays[key], float).ravel()
+        if key in r.arrays:
+            a = np.asarray(r.arrays[key], float).ravel()
+        else:  # a measure of the lake metrics: every coloured block's cells
+            a = np.concatenate([np.ravel(v) for _g, v in self.doc.colour_layers()] or [np.zeros(0)])
         a = a[np.isfinite(a)]
         if a.size:
             y, x = np.histogram(a, bins=40)

@@ -7,8 +7,12 @@ The whole of :func:`meshcore.mesh_outline` from the command line::
 1. **read** OUTLINE (any point file: CSV/TXT, KML/KMZ, GeoJSON, shapefile, DXF).  The ring
    with the largest area is the shore; every other ring must lie inside it and is an island
    (GeoJSON interior rings, KML ``innerBoundaryIs``, shapefile holes, extra CSV rings).
-   Lon/lat is projected to the UTM zone of the centroid, or to ``--crs``; the grid is made
-   and written in that CRS's world coordinates (metres, no local offset).
+   Lon/lat is projected to the UTM zone of the centroid, or to ``--crs``, relative to a round
+   local origin (:func:`meshcore.crs.project`'s ``origin="auto"``, what the app does on
+   import): the layout and the grid are computed in these local coordinates, so that the app
+   and this command compute them from the same numbers and give the same blocks and grid
+   (the layout's discrete choices are not translation invariant to the last bit).  Every
+   output holds world coordinates of that CRS (metres, the origin added when writing).
 2. **layout** — :func:`meshcore.layout.auto_layout` at the cell size ``--cell-size`` (default
    ``sqrt(water area / 10 000)``, or ``/ --cells``); a ``.ddb`` output asks for a layout
    without 3- or 5-block corners (``--regular``), the only kind Delft3D can couple.
@@ -204,8 +208,13 @@ def _crs_label(crs: str | None) -> str:
 
 
 def _read(args: argparse.Namespace, say: _Say):
-    """The water polygon in world coordinates of the grid's CRS, and its frame."""
-    from ..crs import is_geographic, normalize_crs, project
+    """The water polygon in local coordinates of the grid's CRS, and its frame (CRS and origin).
+
+    Points projected from lon/lat get the round local origin the app's import gives them
+    (:func:`local_frame`); points kept as they are keep their coordinates (origin 0), as in
+    the app.
+    """
+    from ..crs import is_geographic, normalize_crs
     from ..io import read_points
     from ..layout.polygon import water_from_points, water_polygon
 
@@ -215,7 +224,7 @@ def _read(args: argparse.Namespace, say: _Say):
         if target is not None and is_geographic(target):
             raise InvalidInputError(f"--crs {args.crs}: a geographic CRS (degrees); give a projected one (metres)")
     ps = read_points(args.outline, columns=args.columns, crs=args.source_crs)
-    local, frame = project(ps, target, origin=None, source_crs=args.source_crs)
+    local, frame = local_frame(ps, target, source_crs=args.source_crs)
     if frame.crs is not None and is_geographic(frame.crs):
         raise InvalidInputError(
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
@@ -231,6 +240,36 @@ def _read(args: argparse.Namespace, say: _Say):
     say(f"read {args.outline}: shore of {len(outer)} points, {isl}; {_crs_label(frame.crs)}{where}")
     _notes(notes)
     return poly, frame
+
+
+def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[Any, Any]:
+    """Project a point set for a lake grid: ``(local point set, Frame)``.
+
+    The rule shared by ``meshcore mesh`` and the app's import (:func:`app.lake.read_lake`):
+    points projected from lon/lat go to ``crs`` relative to the round origin of
+    :func:`meshcore.crs.project` (``origin="auto"``); points not projected keep their
+    coordinates.  Subtracting a round origin is exact, so the world coordinates are
+    ``local + origin`` to the last bit.
+    """
+    from ..crs import is_geographic, project
+
+    local, frame = project(ps, crs, origin=None, source_crs=source_crs)
+    src = frame.source_crs
+    if src is not None and is_geographic(src) and frame.crs is not None and frame.crs != src:
+        local, frame = project(ps, crs, origin="auto", source_crs=source_crs)
+    return local, frame
+
+
+def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
+    """The grid, the water and the frame in world coordinates (origin added, frame origin 0)."""
+    from shapely import affinity
+
+    ox, oy = frame.origin
+    if ox == 0.0 and oy == 0.0:
+        return mb, poly, frame
+    grids = tuple(g.replaced(x=g.x + ox, y=g.y + oy) for g in mb.grids)
+    world = dataclasses.replace(frame, origin=(0.0, 0.0))
+    return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
 
 
 def _without_lines_on_the_shore(ps: Any) -> Any:
@@ -408,12 +447,12 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    mb = dataclasses.replace(mb, frame=frame)
-    if args.case:
+    if args.case:  # the layout in its local frame (the case's [crs] table holds the origin)
         from ..case import layout_case, save_case
 
         save_case(layout_case(lay, crs=frame, description=f"made by meshcore mesh from {args.outline}"), args.case)
         say(f"wrote {args.case} (the layout: edit it and run 'meshcore generate {args.case}')")
+    mb, poly, frame = _world(dataclasses.replace(mb, frame=frame), poly, frame)
     m = lake_metrics(mb, polygon=poly, cell_size=h)
     n_folded = int(m.values("folded").sum())
     say(f"quality: {n_folded} folded cells, mean deviation from 90° {m.mean('deviation'):.2f}°, {say.lap():.1f} s")

@@ -30,7 +30,7 @@ def lay_out(qtbot, win, path, cell_size=None):
         win.lake_panel.cell_size.setValue(cell_size)
         win.lake_panel.cell_size.editingFinished.emit()
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None or win.lake_ctl.last_error, timeout=120_000)
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error), timeout=120_000)
     assert win.lake_ctl.last_error is None
     wait_idle(qtbot, win)
     return win.doc.project.layout
@@ -114,27 +114,65 @@ def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
         assert (len(misses) > 0) == any(r.limit.statistic == "each" for r in v.failed)
 
 
-def test_the_same_layout_as_meshcore_mesh(qtbot, win):
-    """The app's layout of a file is the CLI's: same water, cell size, multiple, blocks, cells."""
-    from meshcore.cli.mesh import LEVELS
-    from meshcore.crs import project
-    from meshcore.io import read_points
-    from meshcore.layout import auto_layout
-    from meshcore.layout.polygon import water_from_points, water_polygon
+def _far_synthetic_lake(path: Path) -> Path:
+    """A lobed lake with islands (about 16 km across) as lon/lat GeoJSON far from any UTM origin."""
+    import json
 
+    import pyproj
+
+    from meshcore.testing import lake_with_islands
+
+    poly = lake_with_islands(3, radius=8000.0, n_islands=2)
+    to_lonlat = pyproj.Transformer.from_crs("EPSG:32610", "EPSG:4326", always_xy=True)
+    rings = []
+    for ring in [poly.exterior, *poly.interiors]:
+        xy = np.asarray(ring.coords) + (687_654.321, 5_432_109.876)  # UTM 10 N, near the zone's edge
+        rings.append(np.column_stack(to_lonlat.transform(xy[:, 0], xy[:, 1])).round(7).tolist())
+    path.write_text(json.dumps({"type": "Polygon", "coordinates": rings}))
+    return path
+
+
+@pytest.mark.parametrize("name", ["taal_lake.kml", "lake_iseo_sparse.geojson", "lake_como.csv", "far synthetic"])
+def test_the_same_layout_and_grid_as_meshcore_mesh(qtbot, win, tmp_path, name):
+    """The app's layout and grid of a file are the CLI's: same blocks, cells and nodes to the last bit.
+
+    The layout's discrete choices change with the last bits of the coordinates (a lake
+    shifted by a round number can get another block count), so both compute in the same
+    local frame; the CLI writes world coordinates = local + origin, as the app exports them.
+    """
+    import contextlib
+    import io
+
+    from app.lake import water
+    from meshcore.cli import main
+    from meshcore.io import read_blocks
+
+    path = _far_synthetic_lake(tmp_path / "far.geojson") if name == "far synthetic" else LAKES / name
     win.lake_ctl.generate_after = False
-    assert win.io.import_points(COMO, project_lonlat=True)
+    assert win.io.import_points(path, project_lonlat=True)
+    lake = win.doc.project.lake
+    h = math.sqrt(water(lake.outline, lake.holes)[0].area / 1500)  # ~1500 cells: quick, several blocks
+    win.lake_ctl.set_cell_size(h)
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
-    app = win.doc.project.layout
-    local, _frame = project(read_points(COMO), "auto", origin=None)  # as `meshcore mesh` reads it
-    outer, islands = water_from_points(local)
-    poly, _ = water_polygon(outer, holes=islands)
-    h = math.sqrt(poly.area / 10_000)  # the CLI's default cell size
-    cli = auto_layout(poly, cell_size=h, multiple=2**LEVELS)
-    assert app.cell_size == pytest.approx(h, rel=1e-9)
-    assert [b.cells for b in app.blocks] == [b.cells for b in cli.blocks]
-    assert app.n_cells == cli.n_cells and 8_000 < app.n_cells < 12_000
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error), timeout=120_000)
+    assert win.lake_ctl.last_error is None
+    win.generate()
+    wait_idle(qtbot, win)
+    app_mb = win.doc.multiblock
+    assert app_mb is not None and win.doc.lake_metrics is not None
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()) as err:
+        rc = main(["mesh", str(path), "--cell-size", repr(h), "-o", str(tmp_path / "cli.npz")])
+    assert rc in (0, 3), err.getvalue()
+    cli = read_blocks(tmp_path / "cli.npz")
+    lay = win.doc.project.layout
+    assert len(lay.blocks) > 1
+    assert [g.cells for g in cli.blocks] == [tuple(b.cells) for b in lay.blocks]
+    p = win.doc.project
+    assert cli.frame.crs == p.crs and cli.frame.origin == (0.0, 0.0)  # the CLI writes world coordinates
+    for k, g in enumerate(app_mb.grids):
+        X, Y = cli.world(k)
+        np.testing.assert_array_equal(g.x + p.origin[0], X)
+        np.testing.assert_array_equal(g.y + p.origin[1], Y)
 
 
 def test_layout_undo_redo_and_clear(qtbot, win):
@@ -236,3 +274,43 @@ def test_a_lake_refused_is_a_message(qtbot, win):
     qtbot.waitUntil(lambda: not win.lake_ctl.busy, timeout=60_000)
     assert win.doc.project.layout is None
     assert "Cannot lay out the lake" in win._status.text() and "cell size" in win._status.text()
+
+
+def test_colour_by_deviation_covers_every_block_of_a_lake(qtbot, win):
+    """``--quality deviation`` (and the Quality panel's combo) colours all blocks by the largest
+    deviation from 90° at each cell's nodes, as ``meshcore mesh --colour deviation`` draws it."""
+    from app.__main__ import quality_label
+    from app.document import DEVIATION
+
+    lay = lay_out(qtbot, win, ISEO, cell_size=600.0)
+    assert quality_label("deviation") == DEVIATION and quality_label("Skew") == "skewness"
+    win.quality_panel.metric.setCurrentText(quality_label("deviation"))
+    assert win.doc.colour_by == DEVIATION
+    canvas, m = win.canvas, win.doc.lake_metrics
+    assert canvas.quality_item is not None and len(canvas.quality_items) == len(lay.blocks) - 1
+    layers = win.doc.colour_layers()
+    assert len(layers) == len(lay.blocks)
+    for (g, values), b in zip(layers, [m.blocks[win.doc.active], *m.blocks[1:]], strict=True):
+        d = b.deviation
+        assert values.shape == g.cells
+        i, j = np.unravel_index(np.nanargmax(values), values.shape)
+        assert values[i, j] == np.nanmax(d[i : i + 2, j : j + 2]) == np.nanmax(values)
+        assert np.nanmax(values) == np.nanmax(d)  # every interior node's value is some cell's
+    # the readout under the cursor names the active block's cell
+    g = layers[0][0]
+    cx, cy = g.x[1:3, 1:3].mean(), g.y[1:3, 1:3].mean()
+    assert DEVIATION in win._cell_readout(cx, cy)
+    win.quality_panel.metric.setCurrentText("none")
+    assert canvas.quality_item is None and canvas.quality_items == []
+
+
+def test_an_unknown_quality_metric_on_the_command_line_is_refused(capsys):
+    from app.__main__ import main, quality_label
+
+    with pytest.raises(ValueError, match="known: none, Jacobian ratio"):
+        quality_label("deviaton")
+    with pytest.raises(ValueError, match="names 3 metrics"):
+        quality_label("ratio")
+    with pytest.raises(SystemExit) as exc:
+        main(["--quality", "deviaton", "--screenshot", "never.png"])
+    assert exc.value.code == 2 and "no such metric" in capsys.readouterr().err
