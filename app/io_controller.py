@@ -387,10 +387,15 @@ class IOController(QtCore.QObject):
             self._autosave.start()
 
     def _dragging(self) -> bool:
-        """True while the user drags a point or a layout handle (or its edit is being computed)."""
+        """True while the user drags a point or a layout handle (or its edit is being computed),
+        or while Generate's solve runs: the save (a few tenths of a second of Python on a big
+        lake) would take the solver's turn; the project is saved when the solve ends.  (With
+        auto-generate every edit solves again: edits are saved while they keep coming.)"""
         tool = getattr(getattr(self.win, "canvas", None), "tool", None)
         lake = getattr(self.win, "lake_ctl", None)
-        return bool(getattr(tool, "dragging", False)) or bool(lake is not None and lake.editing)
+        solver = getattr(self.win, "solver", None)
+        solving = solver is not None and solver.state == "running" and not solver.auto
+        return bool(getattr(tool, "dragging", False)) or bool(lake is not None and lake.editing) or solving
 
     def _clean_changed(self, clean: bool) -> None:
         if clean:  # saved (or undone back to the saved state): nothing to recover

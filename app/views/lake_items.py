@@ -106,7 +106,15 @@ class LakeOverlay:
         self.shown_labels = list(texts)
 
     def set_misses(self, points: np.ndarray | None) -> None:
-        """Ring the places that miss the chosen quality preset (None: none)."""
+        """Ring the places that miss the chosen quality preset (None: none).
+
+        The same points again are not set again (a refresh selects the first failed limit and
+        reports it twice; thousands of scatter points take a tenth of a second each time).
+        """
+        old = getattr(self, "_misses_shown", None)
+        if old is not None and points is not None and old.shape == np.shape(points) and np.array_equal(old, points):
+            return
+        self._misses_shown = None if points is None else np.array(points, float)
         set_points(self.misses, points)
 
     def set_drag_point(self, xy) -> None:

@@ -115,3 +115,22 @@ def test_a_bug_in_the_solver_is_logged_with_its_traceback(qtbot, win, caplog, mo
     rec = [r for r in caplog.records if r.exc_info and r.exc_info[0] is ZeroDivisionError]
     assert rec and "broken" in "".join(traceback.format_tb(rec[0].exc_info[2]))
     assert "internal error" in win._status.text() and "ZeroDivisionError" in win._status.text()
+
+
+def test_autosave_waits_for_the_end_of_a_generate_solve(qtbot, win, monkeypatch):
+    """The save (tenths of a second of Python on a big lake) would take the solver's turn: it
+    waits until Generate's solve ends; with auto-generate the edits are saved as they come."""
+    writes = []
+    monkeypatch.setattr(recovery, "write", lambda *a, **k: writes.append(1))
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.editor.set_block_options(weights=(0.3, 0.7))
+    monkeypatch.setattr(win.solver, "state", "running")
+    win.io.autosave()
+    assert writes == [] and win.io._autosave.isActive()  # tried again later
+    win.solver.auto = True
+    win.io.autosave()
+    assert writes == [1]
+    win.solver.auto = False
+    win.editor.set_block_options(weights=(0.4, 0.6))
+    monkeypatch.setattr(win.solver, "state", "idle")
+    qtbot.waitUntil(lambda: len(writes) == 2, timeout=10_000)
