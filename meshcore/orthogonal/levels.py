@@ -93,8 +93,11 @@ def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -
         d = (s2 - s1) % total
         if d > total / 2:  # the short way round
             d -= total
-        p = ring_point(rings[r1], np.array([s1 + d / 2]))[0]
-        _move_if_valid(xs[b], ys[b], ij, p)
+        # halfway along the shore, else elsewhere on the shore between the two (a sharp bend
+        # of the shore between them can leave no convex cell at halfway), else towards halfway
+        at = ring_point(rings[r1], s1 + d * np.array([0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9]))
+        if not any(_moved_to(xs[b], ys[b], ij, p) for p in at):
+            _move_if_valid(xs[b], ys[b], ij, at[0])
     return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)]
 
 
@@ -114,6 +117,16 @@ def _convex_around(x: np.ndarray, y: np.ndarray, ij) -> bool:
                 if ax * by - ay * bx <= 0.0:
                     return False
     return True
+
+
+def _moved_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
+    """Move node ``ij`` to ``p`` if its cells stay convex there; True if it moved."""
+    ox, oy = x[ij], y[ij]
+    x[ij], y[ij] = p[0], p[1]
+    if _convex_around(x, y, ij):
+        return True
+    x[ij], y[ij] = ox, oy
+    return False
 
 
 def _move_if_valid(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> None:
