@@ -84,11 +84,22 @@ def auto_layout(
     shores = shore_at_scale(poly, h)
     if shores.change is not None:
         more.append(shores.change.note())
+    from ..errors import TopologyError
+
+    try:
+        return _layout(shores, h, notes + more, multiple=multiple, regular=regular, normal=True)
+    except TopologyError:
+        # the cuts along the shore's normal can leave T-junctions no integer counts satisfy:
+        # the layout without them (the splits of earlier versions) before giving up
+        return _layout(shores, h, notes + more, multiple=multiple, regular=regular, normal=False)
+
+
+def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bool) -> Layout:
     poly = shores.grid
-    sk, chords, _, pieces = layout_pieces(shores.layout, h, regular=regular)
+    sk, chords, _, pieces = layout_pieces(shores.layout, h, regular=regular, normal=normal)
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
-        sk, chords, _, moved = layout_pieces(poly, h, regular=regular)
+        sk, chords, _, moved = layout_pieces(poly, h, regular=regular, normal=normal)
     pieces = moved
     topo, _ = build_topology(pieces, h, multiple=multiple)
     blocks = tuple(
@@ -108,7 +119,7 @@ def auto_layout(
         multiple=multiple,
         skeleton=sk,
         chords=tuple(chords),
-        notes=tuple(notes) + tuple(more),
+        notes=tuple(notes),
     )
     _check_case(lay)
     return lay

@@ -108,10 +108,11 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
 
 
 def layout_pieces(
-    poly, h: float, *, regular: bool = False
+    poly, h: float, *, regular: bool = False, normal: bool = True
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
-    (``regular``: only nodes where four blocks meet, see :func:`~.split.best_split`)."""
+    (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
+    normal; see :func:`~.split.best_split`)."""
     import shapely
     from shapely.geometry import Point, Polygon
 
@@ -127,7 +128,7 @@ def layout_pieces(
         P = Polygon(r)
         inside = [j for j in junctions if P.contains(Point(j))]
         centre = np.mean(inside, axis=0) if inside else None
-        pieces, new_cuts, _ = best_split(r, sigma=sigma, min_width=3 * h, center=centre, regular=regular)
+        pieces, new_cuts, _ = best_split(r, sigma=sigma, min_width=3 * h, center=centre, regular=regular, normal=normal)
         rings += [p for p, _ in pieces]
         forced += [f for _, f in pieces]
         cuts += new_cuts

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-__all__ = ["choose_corners", "corner_cost", "turning"]
+__all__ = ["bulge_ratio", "choose_corners", "corner_cost", "turning"]
 
 #: A vertex turning more than this (degrees, at scale) counts as a sharp feature.
 SHARP = 30.0
@@ -91,6 +91,30 @@ def side_cost(s: np.ndarray, total: float, corners) -> float:
     if min(L) <= 0:
         return math.inf
     return SIDE_WEIGHT * (math.log(L[0] / L[2]) ** 2 + math.log(L[1] / L[3]) ** 2)
+
+
+def bulge_ratio(ring: np.ndarray, corners) -> float:
+    """``R``: the area of ``ring`` over the product of the mean lengths of its two pairs of
+    opposite sides between ``corners`` (1 for a rectangle, an annular sector or a straight or
+    bent strip; 1.27 for a disc with four corners a quarter apart).
+
+    Four corners bunched together on one part of a round region give ``R ≫ 1``: its cells
+    fan out from two short sides across the whole basin, although every corner may be a right
+    angle and no side bends sharply.
+    """
+    s, total = _arclength_closed(ring)
+    pos = [s[i] for i in sorted(corners)]
+    L = [(pos[(k + 1) % 4] - pos[k]) % total for k in range(4)]
+    x, y = ring[:, 0], ring[:, 1]
+    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    return area / max(0.25 * (L[0] + L[2]) * (L[1] + L[3]), 1e-300)
+
+
+def bulge_cost(ring: np.ndarray, corners) -> float:
+    """``SIDE_WEIGHT × log² R`` for a region that holds more water than its sides span
+    (:func:`bulge_ratio` ``R > 1``); nothing for ``R ≤ 1``."""
+    R = bulge_ratio(ring, corners)
+    return SIDE_WEIGHT * math.log(R) ** 2 if R > 1.0 else 0.0
 
 
 def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float) -> list[int]:
@@ -174,4 +198,5 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     for c in picks:
         d = np.abs(s - s[c])
         near |= np.minimum(d, total - d) < sigma
-    return tuple(picks), corner_cost(t, picks, near) + side_cost(s, total, picks)
+    cost = corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks)
+    return tuple(picks), cost

@@ -135,11 +135,53 @@ def _motorcycle_cuts(ring: np.ndarray, sigma: float):
     return out
 
 
-def _reflex_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float) -> list[int]:
-    """Reflex vertices (turning < −45° at scale), the sharpest within ``± sigma`` only."""
+def _normal_cuts(ring: np.ndarray, sigma: float, *, even: bool = False, count: int = 32):
+    """Candidate cuts ``(piece_a, piece_b, segment)`` along the inward normal of the shore.
+
+    A smooth bay between two lobes of a round lake turns too gently to be a reflex corner at
+    the cells' scale, and a round basin has no reflex corner at all, yet neither can be one
+    block.  A cut along the normal of a smooth shore leaves a right angle on both of its sides
+    there (across a disc it is a diameter: right angles at both ends).  Candidates start at
+    the concave bends at the region's own scale (half its width), or with ``even`` at
+    ``count`` points evenly spaced round it (:func:`best_split` tries those only when nothing
+    else pays: in channel junctions they also won by a little, where the motorcycle cut from
+    the junction's corner makes the better grid); sharp reflex corners are left to
+    :func:`_motorcycle_cuts`.
+    """
+    w = _width(ring)
+    big = max(sigma, 0.5 * w)
+    tb = turning(ring, big)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
+    total = s[-1] + math.hypot(*(ring[0] - ring[-1]))
+    t = turning(ring, sigma)
+    starts = [] if even else _reflex_peaks(tb, s, total, big, limit=-20.0)
+    if even:
+        at = np.minimum(np.searchsorted(s, np.linspace(0.0, total, count, endpoint=False)), len(ring) - 1)
+        starts = sorted({int(v) for v in at})
+    out = []
+    for v in starts:
+        if abs(t[v]) > SHARP:
+            continue  # a corner: a cut from it makes no right angles (reflex: motorcycle cuts)
+        back = _point_along(ring, s, total, s[v] - sigma)
+        ahead = _point_along(ring, s, total, s[v] + sigma)
+        d = ahead - back
+        nd = math.hypot(*d)
+        if nd == 0:
+            continue
+        hit = _ray_to_boundary(ring, v, np.array([-d[1], d[0]]) / nd)
+        if hit is None:
+            continue
+        res = _split_ring(ring, v, *hit)
+        if res is not None:
+            out.append((res[0], res[1], np.array([ring[v], res[2]])))
+    return out
+
+
+def _reflex_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float = -45.0) -> list[int]:
+    """Reflex vertices (turning < ``limit`` at scale), the sharpest within ``± sigma`` only."""
     taken: list[int] = []
     for i in np.argsort(t):
-        if t[i] >= -45.0:
+        if t[i] >= limit:
             break
         if all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in taken):
             taken.append(int(i))
@@ -166,46 +208,76 @@ def _orient(r: np.ndarray) -> np.ndarray:
 
 
 def best_split(
-    ring: np.ndarray, *, sigma: float, min_width: float, center=None, depth: int = 4, forced=(), regular: bool = False
+    ring: np.ndarray,
+    *,
+    sigma: float,
+    min_width: float,
+    center=None,
+    depth: int = 4,
+    forced=(),
+    regular: bool = False,
+    normal: bool = True,
 ):
     """Pieces and cuts (segments) of a greedy split of ``ring`` (maybe none).
 
     Returns ``(pieces, cuts, cost)`` with ``pieces`` a list of ``(ring, corners)``: a CCW ring
     and the points that must be among its corners (a butterfly's), usually none.  The cut (or
     star, or butterfly) whose pieces are cheapest is applied if it lowers the cost, then the
-    pieces are split again, at most ``depth`` levels deep.  ``regular``: no star and no
-    butterfly, so no node where three or five blocks meet (Delft3D's domain decomposition
-    couples grid lines of the same direction only).
+    pieces are split again, at most ``depth`` levels deep.  When nothing pays, cuts along the
+    shore's normal from evenly spaced points are tried as a last resort (a round basin has no
+    corner to cut from).  ``regular``: no star and no butterfly, so no node where three or five
+    blocks meet (Delft3D's domain decomposition couples grid lines of the same direction only).
+    ``normal=False``: no cuts along the shore's normal (the splits of earlier versions).
     """
     base = region_cost(ring, sigma, forced)
     if depth <= 0 or base <= _GOOD:
         return [(ring, tuple(forced))], [], base
-    options = []
-    if not len(forced):
-        for a, b, seg in _motorcycle_cuts(ring, sigma):
-            a, b = _orient(a), _orient(b)
-            if min(_width(a), _width(b)) < min_width or not (_valid(a) and _valid(b)):
-                continue
-            options.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
-        if center is not None and not regular:
-            star = _star(ring, np.asarray(center, float), sigma, min_width)
-            if star is not None:
-                options.append(([(p, ()) for p in star[0]], star[1], star[2]))
-        fly = None if regular else _butterfly(ring, sigma, min_width)
-        if fly is not None:
-            options.append(fly)
-    if not options:
+    options = _options(ring, sigma, min_width, center, forced, regular, normal)
+    best = min(options, key=lambda o: o[2]) if options else None
+    if (best is None or best[2] >= base - _GOOD) and normal and not len(forced):
+        # last resort (a round basin): cuts along the shore's normal from evenly spaced points
+        more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
+        best = min(more + options, key=lambda o: o[2]) if more else best
+    if best is None or best[2] >= base - _GOOD:
         return [(ring, tuple(forced))], [], base
-    pieces, cuts, cost = min(options, key=lambda o: o[2])
-    if cost >= base - _GOOD:
-        return [(ring, tuple(forced))], [], base
+    pieces, cuts, _ = best
     out_p, out_c, total = [], list(cuts), 0.0
     for pc, fc in pieces:
-        pp, cc, c = best_split(pc, sigma=sigma, min_width=min_width, depth=depth - 1, forced=fc, regular=regular)
+        pp, cc, c = best_split(
+            pc, sigma=sigma, min_width=min_width, depth=depth - 1, forced=fc, regular=regular, normal=normal
+        )
         out_p += pp
         out_c += cc
         total += c
     return out_p, out_c, total
+
+
+def _cut_options(cuts, sigma: float, min_width: float) -> list:
+    """``(pieces, cuts, cost)`` of the admissible single cuts among ``cuts``."""
+    out = []
+    for a, b, seg in cuts:
+        a, b = _orient(a), _orient(b)
+        if min(_width(a), _width(b)) < min_width or not (_valid(a) and _valid(b)):
+            continue
+        out.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
+    return out
+
+
+def _options(ring, sigma, min_width, center, forced, regular, normal) -> list:
+    """Every admissible split of ``ring``: motorcycle cuts, normal cuts from its bays, the star
+    from ``center``, the butterfly (none for a piece with ``forced`` corners)."""
+    if len(forced):
+        return []
+    cuts = _motorcycle_cuts(ring, sigma) + (_normal_cuts(ring, sigma) if normal else [])
+    options = _cut_options(cuts, sigma, min_width)
+    if center is not None and not regular:
+        star = _star(ring, np.asarray(center, float), sigma, min_width)
+        if star is not None:
+            options.append(([(p, ()) for p in star[0]], star[1], star[2]))
+    fly = None if regular else _butterfly(ring, sigma, min_width)
+    if fly is not None:
+        options.append(fly)
+    return options
 
 
 #: A region whose corner cost is below this (four corners within ~20° of a right angle, no

@@ -239,3 +239,37 @@ def test_a_spike_narrower_than_half_a_cell_is_smoothed_out_with_a_note():
     isl = Polygon([(0, 0), (10, 0), (10, 4), (0, 4)], [[(4, 3.95), (6, 3.95), (6, 3.0), (4, 3.0)]])
     same, notes = without_slivers(isl, 0.125)
     assert same is isl and not notes
+
+
+@pytest.mark.parametrize("seed, kind", [(0, "disc"), (2, "disc"), (0, "blob")])
+def test_round_lakes_with_islands_get_blocks_that_follow_the_basin(seed, kind):
+    """A disc or a lobed basin with islands: no block fans out from a few bunched corners across
+    half the basin (the grid then leaves the shore by several cells and loses orthogonality).
+    The split tries cuts along the shore's normal (from bays, or round a basin with no corner
+    at all) and charges a block whose area is far larger than its sides span."""
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout.corners import bulge_ratio
+    from meshcore.quality import lake_metrics
+
+    poly = testing.round_lake(seed, kind=kind)
+    lay = auto_layout(poly, target_cells=3000, multiple=4)
+    _check_valid(lay)
+    mb = mesh_layout(lay, levels=2)
+    m = lake_metrics(mb, polygon=poly)
+    assert m.values("folded").sum() == 0
+    assert m.share("deviation", 3.0) >= 0.85  # main before the normal cuts: 81 % for disc 0
+    assert m.coverage.hausdorff_cells <= 1.0  # main before: 10.8 (disc 0) and 3.0 (disc 2) cells
+    # a disc with four corners a quarter apart has R = π/(π/2)² ≈ 1.27
+    assert max(bulge_ratio(p.ring, p.corners) for p in lay.pieces) < 2.0
+
+
+def test_bulge_ratio_of_simple_shapes():
+    from meshcore.layout.corners import bulge_ratio
+
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    disc = np.column_stack([np.cos(t), np.sin(t)])
+    assert bulge_ratio(disc, (0, 100, 200, 300)) == pytest.approx(4 / np.pi, rel=1e-3)
+    # the same disc with its corners bunched on one quarter fans out from short sides
+    assert bulge_ratio(disc, (0, 20, 40, 60)) > 3.0
+    rect = np.array([(0, 0), (3, 0), (3, 1), (0, 1)], float)
+    assert bulge_ratio(rect, (0, 1, 2, 3)) == pytest.approx(1.0)
