@@ -46,7 +46,7 @@ _CHILD = r"""
 import json, sys, time
 import numpy as np
 from meshcore import testing
-from meshcore.crs import project
+from meshcore.cli.mesh import local_frame
 from meshcore.io import read_points
 from meshcore.lakegrid import mesh_outline
 from meshcore.layout.polygon import water_from_points, water_polygon
@@ -56,7 +56,7 @@ t0 = time.perf_counter()
 if what.startswith("testing."):
     poly = eval(what)
 else:
-    ps, _ = project(read_points(what), "auto", origin=None)
+    ps, _ = local_frame(read_points(what), "auto")  # the frame `meshcore mesh` and the app lay out in
     outer, islands = water_from_points(ps)
     poly, _ = water_polygon(outer, holes=islands)
 t1 = time.perf_counter()
