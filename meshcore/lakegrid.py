@@ -92,7 +92,8 @@ def iterate_layout(
     *,
     start: str = "winslow",
     levels: int | None = None,
-    sweeps: tuple[int, ...] = (400, 150, 80),
+    sweeps: tuple[int, ...] = (200, 150, 400),
+    stall: float | None = 0.0025,
     smooth: float | tuple[float, ...] = 0.0,
     omega: float = 1.8,
     pin_angle: float | None = None,
@@ -104,6 +105,10 @@ def iterate_layout(
 ) -> Generator[SolverProgress, Any, Any]:
     """:func:`mesh_layout` as a generator of :class:`~meshcore.elliptic.SolverProgress`.
 
+    ``sweeps`` are the most sweeps per level, the finest level last (with fewer levels the
+    coarsest ones are dropped, with more the first repeats).  ``stall``: the finest level stops
+    as soon as its share of nodes with ``|cos| ≤ 0.02`` rises by less than that over 20 sweeps
+    (see :func:`~meshcore.orthogonal.iterate_orthogonalize`; None: always ``sweeps[-1]``).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped").  Returns
@@ -136,12 +141,13 @@ def iterate_layout(
             rings,
             every=every,
             tol=tol,
-            max_sweeps=sweeps[min(lev, len(sweeps) - 1)],
+            max_sweeps=sweeps[max(0, len(sweeps) - len(tops) + lev)],
             smooth=_per_level(smooth, lev),
             omega=omega,
             pin_angle=pin_angle,
             shore_smooth=shore_smooth,
             size_ratio=size_ratio,
+            stall=stall if lev == len(tops) - 1 else None,
         )
         try:
             it, d, snap = next(gen)

@@ -34,7 +34,7 @@ import numpy as np
 from . import _kernels
 from .shore import project_to_rings
 
-__all__ = ["OrthoResult", "iterate_orthogonalize", "orthogonalize"]
+__all__ = ["OrthoResult", "iterate_orthogonalize", "orthogonal_share", "orthogonalize"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -169,6 +169,18 @@ def _ring_tables(rings):
     return np.vstack(rings).astype(np.float64), np.concatenate(parts), np.array(off, dtype=np.int64)
 
 
+def orthogonal_share(X, Y, nodes, nbr, limit: float = 0.02) -> float:
+    """Share of the regular nodes ``nodes`` (neighbours ``nbr``: E, W, N, S, …) whose node
+    orthogonality ``|cos|`` (central differences, as :mod:`meshcore.quality`) is at most ``limit``."""
+    if not len(nodes):
+        return 1.0
+    ax, ay = X[nbr[:, 0]] - X[nbr[:, 1]], Y[nbr[:, 0]] - Y[nbr[:, 1]]
+    bx, by = X[nbr[:, 2]] - X[nbr[:, 3]], Y[nbr[:, 2]] - Y[nbr[:, 3]]
+    norm = np.sqrt((ax * ax + ay * ay) * (bx * bx + by * by))
+    dot = np.abs(ax * bx + ay * by)
+    return float(np.mean(dot <= limit * norm))
+
+
 def orthogonalize(topology, grids, rings, **options):
     """Orthogonalise ``grids`` (one per block of ``topology``) with shore nodes sliding on ``rings``.
 
@@ -195,11 +207,19 @@ def iterate_orthogonalize(
     shore_gap: float = 0.25,
     size_ratio: tuple[float, float] | None = (1.2, 2.0),
     size_relax: float = 0.05,
+    stall: float | None = None,
+    stall_every: int = 20,
     callback=None,
 ):
     """:func:`orthogonalize` as a generator: every ``every`` sweeps it yields
     ``(sweep, change, grids)`` (the change per sweep relative to the median edge, the current
-    grids); ``"stop"`` sent to it ends the sweeps.  Returns the :class:`OrthoResult`."""
+    grids); ``"stop"`` sent to it ends the sweeps.  Returns the :class:`OrthoResult`.
+
+    ``stall``: also stop (``converged`` True) when, over ``stall_every`` sweeps, the share of
+    regular nodes with ``|cos| ≤ 0.02`` (:func:`orthogonal_share`) rose by less than ``stall``
+    (e.g. 0.0025: a quarter of a percentage point).  The largest move per sweep is no measure of
+    that: a few nodes held by the fold guard or by the shore keep it near 1e-2 while the
+    orthogonality of all the others still improves, or long after it stopped improving."""
     t0 = time.perf_counter()
     lo, hi = size_ratio if size_ratio is not None else (np.inf, np.inf)
     bx, by = np.zeros(len(topology.node_map.nodes)), np.zeros(len(topology.node_map.nodes))
@@ -225,6 +245,7 @@ def iterate_orthogonalize(
     hist = []
     it = 0
     converged = False
+    share = orthogonal_share(X, Y, m.nodes, m.nbr) if stall is not None else 0.0
     for it in range(1, max_sweeps + 1):
         d1 = _kernels.sweep(
             X,
@@ -276,6 +297,12 @@ def iterate_orthogonalize(
         if d < tol:
             converged = True
             break
+        if stall is not None and it % stall_every == 0:
+            now = orthogonal_share(X, Y, m.nodes, m.nbr)
+            if now - share < stall:
+                converged = True
+                break
+            share = now
         if every and it % every == 0:
             snap = tuple(g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True))
             if (yield (it, d, snap)) == "stop":

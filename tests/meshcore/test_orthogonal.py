@@ -148,3 +148,47 @@ def test_the_size_blend_evens_out_a_jump_in_spacing(jump, lo_hi):
     assert worst_ratio(x) < 0.5 * (lo_hi[0] + lo_hi[1])
     assert lake_metrics(res.grids[0]).max("deviation") < 0.5
     assert np.all(np.diff(x, axis=0) > 0) and np.all(np.diff(y, axis=1) > 0)
+
+
+@pytest.mark.parametrize("limit", [0.02, 0.05, 0.3])
+def test_the_orthogonal_share_is_the_quality_modules_share(limit):
+    from meshcore.orthogonal.driver import _assemble, orthogonal_share
+
+    rng = np.random.default_rng(7)
+    xi, eta = np.meshgrid(np.linspace(0, 3, 25), np.linspace(0, 1, 11), indexing="ij")
+    x = xi + 0.2 * eta**2 + 0.01 * rng.standard_normal(xi.shape)
+    y = eta + 0.1 * np.sin(2 * xi) + 0.01 * rng.standard_normal(xi.shape)
+    topo, g = _one_block(x, y)
+    X, Y = _assemble([g], topo.node_map)
+    share = orthogonal_share(X, Y, topo.node_map.nodes, topo.node_map.nbr, limit)
+    assert 0.0 < share < 1.0  # a mix: the comparison means something
+    assert share == pytest.approx(lake_metrics(g).share("cos", limit), abs=1e-12)
+
+
+def test_stall_stops_the_sweeps_once_orthogonality_stops_improving():
+    rng = np.random.default_rng(3)
+    xi, eta = np.meshgrid(np.linspace(0, 4, 33), np.linspace(0, 1, 9), indexing="ij")
+    x = xi + 0.02 * rng.standard_normal(xi.shape)
+    y = eta + 0.02 * rng.standard_normal(xi.shape)
+    x[:, [0, -1]], y[:, [0, -1]] = xi[:, [0, -1]], eta[:, [0, -1]]
+    x[[0, -1]], y[[0, -1]] = xi[[0, -1]], eta[[0, -1]]
+    topo, g = _one_block(x, y)
+    opts = {"max_sweeps": 400, "tol": 0.0, "smooth": 0.0, "size_ratio": None}
+    full = orthogonalize(topo, [g], [], **opts)
+    assert full.sweeps == 400 and not full.converged
+    # no gain of 100 % of the nodes in 10 sweeps: stops at the first check
+    assert orthogonalize(topo, [g], [], stall=1.0, stall_every=10, **opts).sweeps == 10
+    early = orthogonalize(topo, [g], [], stall=0.001, stall_every=10, **opts)
+    assert early.converged and 10 <= early.sweeps < 400
+    share = lake_metrics(list(early.grids)).share("cos", 0.02)
+    assert share >= lake_metrics(list(full.grids)).share("cos", 0.02) - 0.01
+
+
+def test_the_finest_level_gets_the_last_sweep_count():
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout import auto_layout
+
+    lay = auto_layout(testing.y_junction(), target_cells=600, multiple=2)
+    done = []
+    mesh_layout(lay, levels=1, sweeps=(11, 7, 5), stall=None, callback=lambda kind, v: done.append(v[1].sweeps))
+    assert done == [7, 5]
