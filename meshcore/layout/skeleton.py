@@ -79,6 +79,7 @@ def _raw_axis(poly, spacing: float, lam: float):
     pts = np.unique(_samples(poly, spacing), axis=0)
     vor = Voronoi(pts)
     V = vor.vertices
+    shapely.prepare(poly)  # many point and segment tests against one shore: seconds → milliseconds on dense shores
     inside = shapely.contains_xy(poly, V[:, 0], V[:, 1])
     rv = np.asarray(vor.ridge_vertices)
     rp = np.asarray(vor.ridge_points)
@@ -90,7 +91,7 @@ def _raw_axis(poly, spacing: float, lam: float):
     rv = rv[gap >= 2.0 * lam]
     # an edge between two inside vertices may still cross a concave shore
     lines = shapely.linestrings(np.stack([V[rv[:, 0]], V[rv[:, 1]]], axis=1))
-    rv = rv[shapely.covered_by(lines, poly)]
+    rv = rv[shapely.covers(poly, lines)]  # covers, not covered_by: the prepared shore is the first argument
     radius = np.full(len(V), np.nan)
     used = np.unique(rv)
     radius[used] = np.hypot(*(V[used] - _nearest(pts, V[used])).T)
