@@ -63,11 +63,9 @@ def _cut_neighbours(a, i, m):
 _cut_neighbours_jit = njit(cache=True, nogil=True, inline="always")(_cut_neighbours)
 
 
-def cut_defect_reference(x, y, fx, fy, wake: int):
-    """NumPy reference of :func:`cut_defect`: ``(rx, ry, den)`` at cut nodes ``1 … wake − 1``."""
-    ni = x.shape[0] - 1
-    i = np.arange(1, wake)
-    m = ni - i
+def _cut_stencil(x, y, i, m):
+    """NumPy references: ``(den, sx, sy)`` of the Winslow stencil at cut node ``(i, 0)``, so that
+    ``N(u) = (sx, sy) - den * (x, y)`` there (``i`` an index or an array of them)."""
     xe, xw, xn, xs, xne, xnw, xse, xsw = _cut_neighbours(x, i, m)
     ye, yw, yn, ys, yne, ynw, yse, ysw = _cut_neighbours(y, i, m)
     xxi, yxi = 0.5 * (xe - xw), 0.5 * (ye - yw)
@@ -78,6 +76,15 @@ def cut_defect_reference(x, y, fx, fy, wake: int):
     den = 2.0 * (a + g)
     sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * (xne - xnw - xse + xsw)
     sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * (yne - ynw - yse + ysw)
+    return den, sx, sy
+
+
+def cut_defect_reference(x, y, fx, fy, wake: int):
+    """NumPy reference of :func:`cut_defect`: ``(rx, ry, den)`` at cut nodes ``1 … wake − 1``."""
+    ni = x.shape[0] - 1
+    i = np.arange(1, wake)
+    m = ni - i
+    den, sx, sy = _cut_stencil(x, y, i, m)
     rx = sx - den * x[i, 0]
     ry = sy - den * y[i, 0]
     if fx.size:
@@ -124,16 +131,7 @@ def relax_cut_reference(x, y, fx, fy, wake: int, sweeps: int) -> None:
     for _ in range(sweeps):
         for i in range(1, wake):
             m = ni - i
-            xe, xw, xn, xs, xne, xnw, xse, xsw = _cut_neighbours(x, i, m)
-            ye, yw, yn, ys, yne, ynw, yse, ysw = _cut_neighbours(y, i, m)
-            xxi, yxi = 0.5 * (xe - xw), 0.5 * (ye - yw)
-            xet, yet = 0.5 * (xn - xs), 0.5 * (yn - ys)
-            a = xet * xet + yet * yet
-            b = xxi * xet + yxi * yet
-            g = xxi * xxi + yxi * yxi
-            den = 2.0 * (a + g)
-            sx = a * (xe + xw) + g * (xn + xs) - 0.5 * b * (xne - xnw - xse + xsw)
-            sy = a * (ye + yw) + g * (yn + ys) - 0.5 * b * (yne - ynw - yse + ysw)
+            den, sx, sy = _cut_stencil(x, y, i, m)
             if fx.size:
                 sx += fx[i, 0]
                 sy += fy[i, 0]
