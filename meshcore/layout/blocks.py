@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
+from ..pointindex import PointIndex, point_key, point_keys
 
 __all__ = ["Piece", "build_topology", "conform", "weld"]
 
@@ -31,10 +32,6 @@ class Piece:
     ring: np.ndarray
     corners: tuple[int, int, int, int]
     name: str = ""
-
-
-def _key(p) -> tuple[float, float]:
-    return (float(p[0]), float(p[1]))
 
 
 def weld(rings: list[np.ndarray], eps: float) -> list[np.ndarray]:
@@ -119,23 +116,28 @@ def _line_work(pieces: list[Piece]):
     """
     names = [pc.name or f"b{k}" for k, pc in enumerate(pieces)]
     rings = dict(zip(names, (pc.ring for pc in pieces), strict=True))
-    corners = {n: [_key(pc.ring[c]) for c in pc.corners] for n, pc in zip(names, pieces, strict=True)}
-    nbrs: dict = {}
-    for pc in pieces:
-        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
-            nbrs.setdefault(_key(a), set()).add(_key(b))
-            nbrs.setdefault(_key(b), set()).add(_key(a))
-    breaks = {c for cs in corners.values() for c in cs} | {v for v, nb in nbrs.items() if len(nb) >= 3}
+    corners = {n: [point_key(pc.ring[c]) for c in pc.corners] for n, pc in zip(names, pieces, strict=True)}
+    breaks = {c for cs in corners.values() for c in cs} | _junctions([pc.ring for pc in pieces])
     return names, rings, corners, breaks
 
 
-def _chains_of(pieces: list[Piece]):
-    """Per ``(piece index, side)`` the chain keys; the chain polylines; the users of each chain."""
+def _junctions(rings: list[np.ndarray]) -> set:
+    """The keys of the vertices joined by edges to three or more other vertices."""
+    ix = PointIndex(rings)
+    edges = np.vstack([np.column_stack([i, np.roll(i, -1)]) for i in ix.ids])
+    edges = np.unique(np.vstack([edges, edges[:, ::-1]]), axis=0)  # each neighbour once
+    degree = np.bincount(edges[:, 0], minlength=len(ix))
+    return set(point_keys(ix.points[degree >= 3]))
+
+
+def _chains_of(pieces: list[Piece], work=None):
+    """Per ``(piece index, side)`` the chain keys; the chain polylines; the users of each chain
+    (``work``: :func:`_line_work` of the pieces, if made already)."""
     from types import SimpleNamespace
 
     from ..multiblock.chains import side_chains
 
-    names, rings, corners, breaks = _line_work(pieces)
+    names, rings, corners, breaks = work if work is not None else _line_work(pieces)
     by_name, chain_pts, users = side_chains([SimpleNamespace(name=n) for n in names], rings, corners, breaks)
     index = {n: k for k, n in enumerate(names)}
     sides = {(index[n], side): keys for (n, side), keys in by_name.items()}
@@ -160,7 +162,8 @@ def build_topology(
     from ..multiblock.chains import chain_topology
     from ..multiblock.outline import BlockOutline
 
-    side_chains, chain_pts, chain_users = _chains_of(pieces)
+    work = _line_work(pieces)
+    side_chains, chain_pts, chain_users = _chains_of(pieces, work)
     for key, users in chain_users.items():
         if len(users) > 2:
             c = np.asarray(key).mean(axis=0)
@@ -172,7 +175,7 @@ def build_topology(
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
     counts = solve_counts(length / cell_size, sides, min_cells=min_cells, multiple=multiple, block_cells=block_cells)
-    names, rings, corners, breaks = _line_work(pieces)
+    names, rings, corners, breaks = work
     specs = [
         BlockOutline(n, tuple(corners[n]), (int(counts[s[0]].sum()), int(counts[s[3]].sum())))
         for n, s in zip(names, sides, strict=True)

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from ..pointindex import PointIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners
@@ -43,21 +44,16 @@ def _insert_mid(r: np.ndarray) -> np.ndarray:
     return np.insert(r, k + 1, 0.5 * (r[k] + r[(k + 1) % len(r)]), axis=0)
 
 
-def _key(p) -> tuple[float, float]:
-    return (float(p[0]), float(p[1]))
-
-
 def _merged(a: np.ndarray, b: np.ndarray):
     """The ring of ``a ∪ b`` when they share one contiguous run of edges, else None."""
     na, nb = len(a), len(b)
-    pos_b = {_key(p): i for i, p in enumerate(b)}
-    shared = [
-        i
-        for i in range(na)
-        if _key(a[i]) in pos_b
-        and _key(a[(i + 1) % na]) in pos_b
-        and (pos_b[_key(a[i])] - pos_b[_key(a[(i + 1) % na])]) % nb == 1
-    ]
+    ix = PointIndex([a, b])
+    ida, idb = ix.ids
+    pos_b = np.full(len(ix), -1)
+    pos_b[idb] = np.arange(nb)  # a point repeated in b: its last position
+    pa = pos_b[ida]
+    pn = np.roll(pa, -1)
+    shared = np.flatnonzero((pa >= 0) & (pn >= 0) & ((pa - pn) % nb == 1)).tolist()
     if not shared or len(shared) >= na - 1:
         return None
     # the shared run in a: edges i, i+1, …, j (cyclic, contiguous)
@@ -69,14 +65,13 @@ def _merged(a: np.ndarray, b: np.ndarray):
     if len(run) != len(shared):
         return None  # two separate contacts: the union would have a hole
     p0, pk = start, (run[-1] + 1) % na  # a[p0] … a[pk] is the shared path
-    out = [a[(pk + t) % na] for t in range((p0 - pk) % na + 1)]  # a from pk round to p0
-    j0 = pos_b[_key(a[p0])]
-    jk = pos_b[_key(a[pk])]
-    out += [b[(j0 + t) % nb] for t in range(1, (jk - j0) % nb)]  # b from p0 round to pk
-    r = np.array(out)
+    j0, jk = int(pa[p0]), int(pa[pk])
+    out = np.vstack(
+        [a[(pk + np.arange((p0 - pk) % na + 1)) % na], b[(j0 + np.arange(1, (jk - j0) % nb)) % nb]]
+    )  # a from pk round to p0, then b from p0 round to pk
     from shapely.geometry import Polygon
 
-    return r if len(r) >= 4 and Polygon(r).is_valid else None
+    return out if len(out) >= 4 and Polygon(out).is_valid else None
 
 
 def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
@@ -86,6 +81,16 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
 
     rings, forced = list(rings), list(forced)
     cost = [choose_corners(r, sigma)[1] for r in rings]
+    box = [np.r_[r.min(axis=0), r.max(axis=0)] for r in rings]
+    seen: dict[tuple[int, int], tuple] = {}  # (id a, id b) → (a, b, union, its cost): each pair once
+
+    def union(i: int, j: int):
+        k = (id(rings[i]), id(rings[j]))
+        if k not in seen:
+            m = _merged(rings[i], rings[j])
+            seen[k] = (rings[i], rings[j], m, None if m is None else choose_corners(m, sigma)[1])
+        return seen[k][2:]
+
     changed = True
     while changed:
         changed = False
@@ -93,13 +98,14 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
             for j in range(i + 1, len(rings)):
                 if forced[i] or forced[j]:
                     continue
-                m = _merged(rings[i], rings[j])
+                if np.any(box[i][:2] > box[j][2:]) or np.any(box[j][:2] > box[i][2:]):
+                    continue  # apart: no shared edge
+                m, c = union(i, j)
                 if m is None:
                     continue
-                c = choose_corners(m, sigma)[1]
                 if c <= min(cost[i] + cost[j], _GOOD) + 1e-9:
-                    rings[i], cost[i] = m, c
-                    del rings[j], cost[j], forced[j]
+                    rings[i], cost[i], box[i] = m, c, np.r_[m.min(axis=0), m.max(axis=0)]
+                    del rings[j], cost[j], forced[j], box[j]
                     changed = True
                     break
             if changed:

@@ -15,21 +15,19 @@ from typing import Any
 
 import numpy as np
 
+from ..pointindex import point_keys
 from .blocks import Piece
 
 __all__ = ["interior_cuts", "outline_blocks", "outline_parts"]
-
-
-def _key(p) -> tuple[float, float]:
-    return (float(p[0]), float(p[1]))
 
 
 def _edge_use(pieces: list[Piece]) -> dict[frozenset, int]:
     """How many pieces use each edge: 1 on the shore, 2 between two blocks."""
     count: dict[frozenset, int] = {}
     for pc in pieces:
-        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
-            e = frozenset((_key(a), _key(b)))
+        kr = point_keys(pc.ring)
+        for a, b in zip(kr, kr[1:] + kr[:1], strict=True):
+            e = frozenset((a, b))
             count[e] = count.get(e, 0) + 1
     return count
 
@@ -82,9 +80,10 @@ def _shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
     count = _edge_use(pieces)
     nxt: dict[tuple, tuple] = {}
     for pc in pieces:  # walked in each piece's own (counter-clockwise) direction
-        for a, b in zip(pc.ring, np.roll(pc.ring, -1, axis=0), strict=True):
-            if count[frozenset((_key(a), _key(b)))] == 1:
-                nxt[_key(a)] = _key(b)
+        kr = point_keys(pc.ring)
+        for a, b in zip(kr, kr[1:] + kr[:1], strict=True):
+            if count[frozenset((a, b))] == 1:
+                nxt[a] = b
     rings = []
     while nxt:
         start, ring = next(iter(nxt)), []

@@ -17,13 +17,10 @@ import math
 
 import numpy as np
 
+from ..pointindex import point_key, point_keys
 from .blocks import Piece, _chains_of
 
 __all__ = ["extend_t_junctions", "t_junctions"]
-
-
-def _key(p) -> tuple[float, float]:
-    return (float(p[0]), float(p[1]))
 
 
 def t_junctions(pieces: list[Piece]) -> list[tuple[int, int]]:
@@ -31,8 +28,8 @@ def t_junctions(pieces: list[Piece]) -> list[tuple[int, int]]:
     side_chains, _chain_pts, _ = _chains_of(pieces)
     out = []
     for pi, pc in enumerate(pieces):
-        pos = {_key(p): i for i, p in enumerate(pc.ring)}
-        corners = {_key(pc.ring[c]) for c in pc.corners}
+        pos = {k: i for i, k in enumerate(point_keys(pc.ring))}
+        corners = {point_key(pc.ring[c]) for c in pc.corners}
         for side in ("bottom", "right", "top", "left"):
             keys = side_chains[(pi, side)]
             for a, b in itertools.pairwise(keys):

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..boundary import Borders
 from ..errors import TopologyError
+from ..pointindex import point_key, point_keys
 from .topology import Block, Interface, MultiBlockTopology, Side
 
 __all__ = ["chain_topology", "side_chains"]
@@ -26,10 +27,6 @@ __all__ = ["chain_topology", "side_chains"]
 SIDES = ("bottom", "right", "top", "left")
 
 Key = tuple  # a chain: its vertices as (x, y) tuples, in the smaller of its two directions
-
-
-def _key(p: np.ndarray) -> tuple[float, float]:
-    return (float(p[0]), float(p[1]))
 
 
 def _resample(chain: np.ndarray, n_cells: int) -> np.ndarray:
@@ -46,21 +43,21 @@ def side_chains(specs: list, rings: dict[str, np.ndarray], corners: dict[str, li
     chain_pts: dict[Key, np.ndarray] = {}
     chain_users: dict[Key, list[tuple[str, str]]] = defaultdict(list)
     for s in specs:
-        r = rings[s.name]
-        n = len(r)
-        pos = {_key(p): i for i, p in enumerate(r)}
+        kr = point_keys(rings[s.name])
+        n = len(kr)
+        pos = {k: i for i, k in enumerate(kr)}
         ci = [pos[c] for c in corners[s.name]]
         for side, (a, b) in zip(SIDES, zip(ci, ci[1:] + ci[:1], strict=True), strict=True):
-            walk = [r[(a + k) % n] for k in range((b - a) % n + 1)]
+            walk = [kr[(a + k) % n] for k in range((b - a) % n + 1)]
             chains, cur = [], [walk[0]]
             for p in walk[1:]:
                 cur.append(p)
-                if _key(p) in breaks:
-                    chains.append(np.array(cur))
+                if p in breaks:
+                    chains.append(cur)
                     cur = [p]
             keys = []
             for ch in chains:
-                fwd = tuple(_key(p) for p in ch)
+                fwd = tuple(ch)
                 key = min(fwd, fwd[::-1])
                 chain_pts.setdefault(key, np.array(key))
                 keys.append(key)
@@ -190,7 +187,7 @@ def _block(s: Any, side_chains: dict, nodes: dict, corners: list, offsets: dict)
             if pieces:
                 if not np.array_equal(p[0], pieces[-1][-1]):
                     p = p[::-1]
-            elif _key(p[0]) != corners[SIDES.index(side)]:
+            elif point_key(p[0]) != corners[SIDES.index(side)]:
                 p = p[::-1]
             offsets[(s.name, side, key)] = (at, at + len(p) - 1)
             at += len(p) - 1

@@ -39,6 +39,7 @@ import numpy as np
 from .._validation import check_allocation, max_nodes, validate_count, validate_points
 from ..boundary import signed_area
 from ..errors import InvalidInputError, TopologyError
+from ..pointindex import point_key, point_keys
 from .topology import MultiBlockTopology
 
 __all__ = ["BlockOutline", "OutlineBlocks", "from_outline", "project_lonlat"]
@@ -139,10 +140,6 @@ def _insert(poly: np.ndarray, k: int, t: float, closed: bool, eps: float) -> tup
     return np.insert(poly, k + 1, p, axis=0), p
 
 
-def _key(p: np.ndarray) -> tuple[float, float]:
-    return (float(p[0]), float(p[1]))
-
-
 def _resolve_cuts(given_ring: np.ndarray, cuts: Sequence[Any]) -> list[np.ndarray]:
     """The cut polylines as points (outline indices replaced by the outline's points)."""
     cut_list = []
@@ -158,20 +155,40 @@ def _resolve_cuts(given_ring: np.ndarray, cuts: Sequence[Any]) -> list[np.ndarra
     return cut_list
 
 
+def _nearest_on_cuts(cut_list: list[np.ndarray], k: int, q: np.ndarray) -> tuple[float, int, int, float]:
+    """(distance, cut, segment, t) of the point nearest to ``q`` on every cut but cut ``k`` (the
+    first cut and segment at the least distance), as :func:`_project_on` per cut, in one pass."""
+    others = [m for m in range(len(cut_list)) if m != k]
+    if not others:
+        return math.inf, -1, -1, 0.0
+    a = np.vstack([cut_list[m][:-1] for m in others])
+    b = np.vstack([cut_list[m][1:] for m in others])
+    d = b - a
+    L2 = (d * d).sum(axis=1)
+    t = np.where(L2 > 0, ((q - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    foot = a + t[:, None] * d
+    dist = np.hypot(*(foot - q).T)
+    i = int(np.argmin(dist))
+    starts = np.cumsum([0] + [len(cut_list[m]) - 1 for m in others])
+    j = int(np.searchsorted(starts, i, side="right")) - 1
+    return float(dist[i]), others[j], i - int(starts[j]), float(t[i])
+
+
 def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: float, eps: float) -> list[np.ndarray]:
     """Move every cut end onto the outline, an island or another cut, inserting the point there;
     returns the shore rings (outline first, then the islands)."""
     rings = list(rings)
+    on_ring = [set(point_keys(r)) for r in rings]
     for k in range(len(cut_list)):
         for end in (0, -1):
             q = cut_list[k][end]
+            if any(point_key(q) in v for v in on_ring):
+                continue  # a vertex of the shore already: it would snap onto itself
             best = min(((_project_on(r, q, True), "outline", ri) for ri, r in enumerate(rings)), key=lambda b: b[0][0])
-            for m, other in enumerate(cut_list):
-                if m == k:
-                    continue
-                cand = _project_on(other, q, False)
-                if cand[0] < best[0][0]:
-                    best = (cand, "cut", m)
+            dist, m, seg, t = _nearest_on_cuts(cut_list, k, q)
+            if dist < best[0][0]:
+                best = ((dist, seg, t), "cut", m)
             (dist, seg, t), kind, m = best
             if dist > snap:
                 raise TopologyError(
@@ -181,6 +198,7 @@ def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: fl
                 )
             if kind == "outline":
                 rings[m], p = _insert(rings[m], seg, t, True, eps)
+                on_ring[m].add(point_key(p))
             else:
                 cut_list[m], p = _insert(cut_list[m], seg, t, False, eps)
             cut_list[k][end] = p
@@ -239,9 +257,10 @@ def _neighbours(rings: list[np.ndarray]) -> dict:
     """Vertex → its neighbours in the line graph of outline and cuts."""
     nbrs: dict = defaultdict(set)
     for r in rings:
-        for a, b in zip(r, np.roll(r, -1, axis=0), strict=True):
-            nbrs[_key(a)].add(_key(b))
-            nbrs[_key(b)].add(_key(a))
+        kr = point_keys(r)
+        for a, b in zip(kr, kr[1:] + kr[:1], strict=True):
+            nbrs[a].add(b)
+            nbrs[b].add(a)
     return nbrs
 
 
@@ -277,21 +296,29 @@ def _block_corners(s: BlockOutline, given_ring: np.ndarray, vertices: np.ndarray
                 f"block {s.name!r}: corner {lab} ({q[0]:.6g}, {q[1]:.6g}) is {dist[k]:.4g} from "
                 f"the nearest outline or cut vertex (snap distance {snap:.4g})"
             )
-        cs.append(_key(vertices[k]))
+        cs.append(point_key(vertices[k]))
     if len(set(cs)) != 4:
         raise TopologyError(f"block {s.name!r}: two corners snap to the same point {cs}")
     return cs
 
 
-def _block_face(s: BlockOutline, cs: list[tuple], rings: list[np.ndarray]) -> int:
-    """The region whose boundary holds the four corners in counter-clockwise order."""
-    cand = []
+def _vertex_faces(rings: list[np.ndarray]) -> dict[tuple, dict[int, int]]:
+    """Vertex → {region: its position on the region's ring} (the last one where it repeats)."""
+    where: dict[tuple, dict[int, int]] = {}
     for fi, r in enumerate(rings):
-        pos = {_key(p): i for i, p in enumerate(r)}
-        if all(c in pos for c in cs):
-            idx = [pos[c] for c in cs]
-            rel = [(i - idx[0]) % len(r) for i in idx]
-            cand.append((fi, rel[0] < rel[1] < rel[2] < rel[3]))
+        for i, k in enumerate(point_keys(r)):
+            where.setdefault(k, {})[fi] = i
+    return where
+
+
+def _block_face(s: BlockOutline, cs: list[tuple], rings: list[np.ndarray], where: dict) -> int:
+    """The region whose boundary holds the four corners in counter-clockwise order
+    (``where``: :func:`_vertex_faces` of ``rings``)."""
+    cand = []
+    for fi in sorted(set.intersection(*(set(where.get(c, ())) for c in cs))):
+        idx = [where[c][fi] for c in cs]
+        rel = [(i - idx[0]) % len(rings[fi]) for i in idx]
+        cand.append((fi, rel[0] < rel[1] < rel[2] < rel[3]))
     if not cand:
         raise TopologyError(
             f"block {s.name!r}: its four corners do not lie on the boundary of one region "
@@ -319,6 +346,7 @@ def _place_blocks(
     if dup:
         raise TopologyError(f"block names must be unique; repeated: {', '.join(dup)}")
     face_of: dict[int, str] = {}
+    where = _vertex_faces(rings)
     block_corners: dict[str, list[tuple]] = {}
     block_face: dict[str, int] = {}
     total_nodes = 0
@@ -329,7 +357,7 @@ def _place_blocks(
             total_nodes, max_nodes(), what=f"nodes of the blocks up to {s.name!r}", env="MESHCORE_MAX_NODES"
         )
         cs = _block_corners(s, given_ring, vertices, snap)
-        fi = _block_face(s, cs, rings)
+        fi = _block_face(s, cs, rings, where)
         if fi in face_of:
             raise TopologyError(f"blocks {face_of[fi]!r} and {s.name!r} overlap: both are the same region")
         face_of[fi] = s.name
