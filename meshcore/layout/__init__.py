@@ -14,7 +14,7 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 * :mod:`.split` — regions that are not four-sided split at their reflex corners or by a star;
 * :mod:`.corners` — four corners per piece, where the boundary turns at the cells' scale;
 * :mod:`.counts` — integer cell counts that agree across every interface (a small MILP);
-* :mod:`.blocks` — the pieces as a :class:`~meshcore.multiblock.MultiBlockTopology`;
+* :mod:`.blocks` — the pieces made conforming, their cell counts;
 * :mod:`.build` — the pipeline;
 * :mod:`.model` — :class:`Layout`; :mod:`.outline` — a layout as shore, islands, cuts and
   blocks (the ``[outline]`` case); :mod:`.edit` — layouts from hand-made cuts and corners.
@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .blocks import build_topology
+from .blocks import block_counts
 from .build import layout_pieces
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .model import Layout, LayoutBlock
@@ -101,14 +101,10 @@ def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bo
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
         sk, chords, _, moved = layout_pieces(poly, h, regular=regular, normal=normal)
     pieces = moved
-    topo, _ = build_topology(pieces, h, multiple=multiple)
+    cells = block_counts(pieces, h, multiple=multiple)
     blocks = tuple(
-        LayoutBlock(
-            pc.name,
-            tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]),
-            tuple(int(c) for c in b.cells),
-        )
-        for pc, b in zip(pieces, topo.blocks, strict=True)
+        LayoutBlock(pc.name, tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]), c)
+        for pc, c in zip(pieces, cells, strict=True)
     )
     lay = Layout(
         polygon=poly,

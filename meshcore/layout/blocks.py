@@ -1,14 +1,14 @@
-r"""From four-cornered pieces to a multiblock topology: chains, counts, borders, interfaces.
+r"""Four-cornered pieces: made conforming, cut into chains, given cell counts.
 
 The pieces are counter-clockwise rings that share their common edges vertex for vertex
 (:func:`conform` inserts every vertex into every ring whose edge it lies on, so T-junctions
 are explicit).  Each ring has four corner indices.  The boundary of each piece is cut into
-**chains** at its corners and wherever the neighbour across changes; a chain is shared by at
-most two pieces.  Counts come from :func:`~meshcore.multiblock.counts.solve_counts`; the chains,
-their nodes (each re-sampled once, uniformly in arc length, and used by both neighbours) and the
-interfaces from :mod:`meshcore.multiblock.chains`, the code of
-:func:`~meshcore.multiblock.from_outline`.
-"""
+**chains** at its corners and wherever the neighbour across changes (by
+:func:`meshcore.multiblock.chains.side_chains`, the code of
+:func:`~meshcore.multiblock.from_outline`); a chain is shared by at most two pieces.
+:func:`block_counts` gives every piece its cells from
+:func:`~meshcore.multiblock.counts.solve_counts`.  The topology itself (chains re-sampled,
+borders, interfaces) is made once, by :meth:`~meshcore.layout.Layout.topology`."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
 from ..pointindex import PointIndex, point_key, point_keys
 
-__all__ = ["Piece", "build_topology", "conform", "weld"]
+__all__ = ["Piece", "block_counts", "conform", "weld"]
 
 BORDERS = ("bottom", "right", "top", "left")
 
@@ -144,25 +144,23 @@ def _chains_of(pieces: list[Piece], work=None):
     return sides, chain_pts, {k: [(index[n], s) for n, s in u] for k, u in users.items()}
 
 
-def build_topology(
+def block_counts(
     pieces: list[Piece],
     cell_size: float,
     *,
     min_cells: int = 3,
     multiple: int = 1,
     block_cells: dict[int, tuple[int, int]] | None = None,
-):
-    """The :class:`MultiBlockTopology` of ``pieces`` with counts for ``cell_size``
-    (``block_cells``: pieces whose cells ``(ni, nj)`` are given); returns it and the chain counts.
+    best: bool = True,
+) -> list[tuple[int, int]]:
+    """The cells ``(ni, nj)`` of every piece for ``cell_size``: integer counts that agree across
+    every interface, closest to the cell size (:func:`~meshcore.multiblock.counts.solve_counts`;
+    ``block_cells``: pieces whose cells are given; ``best=False``: any counts that agree, to see
+    whether there are any).  Raises :class:`TopologyError` when there are none."""
+    return _counts(_line_work(pieces), pieces, cell_size, min_cells, multiple, block_cells, best)[0]
 
-    The counts come from :func:`~meshcore.multiblock.counts.solve_counts`; the blocks, their
-    shared chains and interfaces from :func:`~meshcore.multiblock.chains.chain_topology`, as
-    :func:`~meshcore.multiblock.from_outline` makes them.
-    """
-    from ..multiblock.chains import chain_topology
-    from ..multiblock.outline import BlockOutline
 
-    work = _line_work(pieces)
+def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
     side_chains, chain_pts, chain_users = _chains_of(pieces, work)
     for key, users in chain_users.items():
         if len(users) > 2:
@@ -174,11 +172,7 @@ def build_topology(
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
-    counts = solve_counts(length / cell_size, sides, min_cells=min_cells, multiple=multiple, block_cells=block_cells)
-    names, rings, corners, breaks = work
-    specs = [
-        BlockOutline(n, tuple(corners[n]), (int(counts[s[0]].sum()), int(counts[s[3]].sum())))
-        for n, s in zip(names, sides, strict=True)
-    ]
-    topo = chain_topology(specs, rings, corners, breaks, multiple, check_geometry=False, cell_size=cell_size)
-    return topo, counts
+    counts = solve_counts(
+        length / cell_size, sides, min_cells=min_cells, multiple=multiple, block_cells=block_cells, best=best
+    )
+    return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts

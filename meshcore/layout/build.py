@@ -205,10 +205,10 @@ def _check_pieces(poly, pieces: list[Piece]) -> None:
 
 def _countable(pieces: list[Piece], h: float) -> bool:
     from ..errors import TopologyError
-    from .blocks import build_topology
+    from .blocks import block_counts
 
     try:
-        build_topology(pieces, h)
+        block_counts(pieces, h, best=False)
     except TopologyError:
         return False
     return True

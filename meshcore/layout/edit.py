@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .blocks import Piece, build_topology, conform
+from .blocks import Piece, block_counts, conform
 from .model import Layout, LayoutBlock
 from .outline import _size
 
@@ -122,10 +122,10 @@ def layout_from_cuts(polygon: Any, cuts: Any, *, cell_size: float, multiple: int
     names = [f"b{k}" for k in range(len(rings))]
     pieces = _pieces_of_regions(rings, corner_pts, names, _size(polygon))
     _check_pieces(polygon, pieces)
-    topo, _ = build_topology(pieces, h, multiple=multiple)
+    cells = block_counts(pieces, h, multiple=multiple)
     blocks = tuple(
-        LayoutBlock(pc.name, tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]), tuple(b.cells))
-        for pc, b in zip(pieces, topo.blocks, strict=True)
+        LayoutBlock(pc.name, tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]), c)
+        for pc, c in zip(pieces, cells, strict=True)
     )
     return Layout(
         polygon=polygon, cell_size=h, cuts=tuple(all_cuts), pieces=tuple(pieces), blocks=blocks, multiple=multiple
@@ -149,18 +149,13 @@ def with_cells(layout: Layout, name: str, cells: tuple[int, int]) -> Layout:
         raise TopologyError(f"block {name!r}: cells ({ni}, {nj}) must be positive multiples of {m}")
     k = names.index(name)
     try:
-        topo, _ = build_topology(
-            list(layout.pieces), layout.cell_size, min_cells=1, multiple=m, block_cells={k: (ni, nj)}
-        )
+        counts = block_counts(list(layout.pieces), layout.cell_size, min_cells=1, multiple=m, block_cells={k: (ni, nj)})
     except TopologyError:
         raise TopologyError(
             f"block {name!r} cannot have ({ni}, {nj}) cells: no cell counts of its neighbours agree with "
             f"them (at a T-junction a side needs room for each of its parts)"
         ) from None
-    blocks = tuple(
-        LayoutBlock(b.name, b.corners, (int(t.cells[0]), int(t.cells[1])))
-        for b, t in zip(layout.blocks, topo.blocks, strict=True)
-    )
+    blocks = tuple(LayoutBlock(b.name, b.corners, c) for b, c in zip(layout.blocks, counts, strict=True))
     import dataclasses
 
     return dataclasses.replace(layout, blocks=blocks)

@@ -81,6 +81,7 @@ def solve_counts(
     multiple: int = 1,
     fixed: dict[int, int] | None = None,
     block_cells: dict[int, tuple[int, int]] | None = None,
+    best: bool = True,
 ) -> np.ndarray:
     """Integer counts per chain.
 
@@ -100,6 +101,9 @@ def solve_counts(
         Blocks whose cells ``(ni, nj)`` are given: their bottom (and top) chains add up to
         ``ni``, their left (and right) chains to ``nj``.  With every block given, the program
         only shares each side's cells among its chains (closest to ``targets``).
+    best : bool
+        False: any counts that satisfy the constraints, not the closest (whether counts
+        exist at all; a hundred times faster on layouts of a hundred blocks).
 
     Raises
     ------
@@ -180,7 +184,7 @@ def solve_counts(
     from scipy.optimize import Bounds
 
     res = milp(
-        cost,
+        cost if best else np.zeros(nv),
         constraints=LinearConstraint(np.array(rows), lo, hi),
         integrality=np.concatenate([np.ones(n), np.zeros(n + 2 * nb + len(jumps))]),
         bounds=Bounds(lb, ub),
