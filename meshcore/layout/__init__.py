@@ -31,7 +31,7 @@ from .build import layout_pieces
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .model import Layout, LayoutBlock
 from .outline import interior_cuts
-from .polygon import water_polygon, without_slivers
+from .polygon import water_polygon, without_dense_vertices, without_slivers
 from .shore import shore_at_scale, transfer, without_narrow_arms
 
 __all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
@@ -77,7 +77,9 @@ def auto_layout(
     """
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else float(np.sqrt(poly.area / target_cells))
+    poly, dense = without_dense_vertices(poly, h)
     poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
+    more = dense + more
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
     more = more + slivers + arms
