@@ -93,7 +93,28 @@ class Level:
         return [g.shape for g in self.ids]
 
 
+def _colour_order(ids: tuple[np.ndarray, ...], args: tuple, n_interior: int) -> tuple:
+    """The table ``args`` with every block's interior rows in 4-colour order (the parity of
+    ``(i, j)``: even ``i`` before odd, in each row parity odd ``j`` before even, then
+    lexicographic), the border rows unchanged.  No two nodes of one colour are in each other's
+    9-point stencil, so consecutive updates of a point sweep do not wait for each other (a
+    lexicographic sweep is one long chain of dependent divisions: 1.5× slower, measured)."""
+    perm, off = [], 0
+    for g in ids:
+        if g.shape[0] < 3 or g.shape[1] < 3:
+            continue
+        a, b = g.shape[0] - 2, g.shape[1] - 2  # interior nodes (i, j) = (1 + ii, 1 + jj)
+        ii, jj = np.divmod(np.arange(a * b), b)
+        colour = 2 * ((ii + 1) % 2) + jj % 2  # i = 1 + ii even first; in a row j = 1 + jj odd first
+        perm.append(off + np.argsort(colour, kind="stable"))
+        off += a * b
+    perm.append(np.arange(n_interior, len(args[0])))
+    order = np.concatenate(perm)
+    return (np.ascontiguousarray(args[0][order]), np.ascontiguousarray(args[1][order]), *args[2:])
+
+
 def _level(ids: tuple[np.ndarray, ...], n: int, args: tuple, n_interior: int) -> Level:
+    args = _colour_order(ids, args, n_interior)
     free = np.zeros(n, dtype=bool)
     free[args[0]] = True
     free[args[2]] = True

@@ -11,7 +11,8 @@ level's nodes, whole grid lines of every block, chosen so that the blocks still
 meet node to node; both directions coarsen, odd cell counts too (a coarse cell
 spans one or two fine cells).
 
-Smoother (one step): a point Gauss–Seidel sweep over the table, a line
+Smoother (one step): a point Gauss–Seidel sweep over the table (block interiors in
+4-colour order, :func:`.hierarchy._colour_order`), a line
 Gauss–Seidel sweep over every interior block line along ξ and then along η
 (tridiagonal solves with frozen coefficients, :func:`._kernels.line_sweep_rhs`:
 robust where cells are stretched, which on the lakes happens where the

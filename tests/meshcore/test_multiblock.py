@@ -815,8 +815,8 @@ def test_line_kernel_matches_numpy_reference():
         fy = f[::-1].copy() if f.size else f
         for lines in lv.lines:
             xk, yk = x.copy(), y.copy()
-            xr, yr = _reference.line_sweep(x, y, f, fy, m.nodes, m.nbr, *lines)
-            d = _kernels.line_sweep_rhs(xk, yk, f, fy, m.nodes, m.nbr, *lines)
+            xr, yr = _reference.line_sweep(x, y, f, fy, lv.args[0], lv.args[1], *lines)
+            d = _kernels.line_sweep_rhs(xk, yk, f, fy, lv.args[0], lv.args[1], *lines)
             assert np.allclose(xk, xr, rtol=0, atol=1e-13) and np.allclose(yk, yr, rtol=0, atol=1e-13)
             assert d == pytest.approx(np.hypot(xr - x, yr - y).max(), rel=1e-9)
             assert np.array_equal(xk[m.boundary], x[m.boundary])
@@ -901,6 +901,29 @@ def test_band_is_the_nodes_two_stencil_steps_from_the_boundary():
         assert sorted(lv.band[0].tolist()) == expect
         assert 0 < len(expect) < len(nodes)
         assert np.array_equal(lv.band[1], nbr[np.isin(nodes, lv.band[0])])
+
+
+def test_level_tables_hold_the_node_map_stencils_in_colour_order(rect):
+    """The finest level's table is the node map's, each block's interior rows re-ordered so that
+    consecutive rows of one colour are never in each other's stencil (four runs per block)."""
+    from meshcore.multiblock import hierarchy
+
+    X, Y, _ = rect
+    for topo in (star(5, 9), four_blocks(X, Y, 12, 7)):
+        m = topo.node_map
+        lv = hierarchy.levels(topo)[0]
+        nodes, nbr = lv.args[0], lv.args[1]
+        assert sorted(map(tuple, np.column_stack([nodes, nbr]).tolist())) == sorted(
+            map(tuple, np.column_stack([m.nodes, m.nbr]).tolist())
+        )
+        assert np.array_equal(nodes[m.n_interior :], m.nodes[m.n_interior :])
+        runs, start = 0, 0
+        for k in range(1, m.n_interior + 1):  # maximal runs of mutually independent rows
+            if k == m.n_interior or np.isin(nbr[start:k], nodes[k]).any() or np.isin(nbr[k], nodes[start:k]).any():
+                runs += 1
+                start = k
+        blocks = sum(g.shape[0] > 2 and g.shape[1] > 2 for g in m.ids)
+        assert runs <= 4 * blocks
 
 
 @pytest.mark.kernel
