@@ -103,11 +103,9 @@ def _colour_order(ids: tuple[np.ndarray, ...], args: tuple, n_interior: int) -> 
     for g in ids:
         if g.shape[0] < 3 or g.shape[1] < 3:
             continue
-        a, b = g.shape[0] - 2, g.shape[1] - 2  # interior nodes (i, j) = (1 + ii, 1 + jj)
-        ii, jj = np.divmod(np.arange(a * b), b)
-        colour = 2 * ((ii + 1) % 2) + jj % 2  # i = 1 + ii even first; in a row j = 1 + jj odd first
-        perm.append(off + np.argsort(colour, kind="stable"))
-        off += a * b
+        idx = off + np.arange((g.shape[0] - 2) * (g.shape[1] - 2)).reshape(g.shape[0] - 2, g.shape[1] - 2)
+        off += idx.size  # idx[ii, jj]: node (i, j) = (1 + ii, 1 + jj); even i first, then odd j first
+        perm += [idx[1::2, 0::2].ravel(), idx[1::2, 1::2].ravel(), idx[0::2, 0::2].ravel(), idx[0::2, 1::2].ravel()]
     perm.append(np.arange(n_interior, len(args[0])))
     order = np.concatenate(perm)
     return (np.ascontiguousarray(args[0][order]), np.ascontiguousarray(args[1][order]), *args[2:])
@@ -281,10 +279,22 @@ def _scale(coarse: Level) -> np.ndarray:
     """FAS scaling of the restricted defect per coarse node (module docstring; α = γ)."""
     scale = np.zeros(coarse.n)
     for gc, (si, sj) in zip(coarse.ids, coarse.sel, strict=True):
-        a2 = np.gradient(si.astype(float))[:, None] ** 2 if len(si) > 1 else np.ones((1, 1))
-        b2 = np.gradient(sj.astype(float))[None, :] ** 2 if len(sj) > 1 else np.ones((1, 1))
+        a2 = _gradient(si)[:, None] ** 2
+        b2 = _gradient(sj)[None, :] ** 2
         scale[gc] = 2.0 * a2 * b2 / (a2 + b2)
     return scale
+
+
+def _gradient(s: np.ndarray) -> np.ndarray:
+    """``np.gradient`` of the kept positions ``s`` (one-sided at the ends; 1 for a single one)."""
+    s = s.astype(float)
+    if len(s) < 2:
+        return np.ones(len(s))
+    g = np.empty(len(s))
+    g[1:-1] = (s[2:] - s[:-2]) / 2.0
+    g[0] = s[1] - s[0]
+    g[-1] = s[-1] - s[-2]
+    return g
 
 
 def _coarser(lv: Level) -> Level | None:

@@ -272,7 +272,7 @@ def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
     blocks given only by their global ids (a multigrid coarse level); ``nodes[:n_interior]`` are
     block-interior nodes."""
     ids = tuple(ids)
-    cells, _, boundary = _cells([f"#{k}" for k in range(len(ids))], ids, n_nodes)
+    cells, boundary = _perimeter_cells(ids), _side_boundary(ids, n_nodes)
     occ = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n_nodes)  # a block's ids are unique
     nodes_l, nbr_l = _interior_stencils(ids)
     border_free = np.flatnonzero(~boundary & (occ > 1))
@@ -291,6 +291,40 @@ def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
         np.array(irr_ring, dtype=np.int64),
     )
     return args, n_interior
+
+
+def _perimeter_cells(ids: Sequence[np.ndarray]) -> np.ndarray:
+    """The CCW cells of every block that touch its border, in the order of :func:`_cells` (every
+    cell around a node shared by blocks is one of them: a shared node is on a border of each)."""
+    out = []
+    for g in ids:
+        a, b = g.shape[0] - 1, g.shape[1] - 1  # cells
+        if a <= 2 or b <= 2:
+            ii, jj = np.divmod(np.arange(a * b), b)
+        else:
+            mid = np.arange(1, a - 1)
+            ii = np.concatenate([np.zeros(b, dtype=np.int64), np.repeat(mid, 2), np.full(b, a - 1)])
+            jj = np.concatenate([np.arange(b), np.tile([0, b - 1], a - 2), np.arange(b)])
+        out.append(np.stack([g[ii, jj], g[ii + 1, jj], g[ii + 1, jj + 1], g[ii, jj + 1]], axis=-1))
+    return np.vstack(out).astype(np.int64)
+
+
+def _side_boundary(ids: Sequence[np.ndarray], n_nodes: int) -> np.ndarray:
+    """Nodes on the outer boundary (the ``boundary`` of :func:`_cells`): the ends of block-side
+    edges that no other block has (an edge inside a block has a cell on either side)."""
+    e0, e1 = [], []
+    for g in ids:
+        for side in (g[:, 0], g[:, -1], g[0, :], g[-1, :]):
+            e0.append(side[:-1])
+            e1.append(side[1:])
+    a, b = np.concatenate(e0), np.concatenate(e1)
+    key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
+    _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
+    one = cnt[inv] == 1
+    boundary = np.zeros(n_nodes, dtype=bool)
+    boundary[a[one]] = True
+    boundary[b[one]] = True
+    return boundary
 
 
 def build_node_map(blocks: Sequence[Any], interfaces: Sequence[Any]) -> NodeMap:

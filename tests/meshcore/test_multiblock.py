@@ -903,6 +903,25 @@ def test_band_is_the_nodes_two_stencil_steps_from_the_boundary():
         assert np.array_equal(lv.band[1], nbr[np.isin(nodes, lv.band[0])])
 
 
+@pytest.mark.parametrize("make", ["star5", "four_blocks", "odd", "shasta"])
+def test_coarse_level_cells_and_boundary_equal_the_full_ones(make, rect, shasta_topology):
+    """The coarse-level tables read only the cells along the block borders and the block sides:
+    the same cells in the same order (the stencil frames depend on it) and the same fixed nodes as
+    the full cell list, on every level."""
+    from meshcore.multiblock import hierarchy, nodemap
+
+    X, Y, _ = rect
+    topo = {"star5": lambda: star(5, 9), "four_blocks": lambda: four_blocks(X, Y, 12, 6),
+            "odd": lambda: four_blocks(X, Y, 14, 5), "shasta": lambda: shasta_topology}[make]()  # fmt: skip
+    for lv in hierarchy.levels(topo):
+        cells, _, boundary = nodemap._cells([str(k) for k in range(len(lv.ids))], lv.ids, lv.n)
+        assert np.array_equal(nodemap._side_boundary(lv.ids, lv.n), boundary)
+        side = np.zeros(lv.n, dtype=bool)
+        for g in lv.ids:
+            side[np.concatenate([g[0], g[-1], g[:, 0], g[:, -1]])] = True
+        assert np.array_equal(nodemap._perimeter_cells(lv.ids), cells[side[cells].any(axis=1)])
+
+
 def test_level_tables_hold_the_node_map_stencils_in_colour_order(rect):
     """The finest level's table is the node map's, each block's interior rows re-ordered so that
     consecutive rows of one colour are never in each other's stencil (four runs per block)."""
