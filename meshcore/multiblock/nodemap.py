@@ -103,7 +103,8 @@ def _global_ids(blocks: Sequence[Any], interfaces: Sequence[Any]) -> tuple[int, 
     n_nodes, compact = connected_components(graph, directed=False)
     ids = tuple(compact[loc].reshape(loc.shape).astype(np.int64) for loc in local)
     for k, g in enumerate(ids):
-        if len(np.unique(g)) != g.size:
+        ring = np.concatenate([g[0], g[-1], g[1:-1, 0], g[1:-1, -1]])  # only border nodes are glued
+        if len(np.unique(ring)) != ring.size:
             raise TopologyError(
                 f"block {blocks[k].name!r}: interfaces glue two nodes of the same block "
                 f"together (a border is joined to itself or to a neighbour's border twice)"
@@ -122,29 +123,29 @@ def _cells(
     cell_block = np.concatenate(
         [np.full((g.shape[0] - 1) * (g.shape[1] - 1), k, dtype=np.int32) for k, g in enumerate(ids)]
     )
-    # edges: count cells per undirected edge
+    # edges in two or more blocks (both ends shared: an edge with a node of one block only is that
+    # block's own, inside it or on the outer boundary): no more than two cells on each, walked in
+    # opposite directions
+    occ = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n_nodes)  # a block's ids are unique
     e0 = cells.reshape(-1)
     e1 = np.roll(cells, -1, axis=1).reshape(-1)
-    key = np.minimum(e0, e1) * n_nodes + np.maximum(e0, e1)
-    ukey, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
+    cand = np.flatnonzero((occ[e0] > 1) & (occ[e1] > 1))
+    a, b = e0[cand], e1[cand]
+    key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
+    ukey, cnt = np.unique(key, return_counts=True)
     if (cnt > 2).any():
         bad = int(ukey[np.argmax(cnt > 2)])
-        hit = np.flatnonzero(key == bad)
+        hit = cand[key == bad]
         which = ", ".join(sorted({names[cell_block[c // 4]] for c in hit}))
         raise TopologyError(
             f"an edge is shared by more than two cells (blocks {which}): interfaces of these blocks overlap"
         )
-    # directed-edge check: a shared edge must be walked in opposite directions
-    _, dcnt = np.unique(e0 * n_nodes + e1, return_counts=True)
-    if (dcnt > 1).any():
+    if len(np.unique(a * n_nodes + b)) != len(cand):
         raise TopologyError(
             "two blocks meet with opposite orientations (a mirrored block): every block must "
             "run bottom → right → top → left counter-clockwise"
         )
-    on_bnd_edge = cnt[inv] == 1
-    boundary = np.zeros(n_nodes, dtype=bool)
-    boundary[e0[on_bnd_edge]] = True
-    boundary[e1[on_bnd_edge]] = True
+    boundary = _side_boundary(ids, n_nodes)
     return cells, cell_block, boundary
 
 
