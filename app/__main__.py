@@ -10,6 +10,9 @@ import threading
 import time
 from pathlib import Path
 
+#: seconds ``--solve`` waits for the layout and the grid (a busy machine may need minutes)
+SOLVE_TIMEOUT_S = 1800.0
+
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gcmesh", description="gcmesh: structured boundary-fitted grids")
@@ -121,7 +124,8 @@ def main(argv: list[str] | None = None) -> int:
     app.processEvents()
     win.canvas.fit()
     if args.solve:
-        solve_as_opened(app, win)
+        if not solve_as_opened(app, win):
+            print(f"gcmesh: --solve: not finished after {SOLVE_TIMEOUT_S:.0f} s; {win._status.text()}", file=sys.stderr)
         app.processEvents()
         if args.quality:
             win.quality_panel.metric.setCurrentText(args.quality)
@@ -139,23 +143,27 @@ def main(argv: list[str] | None = None) -> int:
     return code
 
 
-def solve_as_opened(app, win, timeout_s: float = 120.0) -> None:
-    """``--solve``: the grid of what was opened, until it is done.
+def solve_as_opened(app, win, timeout_s: float | None = None) -> bool:
+    """``--solve``: the grid of what was opened, until it is done; False if not done in ``timeout_s``.
 
     A lake whose import offered Auto layout (arms or islands) is laid out first, as the offer's
-    button does; one block over such a lake would be a poor grid, or cover its islands.
+    button does; one block over such a lake would be a poor grid, or cover its islands.  The
+    layout and the grid may take minutes on a busy machine: the default wait is
+    :data:`SOLVE_TIMEOUT_S` for both together.
     """
+    t_end = time.perf_counter() + (SOLVE_TIMEOUT_S if timeout_s is None else timeout_s)
     if win.lake_ctl.prompt is not None:
         done: list = []
         win.lake_ctl.layout_done.connect(done.append)
         if win.lake_ctl.auto_layout():  # the grid starts when the layout is set
-            t_end = time.perf_counter() + timeout_s
             while not done and time.perf_counter() < t_end:
                 app.processEvents()
                 time.sleep(0.01)
+            if not done or done[0] is None:
+                return False
     else:
         win.generate()
-    win.solver.wait(timeout_s=timeout_s)
+    return win.solver.wait(timeout_s=max(0.0, t_end - time.perf_counter()))
 
 
 if __name__ == "__main__":

@@ -197,6 +197,18 @@ ACTIONS: tuple[ActionSpec, ...] = (
         checked=True,
         help="show / hide the boundary points and markers",
     ),
+    ActionSpec(
+        "misses",
+        "Preset &misses",
+        "show_misses",
+        ("Q",),
+        "mark the places that miss the quality preset's selected limit (off by itself while a metric "
+        "colours the cells: then they are thin rings)",
+        "&View",
+        checkable=True,
+        checked=True,
+        help="show / hide the places that miss the quality preset",
+    ),
     ActionSpec("docks", "", "@docks", menu="&View", separator=True),
     ActionSpec("examples", "", "@examples", menu="E&xamples"),
     # Help

@@ -45,19 +45,20 @@ class PointData:
 
 
 def read_points(path) -> PointData:
-    """Read a boundary point file with :func:`meshcore.io.read_points` (every format it knows)."""
-    from meshcore import crs as mcrs
+    """Read a boundary point file with :func:`meshcore.io.read_points` (every format it knows).
+
+    ``lonlat`` follows the rule of ``meshcore mesh`` (:func:`meshcore.cli.mesh.is_lonlat`): the
+    file says so, or it says nothing and its numbers look like degrees (a headerless CSV).
+    """
     from meshcore import io as mio
+    from meshcore.cli.mesh import is_lonlat
 
     path = Path(path)
     ps = mio.read_points(path)
     if not ps.polylines:
         raise ReadError(f"{path}: the file holds no polyline")
     pts = np.asarray(ps.polylines[0].points, float)
-    geographic = (ps.crs is not None and mcrs.is_geographic(ps.crs)) or (
-        ps.crs is None and mcrs.looks_lonlat(pts) and path.suffix.lower() in (".kml", ".kmz", ".geojson")
-    )
-    return PointData(_drop_closing(pts), bool(geographic), str(path), ps)
+    return PointData(_drop_closing(pts), is_lonlat(ps), str(path), ps)
 
 
 def to_local(pd: PointData, frame=None) -> tuple[np.ndarray, object]:

@@ -225,10 +225,12 @@ class IOController(QtCore.QObject):
         if pd.pointset is None:
             return None
         try:
-            outer, islands, _fr = read_lake(pd.pointset, frame, lonlat=lonlat)
+            outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat)
         except (MeshcoreError, ValueError) as exc:
             log.info("%s: not read as a lake (%s)", pd.path, exc)
             return None
+        for note in notes:  # what meshcore mesh prints as notes
+            self.doc.report("warning", f"{Path(pd.path).name}: {note}")
         return Lake(outline=outer, holes=tuple(islands))
 
     def _add_imported(self, block: Block, frame, name: str, *, lake=None) -> None:

@@ -4,8 +4,9 @@ The same functions as ``meshcore mesh`` (:mod:`meshcore.cli.mesh`) so that the s
 gives the same layout in the app and on the command line:
 
 * the water: every ring of the point file, projected like the rest of the project
-  (:func:`meshcore.crs.project`), split into shore and islands by
-  :func:`meshcore.layout.polygon.water_from_points`;
+  (:func:`meshcore.cli.mesh.local_frame`; lon/lat by :func:`meshcore.cli.mesh.is_lonlat`),
+  split into shore and islands by :func:`meshcore.cli.mesh.lake_rings` (open lines touching
+  the shore dropped);
 * the layout: :func:`meshcore.layout.auto_layout` at the cell size the user set, or at
   ``sqrt(water area / 10 000)`` (:data:`meshcore.cli.mesh.DEFAULT_CELLS`), with cell counts
   that are multiples of ``2**LEVELS`` (the grid sequencing of :func:`meshcore.lakegrid.mesh_layout`);
@@ -91,17 +92,18 @@ class Lake:
 
 
 # ------------------------------------------------------------------ reading
-def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tuple[np.ndarray, list, Any]:
-    """Shore, islands and frame of a point file's rings (lon/lat projected as the CLI does).
+def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tuple[np.ndarray, list, Any, list[str]]:
+    """Shore, islands, frame and notes of a point file's rings, by the rules of ``meshcore mesh``.
 
     ``pointset`` is the :class:`meshcore.io.PointSet` read from the file; with ``lonlat``
     its degrees go to ``frame`` (the project's) or to the UTM zone of the centroid with a
-    round local origin.  Raises :class:`~meshcore.MeshcoreError` when the rings are not
-    one lake (an island outside the shore, a ring of fewer than three points).
+    round local origin (:func:`meshcore.cli.mesh.local_frame`).  Open lines touching the
+    shore are dropped with a note (:func:`meshcore.cli.mesh.lake_rings`).  Raises
+    :class:`~meshcore.MeshcoreError` when the rings are not one lake (an island outside the
+    shore, a ring of fewer than three points).
     """
     from meshcore import crs as mcrs
-    from meshcore.cli.mesh import local_frame
-    from meshcore.layout.polygon import water_from_points
+    from meshcore.cli.mesh import lake_rings, local_frame
 
     ps = pointset
     if lonlat:
@@ -110,8 +112,8 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
             ps, frame = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)
         else:  # the rule of ``meshcore mesh``: the same local numbers, the same layout and grid
             ps, frame = local_frame(ps, "auto", source_crs=src)
-    outer, islands = water_from_points(ps)
-    return np.asarray(outer, float), [np.asarray(r, float) for r in islands], frame
+    outer, islands, notes = lake_rings(ps)
+    return outer, islands, frame, notes
 
 
 def water(outline: Any, holes: Any = ()) -> Any:

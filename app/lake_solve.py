@@ -23,6 +23,7 @@ import inspect
 import threading
 import time
 from collections.abc import Generator, Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,12 +31,30 @@ from meshcore import SolverProgress, StructuredGrid
 
 from .results import ALL_BLOCKS, BlockResult
 
-__all__ = ["TOLERANCE", "layout_topology", "solve_layout"]
+__all__ = ["TOLERANCE", "LakeProgress", "layout_topology", "level_labels", "solve_layout"]
 
 #: the sweep tolerance of :func:`meshcore.lakegrid.iterate_layout` (largest move / cell size)
 TOLERANCE = 1e-5
 #: sweeps between two snapshots of a warm solve (the canvas redraws after each)
 WARM_EVERY = 2
+
+
+@dataclass(frozen=True, slots=True)
+class LakeProgress(SolverProgress):
+    """A :class:`~meshcore.SolverProgress` of a lake grid with its levels so far.
+
+    ``levels``: ``(sweep, label)`` for each level of the grid sequencing begun so far (the
+    sweep count at its start, e.g. ``(0, "cells ÷ 4"), (200, "cells ÷ 2"), (350, "full")``):
+    the convergence plot marks them (the change per sweep rises where a finer level begins).
+    """
+
+    levels: tuple[tuple[int, str], ...] = field(default=(), repr=False)
+
+
+def level_labels(n_levels: int) -> list[str]:
+    """The labels of ``n_levels`` levels, coarsest first: ``["cells ÷ 4", "cells ÷ 2", "full"]``."""
+    return [f"cells ÷ {2 ** (n_levels - 1 - k)}" if k < n_levels - 1 else "full" for k in range(n_levels)]
+
 
 _topologies: dict[int, tuple] = {}  # id(layout) -> (layout, topology): the last few layouts' topologies
 
@@ -91,11 +110,20 @@ def _cold(layout, stop_event):
     from meshcore.lakegrid import iterate_layout
     from meshcore.multiblock import initial_grids
 
-    gen = iterate_layout(layout, stop_event=stop_event)
+    n_levels = 1 + (max(0, int(np.log2(layout.multiple))) if layout.multiple > 1 else 0)  # as iterate_layout
+    labels = level_labels(n_levels)
+    levels = [(0, labels[0])]
+
+    def level_done(_what, value):  # called by iterate_layout as a level ends, before the next one's sweeps
+        lev, res = value
+        if lev + 1 < n_levels:
+            levels.append((levels[-1][0] + res.sweeps, labels[lev + 1]))
+
+    gen = iterate_layout(layout, stop_event=stop_event, level_callback=level_done)
     try:
         snap = next(gen)
         while True:
-            cmd = yield ALL_BLOCKS, snap
+            cmd = yield ALL_BLOCKS, _with_levels(snap, levels)
             snap = gen.send(cmd)
     except StopIteration as fin:
         mb = fin.value
@@ -104,6 +132,13 @@ def _cold(layout, stop_event):
         return BlockResult(grids={}, initial={})
     starts = dict(enumerate(initial_grids(mb.topology)))
     return BlockResult(grids=dict(enumerate(mb.grids)), initial=starts, multiblock=mb, metrics=_metrics(layout, mb))
+
+
+def _with_levels(snap, levels) -> LakeProgress:
+    s = snap
+    return LakeProgress(
+        s.iteration, s.residual, s.tolerance, s.grid, s.elapsed, s.method, s.history, s.grids, tuple(levels)
+    )
 
 
 def _warm(layout, warm, stop_event):
@@ -120,7 +155,8 @@ def _warm(layout, warm, stop_event):
     t0 = time.perf_counter()
     history: list[tuple[int, float]] = []
     # the moved grid is shown at once (never the start grid): a drag's redraw does not wait for sweeps
-    first = SolverProgress(0, float("nan"), TOLERANCE, None, 0.0, "orthogonal", (), tuple(grids))
+    warm_level = ((0, "full, from the previous grid"),)
+    first = LakeProgress(0, float("nan"), TOLERANCE, None, 0.0, "orthogonal", (), tuple(grids), warm_level)
     cmd = yield ALL_BLOCKS, first
     stopped = cmd == "stop" or (stop_event is not None and stop_event.is_set())
     if stopped:  # a newer edit is waiting: the moved grid is the result (no metrics: nobody reads them)
@@ -130,8 +166,9 @@ def _warm(layout, warm, stop_event):
         it, d, snap = next(gen)
         while True:
             history.append((it, d))
-            progress = SolverProgress(
-                it, float(d), TOLERANCE, None, time.perf_counter() - t0, "orthogonal", tuple(history), snap
+            elapsed = time.perf_counter() - t0
+            progress = LakeProgress(
+                it, float(d), TOLERANCE, None, elapsed, "orthogonal", tuple(history), snap, warm_level
             )
             cmd = yield ALL_BLOCKS, progress
             stopped = cmd == "stop" or (stop_event is not None and stop_event.is_set())

@@ -213,6 +213,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.params_panel.committed.connect(self.focus_canvas)
         self.lake_panel.committed.connect(self.focus_canvas)
         self.lake_quality.misses.connect(self.canvas.lake_items.set_misses)
+        self.lake_quality.table.clicked.connect(lambda _i: self.show_misses(True))  # a limit picked: show where
+        self.doc.colour_changed.connect(self._misses_for_colours)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
         self.stack.cleanChanged.connect(self._update_title)
@@ -387,6 +389,20 @@ class MainWindow(QtWidgets.QMainWindow):
             return
         for text in advice:
             self.doc.report("warning", f"{b.name}: {text}")
+
+    def show_misses(self, on: bool) -> None:
+        """Show or hide the places that miss the quality preset (View ▸ Preset misses)."""
+        if self.a_misses.isChecked() != bool(on):
+            self.a_misses.setChecked(bool(on))
+        self.canvas.lake_items.set_misses_visible(on)
+
+    def _misses_for_colours(self, label: str) -> None:
+        """Cells coloured by a metric: the misses step aside (they would hide the colours), and back."""
+        coloured = label != "none"
+        self.show_misses(not coloured)
+        if coloured and self.lake_quality.verdict is not None and not self.lake_quality.verdict.passed:
+            key = self.a_misses.shortcut().toString(QtGui.QKeySequence.SequenceFormat.NativeText)
+            self.message(f"Cells coloured by {label}; the preset's misses are hidden — View ▸ Preset misses ({key})")
 
     # ------------------------------------------------------------- window
     def _update_title(self, *_a) -> None:

@@ -32,7 +32,7 @@ class SolveStatus(QtCore.QObject):
         self.label = QtWidgets.QLabel("idle")
         self.frames: list[float] = []  # times of the last redraws (for the redraws/s read-out)
         self._history_at = 0.0  # when the convergence plot was last drawn
-        self._last_history: tuple | None = None  # (history, tolerance) of the last multiblock snapshot
+        self._last_history: tuple | None = None  # (history, tolerance, levels) of the last multiblock snapshot
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
         self.doc.opened.connect(self.on_opened)
@@ -56,11 +56,12 @@ class SolveStatus(QtCore.QObject):
         if k == ALL_BLOCKS:  # a multiblock solve: every block at once
             now = time.perf_counter()
             # the plot at most every HISTORY_EVERY s: it repaints its axes (costly in a drag's redraws)
+            levels = getattr(snap, "levels", ())  # a lake grid's levels (app.lake_solve.LakeProgress)
             if snap.history:
-                self._last_history = (snap.history, snap.tolerance)
+                self._last_history = (snap.history, snap.tolerance, levels)
             if snap.history and now - self._history_at >= HISTORY_EVERY:
                 self._history_at = now
-                self.conv.set_history(list(snap.history), snap.tolerance)
+                self.conv.set_history(list(snap.history), snap.tolerance, levels)
             self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
             return
         if k == self.doc.active:  # history and residual are relative to the grid size
@@ -121,7 +122,7 @@ class SolveStatus(QtCore.QObject):
     def _lake_final(self, mb) -> None:
         info = mb.info
         if self._last_history is not None:  # the whole history (the plot is throttled while solving)
-            self.conv.set_history(list(self._last_history[0]), self._last_history[1])
+            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
         m = self.doc.lake_metrics
         dt = self.solver.t_done - self.solver.t_start
         cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)

@@ -343,6 +343,7 @@ class Canvas(pg.PlotWidget):
         r = self.doc.quality
         self.set_folded(self.doc.quality_grid, r.folded if r is not None else None)
         self.clear_highlight()
+        self.lake_items.set_misses_style(over_colours=bool(layers))
         self.lake_items.set_solving(self.doc.solving)
 
     def zoom_to_cell(self, i: int, j: int) -> None:

@@ -47,6 +47,8 @@ class LakeOverlay:
         self.corners = Scatter(size=8, symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush("#ffd700"))
         self.corners.setZValue(23)
         self.misses = Scatter(size=5, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 170))
+        self.misses_on = True  # View ▸ Preset misses (off by itself while a metric colours the cells)
+        self.misses_over_colours = False  # cells coloured: the misses are drawn as thin rings
         self.misses.setZValue(31)
         self.drag_point = Scatter(size=13, symbol="o", pen=pg.mkPen("#d62728", width=2), brush=None)
         self.drag_point.setZValue(43)
@@ -136,4 +138,28 @@ class LakeOverlay:
 
     def set_solving(self, solving: bool) -> None:
         """The places that miss a preset belong to the last grid: hidden while a new one is made."""
-        self.misses.setVisible(not solving)
+        self._solving = bool(solving)
+        self._show_misses()
+
+    def set_misses_visible(self, on: bool) -> None:
+        """Show or hide the places that miss the preset (View ▸ Preset misses)."""
+        self.misses_on = bool(on)
+        self._show_misses()
+
+    def set_misses_style(self, over_colours: bool) -> None:
+        """Filled orange dots on a plain grid; thin dark rings over coloured cells (the colour shows through)."""
+        over_colours = bool(over_colours)
+        if over_colours == self.misses_over_colours:
+            return
+        self.misses_over_colours = over_colours
+        if over_colours:
+            self.misses.setPen(pg.mkPen(0, 0, 0, 200, width=1))
+            self.misses.setBrush(None)
+            self.misses.setSize(6)
+        else:
+            self.misses.setPen(None)
+            self.misses.setBrush(pg.mkBrush(255, 127, 14, 170))
+            self.misses.setSize(5)
+
+    def _show_misses(self) -> None:
+        self.misses.setVisible(self.misses_on and not getattr(self, "_solving", False))

@@ -74,7 +74,14 @@ class BlocksPanel(QtWidgets.QTreeWidget):
 
 
 class ConvergencePanel(pg.PlotWidget):
-    """log10(residual) against iteration, growing live."""
+    """log10(residual) against iteration, growing live; the levels of a lake grid marked.
+
+    A lake grid is made coarse to fine: its change per sweep rises where a finer level
+    begins.  :meth:`set_history` with ``levels`` draws a dashed line and the level's name
+    at each level's first sweep, so the rise is read as what it is.
+    """
+
+    LEVEL_PEN = pg.mkPen("#7f7f7f", width=1, style=QtCore.Qt.PenStyle.DashLine)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent=parent, background="w")
@@ -86,11 +93,19 @@ class ConvergencePanel(pg.PlotWidget):
         self.tol_line = pg.InfiniteLine(angle=0, pen=pg.mkPen("#d62728", style=QtCore.Qt.PenStyle.DashLine))
         self.addItem(self.tol_line)
         self.tol_line.hide()
+        self.level_lines: list[pg.InfiniteLine] = []
+        self.levels: tuple[tuple[int, str], ...] = ()  # the marked levels: (first sweep, name)
         self.setMinimumHeight(120)
         for ax in ("left", "bottom"):
             self.getAxis(ax).enableAutoSIPrefix(False)
 
-    def set_history(self, history, tolerance: float | None = None) -> None:
+    def set_history(self, history, tolerance: float | None = None, levels=()) -> None:
+        """Plot ``(iteration, residual)`` pairs; ``levels``: ``(first sweep, name)`` of each level begun.
+
+        With levels (a lake grid) the axes say what is plotted: sweeps, and the largest move of
+        a node per sweep over the cell size.
+        """
+        self._set_levels(tuple((int(k), str(name)) for k, name in levels))
         if not history:
             self.curve.setData([], [])
             return
@@ -101,9 +116,34 @@ class ConvergencePanel(pg.PlotWidget):
             self.tol_line.setValue(math.log10(tolerance))
             self.tol_line.show()
 
+    def _set_levels(self, levels: tuple[tuple[int, str], ...]) -> None:
+        if levels == self.levels:
+            return
+        self.levels = levels
+        while len(self.level_lines) < len(levels):
+            line = pg.InfiniteLine(
+                angle=90,
+                pen=self.LEVEL_PEN,
+                label="",
+                labelOpts={"position": 0.92, "color": "#555", "anchors": [(0, 0), (0, 0)]},
+            )
+            self.addItem(line)
+            self.level_lines.append(line)
+        for k, line in enumerate(self.level_lines):
+            if k < len(levels):
+                line.setValue(levels[k][0])
+                line.label.setFormat(levels[k][1])
+                line.show()
+            else:
+                line.hide()
+        lake = bool(levels)
+        self.setLabel("left", "largest move / cell" if lake else "residual / L")
+        self.setLabel("bottom", "sweep" if lake else "iteration")
+
     def clear_history(self) -> None:
         self.curve.setData([], [])
         self.tol_line.hide()
+        self._set_levels(())
 
 
 class QualityPanel(QtWidgets.QWidget):

@@ -216,7 +216,7 @@ def _read(args: argparse.Namespace, say: _Say):
     """
     from ..crs import is_geographic, normalize_crs
     from ..io import read_points
-    from ..layout.polygon import water_from_points, water_polygon
+    from ..layout.polygon import water_polygon
 
     target = args.crs
     if target.strip().lower() not in ("auto", "none", "local"):
@@ -229,7 +229,8 @@ def _read(args: argparse.Namespace, say: _Say):
         raise InvalidInputError(
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
         )
-    outer, islands = water_from_points(_without_lines_on_the_shore(local))
+    outer, islands, dropped = lake_rings(local)
+    _notes(dropped)
     try:
         poly, notes = water_polygon(outer, holes=islands)
     except InvalidInputError as exc:
@@ -242,22 +243,58 @@ def _read(args: argparse.Namespace, say: _Say):
     return poly, frame
 
 
+def is_lonlat(ps: Any, source_crs: Any = None) -> bool:
+    """True when a point set holds longitude/latitude degrees.
+
+    The rule shared by ``meshcore mesh`` and the app's import: the CRS the file declares
+    (or ``source_crs``) is geographic, or the file declares none and every point looks like
+    degrees (:func:`meshcore.crs.looks_lonlat`; e.g. a CSV of lon, lat numbers without a
+    header).
+    """
+    from ..crs import is_geographic, looks_lonlat, normalize_crs
+
+    src = normalize_crs(source_crs) if source_crs is not None else ps.crs
+    if src is not None:
+        return bool(is_geographic(src))
+    pts = [np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines]
+    return bool(pts) and looks_lonlat(np.vstack(pts))
+
+
 def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[Any, Any]:
     """Project a point set for a lake grid: ``(local point set, Frame)``.
 
     The rule shared by ``meshcore mesh`` and the app's import (:func:`app.lake.read_lake`):
-    points projected from lon/lat go to ``crs`` relative to the round origin of
-    :func:`meshcore.crs.project` (``origin="auto"``); points not projected keep their
-    coordinates.  Subtracting a round origin is exact, so the world coordinates are
-    ``local + origin`` to the last bit.
+    points in lon/lat (:func:`is_lonlat`, also when the file does not say so) go to ``crs``
+    relative to the round origin of :func:`meshcore.crs.project` (``origin="auto"``); points
+    not projected keep their coordinates.  Subtracting a round origin is exact, so the world
+    coordinates are ``local + origin`` to the last bit.
     """
-    from ..crs import is_geographic, project
+    from ..crs import LONLAT, is_geographic, project
 
+    keep = crs is None or (isinstance(crs, str) and crs.strip().lower() in ("none", "local"))
+    if source_crs is None and ps.crs is None and not keep and is_lonlat(ps):
+        source_crs = LONLAT  # what project would guess: said here, where the app's import reads it too
     local, frame = project(ps, crs, origin=None, source_crs=source_crs)
     src = frame.source_crs
     if src is not None and is_geographic(src) and frame.crs is not None and frame.crs != src:
         local, frame = project(ps, crs, origin="auto", source_crs=source_crs)
     return local, frame
+
+
+def lake_rings(ps: Any) -> tuple[np.ndarray, list[np.ndarray], list[str]]:
+    """Shore, islands and notes of a point set's rings: the rule shared by ``meshcore mesh`` and the app.
+
+    Open polylines that touch the shore (an inlet or a cut drawn on it) are dropped with a
+    note (:func:`without_lines_on_the_shore`); the rest is split into the shore (the ring of
+    largest area) and islands by :func:`~meshcore.layout.polygon.water_from_points`, which
+    raises :class:`~meshcore.errors.InvalidInputError` naming a ring that is not part of one
+    lake.
+    """
+    from ..layout.polygon import water_from_points
+
+    kept, notes = without_lines_on_the_shore(ps)
+    outer, islands = water_from_points(kept)
+    return np.asarray(outer, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in islands], notes
 
 
 def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
@@ -272,28 +309,31 @@ def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
     return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
 
 
-def _without_lines_on_the_shore(ps: Any) -> Any:
-    """Drop open polylines that touch the shore (an inlet or a cut drawn on it), with a note.
+def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
+    """Drop open polylines that touch the shore (an inlet or a cut drawn on it): ``(kept, notes)``.
 
     The shore is the ring of largest area, as :func:`~meshcore.layout.polygon.water_from_points`
-    picks it; an open line that meets it cannot be an island.
+    picks it; an open line that meets it cannot be an island.  ``notes`` names the dropped
+    lines (empty when none was dropped).
     """
     import shapely
 
-    if len(ps.polylines) < 2 or any(len(pl.points) < 3 for pl in ps.polylines):
-        return ps  # water_from_points names the short ring
-    shore = max(ps.polylines, key=lambda pl: abs(shapely.Polygon(pl.points).area))
+    rings = [pl for pl in ps.polylines if len(pl.points) >= 3]
+    if len(ps.polylines) < 2 or not rings:
+        return ps, []  # water_from_points names what is missing
+    shore = max(rings, key=lambda pl: abs(shapely.Polygon(pl.points).area))
     ring = shapely.LinearRing(shore.points)
     keep: list[Any] = []
     dropped: list[Any] = []
     for pl in ps.polylines:
-        line = pl is not shore and not pl.closed and shapely.LineString(pl.points).intersects(ring)
+        line = pl is not shore and not pl.closed and len(pl.points) >= 2  # a single point: named later
+        line = line and shapely.LineString(pl.points).intersects(ring)
         (dropped if line else keep).append(pl)
-    if dropped:
-        names = ", ".join(repr(pl.name) for pl in dropped)
-        what = "an open line" if len(dropped) == 1 else "open lines"
-        _notes([f"{names}: {what} touching the shore, not an island: ignored"])
-    return ps.with_points(keep, ps.crs)
+    if not dropped:
+        return ps, []
+    names = ", ".join(repr(pl.name) for pl in dropped)
+    what = "an open line" if len(dropped) == 1 else "open lines"
+    return ps.with_points(keep, ps.crs), [f"{names}: {what} touching the shore, not an island: ignored"]
 
 
 def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:

@@ -114,10 +114,8 @@ def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
         assert (len(misses) > 0) == any(r.limit.statistic == "each" for r in v.failed)
 
 
-def _far_synthetic_lake(path: Path) -> Path:
-    """A lobed lake with islands (about 16 km across) as lon/lat GeoJSON far from any UTM origin."""
-    import json
-
+def _far_synthetic_rings() -> list[np.ndarray]:
+    """A lobed lake with islands (about 16 km across) in lon/lat, far from any UTM origin."""
     import pyproj
 
     from meshcore.testing import lake_with_islands
@@ -127,15 +125,38 @@ def _far_synthetic_lake(path: Path) -> Path:
     rings = []
     for ring in [poly.exterior, *poly.interiors]:
         xy = np.asarray(ring.coords) + (687_654.321, 5_432_109.876)  # UTM 10 N, near the zone's edge
-        rings.append(np.column_stack(to_lonlat.transform(xy[:, 0], xy[:, 1])).round(7).tolist())
-    path.write_text(json.dumps({"type": "Polygon", "coordinates": rings}))
+        rings.append(np.column_stack(to_lonlat.transform(xy[:, 0], xy[:, 1])).round(7))
+    return rings
+
+
+def _far_synthetic_lake(path: Path) -> Path:
+    """:func:`_far_synthetic_rings` as lon/lat GeoJSON."""
+    import json
+
+    path.write_text(json.dumps({"type": "Polygon", "coordinates": [r.tolist() for r in _far_synthetic_rings()]}))
     return path
 
 
-@pytest.mark.parametrize("name", ["taal_lake.kml", "lake_iseo_sparse.geojson", "lake_como.csv", "far synthetic"])
+def _headerless_csv(path: Path) -> Path:
+    """:func:`_far_synthetic_rings` as a CSV of bare lon, lat numbers (no header, no CRS), rings
+    separated by blank lines, and an open line from the shore into the water (a drawn inlet)."""
+    rings = _far_synthetic_rings()
+    shore = rings[0]
+    k = len(shore) // 3
+    inlet = np.vstack([shore[k], shore[k] + 0.3 * (rings[1].mean(axis=0) - shore[k])])
+    blocks = ["\n".join(f"{x:.7f},{y:.7f}" for x, y in r) for r in [*rings, inlet]]
+    path.write_text("\n\n".join(blocks) + "\n")
+    return path
+
+
+@pytest.mark.parametrize(
+    "name", ["taal_lake.kml", "lake_iseo_sparse.geojson", "lake_como.csv", "far synthetic", "headerless csv"]
+)
 def test_the_same_layout_and_grid_as_meshcore_mesh(qtbot, win, tmp_path, name):
     """The app's layout and grid of a file are the CLI's: same blocks, cells and nodes to the last bit.
 
+    A CSV of bare lon/lat numbers is projected by both (one rule, :func:`meshcore.cli.mesh.is_lonlat`),
+    and an open line touching its shore is dropped by both (:func:`meshcore.cli.mesh.lake_rings`).
     The layout's discrete choices change with the last bits of the coordinates (a lake
     shifted by a round number can get another block count), so both compute in the same
     local frame; the CLI writes world coordinates = local + origin, as the app exports them.
@@ -147,10 +168,16 @@ def test_the_same_layout_and_grid_as_meshcore_mesh(qtbot, win, tmp_path, name):
     from meshcore.cli import main
     from meshcore.io import read_blocks
 
-    path = _far_synthetic_lake(tmp_path / "far.geojson") if name == "far synthetic" else LAKES / name
+    made = {"far synthetic": _far_synthetic_lake, "headerless csv": _headerless_csv}
+    path = made[name](tmp_path / f"made{'.csv' if 'csv' in name else '.geojson'}") if name in made else LAKES / name
     win.lake_ctl.generate_after = False
     assert win.io.import_points(path, project_lonlat=True)
     lake = win.doc.project.lake
+    assert win.doc.project.crs.startswith("EPSG:32")  # lon/lat recognised and projected, header or not
+    if name == "headerless csv":  # the inlet line dropped with a note, as the CLI does
+        assert len(lake.holes) == 2
+        notes = [t for lv, t in win.messages_panel.messages() if "touching the shore" in t]
+        assert len(notes) == 1 and "not an island" in notes[0]
     h = math.sqrt(water(lake.outline, lake.holes)[0].area / 1500)  # ~1500 cells: quick, several blocks
     win.lake_ctl.set_cell_size(h)
     win.a_auto_layout.trigger()
@@ -163,6 +190,7 @@ def test_the_same_layout_and_grid_as_meshcore_mesh(qtbot, win, tmp_path, name):
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()) as err:
         rc = main(["mesh", str(path), "--cell-size", repr(h), "-o", str(tmp_path / "cli.npz")])
     assert rc in (0, 3), err.getvalue()
+    assert ("touching the shore" in err.getvalue()) == (name == "headerless csv")
     cli = read_blocks(tmp_path / "cli.npz")
     lay = win.doc.project.layout
     assert len(lay.blocks) > 1
@@ -314,3 +342,76 @@ def test_an_unknown_quality_metric_on_the_command_line_is_refused(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["--quality", "deviaton", "--screenshot", "never.png"])
     assert exc.value.code == 2 and "no such metric" in capsys.readouterr().err
+
+
+def test_an_open_line_on_the_shore_is_not_an_island_in_the_app_either(qtbot, win):
+    """The DXF of ``meshcore mesh``'s inlet test (UTM metres, no CRS in the file): its open inlet
+    line drawn from the shore is dropped with the CLI's note; the shore alone is the lake."""
+    pytest.importorskip("ezdxf")
+    src = Path(__file__).resolve().parents[2] / "tests" / "data" / "lake_zurich_sparse_utm32.dxf"
+    from meshcore.cli.mesh import lake_rings
+    from meshcore.io import read_points
+
+    shore, islands, notes = lake_rings(read_points(src))
+    assert islands == [] and len(notes) == 1
+    assert win.io.import_points(src)
+    lake = win.doc.project.lake
+    assert lake is not None and lake.holes == ()
+    np.testing.assert_array_equal(lake.outline, shore)
+    assert win.doc.project.crs == ""  # metres without a CRS: not mistaken for degrees
+    said = [t for lv, t in win.messages_panel.messages() if lv == "warning" and "touching the shore" in t]
+    assert said == [f"{src.name}: {notes[0]}"]
+
+
+def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtbot, win):
+    """The lake grid is made coarse to fine: the convergence plot marks where each level begins
+    (every live snapshot before a mark has the coarser level's cells, every one after it the
+    finer's).  Cells coloured by a metric: the preset's misses are hidden (they would cover the
+    colours), View ▸ Preset misses (Q) brings them back as thin rings; no colouring, dots again."""
+    from app.document import DEVIATION
+    from app.pipeline import ALL_BLOCKS
+
+    seen = []  # (sweep, cells of all blocks) of every live snapshot
+    win.solver.progress.connect(
+        lambda k, snap: (
+            seen.append((snap.iteration, sum(g.cells[0] * g.cells[1] for g in snap.grids)))
+            if k == ALL_BLOCKS and snap.grids
+            else None
+        )
+    )
+    lay = lay_out(qtbot, win, ISEO, cell_size=600.0)
+    conv = win.conv_panel
+    names = [name for _k, name in conv.levels]
+    assert names == ["cells ÷ 4", "cells ÷ 2", "full"] and lay.multiple == 4
+    starts = [k for k, _name in conv.levels]
+    assert starts[0] == 0 and starts[1] < starts[2] < win.doc.multiblock.info.iterations
+    lines = [ln for ln in conv.level_lines if ln.isVisible()]
+    assert [ln.value() for ln in lines] == starts and [ln.label.format for ln in lines] == names
+    full = sum(b.cells[0] * b.cells[1] for b in lay.blocks)
+    for it, cells in seen:  # each snapshot has the cells of the level its sweep lies in
+        lev = sum(it > k for k in starts[1:])
+        assert cells == full // 4 ** (2 - lev), (it, cells, starts)
+    assert {sum(it > k for k in starts[1:]) for it, _c in seen} == {0, 1, 2}
+    assert conv.getAxis("bottom").labelText == "sweep"
+
+    from PySide6 import QtCore
+
+    items, pts = win.canvas.lake_items, np.array([[0.0, 0.0], [100.0, 50.0]])
+
+    def filled():
+        return items.misses.opts["brush"].style() != QtCore.Qt.BrushStyle.NoBrush
+
+    win.lake_quality.misses.emit(pts)
+    assert items.misses.isVisible() and win.a_misses.isChecked() and filled()
+    win.quality_panel.metric.setCurrentText(DEVIATION)
+    assert not items.misses.isVisible() and not win.a_misses.isChecked()
+    assert "Preset misses" in win._status.text() or win.lake_quality.verdict.passed
+    win.a_misses.trigger()  # Q: over the colours, as thin rings
+    assert items.misses.isVisible() and items.misses_over_colours and not filled()
+    win.a_misses.trigger()
+    assert not items.misses.isVisible()
+    win.lake_quality.table.clicked.emit(win.lake_quality.table.model().index(0, 0))  # a limit picked: where?
+    assert items.misses.isVisible() and win.a_misses.isChecked()
+    win.quality_panel.metric.setCurrentText("none")
+    assert items.misses.isVisible() and not items.misses_over_colours and filled()
+    np.testing.assert_array_equal(np.column_stack(items.misses.getData()), pts)

@@ -554,3 +554,33 @@ def test_case_option_refused_before_the_work(tmp_path, synthetic_csv):
     _refused(run, tmp_path, "--case", ".toml", before={"lake.csv"})
     run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "m.npz", "--case", tmp_path / "no" / "lay.toml")
     _refused(run, tmp_path, "--case", "folder", before={"lake.csv"})
+
+
+def test_lake_rings_and_lonlat_rules_shared_with_the_app(tmp_path):
+    """The rules ``meshcore mesh`` and the app's import share (:mod:`meshcore.cli.mesh`): bare
+    numbers that look like degrees are lon/lat, metres are not, a declared CRS decides; an open
+    line of two points touching the shore is dropped with a note, one off the shore is an error."""
+    from meshcore.cli.mesh import is_lonlat, lake_rings
+    from meshcore.errors import InvalidInputError
+    from meshcore.io import read_points
+
+    shore, island = _synthetic_rings()
+    to_ll = pyproj.Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True)
+    ll = [np.column_stack(to_ll.transform(r[:, 0], r[:, 1])) for r in (shore, island)]
+    inlet = np.vstack([ll[0][5], ll[0][5] + 0.2 * (ll[1].mean(axis=0) - ll[0][5])])
+
+    def csv(name, rings, header=""):
+        f = tmp_path / name
+        f.write_text(header + "\n\n".join("\n".join(f"{x:.7f},{y:.7f}" for x, y in r) for r in rings) + "\n")
+        return read_points(f)
+
+    bare = csv("bare.csv", [*ll, inlet])
+    assert bare.crs is None and is_lonlat(bare) and not is_lonlat(bare, "EPSG:32633")
+    assert not is_lonlat(csv("metres.csv", [shore, island]))
+    outer, islands, notes = lake_rings(bare)
+    assert len(outer) == len(shore) and len(islands) == 1 and len(notes) == 1 and "touching the shore" in notes[0]
+    away = np.vstack([ll[1].mean(axis=0), ll[1].mean(axis=0) + 1e-3])  # two points inside the island's bay
+    with pytest.raises(InvalidInputError, match="3 distinct points"):
+        lake_rings(csv("away.csv", [*ll, away]))
+    run = mesh(tmp_path / "bare.csv", "--cells", 300, "-o", tmp_path / "b.npz")
+    assert run.rc == 0 and "touching the shore" in run.err and "EPSG:32633" in run.err, run.err
