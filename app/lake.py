@@ -151,15 +151,19 @@ def cell_size_of(lake: Lake) -> float:
     return default_cell_size(poly.area, lake.target_cells)
 
 
-def compute_layout(lake: Lake) -> Any:
+def compute_layout(lake: Lake, cuts: Any = None) -> Any:
     """The :class:`meshcore.layout.Layout` of ``lake`` (what ``meshcore mesh`` would make).
 
     Runs :func:`meshcore.layout.auto_layout` (seconds on a 10 000-cell lake: call it off the
-    GUI thread).  Raises :class:`~meshcore.MeshcoreError` naming the problem.
+    GUI thread); with ``cuts`` (cut lines drawn by hand, in any topology: ending on the shore,
+    on other cuts or meeting at a point) :func:`meshcore.layout.layout_from_cuts` makes the
+    blocks between them instead, each with four corners where it turns.  Raises
+    :class:`~meshcore.MeshcoreError` naming the problem (e.g. the region that cannot be
+    four-sided).
     """
     from meshcore.cli.mesh import LEVELS, MIN_CELLS
     from meshcore.errors import InvalidInputError
-    from meshcore.layout import auto_layout
+    from meshcore.layout import auto_layout, layout_from_cuts
 
     poly, _ = water(lake.outline, lake.holes)
     h = cell_size_of(lake)
@@ -170,6 +174,8 @@ def compute_layout(lake: Lake) -> Any:
         raise InvalidInputError(
             f"a cell size of {h:.4g} gives about {est:.2g} cells; give at most {math.sqrt(poly.area / MIN_CELLS):.4g}"
         )
+    if cuts:
+        return layout_from_cuts(poly, [np.asarray(c, float) for c in cuts], cell_size=h, multiple=2**LEVELS)
     return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular)
 
 

@@ -29,10 +29,10 @@ EDIT_GAP_S = 0.25
 log = logging.getLogger(__name__)
 
 
-def _layout_job(lake: Lake):
-    """The worker body: the layout, or the message of why there is none."""
+def _layout_job(lake: Lake, cuts=None):
+    """The worker body: the layout (of the cut lines drawn, if any), or the message of why there is none."""
     try:
-        layout = compute_layout(lake)
+        layout = compute_layout(lake, cuts)
         layout_topology(layout)
         return lake, layout, None
     except MeshcoreError as exc:
@@ -119,36 +119,60 @@ class LakeController(QtCore.QObject):
         if lake is None:
             self.win.message("Auto layout needs a lake: import an outline (Ctrl+I) or draw and close a loop")
             return False
-        if self.busy:
-            return False
         if regular is not None:
             lake = lake.replaced(regular=bool(regular))
+        kind = "regular layout (no 3- or 5-block corners)" if lake.regular else "layout"
+        return self._start(lake, None, f"Computing the block {kind} of the lake…")
+
+    def split_by_cuts(self, cuts) -> bool:
+        """Blocks between the cut lines drawn by hand, in any topology (worker; set undoable, then gridded).
+
+        Cuts may end on the shore, on an island or on another cut (a T), meet at a point, or
+        bound a region on any number of sides; each region gets four corners where it turns and
+        cell counts that agree across every cut (:func:`meshcore.layout.layout_from_cuts`).  A
+        region that cannot be four-sided is a message naming it.
+        """
+        lake = self.lake()
+        if lake is None:
+            self.win.message("Splitting a lake needs its outline: import it (Ctrl+I) or draw and close a loop")
+            return False
+        n = len(cuts)
+        return self._start(lake, tuple(cuts), f"Splitting the lake by {n} cut line{'s' * (n != 1)}…")
+
+    def _start(self, lake: Lake, cuts, text: str) -> bool:
+        if self.busy:
+            return False
         self.close_prompt()
         self.win.solver.stop()
         self.last_error = None
-        worker = create_worker(_layout_job, lake.replaced(layout=None), _start_thread=False)
-        worker.returned.connect(self._on_returned)
+        worker = create_worker(_layout_job, lake.replaced(layout=None), cuts, _start_thread=False)
+        worker.returned.connect(lambda value: self._on_returned(value, cuts))
         worker.errored.connect(self._on_errored)
         self._worker = worker
         self.busy_changed.emit(True)
-        kind = "regular layout (no 3- or 5-block corners)" if lake.regular else "layout"
-        self.win.message(f"Computing the block {kind} of the lake…")
+        self.win.message(text)
         worker.start()
         return True
 
-    def _on_returned(self, value) -> None:
+    def _on_returned(self, value, cuts=None) -> None:
         lake, layout, err = value
         self._worker = None
         self.busy_changed.emit(False)
         if layout is None:
             self.last_error = err
-            self.win.error("Cannot lay out the lake", err)
+            self.win.error("Cannot split the lake by its cut lines" if cuts else "Cannot lay out the lake", err)
             self.layout_done.emit(None)
             return
-        self.editor.set_lake(lake.replaced(layout=layout), "Auto layout")
+        n = len(layout.blocks)
+        if cuts:  # the drawn cut lines become the layout's: one undo step brings them back
+            from .lake import with_layout
+
+            after = with_layout(self.doc.project, lake.replaced(layout=layout)).replaced(cut_lines=())
+            self.editor.replace_project(after, f"Split into {n} blocks by cut lines")
+        else:
+            self.editor.set_lake(lake.replaced(layout=layout), "Auto layout")
         for note in layout.notes:
             self.doc.report("info", f"layout: {note}")
-        n = len(layout.blocks)
         self.win.message(
             f"Layout: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells at {layout.cell_size:.4g} m — "
             "generating the orthogonal grid (Ctrl+Z undoes the layout)"

@@ -44,7 +44,7 @@ class LakeProgress(SolverProgress):
     """A :class:`~meshcore.SolverProgress` of a lake grid with its levels so far.
 
     ``levels``: ``(sweep, label)`` for each level of the grid sequencing begun so far (the
-    sweep count at its start, e.g. ``(0, "cells ÷ 4"), (200, "cells ÷ 2"), (350, "full")``):
+    sweep count at its start, e.g. ``(0, "cells ÷4"), (200, "÷2"), (350, "full")``):
     the convergence plot marks them (the change per sweep rises where a finer level begins).
     """
 
@@ -52,8 +52,11 @@ class LakeProgress(SolverProgress):
 
 
 def level_labels(n_levels: int) -> list[str]:
-    """The labels of ``n_levels`` levels, coarsest first: ``["cells ÷ 4", "cells ÷ 2", "full"]``."""
-    return [f"cells ÷ {2 ** (n_levels - 1 - k)}" if k < n_levels - 1 else "full" for k in range(n_levels)]
+    """The labels of ``n_levels`` levels, coarsest first: ``["cells ÷4", "÷2", "full"]``."""
+    return [
+        ("cells " if k == 0 else "") + f"÷{2 ** (n_levels - 1 - k)}" if k < n_levels - 1 else "full"
+        for k in range(n_levels)
+    ]
 
 
 _topologies: dict[int, tuple] = {}  # id(layout) -> (layout, topology): the last few layouts' topologies

@@ -309,29 +309,42 @@ class MainWindow(QtWidgets.QMainWindow):
         self.editor._edit_block(SetBlockOptions, boundary_to_loop, "Convert borders to loop")
 
     def split_by_cuts(self) -> bool:
-        """Turn the active loop + the drawn cut lines into a multiblock case (undoable)."""
+        """Turn the outline + the drawn cut lines into blocks (undoable).
+
+        A lake (an imported outline), or cuts that do not make a chain of blocks (a cut ending on
+        another, cuts meeting at a point, a region bordered by three or more cuts): the lake's
+        block layout between the cuts (:meth:`LakeController.split_by_cuts`, in a worker), gridded
+        orthogonally and editable with the Layout tool.  A drawn loop cut into a chain: a
+        multiblock case solved together (``meshcore.case.cut_case``), as before.
+        """
         from meshcore.case import cut_case
 
         p = self.doc.project
         b = self.doc.block
-        if p.multiblock is not None or not b.closed or b.boundary is not None:
+        if p.multiblock is not None or p.layout is not None or not b.closed or b.boundary is not None:
             self.message("Split needs a closed loop of points (draw or import one) and cut lines across it")
             return False
-        try:
-            case = cut_case(b.points, list(p.cut_lines), cells_across=(b.cell_counts or (32, 16))[1], title=p.title)
-            after = fio.project_from_multiblock_case(case)
-        except (MeshcoreError, ValueError) as exc:
-            self.error("Cannot split by cut lines", exc)
+        if not p.cut_lines:
+            self.message("Draw cut lines first: Cut line tool (L), click from shore to shore, Enter")
             return False
-        after = after.replaced(crs=p.crs, origin=p.origin, source_crs=p.source_crs, title=p.title)
-        self.editor.replace_project(after, f"Split into {len(after.blocks)} blocks")
-        self.doc.set_active(0)
-        self.set_tool("pan")
-        self.message(
-            f"Split into {len(after.blocks)} blocks (η cells {(b.cell_counts or (32, 16))[1]} across every block); "
-            "F5 solves them together — Ctrl+Z undoes the split"
-        )
-        return True
+        if p.lake is None:
+            try:
+                case = cut_case(b.points, list(p.cut_lines), cells_across=(b.cell_counts or (32, 16))[1], title=p.title)
+                after = fio.project_from_multiblock_case(case)
+            except (MeshcoreError, ValueError) as exc:  # not a chain: the lake way takes any topology
+                log.info("cut lines not a chain (%s): splitting as a lake", exc)
+            else:
+                after = after.replaced(crs=p.crs, origin=p.origin, source_crs=p.source_crs, title=p.title)
+                self.editor.replace_project(after, f"Split into {len(after.blocks)} blocks")
+                self.doc.set_active(0)
+                self.set_tool("pan")
+                self.message(
+                    f"Split into {len(after.blocks)} blocks (η cells {(b.cell_counts or (32, 16))[1]} across every "
+                    "block); F5 solves them together — Ctrl+Z undoes the split"
+                )
+                return True
+        self.show_lake()
+        return self.lake_ctl.split_by_cuts(list(p.cut_lines))
 
     def auto_layout_regular(self) -> None:
         """Auto layout without 3- or 5-block corners (what Delft3D domain decomposition couples)."""

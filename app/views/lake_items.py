@@ -19,6 +19,8 @@ __all__ = ["LakeOverlay", "block_label_points"]
 CUT_COLOUR = "#9467bd"
 SHORE_COLOUR = "#1f5fa8"
 MISS_COLOUR = "#ff7f0e"
+#: more places that miss a preset than this: drawn smaller and fainter
+MANY_MISSES = 1000
 
 
 def block_label_points(layout) -> np.ndarray:
@@ -117,6 +119,8 @@ class LakeOverlay:
         if old is not None and points is not None and old.shape == np.shape(points) and np.array_equal(old, points):
             return
         self._misses_shown = None if points is None else np.array(points, float)
+        self._misses_many = points is not None and len(points) > MANY_MISSES
+        self._style_misses()
         set_points(self.misses, points)
 
     def set_drag_point(self, xy) -> None:
@@ -148,18 +152,25 @@ class LakeOverlay:
 
     def set_misses_style(self, over_colours: bool) -> None:
         """Filled orange dots on a plain grid; thin dark rings over coloured cells (the colour shows through)."""
-        over_colours = bool(over_colours)
-        if over_colours == self.misses_over_colours:
+        if bool(over_colours) != self.misses_over_colours:
+            self.misses_over_colours = bool(over_colours)
+            self._style_misses()
+
+    def _style_misses(self) -> None:
+        """Dots, or rings over colours; smaller and fainter when there are many (they would paint the lake orange)."""
+        many = getattr(self, "_misses_many", False)
+        key = (self.misses_over_colours, many)
+        if key == getattr(self, "_misses_style", None):
             return
-        self.misses_over_colours = over_colours
-        if over_colours:
-            self.misses.setPen(pg.mkPen(0, 0, 0, 200, width=1))
+        self._misses_style = key
+        if self.misses_over_colours:
+            self.misses.setPen(pg.mkPen(0, 0, 0, 110 if many else 200, width=1))
             self.misses.setBrush(None)
-            self.misses.setSize(6)
+            self.misses.setSize(4 if many else 6)
         else:
             self.misses.setPen(None)
-            self.misses.setBrush(pg.mkBrush(255, 127, 14, 170))
-            self.misses.setSize(5)
+            self.misses.setBrush(pg.mkBrush(255, 127, 14, 110 if many else 170))
+            self.misses.setSize(3 if many else 5)
 
     def _show_misses(self) -> None:
         self.misses.setVisible(self.misses_on and not getattr(self, "_solving", False))

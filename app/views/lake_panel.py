@@ -40,7 +40,15 @@ class LakePanel(QtWidgets.QWidget):
         form.addRow(self.regular)
         self.button = QtWidgets.QPushButton("Auto layout")
         self.button.setToolTip("split the lake into four-sided blocks that follow its arms, then generate (Ctrl+L)")
-        form.addRow(self.button)
+        self.split = QtWidgets.QPushButton("Split by the cut lines drawn")
+        self.split.setToolTip(
+            "blocks between cut lines drawn by hand (Cut line tool, L): cuts may end on the shore, an island or "
+            "another cut, or meet at a point (Ctrl+K)"
+        )
+        buttons = QtWidgets.QHBoxLayout()
+        buttons.addWidget(self.button, 1)
+        buttons.addWidget(self.split, 1)
+        form.addRow(buttons)
         self.summary = QtWidgets.QLabel()
         self.summary.setWordWrap(True)
         form.addRow(self.summary)
@@ -72,6 +80,7 @@ class LakePanel(QtWidgets.QWidget):
         self.cell_size.editingFinished.connect(self._cell_size_edited)
         self.regular.toggled.connect(self._regular_toggled)
         self.button.clicked.connect(lambda: self.ctl.auto_layout())
+        self.split.clicked.connect(lambda: self.ctl.win.split_by_cuts())
         controller.busy_changed.connect(self._busy)
         doc.project_changed.connect(lambda _p: self.refresh())
         self.refresh()
@@ -87,13 +96,15 @@ class LakePanel(QtWidgets.QWidget):
             w.blockSignals(False)
         self.setEnabled(lake is not None)
         lay = p.layout
+        self.split.setEnabled(lay is None and bool(p.cut_lines) and not self.ctl.busy)
         if lay is None:
             self.summary.setText(
-                "No layout yet: Auto layout splits the lake into blocks."
+                "No layout yet: Auto layout splits the lake into blocks, or draw cut lines (L) and split by them."
                 if lake is not None
                 else "Import a lake outline (Ctrl+I) or draw and close a loop."
             )
             self.table.setRowCount(0)
+            self._show_active()
             return
         n = len(lay.blocks)
         self.summary.setText(f"{n} block{'s' * (n != 1)}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m")
@@ -133,6 +144,7 @@ class LakePanel(QtWidgets.QWidget):
 
     def _busy(self, busy: bool) -> None:
         self.button.setEnabled(not busy)
+        self.split.setEnabled(not busy and self.doc.project.layout is None and bool(self.doc.project.cut_lines))
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
 

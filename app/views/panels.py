@@ -131,6 +131,7 @@ class ConvergencePanel(pg.PlotWidget):
             self.level_lines.append(line)
         for k, line in enumerate(self.level_lines):
             if k < len(levels):
+                line.label.setPosition(0.93 if k % 2 == 0 else 0.78)  # neighbours' names do not overlap
                 line.setValue(levels[k][0])
                 line.label.setFormat(levels[k][1])
                 line.show()

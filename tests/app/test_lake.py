@@ -382,7 +382,7 @@ def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtb
     lay = lay_out(qtbot, win, ISEO, cell_size=600.0)
     conv = win.conv_panel
     names = [name for _k, name in conv.levels]
-    assert names == ["cells ÷ 4", "cells ÷ 2", "full"] and lay.multiple == 4
+    assert names == ["cells ÷4", "÷2", "full"] and lay.multiple == 4
     starts = [k for k, _name in conv.levels]
     assert starts[0] == 0 and starts[1] < starts[2] < win.doc.multiblock.info.iterations
     lines = [ln for ln in conv.level_lines if ln.isVisible()]
@@ -415,3 +415,6 @@ def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtb
     win.quality_panel.metric.setCurrentText("none")
     assert items.misses.isVisible() and not items.misses_over_colours and filled()
     np.testing.assert_array_equal(np.column_stack(items.misses.getData()), pts)
+    # thousands of misses (a poor hand layout): smaller and fainter, not an orange lake
+    win.lake_quality.misses.emit(np.random.default_rng(0).uniform(0, 1000, (5000, 2)))
+    assert items.misses.opts["size"] < 5 and items.misses.opts["brush"].color().alpha() < 170

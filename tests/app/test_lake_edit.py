@@ -251,3 +251,68 @@ def test_what_would_slow_a_drags_redraws_is_off_the_canvas(qtbot, laid):
     assert misses.isVisible()
     win.doc.clear_grids()
     assert c.getPlotItem().getAxis("left").grid  # back behind an outline
+
+
+def _y_lake_csv(path: Path) -> Path:
+    """A Y-shaped lake (three 6-km arms, 1 km wide, meeting at the origin) as an x,y CSV in metres."""
+    from shapely import affinity
+
+    from meshcore.testing import y_junction
+
+    poly = affinity.scale(y_junction(6.0, 1.0), 1000.0, 1000.0, origin=(0.0, 0.0))
+    ring = np.asarray(poly.exterior.coords)[:-1]
+    path.write_text("x,y\n" + "\n".join(f"{x:.3f},{y:.3f}" for x, y in ring) + "\n")
+    return path
+
+
+# cut lines clicked roughly by hand on the Y lake (metres): a T (the second cut ends on the first)
+# and three cuts meeting at the junction (the three-cut case of the issue)
+HAND_CUTS = {
+    "T": [[(-520.0, 290.0), (520.0, 290.0)], [(10.0, -600.0), (0.0, 0.0), (20.0, 270.0)]],
+    "meeting at a point": [[(0.0, 0.0), (-510.0, 300.0)], [(0.0, 0.0), (0.0, -600.0)], [(0.0, 0.0), (510.0, 280.0)]],
+}
+
+
+@pytest.mark.parametrize("kind", sorted(HAND_CUTS))
+def test_cut_lines_drawn_by_hand_in_any_topology_split_a_lake(qtbot, win, tmp_path, kind):
+    """Item 1 of the issue: a branched lake split by hand. Cuts drawn with the Cut line tool that
+    end on another cut (T) or meet at a point give blocks (Block ▸ Split, Ctrl+K) whose cells
+    agree across every cut, an orthogonal grid without folds, and one undo step back to the cuts."""
+    from PySide6 import QtCore
+
+    assert win.io.import_points(_y_lake_csv(tmp_path / "y.csv"))
+    assert win.doc.project.lake is not None and win.doc.project.crs == ""
+    win.lake_ctl.set_cell_size(100.0)
+    win.set_tool("cut")
+    tool = win.canvas.tool
+    for cut in HAND_CUTS[kind]:
+        for xy in cut:
+            tool.click(xy)
+        tool.key(QtCore.Qt.Key.Key_Return)
+    before = win.doc.project
+    assert len(before.cut_lines) == len(HAND_CUTS[kind])
+    win.a_split.trigger()
+    qtbot.waitUntil(lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error), timeout=120_000)
+    assert win.lake_ctl.last_error is None
+    wait_idle(qtbot, win)
+    p = win.doc.project
+    lay = p.layout
+    assert len(lay.blocks) == 3 and p.cut_lines == ()  # the drawn lines are the layout's cuts now
+    topo = lay.topology()  # every interface's cells agree (raises otherwise)
+    assert len(topo.interfaces) >= 2
+    # one cut end inside the water: the T's foot, on the first cut; or the junction, where three cuts end
+    ends = np.round([c[k] for c in lay.cuts for k in (0, -1)], 6)
+    nodes, counts = np.unique(
+        [e for e in ends if lay.polygon.boundary.distance(shapely.Point(e)) > 100.0], axis=0, return_counts=True
+    )
+    assert len(nodes) == 1
+    if kind == "T":
+        on = [c for c in lay.cuts if shapely.LineString(c).distance(shapely.Point(nodes[0])) < 1e-6]
+        assert counts.tolist() == [1] and len(on) == 2 and abs(nodes[0][1] - 290.0) < 25.0
+    else:
+        assert counts.tolist() == [3] and np.hypot(*nodes[0]) < 25.0
+    assert [win.doc.grids[k].cells for k in range(3)] == [tuple(b.cells) for b in lay.blocks]
+    assert win.doc.lake_metrics is not None and win.doc.lake_metrics.summary()["folded_cells"] == 0
+    assert win.stack.undoText() == "Split into 3 blocks by cut lines"
+    win.stack.undo()
+    assert win.doc.project.layout is None and len(win.doc.project.cut_lines) == len(HAND_CUTS[kind])
