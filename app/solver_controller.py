@@ -248,6 +248,7 @@ class SolverController(QtCore.QObject):
             return
         self._dirty = False
         self._pace()
+        drawn = False  # a frame only when a grid changed (a lake grid made again unseen sends none)
         for k, event in self._latest.items():
             if k == ALL_BLOCKS and isinstance(event, SolverProgress):  # a multiblock solve: every block
                 for i, g in enumerate(event.grids):
@@ -255,8 +256,10 @@ class SolverController(QtCore.QObject):
                     if i in self._smoothed or not self._showing_other(i, g):
                         self.doc.grids[i] = g
                         self._smoothed.add(i)
+                        drawn = True
                 self.progress.emit(k, event)
                 continue
+            drawn = True
             if not isinstance(event, (StartGrid, SolverProgress, Repaired, Done)):
                 continue
             if isinstance(event, StartGrid) and self._showing(k, event.grid):
@@ -267,8 +270,9 @@ class SolverController(QtCore.QObject):
             if isinstance(event, SolverProgress):
                 self._smoothed.add(k)
                 self.progress.emit(k, event)
-        self.doc.grids_changed.emit()
-        self.redrawn.emit()
+        if drawn:
+            self.doc.grids_changed.emit()
+            self.redrawn.emit()
 
     def _pace(self) -> None:
         """Start a frame: widen the gap to the next one while the GUI thread's share of the process's

@@ -40,7 +40,7 @@ class LakePanel(QtWidgets.QWidget):
         form.addRow(self.regular)
         self.button = QtWidgets.QPushButton("Auto layout")
         self.button.setToolTip("split the lake into four-sided blocks that follow its arms, then generate (Ctrl+L)")
-        self.split = QtWidgets.QPushButton("Split by the cut lines drawn")
+        self.split = QtWidgets.QPushButton("Split by cuts")
         self.split.setToolTip(
             "blocks between cut lines drawn by hand (Cut line tool, L): cuts may end on the shore, an island or "
             "another cut, or meet at a point (Ctrl+K)"
@@ -211,7 +211,11 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.setVisible(self.doc.project.layout is not None)
         if m is None:
             self.verdict = None
-            self.headline.setText("No lake grid yet (Auto layout, then it generates).")
+            self.headline.setText(
+                "No lake grid yet (Auto layout, then it generates)."
+                if self.doc.project.layout is None
+                else "The verdict follows when the grid of this layout is made (F5 if it is not being made)."
+            )
             self.table.setRowCount(0)
             self.misses.emit(None)
             return

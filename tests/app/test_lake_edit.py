@@ -84,6 +84,15 @@ def test_drag_a_cut_end_along_the_shore_and_the_grid_follows(qtbot, laid):
     assert any(not np.array_equal(win.doc.grids[k].x, g.x) for k, g in grids0.items())
     assert shown_start == []
     assert win.doc.lake_metrics is not None and win.doc.lake_metrics.summary()["folded_cells"] == 0
+    # the final grid of the edit is the one meshcore makes of the new layout (coarse to fine), not
+    # the warm start's: the same grid as `meshcore generate` of the saved layout
+    from meshcore.lakegrid import mesh_layout
+
+    ref = mesh_layout(lay1)
+    for k, g in enumerate(ref.grids):
+        np.testing.assert_array_equal(win.doc.grids[k].x, g.x)
+        np.testing.assert_array_equal(win.doc.grids[k].y, g.y)
+    assert [lv for _k, lv in win.conv_panel.levels] == ["from the previous grid", "cells ÷4", "÷2", "full"]
     win.stack.undo()
     assert win.doc.project.layout is lay0
 
