@@ -439,12 +439,14 @@ class LayoutTool(Tool):
         if q == h.xy:
             return
         tol = 1e-9 * max(1.0, float(np.sqrt(base.polygon.area)))
-        parts = moved_parts(self._parts, h.xy, q, tol, shore=shore_points(base) if h.kind == "shore" else None)
-        if h.kind == "shore" and not _shore_moved(self._parts, parts):
-            self.controller.win.message("This shore point is not on the layout's shore: it cannot be dragged")
-            return
+        before, shore = self._parts, shore_points(base) if h.kind == "shore" else None
 
-        def make():
+        def make():  # in the layout worker: the GUI thread only places the handle (most steps are dropped)
+            from meshcore.errors import InvalidInputError
+
+            parts = moved_parts(before, h.xy, q, tol, shore=shore)
+            if shore is not None and not _shore_moved(before, parts):
+                raise InvalidInputError("this shore point is not on the layout's shore: it cannot be dragged")
             return moved_layout(base, parts)
 
         what = KIND_NAMES[h.kind]

@@ -239,7 +239,10 @@ class Canvas(pg.PlotWidget):
             op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
         set_points(self.other_points_item, np.vstack(op) if op else None)
         loops = []
-        for b in doc.project.blocks:
+        # a lake layout's blocks are its shore and cuts, drawn by the lake overlay: a dashed copy of every
+        # block's loop would repaint (slowly: a dashed pen) with every frame of a drag
+        blocks = () if doc.project.layout is not None else doc.project.blocks
+        for b in blocks:
             if b.boundary is not None:
                 p = np.vstack([b.boundary[0], b.boundary[1], b.boundary[2][::-1], b.boundary[3][::-1]])
             else:

@@ -250,6 +250,8 @@ def test_what_would_slow_a_drags_redraws_is_off_the_canvas(qtbot, laid):
     # the coordinate grid behind the canvas is off under a grid (its axes repaint with every frame)
     assert win.doc.grids and c.getPlotItem().getAxis("left").grid is False
     assert c.selected_item.boundingRect().isEmpty()  # an empty scatter takes no part in a repaint
+    x_loops = c.loop_curve.getData()[0]
+    assert x_loops is None or len(x_loops) == 0  # no dashed copy of the blocks' loops (shore and cuts)
     # the places missing a preset belong to the last grid: hidden while a new one is made
     misses = c.lake_items.misses
     grids, initial, mb = dict(win.doc.grids), dict(win.doc.initial), win.doc.multiblock
