@@ -15,6 +15,7 @@ import logging
 import time
 from pathlib import Path
 
+import numpy as np
 from PySide6 import QtCore, QtWidgets
 
 from meshcore import MeshcoreError
@@ -294,12 +295,25 @@ class IOController(QtCore.QObject):
         return True
 
     def _folds_confirmed(self) -> bool:
-        """A lake grid with folded cells: warn (and ask, unless quiet) before writing it."""
+        """A grid with folded or non-convex cells (a lake's, or any block's): warn (and ask, unless quiet)
+        before writing it; the warning names the blocks."""
+        from meshcore.quality import quality
+
         m = self.doc.lake_metrics
-        n = int(m.values("folded").sum()) if m is not None else 0
+        names = [b.name for b in self.doc.project.blocks]
+        if m is not None:
+            bad = [(b.name, int(np.sum(b.folded))) for b in m.blocks]
+        else:  # every block the export writes (a hand-made case, one block)
+            bad = []
+            for k, g in sorted(self.doc.grids.items()):
+                r = quality(g)
+                bad.append((names[k] if k < len(names) else f"block {k + 1}", max(r.n_folded, r.n_nonconvex)))
+        bad = [(name, n) for name, n in bad if n]
+        n = sum(k for _name, k in bad)
         if not n:
             return True
-        text = f"The grid has {n} folded or non-convex cell(s); a model may refuse it"
+        where = ", ".join(f"{name}: {k}" for name, k in bad[:8]) + (", …" if len(bad) > 8 else "")
+        text = f"The grid has {n} folded or non-convex cell(s) ({where}); a model may refuse it"
         self.doc.report("warning", text)
         if self.quiet:
             return True

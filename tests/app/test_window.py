@@ -277,6 +277,33 @@ def test_quality_panel_lists_folded_cells_and_zooms(qtbot, win):
     assert win.canvas.quality_item is not None
 
 
+def test_exporting_folded_cells_warns_and_asks(qtbot, win, tmp_path, monkeypatch):
+    """Issue 13, item 1: a grid with folded cells was exported without a word. Any grid (not only a
+    lake's) is checked: the warning names the block and the count, and the user may say no."""
+    from PySide6 import QtWidgets
+
+    x, y = np.meshgrid(np.arange(6.0), np.arange(5.0), indexing="ij")
+    x[2, 2], y[2, 2] = 3.6, 2.9  # pull a node across its neighbour: folded cells
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.doc.set_grids({0: StructuredGrid(x, y)})
+    name = win.doc.project.blocks[0].name
+    win.quiet = False
+    asked = []
+
+    def answer(_parent, _title, text, *_a, **_k):
+        asked.append(text)
+        return QtWidgets.QMessageBox.StandardButton.No
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", answer)
+    out = tmp_path / "folded.vts"
+    assert not win.io.export_mesh(out) and not out.exists()
+    assert len(asked) == 1 and "folded or non-convex" in asked[0] and f"{name}: " in asked[0]
+    warned = [t for lv, t in win.messages_panel.messages() if lv == "warning" and "folded" in t]
+    assert warned and f"{name}: " in warned[-1]
+    win.quiet = True  # quiet (scripts): written, the warning kept
+    assert win.io.export_mesh(out) and out.exists()
+
+
 def test_parameter_validation_is_immediate(qtbot, win):
     win.io.open_example("bottle-coarse", confirm=False)
     pp = win.params_panel
