@@ -26,13 +26,23 @@ from .examples import load_example
 from .lake import Lake, looks_branched, read_lake
 from .project import Block, Project, block_from_points
 
-__all__ = ["MAX_RECENT", "IOController"]
+__all__ = ["MAX_RECENT", "IOController", "export_default"]
 
 log = logging.getLogger(__name__)
 
 MAX_RECENT = 8
 DEBOUNCE_MS = 1000
 MAX_DELAY_S = 2.0
+
+
+def export_default(project) -> str:
+    """The format the export dialog offers first: Delft3D domain decomposition for a lake layout of
+    several blocks (what lake modellers export), VTK multiblock for other cases of several blocks, VTK
+    structured grid for one block (it offered PLOT3D, the first format meshcore writes)."""
+    n = len(project.blocks)
+    if project.layout is not None and n > 1:
+        return "delft3d-dd"
+    return "vtm" if n > 1 else "vts"
 
 
 class IOController(QtCore.QObject):
@@ -262,7 +272,11 @@ class IOController(QtCore.QObject):
             return
         fmts = fio.mesh_formats()
         filt = ";;".join(f"{d} ({p})" for d, p in fmts)
-        path, chosen = QtWidgets.QFileDialog.getSaveFileName(self._parent(), "Export mesh", self.last_dir(), filt)
+        want = export_default(self.doc.project)
+        first = next((f"{d} ({p})" for d, p in fmts if d.endswith(f"[{want}]")), "")
+        path, chosen = QtWidgets.QFileDialog.getSaveFileName(
+            self._parent(), "Export mesh", self.last_dir(), filt, first
+        )
         if path:
             if not Path(path).suffix:
                 pat = next((p for d, p in fmts if chosen.startswith(d)), "*.vts")

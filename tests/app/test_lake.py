@@ -243,6 +243,9 @@ def test_export_como_to_delft3d_dd_and_vtm(qtbot, win, tmp_path):
     lay = lay_out(qtbot, win, COMO)
     assert 8_000 < lay.n_cells < 12_000
     assert win.doc.lake_metrics.summary()["folded_cells"] == 0
+    from app.io_controller import export_default
+
+    assert export_default(win.doc.project) == "delft3d-dd"  # the export dialog offers it first
     out = tmp_path / "como.ddb"
     assert win.io.export_mesh(out), win._status.text()
     back = read(out)
