@@ -80,14 +80,17 @@ def main(argv: list[str] | None = None) -> int:
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     t0 = time.perf_counter()
-    # load the numba kernels (warm cache: well under a second) and shapely while Qt starts
+    # Qt's Python modules first, in this thread alone: shiboken's start-up walks sys.modules, and a
+    # module imported meanwhile by the warm-up thread (numba importing numpy.ma) aborted the process
+    # ("Fatal Python error: libshiboken/signature: could not initialize part 2", seen under load)
+    import pyqtgraph as pg
+    from PySide6 import QtCore, QtGui, QtWidgets  # noqa: F401
+
+    # then the numba kernels (warm cache: well under a second) and shapely while the window is made
     from .pipeline import warmup
 
     warm = threading.Thread(target=warmup, name="gcmesh-warmup", daemon=True)
     warm.start()
-
-    import pyqtgraph as pg
-    from PySide6 import QtWidgets
 
     pg.setConfigOptions(antialias=False, background="w", foreground="k")
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
