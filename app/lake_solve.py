@@ -176,7 +176,7 @@ def _warm(layout, warm, stop_event):
     t0 = time.perf_counter()
     history: list[tuple[int, float]] = []
     # the moved grid is shown at once (never the start grid): a drag's redraw does not wait for sweeps
-    warm_level = ((0, "from the previous grid"),)
+    warm_level = ((0, "warm start"),)
     first = LakeProgress(0, float("nan"), TOLERANCE, None, 0.0, "orthogonal", (), tuple(grids), warm_level)
     cmd = yield ALL_BLOCKS, first
     stopped = cmd == "stop" or (stop_event is not None and stop_event.is_set())

@@ -92,7 +92,7 @@ def test_drag_a_cut_end_along_the_shore_and_the_grid_follows(qtbot, laid):
     for k, g in enumerate(ref.grids):
         np.testing.assert_array_equal(win.doc.grids[k].x, g.x)
         np.testing.assert_array_equal(win.doc.grids[k].y, g.y)
-    assert [lv for _k, lv in win.conv_panel.levels] == ["from the previous grid", "cells ÷4", "÷2", "full"]
+    assert [lv for _k, lv in win.conv_panel.levels] == ["warm start", "cells ÷4", "÷2", "full"]
     win.stack.undo()
     assert win.doc.project.layout is lay0
 
