@@ -342,7 +342,7 @@ def test_command_line_screenshot(tmp_path):
         ],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=600,  # a start on a loaded machine took over 120 s (the full suite with four others)
         cwd=Path(__file__).resolve().parents[2],
     )
     assert r.returncode == 0, r.stderr
