@@ -172,7 +172,14 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
+    # targets rounded to 1e-6 cells: the program has many equally good counts, and lengths that
+    # differ in the last bits (an outline shifted by a round number) must not choose among them
     counts = solve_counts(
-        length / cell_size, sides, min_cells=min_cells, multiple=multiple, block_cells=block_cells, best=best
+        np.round(length / cell_size, 6),
+        sides,
+        min_cells=min_cells,
+        multiple=multiple,
+        block_cells=block_cells,
+        best=best,
     )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts

@@ -165,7 +165,7 @@ def _chain_counts(
                     users[index[k]] += 1
         targets = length * scale / np.maximum(users, 1)
     else:
-        targets = length / float(cell_size)
+        targets = np.round(length / float(cell_size), 6)  # as the layout's counts (meshcore.layout.blocks)
     sides = [tuple([index[k] for k in side_chains[(s.name, side)]] for side in SIDES) for s in specs]
     cells = {bi: (int(s.cells[0]), int(s.cells[1])) for bi, s in enumerate(specs)}
     try:
