@@ -125,9 +125,9 @@ def layout_pieces(
     sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
     chords = place_chords(poly, sk, min_length=2 * h)
     dense = shapely.segmentize(poly, h)
-    regions, cuts = partition(dense, [_densify(c.points, h) for c in chords])
-    junctions = sk.nodes[sk.degree() >= 3]
     sigma = 1.5 * h
+    regions, cuts = partition(dense, [_densify(c.points, h) for c in chords], sigma)
+    junctions = sk.nodes[sk.degree() >= 3]
     rings: list[np.ndarray] = []
     forced: list[tuple] = []
     for r in regions:

@@ -12,7 +12,12 @@ import math
 
 import numpy as np
 
-__all__ = ["partition", "snap_to_rings"]
+__all__ = ["partition", "snap_to_rings", "to_tips"]
+
+#: The narrowest angle (degrees, read at the corners' scale) an island cut may make with a
+#: shore: a cut that meets a ring at a grazing angle leaves a wedge, a block corner of a few
+#: degrees whose cells cannot be orthogonal (nor, on the coarse levels, convex).
+MIN_CORNER_ANGLE = 30.0
 
 
 def _project(poly_pts: np.ndarray, q: np.ndarray, closed: bool):
@@ -69,22 +74,68 @@ def snap_to_rings(rings: list[np.ndarray], cuts: list[np.ndarray], eps: float):
     return rings, cuts
 
 
-def partition(poly, cuts: list[np.ndarray]) -> tuple[list[np.ndarray], list[np.ndarray]]:
+def _tips(ring: np.ndarray, sigma: float, outer: bool) -> np.ndarray:
+    """The vertices of a shore ring where the water turns sharply round a point of land (a
+    peninsula's or an island's tip): turning of at least 45° away from the water, both at the
+    vertex and at scale ``sigma``."""
+    from .corners import _raw_turning, turning
+
+    x, y = ring[:, 0], ring[:, 1]
+    ccw = float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) > 0
+    sign = 1.0 if (ccw if outer else not ccw) else -1.0
+    # sharp at the vertex itself, not only at scale (a small round island turns as much at scale)
+    return np.flatnonzero((sign * turning(ring, sigma) <= -45.0) & (sign * _raw_turning(ring) <= -45.0))
+
+
+def to_tips(rings: list[np.ndarray], cuts: list[np.ndarray], sigma: float) -> list[np.ndarray]:
+    """The cuts with every end that lands within ``sigma`` of a tip of land (:func:`_tips`) moved
+    onto the tip, the cut's other points shifted in proportion to their distance along it.
+
+    An end beside a tip leaves a block corner a cell from where the shore bends back round the
+    land: at the grid's coarse levels that corner cell cannot be convex.  At the tip itself the
+    corner takes the bend.
+    """
+    tips = (
+        np.vstack([r[_tips(r, sigma, k == 0)] for k, r in enumerate(rings)] or [np.zeros((0, 2))])
+        if rings
+        else np.zeros((0, 2))
+    )
+    if not len(tips):
+        return cuts
+    out = []
+    for c in cuts:
+        c = np.array(c, dtype=float)
+        s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(c, axis=0).T))])
+        if s[-1] <= 0:
+            out.append(c)
+            continue
+        for end, w in ((0, 1.0 - s / s[-1]), (-1, s / s[-1])):
+            d = np.hypot(*(tips - c[end]).T)
+            k = int(np.argmin(d))
+            if 0.0 < d[k] <= sigma and d[k] < 0.25 * s[-1]:
+                c = c + w[:, None] * (tips[k] - c[end])
+        out.append(c)
+    return out
+
+
+def partition(poly, cuts: list[np.ndarray], sigma: float | None = None) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Counter-clockwise rings of the regions that ``cuts`` make of the polygon ``poly``.
 
     A region that still holds an island gets two more cuts, from the island to the region's
     outer ring at the nearest points on either side (so every region is simply connected);
-    returns the rings and the final list of cuts.
+    returns the rings and the final list of cuts.  ``sigma`` (the corners' scale): island
+    cuts that meet a ring at less than :data:`MIN_CORNER_ANGLE` there (a wedge) are
+    taken only when there is no other.
     """
     from ..errors import TopologyError
 
     cuts = list(cuts)
     for _ in range(2 * len(poly.interiors) + 2):  # each round joins an island to another ring
-        faces, cuts = _faces(poly, cuts)
+        faces, cuts = _faces(poly, cuts, sigma)
         holed = [f for f in faces if f.interiors]
         if not holed:
             break
-        new = [c for f in holed for c in _island_cuts(f)]
+        new = [c for f in holed for c in _island_cuts(f, sigma, cuts)]
         if not new:
             break
         cuts += new
@@ -97,13 +148,15 @@ def partition(poly, cuts: list[np.ndarray]) -> tuple[list[np.ndarray], list[np.n
     return [np.asarray(f.exterior.coords)[:-1] for f in faces], cuts
 
 
-def _faces(poly, cuts):
+def _faces(poly, cuts, sigma: float | None = None):
     import shapely
     from shapely.geometry import LineString
     from shapely.geometry.polygon import orient
 
     rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(h.coords)[:-1] for h in poly.interiors)]
     size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
+    if sigma is not None:
+        cuts = to_tips(rings, cuts, sigma)
     rings, cuts = snap_to_rings(rings, cuts, 1e-9 * size)
     lines = [LineString(np.vstack([r, r[:1]])) for r in rings] + [LineString(c) for c in cuts]
     noded = shapely.union_all(lines)
@@ -118,7 +171,27 @@ def _faces(poly, cuts):
     return out, cuts
 
 
-def _island_cuts(face) -> list[np.ndarray]:
+def _meets_at(ring, end: np.ndarray, other: np.ndarray, sigma: float) -> float:
+    """The narrower of the two angles (degrees) between a cut from ``end`` to ``other`` and the
+    ring ``ring`` (a shapely LinearRing through ``end``), the ring read ``sigma`` either side."""
+    s = ring.project(_point(end))
+    d = other - end
+    worst = 180.0
+    for ds in (-sigma, sigma):
+        q = np.asarray(ring.interpolate((s + ds) % ring.length).coords[0]) - end
+        den = math.hypot(*q) * math.hypot(*d)
+        if den > 0:
+            worst = min(worst, math.degrees(math.acos(max(-1.0, min(1.0, float(q @ d) / den)))))
+    return worst
+
+
+def _point(p):
+    from shapely.geometry import Point
+
+    return Point(float(p[0]), float(p[1]))
+
+
+def _island_cuts(face, sigma: float | None = None, existing=()) -> list[np.ndarray]:
     """Two straight cuts from each island of ``face`` to another shore (the region's outer ring or
     another island), on opposite sides of the island: the shortest segments that stay in the water.
 
@@ -157,18 +230,56 @@ def _island_cuts(face) -> list[np.ndarray]:
         if not cand:
             continue
         cand.sort(key=lambda t: t[0])
+        if sigma is not None:
+            cand = _without_wedges(cand, hole, rings, sigma) or cand
+            cand = _apart(cand, [*existing, *cuts], 2 * sigma) or cand
         first = cand[0][1]
         cuts.append(first)
         c = np.asarray(hole.centroid.coords[0])
         d = first[0] - c
+        others = [seg for _, seg in cand if not LineString(seg).intersects(LineString(first))]
         far = [
             seg
-            for _, seg in cand
+            for seg in others
             if float(np.dot(seg[0] - c, d)) < 0 and not LineString(seg).intersects(Point(first[1]))
         ]
-        far = [seg for seg in far if not LineString(seg).crosses(LineString(first))]
+        if sigma is not None:  # not alongside the first: the strip between them would be a sliver
+            apart = [seg for _, seg in _apart([(0.0, seg) for seg in others], [first], 2 * sigma)]
+            far = [seg for seg in far if any(seg is a for a in apart)] or apart or far
         if not far:  # no cut on the far side: any other that leaves the first cut alone
-            far = [seg for _, seg in cand if not LineString(seg).intersects(LineString(first))]
+            far = others
         if far:
             cuts.append(far[0])
     return cuts
+
+
+def _without_wedges(cand: list, hole, rings, sigma: float) -> list:
+    """The candidate island cuts that meet both of their rings at no less than
+    :data:`MIN_CORNER_ANGLE` (read at scale ``sigma``)."""
+    out = []
+    for length, seg in cand:
+        far = min(rings, key=lambda r: r.distance(_point(seg[1])))
+        if min(_meets_at(hole, seg[0], seg[1], sigma), _meets_at(far, seg[1], seg[0], sigma)) >= MIN_CORNER_ANGLE:
+            out.append((length, seg))
+    return out
+
+
+def _apart(cand: list, cuts, gap: float) -> list:
+    """The candidate cuts that keep ``gap`` from every one of ``cuts``: neither end within
+    ``gap`` of an end of one (the short stretch of shore between the two ends would be a
+    wedge's tip or a block side a cell long; ending on a cut, a T, is fine), not alongside one
+    (Hausdorff distance: a strip between two cuts that close would be a sliver; a cut from an
+    island beside a chord that already joins it to the next island, for one)."""
+    from shapely.geometry import LineString, Point
+
+    lines = [LineString(c) for c in cuts]
+    tips = [Point(p) for c in cuts for p in (c[0], c[-1])]
+
+    def ok(seg) -> bool:
+        ends = (Point(seg[0]), Point(seg[-1]))
+        ls = LineString(seg)
+        return all(e.distance(t) >= gap for e in ends for t in tips) and all(
+            ls.hausdorff_distance(o) >= gap for o in lines
+        )
+
+    return [(L, seg) for L, seg in cand if ok(seg)]
