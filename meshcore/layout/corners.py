@@ -150,6 +150,18 @@ def _smooth_corners(raw: np.ndarray, a: int, b: int, m: int) -> list[int]:
     return out
 
 
+def _where_it_bends(raw: np.ndarray, s: np.ndarray, total: float, i: int, reach: float) -> int:
+    """The vertex within ``reach`` (arc length) of a sharp corner ``i`` where the boundary itself
+    turns most, if it turns more there than at ``i`` and by more than :data:`SHARP`: read at
+    scale, the vertices beside a cut's end turn almost as much as the end, but a block corner
+    one vertex off it has a straight or reflex angle in the grid (its corner cell cannot be
+    convex)."""
+    d = np.abs(s - s[i])
+    near = np.flatnonzero(np.minimum(d, total - d) <= reach)
+    j = int(near[np.argmax(raw[near])])
+    return j if raw[j] > max(raw[i], SHARP) else i
+
+
 def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     """The four corner indices (increasing, counter-clockwise) of a CCW ring, and their cost.
 
@@ -169,6 +181,7 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     tt = t.copy()
     tt[forced] = 1e9  # forced first
     picks = _sharp_peaks(tt, s, total, min(sigma, 0.1 * total), 45.0)[:4]
+    picks = [p if p in forced else _where_it_bends(raw, s, total, p, 0.5 * sigma) for p in picks]
     if len(picks) < 4:
         picks = sorted(picks)
         missing = 4 - len(picks)
