@@ -166,6 +166,10 @@ def iterate_layout(
             level_callback("level", (lev, res))
         if stopped:
             break
+    if not stopped:
+        # a fold the coarse level could not resolve (a block corner beside a sharp bend of the
+        # shore is non-convex at 2**levels cells but not on the finest level): repaired there
+        grids, fine_repaired = _repair_folds(grids)
     elapsed = time.perf_counter() - t0
     if stopped:
         msg = "stopped"
@@ -173,6 +177,8 @@ def iterate_layout(
         msg = f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; start: {how}"
         if repaired:
             msg += f"; {repaired} coarse block(s) repaired by the fold-free method"
+        if fine_repaired:
+            msg += f"; {fine_repaired} block(s) repaired by the fold-free method on the finest level"
     info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology
