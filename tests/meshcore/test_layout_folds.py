@@ -1,0 +1,103 @@
+"""No folded cells from the layout: no wedge or sliver blocks, no block corner beside a tip of land.
+
+Folds in the lake grids came from the layout, not from the smoother: a cut from an island
+that runs beside the chord which already joins it to the next island (a sliver block between
+them), a cut that ends a cell from a peninsula's tip (its block corner is non-convex on the
+coarse levels), a block corner one vertex off the cut's end.  ``benchmarks/fold_sweep.py``
+counts the folds over many generated lakes; these tests pin the causes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from shapely.geometry import LineString, Point, Polygon
+from shapely.geometry.polygon import orient
+
+from meshcore import testing
+from meshcore.layout import auto_layout
+from meshcore.layout.corners import _raw_turning, turning
+from meshcore.layout.regions import to_tips
+
+
+def _two_islands(gap: float = 1.0, r2: float = 0.5):
+    """A round lake with two round islands ``gap`` apart (a narrow passage between them)."""
+    outer = Point(0, 0).buffer(10, quad_segs=32)
+    a = Point(-2, 0).buffer(1.5, quad_segs=12)
+    b = Point(-0.5 + gap + r2, 0.3).buffer(r2, quad_segs=12)
+    return orient(Polygon(outer.exterior, [a.exterior, b.exterior]), 1.0)
+
+
+def _narrowest_corner(lay) -> float:
+    return min(180.0 - float(turning(pc.ring, 1.5 * lay.cell_size)[list(pc.corners)].max()) for pc in lay.pieces)
+
+
+@pytest.mark.parametrize("gap", [1.0, 1.5])
+def test_no_sliver_block_between_cuts_that_join_two_islands(gap):
+    # the chord through the passage joins the islands; the islands' own cuts must not run
+    # beside it (before: a block of 0.1 cells² with a 1° corner between the two lines)
+    lay = auto_layout(_two_islands(gap), target_cells=4000)
+    h = lay.cell_size
+    assert min(Polygon(pc.ring).area for pc in lay.pieces) >= 4 * h * h
+    assert _narrowest_corner(lay) >= 15.0
+    cuts = [LineString(c) for c in lay.cuts]
+    for i, a in enumerate(cuts):
+        for b in cuts[i + 1 :]:
+            assert a.hausdorff_distance(b) >= 1.5 * h
+
+
+def test_a_cut_that_ends_beside_a_tip_of_land_is_moved_onto_it():
+    # a peninsula with a sharp tip at (5, 4) in a 10 × 10 basin (outer ring counter-clockwise)
+    ring = np.array([(0, 0), (10, 0), (10, 10), (5.2, 10), (5, 4), (4.8, 10), (0, 10)], dtype=float)
+    sigma = 0.3
+    near = np.array([[5.1, 3.85], [5.1, 0.0]])  # ends 0.18 from the tip
+    far = np.array([[8.0, 3.0], [8.0, 0.0]])
+    moved, kept = to_tips([ring], [near, far], sigma)
+    assert moved[0] == pytest.approx([5.0, 4.0])
+    assert moved[-1] == pytest.approx([5.1, 0.0])  # the other end stays
+    assert np.array_equal(kept, far)
+    # a round island turns as much at scale everywhere: it has no tip
+    circle = np.asarray(Point(0, 0).buffer(1.0, quad_segs=16).exterior.coords)[:-1][::-1]
+    cut = np.array([[0.0, 1.1], [0.0, 3.0]])
+    (same,) = to_tips([ring, circle], [cut], 0.3)
+    assert np.array_equal(same, cut)
+
+
+@pytest.mark.parametrize("make", [lambda: testing.lake_with_islands(2), lambda: testing.round_lake(1, kind="blob")])
+def test_block_corners_are_where_the_boundary_bends(make):
+    # a block corner read at scale may fall a vertex beside the cut's end; in the grid its
+    # corner cell then has a straight or reflex angle. Every corner the layout picks at a
+    # sharp bend is at a vertex that turns into the block.
+    lay = auto_layout(make(), target_cells=4000)
+    for pc in lay.pieces:
+        t = turning(pc.ring, 1.5 * lay.cell_size)
+        raw = _raw_turning(pc.ring)
+        for c in pc.corners:
+            if t[c] >= 45.0:
+                assert raw[c] > 0.0, (pc.name, pc.ring[c])
+
+
+FOLD_CASES = {
+    "islands 6": lambda: testing.lake_with_islands(6),
+    "islands 7": lambda: testing.lake_with_islands(7),
+    "disc 6": lambda: testing.round_lake(6, kind="disc"),
+    "disc 9": lambda: testing.round_lake(9, kind="disc"),
+    "arms 3": lambda: testing.round_lake(3, kind="arms"),
+    "two islands": _two_islands,
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(FOLD_CASES))
+def test_lakes_that_folded_have_no_folded_cells(name):
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.quality import lake_metrics
+
+    poly = FOLD_CASES[name]()
+    mb = mesh_outline(poly, target_cells=6000)
+    m = lake_metrics(mb, polygon=poly)
+    assert int(m.values("folded").sum()) == 0
+    assert m.share("deviation", 3.0) >= 0.8
+    assert math.isfinite(m.summary()["mean_deviation_deg"])
