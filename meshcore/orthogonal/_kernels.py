@@ -319,15 +319,51 @@ def _bend(R, S, r0, s0, n, sp, s, sn, px, py, x, y, qx, qy, limit):
     return max(g1, g2) - limit
 
 
+@njit(cache=True, inline="always")
+def _window(a, b, c, d):
+    """``[a, b] ∩ [c, d]``; when they do not meet, the point halfway between the two gaps' ends."""
+    lo_ = max(a, c)
+    hi_ = min(b, d)
+    if lo_ > hi_:
+        m = 0.5 * (lo_ + hi_)
+        return m, m
+    return lo_, hi_
+
+
 @njit(cache=True, nogil=True)
 def shore_sweep(
-    X, Y, free, bnode, binner, bprev, bnext, bring, bs, R, S, roff, cptr, cells, omega, mu, gap, jmin, lo, hi, bz, relax
+    X,
+    Y,
+    free,
+    bnode,
+    binner,
+    bprev,
+    bnext,
+    bring,
+    bs,
+    R,
+    S,
+    roff,
+    cptr,
+    cells,
+    omega,
+    mu,
+    gap,
+    jmin,
+    lo,
+    hi,
+    bz,
+    relax,
+    across,
 ):
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours, pulled
     ``mu`` towards the middle of the two — more where the two arcs differ by a ratio above
     ``lo`` (state ``bz`` per free node, as in :func:`_target`) — and never so far that they
-    differ by more than ``lo``; returns the largest move."""
+    differ by more than ``lo``.  Next to a cut line's end on the shore (``across[k]``: the shore
+    node beyond that end, before and after, or -1) the arc to the end also stays within ``lo`` of
+    the arc beyond it (where both limits cannot hold, halfway between them); returns the largest
+    move."""
     big = 0.0
     before = np.empty(16)
     after = np.empty(16)
@@ -354,8 +390,17 @@ def shore_sweep(
         # ``lo`` (the smoothness limit): sliding to the foot of the perpendicular, shore nodes
         # next to an obtuse block corner otherwise crowd into it, each arc 1.7 times the next
         margin = (sn - sp) * max(0.1, 1.0 / (1.0 + lo))
+        wa, wb = sp + margin, sn - margin
+        # next to a cut line's end (``across``: the shore node beyond it), the edge to that end
+        # within ``lo`` of the edge beyond it: the first cells on the two sides of the cut alike
+        if across[k, 0] >= 0:
+            out = (sp - bs[across[k, 0]]) % total
+            wa, wb = _window(wa, wb, sp + out / lo, sp + out * lo)
+        if across[k, 1] >= 0:
+            out = (bs[across[k, 1]] - sn) % total
+            wa, wb = _window(wa, wb, sn - out * lo, sn - out / lo)
         q = binner[k]
-        sf = _foot(R, S, r0, s0, n, X[q], Y[q], sp + margin, sn - margin)
+        sf = _foot(R, S, r0, s0, n, X[q], Y[q], wa, wb)
         # a pull to the middle keeps the spacing: a little, more where the spacing jumps
         a1, a2 = s - sp, sn - s
         if a1 > 0.0 and a2 > 0.0:

@@ -8,7 +8,9 @@ elliptic solution) and the shore it lies on, and iterates
    5 blocks meet (see :mod:`._kernels`);
 2. a sweep that slides every shore node with two cells around it along the shore, to the foot
    of the perpendicular from its inward neighbour.  Nodes with one cell (convex block corners)
-   or three (reflex corners) stay where the layout put them;
+   or three (reflex corners, cut lines ending beside a block's side) stay where the layout put
+   them; the shore edges on the two sides of such an end are the first cells of two blocks, so
+   the nodes next to it keep their edge within ``lo`` of the edge beyond it;
 
 until the largest move is below ``tol`` × the median edge length.
 
@@ -112,6 +114,21 @@ def _shore_data(X, Y, m, cells, cnt, rings):
             nxt[i], prev[i] = j1, j0
     free = (cnt[nodes] == 2) & (inner >= 0) & (prev >= 0) & bool(rings)
     return nodes, inner, prev, nxt, ring_of, s_of, free
+
+
+def _across_cut_ends(bn, bprev, bnext, free, cnt) -> np.ndarray:
+    """``(len(bn), 2)``: for a free shore node next to a cut line's end on the shore (a fixed
+    node with three or more cells), the shore node beyond that end (before it, after it), else -1.
+
+    The shore is one line of edges through such an end although its two sides belong to two
+    blocks: the edge before it and the edge after it are the first cells of the blocks on the
+    two sides of the cut, whose areas the cross-interface ratio compares."""
+    out = -np.ones((len(bn), 2), dtype=np.int64)
+    for i in np.flatnonzero(free):
+        for col, (nb, beyond) in enumerate(((bprev[i], bprev), (bnext[i], bnext))):
+            if nb >= 0 and not free[nb] and cnt[bn[nb]] >= 3 and beyond[nb] >= 0:
+                out[i, col] = beyond[nb]
+    return out
 
 
 def _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, h: float, angle: float) -> int:
@@ -239,6 +256,7 @@ def iterate_orthogonalize(
         _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, float(np.median(edge0)), pin_angle)
     R, S, roff = _ring_tables(rings) if rings else (np.zeros((1, 2)), np.zeros(2), np.zeros(2, dtype=np.int64))
     fidx = np.flatnonzero(free).astype(np.int64)
+    across = _across_cut_ends(bn, bprev, bnext, free, cnt)
     bz = np.zeros(len(fidx))
     edge = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
     h = float(np.median(edge))
@@ -289,6 +307,7 @@ def iterate_orthogonalize(
             hi,
             bz,
             size_relax,
+            across,
         )
         d = max(d1, d2) / h
         hist.append(d)
