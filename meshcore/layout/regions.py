@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-__all__ = ["partition", "snap_to_rings", "to_tips"]
+__all__ = ["partition", "snap_to_rings"]
 
 #: The narrowest angle (degrees, read at the corners' scale) an island cut may make with a
 #: shore: a cut that meets a ring at a grazing angle leaves a wedge, a block corner of a few
@@ -74,50 +74,6 @@ def snap_to_rings(rings: list[np.ndarray], cuts: list[np.ndarray], eps: float):
     return rings, cuts
 
 
-def _tips(ring: np.ndarray, sigma: float, outer: bool) -> np.ndarray:
-    """The vertices of a shore ring where the water turns sharply round a point of land (a
-    peninsula's or an island's tip): turning of at least 45° away from the water, both at the
-    vertex and at scale ``sigma``."""
-    from .corners import _raw_turning, turning
-
-    x, y = ring[:, 0], ring[:, 1]
-    ccw = float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) > 0
-    sign = 1.0 if (ccw if outer else not ccw) else -1.0
-    # sharp at the vertex itself, not only at scale (a small round island turns as much at scale)
-    return np.flatnonzero((sign * turning(ring, sigma) <= -45.0) & (sign * _raw_turning(ring) <= -45.0))
-
-
-def to_tips(rings: list[np.ndarray], cuts: list[np.ndarray], sigma: float) -> list[np.ndarray]:
-    """The cuts with every end that lands within ``sigma`` of a tip of land (:func:`_tips`) moved
-    onto the tip, the cut's other points shifted in proportion to their distance along it.
-
-    An end beside a tip leaves a block corner a cell from where the shore bends back round the
-    land: at the grid's coarse levels that corner cell cannot be convex.  At the tip itself the
-    corner takes the bend.
-    """
-    tips = (
-        np.vstack([r[_tips(r, sigma, k == 0)] for k, r in enumerate(rings)] or [np.zeros((0, 2))])
-        if rings
-        else np.zeros((0, 2))
-    )
-    if not len(tips):
-        return cuts
-    out = []
-    for c in cuts:
-        c = np.array(c, dtype=float)
-        s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(c, axis=0).T))])
-        if s[-1] <= 0:
-            out.append(c)
-            continue
-        for end, w in ((0, 1.0 - s / s[-1]), (-1, s / s[-1])):
-            d = np.hypot(*(tips - c[end]).T)
-            k = int(np.argmin(d))
-            if 0.0 < d[k] <= sigma and d[k] < 0.25 * s[-1]:
-                c = c + w[:, None] * (tips[k] - c[end])
-        out.append(c)
-    return out
-
-
 def partition(poly, cuts: list[np.ndarray], sigma: float | None = None) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Counter-clockwise rings of the regions that ``cuts`` make of the polygon ``poly``.
 
@@ -131,7 +87,7 @@ def partition(poly, cuts: list[np.ndarray], sigma: float | None = None) -> tuple
 
     cuts = list(cuts)
     for _ in range(2 * len(poly.interiors) + 2):  # each round joins an island to another ring
-        faces, cuts = _faces(poly, cuts, sigma)
+        faces, cuts = _faces(poly, cuts)
         holed = [f for f in faces if f.interiors]
         if not holed:
             break
@@ -148,15 +104,13 @@ def partition(poly, cuts: list[np.ndarray], sigma: float | None = None) -> tuple
     return [np.asarray(f.exterior.coords)[:-1] for f in faces], cuts
 
 
-def _faces(poly, cuts, sigma: float | None = None):
+def _faces(poly, cuts):
     import shapely
     from shapely.geometry import LineString
     from shapely.geometry.polygon import orient
 
     rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(h.coords)[:-1] for h in poly.interiors)]
     size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
-    if sigma is not None:
-        cuts = to_tips(rings, cuts, sigma)
     rings, cuts = snap_to_rings(rings, cuts, 1e-9 * size)
     lines = [LineString(np.vstack([r, r[:1]])) for r in rings] + [LineString(c) for c in cuts]
     noded = shapely.union_all(lines)
