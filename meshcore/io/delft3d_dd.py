@@ -22,7 +22,8 @@ reads a constant-``m`` segment of the first domain as a constant-``m`` segment
 of the second).  The writer therefore turns blocks by quarter turns of their
 index space (fewest turned blocks) so that every interface joins a right
 border to a left one or a top border to a bottom one; a layout where that is
-impossible — a corner where 3 or 5 blocks meet — is a clear
+impossible — a corner where 3 or 5 blocks meet, or a ring of blocks round
+an island whose index directions come back turned by a quarter — is a clear
 :class:`~meshcore.errors.WriteError`.
 
 Couplings are found from the coordinates: border edges of two blocks whose end
@@ -163,7 +164,9 @@ def _turns(blocks: list[StructuredGrid], couplings: list[Coupling], names: tuple
                         f"M-lines only to M-lines and N-lines to N-lines, and no turning of the blocks "
                         f"makes the interface {names[c.a]}.{c.border_a} ↔ {names[c.b]}.{c.border_b} near "
                         f"({p[0]:.8g}, {p[1]:.8g}) agree with the others around it (a corner where 3 or 5 "
-                        f"blocks meet); use a layout with 4 blocks at every inner corner"
+                        f"blocks meet, or blocks round an island whose index directions turn by a quarter "
+                        f"on the way round); use a layout with 4 blocks at every inner corner and blocks "
+                        f"round each island that close up"
                     )
         best = max(range(4), key=lambda s: (sum((turns[k] + s) % 4 == 0 for k in comp), -s))
         for k in comp:
