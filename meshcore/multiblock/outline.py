@@ -114,17 +114,20 @@ class OutlineBlocks:
 
 def _project_on(poly: np.ndarray, q: np.ndarray, closed: bool) -> tuple[float, int, float]:
     """(distance, segment index, parameter t) of the point of ``poly`` nearest to ``q``."""
-    a = poly
     b = np.roll(poly, -1, axis=0) if closed else poly[1:]
-    a = a if closed else poly[:-1]
+    dist, t = _feet(poly if closed else poly[:-1], b, q)
+    k = int(np.argmin(dist))
+    return float(dist[k]), k, float(t[k])
+
+
+def _feet(a: np.ndarray, b: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance from ``q`` to each segment ``a[k] → b[k]`` and the parameter of its foot."""
     d = b - a
     L2 = (d * d).sum(axis=1)
     t = np.where(L2 > 0, ((q - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0)
     t = np.clip(t, 0.0, 1.0)
     foot = a + t[:, None] * d
-    dist = np.hypot(*(foot - q).T)
-    k = int(np.argmin(dist))
-    return float(dist[k]), k, float(t[k])
+    return np.hypot(*(foot - q).T), t
 
 
 def _insert(poly: np.ndarray, k: int, t: float, closed: bool, eps: float) -> tuple[np.ndarray, np.ndarray]:
@@ -163,12 +166,7 @@ def _nearest_on_cuts(cut_list: list[np.ndarray], k: int, q: np.ndarray) -> tuple
         return math.inf, -1, -1, 0.0
     a = np.vstack([cut_list[m][:-1] for m in others])
     b = np.vstack([cut_list[m][1:] for m in others])
-    d = b - a
-    L2 = (d * d).sum(axis=1)
-    t = np.where(L2 > 0, ((q - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    foot = a + t[:, None] * d
-    dist = np.hypot(*(foot - q).T)
+    dist, t = _feet(a, b, q)
     i = int(np.argmin(dist))
     starts = np.cumsum([0] + [len(cut_list[m]) - 1 for m in others])
     j = int(np.searchsorted(starts, i, side="right")) - 1
