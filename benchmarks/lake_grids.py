@@ -67,7 +67,8 @@ c2 = time.process_time()
 m = lake_metrics(mb, polygon=poly)
 s = m.summary()
 v = m.values("interface_ratio")
-s.update(read_s=t1 - t0, mesh_s=t2 - t1, cpu_s=c2 - c1, islands=len(poly.interiors), converged=mb.converged,
+s.update(target_cells=cells, read_s=t1 - t0, mesh_s=t2 - t1, cpu_s=c2 - c1, islands=len(poly.interiors),
+         converged=mb.converged,
          pct_interface_le_2=float(100 * np.mean(v <= 2)) if len(v) else None)
 print("RESULT " + json.dumps(s))
 """
@@ -133,6 +134,7 @@ TARGETS = [
     ("≥ 80 % of nodes with |cos| ≤ 0.02", lambda s: s["pct_nodes_cos_le_0.02"] >= 80),
     ("≥ 95 % of edge pairs ≤ 1.2", lambda s: s["pct_smoothness_le_1.2"] >= 95),
     ("every interface ratio ≤ 2", lambda s: (s["max_interface_ratio"] or 1) <= 2),
+    ("total cells 0.5–2× of area / h²", lambda s: 0.5 <= s["cells"] / s.get("target_cells", s["cells"]) <= 2),
     ("grid area within 1 %", lambda s: abs(s["area_ratio"] - 1) <= 0.01),
     ("shoreline within 0.5 cells", lambda s: s["hausdorff_cells"] <= 0.5),
     ("≤ 20 s", lambda s: s["mesh_s"] <= 20),
