@@ -22,6 +22,7 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -88,20 +89,45 @@ def auto_layout(
         more.append(shores.change.note())
     from ..errors import TopologyError
 
-    try:
-        return _layout(shores, h, notes + more, multiple=multiple, regular=regular, normal=True)
-    except TopologyError:
+    first = None
+    for scale in LAYOUT_SCALES:
         # the cuts along the shore's normal can leave T-junctions no integer counts satisfy:
-        # the layout without them (the splits of earlier versions) before giving up
-        return _layout(shores, h, notes + more, multiple=multiple, regular=regular, normal=False)
+        # the layout without them (the splits of earlier versions) next
+        for normal in (True, False):
+            try:
+                lay = _layout(shores, h, notes + more, multiple=multiple, regular=regular, normal=normal, scale=scale)
+            except TopologyError as exc:
+                first = first or exc
+                continue
+            if scale != 1.0:
+                why = str(first).removeprefix("automatic layout: ").split(";")[0]
+                note = (
+                    f"layout drawn at {scale:g} × the cell size (cuts, narrowest blocks, corners; the cells "
+                    f"keep the asked size): at the cell size itself {why}"
+                )
+                lay = dataclasses.replace(lay, notes=(*lay.notes, note))
+            return lay
+    assert first is not None
+    raise first
 
 
-def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bool) -> Layout:
+#: When no layout at the cell size has agreeing counts (or no cut from an island stays in
+#: the water), the layout's geometry — sampling, shortest cut, narrowest block, the scale at
+#: which corners are read, all multiples of the cell size — is drawn at these multiples of
+#: it in turn (the cells keep the asked size): a T-junction that no counts satisfy, or a cut
+#: that grazes the shore, depends on where chords fall, and a slightly other scale moves them.
+#: Seen on generated lakes with islands (round_lake(2), lake_with_islands(429/432)): each
+#: failed at the cell size and passed at one of the others.
+LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
+
+
+def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bool, scale: float = 1.0) -> Layout:
     poly = shores.grid
-    sk, chords, _, pieces = layout_pieces(shores.layout, h, regular=regular, normal=normal)
+    hl = scale * h  # the layout's geometry; counts at h
+    sk, chords, _, pieces = layout_pieces(shores.layout, hl, regular=regular, normal=normal)
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
-        sk, chords, _, moved = layout_pieces(poly, h, regular=regular, normal=normal)
+        sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal)
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple)
     blocks = tuple(
