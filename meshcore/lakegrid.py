@@ -63,13 +63,21 @@ def _per_level(value, lev: int) -> float:
     return float(value[min(lev, len(value) - 1)])
 
 
+#: The most iterations of the start grid's solve (a start for the orthogonal levels, not a
+#: result): its multigrid converges in 2–7 cycles on 60 real lakes' coarsest levels, but where
+#: it gives up, the SOR it falls back to ran to the default 50 000 sweeps, not converging, on
+#: one (held-out lake g180645, 47 blocks, 1007 coarse cells: 11.7 CPU-s of its 17.5); capped,
+#: the same final quality (folded cells 1 → 1, nodes within 3° 90.3 → 91.1 %) in 7.2 CPU-s.
+START_ITERATIONS = 2000
+
+
 def _start(topo, how: str):
     """A start grid on the coarsest level: the algebraic (TFI) grids relaxed as one grid."""
     from .multiblock import initial_grids, solve_multiblock
     from .orthogonal import orthogonalize
 
     if how == "winslow":
-        mb = solve_multiblock(topo)
+        mb = solve_multiblock(topo, max_iterations=START_ITERATIONS)
         return list(mb.grids), f"multiblock Winslow ({mb.info.message})"
     g0 = initial_grids(topo)
     res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4, size_ratio=None)

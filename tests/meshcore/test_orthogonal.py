@@ -192,3 +192,20 @@ def test_the_finest_level_gets_the_last_sweep_count():
     done = []
     mesh_layout(lay, levels=1, sweeps=(11, 7, 5), stall=None, callback=lambda kind, v: done.append(v[1].sweeps))
     assert done == [7, 5]
+
+
+def test_the_start_grids_solve_stops_at_its_iteration_cap(monkeypatch):
+    """The coarsest level's start is a start: its solve stops after START_ITERATIONS even where
+    it does not converge (a held-out lake's SOR fallback ran 50 000 sweeps there)."""
+    import meshcore.lakegrid as lg
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+
+    topo = auto_layout(testing.y_junction(), target_cells=600).topology()
+    monkeypatch.setattr(lg, "START_ITERATIONS", 1)
+    grids, how = lg._start(topo, "winslow")
+    assert "not converged after 1 iteration" in how
+    assert len(grids) == len(topo.blocks)
+    monkeypatch.setattr(lg, "START_ITERATIONS", 2000)
+    _, how = lg._start(topo, "winslow")
+    assert "(converged" in how
