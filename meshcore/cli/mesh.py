@@ -34,6 +34,7 @@ import argparse
 import dataclasses
 import io
 import math
+import re
 import sys
 import time
 from pathlib import Path
@@ -230,16 +231,16 @@ def _read(args: argparse.Namespace, say: _Say):
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
         )
     outer, islands, dropped = lake_rings(local)
-    _notes(dropped)
+    _notes(dropped, frame)
     try:
         poly, notes = water_polygon(outer, holes=islands)
     except InvalidInputError as exc:
-        raise InvalidInputError(f"{args.outline}: {exc}") from None
+        raise InvalidInputError(in_world(f"{args.outline}: {exc}", frame)) from None
     n_isl = len(islands)
     where = f" from {frame.source_crs}" if frame.source_crs and frame.source_crs != frame.crs else ""
     isl = f"{n_isl} island{'s' * (n_isl != 1)} ({sum(len(r) for r in islands)} points)" if n_isl else "no islands"
     say(f"read {args.outline}: shore of {len(outer)} points, {isl}; {_crs_label(frame.crs)}{where}")
-    _notes(notes)
+    _notes(notes, frame)
     return poly, frame
 
 
@@ -362,26 +363,40 @@ def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, s
     return h, f"cell size {h:.4g}{unit} ({why}, about {est:,.0f} cells)"
 
 
-def _notes(notes: Any) -> None:
-    """What the pipeline changed in the water (islands joined or too small): shown even with -q."""
+def _notes(notes: Any, frame: Any = None) -> None:
+    """What the pipeline changed in the water (islands joined or too small): shown even with -q
+    (places in the grid's CRS: :func:`in_world`)."""
     for n in notes:
-        print(f"meshcore mesh: note: {n}", file=sys.stderr)
+        print(f"meshcore mesh: note: {in_world(n, frame)}", file=sys.stderr)
 
 
-def _layout(args, poly, h: float, regular: bool, say: _Say):
+_NEAR = re.compile(r"near \((-?\d[\d.]*(?:e[+-]?\d+)?), (-?\d[\d.]*(?:e[+-]?\d+)?)\)")
+
+
+def in_world(msg: str, frame: Any) -> str:
+    """``msg`` with every place ``near (x, y)`` moved from the local frame the layout and the
+    solver work in to the grid's CRS (``frame``'s origin added, to the centimetre), as the
+    quality table and the written grid give them; unchanged without an origin."""
+    ox, oy = getattr(frame, "origin", None) or (0.0, 0.0)
+    if ox == 0.0 and oy == 0.0:
+        return msg
+    return _NEAR.sub(lambda m: f"near ({float(m[1]) + ox:.11g}, {float(m[2]) + oy:.11g})", msg)
+
+
+def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
     from ..layout import auto_layout
 
     try:
         lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular)
     except InvalidInputError as exc:
-        msg = str(exc)
+        msg = in_world(str(exc), frame)
         raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None
     n = len(lay.blocks)
     say(
         f"layout: {n} block{'s' * (n != 1)}, {lay.n_cells:,} cells"
         f"{' (regular: no 3- or 5-block corners)' if regular else ''}, {say.lap():.1f} s"
     )
-    _notes(lay.notes)
+    _notes(lay.notes, frame)
     return lay
 
 
@@ -475,11 +490,14 @@ def run(args: argparse.Namespace) -> int:
     say(f"water area {poly.area / 1e6:.4g} km², {how}" if frame.crs else f"water area {poly.area:.6g}, {how}")
     say.lap()
     try:
-        lay = _layout(args, poly, h, regular, say)
+        lay = _layout(args, poly, h, regular, say, frame)
         _check_blocks(outputs, lay)
         mb = _grid(lay, say)
-    except MeshcoreError:
-        raise
+    except MeshcoreError as exc:
+        msg = in_world(str(exc), frame)
+        if msg == str(exc):
+            raise
+        raise type(exc)(msg) from None
     except Exception as exc:  # a bug of the pipeline, not bad input: one line, exit 1
         print(
             f"meshcore mesh: internal error while making the grid of {args.outline} "

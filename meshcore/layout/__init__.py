@@ -143,10 +143,36 @@ def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bo
         multiple=multiple,
         skeleton=sk,
         chords=tuple(chords),
-        notes=tuple(notes),
+        notes=tuple(notes) + _cells_note(pieces, cells, h),
     )
     _check_case(lay)
     return lay
+
+
+#: Total cells outside this range of area / h² (issue 12's target) get a note naming the block
+#: that strays most (its cells against its own area / h²) and where it is.
+CELLS_RANGE = (0.5, 2.0)
+
+
+def _cells_note(pieces, cells, h: float) -> tuple[str, ...]:
+    """A note when the integer counts give far fewer or more cells than the area asks for: a
+    chain of blocks shares one count across, so a wide block between narrow ones (a basin
+    between arms, the water round an island beside a narrow passage) gets the narrow ones'."""
+    from shapely.geometry import Polygon
+
+    polys = [Polygon(pc.ring) for pc in pieces]
+    share = np.array([a * b * h * h / p.area for (a, b), p in zip(cells, polys, strict=True)])
+    total = sum(a * b for a, b in cells) * h * h / sum(p.area for p in polys)
+    if CELLS_RANGE[0] <= total <= CELLS_RANGE[1]:
+        return ()
+    k = int(np.argmin(share)) if total < CELLS_RANGE[0] else int(np.argmax(share))
+    c = polys[k].representative_point()
+    return (
+        f"the blocks' cell counts give {total:.2f} × the cells of the asked size (area / h²): "
+        f"counts must agree along each chain of blocks, and block {pieces[k].name} near "
+        f"({c.x:.6g}, {c.y:.6g}) gets {share[k]:.2f} × its own; a cut line there that ends on "
+        f"another (a T-junction) lets its counts differ from its neighbours'",
+    )
 
 
 def _check_case(lay: Layout) -> None:

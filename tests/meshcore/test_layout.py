@@ -315,3 +315,23 @@ def test_a_round_lake_with_an_island_near_the_shore_gets_the_cells_it_asks_for()
     poly = testing.round_lake(1021, kind="blob")
     lay = auto_layout(poly, target_cells=3000)
     assert lay.n_cells * lay.cell_size**2 / poly.area >= 0.5
+
+
+def test_a_layout_far_from_the_asked_cells_says_so_and_where():
+    """Counts that give far fewer cells than area / h² (a chain of blocks tied to a narrow
+    passage) come with a note naming the block that strays most and a point inside it."""
+    from shapely.geometry import Point, Polygon
+
+    poly = testing.round_lake(1021, kind="blob")
+    lay = auto_layout(poly, target_cells=3000)
+    total = lay.n_cells * lay.cell_size**2 / poly.area
+    assert total < 0.5
+    (note,) = [n for n in lay.notes if "× the cells of the asked size" in n]
+    assert f"{total:.2f} ×" in note
+    name = note.split("block ")[1].split()[0]
+    x, y = (float(v) for v in note.split("near (")[1].split(")")[0].split(", "))
+    piece = next(p for p in lay.pieces if p.name == name)
+    assert Polygon(piece.ring).buffer(1e-6 * math.sqrt(poly.area)).contains(Point(x, y))
+    ok = auto_layout(testing.y_junction(), target_cells=3000)  # within 0.5–2×: no such note
+    assert 0.5 <= ok.n_cells * ok.cell_size**2 / ok.polygon.area <= 2
+    assert not [n for n in ok.notes if "× the cells of the asked size" in n]

@@ -584,3 +584,39 @@ def test_lake_rings_and_lonlat_rules_shared_with_the_app(tmp_path):
         lake_rings(csv("away.csv", [*ll, away]))
     run = mesh(tmp_path / "bare.csv", "--cells", 300, "-o", tmp_path / "b.npz")
     assert run.rc == 0 and "touching the shore" in run.err and "EPSG:32633" in run.err, run.err
+
+
+def test_places_in_notes_are_in_the_grids_crs(tmp_path):
+    """A note's ``near (x, y)`` names a place in the output's coordinates (the CRS, origin
+    added), as the quality table does: a lon/lat lake whose layout has too few cells."""
+    from meshcore import testing
+
+    poly = testing.round_lake(1021, kind="blob")  # a layout with 0.25 × the asked cells
+    lon0, lat0, deg = 10.0, 45.0, 300.0 / 111_320.0  # 1 unit = 300 m
+    rings = [np.asarray(r.coords) for r in (poly.exterior, *poly.interiors)]
+    kx = deg / math.cos(math.radians(lat0))
+    lonlat = [np.column_stack([lon0 + r[:, 0] * kx, lat0 + r[:, 1] * deg]) for r in rings]
+    path = tmp_path / "lake.geojson"
+    geom = {"type": "Polygon", "coordinates": [r.tolist() for r in lonlat]}
+    path.write_text(json.dumps({"type": "Feature", "geometry": geom, "properties": {}}))
+    water = projected(lonlat, "EPSG:32632")
+    h = math.sqrt(water.area / 3000)
+    r = mesh(path, "--cell-size", h, "-o", tmp_path / "g.vtm", "-q")
+    assert r.rc in (0, 3), r.err
+    (note,) = [n for n in r.err.splitlines() if "× the cells of the asked size" in n]
+    x, y = (float(v) for v in note.split("near (")[1].split(")")[0].split(", "))
+    assert water.buffer(h).contains(shapely.Point(x, y)), (x, y, water.bounds)
+
+
+def test_in_world_moves_only_places_by_the_origin():
+    from types import SimpleNamespace
+
+    from meshcore.cli.mesh import in_world
+
+    frame = SimpleNamespace(origin=(500000.0, 5000000.0))
+    msg = "block b3 (24, 16) near (-5920.77, 2728.88) and near (1e-05, -3.5e+02); cells (4, 8)"
+    assert in_world(msg, frame) == (
+        "block b3 (24, 16) near (494079.23, 5002728.88) and near (500000.00001, 4999650); cells (4, 8)"
+    )
+    assert in_world(msg, SimpleNamespace(origin=(0.0, 0.0))) == msg
+    assert in_world(msg, None) == msg
