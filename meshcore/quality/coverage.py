@@ -119,7 +119,17 @@ def _block_region(g: StructuredGrid, folded: np.ndarray) -> Any:
     cells = shapely.polygons(np.stack([c, d], axis=-1))
     bad = ~shapely.is_valid(cells)
     cells[bad] = shapely.make_valid(cells[bad])
-    return shapely.union_all(cells)
+    return _areal(shapely.union_all(cells))
+
+
+def _areal(geom: Any) -> Any:
+    """The polygons of ``geom``: a folded cell made valid can leave lines and points beside
+    them (a GeometryCollection), whose boundary is empty: the shore distance had no points."""
+    import shapely
+
+    if geom.geom_type in ("Polygon", "MultiPolygon"):
+        return geom
+    return shapely.union_all([p for p in shapely.get_parts(geom) if p.geom_type in ("Polygon", "MultiPolygon")])
 
 
 def _directed(points: np.ndarray, lines: Any) -> tuple[float, int]:
@@ -156,7 +166,7 @@ def coverage(
     import shapely
 
     poly = as_polygon(polygon, holes)
-    union = shapely.union_all([_block_region(g, b.folded) for g, b in zip(grids, block_metrics, strict=True)])
+    union = _areal(shapely.union_all([_block_region(g, b.folded) for g, b in zip(grids, block_metrics, strict=True)]))
     n_cells = sum(g.cells[0] * g.cells[1] for g in grids)
     h = float(cell_size) if cell_size is not None else math.sqrt(union.area / max(n_cells, 1))
     if not h > 0:

@@ -94,3 +94,24 @@ def test_quality_invariant_under_similarity(dx, dy, angle, scale, seed):
     for k in INVARIANT:
         np.testing.assert_allclose(a[k], b[k], rtol=1e-7, atol=1e-7, err_msg=k)
     np.testing.assert_allclose(b["area"], a["area"] * scale**2, rtol=1e-7, atol=1e-9 * scale**2)
+
+
+def test_coverage_of_a_grid_with_a_collapsed_cell_sticking_out():
+    """A collapsed cell made valid is a line; where it sticks out of the other cells the union
+    is a GeometryCollection whose boundary is empty: the shore distance crashed (argmax of an
+    empty sequence, seen on a generated lake's badly folded grid).  Now: the polygons only."""
+    from types import SimpleNamespace
+
+    from shapely.geometry import Polygon
+
+    from meshcore.grid import StructuredGrid
+    from meshcore.quality.coverage import coverage
+
+    # cells 0, 1: a square and a triangle over [0, 2] × [0, 1]; cell 2: the segment (2, 0)–(4, 0)
+    x = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [3.0, 4.0]])
+    y = np.array([[0.0, 1.0], [0.0, 1.0], [0.0, 0.0], [0.0, 0.0]])
+    g = StructuredGrid(x, y)
+    water = Polygon([(0, 0), (2, 0), (2, 1), (0, 1)])
+    c = coverage([g], [SimpleNamespace(folded=np.array([[False], [False], [True]]))], water, cell_size=1.0)
+    assert c.grid_area == pytest.approx(1.5)  # the square and the triangle; the line adds nothing
+    assert c.hausdorff == pytest.approx(math.sqrt(0.5))  # the triangle's slope misses (2, 1) by √½
