@@ -1131,3 +1131,29 @@ def test_vectorised_border_stencils_equal_the_node_by_node_ones(make, rect):
     assert len(fast[0]) > 0
     for a, b in zip(fast, slow, strict=True):
         assert np.array_equal(np.asarray(a), np.asarray(b))
+
+
+def test_sor_after_a_slow_multigrid_starts_from_the_start_grid(monkeypatch):
+    """When the multigrid gives up ("slow"), SOR starts again from the start grid, not from the
+    cycles' grid: the result is the SOR grid to the bit (a generated lake's coarsest level,
+    round_lake(1, blob), ended far off from the cycles' grid: 1290 folded cells at the end)."""
+    import meshcore.multiblock.multigrid as mg
+
+    X, Y = curved_rectangle(64, 32)
+    monkeypatch.setattr(mg, "AUTO_GIVE_UP_RATE", 0.0)  # every multigrid is "slow" after 3 cycles
+    auto = solve_multiblock(four_blocks(X, Y, 32, 16), tolerance=1e-12)
+    assert "multigrid was slow" in auto.info.message and auto.info.method.startswith("smooth/blocks-sor after 3")
+    sor = solve_multiblock(four_blocks(X, Y, 32, 16), tolerance=1e-12, engine="blocks")
+    assert auto.converged and sor.converged
+    for a, b in zip(auto, sor, strict=True):
+        assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+
+
+def test_a_round_lakes_start_grid_converges_where_the_multigrid_gives_up():
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+    from meshcore.orthogonal.levels import coarsen_topology
+
+    lay = auto_layout(testing.round_lake(1, kind="blob"), target_cells=15000, multiple=4)
+    mb = solve_multiblock(coarsen_topology(lay.topology(), 4), max_iterations=2000)
+    assert mb.converged, mb.info.message
