@@ -191,7 +191,11 @@ def _dry_run_ddb(p: Path, lay: Any) -> None:
         try:
             write(trial, grids, block_names=[b.name for b in topo.blocks])
         except WriteError as exc:
+            from ..layout.frames import frame_defects
+
             msg = str(exc).replace(f"{trial}: ", "").replace(str(trial), str(p))
+            where = "; ".join(d.note() for d in frame_defects(list(lay.pieces)))
+            msg += f"; here {where}" if where else ""
             raise InvalidInputError(f"-o {p}: {msg} (write .vtm, .cgns or .xyz instead)") from None
 
 

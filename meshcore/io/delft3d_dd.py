@@ -292,8 +292,10 @@ class DomainDecomposition:
     files: tuple[str, ...]
     interfaces: tuple[Any, ...]  # meshcore.multiblock.Interface
 
-    def topology(self) -> Any:
-        """A validated :class:`~meshcore.multiblock.MultiBlockTopology` of the blocks."""
+    def topology(self, *, check_geometry: bool = True) -> Any:
+        """A validated :class:`~meshcore.multiblock.MultiBlockTopology` of the blocks
+        (``check_geometry=False``: without the shapely checks, which take the water round an
+        island for a gap between blocks; the couplings are checked node for node either way)."""
         from ..boundary import Borders
         from ..multiblock import Block, MultiBlockTopology
 
@@ -301,7 +303,7 @@ class DomainDecomposition:
             Block(n, Borders(*(g.border(b) for b in BORDER_NAMES)))
             for n, g in zip(self.blocks.block_names, self.blocks.blocks, strict=True)
         )
-        return MultiBlockTopology(bl, self.interfaces)
+        return MultiBlockTopology(bl, self.interfaces, check_geometry=check_geometry)
 
 
 def _tokens(path: Path) -> list[tuple[int, str]]:

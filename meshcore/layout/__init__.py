@@ -13,6 +13,8 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 * :mod:`.regions` — the regions between shores and cuts, islands cut free;
 * :mod:`.split` — regions that are not four-sided split at their reflex corners or by a star;
 * :mod:`.corners` — four corners per piece, where the boundary turns at the cells' scale;
+* :mod:`.frames` — in regular mode, corners re-chosen so that the blocks' index directions
+  close up round every island (what Delft3D's domain decomposition needs);
 * :mod:`.counts` — integer cell counts that agree across every interface (a small MILP);
 * :mod:`.blocks` — the pieces made conforming, their cell counts;
 * :mod:`.build` — the pipeline;
@@ -30,6 +32,7 @@ import numpy as np
 from .blocks import block_counts
 from .build import layout_pieces
 from .edit import layout_from_cuts, layout_from_outline, with_cells
+from .frames import frame_defects
 from .model import Layout, LayoutBlock
 from .outline import interior_cuts
 from .polygon import water_polygon, without_dense_vertices, without_slivers
@@ -64,7 +67,10 @@ def auto_layout(
         solvers coarsen ``k`` times).
     regular : bool
         No node where three or five blocks meet (no star at Y junctions, no butterfly in
-        basins): what Delft3D's domain decomposition can couple.
+        basins) and block corners round every island that close up (:mod:`.frames`): what
+        Delft3D's domain decomposition can couple.  Where the corners cannot be made to close,
+        the layout is returned as it is; :func:`~.frames.frame_defects` of its pieces names
+        the islands.
 
     Returns
     -------
@@ -90,6 +96,7 @@ def auto_layout(
     from ..errors import TopologyError
 
     first = None
+    kept = None  # a regular layout whose blocks do not close up round an island (.frames)
     for scale in LAYOUT_SCALES:
         # the cuts along the shore's normal can leave T-junctions no integer counts satisfy:
         # the layout without them (the splits of earlier versions) next
@@ -106,7 +113,12 @@ def auto_layout(
                     f"keep the asked size): at the cell size itself {why}"
                 )
                 lay = dataclasses.replace(lay, notes=(*lay.notes, note))
+            elif regular and frame_defects(list(lay.pieces)):
+                kept = kept or lay  # the other splits may close up: tried next, this one if not
+                continue
             return lay
+        if kept is not None:
+            return kept
     assert first is not None
     raise first
 

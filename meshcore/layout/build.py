@@ -24,6 +24,7 @@ from ..pointindex import PointIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners
+from .frames import close_frames
 from .regions import partition
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, forced_indices
@@ -152,9 +153,26 @@ def layout_pieces(
         idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
         pieces.append(Piece(r, idx))
     _check_pieces(poly, pieces)
-    pieces, cuts = _make_countable(pieces, cuts, h, size)
+    if regular:  # every island's ring of blocks closes up (Delft3D's domain decomposition)
+        pieces, cuts = _closed(pieces, cuts, h, size, sigma)
+    else:
+        pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
     return sk, chords, cuts, pieces
+
+
+def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float):
+    """The pieces with corners that close up round every island (:func:`~.frames.close_frames`),
+    the first choice whose cells can be counted; the pieces as they are when there is none
+    (their layout is valid, Delft3D's domain decomposition cannot couple it)."""
+    from ..errors import TopologyError
+
+    for closed in close_frames(pieces, sigma):
+        try:
+            return _make_countable(closed, cuts, h, size)
+        except TopologyError:
+            continue
+    return _make_countable(pieces, cuts, h, size)
 
 
 def _welded(rings: list[np.ndarray], forced: list[tuple], eps: float):

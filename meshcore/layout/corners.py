@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-__all__ = ["bulge_ratio", "choose_corners", "corner_cost", "turning"]
+__all__ = ["bulge_ratio", "choose_corners", "corner_cost", "set_cost", "turning"]
 
 #: A vertex turning more than this (degrees, at scale) counts as a sharp feature.
 SHARP = 30.0
@@ -207,9 +207,17 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
         picks = sorted(set(picks + order[: 4 - len(picks)]))[:4]
     if len(picks) != 4:
         return None, math.inf
-    near = np.zeros(n, dtype=bool)
+    return tuple(picks), set_cost(ring, sigma, picks, t=t)
+
+
+def set_cost(ring: np.ndarray, sigma: float, picks, *, t: np.ndarray | None = None) -> float:
+    """The cost of the four corners ``picks`` (increasing indices) of a CCW ring: the corners'
+    turning (:func:`corner_cost`), opposite sides' lengths (:func:`side_cost`) and the bulge
+    (:func:`bulge_cost`); ``t``: :func:`turning` of the ring at ``sigma``, if made already."""
+    t = turning(ring, sigma) if t is None else t
+    s, total = _arclength_closed(ring)
+    near = np.zeros(len(ring), dtype=bool)
     for c in picks:
         d = np.abs(s - s[c])
         near |= np.minimum(d, total - d) < sigma
-    cost = corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks)
-    return tuple(picks), cost
+    return corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks)

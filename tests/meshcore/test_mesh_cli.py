@@ -269,6 +269,29 @@ def test_kml_islands_are_left_out_of_the_grid(tmp_path):
     assert (tmp_path / "q.png").stat().st_size > 10_000
 
 
+def test_a_lake_with_an_island_is_written_as_domain_decomposition(tmp_path):
+    """Lake Iseo (one island) as Delft3D DD: the blocks round the island close up (before the
+    regular layout's corners were re-chosen, every lake with islands was refused here)."""
+    src = LAKES / "lake_iseo_sparse.geojson"
+    run = mesh(src, "--cells", 1000, "-o", tmp_path / "i.ddb", "-o", tmp_path / "i.npz")
+    assert run.rc == 0, run.err
+    assert "1 island" in run.err
+    ref = blocks_of(read_blocks(tmp_path / "i.npz"))
+    lines = parse_ddb(tmp_path / "i.ddb")
+    files = sorted({ln[0] for ln in lines} | {ln[2] for ln in lines})
+    assert len(files) == len(ref)  # every block coupled
+    grd = {f: parse_grd(tmp_path / f) for f in files}
+    assert node_set(grd.values()) == node_set(ref)
+    for fa, mna, fb, mnb in lines:  # each coupling joins coinciding grid points, M-lines to M-lines
+        assert (mna[0] == mna[2]) == (mnb[0] == mnb[2])
+        np.testing.assert_allclose(segment(*grd[fa], mna), segment(*grd[fb], mnb), atol=1e-6)
+    from meshcore.io.delft3d_dd import read_dd
+
+    read_dd(tmp_path / "i.ddb").topology(check_geometry=False)
+    water = projected(geojson_rings(src), "EPSG:32632")  # 10.1° E: UTM zone 32 N
+    check_covers_the_water(ref, water)
+
+
 def _synthetic_rings(x0: float = 500_000.0, y0: float = 5_200_000.0):
     """An elliptic lake (6 × 3.6 km) with a round island (1 km) off its centre, in metres."""
     t = np.linspace(0, 2 * np.pi, 48, endpoint=False)

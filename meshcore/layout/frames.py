@@ -1,0 +1,266 @@
+r"""Index frames that close up: the corners a regular layout needs round every island.
+
+Delft3D's domain decomposition couples an M grid line only to an M line (see
+:mod:`meshcore.io.delft3d_dd`).  Each block's index directions ``(i, j)`` are a frame; across
+an interface the writer may turn a block by quarter turns so that the frames agree.  That is
+possible for every block at once only when, walking round any loop of blocks, the frame comes
+back unturned: its **holonomy** is zero (mod four quarter turns).
+
+The holonomy is read off the block corners.  At a vertex ``v`` let ``m`` be the number of
+blocks that have it on their boundary and ``c`` how many of them have a corner there; each
+block spans a quarter turn of the frame at its corner and a half turn elsewhere, so the blocks
+round ``v`` span ``q = 2m − c`` quarter turns:
+
+* a vertex inside the water needs ``q = 4`` (four corners, a T-junction's ``2 + 1 + 1``, or a
+  cut's ``2 + 2``); a node where three or five blocks meet (``q = 3`` or ``5``) turns the
+  frame by a quarter;
+* going round an island the frame turns by ``Σ (2 − q)`` quarter turns over its vertices
+  (a straight shore spans a half turn: ``q = 2``), i.e. by ``C − 2 E`` with ``C`` the block
+  corners on the island and ``E = Σ (m − 1)`` the cut ends there.  A ring of blocks closes
+  up when that is ``≡ 0 (mod 4)``.  Round the outer shore it then closes by itself (the
+  turns of all loops add up to that of the whole outline).
+
+A ring of blocks round an island is left turned by a quarter when, say, a cut leaves the
+island continuing one of its sides (one block has a corner there, its neighbour none:
+``q = 3``), or a block takes a corner on a rounded tip of the island.
+
+:func:`frame_defects` finds the islands and nodes that do not close.  :func:`close_frames`
+re-chooses corners where they do not: every piece at an island or a defect may move one of its
+corners to another of its vertices where a cut ends, blocks meet or the shore bends; a small
+integer program (HiGHS) picks the moves that close every island and node at the least corner
+cost (:func:`~.corners.set_cost`).  Layouts that close already are left as they are.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..pointindex import PointIndex
+from .blocks import Piece
+from .corners import SHARP, set_cost, turning
+
+__all__ = ["FrameDefect", "close_frames", "frame_defects"]
+
+
+@dataclass(frozen=True, slots=True)
+class FrameDefect:
+    """A loop of blocks whose index frame comes back turned by ``turn`` quarter turns:
+    round an island (``kind == "island"``, ``where`` a point of its shore) or round a node
+    inside the water where blocks do not meet four corners to four (``kind == "node"``)."""
+
+    kind: str
+    where: tuple[float, float]
+    turn: int
+
+    def note(self) -> str:
+        x, y = self.where
+        if self.kind == "island":
+            return (
+                f"the blocks round the island at ({x:.8g}, {y:.8g}) come back turned by {self.turn} quarter "
+                f"turn{'s' if self.turn > 1 else ''} (their corners on it minus twice the cut ends there "
+                f"is not a multiple of 4)"
+            )
+        return (
+            f"the blocks at ({x:.8g}, {y:.8g}) do not meet four corners to four: their index directions come "
+            f"back turned by {self.turn} quarter turn{'s' if self.turn > 1 else ''} round it"
+        )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Vertices:
+    """The pieces' vertices numbered: ``m`` blocks and ``c`` corners at each, which boundary
+    loop each lies on (``-1``: inside the water; ``0``: the outer shore)."""
+
+    index: PointIndex
+    m: np.ndarray
+    c: np.ndarray
+    loop: np.ndarray
+
+
+def _vertices(pieces: list[Piece]) -> _Vertices:
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    ix = PointIndex([pc.ring for pc in pieces])
+    n = len(ix)
+    m = np.zeros(n, dtype=int)
+    c = np.zeros(n, dtype=int)
+    edges = []
+    for ids, pc in zip(ix.ids, pieces, strict=True):
+        m[np.unique(ids)] += 1
+        c[np.unique(ids[list(pc.corners)])] += 1
+        e = np.sort(np.column_stack([ids, np.roll(ids, -1)]), axis=1)
+        edges.append(e[e[:, 0] != e[:, 1]])
+    e, used = np.unique(np.vstack(edges), axis=0, return_counts=True)
+    bnd = e[used == 1]  # an edge of one piece only: on a shore
+    loop = np.full(n, -1)
+    if len(bnd):
+        g = coo_matrix((np.ones(len(bnd)), (bnd[:, 0], bnd[:, 1])), shape=(n, n))
+        _, lab = connected_components(g, directed=False)
+        on = np.unique(bnd)
+        # the lexicographically last point (largest x) is on the outer shore: its loop is 0
+        outer = lab[on[-1]]
+        labels = {outer: 0}
+        for v in on:
+            labels.setdefault(lab[v], len(labels))
+            loop[v] = labels[lab[v]]
+    return _Vertices(ix, m, c, loop)
+
+
+def _island_turns(v: _Vertices) -> dict[int, int]:
+    """Quarter turns (mod 4) of the frame round every island loop."""
+    out: dict[int, int] = {}
+    for k in range(1, int(v.loop.max(initial=0)) + 1):
+        on = v.loop == k
+        out[k] = int((v.c[on].sum() - 2 * (v.m[on] - 1).sum()) % 4)
+    return out
+
+
+def frame_defects(pieces: list[Piece]) -> list[FrameDefect]:
+    """The islands and inner nodes round which the blocks' index frames do not close up."""
+    v = _vertices(pieces)
+    out = []
+    for k, turn in _island_turns(v).items():
+        if turn:
+            p = v.index.points[np.flatnonzero(v.loop == k)[0]]
+            out.append(FrameDefect("island", (float(p[0]), float(p[1])), turn))
+    q = 2 * v.m - v.c
+    for i in np.flatnonzero((v.loop < 0) & (q != 4)):
+        p = v.index.points[i]
+        out.append(FrameDefect("node", (float(p[0]), float(p[1])), int((4 - q[i]) % 4)))
+    return out
+
+
+#: At most this many shore bends per piece are tried as new corners (the sharpest, one per
+#: corner window): a corner moved off an island goes where the shore turns most.
+_BENDS = 6
+
+#: The least turning (degrees, at the corners' scale) of a vertex that becomes a corner: a
+#: corner on a straight line is a cell of 180°.  Half of :data:`~.corners.SHARP`: on 20 lakes
+#: with islands (``testing.lake_with_islands(0..19)``, 2000 cells) 19 closed with it, 17 with
+#: ``SHARP`` itself, 16 with no limit (a corner at a T on a straight side can also make the
+#: cells uncountable, and the next choice is then tried).
+_LEAST_TURN = SHARP / 2
+
+#: Corners one piece may move (two: a block between two islands, or an island and a node, may
+#: have to give one corner to each).
+_MOVES = 2
+
+#: Added to the cost of every piece whose corners change (the corner cost of one corner 10°
+#: off a right angle, in squared degrees): of equally good choices, the fewest changed blocks.
+_CHANGE = 100.0
+
+
+def _candidates(pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float) -> list[tuple[tuple[int, ...], float]]:
+    """``(corners, cost)`` of the piece's current corners (0) and of every move of one or two
+    corners to other vertices where blocks meet (a cut end, a T) or the shore bends (the rise
+    of :func:`~.corners.set_cost`, plus :data:`_CHANGE` per corner).
+
+    A new corner turns by at least :data:`_LEAST_TURN`; shore bends are taken one per
+    ``sigma`` of arc length, the sharpest first.
+    """
+    ring = pc.ring
+    t = turning(ring, sigma)
+    meet = np.flatnonzero(v.m[ids] >= np.where(v.loop[ids] < 0, 3, 2))
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
+    total = s[-1] + float(np.hypot(*(ring[0] - ring[-1])))
+
+    def apart(i: int, others) -> bool:
+        return all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in others)
+
+    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & (t >= _LEAST_TURN))
+    bends: list[int] = []
+    for i in shore[np.argsort(-t[shore])]:
+        if apart(int(i), bends):
+            bends.append(int(i))
+        if len(bends) >= _BENDS:
+            break
+    here = tuple(sorted(pc.corners))
+    now = set_cost(ring, sigma, here, t=t)
+    options = {here: 0.0}
+    to = sorted(({int(i) for i in meet if t[i] >= _LEAST_TURN} | set(bends)) - set(here))
+    for k in range(1, _MOVES + 1):
+        for a in itertools.combinations(here, k):
+            for b in itertools.combinations(to, k):
+                new = tuple(sorted({*here} - {*a} | {*b}))
+                if new not in options:  # what the move costs; one that lowers the cost is no reason to move
+                    options[new] = max(set_cost(ring, sigma, new, t=t) - now, 0.0) + k * _CHANGE
+    return list(options.items())
+
+
+def close_frames(pieces: list[Piece], sigma: float, *, tries: int = 3) -> Iterator[list[Piece]]:
+    """The pieces with corners re-chosen so that every island and inner node closes up
+    (:func:`frame_defects` empty): up to ``tries`` choices, the one of least corner cost first
+    (a caller that cannot count the cells of one takes the next).  Yields nothing when the
+    pieces close already or when no moves of one corner per piece make them close."""
+    from scipy.optimize import Bounds, LinearConstraint, milp
+
+    if not frame_defects(pieces):
+        return
+    v = _vertices(pieces)
+    bad = {i for d in frame_defects(pieces) if d.kind == "node" for i in v.index.find([d.where]).tolist()}
+    movable = [k for k, ids in enumerate(v.index.ids) if (v.loop[ids] > 0).any() or bool(bad & set(ids.tolist()))]
+    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma) for k in movable}
+    cols = [(k, cs, cost) for k in movable for cs, cost in cand[k]]
+    islands = sorted(_island_turns(v))
+    nx, nz = len(cols), len(islands)
+    # the corners every vertex gets: fixed pieces' as they are, movable ones' by their choice
+    fixed_c = v.c.copy()
+    for k in movable:
+        fixed_c[v.index.ids[k][list(pieces[k].corners)]] -= 1
+    touched: dict[int, list[int]] = {}
+    for j, (k, cs, _) in enumerate(cols):
+        for i in v.index.ids[k][list(cs)].tolist():
+            touched.setdefault(i, []).append(j)
+    rows, want = [], []
+
+    def equal(cols_of: list[int], value: float, z: int | None = None) -> None:
+        r = np.zeros(nx + nz)
+        np.add.at(r, cols_of, 1.0)
+        if z is not None:
+            r[nx + z] = -4.0
+        rows.append(r)
+        want.append(value)
+
+    for k in movable:  # one choice per piece
+        equal([j for j, col in enumerate(cols) if col[0] == k], 1.0)
+    for i in sorted({i for i in touched if v.loop[i] < 0} | bad):  # q = 2m − c = 4 inside the water
+        equal(touched.get(i, []), float(2 * v.m[i] - 4 - fixed_c[i]))
+    for z, k in enumerate(islands):  # C − 2E = 4 z round every island
+        on = v.loop == k
+        equal(
+            [j for i in np.flatnonzero(on).tolist() for j in touched.get(i, [])],
+            float(2 * (v.m[on] - 1).sum() - fixed_c[on].sum()),
+            z,
+        )
+    cost = np.concatenate([[col[2] for col in cols], np.zeros(nz)])
+    big = 4.0 * len(v.m)
+    lb = np.concatenate([np.zeros(nx), np.full(nz, -big)])
+    ub = np.concatenate([np.ones(nx), np.full(nz, big)])
+    cuts: list[np.ndarray] = []
+    hi: list[float] = []
+    for _ in range(tries):
+        low = np.array(want + [-np.inf] * len(cuts), dtype=float)
+        res = milp(
+            cost,
+            constraints=LinearConstraint(np.array(rows + cuts), low, np.array(want + hi, dtype=float)),
+            integrality=np.ones(nx + nz),
+            bounds=Bounds(lb, ub),
+            options={"time_limit": 60.0},
+        )
+        if res.x is None or res.status not in (0, 1):
+            return
+        chosen = np.flatnonzero(np.rint(res.x[:nx]) == 1)
+        out = list(pieces)
+        for j in chosen.tolist():
+            k, cs, _ = cols[j]
+            out[k] = Piece(pieces[k].ring, (cs[0], cs[1], cs[2], cs[3]), pieces[k].name)
+        yield out
+        r = np.zeros(nx + nz)  # the next choice differs from this one in at least one piece
+        r[chosen] = 1.0
+        cuts.append(r)
+        hi.append(float(len(chosen) - 1))
