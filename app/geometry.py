@@ -19,13 +19,16 @@ __all__ = [
     "fit_image",
     "grid_lines",
     "image_bounds",
+    "label_levels",
     "line_alpha",
+    "marker_size",
     "nearest_point",
     "nearest_segment",
     "points_in_box",
     "similarity_from_pairs",
     "snap",
     "typical_cell_size",
+    "typical_spacing",
     "union_bounds",
 ]
 
@@ -286,6 +289,68 @@ def line_alpha(cell_pixels: float, *, full: float = 8.0, faint: float = 2.0, flo
         return 1.0
     t = (cell_pixels - faint) / (full - faint)
     return float(floor + (1.0 - floor) * min(max(t, 0.0), 1.0))
+
+
+def marker_size(spacing_pixels: float, full: float, *, least: float = 3.0) -> float:
+    """Symbol size (pixels) of markers ``spacing_pixels`` apart on screen (level of detail).
+
+    ``full`` when they are at least ``1.5 × full`` apart (a gap of half a symbol between them),
+    else two thirds of the spacing, so neighbours never merge into one blob; 0 (hidden) when that
+    is below ``least`` pixels: a zoomed-out shore of thousands of points is its line, not a
+    black band.  A non-finite spacing (one marker) gives ``full``.
+    """
+    if not math.isfinite(spacing_pixels) or spacing_pixels >= 1.5 * full:
+        return float(full)
+    size = spacing_pixels / 1.5
+    return float(size) if size >= least else 0.0
+
+
+def typical_spacing(points: np.ndarray, *, along: bool = False) -> float:
+    """The median distance from each point to its nearest other point (inf for fewer than two).
+
+    ``along``: the points are a polyline's, in order: the median distance between consecutive
+    distinct points instead (linear time: the canvas measures a dragged outline every frame).
+    """
+    p = np.asarray(points, float).reshape(-1, 2)
+    if along:
+        d = np.hypot(*np.diff(p, axis=0).T)
+        d = d[d > 0]
+        return float(np.median(d)) if len(d) else math.inf
+    p = np.unique(p, axis=0)
+    if len(p) < 2:
+        return math.inf
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(p).query(p, k=2)
+    return float(np.median(d[:, 1]))
+
+
+def label_levels(at: np.ndarray, half: np.ndarray, fits: np.ndarray, order) -> np.ndarray:
+    """Level of detail of labels: which text each label shows, so that none overlaps another.
+
+    ``at`` (n, 2) are the labels' centres, ``half`` (n, L, 2) the half width and height of each of
+    a label's L texts (most detailed first, in model units: their screen size times the pixel size),
+    ``fits`` (n, L) whether that text lies inside the label's own region (a block) on screen.
+    Labels are placed in ``order`` (most important first); each shows its most detailed text that
+    fits and overlaps no label already placed.  Returns the text index per label, −1 for hidden.
+    """
+    at = np.asarray(at, float).reshape(-1, 2)
+    half = np.asarray(half, float).reshape(len(at), -1, 2)
+    fits = np.asarray(fits, bool).reshape(half.shape[:2])
+    out = np.full(len(at), -1, dtype=int)
+    placed = np.zeros((0, 4))  # x0, y0, x1, y1 of the labels shown
+    for k in order:
+        for lev in range(half.shape[1]):
+            if not fits[k, lev]:
+                continue
+            x0, y0 = at[k] - half[k, lev]
+            x1, y1 = at[k] + half[k, lev]
+            hit = (placed[:, 0] < x1) & (x0 < placed[:, 2]) & (placed[:, 1] < y1) & (y0 < placed[:, 3])
+            if not hit.any():
+                out[k] = lev
+                placed = np.vstack([placed, [x0, y0, x1, y1]])
+                break
+    return out
 
 
 def cell_centres(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

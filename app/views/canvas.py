@@ -38,6 +38,8 @@ CORNER_LABELS = ("SW", "SE", "NE", "NW")
 #: outward normal = this sign × the left-hand normal of the border direction
 #: (bottom/right have the interior on their left, top/left on their right)
 _OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
+#: the point scatters' full symbol sizes (pixels), as made in Canvas._make_point_items
+_MARKER_FULL = {"points": 7.0, "other": 5.0}
 
 
 class Canvas(pg.PlotWidget):
@@ -68,6 +70,9 @@ class Canvas(pg.PlotWidget):
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self._label_at: dict[str, tuple[float, float, float]] = {}
         self.markers_visible = True
+        # level of detail of the point markers: their typical spacing (model units), their size shown
+        self._spacing: dict[str, float] = {"points": np.inf, "other": np.inf}
+        self._marker_sizes: dict[str, float] = {}
         self._bg_transform = (1.0, 0.0, 0.0, 0.0)
         self._vb.sigRangeChanged.connect(self._place_labels)
         self._vb.sigRangeChanged.connect(self._apply_level_of_detail)
@@ -143,10 +148,10 @@ class Canvas(pg.PlotWidget):
 
     def _make_point_items(self) -> None:
         """Points, other blocks' points, selection, corners, folded-cell markers."""
-        self.points_item = Scatter(size=7, pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
+        self.points_item = Scatter(size=_MARKER_FULL["points"], pen=pg.mkPen("#222"), brush=pg.mkBrush("#ffffff"))
         self.points_item.setZValue(20)
         self.addItem(self.points_item)
-        self.other_points_item = Scatter(size=5, pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
+        self.other_points_item = Scatter(size=_MARKER_FULL["other"], pen=pg.mkPen("#999"), brush=pg.mkBrush("#ddd"))
         self.other_points_item.setZValue(19)
         self.addItem(self.other_points_item)
         self.selected_item = Scatter(size=11, pen=pg.mkPen("#d62728", width=2), brush=None)
@@ -227,6 +232,7 @@ class Canvas(pg.PlotWidget):
         self._draw_points()
         set_polylines(self.cut_curve, self.doc.project.cut_lines)
         self.refresh_selection()
+        self._size_markers()
 
     def _draw_loops(self) -> None:
         """Other blocks' points, faint, and every block's loop as a dashed line."""
@@ -238,6 +244,7 @@ class Canvas(pg.PlotWidget):
         if not multiblock:
             op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
         set_points(self.other_points_item, np.vstack(op) if op else None)
+        self._spacing["other"] = min((geo.typical_spacing(p, along=True) for p in op), default=np.inf)
         loops = []
         # a lake layout's blocks are its shore and cuts, drawn by the lake overlay: a dashed copy of every
         # block's loop would repaint (slowly: a dashed pen) with every frame of a drag
@@ -276,9 +283,8 @@ class Canvas(pg.PlotWidget):
             x, y, ang = m
             a.setPos(x, y)
             a.setStyle(angle=180.0 - ang)  # ArrowItem points along −x at angle 0, y down in screen
-            a.setVisible(self.markers_visible)
             t.setText(f"{name} · {block.node_count(name)}")
-            self._label_at[name] = (x, y, ang)
+            self._label_at[name] = (x, y, ang, geo.polyline_length(p))
         self._place_labels()
 
     def _draw_points(self) -> None:
@@ -291,6 +297,7 @@ class Canvas(pg.PlotWidget):
             solved_together = self.doc.project.multiblock is not None or self.doc.project.layout is not None
             disp = None if solved_together else np.vstack(block.boundary)
         set_points(self.points_item, disp)
+        self._spacing["points"] = geo.typical_spacing(disp, along=True) if disp is not None else np.inf
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
             cp = pts[list(block.corners)]
             self.corner_item.setData(cp[:, 0], cp[:, 1])
@@ -303,9 +310,10 @@ class Canvas(pg.PlotWidget):
                 lab.setText("")
 
     def _place_labels(self, *_args) -> None:
-        """Put each border label just outside the middle of its border (any orientation)."""
+        """Put each border label just outside the middle of its border (any orientation); a border
+        shorter on screen than its label shows neither label nor arrow (they would hide the block)."""
         px = self.pixel()
-        for name, (x, y, ang) in self._label_at.items():
+        for name, (x, y, ang, length) in self._label_at.items():
             a = np.radians(ang)
             sgn = _OUTWARD[name]
             nx, ny = -np.sin(a) * sgn, np.cos(a) * sgn
@@ -314,6 +322,9 @@ class Canvas(pg.PlotWidget):
             off = (8.0 + 0.5 * r.width() * abs(nx) + 0.5 * r.height() * abs(ny)) * px
             t.setAnchor((0.5, 0.5))
             t.setPos(x + off * nx, y + off * ny)
+            roomy = length / px >= max(r.width(), 3 * 14.0)  # the label's width, three arrow heads
+            t.setVisible(self.markers_visible and roomy)
+            self.border_arrows[name].setVisible(self.markers_visible and roomy)
 
     def refresh_selection(self) -> None:
         pts = self.doc.block.points
@@ -407,12 +418,28 @@ class Canvas(pg.PlotWidget):
         self._apply_level_of_detail()
 
     def _apply_level_of_detail(self, *_args) -> None:
-        """Fade the grid lines when the cells are only a few pixels wide on screen."""
+        """Fade the grid lines when the cells are only a few pixels wide on screen; show the block
+        labels as the blocks' size on screen allows."""
+        self.lake_items.apply_level_of_detail()
+        self._size_markers()
         alpha = geo.line_alpha(self._cell_size / self.pixel()) if self._cell_size > 0 else 1.0
         colour = QtGui.QColor(self._grid_colour)
         colour.setAlphaF(alpha)
         if self.grid_curve.opts["pen"].color() != colour:
             self.grid_curve.setPen(pg.mkPen(colour, width=1, cosmetic=True))
+
+    def _size_markers(self) -> None:
+        """Shrink the boundary points where they crowd on screen, hide them where they would touch
+        (:func:`app.geometry.marker_size`): a zoomed-out outline of thousands of points is its line."""
+        px = self.pixel()
+        items = {"points": self.points_item, "other": self.other_points_item}
+        for name, item in items.items():
+            size = geo.marker_size(self._spacing[name] / px, _MARKER_FULL[name])
+            if size != self._marker_sizes.get(name):
+                self._marker_sizes[name] = size
+                if size > 0:
+                    item.setSize(size)
+            item.setVisible(self.markers_visible and size > 0)
 
     def set_grid_visible(self, on: bool) -> None:
         """Show or hide the grid lines (View ▸ Grid lines)."""
@@ -422,10 +449,12 @@ class Canvas(pg.PlotWidget):
         """Show or hide the boundary points, corners, arrows and labels (View ▸ Boundary markers)."""
         on = bool(on)
         self.markers_visible = on
-        items = [self.points_item, self.other_points_item, self.corner_item, self.selected_item]
+        items = [self.corner_item, self.selected_item]
         items += [*self.corner_labels, *self.border_arrows.values(), *self.border_labels.values()]
         for it in items:
             it.setVisible(on)
+        self._size_markers()
+        self._place_labels()  # the border labels and arrows: only where their border has room
         self.lake_items.set_markers_visible(on)
 
     def set_folded(self, grid: StructuredGrid | None, cells: np.ndarray | None) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6 import QtCore, QtGui
+from PySide6 import QtCore, QtGui, QtWidgets
 
 from .items import Scatter, set_points, set_polylines
 
@@ -21,15 +21,31 @@ SHORE_COLOUR = "#1f5fa8"
 MISS_COLOUR = "#ff7f0e"
 #: more places that miss a preset than this: drawn smaller and fainter
 MANY_MISSES = 1000
+#: full symbol sizes (pixels) of the cut ends and the block corners
+_FULL = {"cut_ends": 9.0, "corners": 8.0}
 
 
-def block_label_points(layout) -> np.ndarray:
-    """A point inside each layout block (where its cell count is written)."""
+def _block_polygons(layout) -> list:
+    """Each layout block's region as a shapely Polygon (made valid)."""
     from shapely.geometry import Polygon
 
     out = []
     for pc in layout.pieces:
-        p = Polygon(np.asarray(pc.ring, float)).representative_point()
+        poly = Polygon(np.asarray(pc.ring, float))
+        out.append(poly if poly.is_valid else poly.buffer(0))
+    return out
+
+
+def block_label_points(layout, polygons=None) -> np.ndarray:
+    """A point inside each layout block where its label has the most room (the pole of inaccessibility)."""
+    from shapely.ops import polylabel
+
+    out = []
+    for poly in polygons if polygons is not None else _block_polygons(layout):
+        if poly.geom_type != "Polygon" or poly.is_empty:  # a piece made invalid: any point inside
+            p = poly.representative_point()
+        else:
+            p = polylabel(poly, tolerance=0.02 * max(np.sqrt(poly.area), 1e-300))
         out.append((p.x, p.y))
     return np.asarray(out, float).reshape(-1, 2)
 
@@ -44,9 +60,13 @@ class LakeOverlay:
         self.shore.setZValue(4)
         self.cuts = pg.PlotCurveItem(pen=pg.mkPen(CUT_COLOUR, width=2.5), connect="finite")
         self.cuts.setZValue(7)
-        self.cut_ends = Scatter(size=9, symbol="o", pen=pg.mkPen(CUT_COLOUR, width=1.5), brush=pg.mkBrush("#fff"))
+        self.cut_ends = Scatter(
+            size=_FULL["cut_ends"], symbol="o", pen=pg.mkPen(CUT_COLOUR, width=1.5), brush=pg.mkBrush("#fff")
+        )
         self.cut_ends.setZValue(24)
-        self.corners = Scatter(size=8, symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush("#ffd700"))
+        self.corners = Scatter(
+            size=_FULL["corners"], symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush("#ffd700")
+        )
         self.corners.setZValue(23)
         self.misses = Scatter(size=5, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 170))
         self.misses_on = True  # View ▸ Preset misses (off by itself while a metric colours the cells)
@@ -61,6 +81,17 @@ class LakeOverlay:
         self.markers_visible = True
         self.labels_on = True  # False during a drag
         self.shown_labels: list[str] = []  # the texts on screen (tests read them)
+        # level of detail of the block labels: per block its texts (name and cells, cells only),
+        # their size in pixels, its region and where its label goes
+        self._label_texts: list[tuple[str, ...]] = []
+        self._label_px = np.zeros((0, 2, 2))
+        self._label_polys: list = []
+        self._label_at = np.zeros((0, 2))
+        self._label_order = np.zeros(0, dtype=int)
+        self._label_level = np.zeros(0, dtype=int)
+        self._label_pixel = 0.0  # the pixel size the levels were chosen for
+        self._marker_spacing = np.inf  # typical distance between the corners and cut ends (model units)
+        self._marker_scale = 1.0  # their size now, a share of the full size
 
     # ------------------------------------------------------------ drawing
     def refresh(self, project) -> None:
@@ -79,6 +110,7 @@ class LakeOverlay:
             set_polylines(self.cuts, [])
             set_points(self.cut_ends, None)
             set_points(self.corners, None)
+            self._marker_spacing = np.inf
             self._set_labels([], np.zeros((0, 2)))
             return
         cuts = [np.asarray(c, float) for c in layout.cuts]
@@ -87,10 +119,17 @@ class LakeOverlay:
         set_points(self.cut_ends, np.vstack(ends) if ends else None)
         corners = np.array([p for b in layout.blocks for p in b.corners], float).reshape(-1, 2)
         set_points(self.corners, np.unique(corners, axis=0) if len(corners) else None)
-        texts = [f"{b.name}\n{b.cells[0]}×{b.cells[1]}" for b in layout.blocks]
-        self._set_labels(texts, block_label_points(layout))
+        from ..geometry import typical_spacing
 
-    def _set_labels(self, texts: list[str], at: np.ndarray) -> None:
+        self._marker_spacing = typical_spacing(np.vstack([corners, *ends]))
+        texts = [(f"{b.name}\n{b.cells[0]}×{b.cells[1]}", f"{b.cells[0]}×{b.cells[1]}") for b in layout.blocks]
+        polys = _block_polygons(layout)
+        self._set_labels(texts, block_label_points(layout, polys), polys)
+
+    def _set_labels(self, texts: list[tuple[str, ...]], at: np.ndarray, polys=()) -> None:
+        """The blocks' labels: each with its texts (most detailed first), shown as the view allows."""
+        import shapely
+
         font = QtGui.QFont()
         font.setPointSize(8)
         while len(self.labels) < len(texts):
@@ -102,12 +141,88 @@ class LakeOverlay:
             self.labels.append(t)
         for k, t in enumerate(self.labels):
             if k < len(texts):
-                t.setText(texts[k])
                 t.setPos(float(at[k, 0]), float(at[k, 1]))
-                t.setVisible(self.markers_visible and self.labels_on)
             else:
                 t.setText("")
-        self.shown_labels = list(texts)
+                t.setVisible(False)
+        probe = QtWidgets.QGraphicsTextItem()  # measures a text as a TextItem shows it (its margins too)
+        probe.setFont(font)
+        px = np.zeros((len(texts), max((len(t) for t in texts), default=0), 2))
+        for k, alts in enumerate(texts):
+            for lev, text in enumerate(alts):
+                probe.setPlainText(text)
+                r = probe.boundingRect()
+                px[k, lev] = (r.width(), r.height())
+        self._label_texts = list(texts)
+        self._label_px = px
+        self._label_polys = list(polys)
+        for p in self._label_polys:
+            shapely.prepare(p)
+        self._label_at = np.asarray(at, float).reshape(-1, 2)
+        areas = np.array([p.area for p in self._label_polys]) if len(self._label_polys) == len(texts) else None
+        # the biggest blocks first: they keep their labels when labels would overlap
+        self._label_order = np.argsort(-areas, kind="stable") if areas is not None else np.arange(len(texts))
+        self._label_level = np.full(len(texts), -2, dtype=int)  # none chosen yet
+        self._label_pixel = 0.0
+        self.apply_level_of_detail(force=True)
+
+    def apply_level_of_detail(self, force: bool = False) -> None:
+        """Show each block label as detailed as its block's size on screen allows (name and cells, cells
+        only, or nothing), never two overlapping: a zoomed-out lake of 80 blocks is not covered in text.
+
+        Called when the view's range changes; cheap (one vectorised containment test per text).
+        """
+        import shapely
+
+        pixel = self.canvas.pixel()
+        self._size_markers(pixel)
+        n = len(self._label_texts)
+        if n == 0 or not (self.labels_on and self.markers_visible):
+            self.shown_labels = []
+            return
+        if not force and pixel == self._label_pixel:
+            return
+        self._label_pixel = pixel
+        margin = 2.0  # pixels between a label and its block's border
+        half = 0.5 * (self._label_px + margin * 2) * pixel
+        if len(self._label_polys) == n:
+            fits = np.zeros(half.shape[:2], bool)
+            polys = np.array(self._label_polys, dtype=object)
+            for lev in range(half.shape[1]):
+                x, y = self._label_at[:, 0], self._label_at[:, 1]
+                boxes = shapely.box(x - half[:, lev, 0], y - half[:, lev, 1], x + half[:, lev, 0], y + half[:, lev, 1])
+                fits[:, lev] = shapely.contains(polys, boxes) & (self._label_px[:, lev, 0] > 0)
+        else:
+            fits = self._label_px[:, :, 0] > 0
+        from ..geometry import label_levels
+
+        levels = label_levels(self._label_at, half, fits, self._label_order)
+        shown = []
+        for k, (t, lev) in enumerate(zip(self.labels, levels, strict=False)):
+            if lev != self._label_level[k]:
+                if lev >= 0:
+                    t.setText(self._label_texts[k][lev])
+                t.setVisible(bool(lev >= 0))
+            if lev >= 0:
+                shown.append(self._label_texts[k][lev])
+        self._label_level = levels
+        self.shown_labels = shown
+
+    def _size_markers(self, pixel: float) -> None:
+        """Corners and cut ends shrink where they crowd on screen, and hide where they would touch
+        (:func:`app.geometry.marker_size`): a zoomed-out lake of 80 blocks is not dotted over."""
+        from ..geometry import marker_size
+
+        full = max(_FULL.values())
+        scale = marker_size(self._marker_spacing / pixel, full) / full
+        if scale != self._marker_scale:
+            self._marker_scale = scale
+            for name, size in _FULL.items():
+                item = getattr(self, name)
+                if scale > 0:
+                    item.setSize(size * scale)
+        for name in _FULL:
+            getattr(self, name).setVisible(self.markers_visible and scale > 0)
 
     def set_misses(self, points: np.ndarray | None) -> None:
         """Ring the places that miss the chosen quality preset (None: none).
@@ -129,16 +244,22 @@ class LakeOverlay:
 
     def set_markers_visible(self, on: bool) -> None:
         self.markers_visible = bool(on)
-        for it in (self.cut_ends, self.corners):
-            it.setVisible(self.markers_visible)
-        for t in self.labels:
-            t.setVisible(self.markers_visible and self.labels_on)
+        self._size_markers(self.canvas.pixel())
+        self._show_labels()
 
     def set_labels_visible(self, on: bool) -> None:
         """Show or hide the blocks' cell counts (hidden during a drag: they repaint with every grid)."""
         self.labels_on = bool(on)
-        for t in self.labels:
-            t.setVisible(self.labels_on and self.markers_visible)
+        self._show_labels()
+
+    def _show_labels(self) -> None:
+        if self.labels_on and self.markers_visible:
+            self._label_level = np.full(len(self._label_texts), -2, dtype=int)  # every label set again
+            self.apply_level_of_detail(force=True)
+        else:
+            for t in self.labels:
+                t.setVisible(False)
+            self.shown_labels = []
 
     def set_solving(self, solving: bool) -> None:
         """The places that miss a preset belong to the last grid: hidden while a new one is made."""

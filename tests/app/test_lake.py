@@ -87,9 +87,13 @@ def test_auto_layout_draws_blocks_and_generates_an_orthogonal_grid(qtbot, win):
     n = len(lay.blocks)
     doc = win.doc
     assert len(doc.project.blocks) == n and n > 1
-    # the canvas: cut lines, block corners and one "name / ni×nj" label per block
+    # the canvas: cut lines, block corners and a "name / ni×nj" (or "ni×nj") label per block with room
+    # on screen (test_canvas_lod.py: the labels as the view zooms)
     items = win.canvas.lake_items
-    assert items.shown_labels == [f"{b.name}\n{b.cells[0]}×{b.cells[1]}" for b in lay.blocks]
+    texts = {f"{b.name}\n{b.cells[0]}×{b.cells[1]}" for b in lay.blocks} | {
+        f"{b.cells[0]}×{b.cells[1]}" for b in lay.blocks
+    }
+    assert len(items.labels) >= n and set(items.shown_labels) <= texts
     assert len(items.cuts.getData()[0]) > 0 and len(items.corners.getData()[0]) >= 4
     # the panel lists the blocks and their cells
     assert win.lake_panel.table.rowCount() == n
