@@ -137,10 +137,11 @@ def looks_branched(outline: Any, holes: Any = ()) -> bool:
 
 # ------------------------------------------------------------------ layout
 def default_cell_size(area: float, target_cells: int | None = None) -> float:
-    """``sqrt(water area / cells)``: the cell size ``meshcore mesh`` chooses by default."""
-    from meshcore.cli.mesh import DEFAULT_CELLS
+    """``sqrt(water area / cells)``: the cell size ``meshcore mesh`` chooses by default
+    (:func:`meshcore.lakegrid.default_cell_size`)."""
+    from meshcore.lakegrid import default_cell_size as rule
 
-    return math.sqrt(float(area) / float(target_cells or DEFAULT_CELLS))
+    return rule(area, target_cells)
 
 
 def cell_size_of(lake: Lake) -> float:

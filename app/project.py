@@ -279,8 +279,10 @@ def default_cells(
     return guess_cells(points, corners, total=total, minimum=minimum)
 
 
-def block_from_points(points: Any, name: str, *, total: int = 40, minimum: int = 8) -> Block:
-    """A closed block from imported boundary points, with the corners and cells ``meshcore import`` chooses.
+def block_from_points(points: Any, name: str, *, total: int | None = None, minimum: int = 8) -> Block:
+    """A closed block from imported boundary points, with the corners and cells ``meshcore import`` chooses
+    (cells of ``meshcore mesh``'s default size, about 10 000 of them; ``total``: about that many along
+    the longer direction instead).
 
     (:func:`meshcore.io.outline.guess_corners`, :func:`~meshcore.io.outline.guess_cells`):
     the same point file gives the same grid in the app and on the command line.

@@ -43,9 +43,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError, MeshcoreError
+from ..lakegrid import DEFAULT_CELLS, default_cell_size
 
-#: Cells of the default grid (``cell size = sqrt(water area / DEFAULT_CELLS)``).
-DEFAULT_CELLS = 10_000
 #: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
 MIN_CELLS = 16
 #: Coarse levels of the grid sequencing (cell counts are multiples of ``2**LEVELS``).
@@ -350,7 +349,7 @@ def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, s
         h, why = float(args.cell_size), "--cell-size"
     else:
         n = args.cells or DEFAULT_CELLS
-        h = math.sqrt(area / n)
+        h = default_cell_size(area, n)
         why = f"sqrt(water area / {n})"
     est = area / h / h  # not area / h², which underflows to 0 for h ≈ 1e-200
     if est > max_nodes():

@@ -47,12 +47,24 @@ def guess_corners(loop: Any) -> tuple[int, int, int, int]:
     return choose_corners(loop, method="outline", upright=True)
 
 
-def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, total: int = 40, minimum: int = 8) -> tuple[int, int]:
-    """Cell counts proportional to the mean lengths of opposite borders.
+def guess_cells(
+    loop: Any,
+    corners: tuple[int, int, int, int],
+    *,
+    cell_size: float | None = None,
+    total: int | None = None,
+    minimum: int = 8,
+) -> tuple[int, int]:
+    """Cell counts proportional to the mean lengths of opposite borders, cells roughly square.
 
-    About ``total`` cells along the longer direction, at least ``minimum``
-    along either, so cells are roughly square.
+    By default the cells are :func:`meshcore.lakegrid.default_cell_size` of the area inside the
+    loop (``sqrt(area / 10 000)``, what ``meshcore mesh`` chooses), or ``cell_size``: each count
+    is a border's mean length over the cell size.  With ``total``: about ``total`` cells along the
+    longer direction instead.  At least ``minimum`` along either; a grid past the node limit
+    (:func:`meshcore._validation.max_nodes`) is scaled down to it, keeping the proportions.
     """
+    from .._validation import max_nodes
+
     p = np.asarray(loop, dtype=np.float64)
     n = len(p)
     seg = np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T)
@@ -73,8 +85,21 @@ def guess_cells(loop: Any, corners: tuple[int, int, int, int], *, total: int = 4
         raise InvalidInputError(f"corners must be 4 integer point indices, got {corners!r}") from None
     lxi = 0.5 * (length(sw, se) + length(ne, nw))
     leta = 0.5 * (length(se, ne) + length(nw, sw))
-    if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
-        return (total, total)
-    if lxi >= leta:
-        return (total, max(minimum, round(total * leta / lxi)))
-    return (max(minimum, round(total * lxi / leta)), total)
+    if total is not None:
+        if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
+            return (total, total)
+        if lxi >= leta:
+            return (total, max(minimum, round(total * leta / lxi)))
+        return (max(minimum, round(total * lxi / leta)), total)
+    from ..boundary import signed_area
+    from ..lakegrid import DEFAULT_CELLS, default_cell_size
+
+    h = float(cell_size) if cell_size is not None else default_cell_size(abs(signed_area(p)))
+    if not (h > 0 and math.isfinite(lxi / h) and math.isfinite(leta / h)):
+        side = max(minimum, round(math.sqrt(DEFAULT_CELLS)))
+        return (side, side)
+    ni, nj = max(minimum, round(lxi / h)), max(minimum, round(leta / h))
+    shrink = math.sqrt(max_nodes() / ((ni + 1) * (nj + 1)))
+    if shrink < 1.0:
+        ni, nj = max(minimum, math.floor(ni * shrink) - 1), max(minimum, math.floor(nj * shrink) - 1)
+    return (ni, nj)

@@ -27,8 +27,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-import numpy as np
-
+from ..lakegrid import DEFAULT_CELLS, default_cell_size
 from .blocks import block_counts
 from .build import layout_pieces
 from .edit import layout_from_cuts, layout_from_outline, with_cells
@@ -46,7 +45,7 @@ def auto_layout(
     *,
     holes: Any = (),
     cell_size: float | None = None,
-    target_cells: int = 10_000,
+    target_cells: int = DEFAULT_CELLS,
     multiple: int = 1,
     regular: bool = False,
 ) -> Layout:
@@ -83,7 +82,7 @@ def auto_layout(
         A polygon that crosses itself, islands outside the water, …, naming the place.
     """
     poly, notes = water_polygon(outline, holes=holes)
-    h = float(cell_size) if cell_size is not None else float(np.sqrt(poly.area / target_cells))
+    h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
     poly, dense = without_dense_vertices(poly, h)
     poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
     more = dense + more

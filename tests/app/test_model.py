@@ -273,7 +273,13 @@ LAKES = sorted((Path(__file__).resolve().parents[2] / "app" / "resources").glob(
 
 @pytest.mark.parametrize("path", [*LAKES, DATA / "lake_zurich_sparse.kml"], ids=lambda p: p.name)
 def test_a_point_file_gives_the_same_grid_in_the_app_and_on_the_command_line(tmp_path, path):
-    """The app's imported block (corners, cells, grid) = ``meshcore import`` + ``meshcore generate``."""
+    """The app's imported block (corners, cells, grid) = ``meshcore import`` + ``meshcore generate``.
+
+    The grids are compared at an eighth of the default cells (about 10 000 cells: a minute to solve
+    twice on a busy machine); the same counts on both sides, as the user would type them.
+    """
+    import dataclasses
+
     from app.io_adapter import read_points, to_local
     from app.project import block_from_points
     from meshcore.case import generate_case, load_case
@@ -287,11 +293,58 @@ def test_a_point_file_gives_the_same_grid_in_the_app_and_on_the_command_line(tmp
     case = load_case(case_path)
     (cb,) = case.blocks
     assert cb.corners == block.corners and cb.cells == block.cells
-    mine = _drain(solve_project(Project(blocks=(block,)))).grids[0]
-    (theirs,) = generate_case(case)
+    small = (max(4, cb.cells[0] // 8), max(4, cb.cells[1] // 8))
+    mine = _drain(solve_project(Project(blocks=(block.replaced(cells=small),)))).grids[0]
+    (theirs,) = generate_case(dataclasses.replace(case, blocks=(dataclasses.replace(cb, cells=small),)))
     assert mine.converged and theirs.converged
     np.testing.assert_array_equal(mine.x, theirs.x)
     np.testing.assert_array_equal(mine.y, theirs.y)
+
+
+def _shapes():
+    """Generated one-block lakes: a disc, an ellipse, a straight channel, a jagged oval (metres)."""
+    import shapely
+
+    from meshcore import testing
+
+    oval = shapely.affinity.scale(shapely.Point(0, 0).buffer(1.0, quad_segs=32), 9_000.0, 2_500.0)
+    return {
+        "disc": shapely.Point(0, 0).buffer(3_000.0, quad_segs=24),
+        "oval": oval,
+        "channel": shapely.affinity.scale(testing.straight_channel(10.0, 1.0), 2_000.0, 2_000.0, origin=(0, 0)),
+        "jagged oval": testing.jagged(oval, 150.0, seed=3),
+    }
+
+
+@pytest.mark.parametrize("name", ["disc", "oval", "channel", "jagged oval"])
+def test_import_defaults_to_the_cell_size_of_meshcore_mesh_and_agrees_with_meshcore_import(tmp_path, name):
+    """One block from an imported outline: square cells of ``sqrt(area / 10 000)`` (the cell-size rule
+    of ``meshcore mesh``), not 40 along the long side (issue 13: 8×40 for a 30-km lake); the counts
+    are those of ``meshcore import`` for the same file."""
+    import math
+
+    from app.io_adapter import read_points
+    from app.project import block_from_points
+    from meshcore.case import load_case
+    from meshcore.cli import main
+    from meshcore.cli.mesh import DEFAULT_CELLS
+
+    poly = _shapes()[name]
+    ring = np.asarray(poly.exterior.coords)[:-1]
+    f = tmp_path / "lake.csv"
+    f.write_text("x,y\n" + "".join(f"{x!r},{y!r}\n" for x, y in ring.tolist()))
+    pts = read_points(f).points
+    block = block_from_points(pts, "lake")
+    assert main(["import", str(f), "-o", str(tmp_path / "lake.toml")]) == 0
+    (cb,) = load_case(tmp_path / "lake.toml").blocks
+    assert (cb.corners, cb.cells) == (block.corners, block.cells)
+    h = math.sqrt(poly.area / DEFAULT_CELLS)
+    borders = geo.border_polylines(pts, block.corners)
+    lxi = 0.5 * (geo.polyline_length(borders["bottom"]) + geo.polyline_length(borders["top"]))
+    leta = 0.5 * (geo.polyline_length(borders["left"]) + geo.polyline_length(borders["right"]))
+    ni, nj = block.cells
+    assert abs(ni - lxi / h) <= 0.5 + 1e-9 and abs(nj - leta / h) <= 0.5 + 1e-9  # cells of the rule's size
+    assert 0.5 * DEFAULT_CELLS <= ni * nj <= 2 * DEFAULT_CELLS
 
 
 def test_a_multiblock_project_yields_live_grids_in_one_thread():
