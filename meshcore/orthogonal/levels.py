@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
-from .shore import project_to_rings, ring_point
+from .shore import arc_lengths, project_to_rings, ring_point
 
 __all__ = ["coarsen_topology", "refine"]
 
@@ -84,8 +84,10 @@ def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -
     if not where:
         return list(grids)
     ends_a = np.asarray(ends)
-    ra, sa, _ = project_to_rings(rings, ends_a[:, :2])
-    rb, sb, _ = project_to_rings(rings, ends_a[:, 2:])
+    n = len(ends_a)
+    r12, s12, _ = project_to_rings(rings, np.vstack([ends_a[:, :2], ends_a[:, 2:]]))  # one tree for both ends
+    ra, sa, rb, sb = r12[:n], s12[:n], r12[n:], s12[n:]
+    cums = [arc_lengths(r) for r in rings]  # once per ring, not per node
     for (b, ij), r1, s1, r2, s2 in zip(where, ra, sa, rb, sb, strict=True):
         if r1 != r2:
             continue
@@ -95,7 +97,7 @@ def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -
             d -= total
         # halfway along the shore, else elsewhere on the shore between the two (a sharp bend
         # of the shore between them can leave no convex cell at halfway), else towards halfway
-        at = ring_point(rings[r1], s1 + d * np.array([0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9]))
+        at = ring_point(rings[r1], s1 + d * np.array([0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9]), cums[r1])
         if not any(_moved_to(xs[b], ys[b], ij, p) for p in at):
             _move_if_valid(xs[b], ys[b], ij, at[0])
     return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)]

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["project_to_rings", "ring_point"]
+__all__ = ["arc_lengths", "project_to_rings", "ring_point"]
 
 
 def _segments(rings: list[np.ndarray]):
@@ -37,9 +37,18 @@ def project_to_rings(rings: list[np.ndarray], pts: np.ndarray):
     return ring[seg], start[seg] + t * L[seg], np.hypot(*(foot - pts).T)
 
 
-def ring_point(ring: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Points at arc lengths ``s`` (any real: the ring is closed) of one ring."""
+def arc_lengths(ring: np.ndarray) -> np.ndarray:
+    """The arc length at each vertex of a closed ring, and at its return to the first (the perimeter)."""
     closed = np.vstack([ring, ring[:1]])
-    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(closed, axis=0).T))])
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(closed, axis=0).T))])
+
+
+def ring_point(ring: np.ndarray, s: np.ndarray, cum: np.ndarray | None = None) -> np.ndarray:
+    """Points at arc lengths ``s`` (any real: the ring is closed) of one ring.
+
+    ``cum``: the ring's :func:`arc_lengths`, when the caller asks for points of one ring many times.
+    """
+    closed = np.vstack([ring, ring[:1]])
+    cum = arc_lengths(ring) if cum is None else cum
     s = np.mod(s, cum[-1])
     return np.column_stack([np.interp(s, cum, closed[:, 0]), np.interp(s, cum, closed[:, 1])])
