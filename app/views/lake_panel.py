@@ -76,6 +76,8 @@ class LakePanel(QtWidgets.QWidget):
         row.addWidget(self.set_cells)
         lay.addLayout(row)
         self.set_cells.clicked.connect(self._set_cells)
+        for w in (self.ni, self.nj):  # Enter in either box sets the cells, as the button does
+            w.lineEdit().returnPressed.connect(self._set_cells)
         doc.active_changed.connect(lambda _k: self._show_active())
         self.cell_size.editingFinished.connect(self._cell_size_edited)
         self.regular.toggled.connect(self._regular_toggled)

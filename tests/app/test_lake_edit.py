@@ -116,6 +116,29 @@ def test_set_one_blocks_cells_and_its_neighbours_follow(qtbot, laid):
     assert win.lake_panel.table.item(0, 1).text() == f"{b0.cells[0] + 2 * m} × {b0.cells[1]}"
 
 
+def test_enter_in_a_blocks_cells_sets_them_and_the_keyboard_goes_back_to_the_canvas(qtbot, laid):
+    """Typing a count in the Lake panel and pressing Enter sets it (issue 13: Enter did nothing, the
+    count was lost unless Set was clicked, and the tool keys went on into the spin box)."""
+    from PySide6 import QtCore, QtWidgets
+
+    win = laid
+    lay0 = win.doc.project.layout
+    win.doc.set_active(0)
+    b0, m = lay0.blocks[0], lay0.multiple
+    box = win.lake_panel.nj
+    box.setFocus()
+    box.selectAll()
+    qtbot.keyClicks(box, str(b0.cells[1] + m))
+    qtbot.keyClick(box, QtCore.Qt.Key.Key_Return)
+    qtbot.waitUntil(lambda: win.doc.project.layout is not lay0 or bool(win.lake_ctl.edit_error), timeout=120_000)
+    wait_idle(qtbot, win)
+    assert win.lake_ctl.edit_error is None
+    assert win.doc.project.layout.blocks[0].cells == (b0.cells[0], b0.cells[1] + m)
+    assert QtWidgets.QApplication.focusWidget() is win.canvas
+    qtbot.keyClick(win.canvas, QtCore.Qt.Key.Key_E)  # a tool key reaches the canvas, not the box
+    assert win.canvas.tool is win.tools["edit"]
+
+
 def test_an_impossible_layout_is_a_message_and_nothing_changes(qtbot, laid):
     from app.layout_edit import handles
 
