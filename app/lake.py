@@ -138,8 +138,8 @@ def looks_branched(outline: Any, holes: Any = ()) -> bool:
 # ------------------------------------------------------------------ layout
 def default_cell_size(area: float, target_cells: int | None = None) -> float:
     """``sqrt(water area / cells)``: the cell size ``meshcore mesh`` chooses by default
-    (:func:`meshcore.lakegrid.default_cell_size`)."""
-    from meshcore.lakegrid import default_cell_size as rule
+    (:func:`meshcore.cellsize.default_cell_size`)."""
+    from meshcore.cellsize import default_cell_size as rule
 
     return rule(area, target_cells)
 

@@ -23,25 +23,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .cellsize import DEFAULT_CELLS
 from .errors import FoldedGridError
 from .grid import SolveInfo
 
 if TYPE_CHECKING:
     from .elliptic import SolverProgress
 
-__all__ = ["DEFAULT_CELLS", "default_cell_size", "iterate_layout", "mesh_layout", "mesh_outline"]
-
-#: Cells of a lake's default grid: ``cell size = sqrt(water area / DEFAULT_CELLS)`` (a grid a
-#: hydrodynamic model runs in minutes, fine enough to resolve the arms of a lake tens of km long).
-DEFAULT_CELLS = 10_000
-
-
-def default_cell_size(area: float, cells: int | None = None) -> float:
-    """``sqrt(area / cells)`` (default :data:`DEFAULT_CELLS`): the side of ``cells`` square cells
-    covering ``area``.  The one default of ``meshcore mesh``, ``meshcore import``, the layout and the app."""
-    import math
-
-    return math.sqrt(float(area) / float(cells or DEFAULT_CELLS))
+__all__ = ["iterate_layout", "mesh_layout", "mesh_outline"]
 
 
 def _shore_rings(poly, step: float) -> list[np.ndarray]:

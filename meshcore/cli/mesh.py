@@ -42,8 +42,8 @@ from typing import Any
 
 import numpy as np
 
+from ..cellsize import DEFAULT_CELLS, default_cell_size
 from ..errors import InvalidInputError, MeshcoreError
-from ..lakegrid import DEFAULT_CELLS, default_cell_size
 
 #: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
 MIN_CELLS = 16

@@ -57,7 +57,7 @@ def guess_cells(
 ) -> tuple[int, int]:
     """Cell counts proportional to the mean lengths of opposite borders, cells roughly square.
 
-    By default the cells are :func:`meshcore.lakegrid.default_cell_size` of the area inside the
+    By default the cells are :func:`meshcore.cellsize.default_cell_size` of the area inside the
     loop (``sqrt(area / 10 000)``, what ``meshcore mesh`` chooses), or ``cell_size``: each count
     is a border's mean length over the cell size.  With ``total``: about ``total`` cells along the
     longer direction instead.  At least ``minimum`` along either; a grid past the node limit
@@ -92,7 +92,7 @@ def guess_cells(
             return (total, max(minimum, round(total * leta / lxi)))
         return (max(minimum, round(total * lxi / leta)), total)
     from ..boundary import signed_area
-    from ..lakegrid import DEFAULT_CELLS, default_cell_size
+    from ..cellsize import DEFAULT_CELLS, default_cell_size
 
     h = float(cell_size) if cell_size is not None else default_cell_size(abs(signed_area(p)))
     if not (h > 0 and math.isfinite(lxi / h) and math.isfinite(leta / h)):

@@ -27,7 +27,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from ..lakegrid import DEFAULT_CELLS, default_cell_size
+from ..cellsize import DEFAULT_CELLS, default_cell_size
 from .blocks import block_counts
 from .build import layout_pieces
 from .edit import layout_from_cuts, layout_from_outline, with_cells
