@@ -27,6 +27,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+import numpy as np
+
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from .blocks import block_counts
 from .build import layout_pieces
