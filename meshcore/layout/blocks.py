@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
+from ..multiblock.shorecells import shore_least
 from ..pointindex import PointIndex, point_key, point_keys
 
 __all__ = ["Piece", "block_counts", "conform", "weld"]
@@ -181,5 +182,8 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
         multiple=multiple,
         block_cells=block_cells,
         best=best,
+        least=shore_least([chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], cell_size, multiple)
+        if best
+        else None,
     )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts

@@ -148,6 +148,7 @@ def _chain_counts(
     """Cells per chain: the integer program of :func:`~.counts.solve_counts` with every block's cells
     given; when it has no solution, the step-by-step count names the block and border at fault."""
     from .counts import solve_counts
+    from .shorecells import shore_least
 
     keys = list(chain_pts)
     index = {k: i for i, k in enumerate(keys)}
@@ -169,7 +170,14 @@ def _chain_counts(
     sides = [tuple([index[k] for k in side_chains[(s.name, side)]] for side in SIDES) for s in specs]
     cells = {bi: (int(s.cells[0]), int(s.cells[1])) for bi, s in enumerate(specs)}
     try:
-        n = solve_counts(targets, sides, min_cells=1, multiple=multiple, block_cells=cells)
+        least = (
+            None
+            if cell_size is None
+            else shore_least(
+                [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], cell_size, multiple
+            )
+        )
+        n = solve_counts(targets, sides, min_cells=1, multiple=multiple, block_cells=cells, least=least)
     except TopologyError:
         _Counts(specs, side_chains, chain_pts, chain_users, multiple).solve()  # names the conflict
         raise

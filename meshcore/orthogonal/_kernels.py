@@ -442,4 +442,10 @@ def shore_sweep(
             step *= 0.5
         if not moved:
             X[p], Y[p] = ox, oy
+            # off the shore (a new node the refinement could not put on it without folding a
+            # cell): as far towards its own shore point as the cells around it allow, so the
+            # grid inside follows it there over the sweeps instead of holding it where it is
+            tx, ty = _ring_point(R, S, r0, s0, n, s)
+            if (tx - ox) ** 2 + (ty - oy) ** 2 > (1e-3 * gap) ** 2:
+                big = max(big, _try_move(X, Y, p, tx, ty, cptr, cells, jmin, before, after))
     return big

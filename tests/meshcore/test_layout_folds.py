@@ -86,15 +86,8 @@ FOLD_CASES = {
 }
 
 
-TIP_FOLD = pytest.mark.xfail(
-    strict=True,
-    reason="1 folded cell at a corner beside an island's tip since the cut ends are no longer moved onto tips "
-    "(that rule made other grids cross islands)",
-)
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param(n, marks=TIP_FOLD) if n == "islands 6" else n for n in FOLD_CASES])
+@pytest.mark.parametrize("name", list(FOLD_CASES))
 def test_lakes_that_folded_have_no_folded_cells(name):
     from meshcore.lakegrid import mesh_outline
     from meshcore.quality import lake_metrics

@@ -1,0 +1,74 @@
+r"""How many cells a stretch of shore needs so that the coarse grid levels still follow it.
+
+The grid is solved coarse first (:mod:`meshcore.orthogonal.levels`): on the coarsest level a
+chain of ``n`` cells has ``n / multiple`` cells, whose straight edges join every
+``multiple``-th node of the chain.  Where the chain is short in cells but long on the shore —
+round a small island, into a bay — those edges are chords across the land: the coarse grid
+crosses the island, and refinement does not bring it back (the fine nodes on the far side of
+the island are out of the water, and the fold-free guard keeps them there).  Before, the
+cell counts left a 13-cell arc round an island (``round_lake(9, kind="disc")``) with 4 cells,
+one coarse edge: the finished grid had nodes 3.7 cells inside the island.
+
+:func:`least_cells` is the count the program (:func:`~.counts.solve_counts`, its ``least``)
+is pushed towards: the fewest cells, a multiple of ``multiple``, whose coarsest-level chords
+stay within :data:`SAG` cells of the chain.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["SAG", "least_cells", "sag"]
+
+#: Largest distance, in (fine) cells, between a shore chain and the straight edges of its
+#: coarsest-level sampling.  One cell: the coarse level's own shore sweep lets a stretch of
+#: shore stray a quarter of a coarse edge (``shore_gap``: one fine cell at ``multiple`` 4) from
+#: the edges between two shore nodes, so a sampling within one cell is one the coarse level
+#: keeps; less asks for denser cells round every curved shore (checked on generated lakes with
+#: islands, ``benchmarks/shore_sweep.py``: 0.5 gave the same shore fit with more cells).
+SAG = 1.0
+#: At most this many times the chain's cells at the cell size: a corner of the shore inside a
+#: chain (no sampling follows it exactly) must not ask for ever more cells.
+MOST = 2.0
+
+
+def sag(chain: np.ndarray, cells: int) -> float:
+    """The largest distance from the vertices of polyline ``chain`` to the straight edges
+    joining its ``cells + 1`` points uniform in arc length (the chain's re-sampling)."""
+    p = np.asarray(chain, dtype=float)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    if s[-1] <= 0.0 or cells < 1:
+        return 0.0
+    u = np.linspace(0.0, s[-1], cells + 1)
+    nodes = np.column_stack([np.interp(u, s, p[:, 0]), np.interp(u, s, p[:, 1])])
+    j = np.clip(np.searchsorted(u, s, side="right") - 1, 0, cells - 1)
+    a, b = nodes[j], nodes[j + 1]
+    d = b - a
+    L2 = (d * d).sum(axis=1)
+    t = np.clip(((p - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+    return float(np.hypot(*(a + t[:, None] * d - p).T).max())
+
+
+def least_cells(chain: np.ndarray, cell_size: float, multiple: int, *, tol: float = SAG, most: float = MOST) -> int:
+    """The fewest cells (a multiple of ``multiple``) for which the chain's sampling at every
+    ``multiple``-th node stays within ``tol`` cells of it; at most ``most`` times its length in
+    cells (rounded up to a multiple), at least ``multiple``."""
+    p = np.asarray(chain, dtype=float)
+    length = float(np.hypot(*np.diff(p, axis=0).T).sum())
+    m = max(int(multiple), 1)
+    top = max(1, math.ceil(most * length / cell_size / m))
+    limit = tol * cell_size
+    for k in range(1, top + 1):
+        if sag(p, k) <= limit:
+            return k * m
+    return top * m
+
+
+def shore_least(chains, on_shore, cell_size: float, multiple: int) -> np.ndarray:
+    """:func:`least_cells` of every chain on the shore (``on_shore``), 0 for the others: the
+    ``least`` of :func:`~.counts.solve_counts`."""
+    return np.array(
+        [least_cells(c, cell_size, multiple) if s else 0 for c, s in zip(chains, on_shore, strict=True)], dtype=float
+    )
