@@ -80,8 +80,8 @@ def _f(fb, m, col):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover - compiled
-    """``steps`` smoothing steps on one level: point sweep, lines along ξ, along η, border sweeps,
-    sweeps over the band next to the fixed boundary."""
+    """``steps`` smoothing steps on one level: point sweep, lines along ξ (even steps) or along η
+    (odd steps), border sweeps, sweeps over the band next to the fixed boundary."""
     x, y, fx, fy = _f(fb, m, C_X), _f(fb, m, C_Y), _f(fb, m, C_FX), _f(fb, m, C_FY)
     nodes = ib[m[C_NODES] : m[C_NODES] + m[C_NREG]]
     nbr = ib[m[C_NBR] : m[C_NBR] + 8 * m[C_NREG]].reshape((m[C_NREG], 8))
@@ -95,10 +95,12 @@ def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover -
     band = ib[m[C_BNODES] : m[C_BNODES] + m[C_NBAND]]
     band_nbr = ib[m[C_BNBR] : m[C_BNBR] + 8 * m[C_NBAND]].reshape((m[C_NBAND], 8))
     no_irr = irr_p[:1]
-    for _ in range(steps):
+    for step in range(steps):
         table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_n, irr_p, ring, 1.0)
-        line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[: nl0 + 1], axis[:nl0])
-        line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[nl0:], axis[nl0:])
+        if step % 2 == 0:
+            line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[: nl0 + 1], axis[:nl0])
+        else:
+            line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[nl0:], axis[nl0:])
         for _ in range(border_sweeps):
             table_sweep_rhs(x, y, fx, fy, nodes[nint:], nbr[nint:], irr_n, irr_p, ring, 1.0)
         for _ in range(band_sweeps):

@@ -796,6 +796,29 @@ def test_coarse_levels_keep_the_blocks_glued():
         assert len(coarse.args[2]) == 1  # the 5-block corner stays irregular
 
 
+@pytest.mark.parametrize("make", ["network", "islands"])
+def test_layout_hierarchy_stops_before_levels_that_barely_coarsen(make):
+    """On generated lake layouts every coarse level keeps at most MAX_KEEP (half) of the finer
+    level's nodes (the last levels kept 60-80 % before: set-up without fewer cycles), and the
+    multigrid still converges to the SOR grid."""
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock.hierarchy import MAX_KEEP, levels
+    from meshcore.testing import channel_network, lake_with_islands
+
+    shape = channel_network(1, n_branches=5) if make == "network" else lake_with_islands(2)
+    topo = auto_layout(shape, target_cells=4000, multiple=4).topology()
+    lvs = levels(topo)
+    assert len(lvs) >= 3
+    assert all(co.n <= MAX_KEEP * fine.n for fine, co in itertools.pairwise(lvs))
+    assert MAX_KEEP <= 0.5
+    mb = solve_multiblock(topo, tolerance=1e-9, engine="multigrid")
+    assert mb.converged
+    sor = solve_multiblock(topo, tolerance=1e-9, engine="blocks", max_iterations=200_000)
+    assert sor.converged
+    for g, k in zip(mb, sor, strict=True):
+        assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-6 * topo.size
+
+
 @pytest.mark.kernel
 def test_line_kernel_matches_numpy_reference():
     """line_sweep_rhs equals tridiagonal solves line by line (NumPy), with and without f."""
