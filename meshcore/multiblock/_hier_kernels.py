@@ -3,7 +3,9 @@
 The set-up runs once per block structure, but on the first solve of a lake
 layout its per-block NumPy calls cost as much as the solve; these two loops do
 the same work in one call each.  NumPy references (test oracles):
-:func:`.hierarchy._block_interp` and :func:`.hierarchy.greedy_reference`.
+:func:`.hierarchy._block_interp`, :func:`.hierarchy.greedy_reference` and
+:func:`.hierarchy.near_reference` (:func:`grow_near` also runs after every cycle of a solve,
+:func:`.multigrid._hot_sweeps`).
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["greedy_drop", "interp_coo"]
+__all__ = ["greedy_drop", "grow_near", "interp_coo"]
 
 
 @njit(cache=True, nogil=True)
@@ -30,6 +32,21 @@ def greedy_drop(cls, line_ptr, adj_ptr, adj, state):  # pragma: no cover - compi
                     keep = True
                     break
             state[q] = 1 if keep else 2
+
+
+@njit(cache=True, nogil=True)
+def grow_near(nodes, nbr, near, width):  # pragma: no cover - compiled
+    """``width`` times: mark (in a copy of the boolean ``near``) every table row's node one of
+    whose eight neighbours is marked; returns the last copy."""
+    for _ in range(width):
+        grown = near.copy()
+        for k in range(nodes.shape[0]):
+            for q in range(8):
+                if near[nbr[k, q]]:
+                    grown[nodes[k]] = True
+                    break
+        near = grown
+    return near
 
 
 @njit(cache=True, nogil=True)

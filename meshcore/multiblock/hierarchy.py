@@ -51,7 +51,7 @@ from .topology import MultiBlockTopology
 #: The numba kernels (``Any``: mypy's numba stubs reject some calls).
 _hk: Any = _typed_hk
 
-__all__ = ["MIN_CELLS", "Level", "levels", "prolong_reference", "restrict_reference", "select"]
+__all__ = ["MIN_CELLS", "Level", "levels", "near_rows", "prolong_reference", "restrict_reference", "select"]
 
 #: A block line keeps at least this many cells (lines with fewer than twice this do not coarsen).
 MIN_CELLS = 2
@@ -133,15 +133,28 @@ def _band(args: tuple, free: np.ndarray) -> tuple:
     stencil) from a fixed node.  The error that a cycle leaves is largest there (measured on the
     lake layouts: next to shore points where the cells are most distorted), and extra point
     sweeps over this band took the lakes from 8 to 5-6 cycles."""
+    return near_rows(args, ~free, BAND_WIDTH)
+
+
+def near_rows(args: tuple, seed: np.ndarray, width: int) -> tuple:
+    """Table arguments (regular rows only, in table order) of the nodes at most ``width`` steps of
+    the 8-point stencil from a node where the boolean array ``seed`` holds."""
     nodes, nbr = args[0], args[1]
-    near = ~free
-    for _ in range(BAND_WIDTH):
+    sel = _hk.grow_near(nodes, nbr, seed, width)[nodes]
+    e = np.zeros(0, dtype=np.int64)
+    return (np.ascontiguousarray(nodes[sel]), np.ascontiguousarray(nbr[sel]), e, np.zeros(1, dtype=np.int64), e)
+
+
+def near_reference(args: tuple, seed: np.ndarray, width: int) -> np.ndarray:
+    """The nodes :func:`near_rows` grows (boolean over all nodes; NumPy reference of
+    :func:`._hier_kernels.grow_near`)."""
+    nodes, nbr = args[0], args[1]
+    near = seed
+    for _ in range(width):
         grown = near.copy()
         grown[nodes[near[nbr].any(axis=1)]] = True
         near = grown
-    sel = near[nodes]
-    e = np.zeros(0, dtype=np.int64)
-    return (np.ascontiguousarray(nodes[sel]), np.ascontiguousarray(nbr[sel]), e, np.zeros(1, dtype=np.int64), e)
+    return near
 
 
 def _lines(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tuple, tuple]:

@@ -819,6 +819,43 @@ def test_layout_hierarchy_stops_before_levels_that_barely_coarsen(make):
         assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-6 * topo.size
 
 
+def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
+    """The point sweeps round the largest defects after each cycle (multigrid.HOT_SWEEPS) take a
+    generated lake with islands from 7 cycles to at most 5 and give the same grid."""
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock import multigrid
+    from meshcore.testing import lake_with_islands
+
+    topo = auto_layout(lake_with_islands(2), target_cells=4000, multiple=4).topology()
+    hot = solve_multiblock(topo, engine="multigrid")
+    tight = solve_multiblock(topo, engine="multigrid", tolerance=1e-9)
+    monkeypatch.setattr(multigrid, "HOT_SWEEPS", 0)
+    cold = solve_multiblock(topo, engine="multigrid")
+    assert hot.converged and cold.converged
+    assert hot.info.iterations <= 5 < cold.info.iterations
+    cold = solve_multiblock(topo, engine="multigrid", tolerance=1e-9)
+    assert tight.converged and cold.converged
+    for g, k in zip(tight, cold, strict=True):
+        assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-6 * topo.size
+
+
+@pytest.mark.kernel
+def test_grow_near_matches_numpy_reference():
+    """The compiled growth of a node set over the table equals the NumPy one (seeds anywhere:
+    fixed, border, irregular and interior nodes)."""
+    from meshcore.multiblock import _hier_kernels
+    from meshcore.multiblock.hierarchy import levels, near_reference, near_rows
+
+    lv = levels(star(5, 9))[0]
+    rng = np.random.default_rng(3)
+    for width in (0, 1, 2, 3):
+        seed = rng.random(lv.n) < 0.02
+        want = near_reference(lv.args, seed, width)
+        got = _hier_kernels.grow_near(lv.args[0], lv.args[1], seed, width)
+        assert np.array_equal(got, want)
+        assert np.array_equal(near_rows(lv.args, seed, width)[0], lv.args[0][want[lv.args[0]]])
+
+
 @pytest.mark.kernel
 def test_line_kernel_matches_numpy_reference():
     """line_sweep_rhs equals tridiagonal solves line by line (NumPy), with and without f."""
