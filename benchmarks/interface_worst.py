@@ -5,6 +5,7 @@ interfaces (blocks, cells, areas in h², edge lengths) and, for every shore node
 meet nearest to them, which block has a corner there (with its angle) and which passes with a side::
 
     python benchmarks/interface_worst.py "islands 2" --cells 15000 --png /tmp/worst.png
+    python benchmarks/interface_worst.py "testing.channel_network(23, n_branches=7)" --png /tmp/w.png
 """
 
 from __future__ import annotations
@@ -54,12 +55,12 @@ def main(argv: list[str] | None = None) -> int:
     from meshcore.quality.interfaces import interface_pairs, signed_area
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("case", help="a name fragment of a lake_grids.py case")
+    ap.add_argument("case", help='a name fragment of a lake_grids.py case, or "testing.…(…)"')
     ap.add_argument("--cells", type=int, default=15000)
     ap.add_argument("--worst", type=int, default=8)
     ap.add_argument("--png", help="a figure of the worst place")
     a = ap.parse_args(argv)
-    cases = lake_grids._cases([a.case])
+    cases = [(a.case, a.case)] if a.case.startswith("testing.") else lake_grids._cases([a.case])
     if not cases:
         raise SystemExit(f"no case matches {a.case!r}")
     name, what = cases[0]
