@@ -27,7 +27,7 @@ __all__ = ["SAG", "least_cells", "sag"]
 #: shore stray a quarter of a coarse edge (``shore_gap``: one fine cell at ``multiple`` 4) from
 #: the edges between two shore nodes, so a sampling within one cell is one the coarse level
 #: keeps; less asks for denser cells round every curved shore (checked on generated lakes with
-#: islands, ``benchmarks/shore_sweep.py``: 0.5 gave the same shore fit with more cells).
+#: islands in a sweep not committed: 0.5 gave the same shore fit with more cells).
 SAG = 1.0
 #: At most this many times the chain's cells at the cell size: a corner of the shore inside a
 #: chain (no sampling follows it exactly) must not ask for ever more cells.
