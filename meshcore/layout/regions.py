@@ -12,24 +12,14 @@ import math
 
 import numpy as np
 
+from ..segments import nearest_on_polyline
+
 __all__ = ["partition", "snap_to_rings"]
 
 #: The narrowest angle (degrees, read at the corners' scale) an island cut may make with a
 #: shore: a cut that meets a ring at a grazing angle leaves a wedge, a block corner of a few
 #: degrees whose cells cannot be orthogonal (nor, on the coarse levels, convex).
 MIN_CORNER_ANGLE = 30.0
-
-
-def _project(poly_pts: np.ndarray, q: np.ndarray, closed: bool):
-    a = poly_pts if closed else poly_pts[:-1]
-    b = np.roll(poly_pts, -1, axis=0) if closed else poly_pts[1:]
-    d = b - a
-    L2 = (d * d).sum(axis=1)
-    t = np.clip(np.where(L2 > 0, ((q - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0), 0.0, 1.0)
-    foot = a + t[:, None] * d
-    dist = np.hypot(*(foot - q).T)
-    k = int(np.argmin(dist))
-    return float(dist[k]), k, float(t[k])
 
 
 def snap_to_rings(rings: list[np.ndarray], cuts: list[np.ndarray], eps: float):
@@ -44,13 +34,13 @@ def snap_to_rings(rings: list[np.ndarray], cuts: list[np.ndarray], eps: float):
             q = cuts[k][end]
             best = None
             for ri, r in enumerate(rings):
-                d, seg, t = _project(r, q, True)
+                d, seg, t = nearest_on_polyline(r, q, True)
                 if best is None or d < best[0]:
                     best = (d, "ring", ri, seg, t)
             for ci in range(len(cuts)):
                 if ci == k:
                     continue
-                d, seg, t = _project(cuts[ci], q, False)
+                d, seg, t = nearest_on_polyline(cuts[ci], q, False)
                 if d < best[0]:
                     best = (d, "cut", ci, seg, t)
             _, kind, idx, seg, t = best

@@ -32,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from ..segments import nearest_on_polyline
+
 __all__ = ["ShoreChange", "shore_at_scale", "wiggle"]
 
 #: Largest wiggle (degrees of turning taken back within ± 2 cells) a shore keeps unsmoothed.
@@ -367,14 +369,9 @@ def _moved(q: np.ndarray, src: list[np.ndarray], dst: list[np.ndarray]) -> np.nd
     """A point on an edge of one of the rings ``src``: the same point of the edge in ``dst``."""
     best: tuple[float, int, int, float] = (math.inf, 0, 0, 0.0)
     for k, r in enumerate(src):
-        a, b = r, np.roll(r, -1, axis=0)
-        d = b - a
-        L2 = np.maximum((d * d).sum(axis=1), 1e-300)
-        t = np.clip(((q - a) * d).sum(axis=1) / L2, 0.0, 1.0)
-        dist = np.hypot(*(a + t[:, None] * d - q).T)
-        i = int(np.argmin(dist))
-        if dist[i] < best[0]:
-            best = (float(dist[i]), k, i, float(t[i]))
+        dist, i, t = nearest_on_polyline(r, q, closed=True)
+        if dist < best[0]:
+            best = (dist, k, i, t)
     _, k, i, u = best
     r = dst[k]
     return r[i] + u * (r[(i + 1) % len(r)] - r[i])

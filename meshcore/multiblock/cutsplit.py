@@ -27,7 +27,8 @@ import numpy as np
 
 from ..boundary import signed_area as _signed_area
 from ..errors import TopologyError
-from .outline import BlockOutline, _insert, _project_on
+from ..segments import nearest_on_polyline
+from .outline import BlockOutline, _insert
 
 __all__ = ["chain_blocks", "snap_cuts_to_outline"]
 
@@ -45,7 +46,7 @@ def snap_cuts_to_outline(outline: np.ndarray, cuts: list[np.ndarray], snap: floa
         if len(c) < 2:
             raise TopologyError(f"cut {k_cut + 1} needs at least two points")
         for end in (0, -1):
-            dist, k, t = _project_on(ring, c[end], True)
+            dist, k, t = nearest_on_polyline(ring, c[end], True)
             if dist > snap:
                 raise TopologyError(
                     f"cut {k_cut + 1}: its {'first' if end == 0 else 'last'} point is {dist:.3g} from the "

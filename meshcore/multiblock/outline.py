@@ -40,6 +40,7 @@ from .._validation import check_allocation, max_nodes, validate_count, validate_
 from ..boundary import signed_area
 from ..errors import InvalidInputError, TopologyError
 from ..pointindex import point_key, point_keys
+from ..segments import feet, nearest_on_polyline
 from .topology import MultiBlockTopology
 
 __all__ = ["BlockOutline", "OutlineBlocks", "from_outline", "project_lonlat"]
@@ -112,24 +113,6 @@ class OutlineBlocks:
     islands: tuple[np.ndarray, ...] = ()  # clockwise rings of the islands (cut ends inserted)
 
 
-def _project_on(poly: np.ndarray, q: np.ndarray, closed: bool) -> tuple[float, int, float]:
-    """(distance, segment index, parameter t) of the point of ``poly`` nearest to ``q``."""
-    b = np.roll(poly, -1, axis=0) if closed else poly[1:]
-    dist, t = _feet(poly if closed else poly[:-1], b, q)
-    k = int(np.argmin(dist))
-    return float(dist[k]), k, float(t[k])
-
-
-def _feet(a: np.ndarray, b: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distance from ``q`` to each segment ``a[k] → b[k]`` and the parameter of its foot."""
-    d = b - a
-    L2 = (d * d).sum(axis=1)
-    t = np.where(L2 > 0, ((q - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    foot = a + t[:, None] * d
-    return np.hypot(*(foot - q).T), t
-
-
 def _insert(poly: np.ndarray, k: int, t: float, closed: bool, eps: float) -> tuple[np.ndarray, np.ndarray]:
     """Insert the point at parameter ``t`` of segment ``k``; return (new poly, the point)."""
     n = len(poly)
@@ -166,7 +149,7 @@ def _nearest_on_cuts(cut_list: list[np.ndarray], k: int, q: np.ndarray) -> tuple
         return math.inf, -1, -1, 0.0
     a = np.vstack([cut_list[m][:-1] for m in others])
     b = np.vstack([cut_list[m][1:] for m in others])
-    dist, t = _feet(a, b, q)
+    dist, t = feet(a, b, q)
     i = int(np.argmin(dist))
     starts = np.cumsum([0] + [len(cut_list[m]) - 1 for m in others])
     j = int(np.searchsorted(starts, i, side="right")) - 1
@@ -183,7 +166,8 @@ def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: fl
             q = cut_list[k][end]
             if any(point_key(q) in v for v in on_ring):
                 continue  # a vertex of the shore already: it would snap onto itself
-            best = min(((_project_on(r, q, True), "outline", ri) for ri, r in enumerate(rings)), key=lambda b: b[0][0])
+            near = ((nearest_on_polyline(r, q, True), "outline", ri) for ri, r in enumerate(rings))
+            best = min(near, key=lambda b: b[0][0])
             dist, m, seg, t = _nearest_on_cuts(cut_list, k, q)
             if dist < best[0][0]:
                 best = ((dist, seg, t), "cut", m)

@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from ..segments import feet
+
 __all__ = ["SAG", "least_cells", "sag"]
 
 #: Largest distance, in (fine) cells, between a shore chain and the straight edges of its
@@ -44,11 +46,7 @@ def sag(chain: np.ndarray, cells: int) -> float:
     u = np.linspace(0.0, s[-1], cells + 1)
     nodes = np.column_stack([np.interp(u, s, p[:, 0]), np.interp(u, s, p[:, 1])])
     j = np.clip(np.searchsorted(u, s, side="right") - 1, 0, cells - 1)
-    a, b = nodes[j], nodes[j + 1]
-    d = b - a
-    L2 = (d * d).sum(axis=1)
-    t = np.clip(((p - a) * d).sum(axis=1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
-    return float(np.hypot(*(a + t[:, None] * d - p).T).max())
+    return float(feet(nodes[j], nodes[j + 1], p)[0].max())
 
 
 def least_cells(chain: np.ndarray, cell_size: float, multiple: int, *, tol: float = SAG, most: float = MOST) -> int:

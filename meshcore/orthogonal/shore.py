@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..segments import feet
+
 __all__ = ["arc_lengths", "project_to_rings", "ring_point"]
 
 
@@ -31,10 +33,8 @@ def project_to_rings(rings: list[np.ndarray], pts: np.ndarray):
     a, b, ring, L, start = _segments(rings)
     tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
     seg = tree.query_nearest(shapely.points(pts), return_distance=False, all_matches=False)[1]
-    d = b[seg] - a[seg]
-    t = np.clip(((pts - a[seg]) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-300), 0.0, 1.0)
-    foot = a[seg] + t[:, None] * d
-    return ring[seg], start[seg] + t * L[seg], np.hypot(*(foot - pts).T)
+    dist, t = feet(a[seg], b[seg], pts)
+    return ring[seg], start[seg] + t * L[seg], dist
 
 
 def arc_lengths(ring: np.ndarray) -> np.ndarray:
