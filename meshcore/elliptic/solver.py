@@ -62,6 +62,10 @@ SNAPSHOT_COST_FACTOR = 20.0
 #: Assumed snapshot copy speed before the first snapshot is timed: fresh pages included
 #: (measured: 67 MB in 130-150 ms when the kernel first compacts transparent huge pages).
 SNAPSHOT_BYTES_PER_S = 0.5e9
+#: Grids whose x, y take at least this many bytes have their snapshots spaced by what a copy
+#: costs.  Smaller grids copy in microseconds: a copy that took long was the process waiting
+#: for a core (a busy machine), and spacing snapshots by it froze the live view for seconds.
+SNAPSHOT_HUGE_BYTES = 4 << 20
 
 
 def register_method(name: str, fn: Callable[..., Generator]) -> None:
@@ -376,7 +380,8 @@ def iterate(
     last = t0
     # until a snapshot has been timed: assume copying x, y of a huge grid (arrays that numpy
     # places in transparent huge pages, ≥ 4 MB) runs at SNAPSHOT_BYTES_PER_S
-    interval_floor = SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S if x.nbytes >= 4 << 20 else 0.0
+    huge = x.nbytes >= SNAPSHOT_HUGE_BYTES
+    interval_floor = SNAPSHOT_COST_FACTOR * 2 * x.nbytes / SNAPSHOT_BYTES_PER_S if huge else 0.0
     gen = METHODS[method](state)
     rel: list[tuple[int, float]] = []  # the relative history so far (extended, not rebuilt, per snapshot)
     converged = False
@@ -401,7 +406,7 @@ def iterate(
                 )
                 last = time.perf_counter()
                 # a snapshot copies x, y: keep that below ~5 % of the solve on huge grids
-                interval_floor = SNAPSHOT_COST_FACTOR * (last - now)
+                interval_floor = SNAPSHOT_COST_FACTOR * (last - now) if huge else 0.0
                 cmd = yield snap
                 if cmd == "stop":
                     stopped = True

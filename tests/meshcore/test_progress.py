@@ -88,3 +88,19 @@ def test_generate_case_reports_multiblock_progress_and_the_cli_prints_it():
         p(SolverProgress(7, 1e-5, 1e-6, None, 2.0, "smooth/multigrid", grids=mb.grids))
         p.done()
     assert "smooth/multigrid: iteration      7" in err.getvalue()
+
+
+def test_a_slow_snapshot_of_a_small_grid_does_not_space_the_next(monkeypatch):
+    """On a busy machine a snapshot may take long because the process waited for a core; on a
+    small grid that is no reason to wait 20 × as long for the next one (the live view froze)."""
+    from meshcore.elliptic import solver
+
+    clock = iter(np.arange(0.0, 1e6, 1.0))  # every reading of the clock one second later
+    monkeypatch.setattr(solver.time, "perf_counter", lambda: float(next(clock)))
+    X, Y = curved_rectangle(32, 16)
+    gen = meshcore.iterate(meshcore.StructuredGrid(X, Y), EllipticConfig(report_interval=0.5), method="sor")
+    snaps = [next(gen) for _ in range(5)]
+    gen.close()
+    # one sweep (one clock reading) between snapshots, however long the last copy seemed to take
+    steps = np.diff([s.iteration for s in snaps])
+    assert steps.max() <= 2 * steps.min(), [s.iteration for s in snaps]
