@@ -98,7 +98,8 @@ def solve_project(
                 if isinstance(event, StartGrid):
                     starts[k] = event.algebraic
                 elif isinstance(event, Done):
-                    notes += [f"{block.name}: {w}" for w in event.warnings]
+                    # meshcore names the block already (run_block's ``where``): not twice
+                    notes += [w if w.startswith(f"{block.name}: ") else f"{block.name}: {w}" for w in event.warnings]
                 cmd = yield k, event
                 event = gen.send(cmd)
         except StopIteration as fin:

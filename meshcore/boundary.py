@@ -136,6 +136,22 @@ class BorderSpec:
         raise InvalidInputError(f"{border} border: expected a distribution spec, got {value!r}")
 
 
+def _which(indices) -> str:
+    """Points named for everyone: ``point 4 (index 3)``, ``points 4, 9 (indices 3, 8)``.
+
+    People (and the app's point rows) count points from 1; case files and arrays index them
+    from 0: a message names both.  At most five, then ``…``.
+    """
+    k = [int(i) for i in indices]
+    more = " …" if len(k) > 5 else ""
+    k = k[:5]
+    one = len(k) == 1
+    return (
+        f"point{'' if one else 's'} {', '.join(str(i + 1) for i in k)}{more} "
+        f"({'index' if one else 'indices'} {', '.join(str(i) for i in k)}{more})"
+    )
+
+
 def _drop_duplicates(p: np.ndarray, *, name: str, tol: float) -> np.ndarray:
     seg = np.hypot(np.diff(p[:, 0]), np.diff(p[:, 1]))
     dup = np.flatnonzero(seg <= tol)
@@ -143,8 +159,7 @@ def _drop_duplicates(p: np.ndarray, *, name: str, tol: float) -> np.ndarray:
         raise BoundaryError(f"{name}: zero-length border (all points coincide)")
     if dup.size:
         warnings.warn(
-            f"{name}: dropped {dup.size} duplicate consecutive point(s) at index "
-            f"{', '.join(str(int(k) + 1) for k in dup[:5])}{' …' if dup.size > 5 else ''}",
+            f"{name}: dropped {dup.size} duplicate consecutive point(s): {_which(dup + 1)}",
             MeshcoreWarning,
             stacklevel=3,
         )
@@ -464,10 +479,11 @@ def borders_from_loop(
         drop = (dup + 1) % n
         bad = [k for k in drop if k in c]
         if bad:
-            raise BoundaryError(f"{prefix}corner point {bad[0]} duplicates its predecessor; pick the first of the two")
+            raise BoundaryError(
+                f"{prefix}the corner on {_which(bad[:1])} duplicates its predecessor; pick the first of the two"
+            )
         warnings.warn(
-            f"{prefix}boundary: dropped {dup.size} duplicate consecutive point(s) at index "
-            f"{', '.join(str(int(k)) for k in drop[:5])}",
+            f"{prefix}boundary: dropped {dup.size} duplicate consecutive point(s): {_which(drop)}",
             MeshcoreWarning,
             stacklevel=2,
         )

@@ -103,6 +103,19 @@ def _angles(p: np.ndarray) -> np.ndarray:
     return ang[::-1].copy() if flip else ang
 
 
+def _angles_of_distinct(p: np.ndarray) -> np.ndarray:
+    """:func:`_angles` with each run of repeated consecutive points measured as one point (every
+    copy gets its angle): a zero-length edge has no direction, and :func:`_angles` would give
+    its ends 180°, a "reflex" corner where a user clicked a point twice.  Repeats are the
+    points :func:`meshcore.boundary.borders_from_loop` drops (within 1e-9 of the loop's size)."""
+    size = check_extent(p, name="boundary points")
+    first = np.hypot(*(p - np.roll(p, 1, axis=0)).T) > 1e-9 * size  # not a repeat of its predecessor
+    if first.all() or first.sum() < 3:
+        return _angles(p)
+    run = np.cumsum(first) - 1  # -1 (the last run) for repeats of the last point that wrap round
+    return _angles(p[first])[run]
+
+
 def _principal_frame(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Centre and rotation (rows = long axis s, short axis t) of the outline."""
     seg = np.hypot(*(np.roll(p, -1, axis=0) - p).T)
@@ -309,7 +322,7 @@ class CornerProblem:
 def corner_problems(points: Any, corners: Any) -> list[CornerProblem]:
     """Corners (``sw, se, ne, nw`` indices into ``points``) that sit on reflex vertices."""
     p, n = _loop(points, "boundary points")
-    ang = _angles(p)
+    ang = _angles_of_distinct(p)
     convex = np.flatnonzero(ang < 180.0)
     out = []
     for name, k in zip(CORNER_NAMES, corners, strict=True):

@@ -471,3 +471,31 @@ def test_random_simple_polygons(boxes, ni, nj):
     if len(loop) < 4:
         return
     _outcome_is_honest(loop, (ni, nj))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_point_given_twice_is_not_a_reflex_corner(seed):
+    """A repeated point (a double click) takes the angle of the point it repeats: the corner
+    advice neither calls a convex vertex reflex nor misses a reflex one (generated outlines)."""
+    from meshcore import testing
+
+    rng = np.random.default_rng(seed)
+    shapes = [
+        testing.round_lake(seed, kind="blob", n_islands=0),
+        testing.round_lake(seed, kind="arms", n_islands=0),
+        testing.lake_with_islands(seed),
+        testing.channel_network(seed),
+    ]
+    for poly in shapes:
+        ring = np.asarray(poly.exterior.coords)[:-1]
+        n = len(ring)
+        for k in rng.choice(n, 4, replace=False):
+            k = int(k)
+            twice = np.insert(ring, k + 1, ring[k], axis=0)  # point k clicked twice
+            corners = [(k + q * n // 4) % n for q in range(4)]
+            want = [(p.corner, p.angle) for p in corner_problems(ring, corners)]
+            for first in (k, k + 1):  # the corner on either copy
+                on_twice = [first] + [c + (c > k) for c in corners[1:]]
+                got = [(p.corner, p.angle) for p in corner_problems(twice, on_twice)]
+                assert [c for c, _ in got] == [c for c, _ in want], (k, first, got, want)
+                np.testing.assert_allclose([a for _, a in got], [a for _, a in want], atol=1e-9)
