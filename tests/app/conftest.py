@@ -7,6 +7,30 @@ import gc
 import pytest
 
 
+def pytest_collection_finish(session) -> None:
+    """Compile (or load from the numba cache) the solver kernels once, before the first GUI test.
+
+    In a checkout whose numba cache is cold (a new worktree, or a kernel file changed) the first
+    solve compiles its kernels in the solver's worker thread: minutes on a busy machine (a
+    300 × 300 block: 130 s wall, 124 s of it compiling ``fmg_start``, at load 4-9), all inside
+    one test's wait.  Here it happens once, outside every test and its time limit.  The app's
+    own start-up warm-up (one block), then a generated lake with islands at three times the
+    default cell size (~1200 cells, several blocks): the lake grid's multigrid, hierarchy and
+    repair kernels, which the warm-up's tiny strip does not reach.
+    """
+    if not any(item.get_closest_marker("gui") for item in session.items):
+        return
+    from app.pipeline import warmup
+    from meshcore import testing
+    from meshcore.cellsize import default_cell_size
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout import auto_layout
+
+    warmup()
+    lake = testing.lake_with_islands(1)
+    mesh_layout(auto_layout(lake, cell_size=3 * default_cell_size(lake.area)))
+
+
 @pytest.fixture(autouse=True)
 def _qt_garbage_collected_in_the_gui_thread():
     """Collect each test's garbage here, in the GUI thread, after its windows closed.

@@ -8,19 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.app.waits import wait_for, wait_idle
+
 pytestmark = pytest.mark.gui
 
 LAKES = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
 ISEO = LAKES / "lake_iseo_sparse.geojson"  # one island (Monte Isola)
 COMO = LAKES / "lake_como.geojson"  # Y-shaped, three arms
-
-
-def wait_idle(qtbot, win, timeout=120_000):
-    """Until neither the layout nor the grid is being computed (a busy machine may take long)."""
-    qtbot.waitUntil(
-        lambda: not win.lake_ctl.busy and not win.solver.running and not win.solver._debounce.isActive(),
-        timeout=timeout,
-    )
 
 
 def lay_out(qtbot, win, path, cell_size=None):
@@ -30,7 +24,7 @@ def lay_out(qtbot, win, path, cell_size=None):
         win.lake_panel.cell_size.setValue(cell_size)
         win.lake_panel.cell_size.editingFinished.emit()
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error), timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
     assert win.lake_ctl.last_error is None
     wait_idle(qtbot, win)
     return win.doc.project.layout
@@ -54,7 +48,7 @@ def test_import_reads_islands_and_offers_auto_layout(qtbot, win):
     win.lake_panel.cell_size.setValue(300.0)
     win.lake_panel.cell_size.editingFinished.emit()
     go.click()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
     wait_idle(qtbot, win)
     lay = win.doc.project.layout
     assert lay.cell_size == 300.0 and len(lay.polygon.interiors) == 1
@@ -185,7 +179,7 @@ def test_the_same_layout_and_grid_as_meshcore_mesh(qtbot, win, tmp_path, name):
     h = math.sqrt(water(lake.outline, lake.holes)[0].area / 1500)  # ~1500 cells: quick, several blocks
     win.lake_ctl.set_cell_size(h)
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error), timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
     assert win.lake_ctl.last_error is None
     win.generate()
     wait_idle(qtbot, win)
@@ -213,7 +207,7 @@ def test_layout_undo_redo_and_clear(qtbot, win):
     shore = win.doc.project
     win.lake_ctl.set_cell_size(300.0)
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
     laid = win.doc.project
     # the block points are not editable in a layout: a clear message instead
     win.editor.move_points([0], (10.0, 0.0))
@@ -267,7 +261,7 @@ def test_a_ddb_that_delft3d_cannot_couple_says_what_to_do(qtbot, win, tmp_path):
     assert not out.exists()
     assert "regular" in win._status.text()
     win.a_auto_layout_regular.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.lake.regular and win.doc.project.layout is not None, timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.lake.regular and win.doc.project.layout is not None)
     wait_idle(qtbot, win)
     if not win.io.export_mesh(out):
         assert "Cannot export" in win._status.text() and not out.exists()
@@ -306,7 +300,7 @@ def test_a_lake_refused_is_a_message(qtbot, win):
     assert win.io.import_points(ISEO, project_lonlat=True)
     win.lake_ctl.set_cell_size(1e6)  # a few cells for the whole lake
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: not win.lake_ctl.busy, timeout=60_000)
+    wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
     assert win.doc.project.layout is None
     assert "Cannot lay out the lake" in win._status.text() and "cell size" in win._status.text()
 

@@ -10,23 +10,12 @@ import pytest
 import shapely
 
 from app import io_controller
+from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
 LAKES = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
 ISEO = LAKES / "lake_iseo_sparse.geojson"
-
-
-def wait_idle(qtbot, win, timeout=120_000):
-    qtbot.waitUntil(
-        lambda: (
-            not win.lake_ctl.busy
-            and not win.lake_ctl.editing
-            and not win.solver.running
-            and not win.solver._debounce.isActive()
-        ),
-        timeout=timeout,
-    )
 
 
 @pytest.fixture
@@ -35,7 +24,7 @@ def laid(qtbot, win):
     assert win.io.import_points(ISEO, project_lonlat=True)
     win.lake_ctl.set_cell_size(300.0)
     win.a_auto_layout.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None, timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
     wait_idle(qtbot, win)
     assert win.canvas.tool is win.tools["layout"]  # Auto layout leads on to editing it
     win.a_auto.trigger()
@@ -130,7 +119,7 @@ def test_enter_in_a_blocks_cells_sets_them_and_the_keyboard_goes_back_to_the_can
     box.selectAll()
     qtbot.keyClicks(box, str(b0.cells[1] + m))
     qtbot.keyClick(box, QtCore.Qt.Key.Key_Return)
-    qtbot.waitUntil(lambda: win.doc.project.layout is not lay0 or bool(win.lake_ctl.edit_error), timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 or bool(win.lake_ctl.edit_error))
     wait_idle(qtbot, win)
     assert win.lake_ctl.edit_error is None
     assert win.doc.project.layout.blocks[0].cells == (b0.cells[0], b0.cells[1] + m)
@@ -264,7 +253,7 @@ def test_the_autosave_waits_for_the_end_of_a_drag(qtbot, laid, monkeypatch):
     assert writes == []  # nothing written while the drag lasts
     tool.drag("finish", (end.xy[0] + 0.2 * h, end.xy[1]), end.xy)
     wait_idle(qtbot, win)
-    qtbot.waitUntil(lambda: len(writes) == 1, timeout=10 * io_controller.DEBOUNCE_MS)
+    wait_for(qtbot, win, lambda: len(writes) == 1)
 
 
 def test_what_would_slow_a_drags_redraws_is_off_the_canvas(qtbot, laid):
@@ -326,7 +315,7 @@ def test_cut_lines_drawn_by_hand_in_any_topology_split_a_lake(qtbot, win, tmp_pa
     before = win.doc.project
     assert len(before.cut_lines) == len(HAND_CUTS[kind])
     win.a_split.trigger()
-    qtbot.waitUntil(lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error), timeout=120_000)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
     assert win.lake_ctl.last_error is None
     wait_idle(qtbot, win)
     p = win.doc.project

@@ -13,6 +13,8 @@ import threading
 import numpy as np
 import pytest
 
+from tests.app.waits import wait_for
+
 pytest.importorskip("pyproj")
 
 
@@ -50,7 +52,7 @@ def test_a_lonlat_case_solves_twice_in_the_app(qtbot, win):
     for _ in range(2):
         assert win.io.open_path(case)
         win.generate()
-        qtbot.waitUntil(lambda: not win.solver.running and bool(win.doc.grids), timeout=300_000)
+        wait_for(qtbot, win, lambda: not win.solver.running and bool(win.doc.grids))
         grids.append({k: (g.x.copy(), g.y.copy()) for k, g in win.doc.grids.items()})
     assert grids[0].keys() == grids[1].keys() and len(grids[0]) == 7
     for k, (x, y) in grids[0].items():

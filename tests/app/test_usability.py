@@ -10,12 +10,9 @@ from PySide6 import QtCore, QtWidgets
 from PySide6.QtTest import QTest
 
 from app import geometry as geo
+from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
-
-
-def wait_idle(qtbot, win, timeout=30_000):
-    qtbot.waitUntil(lambda: not win.solver.running and not win.solver._debounce.isActive(), timeout=timeout)
 
 
 def solved(qtbot, win, name="bottle-coarse"):
@@ -72,7 +69,7 @@ def test_quality_table_is_cleared_while_a_new_solve_runs(qtbot, win):
     win.editor.set_block_options(cells=(200, 200))
     win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     win.generate()
-    qtbot.waitUntil(lambda: win.solver.state == "running", timeout=10_000)
+    wait_for(qtbot, win, lambda: win.solver.state == "running")
     assert win.quality_panel.table.rowCount() == 0 and win.doc.quality is None
     win.solver.stop()
     wait_idle(qtbot, win)
@@ -82,20 +79,21 @@ def test_grid_lines_fade_when_cells_are_a_few_pixels(qtbot, win):
     assert geo.line_alpha(20.0) == 1.0 and geo.line_alpha(1.0) == pytest.approx(0.12)
     a = [geo.line_alpha(px) for px in np.linspace(0.5, 12, 30)]
     assert all(p <= q for p, q in itertools.pairwise(a))  # more pixels, more ink
+    from app.pipeline import block_initial_grid
+
     win.io.open_example("bottle-coarse", confirm=False)
     win.editor.set_block_options(cells=(300, 300))
-    win.editor.set_solver(max_iterations=3, repair="off", threads=1)  # any grid of small cells will do
-    win.generate()
-    wait_idle(qtbot, win, timeout=120_000)  # a busy machine is slow; the test is about drawing
+    # the test is about drawing: any grid of small cells will do, the algebraic one (no solve)
+    win.doc.set_grids({0: block_initial_grid(win.doc.block)})
 
     def alpha():
         return win.canvas.grid_curve.opts["pen"].color().alphaF()
 
     win.canvas.fit()  # the view settles through the event loop: wait for it, however busy the machine
-    qtbot.waitUntil(lambda: alpha() < 0.5, timeout=20_000)
+    wait_for(qtbot, win, lambda: alpha() < 0.5)
     g = win.doc.grid
     win.canvas.zoom_to((g.x[150, 150], g.y[150, 150], g.x[153, 153], g.y[153, 153]), margin=0)
-    qtbot.waitUntil(lambda: alpha() == 1.0, timeout=20_000)
+    wait_for(qtbot, win, lambda: alpha() == 1.0)
 
 
 def test_markers_and_grid_lines_can_be_hidden(qtbot, win):
@@ -121,7 +119,7 @@ def test_the_window_fits_its_screen_and_remembers_its_size(qtbot, tmp_path):
     w = MainWindow(settings=settings, recovery=tmp_path / "r.toml")
     qtbot.addWidget(w)
     w.show()
-    qtbot.waitUntil(lambda: w._shown, timeout=5_000)
+    wait_for(qtbot, w, lambda: w._shown)
     qtbot.wait(20)
     avail = w.screen().availableGeometry()
     assert avail.contains(w.frameGeometry()), (avail, w.frameGeometry())
@@ -142,7 +140,7 @@ def test_focus_returns_to_the_canvas_after_an_edit(qtbot, win):
     pp.ni.lineEdit().selectAll()
     QTest.keyClicks(pp.ni, "9")
     QTest.keyClick(pp.ni, QtCore.Qt.Key.Key_Return)
-    qtbot.waitUntil(lambda: win.focusWidget() is win.canvas, timeout=2_000)
+    wait_for(qtbot, win, lambda: win.focusWidget() is win.canvas)
     assert win.doc.block.cells[0] == 9
     # moving on with Tab keeps the keyboard in the panel
     pp.ni.setFocus()
@@ -155,7 +153,7 @@ def test_focus_returns_to_the_canvas_after_an_edit(qtbot, win):
     pp.initial.setFocus()
     pp.initial.setCurrentText("tfi")
     pp.initial.activated.emit(pp.initial.currentIndex())
-    qtbot.waitUntil(lambda: win.focusWidget() is win.canvas, timeout=2_000)
+    wait_for(qtbot, win, lambda: win.focusWidget() is win.canvas)
 
 
 # -------------------------------------------------------------- messages
@@ -222,6 +220,23 @@ def test_corner_tool_counts_points_from_one(qtbot, win):
     qtbot.wait(20)
     win.canvas.tool.click((0.0, 0.0))
     assert "= point 1;" in win._status.text()
+
+
+def test_a_point_clicked_twice_is_named_from_one_and_is_no_reflex_corner(qtbot, win):
+    """The duplicate is the 4th point drawn: messages say "point 4" as the app counts (they said
+    "index 3"), and the true 90° corner beside it is not called reflex (it was: 180°)."""
+    for xy in [(0, 0), (2, 0), (4, 0), (4, 0), (4, 2), (2, 2), (0, 2), (0, 1)]:
+        win.editor.add_point(xy)
+    win.editor.close_loop()
+    win.editor.set_corners((0, 2, 4, 6))  # SE on the first of the two (4, 0)
+    win.generate()
+    wait_idle(qtbot, win)
+    notes = [t for lv, t in win.messages_panel.messages() if lv == "warning"]
+    dup = [t for t in notes if "duplicate" in t]
+    assert len(dup) == 1 and "point 4 (index 3)" in dup[0], notes
+    assert not dup[0].startswith("block: block:")  # the block named once
+    assert not any("reflex" in t for t in notes), notes
+    assert win.doc.grid is not None and win.doc.grid.converged
 
 
 # ------------------------------------------------------------- background

@@ -10,6 +10,7 @@ from PySide6 import QtCore
 from PySide6.QtTest import QTest
 
 from meshcore import StructuredGrid
+from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
@@ -25,10 +26,6 @@ def click_at(win, xy, *, delay=60):
     QTest.mouseClick(
         win.canvas.viewport(), QtCore.Qt.MouseButton.LeftButton, QtCore.Qt.KeyboardModifier.NoModifier, pos, delay
     )
-
-
-def wait_idle(qtbot, win, timeout=20_000):
-    qtbot.waitUntil(lambda: not win.solver.running and not win.solver._debounce.isActive(), timeout=timeout)
 
 
 def test_click_a_square_pick_corners_generate(qtbot, win):
@@ -125,13 +122,13 @@ def test_stop_during_a_long_solve(qtbot, win):
     win.editor.set_block_options(cells=(300, 300))
     win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     win.generate()
-    qtbot.waitUntil(lambda: win.doc.grid is not None and win.doc.grid.cells == (300, 300), timeout=10_000)
+    wait_for(qtbot, win, lambda: win.doc.grid is not None and win.doc.grid.cells == (300, 300))
     qtbot.wait(200)
     assert win.solver.running
     win.solver.stop()
     # the solve alone would run for hours (tolerance 1e-300): ending at all proves the stop worked;
     # how fast it stops is measured by app/bench.py, not asserted here (a busy machine is slow)
-    qtbot.waitUntil(lambda: not win.solver.running, timeout=120_000)
+    wait_for(qtbot, win, lambda: not win.solver.running)
     g = win.doc.grid
     assert g.info.message == "stopped" and not g.converged and b.cells != g.cells
 
@@ -141,7 +138,7 @@ def test_pause_and_resume(qtbot, win):
     win.editor.set_block_options(cells=(200, 200))
     win.editor.set_solver(method="sor", tolerance=1e-300, max_iterations=10_000_000)
     win.generate()
-    qtbot.waitUntil(lambda: win.solver.state == "running" and bool(win.solver._latest), timeout=10_000)
+    wait_for(qtbot, win, lambda: win.solver.state == "running" and bool(win.solver._latest))
     win.solver.pause()
     # progress already queued when the worker paused may still arrive (a busy machine delays it):
     # wait until the iteration stands still, then check that it stays still
@@ -149,7 +146,7 @@ def test_pause_and_resume(qtbot, win):
     qtbot.wait(500)
     assert _iteration(win) == it  # nothing moves while paused
     win.solver.resume()
-    qtbot.waitUntil(lambda: _iteration(win) > it, timeout=5_000)
+    wait_for(qtbot, win, lambda: _iteration(win) > it)
     win.solver.stop()
     wait_idle(qtbot, win)
 
@@ -512,7 +509,7 @@ def test_multiblock_case_solves_exports_and_refuses_edits(qtbot, win, tmp_path):
     p = win.doc.project
     assert p.multiblock is not None and len(p.blocks) == 6
     win.generate()
-    wait_idle(qtbot, win, timeout=60_000)
+    wait_idle(qtbot, win)
     assert sorted(win.doc.grids) == list(range(6))
     assert all(g.converged for g in win.doc.grids.values())
     assert win.doc.multiblock is not None and len(win.doc.multiblock.grids) == 6  # the document owns it
@@ -553,7 +550,7 @@ def test_cut_lines_split_a_channel_into_blocks(qtbot, win):
     assert p.multiblock is not None and len(p.blocks) == 3
     assert all(b.cell_counts[1] == 8 for b in p.blocks)  # the η count is shared along the chain
     win.generate()
-    wait_idle(qtbot, win, timeout=60_000)
+    wait_idle(qtbot, win)
     g = [win.doc.grids[k] for k in range(3)]
     assert all(x.converged for x in g)
     # interface nodes are identical: each of the two cuts is a side of two blocks, node for node
@@ -580,7 +577,7 @@ def test_control_functions_from_the_panel_match_meshcore(qtbot, win):
     assert ctl["borders"] == {"bottom": {"angle": 90.0, "spacing": 0.05}}
     win.editor.set_solver(method="sor", max_iterations=400)  # enough to show it; keeps the test fast
     win.generate()
-    wait_idle(qtbot, win, timeout=60_000)
+    wait_idle(qtbot, win)
     g = win.doc.grid
     b = win.doc.block
     ref = generate_block(

@@ -13,6 +13,7 @@ import pytest
 from PySide6 import QtGui, QtWidgets
 
 from app import actions, recovery
+from tests.app.waits import wait_for
 
 pytestmark = pytest.mark.gui
 
@@ -60,7 +61,7 @@ def test_autosave_follows_edits_without_being_asked(qtbot, win):
     win.io.open_example("bottle-coarse", confirm=False)
     assert not recovery.exists(path)
     win.editor.set_block_options(weights=(0.25, 0.75))
-    qtbot.waitUntil(lambda: path.exists(), timeout=10_000)  # debounced: shortly after the edit
+    wait_for(qtbot, win, lambda: path.exists())  # debounced: shortly after the edit
     q, _ = recovery.read(path)
     assert q == win.doc.project
     # a long drag: edits keep coming, and the work is saved while they do
@@ -111,7 +112,7 @@ def test_a_bug_in_the_solver_is_logged_with_its_traceback(qtbot, win, caplog, mo
     win.io.open_example("bottle-coarse", confirm=False)
     with caplog.at_level(logging.INFO, logger="app"):
         win.generate()
-        qtbot.waitUntil(lambda: not win.solver.running, timeout=20_000)
+        wait_for(qtbot, win, lambda: not win.solver.running)
     rec = [r for r in caplog.records if r.exc_info and r.exc_info[0] is ZeroDivisionError]
     assert rec and "broken" in "".join(traceback.format_tb(rec[0].exc_info[2]))
     assert "internal error" in win._status.text() and "ZeroDivisionError" in win._status.text()
@@ -133,4 +134,4 @@ def test_autosave_waits_for_the_end_of_a_generate_solve(qtbot, win, monkeypatch)
     win.solver.auto = False
     win.editor.set_block_options(weights=(0.4, 0.6))
     monkeypatch.setattr(win.solver, "state", "idle")
-    qtbot.waitUntil(lambda: len(writes) == 2, timeout=10_000)
+    wait_for(qtbot, win, lambda: len(writes) == 2)
