@@ -163,3 +163,46 @@ def test_a_cut_end_dragged_across_another_cut_is_refused():
     across = moved_parts(parts, end.xy, place(lay, end, (8.0, 2.0), parts), 1e-9)  # past the cut at x = 6
     with pytest.raises(TopologyError, match="block 'a'"):
         moved_layout(lay, across)
+
+
+def _handles_by_scan(layout):
+    """The rule of :func:`handles` written plainly (every candidate against every handle kept): the oracle."""
+    from app.layout_edit import shore_points
+
+    tol = 1e-9 * max(1.0, float(np.sqrt(layout.polygon.area)))
+    cand = [tuple(map(float, p)) for c in layout.cuts for p in (c[0], c[-1])]
+    cand += [tuple(map(float, p)) for b in layout.blocks for p in b.corners]
+    cand += [tuple(map(float, p)) for c in layout.cuts for p in np.asarray(c, float)[1:-1]]
+    cand += [tuple(map(float, p)) for p in shore_points(layout)]
+    out = []
+    for p in cand:
+        if not any(abs(p[0] - q[0]) <= tol and abs(p[1] - q[1]) <= tol for q in out):
+            out.append(p)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_handles_are_those_of_the_plain_scan(seed):
+    """The grid of tol-sized cells finds the same handles as a scan of all (generated lakes)."""
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+
+    for poly in (testing.channel_network(seed), testing.lake_with_islands(seed)):
+        lay = auto_layout(poly, cell_size=float(np.sqrt(poly.area / 1500)), multiple=2)
+        assert [h.xy for h in handles(lay)] == _handles_by_scan(lay)
+
+
+def test_points_within_the_tolerance_across_a_cell_edge_are_one_handle():
+    from types import SimpleNamespace
+
+    from shapely.geometry import Polygon
+
+    poly = Polygon([(0, 0), (4, 0), (4, 1), (0, 1)])
+    tol = 1e-9 * 2.0  # handles' tolerance for this area (4)
+    edge = 1000 * tol  # a cell edge of its grid
+    a, b = (1.0 + edge - 0.3 * tol, 0.5), (1.0 + edge + 0.3 * tol, 0.5 + 0.5 * tol)
+    lay = SimpleNamespace(
+        polygon=poly, cuts=[np.array([(1.0, 0.0), a, (1.0, 1.0)]), np.array([(2.0, 0.0), b, (2.0, 1.0)])], blocks=[]
+    )
+    xy = [h.xy for h in handles(lay)]
+    assert xy == _handles_by_scan(lay) and (a in xy) != (b in xy)
