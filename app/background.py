@@ -77,8 +77,8 @@ class BackgroundController(QtCore.QObject):
         tr = geo.fit_image(w, h, bounds)
         project = self.doc.project.replaced(background=Background(str(path), tr))
         self.win.editor.replace_project(project, "Load background")
-        if bounds is None:
-            self.win.canvas.fit()
+        # the image covers the outline and reaches past it on one side: show all of it
+        self.win.canvas.fit()
         self.win.message("Background loaded: File ▸ Calibrate to place it by two known points, then trace with Draw")
 
     def ask_true_points(self, pair) -> None:

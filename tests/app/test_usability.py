@@ -265,6 +265,19 @@ def test_a_background_is_in_view_after_loading_fitting_and_calibrating(qtbot, wi
     assert _in_view(win, (1000, 5000, 1400, 5200))  # the view follows it to its true place
 
 
+def test_a_background_loaded_over_an_outline_is_all_in_view(qtbot, win, tmp_path):
+    """The image covers the outline's box and reaches past it on one side (a wide image over a
+    tall outline): that side was out of view until Fit view."""
+    for xy in [(0, 0), (10, 0), (10, 100), (0, 100.0)]:
+        win.editor.add_point(xy)
+    win.editor.close_loop()
+    win.canvas.zoom_to((0, 0, 10, 100))
+    win.background.load(str(_image(tmp_path, w=40, h=20)))
+    a, _b, tx, ty = win.doc.project.background.transform
+    assert (tx, ty) == (0.0, 0.0) and a * 40 > 100  # over the outline, 200 wide
+    assert _in_view(win, geo.image_bounds(40, 20, win.doc.project.background.transform))
+
+
 @pytest.mark.parametrize("with_crs", [True, False])
 def test_calibration_by_longitude_and_latitude(qtbot, win, tmp_path, with_crs):
     from pyproj import Transformer
