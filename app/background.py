@@ -88,25 +88,31 @@ class BackgroundController(QtCore.QObject):
             self.win.message("Load a background image first")
             self.win.set_tool("pan")
             return
-        answer = _TrueCoordinatesDialog(self.win, pair, self.doc.project.crs).ask()
+        p = self.doc.project
+        answer = _TrueCoordinatesDialog(self.win, pair, p.crs, p.origin).ask()
         self.win.set_tool("draw")  # first: its tip would hide the outcome in the status bar
         if answer is not None:
-            true, lonlat = answer
+            true, kind = answer
             try:
-                self.calibrate(pair, true, lonlat=lonlat)
+                self.calibrate(pair, true, lonlat=kind == "lonlat", world=kind == "world")
             except (ValueError, MeshcoreError) as exc:
                 self.win.error("Calibration", exc)
 
-    def calibrate(self, shown, true, *, lonlat: bool = False) -> None:
+    def calibrate(self, shown, true, *, lonlat: bool = False, world: bool = False) -> None:
         """Move the background so that the two ``shown`` model points land on ``true``.
 
         With ``lonlat`` the true points are longitude/latitude degrees: they are
         projected to the project's CRS, or, when it has none yet, to the UTM zone
-        of the points, which the project then adopts (one undo step).
+        of the points, which the project then adopts (one undo step).  With ``world``
+        they are projected metres in the project's CRS (easting, northing, as a map's
+        grid gives them), not the model's coordinates relative to its local origin.
         """
         project = self.doc.project
         bg = project.background
-        if lonlat:
+        if world:
+            ox, oy = project.origin
+            true = [(float(x) - ox, float(y) - oy) for x, y in true]
+        elif lonlat:
             local, frame = fio.lonlat_to_local(true, fio.project_frame(project))
             true = [tuple(p) for p in local]
             if not project.crs and frame.crs:
@@ -122,38 +128,60 @@ class BackgroundController(QtCore.QObject):
 
 
 class _TrueCoordinatesDialog(QtWidgets.QDialog):
-    """Asks for the true coordinates of two picked points: model x, y or longitude, latitude."""
+    """Asks for the true coordinates of two picked points: model x, y, projected easting and
+    northing in the project's CRS (when it has one), or longitude, latitude."""
 
-    def __init__(self, parent, pair, crs: str) -> None:
+    def __init__(self, parent, pair, crs: str, origin=(0.0, 0.0)) -> None:
         super().__init__(parent)
         self.setWindowTitle("Calibrate background")
+        self._pair, self._origin = [tuple(map(float, p)) for p in pair], tuple(map(float, origin))
         form = QtWidgets.QFormLayout(self)
-        self.lonlat = QtWidgets.QCheckBox("longitude, latitude (degrees)")
-        self.lonlat.setToolTip(
-            f"projected to the project's {crs}" if crs else "projected to the UTM zone of the two points"
+        self.kind = QtWidgets.QComboBox()
+        self.kind.addItem("model x, y", "model")
+        if crs:
+            self.kind.addItem(f"easting, northing (m, {crs})", "world")
+        self.kind.addItem("longitude, latitude (degrees)", "lonlat")
+        self.kind.setToolTip(
+            f"longitude, latitude: projected to the project's {crs}"
+            if crs
+            else "longitude, latitude: projected to the UTM zone of the two points"
         )
-        form.addRow("Coordinates are", self.lonlat)
+        form.addRow("Coordinates are", self.kind)
         self.edits = []
-        for k, (x, y) in enumerate(pair):
-            ex, ey = QtWidgets.QLineEdit(f"{x:.6g}"), QtWidgets.QLineEdit(f"{y:.6g}")
+        for k in range(2):
+            ex, ey = QtWidgets.QLineEdit(), QtWidgets.QLineEdit()
             row = QtWidgets.QHBoxLayout()
             row.addWidget(ex)
             row.addWidget(ey)
-            form.addRow(f"point {k + 1}: x, y / lon, lat", row)
+            form.addRow(f"point {k + 1}", row)
             self.edits += [ex, ey]
+        self._fill()
+        self.kind.currentIndexChanged.connect(self._fill)
         sb = QtWidgets.QDialogButtonBox.StandardButton
         bb = QtWidgets.QDialogButtonBox(sb.Ok | sb.Cancel)
         bb.accepted.connect(self.accept)
         bb.rejected.connect(self.reject)
         form.addRow(bb)
 
+    def _fill(self, *_args) -> None:
+        """The picked points where they are now, in the frame chosen (blank for lon/lat: unknown)."""
+        kind = self.kind.currentData()
+        shift = self._origin if kind == "world" else (0.0, 0.0)
+        for k, (x, y) in enumerate(self._pair):
+            for e, v, o in ((self.edits[2 * k], x, shift[0]), (self.edits[2 * k + 1], y, shift[1])):
+                e.setText("" if kind == "lonlat" else f"{v + o:.1f}" if kind == "world" else f"{v:.6g}")
+
+    def answer(self):
+        """``(((x0, y0), (x1, y1)), kind)`` as typed, kind "model", "world" or "lonlat" (ValueError: not numbers)."""
+        v = [float(e.text()) for e in self.edits]
+        return ((v[0], v[1]), (v[2], v[3])), self.kind.currentData()
+
     def ask(self):
-        """``(((x0, y0), (x1, y1)), lonlat)``, or None when cancelled or not numbers."""
+        """:meth:`answer` after OK, or None when cancelled or not numbers."""
         if self.exec() != QtWidgets.QDialog.DialogCode.Accepted:
             return None
         try:
-            v = [float(e.text()) for e in self.edits]
+            return self.answer()
         except ValueError as exc:
             self.parent().error("Calibration", exc)
             return None
-        return ((v[0], v[1]), (v[2], v[3])), self.lonlat.isChecked()

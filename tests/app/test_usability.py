@@ -303,6 +303,32 @@ def test_calibration_by_longitude_and_latitude(qtbot, win, tmp_path, with_crs):
     assert win.doc.project.crs == ("EPSG:32632" if with_crs else "")
 
 
+def test_calibration_by_projected_eastings_and_northings(qtbot, win, tmp_path):
+    """A lake project in UTM keeps a local origin: a map's grid gives world metres (E, N), which
+    calibrate the image where it belongs (they were taken as local x, y: 700 km away)."""
+    from app.background import _TrueCoordinatesDialog
+    from app.project import Project
+
+    win.io.set_project(Project(crs="EPSG:32632", origin=(700000.0, 4700000.0), source_crs="EPSG:4326"))
+    win.background.load(str(_image(tmp_path)))
+    a, b, tx, ty = win.doc.project.background.transform
+    shown = [(tx, ty), (a * 40 + tx, b * 40 + ty)]  # pixels (0, 0) and (40, 0) as drawn now
+    dialog = _TrueCoordinatesDialog(win, shown, "EPSG:32632", (700000.0, 4700000.0))
+    kinds = [dialog.kind.itemData(k) for k in range(dialog.kind.count())]
+    assert kinds == ["model", "world", "lonlat"]
+    dialog.kind.setCurrentIndex(1)  # the picked points shown as eastings and northings
+    pair, kind = dialog.answer()
+    assert kind == "world" and pair[0] == pytest.approx((tx + 700000.0, ty + 4700000.0))
+    for e, v in zip(dialog.edits, ("701000", "4705000", "701400", "4705000"), strict=True):
+        e.setText(v)
+    pair, kind = dialog.answer()
+    win.background.calibrate(shown, pair, world=True)
+    a, b, tx, ty = win.doc.project.background.transform
+    assert (tx, ty) == pytest.approx((1000.0, 5000.0)) and complex(a, b) * 40 == pytest.approx(400.0)
+    assert _in_view(win, (1000, 5000, 1400, 5200))
+    assert [_TrueCoordinatesDialog(win, shown, "").kind.itemData(k) for k in range(2)] == ["model", "lonlat"]
+
+
 # ------------------------------------------------------------------ flicker
 def test_a_drag_with_auto_generate_never_shows_the_start_grid(qtbot, win):
     from app.bench import _is_start
