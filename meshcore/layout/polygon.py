@@ -206,7 +206,15 @@ def water_from_points(pointset: Any):
     shell = Polygon(outer).buffer(0)
     islands = []
     for _, name, p in rings[1:]:
-        if not shell.contains(Polygon(p).representative_point()):
+        ring = Polygon(p)
+        if ring.boundary.intersects(shell.boundary):
+            c = ring.boundary.intersection(shell.boundary).representative_point()
+            raise InvalidInputError(
+                f"{pointset.source or 'points'}: {name!r} crosses the shore of {oname!r} near "
+                f"({c.x:.6g}, {c.y:.6g}) — an island must lie inside the shore (a ring that reaches the "
+                f"land is part of the shore: draw it into the outline)"
+            )
+        if not shell.contains(ring.representative_point()):
             raise InvalidInputError(
                 f"{pointset.source or 'points'}: {name!r} lies outside the outline {oname!r} — one lake per "
                 f"file (islands are rings inside the shore)"

@@ -440,8 +440,13 @@ def test_default_cell_size_and_a_one_block_format_refused_before_the_solve(tmp_p
             "5000,0,other\n6000,0,other\n6000,1000,other\n",
             ("bad.csv", "'other'", "outside the outline"),
         ),
+        (  # an island drawn across the shore: named, with the place where it crosses
+            "x,y,ring\n0,0,shore\n4000,0,shore\n4000,2000,shore\n0,2000,shore\n"
+            "3000,800,isle\n4500,800,isle\n4500,1200,isle\n3000,1200,isle\n3000,800,isle\n",
+            ("bad.csv", "'isle' crosses the shore of 'shore' near (4000, 1200)"),
+        ),
     ],
-    ids=["not-a-number", "bow-tie", "second-lake"],
+    ids=["not-a-number", "bow-tie", "second-lake", "island-across-the-shore"],
 )
 def test_bad_outline_file(tmp_path, text, needles):
     f = tmp_path / "bad.csv"
