@@ -38,6 +38,7 @@ from .model import Layout, LayoutBlock
 from .outline import interior_cuts
 from .polygon import water_polygon, without_dense_vertices, without_slivers
 from .shore import shore_at_scale, transfer, without_narrow_arms
+from .widen import widen_starved
 
 __all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
 
@@ -143,23 +144,36 @@ def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bo
         sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal)
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple)
-    blocks = tuple(
-        LayoutBlock(pc.name, tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]), c)
-        for pc, c in zip(pieces, cells, strict=True)
-    )
-    lay = Layout(
-        polygon=poly,
-        cell_size=h,
-        cuts=tuple(interior_cuts(pieces)),  # the lines between blocks (merged strips lose theirs)
-        pieces=tuple(pieces),
-        blocks=blocks,
-        multiple=multiple,
-        skeleton=sk,
-        chords=tuple(chords),
-        notes=tuple(notes) + _cells_note(pieces, cells, h),
-    )
-    _check_case(lay)
-    return lay
+
+    def made(pieces, cells) -> Layout:
+        blocks = tuple(
+            LayoutBlock(pc.name, tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]), c)
+            for pc, c in zip(pieces, cells, strict=True)
+        )
+        lay = Layout(
+            polygon=poly,
+            cell_size=h,
+            cuts=tuple(interior_cuts(pieces)),  # the lines between blocks (merged strips lose theirs)
+            pieces=tuple(pieces),
+            blocks=blocks,
+            multiple=multiple,
+            skeleton=sk,
+            chords=tuple(chords),
+            notes=tuple(notes) + _cells_note(pieces, cells, h),
+        )
+        _check_case(lay)
+        return lay
+
+    if not regular:  # a block starved by its chain's count: a band along its side, the rest apart
+        wider, more = widen_starved(pieces, cells, h, multiple=multiple)
+        if wider is not pieces:
+            from ..errors import TopologyError
+
+            try:
+                return made(wider, more)
+            except TopologyError:
+                pass  # a split the case cannot express: the layout without it
+    return made(pieces, cells)
 
 
 #: Total cells outside this range of area / h² (issue 12's target) get a note naming the block

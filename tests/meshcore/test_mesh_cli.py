@@ -619,7 +619,7 @@ def test_places_in_notes_are_in_the_grids_crs(tmp_path):
     added), as the quality table does: a lon/lat lake whose layout has too few cells."""
     from meshcore import testing
 
-    poly = testing.round_lake(1021, kind="blob")  # a layout with 0.25 × the asked cells
+    poly = testing.round_lake(1021, kind="blob")  # regular: a layout with 0.25 × the asked cells
     lon0, lat0, deg = 10.0, 45.0, 300.0 / 111_320.0  # 1 unit = 300 m
     rings = [np.asarray(r.coords) for r in (poly.exterior, *poly.interiors)]
     kx = deg / math.cos(math.radians(lat0))
@@ -629,7 +629,7 @@ def test_places_in_notes_are_in_the_grids_crs(tmp_path):
     path.write_text(json.dumps({"type": "Feature", "geometry": geom, "properties": {}}))
     water = projected(lonlat, "EPSG:32632")
     h = math.sqrt(water.area / 3000)
-    r = mesh(path, "--cell-size", h, "-o", tmp_path / "g.vtm", "-q")
+    r = mesh(path, "--cell-size", h, "-o", tmp_path / "g.vtm", "-q", "--regular")
     assert r.rc in (0, 3), r.err
     (note,) = [n for n in r.err.splitlines() if "× the cells of the asked size" in n]
     x, y = (float(v) for v in note.split("near (")[1].split(")")[0].split(", "))
