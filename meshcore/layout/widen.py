@@ -30,7 +30,8 @@ import math
 import numpy as np
 
 from ..errors import TopologyError
-from .blocks import Piece, block_counts, conform, weld
+from ..pointindex import point_keys
+from .blocks import Piece, _line_work, block_counts, conform, weld
 
 __all__ = ["STARVED", "widen_starved"]
 
@@ -51,6 +52,10 @@ MIN_TIP = 20.0
 STRAIGHT = 135.0
 #: ... and one sharper than this (a ring turning by more than 70°) must be a corner of it.
 KINK = 110.0
+#: A cut end closer than this many cell sizes to a chain end (a corner, a T-junction) is moved
+#: onto it (``lake_with_islands(5, n_islands=1)``: a cut ending 0.1 cells beside a corner made
+#: a chain of one cell between two of 25, a cross-interface area ratio of 111).
+SNAP = 1.0
 #: Blocks tried per round: the split that brings the blocks' cells nearest their areas wins.
 CANDIDATES = 8
 #: Rounds of splits (each splits one block): a layout has few starved blocks.
@@ -73,9 +78,10 @@ def _ccw(poly) -> np.ndarray:
     return np.asarray(orient(poly, 1.0).exterior.coords)[:-1]
 
 
-def _split(pc: Piece, cells: tuple[int, int], h: float, size: float):
-    """The band-and-rest splits of a starved piece (up to two: along either long side), as
-    ``(band ring, its forced corner points, rest ring, its forced corner points)``."""
+def _split(pc: Piece, cells: tuple[int, int], h: float, size: float, breaks: np.ndarray):
+    """The band-and-rest splits of a starved piece (both widths, either long side), as
+    ``(band ring, its forced corner points, rest ring, its forced corner points)``; ``breaks``:
+    the points where chains end (block corners, T-junctions, cut ends on the shore)."""
     from shapely.geometry import LineString, Polygon
 
     sides = _sides(pc)
@@ -97,6 +103,7 @@ def _split(pc: Piece, cells: tuple[int, int], h: float, size: float):
             cut = _cut_line(P, LineString(sides[s]).buffer(d, quad_segs=16), eps)
             if cut is None:
                 continue
+            cut = _snapped(cut, breaks, SNAP * h)
             res = _rings(pc.ring, sides[s][[0, -1]], cut, eps)
             if res is None:
                 continue
@@ -135,6 +142,19 @@ def _forced(ring: np.ndarray, corners: np.ndarray, cut: np.ndarray, h: float):
 
 def _index(ring: np.ndarray, q: np.ndarray) -> int:
     return int(np.argmin(np.hypot(*(ring - q).T)))
+
+
+def _snapped(cut: np.ndarray, breaks: np.ndarray, tol: float) -> np.ndarray:
+    """The cut with each end moved onto the nearest chain end within ``tol``: a cut ending a
+    hair beside another block's corner would make a chain a fraction of a cell long."""
+    cut = cut.copy()
+    if len(breaks):
+        for e in (0, -1):
+            dist = np.hypot(*(breaks - cut[e]).T)
+            k = int(np.argmin(dist))
+            if dist[k] <= tol:
+                cut[e] = breaks[k]
+    return cut
 
 
 def _cut_line(P, zone, eps: float):
@@ -282,13 +302,16 @@ def widen_starved(pieces: list[Piece], cells: list[tuple[int, int]], h: float, *
         if share.min() >= STARVED and share.max() <= 1.0 / STARVED:
             break
         miss = _miss(pieces, cells, h)
+        ends = _line_work(pieces)[3]  # where chains end
         best = None
         # the starved blocks, and others below their share of cells (a block fed by the first
         # split whose chain overfills a narrow neighbour), the most starved first
         for k in np.argsort(share)[:CANDIDATES]:
             if share[k] >= 1.0:
                 break
-            for band_ring, band_forced, rest_ring, rest_forced in _split(pieces[k], cells[k], h, size):
+            ring = pieces[k].ring
+            breaks = ring[[i for i, q in enumerate(point_keys(ring)) if q in ends]]
+            for band_ring, band_forced, rest_ring, rest_forced in _split(pieces[k], cells[k], h, size, breaks):
                 picked = [_corners(ring, pts, h) for ring, pts in ((band_ring, band_forced), (rest_ring, rest_forced))]
                 if picked[0] is None or picked[1] is None:
                     continue
