@@ -233,13 +233,13 @@ def _pieces(rings: list[np.ndarray], corner_pts: list, size: float) -> list[Piec
     rings = conform(rings, 1e-9 * size)
     if not _clean(rings):
         return None
-    out = []
+    out: list[Piece] = []
     for r, cs in zip(rings, corner_pts, strict=True):
-        idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
-        if len(set(idx)) != 4:
+        a, b, c, d = sorted(int(np.argmin(np.hypot(*(r - q).T))) for q in cs)
+        if len({a, b, c, d}) != 4:
             return None
-        out.append(Piece(r, idx, ""))
-    return [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(out)]
+        out.append(Piece(r, (a, b, c, d), f"b{len(out)}"))
+    return out
 
 
 def _clean(rings: list[np.ndarray]) -> bool:
