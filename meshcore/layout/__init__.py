@@ -16,6 +16,8 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 * :mod:`.frames` — in regular mode, corners re-chosen so that the blocks' index directions
   close up round every island (what Delft3D's domain decomposition needs);
 * :mod:`.counts` — integer cell counts that agree across every interface (a small MILP);
+* :mod:`.widen` — when the counts starve the layout, a block on a chain that widens split into
+  a band and the rest (T-junctions that free the rest's counts);
 * :mod:`.blocks` — the pieces made conforming, their cell counts;
 * :mod:`.build` — the pipeline;
 * :mod:`.model` — :class:`Layout`; :mod:`.outline` — a layout as shore, islands, cuts and
