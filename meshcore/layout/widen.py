@@ -47,10 +47,13 @@ MIN_REST = 0.2
 #: nodes within 3°; 20° leaves room below that, and the grids of every split the generated
 #: lakes made are measured in ``docs/lake-grids.md``.
 MIN_TIP = 20.0
-#: A cut end where a ring turns by less than this (its angle there above 180° minus it) is a
-#: point on one of its sides, not a corner (degrees): the band's side bends there.
+#: A cut end where a ring's angle is above this (degrees; it turns by less than 45°) is a point
+#: on one of its sides, not a corner: the band's side bends there.  45° is where
+#: :func:`~.corners.choose_corners` starts reading a turn as a corner.
 STRAIGHT = 135.0
-#: ... and one sharper than this (a ring turning by more than 70°) must be a corner of it.
+#: ... and a ring with four corners already must not turn by more than 70° at a cut end (an
+#: angle below this): a side that bends that much at one point is a corner in all but name,
+#: its grid lines would kink there.
 KINK = 110.0
 #: A cut end closer than this many cell sizes to a chain end (a corner, a T-junction) is moved
 #: onto it (``lake_with_islands(5, n_islands=1)``: a cut ending 0.1 cells beside a corner made
@@ -70,12 +73,6 @@ def _sides(pc: Piece) -> list[np.ndarray]:
 
 def _length(line: np.ndarray) -> float:
     return float(np.hypot(*np.diff(line, axis=0).T).sum())
-
-
-def _ccw(poly) -> np.ndarray:
-    from shapely.geometry.polygon import orient
-
-    return np.asarray(orient(poly, 1.0).exterior.coords)[:-1]
 
 
 def _split(pc: Piece, cells: tuple[int, int], h: float, size: float, breaks: np.ndarray):
@@ -218,12 +215,6 @@ def _angle_at(ring: np.ndarray, i: int, h: float) -> float:
     a, b = out
     ang = math.degrees(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b))
     return ang % 360.0
-
-
-def _pt(q):
-    from shapely.geometry import Point
-
-    return Point(float(q[0]), float(q[1]))
 
 
 def _pieces(rings: list[np.ndarray], corner_pts: list, size: float) -> list[Piece] | None:
