@@ -24,6 +24,7 @@ from meshcore.io import write
 from meshcore.io.delft3d_dd import read_dd
 from meshcore.layout import auto_layout
 from meshcore.layout.blocks import Piece
+from meshcore.layout.corners import SHARP, _arclength_closed, _raw_turning
 from meshcore.layout.frames import frame_defects
 from tests.meshcore.test_delft3d_dd import node_runs
 
@@ -84,6 +85,41 @@ def test_nearly_every_generated_island_lake_closes_up():
     # before frames.close_frames none did: every one had a ring of blocks turned by a quarter
     still = [e for e in CASES if not _check(e)]
     assert len(still) <= 0.1 * len(CASES), still
+
+
+#: lakes whose closed-up regular layouts at 2000 cells had corners moved beside a cut's end
+#: or an island's tip (and folded cells there) before the moves had to be bends of their own
+MOVED_CASES = ["lake_with_islands(4)", "lake_with_islands(5)"]
+
+
+@pytest.mark.parametrize("expr", MOVED_CASES)
+def test_corners_moved_to_close_the_frames_are_bends_of_their_own(expr):
+    # read at the corners' scale, the vertices beside a sharp bend borrow its turn; a corner
+    # moved there has a straight or reflex angle of its own a fraction of a cell from the bend
+    # (before: own turning -9 to 2°, beside cut ends turning 101-119°)
+    lay = _regular(expr, 2000)
+    assert not frame_defects(list(lay.pieces))
+    sigma = 1.5 * lay.cell_size
+    for pc in lay.pieces:
+        raw = _raw_turning(pc.ring)
+        s, total = _arclength_closed(pc.ring)
+        for c in pc.corners:
+            d = np.abs(s - s[c])
+            beside = raw[np.minimum(d, total - d) <= 0.5 * sigma].max()
+            assert beside <= max(raw[c], SHARP) + 30.0, (pc.name, pc.ring[c], raw[c], beside)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("expr", MOVED_CASES)
+def test_closed_up_regular_grids_have_no_folded_cells(expr):
+    # before: 4 folded cells each, all at corners moved beside a cut's end
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
+
+    lay = _regular(expr, 2000)  # what mesh_outline(..., regular=True) lays out
+    assert not frame_defects(list(lay.pieces))
+    mb = mesh_layout(lay, levels=2)
+    assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
 
 
 # ------------------------------------------------------------------ the holonomy itself
