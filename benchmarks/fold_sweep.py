@@ -10,6 +10,7 @@ the share of nodes within 3°, time::
     python benchmarks/fold_sweep.py                      # every family, 6 seeds each
     python benchmarks/fold_sweep.py --only round,islands --seeds 12 --cells 15000
     python benchmarks/fold_sweep.py --layout-only         # blocks and slivers only (fast)
+    python benchmarks/fold_sweep.py --only islands,round --regular   # Delft3D DD layouts
 
 ``--json FILE`` writes the rows for comparisons between versions.  The cases run in one
 process, one after another (the kernels compile once); an exception is one failed row.
@@ -98,7 +99,7 @@ def sliver_stats(layout) -> tuple[int, float]:
     return few, ang
 
 
-def run_case(poly, cells: int, layout_only: bool) -> dict:
+def run_case(poly, cells: int, layout_only: bool, regular: bool = False) -> dict:
     from meshcore.lakegrid import mesh_layout
     from meshcore.layout import auto_layout
     from meshcore.quality import lake_metrics
@@ -106,7 +107,7 @@ def run_case(poly, cells: int, layout_only: bool) -> dict:
 
     h = math.sqrt(poly.area / cells)
     c0, t0 = time.process_time(), time.perf_counter()
-    lay = auto_layout(poly, cell_size=h, multiple=4)
+    lay = auto_layout(poly, cell_size=h, multiple=4, regular=regular)
     few, ang = sliver_stats(lay)
     row = {"blocks": len(lay.blocks), "fewest_cells": few, "narrowest_deg": round(ang, 1)}
     row["layout_s"] = round(time.perf_counter() - t0, 2)
@@ -142,12 +143,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=6)
     ap.add_argument("--cells", type=int, default=15000)
     ap.add_argument("--layout-only", action="store_true")
+    ap.add_argument("--regular", action="store_true", help="regular layouts (Delft3D domain decomposition)")
     ap.add_argument("--json", help="write the rows here")
     a = ap.parse_args(argv)
     fam = families(a.seeds)
     only = [o.strip() for o in a.only.split(",")] if a.only else None
     rows = []
-    print(f"# fold sweep, {a.cells} cells, load {os.getloadavg()[0]:.1f}", flush=True)
+    print(f"# fold sweep, {a.cells} cells{', regular' if a.regular else ''}, load {os.getloadavg()[0]:.1f}", flush=True)
     print("| case | blocks | fewest cells | narrowest ° | folded | per level | within 3° % | s (CPU) |")
     print("|---|---|---|---|---|---|---|---|", flush=True)
     for name_f, cases in fam.items():
@@ -155,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         for name, build in cases:
             try:
-                r = run_case(build(), a.cells, a.layout_only)
+                r = run_case(build(), a.cells, a.layout_only, a.regular)
             except Exception as exc:
                 r = {"error": f"{type(exc).__name__}: {exc}"[:160]}
                 traceback.print_exc(limit=3)
