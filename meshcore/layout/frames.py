@@ -179,27 +179,28 @@ def _own_turning(ring: np.ndarray, sigma: float, t: np.ndarray, s: np.ndarray, t
     return seen
 
 
-def _candidates(pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float) -> list[tuple[tuple[int, ...], float]]:
+def _candidates(
+    pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float, own: bool = True
+) -> list[tuple[tuple[int, ...], float]]:
     """``(corners, cost)`` of the piece's current corners (0) and of every move of one or two
     corners to other vertices where blocks meet (a cut end, a T) or the shore bends (the rise
     of :func:`~.corners.set_cost`, plus :data:`_CHANGE` per corner).
 
-    A new corner turns by at least :data:`_LEAST_TURN`; the costs are read with the turning the
-    corner cells see (:func:`_own_turning`); shore bends are taken one per ``sigma`` of arc
-    length, the sharpest first.
+    A new corner turns by at least :data:`_LEAST_TURN`; shore bends are taken one per ``sigma``
+    of arc length, the sharpest first; the costs are read with the turning the corner cells
+    see (:func:`_own_turning`; with ``own`` False, the turning at ``sigma``).
     """
     ring = pc.ring
     meet = np.flatnonzero(v.m[ids] >= np.where(v.loop[ids] < 0, 3, 2))
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
     total = s[-1] + float(np.hypot(*(ring[0] - ring[-1])))
     t = turning(ring, sigma)
-    least = t >= _LEAST_TURN
-    t = _own_turning(ring, sigma, t, s, total)
+    seen = _own_turning(ring, sigma, t, s, total) if own else t
 
     def apart(i: int, others) -> bool:
         return all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in others)
 
-    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & least)
+    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & (t >= _LEAST_TURN))
     bends: list[int] = []
     for i in shore[np.argsort(-t[shore])]:
         if apart(int(i), bends):
@@ -207,23 +208,25 @@ def _candidates(pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float) -> list[
         if len(bends) >= _BENDS:
             break
     here = tuple(sorted(pc.corners))
-    now = set_cost(ring, sigma, here, t=t)
+    now = set_cost(ring, sigma, here, t=seen)
     options = {here: 0.0}
-    to = sorted(({int(i) for i in meet if least[i]} | set(bends)) - set(here))
+    to = sorted(({int(i) for i in meet if t[i] >= _LEAST_TURN} | set(bends)) - set(here))
     for k in range(1, _MOVES + 1):
         for a in itertools.combinations(here, k):
             for b in itertools.combinations(to, k):
                 new = tuple(sorted({*here} - {*a} | {*b}))
                 if new not in options:  # what the move costs; one that lowers the cost is no reason to move
-                    options[new] = max(set_cost(ring, sigma, new, t=t) - now, 0.0) + k * _CHANGE
+                    options[new] = max(set_cost(ring, sigma, new, t=seen) - now, 0.0) + k * _CHANGE
     return list(options.items())
 
 
-def close_frames(pieces: list[Piece], sigma: float, *, tries: int = 3) -> Iterator[list[Piece]]:
+def close_frames(pieces: list[Piece], sigma: float, *, tries: int = 3, own: bool = True) -> Iterator[list[Piece]]:
     """The pieces with corners re-chosen so that every island and inner node closes up
     (:func:`frame_defects` empty): up to ``tries`` choices, the one of least corner cost first
     (a caller that cannot count the cells of one takes the next).  Yields nothing when the
-    pieces close already or when no moves of one corner per piece make them close."""
+    pieces close already or when no moves of one corner per piece make them close.  ``own``:
+    corners cost the turning their cells see (:func:`_own_turning`); False: the turning at
+    ``sigma`` (a fallback: its choices close some layouts whose ``own`` ones cannot be counted)."""
     from scipy.optimize import Bounds, LinearConstraint, milp
 
     if not frame_defects(pieces):
@@ -231,7 +234,7 @@ def close_frames(pieces: list[Piece], sigma: float, *, tries: int = 3) -> Iterat
     v = _vertices(pieces)
     bad = {i for d in frame_defects(pieces) if d.kind == "node" for i in v.index.find([d.where]).tolist()}
     movable = [k for k, ids in enumerate(v.index.ids) if (v.loop[ids] > 0).any() or bool(bad & set(ids.tolist()))]
-    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma) for k in movable}
+    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma, own) for k in movable}
     cols = [(k, cs, cost) for k in movable for cs, cost in cand[k]]
     islands = sorted(_island_turns(v))
     nx, nz = len(cols), len(islands)
