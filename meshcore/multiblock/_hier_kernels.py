@@ -145,3 +145,240 @@ def position_classes(el, gid, n_el, n_gid):  # pragma: no cover - compiled
             nc += 1
         out[e] = label[r]
     return out
+
+
+# ------------------------------------------------------------------ per-block tables in one call
+# Blocks given flat: block ``b``'s global ids are ``flat[off[b]:off[b + 1]]``, row-major of shape
+# ``shape[b]`` (node counts).  Each kernel does what a NumPy function does block by block (its
+# reference, named in the docstring), in the same order, so the tables are identical.
+
+
+@njit(cache=True, nogil=True)
+def perimeter_cells(flat, off, shape):  # pragma: no cover - compiled
+    """The CCW cells of every block that touch its border (reference
+    :func:`.nodemap._perimeter_cells`)."""
+    total = 0
+    for b in range(shape.shape[0]):
+        a, c = shape[b, 0] - 1, shape[b, 1] - 1
+        total += a * c if a <= 2 or c <= 2 else 2 * c + 2 * (a - 2)
+    out = np.empty((total, 4), dtype=np.int64)
+    q = 0
+    for b in range(shape.shape[0]):
+        a, c, nj, o = shape[b, 0] - 1, shape[b, 1] - 1, shape[b, 1], off[b]
+        for i in range(a):
+            inner = a > 2 and c > 2 and 0 < i < a - 1
+            for j in range(c):
+                if inner and 0 < j < c - 1:
+                    continue
+                out[q, 0] = flat[o + i * nj + j]
+                out[q, 1] = flat[o + (i + 1) * nj + j]
+                out[q, 2] = flat[o + (i + 1) * nj + j + 1]
+                out[q, 3] = flat[o + i * nj + j + 1]
+                q += 1
+    return out
+
+
+@njit(cache=True, nogil=True)
+def interior_stencils(flat, off, shape):  # pragma: no cover - compiled
+    """``(nodes, nbr)``: every block's interior nodes (row-major, block by block) and their 8
+    neighbours E, W, N, S, NE, NW, SE, SW (reference :func:`.nodemap._interior_stencils`)."""
+    total = 0
+    for b in range(shape.shape[0]):
+        if shape[b, 0] >= 3 and shape[b, 1] >= 3:
+            total += (shape[b, 0] - 2) * (shape[b, 1] - 2)
+    nodes = np.empty(total, dtype=np.int64)
+    nbr = np.empty((total, 8), dtype=np.int64)
+    q = 0
+    for b in range(shape.shape[0]):
+        ni, nj, o = shape[b, 0], shape[b, 1], off[b]
+        if ni < 3 or nj < 3:
+            continue
+        for i in range(1, ni - 1):
+            for j in range(1, nj - 1):
+                p = o + i * nj + j
+                nodes[q] = flat[p]
+                nbr[q, 0] = flat[p + nj]
+                nbr[q, 1] = flat[p - nj]
+                nbr[q, 2] = flat[p + 1]
+                nbr[q, 3] = flat[p - 1]
+                nbr[q, 4] = flat[p + nj + 1]
+                nbr[q, 5] = flat[p - nj + 1]
+                nbr[q, 6] = flat[p + nj - 1]
+                nbr[q, 7] = flat[p - nj - 1]
+                q += 1
+    return nodes, nbr
+
+
+@njit(cache=True, nogil=True)
+def colour_perm(shape, n_rows):  # pragma: no cover - compiled
+    """The 4-colour order of the interior rows (those of :func:`interior_stencils`), then rows
+    ``n_interior … n_rows − 1`` unchanged (reference :func:`.hierarchy._colour_order`)."""
+    order = np.empty(n_rows, dtype=np.int64)
+    q = 0
+    start = 0
+    for b in range(shape.shape[0]):
+        ni, nj = shape[b, 0] - 2, shape[b, 1] - 2
+        if ni < 1 or nj < 1:
+            continue
+        for pi, pj in ((1, 0), (1, 1), (0, 0), (0, 1)):
+            for i in range(pi, ni, 2):
+                for j in range(pj, nj, 2):
+                    order[q] = start + i * nj + j
+                    q += 1
+        start += ni * nj
+    for r in range(start, n_rows):
+        order[q] = r
+        q += 1
+    return order
+
+
+@njit(cache=True, nogil=True)
+def block_lines(flat, off, shape, pos, axis):  # pragma: no cover - compiled
+    """``(rows, ptr)``: every interior line of every block along ``axis`` (0: ξ, i varies) as
+    table rows ``pos[node]`` (reference :func:`.hierarchy._lines`)."""
+    n_rows, n_lines = 0, 0
+    for b in range(shape.shape[0]):
+        ni, nj = shape[b, 0] - 2, shape[b, 1] - 2
+        if ni >= 1 and nj >= 1:
+            n_rows += ni * nj
+            n_lines += nj if axis == 0 else ni
+    rows = np.empty(n_rows, dtype=np.int64)
+    ptr = np.empty(n_lines + 1, dtype=np.int64)
+    ptr[0] = 0
+    q, L = 0, 0
+    for b in range(shape.shape[0]):
+        ni, nj, o, w = shape[b, 0] - 2, shape[b, 1] - 2, off[b], shape[b, 1]
+        if ni < 1 or nj < 1:
+            continue
+        outer, inner = (nj, ni) if axis == 0 else (ni, nj)
+        for s in range(outer):
+            for t in range(inner):
+                i, j = (t, s) if axis == 0 else (s, t)
+                rows[q] = pos[flat[o + (i + 1) * w + j + 1]]
+                q += 1
+            L += 1
+            ptr[L] = q
+    return rows, ptr
+
+
+@njit(cache=True, nogil=True)
+def gather_kept(flat, off, shape, si, si_off, sj, sj_off):  # pragma: no cover - compiled
+    """The ids at the kept positions ``si × sj`` of every block, flat (block ``b``: row-major
+    ``len(si_b) × len(sj_b)``; reference: ``g[np.ix_(si, sj)]`` block by block)."""
+    total = 0
+    for b in range(shape.shape[0]):
+        total += (si_off[b + 1] - si_off[b]) * (sj_off[b + 1] - sj_off[b])
+    out = np.empty(total, dtype=np.int64)
+    q = 0
+    for b in range(shape.shape[0]):
+        nj, o = shape[b, 1], off[b]
+        for a in range(si_off[b], si_off[b + 1]):
+            for c in range(sj_off[b], sj_off[b + 1]):
+                out[q] = flat[o + si[a] * nj + sj[c]]
+                q += 1
+    return out
+
+
+@njit(cache=True, nogil=True)
+def line_elements(flat, off, shape):  # pragma: no cover - compiled
+    """``(el, gid, line_ptr)``: the line positions of every block (block ``b``: its ``ni``
+    positions along ξ, then its ``nj`` along η, numbered on from the last block's) paired with the
+    border nodes on them (bottom, top rows on the ξ positions, left, right on the η ones), and the
+    first position of every line (reference: :func:`.hierarchy.positions_reference`'s pairs)."""
+    nb = shape.shape[0]
+    n_pairs = 0
+    for b in range(nb):
+        n_pairs += 2 * (shape[b, 0] + shape[b, 1])
+    el = np.empty(n_pairs, dtype=np.int64)
+    gid = np.empty(n_pairs, dtype=np.int64)
+    line_ptr = np.empty(2 * nb + 1, dtype=np.int64)
+    line_ptr[0] = 0
+    total, q = 0, 0
+    for b in range(nb):
+        ni, nj, o = shape[b, 0], shape[b, 1], off[b]
+        for i in range(ni):  # bottom (j = 0), then top (j = nj − 1)
+            el[q], gid[q] = total + i, flat[o + i * nj]
+            q += 1
+        for i in range(ni):
+            el[q], gid[q] = total + i, flat[o + i * nj + nj - 1]
+            q += 1
+        for j in range(nj):  # left (i = 0), then right (i = ni − 1)
+            el[q], gid[q] = total + ni + j, flat[o + j]
+            q += 1
+        for j in range(nj):
+            el[q], gid[q] = total + ni + j, flat[o + (ni - 1) * nj + j]
+            q += 1
+        line_ptr[2 * b + 1] = total + ni
+        total += ni + nj
+        line_ptr[2 * b + 2] = total
+    return el, gid, line_ptr
+
+
+@njit(cache=True, nogil=True)
+def keep_classes(cls, line_ptr, n_classes, min_cells):  # pragma: no cover - compiled
+    """The kept (1) and dropped (2) position classes of the next coarser level, line ``L`` being
+    ``cls[line_ptr[L]:line_ptr[L + 1]]``: the ends of every line, every position of a line with
+    fewer than ``2 · min_cells`` cells and a class twice in a row are kept; the rest by
+    :func:`greedy_drop` over the classes' neighbours along the lines (reference
+    :func:`.hierarchy.select_reference`)."""
+    state = np.zeros(n_classes, dtype=np.int64)
+    deg = np.zeros(n_classes + 1, dtype=np.int64)
+    for L in range(line_ptr.shape[0] - 1):
+        a, b = line_ptr[L], line_ptr[L + 1]
+        state[cls[a]] = 1
+        state[cls[b - 1]] = 1
+        short = b - a - 1 < 2 * min_cells
+        for t in range(a, b):
+            if short or (t > a and cls[t] == cls[t - 1]):
+                state[cls[t]] = 1
+        for t in range(a + 1, b):
+            deg[cls[t - 1] + 1] += 1
+            deg[cls[t] + 1] += 1
+    for c in range(n_classes):
+        deg[c + 1] += deg[c]
+    adj = np.empty(deg[n_classes], dtype=np.int64)
+    fill = deg[:-1].copy()
+    for L in range(line_ptr.shape[0] - 1):
+        for t in range(line_ptr[L] + 1, line_ptr[L + 1]):
+            p, q = cls[t - 1], cls[t]
+            adj[fill[p]] = q
+            fill[p] += 1
+            adj[fill[q]] = p
+            fill[q] += 1
+    greedy_drop(cls, line_ptr, deg, adj, state)
+    return state
+
+
+@njit(cache=True, nogil=True)
+def _gradient(s, out):  # pragma: no cover - compiled
+    """``np.gradient`` of the positions ``s`` (one-sided at the ends; 1 for a single one)."""
+    n = s.shape[0]
+    if n < 2:
+        out[:n] = 1.0
+        return
+    out[0] = s[1] - s[0]
+    out[n - 1] = s[n - 1] - s[n - 2]
+    for k in range(1, n - 1):
+        out[k] = (s[k + 1] - s[k - 1]) / 2.0
+
+
+@njit(cache=True, nogil=True)
+def fas_scale(coarse_flat, coarse_off, si, si_off, sj, sj_off, n):  # pragma: no cover - compiled
+    """The FAS scaling ``2 a² b² / (a² + b²)`` of every coarse node (``a, b``: the gradients of the
+    kept positions along ξ and η; a node of several blocks takes the last block's; reference
+    :func:`.hierarchy.scale_reference`)."""
+    scale = np.zeros(n)
+    for b in range(si_off.shape[0] - 1):
+        s_i = si[si_off[b] : si_off[b + 1]].astype(np.float64)
+        s_j = sj[sj_off[b] : sj_off[b + 1]].astype(np.float64)
+        gi = np.empty(s_i.shape[0])
+        gj = np.empty(s_j.shape[0])
+        _gradient(s_i, gi)
+        _gradient(s_j, gj)
+        ncj, o = s_j.shape[0], coarse_off[b]
+        for i in range(s_i.shape[0]):
+            a2 = gi[i] * gi[i]
+            for j in range(ncj):
+                b2 = gj[j] * gj[j]
+                scale[coarse_flat[o + i * ncj + j]] = 2.0 * a2 * b2 / (a2 + b2)
+    return scale

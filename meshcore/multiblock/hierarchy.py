@@ -35,6 +35,7 @@ FAS scaling of the restricted defect: in index units ``A = −N/(2(α+γ))`` wit
 from __future__ import annotations
 
 import hashlib
+import itertools
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -45,7 +46,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from . import _hier_kernels as _typed_hk
-from .nodemap import solver_tables
+from .nodemap import flat_ids, solver_tables
 from .topology import MultiBlockTopology
 
 #: The numba kernels (``Any``: mypy's numba stubs reject some calls).
@@ -101,11 +102,20 @@ class Level:
 
 
 def _colour_order(ids: tuple[np.ndarray, ...], args: tuple, n_interior: int) -> tuple:
+    """The table ``args`` with every block's interior rows in 4-colour order (one compiled call,
+    :func:`._hier_kernels.colour_perm`; see :func:`colour_order_reference`)."""
+    shape = np.array([g.shape for g in ids], dtype=np.int64).reshape(-1, 2)
+    order = _hk.colour_perm(shape, len(args[0]))
+    return (np.ascontiguousarray(args[0][order]), np.ascontiguousarray(args[1][order]), *args[2:])
+
+
+def colour_order_reference(ids: tuple[np.ndarray, ...], args: tuple, n_interior: int) -> tuple:
     """The table ``args`` with every block's interior rows in 4-colour order (the parity of
     ``(i, j)``: even ``i`` before odd, in each row parity odd ``j`` before even, then
     lexicographic), the border rows unchanged.  No two nodes of one colour are in each other's
     9-point stencil, so consecutive updates of a point sweep do not wait for each other (a
-    lexicographic sweep is one long chain of dependent divisions: 1.5× slower, measured)."""
+    lexicographic sweep is one long chain of dependent divisions: 1.5× slower, measured).
+    NumPy reference of :func:`_colour_order`."""
     perm, off = [], 0
     for g in ids:
         if g.shape[0] < 3 or g.shape[1] < 3:
@@ -159,7 +169,22 @@ def near_reference(args: tuple, seed: np.ndarray, width: int) -> np.ndarray:
 
 def _lines(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tuple, tuple]:
     """``(along ξ, along η)``, each ``(rows, ptr, axis)``: every interior line of every block as
-    table rows (interior nodes only; the lines end next to the block borders)."""
+    table rows, one compiled call per direction (:func:`._hier_kernels.block_lines`; see
+    :func:`lines_reference`)."""
+    pos = np.full(n, -1, dtype=np.int64)
+    pos[nodes] = np.arange(len(nodes))
+    flat, off, shape = flat_ids(ids)
+    out = []
+    for ax in (0, 1):
+        rows, ptr = _hk.block_lines(flat, off, shape, pos, ax)
+        out.append((rows, ptr, np.full(len(ptr) - 1, ax, dtype=np.int64)))
+    return out[0], out[1]
+
+
+def lines_reference(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tuple, tuple]:
+    """``(along ξ, along η)``, each ``(rows, ptr, axis)``: every interior line of every block as
+    table rows (interior nodes only; the lines end next to the block borders).  NumPy reference
+    of :func:`_lines`."""
     pos = np.full(n, -1, dtype=np.int64)
     pos[nodes] = np.arange(len(nodes))
     inner = [pos[g[1:-1, 1:-1]] for g in ids if g.shape[0] > 2 and g.shape[1] > 2]
@@ -209,7 +234,22 @@ def positions_reference(ids: tuple[np.ndarray, ...]) -> np.ndarray:
 
 def select(ids: tuple[np.ndarray, ...]) -> list | None:
     """The kept positions ``[(si, sj), ...]`` of every block for the next coarser level, or None
-    (see the module docstring)."""
+    (see the module docstring; compiled: :func:`._hier_kernels.keep_classes`, reference
+    :func:`select_reference`)."""
+    flat, off, shape = flat_ids(ids)
+    el, gid, line_ptr = _hk.line_elements(flat, off, shape)
+    comp = _hk.position_classes(el, gid, int(line_ptr[-1]), int(gid.max()) + 1)
+    state = _hk.keep_classes(comp, line_ptr, int(comp.max()) + 1, MIN_CELLS)
+    if (state != 2).all():
+        return None
+    kept = state[comp] != 2
+    spans = [np.flatnonzero(kept[a:b]) for a, b in itertools.pairwise(line_ptr.tolist())]
+    return list(zip(spans[0::2], spans[1::2], strict=True))
+
+
+def select_reference(ids: tuple[np.ndarray, ...]) -> list | None:
+    """:func:`select` with the classes' neighbours in a scipy matrix (reference of
+    :func:`._hier_kernels.keep_classes`)."""
     lines, comp = _positions(ids)
     nc = int(comp.max()) + 1
     forced = np.zeros(nc, dtype=bool)
@@ -264,6 +304,13 @@ def _block_interp(shape: tuple[int, int], si: np.ndarray, sj: np.ndarray) -> tup
     return fine.ravel()[keep], coarse.ravel()[keep], w.ravel()[keep]
 
 
+def _offsets(parts: list) -> np.ndarray:
+    """``[0, len(parts[0]), len(parts[0]) + len(parts[1]), …]`` (int64)."""
+    off = np.zeros(len(parts) + 1, dtype=np.int64)
+    np.cumsum([len(p) for p in parts], out=off[1:])
+    return off
+
+
 def _transfers(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarray]:
     """``(P, R, rsum)`` over the global node arrays (see the module docstring).
 
@@ -296,7 +343,19 @@ def _transfers(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarray]:
 
 
 def _scale(coarse: Level) -> np.ndarray:
-    """FAS scaling of the restricted defect per coarse node (module docstring; α = γ)."""
+    """FAS scaling of the restricted defect per coarse node (module docstring; α = γ), one
+    compiled call (:func:`._hier_kernels.fas_scale`; reference :func:`scale_reference`)."""
+    si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
+    flat = np.concatenate([g.ravel() for g in coarse.ids]).astype(np.int64, copy=False)
+    coarse_off = _offsets([g.ravel() for g in coarse.ids])
+    return _hk.fas_scale(
+        flat, coarse_off, np.concatenate(si).astype(np.int64), _offsets(si), np.concatenate(sj).astype(np.int64),
+        _offsets(sj), coarse.n,
+    )  # fmt: skip
+
+
+def scale_reference(coarse: Level) -> np.ndarray:
+    """FAS scaling of the restricted defect per coarse node, block by block (reference of :func:`_scale`)."""
     scale = np.zeros(coarse.n)
     for gc, (si, sj) in zip(coarse.ids, coarse.sel, strict=True):
         a2 = _gradient(si)[:, None] ** 2
@@ -322,12 +381,15 @@ def _coarser(lv: Level) -> Level | None:
     sel = select(lv.ids)
     if sel is None:
         return None
-    sub = [g[np.ix_(si, sj)] for g, (si, sj) in zip(lv.ids, sel, strict=True)]
-    inj, inv = np.unique(np.concatenate([s.ravel() for s in sub]), return_inverse=True)
+    si, sj = [s[0] for s in sel], [s[1] for s in sel]
+    si_off, sj_off = _offsets(si), _offsets(sj)
+    kept = _hk.gather_kept(*flat_ids(lv.ids), np.concatenate(si), si_off, np.concatenate(sj), sj_off)
+    inj, inv = np.unique(kept, return_inverse=True)  # kept: g[np.ix_(si, sj)] of every block
     if len(inj) > MAX_KEEP * lv.n:
         return None
-    cuts = np.cumsum([s.size for s in sub])[:-1]
-    ids = tuple(part.reshape(s.shape).astype(np.int64) for part, s in zip(np.split(inv, cuts), sub, strict=True))
+    inv = inv.astype(np.int64, copy=False)
+    cut = np.concatenate([[0], np.cumsum(np.diff(si_off) * np.diff(sj_off))])
+    ids = tuple(inv[a:b].reshape(len(i), len(j)) for a, b, i, j in zip(cut[:-1], cut[1:], si, sj, strict=True))
     args, n_interior = solver_tables(ids, len(inj))
     co = _level(ids, len(inj), args, n_interior)
     co.sel, co.inj = tuple(sel), inj.astype(np.int64)

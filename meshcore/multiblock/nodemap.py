@@ -22,6 +22,10 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import TopologyError
+from . import _hier_kernels as _typed_hk
+
+#: The numba kernels (``Any``: mypy's numba stubs reject some calls).
+_hk: Any = _typed_hk
 
 __all__ = ["Corner", "NodeMap", "border_index", "build_node_map"]
 
@@ -271,19 +275,17 @@ def node_xy(blocks: Sequence[Any], ids: Sequence[np.ndarray], n: int) -> tuple[f
 def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
     """``(args, n_interior)``: the table arguments ``(nodes, nbr, irr_nodes, irr_ptr, irr_ring)`` of
     blocks given only by their global ids (a multigrid coarse level); ``nodes[:n_interior]`` are
-    block-interior nodes."""
+    block-interior nodes.  The per-block tables come from one compiled call each
+    (:mod:`._hier_kernels`; references :func:`_perimeter_cells`, :func:`_interior_stencils`)."""
     ids = tuple(ids)
-    cells, boundary = _perimeter_cells(ids), _side_boundary(ids, n_nodes)
-    occ = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n_nodes)  # a block's ids are unique
-    nodes_l, nbr_l = _interior_stencils(ids)
+    flat, off, shape = flat_ids(ids)
+    cells, boundary = _hk.perimeter_cells(flat, off, shape), _side_boundary(ids, n_nodes)
+    occ = np.bincount(flat, minlength=n_nodes)  # a block's ids are unique
+    int_nodes, int_nbr = _hk.interior_stencils(flat, off, shape)
     border_free = np.flatnonzero(~boundary & (occ > 1))
     reg_n, reg_nb, irr_n, irr_ptr, irr_ring = _border_stencils(cells, border_free, str)
-    n_interior = int(sum(len(c) for c in nodes_l))
-    if reg_n:
-        nodes_l.append(np.array(reg_n, dtype=np.int64))
-        nbr_l.append(np.array(reg_nb, dtype=np.int64).reshape(-1, 8))
-    nodes = np.concatenate(nodes_l).astype(np.int64) if nodes_l else np.zeros(0, np.int64)
-    nbr = np.vstack(nbr_l).astype(np.int64) if nbr_l else np.zeros((0, 8), np.int64)
+    nodes = np.concatenate([int_nodes, np.array(reg_n, dtype=np.int64)])
+    nbr = np.vstack([int_nbr, np.array(reg_nb, dtype=np.int64).reshape(-1, 8)])
     args = (
         np.ascontiguousarray(nodes),
         np.ascontiguousarray(nbr),
@@ -291,7 +293,17 @@ def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
         np.array(irr_ptr, dtype=np.int64),
         np.array(irr_ring, dtype=np.int64),
     )
-    return args, n_interior
+    return args, len(int_nodes)
+
+
+def flat_ids(ids: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(flat, off, shape)``: the blocks' global ids in one array (block ``b`` row-major at
+    ``flat[off[b]:off[b + 1]]``, node counts ``shape[b]``), as the kernels of :mod:`._hier_kernels` take them."""
+    flat = np.concatenate([np.ravel(g) for g in ids]).astype(np.int64, copy=False)
+    shape = np.array([g.shape for g in ids], dtype=np.int64).reshape(-1, 2)
+    off = np.zeros(len(ids) + 1, dtype=np.int64)
+    np.cumsum(shape[:, 0] * shape[:, 1], out=off[1:])
+    return flat, off, shape
 
 
 def _perimeter_cells(ids: Sequence[np.ndarray]) -> np.ndarray:

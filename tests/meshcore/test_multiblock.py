@@ -944,6 +944,59 @@ def test_setup_kernels_match_their_references(make, rect):
         assert np.array_equal(state, expect) and (state == 2).any() and (state == 1).any()
 
 
+@pytest.mark.kernel
+@pytest.mark.parametrize("make", ["star5", "odd", "network", "islands", "spiral"])
+def test_level_table_kernels_match_their_numpy_references(make):
+    """The per-block tables of every level built in one compiled call each (perimeter cells,
+    interior stencils, 4-colour order, block lines, the choice of kept positions, FAS scaling,
+    kept ids) equal the block-by-block NumPy references: 5-block corners, odd counts, thin blocks
+    and generated lake layouts."""
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock import _hier_kernels, hierarchy, nodemap
+    from meshcore.testing import channel_network, lake_with_islands, spiral
+
+    if make == "star5":
+        topo = star(5, 9)
+    elif make == "odd":
+        topo = two_blocks(*curved_rectangle(45, 13), 17)
+    else:
+        shape = {"network": channel_network(3, n_branches=4), "islands": lake_with_islands(1), "spiral": spiral()}
+        topo = auto_layout(shape[make], target_cells=3000, multiple=4).topology()
+    lvs = hierarchy.levels(topo)
+    assert len(lvs) >= 2
+    thin = 0
+    for k, lv in enumerate(lvs):
+        flat, off, shape = nodemap.flat_ids(lv.ids)
+        thin += int((shape.min(axis=1) <= 3).sum())
+        assert np.array_equal(_hier_kernels.perimeter_cells(flat, off, shape), nodemap._perimeter_cells(lv.ids))
+        nodes_l, nbr_l = nodemap._interior_stencils(lv.ids)
+        nodes, nbr = _hier_kernels.interior_stencils(flat, off, shape)
+        assert np.array_equal(nodes, np.concatenate(nodes_l)) and np.array_equal(nbr, np.vstack(nbr_l))
+        args, n_int = nodemap.solver_tables(lv.ids, lv.n) if k else ((lv.args[0], lv.args[1]), topo.node_map.n_interior)
+        if k:  # the finest level's table comes from the node map, already in colour order
+            got = hierarchy._colour_order(lv.ids, args, n_int)
+            want = hierarchy.colour_order_reference(lv.ids, args, n_int)
+            assert all(np.array_equal(a, b) for a, b in zip(got, want, strict=True))
+        for (r1, p1, a1), (r2, p2, a2) in zip(
+            hierarchy._lines(lv.ids, lv.args[0], lv.n), hierarchy.lines_reference(lv.ids, lv.args[0], lv.n), strict=True
+        ):
+            assert np.array_equal(r1, r2) and np.array_equal(p1, p2) and np.array_equal(a1, a2)
+        want_sel, got_sel = hierarchy.select_reference(lv.ids), hierarchy.select(lv.ids)
+        assert (want_sel is None) == (got_sel is None)
+        for (a1, b1), (a2, b2) in zip(want_sel or [], got_sel or [], strict=True):
+            assert np.array_equal(a1, a2) and np.array_equal(b1, b2)
+        if k:
+            assert np.array_equal(hierarchy._scale(lv), hierarchy.scale_reference(lv))
+            fine = lvs[k - 1]
+            want_inj = np.unique(
+                np.concatenate([g[np.ix_(si, sj)].ravel() for g, (si, sj) in zip(fine.ids, lv.sel, strict=True)])
+            )
+            assert np.array_equal(lv.inj, want_inj)
+            for g, gc, (si, sj) in zip(fine.ids, lv.ids, lv.sel, strict=True):
+                assert np.array_equal(lv.inj[gc], g[np.ix_(si, sj)])
+    assert thin or make in ("star5", "odd")  # the layouts' coarse levels have blocks with one interior line
+
+
 def test_band_is_the_nodes_two_stencil_steps_from_the_boundary():
     """The smoother's boundary band holds exactly the regular free nodes whose 8-point stencil
     reaches a fixed node within BAND_WIDTH steps (breadth-first search over the stencils)."""
