@@ -382,3 +382,102 @@ def fas_scale(coarse_flat, coarse_off, si, si_off, sj, sj_off, n):  # pragma: no
                 b2 = gj[j] * gj[j]
                 scale[coarse_flat[o + i * ncj + j]] = 2.0 * a2 * b2 / (a2 + b2)
     return scale
+
+
+@njit(cache=True, nogil=True)
+def transfer_csr(rows, cols, vals, n_fine, n_coarse, fine_free, coarse_free):  # pragma: no cover
+    """``P`` and ``R`` in CSR from the COO entries of :func:`interp_coo` (reference
+    :func:`.hierarchy.transfers_reference`, scipy): ``P`` sums the entries of a (row, column)
+    pair, columns ascending, rows of fixed fine nodes empty; ``rsum`` are the column sums of
+    ``P`` (fine rows ascending), and ``R = D⁻¹ Pᵀ`` with the rows of fixed coarse nodes empty.
+    Returns ``(p_ptr, p_idx, p_val, r_ptr, r_idx, r_val, rsum)``."""
+    nnz = rows.shape[0]
+    ptr = np.zeros(n_fine + 1, dtype=np.int64)
+    for q in range(nnz):
+        ptr[rows[q] + 1] += 1
+    for r in range(n_fine):
+        ptr[r + 1] += ptr[r]
+    idx = np.empty(nnz, dtype=np.int64)
+    val = np.empty(nnz)
+    fill = ptr[:-1].copy()
+    for q in range(nnz):
+        p = fill[rows[q]]
+        idx[p] = cols[q]
+        val[p] = vals[q]
+        fill[rows[q]] += 1
+    # each row: columns ascending (insertion sort: a row has at most 4 entries per block), the
+    # entries of one column summed, compacted into p_*
+    p_ptr = np.zeros(n_fine + 1, dtype=np.int64)
+    p_idx = np.empty(nnz, dtype=np.int64)
+    p_val = np.empty(nnz)
+    q = 0
+    for r in range(n_fine):
+        a, b = ptr[r], ptr[r + 1]
+        for t in range(a + 1, b):
+            ci, cv = idx[t], val[t]
+            u = t - 1
+            while u >= a and idx[u] > ci:
+                idx[u + 1] = idx[u]
+                val[u + 1] = val[u]
+                u -= 1
+            idx[u + 1] = ci
+            val[u + 1] = cv
+        t = a
+        while t < b:
+            ci, s = idx[t], val[t]
+            t += 1
+            while t < b and idx[t] == ci:
+                s += val[t]
+                t += 1
+            p_idx[q] = ci
+            p_val[q] = s
+            q += 1
+        p_ptr[r + 1] = q
+    # the transpose (fine rows ascending in every coarse row) and its row sums
+    r_ptr = np.zeros(n_coarse + 1, dtype=np.int64)
+    rsum = np.zeros(n_coarse)
+    for t in range(q):
+        r_ptr[p_idx[t] + 1] += 1
+    for c in range(n_coarse):
+        r_ptr[c + 1] += r_ptr[c]
+    t_idx = np.empty(q, dtype=np.int64)
+    t_val = np.empty(q)
+    fill = r_ptr[:-1].copy()
+    for r in range(n_fine):
+        for t in range(p_ptr[r], p_ptr[r + 1]):
+            c = p_idx[t]
+            t_idx[fill[c]] = r
+            t_val[fill[c]] = p_val[t]
+            fill[c] += 1
+    for c in range(n_coarse):
+        s = 0.0
+        for t in range(r_ptr[c], r_ptr[c + 1]):
+            s += t_val[t]
+        rsum[c] = s
+    # R: rows of fixed coarse nodes dropped, the rest scaled by 1 / rsum
+    out_ptr = np.zeros(n_coarse + 1, dtype=np.int64)
+    out_idx = np.empty(q, dtype=np.int64)
+    out_val = np.empty(q)
+    k = 0
+    for c in range(n_coarse):
+        if coarse_free[c]:
+            inv = 1.0 / (rsum[c] if rsum[c] > 0 else 1.0)
+            for t in range(r_ptr[c], r_ptr[c + 1]):
+                v = t_val[t] * inv
+                if v != 0.0:
+                    out_idx[k] = t_idx[t]
+                    out_val[k] = v
+                    k += 1
+        out_ptr[c + 1] = k
+    # P: rows of fixed fine nodes dropped
+    f_ptr = np.zeros(n_fine + 1, dtype=np.int64)
+    k2 = 0
+    for r in range(n_fine):
+        if fine_free[r]:
+            for t in range(p_ptr[r], p_ptr[r + 1]):
+                if p_val[t] != 0.0:
+                    p_idx[k2] = p_idx[t]
+                    p_val[k2] = p_val[t]
+                    k2 += 1
+        f_ptr[r + 1] = k2
+    return f_ptr, p_idx[:k2].copy(), p_val[:k2].copy(), out_ptr, out_idx[:k].copy(), out_val[:k].copy(), rsum

@@ -311,27 +311,47 @@ def _offsets(parts: list) -> np.ndarray:
     return off
 
 
+def _interp_coo(fine: Level, coarse: Level) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """COO ``(rows, cols, vals)`` of the prolongation, every block's entries weighted by ``1/mult``
+    (:func:`._hier_kernels.interp_coo`)."""
+    si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
+    return _hk.interp_coo(
+        *flat_ids(fine.ids),
+        np.concatenate([g.ravel() for g in coarse.ids]).astype(np.int64, copy=False),
+        _offsets([g.ravel() for g in coarse.ids]),
+        np.concatenate(si).astype(np.int64),
+        _offsets(si),
+        np.concatenate(sj).astype(np.int64),
+        _offsets(sj),
+        fine.mult,
+    )
+
+
 def _transfers(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarray]:
     """``(P, R, rsum)`` over the global node arrays (see the module docstring).
 
     Every block that holds a shared fine node gives it the same row (interface values come from
     interface values only), so summing each block's rows weighted by ``1/mult`` gives that row
+    once: ``P``; the restriction is its transpose normalised by the row sums.  The sparse
+    matrices are assembled in one compiled call (:func:`._hier_kernels.transfer_csr`; reference
+    :func:`transfers_reference`).
+    """
+    r, c, v = _interp_coo(fine, coarse)
+    pp, pi, pv, rp, ri, rv, rsum = _hk.transfer_csr(r, c, v, fine.n, coarse.n, fine.free, coarse.free)
+    P = sp.csr_matrix((pv, pi, pp), shape=(fine.n, coarse.n))
+    R = sp.csr_matrix((rv, ri, rp), shape=(coarse.n, fine.n))
+    return P, R, rsum
+
+
+def transfers_reference(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarray]:
+    """:func:`_transfers` with scipy's sparse conversions (reference of
+    :func:`._hier_kernels.transfer_csr`).
+
+    Every block that holds a shared fine node gives it the same row (interface values come from
+    interface values only), so summing each block's rows weighted by ``1/mult`` gives that row
     once: ``P``; the restriction is its transpose normalised by the row sums.
     """
-    off = lambda parts: np.concatenate([[0], np.cumsum([len(p) for p in parts])]).astype(np.int64)  # noqa: E731
-    si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
-    r, c, v = _hk.interp_coo(
-        np.concatenate([g.ravel() for g in fine.ids]),
-        off([g.ravel() for g in fine.ids]),
-        np.array([g.shape for g in fine.ids], dtype=np.int64),
-        np.concatenate([g.ravel() for g in coarse.ids]),
-        off([g.ravel() for g in coarse.ids]),
-        np.concatenate(si).astype(np.int64),
-        off(si),
-        np.concatenate(sj).astype(np.int64),
-        off(sj),
-        fine.mult,
-    )
+    r, c, v = _interp_coo(fine, coarse)
     P = sp.csr_matrix((v, (r, c)), shape=(fine.n, coarse.n))
     Pt = P.T.tocsr()
     rsum = np.asarray(Pt.sum(axis=1)).ravel()

@@ -949,7 +949,7 @@ def test_setup_kernels_match_their_references(make, rect):
 def test_level_table_kernels_match_their_numpy_references(make):
     """The per-block tables of every level built in one compiled call each (perimeter cells,
     interior stencils, 4-colour order, block lines, the choice of kept positions, FAS scaling,
-    kept ids) equal the block-by-block NumPy references: 5-block corners, odd counts, thin blocks
+    kept ids, sparse transfers) equal the block-by-block NumPy references: 5-block corners, odd counts, thin blocks
     and generated lake layouts."""
     from meshcore.layout import auto_layout
     from meshcore.multiblock import _hier_kernels, hierarchy, nodemap
@@ -988,6 +988,13 @@ def test_level_table_kernels_match_their_numpy_references(make):
         if k:
             assert np.array_equal(hierarchy._scale(lv), hierarchy.scale_reference(lv))
             fine = lvs[k - 1]
+            got_t, want_t = hierarchy._transfers(fine, lv), hierarchy.transfers_reference(fine, lv)
+            for a, b in zip(got_t[:2], want_t[:2], strict=True):
+                assert a.shape == b.shape
+                assert all(
+                    np.array_equal(u, w) for u, w in ((a.indptr, b.indptr), (a.indices, b.indices), (a.data, b.data))
+                )
+            assert np.array_equal(got_t[2], want_t[2])
             want_inj = np.unique(
                 np.concatenate([g[np.ix_(si, sj)].ravel() for g, (si, sj) in zip(fine.ids, lv.sel, strict=True)])
             )
