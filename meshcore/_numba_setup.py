@@ -58,6 +58,7 @@ KERNEL_MODULES = (
     "multiblock/_kernels.py",
     "multiblock/_mg_fused.py",
     "multiblock/_hier_kernels.py",
+    "multiblock/_start_kernels.py",
     "foldfree/_kernels.py",
     "orthogonal/_kernels.py",
 )

@@ -6,10 +6,14 @@ from typing import Any
 
 import numpy as np
 
-from ..algebraic import algebraic_grid
+from ..algebraic import _frame, algebraic_grid
 from ..boundary import Borders
 from ..grid import StructuredGrid
+from . import _start_kernels as _typed_sk
 from .topology import MultiBlockTopology
+
+#: The numba kernel (``Any``: mypy's numba stubs reject some calls).
+_sk: Any = _typed_sk
 
 __all__ = ["initial_grids", "snapped_borders"]
 
@@ -50,9 +54,16 @@ def snapped_borders(topology: MultiBlockTopology) -> list:
 
 
 def initial_grids(topology: MultiBlockTopology) -> list[StructuredGrid]:
-    """Algebraic start grid of each block from its (snapped) borders."""
+    """Algebraic start grid of each block from its (snapped) borders (``initial = "tfi"``: one
+    compiled call per block, :func:`._start_kernels.tfi_fill`, the grid of
+    :func:`meshcore.algebraic.tfi`)."""
     out = []
     for b, bd in zip(topology.blocks, snapped_borders(topology), strict=True):
-        g = algebraic_grid(bd, b.initial, weights=b.weights)
-        out.append(g.replaced(names=dict(b.names)))
+        if b.initial == "tfi":
+            x, y = _frame(bd)
+            _sk.tfi_fill(x, y)
+            out.append(StructuredGrid(x, y, names=dict(b.names)))
+        else:
+            g = algebraic_grid(bd, b.initial, weights=b.weights)
+            out.append(g.replaced(names=dict(b.names)))
     return out

@@ -1004,6 +1004,36 @@ def test_level_table_kernels_match_their_numpy_references(make):
     assert thin or make in ("star5", "odd")  # the layouts' coarse levels have blocks with one interior line
 
 
+@pytest.mark.kernel
+@pytest.mark.parametrize("make", ["star5", "network", "islands", "spiral"])
+def test_compiled_start_grids_equal_the_numpy_tfi(make):
+    """The start grids of a multiblock solve (one compiled call per block) are the NumPy
+    transfinite interpolation of meshcore.algebraic, bit for bit; a block asking for the paper's
+    weighted average still gets it."""
+    import dataclasses
+
+    from meshcore.algebraic import tfi, weighted_average
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock.start import initial_grids, snapped_borders
+    from meshcore.testing import channel_network, lake_with_islands, spiral
+
+    if make == "star5":
+        topo = star(5, 9)
+    else:
+        shape = {"network": channel_network(3, n_branches=4), "islands": lake_with_islands(1), "spiral": spiral()}
+        topo = auto_layout(shape[make], target_cells=3000, multiple=4).topology()
+    assert all(b.initial == "tfi" for b in topo.blocks)
+    got = initial_grids(topo)
+    for g, b, bd in zip(got, topo.blocks, snapped_borders(topo), strict=True):
+        want = tfi(bd)
+        assert np.array_equal(g.x, want.x) and np.array_equal(g.y, want.y) and g.names == dict(b.names)
+    blocks = (dataclasses.replace(topo.blocks[0], initial="weighted"), *topo.blocks[1:])
+    mixed = MultiBlockTopology(blocks, topo.interfaces, check_geometry=False)
+    g0 = initial_grids(mixed)[0]
+    want = weighted_average(snapped_borders(mixed)[0], blocks[0].weights)
+    assert np.array_equal(g0.x, want.x) and np.array_equal(g0.y, want.y)
+
+
 def test_band_is_the_nodes_two_stencil_steps_from_the_boundary():
     """The smoother's boundary band holds exactly the regular free nodes whose 8-point stencil
     reaches a fixed node within BAND_WIDTH steps (breadth-first search over the stencils)."""
