@@ -8,8 +8,6 @@ the same order, so the grids are identical (test oracle: :func:`meshcore.algebra
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
@@ -23,7 +21,7 @@ def _arc_fraction(x, y, out):  # pragma: no cover - compiled
     n = x.shape[0]
     out[0] = 0.0
     for k in range(1, n):
-        out[k] = out[k - 1] + math.hypot(x[k] - x[k - 1], y[k] - y[k - 1])
+        out[k] = out[k - 1] + np.hypot(x[k] - x[k - 1], y[k] - y[k - 1])  # C hypot, as NumPy (not Python's math.hypot)
     total = out[n - 1]
     if total > 0:
         for k in range(n):
