@@ -26,12 +26,13 @@ from ._validation import validate_choice, validate_fraction
 from .boundary import Borders
 from .grid import StructuredGrid
 
-__all__ = ["INITIAL_METHODS", "algebraic_grid", "tfi", "weighted_average"]
+__all__ = ["INITIAL_METHODS", "algebraic_grid", "border_frame", "tfi", "weighted_average"]
 
 INITIAL_METHODS = ("weighted", "tfi")
 
 
-def _frame(borders: Borders) -> tuple[np.ndarray, np.ndarray]:
+def border_frame(borders: Borders) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, y)`` node arrays of a block with the border nodes set (the interior uninitialised)."""
     ni, nj = borders.check_counts()
     x = np.empty((ni + 1, nj + 1))
     y = np.empty((ni + 1, nj + 1))
@@ -47,7 +48,7 @@ def weighted_average(borders: Borders, weights: tuple[float, float] = (0.5, 0.5)
     """The paper's algebraic grid (eq. 34) with ``weights = (p13_x, p13_y)``."""
     px = validate_fraction(weights[0], name="weight p13_x")
     py = validate_fraction(weights[1], name="weight p13_y")
-    x, y = _frame(borders)
+    x, y = border_frame(borders)
     ni, nj = x.shape[0] - 1, x.shape[1] - 1
     i = np.arange(ni + 1)[:, None] / ni
     j = np.arange(nj + 1)[None, :] / nj
@@ -65,7 +66,7 @@ def _arc_fraction(p: np.ndarray) -> np.ndarray:
 
 def tfi(borders: Borders) -> StructuredGrid:
     """Linear transfinite interpolation with arc-length blending (Soni)."""
-    x, y = _frame(borders)
+    x, y = border_frame(borders)
     sb = _arc_fraction(borders.bottom)[:, None]
     st = _arc_fraction(borders.top)[:, None]
     tl = _arc_fraction(borders.left)[None, :]

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from ..algebraic import _frame, algebraic_grid
+from ..algebraic import algebraic_grid, border_frame
 from ..boundary import Borders
 from ..grid import StructuredGrid
 from . import _start_kernels as _typed_sk
@@ -60,7 +60,7 @@ def initial_grids(topology: MultiBlockTopology) -> list[StructuredGrid]:
     out = []
     for b, bd in zip(topology.blocks, snapped_borders(topology), strict=True):
         if b.initial == "tfi":
-            x, y = _frame(bd)
+            x, y = border_frame(bd)
             _sk.tfi_fill(x, y)
             out.append(StructuredGrid(x, y, names=dict(b.names)))
         else:
