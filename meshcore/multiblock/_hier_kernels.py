@@ -385,6 +385,26 @@ def fas_scale(coarse_flat, coarse_off, si, si_off, sj, sj_off, n):  # pragma: no
 
 
 @njit(cache=True, nogil=True)
+def _bucket(keys, other, vals, n):  # pragma: no cover
+    """The entries ``(other[q], vals[q])`` grouped by ``keys[q] ∈ [0, n)``, in their order within
+    a group (a counting sort): ``(ptr, idx, val)``, group ``k`` at ``ptr[k]:ptr[k + 1]``."""
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    for q in range(keys.shape[0]):
+        ptr[keys[q] + 1] += 1
+    for k in range(n):
+        ptr[k + 1] += ptr[k]
+    idx = np.empty(keys.shape[0], dtype=np.int64)
+    val = np.empty(keys.shape[0])
+    fill = ptr[:-1].copy()
+    for q in range(keys.shape[0]):
+        j = fill[keys[q]]
+        idx[j] = other[q]
+        val[j] = vals[q]
+        fill[keys[q]] += 1
+    return ptr, idx, val
+
+
+@njit(cache=True, nogil=True)
 def transfer_csr(rows, cols, vals, n_fine, n_coarse, fine_free, coarse_free):  # pragma: no cover
     """``P`` and ``R`` in CSR from the COO entries of :func:`interp_coo` (reference
     :func:`.hierarchy.transfers_reference`, scipy): ``P`` sums the entries of a (row, column)
@@ -392,19 +412,7 @@ def transfer_csr(rows, cols, vals, n_fine, n_coarse, fine_free, coarse_free):  #
     ``P`` (fine rows ascending), and ``R = D⁻¹ Pᵀ`` with the rows of fixed coarse nodes empty.
     Returns ``(p_ptr, p_idx, p_val, r_ptr, r_idx, r_val, rsum)``."""
     nnz = rows.shape[0]
-    ptr = np.zeros(n_fine + 1, dtype=np.int64)
-    for q in range(nnz):
-        ptr[rows[q] + 1] += 1
-    for r in range(n_fine):
-        ptr[r + 1] += ptr[r]
-    idx = np.empty(nnz, dtype=np.int64)
-    val = np.empty(nnz)
-    fill = ptr[:-1].copy()
-    for q in range(nnz):
-        p = fill[rows[q]]
-        idx[p] = cols[q]
-        val[p] = vals[q]
-        fill[rows[q]] += 1
+    ptr, idx, val = _bucket(rows, cols, vals, n_fine)
     # each row: columns ascending (insertion sort: a row has at most 4 entries per block), the
     # entries of one column summed, compacted into p_*
     p_ptr = np.zeros(n_fine + 1, dtype=np.int64)
@@ -434,21 +442,11 @@ def transfer_csr(rows, cols, vals, n_fine, n_coarse, fine_free, coarse_free):  #
             q += 1
         p_ptr[r + 1] = q
     # the transpose (fine rows ascending in every coarse row) and its row sums
-    r_ptr = np.zeros(n_coarse + 1, dtype=np.int64)
-    rsum = np.zeros(n_coarse)
-    for t in range(q):
-        r_ptr[p_idx[t] + 1] += 1
-    for c in range(n_coarse):
-        r_ptr[c + 1] += r_ptr[c]
-    t_idx = np.empty(q, dtype=np.int64)
-    t_val = np.empty(q)
-    fill = r_ptr[:-1].copy()
+    p_row = np.empty(q, dtype=np.int64)
     for r in range(n_fine):
-        for t in range(p_ptr[r], p_ptr[r + 1]):
-            c = p_idx[t]
-            t_idx[fill[c]] = r
-            t_val[fill[c]] = p_val[t]
-            fill[c] += 1
+        p_row[p_ptr[r] : p_ptr[r + 1]] = r
+    r_ptr, t_idx, t_val = _bucket(p_idx[:q], p_row, p_val[:q], n_coarse)
+    rsum = np.zeros(n_coarse)
     for c in range(n_coarse):
         s = 0.0
         for t in range(r_ptr[c], r_ptr[c + 1]):
