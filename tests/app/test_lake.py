@@ -364,18 +364,14 @@ def test_an_open_line_on_the_shore_is_not_an_island_in_the_app_either(qtbot, win
     assert said == [f"{src.name}: {notes[0]}"]
 
 
-def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtbot, win, monkeypatch):
+def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtbot, win):
     """The lake grid is made coarse to fine: the convergence plot marks where each level begins
     (every live snapshot before a mark has the coarser level's cells, every one after it the
     finer's).  Cells coloured by a metric: the preset's misses are hidden (they would cover the
     colours), View ▸ Preset misses (Q) brings them back as thin rings; no colouring, dots again."""
-    import app.solver_controller as controller
     from app.document import DEVIATION
     from app.pipeline import ALL_BLOCKS
 
-    # live frames from the start: a coarse lake on a quiet machine is solved within
-    # FIRST_FRAME_DELAY, and then shows only its final grid (a clean clone's CI saw no snapshot)
-    monkeypatch.setattr(controller, "FIRST_FRAME_DELAY", 0.0)
     seen = []  # (sweep, cells of all blocks) of every live snapshot
     win.solver.progress.connect(
         lambda k, snap: (
