@@ -37,13 +37,6 @@ log = logging.getLogger(__name__)
 DRAW_BUDGET = 0.15
 #: The longest gap between two live frames of such a solve (seconds).
 MAX_FRAME_GAP = 1.0
-#: The first live frame of such a solve comes this long after Generate (seconds): a solve that
-#: ends sooner shows only its final grid.  The start grid drawn at once and the frames of the
-#: first cycles cost the GUI thread about as much CPU time as a 7-block lake's whole solve
-#: (shasta-multiblock-fine: 65 ms of GUI thread against 70 ms of solver, measured), and on a
-#: busy machine that time is taken from the solver; 0.1 s is about where a wait starts to be
-#: noticed, so a longer solve still shows its grid moving from the start.
-FIRST_FRAME_DELAY = 0.1
 
 
 def _run(run_id, project, warm, stop_event, smooth):
@@ -156,8 +149,7 @@ class SolverController(QtCore.QObject):
         self._worker = worker
         self.t_start = time.perf_counter()
         self._gap = self.frame_interval
-        first = 0.0 if self.auto else FIRST_FRAME_DELAY  # live editing: the 1st frame at once
-        self._last_flush, self._gui_cpu = self.t_start + first - self._gap, time.thread_time()
+        self._last_flush, self._gui_cpu = self.t_start - self._gap, time.thread_time()  # 1st frame at once
         self._proc_cpu = time.process_time()
         self._set_state("running")
         worker.start()
@@ -336,7 +328,7 @@ class SolverController(QtCore.QObject):
             self._set_state("idle")
             self.finished.emit(None)
             return
-        self._dirty = False  # the final grids below replace the latest snapshot: no frame of it
+        self._flush()
         grids = dict(self.doc.grids)
         grids.update(result.grids)
         initial = dict(self.doc.initial)

@@ -351,25 +351,6 @@ def test_a_drag_with_auto_generate_never_shows_the_start_grid(qtbot, win):
     assert win.doc.grid.converged
 
 
-def test_a_generate_that_ends_before_the_first_frame_draws_only_the_final_grid(qtbot, win, monkeypatch):
-    """A solve started by Generate draws its first live frame FIRST_FRAME_DELAY after the start
-    (the start grid and the first cycles' frames took the GUI thread as much CPU time as a short
-    solve); one that ends sooner draws once, its final grid (not the latest snapshot, then the
-    final grid).  With auto-generate the first frame comes at once (a drag's frames:
-    test_a_drag_with_auto_generate_never_shows_the_start_grid)."""
-    import app.solver_controller as controller
-
-    monkeypatch.setattr(controller, "FIRST_FRAME_DELAY", 3600.0)
-    win.io.open_example("shasta-multiblock-coarse", confirm=False)
-    shown = []
-    win.doc.grids_changed.connect(lambda: shown.append(dict(win.doc.grids)))
-    with qtbot.waitSignal(win.solver.finished, timeout=120_000):
-        win.generate()
-    assert len(shown) == 1  # one frame: the final grids
-    assert win.doc.multiblock is not None and win.doc.multiblock.converged
-    assert all(shown[0][k] is g for k, g in enumerate(win.doc.multiblock.grids))
-
-
 def test_typed_cells_survive_setting_corners(qtbot, win):
     square = [(0, 0), (4, 0), (8, 0), (8, 2), (4, 2), (0, 2.0)]
     for xy in square:
