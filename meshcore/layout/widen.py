@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import TopologyError
 from ..pointindex import point_keys
+from ..segments import nearest_on_polyline
 from .blocks import Piece, _line_work, block_counts, conform, weld
 
 __all__ = ["STARVED", "widen_starved"]
@@ -168,11 +169,7 @@ def _cut_line(P, zone, eps: float):
 
 def _insert(ring: np.ndarray, q: np.ndarray, eps: float) -> tuple[np.ndarray, int]:
     """``ring`` with the point ``q`` (on one of its edges) inserted, and its index."""
-    a, b = ring, np.roll(ring, -1, axis=0)
-    d = b - a
-    t = np.clip(np.einsum("ij,ij->i", q - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
-    dist = np.hypot(*(a + t[:, None] * d - q).T)
-    k = int(np.argmin(dist))
+    k = nearest_on_polyline(ring, q, closed=True)[1]
     if np.hypot(*(ring[k] - q)) <= eps:
         return ring, k
     if np.hypot(*(ring[(k + 1) % len(ring)] - q)) <= eps:
