@@ -248,15 +248,19 @@ def place_chords(
                     score[np.abs(s - s[i]) < L / 3.0] = np.inf
         for i, kind in picks:
             chords.append(Chord(k, float(s[i]), ends[i].copy(), kind))
-    # drop chords that cross or crowd an earlier one (junction and tip chords first)
+    # drop chords that cross or crowd an earlier one (junction and tip chords first).  Two
+    # chords crowd each other when they come closer than a quarter of the SHORTER one: the
+    # zone between them is at most as wide as that chord's channel.  (A quarter of the chord
+    # being placed dropped the long chord across a wide lobe whose end came near a narrow
+    # arm's chord at a blunt notch: the lobe then went into the junction's block, one side
+    # wrapped round the whole lobe, and the grid left the shore by 1.6 cells.)
     order = {"passage": 0, "junction": 1, "tip": 2, "ring": 3, "middle": 4}
     chords.sort(key=lambda c: order[c.kind])
     kept: list[Chord] = []
     lines: list = []
     for c in chords:
         ls = LineString(c.points)
-        r = 0.25 * math.hypot(*(c.points[1] - c.points[0]))
-        if any(ls.distance(o) < r for o in lines):
+        if any(ls.distance(o) < 0.25 * min(ls.length, o.length) for o in lines):
             continue
         kept.append(c)
         lines.append(ls)
