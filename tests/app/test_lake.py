@@ -254,10 +254,19 @@ def test_export_como_to_delft3d_dd_and_vtm(qtbot, win, tmp_path):
 
 
 def test_a_ddb_that_delft3d_cannot_couple_says_what_to_do(qtbot, win, tmp_path):
-    lay_out(qtbot, win, LAKES / "lake_como_sparse.geojson", cell_size=300.0)
+    """A symmetric Y gets a star at its junction (three blocks meet at a node), which Delft3D's
+    domain decomposition cannot couple: export says so and offers the regular layout.  (Como
+    at 300 m was used here until its default layout became one Delft3D can couple.)"""
+    from meshcore import testing
+
+    shore = 1000.0 * np.asarray(testing.y_junction().exterior.coords)[:-1]  # metres, not degrees
+    src = tmp_path / "y.csv"
+    np.savetxt(src, shore, delimiter=",", header="x,y", comments="")
+    lay_out(qtbot, win, src, cell_size=100.0)
+    m = win.doc.project.layout.topology().node_map
+    assert any(c.valence == 3 for c in m.corners)  # the star
     out = tmp_path / "x.ddb"
-    if win.io.export_mesh(out):
-        pytest.skip("this layout can be coupled by Delft3D")  # meshcore's layout improved
+    assert not win.io.export_mesh(out)
     assert not out.exists()
     assert "regular" in win._status.text()
     win.a_auto_layout_regular.trigger()
