@@ -122,6 +122,43 @@ def test_closed_up_regular_grids_have_no_folded_cells(expr):
     assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
 
 
+#: a lake whose closed-up regular layout at 15 000 cells gave one block two sides a fraction of a
+#: cell long: close_frames moved its two outer-shore corners onto an island's tip, one vertex
+#: beside the cut's end there (a 4 x 92 block with sides of 0.35 and 0.9 cells; 51 folded cells)
+SHORT_CASE = ("lake_with_islands(28)", 15000)
+
+
+def _short_sides(lay) -> list[tuple[str, float]]:
+    """``(block, length in cells)`` of every block side shorter than the corners' scale."""
+    h = lay.cell_size
+    out = []
+    for pc in lay.pieces:
+        s, total = _arclength_closed(pc.ring)
+        pos = s[sorted(pc.corners)]
+        for L in np.diff(np.r_[pos, pos[0] + total]):
+            if L / h < 1.5:
+                out.append((pc.name, float(L / h)))
+    return out
+
+
+def test_closing_the_frames_gives_no_block_two_sides_a_fraction_of_a_cell_long():
+    lay = _regular(*SHORT_CASE)
+    assert not frame_defects(list(lay.pieces))
+    names = [b for b, _ in _short_sides(lay)]
+    assert all(names.count(b) < 2 for b in names), _short_sides(lay)
+
+
+@pytest.mark.slow
+def test_closed_up_regular_grid_of_a_lake_with_islands_has_no_folded_cells_at_15000_cells():
+    # before: 51 folded cells at the island's tip where a block had two sides under a cell long
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
+
+    lay = _regular(*SHORT_CASE)
+    mb = mesh_layout(lay, levels=2)
+    assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
+
+
 # ------------------------------------------------------------------ the holonomy itself
 def _square_ring(extra: bool) -> list[Piece]:
     """Four trapezoids round a square island (an O-grid ring); with ``extra`` the first one has
