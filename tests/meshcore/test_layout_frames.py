@@ -122,10 +122,12 @@ def test_closed_up_regular_grids_have_no_folded_cells(expr):
     assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
 
 
-#: a lake whose closed-up regular layout at 15 000 cells gave one block two sides a fraction of a
-#: cell long: close_frames moved its two outer-shore corners onto an island's tip, one vertex
-#: beside the cut's end there (a 4 x 92 block with sides of 0.35 and 0.9 cells; 51 folded cells)
-SHORT_CASE = ("lake_with_islands(28)", 15000)
+#: lakes whose closed-up regular layouts at 15 000 cells gave one block two sides a fraction of a
+#: cell long: in (28) close_frames moved a block's two outer-shore corners onto an island's tip,
+#: one vertex beside the cut's end there (a 4 x 92 block with sides of 0.35 and 0.9 cells; 51
+#: folded cells, at main d234237; (8): 2 folded cells then, and still two short sides after the
+#: chords' crowding rule changed in 9582621)
+SHORT_CASES = [("lake_with_islands(28)", 15000), ("lake_with_islands(8)", 15000)]
 
 
 def _short_sides(lay) -> list[tuple[str, float]]:
@@ -141,20 +143,22 @@ def _short_sides(lay) -> list[tuple[str, float]]:
     return out
 
 
-def test_closing_the_frames_gives_no_block_two_sides_a_fraction_of_a_cell_long():
-    lay = _regular(*SHORT_CASE)
+@pytest.mark.parametrize("case", SHORT_CASES)
+def test_closing_the_frames_gives_no_block_two_sides_a_fraction_of_a_cell_long(case):
+    lay = _regular(*case)
     assert not frame_defects(list(lay.pieces))
     names = [b for b, _ in _short_sides(lay)]
     assert all(names.count(b) < 2 for b in names), _short_sides(lay)
 
 
 @pytest.mark.slow
-def test_closed_up_regular_grid_of_a_lake_with_islands_has_no_folded_cells_at_15000_cells():
-    # before: 51 folded cells at the island's tip where a block had two sides under a cell long
+@pytest.mark.parametrize("case", SHORT_CASES)
+def test_closed_up_regular_grid_of_a_lake_with_islands_has_no_folded_cells_at_15000_cells(case):
+    # before (d234237): 51 and 2 folded cells, where a block had two sides under a cell long
     from meshcore.lakegrid import mesh_layout
     from meshcore.quality import lake_metrics
 
-    lay = _regular(*SHORT_CASE)
+    lay = _regular(*case)
     mb = mesh_layout(lay, levels=2)
     assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
 
