@@ -13,7 +13,7 @@ both give the same iterates (the test oracle compares them).
 
 Level ``k`` holds its node values ``x, y, f_x, f_y, r_x, r_y, v_x, v_y``
 (``v``: the injected finer values a coarse level started from), its table
-(``nodes, nbr``, irregular nodes, the block lines along ξ then along η), and on
+(``nodes, nbr``, irregular nodes, the block lines along ξ then along η, their rows gathered), and on
 a coarse level the injection, the FAS scaling, the free-node mask and the
 transfers: ``P`` (finer × this level) and ``R`` (this level × finer), CSR.
 """
@@ -46,7 +46,8 @@ __all__ = ["META_COLS", "vcycle"]
     C_IRRN,
     C_IRRP,
     C_RING,
-    C_ROWS,
+    C_LNODES,  # the line tables (nodes, neighbour rows in line order; ξ then η)
+    C_LNBR,
     C_LPTR,
     C_LAXIS,
     C_INJ,
@@ -68,8 +69,8 @@ __all__ = ["META_COLS", "vcycle"]
     C_SCALE,
     C_PVAL,
     C_RVAL,
-) = range(38)
-META_COLS = 38
+) = range(39)
+META_COLS = 39
 
 
 @njit(cache=True, nogil=True)
@@ -88,7 +89,8 @@ def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover -
     irr_n = ib[m[C_IRRN] : m[C_IRRN] + m[C_NIRR]]
     irr_p = ib[m[C_IRRP] : m[C_IRRP] + m[C_NIRR] + 1]
     ring = ib[m[C_RING] : m[C_RING] + m[C_NRING]]
-    rows = ib[m[C_ROWS] : m[C_ROWS] + m[C_NROWS]]
+    lnodes = ib[m[C_LNODES] : m[C_LNODES] + m[C_NROWS]]
+    lnbr = ib[m[C_LNBR] : m[C_LNBR] + 8 * m[C_NROWS]].reshape((m[C_NROWS], 8))
     lptr = ib[m[C_LPTR] : m[C_LPTR] + m[C_NL] + 1]
     axis = ib[m[C_LAXIS] : m[C_LAXIS] + m[C_NL]]
     nl0, nint = m[C_NL0], m[C_NINT]
@@ -98,9 +100,9 @@ def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover -
     for step in range(steps):
         table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_n, irr_p, ring, 1.0)
         if step % 2 == 0:
-            line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[: nl0 + 1], axis[:nl0])
+            line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, lptr[: nl0 + 1], axis[:nl0])
         else:
-            line_sweep_rhs(x, y, fx, fy, nodes, nbr, rows, lptr[nl0:], axis[nl0:])
+            line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, lptr[nl0:], axis[nl0:])
         for _ in range(border_sweeps):
             table_sweep_rhs(x, y, fx, fy, nodes[nint:], nbr[nint:], irr_n, irr_p, ring, 1.0)
         for _ in range(band_sweeps):

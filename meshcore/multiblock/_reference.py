@@ -35,8 +35,9 @@ def jacobi_targets(x, y, nodes, nbr, irr_nodes, irr_ptr, irr_ring):
 
 
 def line_sweep(x, y, fx, fy, nodes, nbr, rows, ptr, axis):
-    """One line Gauss–Seidel sweep (reference of :func:`._kernels.line_sweep_rhs`): line by
-    line, the tridiagonal system with coefficients frozen at the current values, solved densely."""
+    """One line Gauss–Seidel sweep (reference of :func:`._kernels.line_sweep_rhs`, which takes the
+    table rows ``rows`` gathered, ``nodes[rows], nbr[rows]``): line by line, the tridiagonal
+    system with coefficients frozen at the current values, solved densely."""
     x, y = np.array(x, dtype=float), np.array(y, dtype=float)
     for L in range(len(ptr) - 1):
         ks = rows[ptr[L] : ptr[L + 1]]

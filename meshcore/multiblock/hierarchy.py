@@ -84,7 +84,7 @@ class Level:
     n: int
     free: np.ndarray  # bool
     mult: np.ndarray  # in how many blocks each node is
-    lines: tuple  # ((rows, ptr, axis) along ξ, along η): block lines relaxed as lines (:func:`_lines`)
+    lines: tuple  # ((nodes, nbr, ptr, axis) along ξ, along η): block lines relaxed as lines (:func:`_line_tables`)
     border: tuple  # table arguments of the free border nodes only
     band: tuple  # table arguments of the regular nodes near the fixed boundary (:func:`_band`)
     sel: tuple = ()  # coarse level: per block (si, sj), the finer block indices kept
@@ -135,7 +135,7 @@ def _level(ids: tuple[np.ndarray, ...], n: int, args: tuple, n_interior: int) ->
     free[args[2]] = True
     mult = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n).astype(float)
     border = (args[0][n_interior:], args[1][n_interior:], *args[2:])
-    return Level(ids, args, n, free, mult, _lines(ids, args[0], n), border, _band(args, free))
+    return Level(ids, args, n, free, mult, _line_tables(ids, args, n), border, _band(args, free))
 
 
 def _band(args: tuple, free: np.ndarray) -> tuple:
@@ -179,6 +179,16 @@ def _lines(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tupl
         rows, ptr = _hk.block_lines(flat, off, shape, pos, ax)
         out.append((rows, ptr, np.full(len(ptr) - 1, ax, dtype=np.int64)))
     return out[0], out[1]
+
+
+def _line_tables(ids: tuple[np.ndarray, ...], args: tuple, n: int) -> tuple[tuple, tuple]:
+    """``(along ξ, along η)``, each ``(nodes, nbr, ptr, axis)``: the table rows of :func:`_lines`
+    gathered in line order, the form :func:`._kernels.line_sweep_rhs` reads in sequence."""
+    nodes, nbr = args[0], args[1]
+    return tuple(  # type: ignore[return-value]
+        (np.ascontiguousarray(nodes[rows]), np.ascontiguousarray(nbr[rows]), ptr, axis)
+        for rows, ptr, axis in _lines(ids, nodes, n)
+    )
 
 
 def lines_reference(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tuple, tuple]:

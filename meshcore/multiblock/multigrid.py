@@ -116,8 +116,7 @@ def _smooth(lv: Level, x, y, fx, fy, steps: int) -> None:
     border and band sweeps."""
     for step in range(steps):
         _kernels.table_sweep_rhs(x, y, fx, fy, *lv.args, 1.0)
-        rows, ptr, axis = lv.lines[step % 2]
-        _kernels.line_sweep_rhs(x, y, fx, fy, lv.args[0], lv.args[1], rows, ptr, axis)
+        _kernels.line_sweep_rhs(x, y, fx, fy, *lv.lines[step % 2])
         for _ in range(BORDER_SWEEPS):
             _kernels.table_sweep_rhs(x, y, fx, fy, *lv.border, 1.0)
         for _ in range(BAND_SWEEPS):
@@ -184,7 +183,7 @@ def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     for k, lv in enumerate(lvs):
         nodes, nbr, irr_n, irr_p, ring = lv.args
-        (rx, px, ax), (ry, py, ay) = lv.lines
+        (nx, bx, px, ax), (ny, by, py, ay) = lv.lines
         meta[k, [F.C_N, F.C_NREG, F.C_NINT, F.C_NIRR, F.C_NRING]] = (
             lv.n,
             len(nodes),
@@ -192,11 +191,12 @@ def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             len(irr_n),
             len(ring),
         )
-        meta[k, [F.C_NROWS, F.C_NL0, F.C_NL]] = len(rx) + len(ry), len(px) - 1, len(px) + len(py) - 2
+        meta[k, [F.C_NROWS, F.C_NL0, F.C_NL]] = len(nx) + len(ny), len(px) - 1, len(px) + len(py) - 2
         for col, a in ((F.C_NODES, nodes), (F.C_NBR, nbr), (F.C_IRRN, irr_n), (F.C_IRRP, irr_p), (F.C_RING, ring)):
             put(col, a)
-        put(F.C_ROWS, np.concatenate([rx, ry]))
-        put(F.C_LPTR, np.concatenate([px, py[1:] + len(rx)]))
+        put(F.C_LNODES, np.concatenate([nx, ny]))
+        put(F.C_LNBR, np.concatenate([bx, by]))
+        put(F.C_LPTR, np.concatenate([px, py[1:] + len(nx)]))
         put(F.C_LAXIS, np.concatenate([ax, ay]))
         meta[k, F.C_NBAND] = len(lv.band[0])
         put(F.C_BNODES, lv.band[0])

@@ -858,7 +858,9 @@ def test_grow_near_matches_numpy_reference():
 
 @pytest.mark.kernel
 def test_line_kernel_matches_numpy_reference():
-    """line_sweep_rhs equals tridiagonal solves line by line (NumPy), with and without f."""
+    """line_sweep_rhs (rows gathered in line order) equals tridiagonal solves line by line over
+    the table rows (NumPy), with and without f."""
+    from meshcore.multiblock import hierarchy
     from meshcore.multiblock.hierarchy import levels
 
     X, Y = curved_rectangle(20, 9)
@@ -871,12 +873,13 @@ def test_line_kernel_matches_numpy_reference():
         x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
     x += 0.01 * rng.standard_normal(x.size) * ~m.boundary
     lv = levels(topo)[0]
+    rows = hierarchy._lines(lv.ids, lv.args[0], lv.n)
     for f in (np.zeros(0), 1e-3 * rng.standard_normal(m.n_nodes)):
         fy = f[::-1].copy() if f.size else f
-        for lines in lv.lines:
+        for table, lines in zip(rows, lv.lines, strict=True):
             xk, yk = x.copy(), y.copy()
-            xr, yr = _reference.line_sweep(x, y, f, fy, lv.args[0], lv.args[1], *lines)
-            d = _kernels.line_sweep_rhs(xk, yk, f, fy, lv.args[0], lv.args[1], *lines)
+            xr, yr = _reference.line_sweep(x, y, f, fy, lv.args[0], lv.args[1], *table)
+            d = _kernels.line_sweep_rhs(xk, yk, f, fy, *lines)
             assert np.allclose(xk, xr, rtol=0, atol=1e-13) and np.allclose(yk, yr, rtol=0, atol=1e-13)
             assert d == pytest.approx(np.hypot(xr - x, yr - y).max(), rel=1e-9)
             assert np.array_equal(xk[m.boundary], x[m.boundary])
