@@ -93,7 +93,7 @@ class Level:
     rsum: np.ndarray | None = None  # row sums of Pᵀ (restriction normalisation)
     P: Any = None  # prolongation from this (coarse) level to the finer one (sparse)
     R: Any = None  # restriction D⁻¹ Pᵀ from the finer level to this one (sparse)
-    packed: Any = None  # finest level: the hierarchy in the flat buffers of the fused cycle
+    packed: Any = None  # finest level: {depth: the first depth levels in the flat buffers of the fused cycle}
 
     @property
     def shapes(self) -> list[tuple[int, int]]:

@@ -221,8 +221,10 @@ def _cycle(lvs: list[Level], k: int, x, y, fx, fy) -> None:
     """One V-cycle from level ``k`` in one compiled call (:func:`._mg_fused.vcycle`)."""
     lv0 = lvs[0]
     if lv0.packed is None:
-        lv0.packed = pack(lvs)
-    fb, ib, meta = lv0.packed
+        lv0.packed = {}
+    if len(lvs) not in lv0.packed:  # one packing per depth (the solver may retry with fewer levels)
+        lv0.packed[len(lvs)] = pack(lvs)
+    fb, ib, meta = lv0.packed[len(lvs)]
     m, n = meta[k], lvs[k].n
     F = _typed_fused
     for col, a in ((F.C_X, x), (F.C_Y, y), (F.C_FX, fx), (F.C_FY, fy)):

@@ -819,6 +819,58 @@ def test_layout_hierarchy_stops_before_levels_that_barely_coarsen(make):
         assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-6 * topo.size
 
 
+def test_auto_retries_multigrid_with_one_level_fewer_before_sor(monkeypatch, rect):
+    """engine="auto": a multigrid that is slow with its whole hierarchy starts over from the start
+    grid with the coarsest level dropped (solver.RETRY_FEWER_LEVELS), and only then falls back
+    to SOR; the cycles of both attempts are counted."""
+    from meshcore.multiblock import multigrid, solver
+    from meshcore.multiblock.hierarchy import levels
+
+    X, Y = curved_rectangle(64, 32)
+    topo = four_blocks(X, Y, 32, 16)
+    depth = len(levels(topo))
+    assert depth >= 3
+    real, seen = multigrid.iterate_fas, []
+
+    def slow_when_deep(x, y, topo_, tol, max_cycles, give_up_rate=None, lvs=None):
+        seen.append(len(lvs))
+        if len(lvs) == depth:  # two cycles, then "slow"
+            yield 1, 1.0
+            yield 2, 0.9
+            return 2, 0.9, [(0, 1.0), (1, 1.0), (2, 0.9)], "slow", depth
+        return (yield from real(x, y, topo_, tol, max_cycles, give_up_rate, lvs))
+
+    monkeypatch.setattr(multigrid, "iterate_fas", slow_when_deep)
+    mb = solve_multiblock(topo, tolerance=1e-10)
+    assert seen == [depth, depth - 1]
+    assert mb.converged and mb.info.method == f"smooth/multigrid({depth - 1} levels)"
+    h = mb.info.residual_history
+    assert [i for i, _ in h] == list(range(len(h))) and mb.info.iterations == len(h) - 1 > 2
+    ref = solve_multiblock(topo, tolerance=1e-10, engine="multigrid")
+    for g, k in zip(mb, ref, strict=True):
+        assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-7 * topo.size
+    seen.clear()  # no retry for engine="multigrid", and none when disabled: SOR
+    monkeypatch.setattr(solver, "RETRY_FEWER_LEVELS", 0)
+    sor = solve_multiblock(topo, tolerance=1e-10)
+    assert seen == [depth] and sor.converged and sor.info.method == "smooth/blocks-sor after 2 multigrid cycles"
+
+
+@pytest.mark.slow
+def test_generated_lake_whose_coarsest_level_stalls_converges_by_multigrid():
+    """A generated lake (round_lake(3), 9 blocks, ~16 000 nodes): with all 5 levels the cycles
+    stall at ~40× the default tolerance (the solve fell back to SOR: 2290 sweeps); engine="auto"
+    retries without the coarsest level and converges by multigrid, to a tight tolerance (the
+    stopping measure is SOR's)."""
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock.hierarchy import levels
+    from meshcore.testing import round_lake
+
+    topo = auto_layout(round_lake(3, kind="blob"), target_cells=15000, multiple=4).topology()
+    n = len(levels(topo))
+    mb = solve_multiblock(topo, tolerance=1e-9)
+    assert mb.converged and mb.info.method == f"smooth/multigrid({n - 1} levels)", mb.info.method
+
+
 def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
     """The point sweeps round the largest defects after each cycle (multigrid.HOT_SWEEPS) take a
     generated lake with islands from 7 cycles to at most 5 and give the same grid."""
@@ -1295,7 +1347,8 @@ def test_sor_after_a_slow_multigrid_starts_from_the_start_grid(monkeypatch):
     X, Y = curved_rectangle(64, 32)
     monkeypatch.setattr(mg, "AUTO_GIVE_UP_RATE", 0.0)  # every multigrid is "slow" after 3 cycles
     auto = solve_multiblock(four_blocks(X, Y, 32, 16), tolerance=1e-12)
-    assert "multigrid was slow" in auto.info.message and auto.info.method.startswith("smooth/blocks-sor after 3")
+    # 3 cycles with every level, 3 with one level fewer (solver.RETRY_FEWER_LEVELS), then SOR
+    assert "multigrid was slow" in auto.info.message and auto.info.method.startswith("smooth/blocks-sor after 6")
     sor = solve_multiblock(four_blocks(X, Y, 32, 16), tolerance=1e-12, engine="blocks")
     assert auto.converged and sor.converged
     for a, b in zip(auto, sor, strict=True):
