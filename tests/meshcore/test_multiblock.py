@@ -1089,6 +1089,47 @@ def test_compiled_start_grids_equal_the_numpy_tfi(make):
     assert np.array_equal(g0.x, want.x) and np.array_equal(g0.y, want.y)
 
 
+@pytest.mark.parametrize("make", ["star5", "network"])
+def test_snapped_borders_give_every_shared_node_its_first_copy(make):
+    """Every copy of a border node (interfaces, corners of 3-5 blocks) gets the coordinates of
+    its first copy, block by block in the order bottom, top, left, right (a loop over the
+    blocks' sides: the reference of the vectorised start.snapped_borders)."""
+    import dataclasses
+
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock.start import snapped_borders
+    from meshcore.testing import channel_network
+
+    if make == "star5":
+        topo = star(5, 9)
+    else:
+        topo = auto_layout(channel_network(3, n_branches=4), target_cells=3000, multiple=4).topology()
+    # every block's copies of the shared nodes a little off (by block): the first copy decides
+    blocks = tuple(
+        dataclasses.replace(
+            b,
+            borders=Borders(
+                **{s: np.asarray(p, dtype=float) + 1e-9 * (k + 1) * topo.size for s, p in b.borders.items()}
+            ),
+        )
+        for k, b in enumerate(topo.blocks)
+    )
+    topo = MultiBlockTopology(blocks, topo.interfaces, check_geometry=False)
+    sides = {"bottom": np.s_[:, 0], "top": np.s_[:, -1], "left": np.s_[0, :], "right": np.s_[-1, :]}
+    first: dict[int, np.ndarray] = {}
+    for b, ids in zip(topo.blocks, topo.node_map.ids, strict=True):
+        for name, sl in sides.items():
+            for p, xy in zip(ids[sl], np.asarray(b.borders[name], dtype=float), strict=True):
+                first.setdefault(int(p), xy)
+    moved = 0  # copies that differed from the first copy before the snap
+    for b, bd, ids in zip(topo.blocks, snapped_borders(topo), topo.node_map.ids, strict=True):
+        for name, sl in sides.items():
+            want = np.array([first[int(p)] for p in ids[sl]])
+            assert np.array_equal(getattr(bd, name), want)
+            moved += int((np.asarray(b.borders[name], dtype=float) != want).any(axis=1).sum())
+    assert moved > 0
+
+
 def test_band_is_the_nodes_two_stencil_steps_from_the_boundary():
     """The smoother's boundary band holds exactly the regular free nodes whose 8-point stencil
     reaches a fixed node within BAND_WIDTH steps (breadth-first search over the stencils)."""
