@@ -40,7 +40,7 @@ from meshcore.multiblock import (  # noqa: E402
     initial_grids,
     solve_multiblock,
 )
-from meshcore.multiblock.solver import _BlockEngine, _TableEngine  # noqa: E402
+from meshcore.multiblock.sor import _BlockEngine, _TableEngine  # noqa: E402
 from tests.meshcore.test_multiblock import borders, curved_rectangle  # noqa: E402  (one definition)
 
 
