@@ -171,10 +171,6 @@ def lake_como(app, win, profile: str | None = None) -> None:
     import tempfile
     from pathlib import Path
 
-    import numpy as np
-
-    from app.layout_edit import handles, place
-
     como = Path(__file__).resolve().parent.parent / "benchmarks" / "lakes" / "lake_como.geojson"
     if win.solver.auto:
         win.a_auto.trigger()
@@ -205,22 +201,64 @@ def lake_como(app, win, profile: str | None = None) -> None:
     for name, (w, c, g) in steps.items():
         print(f"  {name:16s} CPU {c:5.1f} s (GUI thread {g:4.1f} s)   wall {w:5.1f} s")
     print(f"Como import -> Delft3D DD: computing (CPU) {cpu:.1f} s, wall {wall:.1f} s")
-    win.a_auto.trigger()  # auto-generate on: the grid follows the layout
+    drag_cut_end(app, win, profile=profile)
+
+
+def _thread_cpu() -> dict[int, float]:
+    """CPU seconds (user + system) of every thread of this process by its native id (Linux; else {})."""
+    out = {}
+    tick = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+    try:
+        tasks = os.listdir("/proc/self/task")
+    except OSError:
+        return out
+    for t in tasks:
+        try:
+            with open(f"/proc/self/task/{t}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:  # the thread ended
+            continue
+        out[int(t)] = (int(fields[11]) + int(fields[12])) / tick  # utime, stime
+    return out
+
+
+def drag_cut_end(app, win, profile: str | None = None) -> dict:
+    """A cut line's end of the window's lake layout dragged along the shore with auto-generate on:
+    redraws/s of wall time, the CPU time per redraw of the GUI thread and of the other threads
+    (the solver and layout workers), and the redraws that showed a start grid (must be 0).
+
+    The start-grid check runs after the drag (the frames' grids are kept until then): it would
+    otherwise count in the GUI thread's CPU time it measures.  ``profile``: a file for the
+    cProfile statistics of the drag (the GUI thread's CPU time).  Returns the numbers printed.
+    """
+    import threading
+
+    import numpy as np
+
+    from app.layout_edit import handles, place
+
+    lay = win.doc.project.layout
+    if not win.solver.auto:
+        win.a_auto.trigger()  # auto-generate on: the grid follows the layout
     win.set_tool("layout")
     end = next(h for h in handles(lay) if h.kind == "end")
     tool = win.tools["layout"]
     frames: list[float] = []
-    starts: list[float] = []
+    shown: list[tuple] = []  # per redraw: (grid, its algebraic start grid) of every block, checked after the drag
 
     def redrawn() -> None:
         frames.append(time.perf_counter())
         doc = win.doc
-        if any(_is_start(g, doc.initial.get(k)) for k, g in doc.grids.items()):
-            starts.append(frames[-1])
+        shown.append(tuple((g, doc.initial.get(k)) for k, g in doc.grids.items()))
 
     win.solver.redrawn.connect(redrawn)
     layouts: list[float] = []  # the layouts shown while dragging (each restarts the solve)
-    win.lake_ctl.layout_done.connect(lambda lay: layouts.append(time.perf_counter()) if lay is not None else None)
+
+    def laid(lay) -> None:
+        if lay is not None:
+            layouts.append(time.perf_counter())
+
+    win.lake_ctl.layout_done.connect(laid)
     h = lay.cell_size
     prof = None
     if profile:
@@ -228,6 +266,8 @@ def lake_como(app, win, profile: str | None = None) -> None:
 
         prof = cProfile.Profile(time.thread_time)  # the GUI thread's CPU time, not the load's wall time
         prof.enable()
+    gui_id = threading.get_native_id()
+    threads0 = _thread_cpu()
     t_drag, c_drag, g_drag = time.perf_counter(), time.process_time(), time.thread_time()
     tool.drag("start", end.xy, end.xy)
     for s in np.linspace(0, 1, 180)[1:]:  # 3 s at 60 Hz: three cells along the shore and back
@@ -236,21 +276,40 @@ def lake_como(app, win, profile: str | None = None) -> None:
         _sleep(app, 1 / 60)
     tool.drag("finish", place(lay, end, (end.xy[0] + h, end.xy[1] + h)), end.xy)
     t_release, c_release, g_release = time.perf_counter(), time.process_time(), time.thread_time()
+    threads1 = _thread_cpu()
     if prof is not None:
         prof.disable()
         prof.dump_stats(profile)
+    n_during = len([f for f in frames if t_drag <= f <= t_release])
     dt = _wait(app, lambda: not win.lake_ctl.editing and not win.solver.running, timeout=600)
-    during = [f for f in frames if t_drag <= f <= t_release]
+    win.solver.redrawn.disconnect(redrawn)
+    win.lake_ctl.layout_done.disconnect(laid)
+    starts = sum(any(_is_start(g, a) for g, a in frame) for frame in shown)
     n_lay = len([t for t in layouts if t <= t_release])
     wall, cpu, gui = t_release - t_drag, c_release - c_drag, g_release - g_drag
+    others = {t: c - threads0.get(t, 0.0) for t, c in threads1.items() if t != gui_id}
+    busy = sorted((c for c in others.values() if c >= 0.05), reverse=True)
+    n = max(n_during, 1)
     print(
         f"drag a cut end on Como ({lay.n_cells} cells, auto-generate; load {os.getloadavg()[0]:.1f}): "
-        f"{len(during) / wall:.1f} redraws/s while dragging ({len(during)} in {wall:.1f} s wall for 3 s of mouse "
+        f"{n_during / wall:.1f} redraws/s while dragging ({n_during} in {wall:.1f} s wall for 3 s of mouse "
         f"moves, {n_lay} layouts); CPU while dragging {cpu:.1f} s (GUI thread {gui:.1f} s): "
-        f"{len(during) / max(cpu, 1e-9):.1f} redraws per CPU-s; {len(starts)} of {len(frames)} redraws showed a "
+        f"{n_during / max(cpu, 1e-9):.1f} redraws per CPU-s; {starts} of {len(frames)} redraws showed a "
         f"start grid, done {dt:.1f} s after release ({win.stack.undoText()!r}, {win.lake_ctl.edit_error or 'no error'})"
     )
-    win.solver.redrawn.disconnect(redrawn)
+    print(
+        f"  CPU per redraw: GUI thread {1000 * gui / n:.1f} ms, other threads {1000 * (cpu - gui) / n:.1f} ms "
+        f"(busiest: {', '.join(f'{c:.1f}' for c in busy[:4]) or '-'} s)"
+    )
+    return {
+        "redraws": n_during,
+        "wall": wall,
+        "cpu": cpu,
+        "gui": gui,
+        "layouts": n_lay,
+        "start_frames": starts,
+        "frames": len(frames),
+    }
 
 
 def _is_start(grid, algebraic) -> bool:
