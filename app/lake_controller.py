@@ -79,6 +79,7 @@ class LakeController(QtCore.QObject):
         self._edit_timer.timeout.connect(self._next_edit)
         self._edit_shown = 0.0  # when the last layout edit was shown
         self.edit_error: str | None = None
+        self._dragging = False  # a drag of the layout is on (the layout tool says so)
 
     @property
     def busy(self) -> bool:
@@ -239,6 +240,21 @@ class LakeController(QtCore.QObject):
             self.win.message(f"Cannot change the layout: {err}", error=True)
             self.layout_done.emit(None)
         self._next_edit()
+        self._end_live()  # the drag's last layout is shown (or refused): its grid goes to the end
+
+    def begin_drag(self) -> None:
+        """A drag of the layout begins: until it ends, the grid's solves stop after their live frames."""
+        self._dragging = True
+        self.win.solver.set_live(True)
+
+    def end_drag(self) -> None:
+        """The drag ends: the grid of its last layout is made to the end (once that layout is shown)."""
+        self._dragging = False
+        self._end_live()
+
+    def _end_live(self) -> None:
+        if not self._dragging and not self.editing:
+            self.win.solver.set_live(False)
 
     def set_block_cells(self, index: int, cells: tuple[int, int]) -> None:
         """Give block ``index`` of the layout ``cells``; the blocks sharing its sides follow (undoable)."""

@@ -70,10 +70,12 @@ def solve_project(
     report_interval: float = 1 / 40,
     smooth: bool = True,
     blocks: list[int] | None = None,
+    hold: threading.Event | None = None,
 ) -> Generator[tuple[int, object], object, BlockResult]:
     """Solve every ready block; yield ``(index, event)``; return :class:`BlockResult`.
 
-    ``warm`` maps a block index to ``(previous algebraic grid, previous grid)``.
+    ``warm`` maps a block index to ``(previous algebraic grid, previous grid)``; ``hold``: a lake
+    layout's warm solve waits for it before its final grid (:func:`app.lake_solve.solve_layout`).
     """
     solver = project.solver.replaced(report_interval=report_interval)
     if project.multiblock is not None:
@@ -81,7 +83,7 @@ def solve_project(
     if project.layout is not None:  # a lake layout: one orthogonal grid over all its blocks
         from .lake_solve import solve_layout
 
-        return (yield from solve_layout(project.lake, warm=warm, stop_event=stop_event))
+        return (yield from solve_layout(project.lake, warm=warm, stop_event=stop_event, hold=hold))
     grids: dict[int, StructuredGrid] = {}
     starts: dict[int, StructuredGrid] = {}
     notes: list[str] = []

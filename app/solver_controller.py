@@ -11,7 +11,9 @@ grid had made the app's solve 2–3× as long as the CLI's.  Edits with auto-gen
 full frame rate (the grid follows the hand).  Stop sets a
 ``threading.Event`` checked by meshcore after every sweep/cycle, so it takes
 effect within one sweep.  With ``auto`` on, every project edit restarts the
-solve (coalesced in one event-loop pass), warm-started from the last grid.
+solve (coalesced in one event-loop pass), warm-started from the last grid.  While a drag is
+on (:meth:`SolverController.set_live`), a lake solve waits after its live frames instead of making
+the final grid that the drag's next step would stop unseen.
 """
 
 from __future__ import annotations
@@ -39,9 +41,9 @@ DRAW_BUDGET = 0.15
 MAX_FRAME_GAP = 1.0
 
 
-def _run(run_id, project, warm, stop_event, smooth):
+def _run(run_id, project, warm, stop_event, smooth, hold=None):
     """The worker body: tag every item with the run id; errors become results."""
-    gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth)
+    gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth, hold=hold)
     try:
         while True:
             k, event = next(gen)
@@ -72,6 +74,8 @@ class SolverController(QtCore.QObject):
         self._worker = None
         self._run = 0
         self._stop_event: threading.Event | None = None
+        self.live = False  # a drag is on: a lake solve holds after its live frames (set_live)
+        self._hold: threading.Event | None = None  # set: the running solve may go on to its final grid
         self._latest: dict[int, object] = {}  # the latest event per block
         self._algebraic: dict[int, StructuredGrid] = {}  # the algebraic grid per block (warm starts)
         self._smoothed: set[int] = set()
@@ -138,10 +142,14 @@ class SolverController(QtCore.QObject):
                 warm[k] = (a, g)
         ev = threading.Event()
         self._stop_event = ev
+        hold = threading.Event()
+        if not self.live:
+            hold.set()
+        self._hold = hold
         self._latest = {}
         self._algebraic = {}
         self._smoothed = set()  # blocks whose snapshots of this run are on screen
-        worker = create_worker(_run, self._run, project, warm, ev, self.smooth, _start_thread=False)
+        worker = create_worker(_run, self._run, project, warm, ev, self.smooth, hold, _start_thread=False)
         worker.yielded.connect(self._on_yielded)
         worker.returned.connect(self._on_returned)
         worker.errored.connect(self._on_errored)
@@ -155,6 +163,14 @@ class SolverController(QtCore.QObject):
         worker.start()
         return True
 
+    def set_live(self, on: bool) -> None:
+        """A drag of the layout begins (True) or ends.  While it is on, a lake solve waits after its live
+        frames (the drag's next step restarts it); when it ends, a waiting solve goes on to the final grid
+        unless a restart is already due (the drag's last step: that solve makes the final grid)."""
+        self.live = bool(on)
+        if not self.live and not self._debounce.isActive() and self._hold is not None:
+            self._hold.set()
+
     def stop(self) -> None:
         """Ask the solver to stop; it returns the current grid at the next sweep."""
         self._restart_pending = False
@@ -163,6 +179,8 @@ class SolverController(QtCore.QObject):
     def _interrupt(self) -> None:
         if self._stop_event is not None:
             self._stop_event.set()
+        if self._hold is not None:  # a solve waiting for the end of a drag: it stops now
+            self._hold.set()
         # no worker.quit(): an aborted superqt worker never emits `returned`; the
         # generator sees the event after the current sweep and returns the grid itself
         if self._worker is not None and self.state == "paused":
@@ -209,6 +227,8 @@ class SolverController(QtCore.QObject):
     def _abandon(self) -> None:
         if self._stop_event is not None:
             self._stop_event.set()
+        if self._hold is not None:
+            self._hold.set()
         if self._worker is not None:
             try:
                 self._worker.resume()

@@ -398,6 +398,8 @@ class LayoutTool(Tool):
 
     def deactivate(self) -> None:
         super().deactivate()
+        if self._handle is not None:  # switched away in the middle of a drag: it ends here
+            self._end_drag()
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
 
@@ -416,6 +418,7 @@ class LayoutTool(Tool):
 
             self._handle, self._base, self._parts = h, lay, outline_parts(lay)
             self._drag = self.editor.new_drag_id()
+            self.controller.begin_drag()
             if self.canvas is not None:  # the cell counts stay; they need not repaint with every grid
                 self.canvas.lake_items.set_labels_visible(False)
         if self._handle is None:
@@ -423,11 +426,15 @@ class LayoutTool(Tool):
         if phase != "start":
             self._move(xy)
         if phase == "finish":
-            self._handle = None
-            if self.canvas is not None:
-                self.canvas.lake_items.set_drag_point(None)
-                self.canvas.lake_items.set_labels_visible(True)
+            self._end_drag()
         return True
+
+    def _end_drag(self) -> None:
+        self._handle = None
+        self.controller.end_drag()
+        if self.canvas is not None:
+            self.canvas.lake_items.set_drag_point(None)
+            self.canvas.lake_items.set_labels_visible(True)
 
     def _move(self, xy) -> None:
         from .layout_edit import KIND_NAMES, moved_layout, moved_parts, place, shore_points

@@ -52,11 +52,13 @@ def test_drag_a_cut_end_along_the_shore_and_the_grid_follows(qtbot, laid):
     h = lay0.cell_size
     path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, 1.5, 6)]
     assert tool.drag("start", tuple(path[0]), end.xy)
+    assert win.solver.live  # while the hand drags, a solve stops after its live frames
     for p in path[1:]:
         tool.drag("move", tuple(p), end.xy)
         qtbot.wait(30)
     tool.drag("finish", tuple(path[-1]), end.xy)
     wait_idle(qtbot, win)
+    assert not win.solver.live
     lay1 = win.doc.project.layout
     assert lay1 is not lay0 and win.lake_ctl.edit_error is None
     assert win.stack.count() == n + 1 and win.stack.undoText().startswith("Move cut end")  # one undo step
