@@ -18,6 +18,9 @@ __all__ = ["SolveStatus"]
 
 #: seconds between two updates of the convergence plot during a multiblock or lake solve
 HISTORY_EVERY = 1.0
+#: seconds between two updates of the solver label during such a solve: each one lays out and repaints
+#: the status bar (2–3 ms of the GUI thread, a tenth of a drag's redraw; four a second are read as well)
+LABEL_EVERY = 0.25
 
 
 class SolveStatus(QtCore.QObject):
@@ -32,6 +35,7 @@ class SolveStatus(QtCore.QObject):
         self.label = QtWidgets.QLabel("idle")
         self.frames: list[float] = []  # times of the last redraws (for the redraws/s read-out)
         self._history_at = 0.0  # when the convergence plot was last drawn
+        self._label_at = 0.0  # when the solver label was last set during a multiblock solve
         self._last_history: tuple | None = None  # (history, tolerance, levels) of the last multiblock snapshot
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
@@ -55,14 +59,17 @@ class SolveStatus(QtCore.QObject):
     def on_progress(self, k: int, snap) -> None:
         if k == ALL_BLOCKS:  # a multiblock solve: every block at once
             now = time.perf_counter()
-            # the plot at most every HISTORY_EVERY s: it repaints its axes (costly in a drag's redraws)
+            # the plot at most every HISTORY_EVERY s: it repaints its axes (costly in a drag's redraws); not
+            # at all while a drag is on (each step restarts the sweeps: the whole history is drawn at the end)
             levels = getattr(snap, "levels", ())  # a lake grid's levels (app.lake_solve.LakeProgress)
             if snap.history:
                 self._last_history = (snap.history, snap.tolerance, levels)
-            if snap.history and now - self._history_at >= HISTORY_EVERY:
+            if snap.history and now - self._history_at >= HISTORY_EVERY and not self.solver.live:
                 self._history_at = now
                 self.conv.set_history(list(snap.history), snap.tolerance, levels)
-            self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
+            if now - self._label_at >= LABEL_EVERY:
+                self._label_at = now
+                self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
             return
         if k == self.doc.active:  # history and residual are relative to the grid size
             self.conv.set_history(list(snap.history), snap.tolerance)

@@ -96,6 +96,7 @@ class LakeOverlay:
         self._label_pixel = 0.0  # the pixel size the levels were chosen for
         self._marker_spacing = np.inf  # typical distance between the corners and cut ends (model units)
         self._marker_scale = 1.0  # their size now, a share of the full size
+        self._labels_due = None  # a layout whose labels are made when they are shown again
 
     # ------------------------------------------------------------ drawing
     def refresh(self, project) -> None:
@@ -110,6 +111,7 @@ class LakeOverlay:
         self._draw_layout(lake.layout)
 
     def _draw_layout(self, layout) -> None:
+        self._labels_due = None
         if layout is None:
             set_polylines(self.cuts, [])
             set_points(self.cut_ends, None)
@@ -126,6 +128,17 @@ class LakeOverlay:
         from ..geometry import typical_spacing
 
         self._marker_spacing = typical_spacing(np.vstack([corners, *ends]))
+        # the labels' places and sizes (a pole of inaccessibility per block, a text measured per label:
+        # 20-30 ms on Como) only when they are shown: a drag hides them and shows four layouts a second
+        self._labels_due = layout
+        if self.labels_on:
+            self._make_labels()
+
+    def _make_labels(self) -> None:
+        """The block labels of the layout drawn last, if not made yet."""
+        layout, self._labels_due = self._labels_due, None
+        if layout is None:
+            return
         texts = [(f"{b.name}\n{b.cells[0]}×{b.cells[1]}", f"{b.cells[0]}×{b.cells[1]}") for b in layout.blocks]
         polys = _block_polygons(layout)
         self._set_labels(texts, block_label_points(layout, polys), polys)
@@ -261,6 +274,8 @@ class LakeOverlay:
         self._show_labels()
 
     def _show_labels(self) -> None:
+        if self.labels_on:
+            self._make_labels()  # the layout's labels, if it came while they were hidden
         if self.labels_on and self.markers_visible:
             self._label_level = np.full(len(self._label_texts), -2, dtype=int)  # every label set again
             self.apply_level_of_detail(force=True)

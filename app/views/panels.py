@@ -39,17 +39,13 @@ class BlocksPanel(QtWidgets.QTreeWidget):
         self.refresh()
 
     def refresh(self) -> None:
-        self.blockSignals(True)
-        self.clear()
-        for k, b in enumerate(self.doc.project.blocks):
+        """List the blocks and their borders; the same rows as shown: nothing done (a drag of a lake
+        layout changes the project several times a second and keeps every block and its cells)."""
+        rows = []
+        for b in self.doc.project.blocks:
             status = "ready" if b.ready else "closed, needs corners" if b.closed else f"{len(b.points)} points, open"
             ni, nj = b.cell_counts or (0, 0)
-            it = QtWidgets.QTreeWidgetItem([b.name, f"{ni + 1}×{nj + 1}", status])
-            it.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("block", k))
-            f = it.font(0)
-            f.setBold(k == self.doc.active)
-            it.setFont(0, f)
-            self.addTopLevelItem(it)
+            borders = []
             for name in BORDER_NAMES:
                 s = b.spec(name)
                 dist = s.distribution
@@ -57,9 +53,25 @@ class BlocksPanel(QtWidgets.QTreeWidget):
                     dist += f" ({'first ' + format(s.first, '.3g') if s.first else ''}"
                     dist += f"{' ' if s.first and s.last else ''}{'last ' + format(s.last, '.3g') if s.last else ''})"
                 label = name + (f" “{s.name}”" if s.name else "")
-                c = QtWidgets.QTreeWidgetItem([label, str(b.node_count(name)), dist])
-                c.setForeground(0, QtGui.QBrush(QtGui.QColor(BORDER_COLOURS[name])))
-                c.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("border", k, name))
+                borders.append((name, label, str(b.node_count(name)), dist))
+            rows.append((b.name, f"{ni + 1}×{nj + 1}", status, tuple(borders)))
+        shown = (tuple(rows), self.doc.active)
+        if shown == getattr(self, "_shown", None):
+            return
+        self._shown = shown
+        self.blockSignals(True)
+        self.clear()
+        for k, (name, nodes, status, borders) in enumerate(rows):
+            it = QtWidgets.QTreeWidgetItem([name, nodes, status])
+            it.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("block", k))
+            f = it.font(0)
+            f.setBold(k == self.doc.active)
+            it.setFont(0, f)
+            self.addTopLevelItem(it)
+            for border, label, count, dist in borders:
+                c = QtWidgets.QTreeWidgetItem([label, count, dist])
+                c.setForeground(0, QtGui.QBrush(QtGui.QColor(BORDER_COLOURS[border])))
+                c.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("border", k, border))
                 it.addChild(c)
             it.setExpanded(k == self.doc.active)
         self.blockSignals(False)
