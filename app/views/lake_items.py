@@ -61,6 +61,8 @@ class LakeOverlay:
         # width 1: a wider pen is several times slower to paint, and the shore repaints with every grid
         self.shore = pg.PlotCurveItem(pen=pg.mkPen(SHORE_COLOUR, width=1), connect="finite")
         self.shore.setZValue(4)
+        # drawn again only when the shore or the view changes, not with every frame of a drag (as the grid)
+        self.shore.setCacheMode(QtWidgets.QGraphicsItem.CacheMode.DeviceCoordinateCache)
         self.cuts = pg.PlotCurveItem(pen=pg.mkPen(CUT_COLOUR, width=2.5), connect="finite")
         self.cuts.setZValue(7)
         self.cut_ends = Scatter(

@@ -425,3 +425,16 @@ def test_grid_segments_are_every_cell_edge_once():
             if i + 1 < 4:
                 want.add(frozenset({(x[i, j], y[i, j]), (x[i + 1, j], y[i + 1, j])}))
     assert got == want
+
+
+def test_edge_pairs_of_several_grids_are_each_grids_segments_in_turn():
+    rng = np.random.default_rng(5)
+    shapes = [(int(a), int(b)) for a, b in rng.integers(2, 9, size=(6, 2))]
+    grids = [(rng.random(s), rng.random(s)) for s in shapes]
+    pairs = geo.edge_pairs(shapes)
+    x = np.concatenate([gx.ravel() for gx, _gy in grids])
+    y = np.concatenate([gy.ravel() for _gx, gy in grids])
+    want = [geo.grid_segments(gx, gy) for gx, gy in grids]
+    np.testing.assert_array_equal(x[pairs], np.concatenate([w[0] for w in want]))
+    np.testing.assert_array_equal(y[pairs], np.concatenate([w[1] for w in want]))
+    assert geo.edge_pairs([]).size == 0
