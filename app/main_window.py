@@ -381,13 +381,15 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_project(self, project: Project) -> None:
         self._update_title()
         pi = self.canvas.getPlotItem()
+        labels = {"bottom": "", "left": ""}
         if project.crs:
             ox, oy = project.origin
-            pi.setLabel("bottom", f"x = E − {ox:.0f} m ({project.crs})")
-            pi.setLabel("left", f"y = N − {oy:.0f} m")
-        else:
-            pi.setLabel("bottom", "")
-            pi.setLabel("left", "")
+            labels = {"bottom": f"x = E − {ox:.0f} m ({project.crs})", "left": f"y = N − {oy:.0f} m"}
+        for side, text in labels.items():
+            # the same text: not set again (it would lay out the axes and make their ticks again, 20 ms
+            # with each of the four layouts a second of a drag)
+            if pi.getAxis(side).labelText != text:
+                pi.setLabel(side, text)
 
     def _check_corners(self, project: Project) -> None:
         """New corners on reflex vertices: say which, and where to move them."""

@@ -64,3 +64,19 @@ def test_the_drag_ring_moving_over_the_grid_does_not_draw_its_cells_again(qtbot,
     c.set_grids({0: _grid(1)})
     c.viewport().repaint()
     assert painted[0] >= 1  # a new grid is drawn
+
+
+def test_an_edit_that_keeps_the_crs_does_not_make_the_axes_again(qtbot, win, painted):
+    c = win.canvas
+    p = win.doc.project.replaced(crs="EPSG:32632", origin=(520000.0, 5090000.0))
+    win.doc.set_project(p)
+    c.viewport().repaint()
+    bottom = c.getPlotItem().getAxis("bottom")
+    assert bottom.labelText == "x = E − 520000 m (EPSG:32632)"
+    picture = bottom.picture
+    assert picture is not None
+    win.doc.set_project(p.replaced(title="an edit"))  # as each step of a drag: a new project, the same CRS
+    c.viewport().repaint()
+    assert bottom.picture is picture  # its ticks and labels were not made again
+    win.doc.set_project(p.replaced(origin=(0.0, 0.0)))
+    assert bottom.labelText == "x = E − 0 m (EPSG:32632)"
