@@ -36,6 +36,10 @@ class SolveStatus(QtCore.QObject):
         self.frames: list[float] = []  # times of the last redraws (for the redraws/s read-out)
         self._history_at = 0.0  # when the convergence plot was last drawn
         self._label_at = 0.0  # when the solver label was last set during a multiblock solve
+        self._label_text = ""  # the latest progress text (shown by the timer when it came too soon)
+        self._label_timer = QtCore.QTimer(self)
+        self._label_timer.setSingleShot(True)
+        self._label_timer.timeout.connect(self._show_label)
         self._last_history: tuple | None = None  # (history, tolerance, levels) of the last multiblock snapshot
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
@@ -67,9 +71,12 @@ class SolveStatus(QtCore.QObject):
             if snap.history and now - self._history_at >= HISTORY_EVERY and not self.solver.live:
                 self._history_at = now
                 self.conv.set_history(list(snap.history), snap.tolerance, levels)
-            if now - self._label_at >= LABEL_EVERY:
-                self._label_at = now
-                self.label.setText(f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}")
+            self._label_text = f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}"
+            wait = self._label_at + LABEL_EVERY - now
+            if wait <= 0:
+                self._show_label()
+            elif not self._label_timer.isActive():  # the latest text, once the gap is over
+                self._label_timer.start(max(1, int(1000 * wait)))
             return
         if k == self.doc.active:  # history and residual are relative to the grid size
             self.conv.set_history(list(snap.history), snap.tolerance)
@@ -78,6 +85,12 @@ class SolveStatus(QtCore.QObject):
             f"{snap.method}: iteration {snap.iteration}, residual {snap.residual:.2e} "
             f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s"
         )
+
+    def _show_label(self) -> None:
+        """The latest progress text, while the solve runs (never over "paused" or the final summary)."""
+        if self.solver.state == "running":
+            self._label_at = time.perf_counter()
+            self.label.setText(self._label_text)
 
     def on_state(self, state: str) -> None:
         running = state != "idle"

@@ -80,3 +80,22 @@ def test_an_edit_that_keeps_the_crs_does_not_make_the_axes_again(qtbot, win, pai
     assert bottom.picture is picture  # its ticks and labels were not made again
     win.doc.set_project(p.replaced(origin=(0.0, 0.0)))
     assert bottom.labelText == "x = E − 0 m (EPSG:32632)"
+
+
+def test_the_solver_label_ends_on_the_latest_progress_of_a_burst(qtbot, win):
+    """The label is set at most a few times a second during a multiblock solve, but it never stays on an
+    old snapshot: a solve that holds after a burst of frames (a drag) shows the last one."""
+    from app.lake_solve import LakeProgress
+    from app.pipeline import ALL_BLOCKS
+
+    status = win.solve_status
+    win.solver._set_state("running")
+    try:
+        for it in (1, 2, 3):
+            win.solver.progress.emit(ALL_BLOCKS, LakeProgress(it, 0.1 / it, 1e-5, None, 0.0, "orthogonal", (), ()))
+        qtbot.waitUntil(lambda: "iteration 3," in status.label.text(), timeout=5000)
+    finally:
+        win.solver._set_state("idle")
+    win.solver.progress.emit(ALL_BLOCKS, LakeProgress(4, 0.01, 1e-5, None, 0.0, "orthogonal", (), ()))
+    qtbot.wait(400)
+    assert "iteration 4," not in status.label.text()  # not over what an idle solver shows
