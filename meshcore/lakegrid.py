@@ -124,9 +124,10 @@ def iterate_layout(
     the :class:`~meshcore.multiblock.MultiBlockGrid` (``mode="orthogonal"``).
     """
     from .elliptic import SolverProgress
-    from .multiblock import MultiBlockGrid
+    from .multiblock import MultiBlockGrid, initial_grids
     from .orthogonal import iterate_orthogonalize
     from .orthogonal.levels import coarsen_topology, refine, refine_shore
+    from .orthogonal.untangle import untangle
 
     t0 = time.perf_counter()
     tol = 1e-5
@@ -137,6 +138,7 @@ def iterate_layout(
     tops = [coarsen_topology(topo, 2**k) if k else topo for k in range(levels, -1, -1)]
     grids, how = _start(tops[0], start)
     grids, repaired = _repair_folds(grids)
+    grids, untangled = untangle(tops[0], grids, layout=initial_grids(tops[0]))
     rings = _shore_rings(layout.polygon, layout.cell_size / 4)
     total = 0
     history: list[tuple[int, float]] = []
@@ -144,6 +146,8 @@ def iterate_layout(
     for lev, tp in enumerate(tops):
         if lev:
             grids = refine_shore(refine(grids), tp, rings)
+            grids, n = untangle(tp, grids)
+            untangled += n
         gen = iterate_orthogonalize(
             tp,
             grids,
@@ -186,6 +190,8 @@ def iterate_layout(
         msg = f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; start: {how}"
         if repaired:
             msg += f"; {repaired} coarse block(s) repaired by the fold-free method"
+        if untangled:
+            msg += f"; {untangled} node(s) moved across cut lines to make their cells convex"
         if fine_repaired:
             msg += f"; {fine_repaired} block(s) repaired by the fold-free method on the finest level"
     info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)

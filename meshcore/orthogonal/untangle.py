@@ -1,0 +1,193 @@
+r"""Untangling across interfaces: make the cells at cut ends convex by moving interface nodes.
+
+The fold-free repair of :mod:`meshcore.foldfree` works on one block with its borders fixed.  A
+cell at a block's corner whose corner node is a cut line's end on the shore cannot be repaired
+that way: its other corners are a shore node, an interface node and an interior node.  Where a
+cut leaves a reflex shore corner, the coarse start solve (Winslow over all blocks as one grid)
+can move the cut's first interface nodes so that one of the two angles at the corner opens
+beyond 180°, although the layout drew both below it.  The orthogonal smoother keeps valid cells
+valid and lets invalid ones only improve, but does not seek that: such a cell stayed non-convex
+through every level (one cell in 4 of 45 generated lakes of fresh seeds at 15 000 cells).
+
+:func:`untangle`, for every non-convex cell:
+
+1. if one of its corners is a cut's end on the shore (a shore node of three or more cells) and
+   ``layout`` grids are given (the blocks' algebraic grids: their borders are the layout's cut
+   lines), puts the interface nodes within :data:`HOPS` edges of that end back towards the
+   layout's line — fully at the end, blending into the solved position further along — and
+   repairs the blocks then invalid with their borders fixed (:func:`meshcore.foldfree.repair`);
+2. then moves, one at a time, each free node (not on the shore) of each cell still bad: to the
+   nearest of a few candidate positions around it (rings of 16 points at ¼, ½ and 1 of its mean
+   edge length, the mean of its edge neighbours) where every cell around it is convex with a
+   margin; where there is none, to the candidate that raises the smallest corner Jacobian most
+   without making another cell around it bad, and its free neighbours get their turn next round.
+
+Nodes of cells that are convex are not moved by step 2; a grid without bad cells comes back as
+it is.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["bad_cells", "untangle"]
+
+#: A corner Jacobian counts as convex above this share of the mean area of the node's cells (the
+#: orthogonal smoother's guard floor is a thousandth; a margin above it lets its sweeps move the
+#: node again).
+MARGIN = 0.02
+#: Rounds of single-node moves (each over the free nodes of the cells still bad, then their
+#: neighbours).
+ROUNDS = 12
+#: Candidate positions of a node: rings at these multiples of its mean edge length, 16 points each.
+RADII = (0.25, 0.5, 1.0)
+#: Interface nodes put back on the layout's cut line near a cut end: those within this many edges
+#: of it (weight of the solved position ``(d - 1) / HOPS`` at ``d`` edges).
+HOPS = 3
+
+
+def _corner_jacobians(X, Y, cells) -> np.ndarray:
+    """``(n, 4)`` corner Jacobians of the CCW cells ``cells`` (ids into X, Y)."""
+    px, py = X[cells], Y[cells]
+    nx, ny = np.roll(px, -1, axis=1), np.roll(py, -1, axis=1)
+    mx, my = np.roll(px, 1, axis=1), np.roll(py, 1, axis=1)
+    return (nx - px) * (my - py) - (ny - py) * (mx - px)
+
+
+def bad_cells(X, Y, cells) -> np.ndarray:
+    """Indices of cells with a corner Jacobian ``≤ 0`` (folded or non-convex)."""
+    return np.flatnonzero((_corner_jacobians(X, Y, cells) <= 0).any(axis=1))
+
+
+def _score(X, Y, cells, around) -> tuple[int, float]:
+    """``(-bad, worst)`` of the cells ``around``: how many are bad (negated), and their smallest
+    corner Jacobian over their mean absolute area (a corner Jacobian of a parallelogram is its
+    area).  Larger is better, compared as a tuple."""
+    j = _corner_jacobians(X, Y, cells[around])
+    area = np.abs(j.sum(axis=1) / 4).mean()
+    return -int((j <= 0).any(axis=1).sum()), float(j.min() / max(area, 1e-300))
+
+
+class _Mesh:
+    """The node arrays of a multiblock grid and the incidence tables :func:`untangle` needs."""
+
+    def __init__(self, topology, grids):
+        from .driver import _assemble
+
+        m = self.m = topology.node_map
+        self.cells = m.cells.astype(np.int64)
+        self.X, self.Y = _assemble(grids, m)
+        flat = self.cells.reshape(-1)
+        order = np.argsort(flat, kind="stable")
+        self.cnt = np.bincount(flat, minlength=m.n_nodes)
+        self.ptr = np.concatenate([[0], np.cumsum(self.cnt)])
+        self.rows = order // 4  # node n's cells: rows[ptr[n]:ptr[n + 1]] of `cells`
+        e = np.column_stack([flat, np.roll(self.cells, -1, axis=1).reshape(-1)])
+        e = np.unique(np.sort(e, axis=1), axis=0)
+        self.nbrs: dict[int, list[int]] = {}
+        for a, b in e:
+            self.nbrs.setdefault(int(a), []).append(int(b))
+            self.nbrs.setdefault(int(b), []).append(int(a))
+
+    def around(self, n: int) -> np.ndarray:
+        return self.rows[self.ptr[n] : self.ptr[n + 1]]
+
+    def grids(self, grids) -> list:
+        return [g.replaced(x=self.X[ids], y=self.Y[ids]) for g, ids in zip(grids, self.m.ids, strict=True)]
+
+
+def _restore_cut_ends(mesh: _Mesh, grids, layout, bad) -> tuple[list, int]:
+    """Step 1 of :func:`untangle`; returns the grids and how many nodes moved."""
+    from ..foldfree import invalid_cells, repair
+    from .driver import _assemble
+
+    m = mesh.m
+    LX, LY = _assemble(layout, m)
+    ends = {int(n) for n in mesh.cells[bad].reshape(-1) if m.boundary[n] and mesh.cnt[n] >= 3}
+    moved = 0
+    for end in sorted(ends):
+        # the interface nodes near the end, by edges along shared nodes (the cut lines)
+        dist = {end: 0}
+        front = [end]
+        for d in range(1, HOPS + 1):
+            nxt = []
+            for u in front:
+                for v in mesh.nbrs.get(u, []):
+                    if v not in dist and m.shared[v] and not m.boundary[v]:
+                        dist[v] = d
+                        nxt.append(v)
+            front = nxt
+        for v, d in dist.items():
+            if d:
+                w = (d - 1) / HOPS
+                mesh.X[v] = LX[v] + w * (mesh.X[v] - LX[v])
+                mesh.Y[v] = LY[v] + w * (mesh.Y[v] - LY[v])
+                moved += 1
+    if not moved:
+        return list(grids), 0
+    out = []
+    for g in mesh.grids(grids):
+        if invalid_cells(np.asarray(g.x, dtype=float), np.asarray(g.y, dtype=float)).any():
+            g = repair(g, strict=False).grid
+        out.append(g)
+    return out, moved
+
+
+def _move_nodes(mesh: _Mesh) -> int:
+    """Step 2 of :func:`untangle`: single-node moves; returns how many were made."""
+    m, X, Y, cells = mesh.m, mesh.X, mesh.Y, mesh.cells
+    ang = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
+    ring = np.column_stack([np.cos(ang), np.sin(ang)])
+    moved = 0
+    todo: set[int] = set()
+    for _ in range(ROUNDS):
+        bad = bad_cells(X, Y, cells)
+        if not len(bad):
+            break
+        nodes = {int(n) for n in cells[bad].reshape(-1) if not m.boundary[n]} | todo
+        todo = set()
+        for n in sorted(nodes):
+            around = mesh.around(n)
+            now = _score(X, Y, cells, around)
+            nb = mesh.nbrs.get(n, [])
+            if (now[0] == 0 and now[1] > MARGIN) or not nb:
+                continue
+            p = np.array([X[n], Y[n]])
+            q = np.column_stack([X[nb], Y[nb]])
+            length = float(np.hypot(*(q - p).T).mean())
+            cand = [q.mean(axis=0)] + [p + r * length * ring[k] for r in RADII for k in range(len(ring))]
+            best, best_p, ok = now, None, []
+            for c in cand:
+                X[n], Y[n] = c
+                s = _score(X, Y, cells, around)
+                if s[0] == 0 and s[1] > MARGIN:
+                    ok.append((float(np.hypot(*(c - p))), c))
+                if s > best:
+                    best, best_p = s, c
+            if ok:
+                X[n], Y[n] = min(ok, key=lambda t: t[0])[1]
+                moved += 1
+            elif best_p is not None:
+                X[n], Y[n] = best_p
+                moved += 1
+                todo |= {v for v in nb if not m.boundary[v]}
+            else:
+                X[n], Y[n] = p
+    return moved
+
+
+def untangle(topology, grids, layout=None) -> tuple[list, int]:
+    """``(grids, moved)``: ``grids`` (one per block of ``topology``) with the free nodes around
+    their non-convex cells moved until those cells are convex, where the steps of the module
+    docstring can; ``layout``: the blocks' algebraic grids (their borders are the layout's lines).
+    ``moved`` counts the node moves made.  Shore nodes never move."""
+    mesh = _Mesh(topology, grids)
+    bad = bad_cells(mesh.X, mesh.Y, mesh.cells)
+    if not len(bad):
+        return list(grids), 0
+    moved = 0
+    if layout is not None:
+        grids, moved = _restore_cut_ends(mesh, grids, layout, bad)
+        mesh = _Mesh(topology, grids)
+    moved += _move_nodes(mesh)
+    return mesh.grids(grids), moved
