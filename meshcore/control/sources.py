@@ -42,6 +42,7 @@ class _BorderState:
     hw_n: np.ndarray = field(init=False)
     gain: np.ndarray = field(init=False)  # adaptive gain multipliers (height, angle) and last error signs
     sign: np.ndarray = field(init=False)
+    unclipped: bool = field(init=False, default=False)  # the last feedback step clipped nothing
 
     def __post_init__(self) -> None:
         n = len(self.s_t)
@@ -95,8 +96,13 @@ class ControlSources:
         #: :mod:`meshcore.elliptic._mg_wake`): :meth:`update` then leaves them alone.
         self.wake_by_solver = False
         #: Set by a solver that converges the grid between updates (the multigrid): the
-        #: feedback gain then adapts per node (see :func:`_adapt`).
+        #: feedback gain then adapts per node while the last update clipped no error
+        #: (see :func:`_adapt`).
         self.adaptive_gain = False
+        self._unclipped = False
+        #: Whether an update since :meth:`initialize` adapted the gains (a solver whose try
+        #: failed starts over with fixed gains only then).
+        self.gains_adapted = False
 
     # -- protocol ---------------------------------------------------------
     def initialize(self, x: np.ndarray, y: np.ndarray, p: np.ndarray, q: np.ndarray) -> None:
@@ -132,6 +138,8 @@ class ControlSources:
         for name in sp.floating:
             self._curves[name], self._fl_s[name] = self._floating_curve(name, x, y)
         self._initialized = True
+        self._unclipped = False
+        self.gains_adapted = False
         self._recompute_tm(x, y)
         self._write(x, y, p, q)
 
@@ -213,6 +221,7 @@ class ControlSources:
         change = 0.0
         for bs in self._bstate.values():
             change = max(change, self._border_step(bs, x, y))
+        self._unclipped = all(bs.unclipped for bs in self._bstate.values())
         self._change = max(change, moved)
         self.history.append((it, self._change))
         self._write(x, y, p, q)
@@ -278,7 +287,9 @@ class ControlSources:
         else:
             g = w
         if g > 0:  # Hilgenstock–White: integral feedback on the measured first cell
-            _feedback(bs, s1[k], ang1[k], lt[k], req_a, g, lim, self.adaptive_gain)
+            adaptive = self.adaptive_gain and self._unclipped
+            self.gains_adapted |= adaptive
+            _feedback(bs, s1[k], ang1[k], lt[k], req_a, g, lim, adaptive)
         if not per and len(bs.hw_n) > 5:
             # Next to a corner of angle θc ≠ 90° the first cell cannot be both
             # orthogonal to the two walls and of the requested height (h = d·tan(θc/2)
@@ -430,9 +441,26 @@ def _adapt(bs: _BorderState, row: int, e: np.ndarray) -> np.ndarray:
     With a solver that converges the grid between updates (the multigrid) the
     first cell responds to the sources at once: an integral feedback then
     creeps towards the request at a rate set by the gain (measured on the NACA
-    O-grid: 0.98 per update in the tail, 275 updates).  A node whose error keeps
-    its sign gets a larger gain, one that overshoots a smaller one (the rule of
-    resilient back-propagation): same fixed point, fewer updates.
+    O-grid: 0.98 per update in the tail, 275 updates; on the C-grid 0.963, 190).
+    A node whose error keeps its sign gets a larger gain, one that overshoots a
+    smaller one (the rule of resilient back-propagation): same fixed point, fewer
+    updates.
+
+    The gains adapt only while the previous update clipped nothing
+    (``_BorderState.unclipped``, see :func:`_feedback`).  At the start the first
+    cells miss the request many times over (NACA O-grid trailing edge: e⁴), the
+    errors are clipped and the sources ramp at the clip rate; a gain grown there
+    multiplies steps the grid cannot follow (adapting from the first update made
+    the O-grid multigrid blow up after 14 updates).  Once the errors are within
+    the clip bounds the map is smooth and the adapted steps are safe; that gate
+    replaced "the cycle left the grid converged" (``r ≤ tol``, which holds only
+    once the sources have almost stopped moving).  Measured (1 thread): NACA O-grid
+    117 → 93 cycles, C-grid 190 → 69, the ellipse O-grids 41 → 24 and 55 → 40, 16
+    generated smooth bodies (64 × 24) 57–73 → 21–35 cycles with fixed gains → adaptive,
+    but one of them (seed 7 of the test) fell into a limit cycle at the trailing nodes
+    (neighbours with grown gains drive a node whose error flips sign) and diverged after
+    242 cycles: a multigrid try whose gains adapted and that fails starts over with fixed
+    gains (:func:`meshcore.elliptic.multigrid._fas`), 73 cycles there.
     """
     k = bs.idx
     sg = np.sign(e)
@@ -445,22 +473,35 @@ def _adapt(bs: _BorderState, row: int, e: np.ndarray) -> np.ndarray:
     return e * gk
 
 
+#: The feedback integrates the log first-cell height error and the angle error (radians)
+#: clipped to these bounds: one update moves a source by at most gain × bound.
+ERR_CLIP_HEIGHT, ERR_CLIP_ANGLE = 1.0, 0.5
+
+
 def _feedback(bs: _BorderState, s1, ang1, lt, req_a, g: float, lim: float, adaptive: bool = False) -> None:
     """Hilgenstock–White: integrate the error of the measured first cell (height, angle) at the controlled
-    nodes (with per-node adaptive gains if ``adaptive``, see :func:`_adapt`)."""
+    nodes (with per-node adaptive gains if ``adaptive``, see :func:`_adapt`).
+
+    Sets ``bs.unclipped``: no error was clipped and no integrator sits at ``±lim``.
+    """
     sigma, rho, along = _FRAME[bs.name]
     k = bs.idx
     req_s = bs.spec.spacing
+    e = np.log(np.maximum(s1, 1e-300) / req_s) if req_s is not None else np.zeros(0)
+    err = np.angle(np.exp(1j * (req_a - ang1))) if req_a is not None else np.zeros(0)
+    unclipped = bool(np.all(np.abs(e) < ERR_CLIP_HEIGHT) and np.all(np.abs(err) < ERR_CLIP_ANGLE))
     if req_s is not None:
-        e = np.clip(np.log(np.maximum(s1, 1e-300) / req_s), -1.0, 1.0)
+        e = np.clip(e, -ERR_CLIP_HEIGHT, ERR_CLIP_HEIGHT)
         bs.hw_n[k] -= sigma * g * (_adapt(bs, 0, e) if adaptive else e)
     if req_a is not None:
         ar = np.minimum(lt / np.maximum(s1, 1e-300), 50.0)
-        err = np.clip(np.angle(np.exp(1j * (req_a - ang1))), -0.5, 0.5)
+        err = np.clip(err, -ERR_CLIP_ANGLE, ERR_CLIP_ANGLE)
         sgn = -rho * sigma * (1 if along == "xi" else -1)
         bs.hw_t[k] += sgn * g * 2.0 * ar * (_adapt(bs, 1, err) if adaptive else err)
+    unclipped &= bool(np.all(np.abs(bs.hw_t[k]) < lim) and np.all(np.abs(bs.hw_n[k]) < lim))
     bs.hw_t[k] = np.clip(bs.hw_t[k], -lim, lim)
     bs.hw_n[k] = np.clip(bs.hw_n[k], -lim, lim)
+    bs.unclipped = unclipped
 
 
 def _attraction(attractors: tuple, I: np.ndarray, J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
