@@ -675,8 +675,9 @@ class _FAS:
 
 def _fas(state: SolverState, gamma: int) -> Generator[str, None, bool]:
     """The FAS solve; if it diverges or stalls, with a control whose sources are metric-scaled
-    it starts over with the sources following the grid (see :mod:`._mg_control`), else (and
-    if that fails too) SOR takes over."""
+    it starts over with the sources following the grid (see :mod:`._mg_control`) and adaptive
+    feedback gains, and if those gains adapted and that fails too, once more with fixed gains;
+    else (and if that fails too) SOR takes over."""
     retry = state.p.size > 0 and bool(getattr(state.sources, "metric_scaled", False))
     why = ""
     # (sources follow the grid, adaptive feedback gains): the last try keeps the gains fixed
