@@ -128,25 +128,42 @@ def outline_points(case: Case) -> np.ndarray:
 
 def case_frame(case: Case) -> Any:
     """The :class:`meshcore.crs.Frame` of a case's grid coordinates (None if unknown)."""
+    return _frame(case, _outline_geometry(case)[3] if case.outline is not None else None)
+
+
+def _frame(case: Case, outline_frame: Any) -> Any:
+    """:func:`case_frame` given the frame of the outline's projection (None if not projected)."""
     from ..crs import frame_from_case
 
-    if case.outline is not None:
-        fr = _outline_geometry(case)[3]
-        if fr is not None and fr.crs is not None:
-            return fr
+    if outline_frame is not None and outline_frame.crs is not None:
+        return outline_frame
     return frame_from_case(case)
 
 
 def _outline_topology(case: Case) -> MultiBlockTopology:
+    return _outline_topology_frame(case)[0]
+
+
+def _outline_topology_frame(case: Case) -> tuple[MultiBlockTopology, Any]:
+    """The topology of an ``[outline]`` case and its :func:`case_frame`, from one read and
+    projection of the outline (the CLI needs both)."""
     assert case.outline is not None
-    xy, cuts, blocks, _, holes = _outline_geometry(case)
+    xy, cuts, blocks, frame, holes = _outline_geometry(case)
     o = case.outline
     try:
-        return from_outline(
+        topo = from_outline(
             xy, cuts=cuts, blocks=blocks, holes=holes, snap=o.snap, multiple=o.multiple, cell_size=o.cell_size
         ).topology
     except InvalidInputError as exc:
         raise type(exc)(f"{case.source}: {exc}") from None
+    return topo, _frame(case, frame)
+
+
+def case_topology_frame(case: Case) -> tuple[MultiBlockTopology, Any]:
+    """``(case_topology(case), case_frame(case))``, reading and projecting an outline once."""
+    if case.outline is not None:
+        return _outline_topology_frame(case)
+    return _interface_topology(case), case_frame(case)
 
 
 def case_layout(case: Case) -> Any:

@@ -14,7 +14,7 @@ from ..generate import generate_block
 from ..grid import StructuredGrid
 from ..spec import SolverSpec
 from .model import Case
-from .multiblock import case_frame, case_layout, case_topology
+from .multiblock import case_frame, case_layout, case_topology_frame
 
 __all__ = ["case_solver", "generate_case", "iterate_multiblock_case"]
 
@@ -79,12 +79,16 @@ def iterate_multiblock_case(
 
         mb = yield from iterate_layout(case_layout(case), stop_event=stop_event)
         return dataclasses.replace(mb, frame=case_frame(case))
+    if topology is None:
+        topology, frame = case_topology_frame(case)
+    else:
+        frame = case_frame(case)
     mb = yield from iterate_multiblock(
-        topology if topology is not None else case_topology(case),
+        topology,
         mode=s.mode,
         start=s.start,
         config=case_solver(case, solver).config(),
         initial=initial,
         stop_event=stop_event,
     )
-    return dataclasses.replace(mb, frame=case_frame(case))
+    return dataclasses.replace(mb, frame=frame)

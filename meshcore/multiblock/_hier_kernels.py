@@ -3,7 +3,8 @@
 The set-up runs once per block structure, but on the first solve of a lake
 layout its per-block NumPy calls cost as much as the solve; these two loops do
 the same work in one call each.  NumPy references (test oracles):
-:func:`.hierarchy._block_interp`, :func:`.hierarchy.greedy_reference` and
+:func:`.hierarchy._block_interp`, :func:`.hierarchy.greedy_reference`,
+:func:`.hierarchy.lines_reference` (:func:`block_lines`) and
 :func:`.hierarchy.near_reference` (:func:`grow_near` also runs after every cycle of a solve,
 :func:`.multigrid._hot_sweeps`).
 """
@@ -232,33 +233,94 @@ def colour_perm(shape, n_rows):  # pragma: no cover - compiled
     return order
 
 
+#: The 8 stencil directions of a table row ``(E, W, N, S, NE, NW, SE, SW)`` as ``(di, dj)``.
+DIRS = np.array([(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)], dtype=np.int64)
+#: ``DIR_INDEX[3 * (di + 1) + dj + 1]``: the row position of direction ``(di, dj)`` (−1 for (0, 0)).
+DIR_INDEX = np.array([7, 1, 5, 3, -1, 2, 6, 0, 4], dtype=np.int64)
+
+
 @njit(cache=True, nogil=True)
-def block_lines(flat, off, shape, pos, axis):  # pragma: no cover - compiled
-    """``(rows, ptr)``: every interior line of every block along ``axis`` (0: ξ, i varies) as
-    table rows ``pos[node]`` (reference :func:`.hierarchy._lines`)."""
+def _find4(row, q):  # pragma: no cover - compiled
+    """The position of node ``q`` among the edge neighbours ``row[:4]`` (−1 if absent)."""
+    for d in range(4):
+        if row[d] == q:
+            return d
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def block_frame_row(row, i_next, i_prev, j_next, j_prev, out):  # pragma: no cover - compiled
+    """``out``: the table row ``row`` (a border node's stencil in the frame of its ring of cells)
+    in a block's frame, given the block's neighbours of the node along +i / −i / +j / −j (−1 where
+    the node is at the block's end in that direction).  Returns False when the row does not hold
+    them (then ``out`` is undefined)."""
+    de = _find4(row, i_next) if i_next >= 0 else -1
+    if de < 0:
+        d = _find4(row, i_prev) if i_prev >= 0 else -1
+        if d < 0:
+            return False
+        de = d ^ 1  # the opposite direction (E↔W, N↔S)
+    dn = _find4(row, j_next) if j_next >= 0 else -1
+    if dn < 0:
+        d = _find4(row, j_prev) if j_prev >= 0 else -1
+        if d < 0:
+            return False
+        dn = d ^ 1
+    if de // 2 == dn // 2:  # not a frame (the four edge neighbours are E, W, N, S)
+        return False
+    for d in range(8):
+        a, b = DIRS[d, 0], DIRS[d, 1]
+        u = a * DIRS[de, 0] + b * DIRS[dn, 0]
+        v = a * DIRS[de, 1] + b * DIRS[dn, 1]
+        k = DIR_INDEX[3 * (u + 1) + v + 1]
+        if k < 0:
+            return False
+        out[d] = row[k]
+    return True
+
+
+@njit(cache=True, nogil=True)
+def block_lines(flat, off, shape, pos, nbr, axis):  # pragma: no cover - compiled
+    """``(rows, lnbr, ptr)``: every interior line of every block along ``axis`` (0: ξ, i varies)
+    as table rows ``pos[node]``, with the line's two end nodes on the block border when they are
+    free regular nodes (an interface), and the rows' stencils in the block's frame ``lnbr`` (the
+    border nodes' rows turned by :func:`block_frame_row`).  Reference: :func:`.hierarchy.lines_reference`."""
     n_rows, n_lines = 0, 0
     for b in range(shape.shape[0]):
         ni, nj = shape[b, 0] - 2, shape[b, 1] - 2
         if ni >= 1 and nj >= 1:
-            n_rows += ni * nj
+            n_rows += (ni + 2) * nj if axis == 0 else ni * (nj + 2)
             n_lines += nj if axis == 0 else ni
     rows = np.empty(n_rows, dtype=np.int64)
+    lnbr = np.empty((n_rows, 8), dtype=np.int64)
     ptr = np.empty(n_lines + 1, dtype=np.int64)
     ptr[0] = 0
     q, L = 0, 0
     for b in range(shape.shape[0]):
-        ni, nj, o, w = shape[b, 0] - 2, shape[b, 1] - 2, off[b], shape[b, 1]
-        if ni < 1 or nj < 1:
+        ni, nj, o, w = shape[b, 0], shape[b, 1], off[b], shape[b, 1]  # nodes
+        if ni < 3 or nj < 3:
             continue
         outer, inner = (nj, ni) if axis == 0 else (ni, nj)
-        for s in range(outer):
+        for s in range(1, outer - 1):
             for t in range(inner):
                 i, j = (t, s) if axis == 0 else (s, t)
-                rows[q] = pos[flat[o + (i + 1) * w + j + 1]]
+                r = pos[flat[o + i * w + j]]
+                if r < 0:
+                    continue
+                if 0 < t < inner - 1:
+                    lnbr[q] = nbr[r]
+                else:
+                    i_next = flat[o + (i + 1) * w + j] if i + 1 < ni else -1
+                    i_prev = flat[o + (i - 1) * w + j] if i > 0 else -1
+                    j_next = flat[o + i * w + j + 1] if j + 1 < nj else -1
+                    j_prev = flat[o + i * w + j - 1] if j > 0 else -1
+                    if not block_frame_row(nbr[r], i_next, i_prev, j_next, j_prev, lnbr[q]):
+                        continue
+                rows[q] = r
                 q += 1
             L += 1
             ptr[L] = q
-    return rows, ptr
+    return rows[:q].copy(), lnbr[:q].copy(), ptr
 
 
 @njit(cache=True, nogil=True)

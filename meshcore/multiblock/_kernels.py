@@ -174,9 +174,11 @@ def line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, ptr, axis):  # pragma: no cover -
     """Line Gauss–Seidel sweep of ``u − T(u) = f`` over block lines (``fx, fy`` empty: ``f = 0``).
 
     Line ``L`` is the nodes ``lnodes[ptr[L]:ptr[L + 1]]`` in order along its block axis
-    ``axis[L]`` (0: W → E, 1: S → N), ``lnbr`` their neighbour rows (the table rows gathered in
-    line order: read in sequence, where the table's colour order made a line along ξ jump
-    through it, 4× slower on a 46 000-node lake, measured); its end neighbours stay fixed.  The coefficients α, β, γ
+    ``axis[L]`` (0: W → E, 1: S → N), ``lnbr`` their neighbour rows in the block's frame (the table
+    rows gathered in line order, those of interface nodes at the line's ends turned into the
+    block's frame, :func:`.hierarchy.lines_reference`; read in sequence, where the table's colour
+    order made a line along ξ jump through it, 4× slower on a 46 000-node lake, measured); its end
+    neighbours stay fixed.  The coefficients α, β, γ
     are frozen at the current values and the tridiagonal system
     ``u_t − c_t (u_{t−1} + u_{t+1}) = f_t + T_t − c_t (u_{t−1} + u_{t+1})|current``
     (``c = α/den`` along ξ, ``γ/den`` along η) is solved exactly (Thomas algorithm), for x and y.

@@ -84,7 +84,7 @@ class Level:
     n: int
     free: np.ndarray  # bool
     mult: np.ndarray  # in how many blocks each node is
-    lines: tuple  # ((nodes, nbr, ptr, axis) along ξ, along η): block lines relaxed as lines (:func:`_line_tables`)
+    lines: tuple  # ((nodes, nbr, ptr, axis) along ξ, along η): block lines, interface ends too (:func:`_line_tables`)
     border: tuple  # table arguments of the free border nodes only
     band: tuple  # table arguments of the regular nodes near the fixed boundary (:func:`_band`)
     sel: tuple = ()  # coarse level: per block (si, sj), the finer block indices kept
@@ -167,44 +167,82 @@ def near_reference(args: tuple, seed: np.ndarray, width: int) -> np.ndarray:
     return near
 
 
-def _lines(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tuple, tuple]:
-    """``(along ξ, along η)``, each ``(rows, ptr, axis)``: every interior line of every block as
-    table rows, one compiled call per direction (:func:`._hier_kernels.block_lines`; see
-    :func:`lines_reference`)."""
+def _lines(ids: tuple[np.ndarray, ...], nodes: np.ndarray, nbr: np.ndarray, n: int) -> tuple[tuple, tuple]:
+    """``(along ξ, along η)``, each ``(rows, lnbr, ptr, axis)``: every interior line of every block
+    as table rows, with its end nodes on interfaces, and the rows' stencils in the block's frame,
+    one compiled call per direction (:func:`._hier_kernels.block_lines`; see :func:`lines_reference`)."""
     pos = np.full(n, -1, dtype=np.int64)
     pos[nodes] = np.arange(len(nodes))
     flat, off, shape = flat_ids(ids)
     out = []
     for ax in (0, 1):
-        rows, ptr = _hk.block_lines(flat, off, shape, pos, ax)
-        out.append((rows, ptr, np.full(len(ptr) - 1, ax, dtype=np.int64)))
+        rows, lnbr, ptr = _hk.block_lines(flat, off, shape, pos, nbr, ax)
+        out.append((rows, lnbr, ptr, np.full(len(ptr) - 1, ax, dtype=np.int64)))
     return out[0], out[1]
 
 
 def _line_tables(ids: tuple[np.ndarray, ...], args: tuple, n: int) -> tuple[tuple, tuple]:
-    """``(along ξ, along η)``, each ``(nodes, nbr, ptr, axis)``: the table rows of :func:`_lines`
+    """``(along ξ, along η)``, each ``(nodes, nbr, ptr, axis)``: the rows of :func:`_lines`
     gathered in line order, the form :func:`._kernels.line_sweep_rhs` reads in sequence."""
     nodes, nbr = args[0], args[1]
     return tuple(  # type: ignore[return-value]
-        (np.ascontiguousarray(nodes[rows]), np.ascontiguousarray(nbr[rows]), ptr, axis)
-        for rows, ptr, axis in _lines(ids, nodes, n)
+        (np.ascontiguousarray(nodes[rows]), lnbr, ptr, axis) for rows, lnbr, ptr, axis in _lines(ids, nodes, nbr, n)
     )
 
 
-def lines_reference(ids: tuple[np.ndarray, ...], nodes: np.ndarray, n: int) -> tuple[tuple, tuple]:
-    """``(along ξ, along η)``, each ``(rows, ptr, axis)``: every interior line of every block as
-    table rows (interior nodes only; the lines end next to the block borders).  NumPy reference
-    of :func:`_lines`."""
+def lines_reference(ids: tuple[np.ndarray, ...], nodes: np.ndarray, nbr: np.ndarray, n: int) -> tuple[tuple, tuple]:
+    """``(along ξ, along η)``, each ``(rows, lnbr, ptr, axis)``: every line of every block through
+    its interior nodes, extended by its two end nodes on the block border when they are free regular
+    nodes (on an interface: the node is then relaxed with the line instead of by point sweeps only),
+    as table rows, and each row's stencil in the block's frame (``E`` = +i, ``N`` = +j): an interior
+    row as the table has it, a border node's row (whose frame the ring of cells gave) turned or
+    mirrored so that its neighbours along the block's +i and +j come first.  Python reference of
+    :func:`_lines`."""
     pos = np.full(n, -1, dtype=np.int64)
     pos[nodes] = np.arange(len(nodes))
-    inner = [pos[g[1:-1, 1:-1]] for g in ids if g.shape[0] > 2 and g.shape[1] > 2]
+    dirs = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)]
     out = []
     for ax in (0, 1):
-        parts = [r.T if ax == 0 else r for r in inner]  # one line per row of each part
-        rows = np.concatenate([p.ravel() for p in parts]) if parts else np.zeros(0, dtype=np.int64)
-        lens = np.concatenate([np.full(p.shape[0], p.shape[1]) for p in parts]) if parts else np.zeros(0)
-        ptr = np.concatenate([[0], np.cumsum(lens)]).astype(np.int64)
-        out.append((rows.astype(np.int64), ptr, np.full(len(lens), ax, dtype=np.int64)))
+        rows, lnbr, ptr = [], [], [0]
+        for g in ids:
+            if g.shape[0] < 3 or g.shape[1] < 3:
+                continue
+            ni, nj = g.shape
+            for s in range(1, (nj if ax == 0 else ni) - 1):
+                for t in range(ni if ax == 0 else nj):
+                    i, j = (t, s) if ax == 0 else (s, t)
+                    r = int(pos[g[i, j]])
+                    if r < 0:
+                        continue
+                    row = [int(v) for v in nbr[r]]
+                    if 0 < i < ni - 1 and 0 < j < nj - 1:
+                        rows.append(r)
+                        lnbr.append(row)
+                        continue
+                    frame = []  # the row's directions of the block's +i and +j
+                    for di, dj in ((1, 0), (0, 1)):
+                        ahead = (i + di, j + dj)
+                        back = (i - di, j - dj)
+                        if ahead[0] < ni and ahead[1] < nj and int(g[ahead]) in row[:4]:
+                            frame.append(dirs[row.index(int(g[ahead]))])
+                        elif back[0] >= 0 and back[1] >= 0 and int(g[back]) in row[:4]:
+                            d = dirs[row.index(int(g[back]))]
+                            frame.append((-d[0], -d[1]))
+                    if len(frame) < 2 or frame[0][0] * frame[1][0] + frame[0][1] * frame[1][1] != 0:
+                        continue
+                    (ei, ej), (ni_, nj_) = frame
+                    turned = [row[dirs.index((a * ei + b * ni_, a * ej + b * nj_))] for a, b in dirs]
+                    rows.append(r)
+                    lnbr.append(turned)
+                ptr.append(len(rows))
+        out.append(
+            (
+                np.array(rows, dtype=np.int64),
+                np.array(lnbr, dtype=np.int64).reshape(-1, 8),
+                np.array(ptr, dtype=np.int64),
+                np.full(len(ptr) - 1, ax, dtype=np.int64),
+            )
+        )
     return out[0], out[1]
 
 
