@@ -95,12 +95,15 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
     changed = True
     while changed:
         changed = False
+        boxes = np.array(box)
         for i in range(len(rings)):
-            for j in range(i + 1, len(rings)):
+            # the pieces after i whose boxes meet i's (the others are apart: no shared edge),
+            # in one test per i: a test per pair made the restarts after each merge quadratic
+            lo, hi = boxes[i + 1 :, :2], boxes[i + 1 :, 2:]
+            meets = ~((boxes[i, :2] > hi).any(axis=1) | (lo > boxes[i, 2:]).any(axis=1))
+            for j in (i + 1 + np.flatnonzero(meets)).tolist():
                 if forced[i] or forced[j]:
                     continue
-                if np.any(box[i][:2] > box[j][2:]) or np.any(box[j][:2] > box[i][2:]):
-                    continue  # apart: no shared edge
                 m, c = union(i, j)
                 if m is None:
                     continue

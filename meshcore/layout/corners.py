@@ -26,19 +26,33 @@ __all__ = ["bulge_ratio", "choose_corners", "corner_cost", "set_cost", "turning"
 SHARP = 30.0
 
 
-def _arclength_closed(ring: np.ndarray) -> tuple[np.ndarray, float]:
-    seg = np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)
+def _edges(ring: np.ndarray) -> np.ndarray:
+    """``ring[i + 1] - ring[i]`` for every vertex of a closed ring (the last back to the first);
+    what ``np.roll(ring, -1, axis=0) - ring`` gives, without its cost (these functions run for
+    every candidate piece of a layout: thousands of small rings)."""
+    ring = np.asarray(ring)
+    d = np.empty_like(ring)
+    np.subtract(ring[1:], ring[:-1], out=d[:-1])
+    np.subtract(ring[:1], ring[-1:], out=d[-1:])
+    return d
+
+
+def _arclength_closed(ring: np.ndarray, d: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """Arc length at every vertex of a closed ring and its perimeter (``d``: its :func:`_edges`)."""
+    d = _edges(ring) if d is None else d
+    seg = np.hypot(d[:, 0], d[:, 1])
     s = np.concatenate([[0.0], np.cumsum(seg[:-1])])
     return s, float(seg.sum())
 
 
-def turning(ring: np.ndarray, sigma: float) -> np.ndarray:
+def turning(ring: np.ndarray, sigma: float, arc: tuple[np.ndarray, float] | None = None) -> np.ndarray:
     """Turning angle (degrees, left = positive) at every vertex of a closed ring, at scale.
 
     The direction before a vertex is that of the chord from the point ``sigma`` behind it
     (along the ring) to the vertex, after it the chord to the point ``sigma`` ahead.
+    ``arc``: the ring's :func:`_arclength_closed`, if made already.
     """
-    s, total = _arclength_closed(ring)
+    s, total = _arclength_closed(ring) if arc is None else arc
     sigma = min(sigma, 0.25 * total)
     xs = np.concatenate([s - total, s, s + total])
     xp = np.vstack([ring, ring, ring])
@@ -54,9 +68,10 @@ def turning(ring: np.ndarray, sigma: float) -> np.ndarray:
     return ang
 
 
-def _raw_turning(ring: np.ndarray) -> np.ndarray:
-    a = ring - np.roll(ring, 1, axis=0)
-    b = np.roll(ring, -1, axis=0) - ring
+def _raw_turning(ring: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
+    """Turning angle (degrees) at every vertex between its two edges (``d``: :func:`_edges`)."""
+    b = _edges(ring) if d is None else d
+    a = np.concatenate([b[-1:], b[:-1]])
     return np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
 
 
@@ -93,27 +108,28 @@ def side_cost(s: np.ndarray, total: float, corners) -> float:
     return SIDE_WEIGHT * (math.log(L[0] / L[2]) ** 2 + math.log(L[1] / L[3]) ** 2)
 
 
-def bulge_ratio(ring: np.ndarray, corners) -> float:
+def bulge_ratio(ring: np.ndarray, corners, arc: tuple[np.ndarray, float] | None = None) -> float:
     """``R``: the area of ``ring`` over the product of the mean lengths of its two pairs of
     opposite sides between ``corners`` (1 for a rectangle, an annular sector or a straight or
     bent strip; 1.27 for a disc with four corners a quarter apart).
 
     Four corners bunched together on one part of a round region give ``R ≫ 1``: its cells
     fan out from two short sides across the whole basin, although every corner may be a right
-    angle and no side bends sharply.
+    angle and no side bends sharply.  ``arc``: the ring's :func:`_arclength_closed`, if made already.
     """
-    s, total = _arclength_closed(ring)
+    s, total = _arclength_closed(ring) if arc is None else arc
     pos = [s[i] for i in sorted(corners)]
     L = [(pos[(k + 1) % 4] - pos[k]) % total for k in range(4)]
     x, y = ring[:, 0], ring[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    x1, y1 = np.concatenate([x[1:], x[:1]]), np.concatenate([y[1:], y[:1]])  # np.roll(·, -1)
+    area = 0.5 * abs(float(np.dot(x, y1) - np.dot(y, x1)))
     return area / max(0.25 * (L[0] + L[2]) * (L[1] + L[3]), 1e-300)
 
 
-def bulge_cost(ring: np.ndarray, corners) -> float:
+def bulge_cost(ring: np.ndarray, corners, arc: tuple[np.ndarray, float] | None = None) -> float:
     """``SIDE_WEIGHT × log² R`` for a region that holds more water than its sides span
     (:func:`bulge_ratio` ``R > 1``); nothing for ``R ≤ 1``."""
-    R = bulge_ratio(ring, corners)
+    R = bulge_ratio(ring, corners, arc)
     return SIDE_WEIGHT * math.log(R) ** 2 if R > 1.0 else 0.0
 
 
@@ -174,9 +190,11 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     n = len(ring)
     if n < 4:
         return None, math.inf
-    t = turning(ring, sigma)
-    raw = _raw_turning(ring)
-    s, total = _arclength_closed(ring)
+    d = _edges(ring)
+    arc = _arclength_closed(ring, d)
+    s, total = arc
+    t = turning(ring, sigma, arc)
+    raw = _raw_turning(ring, d)
     forced = sorted({int(f) for f in forced})
     tt = t.copy()
     tt[forced] = 1e9  # forced first
@@ -207,17 +225,21 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
         picks = sorted(set(picks + order[: 4 - len(picks)]))[:4]
     if len(picks) != 4:
         return None, math.inf
-    return tuple(picks), set_cost(ring, sigma, picks, t=t)
+    return tuple(picks), set_cost(ring, sigma, picks, t=t, arc=arc)
 
 
-def set_cost(ring: np.ndarray, sigma: float, picks, *, t: np.ndarray | None = None) -> float:
+def set_cost(
+    ring: np.ndarray, sigma: float, picks, *, t: np.ndarray | None = None, arc: tuple[np.ndarray, float] | None = None
+) -> float:
     """The cost of the four corners ``picks`` (increasing indices) of a CCW ring: the corners'
     turning (:func:`corner_cost`), opposite sides' lengths (:func:`side_cost`) and the bulge
-    (:func:`bulge_cost`); ``t``: :func:`turning` of the ring at ``sigma``, if made already."""
-    t = turning(ring, sigma) if t is None else t
-    s, total = _arclength_closed(ring)
+    (:func:`bulge_cost`); ``t``: :func:`turning` of the ring at ``sigma``, ``arc``: its
+    :func:`_arclength_closed`, if made already."""
+    arc = _arclength_closed(ring) if arc is None else arc
+    t = turning(ring, sigma, arc) if t is None else t
+    s, total = arc
     near = np.zeros(len(ring), dtype=bool)
     for c in picks:
         d = np.abs(s - s[c])
         near |= np.minimum(d, total - d) < sigma
-    return corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks)
+    return corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks, arc)

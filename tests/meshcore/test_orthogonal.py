@@ -209,3 +209,21 @@ def test_the_start_grids_solve_stops_at_its_iteration_cap(monkeypatch):
     monkeypatch.setattr(lg, "START_ITERATIONS", 2000)
     _, how = lg._start(topo, "winslow")
     assert "(converged" in how
+
+
+def test_the_ring_search_from_a_hint_is_the_bisection():
+    """The shore sweep's walk from a segment near the point finds the segment bisection finds,
+    for any hint: far ones, ties (zero-length segments), the ends and just outside them."""
+    rng = np.random.default_rng(7)
+    for trial in range(40):
+        n = int(rng.integers(1, 300))
+        seg = rng.uniform(0.0, 2.0, n) * (rng.random(n) > 0.2)  # a fifth of zero length
+        S = np.concatenate([[0.0], np.cumsum(seg)])
+        pad = int(rng.integers(0, 5))  # the ring's table starts at an offset in the shared array
+        SS = np.concatenate([np.full(pad, -1.0), S, np.full(3, 1e9)])
+        total = S[-1]
+        us = np.concatenate([rng.uniform(0.0, max(total, 1e-9), 30), S[:-1], [0.0, -1e-17, total, total + 1e-12]])
+        for u in us:
+            want = _kernels._segment(SS, pad, n, u)
+            for hint in {0, n - 1, want, max(0, want - 5), min(n - 1, want + 40), int(rng.integers(0, n))}:
+                assert _kernels._segment_from(SS, pad, n, u, hint) == want, (trial, u, hint)
