@@ -150,7 +150,7 @@ def _smooth_corners(raw: np.ndarray, a: int, b: int, m: int) -> list[int]:
     quantiles ``(k + ½) / m`` of its total turning (a rounded end gets its corners at 45° and
     135° of a 180° turn)."""
     n = len(raw)
-    idx = [(a + k) % n for k in range(1, (b - a) % n if (b - a) % n else n)]
+    idx = ((a + np.arange(1, (b - a) % n if (b - a) % n else n)) % n).tolist()
     if len(idx) < m:
         return []
     cum = np.cumsum(np.maximum(raw[idx], 0.0))
@@ -208,9 +208,7 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
             picks = _smooth_corners(raw, 0, 0, 4)
         else:
             stretches = [(a, b) for a, b in zip(picks, picks[1:] + picks[:1], strict=True)]
-            turn = np.array(
-                [np.maximum(raw[[(a + k) % n for k in range(1, (b - a) % n or n)]], 0).sum() for a, b in stretches]
-            )
+            turn = np.array([np.maximum(raw[(a + np.arange(1, (b - a) % n or n)) % n], 0).sum() for a, b in stretches])
             share = np.zeros(len(stretches), dtype=int)
             for _ in range(missing):  # largest remaining turn per corner gets the next one
                 share[int(np.argmax(turn / (share + 1)))] += 1
