@@ -72,15 +72,16 @@ def _per_level(value, lev: int) -> float:
 START_ITERATIONS = 2000
 
 
-def _start(topo, how: str):
-    """A start grid on the coarsest level: the algebraic (TFI) grids relaxed as one grid."""
+def _start(topo, how: str, g0: list | None = None):
+    """A start grid on the coarsest level: the algebraic (TFI) grids relaxed as one grid
+    (``g0``: those grids, :func:`~meshcore.multiblock.initial_grids`, if made already)."""
     from .multiblock import initial_grids, solve_multiblock
     from .orthogonal import orthogonalize
 
     if how == "winslow":
-        mb = solve_multiblock(topo, max_iterations=START_ITERATIONS)
+        mb = solve_multiblock(topo, max_iterations=START_ITERATIONS, initial=g0)
         return list(mb.grids), f"multiblock Winslow ({mb.info.message})"
-    g0 = initial_grids(topo)
+    g0 = initial_grids(topo) if g0 is None else g0
     res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4, size_ratio=None)
     return list(res.grids), f"algebraic grids relaxed as one grid ({res.sweeps} sweeps)"
 
@@ -136,9 +137,10 @@ def iterate_layout(
         levels = max(0, int(np.log2(layout.multiple))) if layout.multiple > 1 else 0
     factor = 2**levels
     tops = [coarsen_topology(topo, 2**k) if k else topo for k in range(levels, -1, -1)]
-    grids, how = _start(tops[0], start)
+    g0 = initial_grids(tops[0])  # the start's first guess, and the layout's lines for untangle
+    grids, how = _start(tops[0], start, g0)
     grids, repaired = _repair_folds(grids)
-    grids, untangled = untangle(tops[0], grids, layout=initial_grids(tops[0]))
+    grids, untangled = untangle(tops[0], grids, layout=g0)
     rings = _shore_rings(layout.polygon, layout.cell_size / 4)
     total = 0
     history: list[tuple[int, float]] = []
