@@ -104,14 +104,16 @@ MAX_NEW_FOLDED, FOLD_GROWTH = 0.02, 2.0
 #: and all stalled with point smoothing; discs, blobs and lakes with islands have ~2 % (the
 #: corner cells) and converge in 5–17 point cycles, each a quarter of a line cycle.
 LINE_ASPECT, LINE_FRACTION = 3.0, 0.1
-#: Levels with fewer nodes than this keep point smoothing (in the fused V-cycle).
-LINE_MIN_NODES = 0
 #: Damping of each line pass (``u ← u + ω (u_lines − u)``).  A line solved with its
 #: coefficients frozen overshoots where the grid folds (the coefficients change much with the
 #: move): undamped, the cycles of a branched lake as one block circled round a defect of
 #: 1e-4 for 100 cycles.  Measured on generated channel networks and a spiral (~24 000 nodes):
 #: ω = 0.9 left one network circling (SOR took over), 0.7 took 1–4 more cycles than 0.8.
 LINE_OMEGA = 0.8
+#: Post-smoothing sweeps on a line-smoothed finest level (``POST`` point sweeps otherwise).
+#: Measured on generated one-block shapes and lakes (~24 000 nodes): 3 and 2 take the same
+#: cycles ± 2, 2 costs 10–20 % less; 1 took up to twice the cycles (a spiral).
+LINE_POST = 2
 #: After this many cycles, a residual that fell less than STALL_FACTOR in the last
 #: STALL_WINDOW cycles hands over to SOR (continuing from the current grid).
 STALL_START, STALL_WINDOW, STALL_FACTOR = 12, 6, 0.9
@@ -439,8 +441,7 @@ class _FAS:
 
         def fused(shp):  # see _pack: V-cycles fuse every serial coarse level
             par = threads > 1 and shp[0] * shp[1] >= PARALLEL_MIN_NODES
-            lines = self.lines and shp[0] * shp[1] >= LINE_MIN_NODES
-            return self.gamma == 1 and not par and not lines and not self.controlled and not self.wake
+            return self.gamma == 1 and not par and not self.lines and not self.controlled and not self.wake
 
         def new(shp, fuse, zero=False):  # a fused level's arrays are placed by _pack
             if fuse:
@@ -476,11 +477,11 @@ class _FAS:
         self.coarsest_sweeps = max(COARSEST_SWEEPS, min(2 * n * n, COARSEST_MAX))
         if self.levels[-1].wake and len(self.levels) > 1:
             self.coarsest_sweeps = COARSEST_LINE_SWEEPS  # line sweeps (see smooth)
-        if self.lines and len(self.levels) > 1 and self.levels[-1].x.size >= LINE_MIN_NODES:
+        if self.lines and len(self.levels) > 1:
             self.coarsest_sweeps = COARSEST_LINE_SWEEPS
         for lv in self.levels:
             lv.par = threads > 1 and lv.x.size >= PARALLEL_MIN_NODES
-            lv.lines = self.lines and lv.x.size >= LINE_MIN_NODES
+            lv.lines = self.lines
             if lv.wake:
                 lv.rcx, lv.rcy = np.zeros(lv.x.shape[0]), np.zeros(lv.x.shape[0])
         self._pack()
@@ -740,7 +741,7 @@ class _FAS:
         for _ in range(self.gamma if k + 1 < len(self.levels) - 1 else 1):
             self.cycle(k + 1)
         self.correct(k)
-        self.smooth(lv, POST if k == 0 else COARSE_POST)
+        self.smooth(lv, COARSE_POST if k else LINE_POST if lv.lines else POST)
         self.smooth_band(lv, k == 0)
 
 
