@@ -104,10 +104,23 @@ def _line(x, y, fx, fy, p, q, use_f, use_pq, i, lo, dg, up, rx, ry):  # pragma: 
     """Solve η line ``i`` (nodes ``j = 1 … nj − 1``) with frozen coefficients, in place."""
     nj1 = x.shape[1]
     n = nj1 - 2
-    for k in range(n):
-        dg[k], cn, cs, rx[k], ry[k] = _node_jit(x, y, fx, fy, p, q, use_f, use_pq, i, k + 1)
-        lo[k] = -cs
-        up[k] = -cn
+    # the flags as constants in each loop: the branches fold away and the loop vectorises
+    # (with the flags as variables the line sweep took 3× as long, measured)
+    if use_pq:
+        for k in range(n):
+            dg[k], cn, cs, rx[k], ry[k] = _node_jit(x, y, fx, fy, p, q, use_f, True, i, k + 1)
+            lo[k] = -cs
+            up[k] = -cn
+    elif use_f:
+        for k in range(n):
+            dg[k], cn, cs, rx[k], ry[k] = _node_jit(x, y, fx, fy, p, q, True, False, i, k + 1)
+            lo[k] = -cs
+            up[k] = -cn
+    else:
+        for k in range(n):
+            dg[k], cn, cs, rx[k], ry[k] = _node_jit(x, y, fx, fy, p, q, False, False, i, k + 1)
+            lo[k] = -cs
+            up[k] = -cn
     rx[0] -= lo[0] * x[i, 0]  # the border nodes stay on the right-hand side
     ry[0] -= lo[0] * y[i, 0]
     rx[n - 1] -= up[n - 1] * x[i, nj1 - 1]
