@@ -31,7 +31,10 @@ as the point update does (same fixed point, same discrete equations).
 Lines of one parity of ``i`` never meet in each other's 9-point stencils: all
 odd lines are relaxed, then all even lines (zebra), and the lines of a pass are
 independent, so the serial and ``parallel=True`` compilations give
-bit-identical results.  Non-periodic grids only (the C-grids that use it).
+bit-identical results.  Non-periodic grids only: the C-grids, and grids whose cells are
+long one way in places and the other way elsewhere (branched lakes as one block), which
+:func:`.multigrid._alt_lines` relaxes by η lines and then by ξ lines (the η lines of the
+transposed level).
 
 The cut.  The η lines run straight through a C-grid's wake cut (see
 :mod:`._mg_wake`): column ``m = ni − i`` from the far field down to the cut,

@@ -22,7 +22,12 @@ Hierarchy: each direction is coarsened (vertex-centred, see
 uniform coarse intervals whose nodes fall between fine nodes: every level is
 uniform in the finest index, and odd sizes converge as fast as even ones).
 Where cells are clearly longer in one direction only the other direction is coarsened (automatic semi-coarsening, see
-:func:`coarsening`), so the point smoother still smooths.  Coarsening stops
+:func:`coarsening`), so the point smoother still smooths.  Where they are long one way in
+some places and the other way elsewhere (a branched lake as one block: arms run along ξ
+and across it), no one coarsening suits point smoothing: such non-periodic grids
+(:func:`anisotropic`) are smoothed on every level by alternating zebra lines, η lines
+then ξ lines, each pass damped (:func:`_alt_lines`, ``LINE_OMEGA``); a point-smoothed solve
+that stalls or diverges goes on with line smoothing before SOR is tried.  Coarsening stops
 before a level that would fold (e.g. a ring of two cells) and keeps a
 periodic direction at ≥ :data:`MIN_PERIODIC_CELLS` cells.  The coarsest level
 is solved by many Gauss–Seidel sweeps.  Periodic ξ (O-grids, column ``ni``
@@ -85,7 +90,7 @@ from . import _mg_lines as L
 from . import _mg_wake as W
 from .solver import SolverState, _sor, _sources_settled, register_method
 
-__all__ = ["MIN_COARSEN_CELLS", "coarsening", "hierarchy", "multigrid", "multigrid_w"]
+__all__ = ["MIN_COARSEN_CELLS", "anisotropic", "coarsening", "hierarchy", "multigrid", "multigrid_w"]
 
 #: A direction is coarsened while it has at least this many cells.
 MIN_COARSEN_CELLS = 4
