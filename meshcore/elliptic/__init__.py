@@ -63,6 +63,10 @@ def warmup(*, multigrid: bool = True, parallel: bool = True) -> None:
         X, Y = np.meshgrid(s, s, indexing="ij")
         X = X + 0.05 * np.sin(np.pi * X) * np.sin(np.pi * Y)
         solve(StructuredGrid(X, Y), method="multigrid", threads=1)
+        # cells long one way at one corner and the other way at the other: line smoothing
+        t = np.linspace(0.0, 1.0, 17)
+        X, Y = np.meshgrid(t * t, 1.0 - (1.0 - t) ** 2, indexing="ij")
+        solve(StructuredGrid(X + 0.1 * Y * Y, Y), method="multigrid", threads=1)
         from . import _mg_wake  # the C-grid wake cut (x, y copies: the rows of a 5×5 square)
 
         r = np.zeros(5)
@@ -72,6 +76,9 @@ def warmup(*, multigrid: bool = True, parallel: bool = True) -> None:
         _kernels.sweep4_parallel(x, y, e, e, 1.0, False)
         r = np.zeros_like(x)
         _mg_kernels.smooth_parallel(x, y, r, r, e, e, False, 1)
+        from . import _mg_lines
+
+        _mg_lines.smooth_lines_parallel(x.copy(), y.copy(), r, r, e, e, 0, 1)
         tab = _multigrid._tables(np.arange(5.0), True, False)  # read-only, as in a solve
         xc = np.zeros((tab[6].size, tab[6].size))
         _mg_kernels.defect_parallel(x, y, e, e, e, e, False, r.copy(), r.copy())
