@@ -259,6 +259,19 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
             layouts.append(time.perf_counter())
 
     win.lake_ctl.layout_done.connect(laid)
+    import app.layout_edit as edit
+
+    made: list[float] = []  # per layout the worker made: CPU seconds of its thread in moved_layout
+    moved = edit.moved_layout
+
+    def timed(base, parts):  # the tool looks moved_layout up at each step: this one is timed
+        c = time.thread_time()
+        try:
+            return moved(base, parts)
+        finally:
+            made.append(time.thread_time() - c)
+
+    edit.moved_layout = timed
     h = lay.cell_size
     prof = None
     if profile:
@@ -281,7 +294,9 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
         prof.disable()
         prof.dump_stats(profile)
     n_during = len([f for f in frames if t_drag <= f <= t_release])
+    n_made = len(made)
     dt = _wait(app, lambda: not win.lake_ctl.editing and not win.solver.running, timeout=600)
+    edit.moved_layout = moved
     win.solver.redrawn.disconnect(redrawn)
     win.lake_ctl.layout_done.disconnect(laid)
     starts = sum(any(_is_start(g, a) for g, a in frame) for frame in shown)
@@ -293,7 +308,9 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
     print(
         f"drag a cut end on Como ({lay.n_cells} cells, auto-generate; load {os.getloadavg()[0]:.1f}): "
         f"{n_during / wall:.1f} redraws/s while dragging ({n_during} in {wall:.1f} s wall for 3 s of mouse "
-        f"moves, {n_lay} layouts); CPU while dragging {cpu:.1f} s (GUI thread {gui:.1f} s): "
+        f"moves); {n_lay / wall:.1f} layouts/s while dragging ({n_lay} shown, {n_made} made, "
+        f"{1000 * sum(made[:n_made]) / max(n_made, 1):.0f} ms CPU each in the layout worker); "
+        f"CPU while dragging {cpu:.1f} s (GUI thread {gui:.1f} s): "
         f"{n_during / max(cpu, 1e-9):.1f} redraws per CPU-s; {starts} of {len(frames)} redraws showed a "
         f"start grid, done {dt:.1f} s after release ({win.stack.undoText()!r}, {win.lake_ctl.edit_error or 'no error'})"
     )
@@ -307,6 +324,7 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
         "cpu": cpu,
         "gui": gui,
         "layouts": n_lay,
+        "layout_cpu": sum(made[:n_made]) / max(n_made, 1),
         "start_frames": starts,
         "frames": len(frames),
     }

@@ -13,9 +13,10 @@ the shore, the islands, the cut lines, each block's corners and cells).  The han
 A move puts the handle at the new place; the cuts through it bend smoothly to follow (their
 far ends stay) and the block corners on them move along (a cut's end and the corners of the
 blocks that meet there move together); it keeps the cell counts (so the grid re-solves from
-the previous one), and the new layout is made by :func:`moved_layout`
-(:func:`meshcore.layout.layout_from_outline`, whose checks name the block or cut that cannot be
-four-sided); a move that would change the blocks (a cut dragged across another) is refused.
+the previous one), and the new layout is made by :func:`moved_layout` (one
+:func:`meshcore.multiblock.from_outline` for the layout and its topology, whose checks name the
+block or cut that cannot be four-sided); a move that would change the blocks (a cut dragged
+across another) is refused.
 """
 
 from __future__ import annotations
@@ -276,21 +277,30 @@ def _straight(a, b, c, tol: float) -> bool:
 def moved_layout(base: Any, parts: dict) -> Any:
     """The layout of ``parts`` (a move of :func:`moved_parts` on ``base``), with ``base``'s blocks.
 
+    One :func:`~meshcore.multiblock.from_outline` of ``parts`` makes both the layout and its
+    topology (kept on it): the one a case of the layout gives, as :meth:`Layout.topology
+    <meshcore.layout.Layout.topology>` would make it by a second call (the same shore, cuts and
+    blocks, at its snap distance and cell size).
+
     Raises :class:`~meshcore.errors.TopologyError` naming the problem when the parts give no
     layout, or when they give other blocks (a cut dragged across another cut or an island):
     a drag keeps the blocks and their cells, so that the grid re-solves from the previous one.
     """
     from meshcore.errors import TopologyError
-    from meshcore.layout import layout_from_outline
+    from meshcore.layout.edit import layout_of_outline
+    from meshcore.layout.outline import topology_snap
+    from meshcore.multiblock.outline import from_outline
 
-    lay = layout_from_outline(
+    ob = from_outline(
         parts["outline"],
         holes=parts["holes"],
         cuts=parts["cuts"],
         blocks=parts["blocks"],
-        cell_size=base.cell_size,
         multiple=base.multiple,
+        snap=topology_snap(base.polygon),
+        cell_size=base.cell_size,
     )
+    lay = layout_of_outline(ob, parts["blocks"], cell_size=base.cell_size, multiple=base.multiple)
     before = [(b.name, tuple(b.cells)) for b in base.blocks]
     after = [(b.name, tuple(b.cells)) for b in lay.blocks]
     if len(after) != len(before):
@@ -301,5 +311,5 @@ def moved_layout(base: Any, parts: dict) -> Any:
     if after != before:
         changed = next(f"{a[0]} ({a[1][0]}×{a[1][1]})" for a, b in zip(after, before, strict=True) if a != b)
         raise TopologyError(f"the move would change block {changed}; a drag keeps every block and its cells")
-    lay.topology()  # here (in the worker): a layout whose blocks cannot be made is refused now
+    object.__setattr__(lay, "_topology", ob.topology)  # made, checked: the layout's own (Layout.topology)
     return lay

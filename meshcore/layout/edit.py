@@ -18,7 +18,7 @@ from .blocks import Piece, block_counts, conform
 from .model import Layout, LayoutBlock
 from .outline import _size
 
-__all__ = ["layout_from_cuts", "layout_from_outline", "with_cells"]
+__all__ = ["layout_from_cuts", "layout_from_outline", "layout_of_outline", "with_cells"]
 
 
 def _pieces_of_regions(rings: list[np.ndarray], corner_points: list[list], names: list[str], size: float):
@@ -48,35 +48,34 @@ def layout_from_outline(
     block, cut or island at fault; ``cell_size`` (default: the mean size of the blocks' cells)
     sets how densely the orthogonal smoother samples the shore.
     """
-    from shapely.geometry import Polygon
-
-    from ..multiblock.outline import BlockOutline, from_outline
-    from .polygon import water_polygon
+    from ..multiblock.outline import from_outline
 
     ob = from_outline(outline, holes=holes, cuts=cuts, blocks=blocks, multiple=multiple)
+    return layout_of_outline(ob, blocks, cell_size=cell_size, multiple=multiple)
+
+
+def layout_of_outline(ob: Any, blocks: Any, *, cell_size: float | None = None, multiple: int = 1):
+    """The :class:`~meshcore.layout.Layout` of ``ob`` (a :func:`meshcore.multiblock.from_outline`
+    of ``blocks``): its regions become the pieces, in the order of ``blocks``."""
+    from ..multiblock.outline import BlockOutline
+    from .polygon import water_polygon
+
     specs = [BlockOutline.coerce(b) for b in blocks]
     poly, notes = water_polygon(ob.outline, holes=list(ob.islands))
     h = float(cell_size) if cell_size else math.sqrt(poly.area / sum(s.cells[0] * s.cells[1] for s in specs))
     regions = list(ob.regions)
     topo = ob.topology
-    by_name = {b.name: b for b in topo.blocks}
+    # every region is one block's (from_outline checks it): the block of each region, in the regions' order
+    block_of = {fi: topo.blocks[k] for k, fi in enumerate(ob.block_regions)}
     names, corners = [], []
-    for r in regions:
-        P = Polygon(r)
-        match = [
-            b
-            for b in topo.blocks
-            if P.buffer(1e-9 * _size(poly)).covers(Polygon(b.borders.loop()).representative_point())
-        ]
-        b = match[0]
+    for fi in range(len(regions)):
+        b = block_of[fi]
         names.append(b.name)
         corners.append([b.borders.bottom[0], b.borders.bottom[-1], b.borders.top[-1], b.borders.top[0]])
     pieces = _pieces_of_regions(regions, corners, names, _size(poly))
     lblocks = tuple(
-        LayoutBlock(
-            n, tuple((float(p[0]), float(p[1])) for p in cs), (int(by_name[n].cells[0]), int(by_name[n].cells[1]))
-        )
-        for n, cs in zip(names, corners, strict=True)
+        LayoutBlock(n, tuple((float(p[0]), float(p[1])) for p in cs), (int(b.cells[0]), int(b.cells[1])))
+        for n, cs, b in zip(names, corners, (block_of[fi] for fi in range(len(regions))), strict=True)
     )
     order = {s.name: k for k, s in enumerate(specs)}
     perm = sorted(range(len(pieces)), key=lambda k: order[names[k]])

@@ -18,7 +18,7 @@ import numpy as np
 from ..pointindex import point_keys
 from .blocks import Piece
 
-__all__ = ["interior_cuts", "outline_blocks", "outline_parts"]
+__all__ = ["interior_cuts", "outline_blocks", "outline_parts", "topology_snap"]
 
 
 def _edge_use(pieces: list[Piece]) -> dict[frozenset, int]:
@@ -120,9 +120,15 @@ def outline_blocks(layout: Any):
         cuts=parts["cuts"],
         blocks=parts["blocks"],
         multiple=layout.multiple,
-        snap=1e-6 * _size(layout.polygon),
+        snap=topology_snap(layout.polygon),
         cell_size=layout.cell_size,
     )
+
+
+def topology_snap(polygon: Any) -> float:
+    """The snap distance of a layout's :func:`outline_blocks`: its parts lie on each other up to
+    rounding (1e-6 of the water's bounding-box diagonal)."""
+    return 1e-6 * _size(polygon)
 
 
 def _size(polygon: Any) -> float:

@@ -111,6 +111,7 @@ class OutlineBlocks:
     cuts: tuple[np.ndarray, ...]
     regions: tuple[np.ndarray, ...]  # CCW vertex rings of the regions
     islands: tuple[np.ndarray, ...] = ()  # clockwise rings of the islands (cut ends inserted)
+    block_regions: tuple[int, ...] = ()  # per block of the topology, the index of its region in ``regions``
 
 
 def _insert(poly: np.ndarray, k: int, t: float, closed: bool, eps: float) -> tuple[np.ndarray, np.ndarray]:
@@ -464,5 +465,10 @@ def from_outline(
         specs, sides, block_corners, breaks, multiple, check_geometry=not islands, cell_size=cell_size
     )
     return OutlineBlocks(
-        topology=topo, outline=ring, cuts=tuple(cut_list), regions=tuple(rings), islands=tuple(islands)
+        topology=topo,
+        outline=ring,
+        cuts=tuple(cut_list),
+        regions=tuple(rings),
+        islands=tuple(islands),
+        block_regions=tuple(block_face[s.name] for s in specs),
     )

@@ -16,6 +16,7 @@ stay within :data:`SAG` cells of the chain.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -52,8 +53,21 @@ def sag(chain: np.ndarray, cells: int) -> float:
 def least_cells(chain: np.ndarray, cell_size: float, multiple: int, *, tol: float = SAG, most: float = MOST) -> int:
     """The fewest cells (a multiple of ``multiple``) for which the chain's sampling at every
     ``multiple``-th node stays within ``tol`` cells of it; at most ``most`` times its length in
-    cells (rounded up to a multiple), at least ``multiple``."""
-    p = np.asarray(chain, dtype=float)
+    cells (rounded up to a multiple), at least ``multiple``.
+
+    Remembered for the last :data:`_REMEMBERED` chains: a layout edited by hand (a cut end
+    dragged) asks again for every shore chain the edit left as it was."""
+    p = np.ascontiguousarray(chain, dtype=float)
+    return _least_cells(p.tobytes(), p.shape, float(cell_size), int(multiple), float(tol), float(most))
+
+
+#: chains whose :func:`least_cells` is remembered (a few layouts: a 16-block lake has ~40 shore chains)
+_REMEMBERED = 2048
+
+
+@functools.lru_cache(maxsize=_REMEMBERED)
+def _least_cells(data: bytes, shape: tuple, cell_size: float, multiple: int, tol: float, most: float) -> int:
+    p = np.frombuffer(data, dtype=float).reshape(shape)
     length = float(np.hypot(*np.diff(p, axis=0).T).sum())
     m = max(int(multiple), 1)
     top = max(1, math.ceil(most * length / cell_size / m))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 import pytest
 from shapely.geometry import Point
@@ -206,3 +208,87 @@ def test_points_within_the_tolerance_across_a_cell_edge_are_one_handle():
     )
     xy = [h.xy for h in handles(lay)]
     assert xy == _handles_by_scan(lay) and (a in xy) != (b in xy)
+
+
+def _same_topology(a, b) -> None:
+    """The layouts ``a`` and ``b`` have the same topology: every block's borders, the interfaces."""
+    ta, tb = a.topology(), b.topology()
+    for p, q in zip(ta.blocks, tb.blocks, strict=True):
+        assert p.name == q.name
+        for side in ("bottom", "right", "top", "left"):
+            assert np.array_equal(getattr(p.borders, side), getattr(q.borders, side))
+    assert ta.interfaces == tb.interfaces
+
+
+def _same_layout(a, b) -> None:
+    """``a`` and ``b`` are the same layout: water, cuts, pieces, blocks, and the same topology."""
+    assert a.polygon.equals_exact(b.polygon, 0.0) and a.cell_size == b.cell_size and a.multiple == b.multiple
+    assert len(a.cuts) == len(b.cuts) and all(np.array_equal(p, q) for p, q in zip(a.cuts, b.cuts, strict=True))
+    for p, q in zip(a.pieces, b.pieces, strict=True):
+        assert p.name == q.name and p.corners == q.corners and np.array_equal(p.ring, q.ring)
+    assert a.blocks == b.blocks and a.notes == b.notes
+    _same_topology(a, b)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_moved_layout_is_the_layout_of_its_case_loaded_fresh(seed):
+    """A drag's layout (one from_outline, its topology kept) is what saving the moved layout as a
+    case and loading it again gives (layout_from_outline, then Layout.topology), for every kind
+    of handle on generated lakes; a move it refuses, the fresh load refuses too."""
+    from app.layout_edit import moved_layout, shore_points
+    from meshcore import testing
+    from meshcore.case import case_layout, dumps_case, layout_case, loads_case
+    from meshcore.errors import TopologyError
+    from meshcore.layout import auto_layout, layout_from_outline
+    from meshcore.layout.outline import outline_parts
+
+    rng = np.random.default_rng(seed)
+    checked = refused = 0
+    for poly in (testing.channel_network(seed), testing.lake_with_islands(seed), testing.round_lake(seed, kind="arms")):
+        h = float(np.sqrt(poly.area / 1200))
+        lay = auto_layout(poly, cell_size=h, multiple=4)
+        parts = outline_parts(lay)
+        tol = 1e-9 * max(1.0, float(np.sqrt(lay.polygon.area)))
+        hs = handles(lay)
+        for kind in ("end", "junction", "cut", "corner", "shore"):
+            of_kind = [x for x in hs if x.kind == kind]
+            for hd in (of_kind[i] for i in rng.choice(len(of_kind), min(2, len(of_kind)), replace=False)):
+                step = rng.uniform(-1.0, 1.0, 2) * h
+                q = place(lay, hd, np.add(hd.xy, step), parts)
+                p2 = moved_parts(parts, hd.xy, q, tol, shore=shore_points(lay) if kind == "shore" else None)
+                with contextlib.suppress(TopologyError):
+                    fast = None
+                    fast = moved_layout(lay, p2)
+                try:
+                    fresh = layout_from_outline(
+                        p2["outline"], holes=p2["holes"], cuts=p2["cuts"], blocks=p2["blocks"], cell_size=h, multiple=4
+                    )
+                    fresh.topology()
+                except TopologyError:
+                    assert fast is None  # refused by both
+                    refused += 1
+                    continue
+                assert fast is not None
+                _same_layout(fast, fresh)
+                # saved as a case and loaded again: the same blocks and nodes (the shore ring may start elsewhere)
+                loaded = case_layout(loads_case(dumps_case(layout_case(fast))))
+                assert loaded.polygon.normalize().equals_exact(fast.polygon.normalize(), 0.0)
+                _same_topology(fast, loaded)
+                checked += 1
+    assert checked >= 15 and refused <= checked
+
+
+def test_a_move_makes_the_layout_and_its_topology_in_one_from_outline(monkeypatch):
+    """The layout worker splits the water once per step (it did twice: the layout, then its topology)."""
+    import meshcore.multiblock.outline as mo
+    from app.layout_edit import moved_layout
+    from meshcore.layout.outline import outline_parts
+
+    lay = _strip()
+    parts = outline_parts(lay)
+    end = next(h for h in handles(lay) if h.xy == (3.0, 2.0))
+    calls = []
+    real = mo.from_outline
+    monkeypatch.setattr(mo, "from_outline", lambda *a, **k: calls.append(1) or real(*a, **k))
+    moved = moved_layout(lay, moved_parts(parts, end.xy, place(lay, end, (4.0, 2.0), parts), 1e-9))
+    assert moved.topology() is not None and len(calls) == 1
