@@ -308,7 +308,8 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
     print(
         f"drag a cut end on Como ({lay.n_cells} cells, auto-generate; load {os.getloadavg()[0]:.1f}): "
         f"{n_during / wall:.1f} redraws/s while dragging ({n_during} in {wall:.1f} s wall for 3 s of mouse "
-        f"moves); {n_lay / wall:.1f} layouts/s while dragging ({n_lay} shown, {n_made} made, "
+        f"moves); {n_lay / wall:.1f} layouts/s while dragging, {n_lay / max(cpu, 1e-9):.1f} per CPU-s "
+        f"({n_lay} shown, {n_made} made, "
         f"{1000 * sum(made[:n_made]) / max(n_made, 1):.0f} ms CPU each in the layout worker); "
         f"CPU while dragging {cpu:.1f} s (GUI thread {gui:.1f} s): "
         f"{n_during / max(cpu, 1e-9):.1f} redraws per CPU-s; {starts} of {len(frames)} redraws showed a "

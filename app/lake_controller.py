@@ -23,8 +23,9 @@ from .lake_solve import layout_topology
 
 __all__ = ["EDIT_GAP_S", "LakeController"]
 
-#: seconds between two layouts of a drag (the grid re-solves from each; see LakeController.edit_layout)
-EDIT_GAP_S = 0.25
+#: seconds between the starts of two layouts of a drag (the grid re-solves from each; see
+#: LakeController.edit_layout): five a second, each left a few smoothed frames of the grid
+EDIT_GAP_S = 0.2
 
 log = logging.getLogger(__name__)
 
@@ -72,12 +73,13 @@ class LakeController(QtCore.QObject):
         self.last_error: str | None = None
         self._edit_worker = None
         self._pending = None  # (make, text, merge key, shore) of the newest layout edit not yet computed
-        # a drag's next layout waits EDIT_GAP_S after the last one was shown: each new layout restarts
-        # the grid's solve, which needs that long to set up and redraw a few smoothed grids
+        # a drag's next layout starts EDIT_GAP_S after the last one started (it is made while the grid
+        # re-solves from the last): each new layout restarts the grid's solve, which needs that long
+        # to set up and redraw a few smoothed grids
         self._edit_timer = QtCore.QTimer(self)
         self._edit_timer.setSingleShot(True)
         self._edit_timer.timeout.connect(self._next_edit)
-        self._edit_shown = 0.0  # when the last layout edit was shown
+        self._edit_started = 0.0  # when the last layout edit was started
         self.edit_error: str | None = None
         self._dragging = False  # a drag of the layout is on (the layout tool says so)
 
@@ -210,7 +212,7 @@ class LakeController(QtCore.QObject):
         if self._pending is None or self._edit_worker is not None:
             return
         make, text, key, shore = self._pending
-        wait = self._edit_shown + EDIT_GAP_S - time.perf_counter()
+        wait = self._edit_started + EDIT_GAP_S - time.perf_counter()
         if key is not None and wait > 0:  # a drag's step: later (the newest step then)
             if not self._edit_timer.isActive():
                 self._edit_timer.start(max(1, int(1000 * wait)))
@@ -220,6 +222,7 @@ class LakeController(QtCore.QObject):
         worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key, shore))
         worker.errored.connect(lambda exc: self._edited((None, f"internal error: {exc}"), text, key, shore))
         self._edit_worker = worker
+        self._edit_started = time.perf_counter()
         worker.start()
 
     def _edited(self, value, text: str, key, shore: bool = False) -> None:
@@ -233,7 +236,6 @@ class LakeController(QtCore.QObject):
                 rings = tuple(np.asarray(r.coords)[:-1] for r in poly.interiors)
                 lake = lake.replaced(outline=np.asarray(poly.exterior.coords)[:-1], holes=rings)
             self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
-            self._edit_shown = time.perf_counter()
             self.layout_done.emit(layout)
         elif layout is None and self._pending is None:  # a refusal only counts for the last request
             self.edit_error = err

@@ -25,27 +25,32 @@ def _borders(topo) -> list[np.ndarray]:
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_counts_the_cells_force_are_the_programs(seed, monkeypatch):
-    """When every block's cells fix every chain's count (no side's cells to share), the counts are
-    taken without the integer program: the same topology as the program gives (generated lakes)."""
+def test_counts_the_cells_imply_give_the_programs_answer(seed, monkeypatch):
+    """The counts the blocks' cells imply are taken as they are (all of them) or fixed in the
+    integer program (some): the same topology as the whole program gives (generated lakes)."""
     import meshcore.multiblock.chains as chains
 
-    forced = []
-    real = chains._Counts.forced
-    monkeypatch.setattr(chains._Counts, "forced", lambda self: forced.append(real(self)) or forced[-1])
+    seen = []
+    real = chains._Counts.implied
+
+    def implied(self):
+        out = real(self)
+        seen.append(out is not None and self.complete(out))
+        return out
+
+    monkeypatch.setattr(chains._Counts, "implied", implied)
     for poly in _shapes(seed):
         lay = auto_layout(poly, cell_size=float(np.sqrt(poly.area / 800)), multiple=4)
         got = outline_blocks(lay).topology
         with monkeypatch.context() as m:
-            m.setattr(chains._Counts, "forced", lambda self: None)  # always the program
+            m.setattr(chains._Counts, "implied", lambda self: None)  # the whole program
             want = outline_blocks(lay).topology
         assert all(np.array_equal(a, b) for a, b in zip(_borders(got), _borders(want), strict=True))
         assert got.interfaces == want.interfaces
-    assert any(f is not None for f in forced)  # the short cut was taken ...
-    assert any(f is None for f in forced)  # ... and not where a side's cells are shared
+    assert any(seen) and not all(seen)  # every chain implied (no program), and some left to it
 
 
-def test_forced_counts_are_none_where_a_side_has_cells_to_share():
+def test_implied_counts_leave_a_sides_cells_to_share():
     from meshcore.multiblock.chains import _Counts, side_chains
     from meshcore.multiblock.outline import BlockOutline
 
@@ -55,10 +60,14 @@ def test_forced_counts_are_none_where_a_side_has_cells_to_share():
     spec = BlockOutline("a", tuple(keys[i] for i in (0, 2, 3, 4)), (4, 2))
     corners = {"a": [keys[i] for i in (0, 2, 3, 4)]}
     sides, pts, users = side_chains([spec], {"a": ring}, corners, set(corners["a"]) | {keys[1]})
-    assert _Counts([spec], sides, pts, users, 1).forced() is None
+    c = _Counts([spec], sides, pts, users, 1)
+    got = c.implied()
+    assert sorted(got.values()) == [2, 2, 4] and not c.complete(got)  # right, left, top; not the bottom's two
     sides, pts, users = side_chains([spec], {"a": ring}, corners, set(corners["a"]))
-    assert sorted(_Counts([spec], sides, pts, users, 1).forced().values()) == [2, 2, 4, 4]
-    assert _Counts([spec], sides, pts, users, 4).forced() is None  # 2 is not a multiple of 4
+    c = _Counts([spec], sides, pts, users, 1)
+    got = c.implied()
+    assert sorted(got.values()) == [2, 2, 4, 4] and c.complete(got)
+    assert _Counts([spec], sides, pts, users, 4).implied() is None  # 2 is not a multiple of 4
 
 
 def test_least_cells_remembered_are_those_computed():
