@@ -44,13 +44,14 @@ def _layout_job(lake: Lake, cuts=None):
 
 
 def _edit_job(make):
-    """The worker body of a layout edit: the new layout, or why there is none."""
+    """The worker body of a layout edit: ``(the new layout, None)``, or ``(None or the layout that
+    stays instead, why there is no new one)``."""
     try:
         layout = make()
         layout_topology(layout)  # here, off the GUI thread: the solve that follows finds it ready
         return layout, None
     except MeshcoreError as exc:
-        return None, str(exc)
+        return getattr(exc, "layout", None), str(exc)  # (layout_edit.MoveRefused: the drag's last good one)
     except Exception as exc:  # a bug must not kill the window
         log.exception("a layout edit failed")
         return None, f"internal error: {type(exc).__name__}: {exc} (the traceback is in the log)"
@@ -237,10 +238,11 @@ class LakeController(QtCore.QObject):
                 lake = lake.replaced(outline=np.asarray(poly.exterior.coords)[:-1], holes=rings)
             self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
             self.layout_done.emit(layout)
-        elif layout is None and self._pending is None:  # a refusal only counts for the last request
+        if err is not None and self._pending is None:  # a refusal only counts for the last request
             self.edit_error = err
             self.win.message(f"Cannot change the layout: {err}", error=True)
-            self.layout_done.emit(None)
+            if layout is None:
+                self.layout_done.emit(None)
         self._next_edit()
         self._end_live()  # the drag's last layout is shown (or refused): its grid goes to the end
 

@@ -27,7 +27,21 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["KIND_NAMES", "Handle", "handles", "moved_layout", "moved_parts", "nearest_handle", "place", "shore_points"]
+from meshcore.errors import TopologyError
+
+__all__ = [
+    "KIND_NAMES",
+    "DragSteps",
+    "Handle",
+    "MoveRefused",
+    "handles",
+    "moved_layout",
+    "moved_parts",
+    "nearest_handle",
+    "place",
+    "settled_layout",
+    "shore_points",
+]
 
 #: the order in which coinciding handles are picked
 _PRIORITY = {"end": 0, "junction": 0, "corner": 1, "cut": 2, "shore": 3}
@@ -274,23 +288,50 @@ def _straight(a, b, c, tol: float) -> bool:
     return cross <= 1e-9 * float(np.dot(ac, ac)) + tol * tol
 
 
-def moved_layout(base: Any, parts: dict) -> Any:
+class DragSteps:
+    """What the steps of one drag share (the layout worker runs them one after another).
+
+    ``cells``: the cells of the chains of every block side (``OutlineBlocks.side_cells``) of the
+    drag's first layout: later steps keep them while they fit (a cut end moved along the shore
+    keeps them), without the integer program that shares a side's cells among its parts (on
+    Como 12 of the 55 ms of a step).  The program's shares can differ a little from the kept
+    ones, so the drag's last layout is made without them (:func:`settled_layout`).  ``good``:
+    the parts of the last step that gave a layout, ``kept``: whether it kept cells.
+    """
+
+    def __init__(self) -> None:
+        self.cells: Any = None
+        self.good: dict | None = None
+        self.kept = False
+
+
+class MoveRefused(TopologyError):
+    """The last step of a drag gives no layout: ``layout`` is the one that stays (the drag's last
+    good step, made as :func:`moved_layout` without kept cells makes it)."""
+
+    def __init__(self, message: str, layout: Any) -> None:
+        super().__init__(message)
+        self.layout = layout
+
+
+def moved_layout(base: Any, parts: dict, steps: DragSteps | None = None) -> Any:
     """The layout of ``parts`` (a move of :func:`moved_parts` on ``base``), with ``base``'s blocks.
 
     One :func:`~meshcore.multiblock.from_outline` of ``parts`` makes both the layout and its
-    topology (kept on it): the one a case of the layout gives, as :meth:`Layout.topology
-    <meshcore.layout.Layout.topology>` would make it by a second call (the same shore, cuts and
-    blocks, at its snap distance and cell size).
+    topology (kept on it): without ``steps``, the one a case of the layout gives, as
+    :meth:`Layout.topology <meshcore.layout.Layout.topology>` would make it by a second call
+    (the same shore, cuts and blocks, at its snap distance and cell size).  ``steps`` (a step
+    of a drag): the chains' cells of the drag's first layout are kept while they fit.
 
     Raises :class:`~meshcore.errors.TopologyError` naming the problem when the parts give no
     layout, or when they give other blocks (a cut dragged across another cut or an island):
     a drag keeps the blocks and their cells, so that the grid re-solves from the previous one.
     """
-    from meshcore.errors import TopologyError
     from meshcore.layout.edit import layout_of_outline
-    from meshcore.layout.outline import topology_snap
+    from meshcore.layout.outline import shore_of, topology_snap
     from meshcore.multiblock.outline import from_outline
 
+    keep = None if steps is None else steps.cells
     ob = from_outline(
         parts["outline"],
         holes=parts["holes"],
@@ -299,6 +340,7 @@ def moved_layout(base: Any, parts: dict) -> Any:
         multiple=base.multiple,
         snap=topology_snap(base.polygon),
         cell_size=base.cell_size,
+        keep_cells=keep,
     )
     lay = layout_of_outline(ob, parts["blocks"], cell_size=base.cell_size, multiple=base.multiple)
     before = [(b.name, tuple(b.cells)) for b in base.blocks]
@@ -311,5 +353,26 @@ def moved_layout(base: Any, parts: dict) -> Any:
     if after != before:
         changed = next(f"{a[0]} ({a[1][0]}×{a[1][1]})" for a, b in zip(after, before, strict=True) if a != b)
         raise TopologyError(f"the move would change block {changed}; a drag keeps every block and its cells")
+    _, islands = shore_of(list(lay.pieces))  # the shore a case of the layout writes: one ring and the islands
+    if len(islands) != len(lay.polygon.interiors):
+        raise TopologyError(
+            "the move would leave the blocks' shore in pieces (a case of it would not read back as one "
+            "shore and its islands); drag it back"
+        )
     object.__setattr__(lay, "_topology", ob.topology)  # made, checked: the layout's own (Layout.topology)
+    if steps is not None:
+        steps.cells = ob.side_cells if keep is None else keep
+        steps.good, steps.kept = parts, keep is not None
     return lay
+
+
+def settled_layout(base: Any, parts: dict, steps: DragSteps | None = None) -> Any:
+    """The last layout of a drag: :func:`moved_layout` of ``parts`` without kept cells (what a
+    case of it gives).  When they give none while the layout on screen kept cells, raises
+    :class:`MoveRefused` with that layout made so."""
+    try:
+        return moved_layout(base, parts)
+    except TopologyError as exc:
+        if steps is None or steps.good is None or not steps.kept:
+            raise
+        raise MoveRefused(str(exc), moved_layout(base, steps.good)) from exc

@@ -359,6 +359,8 @@ class LayoutTool(Tool):
         self._base = None
         self._parts: dict | None = None
         self._drag = None
+        self._steps = None  # what the steps of the drag share (layout_edit.DragSteps)
+        self._last_xy = None  # where the drag's last step went (None: no step yet)
         self._cache: tuple | None = None  # (layout, its handles)
 
     def activate(self) -> None:
@@ -416,45 +418,59 @@ class LayoutTool(Tool):
                 return False
             from meshcore.layout.outline import outline_parts
 
+            from .layout_edit import DragSteps
+
             self._handle, self._base, self._parts = h, lay, outline_parts(lay)
+            self._steps, self._last_xy = DragSteps(), None
             self._drag = self.editor.new_drag_id()
             self.controller.begin_drag()
             if self.canvas is not None:  # the cell counts stay; they need not repaint with every grid
                 self.canvas.lake_items.set_labels_visible(False)
         if self._handle is None:
             return False
-        if phase != "start":
+        if phase == "move":
             self._move(xy)
         if phase == "finish":
-            self._end_drag()
+            self._end_drag(xy)
         return True
 
-    def _end_drag(self) -> None:
+    def _end_drag(self, xy=None) -> None:
+        """The drag ends (at ``xy``, else where its last step went): its last layout is made as a
+        case of it gives it (the steps before kept the chains' cells of the first)."""
+        xy = self._last_xy if xy is None else xy
+        if xy is not None:
+            self._move(xy, final=True)
         self._handle = None
         self.controller.end_drag()
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
             self.canvas.lake_items.set_labels_visible(True)
 
-    def _move(self, xy) -> None:
-        from .layout_edit import KIND_NAMES, moved_layout, moved_parts, place, shore_points
+    def _move(self, xy, final: bool = False) -> None:
+        """A step of the drag to ``xy``; ``final``: its last, made without the kept cells (and made
+        even where it began, when steps went elsewhere: the layout goes back to the start's)."""
+        from .layout_edit import KIND_NAMES, moved_layout, moved_parts, place, settled_layout, shore_points
 
-        base, h = self._base, self._handle
+        base, h, steps = self._base, self._handle, self._steps
         q = place(base, h, xy, self._parts)
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(q)
-        if q == h.xy:
-            return
         tol = 1e-9 * max(1.0, float(np.sqrt(base.polygon.area)))
+        back = bool(np.hypot(q[0] - h.xy[0], q[1] - h.xy[1]) <= tol)  # where it began
+        if back and not (final and self._last_xy is not None):
+            return
+        self._last_xy = xy
         before, shore = self._parts, shore_points(base) if h.kind == "shore" else None
 
         def make():  # in the layout worker: the GUI thread only places the handle (most steps are dropped)
             from meshcore.errors import InvalidInputError
 
+            if final and back:  # the layout it began with
+                return base
             parts = moved_parts(before, h.xy, q, tol, shore=shore)
             if shore is not None and not _shore_moved(before, parts):
                 raise InvalidInputError("this shore point is not on the layout's shore: it cannot be dragged")
-            return moved_layout(base, parts)
+            return settled_layout(base, parts, steps) if final else moved_layout(base, parts, steps)
 
         what = KIND_NAMES[h.kind]
         self.controller.edit_layout(make, f"Move {what}", merge_key=("layout", self._drag), shore=h.kind == "shore")

@@ -18,7 +18,7 @@ import numpy as np
 from ..pointindex import point_keys
 from .blocks import Piece
 
-__all__ = ["interior_cuts", "outline_blocks", "outline_parts", "topology_snap"]
+__all__ = ["interior_cuts", "outline_blocks", "outline_parts", "shore_of", "topology_snap"]
 
 
 def _edge_use(pieces: list[Piece]) -> dict[frozenset, int]:
@@ -74,7 +74,7 @@ def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
     return cuts
 
 
-def _shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
+def shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
     """The shore as the pieces have it (every vertex a piece has on it): the edges that only one
     piece uses, joined into rings; the ring of largest area is the outline, the others islands."""
     count = _edge_use(pieces)
@@ -104,7 +104,7 @@ def outline_parts(layout: Any) -> dict[str, Any]:
     every vertex the blocks have on them, the cut polylines and ``{"name", "corners", "cells"}``
     per block.
     """
-    outline, holes = _shore_of(list(layout.pieces))
+    outline, holes = shore_of(list(layout.pieces))
     blocks = [{"name": b.name, "corners": [list(c) for c in b.corners], "cells": list(b.cells)} for b in layout.blocks]
     return {"outline": outline, "holes": holes, "cuts": interior_cuts(list(layout.pieces)), "blocks": blocks}
 

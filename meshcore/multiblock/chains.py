@@ -13,6 +13,7 @@ Used by :func:`meshcore.multiblock.from_outline`.
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -166,11 +167,36 @@ class _Counts:
         return self.count
 
 
+def _kept(counts: _Counts, keep: Mapping[tuple[str, str], Sequence[int]]) -> dict[Key, int] | None:
+    """The counts of ``keep`` (cells per chain of each block side, in the side's order) when every
+    side still has that many chains, the two blocks of a shared chain agree on it and the counts
+    are valid (multiples of ``multiple``, every side adding up); else None."""
+    out: dict[Key, int] = {}
+    for bs, keys in counts.side_chains.items():
+        given = keep.get(bs)
+        if given is None or len(given) != len(keys):
+            return None
+        for k, c in zip(keys, given, strict=True):
+            if out.setdefault(k, int(c)) != int(c):
+                return None
+    m = counts.multiple
+    if any(c < m or c % m for c in out.values()) or not counts.complete(out):
+        return None
+    return out
+
+
 def _chain_counts(
-    specs: list, side_chains: dict, chain_pts: dict, chain_users: dict, multiple: int, cell_size: float | None
+    specs: list,
+    side_chains: dict,
+    chain_pts: dict,
+    chain_users: dict,
+    multiple: int,
+    cell_size: float | None,
+    keep: Mapping[tuple[str, str], Sequence[int]] | None = None,
 ) -> dict[Key, int]:
     """Cells per chain: the integer program of :func:`~.counts.solve_counts` with every block's cells
-    given; when it has no solution, the step-by-step count names the block and border at fault."""
+    given; when it has no solution, the step-by-step count names the block and border at fault.
+    ``keep``: counts per block side taken instead of the program's while they still fit (:func:`_kept`)."""
     from .counts import solve_counts
     from .shorecells import shore_least
 
@@ -179,6 +205,9 @@ def _chain_counts(
     implied = counts.implied()
     if implied is not None and counts.complete(implied):  # the cells fix every chain: the only solution
         return {k: int(implied[k]) for k in keys}
+    kept = None if keep is None else _kept(counts, keep)
+    if kept is not None:
+        return {k: kept[k] for k in keys}
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     if cell_size is None:  # each chain at the cell size of the sides it lies on
@@ -249,8 +278,10 @@ def chain_topology(
     *,
     check_geometry: bool = True,
     cell_size: float | None = None,
-) -> MultiBlockTopology:
-    """The topology of blocks on regions.
+    keep: Mapping[tuple[str, str], Sequence[int]] | None = None,
+) -> tuple[MultiBlockTopology, dict[tuple[str, str], tuple[int, ...]]]:
+    """The topology of blocks on regions, and the cells of the chains of every block side
+    (``(block, side) →`` counts in the side's order).
 
     ``specs``: the :class:`~.outline.BlockOutline` of each block; ``rings``: its
     region (counter-clockwise vertex ring); ``corners``: its four corner
@@ -259,10 +290,11 @@ def chain_topology(
     skips the topology's shapely checks (islands are holes the blocks do not cover).
     Where a side has several chains, its cells are shared among them as
     :func:`~.counts.solve_counts` does: closest to ``length / cell_size`` (default: each
-    side's own cell size), integer and consistent round every block.
+    side's own cell size), integer and consistent round every block.  ``keep`` (such counts of
+    the layout before an edit) is taken instead where it still fits every side.
     """
     sides, chain_pts, chain_users = side_chains(specs, rings, corners, breaks)
-    count = _chain_counts(specs, sides, chain_pts, chain_users, multiple, cell_size)
+    count = _chain_counts(specs, sides, chain_pts, chain_users, multiple, cell_size, keep)
     nodes = {key: _resample(chain_pts[key], count[key]) for key in chain_pts}
     offsets: dict[tuple[str, str, Key], tuple[int, int]] = {}
     blocks = [_block(s, sides, nodes, corners[s.name], offsets) for s in specs]
@@ -273,4 +305,5 @@ def chain_topology(
             a0, a1 = offsets[(ba, sa, key)]
             b0, b1 = offsets[(bb, sb, key)]
             interfaces.append(Interface(Side(ba, sa, a0, a1), Side(bb, sb, b0, b1), None))
-    return MultiBlockTopology(tuple(blocks), tuple(interfaces), check_geometry=check_geometry)
+    topo = MultiBlockTopology(tuple(blocks), tuple(interfaces), check_geometry=check_geometry)
+    return topo, {bs: tuple(count[k] for k in keys) for bs, keys in sides.items()}

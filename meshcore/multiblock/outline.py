@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -112,6 +112,9 @@ class OutlineBlocks:
     regions: tuple[np.ndarray, ...]  # CCW vertex rings of the regions
     islands: tuple[np.ndarray, ...] = ()  # clockwise rings of the islands (cut ends inserted)
     block_regions: tuple[int, ...] = ()  # per block of the topology, the index of its region in ``regions``
+    side_cells: Mapping[tuple[str, str], tuple[int, ...]] = field(
+        default_factory=dict
+    )  # (block, side) → its chains' cells
 
 
 def _insert(poly: np.ndarray, k: int, t: float, closed: bool, eps: float) -> tuple[np.ndarray, np.ndarray]:
@@ -389,6 +392,7 @@ def from_outline(
     snap: float | None = None,
     multiple: int = 1,
     cell_size: float | None = None,
+    keep_cells: Mapping[tuple[str, str], Sequence[int]] | None = None,
 ) -> OutlineBlocks:
     """Split a closed outline by cut lines into four-sided blocks glued by interfaces.
 
@@ -415,6 +419,11 @@ def from_outline(
     snap : float, optional
         Distance within which cut ends and corners are snapped
         (default ``1e-3 ×`` the outline's bounding-box diagonal).
+    keep_cells : mapping, optional
+        The ``side_cells`` of an earlier result (the layout before a cut end was dragged):
+        where a block side has several parts, their cells are kept while they still fit,
+        without the integer program that shares them (a drag's steps are quicker).  The
+        program's shares can differ: a layout to keep is made without ``keep_cells``.
 
     Returns
     -------
@@ -461,8 +470,8 @@ def from_outline(
     sides = {s.name: rings[block_face[s.name]] for s in specs}
     # with islands the blocks leave holes by design; the regions were checked above (they are the
     # water exactly, each is one block)
-    topo = chain_topology(
-        specs, sides, block_corners, breaks, multiple, check_geometry=not islands, cell_size=cell_size
+    topo, side_cells = chain_topology(
+        specs, sides, block_corners, breaks, multiple, check_geometry=not islands, cell_size=cell_size, keep=keep_cells
     )
     return OutlineBlocks(
         topology=topo,
@@ -471,4 +480,5 @@ def from_outline(
         regions=tuple(rings),
         islands=tuple(islands),
         block_regions=tuple(block_face[s.name] for s in specs),
+        side_cells=side_cells,
     )

@@ -157,6 +157,52 @@ def test_an_impossible_layout_is_a_message_and_nothing_changes(qtbot, laid):
     assert win.docks["messages"].isVisible()
 
 
+def test_a_drag_ending_where_it_began_gives_the_layout_back(qtbot, laid):
+    """Out and back to the very point it started from: the layout before the drag, not the last step's."""
+    from app.layout_edit import handles
+
+    win = laid
+    lay0 = win.doc.project.layout
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    h = lay0.cell_size
+    tool = win.canvas.tool
+    assert tool.drag("start", end.xy, end.xy)
+    for f in (0.5, 1.0, 0.5):
+        tool.drag("move", (end.xy[0] + f * h, end.xy[1] + f * h), end.xy)
+        qtbot.wait(30)
+    tool.drag("finish", end.xy, end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and win.lake_ctl.edit_error is None
+
+
+def test_a_drag_refused_at_its_end_keeps_its_last_good_layout_as_a_case_gives_it(qtbot, laid, monkeypatch):
+    """Steps that kept the chains' cells, then a refused end: the last good step stays, made fresh
+    (the program's cells), with the refusal in a message."""
+    from app.layout_edit import handles
+    from meshcore.case import case_layout, dumps_case, layout_case, loads_case
+
+    win = laid
+    lay0 = win.doc.project.layout
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    h = lay0.cell_size
+    x0, _y0, x1, y1 = lay0.polygon.bounds
+    tool = win.canvas.tool
+    assert tool.drag("start", end.xy, end.xy)
+    for f in (0.3, 0.6):
+        tool.drag("move", (end.xy[0] + f * h, end.xy[1] + f * h), end.xy)
+        wait_for(qtbot, win, lambda: not win.lake_ctl.editing)
+    assert tool._steps.kept  # the second step kept the first one's cells
+    monkeypatch.setattr("app.layout_edit.place", lambda *a, **k: (x1 + (x1 - x0), y1))  # then far off the shore
+    tool.drag("finish", (x1 + (x1 - x0), y1), end.xy)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert lay1 is not lay0 and "from the shore" in win.lake_ctl.edit_error and win.docks["messages"].isVisible()
+    fresh = case_layout(loads_case(dumps_case(layout_case(lay1))))
+    for a, b in zip(lay1.topology().blocks, fresh.topology().blocks, strict=True):
+        np.testing.assert_array_equal(a.borders.bottom, b.borders.bottom)
+        np.testing.assert_array_equal(a.borders.left, b.borders.left)
+
+
 def test_drag_a_block_corner_to_another_vertex_of_its_block(qtbot, laid):
     from app.layout_edit import handles
 

@@ -292,3 +292,83 @@ def test_a_move_makes_the_layout_and_its_topology_in_one_from_outline(monkeypatc
     monkeypatch.setattr(mo, "from_outline", lambda *a, **k: calls.append(1) or real(*a, **k))
     moved = moved_layout(lay, moved_parts(parts, end.xy, place(lay, end, (4.0, 2.0), parts), 1e-9))
     assert moved.topology() is not None and len(calls) == 1
+
+
+def _drag_steps(seed: int):
+    """A generated lake whose layout has block sides of several parts (their cells are shared by
+    the integer program), a cut end on such a block, and the drag's steps along the shore."""
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+    from meshcore.layout.outline import outline_blocks, outline_parts
+
+    for k in range(20):
+        poly = testing.channel_network(seed + k)
+        lay = auto_layout(poly, cell_size=float(np.sqrt(poly.area / 1200)), multiple=4)
+        cells = outline_blocks(lay).side_cells
+        if any(len(v) > 1 for v in cells.values()):
+            break
+    parts = outline_parts(lay)
+    tol = 1e-9 * max(1.0, float(np.sqrt(lay.polygon.area)))
+    h = lay.cell_size
+    ends = [x for x in handles(lay) if x.kind == "end"]
+    return lay, parts, tol, h, ends
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_drags_steps_keep_the_first_steps_cells_and_its_end_is_made_fresh(seed, monkeypatch):
+    """The steps of a drag keep the chains' cells of its first step (no integer program); the
+    drag's last layout is the one a case of it gives (the program's cells), on generated lakes."""
+    import meshcore.multiblock.counts as counts
+    from app.layout_edit import DragSteps, moved_layout, settled_layout
+    from meshcore.case import case_layout, dumps_case, layout_case, loads_case
+    from meshcore.errors import TopologyError
+
+    lay, parts, tol, h, ends = _drag_steps(seed)
+    programs = []
+    real = counts.solve_counts
+    monkeypatch.setattr(counts, "solve_counts", lambda *a, **k: programs.append(1) or real(*a, **k))
+    done = 0
+    for end in ends:
+        steps, last = DragSteps(), None
+        for f in (0.2, 0.5, 0.9, 1.3):
+            q = place(lay, end, np.add(end.xy, (f * h, 0.7 * f * h)), parts)
+            with contextlib.suppress(TopologyError):
+                n = len(programs)
+                moved_layout(lay, moved_parts(parts, end.xy, q, tol), steps)
+                if steps.kept:  # a later step: the first step's cells, without the program
+                    assert len(programs) == n or n == 0
+                last = q
+        if last is None or steps.cells is None:
+            continue
+        p2 = moved_parts(parts, end.xy, last, tol)
+        final = settled_layout(lay, p2, steps)
+        _same_layout(final, moved_layout(lay, p2))
+        _same_topology(final, case_layout(loads_case(dumps_case(layout_case(final)))))
+        done += 1
+    assert done >= 2 and programs
+
+
+def test_a_drag_refused_at_its_end_leaves_its_last_good_layout_made_fresh():
+    from app.layout_edit import DragSteps, MoveRefused, moved_layout, settled_layout
+    from meshcore.errors import TopologyError
+
+    lay = _strip()
+    parts = moved_parts_of(lay)
+    end = next(h for h in handles(lay) if h.xy == (3.0, 2.0))
+    steps = DragSteps()
+    for x in (3.5, 4.0):
+        moved_layout(lay, moved_parts(parts, end.xy, place(lay, end, (x, 2.0), parts), 1e-9), steps)
+    assert steps.kept
+    across = moved_parts(parts, end.xy, place(lay, end, (8.0, 2.0), parts), 1e-9)  # past the cut at x = 6
+    with pytest.raises(MoveRefused) as err:
+        settled_layout(lay, across, steps)
+    _same_layout(err.value.layout, moved_layout(lay, moved_parts(parts, end.xy, (4.0, 2.0), 1e-9)))
+    with pytest.raises(TopologyError) as err2:  # no kept cells on screen: the plain refusal
+        settled_layout(lay, across, DragSteps())
+    assert not isinstance(err2.value, MoveRefused)
+
+
+def moved_parts_of(lay):
+    from meshcore.layout.outline import outline_parts
+
+    return outline_parts(lay)
