@@ -264,10 +264,10 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
     made: list[float] = []  # per layout the worker made: CPU seconds of its thread in moved_layout
     moved = edit.moved_layout
 
-    def timed(base, parts):  # the tool looks moved_layout up at each step: this one is timed
+    def timed(*args):  # the tool looks moved_layout up at each step: this one is timed
         c = time.thread_time()
         try:
-            return moved(base, parts)
+            return moved(*args)
         finally:
             made.append(time.thread_time() - c)
 
