@@ -25,14 +25,25 @@ Minimise ``E = Σ_cells Σ_corners F/χ(D, ε)`` (see
    keeps every corner Jacobian positive, so the grid stays valid.
 
 :func:`repair` applies this to *patches*: the invalid cells dilated by ``r``
-cells, with all other nodes fixed; ``r`` doubles until the patch succeeds or
-covers 30 % of the block.  If that fails, a *multilevel start*: every second
-grid line gives a coarse grid, which is solved (Winslow) and repaired; its
-bilinear prolongation is convex inside every convex coarse cell (iso-lines
-of a bilinear map are straight, so a fine corner Jacobian is the bilinear
-Jacobian times the index steps), and only cells near the finer boundary
-need a local repair.  The last resort is the whole block with a full
-minimisation per ε.  A Winslow grid that folds in a few places is repaired
+cells, with all other nodes fixed.  The patch falls apart into connected
+pieces, each minimised on its own: a piece that ends valid keeps its nodes,
+a failed one gets them back and grows (``r`` doubles) until it covers 30 %
+of the block, so one fold that cannot be repaired locally does not drag the
+others along.  For the cells still bad, a *multilevel start*: every second
+grid line gives a coarse grid, which is solved (Winslow) and repaired (the
+same steps, recursively); its bilinear prolongation is convex inside every
+convex coarse cell (iso-lines of a bilinear map are straight, so a fine
+corner Jacobian is the bilinear Jacobian times the index steps), and only
+cells near the finer boundary need a local repair.  It replaces the grid
+within :data:`TRANSPLANT` cells of the cells still bad (then the seam is
+relaxed), or, if that fails, the whole grid (then relaxed by barrier
+sweeps).  The whole block with a full minimisation per ε is tried on the
+coarse levels of that recursion and on grids too small to coarsen; on the
+given grid it never succeeded where the coarse start had failed (15 generated
+one-block shapes, 8 real lakes) and cost 18 s of CPU on a 24 000-node lake,
+so it is not tried there.  A repair that fails keeps the pieces it repaired
+and names the cells still bad.
+A Winslow grid that folds in a few places is repaired
 at a small fraction of the cost of the elliptic solve.  :func:`smooth`
 minimises over the whole block (``method="foldfree"`` of
 :func:`meshcore.generate_block`).  Periodic (O-grid) blocks are supported:
@@ -57,6 +68,7 @@ from ..errors import FoldedGridError
 from ..grid import SolveInfo, StructuredGrid
 from .cells import (
     BoundaryCorner,
+    _dilate,
     _exempt_bits,
     _failure_message,
     _folded,
@@ -67,6 +79,20 @@ from .cells import (
     invalid_cells,
 )
 from .minimise import minimise, patches
+
+#: Cells around those still bad after the local repair that take the coarse-grid start's nodes
+#: (the multilevel stage, first try).  4, 8, 16 on 5 generated one-block shapes whose repair took
+#: this path and a lake: 8 and 16 took 0.6–1.0 CPU-s each, 4 up to twice as long (its
+#: seam folded again more often); the smaller of the two keeps more of the elliptic grid.
+TRANSPLANT = 8
+#: Cells beyond the transplanted region whose nodes are relaxed with it (the seam between the
+#: coarse start and the kept grid): largest adjacent size ratio 168 → 56, 1320 → 61 on two of the
+#: grids above, no change on the others, at no measurable cost.
+SEAM = 4
+#: Most barrier sweeps when a coarse start is relaxed.  0, 25, 100, 400 on 5 grids (4 generated,
+#: a lake) whose repair relaxed the whole block: no setting better on all of mean orthogonality,
+#: largest size ratio and least Jacobian ratio; 400 cost up to 4 CPU-s more at 24 000 nodes than 100.
+RELAX_SWEEPS = 100
 
 __all__ = [
     "BoundaryCorner",
@@ -181,6 +207,13 @@ def repair(
         ``result.grid`` is the repaired grid (``info.method`` ends in
         ``+foldfree`` when nodes moved, ``info.message`` says why).
     """
+    return _repair(grid, radius, tolerance, max_sweeps, strict, whole=False)
+
+
+def _repair(
+    grid: StructuredGrid, radius: int, tolerance: float, max_sweeps: int, strict: bool, *, whole: bool
+) -> FoldFreeResult:
+    """:func:`repair`; ``whole``: try the whole block when the coarse start fails (the coarse levels)."""
     t0 = time.perf_counter()
     x, y, bad, exempt, ex_bits = _prepare(grid)
     before, folded_before = int(bad.sum()), _folded(x, y)
@@ -191,22 +224,15 @@ def repair(
         res = _result(grid, x, y, ok=True, before=0, nodes=0, sweeps=0, method=grid.info.method, msg=msg, **common)
         return _raise_if_failed(res, strict and not res.ok)
     opts = {"tolerance": tolerance, "max_sweeps": max_sweeps, "periodic": grid.periodic}
-    x0, y0 = x.copy(), y.copy()
     ok, nfree, total = patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, **opts)
     how = ""
-    start = None
-    if not ok:
-        x[...], y[...] = x0, y0
-        ok, nfree, total, start = _multilevel(grid, x, y, ex_bits, radius, opts, nfree, total)
+    coarse = min(grid.cells) >= 8
+    if not ok and coarse:
+        # the pieces repaired so far stay; the rest from a coarse-grid start
+        ok, nfree, total = _multilevel(grid, x, y, ex_bits, radius, opts, nfree, total, seam=not whole)
         how = " after a coarse-grid (multilevel) start" if ok else ""
-    if not ok:
-        # last resort: the whole block, a full minimisation per ε, from the start with fewer bad cells
-        x[...], y[...] = x0, y0
-        if start is not None and invalid_cells(start[0], start[1], ex_bits).sum() < before:
-            x[...], y[...] = start
-            bad = invalid_cells(x, y, ex_bits)
-        n = max(grid.cells)
-        ok, nfree, sw = patches(x, y, bad, ex_bits, radius=n, max_fraction=1.0, inner=20, **opts)
+    if not ok and (whole or not coarse):
+        ok, nfree, sw = _whole(grid, x, y, ex_bits, opts)
         total += sw
     origin = f"{grid.info.method} {grid.info.message}".strip()
     if ok:
@@ -222,6 +248,25 @@ def repair(
     return _raise_if_failed(res, strict and not res.ok)
 
 
+def _whole(
+    grid: StructuredGrid, x: np.ndarray, y: np.ndarray, ex_bits: np.ndarray, opts: dict
+) -> tuple[bool, int, int]:
+    """The whole block, a full minimisation per ε (``(ok, free nodes, sweeps)``; ``x, y`` kept on failure)."""
+    n = max(grid.cells)
+    return patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=n, max_fraction=1.0, inner=20, **opts)
+
+
+def _relax(x: np.ndarray, y: np.ndarray, region: np.ndarray, ex_bits: np.ndarray, opts: dict) -> int:
+    """At most ``RELAX_SWEEPS`` barrier sweeps over the nodes of the valid cells ``region``; the sweeps made."""
+    nodes = _nodes_of(region, opts["periodic"])
+    if nodes.size == 0:
+        return 0
+    cells = _touched_cells(nodes, region.shape, opts["periodic"])
+    tol = opts["tolerance"] * _median_edge(x, y, cells)
+    sweeps = min(opts["max_sweeps"], RELAX_SWEEPS)
+    return minimise(x, y, nodes, cells, ex_bits, tol=tol, max_sweeps=sweeps, periodic=opts["periodic"])[1]
+
+
 def _multilevel(
     grid: StructuredGrid,
     x: np.ndarray,
@@ -231,28 +276,58 @@ def _multilevel(
     opts: dict,
     nfree: int,
     total: int,
-) -> tuple[bool, int, int, tuple[np.ndarray, np.ndarray] | None]:
-    """The multilevel stage of :func:`repair`: ``(ok, free nodes, sweeps, coarse start)``; on success in ``x, y``."""
+    *,
+    seam: bool,
+) -> tuple[bool, int, int]:
+    """The multilevel stage of :func:`repair`: ``(ok, free nodes, sweeps)``.
+
+    ``x, y`` hold the grid with the pieces repaired locally so far.  First the
+    coarse start replaces the nodes within ``TRANSPLANT`` cells of the cells
+    still bad and those are repaired locally (the rest of the grid is kept;
+    ``seam``: the seam is relaxed; not on the coarse levels, where a relaxed
+    seam made a 20 × 30 hairpin slot fail one level up);
+    if that fails, the whole grid becomes the coarse start, its few bad cells
+    (near the finer boundary) are repaired locally and the block is relaxed
+    by barrier sweeps.  On failure ``x, y`` keep the grid with the fewest bad
+    cells.
+    """
     ni, nj = grid.cells
-    start = _coarse_start(grid) if min(ni, nj) >= 8 else None
+    start = _coarse_start(grid)
     if start is None:
-        return False, nfree, total, None
+        return False, nfree, total
     x2, y2 = start
-    bad2 = invalid_cells(x2, y2, ex_bits)
-    ok2, sw2 = True, 0
-    if bad2.any():
-        ok2, _, sw2 = patches(x2, y2, bad2, ex_bits, radius=radius, max_fraction=0.3, **opts)
-    total += sw2
-    if not ok2:
-        return False, nfree, total, start
-    # the prolonged grid is piecewise bilinear: relax it on the whole block
-    nodes = _nodes_of(np.ones((ni, nj), dtype=bool), grid.periodic)
-    cells = _touched_cells(nodes, (ni, nj), grid.periodic)
-    h = _median_edge(x2, y2, cells)
-    tol = opts["tolerance"] * h
-    _, sw3 = minimise(x2, y2, nodes, cells, ex_bits, tol=tol, max_sweeps=opts["max_sweeps"], periodic=grid.periodic)
+    bad = invalid_cells(x, y, ex_bits)
+    xk, yk = x.copy(), y.copy()
+    # (1) the coarse start only around the cells still bad
+    region = _dilate(bad, TRANSPLANT, grid.periodic)
+    nodes = _nodes_of(region, grid.periodic)
+    ii, jj = nodes[:, 0], nodes[:, 1]
+    x[ii, jj], y[ii, jj] = x2[ii, jj], y2[ii, jj]
+    if grid.periodic:
+        x[-1, :], y[-1, :] = x[0, :], y[0, :]
+    ok, nf, sw = patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=radius, max_fraction=0.3, **opts)
+    total += sw
+    if ok:
+        # relax the seam between the coarse start and the kept grid: barrier sweeps around the region
+        if seam:
+            total += _relax(x, y, _dilate(region, SEAM, grid.periodic), ex_bits, opts)
+        return True, nfree + nf, total
+    best = (int(bad.sum()), xk, yk)
+    now = int(invalid_cells(x, y, ex_bits).sum())
+    if now < best[0]:
+        best = (now, x.copy(), y.copy())
+    # (2) the whole coarse start
     x[...], y[...] = x2, y2
-    return True, len(nodes), total + sw3, start
+    ok, nf, sw = patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=radius, max_fraction=0.3, **opts)
+    total += sw
+    if ok:
+        # the prolonged grid is piecewise bilinear: relax it on the whole block
+        whole = np.ones((ni, nj), dtype=bool)
+        return True, len(_nodes_of(whole, grid.periodic)), total + _relax(x, y, whole, ex_bits, opts)
+    now = int(invalid_cells(x, y, ex_bits).sum())
+    if now >= best[0]:
+        x[...], y[...] = best[1], best[2]
+    return False, nfree, total
 
 
 def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
@@ -270,7 +345,7 @@ def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
     ic = np.unique(np.r_[np.arange(0, ni + 1, 2), ni])
     jc = np.unique(np.r_[np.arange(0, nj + 1, 2), nj])
     gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)], periodic=grid.periodic))
-    res = repair(gc, strict=False)
+    res = _repair(gc, 2, 1e-4, 400, False, whole=True)
     if not res.ok:
         return None
     xc, yc = res.grid.x, res.grid.y
@@ -319,7 +394,7 @@ def smooth(
     ok = True
     if before and nodes.size:
         # untangle first where it is cheap: local patches, multilevel start, whole block
-        fixed = repair(grid, strict=False)
+        fixed = _repair(grid, 2, 1e-4, 400, False, whole=True)
         sw += fixed.sweeps
         ok = fixed.ok
         if ok:

@@ -73,6 +73,32 @@ def minimise(
     return dmin > 0.0, sweeps
 
 
+def _components(mask: np.ndarray, periodic: bool) -> list[np.ndarray]:
+    """The 8-connected components of ``mask`` (boolean masks), joined across the seam if ``periodic``."""
+    from scipy import ndimage
+
+    lab, n = ndimage.label(mask, structure=np.ones((3, 3), dtype=bool))
+    if periodic and n > 1:  # column ni − 1 touches column 0: join labels that meet there
+        parent = list(range(n + 1))
+
+        def root(a: int) -> int:
+            while parent[a] != a:
+                parent[a] = parent[parent[a]]
+                a = parent[a]
+            return a
+
+        nj = mask.shape[1]
+        for j in range(nj):
+            a = lab[-1, j]
+            if not a:
+                continue
+            for dj in (-1, 0, 1):
+                if 0 <= j + dj < nj and lab[0, j + dj]:
+                    parent[root(int(lab[0, j + dj]))] = root(int(a))
+        lab = np.array([root(k) for k in range(n + 1)])[lab]
+    return [lab == k for k in np.unique(lab[lab > 0])]
+
+
 def patches(
     x: np.ndarray,
     y: np.ndarray,
@@ -86,45 +112,59 @@ def patches(
     inner: int | None = None,
     periodic: bool = False,
 ) -> tuple[bool, int, int]:
-    """Barrier minimisation on patches around ``bad``; the radius doubles on failure.
+    """Barrier minimisation on patches around ``bad``, each connected patch on its own.
 
-    Stops when the patch covers more than ``max_fraction`` of the cells (the
-    whole block is always allowed when ``max_fraction ≥ 1``).  On failure the
-    nodes are left as they were.  Returns ``(ok, free nodes, sweeps)``.
+    The patch of radius ``r`` (cells) around the bad cells falls apart into
+    connected pieces; each is minimised with every node outside it fixed.
+    A piece that ends valid keeps its nodes; a failed piece gets its nodes
+    back and its bad cells try again with ``2 r``, until the piece covers
+    more than ``max_fraction`` of the cells (the whole block is always
+    allowed when ``max_fraction ≥ 1``).  So a fold that cannot be repaired
+    locally no longer makes every other one grow with it, and the cost
+    follows the size of the pieces, not of the block.  Returns
+    ``(ok, free nodes, sweeps)``; on failure the repaired pieces stay.
     """
     ni, nj = bad.shape
     r = max(1, int(radius))
     total = 0
     nfree = 0
-    while True:
-        patch = _dilate(bad, r, periodic) if r < max(ni, nj) else np.ones_like(bad)
-        if patch.mean() > max_fraction and max_fraction < 1.0:
-            return False, nfree, total
-        nodes = _nodes_of(patch, periodic)
-        if nodes.size == 0:
-            return False, 0, total
-        cells = _touched_cells(nodes, (ni, nj), periodic)
-        h = _median_edge(x, y, cells)
-        xs, ys = x.copy(), y.copy()
-        ok, sw = minimise(
-            x,
-            y,
-            nodes,
-            cells,
-            ex_bits,
-            tol=tolerance * h,
-            max_sweeps=max_sweeps,
-            inner=inner,
-            periodic=periodic,
-        )
-        total += sw
-        nfree = len(nodes)
-        if ok:
-            bad_now = invalid_cells(x, y, ex_bits)
-            if not bad_now.any():
-                return True, nfree, total
-            bad = bad | bad_now
-        x[...], y[...] = xs, ys
-        if patch.all():
-            return False, nfree, total
+    todo = bad.copy()
+    given_up = np.zeros_like(bad)
+    while todo.any():
+        whole = r >= max(ni, nj)
+        mask = np.ones_like(bad) if whole else _dilate(todo, r, periodic)
+        failed = np.zeros_like(bad)
+        for piece in [mask] if whole else _components(mask, periodic):
+            if max_fraction < 1.0 and piece.sum() > max_fraction * piece.size:
+                given_up |= piece & todo
+                continue
+            nodes = _nodes_of(piece, periodic)
+            if nodes.size == 0:
+                given_up |= piece & todo
+                continue
+            cells = _touched_cells(nodes, (ni, nj), periodic)
+            h = _median_edge(x, y, cells)
+            xs, ys = x[nodes[:, 0], nodes[:, 1]].copy(), y[nodes[:, 0], nodes[:, 1]].copy()
+            ok, sw = minimise(
+                x,
+                y,
+                nodes,
+                cells,
+                ex_bits,
+                tol=tolerance * h,
+                max_sweeps=max_sweeps,
+                inner=inner,
+                periodic=periodic,
+            )
+            total += sw
+            nfree += len(nodes)
+            if not ok:  # the piece's nodes go back (seam copies too)
+                x[nodes[:, 0], nodes[:, 1]], y[nodes[:, 0], nodes[:, 1]] = xs, ys
+                if periodic:
+                    x[-1, :], y[-1, :] = x[0, :], y[0, :]
+                failed |= piece
+        if whole:
+            given_up |= failed
+        todo = invalid_cells(x, y, ex_bits) & ~given_up
         r *= 2
+    return not invalid_cells(x, y, ex_bits).any(), nfree, total
