@@ -169,6 +169,34 @@ def _failure_message(grid: StructuredGrid, bad: np.ndarray, exempt: list[Boundar
         f"(raise cells in {'ξ' if border in ('bottom', 'top') else 'η'}) or a finer distribution "
         f"there, choose other corners, or split the region into blocks"
     )
+    places = _places(x, y, bad)
+    if len(places) > 1:
+        msg += f". The bad cells lie in {len(places)} places: " + "; ".join(places[:8])
+        if len(places) > 8:
+            msg += f"; and {len(places) - 8} more"
     if exempt:
         msg += "; also: " + "; ".join(c.message for c in exempt)
     return msg
+
+
+def _places(x: np.ndarray, y: np.ndarray, bad: np.ndarray) -> list[str]:
+    """The connected groups of bad cells, largest first: how many, their index ranges, the border
+    nearest to them (index space) and where their middle cell is."""
+    from scipy import ndimage
+
+    ni, nj = bad.shape
+    lab, n = ndimage.label(bad, structure=np.ones((3, 3), dtype=bool))
+    out = []
+    for k in sorted(range(1, n + 1), key=lambda k: -int((lab == k).sum())):
+        idx = np.argwhere(lab == k)
+        ci, cj = idx[len(idx) // 2]
+        cx = 0.25 * (x[ci, cj] + x[ci + 1, cj] + x[ci + 1, cj + 1] + x[ci, cj + 1])
+        cy = 0.25 * (y[ci, cj] + y[ci + 1, cj] + y[ci + 1, cj + 1] + y[ci, cj + 1])
+        i0, j0 = idx.min(axis=0)
+        i1, j1 = idx.max(axis=0)
+        d = {"bottom": j0, "top": nj - 1 - j1, "left": i0, "right": ni - 1 - i1}
+        border = min(d, key=d.get)
+        rng = f"i {i0}–{i1}" if i0 != i1 else f"i {i0}"
+        rng += f", j {j0}–{j1}" if j0 != j1 else f", j {j0}"
+        out.append(f"{len(idx)} cell(s) at {rng} by the {border} border, around ({cx:.6g}, {cy:.6g})")
+    return out

@@ -76,3 +76,16 @@ def test_a_failed_repair_keeps_the_places_it_repaired():
     assert after[40:50].any()
     assert "no fold-free grid" in r.message
     assert r.invalid_after < r.invalid_before
+
+
+def test_the_failure_names_each_place():
+    # two top-border nodes pulled below the bottom border, far apart: two places no grid with these
+    # borders makes valid; the message says how many places and where each is
+    x, y = _rectangle(60, 20)
+    y[12, -1] = -1.0
+    y[45, -1] = -1.0
+    r = repair(StructuredGrid(x, y), strict=False)
+    assert not r.ok
+    assert "lie in 2 places" in r.message
+    assert "2 cell(s) at i 11–12, j 19 by the top border, around (3.125, 3.375)" in r.message
+    assert "2 cell(s) at i 44–45, j 19 by the top border, around (11.375, 3.375)" in r.message
