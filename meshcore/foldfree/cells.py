@@ -200,7 +200,7 @@ def _places(x: np.ndarray, y: np.ndarray, bad: np.ndarray) -> list[str]:
         i0, j0 = idx.min(axis=0)
         i1, j1 = idx.max(axis=0)
         d = {"bottom": j0, "top": nj - 1 - j1, "left": i0, "right": ni - 1 - i1}
-        border = min(d, key=d.get)
+        border = min(d, key=lambda k: d[k])
         rng = f"i {i0}–{i1}" if i0 != i1 else f"i {i0}"
         rng += f", j {j0}–{j1}" if j0 != j1 else f", j {j0}"
         out.append(f"{len(idx)} cell(s) at {rng} by the {border} border, around ({cx:.6g}, {cy:.6g})")
