@@ -207,11 +207,17 @@ def repair(
         ``result.grid`` is the repaired grid (``info.method`` ends in
         ``+foldfree`` when nodes moved, ``info.message`` says why).
     """
-    return _repair(grid, radius, tolerance, max_sweeps, strict, whole=False)
+    return _repair(grid, radius=radius, tolerance=tolerance, max_sweeps=max_sweeps, strict=strict, whole=False)
 
 
 def _repair(
-    grid: StructuredGrid, radius: int, tolerance: float, max_sweeps: int, strict: bool, *, whole: bool
+    grid: StructuredGrid,
+    *,
+    radius: int = 2,
+    tolerance: float = 1e-4,
+    max_sweeps: int = 400,
+    strict: bool = False,
+    whole: bool,
 ) -> FoldFreeResult:
     """:func:`repair`; ``whole``: try the whole block when the coarse start fails (the coarse levels)."""
     t0 = time.perf_counter()
@@ -345,7 +351,7 @@ def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
     ic = np.unique(np.r_[np.arange(0, ni + 1, 2), ni])
     jc = np.unique(np.r_[np.arange(0, nj + 1, 2), nj])
     gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)], periodic=grid.periodic))
-    res = _repair(gc, 2, 1e-4, 400, False, whole=True)
+    res = _repair(gc, whole=True)
     if not res.ok:
         return None
     xc, yc = res.grid.x, res.grid.y
@@ -394,7 +400,7 @@ def smooth(
     ok = True
     if before and nodes.size:
         # untangle first where it is cheap: local patches, multilevel start, whole block
-        fixed = _repair(grid, 2, 1e-4, 400, False, whole=True)
+        fixed = _repair(grid, whole=True)
         sw += fixed.sweeps
         ok = fixed.ok
         if ok:
