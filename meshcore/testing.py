@@ -9,6 +9,8 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
 * :func:`jagged_cells` — any of them with shores jagged at the scale of the cells (the
   outlines traced from aerial images);
 * :func:`lake_with_islands` — a lobed lake with islands, some close to the shore;
+* :func:`small_islands` — islands from a third of a cell to five cells across, thin, bent,
+  near the shore and each other;
 * :func:`spiral` — a channel wound round more than once;
 * :func:`y_junction`, :func:`straight_channel`, :func:`rectangle_with_hole` — the textbook cases.
 
@@ -30,6 +32,7 @@ __all__ = [
     "jagged_cells",
     "lake_with_islands",
     "rectangle_with_hole",
+    "small_islands",
     "spiral",
     "straight_channel",
     "y_junction",
@@ -272,3 +275,73 @@ def round_lake(seed: int, *, radius: float = 10.0, kind: str = "blob", n_islands
             continue
         holes.append(isl)
     return _clean(Polygon(outer.exterior, [h.exterior for h in holes]))
+
+
+def small_islands(
+    seed: int,
+    *,
+    cell_size: float = 0.25,
+    n_islands: int = 6,
+    widths: tuple[float, float] = (0.3, 5.0),
+    radius: float = 10.0,
+):
+    """A lobed lake with ``n_islands`` small islands ``widths`` cells across (log-uniform).
+
+    The islands are of three kinds, chosen at random: ``blob`` (an ellipse up to twice as long
+    as wide), ``needle`` (a capsule 3–10 times as long as wide) and ``hairpin`` (a spike
+    tapering from its width to a sharp tip over 3–8 widths).  A third of them lie 0.3–3 cells
+    from the shore, a third as far from the island before them, the rest anywhere.  For the
+    question what a grid of cell size ``cell_size`` does with an island it can or cannot go
+    round (mesh with ``cell_size=cell_size``).
+    """
+    from shapely import affinity
+    from shapely.geometry import LineString, Point, Polygon
+
+    rng = np.random.default_rng(seed)
+    h = float(cell_size)
+    t = np.linspace(0, 2 * math.pi, 240, endpoint=False)
+    r = np.ones_like(t)
+    for k in range(2, 6):
+        r += rng.uniform(0.0, 0.25 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
+    r *= radius / r.max()
+    outer = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    body = outer.buffer(-0.3 * h)
+    holes: list[Polygon] = []
+    tries = 0
+    while len(holes) < n_islands and tries < 2000:
+        tries += 1
+        w = h * math.exp(rng.uniform(math.log(widths[0]), math.log(widths[1])))
+        kind = ("blob", "needle", "hairpin")[int(rng.integers(0, 3))]
+        if kind == "blob":
+            isl = affinity.scale(Point(0, 0).buffer(0.5 * w, quad_segs=8), rng.uniform(1.0, 2.0), 1.0)
+        elif kind == "needle":
+            length = w * rng.uniform(3.0, 10.0)
+            isl = LineString([(-0.5 * length, 0), (0.5 * length, 0)]).buffer(0.5 * w, quad_segs=4)
+        else:
+            length = w * rng.uniform(3.0, 8.0)
+            bow = rng.uniform(-0.3, 0.3) * length  # a bent spike
+            xs = np.linspace(0.0, length, 12)
+            half = 0.5 * w * (1.0 - xs / length) ** 0.7
+            mid = bow * (xs / length) ** 2
+            pts = np.vstack([np.column_stack([xs, mid + half]), np.column_stack([xs[::-1], (mid - half)[::-1]])[1:]])
+            isl = Point(0, 0).buffer(0.5 * w, quad_segs=4).union(Polygon(pts))
+        isl = affinity.rotate(isl, rng.uniform(0, 360), origin=(0, 0))
+        where = rng.uniform()
+        gap = h * rng.uniform(0.3, 3.0)
+        if where < 1 / 3:  # near the shore
+            p = np.asarray(outer.exterior.interpolate(rng.uniform(0, outer.exterior.length)).coords[0])
+            c = p * (1.0 - (gap + 2.0 * w) / max(np.hypot(*p), 1e-9))
+        elif where < 2 / 3 and holes:  # near the island before
+            prev = holes[-1]
+            a = rng.uniform(0, 2 * math.pi)
+            d = np.array([math.cos(a), math.sin(a)])
+            c = np.asarray(prev.centroid.coords[0]) + d * (math.sqrt(prev.area) + gap + w)
+        else:
+            c = rng.uniform(-radius, radius, 2)
+        isl = affinity.translate(isl, *c)
+        if not isl.is_valid or not body.contains(isl):
+            continue
+        if any(isl.distance(o) < 0.3 * h for o in holes):
+            continue
+        holes.append(isl)
+    return _clean(Polygon(outer.exterior, [g.exterior for g in holes]))

@@ -4,8 +4,24 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   (islands excluded from both); ``area_error = |area_ratio − 1|``.
 * ``hausdorff`` — Hausdorff distance between the grid's outer boundary (every
   ring of the union of cells: the shore and the islands) and the polygon's
-  boundary, and ``hausdorff_cells`` the same in units of the cell size
-  (``sqrt(grid area / cells)`` unless given).
+  boundary (the shore and every island the grid goes round), and
+  ``hausdorff_cells`` the same in units of the cell size (``sqrt(grid area /
+  cells)`` unless given);
+* ``islands_covered`` — the polygon's islands that the grid covers (at least
+  half of the island's area lies under its cells): an island too small for the
+  cell size, left out of the layout, or one the grid was laid over.  Each is
+  named (its number among the polygon's islands, from 1), with its area, its
+  width (the diameter of the largest disc inside it) and a point inside it;
+  the table lists them on a row of their own.  Their rims are not part of the
+  Hausdorff distance above: an island of a cell's width that the grid covers
+  would otherwise read as a shore tens of cells off wherever it lies, hiding
+  the distance of the shores the grid does follow.  Its area is: the grid area
+  counts the water over it, so the area ratio rises by its share;
+* ``island_cells`` — cells whose centre lies inside an island the grid goes
+  round (a narrow end of it that a block side cut across, say), per island:
+  its number, how many cells, the deepest such centre (its distance from the
+  island's rim, in cells) and where it is.  A grid that follows every island
+  within half a cell has none deeper than half a cell.
 
 The union of a block's cells is its boundary loop when no cell is folded and
 the loop is simple (a locally one-to-one map of a square whose boundary is a
@@ -29,7 +45,42 @@ from ..errors import InvalidInputError
 from ..grid import StructuredGrid
 from .samples import Samples
 
-__all__ = ["Coverage", "as_polygon", "coverage"]
+__all__ = ["Coverage", "CoveredIsland", "as_polygon", "coverage", "island_width"]
+
+#: An island is covered when at least this share of its area lies under the grid's cells: a grid
+#: that goes round an island leaves only the slivers between its boundary chords and a curved
+#: rim under cells (a few percent on islands one or two cells across), one laid over it nearly all.
+COVERED = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class CoveredIsland:
+    """An island of the water polygon that the grid covers: its number among the polygon's
+    islands (from 1), area, width (diameter of the largest disc inside it), a point inside it,
+    and the share of its area under the grid's cells."""
+
+    index: int
+    area: float
+    width: float
+    x: float
+    y: float
+    share: float
+
+    def describe(self, cell_size: float) -> str:
+        return (
+            f"island {self.index} ({self.width / cell_size:.2g} cells across, {self.area / cell_size**2:.2g} cells² "
+            f"near ({self.x:.6g}, {self.y:.6g}))"
+        )
+
+
+def island_width(island: Any, tolerance: float) -> tuple[float, Any]:
+    """The diameter of the largest disc inside the polygon ``island`` (to ``tolerance``) and its
+    centre: how wide the island is where it is widest, whatever its shape (a needle's width, not
+    its length; a blob's diameter)."""
+    from shapely.ops import polylabel
+
+    c = polylabel(island, tolerance=max(tolerance, 1e-12 * max(island.length, 1e-300)))
+    return 2.0 * float(island.exterior.distance(c)), c
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +94,8 @@ class Coverage:
     cell_size: float
     where: tuple[float, float]  # the point where the Hausdorff distance is reached
     side: str  # "grid" (a grid boundary point far from the shore) or "shore"
+    islands_covered: tuple[CoveredIsland, ...] = ()
+    island_cells: tuple[tuple[int, int, float, float, float], ...] = ()  # (island, cells, depth, x, y)
 
     @property
     def hausdorff_cells(self) -> float:
@@ -60,6 +113,9 @@ class Coverage:
             "hausdorff": self.hausdorff,
             "hausdorff_cells": self.hausdorff_cells,
             "cell_size": self.cell_size,
+            "islands_covered": len(self.islands_covered),
+            "cells_over_islands": sum(t[1] for t in self.island_cells),
+            "deepest_cell_on_island": max((t[2] for t in self.island_cells), default=0.0),
         }
 
     def rows(self) -> list[tuple[str, str, str]]:
@@ -72,7 +128,32 @@ class Coverage:
                 f"{self.hausdorff_cells:.3g} cells ({self.hausdorff:.4g}; cell size {self.cell_size:.4g})",
                 f"{what} ({x:.6g}, {y:.6g})",
             ),
-        ]
+        ] + self._island_rows()
+
+    def _island_rows(self) -> list[tuple[str, str, str]]:
+        rows = []
+        if self.islands_covered:
+            isl = self.islands_covered
+            area = sum(i.area for i in isl)
+            names = "; ".join(i.describe(self.cell_size) for i in isl[:5]) + ("; …" if len(isl) > 5 else "")
+            rows.append(
+                (
+                    "islands under the grid (not in the shoreline distance)",
+                    f"{len(isl)} ({100 * area / self.polygon_area:.2g} % of the water area)",
+                    names,
+                )
+            )
+        if self.island_cells:
+            n = sum(t[1] for t in self.island_cells)
+            deep = max(t[2] for t in self.island_cells)
+            where = "; ".join(
+                f"island {k}: {c}, up to {d:.2g} cells inside near ({x:.6g}, {y:.6g})"
+                for k, c, d, x, y in self.island_cells[:5]
+            )
+            rows.append(
+                ("cells with their centre on an island the grid goes round", f"{n} (up to {deep:.2g} cells in)", where)
+            )
+        return rows
 
     def samples(self, metric: str) -> Any:
         v = self.area_error if metric == "area_error" else self.hausdorff_cells
@@ -171,7 +252,8 @@ def coverage(
     h = float(cell_size) if cell_size is not None else math.sqrt(union.area / max(n_cells, 1))
     if not h > 0:
         raise InvalidInputError(f"cell_size must be positive, got {h}")
-    gb, sb = union.boundary, poly.boundary
+    covered, rims, land = _islands(poly, union, h)
+    gb, sb = union.boundary, shapely.union_all(rims)
     step = h / 10.0
     gp, sp = _boundary_points(gb, step), _boundary_points(sb, step)
     d_grid, kg = _directed(gp, sb)
@@ -188,4 +270,53 @@ def coverage(
         cell_size=h,
         where=(float(where[0]), float(where[1])),
         side=side,
+        islands_covered=covered,
+        island_cells=_cells_on(land, grids, h),
     )
+
+
+def _cells_on(islands: list[tuple[int, Any]], grids: Sequence[StructuredGrid], h: float) -> tuple:
+    """Per island (number, polygon) with cell centres inside it: (number, count, depth of the
+    deepest in cells, its place)."""
+    import shapely
+
+    if not islands:
+        return ()
+    cx, cy = [], []
+    for g in grids:
+        x, y = np.asarray(g.x, dtype=float), np.asarray(g.y, dtype=float)
+        cx.append((0.25 * (x[:-1, :-1] + x[1:, :-1] + x[1:, 1:] + x[:-1, 1:])).ravel())
+        cy.append((0.25 * (y[:-1, :-1] + y[1:, :-1] + y[1:, 1:] + y[:-1, 1:])).ravel())
+    px, py = np.concatenate(cx), np.concatenate(cy)
+    out = []
+    for k, island in islands:
+        inside = np.flatnonzero(shapely.contains_xy(island, px, py))
+        if len(inside):
+            depth = shapely.distance(shapely.points(px[inside], py[inside]), island.exterior)
+            d = int(np.argmax(depth))
+            out.append((k, len(inside), float(depth[d]) / h, float(px[inside[d]]), float(py[inside[d]])))
+    return tuple(out)
+
+
+def _islands(poly: Any, union: Any, h: float) -> tuple[tuple[CoveredIsland, ...], list[Any], list[tuple[int, Any]]]:
+    """The islands of ``poly`` the grid (``union``) covers, the rings it is measured against
+    (every outer ring and every island ring not covered), and the islands not covered."""
+    from shapely.geometry import Polygon
+
+    covered: list[CoveredIsland] = []
+    rims: list[Any] = []
+    land: list[tuple[int, Any]] = []
+    k = 0
+    for part in getattr(poly, "geoms", [poly]):
+        rims.append(part.exterior)
+        for ring in part.interiors:
+            k += 1
+            island = Polygon(ring)
+            share = union.intersection(island).area / island.area if island.area > 0 else 0.0
+            if share < COVERED:
+                rims.append(ring)
+                land.append((k, island))
+                continue
+            width, c = island_width(island, 0.01 * h)
+            covered.append(CoveredIsland(k, float(island.area), width, float(c.x), float(c.y), float(share)))
+    return tuple(covered), rims, land

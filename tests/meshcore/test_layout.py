@@ -186,7 +186,7 @@ def test_small_islands_are_dropped_with_a_note():
     tiny = [[5, 3], [5.05, 3], [5.05, 3.05], [5, 3.05]]
     lay = auto_layout(outer, holes=[tiny], cell_size=0.2)
     assert not lay.polygon.interiors
-    assert any("island 1" in n and "ignored" in n for n in lay.notes)
+    assert any("island 1" in n and "left out" in n for n in lay.notes)
 
 
 def test_counts_agree_and_respect_fixed_values():

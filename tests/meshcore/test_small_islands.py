@@ -1,0 +1,148 @@
+"""Islands a cell or two across: kept and followed, or left out with a note — never meshed over silently.
+
+Shapes: :func:`meshcore.testing.small_islands` (islands 0.3–5 cells across: blobs, needles,
+bent spikes, near the shore and each other), at a cell size ``h`` given to the layout.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from shapely.geometry import Polygon
+
+from meshcore import testing
+from meshcore.layout.polygon import water_polygon
+from meshcore.quality import lake_metrics
+from meshcore.quality.coverage import island_width
+
+H = 0.25
+
+
+def _islands(poly) -> list[Polygon]:
+    return [Polygon(r) for r in poly.interiors]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_small_islands_are_what_they_say(seed):
+    poly = testing.small_islands(seed, cell_size=H, n_islands=8)
+    assert poly.is_valid and len(poly.interiors) == 8
+    assert testing.small_islands(seed, cell_size=H, n_islands=8).equals(poly)
+    for isl in _islands(poly):
+        w, _ = island_width(isl, 0.005 * H)
+        assert 0.3 * H * 0.9 <= w <= 5.0 * H * 1.05
+        assert isl.distance(poly.exterior) >= 0.25 * H
+
+
+def test_island_width_is_the_widest_disc():
+    from shapely.geometry import LineString, Point
+
+    disc = Point(0, 0).buffer(1.0, quad_segs=64)
+    assert island_width(disc, 1e-4)[0] == pytest.approx(2.0, rel=1e-3)
+    needle = LineString([(0, 0), (10, 0)]).buffer(0.5, quad_segs=16)  # 1 wide, 11 long
+    assert island_width(needle, 1e-4)[0] == pytest.approx(1.0, rel=1e-3)
+    assert 4 * needle.area / needle.length > 1.8  # what the old rule read as its width
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_islands_narrower_than_two_cells_are_left_out_with_a_note_naming_them(seed):
+    poly = testing.small_islands(seed, cell_size=H, n_islands=8)
+    out, notes = water_polygon(poly, drop_islands_below=2 * H)
+    widths = [island_width(isl, 0.02 * H)[0] for isl in _islands(poly)]
+    dropped = [k + 1 for k, w in enumerate(widths) if w < 2 * H]
+    assert len(out.interiors) == len(widths) - len(dropped)
+    kept = _islands(out)
+    for k, isl in enumerate(_islands(poly), start=1):
+        assert (k not in dropped) == any(isl.equals(o) for o in kept)
+    assert len(notes) == len(dropped)
+    for k, note in zip(dropped, notes, strict=True):
+        m = re.match(r"island (\d+) near \((\S+), (\S+)\) is (\S+) across at its widest \(area (\S+), ", note)
+        assert m and int(m[1]) == k, note
+        isl = _islands(poly)[k - 1]
+        assert isl.contains(Polygon(isl.exterior).representative_point())
+        assert isl.buffer(1e-4).contains(Polygon([(float(m[2]), float(m[3]))] * 3).centroid)  # the place is on it
+        assert float(m[4]) == pytest.approx(widths[k - 1], rel=0.02)
+        assert float(m[5]) == pytest.approx(isl.area, rel=5e-3)
+
+
+def test_a_needle_narrower_than_two_cells_is_left_out_however_long():
+    """A needle 1.2 cells wide and 11 long: no block side can turn round its ends (the old rule,
+    4 · area / perimeter ≈ 2.2 cells, kept it and the grid covered its ends)."""
+    from shapely.geometry import LineString, Point
+
+    lake = Point(0, 0).buffer(10.0, quad_segs=32)
+    needle = LineString([(-1.25, 0), (1.25, 0)]).buffer(0.6 * H, quad_segs=8)
+    blob = Point(4, 4).buffer(1.5 * H, quad_segs=8)  # 3 cells across: kept
+    out, notes = water_polygon(Polygon(lake.exterior, [needle.exterior, blob.exterior]), drop_islands_below=2 * H)
+    assert len(out.interiors) == 1 and Polygon(out.interiors[0]).equals(blob)
+    assert len(notes) == 1 and notes[0].startswith("island 1 near (")
+    assert "a cell size of at most 0.15 would keep it" in notes[0]
+
+
+# --------------------------------------------------------------- the quality report
+def _ring_blocks():
+    from tests.meshcore.test_lake_quality import ring_of_blocks
+
+    return ring_of_blocks()
+
+
+def test_the_report_names_an_island_under_the_grid_and_measures_the_shores_it_follows():
+    blocks, poly = _ring_blocks()  # four blocks round the square [1, 2]² in [0, 3]²
+    small = [(0.2, 0.2), (0.5, 0.2), (0.5, 0.3), (0.2, 0.3)]  # under block 0: 0.3 × 0.1
+    c = lake_metrics(blocks, polygon=Polygon(poly.exterior, [poly.interiors[0], small])).coverage
+    assert len(c.islands_covered) == 1
+    isl = c.islands_covered[0]
+    assert isl.index == 2 and isl.area == pytest.approx(0.03) and isl.width == pytest.approx(0.1, rel=0.02)
+    assert isl.share == pytest.approx(1.0) and 0.2 < isl.x < 0.5 and 0.2 < isl.y < 0.3
+    assert c.hausdorff == pytest.approx(0.0, abs=1e-12)  # shore and the square island: followed exactly
+    assert c.as_dict()["islands_covered"] == 1
+    rows = {r[0]: r for r in c.rows()}
+    row = rows["islands under the grid (not in the shoreline distance)"]
+    assert row[1].startswith("1 (") and "island 2 (" in row[2]
+    # without the small island: nothing to report
+    c0 = lake_metrics(blocks, polygon=poly).coverage
+    assert c0.islands_covered == () and c0.island_cells == () and len(c0.rows()) == 2
+
+
+def test_the_report_counts_cells_over_an_island_the_grid_goes_round():
+    blocks, poly = _ring_blocks()
+    # the island drawn larger than the hole the grid leaves: a strip of it lies under block 0's cells
+    bigger = [(1, 0.6), (2, 0.6), (2, 2), (1, 2)]
+    c = lake_metrics(blocks, polygon=Polygon(poly.exterior, [bigger])).coverage
+    assert c.islands_covered == ()
+    (k, n, depth, x, y), *_ = c.island_cells
+    assert k == 1 and n >= 1 and Polygon(bigger).contains(Polygon([(x, y)] * 3).centroid)
+    assert depth * c.cell_size == pytest.approx(Polygon(bigger).exterior.distance(Polygon([(x, y)] * 3).centroid))
+    assert c.as_dict()["cells_over_islands"] == sum(t[1] for t in c.island_cells)
+    assert any(r[0].startswith("cells with their centre on an island") for r in c.rows())
+    assert c.hausdorff == pytest.approx(0.4, rel=1e-9)  # the island's rim lies 0.4 below the grid's
+
+
+# --------------------------------------------------------------- the pipeline
+def _mesh(seed: int, regular: bool):
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout import auto_layout
+
+    poly = testing.small_islands(seed, cell_size=H, n_islands=8)
+    lay = auto_layout(poly, cell_size=H, multiple=4, regular=regular)
+    return poly, lay, mesh_layout(lay, levels=2)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("regular", [False, True])
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4, 7])
+def test_every_island_is_followed_or_reported(seed, regular):
+    """Each island of the outline is either a hole of the grid or left out with a note naming it,
+    and the quality report against the outline says the same."""
+    poly, lay, mb = _mesh(seed, regular)
+    m = lake_metrics(mb, polygon=poly, cell_size=H)
+    c = m.coverage
+    noted = {int(n.split()[1]) for n in lay.notes if n.startswith("island ") and "left out" in n}
+    covered = {i.index for i in c.islands_covered}
+    assert covered == noted
+    for k, isl in enumerate(_islands(poly), start=1):
+        w, _ = island_width(isl, 0.02 * H)
+        assert (k in noted) == (w < 2 * H), (k, w / H)
+    assert len(lay.polygon.interiors) == len(poly.interiors) - len(noted)
+    rows = {r[0] for r in m.coverage.rows()}
+    assert ("islands under the grid (not in the shoreline distance)" in rows) == bool(noted)
