@@ -528,8 +528,12 @@ def run(args: argparse.Namespace) -> int:
         for name in dict.fromkeys(args.preset or ()):
             print("\n" + check(m, name).table())
         print(f"\n{len(mb.grids)} blocks, {m.summary()['cells']:,} cells in {time.perf_counter() - t_start:.1f} s")
-    if n_folded or not mb.converged:
+    for w in m.coverage.warnings():  # islands lost or cut across: shown even with -q
+        print(f"meshcore mesh: warning: {w}", file=sys.stderr)
+    lost = len(m.coverage.islands_lost)
+    if n_folded or not mb.converged or lost:
         why = f"{n_folded} folded or non-convex cells" if n_folded else "the solver did not converge"
+        why = why if n_folded or not mb.converged else f"{lost} island(s) under the grid"
         print(f"meshcore mesh: warning: {why} (exit code 3)", file=sys.stderr)
         return 3
     return 0

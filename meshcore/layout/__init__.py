@@ -38,7 +38,7 @@ from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
 from .model import Layout, LayoutBlock
 from .outline import interior_cuts
-from .polygon import water_polygon, without_dense_vertices, without_slivers
+from .polygon import MIN_ISLAND_CELLS, water_polygon, without_dense_vertices, without_slivers
 from .shore import shore_at_scale, transfer, without_narrow_arms
 from .widen import widen_starved
 
@@ -89,7 +89,7 @@ def auto_layout(
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
     poly, dense = without_dense_vertices(poly, h)
-    poly, more = water_polygon(poly, drop_islands_below=2.0 * h)
+    poly, more = water_polygon(poly, drop_islands_below=MIN_ISLAND_CELLS * h)
     more = dense + more
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)

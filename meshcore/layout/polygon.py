@@ -29,7 +29,11 @@ import numpy as np
 
 from ..errors import InvalidInputError
 
-__all__ = ["water_polygon", "without_dense_vertices"]
+__all__ = ["MIN_ISLAND_CELLS", "water_polygon", "without_dense_vertices"]
+
+#: The layout keeps an island at least this many cells across where it is widest (the
+#: ``drop_islands_below`` it passes, in cells; see the module docstring for the measurement).
+MIN_ISLAND_CELLS = 2.0
 
 
 def _ring(points: Any, what: str) -> np.ndarray:

@@ -8,19 +8,22 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   ``hausdorff_cells`` the same in units of the cell size (``sqrt(grid area /
   cells)`` unless given);
 * ``islands_covered`` — the polygon's islands that the grid covers (at least
-  half of the island's area lies under its cells): an island too small for the
-  cell size, left out of the layout, or one the grid was laid over.  Each is
-  named (its number among the polygon's islands, from 1), with its area, its
-  width (the diameter of the largest disc inside it) and a point inside it;
-  the table lists them on a row of their own.  Their rims are not part of the
-  Hausdorff distance above: an island of a cell's width that the grid covers
-  would otherwise read as a shore tens of cells off wherever it lies, hiding
-  the distance of the shores the grid does follow.  Its area is: the grid area
-  counts the water over it, so the area ratio rises by its share;
-* ``island_cells`` — cells whose centre lies inside an island the grid goes
-  round (a narrow end of it that a block side cut across, say), per island:
-  its number, how many cells, the deepest such centre (its distance from the
-  island's rim, in cells) and where it is.  A grid that follows every island
+  half of the island's area lies under its cells).  Each is named (its number
+  among the polygon's islands, from 1), with its area, its width (the diameter
+  of the largest disc inside it) and a point inside it; the table lists them on
+  a row of their own.  One narrower than two cells is **left out**: the layout
+  leaves such islands out by design (:data:`~meshcore.layout.polygon.MIN_ISLAND_CELLS`),
+  and its rim is not part of the Hausdorff distance above (an island a cell
+  across under the grid would read as a shore tens of cells off wherever it
+  lies, hiding the distance of the shores the grid follows).  A wider one is
+  **lost** (:attr:`Coverage.islands_lost`): the grid should go round it; its rim
+  stays in the Hausdorff distance.  The area of either is counted: the grid
+  area includes the water over it, so the area ratio rises by its share;
+* ``island_cells`` — cells whose centre lies on land: inside an island the
+  grid goes round (a narrow end of it that a block side cut across, say), or
+  beyond the outer shore (across a narrow peninsula) — per island (its number;
+  0 for the outer shore): how many cells, the deepest such centre (its distance
+  from that shore, in cells) and where it is.  A grid that follows every shore
   within half a cell has none deeper than half a cell.
 
 The union of a block's cells is its boundary loop when no cell is folded and
@@ -69,8 +72,14 @@ class CoveredIsland:
     def describe(self, cell_size: float) -> str:
         return (
             f"island {self.index} ({self.width / cell_size:.2g} cells across, {self.area / cell_size**2:.2g} cells² "
-            f"near ({self.x:.6g}, {self.y:.6g}))"
+            f"near ({self.x:.6g}, {self.y:.6g}){'' if self.left_out(cell_size) else ', lost'})"
         )
+
+    def left_out(self, cell_size: float) -> bool:
+        """Narrower than the layout keeps (:data:`~meshcore.layout.polygon.MIN_ISLAND_CELLS`)."""
+        from ..layout.polygon import MIN_ISLAND_CELLS
+
+        return self.width < MIN_ISLAND_CELLS * cell_size
 
 
 def island_width(island: Any, tolerance: float) -> tuple[float, Any]:
@@ -102,6 +111,29 @@ class Coverage:
         return self.hausdorff / self.cell_size if self.cell_size > 0 else math.inf
 
     @property
+    def islands_lost(self) -> tuple[CoveredIsland, ...]:
+        """The islands under the grid that are wide enough for the layout to go round them."""
+        return tuple(i for i in self.islands_covered if not i.left_out(self.cell_size))
+
+    def warnings(self) -> list[str]:
+        """One sentence per island the grid covers although it should go round it, and per island
+        with cells more than half a cell inside its shore: what a user must not miss.  (Cells
+        beyond the outer shore are in the table only: the layout smooths a shore jagged below the
+        cell size on purpose, with a note saying how far its shore moved.)"""
+        out = [
+            f"{i.describe(self.cell_size)} is under the grid although the layout goes round it: the grid "
+            f"lost it (make its blocks by hand in a [outline] case, or try another cell size)"
+            for i in self.islands_lost
+        ]
+        out += [
+            f"{n} cell(s) lie {_land(k)}, up to {d:.2g} cells inside its shore near ({x:.6g}, {y:.6g}): "
+            f"the grid cuts across it there"
+            for k, n, d, x, y in self.island_cells
+            if d > 0.5 and k  # the outer shore's: a jagged shore smoothed on purpose (and noted)
+        ]
+        return out
+
+    @property
     def area_error(self) -> float:
         return abs(self.area_ratio - 1.0)
 
@@ -114,6 +146,7 @@ class Coverage:
             "hausdorff_cells": self.hausdorff_cells,
             "cell_size": self.cell_size,
             "islands_covered": len(self.islands_covered),
+            "islands_lost": len(self.islands_lost),
             "cells_over_islands": sum(t[1] for t in self.island_cells),
             "deepest_cell_on_island": max((t[2] for t in self.island_cells), default=0.0),
         }
@@ -138,8 +171,9 @@ class Coverage:
             names = "; ".join(i.describe(self.cell_size) for i in isl[:5]) + ("; …" if len(isl) > 5 else "")
             rows.append(
                 (
-                    "islands under the grid (not in the shoreline distance)",
-                    f"{len(isl)} ({100 * area / self.polygon_area:.2g} % of the water area)",
+                    "islands under the grid",
+                    f"{len(isl)} ({100 * area / self.polygon_area:.2g} % of the water area"
+                    f"{f'; {len(self.islands_lost)} lost' if self.islands_lost else ''})",
                     names,
                 )
             )
@@ -147,12 +181,10 @@ class Coverage:
             n = sum(t[1] for t in self.island_cells)
             deep = max(t[2] for t in self.island_cells)
             where = "; ".join(
-                f"island {k}: {c}, up to {d:.2g} cells inside near ({x:.6g}, {y:.6g})"
+                f"{_land(k).removeprefix('on ')}: {c}, up to {d:.2g} cells inside near ({x:.6g}, {y:.6g})"
                 for k, c, d, x, y in self.island_cells[:5]
             )
-            rows.append(
-                ("cells with their centre on an island the grid goes round", f"{n} (up to {deep:.2g} cells in)", where)
-            )
+            rows.append(("cells with their centre on land", f"{n} (up to {deep:.2g} cells in)", where))
         return rows
 
     def samples(self, metric: str) -> Any:
@@ -271,17 +303,21 @@ def coverage(
         where=(float(where[0]), float(where[1])),
         side=side,
         islands_covered=covered,
-        island_cells=_cells_on(land, grids, h),
+        island_cells=_cells_on(poly, land, grids, h),
     )
 
 
-def _cells_on(islands: list[tuple[int, Any]], grids: Sequence[StructuredGrid], h: float) -> tuple:
-    """Per island (number, polygon) with cell centres inside it: (number, count, depth of the
-    deepest in cells, its place)."""
-    import shapely
+def _land(k: int) -> str:
+    return f"on island {k}" if k else "beyond the outer shore"
 
-    if not islands:
-        return ()
+
+def _cells_on(poly: Any, islands: list[tuple[int, Any]], grids: Sequence[StructuredGrid], h: float) -> tuple:
+    """Per shore with cell centres on its land — beyond the outer rings of ``poly`` (number 0),
+    inside one of ``islands`` (number, polygon) — (number, count, depth of the deepest in cells,
+    its place)."""
+    import shapely
+    from shapely.geometry import Polygon
+
     cx, cy = [], []
     for g in grids:
         x, y = np.asarray(g.x, dtype=float), np.asarray(g.y, dtype=float)
@@ -289,6 +325,12 @@ def _cells_on(islands: list[tuple[int, Any]], grids: Sequence[StructuredGrid], h
         cy.append((0.25 * (y[:-1, :-1] + y[1:, :-1] + y[1:, 1:] + y[:-1, 1:])).ravel())
     px, py = np.concatenate(cx), np.concatenate(cy)
     out = []
+    shell = shapely.union_all([Polygon(p.exterior) for p in getattr(poly, "geoms", [poly])])
+    beyond = np.flatnonzero(~shapely.contains_xy(shell, px, py))
+    if len(beyond):
+        depth = shapely.distance(shapely.points(px[beyond], py[beyond]), shell.boundary)
+        d = int(np.argmax(depth))
+        out.append((0, len(beyond), float(depth[d]) / h, float(px[beyond[d]]), float(py[beyond[d]])))
     for k, island in islands:
         inside = np.flatnonzero(shapely.contains_xy(island, px, py))
         if len(inside):
@@ -319,4 +361,6 @@ def _islands(poly: Any, union: Any, h: float) -> tuple[tuple[CoveredIsland, ...]
                 continue
             width, c = island_width(island, 0.01 * h)
             covered.append(CoveredIsland(k, float(island.area), width, float(c.x), float(c.y), float(share)))
+            if not covered[-1].left_out(h):
+                rims.append(ring)  # lost: measured
     return tuple(covered), rims, land

@@ -97,11 +97,25 @@ def test_the_report_names_an_island_under_the_grid_and_measures_the_shores_it_fo
     assert c.hausdorff == pytest.approx(0.0, abs=1e-12)  # shore and the square island: followed exactly
     assert c.as_dict()["islands_covered"] == 1
     rows = {r[0]: r for r in c.rows()}
-    row = rows["islands under the grid (not in the shoreline distance)"]
+    row = rows["islands under the grid"]
     assert row[1].startswith("1 (") and "island 2 (" in row[2]
+    assert c.islands_lost == () and c.warnings() == []
     # without the small island: nothing to report
     c0 = lake_metrics(blocks, polygon=poly).coverage
     assert c0.islands_covered == () and c0.island_cells == () and len(c0.rows()) == 2
+
+
+def test_an_island_two_cells_wide_under_the_grid_is_lost_and_measured():
+    blocks, poly = _ring_blocks()  # cell size sqrt(8 / 64) = 0.354: two cells are 0.71
+    wide = [(1.1, 0.1), (1.9, 0.1), (1.9, 0.9), (1.1, 0.9)]  # 0.8 across, under block 0
+    c = lake_metrics(blocks, polygon=Polygon(poly.exterior, [poly.interiors[0], wide])).coverage
+    (isl,) = c.islands_covered
+    assert c.islands_lost == (isl,) and isl.index == 2 and isl.width == pytest.approx(0.8, rel=0.02)
+    assert c.hausdorff == pytest.approx(0.5, abs=c.cell_size / 20)  # its middle is 0.5 from the grid's rims
+    assert c.as_dict()["islands_lost"] == 1
+    (w,) = c.warnings()
+    assert w.startswith("island 2 (2.3 cells across") and "lost it" in w
+    assert "1 lost" in next(r[1] for r in c.rows() if r[0] == "islands under the grid")
 
 
 def test_the_report_counts_cells_over_an_island_the_grid_goes_round():
@@ -114,8 +128,17 @@ def test_the_report_counts_cells_over_an_island_the_grid_goes_round():
     assert k == 1 and n >= 1 and Polygon(bigger).contains(Polygon([(x, y)] * 3).centroid)
     assert depth * c.cell_size == pytest.approx(Polygon(bigger).exterior.distance(Polygon([(x, y)] * 3).centroid))
     assert c.as_dict()["cells_over_islands"] == sum(t[1] for t in c.island_cells)
-    assert any(r[0].startswith("cells with their centre on an island") for r in c.rows())
+    assert any(r[0] == "cells with their centre on land" and "island 1: " in r[2] for r in c.rows())
     assert c.hausdorff == pytest.approx(0.4, rel=1e-9)  # the island's rim lies 0.4 below the grid's
+    assert any("inside its shore" in w for w in c.warnings())  # 0.275 = 0.78 cells deep
+    assert [w for w in c.warnings() if "on island 1, up to" in w] == (
+        [
+            f"{n} cell(s) lie on island 1, up to {d:.2g} cells inside its shore near ({x:.6g}, {y:.6g}): "
+            "the grid cuts across it there"
+            for _, n, d, x, y in c.island_cells
+            if d > 0.5
+        ]
+    )
 
 
 # --------------------------------------------------------------- the pipeline
@@ -145,4 +168,44 @@ def test_every_island_is_followed_or_reported(seed, regular):
         assert (k in noted) == (w < 2 * H), (k, w / H)
     assert len(lay.polygon.interiors) == len(poly.interiors) - len(noted)
     rows = {r[0] for r in m.coverage.rows()}
-    assert ("islands under the grid (not in the shoreline distance)" in rows) == bool(noted)
+    assert ("islands under the grid" in rows) == bool(noted)
+
+
+def test_the_report_counts_cells_beyond_the_outer_shore():
+    """A notch of land cut into the shore under block 0's cells (a peninsula the grid crossed)."""
+    blocks, poly = _ring_blocks()
+    shore = [(0, 0), (1.0, 0), (1.4, 0.8), (1.8, 0), (3, 0), (3, 3), (0, 3)]
+    c = lake_metrics(blocks, polygon=Polygon(shore, [poly.interiors[0]])).coverage
+    (k, n, depth, x, y), *rest = c.island_cells
+    assert k == 0 and n >= 1 and not rest
+    assert not Polygon(shore).contains(Polygon([(x, y)] * 3).centroid)
+    assert depth * c.cell_size == pytest.approx(Polygon(shore).exterior.distance(Polygon([(x, y)] * 3).centroid))
+    assert depth > 0 and c.warnings() == []  # in the table, not a warning (a jagged shore is smoothed on purpose)
+    assert "beyond the outer shore: " in next(r[2] for r in c.rows() if r[0] == "cells with their centre on land")
+
+
+def test_the_cli_warns_and_exits_3_when_the_grid_lost_an_island(tmp_path, monkeypatch):
+    """A layout made without the island (as a grid that slid off it would be): the grid is
+    written, the island named on stderr (even with -q), exit code 3."""
+    from meshcore import layout as layout_module
+    from tests.meshcore.test_mesh_cli import _synthetic_rings, mesh
+
+    f = tmp_path / "lake.csv"
+    shore, island = _synthetic_rings()
+    rows = [f"{x:.3f},{y:.3f},shore" for x, y in shore] + [f"{x:.3f},{y:.3f},island" for x, y in island]
+    f.write_text("x,y,ring\n" + "\n".join(rows) + "\n")
+    real = layout_module.auto_layout
+
+    def without_islands(poly, **kw):
+        return real(Polygon(poly.exterior), **kw)
+
+    monkeypatch.setattr(layout_module, "auto_layout", without_islands)
+    run = mesh(f, "--cells", 400, "-o", tmp_path / "s.vtm", "-q")
+    assert run.rc == 3, run.err
+    lines = run.err.splitlines()
+    assert any(ln.startswith("meshcore mesh: warning: island 1 (") and "lost it" in ln for ln in lines), run.err
+    assert lines[-1] == "meshcore mesh: warning: 1 island(s) under the grid (exit code 3)"
+    assert (tmp_path / "s.vtm").exists()
+    monkeypatch.setattr(layout_module, "auto_layout", real)
+    run = mesh(f, "--cells", 400, "-o", tmp_path / "t.vtm", "-q")
+    assert run.rc == 0 and "warning" not in run.err, run.err
