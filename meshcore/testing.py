@@ -284,6 +284,7 @@ def small_islands(
     n_islands: int = 6,
     widths: tuple[float, float] = (0.3, 5.0),
     radius: float = 10.0,
+    peninsulas: int = 0,
 ):
     """A lobed lake with ``n_islands`` small islands ``widths`` cells across (log-uniform).
 
@@ -292,7 +293,9 @@ def small_islands(
     tapering from its width to a sharp tip over 3–8 widths).  A third of them lie 0.3–3 cells
     from the shore, a third as far from the island before them, the rest anywhere.  For the
     question what a grid of cell size ``cell_size`` does with an island it can or cannot go
-    round (mesh with ``cell_size=cell_size``).
+    round (mesh with ``cell_size=cell_size``).  ``peninsulas``: as many spikes of land of the
+    same widths reaching 3–10 widths into the water from the shore (the same question for the
+    outer shore), made before the islands.
     """
     from shapely import affinity
     from shapely.geometry import LineString, Point, Polygon
@@ -305,6 +308,22 @@ def small_islands(
         r += rng.uniform(0.0, 0.25 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
     r *= radius / r.max()
     outer = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    for _ in range(peninsulas):
+        w = h * math.exp(rng.uniform(math.log(widths[0]), math.log(widths[1])))
+        p = np.asarray(outer.exterior.interpolate(rng.uniform(0, outer.exterior.length)).coords[0])
+        inward = -p / max(np.hypot(*p), 1e-9)
+        turn = rng.uniform(-0.5, 0.5)  # not quite towards the centre
+        d = np.array(
+            [
+                inward[0] * math.cos(turn) - inward[1] * math.sin(turn),
+                inward[0] * math.sin(turn) + inward[1] * math.cos(turn),
+            ]
+        )
+        length = w * rng.uniform(3.0, 10.0)
+        spike = LineString([p - 2.0 * w * d, p + length * d]).buffer(0.5 * w, quad_segs=4)
+        cut = outer.difference(spike)
+        parts = [g for g in getattr(cut, "geoms", [cut]) if g.geom_type == "Polygon"]
+        outer = Polygon(max(parts, key=lambda g: g.area).exterior)
     body = outer.buffer(-0.3 * h)
     holes: list[Polygon] = []
     tries = 0

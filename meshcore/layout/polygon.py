@@ -162,9 +162,29 @@ def without_slivers(poly: Any, width: float) -> tuple[Any, list[str]]:
 
     note = (
         f"spikes of water or land narrower than {width:.3g} (half a cell) smoothed out of the shore "
-        f"({100 * moved / poly.area:.2g} % of the water area moved)"
+        f"({100 * moved / poly.area:.2g} % of the water area moved{_largest_spikes(poly, clean, width)})"
     )
     return orient(clean.simplify(1e-3 * width), 1.0), [note]
+
+
+def _largest_spikes(poly: Any, clean: Any, width: float, n: int = 3) -> str:
+    """``; the largest: land … near (x, y), …`` — the ``n`` largest pieces of land the grid will
+    cover and of water it will leave out, with their length (half the perimeter) and place."""
+    from ..quality.coverage import island_width
+
+    pieces = []
+    for what, geom in (("land", clean.difference(poly)), ("water", poly.difference(clean))):
+        for g in getattr(geom, "geoms", [geom]):
+            if g.geom_type == "Polygon" and g.area > 1e-6 * width * width:
+                pieces.append((g.area, what, g))
+    big = sorted(pieces, key=lambda t: -t[0])[:n]
+    if not big or big[0][2].length < 4 * width:  # only teeth: nothing worth naming
+        return ""
+    said = []
+    for _, what, g in big:
+        _, c = island_width(g, 0.05 * width)
+        said.append(f"{what} {0.5 * g.length:.3g} long near ({c.x:.6g}, {c.y:.6g})")
+    return "; the largest: " + ", ".join(said) + " (the grid covers land and leaves out water there)"
 
 
 #: A shore with more vertices than this per cell length is simplified before the layout ...

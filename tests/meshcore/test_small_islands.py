@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 from shapely.geometry import Polygon
 
@@ -209,3 +210,43 @@ def test_the_cli_warns_and_exits_3_when_the_grid_lost_an_island(tmp_path, monkey
     monkeypatch.setattr(layout_module, "auto_layout", real)
     run = mesh(f, "--cells", 400, "-o", tmp_path / "t.vtm", "-q")
     assert run.rc == 0 and "warning" not in run.err, run.err
+
+
+def test_a_thin_peninsula_smoothed_out_is_named():
+    """A spike of land 0.3 cells wide and 4 long from the shore: the grid cannot follow it
+    (narrower than half a cell); the note says where it is and how long."""
+    from shapely.geometry import LineString, Point
+
+    from meshcore.layout.polygon import without_slivers
+
+    lake = Point(0, 0).buffer(10.0, quad_segs=32)
+    spike = LineString([(0, -11), (0, -10 + 4 * H)]).buffer(0.15 * H, cap_style="flat")
+    poly = Polygon(lake.difference(spike).exterior)
+    out, (note,) = without_slivers(poly, 0.5 * H)
+    m = re.search(r"the largest: land (\S+) long near \((\S+), (\S+)\)", note)
+    assert m, note
+    assert float(m[1]) == pytest.approx(4 * H, rel=0.1)
+    assert abs(float(m[2])) < 0.15 * H and -10 < float(m[3]) < -10 + 4 * H
+    assert out.area > poly.area  # the spike's land is water now
+    # a shore with teeth only: no place named
+    teeth = testing.jagged(Point(0, 0).buffer(10.0, quad_segs=32), 0.02 * H, seed=1)
+    assert all("the largest" not in n for n in without_slivers(teeth, 0.5 * H)[1])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(12))
+def test_peninsulas_are_followed_or_named(seed):
+    """small_islands with thin spikes of land from the shore: cells beyond the shore stay within
+    half a cell of it, and a peninsula left out is named by place in a note."""
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout import auto_layout
+
+    poly = testing.small_islands(seed, cell_size=H, n_islands=4, peninsulas=5)
+    lay = auto_layout(poly, cell_size=H, multiple=4)
+    c = lake_metrics(mesh_layout(lay, levels=2), polygon=poly, cell_size=H).coverage
+    beyond = [t for t in c.island_cells if t[0] == 0]
+    assert all(d <= 0.6 for _, _, d, _, _ in beyond), beyond
+    if c.hausdorff_cells > 1.0:  # the grid's shore is far from the outline somewhere: a note says where
+        x, y = c.where
+        places = [tuple(map(float, p)) for n in lay.notes for p in re.findall(r"near \((\S+), (\S+)\)", n)]
+        assert any(np.hypot(x - px, y - py) < 6 * H for px, py in places), (c.where, lay.notes)
