@@ -28,12 +28,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError
+from ..quality.coverage import MIN_ISLAND_CELLS, island_width
 
 __all__ = ["MIN_ISLAND_CELLS", "water_polygon", "without_dense_vertices"]
-
-#: The layout keeps an island at least this many cells across where it is widest (the
-#: ``drop_islands_below`` it passes, in cells; see the module docstring for the measurement).
-MIN_ISLAND_CELLS = 2.0
 
 
 def _ring(points: Any, what: str) -> np.ndarray:
@@ -116,8 +113,6 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
         if isl is None:
             continue
         if drop_islands_below > 0:
-            from ..quality.coverage import island_width
-
             width, c = island_width(isl, 0.01 * drop_islands_below)
             if width < drop_islands_below:
                 notes.append(
@@ -170,8 +165,6 @@ def without_slivers(poly: Any, width: float) -> tuple[Any, list[str]]:
 def _largest_spikes(poly: Any, clean: Any, width: float, n: int = 3) -> str:
     """``; the largest: land … near (x, y), …`` — the ``n`` largest pieces of land the grid will
     cover and of water it will leave out, with their length (half the perimeter) and place."""
-    from ..quality.coverage import island_width
-
     pieces = []
     for what, geom in (("land", clean.difference(poly)), ("water", poly.difference(clean))):
         for g in getattr(geom, "geoms", [geom]):

@@ -12,7 +12,7 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   among the polygon's islands, from 1), with its area, its width (the diameter
   of the largest disc inside it) and a point inside it; the table lists them on
   a row of their own.  One narrower than two cells is **left out**: the layout
-  leaves such islands out by design (:data:`~meshcore.layout.polygon.MIN_ISLAND_CELLS`),
+  leaves such islands out by design (:data:`MIN_ISLAND_CELLS`),
   and its rim is not part of the Hausdorff distance above (an island a cell
   across under the grid would read as a shore tens of cells off wherever it
   lies, hiding the distance of the shores the grid follows).  A wider one is
@@ -48,7 +48,13 @@ from ..errors import InvalidInputError
 from ..grid import StructuredGrid
 from .samples import Samples
 
-__all__ = ["Coverage", "CoveredIsland", "as_polygon", "coverage", "island_width"]
+__all__ = ["MIN_ISLAND_CELLS", "Coverage", "CoveredIsland", "as_polygon", "coverage", "island_width"]
+
+#: The layout keeps an island at least this many cells across where it is widest
+#: (:func:`island_width`; :func:`meshcore.layout.polygon.water_polygon` is given it times the
+#: cell size, and its docstring has the measurement behind it); a narrower one under the grid is
+#: left out by design, a wider one lost.
+MIN_ISLAND_CELLS = 2.0
 
 #: An island is covered when at least this share of its area lies under the grid's cells: a grid
 #: that goes round an island leaves only the slivers between its boundary chords and a curved
@@ -76,9 +82,7 @@ class CoveredIsland:
         )
 
     def left_out(self, cell_size: float) -> bool:
-        """Narrower than the layout keeps (:data:`~meshcore.layout.polygon.MIN_ISLAND_CELLS`)."""
-        from ..layout.polygon import MIN_ISLAND_CELLS
-
+        """Narrower than the layout keeps (:data:`MIN_ISLAND_CELLS`)."""
         return self.width < MIN_ISLAND_CELLS * cell_size
 
 
