@@ -286,12 +286,20 @@ _GOOD = 4 * 20.0**2
 
 
 def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
-    """Spokes from ``center`` to 3–5 reflex vertices: the cheapest admissible star.
+    """Straight spokes from ``center`` to 3–5 reflex vertices: the cheapest admissible star.
 
-    A spoke reaches its reflex corner along the continuation of the shore that arrives there
-    (walking the region counter-clockwise): the piece on that side sees a straight side, the
-    other piece a corner — no piece is left with a half-way angle, and a symmetric junction
-    gets a symmetric star (the rule turns with the junction).
+    Spokes are straight segments (sampled every ``sigma``): the grid solves move interface
+    nodes along and across cut lines and straighten a curved spoke anyway.  Spokes that reached
+    their corner along the continued shore (quadratic Béziers, earlier versions) gave one piece
+    a small angle there in the layout which the solves opened to 150–180° (a fan of cells in its
+    corner): generated Y junctions had cells 2.5× apart across the spoke's shore end.
+
+    A straight spoke halves the reflex angle, so a piece between two spokes is a pentagon (the
+    centre, two halved reflex corners, the two corners of its arm's opening); such a piece
+    gets a spoke of its own from the centre to its far side (:func:`_far_spoke`) when that
+    pays.  Without it the piece was split again by a cut from one of the evenly spaced shore
+    points of the last resort (:func:`best_split`), unevenly: a symmetric Y in 8 or 9 blocks
+    of different counts.  A symmetric junction gets a symmetric star.
     """
     from shapely.geometry import LineString, Point, Polygon
 
@@ -305,37 +313,90 @@ def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
     room = poly.buffer(1e-9 * math.sqrt(poly.area))
     spoke_of = {}
     for v in reflex:
-        back = _point_along(ring, s, total, s[v] - sigma)
-        u = ring[v] - back
-        nu = math.hypot(*u)
-        d = math.hypot(*(center - ring[v]))
-        if nu == 0 or d == 0:
-            continue
-        knee = ring[v] + u / nu * 0.5 * d
-        # a quadratic Bézier from the centre that arrives along the continued shore
-        tt = np.linspace(0.0, 1.0, max(3, int(np.ceil(d / sigma)) + 2))[:, None]
-        sp = (1 - tt) ** 2 * center + 2 * (1 - tt) * tt * knee + tt**2 * ring[v]
-        sp[0], sp[-1] = center, ring[v]
-        if room.covers(LineString(sp)):
+        sp = _segment(center, ring[v], sigma)
+        if sp is not None and room.covers(LineString(sp)):
             spoke_of[v] = sp
     reflex = [v for v in reflex if v in spoke_of]
     best = None
+    n = len(ring)
     for k in (3, 4, 5):
         for combo in itertools.combinations(reflex, k):
             spokes = [LineString(spoke_of[v]) for v in combo]
             if any(spokes[i].crosses(spokes[j]) for i in range(k) for j in range(i + 1, k)):
                 continue
-            pieces = []
+            pieces, extra, cost = [], [], 0.0
             for v0, v1 in zip(combo, combo[1:] + combo[:1], strict=True):
-                arc = [ring[(v0 + q) % len(ring)] for q in range((v1 - v0) % len(ring) + 1)]
-                pieces.append(_orient(np.array([*spoke_of[v0][:-1], *arc, *spoke_of[v1][-2:0:-1]])))
+                arc = np.array([ring[(v0 + q) % n] for q in range((v1 - v0) % n + 1)])
+                sub, sp, c = _far_spoke(spoke_of[v0], arc, spoke_of[v1], sigma, min_width)
+                pieces += sub
+                extra += sp
+                cost += c
             if min(_width(p) for p in pieces) < min_width:
                 continue
             if not all(Polygon(p).is_valid for p in pieces):
                 continue
-            cost = sum(region_cost(p, sigma) for p in pieces)
             if best is None or cost < best[2]:
-                best = (pieces, [spoke_of[v] for v in combo], cost)
+                best = (pieces, [spoke_of[v] for v in combo] + extra, cost)
+    return best
+
+
+def _segment(a: np.ndarray, b: np.ndarray, sigma: float):
+    """The straight segment from ``a`` to ``b`` sampled every ``sigma`` or less (None if a = b)."""
+    d = math.hypot(*(b - a))
+    if d == 0:
+        return None
+    tt = np.linspace(0.0, 1.0, max(3, int(np.ceil(d / sigma)) + 2))[:, None]
+    sp = (1 - tt) * a + tt * b
+    sp[0], sp[-1] = a, b
+    return sp
+
+
+def _far_spoke(sp0: np.ndarray, arc: np.ndarray, sp1: np.ndarray, sigma: float, min_width: float):
+    """The star piece between spokes ``sp0`` and ``sp1`` (both from the centre), maybe split in two.
+
+    ``arc`` runs counter-clockwise from the end of ``sp0`` to the end of ``sp1``.  The extra
+    spoke runs from the centre to a point of the arc where it meets the arc at a right angle (the
+    foot of the perpendicular inside an edge, or a vertex where the feet on both of its edges
+    fall: across an arm's opening, its middle), at least ``min_width`` from both ends of the arc
+    along it; the four such points nearest the centre are tried.  It is kept when it lowers the
+    piece's corner cost at all (not by the margin :data:`_GOOD` of :func:`best_split`: the pieces
+    of one symmetric junction, drawn between chords placed on a sampled skeleton, differ by more
+    than that margin in cost, and some were split, some not).  Returns ``(pieces, extra spokes, cost)``.
+    """
+    from shapely.geometry import LineString, Polygon
+
+    c = sp0[0]
+    whole = _orient(np.array([*sp0[:-1], *arc, *sp1[-2:0:-1]]))
+    cost = region_cost(whole, sigma)
+    if cost <= _GOOD:
+        return [whole], [], cost
+    a, b = arc[:-1], arc[1:]
+    e = b - a
+    L = np.maximum(np.hypot(*e.T), 1e-300)
+    u = ((c - a) * e).sum(axis=1) / (L * L)
+    s = np.concatenate([[0.0], np.cumsum(L)])
+    eps = 1e-9
+    # (edge k, head, the point): the foot inside edge k, or a vertex j where the feet on both of
+    # its edges fall onto it (the nearest point of the arc to the centre there)
+    inside = np.flatnonzero((u > eps) & (u < 1 - eps))
+    cand = [(k, arc[: k + 1], a[k] + u[k] * e[k], s[k] + u[k] * L[k]) for k in inside]
+    cand += [(j, arc[:j], arc[j], s[j]) for j in range(1, len(arc) - 1) if u[j - 1] >= 1 - eps and u[j] <= eps]
+    cand = [x for x in cand if min_width <= x[3] <= s[-1] - min_width]
+    cand.sort(key=lambda x: math.hypot(*(x[2] - c)))
+    best = ([whole], [], cost)
+    piece = Polygon(whole).buffer(1e-9 * math.sqrt(Polygon(whole).area))
+    for k, head, q, _ in cand[:4]:
+        sp = _segment(c, q, sigma)
+        if sp is None or not piece.covers(LineString(sp)):
+            continue
+        tail = arc[k + 1 :]
+        p0 = _orient(np.array([*sp0[:-1], *head, q, *sp[-2:0:-1]]))
+        p1 = _orient(np.array([*sp[:-1], q, *tail, *sp1[-2:0:-1]]))
+        if min(_width(p0), _width(p1)) < min_width or not (_valid(p0) and _valid(p1)):
+            continue
+        split = region_cost(p0, sigma) + region_cost(p1, sigma)
+        if split < best[2]:
+            best = ([p0, p1], [sp], split)
     return best
 
 
