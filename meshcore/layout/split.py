@@ -378,12 +378,12 @@ def _far_spoke(sp0: np.ndarray, arc: np.ndarray, sp1: np.ndarray, sigma: float, 
     eps = 1e-9
     # (edge k, head, the point): the foot inside edge k, or a vertex j where the feet on both of
     # its edges fall onto it (the nearest point of the arc to the centre there)
-    inside = np.flatnonzero((u > eps) & (u < 1 - eps))
+    inside = [int(k) for k in np.flatnonzero((u > eps) & (u < 1 - eps))]
     cand = [(k, arc[: k + 1], a[k] + u[k] * e[k], s[k] + u[k] * L[k]) for k in inside]
     cand += [(j, arc[:j], arc[j], s[j]) for j in range(1, len(arc) - 1) if u[j - 1] >= 1 - eps and u[j] <= eps]
     cand = [x for x in cand if min_width <= x[3] <= s[-1] - min_width]
     cand.sort(key=lambda x: math.hypot(*(x[2] - c)))
-    best = ([whole], [], cost)
+    best: tuple[list[np.ndarray], list[np.ndarray], float] = ([whole], [], cost)
     piece = Polygon(whole).buffer(1e-9 * math.sqrt(Polygon(whole).area))
     for k, head, q, _ in cand[:4]:
         sp = _segment(c, q, sigma)
