@@ -105,8 +105,9 @@ def test_a_jagged_straight_channel_stays_a_few_blocks(cells, seed):
     assert len(note) == 1 and "cells from the outline" in note[0]
 
 
-@NORMAL_CUTS
-@pytest.mark.parametrize("seed", range(3))
+# seed 0 passes since the Y's star has six blocks round its centre (the clean Y 6 -> 9 blocks, its
+# jagged twin 11 as before); seeds 1 and 2 still fail on their networks (10 -> 15, 14 -> 20 blocks)
+@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=NORMAL_CUTS), pytest.param(2, marks=NORMAL_CUTS)])
 def test_jagged_branched_lakes_keep_their_layout_size(seed):
     for clean in (testing.y_junction(), testing.channel_network(seed + 1, n_branches=5)):
         n_clean = len(auto_layout(clean).blocks)
