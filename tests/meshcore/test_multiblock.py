@@ -890,8 +890,9 @@ def test_generated_lake_whose_coarsest_level_stalls_converges_by_multigrid():
 
 
 def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
-    """The point sweeps round the largest defects after each cycle (multigrid.HOT_SWEEPS) take a
-    generated lake with islands from 7 cycles to at most 5 and give the same grid."""
+    """The point sweeps round the largest defects after each cycle (multigrid.HOT_SWEEPS) save
+    cycles on a generated lake with islands and give the same grid (7 -> 5 cycles when written;
+    12 -> 9 on its layout since the Y stars got six blocks round the centre, 6 -> 5 before)."""
     from meshcore.layout import auto_layout
     from meshcore.multiblock import multigrid
     from meshcore.testing import lake_with_islands
@@ -902,7 +903,7 @@ def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
     monkeypatch.setattr(multigrid, "HOT_SWEEPS", 0)
     cold = solve_multiblock(topo, engine="multigrid")
     assert hot.converged and cold.converged
-    assert hot.info.iterations <= 5 < cold.info.iterations
+    assert hot.info.iterations < cold.info.iterations
     cold = solve_multiblock(topo, engine="multigrid", tolerance=1e-9)
     assert tight.converged and cold.converged
     for g, k in zip(tight, cold, strict=True):
