@@ -892,7 +892,7 @@ def test_generated_lake_whose_coarsest_level_stalls_converges_by_multigrid():
 def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
     """The point sweeps round the largest defects after each cycle (multigrid.HOT_SWEEPS) save
     cycles on a generated lake with islands and give the same grid (7 -> 5 cycles when written;
-    12 -> 9 on its layout since the Y stars got six blocks round the centre, 6 -> 5 before)."""
+    9 -> 7 on its layout since the Y stars got six blocks round the centre, 6 -> 4 before)."""
     from meshcore.layout import auto_layout
     from meshcore.multiblock import multigrid
     from meshcore.testing import lake_with_islands
