@@ -300,6 +300,15 @@ def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
     pays.  Without it the piece was split again by a cut from one of the evenly spaced shore
     points of the last resort (:func:`best_split`), unevenly: a symmetric Y in 8 or 9 blocks
     of different counts.  A symmetric junction gets a symmetric star.
+
+    A spoke must split its reflex corner into two angles of at most 180° (+ :data:`SHARP`, a
+    bend the corners do not count as sharp), so that no piece keeps a reflex bend at its end.
+    A spoke to a far reflex vertex, typically the sharp tip of an island or a peninsula seen
+    from across a wide junction, can arrive almost along one of its shores: one side of it a
+    sliver (16° on a generated lake), the other still reflex (299°), which a second cut from
+    the same vertex then splits; the grid fans out from that vertex (cells 47× apart across
+    the cut on ``lake_with_islands``, 4-5× without such spokes; no spoke of a channel
+    junction's star leaves more than ~200° on a side).
     """
     from shapely.geometry import LineString, Point, Polygon
 
@@ -314,7 +323,9 @@ def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
     spoke_of = {}
     for v in reflex:
         sp = _segment(center, ring[v], sigma)
-        if sp is not None and room.covers(LineString(sp)):
+        if sp is None or max(_sides(ring, s, total, v, center, sigma)) > 180.0 + SHARP:
+            continue  # (a spoke that leaves a reflex side: see above)
+        if room.covers(LineString(sp)):
             spoke_of[v] = sp
     reflex = [v for v in reflex if v in spoke_of]
     best = None
@@ -338,6 +349,21 @@ def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
             if best is None or cost < best[2]:
                 best = (pieces, [spoke_of[v] for v in combo] + extra, cost)
     return best
+
+
+def _sides(ring: np.ndarray, s: np.ndarray, total: float, v: int, center: np.ndarray, sigma: float):
+    """The water angles (degrees) either side of a straight spoke from ``center`` to vertex ``v``:
+    from the shore ahead of ``v`` round to the spoke, and from the spoke round to the shore behind
+    (their sum is the reflex angle at ``v``), the shore read ``sigma`` along it as in
+    :func:`~.corners.turning` (``s``: arc length at the vertices, ``total``: the perimeter)."""
+    ahead = _point_along(ring, s, total, s[v] + sigma) - ring[v]
+    back = _point_along(ring, s, total, s[v] - sigma) - ring[v]
+    d = center - ring[v]
+
+    def deg(u):
+        return math.degrees(math.atan2(u[1], u[0]))
+
+    return (deg(d) - deg(ahead)) % 360.0, (deg(back) - deg(d)) % 360.0
 
 
 def _segment(a: np.ndarray, b: np.ndarray, sigma: float):
