@@ -109,6 +109,7 @@ def iterate_layout(
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
     size_ratio: tuple[float, float] | None = (1.15, 2.0),
+    hold_ends: bool = False,
     every: int | None = 25,
     level_callback: Callable[[str, Any], Any] | None = None,
     stop_event: Any = None,
@@ -119,6 +120,8 @@ def iterate_layout(
     coarsest ones are dropped, with more the first repeats).  ``stall``: the finest level stops
     as soon as its share of nodes with ``|cos| ≤ 0.02`` rises by less than that over 20 sweeps
     (see :func:`~meshcore.orthogonal.iterate_orthogonalize`; None: always ``sweeps[-1]``).
+    ``hold_ends``: keep the lines leaving cut ends at reflex shore corners near their angles
+    (:func:`~meshcore.orthogonal.iterate_orthogonalize`; off by default, see there).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped").  Returns
@@ -162,6 +165,7 @@ def iterate_layout(
             pin_angle=pin_angle,
             shore_smooth=shore_smooth,
             size_ratio=size_ratio,
+            hold_ends=hold_ends,
             stall=stall if lev == len(tops) - 1 else None,
         )
         try:

@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["jacobi_targets", "shore_sweep", "sweep"]
+__all__ = ["hold_fans", "jacobi_targets", "shore_sweep", "sweep"]
 
 
 @njit(cache=True, inline="always")
@@ -476,4 +476,69 @@ def shore_sweep(
             tx, ty = _ring_point(R, S, r0, s0, n, s, hint)
             if (tx - ox) ** 2 + (ty - oy) ** 2 > (1e-3 * gap) ** 2:
                 big = max(big, _try_move(X, Y, p, tx, ty, cptr, cells, jmin, before, after))
+    return big
+
+
+@njit(cache=True, inline="always")
+def _fan_angles(w, corner, a0, m):
+    """The angles of the ``m`` cells round a cut end whose water angle is ``w``: a cell that is its
+    block's corner (``corner[a0 + q]``) a right angle, or half the water angle shared among those
+    corners where that is less; the other cells (two per block whose side passes) share the rest."""
+    nc = 0
+    for q in range(m):
+        if corner[a0 + q]:
+            nc += 1
+    if nc == 0 or nc == m:
+        return w / m, w / m
+    ac = min(0.5 * math.pi, 0.5 * w / nc)
+    return ac, (w - nc * ac) / (m - nc)
+
+
+@njit(cache=True, nogil=True)
+def hold_fans(X, Y, ends, fptr, fan, corner, cptr, cells, jmin, least, slack, lo):
+    """Keep the grid lines that leave each cut line's end on the shore near set angles:
+    ``fan[fptr[k]:fptr[k + 1]]`` are the neighbours of ``ends[k]`` in counter-clockwise order, a
+    shore node first and last, the nodes of the lines into the water between; the cell between
+    lines ``q`` and ``q + 1`` is meant to get the angle :func:`_fan_angles` gives it
+    (``corner[fptr[k] + q]``: it is the only cell of its block there).  A line more than
+    ``slack`` times the mean cell angle off its place is turned about the end back to that
+    distance, and no line is shorter than the shore edges at the end (their geometric mean) over
+    ``lo``.  Ends whose water angle is below ``least`` are left alone.  Moves are fold-guarded
+    as :func:`_try_move`; returns the largest."""
+    big = 0.0
+    before = np.empty(16)
+    after = np.empty(16)
+    for k in range(len(ends)):
+        c = ends[k]
+        a0 = fptr[k]
+        m = fptr[k + 1] - a0 - 1  # cells at the end
+        ax, ay = X[fan[a0]] - X[c], Y[fan[a0]] - Y[c]
+        bx, by = X[fan[a0 + m]] - X[c], Y[fan[a0 + m]] - Y[c]
+        w = math.atan2(ax * by - ay * bx, ax * bx + ay * by)
+        if w <= 0.0:
+            w += 2.0 * math.pi
+        if w < least:
+            continue
+        ac, aside = _fan_angles(w, corner, a0, m)
+        t0 = math.atan2(ay, ax)
+        band = slack * w / m
+        short = math.sqrt(math.sqrt((ax * ax + ay * ay) * (bx * bx + by * by))) / lo
+        tau = 0.0
+        for q in range(1, m):
+            tau += ac if corner[a0 + q - 1] else aside
+            p = fan[a0 + q]
+            dx, dy = X[p] - X[c], Y[p] - Y[c]
+            r = math.sqrt(dx * dx + dy * dy)
+            phi = math.atan2(ax * dy - ay * dx, ax * dx + ay * dy)  # from line 0, counter-clockwise
+            if phi < 0.0:
+                phi += 2.0 * math.pi
+            off = phi - tau
+            if abs(off) <= band and r >= short:
+                continue
+            phi = tau + min(max(off, -band), band)
+            r = max(r, short)
+            d = _try_move(
+                X, Y, p, X[c] + r * math.cos(t0 + phi), Y[c] + r * math.sin(t0 + phi), cptr, cells, jmin, before, after
+            )
+            big = max(big, d)
     return big

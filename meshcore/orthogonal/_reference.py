@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ortho_targets"]
+__all__ = ["fan_targets", "ortho_targets"]
 
 
 def blend(smooth: float, h1: np.ndarray, h2: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -50,3 +50,36 @@ def ortho_targets(
     tx = (a[0] * x[e] + a[1] * x[w] + a[2] * x[n] + a[3] * x[s]) / den
     ty = (a[0] * y[e] + a[1] * y[w] + a[2] * y[n] + a[3] * y[s]) / den
     return tx, ty
+
+
+def fan_targets(x, y, ends, fptr, fan, corner, least: float, slack: float, lo: float):
+    """Where :func:`._kernels.hold_fans` puts the nodes of the lines leaving each cut end, all
+    from the same old positions and without the fold guard: ``(nodes, tx, ty)`` of the lines it
+    moves."""
+    nodes, tx, ty = [], [], []
+    for k, c in enumerate(ends):
+        f = fan[fptr[k] : fptr[k + 1]]
+        cor = corner[fptr[k] : fptr[k + 1] - 1]
+        v = np.column_stack([x[f] - x[c], y[f] - y[c]])
+        m = len(f) - 1
+        w = float(np.mod(np.arctan2(v[-1, 1], v[-1, 0]) - np.arctan2(v[0, 1], v[0, 0]), 2 * np.pi)) or 2 * np.pi
+        if w < least:
+            continue
+        nc = int(cor.sum())
+        ac = aside = w / m
+        if 0 < nc < m:
+            ac = min(np.pi / 2, 0.5 * w / nc)
+            aside = (w - nc * ac) / (m - nc)
+        tau = np.cumsum(np.where(cor, ac, aside))[:-1]  # line q after cells 0 .. q-1
+        phi = np.mod(np.arctan2(v[1:-1, 1], v[1:-1, 0]) - np.arctan2(v[0, 1], v[0, 0]), 2 * np.pi)
+        r = np.hypot(*v[1:-1].T)
+        short = np.sqrt(np.hypot(*v[0]) * np.hypot(*v[-1])) / lo
+        band = slack * w / m
+        off = phi - tau
+        move = (np.abs(off) > band) | (r < short)
+        new = np.arctan2(v[0, 1], v[0, 0]) + tau + np.clip(off, -band, band)
+        r = np.maximum(r, short)
+        nodes.extend(f[1:-1][move])
+        tx.extend((x[c] + r * np.cos(new))[move])
+        ty.extend((y[c] + r * np.sin(new))[move])
+    return np.asarray(nodes, dtype=np.int64), np.asarray(tx), np.asarray(ty)

@@ -11,6 +11,14 @@ elliptic solution) and the shore it lies on, and iterates
    or three (reflex corners, cut lines ending beside a block's side) stay where the layout put
    them; the shore edges on the two sides of such an end are the first cells of two blocks, so
    the nodes next to it keep their edge within ``lo`` of the edge beyond it;
+3. optionally (``hold_ends``), where such an end sits at a reflex shore corner (water angle at
+   least :data:`FAN_LEAST`), a turn of the grid lines leaving it back towards set angles (a block
+   corner there a right angle, the blocks whose side passes it the rest) and out to the length of
+   the shore edges there (:func:`._kernels.hold_fans`).  Left alone, the start solve and the
+   levels can turn the cut's first edge until the corner block's angle is 150–180° — a polar fan
+   whose cells are 10–80 times smaller than those across the cut.  Off by default: it removes
+   those fans but, holding only the first edge, makes a kink where the drawn cut bends a few
+   cells on, and on 90 generated lakes the two effects cancel (see ``docs/lake-grids.md``);
 
 until the largest move is below ``tol`` × the median edge length.
 
@@ -131,6 +139,60 @@ def _across_cut_ends(bn, bprev, bnext, free, cnt) -> np.ndarray:
     return out
 
 
+#: The least water angle (radians) at a cut end on the shore for :func:`._kernels.hold_fans` to
+#: act: 225 degrees, halfway between a straight shore (180: a cut ending beside a block's side
+#: there turns that side, no corner to keep) and the 270 of a block corner beside a side passing
+#: straight.  The fans it stops (a corner block's angle turned to 150-180 degrees by the start
+#: solve and the levels, cells 10-80 times smaller than across the cut) were all at reflex
+#: corners, 240-300 degrees, on generated lakes (fresh_sweep seeds 499000 ...).
+FAN_LEAST = float(np.radians(225.0))
+#: How far (times the mean cell angle ``W / cells``) a line at a cut end may stray from its set
+#: angle before :func:`._kernels.hold_fans` turns it back.  Measured on 45 generated lakes (fresh
+#: seeds 499000, 15 000 cells): 0 (every line held exactly) turned the first edge against the way
+#: the drawn cut bends two cells on and made kinks there (lakes with every interface ratio <= 2
+#: 14 -> 12); 0.3 kept 14 and cut the worst fans; 0.45 let some come back (net 499004 35 -> 75).
+FAN_SLACK = 0.3
+
+
+def _cut_end_fans(cells, cell_block, boundary, bn, free, cnt):
+    """``(ends, fptr, fan, corner)`` for :func:`._kernels.hold_fans`: every fixed shore node with
+    three or more cells (a cut line's end), its neighbours in counter-clockwise order round it
+    (``fan[fptr[k]:fptr[k + 1]]``), from one shore neighbour through the nodes of the lines into
+    the water to the other, and per cell between two of them (``corner[fptr[k] + q]``, the cell
+    after ``fan[fptr[k] + q]``) whether it is its block's only cell there; ends whose fan is not of
+    that form (a line ending on the shore too) are left out."""
+    ends, ptr, fan, corner = [], [0], [], []
+    for c in bn[~free & (cnt[bn] >= 3)]:
+        rows = np.flatnonzero((cells == c).any(axis=1))
+        nxt, blk = {}, {}
+        for r in rows:
+            k = int(np.flatnonzero(cells[r] == c)[0])
+            a = int(cells[r, (k + 1) % 4])
+            nxt[a] = int(cells[r, (k + 3) % 4])
+            blk[a] = int(cell_block[r])
+        first = set(nxt) - set(nxt.values())
+        if len(first) != 1:
+            continue
+        chain = [first.pop()]
+        while chain[-1] in nxt and len(chain) <= len(nxt):
+            chain.append(nxt[chain[-1]])
+        if len(chain) != len(nxt) + 1 or not (boundary[chain[0]] and boundary[chain[-1]]):
+            continue
+        if boundary[chain[1:-1]].any():
+            continue
+        blocks = [blk[a] for a in chain[:-1]]
+        ends.append(int(c))
+        fan.extend(chain)
+        corner.extend([blocks.count(b) == 1 for b in blocks] + [False])
+        ptr.append(len(fan))
+    return (
+        np.array(ends, dtype=np.int64),
+        np.array(ptr, dtype=np.int64),
+        np.array(fan, dtype=np.int64),
+        np.array(corner, dtype=np.bool_),
+    )
+
+
 def _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, h: float, angle: float) -> int:
     """Put a shore node on every sharp bend of the shore and keep it there.
 
@@ -224,6 +286,7 @@ def iterate_orthogonalize(
     shore_gap: float = 0.25,
     size_ratio: tuple[float, float] | None = (1.2, 2.0),
     size_relax: float = 0.05,
+    hold_ends: bool = False,
     stall: float | None = None,
     stall_every: int = 20,
     callback=None,
@@ -231,6 +294,9 @@ def iterate_orthogonalize(
     """:func:`orthogonalize` as a generator: every ``every`` sweeps it yields
     ``(sweep, change, grids)`` (the change per sweep relative to the median edge, the current
     grids); ``"stop"`` sent to it ends the sweeps.  Returns the :class:`OrthoResult`.
+
+    ``hold_ends``: keep the lines leaving cut ends at reflex shore corners near their angles
+    (step 3 of the module docstring).
 
     ``stall``: also stop (``converged`` True) when, over ``stall_every`` sweeps, the share of
     regular nodes with ``|cos| ≤ 0.02`` (:func:`orthogonal_share`) rose by less than ``stall``
@@ -257,6 +323,7 @@ def iterate_orthogonalize(
     R, S, roff = _ring_tables(rings) if rings else (np.zeros((1, 2)), np.zeros(2), np.zeros(2, dtype=np.int64))
     fidx = np.flatnonzero(free).astype(np.int64)
     across = _across_cut_ends(bn, bprev, bnext, free, cnt)
+    fans = _cut_end_fans(cells, m.cell_block, m.boundary, bn, free, cnt) if hold_ends and rings else None
     bz = np.zeros(len(fidx))
     edge = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
     h = float(np.median(edge))
@@ -309,7 +376,8 @@ def iterate_orthogonalize(
             size_relax,
             across,
         )
-        d = max(d1, d2) / h
+        d3 = _kernels.hold_fans(X, Y, *fans, cptr, ncells, jmin, FAN_LEAST, FAN_SLACK, lo) if fans is not None else 0.0
+        d = max(d1, d2, d3) / h
         hist.append(d)
         if callback is not None and it % 50 == 0:
             callback(it, d)

@@ -227,3 +227,81 @@ def test_the_ring_search_from_a_hint_is_the_bisection():
             want = _kernels._segment(SS, pad, n, u)
             for hint in {0, n - 1, want, max(0, want - 5), min(n - 1, want + 40), int(rng.integers(0, n))}:
                 assert _kernels._segment_from(SS, pad, n, u, hint) == want, (trial, u, hint)
+
+
+def _fan(theta, blocks, r=1.0):
+    """A cut end at the origin with lines at angles ``theta`` (the first and last on the shore),
+    one cell between each two (of block ``blocks[q]``), closed by a node further out."""
+    m = len(theta) - 1
+    X = np.r_[0.0, r * np.cos(theta), 1.6 * np.cos(0.5 * (theta[:-1] + theta[1:]))]
+    Y = np.r_[0.0, r * np.sin(theta), 1.6 * np.sin(0.5 * (theta[:-1] + theta[1:]))]
+    cells = np.array([[0, 1 + q, 2 + m + q, 2 + q] for q in range(m)], dtype=np.int64)
+    boundary = np.zeros(len(X), dtype=bool)
+    boundary[[0, 1, 1 + m]] = True
+    cnt = np.bincount(cells.ravel(), minlength=len(X))
+    bn = np.flatnonzero(boundary)
+    return X, Y, cells, np.asarray(blocks), boundary, bn, cnt
+
+
+@pytest.mark.parametrize(
+    ("theta_deg", "blocks"),
+    [
+        ([0, 40, 200, 290], [0, 1, 1]),  # a corner block squeezed, the side block's line off
+        ([0, 175, 230, 300], [0, 1, 1]),  # a corner block opened into a fan (the shore-end fan)
+        ([0, 100, 150, 200, 330], [0, 1, 1, 2]),  # two corner blocks beside a side
+        ([0, 30, 100, 200], [0, 1, 1]),  # under the least water angle: left alone
+    ],
+)
+def test_the_fan_hold_is_the_numpy_oracle(theta_deg, blocks):
+    from meshcore.orthogonal._reference import fan_targets
+    from meshcore.orthogonal.driver import _cut_end_fans, _node_cells
+
+    X, Y, cells, blk, boundary, bn, cnt = _fan(np.radians(theta_deg), blocks, r=0.3)
+    free = np.zeros(len(bn), dtype=bool)
+    ends, fptr, fan, corner = _cut_end_fans(cells, blk, boundary, bn, free, cnt)
+    assert list(ends) == [0] and list(fan) == list(range(1, len(theta_deg) + 1))
+    cptr, ncells, _ = _node_cells(cells, len(X))
+    args = (np.radians(225.0), 0.3, 1.15)
+    nodes, tx, ty = fan_targets(X, Y, ends, fptr, fan, corner, *args)
+    x1, y1 = X.copy(), Y.copy()
+    _kernels.hold_fans(x1, y1, ends, fptr, fan, corner, cptr, ncells, np.full(len(X), -np.inf), *args)
+    moved = np.flatnonzero((x1 != X) | (y1 != Y))
+    assert sorted(moved) == sorted(nodes)
+    np.testing.assert_allclose(x1[nodes], tx, atol=1e-13)
+    np.testing.assert_allclose(y1[nodes], ty, atol=1e-13)
+    if theta_deg[-1] >= 225:
+        assert len(nodes)  # every case above the least angle is off its place or too short
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: testing.channel_network(24, n_branches=5),
+        lambda: testing.channel_network(26, n_branches=7),
+        lambda: testing.lake_with_islands(12),
+    ],
+)
+def test_no_block_corner_opens_into_a_fan_at_a_cut_end(make):
+    """Where a cut ends at a reflex shore corner, the solves can turn its first edge until the
+    corner block's angle there is 150-180 degrees (a polar fan: cells 10-60 times smaller than
+    across the cut; without ``hold_ends`` 180 and 140 degrees on the first and last lake here);
+    the fan hold keeps it near its share of the water angle."""
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.orthogonal.driver import _assemble, _cut_end_fans
+
+    poly = make()
+    mb = mesh_outline(poly, target_cells=4000, hold_ends=True)
+    m = mb.topology.node_map
+    X, Y = _assemble(mb.grids, m)
+    cells = m.cells.astype(np.int64)
+    cnt = np.bincount(cells.ravel(), minlength=m.n_nodes)
+    bn = np.flatnonzero(m.boundary)
+    ends, fptr, fan, corner = _cut_end_fans(cells, m.cell_block, m.boundary, bn, np.zeros(len(bn), bool), cnt)
+    worst = 0.0
+    for k, c in enumerate(ends):
+        f = fan[fptr[k] : fptr[k + 1]]
+        d = np.degrees(np.mod(np.diff(np.arctan2(Y[f] - Y[c], X[f] - X[c])), 2 * np.pi))
+        if d.sum() >= 225:
+            worst = max(worst, float(d[corner[fptr[k] : fptr[k + 1] - 1]].max(initial=0.0)))
+    assert 0 < worst < 140
+    assert lake_metrics(mb, polygon=poly).values("folded").sum() == 0
