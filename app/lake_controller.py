@@ -175,7 +175,7 @@ class LakeController(QtCore.QObject):
             self.editor.replace_project(after, f"Split into {n} blocks by cut lines")
         else:
             self.editor.set_lake(lake.replaced(layout=layout), "Auto layout")
-        for note in layout.notes:
+        for note in layout.notes:  # what meshcore mesh prints as notes (the Lake panel counts them)
             self.doc.report("info", f"layout: {note}")
         self.win.message(
             f"Layout: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells at {layout.cell_size:.4g} m — "

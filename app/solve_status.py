@@ -158,6 +158,10 @@ class SolveStatus(QtCore.QObject):
         mb = self.doc.multiblock
         if self.doc.project.layout is not None and mb is not None:
             self.doc.report("info", f"lake grid: {mb.info.message}")
+            m = self.doc.lake_metrics
+            cov = getattr(m, "coverage", None)
+            for w in cov.warnings() if cov is not None else ():  # islands under the grid: as meshcore mesh warns
+                self.doc.report("warning", f"lake grid: {w}")
             return
         for k, g in sorted(self.doc.grids.items()):
             note = (g.info.message or "").strip()

@@ -12,7 +12,8 @@ The pipeline (every step a module of its own):
 4. **quality** — :func:`meshcore.quality.lake_metrics` against the water polygon.
 
 The result is a :class:`~meshcore.multiblock.MultiBlockGrid` (``mode="orthogonal"``) whose
-``info`` says what was done and whose ``layout`` attribute is the layout.
+``info`` says what was done and whose ``notes`` are the layout's (what was changed in the water:
+islands left out, a shore smoothed, …; ``meshcore mesh`` prints them as notes).
 """
 
 from __future__ import annotations
@@ -203,7 +204,7 @@ def iterate_layout(
     info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology
-    return MultiBlockGrid(tuple(grids), names, tp.interfaces, "orthogonal", info, tp)
+    return MultiBlockGrid(tuple(grids), names, tp.interfaces, "orthogonal", info, tp, notes=tuple(layout.notes))
 
 
 def mesh_outline(
@@ -238,6 +239,9 @@ def mesh_outline(
     Returns
     -------
     MultiBlockGrid
+        Its ``notes`` say what the layout changed in the water (islands narrower than two cells
+        left out, arms too narrow for a block, a shore smoothed below the cell size, …), each in
+        a sentence naming the place; ``info.message`` says how many there are.
     """
     from .layout import auto_layout
 
@@ -247,6 +251,9 @@ def mesh_outline(
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics
 
+    if mb.notes:
+        n = len(mb.notes)
+        mb = _with_info(mb, message=f"{mb.info.message}; {n} layout note{'s' * (n != 1)} (grid.notes)")
     folded = sum(int(block_metrics(g).folded.sum()) for g in mb.grids)
     if folded:
         msg = f"{mb.info.message}; {folded} folded or non-convex cell(s) remain"

@@ -105,11 +105,15 @@ class LakePanel(QtWidgets.QWidget):
                 if lake is not None
                 else "Import a lake outline (Ctrl+I) or draw and close a loop."
             )
+            self.summary.setToolTip("")
             self.table.setRowCount(0)
             self._show_active()
             return
-        n = len(lay.blocks)
-        self.summary.setText(f"{n} block{'s' * (n != 1)}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m")
+        n, k = len(lay.blocks), len(lay.notes)
+        # what the layout changed in the water (an island left out, a shore smoothed): in full in Messages
+        notes = f" — {k} note{'s' * (k != 1)} on the water (Messages)" if k else ""
+        self.summary.setText(f"{n} block{'s' * (n != 1)}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m{notes}")
+        self.summary.setToolTip("\n\n".join(lay.notes))
         self.table.setRowCount(n)
         for k, b in enumerate(lay.blocks):
             self.table.setItem(k, 0, QtWidgets.QTableWidgetItem(b.name))

@@ -69,6 +69,10 @@ class MultiBlockGrid:
     info: SolveInfo = field(default_factory=SolveInfo)
     topology: MultiBlockTopology | None = field(default=None, repr=False)
     frame: Any = field(default=None, repr=False)  # meshcore.crs.Frame of the coordinates
+    #: What was changed in the water or the layout on the way (islands left out, a shore
+    #: smoothed, cell counts far from the asked size): a lake grid's layout notes
+    #: (:func:`meshcore.mesh_outline`; what ``meshcore mesh`` prints as notes)
+    notes: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.grids)

@@ -251,6 +251,19 @@ def test_export_como_to_delft3d_dd_and_vtm(qtbot, win, tmp_path):
     assert sum(g.cells[0] * g.cells[1] for g in back.blocks) == lay.n_cells
     assert win.io.export_mesh(tmp_path / "como.vtm")
     assert (tmp_path / "como.vtm").exists()
+    # the same file through `meshcore mesh` (a .ddb asks it for a regular layout): the same blocks,
+    # cells and nodes as the app's export (the same layout in the app and the CLI)
+    from meshcore.cli import main
+
+    cli = tmp_path / "cli" / "como.ddb"
+    cli.parent.mkdir()
+    assert main(["mesh", str(COMO), "-o", str(cli), "-q"]) == 0
+    want = read(cli)
+    assert [g.cells for g in back.blocks] == [g.cells for g in want.blocks]
+    for g, h in zip(back.blocks, want.blocks, strict=True):
+        np.testing.assert_array_equal(g.x, h.x)
+        np.testing.assert_array_equal(g.y, h.y)
+    assert sorted(p.name for p in out.parent.glob("como*.grd")) == sorted(p.name for p in cli.parent.glob("*.grd"))
 
 
 def test_a_ddb_that_delft3d_cannot_couple_says_what_to_do(qtbot, win, tmp_path):
@@ -430,3 +443,54 @@ def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtb
     # thousands of misses (a poor hand layout): smaller and fainter, not an orange lake
     win.lake_quality.misses.emit(np.random.default_rng(0).uniform(0, 1000, (5000, 2)))
     assert items.misses.opts["size"] < 5 and items.misses.opts["brush"].color().alpha() < 170
+
+
+def _thin_island_lake(path, h: float = 500.0):
+    """A round lake (lon/lat, 20 cells of ``h`` metres in radius) with an island 1.2 cells wide (the
+    layout leaves it out) and one 4 cells wide."""
+    import json
+
+    from shapely import affinity
+    from shapely.geometry import LineString, Point, Polygon, mapping
+
+    lake = Point(0, 0).buffer(20 * h, quad_segs=32)
+    needle = LineString([(-5 * h, 0), (5 * h, 0)]).buffer(0.6 * h, quad_segs=8)
+    blob = Point(8 * h, 8 * h).buffer(2.0 * h, quad_segs=8)
+    metres = Polygon(lake.exterior, [needle.exterior, blob.exterior])
+    lat = 46.0  # degrees of a metre there: the widths change by < 1 % in UTM
+    poly = affinity.affine_transform(metres, [1 / (111_320 * math.cos(math.radians(lat))), 0, 0, 1 / 111_320, 9.0, lat])
+    path.write_text(json.dumps({"type": "Feature", "properties": {}, "geometry": mapping(poly)}))
+    return path
+
+
+def test_layout_notes_reach_the_message_panel_and_the_status_line(qtbot, win, tmp_path):
+    """An island narrower than two cells is left out by the layout: its note, naming it, is in the
+    message panel (as ``meshcore mesh`` prints it), and the Lake panel's summary counts the notes."""
+    from meshcore.layout import auto_layout
+
+    src = _thin_island_lake(tmp_path / "thin.geojson")
+    lay = lay_out(qtbot, win, src, cell_size=500.0)
+    assert len(win.doc.project.lake.holes) == 2 and len(lay.polygon.interiors) == 1  # the needle left out
+    lake = win.doc.project.lake
+    assert lay.notes == auto_layout(lake.outline, holes=lake.holes, cell_size=500.0, multiple=4).notes
+    shown = [t for _lv, t in win.messages_panel.messages()]
+    for note in lay.notes:
+        assert f"layout: {note}" in shown
+    assert any("left out" in t and t.startswith("layout: island 1 near (") for t in shown), shown
+    k = len(lay.notes)
+    summary = win.lake_panel.summary
+    assert f"{k} note{'s' * (k != 1)} on the water" in summary.text()
+    assert all(note in summary.toolTip() for note in lay.notes)
+
+
+def test_islands_under_the_grid_are_warned_of(qtbot, win, tmp_path, monkeypatch):
+    """What ``meshcore mesh`` warns of after the grid (an island under it, cells across one) is a
+    warning in the message panel, not only a number in the quality table."""
+    from meshcore.quality import coverage
+
+    said = ["island 1 near (1, 2) is under the grid although the layout goes round it: the grid lost it"]
+    monkeypatch.setattr(coverage.Coverage, "warnings", lambda self: list(said))
+    lay_out(qtbot, win, _thin_island_lake(tmp_path / "thin.geojson"), cell_size=500.0)
+    assert win.doc.lake_metrics is not None
+    warned = [t for lv, t in win.messages_panel.messages() if lv == "warning"]
+    assert f"lake grid: {said[0]}" in warned
