@@ -241,6 +241,12 @@ def test_export_como_to_delft3d_dd_and_vtm(qtbot, win, tmp_path):
     lay = lay_out(qtbot, win, COMO)
     assert 8_000 < lay.n_cells < 12_000
     assert win.doc.lake_metrics.summary()["folded_cells"] == 0
+    # the lake-grid issue's targets, as the user reads them: the gcmesh-lake preset in the quality dock
+    box = win.lake_quality
+    box.preset.setCurrentText("gcmesh-lake")
+    rows = [box.table.item(k, 0).text() for k in range(box.table.rowCount())]
+    assert "gcmesh-lake: PASS" in box.headline.text() and len(rows) == 8, (box.headline.text(), rows)
+    assert all(t.startswith("pass") for t in rows), rows
     from app.io_controller import export_default
 
     assert export_default(win.doc.project) == "delft3d-dd"  # the export dialog offers it first
