@@ -23,7 +23,7 @@ from meshcore import MeshcoreError
 from . import io_adapter as fio
 from . import recovery
 from .examples import load_example
-from .lake import Lake, looks_branched, read_lake
+from .lake import Lake, looks_branched, read_lake, water
 from .project import Block, Project, block_from_points
 
 __all__ = ["MAX_RECENT", "IOController", "export_default"]
@@ -240,6 +240,10 @@ class IOController(QtCore.QObject):
         except (MeshcoreError, ValueError) as exc:
             log.info("%s: not read as a lake (%s)", pd.path, exc)
             return None
+        try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
+            notes = notes + water(outer, islands)[1]
+        except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring
+            log.info("%s: the water polygon: %s", pd.path, exc)
         for note in notes:  # what meshcore mesh prints as notes
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
         return Lake(outline=outer, holes=tuple(islands))

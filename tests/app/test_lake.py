@@ -500,3 +500,23 @@ def test_islands_under_the_grid_are_warned_of(qtbot, win, tmp_path, monkeypatch)
     assert win.doc.lake_metrics is not None
     warned = [t for lv, t in win.messages_panel.messages() if lv == "warning"]
     assert f"lake grid: {said[0]}" in warned
+
+
+def test_islands_that_touch_are_joined_with_a_note_on_import(qtbot, win, tmp_path):
+    """Two islands that touch are one island to the layout: the import says so, as ``meshcore mesh``
+    does on reading the file (the layout, made from the joined water, has no note of it)."""
+    import json
+
+    from shapely import affinity
+    from shapely.geometry import Point, Polygon, box, mapping
+
+    h = 500.0
+    lake = Point(0, 0).buffer(20 * h, quad_segs=32)
+    a, b = box(-4 * h, -2 * h, 0, 2 * h), box(0, -1 * h, 3 * h, 1 * h)  # sharing a side
+    metres = Polygon(lake.exterior, [a.exterior, b.exterior])
+    poly = affinity.affine_transform(metres, [1 / (111_320 * math.cos(math.radians(46))), 0, 0, 1 / 111_320, 9.0, 46.0])
+    src = tmp_path / "two_islands.geojson"
+    src.write_text(json.dumps({"type": "Feature", "properties": {}, "geometry": mapping(poly)}))
+    assert win.io.import_points(src, project_lonlat=True)
+    said = [t for lv, t in win.messages_panel.messages() if lv == "warning"]
+    assert f"{src.name}: islands 1 and 2 touch: joined into one" in said, said
