@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from ..cellratio import cell_ratio
 from ..errors import InvalidInputError
 
 __all__ = ["guess_cells", "guess_corners", "outline_loop"]
@@ -55,11 +56,18 @@ def guess_cells(
     total: int | None = None,
     minimum: int = 8,
 ) -> tuple[int, int]:
-    """Cell counts proportional to the mean lengths of opposite borders, cells roughly square.
+    """Cell counts whose cells are near square: ``ni : nj`` is the ratio at which the Winslow grid's
+    median cell is square (:func:`meshcore.cellratio.cell_ratio`).
+
+    The ratio of the mean lengths of opposite borders, the guess before, counts every arm that a
+    border traces in and out (a branched lake's bottom and top borders): cells came out three to
+    four times longer across than along, too few rows to follow the arms.  On a rectangle both
+    are its side ratio.  Where the ratio is not defined (a loop that crosses itself), the border
+    lengths.
 
     By default the cells are :func:`meshcore.cellsize.default_cell_size` of the area inside the
-    loop (``sqrt(area / 10 000)``, what ``meshcore mesh`` chooses), or ``cell_size``: each count
-    is a border's mean length over the cell size.  With ``total``: about ``total`` cells along the
+    loop (``sqrt(area / 10 000)``, what ``meshcore mesh`` chooses), or ``cell_size``: ``ni · nj``
+    is the area over the cell size squared.  With ``total``: about ``total`` cells along the
     longer direction instead.  At least ``minimum`` along either; a grid past the node limit
     (:func:`meshcore._validation.max_nodes`) is scaled down to it, keeping the proportions.
     """
@@ -83,22 +91,27 @@ def guess_cells(
         sw, se, ne, nw = (int(c) % n for c in corners)
     except (TypeError, ValueError):
         raise InvalidInputError(f"corners must be 4 integer point indices, got {corners!r}") from None
-    lxi = 0.5 * (length(sw, se) + length(ne, nw))
-    leta = 0.5 * (length(se, ne) + length(nw, sw))
+    ratio = cell_ratio(p, (sw, se, ne, nw))
+    if not (ratio > 0 and math.isfinite(ratio)):
+        lxi = 0.5 * (length(sw, se) + length(ne, nw))
+        leta = 0.5 * (length(se, ne) + length(nw, sw))
+        ratio = lxi / leta if lxi > 0 and leta > 0 else math.nan
     if total is not None:
-        if lxi <= 0 or leta <= 0 or not math.isfinite(lxi / leta):
+        if not (ratio > 0 and math.isfinite(ratio)):
             return (total, total)
-        if lxi >= leta:
-            return (total, max(minimum, round(total * leta / lxi)))
-        return (max(minimum, round(total * lxi / leta)), total)
+        if ratio >= 1:
+            return (total, max(minimum, round(total / ratio)))
+        return (max(minimum, round(total * ratio)), total)
     from ..boundary import signed_area
     from ..cellsize import DEFAULT_CELLS, default_cell_size
 
-    h = float(cell_size) if cell_size is not None else default_cell_size(abs(signed_area(p)))
-    if not (h > 0 and math.isfinite(lxi / h) and math.isfinite(leta / h)):
+    area = abs(signed_area(p))
+    h = float(cell_size) if cell_size is not None else default_cell_size(area)
+    cells = area / h**2 if h > 0 else math.nan
+    if not (cells > 0 and math.isfinite(cells) and ratio > 0 and math.isfinite(ratio)):
         side = max(minimum, round(math.sqrt(DEFAULT_CELLS)))
         return (side, side)
-    ni, nj = max(minimum, round(lxi / h)), max(minimum, round(leta / h))
+    ni, nj = max(minimum, round(math.sqrt(cells * ratio))), max(minimum, round(math.sqrt(cells / ratio)))
     shrink = math.sqrt(max_nodes() / ((ni + 1) * (nj + 1)))
     if shrink < 1.0:
         ni, nj = max(minimum, math.floor(ni * shrink) - 1), max(minimum, math.floor(nj * shrink) - 1)

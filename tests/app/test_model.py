@@ -326,6 +326,7 @@ def test_import_defaults_to_the_cell_size_of_meshcore_mesh_and_agrees_with_meshc
     from app.io_adapter import read_points
     from app.project import block_from_points
     from meshcore.case import load_case
+    from meshcore.cellratio import cell_ratio
     from meshcore.cli import main
     from meshcore.cli.mesh import DEFAULT_CELLS
 
@@ -338,12 +339,11 @@ def test_import_defaults_to_the_cell_size_of_meshcore_mesh_and_agrees_with_meshc
     assert main(["import", str(f), "-o", str(tmp_path / "lake.toml")]) == 0
     (cb,) = load_case(tmp_path / "lake.toml").blocks
     assert (cb.corners, cb.cells) == (block.corners, block.cells)
-    h = math.sqrt(poly.area / DEFAULT_CELLS)
-    borders = geo.border_polylines(pts, block.corners)
-    lxi = 0.5 * (geo.polyline_length(borders["bottom"]) + geo.polyline_length(borders["top"]))
-    leta = 0.5 * (geo.polyline_length(borders["left"]) + geo.polyline_length(borders["right"]))
+    # cells of the rule's size (area / h² = DEFAULT_CELLS of them), ni : nj at which the Winslow
+    # grid's median cell is square (meshcore.cellratio)
+    r = cell_ratio(pts, block.corners)
     ni, nj = block.cells
-    assert abs(ni - lxi / h) <= 0.5 + 1e-9 and abs(nj - leta / h) <= 0.5 + 1e-9  # cells of the rule's size
+    assert abs(ni - math.sqrt(DEFAULT_CELLS * r)) <= 0.5 + 1e-9 and abs(nj - math.sqrt(DEFAULT_CELLS / r)) <= 0.5 + 1e-9
     assert 0.5 * DEFAULT_CELLS <= ni * nj <= 2 * DEFAULT_CELLS
 
 
