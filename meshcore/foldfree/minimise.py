@@ -111,6 +111,7 @@ def patches(
     max_sweeps: int,
     inner: int | None = None,
     periodic: bool = False,
+    max_radius: int | None = None,
 ) -> tuple[bool, int, int]:
     """Barrier minimisation on patches around ``bad``, each connected patch on its own.
 
@@ -119,7 +120,7 @@ def patches(
     A piece that ends valid keeps its nodes; a failed piece gets its nodes
     back and its bad cells try again with ``2 r``, until the piece covers
     more than ``max_fraction`` of the cells (the whole block is always
-    allowed when ``max_fraction ≥ 1``).  So a fold that cannot be repaired
+    allowed when ``max_fraction ≥ 1``) or ``r`` would pass ``max_radius``.  So a fold that cannot be repaired
     locally no longer makes every other one grow with it, and the cost
     follows the size of the pieces, not of the block.  Returns
     ``(ok, free nodes, sweeps)``; on failure the repaired pieces stay.
@@ -130,7 +131,7 @@ def patches(
     nfree = 0
     todo = bad.copy()
     given_up = np.zeros_like(bad)
-    while todo.any():
+    while todo.any() and (max_radius is None or r <= max_radius):
         whole = r >= max(ni, nj)
         mask = np.ones_like(bad) if whole else _dilate(todo, r, periodic)
         failed = np.zeros_like(bad)

@@ -89,3 +89,30 @@ def test_the_failure_names_each_place():
     assert "lie in 2 places" in r.message
     assert "2 cell(s) at i 11–12, j 19 by the top border, around (3.125, 3.375)" in r.message
     assert "2 cell(s) at i 44–45, j 19 by the top border, around (11.375, 3.375)" in r.message
+
+
+def test_pieces_grow_no_wider_than_max_radius(monkeypatch):
+    # a top-border node pulled below the bottom border: no patch repairs it; with max_radius the
+    # pieces tried stay within that many cells of it (the coarse start's case), without it they
+    # grew until they covered 30 % of the block
+    import meshcore.foldfree.minimise as mm
+
+    x, y = _rectangle(120, 20)
+    y[60, -1] = -1.0
+    bad = invalid_cells(x, y)
+    tried = []
+    real = mm.minimise
+
+    def spy(x, y, nodes, *args, **kw):
+        tried.append(nodes[:, 0].copy())
+        return real(x, y, nodes, *args, **kw)
+
+    monkeypatch.setattr(mm, "minimise", spy)
+    opts = {"tolerance": 1e-4, "max_sweeps": 50}
+    ex = np.zeros(bad.shape, dtype=np.uint8)
+    ok, _, _ = mm.patches(x.copy(), y.copy(), bad, ex, radius=2, max_fraction=0.3, max_radius=8, **opts)
+    assert not ok and tried
+    assert all(abs(i - 60).max() <= 8 + 1 for i in tried)
+    tried.clear()
+    ok, _, _ = mm.patches(x.copy(), y.copy(), bad, ex, radius=2, max_fraction=0.3, **opts)
+    assert not ok and max(abs(i - 60).max() for i in tried) > 8 + 1
