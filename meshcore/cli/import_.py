@@ -4,8 +4,9 @@ Reads POINTS (CSV/TXT, KML/KMZ, GeoJSON, shapefile, DXF), projects lon/lat to
 the UTM zone of the centroid (``--crs auto``, the default) or to a given EPSG
 code, moves the points to a local origin, picks the outline (the longest ring,
 or ``--polyline NAME``), four corners (``--corners`` or a guess along the
-principal axes) and cell counts (``--cells``, or square cells of ``meshcore mesh``'s default
-cell size ``sqrt(area / 10 000)``: about 10 000 cells), and
+principal axes) and cell counts (``--cells``, or about 10 000 cells of ``meshcore mesh``'s default
+cell size ``sqrt(area / 10 000)``, ``ni : nj`` the ratio at which the Winslow grid's median cell
+is square: :func:`meshcore.cellratio.cell_ratio`), and
 writes a case file whose top-level ``crs`` table records the CRS and origin.
 
 Input is refused where it is typed: corner indices out of range, repeated or
@@ -42,7 +43,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         nargs=2,
         type=int,
         metavar=("NI", "NJ"),
-        help="cell counts (default: square cells of meshcore mesh's default size, sqrt(area / 10 000))",
+        help="cell counts (default: about 10 000 near-square cells of size sqrt(area / 10 000), as meshcore mesh)",
     )
     p.add_argument("--name", help="block name (default: the polyline's name)")
     p.add_argument(
