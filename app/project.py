@@ -272,7 +272,7 @@ def next_block_name(project: Project) -> str:
 def default_cells(
     points: np.ndarray, corners: tuple[int, int, int, int], total: int = 40, minimum: int = 2
 ) -> tuple[int, int]:
-    """Cell counts proportional to the mean lengths of opposite borders (:func:`meshcore.io.outline.guess_cells`).
+    """Cell counts whose Winslow grid has square cells on median (:func:`meshcore.io.outline.guess_cells`).
 
     About ``total`` cells along the longer direction, at least ``minimum`` along either.
     """
