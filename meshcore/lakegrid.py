@@ -131,7 +131,8 @@ def iterate_layout(
     from .elliptic import SolverProgress
     from .multiblock import MultiBlockGrid, initial_grids
     from .orthogonal import iterate_orthogonalize
-    from .orthogonal.levels import coarsen_topology, refine, refine_shore
+    from .orthogonal.driver import SHORE_GAP
+    from .orthogonal.levels import coarsen_topology, fit_bends, fit_ends, refine, refine_shore
     from .orthogonal.untangle import untangle
 
     t0 = time.perf_counter()
@@ -147,11 +148,20 @@ def iterate_layout(
     grids, untangled = untangle(tops[0], grids, layout=g0)
     rings = _shore_rings(layout.polygon, layout.cell_size / 4)
     total = 0
+    fitted = 0
     history: list[tuple[int, float]] = []
     stopped = False
     for lev, tp in enumerate(tops):
         if lev:
             grids = refine_shore(refine(grids), tp, rings)
+        # shore edges that cut across a bend (coarse edges, midpoints of the refinement, a cut end
+        # short of a tip): their node put on the bend, for the shore sweep to keep there
+        gap = SHORE_GAP * layout.cell_size * 2 ** (len(tops) - 1 - lev)
+        grids, n = fit_ends(grids, tp, rings, gap)
+        fitted += n
+        grids, n = fit_bends(grids, tp, rings, gap)
+        fitted += n
+        if lev:
             grids, n = untangle(tp, grids)
             untangled += n
         gen = iterate_orthogonalize(

@@ -237,6 +237,12 @@ def _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, h: float, angl
     return pinned
 
 
+#: How far (times the median edge) the shore between two consecutive shore nodes may stray from
+#: the edge between them before the shore sweep stops a node sliding that way (a quarter cell:
+#: then the grid follows the shore within half a cell, the issue-12 target, with room to spare).
+SHORE_GAP = 0.25
+
+
 def _ring_tables(rings):
     """Points of all rings in one array (ring k: ``R[roff[k]:roff[k+1]]``) and their cumulative
     arc lengths (ring k: ``S[roff[k]+k : roff[k+1]+k+1]``, from 0 to the perimeter)."""
@@ -283,7 +289,7 @@ def iterate_orthogonalize(
     pin_angle: float | None = None,
     shore_smooth: float = 0.15,
     guard: bool = True,
-    shore_gap: float = 0.25,
+    shore_gap: float = SHORE_GAP,
     size_ratio: tuple[float, float] | None = (1.2, 2.0),
     size_relax: float = 0.05,
     hold_ends: bool = False,

@@ -15,7 +15,7 @@ import numpy as np
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
 from .shore import arc_lengths, project_to_rings, ring_point
 
-__all__ = ["coarsen_topology", "refine"]
+__all__ = ["coarsen_topology", "fit_bends", "fit_ends", "refine", "refine_shore"]
 
 
 def _refine_grid(x: np.ndarray) -> np.ndarray:
@@ -181,3 +181,212 @@ def _move_if_valid(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> None:
         if _convex_around(x, y, ij):
             return
     x[ij], y[ij] = ox, oy
+
+
+def _arc(cum: np.ndarray, s1: float, d: float) -> np.ndarray:
+    """Indices of the ring's vertices strictly inside the arc from ``s1`` over ``d`` (either
+    sign) of a ring with :func:`~.shore.arc_lengths` ``cum``, in order along it."""
+    total, v = cum[-1], cum[:-1]
+    a = (s1 if d >= 0 else s1 + d) % total
+    b = a + abs(d)
+    i0 = int(np.searchsorted(v, a, side="right"))
+    if b <= total:
+        idx = np.arange(i0, int(np.searchsorted(v, b, side="left")))
+    else:
+        idx = np.concatenate([np.arange(i0, len(v)), np.arange(int(np.searchsorted(v, b - total, side="left")))])
+    return idx if d >= 0 else idx[::-1]
+
+
+def _chord_gaps(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each row of ``pts`` from the segment ``a``–``b``."""
+    ab = b - a
+    L2 = float(ab @ ab)
+    t = np.clip((pts - a) @ ab / L2, 0.0, 1.0) if L2 > 0 else np.zeros(len(pts))
+    return np.hypot(*(pts - a - t[:, None] * ab).T)
+
+
+def _best_on_arc(ring: np.ndarray, cum: np.ndarray, sp: float, d: float, p: np.ndarray, q: np.ndarray):
+    """``(now, best, s, point)`` for a shore node between shore neighbours ``p`` (at arc length
+    ``sp``) and ``q`` (``d`` further along): the largest distance of the shore between them from
+    the node's two edges with the node where it is (``now``: nan, the caller's), and the least
+    such distance over the ring's vertices on that arc as places for the node (``best``), with
+    that vertex's arc length and point."""
+    idx = _arc(cum, sp, d)
+    if len(idx) < 1:
+        return np.inf, None, None
+    pts = ring[idx]
+    n = len(idx)
+    g1 = np.zeros(n)
+    g2 = np.zeros(n)
+    for j in range(n):  # the node at vertex j: the vertices before it against edge p-j, after against j-q
+        g1[j] = _chord_gaps(pts[:j], p, pts[j]).max() if j else 0.0
+        g2[j] = _chord_gaps(pts[j + 1 :], pts[j], q).max() if j < n - 1 else 0.0
+    worst = np.maximum(g1, g2)
+    j = int(np.argmin(worst))
+    return float(worst[j]), float(cum[idx[j]]), pts[j]
+
+
+def _better(ring: np.ndarray, cum: np.ndarray, s3: np.ndarray, trio: np.ndarray, limit: float):
+    """``(point, s)``: where on the shore to put the middle one of three consecutive shore nodes
+    (``trio``, at arc lengths ``s3`` of ``ring``) whose two edges leave the shore between the
+    outer two more than ``limit`` away, if a vertex of the ring there is better: its edges within
+    ``limit`` of the shore, or at least half as far as now; else ``(None, None)``."""
+    total = cum[-1]
+    d = (s3[2] - s3[0]) % total
+    if d > total / 2:  # the short way round
+        d -= total
+    inside = _arc(cum, s3[0], d)
+    t = (cum[inside] - s3[0]) % total if d >= 0 else (s3[0] - cum[inside]) % total
+    t1 = (s3[1] - s3[0]) % total if d >= 0 else (s3[0] - s3[1]) % total
+    if not 0.0 < t1 < abs(d):  # the short way between the outer two does not pass the middle one
+        return None, None
+    side1, side2 = ring[inside[t < t1]], ring[inside[t > t1]]
+    now = max(
+        _chord_gaps(side1, trio[0], trio[1]).max() if len(side1) else 0.0,
+        _chord_gaps(side2, trio[1], trio[2]).max() if len(side2) else 0.0,
+    )
+    if now <= limit:
+        return None, None
+    best, sb, at = _best_on_arc(ring, cum, s3[0], d, trio[0], trio[2])
+    if at is None or not (best < limit or best <= 0.5 * now):
+        return None, None
+    return at, sb
+
+
+def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit: float) -> tuple[list, int]:
+    """``(grids, moved)``: every free shore node (on a block's side, in one block only) whose two
+    shore edges leave the shore between its neighbours more than ``limit`` away — the grid cuts off
+    a headland, an island's tip or the bend next to a cut end — moved to the ring vertex between its
+    neighbours where the larger of the two distances is least, if that is below ``limit`` or at most
+    half the distance now, and the cells around it stay convex (alone, or with the nodes inwards of it
+    carried along as :func:`refine_shore` does).
+
+    The orthogonal smoother's shore sweep lets a node slide only where its edges stay within its
+    ``shore_gap`` of the shore, or come no further from it: it keeps a shore it follows, but does not
+    reach for a bend its edges already cut across (the start grid's coarse edges, the midpoints the
+    refinement put on the arc between two nodes, a cut end the layout put short of a tip)."""
+    if not rings:
+        return list(grids), 0
+    m = topology.node_map
+    cums = [arc_lengths(r) for r in rings]
+    xs = [np.array(g.x) for g in grids]
+    ys = [np.array(g.y) for g in grids]
+    moved = 0
+    sides = []  # (block, its side's nodes, which of them are on the shore, where they start in pts)
+    pts = []
+    for b, ids in enumerate(m.ids):
+        n1, m1 = ids.shape
+        for fixed_i, fixed_j in ((None, 0), (None, m1 - 1), (0, None), (n1 - 1, None)):
+            count = n1 if fixed_i is None else m1
+            line = [(t, fixed_j) if fixed_i is None else (fixed_i, t) for t in range(count)]
+            on = [bool(m.boundary[ids[ij]]) for ij in line]
+            if sum(on) >= 3:
+                sides.append((b, fixed_i, fixed_j, line, on, len(pts)))
+                pts.extend((xs[b][ij], ys[b][ij]) for ij in line)
+    if not sides:
+        return list(grids), 0
+    ring_all, s_all, _ = project_to_rings(rings, np.asarray(pts))  # one tree for every side
+    per = np.array([c[-1] for c in cums])
+    pts_a = np.asarray(pts)
+    for b, fixed_i, fixed_j, line, on, at0 in sides:
+        ids = m.ids[b]
+        r_of, s_of = ring_all[at0 : at0 + len(line)], s_all[at0 : at0 + len(line)]
+        # a shore arc of length L between two points c apart strays at most sqrt(L² - c²) / 2
+        # from their chord: only edges that could stray more than ``limit`` are looked at
+        total = per[r_of[:-1]]
+        arc = np.abs((s_of[1:] - s_of[:-1] + 0.5 * total) % total - 0.5 * total)
+        chord = np.hypot(*np.diff(pts_a[at0 : at0 + len(line)], axis=0).T)
+        far = 0.5 * np.sqrt(np.maximum(arc**2 - chord**2, 0.0)) > limit
+        for k in range(1, len(line) - 1):
+            if not (far[k - 1] or far[k]):
+                continue
+            ij = line[k]
+            r = int(r_of[k])
+            if not (on[k - 1] and on[k] and on[k + 1]) or m.shared[ids[ij]] or r_of[k - 1] != r or r_of[k + 1] != r:
+                continue
+            trio = np.array([[xs[b][line[t]], ys[b][line[t]]] for t in (k - 1, k, k + 1)])
+            at, sb = _better(rings[r], cums[r], s_of[k - 1 : k + 2], trio, limit)
+            if at is None:
+                continue
+            col = _column(ids.shape, ij, fixed_i, fixed_j)
+            if _moved_to(xs[b], ys[b], ij, at) or _carried_to(xs[b], ys[b], ij, col, at):
+                s_of[k] = sb
+                moved += 1
+    return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)], moved
+
+
+def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit: float) -> tuple[list, int]:
+    """``(grids, moved)``: :func:`fit_bends` for the shore nodes the smoother holds fixed — block
+    corners and cut lines' ends on the shore (one, three or more cells) — moved, with every block
+    around them, to the ring vertex between their two shore neighbours where their two edges leave
+    the shore least, where that helps as :func:`fit_bends` requires and every cell around stays
+    convex.  A cut the layout ended a few tenths of a cell short of an island's or a headland's
+    tip leaves it outside the grid, and no free node can reach it: the block whose side passes the
+    end would need a reflex cell to go round it."""
+    from .driver import _assemble
+    from .untangle import _Mesh, _score
+
+    if not rings:
+        return list(grids), 0
+    m = topology.node_map
+    X, Y = _assemble(grids, m)
+    cells = m.cells.astype(np.int64)
+    cnt = np.bincount(cells.reshape(-1), minlength=m.n_nodes)
+    u, v = cells.reshape(-1), np.roll(cells, -1, axis=1).reshape(-1)
+    key, ce = np.unique(np.minimum(u, v) * np.int64(m.n_nodes) + np.maximum(u, v), return_counts=True)
+    shore_nbrs: dict[int, list[int]] = {}
+    for a, b in zip(*np.divmod(key[ce == 1], np.int64(m.n_nodes)), strict=True):
+        shore_nbrs.setdefault(int(a), []).append(int(b))
+        shore_nbrs.setdefault(int(b), []).append(int(a))
+    ends = [n for n, nb in shore_nbrs.items() if len(nb) == 2 and cnt[n] != 2]
+    if not ends:
+        return list(grids), 0
+    cums = [arc_lengths(r) for r in rings]
+    trios = np.array([[shore_nbrs[n][0], n, shore_nbrs[n][1]] for n in ends])
+    r_all, s_all, _ = project_to_rings(rings, np.column_stack([X[trios.ravel()], Y[trios.ravel()]]))
+    todo = []
+    for k, n in enumerate(ends):
+        r = int(r_all[3 * k + 1])
+        if r_all[3 * k] != r or r_all[3 * k + 2] != r:
+            continue
+        trio = np.column_stack([X[trios[k]], Y[trios[k]]])
+        at, _ = _better(rings[r], cums[r], s_all[3 * k : 3 * k + 3], trio, limit)
+        if at is not None:
+            todo.append((n, trio[1], at))
+    if not todo:
+        return list(grids), 0
+    mesh = _Mesh(topology, grids)  # the incidence tables, only where an end moves
+    X, Y = mesh.X, mesh.Y
+    moved = 0
+    for n, here, at in todo:
+        # alone, else with the first nodes of the cut line leaving it carried along
+        line = _cut_line(mesh, n)
+        for k in (0, len(line)):
+            nodes = [n, *line[:k]]
+            old = [(X[v], Y[v]) for v in nodes]
+            around = np.unique(np.concatenate([mesh.around(v) for v in nodes]))
+            before = _score(X, Y, cells, around)
+            for t, v in enumerate(nodes):
+                w = 1.0 - t / len(nodes)
+                X[v], Y[v] = old[t][0] + w * (at[0] - here[0]), old[t][1] + w * (at[1] - here[1])
+            if _score(X, Y, cells, around)[0] >= before[0]:  # no cell around made non-convex
+                moved += 1
+                break
+            for v, (px, py) in zip(nodes, old, strict=True):
+                X[v], Y[v] = px, py
+    return mesh.grids(grids), moved
+
+
+def _cut_line(mesh, n: int) -> list[int]:
+    """Up to :data:`CARRY` nodes along the one cut line (shared nodes off the shore) leaving the
+    shore node ``n``, nearest first; none where no single line leaves it."""
+    m = mesh.m
+    out: list[int] = []
+    prev, at = -1, n
+    for _ in range(CARRY):
+        nxt = [v for v in mesh.nbrs(at) if v != prev and m.shared[v] and not m.boundary[v]]
+        if len(nxt) != 1:
+            break
+        prev, at = at, nxt[0]
+        out.append(at)
+    return out

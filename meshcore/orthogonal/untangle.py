@@ -82,12 +82,18 @@ class _Mesh:
         self.cnt = np.bincount(flat, minlength=m.n_nodes)
         self.ptr = np.concatenate([[0], np.cumsum(self.cnt)])
         self.rows = order // 4  # node n's cells: rows[ptr[n]:ptr[n + 1]] of `cells`
-        e = np.column_stack([flat, np.roll(self.cells, -1, axis=1).reshape(-1)])
-        e = np.unique(np.sort(e, axis=1), axis=0)
-        self.nbrs: dict[int, list[int]] = {}
-        for a, b in e:
-            self.nbrs.setdefault(int(a), []).append(int(b))
-            self.nbrs.setdefault(int(b), []).append(int(a))
+        # edge neighbours of every node, ascending (CSR: nbr[nptr[n]:nptr[n + 1]])
+        n_all = np.int64(m.n_nodes)
+        u, v = flat, np.roll(self.cells, -1, axis=1).reshape(-1)
+        a, b = np.divmod(np.unique(np.minimum(u, v) * n_all + np.maximum(u, v)), n_all)
+        src, dst = np.concatenate([a, b]), np.concatenate([b, a])
+        order = np.lexsort((dst, src))
+        self.nbr = dst[order]
+        self.nptr = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=m.n_nodes))])
+
+    def nbrs(self, n: int) -> list[int]:
+        """The nodes one edge from node ``n``, ascending."""
+        return [int(v) for v in self.nbr[self.nptr[n] : self.nptr[n + 1]]]
 
     def around(self, n: int) -> np.ndarray:
         return self.rows[self.ptr[n] : self.ptr[n + 1]]
@@ -112,7 +118,7 @@ def _restore_cut_ends(mesh: _Mesh, grids, layout, bad) -> tuple[list, int]:
         for d in range(1, HOPS + 1):
             nxt = []
             for u in front:
-                for v in mesh.nbrs.get(u, []):
+                for v in mesh.nbrs(u):
                     if v not in dist and m.shared[v] and not m.boundary[v]:
                         dist[v] = d
                         nxt.append(v)
@@ -149,7 +155,7 @@ def _move_nodes(mesh: _Mesh) -> int:
         for n in sorted(nodes):
             around = mesh.around(n)
             now = _score(X, Y, cells, around)
-            nb = mesh.nbrs.get(n, [])
+            nb = mesh.nbrs(n)
             if (now[0] == 0 and now[1] > MARGIN) or not nb:
                 continue
             p = np.array([X[n], Y[n]])
@@ -181,10 +187,13 @@ def untangle(topology, grids, layout=None) -> tuple[list, int]:
     their non-convex cells moved until those cells are convex, where the steps of the module
     docstring can; ``layout``: the blocks' algebraic grids (their borders are the layout's lines).
     ``moved`` counts the node moves made.  Shore nodes never move."""
+    from .driver import _assemble
+
+    X, Y = _assemble(grids, topology.node_map)
+    if not len(bad_cells(X, Y, topology.node_map.cells)):  # the usual case: no tables needed
+        return list(grids), 0
     mesh = _Mesh(topology, grids)
     bad = bad_cells(mesh.X, mesh.Y, mesh.cells)
-    if not len(bad):
-        return list(grids), 0
     moved = 0
     if layout is not None:
         grids, moved = _restore_cut_ends(mesh, grids, layout, bad)
