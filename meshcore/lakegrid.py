@@ -207,6 +207,8 @@ def iterate_layout(
         msg = f"orthogonal grid on {len(tops)} level(s) (cells ÷ {factor} … 1), {total} sweeps; start: {how}"
         if repaired:
             msg += f"; {repaired} coarse block(s) repaired by the fold-free method"
+        if fitted:
+            msg += f"; {fitted} shore node(s) put on bends of the shore their edges cut across"
         if untangled:
             msg += f"; {untangled} node(s) moved across cut lines to make their cells convex"
         if fine_repaired:

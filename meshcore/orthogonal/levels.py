@@ -273,7 +273,7 @@ def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limi
     ys = [np.array(g.y) for g in grids]
     moved = 0
     sides = []  # (block, its side's nodes, which of them are on the shore, where they start in pts)
-    pts = []
+    pts: list[tuple[float, float]] = []
     for b, ids in enumerate(m.ids):
         n1, m1 = ids.shape
         for fixed_i, fixed_j in ((None, 0), (None, m1 - 1), (0, None), (n1 - 1, None)):
@@ -282,7 +282,7 @@ def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limi
             on = [bool(m.boundary[ids[ij]]) for ij in line]
             if sum(on) >= 3:
                 sides.append((b, fixed_i, fixed_j, line, on, len(pts)))
-                pts.extend((xs[b][ij], ys[b][ij]) for ij in line)
+                pts.extend((float(xs[b][ij]), float(ys[b][ij])) for ij in line)
     if not sides:
         return list(grids), 0
     ring_all, s_all, _ = project_to_rings(rings, np.asarray(pts))  # one tree for every side
@@ -332,8 +332,8 @@ def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit
     X, Y = _assemble(grids, m)
     cells = m.cells.astype(np.int64)
     cnt = np.bincount(cells.reshape(-1), minlength=m.n_nodes)
-    u, v = cells.reshape(-1), np.roll(cells, -1, axis=1).reshape(-1)
-    key, ce = np.unique(np.minimum(u, v) * np.int64(m.n_nodes) + np.maximum(u, v), return_counts=True)
+    e0, e1 = cells.reshape(-1), np.roll(cells, -1, axis=1).reshape(-1)
+    key, ce = np.unique(np.minimum(e0, e1) * np.int64(m.n_nodes) + np.maximum(e0, e1), return_counts=True)
     shore_nbrs: dict[int, list[int]] = {}
     for a, b in zip(*np.divmod(key[ce == 1], np.int64(m.n_nodes)), strict=True):
         shore_nbrs.setdefault(int(a), []).append(int(b))
