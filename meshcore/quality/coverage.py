@@ -19,6 +19,11 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   **lost** (:attr:`Coverage.islands_lost`): the grid should go round it; its rim
   stays in the Hausdorff distance.  The area of either is counted: the grid
   area includes the water over it, so the area ratio rises by its share;
+* ``hausdorff_as_given`` — the same with the shore's spikes of water or land
+  narrower than half a cell included.  The layout smooths those out on purpose
+  (:func:`meshcore.layout.polygon.without_slivers`, with a note: no grid line can
+  follow them without folding a cell), so ``hausdorff`` leaves the shore points
+  on them out; the table shows both where they differ;
 * ``island_cells`` — cells whose centre lies on land: inside an island the
   grid goes round (a narrow end of it that a block side cut across, say), or
   beyond the outer shore (across a narrow peninsula) — per island (its number;
@@ -109,6 +114,9 @@ class Coverage:
     side: str  # "grid" (a grid boundary point far from the shore) or "shore"
     islands_covered: tuple[CoveredIsland, ...] = ()
     island_cells: tuple[tuple[int, int, float, float, float], ...] = ()  # (island, cells, depth, x, y)
+    #: the Hausdorff distance to the shore as given, its spikes narrower than half a cell included
+    #: (``hausdorff`` leaves them out: the layout smooths them out on purpose, with a note)
+    hausdorff_as_given: float = math.nan
 
     @property
     def hausdorff_cells(self) -> float:
@@ -148,6 +156,7 @@ class Coverage:
             "area_ratio": self.area_ratio,
             "hausdorff": self.hausdorff,
             "hausdorff_cells": self.hausdorff_cells,
+            "hausdorff_as_given_cells": self.hausdorff_as_given / self.cell_size if self.cell_size > 0 else math.inf,
             "cell_size": self.cell_size,
             "islands_covered": len(self.islands_covered),
             "islands_lost": len(self.islands_lost),
@@ -158,14 +167,29 @@ class Coverage:
     def rows(self) -> list[tuple[str, str, str]]:
         x, y = self.where
         what = "grid boundary point" if self.side == "grid" else "shore point"
+        return (
+            [
+                ("grid area / polygon area", f"{self.area_ratio:.5f}", ""),
+                (
+                    "shoreline distance (Hausdorff)",
+                    f"{self.hausdorff_cells:.3g} cells ({self.hausdorff:.4g}; cell size {self.cell_size:.4g})",
+                    f"{what} ({x:.6g}, {y:.6g})",
+                ),
+            ]
+            + self._spike_rows()
+            + self._island_rows()
+        )
+
+    def _spike_rows(self) -> list[tuple[str, str, str]]:
+        if not self.hausdorff_as_given > self.hausdorff:
+            return []
         return [
-            ("grid area / polygon area", f"{self.area_ratio:.5f}", ""),
             (
-                "shoreline distance (Hausdorff)",
-                f"{self.hausdorff_cells:.3g} cells ({self.hausdorff:.4g}; cell size {self.cell_size:.4g})",
-                f"{what} ({x:.6g}, {y:.6g})",
-            ),
-        ] + self._island_rows()
+                "shoreline distance, spikes included",
+                f"{self.hausdorff_as_given / self.cell_size:.3g} cells",
+                "spikes of the shore narrower than half a cell, smoothed out by the layout on purpose",
+            )
+        ]
 
     def _island_rows(self) -> list[tuple[str, str, str]]:
         rows = []
@@ -293,7 +317,13 @@ def coverage(
     step = h / 10.0
     gp, sp = _boundary_points(gb, step), _boundary_points(sb, step)
     d_grid, kg = _directed(gp, sb)
-    d_shore, ks = _directed(sp, gb)
+    # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
+    # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart
+    spikes = _spikes(poly, h)
+    keep = ~shapely.contains_xy(spikes, sp[:, 0], sp[:, 1]) if spikes is not None else np.ones(len(sp), bool)
+    d_given, _ = _directed(sp, gb)
+    d_shore, ks = _directed(sp[keep], gb) if keep.any() else (0.0, 0)
+    sp = sp[keep] if keep.any() else sp
     if d_grid >= d_shore:
         dist, where, side = d_grid, gp[kg], "grid"
     else:
@@ -308,7 +338,20 @@ def coverage(
         side=side,
         islands_covered=covered,
         island_cells=_cells_on(poly, land, grids, h),
+        hausdorff_as_given=max(d_grid, d_given),
     )
+
+
+def _spikes(poly: Any, h: float) -> Any:
+    """Where the shore's spikes of water or land narrower than half a cell lie (what
+    :func:`~meshcore.layout.polygon.without_slivers` removes, a little widened so that the shore
+    points on their rims fall inside), or None."""
+    from ..layout.polygon import without_slivers
+
+    clean, notes = without_slivers(poly, 0.5 * h)
+    if not notes:
+        return None
+    return poly.symmetric_difference(clean).buffer(1e-3 * h)
 
 
 def _land(k: int) -> str:

@@ -250,3 +250,23 @@ def test_peninsulas_are_followed_or_named(seed):
         x, y = c.where
         places = [tuple(map(float, p)) for n in lay.notes for p in re.findall(r"near \((\S+), (\S+)\)", n)]
         assert any(np.hypot(x - px, y - py) < 6 * H for px, py in places), (c.where, lay.notes)
+
+
+@pytest.mark.parametrize(("width", "left_out"), [(0.1, True), (1.0, False)])
+def test_a_spike_of_land_narrower_than_half_a_cell_is_measured_apart(width, left_out):
+    # a 10 x 10 lake gridded as a square (cell 0.5) with a spike of land 2 long from its bottom
+    # shore: narrower than half a cell, the layout smooths it out (with a note) and the shore
+    # distance leaves it out, the distance to the shore as given keeps it; wider, both keep it
+    from meshcore import StructuredGrid
+
+    w = width / 2
+    poly = Polygon([(0, 0), (5 - w, 0), (5, 2), (5 + w, 0), (10, 0), (10, 10), (0, 10)])
+    x, y = np.meshgrid(np.linspace(0, 10, 21), np.linspace(0, 10, 21), indexing="ij")
+    cov = lake_metrics(StructuredGrid(x, y), polygon=poly).coverage
+    assert cov.hausdorff_as_given / cov.cell_size == pytest.approx(4.0, rel=0.05)
+    if left_out:
+        assert cov.hausdorff_cells < 0.1
+        assert any("spikes included" in r[0] for r in cov.rows())
+    else:
+        assert cov.hausdorff_cells == pytest.approx(4.0, rel=0.05)
+        assert not any("spikes included" in r[0] for r in cov.rows())
