@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError
-from ..quality.coverage import MIN_ISLAND_CELLS, island_width
+from ..quality.coverage import MIN_ISLAND_CELLS, island_width, without_spikes
 
 __all__ = ["MIN_ISLAND_CELLS", "water_polygon", "without_dense_vertices"]
 
@@ -138,21 +138,10 @@ def without_slivers(poly: Any, width: float) -> tuple[Any, list[str]]:
 
     No grid line can follow a spike narrower than half a cell: its cells would fold.
     """
-    if width <= 0:
-        return poly, []
-    r = 0.5 * width
-    opts = {"join_style": "mitre", "mitre_limit": 10.0}
-    clean = poly.buffer(-r, **opts).buffer(r, **opts).buffer(r, **opts).buffer(-r, **opts)
-    if (
-        clean.geom_type != "Polygon"
-        or len(clean.interiors) != len(poly.interiors)
-        or abs(clean.area - poly.area) > 0.01 * poly.area
-        or not clean.is_valid
-    ):
+    clean = without_spikes(poly, width)
+    if clean is None:
         return poly, []
     moved = poly.symmetric_difference(clean).area
-    if moved <= 1e-9 * poly.area:
-        return poly, []
     from shapely.geometry.polygon import orient
 
     note = (

@@ -53,7 +53,7 @@ from ..errors import InvalidInputError
 from ..grid import StructuredGrid
 from .samples import Samples
 
-__all__ = ["MIN_ISLAND_CELLS", "Coverage", "CoveredIsland", "as_polygon", "coverage", "island_width"]
+__all__ = ["MIN_ISLAND_CELLS", "Coverage", "CoveredIsland", "as_polygon", "coverage", "island_width", "without_spikes"]
 
 #: The layout keeps an island at least this many cells across where it is widest
 #: (:func:`island_width`; :func:`meshcore.layout.polygon.water_polygon` is given it times the
@@ -342,16 +342,35 @@ def coverage(
     )
 
 
+def without_spikes(poly: Any, width: float) -> Any:
+    """``poly`` without its spikes of water or land narrower than ``width`` (a morphological opening
+    and closing with mitred corners), or None where that changes nothing or more than the spikes
+    (splits the water, joins an island to the shore, or moves 1 % of its area).  The layout smooths
+    them out (:func:`meshcore.layout.polygon.without_slivers`, half a cell), the shore distance
+    measures them apart (:func:`coverage`)."""
+    if width <= 0:
+        return None
+    r = 0.5 * width
+    opts = {"join_style": "mitre", "mitre_limit": 10.0}
+    clean = poly.buffer(-r, **opts).buffer(r, **opts).buffer(r, **opts).buffer(-r, **opts)
+    if (
+        clean.geom_type != "Polygon"
+        or len(clean.interiors) != len(poly.interiors)
+        or abs(clean.area - poly.area) > 0.01 * poly.area
+        or not clean.is_valid
+    ):
+        return None
+    if poly.symmetric_difference(clean).area <= 1e-9 * poly.area:
+        return None
+    return clean
+
+
 def _spikes(poly: Any, h: float) -> Any:
     """Where the shore's spikes of water or land narrower than half a cell lie (what
-    :func:`~meshcore.layout.polygon.without_slivers` removes, a little widened so that the shore
-    points on their rims fall inside), or None."""
-    from ..layout.polygon import without_slivers
-
-    clean, notes = without_slivers(poly, 0.5 * h)
-    if not notes:
-        return None
-    return poly.symmetric_difference(clean).buffer(1e-3 * h)
+    :func:`without_spikes` removes, a little widened so that the shore points on their rims fall
+    inside), or None."""
+    clean = without_spikes(poly, 0.5 * h)
+    return None if clean is None else poly.symmetric_difference(clean).buffer(1e-3 * h)
 
 
 def _land(k: int) -> str:
