@@ -94,6 +94,7 @@ class Level:
     P: Any = None  # prolongation from this (coarse) level to the finer one (sparse)
     R: Any = None  # restriction D⁻¹ Pᵀ from the finer level to this one (sparse)
     packed: Any = None  # finest level: {depth: the first depth levels in the flat buffers of the fused cycle}
+    flat: tuple = ()  # :func:`.nodemap.flat_ids` of ``ids`` (the kernels' form, built once per level)
 
     @property
     def shapes(self) -> list[tuple[int, int]]:
@@ -128,14 +129,15 @@ def colour_order_reference(ids: tuple[np.ndarray, ...], args: tuple, n_interior:
     return (np.ascontiguousarray(args[0][order]), np.ascontiguousarray(args[1][order]), *args[2:])
 
 
-def _level(ids: tuple[np.ndarray, ...], n: int, args: tuple, n_interior: int) -> Level:
+def _level(ids: tuple[np.ndarray, ...], n: int, args: tuple, n_interior: int, flat: tuple | None = None) -> Level:
+    flat = flat_ids(ids) if flat is None else flat
     args = _colour_order(ids, args, n_interior)
     free = np.zeros(n, dtype=bool)
     free[args[0]] = True
     free[args[2]] = True
-    mult = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n).astype(float)
+    mult = np.bincount(flat[0], minlength=n).astype(float)
     border = (args[0][n_interior:], args[1][n_interior:], *args[2:])
-    return Level(ids, args, n, free, mult, _line_tables(ids, args, n), border, _band(args, free))
+    return Level(ids, args, n, free, mult, _line_tables(ids, args, n), border, _band(args, free), flat=flat)
 
 
 def _band(args: tuple, free: np.ndarray) -> tuple:
@@ -280,18 +282,20 @@ def positions_reference(ids: tuple[np.ndarray, ...]) -> np.ndarray:
     return connected_components(graph, directed=False)[1][:total]
 
 
-def select(ids: tuple[np.ndarray, ...]) -> list | None:
+def select(ids: tuple[np.ndarray, ...], flat: tuple | None = None) -> list | None:
     """The kept positions ``[(si, sj), ...]`` of every block for the next coarser level, or None
     (see the module docstring; compiled: :func:`._hier_kernels.keep_classes`, reference
-    :func:`select_reference`)."""
-    flat, off, shape = flat_ids(ids)
-    el, gid, line_ptr = _hk.line_elements(flat, off, shape)
+    :func:`select_reference`); ``flat``: :func:`.nodemap.flat_ids` of ``ids`` when known."""
+    fl, off, shape = flat_ids(ids) if flat is None else flat
+    el, gid, line_ptr = _hk.line_elements(fl, off, shape)
     comp = _hk.position_classes(el, gid, int(line_ptr[-1]), int(gid.max()) + 1)
     state = _hk.keep_classes(comp, line_ptr, int(comp.max()) + 1, MIN_CELLS)
     if (state != 2).all():
         return None
-    kept = state[comp] != 2
-    spans = [np.flatnonzero(kept[a:b]) for a, b in itertools.pairwise(line_ptr.tolist())]
+    idx = np.flatnonzero(state[comp] != 2)  # kept elements; line L holds line_ptr[L]:line_ptr[L + 1]
+    local = idx - line_ptr[np.searchsorted(line_ptr, idx, side="right") - 1]
+    cut = np.searchsorted(idx, line_ptr).tolist()
+    spans = [local[a:b] for a, b in itertools.pairwise(cut)]
     return list(zip(spans[0::2], spans[1::2], strict=True))
 
 
@@ -364,9 +368,9 @@ def _interp_coo(fine: Level, coarse: Level) -> tuple[np.ndarray, np.ndarray, np.
     (:func:`._hier_kernels.interp_coo`)."""
     si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
     return _hk.interp_coo(
-        *flat_ids(fine.ids),
-        np.concatenate([g.ravel() for g in coarse.ids]).astype(np.int64, copy=False),
-        _offsets([g.ravel() for g in coarse.ids]),
+        *fine.flat,
+        coarse.flat[0],
+        coarse.flat[1],
         np.concatenate(si).astype(np.int64),
         _offsets(si),
         np.concatenate(sj).astype(np.int64),
@@ -414,8 +418,7 @@ def _scale(coarse: Level) -> np.ndarray:
     """FAS scaling of the restricted defect per coarse node (module docstring; α = γ), one
     compiled call (:func:`._hier_kernels.fas_scale`; reference :func:`scale_reference`)."""
     si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
-    flat = np.concatenate([g.ravel() for g in coarse.ids]).astype(np.int64, copy=False)
-    coarse_off = _offsets([g.ravel() for g in coarse.ids])
+    flat, coarse_off = coarse.flat[0], coarse.flat[1]
     return _hk.fas_scale(
         flat, coarse_off, np.concatenate(si).astype(np.int64), _offsets(si), np.concatenate(sj).astype(np.int64),
         _offsets(sj), coarse.n,
@@ -446,20 +449,21 @@ def _gradient(s: np.ndarray) -> np.ndarray:
 
 def _coarser(lv: Level) -> Level | None:
     """The next coarser level of ``lv``, or None when it would not pay."""
-    sel = select(lv.ids)
+    sel = select(lv.ids, lv.flat)
     if sel is None:
         return None
     si, sj = [s[0] for s in sel], [s[1] for s in sel]
     si_off, sj_off = _offsets(si), _offsets(sj)
-    kept = _hk.gather_kept(*flat_ids(lv.ids), np.concatenate(si), si_off, np.concatenate(sj), sj_off)
+    kept = _hk.gather_kept(*lv.flat, np.concatenate(si), si_off, np.concatenate(sj), sj_off)
     inj, inv = np.unique(kept, return_inverse=True)  # kept: g[np.ix_(si, sj)] of every block
     if len(inj) > MAX_KEEP * lv.n:
         return None
     inv = inv.astype(np.int64, copy=False)
     cut = np.concatenate([[0], np.cumsum(np.diff(si_off) * np.diff(sj_off))])
     ids = tuple(inv[a:b].reshape(len(i), len(j)) for a, b, i, j in zip(cut[:-1], cut[1:], si, sj, strict=True))
-    args, n_interior = solver_tables(ids, len(inj))
-    co = _level(ids, len(inj), args, n_interior)
+    flat = flat_ids(ids)
+    args, n_interior = solver_tables(ids, len(inj), flat)
+    co = _level(ids, len(inj), args, n_interior, flat)
     co.sel, co.inj = tuple(sel), inj.astype(np.int64)
     co.scale = _scale(co)
     co.P, co.R, co.rsum = _transfers(lv, co)

@@ -105,14 +105,20 @@ def _global_ids(blocks: Sequence[Any], interfaces: Sequence[Any]) -> tuple[int, 
     a, b = np.concatenate(pa), np.concatenate(pb)
     graph = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(n, n))
     n_nodes, compact = connected_components(graph, directed=False)
-    ids = tuple(compact[loc].reshape(loc.shape).astype(np.int64) for loc in local)
-    for k, g in enumerate(ids):
-        ring = np.concatenate([g[0], g[-1], g[1:-1, 0], g[1:-1, -1]])  # only border nodes are glued
-        if len(np.unique(ring)) != ring.size:
-            raise TopologyError(
-                f"block {blocks[k].name!r}: interfaces glue two nodes of the same block "
-                f"together (a border is joined to itself or to a neighbour's border twice)"
-            )
+    compact = compact.astype(np.int64)
+    ids = tuple(
+        compact[off : off + a * c].reshape(a, c) for off, (a, c) in zip(offsets[:-1].tolist(), shapes, strict=True)
+    )
+    # only border nodes are glued: a block whose border nodes are not all distinct
+    ring_k = np.concatenate([np.full(2 * (a + c) - 4, k, dtype=np.int64) for k, (a, c) in enumerate(shapes)])
+    ring = np.concatenate([np.concatenate([g[0], g[-1], g[1:-1, 0], g[1:-1, -1]]) for g in ids])
+    key = np.unique(ring_k * n_nodes + ring, return_counts=True)
+    if (key[1] > 1).any():
+        k = int(key[0][np.argmax(key[1] > 1)] // n_nodes)
+        raise TopologyError(
+            f"block {blocks[k].name!r}: interfaces glue two nodes of the same block "
+            f"together (a border is joined to itself or to a neighbour's border twice)"
+        )
     return int(n_nodes), ids
 
 
@@ -171,7 +177,9 @@ def _regular_rings(cells: np.ndarray, nodes: np.ndarray) -> tuple[np.ndarray, np
     close, left to :func:`_ring_stencils`)."""
     m = len(nodes)
     flat = cells.ravel()
-    idx = np.flatnonzero(np.isin(flat, nodes))  # cell-major: ascending cell index per node
+    want = np.zeros(int(max(flat.max(initial=-1), nodes.max(initial=-1))) + 1, dtype=bool)
+    want[nodes] = True
+    idx = np.flatnonzero(want[flat])  # cell-major: ascending cell index per node
     idx = idx[np.argsort(flat[idx], kind="stable")]
     cidx, pos = idx // 4, idx % 4
     c = cells[cidx]
@@ -272,13 +280,49 @@ def node_xy(blocks: Sequence[Any], ids: Sequence[np.ndarray], n: int) -> tuple[f
     return (math.nan, math.nan)
 
 
-def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
+def corner_records(
+    blocks: Sequence[Any], ids: Sequence[np.ndarray], nodes: Sequence[int], count: np.ndarray, boundary: np.ndarray
+) -> list[Corner]:
+    """The :class:`Corner` of every node in ``nodes``: its owners and coordinates as
+    :func:`node_owners` and :func:`node_xy` give them (their reference), from one pass over the
+    blocks' ids where those scan every block once per node (a 55-block lake layout: 6.6 → 0.5 ms)."""
+    nodes = [int(n) for n in nodes]
+    if not nodes:
+        return []
+    flat, off, shape = flat_ids(ids)
+    want = np.zeros(len(count), dtype=bool)
+    want[nodes] = True
+    pos = np.flatnonzero(want[flat])  # block order, row-major in a block
+    pos = pos[np.argsort(flat[pos], kind="stable")]  # grouped by node, in that order
+    blk = np.searchsorted(off, pos, side="right") - 1
+    ii, jj = np.divmod(pos - off[blk], shape[blk, 1])
+    start = np.searchsorted(flat[pos], nodes)
+    stop = np.searchsorted(flat[pos], nodes, side="right")
+    blk_l, ii_l, jj_l = blk.tolist(), ii.tolist(), jj.tolist()
+    out = []
+    for n, a, b in zip(nodes, start.tolist(), stop.tolist(), strict=True):
+        owners = tuple(f"{blocks[blk_l[q]].name}({ii_l[q]},{jj_l[q]})" for q in range(a, b))
+        point = (math.nan, math.nan)
+        for q in range(a, b):  # the first block that holds n on a border, its first border with n
+            k, i, j = blk_l[q], ii_l[q], jj_l[q]
+            ni, nj = int(shape[k, 0]) - 1, int(shape[k, 1]) - 1
+            where = [(bd, t) for bd, t, on in (("bottom", i, j == 0), ("top", i, j == nj), ("left", j, i == 0),
+                                               ("right", j, i == ni)) if on]  # fmt: skip
+            if where:
+                pt = blocks[k].borders[where[0][0]][where[0][1]]
+                point = (float(pt[0]), float(pt[1]))
+                break
+        out.append(Corner(node=n, point=point, blocks=owners, valence=int(count[n]), free=not bool(boundary[n])))
+    return out
+
+
+def solver_tables(ids: Sequence[np.ndarray], n_nodes: int, flat: tuple | None = None) -> tuple[tuple, int]:
     """``(args, n_interior)``: the table arguments ``(nodes, nbr, irr_nodes, irr_ptr, irr_ring)`` of
     blocks given only by their global ids (a multigrid coarse level); ``nodes[:n_interior]`` are
     block-interior nodes.  The per-block tables come from one compiled call each
     (:mod:`._hier_kernels`; references :func:`_perimeter_cells`, :func:`_interior_stencils`)."""
     ids = tuple(ids)
-    flat, off, shape = flat_ids(ids)
+    flat, off, shape = flat_ids(ids) if flat is None else flat
     cells, boundary = _hk.perimeter_cells(flat, off, shape), _side_boundary(ids, n_nodes)
     occ = np.bincount(flat, minlength=n_nodes)  # a block's ids are unique
     int_nodes, int_nbr = _hk.interior_stencils(flat, off, shape)
@@ -299,7 +343,7 @@ def solver_tables(ids: Sequence[np.ndarray], n_nodes: int) -> tuple[tuple, int]:
 def flat_ids(ids: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(flat, off, shape)``: the blocks' global ids in one array (block ``b`` row-major at
     ``flat[off[b]:off[b + 1]]``, node counts ``shape[b]``), as the kernels of :mod:`._hier_kernels` take them."""
-    flat = np.concatenate([np.ravel(g) for g in ids]).astype(np.int64, copy=False)
+    flat = np.concatenate([g.ravel() for g in ids]).astype(np.int64, copy=False)
     shape = np.array([g.shape for g in ids], dtype=np.int64).reshape(-1, 2)
     off = np.zeros(len(ids) + 1, dtype=np.int64)
     np.cumsum(shape[:, 0] * shape[:, 1], out=off[1:])
@@ -345,23 +389,16 @@ def build_node_map(blocks: Sequence[Any], interfaces: Sequence[Any]) -> NodeMap:
     n_nodes, ids = _global_ids(blocks, interfaces)
     cells, cell_block, boundary = _cells([b.name for b in blocks], ids, n_nodes)
     count = np.bincount(cells.reshape(-1), minlength=n_nodes)  # cells per node
-    occ = np.bincount(np.concatenate([np.unique(g) for g in ids]), minlength=n_nodes)
+    occ = np.bincount(np.concatenate([g.ravel() for g in ids]), minlength=n_nodes)  # a block's ids are unique
     shared = occ > 1
     nodes_l, nbr_l = _interior_stencils(ids)
     border_free = np.flatnonzero(~boundary & shared)
     label = lambda n: " = ".join(node_owners(blocks, ids, n))  # noqa: E731
     reg_n, reg_nb, irr_n, irr_ptr, irr_ring = _border_stencils(cells, border_free, label)
     # corner records: nodes in ≥ 3 blocks, or irregular
-    corners = [
-        Corner(
-            node=n,
-            point=node_xy(blocks, ids, n),
-            blocks=node_owners(blocks, ids, n),
-            valence=int(count[n]),
-            free=not bool(boundary[n]),
-        )
-        for n in np.flatnonzero(occ >= 3).tolist() + [m for m in irr_n if occ[m] < 3]
-    ]
+    corners = corner_records(
+        blocks, ids, np.flatnonzero(occ >= 3).tolist() + [m for m in irr_n if occ[m] < 3], count, boundary
+    )
     n_interior = int(sum(len(c) for c in nodes_l))
     if reg_n:
         nodes_l.append(np.array(reg_n, dtype=np.int64))

@@ -167,6 +167,7 @@ class MultiBlockTopology:
     interfaces: tuple[Interface, ...] = ()
     check_geometry: bool = True
     _map: list = field(default_factory=list, repr=False)
+    _size: list = field(default_factory=list, repr=False)  # [size], computed once (blocks are frozen)
 
     def __post_init__(self) -> None:
         blocks = tuple(self.blocks)
@@ -196,8 +197,11 @@ class MultiBlockTopology:
     # ------------------------------------------------------------ basics
     @property
     def size(self) -> float:
-        allp = np.vstack([b.borders.loop() for b in self.blocks])
-        return float(math.hypot(*(allp.max(axis=0) - allp.min(axis=0))))
+        """The diagonal of the bounding box of all blocks (the stopping rule's length)."""
+        if not self._size:
+            allp = np.vstack([b.borders.loop() for b in self.blocks])
+            self._size.append(float(math.hypot(*(allp.max(axis=0) - allp.min(axis=0)))))
+        return self._size[0]
 
     def block(self, name: str) -> Block:
         for b in self.blocks:

@@ -1179,6 +1179,39 @@ def test_level_table_kernels_match_their_numpy_references(make):
     assert thin or make in ("star5", "odd")  # the layouts' coarse levels have blocks with one interior line
 
 
+@pytest.mark.parametrize("make", ["star5", "network", "islands"])
+def test_corner_records_equal_the_node_by_node_reference(make):
+    """The node map's corners (owners, coordinates), built in one pass over the blocks' ids,
+    equal node_owners / node_xy node by node: a 5-block corner, the junctions and islands of
+    generated layouts, and any other nodes (shore, interface, block interior: no border, NaN)."""
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock import nodemap
+    from meshcore.testing import channel_network, lake_with_islands
+
+    if make == "star5":
+        topo = star(5, 9)
+    else:
+        shape = {"network": channel_network(3, n_branches=6), "islands": lake_with_islands(1)}[make]
+        topo = auto_layout(shape, target_cells=3000, multiple=4).topology()
+    m = topo.node_map
+    assert len(m.corners) >= (1 if make == "star5" else 3)
+    count = np.bincount(m.cells.ravel(), minlength=m.n_nodes)
+    rng = np.random.default_rng(0)
+    nodes = [c.node for c in m.corners] + rng.choice(m.n_nodes, 60, replace=False).tolist()
+    interior = int(m.ids[0][1, 1])
+    got = nodemap.corner_records(topo.blocks, m.ids, nodes + [interior], count, m.boundary)
+    assert [c.node for c in got] == nodes + [interior]
+    for c in got:
+        want_xy = nodemap.node_xy(topo.blocks, m.ids, c.node)
+        assert c.blocks == nodemap.node_owners(topo.blocks, m.ids, c.node)
+        assert np.array_equal(c.point, want_xy, equal_nan=True)
+        assert (c.valence, c.free) == (int(count[c.node]), not bool(m.boundary[c.node]))
+    assert np.isnan(got[-1].point).all() and len(got[-1].blocks) == 1
+    assert [(c.node, c.blocks, c.point) for c in m.corners] == [
+        (c.node, c.blocks, c.point) for c in got[: len(m.corners)]
+    ]
+
+
 @pytest.mark.kernel
 @pytest.mark.parametrize("make", ["star5", "network", "islands", "spiral"])
 def test_compiled_start_grids_equal_the_numpy_tfi(make):
