@@ -910,6 +910,35 @@ def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
         assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-6 * topo.size
 
 
+@pytest.mark.parametrize("make", ["star5", "islands"])
+def test_defect_after_the_hot_spot_sweeps_is_the_full_defect(make):
+    """After the hot-spot sweeps only the defect round the swept nodes is recomputed: the same
+    largest defect and the same defect at every node as a full table_defect (a 5-block corner:
+    its irregular node; a generated lake with islands), also when a node is NaN."""
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock import _kernels, multigrid
+    from meshcore.multiblock.hierarchy import levels
+    from meshcore.testing import lake_with_islands
+
+    topo = star(5, 9) if make == "star5" else auto_layout(lake_with_islands(2), target_cells=4000).topology()
+    lv = levels(topo)[0]
+    m = topo.node_map
+    x, y = np.empty(m.n_nodes), np.empty(m.n_nodes)
+    for g, ids in zip(meshcore.multiblock.initial_grids(topo), m.ids, strict=True):
+        x[ids.ravel()], y[ids.ravel()] = g.x.ravel(), g.y.ravel()
+    zero = np.zeros(lv.n)
+    rx, ry = np.zeros(lv.n), np.zeros(lv.n)
+    _kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry)
+    swept = multigrid._hot_sweeps(lv, x, y, rx, ry)
+    assert 0 < len(swept[0]) < len(lv.args[0])  # some rows, not all
+    got = multigrid._defect_after(lv, x, y, zero, rx, ry, swept[0])
+    wx, wy = np.zeros(lv.n), np.zeros(lv.n)
+    want = _kernels.table_defect(x, y, zero, zero, *lv.args, wx, wy)
+    assert got == want and np.array_equal(rx, wx) and np.array_equal(ry, wy)
+    x[swept[0][0]] = np.nan
+    assert multigrid._defect_after(lv, x, y, zero, rx, ry, swept[0][:1]) == np.inf
+
+
 @pytest.mark.kernel
 def test_grow_near_matches_numpy_reference():
     """The compiled growth of a node set over the table equals the NumPy one (seeds anywhere:
