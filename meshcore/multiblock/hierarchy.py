@@ -95,6 +95,7 @@ class Level:
     R: Any = None  # restriction D⁻¹ Pᵀ from the finer level to this one (sparse)
     packed: Any = None  # finest level: {depth: the first depth levels in the flat buffers of the fused cycle}
     flat: tuple = ()  # :func:`.nodemap.flat_ids` of ``ids`` (the kernels' form, built once per level)
+    sel_flat: tuple = ()  # coarse level: :func:`_sel_flat` of ``sel``
 
     @property
     def shapes(self) -> list[tuple[int, int]]:
@@ -363,20 +364,18 @@ def _offsets(parts: list) -> np.ndarray:
     return off
 
 
+def _sel_flat(sel: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(si, si_off, sj, sj_off)``: the kept positions of every block in one array per direction
+    (block ``b``'s at ``si[si_off[b]:si_off[b + 1]]``), as the kernels take them."""
+    si, sj = [s[0] for s in sel], [s[1] for s in sel]
+    return np.concatenate(si).astype(np.int64), _offsets(si), np.concatenate(sj).astype(np.int64), _offsets(sj)
+
+
 def _interp_coo(fine: Level, coarse: Level) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """COO ``(rows, cols, vals)`` of the prolongation, every block's entries weighted by ``1/mult``
     (:func:`._hier_kernels.interp_coo`)."""
-    si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
-    return _hk.interp_coo(
-        *fine.flat,
-        coarse.flat[0],
-        coarse.flat[1],
-        np.concatenate(si).astype(np.int64),
-        _offsets(si),
-        np.concatenate(sj).astype(np.int64),
-        _offsets(sj),
-        fine.mult,
-    )
+    sel = coarse.sel_flat or _sel_flat(coarse.sel)
+    return _hk.interp_coo(*fine.flat, coarse.flat[0], coarse.flat[1], *sel, fine.mult)
 
 
 def _transfers(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarray]:
@@ -417,12 +416,7 @@ def transfers_reference(fine: Level, coarse: Level) -> tuple[Any, Any, np.ndarra
 def _scale(coarse: Level) -> np.ndarray:
     """FAS scaling of the restricted defect per coarse node (module docstring; α = γ), one
     compiled call (:func:`._hier_kernels.fas_scale`; reference :func:`scale_reference`)."""
-    si, sj = [s[0] for s in coarse.sel], [s[1] for s in coarse.sel]
-    flat, coarse_off = coarse.flat[0], coarse.flat[1]
-    return _hk.fas_scale(
-        flat, coarse_off, np.concatenate(si).astype(np.int64), _offsets(si), np.concatenate(sj).astype(np.int64),
-        _offsets(sj), coarse.n,
-    )  # fmt: skip
+    return _hk.fas_scale(coarse.flat[0], coarse.flat[1], *(coarse.sel_flat or _sel_flat(coarse.sel)), coarse.n)
 
 
 def scale_reference(coarse: Level) -> np.ndarray:
@@ -453,8 +447,9 @@ def _coarser(lv: Level) -> Level | None:
     if sel is None:
         return None
     si, sj = [s[0] for s in sel], [s[1] for s in sel]
-    si_off, sj_off = _offsets(si), _offsets(sj)
-    kept = _hk.gather_kept(*lv.flat, np.concatenate(si), si_off, np.concatenate(sj), sj_off)
+    sel_flat = _sel_flat(sel)
+    si_off, sj_off = sel_flat[1], sel_flat[3]
+    kept = _hk.gather_kept(*lv.flat, *sel_flat)
     inj, inv = np.unique(kept, return_inverse=True)  # kept: g[np.ix_(si, sj)] of every block
     if len(inj) > MAX_KEEP * lv.n:
         return None
@@ -464,7 +459,7 @@ def _coarser(lv: Level) -> Level | None:
     flat = flat_ids(ids)
     args, n_interior = solver_tables(ids, len(inj), flat)
     co = _level(ids, len(inj), args, n_interior, flat)
-    co.sel, co.inj = tuple(sel), inj.astype(np.int64)
+    co.sel, co.sel_flat, co.inj = tuple(sel), sel_flat, inj.astype(np.int64)
     co.scale = _scale(co)
     co.P, co.R, co.rsum = _transfers(lv, co)
     return co

@@ -217,7 +217,9 @@ def _border_stencils(cells: np.ndarray, border_free: np.ndarray, label: Any) -> 
 def _ring_stencils(cells: np.ndarray, border_free: np.ndarray, label: Any) -> tuple[list, list, list, list, list]:
     """:func:`_border_stencils` node by node (reference; irregular nodes and the errors)."""
     inc = defaultdict(list)
-    sel = np.isin(cells, border_free)
+    want = np.zeros(int(max(cells.max(initial=-1), border_free.max(initial=-1))) + 1, dtype=bool)
+    want[border_free] = True
+    sel = want[cells]  # np.isin(cells, border_free)
     for cidx, pos in zip(*np.nonzero(sel), strict=True):
         inc[int(cells[cidx, pos])].append((int(cidx), int(pos)))
     reg_n: list[int] = []
@@ -323,7 +325,7 @@ def solver_tables(ids: Sequence[np.ndarray], n_nodes: int, flat: tuple | None = 
     (:mod:`._hier_kernels`; references :func:`_perimeter_cells`, :func:`_interior_stencils`)."""
     ids = tuple(ids)
     flat, off, shape = flat_ids(ids) if flat is None else flat
-    cells, boundary = _hk.perimeter_cells(flat, off, shape), _side_boundary(ids, n_nodes)
+    cells, boundary = _hk.perimeter_cells(flat, off, shape), _side_boundary(ids, n_nodes, (flat, off, shape))
     occ = np.bincount(flat, minlength=n_nodes)  # a block's ids are unique
     int_nodes, int_nbr = _hk.interior_stencils(flat, off, shape)
     border_free = np.flatnonzero(~boundary & (occ > 1))
@@ -366,9 +368,34 @@ def _perimeter_cells(ids: Sequence[np.ndarray]) -> np.ndarray:
     return np.vstack(out).astype(np.int64)
 
 
-def _side_boundary(ids: Sequence[np.ndarray], n_nodes: int) -> np.ndarray:
+def _side_boundary(ids: Sequence[np.ndarray], n_nodes: int, flat: tuple | None = None) -> np.ndarray:
     """Nodes on the outer boundary (the ``boundary`` of :func:`_cells`): the ends of block-side
-    edges that no other block has (an edge inside a block has a cell on either side)."""
+    edges that no other block has (an edge inside a block has a cell on either side).  The edges
+    of all blocks' sides at once from :func:`flat_ids` (``flat`` when known); reference
+    :func:`side_boundary_reference`, block by block."""
+    fl, off, shape = flat_ids(ids) if flat is None else flat
+    ends = []
+    for k, step in ((0, shape[:, 1]), (1, np.ones(len(shape), dtype=np.int64))):  # edges along i, along j
+        n_e = shape[:, k] - 1  # edges per side
+        blk = np.repeat(np.arange(len(shape)), n_e)
+        t = np.arange(blk.size) - np.repeat(np.cumsum(n_e) - n_e, n_e)  # edge index along the side
+        first = off[blk] + t * step[blk]  # the side through node (0, 0)
+        other = (shape[blk, 1] - 1) if k == 0 else (shape[blk, 0] - 1) * shape[blk, 1]  # the opposite side
+        for o in (0, other):
+            ends.append((first + o, first + o + step[blk]))
+    a = fl[np.concatenate([e[0] for e in ends])]
+    b = fl[np.concatenate([e[1] for e in ends])]
+    key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
+    _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
+    one = cnt[inv] == 1
+    boundary = np.zeros(n_nodes, dtype=bool)
+    boundary[a[one]] = True
+    boundary[b[one]] = True
+    return boundary
+
+
+def side_boundary_reference(ids: Sequence[np.ndarray], n_nodes: int) -> np.ndarray:
+    """:func:`_side_boundary` block by block (reference)."""
     e0, e1 = [], []
     for g in ids:
         for side in (g[:, 0], g[:, -1], g[0, :], g[-1, :]):

@@ -1174,6 +1174,7 @@ def test_level_table_kernels_match_their_numpy_references(make):
         flat, off, shape = nodemap.flat_ids(lv.ids)
         thin += int((shape.min(axis=1) <= 3).sum())
         assert np.array_equal(_hier_kernels.perimeter_cells(flat, off, shape), nodemap._perimeter_cells(lv.ids))
+        assert np.array_equal(nodemap._side_boundary(lv.ids, lv.n), nodemap.side_boundary_reference(lv.ids, lv.n))
         nodes_l, nbr_l = nodemap._interior_stencils(lv.ids)
         nodes, nbr = _hier_kernels.interior_stencils(flat, off, shape)
         assert np.array_equal(nodes, np.concatenate(nodes_l)) and np.array_equal(nbr, np.vstack(nbr_l))
@@ -1344,6 +1345,7 @@ def test_coarse_level_cells_and_boundary_equal_the_full_ones(make, rect, shasta_
     for lv in hierarchy.levels(topo):
         cells, _, boundary = nodemap._cells([str(k) for k in range(len(lv.ids))], lv.ids, lv.n)
         assert np.array_equal(nodemap._side_boundary(lv.ids, lv.n), boundary)
+        assert np.array_equal(nodemap.side_boundary_reference(lv.ids, lv.n), boundary)
         side = np.zeros(lv.n, dtype=bool)
         for g in lv.ids:
             side[np.concatenate([g[0], g[-1], g[:, 0], g[:, -1]])] = True
