@@ -141,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
             print(reports[k].table())
         if hasattr(result, "report"):  # multiblock: connectivity and interface quality
             print(result.report())
-            print(result.quality().table())
+            print(result.quality(reports).table())
         print(f"done in {elapsed:.3f} s" + (f"; wrote {args.output}" if args.output else ""))
     if not converged:
         print("meshcore generate: warning: the solver did not converge (exit code 3)", file=sys.stderr)

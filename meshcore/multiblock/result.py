@@ -115,8 +115,12 @@ class MultiBlockGrid:
             worst = max(worst, float(np.hypot(*(pa - pb).T).max()))
         return worst
 
-    def quality(self) -> MultiBlockQuality:
-        reports = {n: quality(g) for n, g in zip(self.names, self.grids, strict=True)}
+    def quality(self, reports: list[QualityReport] | None = None) -> MultiBlockQuality:
+        """Per block and across interfaces; ``reports``: the blocks' :func:`meshcore.quality.quality`
+        when the caller has them (the CLI prints them first)."""
+        if reports is None:
+            reports = [quality(g) for g in self.grids]
+        by_name = dict(zip(self.names, reports, strict=True))
         inter: dict[str, float] = {}
         if len(self.grids) > 1:
             pairs = interface_pairs(self.grids)  # the cross-interface ratio of meshcore.quality
@@ -124,10 +128,10 @@ class MultiBlockGrid:
                 k = f"{self.names[min(p, q)]} ↔ {self.names[max(p, q)]}"
                 inter[k] = max(inter.get(k, 1.0), float(r))
         return MultiBlockQuality(
-            blocks=reports,
+            blocks=by_name,
             interfaces=inter,
-            n_folded=sum(r.n_folded for r in reports.values()),
-            worst_inside=max(r.max_size_ratio for r in reports.values()),
+            n_folded=sum(r.n_folded for r in by_name.values()),
+            worst_inside=max(r.max_size_ratio for r in by_name.values()),
             worst_interface=max(inter.values(), default=1.0),
         )
 

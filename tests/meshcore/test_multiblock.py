@@ -276,6 +276,10 @@ def test_shasta_lake_quality_and_glue(shasta_topology, mode):
     assert set(q.interfaces) == {" ↔ ".join(sorted((i.a.block, i.b.block), key=mb.names.index)) for i in mb.interfaces}
     if mode == "smooth":
         assert q.worst_interface <= 1.5 * q.worst_inside
+    from meshcore.quality import quality
+
+    given = mb.quality([quality(g) for g in mb.grids])  # the CLI's reports, not made twice
+    assert given.table() == q.table() and given.blocks.keys() == q.blocks.keys()
 
 
 def test_smooth_interfaces_are_smoother_than_frozen(shasta_topology):
