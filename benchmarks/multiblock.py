@@ -14,6 +14,9 @@ Run from the repository root (serial kernels; timings are best of ``--repeat``):
    single-block one.
 3. Shasta Lake (the example cases): smooth (frozen start / algebraic start)
    and frozen, against one curved-rectangle block with the same node count.
+4. Where the multiblock CLI's time goes (``--stages``): CPU time per stage of
+   ``generate_case`` on the Shasta examples (and refined 2×), min of ``--repeat``
+   runs with the multigrid set-up built in each (as in a new process).
 """
 
 from __future__ import annotations
@@ -193,17 +196,96 @@ def lake(repeat: int, quick: bool) -> None:
     print()
 
 
+#: The stages of ``generate_case`` of an ``[outline]`` multiblock case: (label, module, function).
+STAGES = (
+    ("outline: read and project", "meshcore.case.multiblock", "_outline_geometry"),
+    ("blocks: chain cell counts (MILP)", "meshcore.multiblock.chains", "_chain_counts"),
+    ("blocks: re-sample the chains", "meshcore.multiblock.chains", "_resample"),
+    ("topology: geometry check", "meshcore.multiblock.topology:MultiBlockTopology", "_check_geometry"),
+    ("topology: node map", "meshcore.multiblock.topology", "build_node_map"),
+    ("start grids", "meshcore.multiblock.solver", "initial_grids"),
+    ("multigrid set-up: levels", "meshcore.multiblock.multigrid", "levels"),
+    ("multigrid set-up: pack", "meshcore.multiblock.multigrid", "pack"),
+    ("cycles: V-cycles", "meshcore.multiblock._mg_fused", "vcycle"),
+    ("cycles: hot-spot sweeps", "meshcore.multiblock.multigrid", "_hot_sweeps"),
+    ("cycles: defects", "meshcore.multiblock._kernels", "table_defect"),
+)
+
+
+def stages(repeat: int, quick: bool) -> None:
+    """CPU time per stage of the multiblock CLI (each stage's function wrapped by a CPU timer)."""
+    import importlib
+
+    from meshcore.case import generate_case, load_case
+    from meshcore.multiblock import hierarchy
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from robust import _refined  # the refined example of the robust.py rows, written once
+
+    spent: dict[str, float] = {}
+
+    def timed(label, fn):
+        def wrapper(*args, **kwargs):
+            t = time.process_time()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                spent[label] = spent.get(label, 0.0) + time.process_time() - t
+
+        return wrapper
+
+    undo = []
+    for label, where, name in STAGES:
+        mod, _, cls = where.partition(":")
+        owner = getattr(importlib.import_module(mod), cls) if cls else importlib.import_module(mod)
+        undo.append((owner, name, getattr(owner, name)))
+        setattr(owner, name, timed(label, getattr(owner, name)))
+    print("## 4. multiblock CLI (generate_case) by stage, CPU ms, min of the repeats\n")
+    runs = [("shasta-multiblock-coarse", 1)]
+    runs += [] if quick else [("shasta-multiblock-fine", 1), ("shasta-multiblock-fine", 2)]
+    rows: dict[str, list[float]] = {}
+    try:
+        for name, k in runs:
+            case = load_case(ROOT / "resources" / "examples" / f"{name}.toml")
+            if k > 1:
+                case = _refined(case, k)
+            cfg = case.solver.replaced(threads=1)
+            best: dict[str, float] = {}
+            for _ in range(repeat + 1):  # the first run loads the kernels
+                hierarchy._CACHE.clear()
+                spent.clear()
+                t = time.process_time()
+                generate_case(case, config=cfg)
+                spent["CLI (all)"] = time.process_time() - t
+                best = {key: min(v, best.get(key, math.inf)) for key, v in spent.items()}
+            for label in [s[0] for s in STAGES] + ["CLI (all)"]:
+                rows.setdefault(label, []).append(best.get(label, 0.0))
+    finally:
+        for owner, name, fn in undo:
+            setattr(owner, name, fn)
+    print("| stage | " + " | ".join(f"{n[18:]}{f' ×{k}' if k > 1 else ''}" for n, k in runs) + " |")
+    print("|---|" + "---|" * len(runs))
+    for label, ts in rows.items():
+        print(f"| {label} | " + " | ".join(f"{1e3 * t:.1f}" for t in ts) + " |")
+    print()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="small sizes only")
+    ap.add_argument("--stages", action="store_true", help="only the CLI's stages (section 4)")
     a = ap.parse_args()
     print(f"numba threading layer: {bk.threading_layer()}; serial kernels; best of {a.repeat}\n")
     meshcore.elliptic.warmup()
+    if a.stages:
+        stages(a.repeat, a.quick)
+        return
     sizes = [(128, 64)] if a.quick else [(128, 64), (256, 128), (512, 256)]
     per_sweep(a.repeat, sizes)
     whole_solves(a.repeat, [(64, 32)] if a.quick else [(128, 64), (256, 128), (512, 256)])
     lake(a.repeat, a.quick)
+    stages(a.repeat, a.quick)
 
 
 if __name__ == "__main__":
