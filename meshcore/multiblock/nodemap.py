@@ -287,7 +287,8 @@ def corner_records(
 ) -> list[Corner]:
     """The :class:`Corner` of every node in ``nodes``: its owners and coordinates as
     :func:`node_owners` and :func:`node_xy` give them (their reference), from one pass over the
-    blocks' ids where those scan every block once per node (a 55-block lake layout: 6.6 → 0.5 ms)."""
+    blocks' ids where those scan every block once per node (the 13 corners of a 55-block lake layout:
+    6.6 → 0.2 ms, measured)."""
     nodes = [int(n) for n in nodes]
     if not nodes:
         return []
