@@ -57,3 +57,15 @@ def rectangle_borders(w: float = 2.0, h: float = 1.0, ni: int = 8, nj: int = 4):
 @pytest.fixture
 def data_dir() -> Path:
     return DATA
+
+
+def one_block_kwargs(poly, nodes: int) -> dict:
+    """``generate_block`` keywords for a shape's outer ring as one block, with the corners and the
+    cell ratio ``meshcore import`` chooses, scaled to about ``nodes`` nodes."""
+    from meshcore.io.outline import guess_cells, guess_corners
+
+    loop = np.asarray(poly.exterior.coords)[:-1]
+    corners = guess_corners(loop)
+    ci, cj = guess_cells(loop, corners)
+    s = math.sqrt(nodes / ((ci + 1) * (cj + 1)))
+    return {"loop": loop, "corners": corners, "cells": (max(4, round(ci * s)), max(4, round(cj * s)))}

@@ -386,6 +386,12 @@ def _side_boundary(ids: Sequence[np.ndarray], n_nodes: int, flat: tuple | None =
             ends.append((first + o, first + o + step[blk]))
     a = fl[np.concatenate([e[0] for e in ends])]
     b = fl[np.concatenate([e[1] for e in ends])]
+    return _single_edges(a, b, n_nodes)
+
+
+def _single_edges(a: np.ndarray, b: np.ndarray, n_nodes: int) -> np.ndarray:
+    """The nodes of the edges ``(a[k], b[k])`` that belong to one block side only (the others
+    are shared by two blocks: an interface), as a mask over the ``n_nodes`` nodes."""
     key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
     _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
     one = cnt[inv] == 1
@@ -403,13 +409,7 @@ def side_boundary_reference(ids: Sequence[np.ndarray], n_nodes: int) -> np.ndarr
             e0.append(side[:-1])
             e1.append(side[1:])
     a, b = np.concatenate(e0), np.concatenate(e1)
-    key = np.minimum(a, b) * n_nodes + np.maximum(a, b)
-    _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
-    one = cnt[inv] == 1
-    boundary = np.zeros(n_nodes, dtype=bool)
-    boundary[a[one]] = True
-    boundary[b[one]] = True
-    return boundary
+    return _single_edges(a, b, n_nodes)
 
 
 def build_node_map(blocks: Sequence[Any], interfaces: Sequence[Any]) -> NodeMap:

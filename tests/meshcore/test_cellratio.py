@@ -11,6 +11,7 @@ import meshcore
 from meshcore import testing
 from meshcore.cellratio import cell_ratio
 from meshcore.io.outline import guess_cells, guess_corners
+from tests.conftest import one_block_kwargs
 
 
 def _rectangle(a: float, b: float, seed: int) -> tuple[np.ndarray, tuple[int, int, int, int]]:
@@ -36,15 +37,6 @@ def _median_log_aspect(g) -> float:
     lxi = 0.5 * (np.hypot(*np.diff([x[:, :-1], y[:, :-1]], axis=1)) + np.hypot(*np.diff([x[:, 1:], y[:, 1:]], axis=1)))
     leta = 0.5 * (np.hypot(*np.diff([x[:-1], y[:-1]], axis=2)) + np.hypot(*np.diff([x[1:], y[1:]], axis=2)))
     return float(np.median(np.log(lxi / leta)))
-
-
-def _one_block(poly, nodes: int) -> dict:
-    """A shape's outer ring as ``meshcore import`` grids it, scaled to about ``nodes`` nodes."""
-    loop = np.asarray(poly.exterior.coords)[:-1]
-    corners = guess_corners(loop)
-    ci, cj = guess_cells(loop, corners)
-    s = math.sqrt(nodes / ((ci + 1) * (cj + 1)))
-    return {"loop": loop, "corners": corners, "cells": (max(4, round(ci * s)), max(4, round(cj * s)))}
 
 
 @pytest.mark.parametrize("a,b,seed", [(10.0, 1.0, 0), (3.0, 7.0, 1), (1.0, 1.0, 2), (250.0, 4.0, 3), (5.0, 2.0, 4)])
@@ -86,7 +78,7 @@ SHAPES = {
 def test_the_guess_gives_near_square_cells(name):
     # the ratio of the borders' lengths gave cells 2–17 times longer across than along on these
     # (median log aspect -0.6 … -2.8): the bottom and top borders trace every arm in and out
-    kw = _one_block(SHAPES[name](), 6000)
+    kw = one_block_kwargs(SHAPES[name](), 6000)
     g = meshcore.generate_block(**kw, repair="off", threads=1)
     assert abs(_median_log_aspect(g)) < math.log(1.4)
 
@@ -96,6 +88,6 @@ def test_the_default_call_is_fold_free(name):
     # with the ratio of the borders' lengths (438×13 and 26×226 cells at this size) the repair
     # left 1373 and 4 bad cells: rows too few for the arms and turns
     shape = {"spiral": testing.spiral, "network-8": lambda: testing.channel_network(8)}[name]()
-    g = meshcore.generate_block(**_one_block(shape, 6000), threads=1)
+    g = meshcore.generate_block(**one_block_kwargs(shape, 6000), threads=1)
     assert g.converged  # the repair reports a grid it could not make valid as not converged
     assert meshcore.quality(g).n_folded == 0

@@ -18,8 +18,7 @@ import pytest
 import meshcore
 from meshcore import testing
 from meshcore.elliptic import _mg_kernels, _mg_lines, multigrid
-from meshcore.io.outline import guess_cells, guess_corners
-from tests.conftest import borders_of
+from tests.conftest import borders_of, one_block_kwargs
 
 E = np.zeros((0, 0))
 
@@ -39,15 +38,6 @@ def _mixed_aspect(ni: int, nj: int, beta: float = 3.0, bend: float = 0.3):
     u = 1.0 - (np.tanh(beta * np.linspace(0, 1, nj + 1)) / np.tanh(beta))[::-1]
     X, Y = np.meshgrid(s, u, indexing="ij")
     return X + bend * np.sin(math.pi * Y), Y + 0.5 * bend * np.sin(math.pi * X)
-
-
-def _one_block(poly, nodes: int) -> dict:
-    """A generated outline as one block the way ``meshcore import`` grids it, ~``nodes`` nodes."""
-    loop = np.asarray(poly.exterior.coords)[:-1]
-    corners = guess_corners(loop)
-    ci, cj = guess_cells(loop, corners)
-    s = math.sqrt(nodes / ((ci + 1) * (cj + 1)))
-    return {"loop": loop, "corners": corners, "cells": (max(4, round(ci * s)), max(4, round(cj * s)))}
 
 
 @pytest.mark.kernel
@@ -115,7 +105,7 @@ def test_line_smoothing_rate_on_a_stretched_curved_grid(cells):
 def test_folded_start_grid_keeps_coarsening():
     """The algebraic start grid of a branched lake folds a few % of its cells; coarse levels
     sampled from it fold about twice that, which is no reason to stop coarsening."""
-    kw = _one_block(testing.channel_network(0), 4000)
+    kw = one_block_kwargs(testing.channel_network(0), 4000)
     g0 = meshcore.generate_block(**kw, smooth=False)
     assert meshcore.quality(g0).n_folded > 0
     levels = multigrid.hierarchy(np.asarray(g0.x), np.asarray(g0.y))
@@ -127,7 +117,7 @@ def test_folded_start_grid_keeps_coarsening():
 def test_branched_lake_as_one_block_converges_by_multigrid_to_the_sor_grid(seed):
     """Generated channel networks as one block (~4000 nodes): before line smoothing these
     three stalled and went on with SOR; now the multigrid converges, to SOR's grid."""
-    kw = _one_block(testing.channel_network(seed), 4000)
+    kw = one_block_kwargs(testing.channel_network(seed), 4000)
     mg = meshcore.generate_block(**kw, threads=1, repair="off", method="multigrid", tolerance=1e-11)
     assert mg.converged and mg.info.message == "converged", mg.info.message
     assert multigrid.last_run["lines"]
