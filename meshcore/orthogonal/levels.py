@@ -206,11 +206,10 @@ def _chord_gaps(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _best_on_arc(ring: np.ndarray, cum: np.ndarray, sp: float, d: float, p: np.ndarray, q: np.ndarray):
-    """``(now, best, s, point)`` for a shore node between shore neighbours ``p`` (at arc length
-    ``sp``) and ``q`` (``d`` further along): the largest distance of the shore between them from
-    the node's two edges with the node where it is (``now``: nan, the caller's), and the least
-    such distance over the ring's vertices on that arc as places for the node (``best``), with
-    that vertex's arc length and point."""
+    """``(best, s, point)`` for a shore node between shore neighbours ``p`` (at arc length ``sp``)
+    and ``q`` (``d`` further along): over the ring's vertices on that arc as places for the node,
+    the least of the largest distances of the shore from the node's two edges (``best``), with
+    that vertex's arc length and point; ``(inf, None, None)`` when the arc holds no vertex."""
     idx = _arc(cum, sp, d)
     if len(idx) < 1:
         return np.inf, None, None
