@@ -80,11 +80,11 @@ def tri_energy(px, py, ax, ay, bx, by, eps):
 
 
 @njit(cache=True, nogil=True)
-def _tri_node(px, py, ax, ay, bx, by, role, eps, out):
+def _tri_node(px, py, ax, ay, bx, by, role, eps, out, full=True):
     """Add f, ∇f, ∇²f w.r.t. node ``role`` (0 = p, 1 = a, 2 = b) into ``out``.
 
-    ``out = [E, gx, gy, hxx, hxy, hyy]``.  Returns False if the triangle is
-    inverted under the ε = 0 barrier (energy infinite).
+    ``out = [E, gx, gy, hxx, hxy, hyy]``; ``full=False``: ``f`` alone (a trial point).
+    Returns False if the triangle is inverted under the ε = 0 barrier (energy infinite).
     """
     ux, uy = ax - px, ay - py
     vx, vy = bx - px, by - py
@@ -103,6 +103,9 @@ def _tri_node(px, py, ax, ay, bx, by, role, eps, out):
             return False
         c1 = c / s
         c2 = eps * eps / (2.0 * s * s * s)
+    if not full:
+        out[0] += f2 * (1.0 / c)
+        return True
     if role == 0:
         gfx, gfy, hf = -2.0 * (ux + vx), -2.0 * (uy + vy), 4.0
         gdx, gdy = uy - vy, vx - ux
@@ -135,11 +138,16 @@ def node_local(x, y, i, j, qx, qy, eps, out, periodic=False):
     ``ni`` repeats column 0, and a seam node ``(0, j)`` also belongs to the
     cells of column ``ni − 1`` (as their corner in column ``ni``).
     """
+    return _node_local(x, y, i, j, qx, qy, eps, out, periodic, np.empty(4), np.empty(4), True)
+
+
+@njit(cache=True, nogil=True)
+def _node_local(x, y, i, j, qx, qy, eps, out, periodic, cx, cy, full):
+    """:func:`node_local` with the caller's scratch corners ``cx, cy`` (4 each: no allocation per
+    node); ``full=False`` sums the energy alone (``out[0]``, the same terms in the same order)."""
     ni1, nj1 = x.shape
     for k in range(6):
         out[k] = 0.0
-    cx = np.empty(4)
-    cy = np.empty(4)
     for dc in range(4):
         ci = i - 1 + (dc & 1)
         cj = j - 1 + (dc >> 1)
@@ -171,7 +179,7 @@ def node_local(x, y, i, j, qx, qy, eps, out, periodic=False):
                 t = (m + 1) % 4
             ta = (t + 1) % 4
             tb = (t + 3) % 4
-            if not _tri_node(cx[t], cy[t], cx[ta], cy[ta], cx[tb], cy[tb], r, eps, out):
+            if not _tri_node(cx[t], cy[t], cx[ta], cy[ta], cx[tb], cy[tb], r, eps, out, full):
                 return False
     return True
 
@@ -193,12 +201,14 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
     """
     out = np.empty(6)
     trial = np.empty(6)
+    cx = np.empty(4)
+    cy = np.empty(4)
     dmax = 0.0
     for k in range(nodes.shape[0]):
         i = nodes[k, 0]
         j = nodes[k, 1]
         qx, qy = x[i, j], y[i, j]
-        if not node_local(x, y, i, j, qx, qy, eps, out, periodic):
+        if not _node_local(x, y, i, j, qx, qy, eps, out, periodic, cx, cy, True):
             continue
         e0, gx, gy = out[0], out[1], out[2]
         hxx, hxy, hyy = out[3], out[4], out[5]
@@ -226,7 +236,7 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
         if omega > 1.0:
             nx = qx + omega * sx
             ny = qy + omega * sy
-            if node_local(x, y, i, j, nx, ny, eps, trial, periodic) and trial[0] < e0:
+            if _node_local(x, y, i, j, nx, ny, eps, trial, periodic, cx, cy, False) and trial[0] < e0:
                 x[i, j] = nx
                 y[i, j] = ny
                 if periodic and i == 0:
@@ -239,7 +249,10 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
         for _ in range(30):
             nx = qx + alpha * sx
             ny = qy + alpha * sy
-            if node_local(x, y, i, j, nx, ny, eps, trial, periodic) and trial[0] <= e0 + 1e-4 * alpha * slope:
+            if (
+                _node_local(x, y, i, j, nx, ny, eps, trial, periodic, cx, cy, False)
+                and trial[0] <= e0 + 1e-4 * alpha * slope
+            ):
                 x[i, j] = nx
                 y[i, j] = ny
                 if periodic and i == 0:

@@ -86,6 +86,32 @@ def test_node_gradient_matches_reference(eps):
             assert out[2] == pytest.approx(gy[i, j], rel=1e-9, abs=1e-9 * abs(gy).max())
 
 
+@pytest.mark.kernel
+@pytest.mark.parametrize("eps", [0.0, 1e-3])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_trial_energy_is_the_full_evaluations_energy(eps, periodic):
+    # the sweep's trial points sum the energy alone (no gradient, no Hessian): the same value, bit
+    # for bit, and the same verdict on inverted triangles, at points that invert some of them
+    x, y = random_grid(ni=9, nj=6, amp=0.2, seed=11)
+    if periodic:
+        x[-1, :], y[-1, :] = x[0, :], y[0, :]
+    rng = np.random.default_rng(12)
+    full, trial = np.empty(6), np.empty(6)
+    cx, cy = np.empty(4), np.empty(4)
+    verdicts = set()
+    for i in range(0 if periodic else 1, x.shape[0] - 1):
+        for j in range(1, x.shape[1] - 1):
+            for scale in (0.0, 0.05, 0.3):
+                qx, qy = x[i, j] + scale * rng.standard_normal(), y[i, j] + scale * rng.standard_normal()
+                a = _kernels.node_local(x, y, i, j, qx, qy, eps, full, periodic)
+                b = _kernels._node_local(x, y, i, j, qx, qy, eps, trial, periodic, cx, cy, False)
+                assert a == b
+                verdicts.add(a)
+                if a:
+                    assert trial[0] == full[0]
+    assert verdicts == ({True, False} if eps == 0.0 else {True})
+
+
 @pytest.mark.parametrize("eps", [0.0, 0.02])
 def test_node_hessian_matches_finite_differences(eps):
     x, y = random_grid(seed=5)
