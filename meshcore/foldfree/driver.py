@@ -38,7 +38,9 @@ corner Jacobian is the bilinear Jacobian times the index steps), and only
 cells near the finer boundary need a local repair.  It replaces the grid
 within :data:`TRANSPLANT` cells of the cells still bad (then the seam is
 relaxed), or, if that fails, the whole grid (then relaxed by barrier
-sweeps).  The whole block with a full minimisation per ε is tried on the
+sweeps); on the coarse levels of that recursion the transplant is skipped
+when the level below needed its whole coarse start (:data:`SKIP_TRANSPLANT`).
+The whole block with a full minimisation per ε is tried on the
 coarse levels of that recursion and on grids too small to coarsen; on the
 given grid it never succeeded where the coarse start had failed (15 generated
 one-block shapes, 8 real lakes) and cost 18 s of CPU on a 24 000-node lake,
@@ -101,6 +103,21 @@ SEAM = 4
 #: a lake) whose repair relaxed the whole block: no setting better on all of mean orthogonality,
 #: largest size ratio and least Jacobian ratio; 400 cost up to 4 CPU-s more at 24 000 nodes than 100.
 RELAX_SWEEPS = 100
+#: On a coarse level of the multilevel start (whose grid only starts the finer one), when the coarse
+#: grid below it needed one of these steps (its own whole coarse start, or the whole block), the
+#: places are wider than a transplant: the transplant is not tried, the whole coarse start follows at
+#: once.  repair() on 22 Winslow grids (6 real lakes at 24 000 nodes, 16 generated one-block shapes
+#: at 6000), four runs alternating with the repair without it, CPU, load 7-9: 17.8 -> 14.1,
+#: 17.0 -> 13.8, 19.7 -> 16.1, 17.5 -> 15.4 s in all (Como 3.9-5.6 -> 2.3-2.9 s, Lugano 3.2-4.2 ->
+#: 2.4-2.8, spiral 1.4-1.5 -> 1.1-1.3; Shasta 2.7-2.9 -> 2.4-3.3); the same grids bit for bit on
+#: 18, all 22 as fold-free as before; the four that differ (mean deviation from orthogonality,
+#: largest size ratio, least Jacobian ratio): Shasta 50.7 -> 50.6°, 37 -> 44, 0.016 -> 0.005;
+#: Como 61.0 -> 61.6°, 100 -> 55, 0.008 -> 0.011; Lugano 60.1 -> 60.3°, 805 -> 35, 0.002 ->
+#: 0.004; spiral 71.0 -> 68.3°, 418 -> 295, 0.003 -> 0.007.  On the given grid the transplant is
+#: still tried (it succeeded on a generated network whose coarse grid needed its whole start), and
+#: when the given grid's repair fails from a start built with skips it is tried once more without
+#: them (a 20 × 30 hairpin slot was left with 2 bad cells otherwise).
+SKIP_TRANSPLANT = ("coarse", "whole")
 
 __all__ = [
     "BoundaryCorner",
@@ -226,8 +243,14 @@ def _repair(
     max_sweeps: int = 400,
     strict: bool = False,
     whole: bool,
+    path: list[str] | None = None,
+    skip: bool = True,
 ) -> FoldFreeResult:
-    """:func:`repair`; ``whole``: try the whole block when the coarse start fails (the coarse levels)."""
+    """:func:`repair`; ``whole``: try the whole block when the coarse start fails (the coarse levels);
+    ``path`` gets the step that made the grid valid (``"local"``, ``"transplant"``, ``"coarse"``:
+    the whole coarse start, ``"whole"``) or ``"failed"``, and ``"skip"`` when a coarse level skipped
+    its transplant (``skip``: allowed, see :data:`SKIP_TRANSPLANT`)."""
+    path = [] if path is None else path
     t0 = time.perf_counter()
     x, y, bad, exempt, ex_bits = _prepare(grid)
     before, folded_before = int(bad.sum()), _folded(x, y)
@@ -243,13 +266,20 @@ def _repair(
     cap = TRANSPLANT if coarse else None
     ok, nfree, total = patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, max_radius=cap, **opts)
     how = ""
+    if ok:
+        path.append("local")
     if not ok and coarse:
         # the pieces repaired so far stay; the rest from a coarse-grid start
-        ok, nfree, total = _multilevel(grid, x, y, ex_bits, radius, opts, nfree, total, seam=not whole)
+        ok, nfree, total = _multilevel(
+            grid, x, y, ex_bits, radius, opts, nfree, total, seam=not whole, path=path, skip=skip
+        )
         how = " after a coarse-grid (multilevel) start" if ok else ""
     if not ok and (whole or not coarse):
         ok, nfree, sw = _whole(grid, x, y, ex_bits, opts)
         total += sw
+        path.append("whole" if ok else "failed")
+    elif not ok:
+        path.append("failed")
     origin = f"{grid.info.method} {grid.info.message}".strip()
     if ok:
         msg = (
@@ -294,6 +324,33 @@ def _multilevel(
     total: int,
     *,
     seam: bool,
+    path: list[str],
+    skip: bool,
+) -> tuple[bool, int, int]:
+    """:func:`_multilevel_once`; on the given grid (``seam``), when that fails from a coarse start
+    whose coarse levels skipped their transplant, once more without skipping (a 20 × 30 hairpin
+    slot failed by two cells with the skips, as :data:`SKIP_TRANSPLANT` says)."""
+    xk, yk = x.copy(), y.copy()
+    ok, nf, total = _multilevel_once(grid, x, y, ex_bits, radius, opts, nfree, total, seam=seam, path=path, skip=skip)
+    if ok or not seam or "skip" not in path:
+        return ok, nf, total
+    x[...], y[...] = xk, yk
+    return _multilevel_once(grid, x, y, ex_bits, radius, opts, nfree, total, seam=seam, path=path, skip=False)
+
+
+def _multilevel_once(
+    grid: StructuredGrid,
+    x: np.ndarray,
+    y: np.ndarray,
+    ex_bits: np.ndarray,
+    radius: int,
+    opts: dict,
+    nfree: int,
+    total: int,
+    *,
+    seam: bool,
+    path: list[str],
+    skip: bool,
 ) -> tuple[bool, int, int]:
     """The multilevel stage of :func:`repair`: ``(ok, free nodes, sweeps)``.
 
@@ -307,13 +364,17 @@ def _multilevel(
     by barrier sweeps.  On failure ``x, y`` keep the grid with the fewest bad
     cells.
     """
-    ni, nj = grid.cells
-    start = _coarse_start(grid)
+    start = _coarse_start(grid, skip, path)
     if start is None:
         return False, nfree, total
-    x2, y2 = start
+    x2, y2, wide = start
     bad = invalid_cells(x, y, ex_bits)
     xk, yk = x.copy(), y.copy()
+    best = (int(bad.sum()), xk, yk)
+    if skip and wide and not seam:  # a coarse level whose own coarse start needed more than a
+        # transplant (see SKIP_TRANSPLANT)
+        path.append("skip")
+        return _whole_start(x, y, x2, y2, ex_bits, radius, opts, nfree, total, best, path)
     # (1) the coarse start only around the cells still bad
     region = _dilate(bad, TRANSPLANT, grid.periodic)
     nodes = _nodes_of(region, grid.periodic)
@@ -331,27 +392,50 @@ def _multilevel(
         # relax the seam between the coarse start and the kept grid: barrier sweeps around the region
         if seam:
             total += _relax(x, y, _dilate(region, SEAM, grid.periodic), ex_bits, opts)
+        path.append("transplant")
         return True, nfree + nf, total
-    best = (int(bad.sum()), xk, yk)
     now = int(invalid_cells(x, y, ex_bits).sum())
     if now < best[0]:
         best = (now, x.copy(), y.copy())
-    # (2) the whole coarse start
+    return _whole_start(x, y, x2, y2, ex_bits, radius, opts, nfree, total, best, path)
+
+
+def _whole_start(
+    x: np.ndarray,
+    y: np.ndarray,
+    x2: np.ndarray,
+    y2: np.ndarray,
+    ex_bits: np.ndarray,
+    radius: int,
+    opts: dict,
+    nfree: int,
+    total: int,
+    best: tuple,
+    path: list[str],
+) -> tuple[bool, int, int]:
+    """Step (2) of :func:`_multilevel`: the whole coarse start ``x2, y2``, its bad cells repaired
+    locally, the block relaxed; on failure ``x, y`` become ``best`` (``(bad cells, x, y)``) unless
+    the coarse start has fewer bad cells."""
     x[...], y[...] = x2, y2
-    ok, nf, sw = patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=radius, max_fraction=0.3, **opts)
+    ok, _, sw = patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=radius, max_fraction=0.3, **opts)
     total += sw
     if ok:
         # the prolonged grid is piecewise bilinear: relax it on the whole block
-        whole = np.ones((ni, nj), dtype=bool)
-        return True, len(_nodes_of(whole, grid.periodic)), total + _relax(x, y, whole, ex_bits, opts)
+        whole = np.ones((x.shape[0] - 1, x.shape[1] - 1), dtype=bool)
+        path.append("coarse")
+        return True, len(_nodes_of(whole, opts["periodic"])), total + _relax(x, y, whole, ex_bits, opts)
     now = int(invalid_cells(x, y, ex_bits).sum())
     if now >= best[0]:
         x[...], y[...] = best[1], best[2]
     return False, nfree, total
 
 
-def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
-    """Multilevel start: every second grid line, Winslow + repair there, bilinear prolongation.
+def _coarse_start(
+    grid: StructuredGrid, skip: bool = True, path: list[str] | None = None
+) -> tuple[np.ndarray, np.ndarray, bool] | None:
+    """Multilevel start: every second grid line, Winslow + repair there, bilinear prolongation;
+    ``(x, y, wide)``, ``wide``: the coarse grid's repair was one of :data:`SKIP_TRANSPLANT`
+    (``skip``: its coarse levels may skip their transplant; ``path`` gets ``"skip"`` if one did).
 
     Inside a convex coarse cell the bilinear map is injective and its
     iso-lines are straight, so the fine cells it creates are convex (their
@@ -365,7 +449,10 @@ def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
     ic = np.unique(np.r_[np.arange(0, ni + 1, 2), ni])
     jc = np.unique(np.r_[np.arange(0, nj + 1, 2), nj])
     gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)], periodic=grid.periodic))
-    res = _repair(gc, whole=True)
+    below: list[str] = []
+    res = _repair(gc, whole=True, path=below, skip=skip)
+    if path is not None and "skip" in below:
+        path.append("skip")
     if not res.ok:
         return None
     xc, yc = res.grid.x, res.grid.y
@@ -388,7 +475,7 @@ def _coarse_start(grid: StructuredGrid) -> tuple[np.ndarray, np.ndarray] | None:
         z = (1 - u) * (1 - v) * a00 + u * (1 - v) * a10 + u * v * a11 + (1 - u) * v * a01
         z[0, :], z[-1, :], z[:, 0], z[:, -1] = f[0, :], f[-1, :], f[:, 0], f[:, -1]
         out.append(np.ascontiguousarray(z))
-    return out[0], out[1]
+    return out[0], out[1], bool(below) and below[-1] in SKIP_TRANSPLANT
 
 
 def smooth(

@@ -116,3 +116,33 @@ def test_pieces_grow_no_wider_than_max_radius(monkeypatch):
     tried.clear()
     ok, _, _ = mm.patches(x.copy(), y.copy(), bad, ex, radius=2, max_fraction=0.3, **opts)
     assert not ok and max(abs(i - 60).max() for i in tried) > 8 + 1
+
+
+@pytest.mark.parametrize(("wide", "seam"), [(True, False), (True, True), (False, False)])
+def test_a_coarse_level_goes_to_the_whole_start_when_the_level_below_needed_it(monkeypatch, wide, seam):
+    # the coarse start's own repair needed its whole coarse start ("wide"): on a coarse level
+    # (seam=False: its grid is only the start of the finer one) the transplant is not tried; on the
+    # given grid (seam=True), or when the level below was repaired by a transplant, it is
+    import meshcore.foldfree.driver as dr
+
+    x, y = _rectangle(40, 20)
+    x2, y2 = x.copy(), y.copy()  # a valid coarse start
+    x[10, 10] += 0.6
+    ex = np.zeros((40, 20), dtype=np.uint8)
+    assert invalid_cells(x, y).any()
+    monkeypatch.setattr(dr, "_coarse_start", lambda grid, *a: (x2.copy(), y2.copy(), wide))
+    radii = []
+    real = dr.patches
+
+    def spy(*args, **kw):
+        radii.append(kw.get("max_radius"))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(dr, "patches", spy)
+    path: list[str] = []
+    opts = {"tolerance": 1e-4, "max_sweeps": 400, "periodic": False}
+    ok, _, _ = dr._multilevel(StructuredGrid(x, y), x, y, ex, 2, opts, 0, 0, seam=seam, path=path, skip=True)
+    assert ok and not invalid_cells(x, y).any()
+    skipped = wide and not seam
+    assert (dr.TRANSPLANT in radii) is not skipped
+    assert path == (["skip", "coarse"] if skipped else ["transplant"])
