@@ -142,10 +142,9 @@ def _island_cuts(face, sigma: float | None = None, existing=()) -> list[np.ndarr
 
     Candidates leave the island at 32 points round it and go to the nearest point of every
     other ring; the shortest one that the water covers is the first cut, the shortest one
-    leaving from the island's far half (seen from the first) is the second.
+    leaving from the island's far half (seen from the first) is the second (:func:`_second_cut`:
+    not alongside the first nor a chord near the island).
     """
-    from shapely.geometry import LineString, Point
-    from shapely.ops import nearest_points
 
     rings = [face.exterior, *face.interiors]
     room = face.buffer(1e-9 * math.sqrt(face.area))
@@ -153,25 +152,9 @@ def _island_cuts(face, sigma: float | None = None, existing=()) -> list[np.ndarr
     for k in range(1, len(rings)):
         hole = rings[k]
         starts = [hole.interpolate(f, normalized=True) for f in np.linspace(0.0, 1.0, 32, endpoint=False)]
-        cand = []
-        for p in starts:
-            for j, other in enumerate(rings):
-                if j == k:
-                    continue
-                _, q = nearest_points(p, other)
-                seg = LineString([p.coords[0], q.coords[0]])
-                if seg.length > 0 and room.covers(seg) and not any(seg.crosses(LineString(c)) for c in cuts):
-                    cand.append((seg.length, np.asarray(seg.coords)))
+        cand = [s for p in starts for s in _sights(p, k, rings, room, cuts)]
         if not cand:  # round a bend: the nearest points are not in sight; try the other rings' vertices
-            for p in starts:
-                for j, other in enumerate(rings):
-                    if j == k:
-                        continue
-                    verts = np.asarray(other.coords)[:-1]
-                    for v in verts[:: max(1, len(verts) // 64)]:
-                        seg = LineString([p.coords[0], tuple(v)])
-                        if seg.length > 0 and room.covers(seg):
-                            cand.append((seg.length, np.asarray(seg.coords)))
+            cand = [s for p in starts for s in _sights(p, k, rings, room, cuts, 64)]
         if not cand:
             continue
         cand.sort(key=lambda t: t[0])
@@ -180,22 +163,69 @@ def _island_cuts(face, sigma: float | None = None, existing=()) -> list[np.ndarr
             cand = _apart(cand, [*existing, *cuts], 2 * sigma) or cand
         first = cand[0][1]
         cuts.append(first)
-        c = np.asarray(hole.centroid.coords[0])
-        d = first[0] - c
-        others = [seg for _, seg in cand if not LineString(seg).intersects(LineString(first))]
-        far = [
-            seg
-            for seg in others
-            if float(np.dot(seg[0] - c, d)) < 0 and not LineString(seg).intersects(Point(first[1]))
-        ]
-        if sigma is not None:  # not alongside the first: the strip between them would be a sliver
-            apart = [seg for _, seg in _apart([(0.0, seg) for seg in others], [first], 2 * sigma)]
-            far = [seg for seg in far if any(seg is a for a in apart)] or apart or far
-        if not far:  # no cut on the far side: any other that leaves the first cut alone
-            far = others
-        if far:
-            cuts.append(far[0])
+        second = _second_cut(first, hole, cand, (starts, k, rings, room, cuts), [*existing, *cuts], sigma)
+        if second is not None:
+            cuts.append(second)
     return cuts
+
+
+def _second_cut(first, hole, cand, sight, earlier, sigma):
+    """The second cut that frees an island, ``first`` being the first: the shortest of ``cand``
+    leaving from the island's far half (seen from ``first``) that keeps ``2 sigma`` from
+    ``first`` and from the ``earlier`` cuts near the island (chords, the cuts of other islands):
+    not alongside one, where the strip between would be a sliver block.  Where no
+    nearest-point candidate does (an island near one side of a wide region sees only that
+    side), the candidates to the rings' vertices (``sight``: the arguments of :func:`_sights`);
+    then, as before, any that keeps the gap, any on the far half, any other."""
+    from shapely.geometry import LineString, Point
+
+    c = np.asarray(hole.centroid.coords[0])
+    d = first[0] - c
+    line = LineString(first)
+
+    def away(seg) -> bool:
+        return float(np.dot(seg[0] - c, d)) < 0 and not LineString(seg).intersects(Point(first[1]))
+
+    others = [seg for _, seg in cand if not LineString(seg).intersects(line)]
+    far = [seg for seg in others if away(seg)]
+    if sigma is None:
+        return (far or others or [None])[0]
+    reach = max((L for L, _ in cand), default=0.0) + 2 * sigma  # the cuts a candidate can lie beside
+    beside = [first, *(e for e in earlier if hole.distance(LineString(e)) < reach)]
+    apart = [seg for _, seg in _apart([(0.0, seg) for seg in others], beside, 2 * sigma)]
+    good = [seg for seg in far if any(seg is a for a in apart)]
+    if not apart:  # every nearest-point cut lies beside one: the rings' vertices
+        starts, k, rings, room, cuts = sight
+        more = sorted((t for p in starts for t in _sights(p, k, rings, room, cuts, 64)), key=lambda t: t[0])
+        more = [(L, seg) for L, seg in more if not LineString(seg).intersects(line)]
+        apart = [seg for _, seg in _apart(_without_wedges(more, hole, rings, sigma) or more, beside, 2 * sigma)]
+        good = [seg for seg in apart if away(seg)]
+    far = good or apart or far or others
+    return far[0] if far else None
+
+
+def _sights(p, k: int, rings, room, cuts, step: int | None = None) -> list:
+    """(length, segment) from the point ``p`` of ring ``k`` to the other rings, the segments that
+    ``room`` covers and that cross none of ``cuts``: to the nearest point of each ring (``step``
+    None), or to every ``len / step``-th vertex of each (round a bend, where the nearest points
+    are out of sight)."""
+    from shapely.geometry import LineString
+    from shapely.ops import nearest_points
+
+    out = []
+    for j, other in enumerate(rings):
+        if j == k:
+            continue
+        if step is None:
+            ends = [nearest_points(p, other)[1].coords[0]]
+        else:
+            verts = np.asarray(other.coords)[:-1]
+            ends = [tuple(v) for v in verts[:: max(1, len(verts) // step)]]
+        for q in ends:
+            seg = LineString([p.coords[0], q])
+            if seg.length > 0 and room.covers(seg) and not any(seg.crosses(LineString(c)) for c in cuts):
+                out.append((seg.length, np.asarray(seg.coords)))
+    return out
 
 
 def _without_wedges(cand: list, hole, rings, sigma: float) -> list:
