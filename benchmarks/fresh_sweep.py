@@ -5,11 +5,12 @@ the layout was checked on them: a rule can fit those shapes and fail on the next
 :func:`meshcore.mesh_outline` (default options, or ``--regular``) on the same families of
 :mod:`meshcore.testing` — channel networks (also with arms narrower than two cells and rough
 shores), lobed lakes with six to ten islands, round lakes with islands, jagged networks, a tight
-spiral — with seeds from ``--base`` (default: a new random base, printed, so that a run can be
-repeated), and prints one row per shape, the issue-12 targets met, and every error: a
-``MeshcoreError`` (a clear message, allowed) or anything else (a bug)::
+spiral (with ``--more``: headlands, dendritic reservoirs, thin peninsulas, small islands, shores
+sampled densely or coarsely, :func:`more_cases`) — with seeds from ``--base`` (default: a new
+random base, printed, so that a run can be repeated), and prints one row per shape, the
+issue-12 targets met, and every error: a ``MeshcoreError`` (a clear message, allowed) or anything else (a bug)::
 
-    python benchmarks/fresh_sweep.py [--base N] [--cells 15000] [--regular] [--json OUT]
+    python benchmarks/fresh_sweep.py [--base N] [--cells 15000] [--regular] [--more] [--json OUT]
 """
 
 from __future__ import annotations
@@ -56,6 +57,35 @@ def cases(base: int) -> dict[str, str]:
     return out
 
 
+def more_cases(base: int) -> dict[str, str]:
+    """The ``--more`` set: what a real lake has and :func:`cases` does not — rounded headlands
+    with islands off their tips, dendritic reservoirs (arms under two cells wide, long thin
+    ridges), islands near the shore and each other, thin peninsulas, and shores sampled
+    densely (12 000 points) or coarsely (20 points)."""
+    out: dict[str, str] = {}
+    for k in range(6):
+        s = base + 600 + k
+        out[f"headlands {s}"] = f"testing.headlands({s}, n={6 + k % 5})"
+        s = base + 700 + k
+        out[f"dendritic {s}"] = f"testing.dendritic({s})"
+    for k in range(4):
+        s = base + 800 + k
+        out[f"peninsulas {s}"] = f"testing.small_islands({s}, n_islands=4, peninsulas=4, widths=(0.5, 3.0))"
+    for k in range(3):
+        s = base + 850 + k
+        out[f"small islands {s}"] = f"testing.small_islands({s}, n_islands=10)"
+    for k in range(2):
+        s = base + 900 + k
+        out[f"dense islands {s}"] = f"testing.resampled(testing.lake_with_islands({s}, n_islands=6), 12000)"
+        s = base + 910 + k
+        out[f"dense net {s}"] = f"testing.resampled(testing.channel_network({s}, n_branches=5), 12000)"
+        s = base + 920 + k
+        out[f"coarse round {s}"] = f"testing.resampled(testing.round_lake({s}, kind='blob', n_islands=2), 20)"
+        s = base + 930 + k
+        out[f"coarse net {s}"] = f"testing.resampled(testing.channel_network({s}, n_branches=3, width=(1.0, 2.0)), 20)"
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     from meshcore.errors import MeshcoreError
 
@@ -64,6 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cells", type=int, default=15000)
     ap.add_argument("--regular", action="store_true", help="Delft3D domain-decomposition layouts")
     ap.add_argument("--json", help="write the results here")
+    ap.add_argument("--more", action="store_true", help="the other set (more_cases): headlands, dendritic, ...")
     a = ap.parse_args(argv)
     base = a.base if a.base is not None else random.SystemRandom().randrange(10_000, 1_000_000, 1000)
     options = {"regular": True} if a.regular else {}
@@ -71,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     print(interface_sweep.HEAD)
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     res: dict[str, dict] = {}
-    todo = cases(base)
+    todo = more_cases(base) if a.more else cases(base)
     for name, expr in todo.items():
         t = time.process_time()
         try:

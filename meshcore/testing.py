@@ -12,6 +12,12 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
 * :func:`small_islands` — islands from a third of a cell to five cells across, thin, bent,
   near the shore and each other;
 * :func:`spiral` — a channel wound round more than once;
+* :func:`headlands` — a basin whose shore has rounded headlands and bays of many sizes, some
+  with islands off their tips (the shores of rift and drowned-valley lakes);
+* :func:`dendritic` — a reservoir behind a dam: a main valley whose side valleys branch again,
+  narrowing with each order down to arms under two cells wide, long thin ridges between them;
+* :func:`resampled` — any of them with its shore sampled densely (10 000+ points) or coarsely
+  (20 points): the same water as an outline from another source;
 * :func:`y_junction`, :func:`straight_channel`, :func:`rectangle_with_hole` — the textbook cases.
 
 >>> from meshcore.testing import channel_network
@@ -28,10 +34,13 @@ import numpy as np
 
 __all__ = [
     "channel_network",
+    "dendritic",
+    "headlands",
     "jagged",
     "jagged_cells",
     "lake_with_islands",
     "rectangle_with_hole",
+    "resampled",
     "small_islands",
     "spiral",
     "straight_channel",
@@ -364,3 +373,132 @@ def small_islands(
             continue
         holes.append(isl)
     return _clean(Polygon(outer.exterior, [g.exterior for g in holes]))
+
+
+def headlands(seed: int, *, radius: float = 10.0, n: int = 8, islands: int = 3):
+    """A round basin whose shore has ``n`` rounded headlands and bays: ridges of land with round
+    tips, 4–15 % of the radius wide, reaching 15–45 % of the radius into the water from random
+    places of the shore, and as many round bays of 10–30 % of the radius pushed out of it; up to
+    ``islands`` round islands off the headlands' tips (4–12 % of the radius, a few percent of it
+    from the tip).  The water then turns 180° round every tip: cut lines there must not fan.
+    """
+    import shapely
+    from shapely.geometry import LineString, Point, Polygon
+
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 2 * math.pi, 360, endpoint=False)
+    r = np.ones_like(t)
+    for k in range(2, 5):
+        r += rng.uniform(0.0, 0.15 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
+    r *= radius / r.max()
+    water = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    for _ in range(n):  # bays first: pushed out of the basin
+        a = rng.uniform(0, 2 * math.pi)
+        rb = rng.uniform(0.1, 0.3) * radius
+        p = np.asarray(
+            water.exterior.interpolate(
+                water.exterior.project(Point(radius * math.cos(a), radius * math.sin(a)))
+            ).coords[0]
+        )
+        water = shapely.union_all(
+            [water, Point(*(p * (1 + 0.5 * rb / max(np.hypot(*p), 1e-9)))).buffer(rb, quad_segs=16)]
+        )
+        water = Polygon(max(getattr(water, "geoms", [water]), key=lambda g: g.area).exterior)
+    tips = []
+    for _ in range(n):  # headlands: ridges of land with round tips
+        w = rng.uniform(0.04, 0.15) * radius
+        p = np.asarray(water.exterior.interpolate(rng.uniform(0, water.exterior.length)).coords[0])
+        inward = -p / max(np.hypot(*p), 1e-9)
+        turn = rng.uniform(-0.7, 0.7)
+        d = np.array(
+            [
+                inward[0] * math.cos(turn) - inward[1] * math.sin(turn),
+                inward[0] * math.sin(turn) + inward[1] * math.cos(turn),
+            ]
+        )
+        length = rng.uniform(0.15, 0.45) * radius
+        ridge = LineString([p - 2.0 * w * d, p + length * d]).buffer(0.5 * w, quad_segs=16)
+        cut = water.difference(ridge)
+        parts = [g for g in getattr(cut, "geoms", [cut]) if g.geom_type == "Polygon"]
+        water = Polygon(max(parts, key=lambda g: g.area).exterior)
+        tips.append((p + length * d, d, w))
+    body = water.buffer(-0.02 * radius)
+    holes: list[Polygon] = []
+    for tip, d, w in tips[: 2 * islands]:
+        if len(holes) >= islands:
+            break
+        size = rng.uniform(0.04, 0.12) * radius
+        c = tip + d * (0.5 * w + rng.uniform(0.02, 0.08) * radius + size)
+        isl = Point(*c).buffer(size, quad_segs=12)
+        if body.contains(isl) and all(isl.distance(o) > 0.03 * radius for o in holes):
+            holes.append(isl)
+    return _clean(Polygon(water.exterior, [g.exterior for g in holes]))
+
+
+def dendritic(seed: int, *, orders: int = 4, width: float = 2.0, length: float = 24.0, narrow: float = 0.06):
+    """A dendritic reservoir: a main valley ``width`` wide and ``length`` long whose side valleys
+    (2–4 per valley, leaving at 30–80° from either bank) branch again for ``orders`` orders, each
+    order 0.35–0.6 times as wide and 0.3–0.5 times as long as its parent, every valley tapering
+    to 60 % of its width at its head and meandering a little.  With the defaults the last order
+    is 0.09–0.43 wide, and 60 % of that at its head (``narrow``: a floor): at 15 000 cells
+    (h ≈ 0.07) many arms are under two cells wide; the land between neighbouring side valleys
+    is a long thin ridge.
+    """
+    import shapely
+    from shapely.geometry import LineString
+
+    rng = np.random.default_rng(seed)
+    pieces = []
+
+    def valley(start: np.ndarray, heading: float, w: float, L: float, order: int) -> None:
+        n_seg = 6
+        pts = [start]
+        ang = heading
+        for _ in range(n_seg):
+            ang += math.radians(rng.uniform(-15.0, 15.0))
+            pts.append(pts[-1] + (L / n_seg) * np.array([math.cos(ang), math.sin(ang)]))
+        line = LineString(pts)
+        # a tapering valley: buffered pieces of decreasing width
+        for k in range(n_seg):
+            wk = max(narrow, w * (1.0 - 0.4 * (k + 0.5) / n_seg))
+            pieces.append(LineString(pts[k : k + 2]).buffer(0.5 * wk, quad_segs=6))
+        if order >= orders:
+            return
+        for _ in range(int(rng.integers(2, 5))):
+            f = rng.uniform(0.15, 0.85)
+            q = np.asarray(line.interpolate(f, normalized=True).coords[0])
+            k = min(int(f * n_seg), n_seg - 1)
+            seg = np.subtract(pts[k + 1], pts[k])
+            base = math.atan2(seg[1], seg[0])
+            side = 1.0 if rng.uniform() < 0.5 else -1.0
+            valley(
+                q,
+                base + side * math.radians(rng.uniform(30.0, 80.0)),
+                w * rng.uniform(0.35, 0.6),
+                L * rng.uniform(0.3, 0.5),
+                order + 1,
+            )
+
+    valley(np.zeros(2), rng.uniform(0, 2 * math.pi), width, length, 1)
+    water = shapely.union_all(pieces).buffer(0.02 * narrow, quad_segs=2).buffer(-0.02 * narrow, quad_segs=2)
+    return _clean(water, min_hole_area=(2 * width) ** 2)
+
+
+def resampled(poly, points: int | None = None, *, spacing: float | None = None):
+    """``poly`` with every ring sampled anew: ``points`` points on the outer shore at equal arc
+    length (islands in proportion to their length, at least 8 each), or one every ``spacing``.
+    Dense (10 000+ points: an outline from a survey) or coarse (20 points: a sketch); coarse
+    sampling cuts corners, so the water changes a little, as it does between two sources.
+    """
+    from shapely.geometry import Polygon
+
+    L0 = poly.exterior.length
+    step = spacing if spacing is not None else L0 / float(points or 1000)
+
+    def ring(r, least: int) -> np.ndarray:
+        n = max(least, round(r.length / step))
+        return np.asarray([r.interpolate(f, normalized=True).coords[0] for f in np.arange(n) / n])
+
+    outer = ring(poly.exterior, 4)
+    holes = [ring(h, 8) for h in poly.interiors]
+    return _clean(Polygon(outer, [h for h in holes if Polygon(h).is_valid]))
