@@ -46,6 +46,7 @@ _CHILD = r"""
 import json, sys, time
 import numpy as np
 from meshcore import testing
+from meshcore.cellsize import default_cell_size
 from meshcore.cli.mesh import local_frame
 from meshcore.io import read_points
 from meshcore.lakegrid import mesh_outline
@@ -64,7 +65,7 @@ c1 = time.process_time()
 mb = mesh_outline(poly, target_cells=cells)
 t2 = time.perf_counter()
 c2 = time.process_time()
-m = lake_metrics(mb, polygon=poly)
+m = lake_metrics(mb, polygon=poly, cell_size=default_cell_size(poly.area, cells))  # the layout's h, as the CLI
 s = m.summary()
 v = m.values("interface_ratio")
 s.update(target_cells=cells, read_s=t1 - t0, mesh_s=t2 - t1, cpu_s=c2 - c1, islands=len(poly.interiors),
