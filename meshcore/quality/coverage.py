@@ -20,10 +20,14 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   stays in the Hausdorff distance.  The area of either is counted: the grid
   area includes the water over it, so the area ratio rises by its share;
 * ``hausdorff_as_given`` — the same with the shore's spikes of water or land
-  narrower than half a cell included.  The layout smooths those out on purpose
-  (:func:`meshcore.layout.polygon.without_slivers`, with a note: no grid line can
-  follow them without folding a cell), so ``hausdorff`` leaves the shore points
-  on them out; the table shows both where they differ;
+  narrower than half a cell, and its dead-end arms narrower than two cells,
+  included.  The layout smooths the former out and leaves the latter out on
+  purpose (:func:`meshcore.layout.polygon.without_slivers`,
+  :func:`meshcore.layout.shore.without_narrow_arms`, each with a note: no grid
+  line can follow a spike without folding a cell, an arm gets cells hundreds of
+  times longer than wide), so ``hausdorff`` leaves the shore points on them out
+  (the arms by the layout's rule: pass its cell size); the table shows both
+  where they differ;
 * ``island_cells`` — cells whose centre lies on land: inside an island the
   grid goes round (a narrow end of it that a block side cut across, say), or
   beyond the outer shore (across a narrow peninsula) — per island (its number;
@@ -114,8 +118,9 @@ class Coverage:
     side: str  # "grid" (a grid boundary point far from the shore) or "shore"
     islands_covered: tuple[CoveredIsland, ...] = ()
     island_cells: tuple[tuple[int, int, float, float, float], ...] = ()  # (island, cells, depth, x, y)
-    #: the Hausdorff distance to the shore as given, its spikes narrower than half a cell included
-    #: (``hausdorff`` leaves them out: the layout smooths them out on purpose, with a note)
+    #: the Hausdorff distance to the shore as given, its spikes narrower than half a cell and arms
+    #: narrower than two cells included (``hausdorff`` leaves them out: the layout smooths and
+    #: leaves them out on purpose, with a note)
     hausdorff_as_given: float = math.nan
 
     @property
@@ -185,9 +190,10 @@ class Coverage:
             return []
         return [
             (
-                "shoreline distance, spikes included",
+                "shoreline distance, spikes included (and narrow arms)",
                 f"{self.hausdorff_as_given / self.cell_size:.3g} cells",
-                "spikes of the shore narrower than half a cell, smoothed out by the layout on purpose",
+                "spikes of the shore narrower than half a cell and arms narrower than two cells, "
+                "smoothed out and left out by the layout on purpose",
             )
         ]
 
@@ -316,12 +322,20 @@ def coverage(
     gb, sb = union.boundary, shapely.union_all(rims)
     step = h / 10.0
     gp, sp = _boundary_points(gb, step), _boundary_points(sb, step)
+    d_grid_given, _ = _directed(gp, sb)
+    d_given, _ = _directed(sp, gb)
+    # the dead-end arms narrower than two cells, which the layout leaves out on purpose
+    # (:func:`meshcore.layout.shore.without_narrow_arms`, its rule at this cell size, with a note):
+    # measured against the water without them, whose shore crosses their mouths
+    water = _without_narrow_arms(poly, h)
+    if water is not poly:
+        sb = shapely.union_all(_islands(water, union, h)[1])
+        sp = _boundary_points(sb, step)
     d_grid, kg = _directed(gp, sb)
     # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
     # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart
-    spikes = _spikes(poly, h)
+    spikes = _spikes(water, h)
     keep = ~shapely.contains_xy(spikes, sp[:, 0], sp[:, 1]) if spikes is not None else np.ones(len(sp), bool)
-    d_given, _ = _directed(sp, gb)
     d_shore, ks = _directed(sp[keep], gb) if keep.any() else (0.0, 0)
     sp = sp[keep] if keep.any() else sp
     if d_grid >= d_shore:
@@ -338,7 +352,7 @@ def coverage(
         side=side,
         islands_covered=covered,
         island_cells=_cells_on(poly, land, grids, h),
-        hausdorff_as_given=max(d_grid, d_given),
+        hausdorff_as_given=max(d_grid_given, d_given),
     )
 
 
@@ -371,6 +385,16 @@ def _spikes(poly: Any, h: float) -> Any:
     inside), or None."""
     clean = without_spikes(poly, 0.5 * h)
     return None if clean is None else poly.symmetric_difference(clean).buffer(1e-3 * h)
+
+
+def _without_narrow_arms(poly: Any, h: float) -> Any:
+    """``poly`` without the dead-end arms narrower than two cells that the layout leaves out of
+    the grid (:func:`meshcore.layout.shore.without_narrow_arms`: its own rule at the same cell
+    size), or ``poly`` itself when it has none."""
+    from ..layout.shore import without_narrow_arms
+
+    kept, notes = without_narrow_arms(poly, h)
+    return kept if notes else poly
 
 
 def _land(k: int) -> str:

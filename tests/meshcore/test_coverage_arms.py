@@ -1,0 +1,44 @@
+"""The shoreline distance leaves out the dead-end arms narrower than two cells that the layout
+leaves out on purpose (:func:`meshcore.layout.shore.without_narrow_arms`, with a note), measured
+against the water without them (its shore crosses their mouths), as it leaves out spikes narrower
+than half a cell; the distance to the shore as given keeps them (``hausdorff_as_given``).  The
+rule is the layout's at the cell size given: an arm the layout would keep stays in."""
+
+from __future__ import annotations
+
+import pytest
+import shapely
+from shapely.geometry import LineString, box
+
+from meshcore import testing
+from meshcore.cellsize import default_cell_size
+from meshcore.lakegrid import mesh_outline
+from meshcore.quality import lake_metrics
+
+CELLS = 2000
+
+
+@pytest.fixture(scope="module")
+def arm_lake():
+    """A 10 × 3 basin with a dead-end arm 0.16 wide (1.3 cells at 2000 cells) and 3 long."""
+    arm = LineString([(5.0, 2.9), (5.5, 6.0)]).buffer(0.08, cap_style="flat")
+    poly = testing._clean(shapely.union_all([box(0.0, 0.0, 10.0, 3.0), arm]))
+    return poly, mesh_outline(poly, target_cells=CELLS)
+
+
+def test_an_arm_the_layout_leaves_out_is_measured_apart(arm_lake):
+    poly, mb = arm_lake
+    assert any("narrower than two cells: left out" in n for n in mb.notes)
+    h = default_cell_size(poly.area, CELLS)  # the layout's
+    cov = lake_metrics(mb, polygon=poly, cell_size=h).coverage
+    assert cov.hausdorff_cells <= 0.5
+    assert cov.hausdorff_as_given / h > 20  # the arm's head, 3 long, is as far from the grid as that
+    assert any("spikes included" in r[0] for r in cov.rows())
+
+
+def test_an_arm_wide_enough_at_the_cell_size_given_stays_in(arm_lake):
+    poly, mb = arm_lake
+    h = default_cell_size(poly.area, CELLS) / 3  # at this size the layout keeps the arm
+    cov = lake_metrics(mb, polygon=poly, cell_size=h).coverage
+    assert cov.hausdorff_cells > 20 * 3
+    assert cov.hausdorff == pytest.approx(cov.hausdorff_as_given)
