@@ -194,7 +194,7 @@ def _second_cut(first, hole, cand, sight, earlier, sigma):
     beside = [first, *(e for e in earlier if hole.distance(LineString(e)) < reach)]
     apart = [seg for _, seg in _apart([(0.0, seg) for seg in others], beside, 2 * sigma)]
     good = [seg for seg in far if any(seg is a for a in apart)]
-    if not apart:  # every nearest-point cut lies beside one: the rings' vertices
+    if others and not apart:  # every nearest-point cut lies beside one: the rings' vertices
         starts, k, rings, room, cuts = sight
         more = sorted((t for p in starts for t in _sights(p, k, rings, room, cuts, 64)), key=lambda t: t[0])
         more = [(L, seg) for L, seg in more if not LineString(seg).intersects(line)]
