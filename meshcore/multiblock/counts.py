@@ -22,6 +22,8 @@ with :func:`scipy.optimize.milp` (HiGHS).  Each block side's constraint couples 
 chains around it, so the programs are small (tens to hundreds of unknowns); with every
 ``|.|`` term's convex hull written in (:data:`HULL_CUTS`) a hundred blocks take about a second.
 Optionally every count is a multiple of ``multiple`` (2**k lets a multigrid coarsen k times).
+When every block's cells are given, most chains are forced and the few solutions are searched
+instead (:mod:`.countsearch`, :data:`SEARCH`).
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ import numpy as np
 
 from ..errors import TopologyError
 
-__all__ = ["solve_counts"]
+__all__ = ["objective", "solve_counts"]
 
 #: Spacings that meet (two chains in a row along a block side, two blocks across their
 #: interface) may differ by this factor before the program pays for it ...
@@ -59,6 +61,10 @@ TIME_LIMIT = 600.0
 #: channel networks of 44/84/124 blocks 0.54/1.27/8.7 s of CPU without them, 0.13/0.51/1.35 s
 #: with them, the same counts.  False: the plain program (the tests' oracle).
 HULL_CUTS = True
+#: With every block's cells given (a case's blocks), search the solutions (:mod:`.countsearch`)
+#: for the least :func:`objective` when there are few, instead of HiGHS (the same optimum, and
+#: mostly the same counts where several are as good).  False: always HiGHS (the tests' oracle).
+SEARCH = True
 
 
 def _jump_pairs(t: np.ndarray, sides, least: float = 1.0) -> list[tuple[list[int], float, list[int], float]]:
@@ -90,6 +96,41 @@ def _jump_pairs(t: np.ndarray, sides, least: float = 1.0) -> list[tuple[list[int
             (a, ta), (b, tb) = users
             out.append((a, float(ta), b, float(tb)))
     return out
+
+
+def objective(t: np.ndarray, sides, jumps: list[tuple[list[int], float, list[int], float]], short):
+    """The program's objective as a function of integer counts (rows: candidates that meet its
+    constraints; returns one cost per row): each ``|.|`` and excess term of :func:`solve_counts`
+    at its value, with ``jumps`` from :func:`_jump_pairs` and ``short`` the ``(chain, least)``
+    pairs.  For :mod:`.countsearch`, which minimises it; the sums over chains are matrices made
+    once (a layout of 37 blocks: ~300 pairs)."""
+    nc, nb, npair = len(t), len(sides), len(jumps)
+    across, mean = np.zeros((nc, 2 * nb)), np.zeros(2 * nb)  # a block's count in each direction
+    for bi, (bottom, right, top, left) in enumerate(sides):
+        for d, (a, b) in enumerate(((bottom, top), (left, right))):
+            np.add.at(across[:, 2 * bi + d], list(a), 1.0)
+            mean[2 * bi + d] = 0.5 * (t[list(a)].sum() + t[list(b)].sum())
+    dens1, dens2, w = np.zeros((nc, npair)), np.zeros((nc, npair)), np.zeros(npair)  # densities that meet
+    for p, (ca, ta, cb, tb) in enumerate(jumps):
+        np.add.at(dens1[:, p], ca, 1.0 / ta)
+        np.add.at(dens2[:, p], cb, 1.0 / tb)
+        w[p] = min(ta, tb)
+    held = np.array([c for c, _ in short], dtype=int)
+    want = np.array([v for _, v in short], dtype=float)
+
+    def cost(n: np.ndarray) -> np.ndarray:
+        n = np.atleast_2d(n).astype(float)
+        x1, x2 = n @ dens1, n @ dens2
+        excess = np.maximum(0.0, w * np.maximum(x1 - JUMP * x2, x2 - JUMP * x1))
+        return (
+            -1e-3 * n.sum(axis=1)
+            + 0.25 * np.abs(n - t).sum(axis=1)
+            + np.abs(n @ across - mean).sum(axis=1)
+            + JUMP_WEIGHT * excess.sum(axis=1)
+            + LEAST_WEIGHT * np.maximum(0.0, want - n[:, held]).sum(axis=1)
+        )
+
+    return cost
 
 
 def solve_counts(
@@ -134,7 +175,7 @@ def solve_counts(
     TopologyError
         When no integer solution exists (e.g. fixed counts that contradict each other).
     """
-    from scipy.optimize import LinearConstraint, milp
+    from .countsearch import best_counts
 
     t = np.asarray(targets, dtype=float)
     n = len(t)
@@ -142,6 +183,17 @@ def solve_counts(
     m = int(multiple)
     jumps = _jump_pairs(t, sides, least=float(max(m, 1)))
     short = [] if least is None else [(c, float(v)) for c, v in enumerate(least) if v > m]
+    for v in (fixed or {}).values():
+        if v % m:
+            raise TopologyError(f"a fixed count {v} is not a multiple of {m}")
+    if SEARCH and block_cells and len(block_cells) == nb:  # few solutions: the best of them, no HiGHS
+        kw = {"min_cells": min_cells, "block_cells": block_cells, "fixed": fixed}
+        search_cost = objective(t, sides, jumps, short) if best else (lambda counts: np.zeros(len(counts)))
+        found = best_counts(n, sides, multiple=m, cost=search_cost, **kw)
+        if found is not None:
+            return found
+    from scipy.optimize import LinearConstraint, milp
+
     # unknowns: k_c (n_c = m k_c); e_c ≥ |n_c − t_c| per chain; f_bd ≥ |N_bd − T_bd| per block and
     # direction, with N_bd the count across the block in that direction and T_bd the mean of its
     # two opposite sides' targets: every block's cells close to the asked size in both directions
@@ -232,8 +284,6 @@ def solve_counts(
     lb = np.concatenate([np.ones(n), np.zeros(n + 2 * nb + len(jumps) + len(short))])
     ub = np.full(nv, np.inf)
     for c, v in (fixed or {}).items():
-        if v % m:
-            raise TopologyError(f"a fixed count {v} is not a multiple of {m}")
         lb[c] = ub[c] = v // m
     from scipy.optimize import Bounds
     from scipy.sparse import csr_array
