@@ -199,7 +199,7 @@ def lake(repeat: int, quick: bool) -> None:
 #: The stages of ``generate_case`` of an ``[outline]`` multiblock case: (label, module, function).
 STAGES = (
     ("outline: read and project", "meshcore.case.multiblock", "_outline_geometry"),
-    ("blocks: chain cell counts (MILP)", "meshcore.multiblock.chains", "_chain_counts"),
+    ("blocks: chain cell counts", "meshcore.multiblock.chains", "_chain_counts"),
     ("blocks: re-sample the chains", "meshcore.multiblock.chains", "_resample"),
     ("topology: geometry check", "meshcore.multiblock.topology:MultiBlockTopology", "_check_geometry"),
     ("topology: node map", "meshcore.multiblock.topology", "build_node_map"),
