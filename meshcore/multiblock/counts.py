@@ -183,13 +183,14 @@ def solve_counts(
     m = int(multiple)
     jumps = _jump_pairs(t, sides, least=float(max(m, 1)))
     short = [] if least is None else [(c, float(v)) for c, v in enumerate(least) if v > m]
-    for v in (fixed or {}).values():
-        if v % m:
-            raise TopologyError(f"a fixed count {v} is not a multiple of {m}")
+    for given in (fixed or {}).values():
+        if given % m:
+            raise TopologyError(f"a fixed count {given} is not a multiple of {m}")
     if SEARCH and block_cells and len(block_cells) == nb:  # few solutions: the best of them, no HiGHS
-        kw = {"min_cells": min_cells, "block_cells": block_cells, "fixed": fixed}
         search_cost = objective(t, sides, jumps, short) if best else (lambda counts: np.zeros(len(counts)))
-        found = best_counts(n, sides, multiple=m, cost=search_cost, **kw)
+        found = best_counts(
+            n, sides, multiple=m, min_cells=min_cells, block_cells=block_cells, cost=search_cost, fixed=fixed
+        )
         if found is not None:
             return found
     from scipy.optimize import LinearConstraint, milp
