@@ -6,6 +6,7 @@ outputs derive from GSHHG data and carry its LGPL-3.0-or-later licence.
 
 from __future__ import annotations
 
+import contextlib
 import zipfile
 from pathlib import Path
 
@@ -31,10 +32,13 @@ def main() -> None:
     # shapefile: polygon ring closed and clockwise (ESRI outer-ring convention), WGS84 .prj
     ring = win[::-1].tolist()
     ring.append(ring[0])
-    with shapefile.Writer(str(HERE / "windermere_sparse"), shapeType=shapefile.POLYGON) as w:
-        w.field("name", "C", 60)
-        w.poly([ring])
-        w.record("Windermere")
+    # our own file objects: pyshp 3.1.9's Writer leaves the .dbf it opens unclosed
+    with contextlib.ExitStack() as files:
+        f = {e: files.enter_context(open(HERE / f"windermere_sparse.{e}", "wb")) for e in ("shp", "shx", "dbf")}
+        with shapefile.Writer(shapeType=shapefile.POLYGON, **f) as w:
+            w.field("name", "C", 60)
+            w.poly([ring])
+            w.record("Windermere")
     (HERE / "windermere_sparse.prj").write_text(WGS84_PRJ)
 
     # DXF: Lake Zurich in UTM 32N metres as a closed LWPOLYLINE, plus a SPLINE through it
