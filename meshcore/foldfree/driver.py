@@ -270,9 +270,17 @@ def _repair(
         path.append("local")
     if not ok and coarse:
         # the pieces repaired so far stay; the rest from a coarse-grid start
+        kept = None if whole else (x.copy(), y.copy())
         ok, nfree, total = _multilevel(
             grid, x, y, ex_bits, radius, opts, nfree, total, seam=not whole, path=path, skip=skip
         )
+        if not ok and kept is not None and "skip" in path:
+            # the given grid failed from a start whose coarse levels skipped their transplant: once
+            # more without skipping (a 20 × 30 hairpin slot failed by two cells, see SKIP_TRANSPLANT)
+            x[...], y[...] = kept
+            ok, nfree, total = _multilevel(
+                grid, x, y, ex_bits, radius, opts, nfree, total, seam=True, path=path, skip=False
+            )
         how = " after a coarse-grid (multilevel) start" if ok else ""
     if not ok and (whole or not coarse):
         ok, nfree, sw = _whole(grid, x, y, ex_bits, opts)
@@ -314,31 +322,6 @@ def _relax(x: np.ndarray, y: np.ndarray, region: np.ndarray, ex_bits: np.ndarray
 
 
 def _multilevel(
-    grid: StructuredGrid,
-    x: np.ndarray,
-    y: np.ndarray,
-    ex_bits: np.ndarray,
-    radius: int,
-    opts: dict,
-    nfree: int,
-    total: int,
-    *,
-    seam: bool,
-    path: list[str],
-    skip: bool,
-) -> tuple[bool, int, int]:
-    """:func:`_multilevel_once`; on the given grid (``seam``), when that fails from a coarse start
-    whose coarse levels skipped their transplant, once more without skipping (a 20 × 30 hairpin
-    slot failed by two cells with the skips, as :data:`SKIP_TRANSPLANT` says)."""
-    xk, yk = x.copy(), y.copy()
-    ok, nf, total = _multilevel_once(grid, x, y, ex_bits, radius, opts, nfree, total, seam=seam, path=path, skip=skip)
-    if ok or not seam or "skip" not in path:
-        return ok, nf, total
-    x[...], y[...] = xk, yk
-    return _multilevel_once(grid, x, y, ex_bits, radius, opts, nfree, total, seam=seam, path=path, skip=False)
-
-
-def _multilevel_once(
     grid: StructuredGrid,
     x: np.ndarray,
     y: np.ndarray,

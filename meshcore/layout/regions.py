@@ -152,9 +152,13 @@ def _island_cuts(face, sigma: float | None = None, existing=()) -> list[np.ndarr
     for k in range(1, len(rings)):
         hole = rings[k]
         starts = [hole.interpolate(f, normalized=True) for f in np.linspace(0.0, 1.0, 32, endpoint=False)]
+
+        def to_vertices(starts=starts, k=k) -> list:  # the cuts as they are when called
+            return [t for p in starts for t in _sights(p, k, rings, room, cuts, 64)]
+
         cand = [s for p in starts for s in _sights(p, k, rings, room, cuts)]
         if not cand:  # round a bend: the nearest points are not in sight; try the other rings' vertices
-            cand = [s for p in starts for s in _sights(p, k, rings, room, cuts, 64)]
+            cand = to_vertices()
         if not cand:
             continue
         cand.sort(key=lambda t: t[0])
@@ -163,19 +167,19 @@ def _island_cuts(face, sigma: float | None = None, existing=()) -> list[np.ndarr
             cand = _apart(cand, [*existing, *cuts], 2 * sigma) or cand
         first = cand[0][1]
         cuts.append(first)
-        second = _second_cut(first, hole, cand, (starts, k, rings, room, cuts), [*existing, *cuts], sigma)
+        second = _second_cut(first, hole, rings, cand, to_vertices, [*existing, *cuts], sigma)
         if second is not None:
             cuts.append(second)
     return cuts
 
 
-def _second_cut(first, hole, cand, sight, earlier, sigma):
+def _second_cut(first, hole, rings, cand, to_vertices, earlier, sigma):
     """The second cut that frees an island, ``first`` being the first: the shortest of ``cand``
     leaving from the island's far half (seen from ``first``) that keeps ``2 sigma`` from
     ``first`` and from the ``earlier`` cuts near the island (chords, the cuts of other islands):
     not alongside one, where the strip between would be a sliver block.  Where no
     nearest-point candidate does (an island near one side of a wide region sees only that
-    side), the candidates to the rings' vertices (``sight``: the arguments of :func:`_sights`);
+    side), the candidates to the rings' vertices (``to_vertices()``);
     then, as before, any that keeps the gap, any on the far half, any other."""
     from shapely.geometry import LineString, Point
 
@@ -195,8 +199,7 @@ def _second_cut(first, hole, cand, sight, earlier, sigma):
     apart = [seg for _, seg in _apart([(0.0, seg) for seg in others], beside, 2 * sigma)]
     good = [seg for seg in far if any(seg is a for a in apart)]
     if others and not apart:  # every nearest-point cut lies beside one: the rings' vertices
-        starts, k, rings, room, cuts = sight
-        more = sorted((t for p in starts for t in _sights(p, k, rings, room, cuts, 64)), key=lambda t: t[0])
+        more = sorted(to_vertices(), key=lambda t: t[0])
         more = [(L, seg) for L, seg in more if not LineString(seg).intersects(line)]
         apart = [seg for _, seg in _apart(_without_wedges(more, hole, rings, sigma) or more, beside, 2 * sigma)]
         good = [seg for seg in apart if away(seg)]
