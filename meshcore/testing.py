@@ -185,12 +185,7 @@ def lake_with_islands(seed: int, *, radius: float = 10.0, lobes: int = 5, n_isla
     from shapely.geometry import Polygon
 
     rng = np.random.default_rng(seed)
-    t = np.linspace(0, 2 * math.pi, 240, endpoint=False)
-    r = np.ones_like(t)
-    for k in range(2, 2 + lobes):
-        r += rng.uniform(0.0, 0.35 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
-    r *= radius / r.max()
-    outer = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    outer = _lobed_disc(rng, radius, 240, range(2, 2 + lobes), 0.35)
     holes = []
     inner = outer.buffer(-0.12 * radius)
     tries = 0
@@ -240,13 +235,7 @@ def round_lake(seed: int, *, radius: float = 10.0, kind: str = "blob", n_islands
     from shapely.geometry import LineString, Point, Polygon
 
     rng = np.random.default_rng(seed)
-    t = np.linspace(0, 2 * math.pi, 360, endpoint=False)
-    r = np.ones_like(t)
-    if kind != "disc" and kind != "ring":
-        for k in range(2, 6):
-            r += rng.uniform(0.0, 0.25 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
-    r *= radius / r.max()
-    outer = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    outer = _lobed_disc(rng, radius, 360, range(2, 6) if kind not in ("disc", "ring") else (), 0.25)
     if kind == "arms":
         arms = []
         for _ in range(int(rng.integers(2, 4))):
@@ -311,12 +300,7 @@ def small_islands(
 
     rng = np.random.default_rng(seed)
     h = float(cell_size)
-    t = np.linspace(0, 2 * math.pi, 240, endpoint=False)
-    r = np.ones_like(t)
-    for k in range(2, 6):
-        r += rng.uniform(0.0, 0.25 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
-    r *= radius / r.max()
-    outer = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    outer = _lobed_disc(rng, radius, 240, range(2, 6), 0.25)
     for _ in range(peninsulas):
         w = h * math.exp(rng.uniform(math.log(widths[0]), math.log(widths[1])))
         p = np.asarray(outer.exterior.interpolate(rng.uniform(0, outer.exterior.length)).coords[0])
@@ -386,12 +370,7 @@ def headlands(seed: int, *, radius: float = 10.0, n: int = 8, islands: int = 3):
     from shapely.geometry import LineString, Point, Polygon
 
     rng = np.random.default_rng(seed)
-    t = np.linspace(0, 2 * math.pi, 360, endpoint=False)
-    r = np.ones_like(t)
-    for k in range(2, 5):
-        r += rng.uniform(0.0, 0.15 / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
-    r *= radius / r.max()
-    water = Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+    water = _lobed_disc(rng, radius, 360, range(2, 5), 0.15)
     for _ in range(n):  # bays first: pushed out of the basin
         a = rng.uniform(0, 2 * math.pi)
         rb = rng.uniform(0.1, 0.3) * radius
@@ -502,3 +481,17 @@ def resampled(poly, points: int | None = None, *, spacing: float | None = None):
     outer = ring(poly.exterior, 4)
     holes = [ring(h, 8) for h in poly.interiors]
     return _clean(Polygon(outer, [h for h in holes if Polygon(h).is_valid]))
+
+
+def _lobed_disc(rng, radius: float, points: int, lobes, amplitude: float):
+    """A disc whose farthest point is ``radius`` from the origin, its radius modulated by the
+    harmonics ``k`` of ``lobes`` with random phases and amplitudes up to ``amplitude / sqrt(k)``
+    (drawn from ``rng`` in that order), as a polygon of ``points`` vertices."""
+    from shapely.geometry import Polygon
+
+    t = np.linspace(0, 2 * math.pi, points, endpoint=False)
+    r = np.ones_like(t)
+    for k in lobes:
+        r += rng.uniform(0.0, amplitude / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
+    r *= radius / r.max()
+    return Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
