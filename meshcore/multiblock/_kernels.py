@@ -32,7 +32,15 @@ from numba import njit
 
 from ..elliptic._stencil import winslow
 
-__all__ = ["line_sweep_rhs", "table_defect", "table_residual", "table_sweep", "table_sweep_rhs"]
+__all__ = [
+    "grow_rows",
+    "line_sweep_rhs",
+    "reverse_table",
+    "table_defect",
+    "table_residual",
+    "table_sweep",
+    "table_sweep_rhs",
+]
 
 
 @njit(cache=True, nogil=True)
@@ -249,3 +257,65 @@ def line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, ptr, axis):  # pragma: no cover -
             if not d <= dmax:  # a NaN makes the measure inf (never 'converged')
                 dmax = d if d == d else np.inf
     return np.sqrt(dmax)
+
+
+# ---------------------------------------------------------------- hot spots
+# The nodes round a few seeds (the largest defects after a cycle, :func:`.multigrid._hot_sweeps`)
+# grown outward from the seeds: :func:`.hierarchy.near_rows` scans the whole table once per step.
+
+
+@njit(cache=True, nogil=True)
+def reverse_table(nodes, nbr, n):  # pragma: no cover - compiled
+    """``(ptr, rows)``: for every node ``q`` of ``n`` the table rows whose stencil holds it,
+    ``rows[ptr[q]:ptr[q + 1]]`` (ascending, a row once per stencil entry)."""
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    for k in range(nodes.shape[0]):
+        for c in range(8):
+            ptr[nbr[k, c] + 1] += 1
+    for q in range(n):
+        ptr[q + 1] += ptr[q]
+    fill = ptr[:-1].copy()
+    rows = np.empty(ptr[n], dtype=np.int64)
+    for k in range(nodes.shape[0]):
+        for c in range(8):
+            q = nbr[k, c]
+            rows[fill[q]] = k
+            fill[q] += 1
+    return ptr, rows
+
+
+@njit(cache=True, nogil=True)
+def grow_rows(nodes, pos, ptr, rows, seeds, width):  # pragma: no cover - compiled
+    """The table rows (ascending) of the nodes at most ``width`` steps of the 8-point stencil from
+    a node of ``seeds``: the rows :func:`.hierarchy.near_rows` selects for the seed mask, grown
+    from the seeds through :func:`reverse_table` ``(ptr, rows)`` (``pos``: node → its table row or
+    −1).  Step ``s`` marks the rows whose stencil holds a node marked in step ``s − 1`` (the seeds
+    in step 1), which are the rows :func:`._hier_kernels.grow_near` marks in its ``s``-th scan."""
+    mark = np.zeros(pos.shape[0], dtype=np.bool_)
+    marked = np.empty(pos.shape[0], dtype=np.int64)
+    m = 0
+    for s in seeds:
+        if not mark[s]:
+            mark[s] = True
+            marked[m] = s
+            m += 1
+    lo = 0
+    for _ in range(width):
+        hi = m
+        for t in range(lo, hi):
+            q = marked[t]
+            for u in range(ptr[q], ptr[q + 1]):
+                p = nodes[rows[u]]
+                if not mark[p]:
+                    mark[p] = True
+                    marked[m] = p
+                    m += 1
+        lo = hi
+    out = np.empty(m, dtype=np.int64)
+    c = 0
+    for t in range(m):
+        r = pos[marked[t]]
+        if r >= 0:
+            out[c] = r
+            c += 1
+    return np.sort(out[:c])

@@ -74,7 +74,7 @@ import numpy as np
 
 from . import _kernels as _typed_kernels
 from . import _mg_fused as _typed_fused
-from .hierarchy import Level, levels, near_rows
+from .hierarchy import Level, hot_rows, levels
 from .topology import MultiBlockTopology
 
 __all__ = ["iterate_fas", "levels"]
@@ -136,7 +136,7 @@ def _hot_sweeps(lv: Level, x, y, rx, ry) -> tuple:
     """Point sweeps (``f = 0``) round the nodes with the largest defect ``(rx, ry)`` (see
     :data:`HOT_SHARE`); returns the table rows swept."""
     d2 = rx * rx + ry * ry
-    rows = near_rows(lv.args, d2 > HOT_SHARE**2 * d2.max(), HOT_WIDTH)
+    rows = hot_rows(lv, np.flatnonzero(d2 > HOT_SHARE**2 * d2.max()), HOT_WIDTH)
     e = np.zeros(0)
     for _ in range(HOT_SWEEPS):
         _kernels.table_sweep_rhs(x, y, e, e, *rows, 1.0)
@@ -149,9 +149,7 @@ def _defect_after(lv: Level, x, y, zero, rx, ry, moved: np.ndarray) -> float:
     irregular nodes, the rest kept.  The same value as a full :func:`._kernels.table_defect` (each
     node's defect is the same expression of its stencil), for the nodes round the hot spots instead
     of all (one defect of the finest level per cycle less)."""
-    seed = np.zeros(lv.n, dtype=bool)
-    seed[moved] = True
-    rows = near_rows(lv.args, seed, 1)
+    rows = hot_rows(lv, moved, 1)
     _kernels.table_defect(x, y, zero, zero, *rows[:2], *lv.args[2:], rx, ry)
     d2 = float((rx * rx + ry * ry).max(initial=0.0))
     return math.sqrt(d2) if d2 == d2 else math.inf

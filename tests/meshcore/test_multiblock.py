@@ -946,9 +946,10 @@ def test_defect_after_the_hot_spot_sweeps_is_the_full_defect(make):
 @pytest.mark.kernel
 def test_grow_near_matches_numpy_reference():
     """The compiled growth of a node set over the table equals the NumPy one (seeds anywhere:
-    fixed, border, irregular and interior nodes)."""
+    fixed, border, irregular and interior nodes), and so does the growth outward from the seeds
+    (``hot_rows``, the hot-spot sweeps')."""
     from meshcore.multiblock import _hier_kernels
-    from meshcore.multiblock.hierarchy import levels, near_reference, near_rows
+    from meshcore.multiblock.hierarchy import hot_rows, levels, near_reference, near_rows
 
     lv = levels(star(5, 9))[0]
     rng = np.random.default_rng(3)
@@ -958,6 +959,8 @@ def test_grow_near_matches_numpy_reference():
         got = _hier_kernels.grow_near(lv.args[0], lv.args[1], seed, width)
         assert np.array_equal(got, want)
         assert np.array_equal(near_rows(lv.args, seed, width)[0], lv.args[0][want[lv.args[0]]])
+        got_rows = hot_rows(lv, np.flatnonzero(seed), width)  # grown from the seeds: the same rows
+        assert all(np.array_equal(a, b) for a, b in zip(got_rows, near_rows(lv.args, seed, width), strict=True))
 
 
 @pytest.mark.kernel
