@@ -5,8 +5,8 @@ layout its per-block NumPy calls cost as much as the solve; these two loops do
 the same work in one call each.  NumPy references (test oracles):
 :func:`.hierarchy._block_interp`, :func:`.hierarchy.greedy_reference`,
 :func:`.hierarchy.lines_reference` (:func:`block_lines`) and
-:func:`.hierarchy.near_reference` (:func:`grow_near` also runs after every cycle of a solve,
-:func:`.multigrid._hot_sweeps`).
+:func:`.hierarchy.near_reference` (:func:`grow_near`: the band of each level; the rows round a
+cycle's hot spots grow from the seeds instead, :func:`._kernels.grow_rows`, tested against it).
 """
 
 from __future__ import annotations
