@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
-from ..multiblock.shorecells import shore_least
+from ..multiblock.shorecells import least_weights, shore_least
 from ..pointindex import PointIndex, point_key, point_keys
 
 __all__ = ["Piece", "block_counts", "conform", "weld"]
@@ -183,6 +183,11 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
         block_cells=block_cells,
         best=best,
         least=shore_least([chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], cell_size, multiple)
+        if best
+        else None,
+        least_weight=least_weights(
+            [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], [pc.ring for pc in pieces]
+        )
         if best
         else None,
     )

@@ -193,12 +193,14 @@ def _chain_counts(
     multiple: int,
     cell_size: float | None,
     keep: Mapping[tuple[str, str], Sequence[int]] | None = None,
+    rings: Mapping[str, np.ndarray] | None = None,
 ) -> dict[Key, int]:
     """Cells per chain: the integer program of :func:`~.counts.solve_counts` with every block's cells
     given; when it has no solution, the step-by-step count names the block and border at fault.
-    ``keep``: counts per block side taken instead of the program's while they still fit (:func:`_kept`)."""
+    ``keep``: counts per block side taken instead of the program's while they still fit (:func:`_kept`);
+    ``rings``: the blocks' regions, for :func:`~.shorecells.least_weights`."""
     from .counts import solve_counts
-    from .shorecells import shore_least
+    from .shorecells import least_weights, shore_least
 
     keys = list(chain_pts)
     counts = _Counts(specs, side_chains, chain_pts, chain_users, multiple)
@@ -234,7 +236,16 @@ def _chain_counts(
                 [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], cell_size, multiple
             )
         )
-        n = solve_counts(targets, sides, min_cells=1, multiple=multiple, block_cells=cells, least=least)
+        weight = (
+            None
+            if least is None or rings is None
+            else least_weights(
+                [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], list(rings.values())
+            )
+        )
+        n = solve_counts(
+            targets, sides, min_cells=1, multiple=multiple, block_cells=cells, least=least, least_weight=weight
+        )
     except TopologyError:
         _Counts(specs, side_chains, chain_pts, chain_users, multiple).solve()  # names the conflict
         raise
@@ -294,7 +305,7 @@ def chain_topology(
     the layout before an edit) is taken instead where it still fits every side.
     """
     sides, chain_pts, chain_users = side_chains(specs, rings, corners, breaks)
-    count = _chain_counts(specs, sides, chain_pts, chain_users, multiple, cell_size, keep)
+    count = _chain_counts(specs, sides, chain_pts, chain_users, multiple, cell_size, keep, rings)
     nodes = {key: _resample(chain_pts[key], count[key]) for key in chain_pts}
     offsets: dict[tuple[str, str, Key], tuple[int, int]] = {}
     blocks = [_block(s, sides, nodes, corners[s.name], offsets) for s in specs]

@@ -49,6 +49,13 @@ JUMP_WEIGHT = 1.0
 #: generated lakes with islands and bays and 6 others, 4 instead of 2 brought the largest
 #: distance of a node outside the water from 2.3 to 1.3 cells at the same cell count.
 LEAST_WEIGHT = 4.0
+#: The same cost where the chain's coarse chords would cross an island (its block wraps an
+#: island's convex side, :func:`~.shorecells.over_island`): there a shortfall puts the coarse
+#: grid over the island, refinement does not bring it back, and the island is lost (the layout
+#: of ``lake_with_islands(263303, n_islands=9, lobes=7)`` left a 2.4-long side round an island,
+#: 26 cells long and 20 least, with 4: one coarse edge, shoreline distance 16 cells).  Near a
+#: hard bound: only a shortfall that costs 16 cells elsewhere per cell stays.
+LAND_WEIGHT = 16.0
 #: HiGHS's wall-clock limit, seconds: a guard against a hang, not a budget.  The counts must
 #: not depend on how busy the machine is: with a 20 s limit a layout of ~90 blocks (2.4 s of
 #: CPU) stopped at a worse incumbent on a loaded machine and came out with other blocks.
@@ -98,12 +105,13 @@ def _jump_pairs(t: np.ndarray, sides, least: float = 1.0) -> list[tuple[list[int
     return out
 
 
-def objective(t: np.ndarray, sides, jumps: list[tuple[list[int], float, list[int], float]], short):
+def objective(t: np.ndarray, sides, jumps: list[tuple[list[int], float, list[int], float]], short, weights=None):
     """The program's objective as a function of integer counts (rows: candidates that meet its
     constraints; returns one cost per row): each ``|.|`` and excess term of :func:`solve_counts`
     at its value, with ``jumps`` from :func:`_jump_pairs` and ``short`` the ``(chain, least)``
-    pairs.  For :mod:`.countsearch`, which minimises it; the sums over chains are matrices made
-    once (a layout of 37 blocks: ~300 pairs)."""
+    pairs (``weights``: the cost per missing cell of each, default :data:`LEAST_WEIGHT`).  For
+    :mod:`.countsearch`, which minimises it; the sums over chains are matrices made once (a
+    layout of 37 blocks: ~300 pairs)."""
     nc, nb, npair = len(t), len(sides), len(jumps)
     across, mean = np.zeros((nc, 2 * nb)), np.zeros(2 * nb)  # a block's count in each direction
     for bi, (bottom, right, top, left) in enumerate(sides):
@@ -117,6 +125,7 @@ def objective(t: np.ndarray, sides, jumps: list[tuple[list[int], float, list[int
         w[p] = min(ta, tb)
     held = np.array([c for c, _ in short], dtype=int)
     want = np.array([v for _, v in short], dtype=float)
+    per = np.full(len(short), LEAST_WEIGHT) if weights is None else np.asarray(weights, dtype=float)
 
     def cost(n: np.ndarray) -> np.ndarray:
         n = np.atleast_2d(n).astype(float)
@@ -127,7 +136,7 @@ def objective(t: np.ndarray, sides, jumps: list[tuple[list[int], float, list[int
             + 0.25 * np.abs(n - t).sum(axis=1)
             + np.abs(n @ across - mean).sum(axis=1)
             + JUMP_WEIGHT * excess.sum(axis=1)
-            + LEAST_WEIGHT * np.maximum(0.0, want - n[:, held]).sum(axis=1)
+            + (per * np.maximum(0.0, want - n[:, held])).sum(axis=1)
         )
 
     return cost
@@ -143,6 +152,7 @@ def solve_counts(
     block_cells: dict[int, tuple[int, int]] | None = None,
     best: bool = True,
     least: Sequence[float] | np.ndarray | None = None,
+    least_weight: Sequence[float] | np.ndarray | None = None,
 ) -> np.ndarray:
     """Integer counts per chain.
 
@@ -169,6 +179,9 @@ def solve_counts(
         Per chain, the count below which it pays :data:`LEAST_WEIGHT` per missing cell (a
         shore chain that the coarse levels would cut across, :mod:`.shorecells`); a soft
         bound, so counts fixed by the user still have a solution.
+    least_weight : sequence of float, optional
+        Per chain, that cost per missing cell instead (:data:`LAND_WEIGHT` where the coarse
+        chords would cross an island, :func:`~.shorecells.least_weights`).
 
     Raises
     ------
@@ -183,11 +196,14 @@ def solve_counts(
     m = int(multiple)
     jumps = _jump_pairs(t, sides, least=float(max(m, 1)))
     short = [] if least is None else [(c, float(v)) for c, v in enumerate(least) if v > m]
+    weights = np.array(
+        [LEAST_WEIGHT if least_weight is None else float(least_weight[c]) for c, _ in short], dtype=float
+    )
     for given in (fixed or {}).values():
         if given % m:
             raise TopologyError(f"a fixed count {given} is not a multiple of {m}")
     if SEARCH and block_cells and len(block_cells) == nb:  # few solutions: the best of them, no HiGHS
-        search_cost = objective(t, sides, jumps, short) if best else (lambda counts: np.zeros(len(counts)))
+        search_cost = objective(t, sides, jumps, short, weights) if best else (lambda counts: np.zeros(len(counts)))
         found = best_counts(
             n, sides, multiple=m, min_cells=min_cells, block_cells=block_cells, cost=search_cost, fixed=fixed
         )
@@ -209,7 +225,7 @@ def solve_counts(
             np.full(n, 0.25),
             np.ones(2 * nb),
             np.full(len(jumps), JUMP_WEIGHT),
-            np.full(len(short), LEAST_WEIGHT),
+            weights,
         ]
     )
     rows: list[dict[int, float]] = []  # sparse: {unknown: coefficient} per row
