@@ -102,3 +102,33 @@ def test_lakes_whose_cut_ends_folded_have_no_bad_cells(make):
     assert m.values("folded").sum() == 0
     assert mb.info.converged
     assert mb.interface_mismatch() == 0.0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_node_moves_stay_in_the_water_on_a_scrambled_grid(seed):
+    """Free nodes thrown about by two edge lengths fold most cells; where no candidate position
+    mends a node's cells, the best one may not be a far one.  Scored over the cells' own mean
+    area, a node taken out of its star made huge slivers that scored better, and round after
+    round of moves flung nodes ever further (headlands(745600) at 15 000 cells: a block 686 611
+    long in a lake 20 across)."""
+    lay = auto_layout(testing.y_junction(), target_cells=1500, multiple=4)
+    topo = coarsen_topology(lay.topology(), 2)
+    grids = initial_grids(topo)
+    m = topo.node_map
+    X, Y, cells = _node_arrays(topo, grids)
+    free = ~m.boundary
+    edge = float(np.median(np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])))
+    rng = np.random.default_rng(seed)
+    X2, Y2 = X.copy(), Y.copy()
+    X2[free] += rng.normal(0, 2 * edge, free.sum())
+    Y2[free] += rng.normal(0, 2 * edge, free.sum())
+    assert len(bad_cells(X2, Y2, cells)) > len(cells) // 4
+    spoilt = [g.replaced(x=X2[ids], y=Y2[ids]) for g, ids in zip(grids, m.ids, strict=True)]
+    out, moved = untangle(topo, spoilt)
+    assert moved > 0
+    X3, Y3, _ = _node_arrays(topo, out)
+    lo = np.minimum([X.min(), Y.min()], [X2.min(), Y2.min()]) - 2 * edge
+    hi = np.maximum([X.max(), Y.max()], [X2.max(), Y2.max()]) + 2 * edge
+    pts = np.column_stack([X3, Y3])
+    assert np.all(pts >= lo) and np.all(pts <= hi)
+    assert len(bad_cells(X3, Y3, cells)) < len(bad_cells(X2, Y2, cells))
