@@ -295,9 +295,16 @@ def _directed(points: np.ndarray, lines: Any) -> tuple[float, int]:
     return float(dist[k]), k
 
 
+#: The most points :func:`_boundary_points` puts on a boundary (a grid flung far beyond its lake
+#: by a solver fault asked for more points than memory holds: 23 GB before the OOM killer).
+MAX_POINTS = 2_000_000
+
+
 def _boundary_points(boundary: Any, step: float) -> np.ndarray:
+    """Points every ``step`` along ``boundary`` (at most about :data:`MAX_POINTS`)."""
     import shapely
 
+    step = max(step, float(shapely.length(boundary)) / MAX_POINTS)
     return shapely.get_coordinates(shapely.segmentize(boundary, step))
 
 

@@ -6,6 +6,7 @@ rule is the layout's at the cell size given: an arm the layout would keep stays 
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import shapely
 from shapely.geometry import LineString, box
@@ -42,3 +43,15 @@ def test_an_arm_wide_enough_at_the_cell_size_given_stays_in(arm_lake):
     cov = lake_metrics(mb, polygon=poly, cell_size=h).coverage
     assert cov.hausdorff_cells > 20 * 3
     assert cov.hausdorff == pytest.approx(cov.hausdorff_as_given)
+
+
+def test_boundary_points_are_bounded_whatever_the_step():
+    """A grid flung far beyond its lake (a solver fault) asked segmentize for h/10 steps along a
+    boundary ~10⁵ cells long: 23 GB.  The points are capped; a lake's boundary keeps its step."""
+    from meshcore.quality.coverage import MAX_POINTS, _boundary_points
+
+    far = shapely.box(0.0, 0.0, 1e6, 1.0).exterior
+    assert len(_boundary_points(far, 1e-4)) <= MAX_POINTS + 5
+    near = shapely.box(0.0, 0.0, 1.0, 1.0).exterior
+    pts = _boundary_points(near, 0.1)
+    assert len(pts) == 41 and np.allclose(np.hypot(*np.diff(pts, axis=0).T), 0.1)
