@@ -10,7 +10,7 @@ sampled densely or coarsely, :func:`more_cases`) — with seeds from ``--base`` 
 random base, printed, so that a run can be repeated), and prints one row per shape, the
 issue-12 targets met, and every error: a ``MeshcoreError`` (a clear message, allowed) or anything else (a bug)::
 
-    python benchmarks/fresh_sweep.py [--base N] [--cells 15000] [--regular] [--more] [--json OUT]
+    python benchmarks/fresh_sweep.py [--base N] [--cells 15000] [--regular] [--more] [--options JSON] [--json OUT]
 """
 
 from __future__ import annotations
@@ -95,10 +95,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--regular", action="store_true", help="Delft3D domain-decomposition layouts")
     ap.add_argument("--json", help="write the results here")
     ap.add_argument("--more", action="store_true", help="the other set (more_cases): headlands, dendritic, ...")
+    ap.add_argument("--options", default="{}", help="more options of mesh_outline as JSON")
     a = ap.parse_args(argv)
     base = a.base if a.base is not None else random.SystemRandom().randrange(10_000, 1_000_000, 1000)
     options = {"regular": True} if a.regular else {}
-    print(f"seeds from {base}, {a.cells} cells{', regular' if a.regular else ''}\n")
+    options.update(json.loads(a.options))
+    more = (", regular" if a.regular else "") + (f", {a.options}" if a.options != "{}" else "")
+    print(f"seeds from {base}, {a.cells} cells{more}\n")
     print(interface_sweep.HEAD)
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     res: dict[str, dict] = {}

@@ -228,6 +228,7 @@ def mesh_outline(
     levels: int = 2,
     regular: bool = False,
     strict: bool = False,
+    thin_arms: bool = False,
     **options: Any,
 ):
     """A model-ready multiblock grid of a lake outline (projected coordinates, e.g. metres).
@@ -247,6 +248,9 @@ def mesh_outline(
     strict : bool
         Raise :class:`~meshcore.errors.FoldedGridError` if the grid has folded cells
         (otherwise ``info.converged`` is False and the message names them).
+    thin_arms : bool
+        Blocks two cells across at junctions and reflex bends of arms 2–4 cells wide
+        (:func:`~meshcore.layout.auto_layout`).
 
     Returns
     -------
@@ -258,7 +262,13 @@ def mesh_outline(
     from .layout import auto_layout
 
     lay = auto_layout(
-        outline, holes=holes, cell_size=cell_size, target_cells=target_cells, multiple=2**levels, regular=regular
+        outline,
+        holes=holes,
+        cell_size=cell_size,
+        target_cells=target_cells,
+        multiple=2**levels,
+        regular=regular,
+        thin_arms=thin_arms,
     )
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics

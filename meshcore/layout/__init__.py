@@ -12,6 +12,7 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 * :mod:`.chords` — cuts across the arms, at right angles to the banks;
 * :mod:`.regions` — the regions between shores and cuts, islands cut free;
 * :mod:`.split` — regions that are not four-sided split at their reflex corners or by a star;
+* :mod:`.width` — how narrow a piece of a split may be;
 * :mod:`.corners` — four corners per piece, where the boundary turns at the cells' scale;
 * :mod:`.frames` — in regular mode, corners re-chosen so that the blocks' index directions
   close up round every island (what Delft3D's domain decomposition needs);
@@ -53,6 +54,7 @@ def auto_layout(
     target_cells: int = DEFAULT_CELLS,
     multiple: int = 1,
     regular: bool = False,
+    thin_arms: bool = False,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -75,6 +77,10 @@ def auto_layout(
         Delft3D's domain decomposition can couple.  Where the corners cannot be made to close,
         the layout is returned as it is; :func:`~.frames.frame_defects` of its pieces names
         the islands.
+    thin_arms : bool
+        Cuts from reflex corners may leave blocks two cells across (three by default): the
+        junctions and reflex bends of arms 2–4 cells wide are split instead of gridded as one
+        block round the corner (:data:`.width.THIN_ACROSS`).
 
     Returns
     -------
@@ -106,7 +112,16 @@ def auto_layout(
         # the layout without them (the splits of earlier versions) next
         for normal in (True, False):
             try:
-                lay = _layout(shores, h, notes + more, multiple=multiple, regular=regular, normal=normal, scale=scale)
+                lay = _layout(
+                    shores,
+                    h,
+                    notes + more,
+                    multiple=multiple,
+                    regular=regular,
+                    normal=normal,
+                    scale=scale,
+                    thin=thin_arms,
+                )
             except TopologyError as exc:
                 first = first or exc
                 continue
@@ -137,13 +152,15 @@ def auto_layout(
 LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
 
 
-def _layout(shores, h: float, notes, *, multiple: int, regular: bool, normal: bool, scale: float = 1.0) -> Layout:
+def _layout(
+    shores, h: float, notes, *, multiple: int, regular: bool, normal: bool, scale: float = 1.0, thin: bool = False
+) -> Layout:
     poly = shores.grid
     hl = scale * h  # the layout's geometry; counts at h
-    sk, chords, _, pieces = layout_pieces(shores.layout, hl, regular=regular, normal=normal)
+    sk, chords, _, pieces = layout_pieces(shores.layout, hl, regular=regular, normal=normal, thin=thin)
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
-        sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal)
+        sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal, thin=thin)
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple)
 

@@ -118,11 +118,12 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
 
 
 def layout_pieces(
-    poly, h: float, *, regular: bool = False, normal: bool = True
+    poly, h: float, *, regular: bool = False, normal: bool = True, thin: bool = False
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
-    normal; see :func:`~.split.best_split`)."""
+    normal; ``thin``: cuts from reflex corners may leave pieces two cells across; see
+    :func:`~.split.best_split`)."""
     import shapely
     from shapely.geometry import Point, Polygon
 
@@ -138,7 +139,9 @@ def layout_pieces(
         P = Polygon(r)
         inside = [j for j in junctions if P.contains(Point(j))]
         centre = np.mean(inside, axis=0) if inside else None
-        pieces, new_cuts, _ = best_split(r, sigma=sigma, min_width=3 * h, center=centre, regular=regular, normal=normal)
+        pieces, new_cuts, _ = best_split(
+            r, sigma=sigma, min_width=3 * h, center=centre, regular=regular, normal=normal, thin=thin
+        )
         rings += [p for p, _ in pieces]
         forced += [f for _, f in pieces]
         cuts += new_cuts

@@ -24,16 +24,11 @@ import math
 import numpy as np
 
 from .corners import SHARP, choose_corners, turning
+from .width import THIN_CUT
+from .width import too_narrow as _too_narrow
+from .width import width as _width
 
 __all__ = ["best_split", "region_cost"]
-
-
-def _width(ring: np.ndarray) -> float:
-    """A width scale of a region: twice its area over its perimeter (exact for long strips)."""
-    from shapely.geometry import Polygon
-
-    p = Polygon(ring)
-    return 2.0 * p.area / max(p.length, 1e-300)
 
 
 def region_cost(ring: np.ndarray, sigma: float, forced=()) -> float:
@@ -217,6 +212,7 @@ def best_split(
     forced=(),
     regular: bool = False,
     normal: bool = True,
+    thin: bool = False,
 ):
     """Pieces and cuts (segments) of a greedy split of ``ring`` (maybe none).
 
@@ -228,11 +224,12 @@ def best_split(
     corner to cut from).  ``regular``: no star and no butterfly, so no node where three or five
     blocks meet (Delft3D's domain decomposition couples grid lines of the same direction only).
     ``normal=False``: no cuts along the shore's normal (the splits of earlier versions).
+    ``thin``: motorcycle cuts may leave pieces two cells across (:data:`.width.THIN_ACROSS`).
     """
     base = region_cost(ring, sigma, forced)
     if depth <= 0 or base <= _GOOD:
         return [(ring, tuple(forced))], [], base
-    options = _options(ring, sigma, min_width, center, forced, regular, normal)
+    options = _options(ring, sigma, min_width, center, forced, regular, normal, thin)
     best = min(options, key=lambda o: o[2]) if options else None
     if (best is None or best[2] >= base - _GOOD) and normal and not len(forced):
         # last resort (a round basin): cuts along the shore's normal from evenly spaced points
@@ -244,7 +241,7 @@ def best_split(
     out_p, out_c, total = [], list(cuts), 0.0
     for pc, fc in pieces:
         pp, cc, c = best_split(
-            pc, sigma=sigma, min_width=min_width, depth=depth - 1, forced=fc, regular=regular, normal=normal
+            pc, sigma=sigma, min_width=min_width, depth=depth - 1, forced=fc, regular=regular, normal=normal, thin=thin
         )
         out_p += pp
         out_c += cc
@@ -252,24 +249,27 @@ def best_split(
     return out_p, out_c, total
 
 
-def _cut_options(cuts, sigma: float, min_width: float) -> list:
-    """``(pieces, cuts, cost)`` of the admissible single cuts among ``cuts``."""
+def _cut_options(cuts, sigma: float, min_width: float, thin: bool = False) -> list:
+    """``(pieces, cuts, cost)`` of the admissible single cuts among ``cuts`` (``thin``:
+    :data:`.width.THIN_ACROSS` for cuts at most :data:`.width.THIN_CUT` × ``min_width`` long)."""
     out = []
     for a, b, seg in cuts:
         a, b = _orient(a), _orient(b)
-        if min(_width(a), _width(b)) < min_width or not (_valid(a) and _valid(b)):
+        here = thin and math.hypot(*(seg[-1] - seg[0])) <= THIN_CUT * min_width
+        if _too_narrow(a, min_width, here) or _too_narrow(b, min_width, here) or not (_valid(a) and _valid(b)):
             continue
         out.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
     return out
 
 
-def _options(ring, sigma, min_width, center, forced, regular, normal) -> list:
-    """Every admissible split of ``ring``: motorcycle cuts, normal cuts from its bays, the star
-    from ``center``, the butterfly (none for a piece with ``forced`` corners)."""
+def _options(ring, sigma, min_width, center, forced, regular, normal, thin=False) -> list:
+    """Every admissible split of ``ring``: motorcycle cuts (``thin``: :data:`.width.THIN_ACROSS`),
+    normal cuts from its bays, the star from ``center``, the butterfly (none for a piece with
+    ``forced`` corners)."""
     if len(forced):
         return []
-    cuts = _motorcycle_cuts(ring, sigma) + (_normal_cuts(ring, sigma) if normal else [])
-    options = _cut_options(cuts, sigma, min_width)
+    options = _cut_options(_motorcycle_cuts(ring, sigma), sigma, min_width, thin)
+    options += _cut_options(_normal_cuts(ring, sigma) if normal else [], sigma, min_width)
     if center is not None and not regular:
         star = _star(ring, np.asarray(center, float), sigma, min_width)
         if star is not None:
