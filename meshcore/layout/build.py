@@ -133,6 +133,8 @@ def layout_pieces(
     sigma = 1.5 * h
     regions, cuts = partition(dense, [_densify(c.points, h) for c in chords], sigma)
     junctions = sk.nodes[sk.degree() >= 3]
+    # thin pieces only in regions that no island bounds (:data:`~.width.THIN_CUT`)
+    islands = shapely.union_all([shapely.LinearRing(r.coords) for r in dense.interiors]) if thin else None
     rings: list[np.ndarray] = []
     forced: list[tuple] = []
     for r in regions:
@@ -140,7 +142,13 @@ def layout_pieces(
         inside = [j for j in junctions if P.contains(Point(j))]
         centre = np.mean(inside, axis=0) if inside else None
         pieces, new_cuts, _ = best_split(
-            r, sigma=sigma, min_width=3 * h, center=centre, regular=regular, normal=normal, thin=thin
+            r,
+            sigma=sigma,
+            min_width=3 * h,
+            center=centre,
+            regular=regular,
+            normal=normal,
+            thin=thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h),
         )
         rings += [p for p, _ in pieces]
         forced += [f for _, f in pieces]
