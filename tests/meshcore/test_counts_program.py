@@ -6,6 +6,8 @@ layouts), and the plain program without the hull rows (generated layouts of many
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -42,6 +44,8 @@ def _objective(
         d1, d2 = n[:, ca].sum(axis=1) / ta, n[:, cb].sum(axis=1) / tb
         excess = np.maximum(w * (d1 - counts.JUMP * d2), w * (d2 - counts.JUMP * d1))
         obj += counts.JUMP_WEIGHT * np.maximum(0.0, excess)
+        steep = np.maximum(w * (d1 - counts.STEEP * d2), w * (d2 - counts.STEEP * d1))
+        obj += counts.STEEP_WEIGHT * np.maximum(0.0, steep)
     if least is not None:
         for c, v in enumerate(least):
             if v > m:
@@ -145,3 +149,76 @@ def test_many_blocks_reach_the_plain_programs_optimum(shape, monkeypatch):
         got, want = _objective(t, sides, n, **kw)[0], _objective(t, sides, plain, **kw)[0]
         assert np.isfinite(got)
         assert got == pytest.approx(want, abs=1e-6)
+
+
+def _short_piece_beside_a_cut(arm_blocks: int = 6):
+    """A block (0) whose left side is a long cut (chain 2, 29 cells long) and a short shore piece
+    (chain 3, 1.6 cells), its right side 44 cells; the cut is the side of a junction block (1) whose
+    opposite side is the mouth of an arm of ``arm_blocks`` blocks 12 cells wide (held-out lake
+    g180632's b18 and b19)."""
+    t = [20.0, 20.0, 29.2, 1.6, 44.0, 12.0, 12.0, 12.0]
+    sides = [([0], [4], [1], [2, 3]), ([5], [7], [6], [2])]
+    mouth = 7
+    for _ in range(arm_blocks):
+        nxt, a, b = len(t), len(t) + 1, len(t) + 2
+        t += [12.0, 15.0, 15.0]
+        sides.append(([a], [nxt], [b], [mouth]))
+        mouth = nxt
+    return np.array(t), sides
+
+
+@pytest.fixture
+def steep(monkeypatch):
+    """The steep jump cost on (off by default: see counts.STEEP_WEIGHT)."""
+    monkeypatch.setattr(counts, "SHORT_JUMPS", True)
+    monkeypatch.setattr(counts, "STEEP_WEIGHT", 8.0)
+
+
+def test_a_short_chain_beside_a_long_one_gets_no_crowd_of_cells(steep):
+    """A chain shorter than ``multiple`` cells pays for its spacing jump too (against the fewest
+    cells it can have): before, it was exempt and took 24 of its side's cells where the cut beside
+    it took 12 (spacing 36× finer: the block fanned into it); now the block's right side gives way."""
+    t, sides = _short_piece_beside_a_cut()
+    n = solve_counts(t, sides, multiple=4)
+    assert n[3] == 4  # the fewest it can have: 4 / 1.6 cells per cell of length, as dense as it must be
+    assert (n[3] / 4) / (n[2] / t[2]) < counts.STEEP  # before: (24 / 4) / (12 / 29.2) = 14.6
+    assert np.isfinite(_objective(t, sides, n, multiple=4)[0])
+
+
+def _chain_jumps(poly, cells: int, multiple: int = 4) -> list[float]:
+    """Density ratios of chains in a row on a block side of the layout's counts: cells per cell of
+    length, a chain shorter than ``multiple`` cells measured against the ``multiple`` cells it
+    cannot go below (a 0.2-cell piece between a block corner and a cut's end has its 4 cells
+    whatever the counts)."""
+    from meshcore.layout import blocks
+
+    lay = auto_layout(
+        np.asarray(poly.exterior.coords)[:-1],
+        holes=[np.asarray(r.coords)[:-1] for r in poly.interiors],
+        target_cells=cells,
+        multiple=multiple,
+    )
+    work = blocks._line_work(lay.pieces)
+    side_chains, chain_pts, _ = blocks._chains_of(lay.pieces, work)
+    index = {k: i for i, k in enumerate(chain_pts)}
+    length = np.array([float(np.hypot(*np.diff(p, axis=0).T).sum()) for p in chain_pts.values()])
+    n = blocks._counts(work, lay.pieces, lay.cell_size, 3, multiple, None, True)[1]
+    density = n / np.maximum(length / lay.cell_size, multiple)
+    out = []
+    for ks in side_chains.values():
+        for a, b in itertools.pairwise([index[k] for k in ks]):
+            out.append(max(density[a], density[b]) / min(density[a], density[b]))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(750300, 750305))
+def test_generated_lakes_with_islands_have_no_crowded_shore_pieces(seed, steep):
+    """Generated lobed lakes with islands at the default 10 000 cells: no chain on a block side is
+    16× denser than the chain beside it (beyond the cells it cannot go below), and at most two are
+    4× denser.  Before: 15.9, 9.3, 9.1, 6.8 and 68.6 at most, 2, 5, 5, 2 and 5 pairs above 4× on
+    these five lakes (a short shore piece beside a long cut given dozens of cells); after: 12.7,
+    2.9, 4.6, 3.2, 10.7 and 1, 0, 1, 0, 2 pairs."""
+    poly = testing.lake_with_islands(seed, n_islands=6 + seed % 5, lobes=4 + seed % 5)
+    jumps = np.array(_chain_jumps(poly, 10000))
+    assert len(jumps) and jumps.max() < 16.0
+    assert (jumps > 4.0).sum() <= 2
