@@ -145,8 +145,8 @@ def iterate_layout(
     g0 = initial_grids(tops[0])  # the start's first guess, and the layout's lines for untangle
     grids, how = _start(tops[0], start, g0)
     grids, repaired = _repair_folds(grids)
-    grids, untangled = untangle(tops[0], grids, layout=g0)
     rings = _shore_rings(layout.polygon, layout.cell_size / 4)
+    grids, untangled = untangle(tops[0], grids, layout=g0, rings=rings)
     total = 0
     fitted = 0
     history: list[tuple[int, float]] = []
@@ -162,7 +162,7 @@ def iterate_layout(
         grids, n = fit_bends(grids, tp, rings, gap)
         fitted += n
         if lev:
-            grids, n = untangle(tp, grids)
+            grids, n = untangle(tp, grids, rings=rings)
             untangled += n
         gen = iterate_orthogonalize(
             tp,

@@ -16,13 +16,18 @@ through every level (one cell in 4 of 45 generated lakes of fresh seeds at 15 00
    lines), puts the interface nodes within :data:`HOPS` edges of that end back towards the
    layout's line — fully at the end, blending into the solved position further along — and
    repairs the blocks then invalid with their borders fixed (:func:`meshcore.foldfree.repair`);
-2. then moves, one at a time, each free node (not on the shore) of each cell still bad: to the
+2. given the shore rings, slides each shore node whose angle in a bad cell only shore nodes make
+   (a block corner on a notch of a rough shore, where the water turns beyond 180°: its one cell of
+   that block is non-convex whatever the free nodes do) along the shore to the nearest place where
+   every cell around it is convex (:func:`_slide_shore_nodes`; after step 3, any shore node of a
+   cell it left bad, then step 3 again);
+3. then moves, one at a time, each free node (not on the shore) of each cell still bad: to the
    nearest of a few candidate positions around it (rings of 16 points at ¼, ½ and 1 of its mean
    edge length, the mean of its edge neighbours) where every cell around it is convex with a
    margin; where there is none, to the candidate that raises the smallest corner Jacobian most
    without making another cell around it bad, and its free neighbours get their turn next round.
 
-Nodes of cells that are convex are not moved by step 2; a grid without bad cells comes back as
+Nodes of cells that are convex are not moved by steps 2 and 3; a grid without bad cells comes back as
 it is.
 """
 
@@ -154,7 +159,7 @@ def _restore_cut_ends(mesh: _Mesh, grids, layout, bad) -> tuple[list, int]:
 
 
 def _move_nodes(mesh: _Mesh) -> int:
-    """Step 2 of :func:`untangle`: single-node moves; returns how many were made."""
+    """Step 3 of :func:`untangle`: single-node moves; returns how many were made."""
     m, X, Y, cells = mesh.m, mesh.X, mesh.Y, mesh.cells
     ang = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
     ring = np.column_stack([np.cos(ang), np.sin(ang)])
@@ -197,11 +202,57 @@ def _move_nodes(mesh: _Mesh) -> int:
     return moved
 
 
-def untangle(topology, grids, layout=None) -> tuple[list, int]:
+#: How far (times its mean edge length) :func:`_slide_shore_nodes` looks along the shore, either way.
+SLIDE = 1.5
+
+
+def _slide_shore_nodes(mesh: _Mesh, rings, only_fixed: bool = True) -> int:
+    """Step 2 of :func:`untangle`: every shore node whose angle in a bad cell is made by shore nodes
+    only (its two neighbours in the cell are on the shore too) moved along its shore ring to the
+    nearest place (within :data:`SLIDE` of its mean edge length either way) where every cell
+    around it is convex; returns how many moved.  A block corner or a cut end the layout put on a
+    notch of a rough shore, where the water turns beyond 180°, leaves its one cell of that block
+    non-convex, and no move of the free nodes can mend that: the other corners of the cell would
+    have to go onto land.  ``only_fixed`` False: every shore node of a bad cell (after step 3,
+    for the cells it left bad)."""
+    from .shore import arc_lengths, project_to_rings, ring_point
+
+    m, X, Y, cells = mesh.m, mesh.X, mesh.Y, mesh.cells
+    bad = cells[bad_cells(X, Y, cells)]
+    j = _corner_jacobians(X, Y, bad)
+    b = m.boundary[bad]
+    # corners whose angle only shore nodes make: the node and its two neighbours in the cell
+    fixed = (j <= 0) & b & np.roll(b, 1, axis=1) & np.roll(b, -1, axis=1) if only_fixed else b
+    nodes = sorted({int(n) for n in bad[fixed]})
+    if not nodes or not rings:
+        return 0
+    r_of, s_of, _ = project_to_rings(rings, np.column_stack([X[nodes], Y[nodes]]))
+    steps = np.linspace(-SLIDE, SLIDE, 30 * int(SLIDE) + 1)
+    steps = steps[np.argsort(np.abs(steps), kind="stable")][1:]  # nearest first, not 0
+    moved = 0
+    for n, r, s in zip(nodes, r_of, s_of, strict=True):
+        around = mesh.around(n)
+        if _score(X, Y, cells, around)[0] == 0:
+            continue
+        nb = mesh.nbrs(n)
+        p = np.array([X[n], Y[n]])
+        length = float(np.hypot(X[nb] - p[0], Y[nb] - p[1]).mean())
+        for c in ring_point(rings[int(r)], s + length * steps, arc_lengths(rings[int(r)])):
+            X[n], Y[n] = c
+            if _score(X, Y, cells, around)[0] == 0:
+                moved += 1
+                break
+        else:
+            X[n], Y[n] = p
+    return moved
+
+
+def untangle(topology, grids, layout=None, rings=None) -> tuple[list, int]:
     """``(grids, moved)``: ``grids`` (one per block of ``topology``) with the free nodes around
     their non-convex cells moved until those cells are convex, where the steps of the module
     docstring can; ``layout``: the blocks' algebraic grids (their borders are the layout's lines).
-    ``moved`` counts the node moves made.  Shore nodes never move."""
+    ``moved`` counts the node moves made.  Shore nodes move only when ``rings`` (the shore rings)
+    are given, along them (step 2)."""
     from .driver import _assemble
 
     X, Y = _assemble(grids, topology.node_map)
@@ -213,5 +264,10 @@ def untangle(topology, grids, layout=None) -> tuple[list, int]:
     if layout is not None:
         grids, moved = _restore_cut_ends(mesh, grids, layout, bad)
         mesh = _Mesh(topology, grids)
+    if rings:
+        moved += _slide_shore_nodes(mesh, rings)
     moved += _move_nodes(mesh)
+    if rings and len(bad_cells(mesh.X, mesh.Y, mesh.cells)):
+        n = _slide_shore_nodes(mesh, rings, only_fixed=False)
+        moved += n + (_move_nodes(mesh) if n else 0)
     return mesh.grids(grids), moved

@@ -1,0 +1,74 @@
+"""Sharp land tips and rough notches on the shore.
+
+* A block side that passes a sharp tip of land (a peninsula's or the gap between two lobes'
+  pointed end) whose own grid line points at the tip: the shore node must go a cell or more out,
+  past the nodes inwards of it, and neither the node alone nor its grid line carried along can
+  keep the cells convex (``channel_network(263005)``: the grid's edge 1.0 cells from the tip).
+  :func:`meshcore.orthogonal.levels.fit_bends` then moves a patch of the block's interior with
+  it and, where even that leaves a cell non-convex, lets the fold-free repair move the rest.
+* A block corner on a notch of a rough shore (the water turning beyond 180° there) keeps its
+  one cell non-convex through every level: no free node can mend it.
+  :func:`meshcore.orthogonal.untangle.untangle` given the shore rings slides it along the shore.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from meshcore import StructuredGrid, testing  # noqa: F401  (testing: used by eval)
+from meshcore.boundary import Borders
+from meshcore.lakegrid import _shore_rings, mesh_outline
+from meshcore.multiblock.topology import Block, MultiBlockTopology
+from meshcore.orthogonal.driver import _assemble
+from meshcore.orthogonal.shore import project_to_rings
+from meshcore.orthogonal.untangle import bad_cells, untangle
+from meshcore.quality.lake import block_metrics
+
+
+def _one_block(x, y):
+    bd = Borders(
+        bottom=np.c_[x[:, 0], y[:, 0]], right=np.c_[x[-1], y[-1]], top=np.c_[x[:, -1], y[:, -1]], left=np.c_[x[0], y[0]]
+    )
+    return MultiBlockTopology((Block("a", bd),), (), check_geometry=False), StructuredGrid(x, y)
+
+
+def _ring(points, step=0.01):
+    from shapely.geometry import Polygon
+
+    return _shore_rings(Polygon(points), step)
+
+
+def test_a_block_corner_on_a_notch_slides_along_the_shore_until_its_cell_is_convex():
+    # the corner node sits on the tip of a tooth of land in the block's corner: the water turns
+    # beyond 180° there and its one cell, between its neighbours (0.5, 0) and (0, 0.25), is
+    # non-convex; no free node can change that
+    X, Y = np.meshgrid(np.linspace(0.0, 4.0, 9), np.linspace(0.0, 1.0, 5), indexing="ij")
+    X[0, 0], Y[0, 0] = 0.2, 0.2
+    topo, g = _one_block(X, Y)
+    rings = _ring([(0, 1), (0, 0.15), (0.2, 0.2), (0.15, 0), (4, 0), (4, 1)])
+    cells = topo.node_map.cells
+    assert len(bad_cells(*_assemble([g], topo.node_map), cells)) == 1
+    (kept,), _ = untangle(topo, [g])  # shore nodes stay without the rings
+    assert len(bad_cells(*_assemble([kept], topo.node_map), cells)) == 1
+    (out,), moved = untangle(topo, [g], rings=rings)
+    assert moved >= 1
+    assert not len(bad_cells(*_assemble([out], topo.node_map), cells))
+    _, _, off = project_to_rings(rings, np.c_[[out.x[0, 0]], [out.y[0, 0]]])
+    assert off[0] < 1e-9  # still on the shore
+    np.testing.assert_array_equal(out.x[1:], X[1:])  # nothing else moved
+    np.testing.assert_array_equal(out.y[1:], Y[1:])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "expr",
+    [
+        "testing.channel_network(158200, n_branches=4, width=(1.0, 3.0), roughness=0.15)",
+        "testing.channel_network(263202, n_branches=4, width=(1.0, 3.0), roughness=0.15)",
+    ],
+)
+def test_rough_generated_networks_fold_no_cell(expr):
+    # rough channel networks of the fresh sweeps at 15 000 cells, 1 folded cell each before
+    mb = mesh_outline(eval(expr), target_cells=15000)
+    assert sum(int(block_metrics(g).folded.sum()) for g in mb.grids) == 0
