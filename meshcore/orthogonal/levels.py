@@ -173,6 +173,72 @@ def _carried_to(x: np.ndarray, y: np.ndarray, ij, col: list, p: np.ndarray) -> b
     return False
 
 
+#: Radii (index steps) of the patches of a block's interior nodes that :func:`_patched_to` moves with
+#: a shore node, smallest first.
+PATCH_RADII = (2, 3, 5, 8)
+
+
+def _patch(shape: tuple[int, int], ij, r: int):
+    """``(i, j, w)``: the block's interior nodes within an index distance ``r`` of ``ij`` and the
+    share ``1 - d / (r + 1)`` of a move of ``ij`` each takes along."""
+    n1, m1 = shape
+    i, j = ij
+    ii, jj = np.meshgrid(
+        np.arange(max(1, i - r), min(n1 - 1, i + r + 1)),
+        np.arange(max(1, j - r), min(m1 - 1, j + r + 1)),
+        indexing="ij",
+    )
+    d = np.hypot(ii - i, jj - j)
+    keep = d < r + 1
+    return ii[keep], jj[keep], 1.0 - d[keep] / (r + 1)
+
+
+def _patched_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
+    """Move node ``ij`` (on a block side) to ``p`` with the patch of :func:`_patch` of the smallest
+    radius of :data:`PATCH_RADII` that leaves every cell around them convex; True if it moved, else
+    nothing moves.  Where the node must go a cell or more out to a sharp tip of land its own grid
+    line points at, the nodes of that line alone (:func:`_carried_to`) cross their neighbours: the
+    patch takes the cells beside them along."""
+    ox, oy = x[ij], y[ij]
+    dx, dy = p[0] - ox, p[1] - oy
+    for r in PATCH_RADII:
+        ii, jj, w = _patch(x.shape, ij, r)
+        old_x, old_y = x[ii, jj].copy(), y[ii, jj].copy()
+        x[ii, jj] += w * dx
+        y[ii, jj] += w * dy
+        x[ij], y[ij] = p[0], p[1]
+        if all(_convex_around(x, y, n) for n in [ij, *zip(ii.tolist(), jj.tolist(), strict=True)]):
+            return True
+        x[ii, jj], y[ii, jj] = old_x, old_y
+        x[ij], y[ij] = ox, oy
+    return False
+
+
+def _repaired_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
+    """Move node ``ij`` (on a block side) to ``p`` with the largest patch of :func:`_patched_to`,
+    then let the fold-free repair (:func:`meshcore.foldfree.repair`, the block's borders fixed) move
+    the block's interior nodes round the cells that leaves non-convex; True if no cell of the block
+    is non-convex that was not before, else nothing moves.  Along a side that passes a sharp tip
+    the solve squeezes the rows next to the shore to a sliver: even the patch leaves the row inwards
+    of the node short of the tip (``channel_network(263005)``: the grid's edge 1.0 cells from it)."""
+    from ..foldfree import invalid_cells, repair
+    from ..grid import StructuredGrid
+
+    before = invalid_cells(x, y)
+    ox, oy = x.copy(), y.copy()
+    ii, jj, w = _patch(x.shape, ij, PATCH_RADII[-1])
+    x[ii, jj] += w * (p[0] - ox[ij])
+    y[ii, jj] += w * (p[1] - oy[ij])
+    x[ij], y[ij] = p[0], p[1]
+    if invalid_cells(x, y).any():
+        res = repair(StructuredGrid(x.copy(), y.copy()), strict=False)
+        x[...], y[...] = res.grid.x, res.grid.y
+    if not (invalid_cells(x, y) & ~before).any():
+        return True
+    x[...], y[...] = ox, oy
+    return False
+
+
 def _move_if_valid(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> None:
     """Move node ``ij`` to ``p``, or as far towards it as keeps its cells convex."""
     ox, oy = x[ij], y[ij]
@@ -308,7 +374,12 @@ def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limi
             if at is None:
                 continue
             col = _column(ids.shape, ij, fixed_i, fixed_j)
-            if _moved_to(xs[b], ys[b], ij, at) or _carried_to(xs[b], ys[b], ij, col, at):
+            if (
+                _moved_to(xs[b], ys[b], ij, at)
+                or _carried_to(xs[b], ys[b], ij, col, at)
+                or _patched_to(xs[b], ys[b], ij, at)
+                or _repaired_to(xs[b], ys[b], ij, at)
+            ):
                 s_of[k] = sb
                 moved += 1
     return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)], moved
