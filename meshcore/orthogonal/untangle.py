@@ -16,11 +16,11 @@ through every level (one cell in 4 of 45 generated lakes of fresh seeds at 15 00
    lines), puts the interface nodes within :data:`HOPS` edges of that end back towards the
    layout's line — fully at the end, blending into the solved position further along — and
    repairs the blocks then invalid with their borders fixed (:func:`meshcore.foldfree.repair`);
-2. given the shore rings, slides each shore node whose angle in a bad cell only shore nodes make
-   (a block corner on a notch of a rough shore, where the water turns beyond 180°: its one cell of
-   that block is non-convex whatever the free nodes do) along the shore to the nearest place where
-   every cell around it is convex (:func:`_slide_shore_nodes`; after step 3, any shore node of a
-   cell it left bad, then step 3 again);
+2. given the shore rings, slides each block corner or cut end on the shore whose angle in a bad
+   cell only shore nodes make (a block corner on a notch of a rough shore, where the water turns
+   beyond 180°: its one cell of that block is non-convex whatever the free nodes do) along the
+   shore to the nearest place where every cell around it is convex (:func:`_slide_shore_nodes`;
+   after step 3, any block corner or cut end of a cell it left bad, then step 3 again);
 3. then moves, one at a time, each free node (not on the shore) of each cell still bad: to the
    nearest of a few candidate positions around it (rings of 16 points at ¼, ½ and 1 of its mean
    edge length, the mean of its edge neighbours) where every cell around it is convex with a
@@ -207,14 +207,15 @@ SLIDE = 1.5
 
 
 def _slide_shore_nodes(mesh: _Mesh, rings, only_fixed: bool = True) -> int:
-    """Step 2 of :func:`untangle`: every shore node whose angle in a bad cell is made by shore nodes
-    only (its two neighbours in the cell are on the shore too) moved along its shore ring to the
+    """Step 2 of :func:`untangle`: every block corner or cut end on the shore (a shore node of one,
+    three or more cells) whose angle in a bad cell is made by shore nodes only (its two neighbours
+    in the cell are on the shore too) moved along its shore ring to the
     nearest place (within :data:`SLIDE` of its mean edge length either way) where every cell
     around it is convex; returns how many moved.  A block corner or a cut end the layout put on a
     notch of a rough shore, where the water turns beyond 180°, leaves its one cell of that block
     non-convex, and no move of the free nodes can mend that: the other corners of the cell would
-    have to go onto land.  ``only_fixed`` False: every shore node of a bad cell (after step 3,
-    for the cells it left bad)."""
+    have to go onto land.  ``only_fixed`` False: every block corner or cut end of a bad cell
+    (after step 3, for the cells it left bad)."""
     from .shore import arc_lengths, project_to_rings, ring_point
 
     m, X, Y, cells = mesh.m, mesh.X, mesh.Y, mesh.cells
@@ -223,7 +224,10 @@ def _slide_shore_nodes(mesh: _Mesh, rings, only_fixed: bool = True) -> int:
     b = m.boundary[bad]
     # corners whose angle only shore nodes make: the node and its two neighbours in the cell
     fixed = (j <= 0) & b & np.roll(b, 1, axis=1) & np.roll(b, -1, axis=1) if only_fixed else b
-    nodes = sorted({int(n) for n in bad[fixed]})
+    # block corners and cut ends only (the shore sweep holds them; a node along a block's side
+    # slides in the sweeps and has free neighbours inwards): slid along a one-cell-wide coarse
+    # block's sides they changed the whole block (``dendritic(911700)``: 0 -> 5 folded cells)
+    nodes = sorted({int(n) for n in bad[fixed] if mesh.cnt[n] != 2})
     if not nodes or not rings:
         return 0
     r_of, s_of, _ = project_to_rings(rings, np.column_stack([X[nodes], Y[nodes]]))
