@@ -216,8 +216,10 @@ def _patched_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
 
 def _repaired_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
     """Move node ``ij`` (on a block side) to ``p`` with the largest patch of :func:`_patched_to`,
-    then let the fold-free repair (:func:`meshcore.foldfree.repair`, the block's borders fixed) move
-    the block's interior nodes round the cells that leaves non-convex; True if no cell of the block
+    then let the fold-free repair (:func:`meshcore.foldfree.repair`) move the interior nodes of that
+    patch's window (its edges fixed: the repair of the whole block, whose patches grow until they
+    are the block, reshaped blocks far from the tip; ``headlands(763605)``: 65 -> 44 % of nodes
+    within 3°) round the cells the move leaves non-convex; True if no cell of the block
     is non-convex that was not before, else nothing moves.  Along a side that passes a sharp tip
     the solve squeezes the rows next to the shore to a sliver: even the patch leaves the row inwards
     of the node short of the tip (``channel_network(263005)``: the grid's edge 1.0 cells from it)."""
@@ -230,9 +232,11 @@ def _repaired_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
     x[ii, jj] += w * (p[0] - ox[ij])
     y[ii, jj] += w * (p[1] - oy[ij])
     x[ij], y[ij] = p[0], p[1]
-    if invalid_cells(x, y).any():
-        res = repair(StructuredGrid(x.copy(), y.copy()), strict=False)
-        x[...], y[...] = res.grid.x, res.grid.y
+    if invalid_cells(x, y).any():  # repaired within the patch's window only, its edges fixed
+        r = PATCH_RADII[-1] + 1
+        win = (slice(max(0, ij[0] - r), ij[0] + r + 1), slice(max(0, ij[1] - r), ij[1] + r + 1))
+        res = repair(StructuredGrid(x[win].copy(), y[win].copy()), strict=False)
+        x[win], y[win] = res.grid.x, res.grid.y
     if not (invalid_cells(x, y) & ~before).any():
         return True
     x[...], y[...] = ox, oy
