@@ -43,6 +43,7 @@ __all__ = [
     "frame_from_case",
     "frame_from_table",
     "is_geographic",
+    "lon_span",
     "looks_lonlat",
     "project",
     "project_arrays",
@@ -199,7 +200,8 @@ def looks_lonlat(points: Any) -> bool:
     """Heuristic: do these unlabelled coordinates look like lon/lat degrees?
 
     True when every point lies in ``[-180, 180] × [-90, 90]``, the extent is
-    at most 20° (a lake or river region, not a whole continent), the centre
+    at most 20° (a lake or river region, not a whole continent; measured across
+    the antimeridian when that is shorter, :func:`lon_span`), the centre
     is more than 1° away from ``(0, 0)`` and the values carry at least three
     decimals (digitised degrees do; unit squares and other small model
     coordinates such as ``0 … 8`` or ``0.5, 1.25`` are not mistaken for degrees).
@@ -210,10 +212,10 @@ def looks_lonlat(points: Any) -> bool:
     lo, hi = p.min(axis=0), p.max(axis=0)
     if lo[0] < -180 or hi[0] > 180 or lo[1] < -90 or hi[1] > 90:
         return False
-    if max(hi - lo) > 20:
+    lon_c, lon_w = lon_span(p[:, 0])
+    if max(lon_w, hi[1] - lo[1]) > 20:
         return False
-    c = 0.5 * (lo + hi)
-    if math.hypot(*c) <= 1.0:
+    if math.hypot(lon_c, 0.5 * (lo[1] + hi[1])) <= 1.0:
         return False
     frac = np.abs(p * 100 - np.round(p * 100))
     return bool((frac > 1e-6).any())
@@ -430,10 +432,34 @@ def project_arrays(
 
 def _lonlat_centroid(pts: np.ndarray, src: str) -> tuple[float, float]:
     if src != LONLAT:
-        lon, lat = transform(src, LONLAT, pts[:, 0], pts[:, 1], "centroid")
-        pts = np.column_stack([lon, lat])
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    return float(0.5 * (lo[0] + hi[0])), float(0.5 * (lo[1] + hi[1]))
+        x, y = transform(src, LONLAT, pts[:, 0], pts[:, 1], "centroid")
+        pts = np.column_stack([x, y])
+    centre, _ = lon_span(pts[:, 0])
+    return centre, float(0.5 * (pts[:, 1].min() + pts[:, 1].max()))
+
+
+def lon_span(lon: Any) -> tuple[float, float]:
+    """Centre and width in degrees of the shortest arc of longitudes holding ``lon``.
+
+    An outline across the antimeridian (179.9° and −179.9°) spans 0.2°, not
+    359.8°: its centre is ±180°, and the UTM zone of the naive centre (0°) would
+    put it 180° from the zone's meridian, where the projection is meaningless.
+
+    Examples
+    --------
+    >>> lon_span([10.0, 12.0])
+    (11.0, 2.0)
+    >>> c, w = lon_span([179.9, -179.9]); (round(abs(c), 6), round(w, 6))
+    (180.0, 0.2)
+    """
+    a = np.asarray(lon, dtype=np.float64).ravel()
+    lo, hi = float(a.min()), float(a.max())
+    w = np.where(a < 0, a + 360.0, a)  # the same points seen from 0°–360°
+    lo2, hi2 = float(w.min()), float(w.max())
+    if hi2 - lo2 < hi - lo:
+        c = 0.5 * (lo2 + hi2)
+        return (c - 360.0 if c > 180.0 else c), hi2 - lo2
+    return 0.5 * (lo + hi), hi - lo
 
 
 # ------------------------------------------------------------ case files

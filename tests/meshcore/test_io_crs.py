@@ -44,7 +44,8 @@ def test_looks_lonlat():
     assert looks_lonlat(zur)
     assert not looks_lonlat([[0, 0], [1, 0], [1, 1]])  # a unit square is model units
     assert not looks_lonlat([[500000, 5e6], [500100, 5e6]])
-    assert not looks_lonlat([[-170, 10], [170, 10]])  # 340° wide: not a lake
+    assert not looks_lonlat([[-100.5, 10.25], [100.5, 10.25]])  # 159° wide either way: not a lake
+    assert looks_lonlat([[179.951, -16.55], [-179.932, -16.55], [-179.932, -16.4]])  # 0.12° across 180°
     assert not looks_lonlat([[0, 0], [8, 0], [8, 4], [0, 4.5]])  # model units, few decimals
 
 
@@ -63,6 +64,32 @@ def test_project_to_utm_and_back():
     np.testing.assert_allclose(np.column_stack([lon, lat]), ps.polylines[0].points, atol=1e-10)
     # the local coordinates are small: |x| ≤ extent, far below UTM's 10⁶–10⁷
     assert np.abs(local.all_points()).max() < 2e4
+
+
+def test_a_lake_across_the_antimeridian_is_projected_like_its_neighbour():
+    """179.9° and −179.9° are 0.2° apart: the UTM zone is 60 (or 1), not the zone of 0°.
+
+    The naive centre of the longitudes, 0°, put the lake 180° from its zone's meridian:
+    a grid in coordinates of ~10⁷ m, distorted out of shape, without a word.
+    """
+    lat = [-16.45, -16.45, -16.35, -16.35]
+    across = PointSet((Polyline("across", np.column_stack([[179.9, -179.9, -179.9, 179.9], lat]), closed=True),))
+    beside = PointSet((Polyline("beside", np.column_stack([[178.9, 179.1, 179.1, 178.9], lat]), closed=True),))
+    a, fa = project(across, source_crs="EPSG:4326")
+    b, fb = project(beside, source_crs="EPSG:4326")
+    assert fa.crs in ("EPSG:32760", "EPSG:32701") and fb.crs == "EPSG:32760"
+    pa, pb = a.polylines[0].points, b.polylines[0].points
+
+    # the same 0.2° × 0.1° box, 1° apart in the same zone: the same sides in metres (~21 km × 11 km;
+    # UTM's scale differs by < 0.1 % between 2° and 3° from the zone's meridian)
+    def sides(p):
+        return np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T)
+
+    np.testing.assert_allclose(sides(pa), sides(pb), rtol=0.002)
+    assert np.all((sides(pa) > 10e3) & (sides(pa) < 23e3))
+    lon, lat2 = fa.to_lonlat(*pa.T)
+    np.testing.assert_allclose(np.mod(lon, 360), np.mod(across.polylines[0].points[:, 0], 360), atol=1e-9)
+    np.testing.assert_allclose(lat2, lat, atol=1e-9)
 
 
 def test_project_to_given_epsg_and_none():
