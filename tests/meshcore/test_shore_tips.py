@@ -18,28 +18,14 @@ import numpy as np
 import pytest
 
 from meshcore import StructuredGrid, testing  # noqa: F401  (testing: used by eval)
-from meshcore.boundary import Borders
-from meshcore.lakegrid import _shore_rings, mesh_outline
-from meshcore.multiblock.topology import Block, MultiBlockTopology
+from meshcore.lakegrid import mesh_outline
 from meshcore.orthogonal.driver import _assemble
 from meshcore.orthogonal.levels import fit_bends
 from meshcore.orthogonal.shore import project_to_rings
 from meshcore.orthogonal.untangle import bad_cells, untangle
 from meshcore.quality import lake_metrics
 from meshcore.quality.lake import block_metrics
-
-
-def _one_block(x, y):
-    bd = Borders(
-        bottom=np.c_[x[:, 0], y[:, 0]], right=np.c_[x[-1], y[-1]], top=np.c_[x[:, -1], y[:, -1]], left=np.c_[x[0], y[0]]
-    )
-    return MultiBlockTopology((Block("a", bd),), (), check_geometry=False), StructuredGrid(x, y)
-
-
-def _ring(points, step=0.01):
-    from shapely.geometry import Polygon
-
-    return _shore_rings(Polygon(points), step)
+from tests.meshcore.test_shore_bends import _one_block, _ring
 
 
 def _tip_block(lean: float, tall: float):
