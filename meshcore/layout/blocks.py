@@ -173,6 +173,7 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
+    pts, on_shore = [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys]
     # targets rounded to 1e-6 cells: the program has many equally good counts, and lengths that
     # differ in the last bits (an outline shifted by a round number) must not choose among them
     counts = solve_counts(
@@ -182,13 +183,7 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
         multiple=multiple,
         block_cells=block_cells,
         best=best,
-        least=shore_least([chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], cell_size, multiple)
-        if best
-        else None,
-        least_weight=least_weights(
-            [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], [pc.ring for pc in pieces]
-        )
-        if best
-        else None,
+        least=shore_least(pts, on_shore, cell_size, multiple) if best else None,
+        least_weight=least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None,
     )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts

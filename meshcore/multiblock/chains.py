@@ -228,21 +228,10 @@ def _chain_counts(
         targets = np.round(length / float(cell_size), 6)  # as the layout's counts (meshcore.layout.blocks)
     sides = [tuple([index[k] for k in side_chains[(s.name, side)]] for side in SIDES) for s in specs]
     cells = {bi: (int(s.cells[0]), int(s.cells[1])) for bi, s in enumerate(specs)}
+    pts, on_shore = [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys]
     try:
-        least = (
-            None
-            if cell_size is None
-            else shore_least(
-                [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], cell_size, multiple
-            )
-        )
-        weight = (
-            None
-            if least is None or rings is None
-            else least_weights(
-                [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys], list(rings.values())
-            )
-        )
+        least = None if cell_size is None else shore_least(pts, on_shore, cell_size, multiple)
+        weight = None if least is None or rings is None else least_weights(pts, on_shore, list(rings.values()))
         n = solve_counts(
             targets, sides, min_cells=1, multiple=multiple, block_cells=cells, least=least, least_weight=weight
         )

@@ -250,7 +250,8 @@ def solve_counts(
     # JUMP times the other
     # h_q ≥ 0 per chain with a ``least`` count, the cells it falls short of it
     nj, ns = len(jumps), len(short)
-    nv = 2 * n + 2 * nb + 2 * nj + ns  # ... and s_p ≥ 0 per pair, the cells beyond STEEP times
+    nst = nj if STEEP_WEIGHT else 0  # ... and s_p ≥ 0 per pair, the cells beyond STEEP times (if paid)
+    nv = 2 * n + 2 * nb + nj + ns + nst
     cost = np.concatenate(
         [
             np.full(n, -1e-3 * m),
@@ -258,7 +259,7 @@ def solve_counts(
             np.ones(2 * nb),
             np.full(len(jumps), JUMP_WEIGHT),
             weights,
-            np.full(nj, STEEP_WEIGHT),
+            np.full(nst, STEEP_WEIGHT),
         ]
     )
     rows: list[dict[int, float]] = []  # sparse: {unknown: coefficient} per row
@@ -340,7 +341,7 @@ def solve_counts(
             r[2 * n + 2 * nb + len(jumps) + q] = 1.0
             r[c] = m * frac
             add(r, m * frac * (lo_k + 1.0), np.inf)
-    lb = np.concatenate([np.ones(n), np.zeros(n + 2 * nb + 2 * nj + ns)])
+    lb = np.concatenate([np.ones(n), np.zeros(nv - n)])
     ub = np.full(nv, np.inf)
     for c, v in (fixed or {}).items():
         lb[c] = ub[c] = v // m
@@ -357,7 +358,7 @@ def solve_counts(
     res = milp(
         cost if best else np.zeros(nv),
         constraints=LinearConstraint(matrix, lo, hi),
-        integrality=np.concatenate([np.ones(n), np.zeros(n + 2 * nb + 2 * nj + ns)]),
+        integrality=np.concatenate([np.ones(n), np.zeros(nv - n)]),
         bounds=Bounds(lb, ub),
         options={"time_limit": TIME_LIMIT, "mip_rel_gap": 0.0},
     )
