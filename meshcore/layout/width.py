@@ -44,14 +44,14 @@ THIN_CUT = 2.0
 
 
 def inscribed(ring: np.ndarray, tol: float) -> float:
-    """The diameter of the largest disc inside ``ring`` (to ``tol``; 0 for an invalid ring)."""
+    """The diameter of the largest disc inside ``ring`` (to ``tol``; 0 for an invalid ring):
+    :func:`~meshcore.quality.coverage.island_width` of the piece."""
     from shapely.geometry import Polygon
-    from shapely.ops import polylabel
+
+    from ..quality.coverage import island_width
 
     p = Polygon(ring)
-    if not p.is_valid:
-        return 0.0
-    return 2.0 * p.exterior.distance(polylabel(p, tolerance=tol))
+    return island_width(p, tol)[0] if p.is_valid else 0.0
 
 
 def too_narrow(ring: np.ndarray, min_width: float, thin: bool = False) -> bool:
