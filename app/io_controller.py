@@ -262,7 +262,9 @@ class IOController(QtCore.QObject):
             k = len(after.blocks) - 1
         if frame is not None and frame.crs:
             after = after.replaced(crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "")
-        if lake is not None and k == 0 and after.layout is None:
+        if lake is not None and after.layout is None and (k == 0 or p.lake is None):
+            # the project's lake (islands, cell size, layout) is this outline's, also when a
+            # block drawn before (a stray click in Draw) keeps it from being block 0
             after = after.replaced(lake=lake)
         self.editor.replace_project(after, f"Import {name}")
         self.doc.set_active(k)

@@ -520,3 +520,14 @@ def test_islands_that_touch_are_joined_with_a_note_on_import(qtbot, win, tmp_pat
     assert win.io.import_points(src, project_lonlat=True)
     said = [t for lv, t in win.messages_panel.messages() if lv == "warning"]
     assert f"{src.name}: islands 1 and 2 touch: joined into one" in said, said
+
+
+def test_a_point_clicked_before_the_import_does_not_drop_its_islands(qtbot, win):
+    """A stray click in Draw made an open one-point block 0; the lake imported next went to
+    block 1 and its islands were dropped: Auto layout laid out the shore alone (the grid over
+    the island, the cell size from the area with it), while the status said '1 island(s)'."""
+    win.editor.add_point((0.0, 0.0))
+    assert len(win.doc.project.blocks[0].points) == 1
+    lay = lay_out(qtbot, win, ISEO, cell_size=300.0)
+    assert len(lay.polygon.interiors) == 1  # Monte Isola
+    assert win.doc.project.lake is not None and len(win.doc.project.lake.holes) == 1
