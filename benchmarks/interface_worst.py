@@ -55,12 +55,15 @@ def main(argv: list[str] | None = None) -> int:
     from meshcore.quality.interfaces import interface_pairs, signed_area
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("case", help='a name fragment of a lake_grids.py case, or "testing.…(…)"')
+    ap.add_argument("case", help='a name fragment of a lake_grids.py case, an outline file, or "testing.…(…)"')
     ap.add_argument("--cells", type=int, default=15000)
     ap.add_argument("--worst", type=int, default=8)
     ap.add_argument("--png", help="a figure of the worst place")
     a = ap.parse_args(argv)
-    cases = [(a.case, a.case)] if a.case.startswith("testing.") else lake_grids._cases([a.case])
+    if a.case.startswith("testing.") or Path(a.case).is_file():  # an expression or any outline file
+        cases = [(a.case, a.case)]
+    else:
+        cases = lake_grids._cases([a.case])
     if not cases:
         raise SystemExit(f"no case matches {a.case!r}")
     name, what = cases[0]
