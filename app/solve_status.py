@@ -44,6 +44,7 @@ class SolveStatus(QtCore.QObject):
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
         self.doc.opened.connect(self.on_opened)
+        self.doc.project_changed.connect(self.on_edited)
         self.solver.state_changed.connect(self.on_state)
         self.solver.error.connect(self.on_error)
         self.solver.progress.connect(self.on_progress)
@@ -57,8 +58,23 @@ class SolveStatus(QtCore.QObject):
 
     def on_opened(self) -> None:
         self.conv.clear_history()
-        self.win.canvas.set_grid_stale(False)
+        self._show_previous(False)
         self.label.setText("idle")
+
+    def on_edited(self, _project) -> None:
+        """An edit with auto-generate off: the grid on screen is the one of before it (a dragged
+        junction's cut lines no longer on its block borders), so it is greyed and said to be, with
+        its verdict, until a solve makes the new one (F5)."""
+        if self.solver.auto or self.solver.running or not self.doc.grids or not self.doc.stale:
+            return
+        self._show_previous(True)
+        self.label.setText("grid of before the edit (F5 makes the new one)")
+
+    def _show_previous(self, on: bool) -> None:
+        self.win.canvas.set_grid_stale(on)
+        box = getattr(self.win, "lake_quality", None)
+        if box is not None:
+            box.set_previous(on)
 
     def on_progress(self, k: int, snap) -> None:
         if k == ALL_BLOCKS:  # a multiblock solve: every block at once
@@ -103,7 +119,7 @@ class SolveStatus(QtCore.QObject):
 
     def on_error(self, text: str) -> None:
         # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why
-        self.win.canvas.set_grid_stale(True)
+        self._show_previous(True)
         self.win.message(f"Cannot generate: {text}", error=True)
         self.label.setText("error")
 
@@ -119,7 +135,7 @@ class SolveStatus(QtCore.QObject):
         g = self.doc.grid
         if self.solver.running or self.solver.last_error:
             return
-        self.win.canvas.set_grid_stale(False)
+        self._show_previous(False)
         if g is None:
             self.label.setText("idle")
             return

@@ -185,6 +185,7 @@ class LakeQualityBox(QtWidgets.QGroupBox):
 
         self.doc = doc
         self.verdict = None
+        self.previous = False  # the verdict is of the grid before the last edit (auto-generate off)
         lay = QtWidgets.QVBoxLayout(self)
         row = QtWidgets.QHBoxLayout()
         row.addWidget(QtWidgets.QLabel("Preset"))
@@ -210,6 +211,12 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         doc.quality_changed.connect(self.refresh)
         self.refresh()
 
+    def set_previous(self, on: bool) -> None:
+        """Say (or stop saying) that the verdict is of the grid before the last edit."""
+        if bool(on) != self.previous:
+            self.previous = bool(on)
+            self.refresh()
+
     def refresh(self) -> None:
         from meshcore.quality import check
 
@@ -230,8 +237,9 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         s = m.summary()
         n_fail = len(v.failed)
         word = "PASS" if v.passed else f"FAIL ({n_fail} of {len(v.results)} limits missed)"
+        before = "<i>Grid of before the last edit</i> (F5 makes the new one) — " if self.previous else ""
         self.headline.setText(
-            f"<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
+            f"{before}<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
             f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded"
         )
         self.table.setRowCount(len(v.results))

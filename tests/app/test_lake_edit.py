@@ -397,3 +397,37 @@ def test_cut_lines_drawn_by_hand_in_any_topology_split_a_lake(qtbot, win, tmp_pa
     assert win.stack.undoText() == "Split into 3 blocks by cut lines"
     win.stack.undo()
     assert win.doc.project.layout is None and len(win.doc.project.cut_lines) == len(HAND_CUTS[kind])
+
+
+def test_with_auto_generate_off_a_drag_greys_the_grid_of_before_until_f5(qtbot, win):
+    """Auto-generate is off by default: a dragged cut end moves the layout, not the grid. The grid
+    on screen (and its verdict) was shown as current, its block borders off the new cut lines."""
+    from app.layout_edit import handles
+
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    win.lake_ctl.set_cell_size(300.0)
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    assert not win.solver.auto
+    pen = lambda: win.canvas.grid_curve.opts["pen"].color().name()  # noqa: E731
+    assert pen() == "#303030" and "before" not in win.lake_quality.headline.text()
+    lay0, grids0 = win.doc.project.layout, dict(win.doc.grids)
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    tool, h = win.canvas.tool, lay0.cell_size
+    path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, 1.5, 4)]
+    assert tool.drag("start", tuple(path[0]), end.xy)
+    for p in path[1:]:
+        tool.drag("move", tuple(p), end.xy)
+        qtbot.wait(30)
+    tool.drag("finish", tuple(path[-1]), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
+    assert all(win.doc.grids[k] is g for k, g in grids0.items())  # no solve: the grid of before
+    assert pen() == "#b0b0b0"
+    assert "before the last edit" in win.lake_quality.headline.text()
+    assert "F5" in win.solve_status.label.text()
+    win.generate()
+    wait_idle(qtbot, win)
+    assert any(not np.array_equal(win.doc.grids[k].x, g.x) for k, g in grids0.items())
+    assert pen() == "#303030" and "before" not in win.lake_quality.headline.text()
