@@ -259,8 +259,13 @@ def _staged(path: Path):
     moved: list[tuple[Path, Path | None]] = []
     try:
         yield stage
+        files = sorted(p for p in stage.iterdir() if p != backup)
+        for f in files:  # only files are replaced: a folder (or link to one) of that name is not output
+            final = directory / f.name
+            if final.is_dir():
+                raise WriteError(f"{path}: {final} is a folder, not a grid file: nothing was written")
         backup.mkdir()
-        for f in sorted(p for p in stage.iterdir() if p != backup):
+        for f in files:
             final = directory / f.name
             old = None
             if final.exists():

@@ -147,6 +147,7 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
     sub = path.with_suffix("")
     parent = path.parent if str(path.parent) else Path(".")
     write_id = uuid.uuid4().hex
+    _check_block_folder(path, sub)
     clean_stale_temporaries(path)
     try:
         tmpdir = Path(tempfile.mkdtemp(prefix=temp_prefix(path), suffix=".tmpdir", dir=parent))
@@ -184,6 +185,35 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
     finally:
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
+
+
+def _check_block_folder(path: Path, sub: Path) -> None:
+    """Refuse to write ``path`` when ``sub`` (the folder its blocks go to, replaced whole) is
+    anything but an earlier write's block folder: a file, a link, or a folder holding any other
+    file (``meshcore mesh lake/outline.kml -o lake.vtm`` deleted the folder of its own input)."""
+    import re
+
+    if not (sub.exists() or sub.is_symlink()):
+        return
+    if sub.is_symlink() or not sub.is_dir():
+        raise WriteError(
+            one_line(f"{path}: its block folder {sub} would replace a file of that name; write to another name")
+        )
+    ours = re.compile(rf"{re.escape(sub.name)}_\d+\.vts")
+    try:
+        others = sorted(
+            e.name for e in os.scandir(sub) if not (ours.fullmatch(e.name) and e.is_file(follow_symlinks=False))
+        )
+    except OSError as exc:
+        raise WriteError(one_line(f"{path}: cannot read its block folder {sub} ({exc.strerror or exc})")) from None
+    if others:
+        listed = ", ".join(others[:3]) + (f" and {len(others) - 3} more" if len(others) > 3 else "")
+        raise WriteError(
+            one_line(
+                f"{path}: its block folder {sub} holds files that are not its blocks ({listed}); "
+                "the folder is replaced whole by a write, so nothing was written: write to another name"
+            )
+        )
 
 
 def _xml_attr(s: str) -> str:

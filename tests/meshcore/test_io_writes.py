@@ -76,6 +76,46 @@ def _dead_pid() -> int:
         pid += 1
 
 
+def test_vtm_never_replaces_a_folder_that_is_not_its_blocks(tmp_path):
+    """A .vtm's blocks go to the folder of its name, replaced whole: ``meshcore mesh
+    lake/outline.kml -o lake.vtm`` deleted the folder holding its own input."""
+    mine = tmp_path / "lake"
+    mine.mkdir()
+    (mine / "outline.kml").write_text("<kml/>")
+    with pytest.raises(WriteError, match="outline.kml") as exc:
+        write(tmp_path / "lake.vtm", meshcore.GridSet((_grid(), _grid(shift=100.0))))
+    assert "\n" not in str(exc.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lake"]  # nothing written, no temporaries
+    assert [p.name for p in mine.iterdir()] == ["outline.kml"]
+    (tmp_path / "lake2").write_text("a file of the block folder's name")
+    with pytest.raises(WriteError, match="replace a file"):
+        write(tmp_path / "lake2.vtm", meshcore.GridSet((_grid(),)))
+    assert (tmp_path / "lake2").read_text() == "a file of the block folder's name"
+    # the folder of an earlier write is replaced (three blocks, then two: no third left behind)
+    f = write(tmp_path / "g.vtm", meshcore.GridSet((_grid(), _grid(shift=100.0), _grid(shift=200.0))))
+    write(f, meshcore.GridSet((_grid(), _grid(shift=100.0))))
+    assert sorted(p.name for p in (tmp_path / "g").iterdir()) == ["g_0.vts", "g_1.vts"]
+    assert len(read_blocks(f).blocks) == 2
+
+
+def test_ddb_never_replaces_a_folder_of_a_block_files_name(tmp_path):
+    """Delft3D DD writes a .grd and .enc per block beside the .ddb: a folder of such a name was
+    moved aside and deleted with the staging folder."""
+    s, t = np.meshgrid(np.linspace(0, 100, 6), np.linspace(0, 60, 4), indexing="ij")
+    blocks = meshcore.GridSet((meshcore.StructuredGrid(s, t), meshcore.StructuredGrid(s + 100, t)))
+    f = write(tmp_path / "g.ddb", blocks)
+    names = sorted(p.name for p in tmp_path.iterdir())
+    (tmp_path / names[1]).unlink()  # a block file's name ...
+    (tmp_path / names[1]).mkdir()  # ... is a folder of the user's now
+    (tmp_path / names[1] / "keep.txt").write_text("mine")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    with pytest.raises(WriteError, match="is a folder"):
+        write(f, blocks)
+    assert (tmp_path / names[1] / "keep.txt").read_text() == "mine"
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == names  # no temporaries
+
+
 def test_stale_temporaries_of_killed_writes_are_removed(tmp_path):
     target = tmp_path / "g.vts"
     dead = tmp_path / f".g.vts.{_dead_pid()}.x1y2.tmp"  # a killed writer's (its process is gone)
