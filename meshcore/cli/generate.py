@@ -88,6 +88,13 @@ def check_output(path: str, option: str, *, blocks: int = 1, figure: bool = Fals
         raise InvalidInputError(f"{option} {p}: the folder {folder} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise InvalidInputError(f"{option} {p}: cannot write in the folder {folder} (permission denied)")
+    if p.suffix.lower() == ".vtm":  # its blocks go to a folder of its name, which must be its own
+        from ..io.vtk_xml import check_block_folder
+
+        try:
+            check_block_folder(p, p.with_suffix(""))
+        except WriteError as exc:
+            raise InvalidInputError(f"{option} {exc}") from None
     return p
 
 

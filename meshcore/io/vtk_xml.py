@@ -147,7 +147,7 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
     sub = path.with_suffix("")
     parent = path.parent if str(path.parent) else Path(".")
     write_id = uuid.uuid4().hex
-    _check_block_folder(path, sub)
+    check_block_folder(path, sub)
     clean_stale_temporaries(path)
     try:
         tmpdir = Path(tempfile.mkdtemp(prefix=temp_prefix(path), suffix=".tmpdir", dir=parent))
@@ -187,7 +187,7 @@ def write_vtm(path: Path, gs: GridSet, *, data: bool = True, **_: Any) -> None:
             shutil.rmtree(old, ignore_errors=True)
 
 
-def _check_block_folder(path: Path, sub: Path) -> None:
+def check_block_folder(path: Path, sub: Path) -> None:
     """Refuse to write ``path`` when ``sub`` (the folder its blocks go to, replaced whole) is
     anything but an earlier write's block folder: a file, a link, or a folder holding any other
     file (``meshcore mesh lake/outline.kml -o lake.vtm`` deleted the folder of its own input)."""

@@ -434,6 +434,19 @@ def test_default_cell_size_and_a_one_block_format_refused_before_the_solve(tmp_p
     assert os.listdir(out) == []
 
 
+def test_a_vtm_whose_block_folder_holds_the_input_is_refused_before_the_solve(tmp_path, synthetic_csv):
+    """``-o lake.vtm`` puts its blocks in ``lake/``, replaced whole: with the outline in that folder
+    the write deleted it (after the solve); now the command stops before any work."""
+    lake = tmp_path / "lake"
+    lake.mkdir()
+    src = lake / "outline.csv"
+    src.write_bytes(Path(synthetic_csv).read_bytes())
+    run = mesh(src, "-o", tmp_path / "lake.vtm")
+    assert run.rc == 2 and "Traceback" not in run.err
+    assert "outline.csv" in run.err.splitlines()[-1] and "grid level" not in run.err
+    assert not (tmp_path / "lake.vtm").exists() and os.listdir(lake) == ["outline.csv"]
+
+
 @pytest.mark.parametrize(
     ("text", "needles"),
     [
