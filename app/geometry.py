@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from meshcore.plot import line_alpha  # the level of detail of the canvas and of meshcore's figures
+
 __all__ = [
     "border_polylines",
     "cell_at",
@@ -285,19 +287,6 @@ def typical_cell_size(grids, sample: int = 20_000) -> float:
     a = np.concatenate(lengths)
     a = a[np.isfinite(a)]
     return float(np.median(a)) if a.size else 0.0
-
-
-def line_alpha(cell_pixels: float, *, full: float = 8.0, faint: float = 2.0, floor: float = 0.12) -> float:
-    """Opacity of grid lines for cells ``cell_pixels`` wide on screen (level of detail).
-
-    Opaque for cells of ``full`` pixels or more, fading linearly to ``floor``
-    at ``faint`` pixels and below: a zoomed-out fine grid reads as a light
-    texture and the cell colouring shows through, instead of a black blob.
-    """
-    if not math.isfinite(cell_pixels) or cell_pixels >= full:
-        return 1.0
-    t = (cell_pixels - faint) / (full - faint)
-    return float(floor + (1.0 - floor) * min(max(t, 0.0), 1.0))
 
 
 def marker_size(spacing_pixels: float, full: float, *, least: float = 3.0) -> float:

@@ -7,6 +7,7 @@ several), the boundary thicker, and optionally the input boundary points.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -15,9 +16,22 @@ import numpy as np
 
 from .grid import StructuredGrid
 
-__all__ = ["plot_grid"]
+__all__ = ["line_alpha", "plot_grid"]
 
 _BLOCK_COLOURS = ["#1f4e9c", "#c0392b", "#1e8449", "#8e44ad", "#d35400", "#117a65", "#7d6608"]
+
+
+def line_alpha(cell_pixels: float, *, full: float = 8.0, faint: float = 2.0, floor: float = 0.12) -> float:
+    """Opacity of grid lines for cells ``cell_pixels`` wide on screen (level of detail).
+
+    Opaque for cells of ``full`` pixels or more, fading linearly to ``floor``
+    at ``faint`` pixels and below: a zoomed-out fine grid reads as a light
+    texture and the cell colouring shows through, instead of a black blob.
+    """
+    if not math.isfinite(cell_pixels) or cell_pixels >= full:
+        return 1.0
+    t = (cell_pixels - faint) / (full - faint)
+    return float(floor + (1.0 - floor) * min(max(t, 0.0), 1.0))
 
 
 def _as_blocks(obj: Any) -> list[StructuredGrid]:

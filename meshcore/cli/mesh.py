@@ -421,6 +421,10 @@ def _grid(lay, say: _Say):
 
 
 # ------------------------------------------------------------------ figure
+#: Resolution of the ``--png`` figure (dots per inch).
+DPI = 150
+
+
 def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any) -> None:
     """One colour per block, or cells coloured by the largest deviation from 90° at their nodes."""
     import matplotlib
@@ -429,6 +433,7 @@ def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: An
 
     from ..grid import BORDER_NAMES
     from ..io import atomic_write_bytes
+    from ..plot import line_alpha
 
     xs = np.concatenate([np.ravel(g.x) for g in mb.grids])
     ys = np.concatenate([np.ravel(g.y) for g in mb.grids])
@@ -438,6 +443,10 @@ def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: An
     ax = fig.add_subplot()
     blocks = matplotlib.colormaps["tab10"].colors
     mesh = None
+    n_cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
+    # grid lines fade where cells are a few pixels wide (a fine grid or a long river at this size
+    # was a black band hiding the blocks' colours and the deviations), as on the app's canvas
+    alpha = line_alpha(math.sqrt(poly.area / max(n_cells, 1)) * s * DPI)
     for k, g in enumerate(mb.grids):
         x, y = np.asarray(g.x), np.asarray(g.y)
         if colour == "deviation":
@@ -451,7 +460,7 @@ def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: An
             line = blocks[k % len(blocks)]
         segs = [np.column_stack([x[i], y[i]]) for i in range(x.shape[0])]
         segs += [np.column_stack([x[:, j], y[:, j]]) for j in range(x.shape[1])]
-        ax.add_collection(LineCollection(segs, colors=[line], linewidths=0.3))
+        ax.add_collection(LineCollection(segs, colors=[line], linewidths=0.3, alpha=alpha))
         ax.add_collection(LineCollection([g.border(b) for b in BORDER_NAMES], colors=[line], linewidths=0.9))
     for ring in [poly.exterior, *poly.interiors]:
         r = np.asarray(ring.coords)
@@ -464,10 +473,9 @@ def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: An
     unit = f" [m, {frame.crs}]" if frame.crs else ""
     ax.set_xlabel(f"x{unit}")
     ax.set_ylabel(f"y{unit}")
-    n_cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
     ax.set_title(f"{len(mb.grids)} blocks, {n_cells:,} cells", fontsize=10)
     buf = io.BytesIO()
-    fig.savefig(buf, format=path.suffix.lower().lstrip("."), dpi=150, bbox_inches="tight")
+    fig.savefig(buf, format=path.suffix.lower().lstrip("."), dpi=DPI, bbox_inches="tight")
     atomic_write_bytes(path, buf.getvalue())
 
 

@@ -311,6 +311,20 @@ def synthetic_csv(tmp_path):
     return f
 
 
+def test_a_fine_grids_figure_fades_its_lines_instead_of_going_dark(tmp_path, synthetic_csv):
+    """At 40 000 cells the --png lines were ~1 pixel apart: the figure went dark, hiding the blocks'
+    colours (a 100 000-cell lake, a long river: black bands). Lines fade with the cells' size in
+    pixels, as on the app's canvas: the figure stays about as light as a coarse grid's."""
+    from PIL import Image
+
+    light = {}
+    for cells in (2000, 40000):
+        run = mesh(synthetic_csv, "--cells", cells, "-o", tmp_path / "s.npz", "--png", tmp_path / f"f{cells}.png")
+        assert run.rc == 0, run.err
+        light[cells] = float(np.asarray(Image.open(tmp_path / f"f{cells}.png").convert("L"), float).mean())
+    assert light[2000] - light[40000] < 9.0, light  # 15.4 grey levels darker before
+
+
 def test_csv_rings_without_a_crs_keep_the_file_coordinates(tmp_path, synthetic_csv):
     run = mesh(synthetic_csv, "--cell-size", 150, "-o", tmp_path / "s.vtm", "-o", tmp_path / "s.npz")
     assert run.rc == 0, run.err
