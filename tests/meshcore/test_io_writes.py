@@ -82,7 +82,7 @@ def test_vtm_never_replaces_a_folder_that_is_not_its_blocks(tmp_path):
     mine = tmp_path / "lake"
     mine.mkdir()
     (mine / "outline.kml").write_text("<kml/>")
-    with pytest.raises(WriteError, match="outline.kml") as exc:
+    with pytest.raises(WriteError, match=r"outline\.kml") as exc:
         write(tmp_path / "lake.vtm", meshcore.GridSet((_grid(), _grid(shift=100.0))))
     assert "\n" not in str(exc.value)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["lake"]  # nothing written, no temporaries
