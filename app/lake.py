@@ -5,8 +5,8 @@ gives the same layout in the app and on the command line:
 
 * the water: every ring of the point file, projected like the rest of the project
   (:func:`meshcore.cli.mesh.local_frame`; lon/lat by :func:`meshcore.cli.mesh.is_lonlat`),
-  split into shore and islands by :func:`meshcore.cli.mesh.lake_rings` (open lines touching
-  the shore dropped);
+  split into shore and islands by :func:`meshcore.cli.mesh.lake_rings` (open lines that
+  cannot be islands dropped with a note);
 * the layout: :func:`meshcore.layout.auto_layout` at the cell size the user set, or at
   ``sqrt(water area / 10 000)`` (:data:`meshcore.cli.mesh.DEFAULT_CELLS`), with cell counts
   that are multiples of ``2**LEVELS`` (the grid sequencing of :func:`meshcore.lakegrid.mesh_layout`);

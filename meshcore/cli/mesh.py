@@ -313,12 +313,20 @@ def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
     return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
 
 
+#: Point files in which an island's ring may be written without its closing point: an open
+#: polyline there is a ring.  The other formats say it (KML, GeoJSON and shapefile geometry types,
+#: a DXF polyline's closed flag): there an open line is a path.
+RINGS_MAY_BE_OPEN = (".csv", ".txt", ".xy", ".dat", ".tsv")
+
+
 def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
-    """Drop open polylines that touch the shore (an inlet or a cut drawn on it): ``(kept, notes)``.
+    """Drop open polylines that cannot be islands: ``(kept, notes)``.
 
     The shore is the ring of largest area, as :func:`~meshcore.layout.polygon.water_from_points`
-    picks it; an open line that meets it cannot be an island.  ``notes`` names the dropped
-    lines (empty when none was dropped).
+    picks it.  An open line that meets it (an inlet or a cut drawn on it) is dropped; so is, in a
+    file whose geometry says what is a ring (not a CSV) and that holds a polygon, an open line in
+    the water (a ferry route, a survey line: read as a ring it was an island of water left out of
+    the grid).  ``notes`` names the dropped lines (empty when none was dropped).
     """
     import shapely
 
@@ -327,17 +335,24 @@ def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
         return ps, []  # water_from_points names what is missing
     shore = max(rings, key=lambda pl: abs(shapely.Polygon(pl.points).area))
     ring = shapely.LinearRing(shore.points)
+    paths = any(pl.closed for pl in ps.polylines) and not str(ps.source).lower().endswith(RINGS_MAY_BE_OPEN)
     keep: list[Any] = []
-    dropped: list[Any] = []
+    touching: list[Any] = []
+    inside: list[Any] = []
     for pl in ps.polylines:
-        line = pl is not shore and not pl.closed and len(pl.points) >= 2  # a single point: named later
-        line = line and shapely.LineString(pl.points).intersects(ring)
-        (dropped if line else keep).append(pl)
-    if not dropped:
-        return ps, []
-    names = ", ".join(repr(pl.name) for pl in dropped)
-    what = "an open line" if len(dropped) == 1 else "open lines"
-    return ps.with_points(keep, ps.crs), [f"{names}: {what} touching the shore, not an island: ignored"]
+        if pl is shore or pl.closed or len(pl.points) < 2:  # a single point: named later
+            keep.append(pl)
+        elif shapely.LineString(pl.points).intersects(ring):
+            touching.append(pl)
+        else:
+            (inside if paths else keep).append(pl)
+    notes = []
+    for dropped, where in ((touching, "touching the shore"), (inside, "in the water (a path, not a ring)")):
+        if dropped:
+            names = ", ".join(repr(pl.name) for pl in dropped)
+            what = "an open line" if len(dropped) == 1 else "open lines"
+            notes.append(f"{names}: {what} {where}, not an island: ignored")
+    return (ps.with_points(keep, ps.crs), notes) if notes else (ps, [])
 
 
 def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:

@@ -358,6 +358,39 @@ def test_geojson_interior_ring_in_lon_lat_to_a_given_crs(tmp_path):
     check_covers_the_water(blocks, projected(geojson_rings(f), "EPSG:3035"))
 
 
+def test_an_open_line_in_the_water_of_a_geojson_is_a_path_not_an_island(tmp_path, synthetic_csv):
+    """A ferry route (a LineString) in a file with the lake's Polygon was read as a ring: an island
+    of water left out of the grid, without a word. In a CSV an open ring is still an island."""
+    to_ll = pyproj.Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True)
+    shore, island = _synthetic_rings()
+    lo, hi = shore.min(axis=0), shore.max(axis=0)
+    route = np.array([lo + (hi - lo) * f for f in ((0.2, 0.3), (0.5, 0.45), (0.8, 0.3))])  # in the water
+    ll = [np.column_stack(to_ll.transform(r[:, 0], r[:, 1])).round(7).tolist() for r in (shore, island, route)]
+    feats = [
+        {
+            "type": "Feature",
+            "properties": {"name": "lake"},
+            "geometry": {"type": "Polygon", "coordinates": [ll[0] + ll[0][:1], ll[1] + ll[1][:1]]},
+        },
+        {"type": "Feature", "properties": {"name": "ferry"}, "geometry": {"type": "LineString", "coordinates": ll[2]}},
+    ]
+    areas = []
+    for k, fs in enumerate((feats[:1], feats)):  # without the route, then with it
+        f = tmp_path / f"lake{k}.geojson"
+        f.write_text(json.dumps({"type": "FeatureCollection", "features": fs}))
+        run = mesh(f, "--cells", 600, "-o", tmp_path / f"s{k}.npz")
+        assert run.rc == 0, run.err
+        areas.append(next(ln for ln in run.err.splitlines() if ln.startswith("water area")))
+    assert "'ferry': an open line in the water" in run.err and "1 island" in run.err
+    assert areas[0] == areas[1]  # the same water, the same cells
+    # a CSV's rings need no closing point: its open third ring is an island (the route as a ring)
+    rows = [f"{x:.3f},{y:.3f},{n}" for n, r in (("shore", shore), ("isle", island), ("route", route)) for x, y in r]
+    g = tmp_path / "rings.csv"
+    g.write_text("x,y,ring\n" + "\n".join(rows) + "\n")
+    run = mesh(g, "--cells", 600, "-o", tmp_path / "t.npz")
+    assert run.rc == 0 and "2 islands" in run.err, run.err
+
+
 def test_geojson_in_projected_metres_needs_and_takes_source_crs(tmp_path):
     """GeoJSON is lon/lat by its spec; a file in UTM metres is refused with the way out named,
     and ``--source-crs`` reads it as such (the grid stays in those metres)."""
