@@ -102,10 +102,20 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
         for j, other in enumerate(rings):
             if Polygon(other).intersects(isl):  # touching islands are one island
                 merged = Polygon(other).union(isl)
-                if merged.geom_type != "Polygon":  # touching at points: close the pinch
-                    merged = merged.buffer(1e-7 * size, join_style="mitre").buffer(-0.5e-7 * size, join_style="mitre")
+                if merged.geom_type != "Polygon":  # touching at points: close the pinch (bevelled: a
+                    # mitre reaches out up to 5 times as far at a sharp tip, across a shore 6e-7 away)
+                    merged = merged.buffer(1e-7 * size, join_style="bevel").buffer(-0.5e-7 * size, join_style="bevel")
                 if merged.geom_type != "Polygon":
-                    raise InvalidInputError(f"islands {j + 1} and {k + 1} overlap in more than one place")
+                    c = Polygon(other).intersection(isl).representative_point()
+                    raise InvalidInputError(
+                        f"islands {j + 1} and {k + 1} overlap in more than one place (near {c.x:.6g}, {c.y:.6g})"
+                    )
+                if not shell.contains(merged):
+                    c = merged.intersection(shell.exterior).representative_point()
+                    raise InvalidInputError(
+                        f"islands {j + 1} and {k + 1} touch each other and the shore near ({c.x:.6g}, {c.y:.6g}): "
+                        f"join them into the outline there"
+                    )
                 notes.append(f"islands {j + 1} and {k + 1} touch: joined into one")
                 rings[j] = np.asarray(merged.exterior.coords)[:-1]
                 isl = None
@@ -127,7 +137,7 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
     if not poly.is_valid or poly.area <= 1e-12 * size * size:
         import shapely
 
-        raise InvalidInputError(f"the water polygon is not valid ({shapely.is_valid_reason(poly)})")
+        raise InvalidInputError(f"the water polygon is not valid ({shapely.is_valid_reason(poly)}, near that point)")
     return poly, notes
 
 
