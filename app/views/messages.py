@@ -8,6 +8,7 @@ the status bar, shortened with "…" to fit, the whole text in its tooltip.
 
 from __future__ import annotations
 
+import collections
 import time
 
 from PySide6 import QtCore, QtGui, QtWidgets
@@ -55,19 +56,21 @@ class MessagePanel(QtWidgets.QWidget):
         row.addWidget(clear)
         lay.addLayout(row)
         doc.reported.connect(self.add)
+        self._levels: collections.Counter[str] = collections.Counter()  # level -> listed messages
         self._update_count()
 
     def add(self, level: str, text: str) -> None:
         """List ``text`` (newest first; the same message again only refreshes its time)."""
         if self.list.count() and self.list.item(0).data(QtCore.Qt.ItemDataRole.UserRole) == (level, text):
-            self.list.takeItem(0)
+            self._take(0)
         it = QtWidgets.QListWidgetItem(f"{_SIGNS.get(level, '')} {time.strftime('%H:%M:%S')}  {text}")
         it.setForeground(QtGui.QBrush(QtGui.QColor(_COLOURS.get(level, "#333333"))))
         it.setToolTip(text)
         it.setData(QtCore.Qt.ItemDataRole.UserRole, (level, text))
         self.list.insertItem(0, it)
+        self._levels[level] += 1
         while self.list.count() > self.MAX_ITEMS:
-            self.list.takeItem(self.list.count() - 1)
+            self._take(self.list.count() - 1)
         self._update_count()
         if level != "info":
             self.attention.emit()
@@ -78,16 +81,22 @@ class MessagePanel(QtWidgets.QWidget):
 
     def clear(self) -> None:
         self.list.clear()
+        self._levels.clear()
         self._update_count()
+
+    def _take(self, row: int) -> None:
+        it = self.list.takeItem(row)
+        self._levels[it.data(QtCore.Qt.ItemDataRole.UserRole)[0]] -= 1
 
     def copy(self) -> None:
         items = self.list.selectedItems() or [self.list.item(k) for k in range(self.list.count())]
         QtWidgets.QApplication.clipboard().setText("\n".join(it.text() for it in items))
 
     def _update_count(self) -> None:
-        levels = [lv for lv, _t in self.messages()]
-        n_err, n_warn = levels.count("error"), levels.count("warning")
-        self.count.setText(f"{n_err} error(s), {n_warn} warning(s)" if levels else "no messages")
+        """The counts of the listed messages, kept as they come and go (reading every item back for each
+        new message took ~4 ms of the GUI thread at the end of every solve once the list was full)."""
+        n_err, n_warn = self._levels["error"], self._levels["warning"]
+        self.count.setText(f"{n_err} error(s), {n_warn} warning(s)" if self.list.count() else "no messages")
 
 
 class ElidedLabel(QtWidgets.QLabel):

@@ -135,3 +135,18 @@ def test_autosave_waits_for_the_end_of_a_generate_solve(qtbot, win, monkeypatch)
     win.editor.set_block_options(weights=(0.4, 0.6))
     monkeypatch.setattr(win.solver, "state", "idle")
     wait_for(qtbot, win, lambda: len(writes) == 2)
+
+
+def test_the_message_count_follows_repeats_the_oldest_dropped_and_clear(qtbot, win, monkeypatch):
+    """The counts under the message list are kept as messages come and go, not read back from the list."""
+    panel = win.messages_panel
+    panel.clear()
+    monkeypatch.setattr(panel, "MAX_ITEMS", 4)
+    for level, text in [("error", "e1"), ("warning", "w1"), ("warning", "w1"), ("info", "i1"), ("warning", "w2")]:
+        win.doc.report(level, text)
+    assert panel.count.text() == "1 error(s), 2 warning(s)"  # the repeated w1 listed once
+    win.doc.report("info", "i2")  # five messages: the oldest (the error) drops out
+    assert [lv for lv, _t in panel.messages()] == ["info", "warning", "info", "warning"]
+    assert panel.count.text() == "0 error(s), 2 warning(s)"
+    panel.clear()
+    assert panel.count.text() == "no messages"
