@@ -107,9 +107,14 @@ class ConvergencePanel(pg.PlotWidget):
         self.tol_line.hide()
         self.level_lines: list[pg.InfiniteLine] = []
         self.levels: tuple[tuple[int, str], ...] = ()  # the marked levels: (first sweep, name)
+        self._ranges: tuple | None = None  # the x and y ranges shown (step_ranges)
         self.setMinimumHeight(120)
         for ax in ("left", "bottom"):
-            self.getAxis(ax).enableAutoSIPrefix(False)
+            axis = self.getAxis(ax)
+            axis.enableAutoSIPrefix(False)
+            # painted into a pixmap once per range: with the grid on, an axis covers the whole plot, and it
+            # drew its grid lines and labels again for every new point of the curve
+            axis.setCacheMode(QtWidgets.QGraphicsItem.CacheMode.DeviceCoordinateCache)
 
     def set_history(self, history, tolerance: float | None = None, levels=()) -> None:
         """Plot ``(iteration, residual)`` pairs; ``levels``: ``(first sweep, name)`` of each level begun.
@@ -127,6 +132,16 @@ class ConvergencePanel(pg.PlotWidget):
         if tolerance:
             self.tol_line.setValue(math.log10(tolerance))
             self.tol_line.show()
+        self._fit(h[ok], tolerance)
+
+    def _fit(self, h: np.ndarray, tolerance: float | None) -> None:
+        """Show the curve and the tolerance in ranges that change in steps (:func:`step_ranges`): the axes,
+        cached as pictures, are drawn again only when a step is passed, not for every new point of a
+        live solve (with autorange they were, their labels and grid lines: most of a live frame's cost)."""
+        ranges = step_ranges(h, tolerance)
+        if ranges is not None and ranges != self._ranges:
+            self._ranges = ranges
+            self.setRange(xRange=ranges[0], yRange=ranges[1], padding=0.02)
 
     def _set_levels(self, levels: tuple[tuple[int, str], ...]) -> None:
         if levels == self.levels:
@@ -157,6 +172,30 @@ class ConvergencePanel(pg.PlotWidget):
         self.curve.setData([], [])
         self.tol_line.hide()
         self._set_levels(())
+        self._ranges = None  # the next history sets them
+
+
+#: the steps of the iteration axis's end, times a power of ten (each at most 1.5 × the one before)
+X_STEPS = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
+
+
+def step_ranges(h: np.ndarray, tolerance: float | None = None):
+    """``((0, x1), (y0, y1))`` of a convergence plot of ``(iteration, residual)`` rows ``h`` (residuals > 0;
+    y in decades, log10): x1 the least of :data:`X_STEPS` × 10^k at or above the last iteration, y0 and y1
+    whole decades around the residuals and the tolerance.  None when ``h`` is empty."""
+    fin = np.isfinite(h).all(axis=1) if len(h) else np.zeros(0, bool)
+    if not fin.any():
+        return None
+    h = h[fin]
+    top = max(float(h[:, 0].max()), 1.0)
+    scale = 10.0 ** math.floor(math.log10(top))
+    x1 = next(f * scale for f in X_STEPS if f * scale >= top)
+    logs = np.log10(h[:, 1])
+    lo, hi = float(logs.min()), float(logs.max())
+    if tolerance:
+        lo, hi = min(lo, math.log10(tolerance)), max(hi, math.log10(tolerance))
+    y0, y1 = math.floor(lo), math.ceil(hi)
+    return (0.0, x1), (float(y0), float(max(y1, y0 + 1)))
 
 
 class QualityPanel(QtWidgets.QWidget):
