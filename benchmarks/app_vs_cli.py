@@ -108,6 +108,29 @@ def _lake_layout_in(app, win, path: Path):
     return done[-1]
 
 
+def window(app, main_window):
+    """The main window as a user who watches the solve sees it: 1400 × 880, the default dock layout (not
+    the one another run saved: settings in a temporary file) with the convergence plot shown.
+
+    The window's layout is restored from the user's settings, which every app window (tests, other
+    runs) writes when it closes: the convergence plot, a tab beside the messages, was shown in some runs
+    and hidden in others, and it is most of the GUI thread's drawing in a live frame.
+    """
+    import tempfile
+
+    from PySide6 import QtCore
+
+    ini = Path(tempfile.mkdtemp(prefix="app_vs_cli-")) / "settings.ini"
+    win = main_window(settings=QtCore.QSettings(str(ini), QtCore.QSettings.Format.IniFormat))
+    win.quiet = True
+    win.fit_on_show = False  # the offscreen screen is 800 × 800: keep the size asked for
+    win.resize(1400, 880)
+    win.show()
+    win.docks["convergence"].raise_()
+    app.processEvents()
+    return win
+
+
 def app_seconds(path: Path, repeats: int, lake: bool = False) -> tuple[float, float, object]:
     from PySide6 import QtCore, QtWidgets
 
@@ -126,10 +149,7 @@ def app_seconds(path: Path, repeats: int, lake: bool = False) -> tuple[float, fl
     controller.solve_project = counted
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
-    win = MainWindow()
-    win.quiet = True
-    win.resize(1400, 880)
-    win.show()
+    win = window(app, MainWindow)
     loop = QtCore.QEventLoop()  # the app's own event loop waits (no polling that eats a core)
     win.solver.finished.connect(lambda _result: loop.quit())
     ts, proc = [], []
