@@ -5,10 +5,15 @@ The worker (superqt ``GeneratorWorker``) iterates :func:`app.pipeline.solve_proj
 in the GUI thread.  Snapshots are
 kept as the *latest* one per block and pushed to the document by a ~30 Hz
 timer, so stale frames are dropped, never queued.  A solve started by *Generate* keeps the
-GUI thread's share of the CPU time small (:data:`DRAW_BUDGET` of the process's CPU time for live
-redraws, the frame gap grows while drawing costs more): on a busy two-core machine 40 redraws/s of a large
-grid had made the app's solve 2–3× as long as the CLI's.  Edits with auto-generate keep the
-full frame rate (the grid follows the hand).  Stop sets a
+GUI thread's share of the CPU time small: a live frame is drawn only once the process has spent
+``1 / DRAW_BUDGET`` times the GUI thread's CPU time since the last frame (its drawing included), and the
+first one only once it has spent that many times the cost of the last frame measured: a solve shorter
+than that draws only its final grid.  The GUI thread's drawing is not free while the solver runs: Qt's
+painting calls keep the GIL (PySide6 6.10: a Python thread got no CPU time during a ``QPainter.drawLines``
+call), so at low load the app's solve takes the solver's CPU time plus the GUI thread's (on a busy
+two-core machine 40 redraws/s of a large grid had made the app's solve 2–3× as long as the CLI's).
+Edits with auto-generate, and a drag of a lake layout, keep the full frame rate (the grid follows the
+hand).  Stop sets a
 ``threading.Event`` checked by meshcore after every sweep/cycle, so it takes
 effect within one sweep.  With ``auto`` on, every project edit restarts the
 solve (coalesced in one event-loop pass), warm-started from the last grid.  While a drag is
@@ -36,9 +41,12 @@ log = logging.getLogger(__name__)
 
 #: Share of the process's CPU time the GUI thread may spend drawing live frames of a solve started
 #: by Generate (the rest is the solver's).
-DRAW_BUDGET = 0.15
+DRAW_BUDGET = 0.08
 #: The longest gap between two live frames of such a solve (seconds).
 MAX_FRAME_GAP = 1.0
+#: The GUI thread's CPU time for a live frame until one was measured (seconds): the first frame of a
+#: solve waits until the process has spent this over :data:`DRAW_BUDGET`.
+FRAME_COST = 0.005
 
 
 def _run(run_id, project, warm, stop_event, smooth, hold=None):
@@ -80,6 +88,7 @@ class SolverController(QtCore.QObject):
         self._algebraic: dict[int, StructuredGrid] = {}  # the algebraic grid per block (warm starts)
         self._smoothed: set[int] = set()
         self._dirty = False
+        self._drawn = False  # a live frame of the running solve was drawn
         self.state = "idle"
         self.t_start = 0.0
         self.t_done = 0.0
@@ -91,13 +100,13 @@ class SolverController(QtCore.QObject):
         # leading-edge throttle: draw a snapshot at once unless the last frame was
         # less than `frame_interval_ms` ago; then draw the latest one when the gap is over
         self.frame_interval = frame_interval_ms / 1000.0
-        self._gap = self.frame_interval  # the current frame gap (paced, see _pace)
         self._last_flush = 0.0
         self._gui_cpu = 0.0  # GUI thread CPU time at the last frame
         self._proc_cpu = 0.0  # the process's CPU time (every thread) at the last frame
+        self.frame_cost = FRAME_COST  # the GUI thread's CPU time between the last two live frames
         self._timer = QtCore.QTimer(self)
         self._timer.setSingleShot(True)
-        self._timer.timeout.connect(self._flush)
+        self._timer.timeout.connect(self._on_timer)
         self._debounce = QtCore.QTimer(self)
         self._debounce.setSingleShot(True)
         self._debounce.setInterval(0)
@@ -149,6 +158,7 @@ class SolverController(QtCore.QObject):
         self._latest = {}
         self._algebraic = {}
         self._smoothed = set()  # blocks whose snapshots of this run are on screen
+        self._drawn = False
         worker = create_worker(_run, self._run, project, warm, ev, self.smooth, hold, _start_thread=False)
         worker.yielded.connect(self._on_yielded)
         worker.returned.connect(self._on_returned)
@@ -156,9 +166,11 @@ class SolverController(QtCore.QObject):
         worker.finished.connect(self._on_finished)
         self._worker = worker
         self.t_start = time.perf_counter()
-        self._gap = self.frame_interval
-        self._last_flush, self._gui_cpu = self.t_start - self._gap, time.thread_time()  # 1st frame at once
-        self._proc_cpu = time.process_time()
+        self._last_flush, self._proc_cpu = self.t_start, time.process_time()
+        if self._full_rate():  # the first frame at once (a drag's redraw does not wait)
+            self._last_flush, self._gui_cpu = self.t_start - self.frame_interval, time.thread_time()
+        else:  # as if a frame had just been drawn: a solve shorter than its budget draws none
+            self._gui_cpu = time.thread_time() - self.frame_cost
         self._set_state("running")
         worker.start()
         return True
@@ -257,17 +269,46 @@ class SolverController(QtCore.QObject):
             self._algebraic[k] = event.algebraic
         self._latest[k] = event
         self._dirty = True
-        wait = self._last_flush + self._gap - time.perf_counter()
+        if not self._timer.isActive():
+            self._on_timer()
+
+    def _on_timer(self) -> None:
+        """Draw the latest snapshot now if its time has come, else come back when it will have."""
+        wait = self._wait()
         if wait <= 0:
             self._flush()
-        elif not self._timer.isActive():
-            self._timer.start(max(1, int(wait * 1000)))
+        elif self._dirty:  # checked again at least once a second (the CPU time due is only a guess in wall time)
+            self._timer.start(max(1, int(min(wait, 1.0) * 1000)))
 
-    def _flush(self) -> None:
+    def _full_rate(self) -> bool:
+        """Every frame the machine can draw: live editing (auto-generate) or a drag of the layout."""
+        return self.auto or self.live
+
+    def _wait(self) -> float:
+        """Seconds until the next live frame may be drawn (≤ 0: now).
+
+        At most one frame per ``frame_interval``; for a solve started by Generate, not before the process
+        has spent ``1 / DRAW_BUDGET`` times the GUI thread's CPU time since the last frame (CPU time, not
+        wall time: on a loaded machine the solver thread gets a fraction of a core, and a budget per wall
+        second would let the drawing take a growing share of what the process gets), nor later than
+        :data:`MAX_FRAME_GAP` after it.  The CPU time still due is waited as wall time and checked again.
+        """
+        now = time.perf_counter()
+        wait = self._last_flush + self.frame_interval - now
+        if self._full_rate():
+            return wait
+        gui = time.thread_time() - self._gui_cpu
+        due = gui / DRAW_BUDGET - (time.process_time() - self._proc_cpu)
+        return max(wait, min(due, self._last_flush + MAX_FRAME_GAP - now))
+
+    def _flush(self, *, draw: bool = True) -> None:
+        """Push the latest snapshots to the document; ``draw`` False: the data and the progress only (the
+        final grids are drawn next: a frame of the stale snapshot would only cost the GUI thread)."""
         if not self._dirty:
             return
         self._dirty = False
-        self._pace()
+        if draw:
+            self._frame_started()
         drawn = False  # a frame only when a grid changed (a lake grid made again unseen sends none)
         for k, event in self._latest.items():
             if k == ALL_BLOCKS and isinstance(event, SolverProgress):  # a multiblock solve: every block
@@ -290,25 +331,17 @@ class SolverController(QtCore.QObject):
             if isinstance(event, SolverProgress):
                 self._smoothed.add(k)
                 self.progress.emit(k, event)
-        if drawn:
+        if drawn and draw:
             self.doc.grids_changed.emit()
             self.redrawn.emit()
 
-    def _pace(self) -> None:
-        """Start a frame: widen the gap to the next one while the GUI thread's share of the process's
-        CPU time since the last frame (its drawing included) is over :data:`DRAW_BUDGET`, narrow it
-        when well under.  CPU time, not wall time: on a loaded machine the solver thread gets a
-        fraction of a core, and a budget per wall second would let the drawing take a growing
-        share of what the process gets (the app's lake solve took 1.4–1.8× the CLI's at load 9)."""
-        now, cpu, proc = time.perf_counter(), time.thread_time(), time.process_time()
-        share = (cpu - self._gui_cpu) / max(proc - self._proc_cpu, 1e-6)
-        self._last_flush, self._gui_cpu, self._proc_cpu = now, cpu, proc
-        if self.auto:  # live editing: every frame the machine can draw
-            self._gap = self.frame_interval
-        elif share > DRAW_BUDGET:
-            self._gap = min(MAX_FRAME_GAP, self._gap * 2.0)
-        elif share < 0.5 * DRAW_BUDGET:
-            self._gap = max(self.frame_interval, self._gap / 1.5)
+    def _frame_started(self) -> None:
+        """A live frame starts: the GUI thread's CPU time since the last one is what that one cost."""
+        now, cpu = time.perf_counter(), time.thread_time()
+        if self._drawn:  # not the first frame of a solve (before it: the estimate the solve began with)
+            self.frame_cost = cpu - self._gui_cpu
+        self._drawn = True
+        self._last_flush, self._gui_cpu, self._proc_cpu = now, cpu, time.process_time()
 
     def _showing(self, k: int, grid: StructuredGrid) -> bool:
         """True when block ``k`` already shows a grid of this shape (from an earlier solve)."""
@@ -329,6 +362,7 @@ class SolverController(QtCore.QObject):
         self._timer.stop()
         self._worker = None
         self.t_done = time.perf_counter()
+        self._drawn = False
         if self._restart_pending:
             # an edit arrived while solving: keep this iterate as the warm start, go again
             if result is not None:
@@ -348,7 +382,7 @@ class SolverController(QtCore.QObject):
             self._set_state("idle")
             self.finished.emit(None)
             return
-        self._flush()
+        self._flush(draw=False)  # its progress (the convergence history ends on it), not a frame
         grids = dict(self.doc.grids)
         grids.update(result.grids)
         initial = dict(self.doc.initial)
