@@ -118,6 +118,12 @@ RELAX_SWEEPS = 100
 #: when the given grid's repair fails from a start built with skips it is tried once more without
 #: them (a 20 × 30 hairpin slot was left with 2 bad cells otherwise).
 SKIP_TRANSPLANT = ("coarse", "whole")
+#: The coarse start is made after one round of patches (``radius``); when its repair needed its
+#: whole coarse start (as :data:`SKIP_TRANSPLANT`), the wider patches are not tried (on a coarse
+#: level the transplant neither: the whole coarse start follows at once; the given grid still
+#: tries its transplant), otherwise the wider patches and the transplant follow as before.
+#: Session 16, measured in benchmarks/RESULTS.md (real lakes as one block).
+EARLY_START = True
 
 __all__ = [
     "BoundaryCorner",
@@ -262,9 +268,7 @@ def _repair(
         return _raise_if_failed(res, strict and not res.ok)
     opts = {"tolerance": tolerance, "max_sweeps": max_sweeps, "periodic": grid.periodic}
     coarse = min(grid.cells) >= 8
-    # where a coarse start follows, pieces grow no wider than its transplant (see TRANSPLANT)
-    cap = TRANSPLANT if coarse else None
-    ok, nfree, total = patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, max_radius=cap, **opts)
+    ok, nfree, total, start = _local(grid, x, y, bad, ex_bits, radius, opts, coarse=coarse, skip=skip, path=path)
     how = ""
     if ok:
         path.append("local")
@@ -272,7 +276,7 @@ def _repair(
         # the pieces repaired so far stay; the rest from a coarse-grid start
         kept = None if whole else (x.copy(), y.copy())
         ok, nfree, total = _multilevel(
-            grid, x, y, ex_bits, radius, opts, nfree, total, seam=not whole, path=path, skip=skip
+            grid, x, y, ex_bits, radius, opts, nfree, total, seam=not whole, path=path, skip=skip, start=start
         )
         if not ok and kept is not None and "skip" in path:
             # the given grid failed from a start whose coarse levels skipped their transplant: once
@@ -300,6 +304,42 @@ def _repair(
     method = f"{grid.info.method}+foldfree"
     res = _result(grid, x, y, ok=ok, before=before, nodes=nfree, sweeps=total, method=method, msg=msg, **common)
     return _raise_if_failed(res, strict and not res.ok)
+
+
+def _local(
+    grid: StructuredGrid,
+    x: np.ndarray,
+    y: np.ndarray,
+    bad: np.ndarray,
+    ex_bits: np.ndarray,
+    radius: int,
+    opts: dict,
+    *,
+    coarse: bool,
+    skip: bool,
+    path: list[str],
+) -> tuple[bool, int, int, tuple[np.ndarray, np.ndarray, bool] | bool | None]:
+    """The local stage of :func:`_repair`: ``(ok, free nodes, sweeps, coarse start)``.
+
+    Where a coarse start can follow (``coarse``) the pieces grow no wider than its transplant
+    (see :data:`TRANSPLANT`), and with :data:`EARLY_START` the coarse start is made after the
+    first round (``radius``): when its repair needed its whole coarse start, the wider rounds are
+    not tried.  The start is returned for :func:`_multilevel` (``None``: not made yet, ``False``:
+    its coarse grid was not repaired).
+    """
+    cap = TRANSPLANT if coarse else None
+    if not (coarse and EARLY_START):
+        return (*patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, max_radius=cap, **opts), None)
+    ok, nfree, total = patches(x, y, bad, ex_bits, radius=radius, max_fraction=0.3, max_radius=radius, **opts)
+    if ok:
+        return ok, nfree, total, None
+    start = _coarse_start(grid, skip, path) or False
+    if start and start[2] and skip:
+        return ok, nfree, total, start
+    ok, nf, sw = patches(
+        x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=2 * radius, max_fraction=0.3, max_radius=cap, **opts
+    )
+    return ok, nfree + nf, total + sw, start
 
 
 def _whole(
@@ -334,6 +374,7 @@ def _multilevel(
     seam: bool,
     path: list[str],
     skip: bool,
+    start: tuple[np.ndarray, np.ndarray, bool] | bool | None = None,
 ) -> tuple[bool, int, int]:
     """The multilevel stage of :func:`repair`: ``(ok, free nodes, sweeps)``.
 
@@ -347,8 +388,9 @@ def _multilevel(
     by barrier sweeps.  On failure ``x, y`` keep the grid with the fewest bad
     cells.
     """
-    start = _coarse_start(grid, skip, path)
     if start is None:
+        start = _coarse_start(grid, skip, path)
+    if not start:  # None or False: the coarse grid was not repaired
         return False, nfree, total
     x2, y2, wide = start
     bad = invalid_cells(x, y, ex_bits)

@@ -146,3 +146,33 @@ def test_a_coarse_level_goes_to_the_whole_start_when_the_level_below_needed_it(m
     skipped = wide and not seam
     assert (dr.TRANSPLANT in radii) is not skipped
     assert path == (["skip", "coarse"] if skipped else ["transplant"])
+
+
+@pytest.mark.parametrize("wide", [True, False])
+def test_the_coarse_start_decides_after_one_round_of_patches(monkeypatch, wide):
+    # EARLY_START: a place the first round of patches (radius 2) does not repair gets the coarse
+    # start at once; when its repair needed the whole coarse start ("wide") no wider patches
+    # follow, otherwise the wider patches (4, 8) do. Then the transplant (the given grid) and,
+    # here, the whole coarse start: the fold cannot be repaired locally
+    import meshcore.foldfree.driver as dr
+
+    x, y = _rectangle(40, 20)
+    x2, y2 = x.copy(), y.copy()  # a valid coarse start (the boundary node is put back below)
+    y[20, -1] = 0.6  # a top-border node pulled down to the third row: no patch can fit the rows above it
+    x2[:, -1], y2[:, -1] = x[:, -1], y[:, -1]
+    y2[:, :-1] *= 0.55 / y2[:, -2:-1].max()  # every row below the top border lies under the dip
+    assert invalid_cells(x, y).any() and not invalid_cells(x2, y2).any()
+    monkeypatch.setattr(dr, "_coarse_start", lambda grid, *a: (x2.copy(), y2.copy(), wide))
+    calls = []
+    real = dr.patches
+
+    def spy(*args, **kw):
+        calls.append((kw.get("radius"), kw.get("max_radius")))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(dr, "patches", spy)
+    res = dr.repair(StructuredGrid(x, y), strict=False)
+    assert calls[0] == (2, 2)  # one round before the coarse start
+    wider = any(r == 4 for r, _ in calls)
+    assert wider is not wide
+    assert res.ok and not invalid_cells(res.grid.x, res.grid.y).any()
