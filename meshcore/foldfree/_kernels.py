@@ -44,7 +44,12 @@ affine function), so the per-node problem is convex.  Each node belongs to 12
 corner triangles (3 in each of its ≤ 4 cells).  :func:`sweep` applies a
 damped Newton step with backtracking on the node's local energy, node by node
 in 4-colour order (nodes of one colour share no cell).  Triangles whose three
-nodes are all fixed are constant and ignored.
+nodes are all fixed are constant and ignored.  The sweep reads a node's
+neighbours once: it keeps each triangle's ``F, ∇F, D, ∇D`` at the node
+(:func:`_node_forms`), from which the energy, gradient and Hessian there
+(:func:`_form_local`, the same terms) and, ``F`` being quadratic and ``D``
+affine in the node, the energy at every trial point (:func:`_form_energy`,
+equal up to rounding) follow.
 """
 
 from __future__ import annotations
@@ -185,6 +190,104 @@ def _node_local(x, y, i, j, qx, qy, eps, out, periodic, cx, cy, full):
 
 
 @njit(cache=True, nogil=True)
+def _node_forms(x, y, i, j, periodic, cx, cy, forms):
+    """The forms of node ``(i, j)``'s (up to) 12 corner triangles, in :func:`_node_local`'s order:
+    ``forms[k] = (F, ∂F/∂x, ∂F/∂y, ∇²F/2, D, ∂D/∂x, ∂D/∂y)`` w.r.t. the node where it is.  ``F`` is
+    quadratic and ``D`` affine in the node, so these give every triangle's ``f_ε`` at any other
+    place of the node exactly (:func:`_form_energy`) without reading the neighbours again.
+    Returns the number of triangles."""
+    ni1, nj1 = x.shape
+    n = 0
+    for dc in range(4):
+        ci = i - 1 + (dc & 1)
+        cj = j - 1 + (dc >> 1)
+        di = i - ci
+        if periodic and ci < 0:
+            ci = ni1 - 2
+            di = 1
+        if ci < 0 or cj < 0 or ci >= ni1 - 1 or cj >= nj1 - 1:
+            continue
+        cx[0], cy[0] = x[ci, cj], y[ci, cj]
+        cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
+        cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
+        cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
+        dj = j - cj
+        m = di if dj == 0 else 3 - di
+        cx[m], cy[m] = x[i, j], y[i, j]
+        for r in range(3):
+            t = m if r == 0 else ((m + 3) % 4 if r == 1 else (m + 1) % 4)
+            ta = (t + 1) % 4
+            tb = (t + 3) % 4
+            ux, uy = cx[ta] - cx[t], cy[ta] - cy[t]
+            vx, vy = cx[tb] - cx[t], cy[tb] - cy[t]
+            forms[n, 0] = ux * ux + uy * uy + vx * vx + vy * vy
+            forms[n, 4] = ux * vy - uy * vx
+            if r == 0:
+                forms[n, 1], forms[n, 2], forms[n, 3] = -2.0 * (ux + vx), -2.0 * (uy + vy), 2.0
+                forms[n, 5], forms[n, 6] = uy - vy, vx - ux
+            elif r == 1:
+                forms[n, 1], forms[n, 2], forms[n, 3] = 2.0 * ux, 2.0 * uy, 1.0
+                forms[n, 5], forms[n, 6] = vy, -vx
+            else:
+                forms[n, 1], forms[n, 2], forms[n, 3] = 2.0 * vx, 2.0 * vy, 1.0
+                forms[n, 5], forms[n, 6] = -uy, ux
+            n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def _form_local(forms, n, eps, out):
+    """:func:`_node_local` (``full``) from the node's forms: ``out = [E, gx, gy, hxx, hxy, hyy]``
+    (the same terms as :func:`_tri_node`); False when a triangle is inverted under ε = 0."""
+    e = gx = gy = hxx = hxy = hyy = 0.0
+    for k in range(n):
+        f2, gfx, gfy, hf = forms[k, 0], forms[k, 1], forms[k, 2], 2.0 * forms[k, 3]
+        d, gdx, gdy = forms[k, 4], forms[k, 5], forms[k, 6]
+        if eps == 0.0:
+            if d <= 0.0:
+                return False
+            c = d
+            c1 = 1.0
+            c2 = 0.0
+        else:
+            s = math.sqrt(eps * eps + d * d)
+            c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
+            if c <= 0.0 or s <= 0.0:
+                return False
+            c1 = c / s
+            c2 = eps * eps / (2.0 * s * s * s)
+        ic = 1.0 / c
+        k1 = f2 * c1 * ic * ic
+        e += f2 * ic
+        gx += gfx * ic - k1 * gdx
+        gy += gfy * ic - k1 * gdy
+        k2 = c1 * ic * ic
+        k3 = f2 * (2.0 * c1 * c1 * ic * ic * ic - c2 * ic * ic)
+        hxx += hf * ic - 2.0 * k2 * gfx * gdx + k3 * gdx * gdx
+        hxy += -k2 * (gfx * gdy + gdx * gfy) + k3 * gdx * gdy
+        hyy += hf * ic - 2.0 * k2 * gfy * gdy + k3 * gdy * gdy
+    out[0], out[1], out[2], out[3], out[4], out[5] = e, gx, gy, hxx, hxy, hyy
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _form_energy(forms, n, dx, dy, eps):
+    """The node's local energy with the node moved by ``(dx, dy)`` from where ``forms`` were
+    taken (``+inf`` where a triangle inverts under the ε = 0 barrier): the trial points of
+    :func:`sweep`, equal to :func:`_node_local` there up to rounding."""
+    e = 0.0
+    dd = dx * dx + dy * dy
+    for k in range(n):
+        f2 = forms[k, 0] + forms[k, 1] * dx + forms[k, 2] * dy + forms[k, 3] * dd
+        d = forms[k, 4] + forms[k, 5] * dx + forms[k, 6] * dy
+        c = _chi(d, eps)
+        if c <= 0.0:
+            return _INF
+        e += f2 * (1.0 / c)
+    return e
+
+
+@njit(cache=True, nogil=True)
 def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
     """One damped-Newton Gauss–Seidel sweep over ``nodes`` (int32 (k, 2), colour ordered).
 
@@ -200,7 +303,7 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
     Returns the largest node displacement.
     """
     out = np.empty(6)
-    trial = np.empty(6)
+    forms = np.empty((12, 7))
     cx = np.empty(4)
     cy = np.empty(4)
     dmax = 0.0
@@ -208,7 +311,8 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
         i = nodes[k, 0]
         j = nodes[k, 1]
         qx, qy = x[i, j], y[i, j]
-        if not _node_local(x, y, i, j, qx, qy, eps, out, periodic, cx, cy, True):
+        nt = _node_forms(x, y, i, j, periodic, cx, cy, forms)
+        if not _form_local(forms, nt, eps, out):
             continue
         e0, gx, gy = out[0], out[1], out[2]
         hxx, hxy, hyy = out[3], out[4], out[5]
@@ -236,7 +340,7 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
         if omega > 1.0:
             nx = qx + omega * sx
             ny = qy + omega * sy
-            if _node_local(x, y, i, j, nx, ny, eps, trial, periodic, cx, cy, False) and trial[0] < e0:
+            if _form_energy(forms, nt, omega * sx, omega * sy, eps) < e0:
                 x[i, j] = nx
                 y[i, j] = ny
                 if periodic and i == 0:
@@ -249,10 +353,7 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
         for _ in range(30):
             nx = qx + alpha * sx
             ny = qy + alpha * sy
-            if (
-                _node_local(x, y, i, j, nx, ny, eps, trial, periodic, cx, cy, False)
-                and trial[0] <= e0 + 1e-4 * alpha * slope
-            ):
+            if _form_energy(forms, nt, alpha * sx, alpha * sy, eps) <= e0 + 1e-4 * alpha * slope:
                 x[i, j] = nx
                 y[i, j] = ny
                 if periodic and i == 0:

@@ -113,6 +113,42 @@ def test_trial_energy_is_the_full_evaluations_energy(eps, periodic):
 
 
 @pytest.mark.parametrize("eps", [0.0, 0.02])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_the_sweep_forms_give_the_node_energy_here_and_at_trial_points(eps, periodic):
+    # the sweep takes each node's triangle forms (F quadratic, D affine in the node) once: the
+    # energy, gradient and Hessian from them are node_local's bit for bit, and a trial point's
+    # energy from them is node_local's there up to rounding, with the same verdict on inverted
+    # triangles (at points that invert some of them)
+    x, y = random_grid(ni=9, nj=6, amp=0.2, seed=21)
+    if periodic:
+        x[-1, :], y[-1, :] = x[0, :], y[0, :]
+    rng = np.random.default_rng(22)
+    ref, out, there = np.empty(6), np.empty(6), np.empty(6)
+    cx, cy = np.empty(4), np.empty(4)
+    forms = np.empty((12, 7))
+    verdicts = set()
+    for i in range(0 if periodic else 1, x.shape[0] - 1):
+        for j in range(1, x.shape[1] - 1):
+            n = _kernels._node_forms(x, y, i, j, periodic, cx, cy, forms)
+            assert n == 12  # four cells round every node here
+            ok = _kernels.node_local(x, y, i, j, x[i, j], y[i, j], eps, ref, periodic)
+            assert _kernels._form_local(forms, n, eps, out) == ok
+            if not ok:
+                continue
+            np.testing.assert_array_equal(out, ref)
+            assert _kernels._form_energy(forms, n, 0.0, 0.0, eps) == ref[0]
+            for scale in (0.05, 0.3):
+                dx, dy = scale * rng.standard_normal(2)
+                ok = _kernels.node_local(x, y, i, j, x[i, j] + dx, y[i, j] + dy, eps, there, periodic)
+                e = _kernels._form_energy(forms, n, dx, dy, eps)
+                assert ok == np.isfinite(e)
+                verdicts.add(ok)
+                if ok:
+                    assert e == pytest.approx(there[0], rel=1e-9)
+    assert verdicts == ({True, False} if eps == 0.0 else {True})
+
+
+@pytest.mark.parametrize("eps", [0.0, 0.02])
 def test_node_hessian_matches_finite_differences(eps):
     x, y = random_grid(seed=5)
     i, j, h = 3, 2, 1e-6
