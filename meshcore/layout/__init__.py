@@ -13,6 +13,8 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 * :mod:`.regions` — the regions between shores and cuts, islands cut free;
 * :mod:`.split` — regions that are not four-sided split at their reflex corners or by a star;
 * :mod:`.width` — how narrow a piece of a split may be;
+* :mod:`.fans` — a piece the greedy split left whole whose grid would fan out from two short
+  sides, split with one step of look-ahead;
 * :mod:`.corners` — four corners per piece, where the boundary turns at the cells' scale;
 * :mod:`.frames` — in regular mode, corners re-chosen so that the blocks' index directions
   close up round every island (what Delft3D's domain decomposition needs);

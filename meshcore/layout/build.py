@@ -24,6 +24,7 @@ from ..pointindex import PointIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners
+from .fans import fans, unfan
 from .frames import close_frames
 from .regions import partition
 from .skeleton import Skeleton, skeleton
@@ -141,6 +142,7 @@ def layout_pieces(
         P = Polygon(r)
         inside = [j for j in junctions if P.contains(Point(j))]
         centre = np.mean(inside, axis=0) if inside else None
+        here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
         pieces, new_cuts, _ = best_split(
             r,
             sigma=sigma,
@@ -148,8 +150,10 @@ def layout_pieces(
             center=centre,
             regular=regular,
             normal=normal,
-            thin=thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h),
+            thin=here,
         )
+        if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
+            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, normal, here)
         rings += [p for p, _ in pieces]
         forced += [f for _, f in pieces]
         cuts += new_cuts
@@ -173,6 +177,34 @@ def layout_pieces(
         pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
     return sk, chords, cuts, pieces
+
+
+def _unfanned(pieces: list, cuts: list, junctions: np.ndarray, sigma: float, normal: bool, thin: bool):
+    """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece that fans
+    (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be."""
+    from shapely.geometry import Point, Polygon
+
+    out: list = []
+    for ring, fc in pieces:
+        if len(fc) or not fans(ring, sigma):
+            out.append((ring, fc))
+            continue
+        P = Polygon(ring)
+        inside = [j for j in junctions if P.contains(Point(j))]
+        got = unfan(
+            ring,
+            sigma=sigma,
+            min_width=2 * sigma,
+            center=np.mean(inside, axis=0) if inside else None,
+            normal=normal,
+            thin=thin,
+        )
+        if got is None:
+            out.append((ring, fc))
+            continue
+        out += got[0]
+        cuts = cuts + got[1]
+    return out, cuts
 
 
 def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float):

@@ -1,0 +1,99 @@
+r"""Pieces that would fan: a split for a piece whose four sides span far less than its water.
+
+The greedy split (:func:`~.split.best_split`) stops when no single cut lowers the corner cost.
+Its cost sees corners and sharp bends; a piece whose corners bunch on one part of its boundary
+costs little more than a good one, yet its grid fans out from two short sides across the whole
+piece.  Two measures of the piece with its chosen corners: the bulge ``R``
+(:func:`~.corners.bulge_ratio`: the area over the product of the mean lengths of its two pairs
+of opposite sides; a rectangle 1, a disc with four corners a quarter apart 1.27) and the ratio
+of opposite sides.  On generated lakes the folded ones had ``R`` of 5–6 — a round lobe behind
+a narrow neck and the strip of water beside it as one block 4 cells across and 184 along
+(`headlands(791603, n=9)`, 43 folded cells), a needle island's far side run round by one block
+side (`small_islands(760001, n_islands=10)`, the island lost) — or ``R`` 1.65 with both pairs of
+opposite sides 11–12× apart: a round basin whose corners bunched by a thin peninsula, its cells
+fanning out from there across the lake (`small_islands(745801, n_islands=4, peninsulas=4,
+widths=(0.5, 3.0))`, 429 folded cells).  No single cut pays there because each piece of any one
+cut still needs cuts of its own.  :func:`unfan` splits such a piece with one step of
+look-ahead: every admissible split, its pieces split greedily again, the cheapest result in
+which no piece fans.  Other pieces are left as the greedy split made them (one step of
+look-ahead everywhere helped some lakes and hurt others: ``docs/lake-grids.md``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["BULGING", "FAN_BULGE", "FAN_PAIRS", "fans", "unfan"]
+
+#: A piece whose chosen corners give :func:`~.corners.bulge_ratio` at least this fans.  On the
+#: 73 generated shapes of `fresh_sweep.py` base 791000 (both sets) every piece was below 2.6
+#: but in two headlands lakes (5.1; 5.3, the 43 folded cells above).
+FAN_BULGE = 3.0
+
+#: ... and a piece with ``R`` above :data:`BULGING` whose two pairs of opposite sides both
+#: differ by at least this factor (its cells differ in area by the square of it).  Base 791000:
+#: every piece below 7.2 but a sliver of ``R`` 0.01 (15).
+FAN_PAIRS = 8.0
+BULGING = 1.2
+
+
+def _pairs(ring: np.ndarray, corners) -> float:
+    """The smaller of the two ratios of opposite sides between ``corners``."""
+    from .corners import _arclength_closed
+
+    s, total = _arclength_closed(ring)
+    c = sorted(corners)
+    L = [max((s[c[(k + 1) % 4]] - s[c[k]]) % total, 1e-300) for k in range(4)]
+    return min(max(L[0], L[2]) / min(L[0], L[2]), max(L[1], L[3]) / min(L[1], L[3]))
+
+
+def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
+    """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) fans."""
+    from .corners import bulge_ratio, choose_corners
+    from .split import forced_indices
+
+    corners, cost = choose_corners(ring, sigma, forced=forced_indices(ring, forced))
+    if corners is None or not math.isfinite(cost):
+        return False
+    R = bulge_ratio(ring, corners)
+    return R >= FAN_BULGE or (R >= BULGING and _pairs(ring, corners) >= FAN_PAIRS)
+
+
+def unfan(ring: np.ndarray, *, sigma: float, min_width: float, center=None, depth: int = 3, **kw):
+    """``(pieces, cuts)`` of a split of a fanning piece ``ring`` in which no piece fans, or None.
+
+    Every admissible split of :func:`~.split._options` (and the shore-normal cuts from evenly
+    spaced points of the last resort) is followed by the greedy split of its pieces
+    (``depth`` − 1 levels); the cheapest result without a fanning piece is returned.
+    ``kw``: ``regular``, ``normal``, ``thin`` of :func:`~.split.best_split`.
+    """
+    from .split import _cut_options, _normal_cuts, _options, best_split
+
+    regular, normal, thin = kw.get("regular", False), kw.get("normal", True), kw.get("thin", False)
+    options = _options(ring, sigma, min_width, center, (), regular, normal, thin)
+    if normal:
+        options += _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
+    best = None
+    for pieces, cuts, _ in options:
+        out_p, out_c, total = [], list(cuts), 0.0
+        for pc, fc in pieces:
+            pp, cc, c = best_split(
+                pc,
+                sigma=sigma,
+                min_width=min_width,
+                depth=depth - 1,
+                forced=fc,
+                regular=regular,
+                normal=normal,
+                thin=thin,
+            )
+            out_p += pp
+            out_c += cc
+            total += c
+        if any(not len(f) and fans(p, sigma) for p, f in out_p):
+            continue
+        if best is None or total < best[2]:
+            best = (out_p, out_c, total)
+    return None if best is None else best[:2]
