@@ -39,13 +39,16 @@ def _objective(
         if block_cells and bi in block_cells:
             ok &= n[:, list(bottom)].sum(axis=1) == block_cells[bi][0]
             ok &= n[:, list(left)].sum(axis=1) == block_cells[bi][1]
-    for ca, ta, cb, tb in counts._jump_pairs(t, sides, least=float(m)):
+    along: list[bool] = []
+    pairs = counts._jump_pairs(t, sides, least=float(m), along=along)
+    for (ca, ta, cb, tb), row_along in zip(pairs, along, strict=True):
         w = min(ta, tb)
         d1, d2 = n[:, ca].sum(axis=1) / ta, n[:, cb].sum(axis=1) / tb
         excess = np.maximum(w * (d1 - counts.JUMP * d2), w * (d2 - counts.JUMP * d1))
         obj += counts.JUMP_WEIGHT * np.maximum(0.0, excess)
         steep = np.maximum(w * (d1 - counts.STEEP * d2), w * (d2 - counts.STEEP * d1))
-        obj += counts.STEEP_WEIGHT * np.maximum(0.0, steep)
+        if counts.STEEP_ACROSS or row_along:
+            obj += counts.STEEP_WEIGHT * np.maximum(0.0, steep)
     if least is not None:
         for c, v in enumerate(least):
             if v > m:
