@@ -573,6 +573,13 @@ TARGETS = "### Issue 15 targets in this run"
 _TARGET_HEAD = ["| target | wanted | measured |", "|---|---|---|"]
 
 
+def _history(section: str) -> str:
+    """The paragraphs of a report section that begin ``Session `` (what each session measured and
+    tried there): a rerun replaces the section's tables and keeps them."""
+    paras = re.split(r"\n[ \t]*\n", section)
+    return "\n\n".join(p.strip("\n") for p in paras if p.startswith("Session "))
+
+
 def merge_report(old: str, header: list[str], sections: dict[str, list[str]], targets: list[str]) -> str:
     """The report after :data:`MARKER`: ``old``'s sections and target rows, with those of the
     sections in ``sections`` replaced (new ones appended in :data:`HEADINGS` order)."""
@@ -586,8 +593,9 @@ def merge_report(old: str, header: list[str], sections: dict[str, list[str]], ta
             continue
         name = next((k for k, (h, _) in HEADINGS.items() if ch.startswith(h)), None)
         kept[name or ch.splitlines()[0]] = ch.strip("\n")
-    for name, lines in sections.items():
-        kept[name] = "\n".join(lines).strip("\n")
+    for name, lines in sections.items():  # the rerun's tables, then the old section's sessions' notes
+        history = _history(kept.get(name, ""))
+        kept[name] = "\n".join(lines).strip("\n") + (f"\n\n{history}" if history else "")
     prefixes = tuple(HEADINGS[k][1] for k in sections)
     rows = [r for r in rows if not r.startswith(prefixes)] + targets
     order = [k for k in HEADINGS if k in kept] + [k for k in kept if k not in HEADINGS]
