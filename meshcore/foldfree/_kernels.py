@@ -146,33 +146,38 @@ def node_local(x, y, i, j, qx, qy, eps, out, periodic=False):
     return _node_local(x, y, i, j, qx, qy, eps, out, periodic, np.empty(4), np.empty(4), True)
 
 
+@njit(cache=True, inline="always")
+def _cell_round(x, y, i, j, dc, periodic, cx, cy):
+    """The corners c0..c3 of the ``dc``-th cell (0..3) round node ``(i, j)`` into ``cx, cy``; returns
+    which corner is the node (``(i, j) = (ci + di, cj + dj)``: 0, 1 on the cell's first row, 2, 3
+    on its second), or −1 when there is no such cell (the node on a border; ``periodic``: column
+    ``ni − 1``'s cells for a seam node)."""
+    ni1, nj1 = x.shape
+    ci = i - 1 + (dc & 1)
+    cj = j - 1 + (dc >> 1)
+    di = i - ci
+    if periodic and ci < 0:
+        ci = ni1 - 2
+        di = 1
+    if ci < 0 or cj < 0 or ci >= ni1 - 1 or cj >= nj1 - 1:
+        return -1
+    cx[0], cy[0] = x[ci, cj], y[ci, cj]
+    cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
+    cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
+    cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
+    return di if j - cj == 0 else 3 - di
+
+
 @njit(cache=True, nogil=True)
 def _node_local(x, y, i, j, qx, qy, eps, out, periodic, cx, cy, full):
     """:func:`node_local` with the caller's scratch corners ``cx, cy`` (4 each: no allocation per
     node); ``full=False`` sums the energy alone (``out[0]``, the same terms in the same order)."""
-    ni1, nj1 = x.shape
     for k in range(6):
         out[k] = 0.0
     for dc in range(4):
-        ci = i - 1 + (dc & 1)
-        cj = j - 1 + (dc >> 1)
-        di = i - ci
-        if periodic and ci < 0:
-            ci = ni1 - 2
-            di = 1
-        if ci < 0 or cj < 0 or ci >= ni1 - 1 or cj >= nj1 - 1:
+        m = _cell_round(x, y, i, j, dc, periodic, cx, cy)
+        if m < 0:
             continue
-        # corners c0..c3 of cell (ci, cj)
-        cx[0], cy[0] = x[ci, cj], y[ci, cj]
-        cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
-        cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
-        cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
-        # which corner is the node: (i,j) = (ci + di, cj + dj)
-        dj = j - cj
-        if dj == 0:
-            m = di  # 0 -> c0, 1 -> c1
-        else:
-            m = 3 - di  # di=1 -> c2, di=0 -> c3
         cx[m], cy[m] = qx, qy
         for r in range(3):
             # triangle with apex t = m, m-1 (node is a), m+1 (node is b)
@@ -196,23 +201,11 @@ def _node_forms(x, y, i, j, periodic, cx, cy, forms):
     quadratic and ``D`` affine in the node, so these give every triangle's ``f_ε`` at any other
     place of the node exactly (:func:`_form_energy`) without reading the neighbours again.
     Returns the number of triangles."""
-    ni1, nj1 = x.shape
     n = 0
     for dc in range(4):
-        ci = i - 1 + (dc & 1)
-        cj = j - 1 + (dc >> 1)
-        di = i - ci
-        if periodic and ci < 0:
-            ci = ni1 - 2
-            di = 1
-        if ci < 0 or cj < 0 or ci >= ni1 - 1 or cj >= nj1 - 1:
+        m = _cell_round(x, y, i, j, dc, periodic, cx, cy)
+        if m < 0:
             continue
-        cx[0], cy[0] = x[ci, cj], y[ci, cj]
-        cx[1], cy[1] = x[ci + 1, cj], y[ci + 1, cj]
-        cx[2], cy[2] = x[ci + 1, cj + 1], y[ci + 1, cj + 1]
-        cx[3], cy[3] = x[ci, cj + 1], y[ci, cj + 1]
-        dj = j - cj
-        m = di if dj == 0 else 3 - di
         cx[m], cy[m] = x[i, j], y[i, j]
         for r in range(3):
             t = m if r == 0 else ((m + 3) % 4 if r == 1 else (m + 1) % 4)
