@@ -62,14 +62,27 @@ from numba import njit
 _INF = np.inf
 
 
+@njit(cache=True, inline="always")
+def _barrier(d, eps):
+    """The regularised area ``c(d) = (d + s) / 2``, ``s = sqrt(ε² + d²)`` (``ε² / (2 (s − d))`` for
+    ``d < 0``: no cancellation; ``c = d`` at ε = 0), and ``c' = c / s``, ``c'' / 2 = ε² / (2 s³)``:
+    ``(c, c', c''/2)``, with ``c = 0`` where the triangle is inverted under the ε = 0 barrier (the
+    caller's energy is infinite there)."""
+    if eps == 0.0:
+        if d <= 0.0:
+            return 0.0, 1.0, 0.0
+        return d, 1.0, 0.0
+    s = math.sqrt(eps * eps + d * d)
+    c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
+    if c <= 0.0 or s <= 0.0:
+        return 0.0, 1.0, 0.0
+    return c, c / s, eps * eps / (2.0 * s * s * s)
+
+
 @njit(cache=True, nogil=True)
 def _chi(d, eps):
-    if eps == 0.0:
-        return d if d > 0.0 else 0.0
-    s = math.sqrt(eps * eps + d * d)
-    if d >= 0.0:
-        return 0.5 * (d + s)
-    return 0.5 * eps * eps / (s - d)  # = (d + s)/2 without cancellation
+    """``c(d)`` of :func:`_barrier` alone (0 where inverted under ε = 0)."""
+    return _barrier(d, eps)[0]
 
 
 @njit(cache=True, nogil=True)
@@ -95,19 +108,9 @@ def _tri_node(px, py, ax, ay, bx, by, role, eps, out, full=True):
     vx, vy = bx - px, by - py
     d = ux * vy - uy * vx
     f2 = ux * ux + uy * uy + vx * vx + vy * vy
-    if eps == 0.0:
-        if d <= 0.0:
-            return False
-        c = d
-        c1 = 1.0
-        c2 = 0.0
-    else:
-        s = math.sqrt(eps * eps + d * d)
-        c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
-        if c <= 0.0 or s <= 0.0:
-            return False
-        c1 = c / s
-        c2 = eps * eps / (2.0 * s * s * s)
+    c, c1, c2 = _barrier(d, eps)
+    if c <= 0.0:
+        return False
     if not full:
         out[0] += f2 * (1.0 / c)
         return True
@@ -236,19 +239,9 @@ def _form_local(forms, n, eps, out):
     for k in range(n):
         f2, gfx, gfy, hf = forms[k, 0], forms[k, 1], forms[k, 2], 2.0 * forms[k, 3]
         d, gdx, gdy = forms[k, 4], forms[k, 5], forms[k, 6]
-        if eps == 0.0:
-            if d <= 0.0:
-                return False
-            c = d
-            c1 = 1.0
-            c2 = 0.0
-        else:
-            s = math.sqrt(eps * eps + d * d)
-            c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
-            if c <= 0.0 or s <= 0.0:
-                return False
-            c1 = c / s
-            c2 = eps * eps / (2.0 * s * s * s)
+        c, c1, c2 = _barrier(d, eps)
+        if c <= 0.0:
+            return False
         ic = 1.0 / c
         k1 = f2 * c1 * ic * ic
         e += f2 * ic
