@@ -128,7 +128,10 @@ def window(app, main_window):
 
     from PySide6 import QtCore
 
-    ini = Path(tempfile.mkdtemp(prefix="app_vs_cli-")) / "settings.ini"
+    # one file, emptied for each window (Qt writes it back when the window's settings are dropped, after
+    # any clean-up at exit: a folder per run was left behind by every run)
+    ini = Path(tempfile.gettempdir()) / "gcmesh-app_vs_cli-settings.ini"
+    ini.unlink(missing_ok=True)
     win = main_window(settings=QtCore.QSettings(str(ini), QtCore.QSettings.Format.IniFormat))
     win.quiet = True
     win.fit_on_show = False  # the offscreen screen is 800 × 800: keep the size asked for
