@@ -126,7 +126,7 @@ def layout_pieces(
     normal; ``thin``: cuts from reflex corners may leave pieces two cells across; see
     :func:`~.split.best_split`)."""
     import shapely
-    from shapely.geometry import Point, Polygon
+    from shapely.geometry import Polygon
 
     sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
     chords = place_chords(poly, sk, min_length=2 * h)
@@ -140,20 +140,18 @@ def layout_pieces(
     forced: list[tuple] = []
     for r in regions:
         P = Polygon(r)
-        inside = [j for j in junctions if P.contains(Point(j))]
-        centre = np.mean(inside, axis=0) if inside else None
         here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
         pieces, new_cuts, _ = best_split(
             r,
             sigma=sigma,
             min_width=3 * h,
-            center=centre,
+            center=_junction_centre(r, junctions),
             regular=regular,
             normal=normal,
             thin=here,
         )
         if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
-            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, normal, here)
+            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here)
         rings += [p for p, _ in pieces]
         forced += [f for _, f in pieces]
         cuts += new_cuts
@@ -179,23 +177,29 @@ def layout_pieces(
     return sk, chords, cuts, pieces
 
 
-def _unfanned(pieces: list, cuts: list, junctions: np.ndarray, sigma: float, normal: bool, thin: bool):
-    """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece that fans
-    (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be."""
+def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
+    """The mean of the skeleton's junctions inside ``ring`` (a star split's centre), or None."""
     from shapely.geometry import Point, Polygon
 
+    P = Polygon(ring)
+    inside = [j for j in junctions if P.contains(Point(j))]
+    return np.mean(inside, axis=0) if inside else None
+
+
+def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: float, normal: bool, thin: bool):
+    """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece that fans
+    (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be (the split's
+    ``min_width``, ``normal`` and ``thin`` as the region's)."""
     out: list = []
     for ring, fc in pieces:
         if len(fc) or not fans(ring, sigma):
             out.append((ring, fc))
             continue
-        P = Polygon(ring)
-        inside = [j for j in junctions if P.contains(Point(j))]
         got = unfan(
             ring,
             sigma=sigma,
-            min_width=2 * sigma,
-            center=np.mean(inside, axis=0) if inside else None,
+            min_width=min_width,
+            center=_junction_centre(ring, junctions),
             normal=normal,
             thin=thin,
         )
