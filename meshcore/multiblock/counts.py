@@ -114,9 +114,10 @@ STEEP_ACROSS = False
 
 
 def _jump_pairs(
-    t: np.ndarray, sides, least: float = 1.0, along: list[bool] | None = None
-) -> list[tuple[list[int], float, list[int], float]]:
-    """Pairs of cell densities (chains, target cells) whose ratio should stay near 1.
+    t: np.ndarray, sides, least: float = 1.0
+) -> tuple[list[tuple[list[int], float, list[int], float]], list[bool]]:
+    """Pairs of cell densities (chains, target cells) whose ratio should stay near 1, and per pair
+    whether it lies along a block side (the first kind below) or across a shared chain.
 
     * two chains in a row on one block side (they meet at a T-junction or where a cut ends on
       the side): the spacing along the side jumps there;
@@ -142,15 +143,13 @@ def _jump_pairs(
             for side in pair:
                 for c in side:
                     across.setdefault(int(c), []).append(cross[d])
-    if along is not None:
-        along.extend([True] * len(out))
+    along = [True] * len(out)
     for users in across.values():
         if len(users) == 2 and min(users[0][1], users[1][1]) >= least:
             (a, ta), (b, tb) = users
             out.append((a, float(ta), b, float(tb)))
-            if along is not None:
-                along.append(False)
-    return out
+            along.append(False)
+    return out, along
 
 
 def objective(
@@ -247,8 +246,7 @@ def solve_counts(
     n = len(t)
     nb = len(sides)
     m = int(multiple)
-    along: list[bool] = []
-    jumps = _jump_pairs(t, sides, least=float(max(m, 1)), along=along)
+    jumps, along = _jump_pairs(t, sides, least=float(max(m, 1)))
     steep_w = np.array([STEEP_WEIGHT if STEEP_ACROSS or a else 0.0 for a in along])
     short = [] if least is None else [(c, float(v)) for c, v in enumerate(least) if v > m]
     weights = np.array(

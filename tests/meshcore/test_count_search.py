@@ -85,7 +85,7 @@ def _searched(t, sides, cells, m, least=None, **kw):
     """:func:`best_counts` with the program's objective: (counts or None, every candidate row
     the objective saw)."""
     seen: list[np.ndarray] = []
-    objective = counts.objective(t, sides, counts._jump_pairs(t, sides, least=float(m)), _short(least, m))
+    objective = counts.objective(t, sides, counts._jump_pairs(t, sides, least=float(m))[0], _short(least, m))
 
     def cost(rows):
         seen.extend(rows)

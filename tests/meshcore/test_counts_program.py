@@ -39,8 +39,7 @@ def _objective(
         if block_cells and bi in block_cells:
             ok &= n[:, list(bottom)].sum(axis=1) == block_cells[bi][0]
             ok &= n[:, list(left)].sum(axis=1) == block_cells[bi][1]
-    along: list[bool] = []
-    pairs = counts._jump_pairs(t, sides, least=float(m), along=along)
+    pairs, along = counts._jump_pairs(t, sides, least=float(m))
     for (ca, ta, cb, tb), row_along in zip(pairs, along, strict=True):
         w = min(ta, tb)
         d1, d2 = n[:, ca].sum(axis=1) / ta, n[:, cb].sum(axis=1) / tb
