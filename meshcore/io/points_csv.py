@@ -8,8 +8,11 @@
   or ``lon``/``lat`` (``longitude``, ``lng``, ``latitude`` …, in either
   order).  ``lon``/``lat`` headers make the CRS ``EPSG:4326`` and are checked
   against the lon/lat range; a ``name``/``id``/``part`` column groups rows into
-  polylines; otherwise the first two numeric columns are x, y;
-* several polylines are separated by blank lines or GMT-style ``> name`` lines.
+  polylines (unless it changes on every row: then it numbers the points);
+  otherwise the first two numeric columns are x, y;
+* several polylines are separated by blank lines or GMT-style ``> name`` lines
+  (runs that only blank lines separate and that close together, none by itself,
+  are one ring cut by stray blank lines).
 
 A ring whose last point repeats the first is marked closed and the repeated
 point dropped.
@@ -318,21 +321,47 @@ def read_points_csv(
     del data
     lay = _Layout(path, text, columns)
     pts, groups = _rows(path, text, lay)
+    if lay.name_col is not None and len(groups) == len(pts) > 2:
+        # a name on every row that changes on every row is a point number ("id,lon,lat",
+        # "fid,x,y"), not the name of polylines of one point each
+        lay.name_col = None
+        pts, groups = _rows(path, text, lay)
     if not groups:
         raise ReadError(f"{path}: no data rows after the header")
+    groups = _one_ring_split_by_blank_lines(pts, groups)
     base = path.stem
     polylines = []
     ends = [g[0] for g in groups[1:]] + [len(pts)]
     for (start, gname, sname, lineno), end in zip(groups, ends, strict=True):
         name = gname or sname or (base if len(groups) == 1 else f"{base} {len(polylines) + 1}")
         if end - start < 2:
-            raise ReadError(f"{path}: polyline {name!r} (line {lineno}) has only {end - start} point")
+            raise ReadError(
+                f"{path}: polyline {name!r} (line {lineno}) has only {end - start} point"
+                + (" (a blank line starts a new polyline)" if gname is None and sname is None else "")
+            )
         polylines.append(make_polyline(name, pts[start:end], closed=closed, where=str(path)))
     declared = normalize_crs(crs) if crs is not None else (LONLAT if lay.lonlat else None)
     if declared == LONLAT:
         for pl in polylines:
             check_lonlat(pl.points, where=f"{path}: {pl.name}")
     return PointSet(tuple(polylines), declared, str(path))
+
+
+def _one_ring_split_by_blank_lines(
+    pts: np.ndarray, groups: list[tuple[int, str | None, str | None, int]]
+) -> list[tuple[int, str | None, str | None, int]]:
+    """The runs of one ring that stray blank lines cut into pieces, joined again.
+
+    Runs that blank lines alone separate (no names), none a ring by itself, whose last point
+    closes on the first run's first point: one ring.  Read apart, the first piece was a ring of
+    its own (a CSV ring may omit its closing point) and the rest lines dropped as touching it.
+    """
+    if len(groups) < 2 or any(g[1] is not None or g[2] is not None for g in groups):
+        return groups
+    ends = [g[0] for g in groups[1:]] + [len(pts)]
+    if any(np.array_equal(pts[g[0]], pts[e - 1]) for g, e in zip(groups, ends, strict=True)):
+        return groups
+    return groups[:1] if np.array_equal(pts[0], pts[-1]) else groups
 
 
 def _find(header: list[str], names: set[str]) -> int | None:
