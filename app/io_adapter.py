@@ -31,7 +31,9 @@ __all__ = [
     "write_mesh",
 ]
 
-POINT_FILTER = "Point files (*.csv *.txt *.xy *.dat *.tsv *.kml *.kmz *.geojson *.json *.shp *.dxf);;All files (*)"
+POINT_FILTER = (
+    "Point files (*.csv *.txt *.xy *.dat *.tsv *.kml *.kmz *.gpx *.geojson *.json *.shp *.dxf);;All files (*)"
+)
 
 
 @dataclass(frozen=True)

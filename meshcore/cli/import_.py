@@ -21,7 +21,7 @@ import argparse
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("points", help="point file (.csv .txt .xy .kml .kmz .geojson .shp .dxf)")
+    p.add_argument("points", help="point file (.csv .txt .xy .kml .kmz .gpx .geojson .shp .dxf)")
     p.add_argument("-o", "--output", required=True, help="case file to write (.toml)")
     p.add_argument(
         "--crs", default="auto", help="target CRS: auto (UTM of the centroid for lon/lat), an EPSG code, or none"

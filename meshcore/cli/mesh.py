@@ -54,7 +54,9 @@ LEVELS = 2
 def add_args(p: argparse.ArgumentParser) -> None:
     from ..quality import PRESETS
 
-    p.add_argument("outline", help="lake outline (.csv .txt .kml .kmz .geojson .shp .dxf); inner rings are islands")
+    p.add_argument(
+        "outline", help="lake outline (.csv .txt .kml .kmz .gpx .geojson .shp .dxf); inner rings are islands"
+    )
     size = p.add_mutually_exclusive_group()
     size.add_argument("--cell-size", type=float, metavar="H", help="cell size in the grid's CRS units (metres)")
     size.add_argument(

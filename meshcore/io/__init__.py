@@ -126,6 +126,7 @@ for _f in (
     ),
     Format("kml", (".kml",), "Google Earth KML", points_reader="kml:read_points_kml", crs=True),
     Format("kmz", (".kmz",), "Google Earth KMZ (zipped KML)", points_reader="kml:read_points_kmz", crs=True),
+    Format("gpx", (".gpx",), "GPS tracks, routes and waypoints", points_reader="gpx:read_points_gpx", crs=True),
     Format(
         "shapefile", (".shp",), "ESRI shapefile (+ .shx, .dbf, .prj)", points_reader="shp:read_points_shp", crs=True
     ),
@@ -273,7 +274,7 @@ def read_points(
     Parameters
     ----------
     path : path-like
-        ``.csv/.txt/.xy/.dat``, ``.geojson/.json``, ``.kml``, ``.kmz``,
+        ``.csv/.txt/.xy/.dat``, ``.geojson/.json``, ``.kml``, ``.kmz``, ``.gpx``,
         ``.shp``, ``.dxf`` — or a grid file, whose four borders are returned.
     format : str, optional
         Format name (see :data:`FORMATS`) overriding the suffix.

@@ -1,7 +1,8 @@
 """KML and KMZ point files as Google Earth saves them.
 
-Every ``Placemark`` with a ``LineString``, ``LinearRing`` or ``Polygon``
-(outer and inner boundaries, also inside ``MultiGeometry``) becomes a named
+Every ``Placemark`` with a ``LineString``, ``LinearRing``, ``Polygon``
+(outer and inner boundaries, also inside ``MultiGeometry``) or ``gx:Track`` (a
+GPS track; also inside ``gx:MultiTrack``) becomes a named
 polyline; consecutive ``Point`` placemarks (points picked by hand) are joined
 into one polyline.  Coordinates are ``lon,lat[,alt]`` tuples (``EPSG:4326``).
 
@@ -105,6 +106,8 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
         elif tag == "LinearRing":
             c = _find_child(child, "coordinates")
             out.append(make_polyline(name, _coordinates(c, f"{where} LinearRing"), closed=True, where=where))
+        elif tag == "Track":  # gx:Track (a GPS track, Google Earth's own extension): <gx:coord>lon lat alt
+            out.append(make_polyline(name, _track(child, f"{where} gx:Track"), closed=None, where=where))
         elif tag == "Point":
             c = _find_child(child, "coordinates")
             pl = Polyline(name, _coordinates(c, f"{where} Point"))
@@ -112,6 +115,22 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
             out.append(pl)
         elif tag != "Placemark":
             stack.extend(reversed(list(child)))
+
+
+def _track(elem, where: str) -> np.ndarray:
+    """The ``lon lat [alt]`` of a ``gx:Track``'s ``gx:coord`` elements as ``(n, 2)``."""
+    pts = []
+    for k, c in enumerate(e for e in elem if _local(e.tag) == "coord"):
+        vals = (c.text or "").split()
+        try:
+            if len(vals) not in (2, 3):
+                raise ValueError
+            pts.append((float(vals[0]), float(vals[1])))
+        except ValueError:
+            raise ReadError(f"{where}: gx:coord {k} {(c.text or '')[:40]!r} is not 'lon lat [alt]'") from None
+    if not pts:
+        raise ReadError(f"{where}: no <gx:coord>")
+    return np.array(pts, dtype=np.float64)
 
 
 def _find_child(elem, tag: str) -> str | None:
@@ -145,7 +164,7 @@ def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
     if not merged:
         raise ReadError(
             f"{where}: no coordinates: none of {n_marks} placemark(s) has a LineString, "
-            f"LinearRing, Polygon or two or more Points"
+            f"LinearRing, Polygon, gx:Track or two or more Points"
         )
     declared = normalize_crs(crs) if crs is not None else LONLAT
     if declared == LONLAT:

@@ -99,7 +99,22 @@ def test_point_readers_survive_corruption(name, data):
 
 @pytest.mark.parametrize(
     "suffix",
-    [".csv", ".kml", ".kmz", ".geojson", ".shp", ".dxf", ".xyz", ".vts", ".vtm", ".npz", ".cgns", ".grd", ".nc"],
+    [
+        ".csv",
+        ".kml",
+        ".kmz",
+        ".gpx",
+        ".geojson",
+        ".shp",
+        ".dxf",
+        ".xyz",
+        ".vts",
+        ".vtm",
+        ".npz",
+        ".cgns",
+        ".grd",
+        ".nc",
+    ],
 )
 @FUZZ
 @given(blob=st.binary(max_size=600))

@@ -52,3 +52,56 @@ def test_a_one_point_piece_says_blank_lines_split(tmp_path):
     with pytest.raises(ReadError) as exc:
         read_points(f)
     assert "line 2" in str(exc.value) and "blank line starts a new polyline" in str(exc.value)
+
+
+LONLAT = [(8.5 + x / 1e5, 47.3 + y / 1e5) for x, y in RECT]
+
+
+def test_kml_gx_track_is_a_line(tmp_path):
+    whens = "".join(f"<when>2020-01-01T00:00:0{k}Z</when>" for k in range(4))
+    coords = "".join(f"<gx:coord>{lo} {la} 312</gx:coord>" for lo, la in LONLAT)
+    f = tmp_path / "walk.kml"
+    f.write_text(
+        '<kml xmlns="http://www.opengis.net/kml/2.2" xmlns:gx="http://www.google.com/kml/ext/2.2"><Document>'
+        f"<Placemark><name>shore walk</name><gx:MultiTrack><gx:Track>{whens}{coords}</gx:Track></gx:MultiTrack>"
+        "</Placemark></Document></kml>"
+    )
+    ps = read_points(f)
+    assert ps.crs == "EPSG:4326" and ps.names == ("shore walk",)
+    np.testing.assert_allclose(ps.polylines[0].points, LONLAT)
+    f.write_text(f.read_text().replace(f"{LONLAT[2][0]} {LONLAT[2][1]} 312", "8.5,47.3"))
+    with pytest.raises(ReadError, match=r"placemark 1 \(shore walk\) gx:Track: gx:coord 2 '8.5,47.3'"):
+        read_points(f)
+
+
+def _gpx(body: str) -> str:
+    return f'<?xml version="1.0"?><gpx version="1.1" xmlns="http://www.topografix.com/GPX/1/1">{body}</gpx>'
+
+
+def test_gpx_tracks_routes_and_waypoints(tmp_path):
+    pts = "".join(f'<trkpt lat="{la}" lon="{lo}"><ele>300</ele></trkpt>' for lo, la in [*LONLAT, LONLAT[0]])
+    rte = "".join(f'<rtept lat="{la}" lon="{lo}"/>' for lo, la in LONLAT[:2])
+    wpt = "".join(f'<wpt lat="{la}" lon="{lo}"><name>w</name></wpt>' for lo, la in LONLAT[:3])
+    f = tmp_path / "gps.gpx"
+    f.write_text(_gpx(f"{wpt}<trk><name>shore</name><trkseg>{pts}</trkseg></trk><rte>{rte}</rte>"))
+    ps = read_points(f)
+    assert ps.crs == "EPSG:4326" and ps.names == ("shore", "route 5", "gps waypoints")
+    assert ps["shore"].closed
+    np.testing.assert_allclose(ps["shore"].points, LONLAT)
+
+
+@pytest.mark.parametrize(
+    ("body", "needle"),
+    [
+        ("<metadata/>", "no track, route or two or more waypoints"),
+        ('<trk><name>t</name><trkseg><trkpt lat="47" lon="8"/></trkseg></trk>', "trk 't': has 1 point(s)"),
+        ('<trk><trkseg><trkpt lat="47" lon="x"/><trkpt lat="47" lon="8"/></trkseg></trk>', "point 0: lat='47' lon='x'"),
+        ('<rte><rtept lat="95" lon="8"/><rtept lat="47" lon="8"/></rte>', "outside the lon/lat range"),
+    ],
+)
+def test_bad_gpx_is_one_clear_error(tmp_path, body, needle):
+    f = tmp_path / "bad.gpx"
+    f.write_text(_gpx(body))
+    with pytest.raises(ReadError) as exc:
+        read_points(f)
+    assert needle in str(exc.value) and str(f) in str(exc.value) and "\n" not in str(exc.value)
