@@ -1,8 +1,9 @@
 r"""Coordinate reference systems: lon/lat detection, UTM projection, local origin.
 
 Shorelines usually arrive in WGS84 longitude/latitude.  A grid is generated in
-a *metric* CRS — by default the UTM zone of the outline's centroid, or a
-user-given EPSG code — and, to keep every digit, *relative to a local origin*:
+a *metric* CRS — by default the UTM zone of the outline's centroid (beyond UTM's
+80°S–84°N the polar stereographic UPS), or a user-given EPSG code — and, to keep
+every digit, *relative to a local origin*:
 
 .. math::
 
@@ -38,6 +39,7 @@ from .errors import InvalidInputError, ReadError
 __all__ = [
     "LONLAT",
     "Frame",
+    "auto_epsg",
     "crs_name",
     "crs_wkt",
     "frame_from_case",
@@ -256,6 +258,20 @@ def utm_epsg(lon: float, lat: float) -> int:
     return (32600 if lat >= 0 else 32700) + zone
 
 
+def auto_epsg(lon: float, lat: float) -> int:
+    """EPSG code of the grid CRS ``crs="auto"`` picks for a lake centred at ``(lon, lat)``.
+
+    The UTM zone (:func:`utm_epsg`) between 80°S and 84°N; beyond, where UTM stops, the
+    Universal Polar Stereographic of that pole with easting, northing axes (EPSG:5041 north,
+    5042 south), as the military grid reference system continues it.
+    """
+    if -180 <= lon <= 180 and lat > 84:
+        return 5041
+    if -180 <= lon <= 180 and lat < -80:
+        return 5042
+    return utm_epsg(lon, lat)
+
+
 def _nice_origin(points: np.ndarray) -> tuple[float, float]:
     """Bounding-box centre rounded to a power of ten of the extent (0 when small)."""
     if len(points) == 0:
@@ -338,7 +354,8 @@ def project(pointset: Any, crs: Any = "auto", *, origin: Any = "auto", source_cr
         As returned by :func:`meshcore.io.read_points`.
     crs : "auto", int, str or None
         Target CRS.  ``"auto"``: lon/lat input (declared, or unlabelled and
-        :func:`looks_lonlat`) goes to the UTM zone of its centroid; projected
+        :func:`looks_lonlat`) goes to the UTM zone of its centroid (UPS
+        beyond 80°S–84°N: :func:`auto_epsg`); projected
         input stays in its CRS; unknown non-geographic input is left as is.
         An EPSG code / CRS string projects to that CRS.  ``None``/``"none"``:
         no projection.
@@ -395,7 +412,7 @@ def project_arrays(
     if target_in == "auto":
         if src is not None and is_geographic(src):
             lon, lat = _lonlat_centroid(pts, src)
-            target = f"EPSG:{utm_epsg(lon, lat)}"
+            target = f"EPSG:{auto_epsg(lon, lat)}"
         else:
             target = src
     elif target_in in (None, "none", "local"):

@@ -105,3 +105,19 @@ def test_bad_gpx_is_one_clear_error(tmp_path, body, needle):
     with pytest.raises(ReadError) as exc:
         read_points(f)
     assert needle in str(exc.value) and str(f) in str(exc.value) and "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize(("lat", "epsg"), [(89.5, "EPSG:5041"), (-85.0, "EPSG:5042"), (83.0, "EPSG:32631")])
+def test_a_lake_beyond_utm_goes_to_polar_stereographic(lat, epsg):
+    pyproj = pytest.importorskip("pyproj")
+    from meshcore.crs import project
+    from meshcore.io import PointSet, Polyline
+
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    lon, la = 0.3 * np.cos(t), lat + 0.02 * np.sin(t)  # ~2 km across
+    local, frame = project(PointSet((Polyline("lake", np.column_stack([lon, la])),), "EPSG:4326"))
+    assert frame.crs == epsg  # was: "no UTM zone for lon=0, lat=89.5" for the first two
+    p = local.polylines[0].points
+    edges = np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T)
+    _, _, geodesic = pyproj.Geod(ellps="WGS84").inv(lon, la, np.roll(lon, -1), np.roll(la, -1))
+    np.testing.assert_allclose(edges, geodesic, rtol=0.01)  # lengths true to 1 % (UPS scale 0.994 at the pole)
