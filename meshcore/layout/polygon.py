@@ -52,6 +52,47 @@ def _ring(points: Any, what: str) -> np.ndarray:
     return p
 
 
+def _on_one_line(ring: np.ndarray, what: str) -> None:
+    """Raise when every point of the ring lies on one straight line (a ring of no area)."""
+    d = ring - ring.mean(axis=0)
+    sv = np.linalg.svd(d, compute_uv=False)
+    if sv[-1] <= 1e-9 * sv[0]:
+        a, b = ring[np.argmin(d @ d[np.argmax(np.abs(d).sum(axis=1))])], ring[np.argmax(np.abs(d).sum(axis=1))]
+        raise InvalidInputError(
+            f"{what} has no area: its {len(ring)} points lie on one straight line, from near "
+            f"({a[0]:.6g}, {a[1]:.6g}) to near ({b[0]:.6g}, {b[1]:.6g})"
+        )
+
+
+def _without_backtracks(ring: np.ndarray, what: str, notes: list[str]) -> np.ndarray:
+    """The ring without points it goes out to and comes straight back from (a spike of no width).
+
+    Such a point turns the ring by 180°: the edges before and after it overlap, which reads as the
+    ring crossing itself, though no water is there.  Each is dropped with a note naming it.
+    """
+    _on_one_line(ring, what)
+    dropped: list[np.ndarray] = []
+    while len(ring) > 3:
+        a, b = ring - np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0) - ring
+        cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        dot = (a * b).sum(axis=1)
+        back = np.flatnonzero((np.abs(cross) <= 1e-9 * np.hypot(*a.T) * np.hypot(*b.T)) & (dot < 0))
+        if not len(back) or len(ring) - len(back) < 3:
+            break
+        dropped.extend(ring[back])
+        ring = np.delete(ring, back, axis=0)
+        keep = np.any(ring != np.roll(ring, 1, axis=0), axis=1)  # the point it came back to, now twice
+        ring = ring[keep] if keep.sum() >= 3 else ring
+    if dropped:
+        places = ", ".join(f"near ({p[0]:.6g}, {p[1]:.6g})" for p in dropped[:3])
+        more = f" and {len(dropped) - 3} more" if len(dropped) > 3 else ""
+        notes.append(
+            f"{what} goes out to a point and straight back (a spike of no width) {places}{more}: "
+            f"{'that point' if len(dropped) == 1 else 'those points'} left out"
+        )
+    return ring
+
+
 def _crossing(ring: np.ndarray, what: str) -> None:
     """Raise when the closed ring crosses itself, naming two crossing segments (from 1)."""
     import shapely
@@ -85,13 +126,13 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
             raise InvalidInputError("give the islands either as the polygon's holes or as holes=, not both")
         holes = [np.asarray(h.coords) for h in outline.interiors]
         outline = np.asarray(outline.exterior.coords)
-    outer = _ring(outline, "outline")
+    outer = _without_backtracks(_ring(outline, "outline"), "the outline", notes)
     _crossing(outer, "the outline")
     shell = Polygon(outer)
     size = math.hypot(*(outer.max(axis=0) - outer.min(axis=0)))
     rings = []
     for k, h in enumerate(holes):
-        r = _ring(h, f"island {k + 1}")
+        r = _without_backtracks(_ring(h, f"island {k + 1}"), f"island {k + 1}", notes)
         _crossing(r, f"island {k + 1}")
         isl = Polygon(r)
         if not shell.contains(isl):

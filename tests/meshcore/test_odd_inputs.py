@@ -121,3 +121,33 @@ def test_a_lake_beyond_utm_goes_to_polar_stereographic(lat, epsg):
     edges = np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T)
     _, _, geodesic = pyproj.Geod(ellps="WGS84").inv(lon, la, np.roll(lon, -1), np.roll(la, -1))
     np.testing.assert_allclose(edges, geodesic, rtol=0.01)  # lengths true to 1 % (UPS scale 0.994 at the pole)
+
+
+def test_a_spike_out_and_back_is_left_out_with_a_note():
+    from meshcore.layout.polygon import water_polygon
+
+    shore = [(0, 0), (2000, 0), (2000, -700), (2000, 0), (4000, 0), (4000, 2000), (2000, 2000), (0, 2000)]
+    isle = [(1000, 800), (1500, 800), (1500, 1200), (1800, 1500), (1500, 1200), (1000, 1200)]
+    poly, notes = water_polygon(shore, holes=[isle])  # was: "the outline crosses itself"
+    assert poly.area == pytest.approx(4000 * 2000 - 500 * 400)
+    assert sorted(map(tuple, np.asarray(poly.exterior.coords)[:-1].tolist())) == sorted(
+        [(0.0, 0.0), (2000.0, 0.0), (4000.0, 0.0), (4000.0, 2000.0), (2000.0, 2000.0), (0.0, 2000.0)]
+    )
+    assert any("the outline goes out to a point and straight back" in n and "near (2000, -700)" in n for n in notes)
+    assert any(n.startswith("island 1 goes out") and "near (1800, 1500)" in n for n in notes)
+
+
+def test_a_straight_ring_is_refused_as_having_no_area():
+    from meshcore.errors import InvalidInputError
+    from meshcore.layout.polygon import water_polygon
+
+    line = [(100.0 * k, 50.0 * k) for k in range(20)]
+    with pytest.raises(InvalidInputError, match=r"the outline has no area: its 20 points lie on one straight line"):
+        water_polygon(line)  # was: "crosses itself: the edge from point 2 to 3 meets …"
+
+
+def test_a_ring_that_goes_on_straight_keeps_its_points():
+    from meshcore.layout.polygon import water_polygon
+
+    poly, notes = water_polygon([(0, 0), (2000, 0), (4000, 0), (4000, 2000), (0, 2000)])
+    assert len(poly.exterior.coords) == 6 and not notes
