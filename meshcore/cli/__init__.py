@@ -80,7 +80,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code (see the module docstring)."""
-    parser = build_parser()
+    try:
+        parser = build_parser()  # imports every subcommand (numba kernels among them): seconds
+    except KeyboardInterrupt:
+        print("meshcore: interrupted", file=sys.stderr)
+        return 130
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a usage error (already printed as one line)

@@ -151,3 +151,32 @@ def test_a_ring_that_goes_on_straight_keeps_its_points():
 
     poly, notes = water_polygon([(0, 0), (2000, 0), (4000, 0), (4000, 2000), (0, 2000)])
     assert len(poly.exterior.coords) == 6 and not notes
+
+
+def test_ctrl_c_while_the_command_loads_is_one_line_exit_130(monkeypatch, capsys):
+    from meshcore import cli
+
+    def interrupted(*_a, **_k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)  # Ctrl-C while numba loads the kernels
+    assert cli.main(["mesh", "x.csv", "-o", "x.vtm"]) == 130
+    assert capsys.readouterr().err == "meshcore: interrupted\n"  # was: a KeyboardInterrupt traceback
+
+
+def test_ctrl_c_during_the_solve_leaves_no_output(tmp_path, monkeypatch, capsys):
+    from meshcore import cli, lakegrid
+
+    def interrupted(*_a, **_k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(lakegrid, "mesh_layout", interrupted)
+    f = tmp_path / "lake.csv"
+    f.write_text(_csv(RECT))
+    out = tmp_path / "out"
+    out.mkdir()
+    rc = cli.main(
+        ["mesh", str(f), "-q", "-o", str(out / "g.vtm"), "-o", str(out / "g.cgns"), "--png", str(out / "g.png")]
+    )
+    assert rc == 130 and capsys.readouterr().err.strip().endswith("interrupted")
+    assert list(out.iterdir()) == []
