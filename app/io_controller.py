@@ -210,6 +210,16 @@ class IOController(QtCore.QObject):
                 except (MeshcoreError, ValueError) as exc:
                     self.win.error("Cannot project coordinates", exc)
                     return False
+        elif pd.pointset is not None and pd.pointset.crs:  # a projected CRS the file declares (.prj, GeoJSON)
+            from meshcore.crs import Frame
+
+            # into the project's CRS and origin, or kept as they are (origin 0) as meshcore mesh keeps them
+            frame = frame if frame is not None and frame.crs else Frame(pd.pointset.crs, (0.0, 0.0), None)
+            try:
+                pts, frame = fio.to_local(pd, frame)
+            except (MeshcoreError, ValueError) as exc:
+                self.win.error("Cannot project coordinates", exc)
+                return False
         lake = self._read_lake(pd, frame, lonlat=bool(pd.lonlat and project_lonlat is not False))
         if lake is not None:
             pts = lake.outline
@@ -237,8 +247,11 @@ class IOController(QtCore.QObject):
             return None
         try:
             outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat)
-        except (MeshcoreError, ValueError) as exc:
-            log.info("%s: not read as a lake (%s)", pd.path, exc)
+        except (MeshcoreError, ValueError) as exc:  # meshcore mesh refuses the file: say why here too
+            self.doc.report(
+                "warning",
+                f"{Path(pd.path).name}: not read as a lake ({exc}); its first line is imported as one block",
+            )
             return None
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
             notes = notes + water(outer, islands)[1]

@@ -106,7 +106,9 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
     from meshcore.cli.mesh import lake_rings, local_frame
 
     ps = pointset
-    if lonlat:
+    if not lonlat and ps.crs and frame is not None and frame.crs and not mcrs.is_geographic(ps.crs):
+        ps, frame = mcrs.project(ps, frame.crs, origin=frame.origin)  # a projected file: into the frame
+    elif lonlat:
         src = mcrs.LONLAT if ps.crs is None else None
         if frame is not None and frame.crs:
             ps, frame = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)

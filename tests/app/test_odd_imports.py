@@ -1,0 +1,69 @@
+"""The app's import of point files that meshcore mesh reads differently or refuses (session 17)."""
+
+from __future__ import annotations
+
+import contextlib
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.gui
+
+pyproj = pytest.importorskip("pyproj")
+shapefile = pytest.importorskip("shapefile")
+
+T = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+LON, LAT = 8.5 + 0.02 * np.cos(T), 47.3 + 0.01 * np.sin(T)  # a lake ~3 km across
+
+
+def _shapefile(path, crs: int):
+    x, y = pyproj.Transformer.from_crs(4326, crs, always_xy=True).transform(LON, LAT)
+    ring = list(zip(x[::-1], y[::-1], strict=True))  # shapefile outer rings run clockwise
+    # our own file objects: pyshp 3.1.9's Writer leaves the .dbf it opens unclosed (ResourceWarning)
+    with contextlib.ExitStack() as files:
+        f = {e: files.enter_context(open(path.with_suffix(f".{e}"), "wb")) for e in ("shp", "shx", "dbf")}
+        with shapefile.Writer(shapeType=shapefile.POLYGON, **f) as w:
+            w.field("name", "C")
+            w.poly([[*ring, ring[0]]])
+            w.record("lake")
+    path.with_suffix(".prj").write_text(pyproj.CRS.from_epsg(crs).to_wkt(pyproj.enums.WktVersion.WKT1_ESRI))
+    return np.column_stack([x, y])
+
+
+def test_a_projected_shapefile_keeps_its_crs(win, tmp_path):
+    world = _shapefile(tmp_path / "lake.shp", 2056)
+    assert win.io.import_points(tmp_path / "lake.shp")
+    p = win.doc.project
+    assert p.crs == "EPSG:2056" and tuple(p.origin) == (0.0, 0.0)  # was: no CRS (exports without one)
+    assert np.min(np.hypot(*(win.doc.block.points[0] - world).T)) < 1e-6
+
+
+def test_a_projected_file_goes_into_the_projects_frame(win, tmp_path):
+    csv = tmp_path / "a.csv"
+    csv.write_text("lon,lat\n" + "\n".join(f"{a},{b}" for a, b in zip(LON + 0.1, LAT, strict=True)) + "\n")
+    assert win.io.import_points(csv, project_lonlat=True)
+    frame = (win.doc.project.crs, tuple(win.doc.project.origin))
+    assert frame[0] == "EPSG:32632" and frame[1] != (0.0, 0.0)
+    _shapefile(tmp_path / "lake.shp", 2056)
+    assert win.io.import_points(tmp_path / "lake.shp")
+    p = win.doc.project
+    assert (p.crs, tuple(p.origin)) == frame
+    x, y = pyproj.Transformer.from_crs(4326, 32632, always_xy=True).transform(LON, LAT)
+    local = np.column_stack([x - frame[1][0], y - frame[1][1]])
+    pts = win.doc.block.points  # was: LV95 metres (2.7e6, 1.2e6) beside UTM metres about the origin
+    assert np.abs(pts.mean(axis=0) - local.mean(axis=0)).max() < 5.0
+
+
+def test_a_file_that_is_not_one_lake_says_why(win, tmp_path):
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append((level, text)))
+    f = tmp_path / "two.csv"
+    rows = [f"{x},{y},A" for x, y in zip(2000 * np.cos(T), 1000 * np.sin(T), strict=True)]
+    rows += [f"{x + 9000},{y},B" for x, y in zip(2000 * np.cos(T), 1000 * np.sin(T), strict=True)]
+    f.write_text("x,y,name\n" + "\n".join(rows) + "\n")
+    assert win.io.import_points(f)
+    assert win.doc.project.lake is None
+    # was: only a log line; meshcore mesh refuses the file with this reason
+    assert any(
+        level == "warning" and "two.csv: not read as a lake" in t and "outside the outline" in t for level, t in said
+    )
