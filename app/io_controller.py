@@ -194,6 +194,12 @@ class IOController(QtCore.QObject):
             return False
         pts = pd.points
         frame = fio.project_frame(self.doc.project)
+        if pd.lonlat and pd.pointset is not None:
+            from meshcore.cli.mesh import lonlat_order_note
+
+            note = lonlat_order_note(pd.pointset)
+            if note:  # as meshcore mesh notes it (its --columns 1 0: a header "lat,lon" in the file here)
+                self.doc.report("warning", note.replace("give --columns 1 0", "add the header 'lat,lon' to the file"))
         if pd.lonlat:
             if project_lonlat is None and not self.quiet:
                 target = frame.crs if frame is not None else "the UTM zone of the outline"

@@ -236,6 +236,7 @@ def _read(args: argparse.Namespace, say: _Say):
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
         )
     outer, islands, dropped = lake_rings(local)
+    _notes([n for n in (lonlat_order_note(ps, args.source_crs, args.columns),) if n], frame)
     _notes(dropped, frame)
     try:
         poly, notes = water_polygon(outer, holes=islands)
@@ -264,6 +265,25 @@ def is_lonlat(ps: Any, source_crs: Any = None) -> bool:
         return bool(is_geographic(src))
     pts = [np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines]
     return bool(pts) and looks_lonlat(np.vstack(pts))
+
+
+def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> str | None:
+    """A note when degrees were read as longitude, latitude with nothing in the file to say so.
+
+    A file without a CRS, a lon/lat header or columns given, whose numbers look like degrees,
+    is read as x = longitude, y = latitude; when every x is within ±90 the columns could as well
+    be latitude, longitude (the order many GPS and spreadsheet exports use), and the grid of a
+    swapped file is a lake elsewhere, stretched and mirrored, without a word.
+    """
+    if source_crs is not None or columns is not None or ps.crs is not None or not is_lonlat(ps):
+        return None
+    pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
+    if np.abs(pts[:, 0]).max() > 90:
+        return None
+    return (
+        f"{ps.source}: no header says which column is which: read as longitude, latitude "
+        f"(x, y); if the first column is the latitude, give --columns 1 0"
+    )
 
 
 def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[Any, Any]:

@@ -67,3 +67,12 @@ def test_a_file_that_is_not_one_lake_says_why(win, tmp_path):
     assert any(
         level == "warning" and "two.csv: not read as a lake" in t and "outside the outline" in t for level, t in said
     )
+
+
+def test_degrees_without_a_header_warn_of_the_column_order(win, tmp_path):
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append((level, text)))
+    f = tmp_path / "gps.csv"
+    f.write_text("".join(f"{b:.6f},{a:.6f}\n" for a, b in zip(LON, LAT, strict=True)))  # lat, lon
+    assert win.io.import_points(f, project_lonlat=True)
+    assert any(lv == "warning" and "read as longitude, latitude" in t and "'lat,lon'" in t for lv, t in said)

@@ -180,3 +180,32 @@ def test_ctrl_c_during_the_solve_leaves_no_output(tmp_path, monkeypatch, capsys)
     )
     assert rc == 130 and capsys.readouterr().err.strip().endswith("interrupted")
     assert list(out.iterdir()) == []
+
+
+def test_degrees_without_a_header_are_noted_as_read_lon_lat(tmp_path):
+    from meshcore.cli.mesh import lonlat_order_note
+
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    ring = np.column_stack([8.5 + 0.02 * np.cos(t), 47.3 + 0.01 * np.sin(t)])
+    lat_lon = tmp_path / "gps.csv"  # a GPS export: latitude first, no header
+    lat_lon.write_text("".join(f"{la:.6f},{lo:.6f}\n" for lo, la in ring))
+    note = lonlat_order_note(read_points(lat_lon))
+    assert note is not None and "read as longitude, latitude" in note and "--columns 1 0" in note
+    assert lonlat_order_note(read_points(lat_lon), columns=("1", "0")) is None
+    header = tmp_path / "h.csv"
+    header.write_text("lat,lon\n" + "".join(f"{la:.6f},{lo:.6f}\n" for lo, la in ring))
+    assert lonlat_order_note(read_points(header)) is None
+    west = tmp_path / "w.csv"  # a longitude beyond ±90: the order is not in doubt
+    west.write_text("".join(f"{lo - 100:.6f},{la:.6f}\n" for lo, la in ring))
+    assert lonlat_order_note(read_points(west)) is None
+
+
+def test_mesh_notes_the_column_order_it_assumed(tmp_path, capsys):
+    from meshcore import cli
+
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    f = tmp_path / "gps.csv"
+    f.write_text("".join(f"{47.3 + 0.01 * np.sin(a):.6f},{8.5 + 0.02 * np.cos(a):.6f}\n" for a in t))
+    assert cli.main(["mesh", str(f), "--cells", "200", "-o", str(tmp_path / "g.vtm")]) == 0
+    err = capsys.readouterr().err
+    assert "note: " in err and "read as longitude, latitude (x, y)" in err and "--columns 1 0" in err
