@@ -4,6 +4,8 @@
   files may use a decimal comma);
 * comment lines start with ``#``, ``%``, ``//`` or ``!``; trailing ``#``
   comments are cut;
+* degrees, minutes, seconds (``46°6'30.5"N``, ``N 46° 6.5'``, ``46 6 30.5 N``) are
+  lon/lat (``EPSG:4326``), a hemisphere letter telling latitude from longitude;
 * an optional header names the columns: ``x``/``y``, ``easting``/``northing``
   or ``lon``/``lat`` (``longitude``, ``lng``, ``latitude`` …, in either
   order).  ``lon``/``lat`` headers make the CRS ``EPSG:4326`` and are checked
@@ -47,6 +49,36 @@ _NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$")
 
 def _is_number(tok: str) -> bool:
     return bool(_NUM.match(tok)) or tok.lower() in {"nan", "inf", "-inf", "+inf"}
+
+
+# degrees, minutes, seconds: 46°6'0.5"N, N 46° 6.25', -46°6'0", 46 6 0.5 N (a hemisphere letter or a
+# degree sign is needed: three plain numbers are three columns)
+_DMS = re.compile(
+    r"""^(?P<h1>[NSEW])?\s*(?P<sign>[+-])?(?P<d>\d+(?:\.\d+)?)\s*(?P<deg>[°º˚d]|\s)\s*"""
+    r"""(?:(?P<m>\d+(?:\.\d+)?)\s*(?:['′’m]|\s)?\s*)?(?:(?P<s>\d+(?:\.\d+)?)\s*(?:["″”s]|''|′′)?\s*)?"""
+    r"""(?P<h2>[NSEW])?$""",
+    re.IGNORECASE,
+)
+
+
+def _dms(tok: str) -> tuple[float, str] | None:
+    """``(degrees, "lat" | "lon" | "")`` of a degrees-minutes-seconds token, or None."""
+    m = _DMS.match(tok.strip())
+    if m is None:
+        return None
+    h = (m["h1"] or m["h2"] or "").upper()
+    if (m["h1"] and m["h2"]) or (not h and m["deg"].isspace()) or (h and m["sign"]):
+        return None
+    d, mi, se = float(m["d"]), float(m["m"] or 0), float(m["s"] or 0)
+    if mi >= 60 or se >= 60 or (m["s"] and m["m"] is None):
+        return None
+    v = d + mi / 60 + se / 3600
+    sign = -1.0 if h in ("S", "W") or m["sign"] == "-" else 1.0
+    return sign * v, {"N": "lat", "S": "lat", "E": "lon", "W": "lon"}.get(h, "")
+
+
+def _is_coord(tok: str) -> bool:
+    return _is_number(tok) or _dms(tok) is not None
 
 
 def _clean_header(tok: str) -> str:
@@ -130,7 +162,7 @@ class _Layout:
         t = self.tokens(first)
         self.header: list[str] | None = None
         self.header_line = 0
-        if not all(_is_number(v) for v in t if v) and not any(_is_number(v) for v in t[:2]):
+        if not all(_is_coord(v) for v in t if v) and not any(_is_coord(v) for v in t[:2]):
             self.header = [_clean_header(v) for v in t]
             self.header_line = first_no
             if len(sample) < 2:
@@ -139,6 +171,7 @@ class _Layout:
             t = self.tokens(first)
         self.first_line, self.width = first_no, len(t)
         self.lonlat = False
+        self.dms = False  # a value was read in degrees, minutes, seconds: lon/lat
         self.name_col: int | None = None
         self.ix, self.iy = self._columns(path, columns, t)
         if self.ix == self.iy:
@@ -175,7 +208,7 @@ class _Layout:
             ix, iy = _find(header, _X_NAMES), _find(header, _Y_NAMES)
             if ix is not None and iy is not None:
                 return ix, iy
-        numeric = [k for k, v in enumerate(first) if _is_number(v)]
+        numeric = [k for k, v in enumerate(first) if _is_coord(v)]
         if len(numeric) < 2:
             what = "no numeric x/y columns" if header is not None else "no numeric columns (need at least two: x, y)"
             sep = {None: "white space", "\t": "tabs"}.get(self.delim, repr(self.delim))
@@ -277,18 +310,34 @@ def _rows(path: Path, text: str, lay: _Layout) -> tuple[np.ndarray, list[tuple[i
                 f"{lay.first_line} has {width}: {_show(s)}"
             )
         try:
-            xs.append(float(t[ix].replace("d", "e").replace("D", "e")))
-            ys.append(float(t[iy].replace("d", "e").replace("D", "e")))
+            x, y = float(t[ix].replace("d", "e").replace("D", "e")), float(t[iy].replace("d", "e").replace("D", "e"))
         except ValueError:
-            raise ReadError(
-                f"{path}: line {lineno}: not a number in column {ix + 1} or {iy + 1}: {_show(s, 60)}"
-            ) from None
+            x, y = _dms_pair(path, lineno, s, t[ix], t[iy], (ix, iy))
+            lay.dms = True
+        xs.append(x)
+        ys.append(y)
         gname = t[nc] if nc is not None else None
         if new_segment or gname != groups[-1][1]:
             groups.append((len(xs) - 1, gname, seg_name, lineno))
             new_segment = False
     pts = np.column_stack([np.frombuffer(xs, dtype=np.float64), np.frombuffer(ys, dtype=np.float64)])
     return pts, groups
+
+
+def _dms_pair(path: Path, lineno: int, s: str, tx: str, ty: str, cols: tuple[int, int]) -> tuple[float, float]:
+    """Longitude, latitude of a line whose x/y are degrees-minutes-seconds (N/S marks a latitude)."""
+    a, b = (_dms(tx) if not _is_number(tx) else (float(tx), "")), (_dms(ty) if not _is_number(ty) else (float(ty), ""))
+    if a is None or b is None:
+        bad = cols[0] if a is None else cols[1]
+        raise ReadError(
+            f"{path}: line {lineno}: not a number in column {bad + 1} (nor degrees, minutes, seconds "
+            f"such as 46°6'30.5\"N): {_show(s, 60)}"
+        )
+    if a[1] == "lat" or b[1] == "lon":
+        a, b = b, a
+    if a[1] == "lat" or b[1] == "lon":
+        raise ReadError(f"{path}: line {lineno}: two latitudes or two longitudes: {_show(s, 60)}")
+    return a[0], b[0]
 
 
 def read_points_csv(
@@ -340,7 +389,7 @@ def read_points_csv(
                 + (" (a blank line starts a new polyline)" if gname is None and sname is None else "")
             )
         polylines.append(make_polyline(name, pts[start:end], closed=closed, where=str(path)))
-    declared = normalize_crs(crs) if crs is not None else (LONLAT if lay.lonlat else None)
+    declared = normalize_crs(crs) if crs is not None else (LONLAT if lay.lonlat or lay.dms else None)
     if declared == LONLAT:
         for pl in polylines:
             check_lonlat(pl.points, where=f"{path}: {pl.name}")

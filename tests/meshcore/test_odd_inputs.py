@@ -209,3 +209,32 @@ def test_mesh_notes_the_column_order_it_assumed(tmp_path, capsys):
     assert cli.main(["mesh", str(f), "--cells", "200", "-o", str(tmp_path / "g.vtm")]) == 0
     err = capsys.readouterr().err
     assert "note: " in err and "read as longitude, latitude (x, y)" in err and "--columns 1 0" in err
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("lat,lon\n46°6'0.0\"N,10°19'30\"E\n46°7'0\"N,10°19'30\"E\n46°7'0\"N,10°21'0\"E\n", None),
+        ("lat;lon\n46 6 0.0 N;10 19 30 E\n46 7 0 N;10 19 30 E\n46 7 0 N;10 21 0 E\n", None),
+        ("46°6.0'N,10°19.5'E\n46°7.0'N,10°19.5'E\n46°7'N,10°21'E\n", None),  # no header: N/S say which
+        ("x,y\n10°19'30\"E,46°6'0\"N\n10°19'30\"E,46°7'0\"N\n10°21'0\"E,46°7'0\"N\n", None),
+        ("S46°6'0\",W10°19'30\"\nS46°7'0\",W10°19'30\"\nS46°7'0\",W10°21'0\"\n", "south-west"),
+    ],
+    ids=["symbols", "spaces", "decimal-minutes", "lon-first", "hemisphere-first"],
+)
+def test_degrees_minutes_seconds_are_lon_lat(tmp_path, text, expected):
+    f = tmp_path / "dms.csv"
+    f.write_text(text, encoding="utf-8")
+    ps = read_points(f)  # was: "line 2: not a number in column 2 or 1"
+    want = np.array([[10.325, 46.1], [10.325, 46.1 + 1 / 60], [10.35, 46.1 + 1 / 60]])
+    if expected == "south-west":
+        want = -want
+    assert ps.crs == "EPSG:4326"
+    np.testing.assert_allclose(ps.polylines[0].points, want, atol=1e-12)
+
+
+def test_a_bad_degrees_minutes_seconds_value_is_named(tmp_path):
+    f = tmp_path / "dms.csv"
+    f.write_text("lat,lon\n46°6'0\"N,10°19'30\"E\n46°7'0\"N,10°79'30\"E\n46°7'0\"N,10°21'0\"E\n", encoding="utf-8")
+    with pytest.raises(ReadError, match=r"line 3: not a number in column 2 \(nor degrees, minutes, seconds"):
+        read_points(f)
