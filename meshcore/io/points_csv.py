@@ -38,10 +38,18 @@ from ._base import PointSet, decode_text, make_polyline, read_bytes
 
 __all__ = ["read_points_csv"]
 
-_X_NAMES = {"x", "easting", "east", "e", "xcoord", "x_coord", "x_m", "xm"}
-_Y_NAMES = {"y", "northing", "north", "n", "ycoord", "y_coord", "y_m", "ym"}
-_LON_NAMES = {"lon", "long", "longitude", "lng", "lambda", "x_lon"}
-_LAT_NAMES = {"lat", "latitude", "phi", "y_lat"}
+# English, and the names of German (Rechtswert/Hochwert, Länge/Breite), French, Spanish, Italian,
+# Dutch exports: columns in the other order are read the right way round
+_X_NAMES = {"x", "easting", "east", "e", "xcoord", "x_coord", "x_m", "xm", "utm_e", "utm_x", "rechtswert", "rechts"}
+_Y_NAMES = {"y", "northing", "north", "n", "ycoord", "y_coord", "y_m", "ym", "utm_n", "utm_y", "hochwert", "hoch"}
+_LON_NAMES = {
+    "lon", "long", "longitude", "lng", "lambda", "x_lon", "länge", "laenge", "längengrad", "geogr_länge",
+    "longitud", "longitudine", "lengtegraad", "lon_dd", "long_dd",
+}  # fmt: skip
+_LAT_NAMES = {
+    "lat", "latitude", "phi", "y_lat", "breite", "breitengrad", "geogr_breite", "latitud", "latitudine",
+    "breedtegraad", "lat_dd",
+}  # fmt: skip
 _NAME_NAMES = {"name", "id", "part", "polyline", "line", "feature", "shape_id", "ring"}
 _COMMENT = ("#", "%", "//", "!")
 _NUM = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eEdD][+-]?\d+)?$")

@@ -238,3 +238,16 @@ def test_a_bad_degrees_minutes_seconds_value_is_named(tmp_path):
     f.write_text("lat,lon\n46°6'0\"N,10°19'30\"E\n46°7'0\"N,10°79'30\"E\n46°7'0\"N,10°21'0\"E\n", encoding="utf-8")
     with pytest.raises(ReadError, match=r"line 3: not a number in column 2 \(nor degrees, minutes, seconds"):
         read_points(f)
+
+
+@pytest.mark.parametrize(
+    ("header", "crs"),
+    [("Breite;Länge", "EPSG:4326"), ("latitud;longitud", "EPSG:4326"), ("Hochwert;Rechtswert", None)],
+)
+def test_headers_of_other_languages_put_the_columns_the_right_way_round(tmp_path, header, crs):
+    f = tmp_path / "p.csv"
+    pts = np.array([[10.33, 46.1], [10.32, 46.11], [10.31, 46.1]]) * (1 if crs else 1e5)
+    f.write_text(header + "\n" + "".join(f"{y:.6f};{x:.6f}\n".replace(".", ",") for x, y in pts), encoding="utf-8")
+    ps = read_points(f)  # was: the first column read as x (longitude), silently swapped
+    assert ps.crs == crs
+    np.testing.assert_allclose(ps.polylines[0].points, pts)
