@@ -141,6 +141,17 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
                 f"island {k + 1} (near {c.x:.6g}, {c.y:.6g}) is not inside the outline or touches it"
             )
         for j, other in enumerate(rings):
+            if Polygon(other).contains(isl) or isl.contains(Polygon(other)):  # a pond on an island
+                inner, outer_k, c = (k + 1, j + 1, isl) if Polygon(other).contains(isl) else (j + 1, k + 1, other)
+                c = Polygon(c).representative_point()
+                notes.append(
+                    f"island {inner} near ({c.x:.6g}, {c.y:.6g}) lies inside island {outer_k}: water on an "
+                    f"island (a pond) is not the lake's, left out"
+                )
+                if outer_k == k + 1:
+                    rings[j] = r
+                isl = None
+                break
             if Polygon(other).intersects(isl):  # touching islands are one island
                 merged = Polygon(other).union(isl)
                 if merged.geom_type != "Polygon":  # touching at points: close the pinch (bevelled: a

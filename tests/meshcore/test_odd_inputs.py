@@ -251,3 +251,16 @@ def test_headers_of_other_languages_put_the_columns_the_right_way_round(tmp_path
     ps = read_points(f)  # was: the first column read as x (longitude), silently swapped
     assert ps.crs == crs
     np.testing.assert_allclose(ps.polylines[0].points, pts)
+
+
+@pytest.mark.parametrize("pond_first", [False, True])
+def test_a_pond_on_an_island_is_left_out_as_such(pond_first):
+    from meshcore.layout.polygon import water_polygon
+
+    shore = [(0, 0), (4000, 0), (4000, 2000), (0, 2000)]
+    isle = [(1000, 500), (2000, 500), (2000, 1500), (1000, 1500)]
+    pond = [(1400, 900), (1600, 900), (1600, 1100), (1400, 1100)]
+    poly, notes = water_polygon(shore, holes=[pond, isle] if pond_first else [isle, pond])
+    assert len(poly.interiors) == 1 and poly.area == pytest.approx(8e6 - 1e6)
+    # was: "islands 1 and 2 touch: joined into one"
+    assert any("lies inside island" in n and "near (1500, 1000)" in n and "pond" in n for n in notes), notes
