@@ -370,10 +370,13 @@ def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
             (inside if paths else keep).append(pl)
     notes = []
     for dropped, where in ((touching, "touching the shore"), (inside, "in the water (a path, not a ring)")):
-        if dropped:
-            names = ", ".join(repr(pl.name) for pl in dropped)
-            what = "an open line" if len(dropped) == 1 else "open lines"
+        lines = [pl for pl in dropped if pl.orientation != "points"]
+        if lines:
+            names = ", ".join(repr(pl.name) for pl in lines)
+            what = "an open line" if len(lines) == 1 else "open lines"
             notes.append(f"{names}: {what} {where}, not an island: ignored")
+    for pl in (pl for pl in touching + inside if pl.orientation == "points"):
+        notes.append(f"{pl.name!r}: {len(pl.points)} single points (placemarks, pins), not a line or a ring: ignored")
     return (ps.with_points(keep, ps.crs), notes) if notes else (ps, [])
 
 

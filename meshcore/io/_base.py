@@ -58,9 +58,10 @@ class Polyline:
     closed : bool
         True for rings (polygons, closed polylines).  The repeated closing
         point is dropped: ``points[-1] != points[0]``.
-    orientation : {"ccw", "cw", ""}
+    orientation : {"ccw", "cw", "", "point", "points"}
         For rings, the orientation as given in the file (sign of the shoelace
-        area in the file's axes); ``""`` for open polylines.
+        area in the file's axes); ``""`` for open polylines; ``"point"`` for one
+        point placemark and ``"points"`` for a run of them joined in file order.
     """
 
     name: str
@@ -171,7 +172,10 @@ def merge_point_runs(polylines: Sequence[Polyline], name: str, where: str) -> li
         if run:
             pts = np.vstack(run)
             if len(pts) >= 2:
-                merged.append(make_polyline(name, pts, where=where))
+                line = make_polyline(name, pts, where=where)
+                if not line.closed:  # marked: single points joined in file order, not a line drawn
+                    object.__setattr__(line, "orientation", "points")
+                merged.append(line)
             run = []
         if pl is not None:
             merged.append(pl)

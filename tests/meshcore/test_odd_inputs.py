@@ -264,3 +264,23 @@ def test_a_pond_on_an_island_is_left_out_as_such(pond_first):
     assert len(poly.interiors) == 1 and poly.area == pytest.approx(8e6 - 1e6)
     # was: "islands 1 and 2 touch: joined into one"
     assert any("lies inside island" in n and "near (1500, 1000)" in n and "pond" in n for n in notes), notes
+
+
+def test_pins_beside_a_lake_polygon_are_named_as_points(tmp_path):
+    from meshcore.cli.mesh import without_lines_on_the_shore
+
+    ring = " ".join(f"{lo},{la}" for lo, la in [*LONLAT, LONLAT[0]])
+    pins = "".join(
+        f"<Placemark><name>{n}</name><Point><coordinates>{lo},{la}</coordinates></Point></Placemark>"
+        for n, lo, la in (("pier", 8.52, 47.301), ("car park", 8.6, 47.4))
+    )
+    f = tmp_path / "lake.kml"
+    f.write_text(
+        '<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark><name>lake</name><Polygon><outerBoundaryIs>'
+        f"<LinearRing><coordinates>{ring}</coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark>{pins}"
+        "</Document></kml>"
+    )
+    kept, notes = without_lines_on_the_shore(read_points(f))
+    assert kept.names == ("lake",)
+    # was: "'lake points': an open line touching the shore, not an island: ignored"
+    assert notes == ["'lake points': 2 single points (placemarks, pins), not a line or a ring: ignored"]
