@@ -84,11 +84,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "-o",
         "--output",
         action="append",
-        required=True,
+        default=[],
         metavar="OUT",
-        help="grid file, repeatable: .vtm .cgns .xyz (PLOT3D) .ddb (Delft3D DD) .npz .su2 .msh .csv",
+        help="grid file, repeatable: .vtm .cgns .xyz (PLOT3D) .ddb (Delft3D DD) .npz .su2 .msh .csv "
+        "(at least one of -o, --png, --case)",
     )
-    p.add_argument("--png", metavar="FIG", help="also draw the grid to this figure (.png .svg .pdf)")
+    p.add_argument("--png", metavar="FIG", help="draw the grid to this figure (.png .svg .pdf)")
     p.add_argument(
         "--case",
         metavar="LAYOUT.toml",
@@ -128,6 +129,8 @@ def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
     from ..io import find_format
     from .generate import check_output
 
+    if not (args.output or args.png or args.case):
+        raise InvalidInputError("nothing to write: give -o OUT (a grid file), --png FIG or --case LAYOUT.toml")
     seen: dict[Path, str] = {}
     out = []
     for opt, path in [("-o", o) for o in args.output] + ([("--png", args.png)] if args.png else []):

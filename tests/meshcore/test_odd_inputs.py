@@ -284,3 +284,16 @@ def test_pins_beside_a_lake_polygon_are_named_as_points(tmp_path):
     assert kept.names == ("lake",)
     # was: "'lake points': an open line touching the shore, not an island: ignored"
     assert notes == ["'lake points': 2 single points (placemarks, pins), not a line or a ring: ignored"]
+
+
+def test_mesh_can_only_draw_the_grid(tmp_path, capsys):
+    from meshcore import cli
+
+    f = tmp_path / "lake.csv"
+    f.write_text(_csv([(2000 * np.cos(a), 1000 * np.sin(a)) for a in np.linspace(0, 6.2, 30)]))
+    png = tmp_path / "look.png"
+    assert cli.main(["mesh", str(f), "--cells", "200", "-q", "--png", str(png)]) == 0  # was: "-o is required"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert cli.main(["mesh", str(f), "--cells", "200"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "nothing to write: give -o OUT" in err
