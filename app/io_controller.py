@@ -217,10 +217,12 @@ class IOController(QtCore.QObject):
                     self.win.error("Cannot project coordinates", exc)
                     return False
         elif pd.pointset is not None and pd.pointset.crs:  # a projected CRS the file declares (.prj, GeoJSON)
-            from meshcore.crs import Frame
+            from meshcore.crs import Frame, is_web_mercator
 
             # into the project's CRS and origin, or kept as they are (origin 0) as meshcore mesh keeps them
-            frame = frame if frame is not None and frame.crs else Frame(pd.pointset.crs, (0.0, 0.0), None)
+            # (Web Mercator, whose metres are not metres, to UTM as meshcore mesh takes it)
+            if frame is None or not frame.crs:
+                frame = None if is_web_mercator(pd.pointset.crs) else Frame(pd.pointset.crs, (0.0, 0.0), None)
             try:
                 pts, frame = fio.to_local(pd, frame)
             except (MeshcoreError, ValueError) as exc:

@@ -171,6 +171,19 @@ def is_geographic(crs: str | None) -> bool:
     return bool(_crs_attribute(crs, lambda c: c.is_geographic))
 
 
+def is_web_mercator(crs: str | None) -> bool:
+    """True for Web ("Pseudo") Mercator (EPSG:3857, 900913 …), whose metres are true metres only at
+    the equator: ``1 / cos(lat)`` of them to a metre (1.44 at 46°, cell areas 2.1 times too large)."""
+    if crs is None or is_geographic(crs):
+        return False
+
+    def pseudo(c: Any) -> bool:
+        op = c.coordinate_operation
+        return op is not None and "pseudo mercator" in (op.method_name or "").lower()
+
+    return bool(_crs_attribute(crs, pseudo))
+
+
 def crs_wkt(crs: str | None) -> str | None:
     """WKT2 of ``crs`` (None for an unknown CRS)."""
     if crs is None:
@@ -410,7 +423,7 @@ def project_arrays(
         src = LONLAT
     target: str | None
     if target_in == "auto":
-        if src is not None and is_geographic(src):
+        if src is not None and (is_geographic(src) or is_web_mercator(src)):  # to true metres
             lon, lat = _lonlat_centroid(pts, src)
             target = f"EPSG:{auto_epsg(lon, lat)}"
         else:

@@ -298,14 +298,14 @@ def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[
     not projected keep their coordinates.  Subtracting a round origin is exact, so the world
     coordinates are ``local + origin`` to the last bit.
     """
-    from ..crs import LONLAT, is_geographic, project
+    from ..crs import LONLAT, is_geographic, is_web_mercator, project
 
     keep = crs is None or (isinstance(crs, str) and crs.strip().lower() in ("none", "local"))
     if source_crs is None and ps.crs is None and not keep and is_lonlat(ps):
         source_crs = LONLAT  # what project would guess: said here, where the app's import reads it too
     local, frame = project(ps, crs, origin=None, source_crs=source_crs)
     src = frame.source_crs
-    if src is not None and is_geographic(src) and frame.crs is not None and frame.crs != src:
+    if src is not None and (is_geographic(src) or is_web_mercator(src)) and frame.crs is not None and frame.crs != src:
         local, frame = project(ps, crs, origin="auto", source_crs=source_crs)
     return local, frame
 

@@ -76,3 +76,17 @@ def test_degrees_without_a_header_warn_of_the_column_order(win, tmp_path):
     f.write_text("".join(f"{b:.6f},{a:.6f}\n" for a, b in zip(LON, LAT, strict=True)))  # lat, lon
     assert win.io.import_points(f, project_lonlat=True)
     assert any(lv == "warning" and "read as longitude, latitude" in t and "'lat,lon'" in t for lv, t in said)
+
+
+def test_web_mercator_is_imported_in_utm_metres(win, tmp_path):
+    import json
+
+    x, y = pyproj.Transformer.from_crs(4326, 3857, always_xy=True).transform(LON, LAT)
+    ring = [[float(a), float(b)] for a, b in zip(x, y, strict=True)]
+    f = tmp_path / "osm.geojson"
+    crs = {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3857"}}
+    f.write_text(json.dumps({"type": "Polygon", "coordinates": [[*ring, ring[0]]], "crs": crs}))
+    assert win.io.import_points(f)
+    assert win.doc.project.crs == "EPSG:32632"  # was EPSG:3857: cells 1.45 times their size in true metres
+    pts = win.doc.block.points
+    assert 3000 < np.ptp(pts[:, 0]) < 3050  # 0.04° of longitude at 47.3° N: 3.02 km (4.45 "km" in Web Mercator)

@@ -297,3 +297,20 @@ def test_mesh_can_only_draw_the_grid(tmp_path, capsys):
     assert cli.main(["mesh", str(f), "--cells", "200"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "nothing to write: give -o OUT" in err
+
+
+def test_web_mercator_metres_go_to_utm():
+    pyproj = pytest.importorskip("pyproj")
+    from meshcore.cli.mesh import local_frame
+    from meshcore.crs import is_web_mercator
+    from meshcore.io import PointSet, Polyline
+
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    lon, lat = 10.3 + 0.03 * np.cos(t), 46.1 + 0.01 * np.sin(t)
+    x, y = pyproj.Transformer.from_crs(4326, 3857, always_xy=True).transform(lon, lat)
+    merc = PointSet((Polyline("lake", np.column_stack([x, y])),), "EPSG:3857")
+    deg = PointSet((Polyline("lake", np.column_stack([lon, lat])),), "EPSG:4326")
+    assert is_web_mercator("EPSG:3857") and not is_web_mercator("EPSG:32632") and not is_web_mercator("EPSG:4326")
+    (a, fa), (b, fb) = local_frame(merc), local_frame(deg)
+    assert fa.crs == fb.crs == "EPSG:32632" and fa.origin == fb.origin  # was: EPSG:3857, areas 2.08 times too large
+    np.testing.assert_allclose(a.polylines[0].points, b.polylines[0].points, atol=1e-6)
