@@ -9,6 +9,8 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
 * :func:`jagged_cells` — any of them with shores jagged at the scale of the cells (the
   outlines traced from aerial images);
 * :func:`lake_with_islands` — a lobed lake with islands, some close to the shore;
+* :func:`archipelago` — a round lake with many polygonal islands a few cells across, some in
+  narrow passages between each other and the shore;
 * :func:`small_islands` — islands from a third of a cell to five cells across, thin, bent,
   near the shore and each other;
 * :func:`spiral` — a channel wound round more than once;
@@ -33,6 +35,7 @@ import math
 import numpy as np
 
 __all__ = [
+    "archipelago",
     "channel_network",
     "dendritic",
     "headlands",
@@ -495,3 +498,6 @@ def _lobed_disc(rng, radius: float, points: int, lobes, amplitude: float):
         r += rng.uniform(0.0, amplitude / k**0.5) * np.cos(k * t + rng.uniform(0, 2 * math.pi))
     r *= radius / r.max()
     return Polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]))
+
+
+from ._archipelago import archipelago  # noqa: E402  (uses _lobed_disc and _clean above)

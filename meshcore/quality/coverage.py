@@ -456,7 +456,9 @@ def _islands(poly: Any, union: Any, h: float) -> tuple[tuple[CoveredIsland, ...]
                 rims.append(ring)
                 land.append((k, island))
                 continue
-            width, c = island_width(island, 0.01 * h)
+            # to the layout's tolerance (``water_polygon``'s, 1 % of the two cells): an island it
+            # left out as narrower than two cells is measured as left out, not lost
+            width, c = island_width(island, 0.01 * MIN_ISLAND_CELLS * h)
             covered.append(CoveredIsland(k, float(island.area), width, float(c.x), float(c.y), float(share)))
             if not covered[-1].left_out(h):
                 rims.append(ring)  # lost: measured
