@@ -105,6 +105,7 @@ def iterate_layout(
     levels: int | None = None,
     sweeps: tuple[int, ...] = (200, 150, 400),
     stall: float | None = 0.0025,
+    stall_limits: tuple[float, ...] | None = None,
     smooth: float | tuple[float, ...] = 0.0,
     omega: float = 1.8,
     pin_angle: float | None = None,
@@ -121,7 +122,9 @@ def iterate_layout(
     ``sweeps`` are the most sweeps per level, the finest level last (with fewer levels the
     coarsest ones are dropped, with more the first repeats).  ``stall``: the finest level stops
     as soon as its share of nodes with ``|cos| ≤ 0.02`` rises by less than that over 20 sweeps
-    (see :func:`~meshcore.orthogonal.iterate_orthogonalize`; None: always ``sweeps[-1]``).
+    and its share within 3° by less than that too (``stall_limits``, default
+    :data:`~meshcore.orthogonal.driver.STALL_LIMITS`; see
+    :func:`~meshcore.orthogonal.iterate_orthogonalize`; None: always ``sweeps[-1]``).
     ``hold_ends``: keep the lines leaving cut ends at reflex shore corners near their angles
     (:func:`~meshcore.orthogonal.iterate_orthogonalize`; off by default, see there).
     ``slide_ends``: block corners and cut ends of cells still non-convex slide along the shore
@@ -136,7 +139,7 @@ def iterate_layout(
     from .elliptic import SolverProgress
     from .multiblock import MultiBlockGrid, initial_grids
     from .orthogonal import iterate_orthogonalize
-    from .orthogonal.driver import SHORE_GAP
+    from .orthogonal.driver import SHORE_GAP, STALL_LIMITS
     from .orthogonal.levels import coarsen_topology, fit_bends, fit_ends, refine, refine_shore
     from .orthogonal.untangle import untangle
 
@@ -183,6 +186,7 @@ def iterate_layout(
             size_ratio=size_ratio,
             hold_ends=hold_ends,
             stall=stall if lev == len(tops) - 1 else None,
+            stall_limits=STALL_LIMITS if stall_limits is None else tuple(stall_limits),
         )
         try:
             it, d, snap = next(gen)
