@@ -238,7 +238,10 @@ def _read(args: argparse.Namespace, say: _Say):
         raise InvalidInputError(
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
         )
-    outer, islands, dropped = lake_rings(local)
+    try:
+        outer, islands, dropped = lake_rings(local)
+    except InvalidInputError as exc:  # places in the grid's CRS, as the layout's
+        raise InvalidInputError(in_world(str(exc), frame)) from None
     _notes([n for n in (lonlat_order_note(ps, args.source_crs, args.columns),) if n], frame)
     _notes(dropped, frame)
     try:

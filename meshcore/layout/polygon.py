@@ -294,9 +294,10 @@ def water_from_points(pointset: Any):
                 f"land is part of the shore: draw it into the outline)"
             )
         if not shell.contains(ring.representative_point()):
+            c = ring.representative_point()  # the place tells rings of one name apart (a MultiGeometry's)
             raise InvalidInputError(
-                f"{pointset.source or 'points'}: {name!r} lies outside the outline {oname!r} — one lake per "
-                f"file (islands are rings inside the shore)"
+                f"{pointset.source or 'points'}: {name!r} near ({c.x:.6g}, {c.y:.6g}) lies outside the outline "
+                f"{oname!r} — one lake per file (islands are rings inside the shore)"
             )
         islands.append(p)
     return outer, islands

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -314,3 +316,24 @@ def test_web_mercator_metres_go_to_utm():
     (a, fa), (b, fb) = local_frame(merc), local_frame(deg)
     assert fa.crs == fb.crs == "EPSG:32632" and fa.origin == fb.origin  # was: EPSG:3857, areas 2.08 times too large
     np.testing.assert_allclose(a.polylines[0].points, b.polylines[0].points, atol=1e-6)
+
+
+def test_two_lakes_of_one_name_are_told_apart_by_place(tmp_path, capsys):
+    from meshcore import cli
+
+    def poly(dlon):
+        ring = " ".join(f"{8.5 + dlon + 0.02 * np.cos(a):.6f},{47.3 + 0.01 * np.sin(a):.6f}" for a in T30)
+        ring = f"<LinearRing><coordinates>{ring}</coordinates></LinearRing>"
+        return f"<Polygon><outerBoundaryIs>{ring}</outerBoundaryIs></Polygon>"
+
+    T30 = np.linspace(0, 2 * np.pi, 30)
+    f = tmp_path / "lakes.kml"
+    f.write_text(
+        '<kml xmlns="http://www.opengis.net/kml/2.2"><Placemark><name>lakes</name><MultiGeometry>'
+        f"{poly(0.0)}{poly(0.2)}</MultiGeometry></Placemark></kml>"
+    )
+    assert cli.main(["mesh", str(f), "-o", str(tmp_path / "g.vtm")]) == 2
+    err = capsys.readouterr().err
+    # was: "'lakes' lies outside the outline 'lakes'"; the place in the grid's CRS (UTM metres, not local)
+    m = re.search(r"'lakes' near \(([\d.]+), ([\d.]+)\) lies outside the outline 'lakes'", err)
+    assert m and 450_000 < float(m[1]) < 500_000 and 5_200_000 < float(m[2]) < 5_300_000, err
