@@ -283,6 +283,8 @@ def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> s
     """
     if source_crs is not None or columns is not None or ps.crs is not None or not is_lonlat(ps):
         return None
+    if not str(ps.source).lower().endswith(RINGS_MAY_BE_OPEN):  # a shapefile or DXF says x, y: lon, lat
+        return None
     pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
     if np.abs(pts[:, 0]).max() > 90:
         return None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import re
 
 import numpy as np
@@ -337,3 +338,18 @@ def test_two_lakes_of_one_name_are_told_apart_by_place(tmp_path, capsys):
     # was: "'lakes' lies outside the outline 'lakes'"; the place in the grid's CRS (UTM metres, not local)
     m = re.search(r"'lakes' near \(([\d.]+), ([\d.]+)\) lies outside the outline 'lakes'", err)
     assert m and 450_000 < float(m[1]) < 500_000 and 5_200_000 < float(m[2]) < 5_300_000, err
+
+
+def test_no_column_order_note_for_a_shapefile_without_prj(tmp_path):
+    shapefile = pytest.importorskip("shapefile")
+    from meshcore.cli.mesh import lonlat_order_note
+
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    ring = [(8.5 + 0.02 * np.cos(a), 47.3 + 0.01 * np.sin(a)) for a in t][::-1]
+    with contextlib.ExitStack() as files:  # pyshp 3.1.9's Writer leaves the .dbf it opens unclosed
+        f = {e: files.enter_context(open(tmp_path / f"lake.{e}", "wb")) for e in ("shp", "shx", "dbf")}
+        with shapefile.Writer(shapeType=shapefile.POLYGON, **f) as w:
+            w.field("name", "C")
+            w.poly([[*ring, ring[0]]])
+            w.record("lake")
+    assert lonlat_order_note(read_points(tmp_path / "lake.shp")) is None  # x, y is lon, lat in a shapefile
