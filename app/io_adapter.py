@@ -49,11 +49,11 @@ class PointData:
 def read_points(path) -> PointData:
     """Read a boundary point file with :func:`meshcore.io.read_points` (every format it knows).
 
-    ``lonlat`` follows the rule of ``meshcore mesh`` (:func:`meshcore.cli.mesh.is_lonlat`): the
+    ``lonlat`` follows the rule of ``meshcore mesh`` (:func:`meshcore.cli.lakefile.is_lonlat`): the
     file says so, or it says nothing and its numbers look like degrees (a headerless CSV).
     """
     from meshcore import io as mio
-    from meshcore.cli.mesh import is_lonlat
+    from meshcore.cli.lakefile import is_lonlat
 
     path = Path(path)
     ps = mio.read_points(path)

@@ -195,7 +195,7 @@ class IOController(QtCore.QObject):
         pts = pd.points
         frame = fio.project_frame(self.doc.project)
         if pd.lonlat and pd.pointset is not None:
-            from meshcore.cli.mesh import lonlat_order_note
+            from meshcore.cli.lakefile import lonlat_order_note
 
             note = lonlat_order_note(pd.pointset)
             if note:  # as meshcore mesh notes it (its --columns 1 0: a header "lat,lon" in the file here)

@@ -4,8 +4,8 @@ The same functions as ``meshcore mesh`` (:mod:`meshcore.cli.mesh`) so that the s
 gives the same layout in the app and on the command line:
 
 * the water: every ring of the point file, projected like the rest of the project
-  (:func:`meshcore.cli.mesh.local_frame`; lon/lat by :func:`meshcore.cli.mesh.is_lonlat`),
-  split into shore and islands by :func:`meshcore.cli.mesh.lake_rings` (open lines that
+  (:func:`meshcore.cli.lakefile.local_frame`; lon/lat by :func:`meshcore.cli.lakefile.is_lonlat`),
+  split into shore and islands by :func:`meshcore.cli.lakefile.lake_rings` (open lines that
   cannot be islands dropped with a note);
 * the layout: :func:`meshcore.layout.auto_layout` at the cell size the user set, or at
   ``sqrt(water area / 10 000)`` (:data:`meshcore.cli.mesh.DEFAULT_CELLS`), with cell counts
@@ -97,13 +97,13 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
 
     ``pointset`` is the :class:`meshcore.io.PointSet` read from the file; with ``lonlat``
     its degrees go to ``frame`` (the project's) or to the UTM zone of the centroid with a
-    round local origin (:func:`meshcore.cli.mesh.local_frame`).  Open lines touching the
-    shore are dropped with a note (:func:`meshcore.cli.mesh.lake_rings`).  Raises
+    round local origin (:func:`meshcore.cli.lakefile.local_frame`).  Open lines touching the
+    shore are dropped with a note (:func:`meshcore.cli.lakefile.lake_rings`).  Raises
     :class:`~meshcore.MeshcoreError` when the rings are not one lake (an island outside the
     shore, a ring of fewer than three points).
     """
     from meshcore import crs as mcrs
-    from meshcore.cli.mesh import lake_rings, local_frame
+    from meshcore.cli.lakefile import lake_rings, local_frame
 
     ps = pointset
     if not lonlat and ps.crs and frame is not None and frame.crs and not mcrs.is_geographic(ps.crs):

@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 def _polygon(what: str):
     from meshcore import testing  # noqa: F401  (used by eval)
-    from meshcore.cli.mesh import local_frame
+    from meshcore.cli.lakefile import local_frame
     from meshcore.io import read_points
     from meshcore.layout.polygon import water_from_points, water_polygon
 

@@ -47,7 +47,7 @@ import json, sys, time
 import numpy as np
 from meshcore import testing
 from meshcore.cellsize import default_cell_size
-from meshcore.cli.mesh import local_frame
+from meshcore.cli.lakefile import local_frame
 from meshcore.io import read_points
 from meshcore.lakegrid import mesh_outline
 from meshcore.layout.polygon import water_from_points, water_polygon

@@ -42,7 +42,7 @@ STAGES = (
 _CHILD = r"""
 import functools, importlib, inspect, json, sys, time
 from meshcore import testing
-from meshcore.cli.mesh import local_frame
+from meshcore.cli.lakefile import local_frame
 from meshcore.io import read_points
 from meshcore.lakegrid import mesh_outline
 from meshcore.layout.polygon import water_from_points, water_polygon

@@ -34,7 +34,6 @@ import argparse
 import dataclasses
 import io
 import math
-import re
 import sys
 import time
 from pathlib import Path
@@ -44,6 +43,7 @@ import numpy as np
 
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from ..errors import InvalidInputError, MeshcoreError
+from .lakefile import in_world, lake_rings, local_frame, lonlat_order_note
 
 #: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
 MIN_CELLS = 16
@@ -220,7 +220,7 @@ def _read(args: argparse.Namespace, say: _Say):
     """The water polygon in local coordinates of the grid's CRS, and its frame (CRS and origin).
 
     Points projected from lon/lat get the round local origin the app's import gives them
-    (:func:`local_frame`); points kept as they are keep their coordinates (origin 0), as in
+    (:func:`~.lakefile.local_frame`); points kept as they are keep their coordinates (origin 0), as in
     the app.
     """
     from ..crs import is_geographic, normalize_crs
@@ -256,81 +256,6 @@ def _read(args: argparse.Namespace, say: _Say):
     return poly, frame
 
 
-def is_lonlat(ps: Any, source_crs: Any = None) -> bool:
-    """True when a point set holds longitude/latitude degrees.
-
-    The rule shared by ``meshcore mesh`` and the app's import: the CRS the file declares
-    (or ``source_crs``) is geographic, or the file declares none and every point looks like
-    degrees (:func:`meshcore.crs.looks_lonlat`; e.g. a CSV of lon, lat numbers without a
-    header).
-    """
-    from ..crs import is_geographic, looks_lonlat, normalize_crs
-
-    src = normalize_crs(source_crs) if source_crs is not None else ps.crs
-    if src is not None:
-        return bool(is_geographic(src))
-    pts = [np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines]
-    return bool(pts) and looks_lonlat(np.vstack(pts))
-
-
-def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> str | None:
-    """A note when degrees were read as longitude, latitude with nothing in the file to say so.
-
-    A file without a CRS, a lon/lat header or columns given, whose numbers look like degrees,
-    is read as x = longitude, y = latitude; when every x is within ±90 the columns could as well
-    be latitude, longitude (the order many GPS and spreadsheet exports use), and the grid of a
-    swapped file is a lake elsewhere, stretched and mirrored, without a word.
-    """
-    if source_crs is not None or columns is not None or ps.crs is not None or not is_lonlat(ps):
-        return None
-    if not str(ps.source).lower().endswith(RINGS_MAY_BE_OPEN):  # a shapefile or DXF says x, y: lon, lat
-        return None
-    pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
-    if np.abs(pts[:, 0]).max() > 90:
-        return None
-    return (
-        f"{ps.source}: no header says which column is which: read as longitude, latitude "
-        f"(x, y); if the first column is the latitude, give --columns 1 0"
-    )
-
-
-def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[Any, Any]:
-    """Project a point set for a lake grid: ``(local point set, Frame)``.
-
-    The rule shared by ``meshcore mesh`` and the app's import (:func:`app.lake.read_lake`):
-    points in lon/lat (:func:`is_lonlat`, also when the file does not say so) go to ``crs``
-    relative to the round origin of :func:`meshcore.crs.project` (``origin="auto"``); points
-    not projected keep their coordinates.  Subtracting a round origin is exact, so the world
-    coordinates are ``local + origin`` to the last bit.
-    """
-    from ..crs import LONLAT, is_geographic, is_web_mercator, project
-
-    keep = crs is None or (isinstance(crs, str) and crs.strip().lower() in ("none", "local"))
-    if source_crs is None and ps.crs is None and not keep and is_lonlat(ps):
-        source_crs = LONLAT  # what project would guess: said here, where the app's import reads it too
-    local, frame = project(ps, crs, origin=None, source_crs=source_crs)
-    src = frame.source_crs
-    if src is not None and (is_geographic(src) or is_web_mercator(src)) and frame.crs is not None and frame.crs != src:
-        local, frame = project(ps, crs, origin="auto", source_crs=source_crs)
-    return local, frame
-
-
-def lake_rings(ps: Any) -> tuple[np.ndarray, list[np.ndarray], list[str]]:
-    """Shore, islands and notes of a point set's rings: the rule shared by ``meshcore mesh`` and the app.
-
-    Open polylines that touch the shore (an inlet or a cut drawn on it) are dropped with a
-    note (:func:`without_lines_on_the_shore`); the rest is split into the shore (the ring of
-    largest area) and islands by :func:`~meshcore.layout.polygon.water_from_points`, which
-    raises :class:`~meshcore.errors.InvalidInputError` naming a ring that is not part of one
-    lake.
-    """
-    from ..layout.polygon import water_from_points
-
-    kept, notes = without_lines_on_the_shore(ps)
-    outer, islands = water_from_points(kept)
-    return np.asarray(outer, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in islands], notes
-
-
 def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
     """The grid, the water and the frame in world coordinates (origin added, frame origin 0)."""
     from shapely import affinity
@@ -341,51 +266,6 @@ def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
     grids = tuple(g.replaced(x=g.x + ox, y=g.y + oy) for g in mb.grids)
     world = dataclasses.replace(frame, origin=(0.0, 0.0))
     return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
-
-
-#: Point files in which an island's ring may be written without its closing point: an open
-#: polyline there is a ring.  The other formats say it (KML, GeoJSON and shapefile geometry types,
-#: a DXF polyline's closed flag): there an open line is a path.
-RINGS_MAY_BE_OPEN = (".csv", ".txt", ".xy", ".dat", ".tsv")
-
-
-def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
-    """Drop open polylines that cannot be islands: ``(kept, notes)``.
-
-    The shore is the ring of largest area, as :func:`~meshcore.layout.polygon.water_from_points`
-    picks it.  An open line that meets it (an inlet or a cut drawn on it) is dropped; so is, in a
-    file whose geometry says what is a ring (not a CSV) and that holds a polygon, an open line in
-    the water (a ferry route, a survey line: read as a ring it was an island of water left out of
-    the grid).  ``notes`` names the dropped lines (empty when none was dropped).
-    """
-    import shapely
-
-    rings = [pl for pl in ps.polylines if len(pl.points) >= 3]
-    if len(ps.polylines) < 2 or not rings:
-        return ps, []  # water_from_points names what is missing
-    shore = max(rings, key=lambda pl: abs(shapely.Polygon(pl.points).area))
-    ring = shapely.LinearRing(shore.points)
-    paths = any(pl.closed for pl in ps.polylines) and not str(ps.source).lower().endswith(RINGS_MAY_BE_OPEN)
-    keep: list[Any] = []
-    touching: list[Any] = []
-    inside: list[Any] = []
-    for pl in ps.polylines:
-        if pl is shore or pl.closed or len(pl.points) < 2:  # a single point: named later
-            keep.append(pl)
-        elif shapely.LineString(pl.points).intersects(ring):
-            touching.append(pl)
-        else:
-            (inside if paths else keep).append(pl)
-    notes = []
-    for dropped, where in ((touching, "touching the shore"), (inside, "in the water (a path, not a ring)")):
-        lines = [pl for pl in dropped if pl.orientation != "points"]
-        if lines:
-            names = ", ".join(repr(pl.name) for pl in lines)
-            what = "an open line" if len(lines) == 1 else "open lines"
-            notes.append(f"{names}: {what} {where}, not an island: ignored")
-    for pl in (pl for pl in touching + inside if pl.orientation == "points"):
-        notes.append(f"{pl.name!r}: {len(pl.points)} single points (placemarks, pins), not a line or a ring: ignored")
-    return (ps.with_points(keep, ps.crs), notes) if notes else (ps, [])
 
 
 def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:
@@ -419,19 +299,6 @@ def _notes(notes: Any, frame: Any = None) -> None:
     (places in the grid's CRS: :func:`in_world`)."""
     for n in notes:
         print(f"meshcore mesh: note: {in_world(n, frame)}", file=sys.stderr)
-
-
-_NEAR = re.compile(r"near \((-?\d[\d.]*(?:e[+-]?\d+)?), (-?\d[\d.]*(?:e[+-]?\d+)?)\)")
-
-
-def in_world(msg: str, frame: Any) -> str:
-    """``msg`` with every place ``near (x, y)`` moved from the local frame the layout and the
-    solver work in to the grid's CRS (``frame``'s origin added, to the centimetre), as the
-    quality table and the written grid give them; unchanged without an origin."""
-    ox, oy = getattr(frame, "origin", None) or (0.0, 0.0)
-    if ox == 0.0 and oy == 0.0:
-        return msg
-    return _NEAR.sub(lambda m: f"near ({float(m[1]) + ox:.11g}, {float(m[2]) + oy:.11g})", msg)
 
 
 def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):

@@ -153,8 +153,8 @@ def _headerless_csv(path: Path) -> Path:
 def test_the_same_layout_and_grid_as_meshcore_mesh(qtbot, win, tmp_path, name):
     """The app's layout and grid of a file are the CLI's: same blocks, cells and nodes to the last bit.
 
-    A CSV of bare lon/lat numbers is projected by both (one rule, :func:`meshcore.cli.mesh.is_lonlat`),
-    and an open line touching its shore is dropped by both (:func:`meshcore.cli.mesh.lake_rings`).
+    A CSV of bare lon/lat numbers is projected by both (one rule, :func:`meshcore.cli.lakefile.is_lonlat`),
+    and an open line touching its shore is dropped by both (:func:`meshcore.cli.lakefile.lake_rings`).
     The layout's discrete choices change with the last bits of the coordinates (a lake
     shifted by a round number can get another block count), so both compute in the same
     local frame; the CLI writes world coordinates = local + origin, as the app exports them.
@@ -378,7 +378,7 @@ def test_an_open_line_on_the_shore_is_not_an_island_in_the_app_either(qtbot, win
     line drawn from the shore is dropped with the CLI's note; the shore alone is the lake."""
     pytest.importorskip("ezdxf")
     src = Path(__file__).resolve().parents[2] / "tests" / "data" / "lake_zurich_sparse_utm32.dxf"
-    from meshcore.cli.mesh import lake_rings
+    from meshcore.cli.lakefile import lake_rings
     from meshcore.io import read_points
 
     shore, islands, notes = lake_rings(read_points(src))

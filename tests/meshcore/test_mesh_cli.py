@@ -652,7 +652,7 @@ def test_lake_rings_and_lonlat_rules_shared_with_the_app(tmp_path):
     """The rules ``meshcore mesh`` and the app's import share (:mod:`meshcore.cli.mesh`): bare
     numbers that look like degrees are lon/lat, metres are not, a declared CRS decides; an open
     line of two points touching the shore is dropped with a note, one off the shore is an error."""
-    from meshcore.cli.mesh import is_lonlat, lake_rings
+    from meshcore.cli.lakefile import is_lonlat, lake_rings
     from meshcore.errors import InvalidInputError
     from meshcore.io import read_points
 
@@ -703,7 +703,7 @@ def test_places_in_notes_are_in_the_grids_crs(tmp_path):
 def test_in_world_moves_only_places_by_the_origin():
     from types import SimpleNamespace
 
-    from meshcore.cli.mesh import in_world
+    from meshcore.cli.lakefile import in_world
 
     frame = SimpleNamespace(origin=(500000.0, 5000000.0))
     msg = "block b3 (24, 16) near (-5920.77, 2728.88) and near (1e-05, -3.5e+02); cells (4, 8)"

@@ -186,7 +186,7 @@ def test_ctrl_c_during_the_solve_leaves_no_output(tmp_path, monkeypatch, capsys)
 
 
 def test_degrees_without_a_header_are_noted_as_read_lon_lat(tmp_path):
-    from meshcore.cli.mesh import lonlat_order_note
+    from meshcore.cli.lakefile import lonlat_order_note
 
     t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
     ring = np.column_stack([8.5 + 0.02 * np.cos(t), 47.3 + 0.01 * np.sin(t)])
@@ -270,7 +270,7 @@ def test_a_pond_on_an_island_is_left_out_as_such(pond_first):
 
 
 def test_pins_beside_a_lake_polygon_are_named_as_points(tmp_path):
-    from meshcore.cli.mesh import without_lines_on_the_shore
+    from meshcore.cli.lakefile import without_lines_on_the_shore
 
     ring = " ".join(f"{lo},{la}" for lo, la in [*LONLAT, LONLAT[0]])
     pins = "".join(
@@ -304,7 +304,7 @@ def test_mesh_can_only_draw_the_grid(tmp_path, capsys):
 
 def test_web_mercator_metres_go_to_utm():
     pyproj = pytest.importorskip("pyproj")
-    from meshcore.cli.mesh import local_frame
+    from meshcore.cli.lakefile import local_frame
     from meshcore.crs import is_web_mercator
     from meshcore.io import PointSet, Polyline
 
@@ -342,7 +342,7 @@ def test_two_lakes_of_one_name_are_told_apart_by_place(tmp_path, capsys):
 
 def test_no_column_order_note_for_a_shapefile_without_prj(tmp_path):
     shapefile = pytest.importorskip("shapefile")
-    from meshcore.cli.mesh import lonlat_order_note
+    from meshcore.cli.lakefile import lonlat_order_note
 
     t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
     ring = [(8.5 + 0.02 * np.cos(a), 47.3 + 0.01 * np.sin(a)) for a in t][::-1]

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from meshcore.cli.mesh import local_frame
+from meshcore.cli.lakefile import local_frame
 from meshcore.io import read_points
 from meshcore.lakegrid import mesh_outline
 from meshcore.layout.polygon import water_from_points, water_polygon
