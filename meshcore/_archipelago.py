@@ -26,7 +26,7 @@ def archipelago(
     from shapely import affinity
     from shapely.geometry import Polygon
 
-    from .testing import _clean, _lobed_disc
+    from .testing import _clean, _lobed_disc, _placed
 
     rng = np.random.default_rng(seed)
     outer = _lobed_disc(rng, radius, 240, range(2, 5), 0.15)
@@ -42,24 +42,19 @@ def archipelago(
         rr = 0.5 * w * rng.uniform(0.75, 1.0, k)
         isl = Polygon(np.column_stack([rr * np.cos(a), rr * np.sin(a)]))
         isl = affinity.scale(isl, rng.uniform(1.0, 1.6), 1.0)
-        isl = affinity.rotate(isl, rng.uniform(0, 360), origin=(0, 0))
-        where = rng.uniform()
-        gap = h * rng.uniform(0.5, 3.0)
-        if where < 1 / 3:  # near the shore
-            p = np.asarray(outer.exterior.interpolate(rng.uniform(0, outer.exterior.length)).coords[0])
-            c = p * (1.0 - (gap + 0.6 * w) / max(np.hypot(*p), 1e-9))
-        elif where < 2 / 3 and holes:  # near an island placed before
-            prev = holes[int(rng.integers(0, len(holes)))]
-            d = rng.uniform(0, 2 * math.pi)
-            c = np.asarray(prev.centroid.coords[0]) + np.array([math.cos(d), math.sin(d)]) * (
-                0.5 * math.sqrt(prev.area) + gap + 0.5 * w
-            )
-        else:
-            c = rng.uniform(-radius, radius, 2)
-        isl = affinity.translate(isl, *c)
-        if not isl.is_valid or not body.contains(isl):
-            continue
-        if any(isl.distance(o) < 0.5 * h for o in holes):
-            continue
-        holes.append(isl)
+        isl = _placed(
+            rng,
+            isl,
+            outer,
+            body,
+            holes,
+            radius,
+            h=h,
+            gaps=(0.5, 3.0),
+            shore=0.6 * w,
+            near=(0.5, 0.5 * w),
+            any_before=True,
+        )
+        if isl is not None and not any(isl.distance(o) < 0.5 * h for o in holes):
+            holes.append(isl)
     return _clean(Polygon(outer.exterior, [g.exterior for g in holes]))

@@ -340,26 +340,37 @@ def small_islands(
             mid = bow * (xs / length) ** 2
             pts = np.vstack([np.column_stack([xs, mid + half]), np.column_stack([xs[::-1], (mid - half)[::-1]])[1:]])
             isl = Point(0, 0).buffer(0.5 * w, quad_segs=4).union(Polygon(pts))
-        isl = affinity.rotate(isl, rng.uniform(0, 360), origin=(0, 0))
-        where = rng.uniform()
-        gap = h * rng.uniform(0.3, 3.0)
-        if where < 1 / 3:  # near the shore
-            p = np.asarray(outer.exterior.interpolate(rng.uniform(0, outer.exterior.length)).coords[0])
-            c = p * (1.0 - (gap + 2.0 * w) / max(np.hypot(*p), 1e-9))
-        elif where < 2 / 3 and holes:  # near the island before
-            prev = holes[-1]
-            a = rng.uniform(0, 2 * math.pi)
-            d = np.array([math.cos(a), math.sin(a)])
-            c = np.asarray(prev.centroid.coords[0]) + d * (math.sqrt(prev.area) + gap + w)
-        else:
-            c = rng.uniform(-radius, radius, 2)
-        isl = affinity.translate(isl, *c)
-        if not isl.is_valid or not body.contains(isl):
-            continue
-        if any(isl.distance(o) < 0.3 * h for o in holes):
-            continue
-        holes.append(isl)
+        isl = _placed(rng, isl, outer, body, holes, radius, h=h, gaps=(0.3, 3.0), shore=2.0 * w, near=(1.0, w))
+        if isl is not None and not any(isl.distance(o) < 0.3 * h for o in holes):
+            holes.append(isl)
     return _clean(Polygon(outer.exterior, [g.exterior for g in holes]))
+
+
+def _placed(
+    rng, isl, outer, body, holes, radius: float, *, h: float, gaps, shore: float, near, any_before: bool = False
+):
+    """The island shape ``isl`` (centred on the origin) turned at random and put, a third of the
+    time each, near the shore (its centre ``gap + shore`` in from a shore point), near an island
+    placed before (``near[0] · sqrt(area) + gap + near[1]`` from its centre: the last one, or
+    any with ``any_before``) or anywhere within ``radius``; ``gap`` uniform in ``gaps`` cells of ``h``.  None
+    when it does not lie inside ``body`` (the water away from the shore)."""
+    from shapely import affinity
+
+    isl = affinity.rotate(isl, rng.uniform(0, 360), origin=(0, 0))
+    where = rng.uniform()
+    gap = h * rng.uniform(*gaps)
+    if where < 1 / 3:  # near the shore
+        p = np.asarray(outer.exterior.interpolate(rng.uniform(0, outer.exterior.length)).coords[0])
+        c = p * (1.0 - (gap + shore) / max(np.hypot(*p), 1e-9))
+    elif where < 2 / 3 and holes:  # near an island placed before
+        prev = holes[int(rng.integers(0, len(holes)))] if any_before else holes[-1]
+        a = rng.uniform(0, 2 * math.pi)
+        d = np.array([math.cos(a), math.sin(a)])
+        c = np.asarray(prev.centroid.coords[0]) + d * (near[0] * math.sqrt(prev.area) + gap + near[1])
+    else:
+        c = rng.uniform(-radius, radius, 2)
+    isl = affinity.translate(isl, *c)
+    return isl if isl.is_valid and body.contains(isl) else None
 
 
 def headlands(seed: int, *, radius: float = 10.0, n: int = 8, islands: int = 3):

@@ -165,14 +165,19 @@ def test_the_orthogonal_share_is_the_quality_modules_share(limit):
     assert share == pytest.approx(lake_metrics(g).share("cos", limit), abs=1e-12)
 
 
-def test_stall_stops_the_sweeps_once_orthogonality_stops_improving():
+def _jittered_strip():
+    """A 32 × 8 strip whose interior nodes are jittered by 2 % of a cell (borders straight)."""
     rng = np.random.default_rng(3)
     xi, eta = np.meshgrid(np.linspace(0, 4, 33), np.linspace(0, 1, 9), indexing="ij")
     x = xi + 0.02 * rng.standard_normal(xi.shape)
     y = eta + 0.02 * rng.standard_normal(xi.shape)
     x[:, [0, -1]], y[:, [0, -1]] = xi[:, [0, -1]], eta[:, [0, -1]]
     x[[0, -1]], y[[0, -1]] = xi[[0, -1]], eta[[0, -1]]
-    topo, g = _one_block(x, y)
+    return _one_block(x, y)
+
+
+def test_stall_stops_the_sweeps_once_orthogonality_stops_improving():
+    topo, g = _jittered_strip()
     opts = {"max_sweeps": 400, "tol": 0.0, "smooth": 0.0, "size_ratio": None}
     full = orthogonalize(topo, [g], [], **opts)
     assert full.sweeps == 400 and not full.converged
@@ -189,13 +194,7 @@ def test_stall_waits_while_any_watched_share_still_rises():
     alone, not while another watched share (``|cos| ≤ 0.02``) still rises: the finest level of a
     lake grid whose 0.02 share stood still over its first 20 sweeps while its 3° share rose
     stopped there (``docs/lake-grids.md``, *Lakes with many islands*)."""
-    rng = np.random.default_rng(3)
-    xi, eta = np.meshgrid(np.linspace(0, 4, 33), np.linspace(0, 1, 9), indexing="ij")
-    x = xi + 0.02 * rng.standard_normal(xi.shape)
-    y = eta + 0.02 * rng.standard_normal(xi.shape)
-    x[:, [0, -1]], y[:, [0, -1]] = xi[:, [0, -1]], eta[:, [0, -1]]
-    x[[0, -1]], y[[0, -1]] = xi[[0, -1]], eta[[0, -1]]
-    topo, g = _one_block(x, y)
+    topo, g = _jittered_strip()
     opts = {"max_sweeps": 400, "tol": 0.0, "smooth": 0.0, "size_ratio": None, "stall": 0.001, "stall_every": 10}
     assert orthogonalize(topo, [g], [], stall_limits=(0.0,), **opts).sweeps == 10
     assert orthogonalize(topo, [g], [], stall_limits=(0.0, 0.02), **opts).sweeps > 10
