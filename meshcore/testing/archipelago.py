@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from ._shapes import _clean, _lobed_disc, _placed
+
 
 def archipelago(
     seed: int,
@@ -25,8 +27,6 @@ def archipelago(
     """
     from shapely import affinity
     from shapely.geometry import Polygon
-
-    from .testing import _clean, _lobed_disc, _placed
 
     rng = np.random.default_rng(seed)
     outer = _lobed_disc(rng, radius, 240, range(2, 5), 0.15)
