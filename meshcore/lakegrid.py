@@ -113,6 +113,7 @@ def iterate_layout(
     size_ratio: tuple[float, float] | None = (1.15, 2.0),
     hold_ends: bool = False,
     slide_ends: bool = False,
+    equalize: bool = False,
     every: int | None = 25,
     level_callback: Callable[[str, Any], Any] | None = None,
     stop_event: Any = None,
@@ -131,6 +132,9 @@ def iterate_layout(
     (:func:`~meshcore.orthogonal.untangle.untangle` given the shore rings; off by default: on fresh
     generated lakes it removed the one folded cell of ``rough net`` 158200 and 263202 but gave
     ``dendritic(911700)`` 2 and left 263202's shore 0.98 cells off, 0.35 before).
+    ``equalize``: after the finest level, the nodes round every interface pair above 2 moved to
+    make its two cells alike within bounds on what that may cost elsewhere
+    (:func:`~meshcore.orthogonal.equalize.equalize_interfaces`; off by default, see there).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped").  Returns
@@ -159,6 +163,7 @@ def iterate_layout(
     fitted = 0
     history: list[tuple[int, float]] = []
     stopped = False
+    equalized = 0
     for lev, tp in enumerate(tops):
         if lev:
             grids = refine_shore(refine(grids), tp, rings)
@@ -209,6 +214,10 @@ def iterate_layout(
         # a fold the coarse level could not resolve (a block corner beside a sharp bend of the
         # shore is non-convex at 2**levels cells but not on the finest level): repaired there
         grids, fine_repaired = _repair_folds(grids)
+        if equalize:
+            from .orthogonal.equalize import equalize_interfaces
+
+            grids, equalized = equalize_interfaces(tp, grids, rings)
     elapsed = time.perf_counter() - t0
     if stopped:
         msg = "stopped"
@@ -222,6 +231,8 @@ def iterate_layout(
             msg += f"; {untangled} node(s) moved across cut lines to make their cells convex"
         if fine_repaired:
             msg += f"; {fine_repaired} block(s) repaired by the fold-free method on the finest level"
+        if equalized:
+            msg += f"; {equalized} patch(es) round interface pairs above 2 made alike"
     info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology

@@ -1,0 +1,374 @@
+r"""A last local step, off by default: cells across an interface made alike where the
+orthogonal solve left them far apart.
+
+The worst cross-interface pairs of a lake grid are single cells beside a cut's end at a reflex
+shore corner, mostly where the block that has its corner there opens to 150–180° (a polar fan
+whose cells shrink into the corner) and the block whose side passes keeps its cells
+(``docs/lake-grids.md``, *Cell-size jumps across interfaces*).  :func:`equalize_interfaces` takes
+each pair above ``limit``, worst first, and moves the nodes within ``depth - 1`` grid edges of its
+two cells — block-interior and interface nodes (with ``SLIDE`` shore nodes too, along the
+shore); cut ends, block corners and nodes where 3 or 5 blocks meet stay — to minimize (BFGS,
+exact gradient)
+
+    Σ_pairs relu(|log A₁/A₂| − log AIM)²  +  penalties,
+
+the penalties keeping every block-interior node's ``|cos|`` within what it had or within the
+report's limits (3°, ``|cos| ≤ 0.02``), every cell corner's deviation within ``CORNER_ADD``
+degrees more than it had (the border nodes the report does not measure: with no bound there the
+optimum kinks the cut and squeezes slivers beside it), consecutive edge ratios along grid lines
+(``W_EDGE``), every corner Jacobian above half of its own, and the moves small.  A patch is kept
+only when its worst pair is lower and inside it no node within 3° or ``|cos| ≤ 0.02`` is lost,
+no interface pair ≤ 2, at most ``EDGE_LOSS`` edge pairs ≤ 1.2, and no corner Jacobian is ≤ 0;
+else half the step, a quarter, or nothing.  Measured in ``docs/lake-grids.md`` (session 17).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .driver import _assemble
+from .shore import arc_lengths, project_to_rings, ring_point
+
+__all__ = ["equalize_interfaces"]
+
+LIMIT = 2.0  # pairs above this are worked on (issue 12's target)
+AIM = 1.8  # the objective pays beyond this
+DEPTH = 3  # free nodes: within DEPTH - 1 grid edges of the pair's cells
+MAX_PATCHES = 24
+COS3 = float(np.sin(np.radians(3.0)))  # the quality report's deviation is arcsin |cos|
+COS_D3D = 0.02
+EDGE = 1.2
+W_COS, W_EDGE, W_JAC = 1e4, 3.0, 10.0
+CORNER_ADD = 5.0
+METHOD = "BFGS"
+SLIDE = False  # shore nodes slide too (on 4 nets: the same ratios within 0.2, shore 0.20 -> 0.26 cells)
+EDGE_LOSS = 10  # edge pairs <= 1.2 a patch may lose
+
+
+class _Tables:
+    """Every cell, node-cos stencil and edge-pair triple of the grid, in global node ids."""
+
+    def __init__(self, topology, grids) -> None:
+        m = topology.node_map
+        cells, cblock, cos5, tri = [], [], [], []
+        self.start = [0]
+        sign = []
+        for b, ids in enumerate(m.ids):
+            n1, m1 = ids.shape
+            c = np.stack([ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]], -1).reshape(-1, 4)
+            cells.append(c)
+            cblock.append(np.full(len(c), b))
+            self.start.append(self.start[-1] + len(c))
+            x, y = np.asarray(grids[b].x), np.asarray(grids[b].y)
+            area = 0.5 * (
+                (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1])
+                - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
+            )
+            sign.append(np.full(len(c), -1.0 if area.sum() < 0 else 1.0))
+            if n1 >= 3 and m1 >= 3:
+                cos5.append(
+                    np.stack(
+                        [ids[1:-1, 1:-1], ids[2:, 1:-1], ids[:-2, 1:-1], ids[1:-1, 2:], ids[1:-1, :-2]], -1
+                    ).reshape(-1, 5)
+                )
+            if n1 >= 3:
+                tri.append(np.stack([ids[:-2, :], ids[1:-1, :], ids[2:, :]], -1).reshape(-1, 3))
+            if m1 >= 3:
+                tri.append(np.stack([ids[:, :-2], ids[:, 1:-1], ids[:, 2:]], -1).reshape(-1, 3))
+        self.cells = np.vstack(cells).astype(np.int64)
+        self.cblock = np.concatenate(cblock)
+        self.sign = np.concatenate(sign)
+        self.cos5 = np.vstack(cos5).astype(np.int64) if cos5 else np.zeros((0, 5), np.int64)
+        self.tri = np.vstack(tri).astype(np.int64) if tri else np.zeros((0, 3), np.int64)
+        self.nj = np.array([ids.shape[1] - 1 for ids in m.ids])
+        cnt = np.bincount(self.cells.ravel(), minlength=m.n_nodes)
+        self.cnt = cnt
+        star = np.zeros(m.n_nodes, bool)
+        for c in m.corners:
+            star[c.node] = True
+        self.shore = m.boundary & (cnt == 2)
+        self.movable = (~m.boundary & ~star & (cnt == 4)) | (self.shore if SLIDE else False)
+        e = np.concatenate([self.cells[:, [0, 1]], self.cells[:, [1, 2]], self.cells[:, [2, 3]], self.cells[:, [3, 0]]])
+        from scipy.sparse import coo_matrix
+
+        n = m.n_nodes
+        A = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
+        self.adj = ((A + A.T) > 0).astype(np.int8)
+
+    def row(self, cell) -> int:
+        b, i, j = (int(v) for v in cell)
+        return self.start[b] + i * self.nj[b] + j
+
+
+def _areas(P: np.ndarray, C: np.ndarray) -> np.ndarray:
+    p0, p1, p2, p3 = P[C[:, 0]], P[C[:, 1]], P[C[:, 2]], P[C[:, 3]]
+    d1, d2 = p2 - p0, p3 - p1
+    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def _jacobians(P: np.ndarray, C: np.ndarray) -> np.ndarray:
+    Q = P[C]  # (n, 4, 2)
+    a = np.roll(Q, -1, axis=1) - Q
+    b = np.roll(Q, 1, axis=1) - Q
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _cos(P: np.ndarray, S: np.ndarray) -> np.ndarray:
+    a = P[S[:, 1]] - P[S[:, 2]]
+    b = P[S[:, 3]] - P[S[:, 4]]
+    nrm = np.hypot(*a.T) * np.hypot(*b.T)
+    return np.abs((a * b).sum(1)) / np.maximum(nrm, 1e-300)
+
+
+def _edge_logs(P: np.ndarray, T: np.ndarray) -> np.ndarray:
+    l1 = np.hypot(*(P[T[:, 1]] - P[T[:, 0]]).T)
+    l2 = np.hypot(*(P[T[:, 2]] - P[T[:, 1]]).T)
+    return np.abs(np.log(np.maximum(l1, 1e-300) / np.maximum(l2, 1e-300)))
+
+
+def _area_grad(P: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Signed areas of quads ``C`` and their gradients ``(n, 4, 2)`` in the 4 corners."""
+    d1 = P[C[:, 2]] - P[C[:, 0]]
+    d2 = P[C[:, 3]] - P[C[:, 1]]
+    A = 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    g2 = 0.5 * np.column_stack([d2[:, 1], -d2[:, 0]])
+    g3 = 0.5 * np.column_stack([-d1[:, 1], d1[:, 0]])
+    return A, np.stack([-g2, -g3, g2, g3], axis=1)
+
+
+def _jacobians_grad(P: np.ndarray, C: np.ndarray):
+    """Corner cross products ``(n, 4)`` and their gradients in the next and the previous corner."""
+    Q = P[C]
+    a = np.roll(Q, -1, axis=1) - Q
+    b = np.roll(Q, 1, axis=1) - Q
+    J = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    dJa = np.stack([b[..., 1], -b[..., 0]], -1)
+    dJb = np.stack([-a[..., 1], a[..., 0]], -1)
+    return J, dJa, dJb
+
+
+def _cos_grad(P: np.ndarray, S: np.ndarray):
+    """``|cos|`` at 5-node stencils and its gradient in the two central differences."""
+    a = P[S[:, 1]] - P[S[:, 2]]
+    b = P[S[:, 3]] - P[S[:, 4]]
+    na, nb = np.hypot(*a.T), np.hypot(*b.T)
+    d = (a * b).sum(1)
+    nn = np.maximum(na * nb, 1e-300)
+    c = np.abs(d) / nn
+    sd = np.sign(d)[:, None]
+    dca = sd * b / nn[:, None] - (c / np.maximum(na, 1e-300) ** 2)[:, None] * a
+    dcb = sd * a / nn[:, None] - (c / np.maximum(nb, 1e-300) ** 2)[:, None] * b
+    return c, dca, dcb
+
+
+def _edge_grad(P: np.ndarray, T: np.ndarray):
+    """``|log l1/l2|`` of consecutive edges and its gradient in the 3 nodes."""
+    v1 = P[T[:, 1]] - P[T[:, 0]]
+    v2 = P[T[:, 2]] - P[T[:, 1]]
+    q1 = np.maximum((v1 * v1).sum(1), 1e-300)
+    q2 = np.maximum((v2 * v2).sum(1), 1e-300)
+    u = 0.5 * (np.log(q1) - np.log(q2))
+    sg = np.sign(u)[:, None]
+    g1 = v1 / q1[:, None]
+    g2 = v2 / q2[:, None]
+    return np.abs(u), -sg * g1, sg * (g1 + g2), -sg * g2
+
+
+class _Patch:
+    """The free nodes round one pair, the stencils they touch, and the objective."""
+
+    def __init__(self, t: _Tables, P0: np.ndarray, seeds: np.ndarray, depth: int, pairs: np.ndarray, shore) -> None:
+        n = len(P0)
+        reach = np.zeros(n, bool)
+        reach[seeds] = True
+        for _ in range(depth - 1):
+            reach = reach | (t.adj @ reach.astype(np.int8) > 0)
+        free = np.flatnonzero(reach & t.movable)
+        isfree = np.zeros(n, bool)
+        isfree[free] = True
+        self.crow = np.flatnonzero(isfree[t.cells].any(1))
+        self.cos = t.cos5[isfree[t.cos5].any(1)]
+        self.tri = t.tri[isfree[t.tri].any(1)]
+        inpatch = np.zeros(len(t.cells), bool)
+        inpatch[self.crow] = True
+        self.pairs = pairs[inpatch[pairs[:, 0]] | inpatch[pairs[:, 1]]]
+        self.free = free
+        self.slide = free[t.shore[free]]
+        self.fly = free[~t.shore[free]]
+        self.P0 = P0
+        self.t = t
+        rings, cums = shore
+        self.rings, self.cums = rings, cums
+        if len(self.slide):
+            r, s, _ = project_to_rings(rings, P0[self.slide])
+            self.ring_of, self.s0 = r.astype(int), s
+        else:
+            self.ring_of, self.s0 = np.zeros(0, int), np.zeros(0)
+        C = t.cells[self.crow]
+        sg = t.sign[self.crow]
+        self.C, self.sg = C, sg
+        self.J0 = sg[:, None] * _jacobians(P0, C)
+        a0 = np.abs(_areas(P0, C))
+        # node scale: the square root of the mean area of the patch's cells
+        self.h = float(np.sqrt(np.mean(a0)))
+        self.n_node_cos = len(self.cos)
+        # every corner of every cell of the patch too (a border node's angles, which the node
+        # measure leaves out: without them the optimum kinks a cut and leaves slivers beside it)
+        corners = np.stack([C, np.roll(C, -1, axis=1), C, np.roll(C, 1, axis=1), C], -1).reshape(-1, 5)
+        self.cos = np.vstack([self.cos, corners])
+        self.c0 = _cos(P0, self.cos)
+        self.e0 = _edge_logs(P0, self.tri)
+        self.r0 = self.ratios(P0)
+        allowed = np.where(self.c0 <= COS_D3D, 0.9 * COS_D3D, np.where(self.c0 <= COS3, 0.9 * COS3, self.c0))
+        allowed = np.maximum(allowed, self.c0)
+        # a cell corner (not a node the quality report measures) may turn by up to CORNER_ADD degrees
+        dev0 = np.degrees(np.arcsin(np.clip(self.c0[self.n_node_cos :], 0.0, 1.0)))
+        allowed[self.n_node_cos :] = np.maximum(
+            allowed[self.n_node_cos :], np.sin(np.radians(np.minimum(dev0 + CORNER_ADD, 90.0)))
+        )
+        self.c_allowed = allowed
+        self.e_allowed = np.maximum(self.e0, np.log(EDGE) * 0.95)
+
+    def positions(self, z: np.ndarray) -> np.ndarray:
+        P = self.P0.copy()
+        k = 2 * len(self.fly)
+        P[self.fly] += self.h * z[:k].reshape(-1, 2)
+        for r in np.unique(self.ring_of):
+            sel = self.ring_of == r
+            P[self.slide[sel]] = ring_point(self.rings[r], self.s0[sel] + self.h * z[k:][sel], self.cums[r])
+        return P
+
+    def ratios(self, P: np.ndarray) -> np.ndarray:
+        a = np.abs(_areas(P, self.t.cells[self.pairs[:, 0]]))
+        b = np.abs(_areas(P, self.t.cells[self.pairs[:, 1]]))
+        return np.abs(np.log(np.maximum(a, 1e-300) / np.maximum(b, 1e-300)))
+
+    def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
+        """The objective and its gradient in ``z``."""
+        P = self.positions(z)
+        G = np.zeros_like(P)
+        C, sg = self.C, self.sg
+        J, dJa, dJb = _jacobians_grad(P, C)
+        J = sg[:, None] * J
+        if (J <= 0).any():
+            return 1e6, np.zeros_like(z)
+        # cross-interface ratios
+        T = self.t.cells
+        Ca, Cb = T[self.pairs[:, 0]], T[self.pairs[:, 1]]
+        Aa, ga = _area_grad(P, Ca)
+        Ab, gb = _area_grad(P, Cb)
+        u = np.log(np.abs(Aa)) - np.log(np.abs(Ab))
+        ex = np.maximum(np.abs(u) - np.log(AIM), 0.0)
+        f = float(np.sum(ex**2))
+        w = 2 * ex * np.sign(u)
+        np.add.at(G, Ca, (w / Aa)[:, None, None] * ga)
+        np.add.at(G, Cb, -(w / Ab)[:, None, None] * gb)
+        # orthogonality at block-interior nodes
+        c, dca, dcb = _cos_grad(P, self.cos)
+        ex = np.maximum(c - self.c_allowed, 0.0)
+        f += W_COS * float(np.sum(ex**2))
+        w = (2 * W_COS * ex)[:, None]
+        S = self.cos
+        np.add.at(G, S[:, 1], w * dca)
+        np.add.at(G, S[:, 2], -w * dca)
+        np.add.at(G, S[:, 3], w * dcb)
+        np.add.at(G, S[:, 4], -w * dcb)
+        # consecutive edges along grid lines
+        e, d0, d1, d2 = _edge_grad(P, self.tri)
+        ex = np.maximum(e - self.e_allowed, 0.0)
+        f += W_EDGE * float(np.sum(ex**2))
+        w = (2 * W_EDGE * ex)[:, None]
+        for k, d in enumerate((d0, d1, d2)):
+            np.add.at(G, self.tri[:, k], w * d)
+        # corner Jacobians kept above half of theirs
+        ex = np.maximum(0.5 - J / self.J0, 0.0)
+        f += W_JAC * float(np.sum(ex**2))
+        w = -2 * W_JAC * ex / self.J0 * sg[:, None]  # d/dJ_raw
+        Cn, Cp = np.roll(C, -1, axis=1), np.roll(C, 1, axis=1)
+        np.add.at(G, Cn, w[..., None] * dJa)
+        np.add.at(G, Cp, w[..., None] * dJb)
+        np.add.at(G, C, -w[..., None] * (dJa + dJb))
+        gz = self.chain(G, z)
+        return f + 1e-3 * float(z @ z), gz + 2e-3 * z
+
+    def chain(self, G: np.ndarray, z: np.ndarray) -> np.ndarray:
+        k = 2 * len(self.fly)
+        out = np.empty_like(z)
+        out[:k] = self.h * G[self.fly].ravel()
+        if len(self.slide):
+            eps = 1e-6 * self.h
+            tang = np.zeros((len(self.slide), 2))
+            for r in np.unique(self.ring_of):
+                sel = self.ring_of == r
+                s = self.s0[sel] + self.h * z[k:][sel]
+                p1 = ring_point(self.rings[r], s + eps, self.cums[r])
+                p0 = ring_point(self.rings[r], s - eps, self.cums[r])
+                tang[sel] = (p1 - p0) / (2 * eps)
+            out[k:] = self.h * (G[self.slide] * tang).sum(1)
+        return out
+
+    def counts(self, P: np.ndarray) -> tuple:
+        c = _cos(P, self.cos[: self.n_node_cos])
+        e = _edge_logs(P, self.tri)
+        r = self.ratios(P)
+        J = self.sg[:, None] * _jacobians(P, self.C)
+        return (
+            int((c <= COS3).sum()),
+            int((c <= COS_D3D).sum()),
+            int((e <= np.log(EDGE)).sum()),
+            int((r <= np.log(LIMIT)).sum()),
+            bool((J > 0).all()),
+        )
+
+
+def equalize_interfaces(
+    topology, grids, rings, *, limit: float = LIMIT, depth: int = DEPTH, max_patches: int = MAX_PATCHES
+) -> tuple[list, int]:
+    """``(grids, patches)``: the grids with the nodes round every interface pair above ``limit``
+    moved to make the two cells alike (see the module docstring), and how many patches were kept."""
+    from scipy.optimize import minimize
+
+    from ..quality.interfaces import interface_pairs
+
+    pr = interface_pairs(grids)
+    if not len(pr["ratio"]) or float(pr["ratio"].max()) <= limit:
+        return list(grids), 0
+    m = topology.node_map
+    t = _Tables(topology, grids)
+    X, Y = _assemble(grids, m)
+    P = np.column_stack([X, Y])
+    pairs = np.array([[t.row(a), t.row(b)] for a, b in zip(pr["cell_a"], pr["cell_b"], strict=True)], np.int64)
+    shore = (list(rings), [arc_lengths(r) for r in rings])
+    tried: set[int] = set()
+    kept = 0
+    for _ in range(max_patches):
+        r = np.abs(np.log(np.abs(_areas(P, t.cells[pairs[:, 0]])) / np.abs(_areas(P, t.cells[pairs[:, 1]]))))
+        order = [q for q in np.argsort(-r) if r[q] > np.log(limit) and int(q) not in tried]
+        if not order:
+            break
+        q = int(order[0])
+        tried.add(q)
+        seeds = np.unique(t.cells[pairs[q]].ravel())
+        patch = _Patch(t, P, seeds, depth, pairs, shore)
+        nz = 2 * len(patch.fly) + len(patch.slide)
+        if not nz:
+            continue
+        res = minimize(patch.objective, np.zeros(nz), jac=True, method=METHOD, options={"maxiter": 300})
+        before = patch.counts(P)
+        for alpha in (1.0, 0.5, 0.25):
+            Pn = patch.positions(alpha * res.x)
+            after = patch.counts(Pn)
+            better = patch.ratios(Pn).max() < patch.r0.max() - 1e-9
+            ok = (
+                after[0] >= before[0]
+                and after[1] >= before[1]
+                and after[2] >= before[2] - EDGE_LOSS
+                and after[3] >= before[3]
+            )
+            if better and after[4] and ok:
+                P = Pn
+                kept += 1
+                break
+    if not kept:
+        return list(grids), 0
+    return [g.replaced(x=P[ids, 0], y=P[ids, 1]) for g, ids in zip(grids, m.ids, strict=True)], kept

@@ -1,0 +1,71 @@
+"""The local step after the orthogonal solve that makes cells across interfaces alike
+(meshcore.orthogonal.equalize, ``mesh_outline(..., equalize=True)``; off by default): a grid
+with no pair above the limit comes back untouched; where it works it lowers the worst pair and
+loses none of the counted targets, moves shore nodes only along the shore and leaves cut ends,
+block corners and star nodes where they were."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from meshcore import testing
+from meshcore.lakegrid import _shore_rings, mesh_layout
+from meshcore.layout import auto_layout
+from meshcore.orthogonal.driver import _assemble
+from meshcore.orthogonal.equalize import COS3, equalize_interfaces
+from meshcore.orthogonal.shore import project_to_rings
+from meshcore.quality import lake_metrics
+from meshcore.quality.interfaces import interface_pairs
+
+
+@pytest.fixture(scope="module")
+def solved():
+    lay = auto_layout(testing.channel_network(7, n_branches=4), target_cells=2000, multiple=4)
+    mb = mesh_layout(lay)
+    return mb, _shore_rings(lay.polygon, lay.cell_size / 4)
+
+
+def test_a_grid_within_the_limit_is_returned_untouched(solved):
+    mb, rings = solved
+    worst = float(interface_pairs(mb.grids)["ratio"].max())
+    grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=worst + 0.01)
+    assert kept == 0
+    assert all(a is b for a, b in zip(grids, mb.grids, strict=True))
+
+
+def test_the_worst_pair_is_lowered_and_no_counted_target_is_lost(solved):
+    mb, rings = solved
+    pr0 = interface_pairs(mb.grids)
+    limit = 1.1  # below this grid's worst pair, so that the step has pairs to work on
+    assert pr0["ratio"].max() > limit
+    grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=limit, max_patches=6)
+    assert kept >= 1
+    pr1 = interface_pairs(grids)
+    assert pr1["ratio"].max() <= pr0["ratio"].max() + 1e-12
+    assert (pr1["ratio"] > limit).sum() <= (pr0["ratio"] > limit).sum()
+    s0, s1 = lake_metrics(mb).summary(), lake_metrics(grids).summary()
+    assert s1["folded_cells"] == 0
+    n0 = sum(int(np.sum(np.nan_to_num(_cos(g), nan=1.0) <= COS3)) for g in mb.grids)
+    n1 = sum(int(np.sum(np.nan_to_num(_cos(g), nan=1.0) <= COS3)) for g in grids)
+    assert n1 >= n0
+    assert s1["pct_nodes_within_3deg"] >= s0["pct_nodes_within_3deg"] - 1e-9
+    # shore nodes on the shore; nodes the step may not move where they were
+    m = mb.topology.node_map
+    X0, Y0 = _assemble(mb.grids, m)
+    X1, Y1 = _assemble(grids, m)
+    cnt = np.bincount(m.cells.ravel(), minlength=m.n_nodes)
+    moved = np.hypot(X1 - X0, Y1 - Y0) > 0
+    assert moved.any()
+    fixed = (m.boundary & (cnt != 2)) | np.isin(np.arange(m.n_nodes), [c.node for c in m.corners])
+    assert not moved[fixed].any()
+    shore = np.flatnonzero(m.boundary & moved)
+    if len(shore):
+        _, _, d = project_to_rings(rings, np.column_stack([X1[shore], Y1[shore]]))
+        assert d.max() < 1e-9
+
+
+def _cos(g) -> np.ndarray:
+    from meshcore.quality.lake import block_metrics
+
+    return block_metrics(g).cos
