@@ -113,7 +113,7 @@ def iterate_layout(
     size_ratio: tuple[float, float] | None = (1.15, 2.0),
     hold_ends: bool = False,
     slide_ends: bool = False,
-    equalize: bool = False,
+    equalize: bool = True,
     every: int | None = 25,
     level_callback: Callable[[str, Any], Any] | None = None,
     stop_event: Any = None,
@@ -134,7 +134,7 @@ def iterate_layout(
     ``dendritic(911700)`` 2 and left 263202's shore 0.98 cells off, 0.35 before).
     ``equalize``: after the finest level, the nodes round every interface pair above 2 moved to
     make its two cells alike within bounds on what that may cost elsewhere
-    (:func:`~meshcore.orthogonal.equalize.equalize_interfaces`; off by default, see there).
+    (:func:`~meshcore.orthogonal.equalize.equalize_interfaces`; on by default, ``equalize=False`` skips it).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped").  Returns

@@ -1,5 +1,5 @@
-r"""A last local step, off by default: cells across an interface made alike where the
-orthogonal solve left them far apart.
+r"""A last local step (on by default in :func:`~meshcore.lakegrid.mesh_layout`): cells across an
+interface made alike where the orthogonal solve left them far apart.
 
 The worst cross-interface pairs of a lake grid are single cells beside a cut's end at a reflex
 shore corner, mostly where the block that has its corner there opens to 150–180° (a polar fan

@@ -1,5 +1,5 @@
 """The local step after the orthogonal solve that makes cells across interfaces alike
-(meshcore.orthogonal.equalize, ``mesh_outline(..., equalize=True)``; off by default): a grid
+(meshcore.orthogonal.equalize, on by default in ``mesh_outline``): a grid
 with no pair above the limit comes back untouched; where it works it lowers the worst pair and
 loses none of the counted targets, moves shore nodes only along the shore and leaves cut ends,
 block corners and star nodes where they were."""
