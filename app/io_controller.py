@@ -193,7 +193,10 @@ class IOController(QtCore.QObject):
             self.win.error("Cannot import points", exc)
             return False
         pts = pd.points
-        frame = fio.project_frame(self.doc.project)
+        # a lake's project gets a new lake, in the file's own frame (the UTM zone of a lon/lat outline,
+        # none for metres); otherwise the points join the project in its frame (a background traced)
+        replace = self.doc.project.lake is not None
+        frame = None if replace else fio.project_frame(self.doc.project)
         if pd.lonlat and pd.pointset is not None:
             from meshcore.cli.lakefile import lonlat_order_note
 
@@ -235,7 +238,7 @@ class IOController(QtCore.QObject):
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
         block = block_from_points(pts, path.stem)
-        self._add_imported(block, frame, path.name, lake=lake)
+        self._add_imported(block, frame, path.name, lake=lake, replace=replace)
         self.remember_dir(path)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
         isl = f" and {len(lake.holes)} island(s)" if lake is not None and lake.holes else ""
@@ -269,11 +272,14 @@ class IOController(QtCore.QObject):
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
         return Lake(outline=outer, holes=tuple(islands))
 
-    def _add_imported(self, block: Block, frame, name: str, *, lake=None) -> None:
-        """Put an imported block into the first empty block (or add it), as one undo step."""
+    def _add_imported(self, block: Block, frame, name: str, *, lake=None, replace: bool = False) -> None:
+        """Put an imported block into the first empty block (or add it), as one undo step; with
+        ``replace`` (a project holding a lake) it replaces the lake, its layout, cuts and frame."""
         p = self.doc.project
-        if p.layout is not None:  # a new outline replaces the laid-out lake (undo brings it back)
-            p = p.replaced(blocks=(Block(name="block"),), lake=None)
+        if replace:  # a new outline replaces the lake, laid out or not (undo brings it back)
+            p = p.replaced(
+                blocks=(Block(name="block"),), lake=None, cut_lines=(), crs="", origin=(0.0, 0.0), source_crs=""
+            )
         empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
         if empty:
             k = empty[0]
