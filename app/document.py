@@ -88,7 +88,9 @@ class Document:
         self.project: Project = project or Project()
         self.grids: dict[int, StructuredGrid] = {}
         self.initial: dict[int, StructuredGrid] = {}
-        self.stale: bool = False
+        self.stale: bool = False  # the grids on screen are not of the project (an edit since their solve)
+        #: the project the final grids were made for: an undo back to it makes them current again
+        self.solved: Project | None = None
         self.selection: frozenset[int] = frozenset()
         self.active: int = 0
         self.path: Path | None = None
@@ -138,7 +140,7 @@ class Document:
         n = len(self.block.points)
         if any(i >= n for i in self.selection):
             self.set_selection(frozenset(i for i in self.selection if i < n))
-        self.stale = True
+        self.stale = not (self.grids and project is self.solved)
         self.project_changed.emit(project)
 
     def reset(self, project: Project, path: Path | None = None) -> None:
@@ -152,6 +154,7 @@ class Document:
         self.project = project
         self.path = Path(path) if path else None
         self.stale = True
+        self.solved = None
         self._update_quality()
         self.opened.emit()
         self.project_changed.emit(project)
@@ -165,19 +168,28 @@ class Document:
         self.grids[index] = grid
         if final:
             self.stale = False
+            self.solved = self.project
         self.grids_changed.emit()
 
     def set_grids(
-        self, grids: dict[int, StructuredGrid], initial: dict | None = None, *, multiblock=None, metrics=None
+        self,
+        grids: dict[int, StructuredGrid],
+        initial: dict | None = None,
+        *,
+        multiblock=None,
+        metrics=None,
+        project: Project | None = None,
     ) -> None:
         """The final grids of a solve (and, for a multiblock case, meshcore's MultiBlockGrid; for a lake,
-        its LakeMetrics if the worker measured them)."""
+        its LakeMetrics if the worker measured them) of ``project`` (default: the current one); of
+        another (an edit made while it solved) they stay marked as of before the edit."""
         self._given_metrics = (multiblock, metrics) if metrics is not None else None
         self.grids = dict(grids)
         if initial is not None:
             self.initial = dict(initial)
         self.multiblock = multiblock
-        self.stale = False
+        self.solved = project if project is not None else self.project
+        self.stale = self.solved is not self.project
         self._final = True
         self.grids_changed.emit()
         self._update_quality()
@@ -187,6 +199,7 @@ class Document:
         self.multiblock = multiblock
 
     def clear_grids(self) -> None:
+        self.solved = None
         self.grids = {}
         self.initial = {}
         self.multiblock = None

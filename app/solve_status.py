@@ -64,8 +64,12 @@ class SolveStatus(QtCore.QObject):
     def on_edited(self, _project) -> None:
         """An edit with auto-generate off: the grid on screen is the one of before it (a dragged
         junction's cut lines no longer on its block borders), so it is greyed and said to be, with
-        its verdict, until a solve makes the new one (F5)."""
-        if self.solver.auto or self.solver.running or not self.doc.grids or not self.doc.stale:
+        its verdict, until a solve makes the new one (F5).  An undo back to the project the grid was
+        made for makes it current again (no F5, and it exports)."""
+        if self.solver.auto or self.solver.running or not self.doc.grids:
+            return
+        if not self.doc.stale:
+            self.on_final()
             return
         self._show_previous(True)
         self.label.setText("grid of before the edit (F5 makes the new one)")
@@ -127,6 +131,8 @@ class SolveStatus(QtCore.QObject):
         if result is not None and self.doc.project.multiblock is not None:
             self.doc.set_multiblock(getattr(result, "multiblock", None))
         self.on_final()
+        if self.doc.stale:  # an edit came while it solved (auto-generate off): the grid of before it
+            self.on_edited(self.doc.project)
         if result is not None and not self.solver.last_error:
             self.report_notes()
 

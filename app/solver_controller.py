@@ -95,6 +95,7 @@ class SolverController(QtCore.QObject):
         self.last_result = None
         self.last_error: str | None = None
         self._restart_pending = False
+        self._project = None  # the project the running solve was started for
         self.gui_thread = QtCore.QThread.currentThread()
         self.thread_violations = 0  # slots found running outside the GUI thread (tests)
         # leading-edge throttle: draw a snapshot at once unless the last frame was
@@ -159,6 +160,7 @@ class SolverController(QtCore.QObject):
         self._algebraic = {}
         self._smoothed = set()  # blocks whose snapshots of this run are on screen
         self._drawn = False
+        self._project = project  # what this run solves (an edit may come before it ends)
         worker = create_worker(_run, self._run, project, warm, ev, self.smooth, hold, _start_thread=False)
         worker.yielded.connect(self._on_yielded)
         worker.returned.connect(self._on_returned)
@@ -391,7 +393,8 @@ class SolverController(QtCore.QObject):
         grids = {k: g for k, g in grids.items() if k in ready}
         mb = getattr(result, "multiblock", None)
         metrics = getattr(result, "metrics", None)
-        self.doc.set_grids(grids, {k: g for k, g in initial.items() if k in ready}, multiblock=mb, metrics=metrics)
+        initial = {k: g for k, g in initial.items() if k in ready}
+        self.doc.set_grids(grids, initial, multiblock=mb, metrics=metrics, project=self._project)
         self.last_result = result
         for w in result.warnings:  # what meshcore warned about (e.g. dropped duplicate points)
             self.doc.report("warning", w)

@@ -9,6 +9,7 @@ import pytest
 import shapely
 
 from meshcore import testing
+from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
@@ -68,3 +69,57 @@ def test_a_lake_in_metres_over_a_projected_one_has_no_crs(qtbot, win, tmp_path):
         shapely.affinity.scale(testing.lake_with_islands(761204), 300, 300, origin=(0, 0)).exterior.coords
     )
     assert np.abs(p.lake.outline).max() == pytest.approx(np.abs(ring).max(), abs=0.01)  # the file's own numbers
+
+
+def _laid_out(qtbot, win, tmp_path, seed: int):
+    """A generated lake in metres, laid out coarse (20 cells to the square root of its area) and gridded."""
+    assert win.io.import_points(_metres_lake(tmp_path / f"lake{seed}.csv", seed))
+    area = shapely.Polygon(win.doc.project.lake.outline, win.doc.project.lake.holes).area
+    win.lake_ctl.set_cell_size(np.sqrt(area) / 20)
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
+    assert win.lake_ctl.last_error is None
+    wait_idle(qtbot, win)
+    return win.doc.project
+
+
+def _drag_a_cut_end(qtbot, win):
+    from app.layout_edit import handles
+
+    lay0 = win.doc.project.layout
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    tool, h = win.canvas.tool, lay0.cell_size
+    path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, 1.0, 4)]
+    assert tool.drag("start", tuple(path[0]), end.xy)
+    for p in path[1:]:
+        tool.drag("move", tuple(p), end.xy)
+        qtbot.wait(30)
+    tool.drag("finish", tuple(path[-1]), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
+
+
+def test_undo_back_to_the_gridded_layout_makes_its_grid_current_again(qtbot, win, tmp_path):
+    """Drag a cut end (auto-generate off: the grid greyed, "of before the last edit"), then undo:
+    the layout is the one the grid was made for, yet the grid stayed greyed, its verdict marked
+    old, and Export refused it ("generate it (F5)") until a solve made the same grid again.  And
+    the other way: an edit (a redo) while F5 solves; the grid that arrives is of the layout before
+    it, but it was shown, and exported, as current."""
+    solved = _laid_out(qtbot, win, tmp_path, 761205)
+    grids = dict(win.doc.grids)
+    pen = lambda: win.canvas.grid_curve.opts["pen"].color().name()  # noqa: E731
+    _drag_a_cut_end(qtbot, win)
+    dragged = win.doc.project
+    assert pen() == "#b0b0b0" and "before the last edit" in win.lake_quality.headline.text()
+    win.stack.undo()
+    assert win.doc.project is solved and win.doc.grids == grids
+    assert not win.doc.stale and pen() == "#303030"
+    assert "before" not in win.lake_quality.headline.text() and "F5" not in win.solve_status.label.text()
+    assert win.io.export_mesh(tmp_path / "lake.vtm")
+    win.generate()  # F5 on the layout of before the drag ...
+    assert win.solver.running
+    win.stack.redo()  # ... and the drag again while it solves
+    assert win.doc.project is dragged
+    wait_idle(qtbot, win)
+    assert win.doc.stale and pen() == "#b0b0b0" and "before the last edit" in win.lake_quality.headline.text()
+    assert not win.io.export_mesh(tmp_path / "dragged.vtm")
