@@ -119,11 +119,14 @@ def main(argv: list[str] | None = None) -> int:
     win.message(f"Ready in {startup:.2f} s. " + win._status.text())
     if not args.screenshot and not args.file and not args.example:
         win.io.offer_recovery()
+    opened = True
     if args.example:
-        if not win.io.open_example(args.example, confirm=False):
-            return 2
-    elif args.file and not win.io.open_path(Path(args.file)):
+        opened = win.io.open_example(args.example, confirm=False)
+    elif args.file:
+        opened = win.io.open_path(Path(args.file))
+    if not opened and (args.solve or args.screenshot):
         return 2
+    # opened by hand (a double-clicked file): the window stays, the error in its message panel
     app.processEvents()
     win.canvas.fit()
     if args.solve:

@@ -123,3 +123,35 @@ def test_undo_back_to_the_gridded_layout_makes_its_grid_current_again(qtbot, win
     wait_idle(qtbot, win)
     assert win.doc.stale and pen() == "#b0b0b0" and "before the last edit" in win.lake_quality.headline.text()
     assert not win.io.export_mesh(tmp_path / "dragged.vtm")
+
+
+def test_a_file_that_fails_to_open_leaves_the_window_open(qtbot, tmp_path, monkeypatch):
+    """``gcmesh lake.geojson`` (a double-clicked file) whose file fails: the error dialog named the
+    place, and on its OK the window vanished (exit 2, as for ``--solve``/``--screenshot``)."""
+    from PySide6 import QtCore, QtWidgets
+
+    import app.__main__ as entry
+    import app.main_window as mw
+
+    bad = tmp_path / "lake.geojson"
+    bad.write_text('{"type": "FeatureCollection", "features": [')
+    made, said, ran = [], [], []
+    real = mw.MainWindow
+
+    def window(**kw):
+        settings = QtCore.QSettings(str(tmp_path / "settings.ini"), QtCore.QSettings.Format.IniFormat)
+        w = real(settings=settings, recovery=tmp_path / "recovery.gcmesh", **kw)
+        qtbot.addWidget(w)
+        made.append(w)
+        return w
+
+    monkeypatch.setattr(mw, "MainWindow", window)
+    monkeypatch.setattr(entry, "_logging", lambda: None)
+    monkeypatch.setattr(entry.sys, "excepthook", entry.sys.excepthook)
+    monkeypatch.setattr(QtWidgets.QMessageBox, "warning", lambda _w, title, text: said.append(text))
+    monkeypatch.setattr(QtWidgets.QApplication, "exec", lambda *_a: ran.append(True) or 0)
+    assert entry.main([str(bad)]) == 0
+    assert ran and made and made[0].isVisible()  # the event loop ran: the window is there to use
+    assert len(said) == 1 and str(bad) in said[0]
+    assert any(str(bad) in t for lv, t in made[0].messages_panel.messages() if lv == "error")
+    made[0].close()
