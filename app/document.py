@@ -45,6 +45,12 @@ METRICS = {
 DEVIATION_LEVELS = (0.0, 10.0)
 
 
+def _made_of(project: Project):
+    """What a project's grid is made of: a lake's grid of its layout alone (the lake's cell size and
+    *regular* are settings for the next Auto layout), every other grid of the whole project."""
+    return project.layout if project.layout is not None else project
+
+
 class Document:
     """Project + grids + selection, with change signals.
 
@@ -140,7 +146,7 @@ class Document:
         n = len(self.block.points)
         if any(i >= n for i in self.selection):
             self.set_selection(frozenset(i for i in self.selection if i < n))
-        self.stale = not (self.grids and project is self.solved)
+        self.stale = not (self.grids and self.solved is not None and _made_of(project) is _made_of(self.solved))
         self.project_changed.emit(project)
 
     def reset(self, project: Project, path: Path | None = None) -> None:
@@ -189,7 +195,7 @@ class Document:
             self.initial = dict(initial)
         self.multiblock = multiblock
         self.solved = project if project is not None else self.project
-        self.stale = self.solved is not self.project
+        self.stale = _made_of(self.solved) is not _made_of(self.project)
         self._final = True
         self.grids_changed.emit()
         self._update_quality()

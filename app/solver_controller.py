@@ -125,7 +125,7 @@ class SolverController(QtCore.QObject):
             self._debounce.start()
 
     def _on_project_changed(self, _project) -> None:
-        if self.auto:
+        if self.auto and self.doc.stale:  # not for an edit the grid is not made of (a lake's cell size)
             self._debounce.start()
 
     def start(self) -> bool:

@@ -7,6 +7,8 @@ whose settings are undoable commands.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
@@ -112,6 +114,9 @@ class LakePanel(QtWidgets.QWidget):
         n, k = len(lay.blocks), len(lay.notes)
         # what the layout changed in the water (an island left out, a shore smoothed): in full in Messages
         notes = f" — {k} note{'s' * (k != 1)} on the water (Messages)" if k else ""
+        h = lake.cell_size if lake is not None else None
+        if h is not None and not math.isclose(h, lay.cell_size, rel_tol=1e-6):  # set since: not applied yet
+            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m"
         self.summary.setText(f"{n} block{'s' * (n != 1)}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m{notes}")
         self.summary.setToolTip("\n\n".join(lay.notes))
         self.table.setRowCount(n)

@@ -155,3 +155,30 @@ def test_a_file_that_fails_to_open_leaves_the_window_open(qtbot, tmp_path, monke
     assert len(said) == 1 and str(bad) in said[0]
     assert any(str(bad) in t for lv, t in made[0].messages_panel.messages() if lv == "error")
     made[0].close()
+
+
+def test_a_new_cell_size_is_for_auto_layout_and_leaves_the_grid_current(qtbot, win, tmp_path):
+    """Cell size 2 h typed in the Lake panel: the grid went grey, "grid of before the last edit (F5
+    makes the new one)", yet F5 solved the same layout again (the same cells at h): the cell size
+    is applied by Auto layout.  With auto-generate on, every change of it re-solved the same grid."""
+    _laid_out(qtbot, win, tmp_path, 761207)
+    lay, grids = win.doc.project.layout, dict(win.doc.grids)
+    h = lay.cell_size
+    win.lake_panel.cell_size.setValue(2 * h)
+    win.lake_panel.cell_size.editingFinished.emit()
+    h2 = win.lake_panel.cell_size.value()  # as the spin box rounds it
+    assert h2 == pytest.approx(2 * h, abs=0.1)
+    assert win.doc.project.lake.cell_size == h2 and win.doc.project.layout is lay
+    assert not win.doc.stale and win.canvas.grid_curve.opts["pen"].color().name() == "#303030"
+    assert "before" not in win.lake_quality.headline.text() and "F5" not in win.solve_status.label.text()
+    assert "Auto layout" in win.lake_panel.summary.text()  # where the new cell size goes
+    assert win.io.export_mesh(tmp_path / "lake.vtm")
+    win.solver.set_auto(True)
+    win.lake_panel.regular.setChecked(True)  # also a setting of the next Auto layout
+    assert not win.solver.running and not win.solver._debounce.isActive()
+    assert win.doc.grids == grids
+    win.a_auto_layout.trigger()  # the cell size applied
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout.cell_size == h2
+    assert "Auto layout" not in win.lake_panel.summary.text()
