@@ -16,7 +16,8 @@ blocks that meet there move together); it keeps the cell counts (so the grid re-
 the previous one), and the new layout is made by :func:`moved_layout` (one
 :func:`meshcore.multiblock.from_outline` for the layout and its topology, whose checks name the
 block or cut that cannot be four-sided); a move that would change the blocks (a cut dragged
-across another) is refused.
+across another) is refused.  :func:`without_cut` removes a cut line: the two blocks it parted
+become one.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ __all__ = [
     "place",
     "settled_layout",
     "shore_points",
+    "without_cut",
 ]
 
 #: the order in which coinciding handles are picked
@@ -376,3 +378,24 @@ def settled_layout(base: Any, parts: dict, steps: DragSteps | None = None) -> An
         if steps is None or steps.good is None or not steps.kept:
             raise
         raise MoveRefused(str(exc), moved_layout(base, steps.good)) from exc
+
+
+def without_cut(layout: Any, k: int) -> Any:
+    """``layout`` without its cut line ``k``: the blocks it parted are one block, cornered where it
+    turns (:func:`meshcore.layout.edit.layout_from_cuts`); every other block keeps its corners, and
+    the cells follow from the layout's cell size."""
+    from shapely.geometry import LineString, Polygon
+
+    from meshcore.layout.edit import layout_from_cuts
+
+    mid = LineString(np.asarray(layout.cuts[k], float)).interpolate(0.5, normalized=True)
+    tol = 1e-6 * layout.cell_size
+    corners = {}
+    for piece in layout.pieces:
+        ring = Polygon(piece.ring)
+        if ring.boundary.distance(mid) <= tol:  # a block the cut bounds: it joins its neighbour
+            continue
+        q = ring.representative_point()
+        corners[(q.x, q.y)] = [piece.ring[i] for i in piece.corners]
+    cuts = [c for j, c in enumerate(layout.cuts) if j != k]
+    return layout_from_cuts(layout.polygon, cuts, cell_size=layout.cell_size, multiple=layout.multiple, corners=corners)

@@ -284,6 +284,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # -------------------------------------------------------------- edits
     def delete_selection(self) -> None:
+        if self.canvas.tool is not None and self.canvas.tool.delete():  # a cut line, with the Layout tool
+            return
         self.editor.delete_points(self.doc.selection)
 
     def select_all(self) -> None:

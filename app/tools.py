@@ -64,6 +64,10 @@ class Tool:
     def key(self, key: int) -> bool:
         return False
 
+    def delete(self) -> bool:
+        """Del (Edit ▸ Delete): True when the tool deleted what it points at (else the selected points go)."""
+        return False
+
     @property
     def dragging(self) -> bool:
         """True while a drag of this tool edits the project (the autosave waits for its end)."""
@@ -349,7 +353,7 @@ class LayoutTool(Tool):
     shortcut = "Y"
     tip = (
         "Layout: drag a cut line's end along the shore, a cut's point, a junction, a block corner or a shore point; "
-        "the layout follows (cells kept) and, with auto-generate, the grid"
+        "the layout follows (cells kept) and, with auto-generate, the grid; Del deletes the cut line pointed at"
     )
     controller = None  # the window's LakeController (it computes new layouts off the GUI thread)
 
@@ -362,6 +366,7 @@ class LayoutTool(Tool):
         self._steps = None  # what the steps of the drag share (layout_edit.DragSteps)
         self._last_xy = None  # where the drag's last step went (None: no step yet)
         self._cache: tuple | None = None  # (layout, its handles)
+        self._hovered: tuple | None = None  # (layout, the handle ringed under the cursor)
 
     def activate(self) -> None:
         if self.doc.project.layout is None:
@@ -396,7 +401,23 @@ class LayoutTool(Tool):
         if self.canvas is None or self._handle is not None:
             return
         h = nearest_handle(self._near(lay, xy), xy, self.tol()) if lay is not None else None
+        self._hovered = (lay, h)
         self.canvas.lake_items.set_drag_point(None if h is None else h.xy)
+
+    def delete(self) -> bool:
+        """Del: the cut line whose end or point is ringed goes; the two blocks it parted become one."""
+        lay = self.doc.project.layout
+        if lay is None or self.controller is None or self._handle is not None:
+            return False
+        was, h = self._hovered or (None, None)
+        if was is not lay or h is None or h.kind not in ("end", "cut"):
+            self.status("Delete a cut line: point at its end or one of its points (ringed), then Del")
+            return True
+        from .layout_edit import without_cut
+
+        k = h.cut
+        self.controller.edit_layout(lambda: without_cut(lay, k), "Delete cut line")
+        return True
 
     def deactivate(self) -> None:
         super().deactivate()

@@ -182,3 +182,31 @@ def test_a_new_cell_size_is_for_auto_layout_and_leaves_the_grid_current(qtbot, w
     wait_idle(qtbot, win)
     assert win.doc.project.layout.cell_size == h2
     assert "Auto layout" not in win.lake_panel.summary.text()
+
+
+def test_del_with_the_layout_tool_deletes_the_cut_line_pointed_at(qtbot, win, tmp_path):
+    """A modeller who wants two blocks as one had no way to remove a cut line of the layout (Del
+    deleted selected shore points only; Auto layout again made the same cuts).  Now Del, with the
+    Layout tool pointing at a cut's end or point, removes that cut: one undo step."""
+    from app.layout_edit import handles
+
+    _laid_out(qtbot, win, tmp_path, 761205)
+    lay = win.doc.project.layout
+    win.set_tool("layout")
+    h = next(h for h in handles(lay) if h.kind == "end")
+    win.canvas.tool.hover(h.xy)  # the end is ringed
+    win.a_delete.trigger()
+    assert win.lake_ctl.editing  # the layout without the cut is being made
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay and not win.lake_ctl.editing)
+    new = win.doc.project.layout
+    assert len(new.cuts) == len(lay.cuts) - 1 and len(new.blocks) == len(lay.blocks) - 1
+    assert not any(np.array_equal(c, lay.cuts[h.cut]) for c in new.cuts)
+    kept = [b for b in lay.blocks if any(np.allclose(b.corners, c.corners) for c in new.blocks)]
+    assert len(kept) == len(lay.blocks) - 2  # only the two blocks it parted changed
+    assert win.stack.undoText() == "Delete cut line"
+    wait_idle(qtbot, win)
+    win.stack.undo()
+    assert win.doc.project.layout is lay
+    win.canvas.tool.hover((1e9, 1e9))  # pointing at nothing: Del says how, and deletes nothing
+    win.a_delete.trigger()
+    assert win.doc.project.layout is lay and "point at" in win.statusBar().currentMessage() + win._status.text()
