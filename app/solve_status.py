@@ -120,6 +120,8 @@ class SolveStatus(QtCore.QObject):
         self.win.a_pause.setChecked(state == "paused")
         if state == "paused":
             self.label.setText("paused")
+        elif state == "running":  # until its first progress (a minute when the first solve compiles its kernels)
+            self.label.setText("solving…")
 
     def on_error(self, text: str) -> None:
         # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why

@@ -210,3 +210,14 @@ def test_del_with_the_layout_tool_deletes_the_cut_line_pointed_at(qtbot, win, tm
     win.canvas.tool.hover((1e9, 1e9))  # pointing at nothing: Del says how, and deletes nothing
     win.a_delete.trigger()
     assert win.doc.project.layout is lay and "point at" in win.statusBar().currentMessage() + win._status.text()
+
+
+def test_the_status_says_solving_from_the_start_of_a_solve(qtbot, win, tmp_path):
+    """The first Auto layout's grid after an install took a minute (its kernels compiling) with Pause
+    and Stop lit and the solver's status reading "idle" until the first progress came."""
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761209))
+    assert win.solve_status.label.text() == "idle"
+    win.generate()
+    assert win.solver.running and win.solve_status.label.text() == "solving…"
+    wait_idle(qtbot, win)
+    assert "solving" not in win.solve_status.label.text()
