@@ -96,6 +96,7 @@ class SolverController(QtCore.QObject):
         self.last_error: str | None = None
         self._restart_pending = False
         self._project = None  # the project the running solve was started for
+        self._resume_wanted = False  # a resume waits for the worker to take its pause
         self.gui_thread = QtCore.QThread.currentThread()
         self.thread_violations = 0  # slots found running outside the GUI thread (tests)
         # leading-edge throttle: draw a snapshot at once unless the last frame was
@@ -197,19 +198,30 @@ class SolverController(QtCore.QObject):
             self._hold.set()
         # no worker.quit(): an aborted superqt worker never emits `returned`; the
         # generator sees the event after the current sweep and returns the grid itself
-        if self._worker is not None and self.state == "paused":
-            self._worker.resume()
-            self._set_state("running")
+        self.resume()
 
     def pause(self) -> None:
         if self._worker is not None and self.state == "running":
+            self._resume_wanted = False
             self._worker.pause()
             self._set_state("paused")
 
     def resume(self) -> None:
         if self._worker is not None and self.state == "paused":
-            self._worker.resume()
+            self._resume_wanted = True
             self._set_state("running")
+            self._resume_worker(self._worker)
+
+    def _resume_worker(self, worker) -> None:
+        """superqt's worker takes a pause at its next yield and ignores a resume before that (Space
+        twice right after F5 left it paused for good, Stop too): the resume waits for the pause."""
+        if worker is not self._worker or not self._resume_wanted:
+            return
+        if worker.is_paused:
+            self._resume_wanted = False
+            worker.resume()
+        else:
+            QtCore.QTimer.singleShot(5, lambda: self._resume_worker(worker))
 
     def toggle_pause(self) -> None:
         self.resume() if self.state == "paused" else self.pause()

@@ -221,3 +221,17 @@ def test_the_status_says_solving_from_the_start_of_a_solve(qtbot, win, tmp_path)
     assert win.solver.running and win.solve_status.label.text() == "solving…"
     wait_idle(qtbot, win)
     assert "solving" not in win.solve_status.label.text()
+
+
+@pytest.mark.parametrize("then", ["resume", "stop"])
+def test_space_twice_or_space_then_esc_right_after_f5_does_not_hang_the_solve(qtbot, win, tmp_path, then):
+    """superqt takes a pause at the worker's next yield and ignored a resume asked before it: F5,
+    Space, Space (or Esc) at once left the solve paused for good with the status saying it ran;
+    Stop could not end it, and closing the window waited for it."""
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761210))
+    win.generate()
+    win.solver.toggle_pause()
+    assert win.solver.state == "paused"
+    win.solver.toggle_pause() if then == "resume" else win.solver.stop()
+    wait_for(qtbot, win, lambda: not win.solver.running, timeout=120_000)
+    assert win.doc.grids
