@@ -214,6 +214,8 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.itemSelectionChanged.connect(self._row_selected)
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)
+        # a project without a layout (New, an example) hides the box even when no grid went with it
+        doc.project_changed.connect(lambda _p: self.setVisible(self.doc.project.layout is not None))
         self.refresh()
 
     def set_previous(self, on: bool) -> None:

@@ -235,3 +235,19 @@ def test_space_twice_or_space_then_esc_right_after_f5_does_not_hang_the_solve(qt
     win.solver.toggle_pause() if then == "resume" else win.solver.stop()
     wait_for(qtbot, win, lambda: not win.solver.running, timeout=120_000)
     assert win.doc.grids
+
+
+def test_the_lake_verdict_box_goes_with_the_layout(qtbot, win, tmp_path):
+    """A cut deleted (the grid dropped: "the verdict follows when the grid of this layout is made"),
+    then File ▸ New or an example without a layout: the lake's verdict box stayed in the Quality dock."""
+    from app.layout_edit import without_cut
+
+    _laid_out(qtbot, win, tmp_path, 761211)
+    box = win.lake_quality
+    assert box.isVisible()
+    lake = win.doc.project.lake
+    win.editor.set_lake(lake.replaced(layout=without_cut(lake.layout, 0)), "Delete cut line")
+    assert not win.doc.grids and box.isVisible()  # the new layout's verdict is still to come
+    win.stack.setClean()
+    win.io.new_project()
+    assert win.doc.project.layout is None and not box.isVisible()
