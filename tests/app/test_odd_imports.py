@@ -39,11 +39,12 @@ def test_a_projected_shapefile_keeps_its_crs(win, tmp_path):
 
 
 def test_a_projected_file_goes_into_the_projects_frame(win, tmp_path):
-    csv = tmp_path / "a.csv"
-    csv.write_text("lon,lat\n" + "\n".join(f"{a},{b}" for a, b in zip(LON + 0.1, LAT, strict=True)) + "\n")
-    assert win.io.import_points(csv, project_lonlat=True)
+    """Points joining a project that has a frame but no lake (a case opened with its CRS) go into
+    that frame; over a lake they replace it (the next test)."""
+    import dataclasses
+
+    win.doc.set_project(dataclasses.replace(win.doc.project, crs="EPSG:32632", origin=(460000.0, 5239000.0)))
     frame = (win.doc.project.crs, tuple(win.doc.project.origin))
-    assert frame[0] == "EPSG:32632" and frame[1] != (0.0, 0.0)
     _shapefile(tmp_path / "lake.shp", 2056)
     assert win.io.import_points(tmp_path / "lake.shp")
     p = win.doc.project
@@ -52,6 +53,18 @@ def test_a_projected_file_goes_into_the_projects_frame(win, tmp_path):
     local = np.column_stack([x - frame[1][0], y - frame[1][1]])
     pts = win.doc.block.points  # was: LV95 metres (2.7e6, 1.2e6) beside UTM metres about the origin
     assert np.abs(pts.mean(axis=0) - local.mean(axis=0)).max() < 5.0
+
+
+def test_a_projected_lake_over_a_lake_replaces_it_in_its_own_crs(win, tmp_path):
+    csv = tmp_path / "a.csv"
+    csv.write_text("lon,lat\n" + "\n".join(f"{a},{b}" for a, b in zip(LON + 0.1, LAT, strict=True)) + "\n")
+    assert win.io.import_points(csv, project_lonlat=True)
+    assert win.doc.project.lake is not None and win.doc.project.crs == "EPSG:32632"
+    world = _shapefile(tmp_path / "lake.shp", 2056)
+    assert win.io.import_points(tmp_path / "lake.shp")
+    p = win.doc.project
+    assert p.crs == "EPSG:2056" and tuple(p.origin) == (0.0, 0.0)  # not LV95 metres in the UTM frame
+    assert np.min(np.hypot(*(p.lake.outline[0] - world).T)) < 1e-6
 
 
 def test_a_file_that_is_not_one_lake_says_why(win, tmp_path):
