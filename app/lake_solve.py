@@ -138,7 +138,9 @@ def _cold(layout, stop_event, *, shown: bool = True, before: tuple = ((), (), 0)
     history0, levels0, offset = before
     levels = [*levels0, (offset, labels[0])]
 
-    def level_done(_what, value):  # called by iterate_layout as a level ends, before the next one's sweeps
+    def level_done(what, value):  # called by iterate_layout as a level ends, before the next one's sweeps
+        if what != "level":  # ("equalize", patches): after the last level
+            return
         lev, res = value
         if lev + 1 < n_levels:
             levels.append((levels[-1][0] + res.sweeps, labels[lev + 1]))

@@ -116,6 +116,8 @@ def run_case(poly, cells: int, layout_only: bool, regular: bool = False) -> dict
     per_level: list[int] = []
 
     def cb(kind, payload):
+        if kind != "level":
+            return
         _lev, res = payload
         per_level.append(sum(int(block_metrics(g).folded.sum()) for g in res.grids))
 

@@ -135,6 +135,8 @@ def iterate_layout(
     ``equalize``: after the finest level, the nodes round every interface pair above 2 moved to
     make its two cells alike within bounds on what that may cost elsewhere
     (:func:`~meshcore.orthogonal.equalize.equalize_interfaces`; on by default, ``equalize=False`` skips it).
+    ``level_callback(kind, value)`` is called with ``("level", (level, result))`` as each level
+    ends and ``("equalize", patches)`` after the equalize step (the patches it kept).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped").  Returns
@@ -218,6 +220,8 @@ def iterate_layout(
             from .orthogonal.equalize import equalize_interfaces
 
             grids, equalized = equalize_interfaces(tp, grids, rings)
+            if level_callback is not None:
+                level_callback("equalize", equalized)
     elapsed = time.perf_counter() - t0
     if stopped:
         msg = "stopped"

@@ -324,6 +324,9 @@ def _grid(lay, say: _Say):
     n_levels = LEVELS + 1
 
     def level(kind: str, value: Any) -> None:
+        if kind == "equalize":
+            say(f"interfaces: {value} patch(es) of cells more than 2× apart across a cut made alike, {say.lap():.1f} s")
+            return
         if kind != "level":
             return
         lev, res = value

@@ -35,6 +35,7 @@ LIMIT = 2.0  # pairs above this are worked on (issue 12's target)
 AIM = 1.8  # the objective pays beyond this
 DEPTH = 3  # free nodes: within DEPTH - 1 grid edges of the pair's cells
 MAX_PATCHES = 24
+MAX_ITER = 300  # BFGS iterations per patch (60: 20–30 % less CPU on 5 lakes, their largest ratio up to 9 % higher)
 COS3 = float(np.sin(np.radians(3.0)))  # the quality report's deviation is arcsin |cos|
 COS_D3D = 0.02
 EDGE = 1.2
@@ -353,7 +354,7 @@ def equalize_interfaces(
         nz = 2 * len(patch.fly) + len(patch.slide)
         if not nz:
             continue
-        res = minimize(patch.objective, np.zeros(nz), jac=True, method=METHOD, options={"maxiter": 300})
+        res = minimize(patch.objective, np.zeros(nz), jac=True, method=METHOD, options={"maxiter": MAX_ITER})
         before = patch.counts(P)
         for alpha in (1.0, 0.5, 0.25):
             Pn = patch.positions(alpha * res.x)

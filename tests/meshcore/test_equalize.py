@@ -69,3 +69,15 @@ def _cos(g) -> np.ndarray:
     from meshcore.quality.lake import block_metrics
 
     return block_metrics(g).cos
+
+
+def test_the_callback_hears_the_step_after_the_last_level():
+    """``meshcore mesh`` prints the step's time on its own line (it was counted in the quality's)."""
+    lay = auto_layout(testing.channel_network(7, n_branches=4), target_cells=2000, multiple=4)
+    heard: list[tuple[str, object]] = []
+    mesh_layout(lay, callback=lambda kind, value: heard.append((kind, value)))
+    assert [k for k, _ in heard] == ["level", "level", "level", "equalize"]
+    assert isinstance(heard[-1][1], int) and heard[-1][1] >= 0
+    heard.clear()
+    mesh_layout(lay, callback=lambda kind, value: heard.append((kind, value)), equalize=False)
+    assert [k for k, _ in heard] == ["level", "level", "level"]
