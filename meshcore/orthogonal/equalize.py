@@ -193,6 +193,7 @@ class _Patch:
         inpatch = np.zeros(len(t.cells), bool)
         inpatch[self.crow] = True
         self.pairs = pairs[inpatch[pairs[:, 0]] | inpatch[pairs[:, 1]]]
+        self.Ca, self.Cb = t.cells[self.pairs[:, 0]], t.cells[self.pairs[:, 1]]
         self.free = free
         self.slide = free[t.shore[free]]
         self.fly = free[~t.shore[free]]
@@ -245,7 +246,21 @@ class _Patch:
         return np.abs(np.log(np.maximum(a, 1e-300) / np.maximum(b, 1e-300)))
 
     def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
-        """The objective and its gradient in ``z``."""
+        """The objective and its gradient in ``z`` (compiled: :func:`._equalize_kernels.objective`)."""
+        from . import _equalize_kernels
+
+        P = self.positions(z)
+        G = np.empty_like(P)
+        ok, f = _equalize_kernels.objective(
+            P, self.C, self.sg, self.J0, self.Ca, self.Cb, float(np.log(AIM)), self.cos, self.c_allowed, W_COS,
+            self.tri, self.e_allowed, W_EDGE, W_JAC, G,
+        )  # fmt: skip
+        if not ok:
+            return 1e6, np.zeros_like(z)
+        return f + 1e-3 * float(z @ z), self.chain(G, z) + 2e-3 * z
+
+    def objective_numpy(self, z: np.ndarray) -> tuple[float, np.ndarray]:
+        """:meth:`objective` in NumPy (the compiled kernel's reference in the tests)."""
         P = self.positions(z)
         G = np.zeros_like(P)
         C, sg = self.C, self.sg

@@ -81,3 +81,31 @@ def test_the_callback_hears_the_step_after_the_last_level():
     heard.clear()
     mesh_layout(lay, callback=lambda kind, value: heard.append((kind, value)), equalize=False)
     assert [k for k, _ in heard] == ["level", "level", "level"]
+
+
+def test_the_compiled_objective_is_the_numpy_one(solved):
+    """:mod:`meshcore.orthogonal._equalize_kernels` against ``_Patch.objective_numpy``: value and
+    gradient at random moves of every patch round the grid's pairs above 1.1."""
+    from meshcore.orthogonal.equalize import _Patch, _Tables
+    from meshcore.orthogonal.shore import arc_lengths
+
+    mb, rings = solved
+    t = _Tables(mb.topology, list(mb.grids))
+    X, Y = _assemble(list(mb.grids), mb.topology.node_map)
+    P = np.column_stack([X, Y])
+    pr = interface_pairs(mb.grids)
+    pairs = np.array([[t.row(a), t.row(b)] for a, b in zip(pr["cell_a"], pr["cell_b"], strict=True)], np.int64)
+    shore = (list(rings), [arc_lengths(r) for r in rings])
+    rng = np.random.default_rng(0)
+    checked = 0
+    for q in np.flatnonzero(pr["ratio"] > 1.1)[:8]:
+        patch = _Patch(t, P, np.unique(t.cells[pairs[q]].ravel()), 3, pairs, shore)
+        nz = 2 * len(patch.fly) + len(patch.slide)
+        for scale in (0.0, 0.02, 0.1):
+            z = scale * rng.standard_normal(nz)
+            f, g = patch.objective(z)
+            f0, g0 = patch.objective_numpy(z)
+            assert f == pytest.approx(f0, rel=1e-12, abs=1e-18)  # (at z = 0: rounding of |cos| at its bound)
+            np.testing.assert_allclose(g, g0, rtol=1e-9, atol=1e-12 * max(1.0, np.abs(g0).max()))
+            checked += f0 > 1e-3 * float(z @ z)  # a move whose terms are not only the small regularizer
+    assert checked >= 4
