@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from meshcore import BORDER_NAMES, BorderSpec, ReadError
+from meshcore import BORDER_NAMES, BorderSpec, MeshcoreError, ReadError
 
 from .project import Block, Project, boundary_to_loop
 
@@ -38,29 +38,86 @@ POINT_FILTER = (
 
 @dataclass(frozen=True)
 class PointData:
-    """The first polyline of a point file; ``lonlat`` when it is in geographic degrees."""
+    """The largest polyline of a point file (``index`` in the file); ``lonlat`` when it is in degrees.
+
+    ``note``: how the file was read when that is not what it says (metres in a lon/lat format).
+    """
 
     points: np.ndarray
     lonlat: bool
     path: str = ""
     pointset: object = None  # the meshcore.io.PointSet, when meshcore read the file
+    index: int = 0
+    note: str = ""
+
+
+def largest_polyline(ps) -> int:
+    """The index of the polyline that encloses the largest area (of its closed ring), then the longest.
+
+    A file that is not one lake (a shore drawn in pieces, or rings that do not nest) is imported
+    as one block: the largest line, not whatever line comes first (a jetty, a small island).
+    """
+    best, key = 0, None
+    for k, pl in enumerate(ps.polylines):
+        p = np.asarray(pl.points, float).reshape(-1, 2)
+        if len(p) < 2:
+            continue
+        x, y = p[:, 0] - p[:, 0].mean(), p[:, 1] - p[:, 1].mean()
+        area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+        length = float(np.hypot(*np.diff(p, axis=0).T).sum())
+        if key is None or (area, length) > key:
+            best, key = k, (area, length)
+    return best
+
+
+def _read_metres_or_raise(path: Path, exc: Exception):
+    """A file of a lon/lat format (GeoJSON, a CSV headed lon/lat) whose numbers are out of the degrees'
+    range: read again as local metres without a CRS, with a note; the error (without the command line's
+    flag, which the app has no use for) when it still cannot be read or its numbers are degrees."""
+    from meshcore import io as mio
+    from meshcore.crs import looks_lonlat
+
+    try:
+        ps = mio.read_points(path, crs="local")
+    except (MeshcoreError, ValueError):
+        ps = None
+    lines = [np.asarray(pl.points, float).reshape(-1, 2) for pl in (ps.polylines if ps is not None else ())]
+    pts = np.vstack(lines) if lines else np.zeros((0, 2))
+    out = (np.abs(pts[:, 0]) > 180) | (np.abs(pts[:, 1]) > 90)
+    # degrees with a few wrong numbers (a typo) stay an error naming the first wrong point
+    typo = out.any() and out.mean() < 0.1 and looks_lonlat(pts[~out])
+    if ps is None or not out.any() or typo:
+        raise ReadError(str(exc).split(" — GeoJSON positions are lon/lat")[0]) from None
+    k = int(np.flatnonzero(out)[0])
+    note = (
+        f"{path.name}: point {k + 1} ({pts[k, 0]:g}, {pts[k, 1]:g}) is no longitude/latitude: "
+        "the file is read as local metres without a CRS (a grid in metres, not placed on the map)"
+    )
+    return ps, note
 
 
 def read_points(path) -> PointData:
     """Read a boundary point file with :func:`meshcore.io.read_points` (every format it knows).
 
     ``lonlat`` follows the rule of ``meshcore mesh`` (:func:`meshcore.cli.lakefile.is_lonlat`): the
-    file says so, or it says nothing and its numbers look like degrees (a headerless CSV).
+    file says so, or it says nothing and its numbers look like degrees (a headerless CSV).  A file
+    whose format says lon/lat but whose numbers are metres is read as metres without a CRS (``note``).
+    The points are those of the largest polyline (:func:`largest_polyline`).
     """
     from meshcore import io as mio
     from meshcore.cli.lakefile import is_lonlat
 
     path = Path(path)
-    ps = mio.read_points(path)
+    note = ""
+    try:
+        ps = mio.read_points(path)
+    except ReadError as exc:
+        ps, note = _read_metres_or_raise(path, exc)
     if not ps.polylines:
         raise ReadError(f"{path}: the file holds no polyline")
-    pts = np.asarray(ps.polylines[0].points, float)
-    return PointData(_drop_closing(pts), is_lonlat(ps), str(path), ps)
+    k = largest_polyline(ps)
+    pts = np.asarray(ps.polylines[k].points, float)
+    return PointData(_drop_closing(pts), is_lonlat(ps), str(path), ps, k, note)
 
 
 def to_local(pd: PointData, frame=None) -> tuple[np.ndarray, object]:
@@ -69,20 +126,21 @@ def to_local(pd: PointData, frame=None) -> tuple[np.ndarray, object]:
     With ``frame`` (a :class:`meshcore.crs.Frame` already used by the project)
     the points go to that CRS and origin; otherwise to the UTM zone of their
     centroid with a round local origin (:func:`meshcore.crs.project`).
-    Returns ``(points, frame)``.
+    Returns ``(points, frame)`` (those of the polyline ``pd.index``).
     """
     from meshcore import crs as mcrs
     from meshcore.io import PointSet, Polyline
 
     ps = pd.pointset
+    k = pd.index
     if ps is None:
-        ps = PointSet((Polyline("points", pd.points, closed=True),), mcrs.LONLAT, pd.path)
+        ps, k = PointSet((Polyline("points", pd.points, closed=True),), mcrs.LONLAT, pd.path), 0
     src = mcrs.LONLAT if pd.lonlat and ps.crs is None else None
     if frame is not None and frame.crs:
         local, fr = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)
     else:
         local, fr = mcrs.project(ps, "auto", source_crs=src)
-    return _drop_closing(np.asarray(local.polylines[0].points, float)), fr
+    return _drop_closing(np.asarray(local.polylines[k].points, float)), fr
 
 
 def lonlat_to_local(points, frame=None) -> tuple[np.ndarray, object]:

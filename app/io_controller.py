@@ -12,6 +12,7 @@ couple of seconds of work.
 from __future__ import annotations
 
 import logging
+import re
 import time
 from pathlib import Path
 
@@ -151,9 +152,17 @@ class IOController(QtCore.QObject):
             return self.save_as()
         return self.save_to(self.doc.path)
 
+    def suggested_path(self) -> str:
+        """What the Save dialog offers: the file saved to, or the project's title (the imported lake's
+        file name) as a .toml in the last folder used, or "untitled.toml" there."""
+        if self.doc.path is not None:
+            return str(self.doc.path)
+        stem = re.sub(r'[\\/:*?"<>|]+', "_", self.doc.project.title).strip(" .") or "untitled"
+        return str(Path(self.last_dir()) / f"{stem}.toml")
+
     def save_as(self) -> bool:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self._parent(), "Save project", self.last_dir(), "gcmesh case (*.toml)"
+            self._parent(), "Save project", self.suggested_path(), "gcmesh case (*.toml)"
         )
         if not path:
             return False
@@ -193,6 +202,8 @@ class IOController(QtCore.QObject):
             self.win.error("Cannot import points", exc)
             return False
         pts = pd.points
+        if pd.note:  # metres in a lon/lat format: read as local metres (the app has no --source-crs)
+            self.doc.report("warning", pd.note)
         # a lake's project gets a new lake, in the file's own frame (the UTM zone of a lon/lat outline,
         # none for metres); otherwise the points join the project in its frame (a background traced)
         replace = self.doc.project.lake is not None
@@ -241,6 +252,8 @@ class IOController(QtCore.QObject):
         self._add_imported(block, frame, path.name, lake=lake, replace=replace)
         self.remember_dir(path)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
+        if pd.note:
+            projected = " (as local metres: its numbers are no longitude/latitude)"
         isl = f" and {len(lake.holes)} island(s)" if lake is not None and lake.holes else ""
         self.win.message(
             f"Imported {len(pts)} points{isl} from {path.name}{projected}; corners chosen "
@@ -261,7 +274,7 @@ class IOController(QtCore.QObject):
         except (MeshcoreError, ValueError) as exc:  # meshcore mesh refuses the file: say why here too
             self.doc.report(
                 "warning",
-                f"{Path(pd.path).name}: not read as a lake ({exc}); its first line is imported as one block",
+                f"{Path(pd.path).name}: not read as a lake ({exc}); its largest line is imported as one block",
             )
             return None
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
@@ -287,6 +300,8 @@ class IOController(QtCore.QObject):
         else:
             after = p.replaced(blocks=(*p.blocks, block))
             k = len(after.blocks) - 1
+        if replace or not p.title:  # the case's title (and the Save dialog's name) is the lake's file name
+            after = after.replaced(title=Path(name).stem)
         if frame is not None and frame.crs:
             after = after.replaced(crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "")
         if lake is not None and after.layout is None and (k == 0 or p.lake is None):
