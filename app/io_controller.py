@@ -510,10 +510,11 @@ class IOController(QtCore.QObject):
             log.exception("the recovery file %s cannot be read; it is removed", self.recovery_path)
             self.discard_recovery()
             return False
+        what = recovery.describe(project, path, recovery.saved_at(self.recovery_path))
         r = QtWidgets.QMessageBox.question(
             self._parent(),
             "Recover project",
-            "gcmesh did not shut down cleanly last time. Restore the autosaved project?",
+            f"gcmesh did not shut down cleanly last time. Restore the autosaved project?\n\n{what}",
         )
         if r != QtWidgets.QMessageBox.StandardButton.Yes:
             self.discard_recovery()

@@ -31,7 +31,7 @@ from meshcore.io import atomic_write_text
 
 from .project import Background, Block, Project, SolverSettings
 
-__all__ = ["discard", "exists", "read", "sidecar", "write"]
+__all__ = ["describe", "discard", "exists", "read", "saved_at", "sidecar", "write"]
 
 FORMAT = "gcmesh-recovery"
 VERSION = 1
@@ -127,6 +127,40 @@ def read(path) -> tuple[Project, Path | None]:
     if state.get("lake"):
         project = _with_lake(project, state["lake"])
     return project, Path(state["path"]) if state.get("path") else None
+
+
+def saved_at(path) -> float | None:
+    """When the recovery files were last written (seconds since the epoch), None if there are none."""
+    times = [p.stat().st_mtime for p in (Path(path), sidecar(path)) if p.exists()]
+    return max(times) if times else None
+
+
+def describe(project: Project, saved_as: Path | None, when: float | None, now: float | None = None) -> str:
+    """What a recovery restores, for the prompt at start-up: the file (or lake) name, its blocks,
+    when it was autosaved; e.g. ``"Lake Tarn.toml: a lake with 3 islands, laid out in 12 blocks —
+    autosaved 2026-12-03 19:02 (14 min ago)"``."""
+    import time
+
+    name = saved_as.name if saved_as is not None else (f"{project.title} (never saved)" if project.title else "")
+    name = name or "an unsaved project"
+    if project.lake is not None:
+        n = len(project.lake.holes)
+        what = "a lake" + (f" with {n} island{'s' * (n != 1)}" if n else "")
+        if project.layout is not None:
+            k = len(project.layout.blocks)
+            what += f", laid out in {k} block{'s' * (k != 1)}"
+    else:
+        k = sum(1 for b in project.blocks if len(b.points) or b.boundary is not None)
+        what = f"{k} block{'s' * (k != 1)}" if k else "no blocks"
+    if len(project.cut_lines):
+        what += f", {len(project.cut_lines)} cut line{'s' * (len(project.cut_lines) != 1)}"
+    if when is None:
+        return f"{name}: {what}"
+    now = time.time() if now is None else now
+    ago = max(0.0, now - when)
+    age = f"{int(ago // 60)} min ago" if ago < 3600 else (f"{ago / 3600:.1f} h ago" if ago < 48 * 3600 else "")
+    stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(when))
+    return f"{name}: {what} — autosaved {stamp}" + (f" ({age})" if age else "")
 
 
 # ----------------------------------------------------------------- helpers

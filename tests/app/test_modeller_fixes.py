@@ -108,3 +108,36 @@ def test_the_save_dialog_offers_the_lake_file_name_and_the_case_is_titled_by_it(
 
     laid = with_layout(win.doc.project, lake.replaced(layout=auto_layout(shapely.Polygon(lake.outline, lake.holes))))
     assert 'title = "Lake Tarn"' in fio.dumps_project(laid)
+
+
+def test_the_recovery_prompt_says_what_it_restores(qtbot, win, tmp_path, monkeypatch):
+    """The prompt at start-up asked "Restore the autosaved project?" without saying which: it names
+    the file (or the lake), its islands and blocks, and when it was autosaved."""
+    import time
+
+    from PySide6 import QtWidgets
+
+    from app import recovery
+    from app.lake import with_layout
+    from meshcore.layout import auto_layout
+    from tests.app.test_modeller import _metres_lake
+
+    assert win.io.import_points(_metres_lake(tmp_path / "Tarn.csv", 761303))
+    lake = win.doc.project.lake
+    layout = auto_layout(shapely.Polygon(lake.outline, lake.holes))
+    project = with_layout(win.doc.project, lake.replaced(layout=layout))
+    recovery.write(project, win.io.recovery_path, tmp_path / "tarn-case.toml")
+    asked = []
+
+    def question(_parent, _title, text, *_a):
+        asked.append(text)
+        return QtWidgets.QMessageBox.StandardButton.No
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    assert not win.io.offer_recovery()
+    (text,) = asked
+    n = len(lake.holes)
+    assert "tarn-case.toml" in text and f"{n} island" in text and f"{len(layout.blocks)} blocks" in text
+    assert time.strftime("%Y-%m-%d", time.localtime()) in text and "min ago" in text
+    # never saved: the lake's file name (the project's title)
+    assert "Tarn (never saved)" in recovery.describe(project, None, None)
