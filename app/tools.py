@@ -417,6 +417,9 @@ class LayoutTool(Tool):
 
         k = h.cut
         self.controller.edit_layout(lambda: without_cut(lay, k), "Delete cut line")
+        self._hovered = None  # the ringed end goes with its cut: no ring left until the mouse moves
+        if self.canvas is not None:
+            self.canvas.lake_items.set_drag_point(None)
         return True
 
     def deactivate(self) -> None:

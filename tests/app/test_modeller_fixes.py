@@ -141,3 +141,25 @@ def test_the_recovery_prompt_says_what_it_restores(qtbot, win, tmp_path, monkeyp
     assert time.strftime("%Y-%m-%d", time.localtime()) in text and "min ago" in text
     # never saved: the lake's file name (the project's title)
     assert "Tarn (never saved)" in recovery.describe(project, None, None)
+
+
+def test_deleting_a_cut_line_updates_the_status_line_and_drops_the_ring(qtbot, win, tmp_path):
+    """Del on a cut line (Layout tool): the status line kept the old "9 blocks" text, and the ring on
+    the deleted cut's end stayed until the mouse moved."""
+    from app.layout_edit import handles
+    from tests.app.test_modeller import _laid_out
+    from tests.app.waits import wait_for
+
+    _laid_out(qtbot, win, tmp_path, 761304)
+    lay = win.doc.project.layout
+    win.set_tool("layout")
+    h = next(h for h in handles(lay) if h.kind == "end")
+    win.canvas.tool.hover(h.xy)
+    assert len(win.canvas.lake_items.drag_point.data) == 1  # the end is ringed
+    win.message(f"Lake grid: {len(lay.blocks)} blocks")  # what the status said after the grid
+    win.a_delete.trigger()
+    assert len(win.canvas.lake_items.drag_point.data) == 0  # the ring went with the cut
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay and not win.lake_ctl.editing)
+    n = len(win.doc.project.layout.blocks)
+    assert n == len(lay.blocks) - 1
+    assert win._status.text().startswith(f"Delete cut line: {n} blocks")
