@@ -158,7 +158,13 @@ def describe(project: Project, saved_as: Path | None, when: float | None, now: f
         return f"{name}: {what}"
     now = time.time() if now is None else now
     ago = max(0.0, now - when)
-    age = f"{int(ago // 60)} min ago" if ago < 3600 else (f"{ago / 3600:.1f} h ago" if ago < 48 * 3600 else "")
+    age = (
+        "just now"
+        if ago < 60
+        else f"{int(ago // 60)} min ago"
+        if ago < 3600
+        else (f"{ago / 3600:.1f} h ago" if ago < 48 * 3600 else "")
+    )
     stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(when))
     return f"{name}: {what} — autosaved {stamp}" + (f" ({age})" if age else "")
 
