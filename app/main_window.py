@@ -33,6 +33,7 @@ from .solve_status import SolveStatus
 from .solver_controller import SolverController
 from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, LayoutTool, PanTool
 from .views.canvas import Canvas
+from .views.docks import fit_docks, narrowable, scrolled
 from .views.lake_panel import LakePanel, LakeQualityBox
 from .views.messages import ElidedLabel, MessagePanel
 from .views.panels import BlocksPanel, ConvergencePanel, ParamsPanel, QualityPanel
@@ -138,7 +139,9 @@ class MainWindow(QtWidgets.QMainWindow):
         ):
             d = QtWidgets.QDockWidget(title, self)
             d.setObjectName(key)
-            d.setWidget(w)
+            # a dock narrower than its contents scrolls, or wraps its text (the Quality panel's plots
+            # crash PySide in a scroll area): a small screen keeps room to draw (fit_docks)
+            d.setWidget(narrowable(w) if key == "quality" else scrolled(w))
             self.addDockWidget(area, d)
             self.docks[key] = d
         self.tabifyDockWidget(self.docks["params"], self.docks["lake"])
@@ -149,7 +152,7 @@ class MainWindow(QtWidgets.QMainWindow):
         vertical, horizontal = QtCore.Qt.Orientation.Vertical, QtCore.Qt.Orientation.Horizontal
         self.resizeDocks([self.docks["blocks"], self.docks["params"]], [230, 520], vertical)
         self.resizeDocks([self.docks["quality"], self.docks["convergence"]], [560, 260], vertical)
-        self.resizeDocks([self.docks["blocks"], self.docks["quality"]], [300, 330], horizontal)
+        self.resizeDocks([self.docks["blocks"], self.docks["quality"]], [330, 330], horizontal)  # the Lake panel: 317
 
     def _make_tools(self) -> None:
         ctx = (self.doc, self.editor, self.canvas, self.message)
@@ -451,6 +454,10 @@ class MainWindow(QtWidgets.QMainWindow):
         for key in VIEW_TOGGLES:
             self.settings.setValue(f"view/{key}", self.actions[key].isChecked())
         ev.accept()
+
+    def resizeEvent(self, ev: QtGui.QResizeEvent) -> None:
+        super().resizeEvent(ev)
+        QtCore.QTimer.singleShot(0, self, lambda: fit_docks(self, self.canvas, self.docks.values()))
 
     def showEvent(self, ev: QtGui.QShowEvent) -> None:
         super().showEvent(ev)

@@ -164,3 +164,11 @@ def test_deleting_a_cut_line_updates_the_status_line_and_drops_the_ring(qtbot, w
     assert n == len(lay.blocks) - 1
     assert win._status.text().startswith(f"Delete cut line: {n} blocks")
 
+
+def test_a_small_window_keeps_room_to_draw(qtbot, win):
+    """At 640×420 the side panels kept their width (the Lake panel ~320 px, Quality ~290 px) and the
+    drawing area shrank to ~70 px; the panels give way now (their contents scroll or wrap)."""
+    win.resize(640, 420)
+    qtbot.waitUntil(lambda: win.width() <= 640 and win.canvas.width() >= 0.4 * win.width(), timeout=20_000)
+    left, right = win.docks["lake"], win.docks["quality"]
+    assert left.isVisible() and right.isVisible() and 0 < left.width() <= 0.3 * win.width()
