@@ -102,6 +102,7 @@ def run_one(expr: str, cells: int, options: dict | None = None) -> dict:
         "shore": s["hausdorff_cells"],
         "shore_grid_h": lake_metrics(mb, polygon=poly).summary()["hausdorff_cells"],  # before: the grid's h
         "cell_size": hl,
+        "aspect": m.max("aspect_ratio"),
         "cpu": cpu,
     }
 
