@@ -253,6 +253,7 @@ def mesh_outline(
     regular: bool = False,
     strict: bool = False,
     thin_arms: bool = False,
+    mouths: bool = False,
     **options: Any,
 ):
     """A model-ready multiblock grid of a lake outline (projected coordinates, e.g. metres).
@@ -275,6 +276,8 @@ def mesh_outline(
     thin_arms : bool
         Blocks two cells across at junctions and reflex bends of arms 2–4 cells wide
         (:func:`~meshcore.layout.auto_layout`).
+    mouths : bool
+        Junction chords at the mouths of arms 4–7 cells wide (:func:`~meshcore.layout.auto_layout`).
 
     Returns
     -------
@@ -293,6 +296,7 @@ def mesh_outline(
         multiple=2**levels,
         regular=regular,
         thin_arms=thin_arms,
+        mouths=mouths,
     )
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics

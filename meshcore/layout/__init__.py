@@ -57,6 +57,7 @@ def auto_layout(
     multiple: int = 1,
     regular: bool = False,
     thin_arms: bool = False,
+    mouths: bool = False,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -83,6 +84,10 @@ def auto_layout(
         Cuts from reflex corners may leave blocks two cells across (three by default): the
         junctions and reflex bends of arms 2–4 cells wide are split instead of gridded as one
         block round the corner (:data:`.width.THIN_ACROSS`).
+    mouths : bool
+        At junctions of three or four arms up to seven cells wide, each arm's chord at its
+        mouth, through the reflex shore corners between the arms (default: just outside the
+        junction's inscribed circle; :func:`~.chords.place_chords`).  Off: measured mixed.
 
     Returns
     -------
@@ -123,6 +128,7 @@ def auto_layout(
                     normal=normal,
                     scale=scale,
                     thin=thin_arms,
+                    mouths=mouths,
                 )
             except TopologyError as exc:
                 first = first or exc
@@ -155,14 +161,23 @@ LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
 
 
 def _layout(
-    shores, h: float, notes, *, multiple: int, regular: bool, normal: bool, scale: float = 1.0, thin: bool = False
+    shores,
+    h: float,
+    notes,
+    *,
+    multiple: int,
+    regular: bool,
+    normal: bool,
+    scale: float = 1.0,
+    thin: bool = False,
+    mouths: bool = False,
 ) -> Layout:
     poly = shores.grid
     hl = scale * h  # the layout's geometry; counts at h
-    sk, chords, _, pieces = layout_pieces(shores.layout, hl, regular=regular, normal=normal, thin=thin)
+    sk, chords, _, pieces = layout_pieces(shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths)
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
-        sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal, thin=thin)
+        sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths)
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple)
 

@@ -119,17 +119,18 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
 
 
 def layout_pieces(
-    poly, h: float, *, regular: bool = False, normal: bool = True, thin: bool = False
+    poly, h: float, *, regular: bool = False, normal: bool = True, thin: bool = False, mouths: bool = False
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
-    normal; ``thin``: cuts from reflex corners may leave pieces two cells across; see
+    normal; ``thin``: cuts from reflex corners may leave pieces two cells across; ``mouths``:
+    junction chords at the arms' mouths, :func:`~.chords.place_chords`; see
     :func:`~.split.best_split`)."""
     import shapely
     from shapely.geometry import Polygon
 
     sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
-    chords = place_chords(poly, sk, min_length=2 * h)
+    chords = place_chords(poly, sk, min_length=2 * h, mouths=mouths)
     dense = shapely.segmentize(poly, h)
     sigma = 1.5 * h
     regions, cuts = partition(dense, [_densify(c.points, h) for c in chords], sigma)

@@ -29,6 +29,12 @@ from .skeleton import Branch, Skeleton
 
 __all__ = ["Chord", "place_chords"]
 
+#: chords at the arms' mouths (``mouths=True``): only at junctions of at most this many arms,
+#: for arms at most this many ``min_length`` wide, this many arm half-widths past the mouth
+MOUTH_MAX_DEGREE = 4
+MOUTH_MAX_WIDTH = 3.5
+MOUTH_MARGIN = 0.05
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Chord:
@@ -37,7 +43,7 @@ class Chord:
     branch: int
     s: float
     points: np.ndarray
-    kind: str  # "junction" | "tip" | "middle" | "ring"
+    kind: str  # "junction" | "mouth" | "tip" | "middle" | "ring" | "passage"
 
 
 def _arclength(p: np.ndarray) -> np.ndarray:
@@ -149,8 +155,11 @@ def _ray_hits(c, d, seg_a, seg_b, reach):
     return hit, tan
 
 
-def _end_offset(sk: Skeleton, br: Branch, s_all: np.ndarray, end: int, degree: np.ndarray, min_length: float) -> float:
-    """Arc length from the branch's end ``end`` (0: start, 1: finish) to its first chord."""
+def _end_offset(
+    sk: Skeleton, br: Branch, s_all: np.ndarray, end: int, degree: np.ndarray, min_length: float, mouths: bool = False
+) -> tuple[float, bool]:
+    """Arc length from the branch's end ``end`` (0: start, 1: finish) to its first chord, and
+    whether that chord is at the arm's mouth (``mouths``, see :func:`place_chords`)."""
     node = br.a if end == 0 else br.b
     P = br.points if end == 0 else br.points[::-1]
     R = br.radius if end == 0 else br.radius[::-1]
@@ -162,7 +171,17 @@ def _end_offset(sk: Skeleton, br: Branch, s_all: np.ndarray, end: int, degree: n
     if degree[node] < 3:
         need = np.maximum(need, np.maximum(2.0 * R, min_length))
     ok = np.flatnonzero(dist >= need)
-    return float(s_loc[ok[0]]) if len(ok) else math.inf
+    if not len(ok):
+        return math.inf, False
+    r_arm, r_node = float(R[ok[0]]), float(sk.node_radius[node])
+    if mouths and 3 <= degree[node] <= MOUTH_MAX_DEGREE and 2.0 * r_arm <= MOUTH_MAX_WIDTH * min_length:
+        # the arm's mouth: where a chord as wide as the arm ends on the junction's inscribed
+        # circle, which touches the shore at the reflex corners between the arms
+        d = math.sqrt(max(r_node * r_node - r_arm * r_arm, 0.0)) + MOUTH_MARGIN * r_arm
+        at = np.flatnonzero(dist >= d)
+        if len(at) and at[0] < ok[0]:
+            return float(s_loc[at[0]]), True
+    return float(s_loc[ok[0]]), False
 
 
 def _pick(s: np.ndarray, err: np.ndarray, u_of_s: np.ndarray, target: float, window: float, limit: float):
@@ -174,14 +193,18 @@ def _pick(s: np.ndarray, err: np.ndarray, u_of_s: np.ndarray, target: float, win
 
 
 def place_chords(
-    poly, sk: Skeleton, *, min_length: float, spacing: float = 4.0, max_angle: float = 30.0
+    poly, sk: Skeleton, *, min_length: float, spacing: float = 4.0, max_angle: float = 30.0, mouths: bool = False
 ) -> list[Chord]:
     """Chords along every branch of ``sk`` (see the module docstring).
 
     ``min_length`` is the shortest chord (a block needs a few cells across), ``spacing`` the
     largest distance between consecutive chords, in channel widths; ``max_angle`` the largest
     deviation from a right angle where a chord meets a bank.  A tip zone is kept at least
-    ``min_length`` long.
+    ``min_length`` long.  ``mouths``: at a junction of three or four arms at most
+    ``MOUTH_MAX_WIDTH · min_length`` wide, an arm's junction chord lies at its mouth, where a
+    chord as wide as the arm ends on the junction's inscribed circle (through the reflex shore
+    corners between the arms); two such chords may meet there.  Off by default: measured mixed
+    (docs/lake-grids.md, Limits).
     """
     import shapely
     from shapely.geometry import LineString
@@ -209,12 +232,13 @@ def place_chords(
                 if i is not None:
                     picks.append((i, "ring"))
         else:
-            s0 = _end_offset(sk, br, s_all, 0, degree, min_length)
-            s1 = L - _end_offset(sk, br, s_all, 1, degree, min_length)
+            e0, m0 = _end_offset(sk, br, s_all, 0, degree, min_length, mouths)
+            e1, m1 = _end_offset(sk, br, s_all, 1, degree, min_length, mouths)
+            s0, s1 = e0, L - e1
             u0, u1 = np.interp(s0, s_all, u_all), np.interp(s1, s_all, u_all)
             if s1 - s0 > 0 and u1 - u0 >= 0.5:
                 n_mid = max(0, math.ceil((u1 - u0) / spacing) - 1)
-                targets = [(u0, _end_kind(degree[br.a])), (u1, _end_kind(degree[br.b]))]
+                targets = [(u0, _end_kind(degree[br.a], m0)), (u1, _end_kind(degree[br.b], m1))]
                 targets += [(u0 + (u1 - u0) * (j + 1) / (n_mid + 1), "middle") for j in range(n_mid)]
                 for tu, kind in targets:
                     lo = 0.0 if kind != "middle" else 0.25 * spacing
@@ -254,18 +278,26 @@ def place_chords(
     # being placed dropped the long chord across a wide lobe whose end came near a narrow
     # arm's chord at a blunt notch: the lobe then went into the junction's block, one side
     # wrapped round the whole lobe, and the grid left the shore by 1.6 cells.)
-    order = {"passage": 0, "junction": 1, "tip": 2, "ring": 3, "middle": 4}
+    order = {"passage": 0, "mouth": 1, "junction": 1, "tip": 2, "ring": 3, "middle": 4}
     chords.sort(key=lambda c: order[c.kind])
     kept: list[Chord] = []
     lines: list = []
     for c in chords:
         ls = LineString(c.points)
-        if any(ls.distance(o) < 0.25 * min(ls.length, o.length) for o in lines):
+        if any(_clash(c, ls, k, o) for k, o in zip(kept, lines, strict=True)):
             continue
         kept.append(c)
         lines.append(ls)
     return kept
 
 
-def _end_kind(deg: int) -> str:
-    return "junction" if deg >= 3 else "tip"
+def _clash(c: Chord, ls, k: Chord, o) -> bool:
+    """Whether chord ``c`` (line ``ls``) crosses or crowds the kept chord ``k`` (line ``o``);
+    two mouth chords may meet at the reflex corner between their arms."""
+    if c.kind == "mouth" and k.kind == "mouth":
+        return bool(ls.crosses(o))
+    return bool(ls.distance(o) < 0.25 * min(ls.length, o.length))
+
+
+def _end_kind(deg: int, mouth: bool = False) -> str:
+    return "tip" if deg < 3 else ("mouth" if mouth else "junction")
