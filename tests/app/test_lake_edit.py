@@ -10,7 +10,7 @@ import pytest
 import shapely
 
 from app import io_controller
-from tests.app.waits import wait_for, wait_idle
+from tests.app.waits import drag_a_cut_end, wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
@@ -402,7 +402,6 @@ def test_cut_lines_drawn_by_hand_in_any_topology_split_a_lake(qtbot, win, tmp_pa
 def test_with_auto_generate_off_a_drag_greys_the_grid_of_before_until_f5(qtbot, win):
     """Auto-generate is off by default: a dragged cut end moves the layout, not the grid. The grid
     on screen (and its verdict) was shown as current, its block borders off the new cut lines."""
-    from app.layout_edit import handles
 
     assert win.io.import_points(ISEO, project_lonlat=True)
     win.lake_ctl.set_cell_size(300.0)
@@ -412,17 +411,8 @@ def test_with_auto_generate_off_a_drag_greys_the_grid_of_before_until_f5(qtbot, 
     assert not win.solver.auto
     pen = lambda: win.canvas.grid_curve.opts["pen"].color().name()  # noqa: E731
     assert pen() == "#303030" and "before" not in win.lake_quality.headline.text()
-    lay0, grids0 = win.doc.project.layout, dict(win.doc.grids)
-    end = next(h for h in handles(lay0) if h.kind == "end")
-    tool, h = win.canvas.tool, lay0.cell_size
-    path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, 1.5, 4)]
-    assert tool.drag("start", tuple(path[0]), end.xy)
-    for p in path[1:]:
-        tool.drag("move", tuple(p), end.xy)
-        qtbot.wait(30)
-    tool.drag("finish", tuple(path[-1]), end.xy)
-    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
-    wait_idle(qtbot, win)
+    grids0 = dict(win.doc.grids)
+    drag_a_cut_end(qtbot, win, reach=1.5)
     assert all(win.doc.grids[k] is g for k, g in grids0.items())  # no solve: the grid of before
     assert pen() == "#b0b0b0"
     assert "before the last edit" in win.lake_quality.headline.text()

@@ -9,7 +9,7 @@ import pytest
 import shapely
 
 from meshcore import testing
-from tests.app.waits import wait_for, wait_idle
+from tests.app.waits import drag_a_cut_end, wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
@@ -83,22 +83,6 @@ def _laid_out(qtbot, win, tmp_path, seed: int):
     return win.doc.project
 
 
-def _drag_a_cut_end(qtbot, win):
-    from app.layout_edit import handles
-
-    lay0 = win.doc.project.layout
-    end = next(h for h in handles(lay0) if h.kind == "end")
-    tool, h = win.canvas.tool, lay0.cell_size
-    path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, 1.0, 4)]
-    assert tool.drag("start", tuple(path[0]), end.xy)
-    for p in path[1:]:
-        tool.drag("move", tuple(p), end.xy)
-        qtbot.wait(30)
-    tool.drag("finish", tuple(path[-1]), end.xy)
-    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
-    wait_idle(qtbot, win)
-
-
 def test_undo_back_to_the_gridded_layout_makes_its_grid_current_again(qtbot, win, tmp_path):
     """Drag a cut end (auto-generate off: the grid greyed, "of before the last edit"), then undo:
     the layout is the one the grid was made for, yet the grid stayed greyed, its verdict marked
@@ -108,7 +92,7 @@ def test_undo_back_to_the_gridded_layout_makes_its_grid_current_again(qtbot, win
     solved = _laid_out(qtbot, win, tmp_path, 761205)
     grids = dict(win.doc.grids)
     pen = lambda: win.canvas.grid_curve.opts["pen"].color().name()  # noqa: E731
-    _drag_a_cut_end(qtbot, win)
+    drag_a_cut_end(qtbot, win)
     dragged = win.doc.project
     assert pen() == "#b0b0b0" and "before the last edit" in win.lake_quality.headline.text()
     win.stack.undo()

@@ -83,3 +83,23 @@ def wait_for(qtbot, win, done: Callable[[], bool], timeout: int = HANG_MS) -> No
 def wait_idle(qtbot, win, timeout: int = HANG_MS) -> None:
     """Until nothing is being computed (:func:`idle`)."""
     wait_for(qtbot, win, lambda: idle(win), timeout)
+
+
+def drag_a_cut_end(qtbot, win, reach: float = 1.0) -> None:
+    """Drag the first cut end of the layout ``reach`` cells along both axes with the Layout tool,
+    in three moves, and wait until the edit is done and the app idle."""
+    import numpy as np
+
+    from app.layout_edit import handles
+
+    lay0 = win.doc.project.layout
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    tool, h = win.canvas.tool, lay0.cell_size
+    path = [np.add(end.xy, (f * h, f * h)) for f in np.linspace(0, reach, 4)]
+    assert tool.drag("start", tuple(path[0]), end.xy)
+    for p in path[1:]:
+        tool.drag("move", tuple(p), end.xy)
+        qtbot.wait(30)
+    tool.drag("finish", tuple(path[-1]), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
