@@ -29,7 +29,7 @@ import numpy as np
 from .driver import _assemble
 from .shore import arc_lengths, project_to_rings, ring_point
 
-__all__ = ["equalize_interfaces"]
+__all__ = ["equalize_interfaces", "warm_up"]
 
 LIMIT = 2.0  # pairs above this are worked on (issue 12's target)
 AIM = 1.8  # the objective pays beyond this
@@ -388,3 +388,13 @@ def equalize_interfaces(
     if not kept:
         return list(grids), 0
     return [g.replaced(x=P[ids, 0], y=P[ids, 1]) for g, ids in zip(grids, m.ids, strict=True)], kept
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's cache) the objective's kernel with the argument types of
+    :meth:`_Patch.objective` (``meshcore._numba_setup.compile_all``)."""
+    from . import _equalize_kernels
+
+    i4, i5, i3 = (np.zeros((0, k), np.int64) for k in (4, 5, 3))
+    f0, f2, P = np.zeros(0), np.zeros((0, 4)), np.zeros((4, 2))
+    _equalize_kernels.objective(P, i4, f0, f2, i4, i4, 0.5, i5, f0, W_COS, i3, f0, W_EDGE, W_JAC, P.copy())
