@@ -217,6 +217,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.lake_panel.committed.connect(self.focus_canvas)
         self.lake_quality.misses.connect(self.canvas.lake_items.set_misses)
         self.lake_quality.table.clicked.connect(lambda _i: self.show_misses(True))  # a limit picked: show where
+        self.lake_quality.go_to.connect(self.show_worst)
         self.doc.colour_changed.connect(self._misses_for_colours)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
@@ -415,6 +416,16 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.a_misses.isChecked() != bool(on):
             self.a_misses.setChecked(bool(on))
         self.canvas.lake_items.set_misses_visible(on)
+
+    def show_worst(self, where, what: str) -> None:
+        """Zoom to the worst place of a quality limit (four cells round it) and say what it is."""
+        lay = self.doc.project.layout
+        h = lay.cell_size if lay is not None else 0.0
+        if not h > 0:
+            g = self.doc.grid
+            h = max(g.bounds()[2] - g.bounds()[0], g.bounds()[3] - g.bounds()[1]) / 50 if g is not None else 1.0
+        self.canvas.zoom_to_point(where.x, where.y, 4 * h)
+        self.message(f"Worst of {what}: {where}")
 
     def _misses_for_colours(self, label: str) -> None:
         """Cells coloured by a metric: the misses step aside (they would hide the colours), and back."""

@@ -379,6 +379,11 @@ class Canvas(pg.PlotWidget):
         cy = 0.25 * (g.y[i, j] + g.y[i + 1, j] + g.y[i + 1, j + 1] + g.y[i, j + 1])
         self.highlight_item.setData([cx], [cy])
 
+    def zoom_to_point(self, x: float, y: float, radius: float) -> None:
+        """Zoom to the square of half-width ``radius`` round ``(x, y)`` and ring the point."""
+        self.zoom_to((x - radius, y - radius, x + radius, y + radius), margin=0.0)
+        self.highlight_item.setData([x], [y])
+
     def clear_highlight(self) -> None:
         self.highlight_item.setData([], [])
 

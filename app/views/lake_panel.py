@@ -14,7 +14,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from ..document import Document
 
-__all__ = ["LakePanel", "LakeQualityBox", "miss_points"]
+__all__ = ["LakePanel", "LakeQualityBox", "miss_points", "worst_miss"]
 
 AUTO_TEXT = "auto (≈10 000 cells)"
 
@@ -175,14 +175,25 @@ def miss_points(verdict, row: int | None = None) -> np.ndarray:
     return np.vstack(out) if out else np.zeros((0, 2))
 
 
+def worst_miss(verdict, row: int):
+    """The worst place (a :class:`meshcore.quality.lake.Location`) of failed limit ``row``, or None."""
+    if verdict is None or not 0 <= row < len(verdict.results):
+        return None
+    r = verdict.results[row]
+    return r.worst[0] if r.passed is False and r.worst else None
+
+
 class LakeQualityBox(QtWidgets.QGroupBox):
     """A model's limits (Delft3D, EFDC, …) against the lake grid: pass/fail per limit.
 
     ``misses`` carries the places that miss the selected limit (the canvas rings them); a new
-    verdict selects its first failed limit.
+    verdict selects its first failed limit.  A double-click (or Enter) on a failed limit sends its
+    worst place by ``go_to`` (the window zooms to it): the worst cell could be found only by
+    scanning hundreds of orange dots.
     """
 
     misses = QtCore.Signal(object)
+    go_to = QtCore.Signal(object, str)  # the worst Location of a limit, what it misses
 
     def __init__(self, doc: Document, parent=None) -> None:
         super().__init__("Lake grid against a model's limits", parent)
@@ -207,11 +218,15 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.verticalHeader().hide()
         self.table.verticalHeader().setDefaultSectionSize(20)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
-        self.table.setToolTip("select a limit: the places that miss it are marked by orange dots on the canvas")
+        self.table.setToolTip(
+            "select a limit: the places that miss it are marked by orange dots on the canvas; "
+            "double-click it (or Enter): zoom to the worst"
+        )
         lay.addWidget(self.table)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.SingleSelection)
         self.table.itemSelectionChanged.connect(self._row_selected)
+        self.table.activated.connect(lambda index: self.go_to_worst(index.row()))
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)
         # a project without a layout (New, an example) hides the box even when no grid went with it
@@ -265,7 +280,11 @@ class LakeQualityBox(QtWidgets.QGroupBox):
                 self.table.setItem(k, c, it)
         self.table.resizeColumnToContents(0)
         self.table.resizeColumnToContents(1)
-        self.table.setFixedHeight(self.table.horizontalHeader().height() + 21 * len(v.results) + 4)
+        # all the limits when there is room, at least one (it scrolls): a fixed height of all of them
+        # made the window's minimum taller than a laptop's screen (with the Quality panel below)
+        head = self.table.horizontalHeader().height() + 4
+        self.table.setMinimumHeight(head + 21 * min(len(v.results), 1))
+        self.table.setMaximumHeight(head + 21 * len(v.results))
         first = next((k for k, r in enumerate(v.results) if r.passed is False), None)
         if first is None:
             self.table.clearSelection()
@@ -273,6 +292,14 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         else:
             self.table.selectRow(first)
             self._row_selected()
+
+    def go_to_worst(self, row: int) -> bool:
+        """Send the worst place of failed limit ``row`` (``go_to``); False if it has none."""
+        where = worst_miss(self.verdict, row)
+        if where is None:
+            return False
+        self.go_to.emit(where, self.verdict.results[row].limit.label)
+        return True
 
     def _row_selected(self) -> None:
         rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []

@@ -177,6 +177,11 @@ class ConvergencePanel(pg.PlotWidget):
 
 #: the steps of the iteration axis's end, times a power of ten (each at most 1.5 × the one before)
 X_STEPS = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
+#: the smallest heights of the Quality panel's table and histogram: with a lake's verdict above
+#: them the panel's minimum was 593 px and the window's 779-794 px, taller than a 1366×768
+#: screen (its status bar and the docks' bottoms off the screen); they grow when there is room
+MIN_TABLE_HEIGHT = 52
+MIN_HIST_HEIGHT = 44
 
 
 def step_ranges(h: np.ndarray, tolerance: float | None = None):
@@ -223,11 +228,11 @@ class QualityPanel(QtWidgets.QWidget):
         self.table.horizontalHeader().setStretchLastSection(True)
         self.table.verticalHeader().hide()
         self.table.verticalHeader().setDefaultSectionSize(20)
-        self.table.setMinimumHeight(150)
+        self.table.setMinimumHeight(MIN_TABLE_HEIGHT)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         lay.addWidget(self.table, 2)
         self.hist = pg.PlotWidget(background="w")
-        self.hist.setMinimumHeight(110)
+        self.hist.setMinimumHeight(MIN_HIST_HEIGHT)
         self.hist.setLabel("left", "cells")
         for ax in ("left", "bottom"):
             self.hist.getAxis(ax).enableAutoSIPrefix(False)
@@ -237,9 +242,11 @@ class QualityPanel(QtWidgets.QWidget):
         self.hist.addItem(self.hist_curve)
         lay.addWidget(self.hist, 2)
         self.hist.hide()
-        lay.addWidget(QtWidgets.QLabel("Folded / non-convex cells (click to zoom):"))
+        self.folded_label = QtWidgets.QLabel()
+        lay.addWidget(self.folded_label)
         self.folded = QtWidgets.QListWidget()
         self.folded.setMaximumHeight(110)
+        self.folded.hide()  # shown when there is a cell to list (the list's height is room the others need)
         self.folded.itemClicked.connect(self._folded_clicked)
         lay.addWidget(self.folded, 1)
         self.metric.currentTextChanged.connect(doc.set_colour_by)
@@ -256,6 +263,7 @@ class QualityPanel(QtWidgets.QWidget):
         """Show the document's quality report (or nothing)."""
         r, grid = self.doc.quality, self.doc.quality_grid
         self.folded.clear()
+        self._show_folded()
         if r is None:
             self.table.setRowCount(0)
             self.hist_curve.setData([0, 1], [0])
@@ -290,7 +298,16 @@ class QualityPanel(QtWidgets.QWidget):
             it.setForeground(QtGui.QBrush(QtGui.QColor("#d00" if c in fold else "#a60")))
             it.setData(QtCore.Qt.ItemDataRole.UserRole, c)
             self.folded.addItem(it)
+        self._show_folded()
         self._histogram()
+
+    def _show_folded(self) -> None:
+        """The list of folded / non-convex cells, or one line saying there are none."""
+        n = self.folded.count()
+        self.folded.setVisible(n > 0)
+        self.folded_label.setText(
+            "Folded / non-convex cells (click to zoom):" if n else "Folded / non-convex cells: none"
+        )
 
     def _on_colour(self, label: str) -> None:
         if self.metric.currentText() != label:

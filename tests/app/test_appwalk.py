@@ -1,0 +1,56 @@
+"""What the modeller's second afternoon in the app found (session 18): each as it went wrong, on generated shapes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.app.test_modeller import _laid_out
+
+pytestmark = pytest.mark.gui
+
+
+def _draw(win, points) -> None:
+    """Click a loop with the Draw tool and close it (Enter)."""
+    from PySide6 import QtCore
+
+    win.set_tool("draw")
+    for xy in points:
+        win.canvas.tool.click(tuple(xy))
+    win.canvas.tool.key(QtCore.Qt.Key.Key_Return)
+
+
+def _loop(n: int = 12, r: float = 500.0) -> np.ndarray:
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.c_[r * np.cos(t), 0.6 * r * np.sin(t)]
+
+
+def test_the_window_of_a_gridded_lake_fits_a_small_screen(qtbot, win, tmp_path):
+    """With a lake's verdict in the Quality panel the window could not be less than 779 px tall (the
+    verdict table's fixed height over the metrics table, the histogram and the folded-cell list):
+    on a 1366×768 screen its status bar was off the screen.  A 1024×600 screen leaves ~530-560 px."""
+    _laid_out(qtbot, win, tmp_path, 761811)
+    assert win.lake_quality.isVisible() and win.lake_quality.table.rowCount() >= 2
+    assert win.minimumSizeHint().height() <= 545
+    win.resize(1024, 540)
+    qtbot.waitUntil(lambda: win.height() <= 545, timeout=20_000)
+
+
+def test_a_failed_limit_double_clicked_zooms_to_its_worst_place(qtbot, win, tmp_path):
+    """The worst cell of a failed limit could only be found by scanning the orange dots: a
+    double-click (or Enter) on the limit zooms to it, rings it and names it in the status line."""
+    _laid_out(qtbot, win, tmp_path, 761811)
+    box = win.lake_quality
+    row = next(k for k, r in enumerate(box.verdict.results) if r.passed is False)
+    worst = box.verdict.results[row].worst[0]
+    win.canvas.fit()
+    index = box.table.model().index(row, 0)
+    box.table.activated.emit(index)
+    (x0, x1), (y0, y1) = win.canvas._vb.viewRange()
+    assert x0 < worst.x < x1 and y0 < worst.y < y1
+    assert x1 - x0 <= 10 * win.doc.project.layout.cell_size  # zoomed in to a few cells
+    assert list(win.canvas.highlight_item.data["x"]) == [worst.x]
+    assert win._status.text().startswith(f"Worst of {box.verdict.results[row].limit.label}")
+    passed = next((k for k, r in enumerate(box.verdict.results) if r.passed), None)
+    if passed is not None:
+        assert not box.go_to_worst(passed)  # a limit met has no worst place to show
