@@ -4,7 +4,9 @@ At 640×420 the docks kept their contents' minimum widths (the Lake panel ~320 p
 and the drawing area shrank to ~70 px.  Each dock's widget sits in a :class:`QScrollArea`, so a
 dock can be narrower than its contents (they scroll), and :func:`fit_docks` narrows the left and
 right docks to :data:`DOCK_SHARE` of the window each when the drawing area would be less than
-:data:`MIN_CANVAS_SHARE` of it.  Views only: nothing here edits the project.
+:data:`MIN_CANVAS_SHARE` of it; when the window grows again they get back the widths they had
+(session 18: a window snapped to half a 1366 px screen, then maximized, kept docks of 170 px that
+cut the Lake and Quality panels).  Views only: nothing here edits the project.
 """
 
 from __future__ import annotations
@@ -17,6 +19,10 @@ __all__ = ["DOCK_SHARE", "MIN_CANVAS_SHARE", "fit_docks", "narrowable", "scrolle
 MIN_CANVAS_SHARE = 0.45
 #: the share of the window's width a side dock is narrowed to then
 DOCK_SHARE = 0.25
+#: dock properties: its width when the window last had room for it, and whether fit_docks narrowed it
+WIDE_WIDTH, NARROWED = "gcmesh_wide_width", "gcmesh_narrowed"
+#: pixels short of its old width at which a dock counts as given back (resizeDocks rounds, splits)
+BACK_SLACK = 12
 
 
 def scrolled(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
@@ -44,15 +50,46 @@ def narrowable(widget: QtWidgets.QWidget) -> QtWidgets.QWidget:
 
 
 def fit_docks(window: QtWidgets.QMainWindow, canvas: QtWidgets.QWidget, docks) -> bool:
-    """Narrow the visible left and right docks when the drawing area is too narrow; True if it did."""
+    """Narrow the visible left and right docks when the drawing area is too narrow, or widen the
+    docks it narrowed back towards their widths of before when there is room again; True if it did."""
     width = window.width()
-    if width <= 0 or canvas.width() >= MIN_CANVAS_SHARE * width:
+    if width <= 0:
         return False
     area = window.dockWidgetArea
     sides = (QtCore.Qt.DockWidgetArea.LeftDockWidgetArea, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
-    wide = [d for d in docks if d.isVisible() and not d.isFloating() and area(d) in sides]
-    wide = [d for d in wide if d.width() > DOCK_SHARE * width]
+    shown = [d for d in docks if d.isVisible() and not d.isFloating() and area(d) in sides]
+    if canvas.width() >= MIN_CANVAS_SHARE * width:
+        return _widen(window, shown, canvas.width() - MIN_CANVAS_SHARE * width)
+    wide = [d for d in shown if d.width() > DOCK_SHARE * width]
     if not wide:
         return False
+    for d in wide:
+        d.setProperty(NARROWED, True)
     window.resizeDocks(wide, [int(DOCK_SHARE * width)] * len(wide), QtCore.Qt.Orientation.Horizontal)
+    return True
+
+
+def _widen(window: QtWidgets.QMainWindow, shown, spare: float) -> bool:
+    """Give the docks narrowed up to ``spare`` pixels of the drawing area, towards their old widths;
+    remember the width of every other dock (a window with room: as it is, or as set by hand)."""
+    narrowed = []
+    for d in shown:
+        old = d.property(WIDE_WIDTH)
+        if d.property(NARROWED) and old is not None and d.width() < int(old) - BACK_SLACK:
+            narrowed.append((d, int(old)))
+        else:
+            d.setProperty(NARROWED, None)
+            d.setProperty(WIDE_WIDTH, d.width())
+    if not narrowed or spare < 1:
+        return False
+    want: dict = {}  # the docks of one side are one column: the most any of them lacks
+    for d, old in narrowed:
+        side = window.dockWidgetArea(d)
+        want[side] = max(want.get(side, 0), old - d.width())
+    f = min(1.0, spare / sum(want.values()))
+    window.resizeDocks(
+        [d for d, _ in narrowed],
+        [d.width() + int(f * (old - d.width())) for d, old in narrowed],
+        QtCore.Qt.Orientation.Horizontal,
+    )
     return True

@@ -36,6 +36,29 @@ def test_the_window_of_a_gridded_lake_fits_a_small_screen(qtbot, win, tmp_path):
     qtbot.waitUntil(lambda: win.height() <= 545, timeout=20_000)
 
 
+def test_the_side_panels_get_their_width_back_when_the_window_grows(qtbot, win):
+    """A window made small (snapped to half a 1366 px screen) narrowed the side panels to a quarter
+    of it; maximized again they stayed that narrow (~170 px: the Lake and Quality panels cut)."""
+    from app.views.docks import MIN_CANVAS_SHARE
+
+    win.resize(1400, 880)
+    qtbot.waitUntil(lambda: win.width() == 1400 and win.docks["quality"].width() > 0, timeout=20_000)
+    qtbot.wait(300)  # the docks fitted to the new size (fit_docks runs after the resize)
+    left, right = win.docks["params"], win.docks["quality"]
+    before = left.width(), right.width()
+    win.resize(640, 600)
+    qtbot.waitUntil(lambda: left.width() <= 0.3 * 640 and right.width() <= 0.3 * 640, timeout=20_000)
+    small = left.width(), right.width()
+    win.resize(1400, 880)
+
+    def back() -> bool:  # their old widths, or as near as leaves the drawing area its share
+        wide = left.width() >= before[0] - 16 and right.width() >= before[1] - 16
+        return wide or win.canvas.width() <= MIN_CANVAS_SHARE * win.width() + 8
+
+    qtbot.waitUntil(lambda: win.width() == 1400 and back(), timeout=20_000)
+    assert left.width() > small[0] + 40 and right.width() > small[1] + 40
+
+
 def test_a_failed_limit_double_clicked_zooms_to_its_worst_place(qtbot, win, tmp_path):
     """The worst cell of a failed limit could only be found by scanning the orange dots: a
     double-click (or Enter) on the limit zooms to it, rings it and names it in the status line."""
