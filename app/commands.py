@@ -20,6 +20,7 @@ from .document import Document
 from .project import Block, Project
 
 __all__ = [
+    "DRAWN_TITLE",
     "AddBlock",
     "AddCutLine",
     "AddPoint",
@@ -34,6 +35,7 @@ __all__ = [
     "SetCorners",
     "SetLake",
     "SetSolver",
+    "drawn_title",
 ]
 
 _MERGE_ID = 4711
@@ -117,6 +119,19 @@ class SetLake(ProjectCommand):
 
 _drag_ids = itertools.count(1)
 
+#: the title of a project whose outline was drawn by clicking (no file named it, no background image)
+DRAWN_TITLE = "drawn lake"
+
+
+def drawn_title(project: Project) -> str:
+    """The title of a drawn outline: the background image it was traced on (its file name), else
+    :data:`DRAWN_TITLE`."""
+    from pathlib import Path
+
+    bg = project.background
+    stem = Path(bg.path).stem.strip() if bg is not None and bg.path else ""
+    return stem or DRAWN_TITLE
+
 
 class Editor:
     """Turns intentions into commands pushed on the undo stack."""
@@ -163,10 +178,14 @@ class Editor:
         self._edit_block(AddPoint, lambda b: pj.with_point_added(b, xy), "Add point")
 
     def close_loop(self) -> None:
+        """Close the drawn loop; a project without a title is titled by it (:func:`drawn_title`),
+        in the same step: a lake drawn by clicking was "untitled" in the window and the Save name."""
         b = self.doc.block
-        if b.closed or len(b.points) < 3:
+        if b.closed or len(b.points) < 3 or self._locked():
             return
-        self._edit_block(CloseLoop, pj.with_loop_closed, "Close boundary")
+        p = self.doc.project
+        after = p.with_block(self.doc.active, pj.with_loop_closed(b))
+        self._push(CloseLoop, after if p.title else after.replaced(title=drawn_title(p)), "Close boundary")
 
     def move_points(self, indices, delta, drag_id=None) -> None:
         key = ("move", drag_id) if drag_id is not None else None

@@ -25,6 +25,38 @@ def _loop(n: int = 12, r: float = 500.0) -> np.ndarray:
     return np.c_[r * np.cos(t), 0.6 * r * np.sin(t)]
 
 
+def test_a_drawn_lake_is_titled_in_the_window_and_the_save_name(qtbot, win, tmp_path, monkeypatch):
+    """A lake drawn by clicking was "untitled" in the window title and in the name Save offered."""
+    from PySide6 import QtWidgets
+
+    from app.commands import DRAWN_TITLE
+
+    _draw(win, _loop())
+    assert win.doc.block.closed
+    assert win.doc.project.title == DRAWN_TITLE
+    assert win.windowTitle().startswith(f"{DRAWN_TITLE} *")
+    offered = []
+
+    def dialog(_parent, _caption, directory, _filter):
+        offered.append(directory)
+        return "", ""
+
+    monkeypatch.setattr(QtWidgets.QFileDialog, "getSaveFileName", dialog)
+    win.io.remember_dir(tmp_path / "x")
+    win.io.save_as()
+    assert offered == [str(tmp_path / f"{DRAWN_TITLE}.toml")]
+    win.stack.undo()  # the title goes with the closing of the loop
+    assert win.doc.project.title == "" and not win.doc.block.closed
+
+
+def test_a_lake_traced_on_a_background_image_is_titled_by_the_image(qtbot, win):
+    from app.commands import drawn_title
+    from app.project import Background
+
+    p = win.doc.project.replaced(background=Background("/maps/Lago di Tovel 1-10000.png", None))
+    assert drawn_title(p) == "Lago di Tovel 1-10000"
+
+
 def test_the_window_of_a_gridded_lake_fits_a_small_screen(qtbot, win, tmp_path):
     """With a lake's verdict in the Quality panel the window could not be less than 779 px tall (the
     verdict table's fixed height over the metrics table, the histogram and the folded-cell list):
