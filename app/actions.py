@@ -39,6 +39,7 @@ class ActionSpec:
     checked: bool = False  # the initial state of a checkable action
     enabled: bool = True
     help: str = ""  # the line in Help ▸ Keyboard shortcuts (default: the text)
+    short: str = ""  # the toolbar's text, when shorter than the menu's (default: the text)
 
 
 def _tool_rows() -> tuple[ActionSpec, ...]:
@@ -61,9 +62,13 @@ def _tool_rows() -> tuple[ActionSpec, ...]:
 ACTIONS: tuple[ActionSpec, ...] = (
     # File
     ActionSpec("new", "&New", "io.new_project", (K.New,), menu="&File", help="new project"),
-    ActionSpec("open", "&Open project…", "io.open_dialog", (K.Open,), menu="&File", toolbar=1.1, help="open"),
+    ActionSpec(
+        "open", "&Open project…", "io.open_dialog", (K.Open,), menu="&File", toolbar=1.1, help="open", short="Open…"
+    ),
     ActionSpec("recent", "Open &recent", "@recent", menu="&File"),
-    ActionSpec("save", "&Save project", "io.save", (K.Save,), menu="&File", toolbar=1.3, help="save project"),
+    ActionSpec(
+        "save", "&Save project", "io.save", (K.Save,), menu="&File", toolbar=1.3, help="save project", short="Save"
+    ),
     ActionSpec("save_as", "Save project &as…", "io.save_as", (K.SaveAs,), menu="&File"),
     ActionSpec(
         "import",
@@ -75,6 +80,7 @@ ACTIONS: tuple[ActionSpec, ...] = (
         separator=True,
         toolbar=1.2,
         help="import boundary points (or drop a file on the window)",
+        short="Import…",
     ),
     ActionSpec("bg", "Load &background image…", "background.dialog", menu="&File"),
     ActionSpec("calib", "&Calibrate background by two points", "@tool:calibrate", menu="&File"),
@@ -171,9 +177,10 @@ ACTIONS: tuple[ActionSpec, ...] = (
         "&Generate",
         toolbar=4.4,
         checkable=True,
+        short="Live",
     ),
     # View
-    ActionSpec("fit", "&Fit view", "canvas.fit", ("F",), menu="&View", toolbar=5, help="fit the view"),
+    ActionSpec("fit", "&Fit view", "canvas.fit", ("F",), menu="&View", toolbar=5, help="fit the view", short="Fit"),
     ActionSpec(
         "grid_lines",
         "&Grid lines",
@@ -277,6 +284,9 @@ def _caller(window, spec: ActionSpec):
 def _describe(a: QtGui.QAction, spec: ActionSpec) -> None:
     if spec.shortcuts:
         a.setShortcuts([_sequence(s) for s in spec.shortcuts])
+    if spec.short:  # a text-only toolbar shows the icon text: at 1024 px Pause, Stop and Fit were behind »
+        a.setIconText(spec.short)
+        a.setToolTip(spec.text.replace("&", ""))  # (a tip below replaces it)
     if spec.tip:
         a.setToolTip(spec.tip)
         a.setStatusTip(spec.tip)

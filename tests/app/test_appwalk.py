@@ -109,3 +109,18 @@ def test_a_failed_limit_double_clicked_zooms_to_its_worst_place(qtbot, win, tmp_
     passed = next((k for k, r in enumerate(box.verdict.results) if r.passed), None)
     if passed is not None:
         assert not box.go_to_worst(passed)  # a limit met has no worst place to show
+
+
+def test_every_toolbar_button_shows_in_a_1024_px_window(qtbot, win):
+    """At 1024 px (a small laptop) Pause, Stop, Auto-generate and Fit view were behind the
+    toolbar's » (Stop only by its key, Esc): the toolbar says "Open…", "Import…", "Save", the menus
+    say it in full."""
+    from PySide6 import QtWidgets
+
+    win.resize(1024, 600)
+    qtbot.waitUntil(lambda: win.width() == 1024, timeout=20_000)
+    tb = win.findChild(QtWidgets.QToolBar, "main-toolbar")
+    qtbot.waitUntil(lambda: tb.width() > 0 and tb.width() <= 1024, timeout=20_000)
+    hidden = [a.iconText() for a in tb.actions() if not a.isSeparator() and not tb.widgetForAction(a).isVisible()]
+    assert hidden == [], (hidden, tb.sizeHint().width())
+    assert win.a_open.text() == "&Open project…" and win.a_open.iconText() == "Open…"
