@@ -388,6 +388,8 @@ class IOController(QtCore.QObject):
         lay = self.doc.project.layout
         if lay is None or Path(path).suffix.lower() != ".ddb" or self.doc.project.lake.regular:
             return False
+        if len(lay.blocks) < 2:  # nothing to couple: the error says to write a .grd (no layout helps)
+            return False
         text = (
             f"Cannot export {Path(path).name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
             "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"

@@ -124,3 +124,19 @@ def test_every_toolbar_button_shows_in_a_1024_px_window(qtbot, win):
     hidden = [a.iconText() for a in tb.actions() if not a.isSeparator() and not tb.widgetForAction(a).isVisible()]
     assert hidden == [], (hidden, tb.sizeHint().width())
     assert win.a_open.text() == "&Open project…" and win.a_open.iconText() == "Open…"
+
+
+def test_a_one_block_lake_exported_as_ddb_is_told_to_write_a_grd_not_to_lay_out_again(qtbot, win, tmp_path):
+    """A lake in one block exported as .ddb said "needs at least two blocks; write one block as
+    .grd" followed by "… couples no corner where 3 or 5 blocks meet: Lake ▸ Auto layout, regular
+    makes a layout it can write" (and offered that layout), which has nothing to couple either."""
+    _laid_out(qtbot, win, tmp_path, 761999)
+    win.lake_ctl.set_cell_size(4 * win.doc.project.layout.cell_size)  # this lake in one block
+    win.a_auto_layout.trigger()
+    from tests.app.waits import wait_for, wait_idle
+
+    wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
+    wait_idle(qtbot, win)
+    assert win.lake_ctl.last_error is None and len(win.doc.project.layout.blocks) == 1
+    assert not win.io.export_mesh(tmp_path / "lake.ddb")
+    assert ".grd" in win._status.text() and "regular" not in win._status.text()
