@@ -170,11 +170,16 @@ class SolveStatus(QtCore.QObject):
         m = self.doc.lake_metrics
         dt = self.solver.t_done - self.solver.t_start
         cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
-        self.label.setText(f"orthogonal: {info.iterations} sweeps, {dt:.1f} s")
+        # stopped (Stop, Esc): the grid as the sweeps left it, without the finest level's repair and the
+        # interface equalizing; it was summed up as a finished grid, nothing said it was not
+        stopped = not info.converged and info.message == "stopped"
+        done = f"stopped after {info.iterations} sweeps" if stopped else f"{info.iterations} sweeps"
+        self.label.setText(f"orthogonal: {done}, {dt:.1f} s")
         folded = int(m.values("folded").sum()) if m is not None else 0
         warn = f" — {folded} FOLDED or non-convex cells" if folded else ""
         mean = f", mean deviation from 90° {m.mean('deviation'):.2f}°" if m is not None else ""
-        self.win.message(f"Lake grid: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
+        what = "Lake grid, stopped before it was finished (F5 makes it again)" if stopped else "Lake grid"
+        self.win.message(f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
 
     def report_notes(self) -> None:
         """Repairs, corner advice and other notes of the solver, in full, in the message panel."""

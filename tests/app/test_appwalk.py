@@ -140,3 +140,18 @@ def test_a_one_block_lake_exported_as_ddb_is_told_to_write_a_grd_not_to_lay_out_
     assert win.lake_ctl.last_error is None and len(win.doc.project.layout.blocks) == 1
     assert not win.io.export_mesh(tmp_path / "lake.ddb")
     assert ".grd" in win._status.text() and "regular" not in win._status.text()
+
+
+def test_a_stopped_lake_grid_is_summed_up_as_stopped(qtbot, win, tmp_path):
+    """Stop (Esc) during a lake solve on its finest level: the grid as the sweeps left it (without the
+    finest level's repair and the interfaces made alike) was summed up as "Lake grid: 16 blocks,
+    7,296 cells …", "orthogonal: 60 sweeps, 7.8 s", as a finished grid is."""
+    import dataclasses
+
+    _laid_out(qtbot, win, tmp_path, 761811)
+    mb = win.doc.multiblock
+    assert not win._status.text().startswith("Lake grid, stopped")
+    info = dataclasses.replace(mb.info, converged=False, message="stopped")
+    win.solve_status._lake_final(dataclasses.replace(mb, info=info))
+    assert win._status.text().startswith("Lake grid, stopped before it was finished")
+    assert "stopped after" in win.solve_status.label.text()
