@@ -42,6 +42,7 @@ __all__ = [
     "place",
     "settled_layout",
     "shore_points",
+    "with_cut",
     "without_cut",
 ]
 
@@ -398,4 +399,25 @@ def without_cut(layout: Any, k: int) -> Any:
         q = ring.representative_point()
         corners[(q.x, q.y)] = [piece.ring[i] for i in piece.corners]
     cuts = [c for j, c in enumerate(layout.cuts) if j != k]
+    return layout_from_cuts(layout.polygon, cuts, cell_size=layout.cell_size, multiple=layout.multiple, corners=corners)
+
+
+def with_cut(layout: Any, cut: Any) -> Any:
+    """``layout`` with a cut line drawn by hand (its ends snap to the shore, an island or a cut): the
+    blocks it crosses are parted and cornered where their parts turn
+    (:func:`meshcore.layout.edit.layout_from_cuts`); every other block keeps its corners, and the
+    cells follow from the layout's cell size."""
+    from shapely.geometry import LineString, Polygon
+
+    from meshcore.layout.edit import layout_from_cuts
+
+    line = LineString(np.asarray(cut, float))
+    corners = {}
+    for piece in layout.pieces:
+        ring = Polygon(piece.ring)
+        if ring.intersection(line).length > 1e-6 * layout.cell_size:  # a block the new cut parts
+            continue
+        q = ring.representative_point()
+        corners[(q.x, q.y)] = [piece.ring[i] for i in piece.corners]
+    cuts = [*layout.cuts, np.asarray(cut, float)]
     return layout_from_cuts(layout.polygon, cuts, cell_size=layout.cell_size, multiple=layout.multiple, corners=corners)

@@ -167,6 +167,7 @@ class MainWindow(QtWidgets.QMainWindow):
         }
         self.tools["draw"].on_closed = lambda: self.set_tool("corners")
         self.tools["layout"].controller = self.lake_ctl
+        self.tools["cut"].controller = self.lake_ctl
 
     def _placeholder(self, name: str, menu: QtWidgets.QMenu, spec: actions.ActionSpec):
         """Fill the ``@name`` rows of the action table (see :func:`app.actions.build`)."""

@@ -270,7 +270,7 @@ class CutTool(Tool):
     shortcut = "L"
     tip = (
         "Cut line: click a polyline from shore to shore, double-click or Enter to finish; "
-        "then Block ▸ Split into blocks by cut lines (Ctrl+K)"
+        "then Block ▸ Split into blocks by cut lines (Ctrl+K) — over a lake's layout it parts the blocks it crosses"
     )
 
     def __init__(self, *a, **kw) -> None:
@@ -296,9 +296,18 @@ class CutTool(Tool):
             return True
         return False
 
+    controller = None  # the window's LakeController: a cut drawn over a lake's layout goes into it
+
     def _finish(self) -> None:
         if len(self.points) >= 2:
-            self.editor.add_cut_line(np.array(self.points))
+            lay = self.doc.project.layout
+            if lay is not None and self.controller is not None:  # it was refused ("change it in the Lake panel")
+                from .layout_edit import with_cut
+
+                cut = np.array(self.points)
+                self.controller.edit_layout(lambda: with_cut(lay, cut), "Add cut line")
+            else:
+                self.editor.add_cut_line(np.array(self.points))
         self.points = []
         self._show()
 

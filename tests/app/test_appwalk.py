@@ -155,3 +155,58 @@ def test_a_stopped_lake_grid_is_summed_up_as_stopped(qtbot, win, tmp_path):
     win.solve_status._lake_final(dataclasses.replace(mb, info=info))
     assert win._status.text().startswith("Lake grid, stopped before it was finished")
     assert "stopped after" in win.solve_status.label.text()
+
+
+def _chord_across(piece_ring) -> np.ndarray:
+    """A line across a block (the polygon ``piece_ring``) through its middle, the short way."""
+    import shapely
+    from shapely.geometry import LineString, Polygon
+
+    block = Polygon(piece_ring)
+    box = np.asarray(block.minimum_rotated_rectangle.exterior.coords)[:4]
+    sides = [box[1] - box[0], box[2] - box[1]]
+    short = min(sides, key=lambda v: np.hypot(*v))
+    c = np.asarray(block.representative_point().coords[0])
+    line = LineString([c - 10 * short, c + 10 * short]).intersection(block.buffer(-1e-6 * block.length))
+    parts = getattr(line, "geoms", [line])
+    best = min(parts, key=lambda g: g.distance(shapely.Point(c)))
+    return np.asarray(best.coords)[[0, -1]]
+
+
+def test_a_cut_drawn_over_a_lake_layout_parts_the_block_it_crosses_and_auto_layout_is_undoable(qtbot, win, tmp_path):
+    """With a layout, the Cut line tool took the modeller's clicks and then said "These blocks are the
+    lake's layout: change it in the Lake panel … or Clear layout": a cut across an arm could only be
+    drawn after throwing the layout away.  It parts the block it crosses now (one undo step); Auto
+    layout after it makes a new layout, and Ctrl+Z brings the hand-made one back."""
+    from PySide6 import QtCore
+
+    from tests.app.waits import wait_for, wait_idle
+
+    _laid_out(qtbot, win, tmp_path, 761811)
+    lay0 = win.doc.project.layout
+    big = max(lay0.pieces, key=lambda p: np.prod(lay0.blocks[lay0.pieces.index(p)].cells))
+    a, b = _chord_across(big.ring)
+    win.set_tool("cut")
+    win.canvas.tool.click(tuple(a))
+    win.canvas.tool.click(tuple(b))
+    win.canvas.tool.key(QtCore.Qt.Key.Key_Return)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
+    cut = win.doc.project.layout
+    assert win.lake_ctl.edit_error is None
+    assert len(cut.blocks) == len(lay0.blocks) + 1 and len(cut.cuts) == len(lay0.cuts) + 1
+    assert win.stack.undoText() == "Add cut line"
+
+    def corners(lb):
+        return frozenset((round(x, 6), round(y, 6)) for x, y in lb.corners)
+
+    kept = {corners(lb) for k, lb in enumerate(lay0.blocks) if lay0.pieces[k] is not big}
+    assert kept and kept <= {corners(lb) for lb in cut.blocks}  # the blocks it does not cross keep their corners
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
+    wait_idle(qtbot, win)
+    assert len(win.doc.project.layout.cuts) == len(lay0.cuts)  # a new layout: the hand-drawn cut is not in it
+    win.stack.undo()
+    assert win.doc.project.layout is cut
+    win.stack.undo()
+    assert win.doc.project.layout is lay0
