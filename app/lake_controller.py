@@ -183,6 +183,7 @@ class LakeController(QtCore.QObject):
         )
         self.layout_done.emit(layout)
         self.win.set_tool("layout")
+        self.win.show_lake()  # its blocks, cells and cell size (Parameters stayed in front: ξ, η of a block it locks)
         if self.generate_after:
             self.win.generate()
 

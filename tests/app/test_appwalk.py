@@ -210,3 +210,20 @@ def test_a_cut_drawn_over_a_lake_layout_parts_the_block_it_crosses_and_auto_layo
     assert win.doc.project.layout is cut
     win.stack.undo()
     assert win.doc.project.layout is lay0
+
+
+def test_auto_layout_of_a_drawn_lake_brings_the_lake_panel_to_the_front(qtbot, win):
+    """A lake drawn and laid out (Ctrl+L) left the Parameters panel in front: the ξ, η and weights of
+    one block, which the layout locks ("These blocks are the lake's layout"), over the Lake panel
+    with the blocks, their cells and the cell size."""
+    from tests.app.waits import wait_for, wait_idle
+
+    win.docks["params"].raise_()
+    qtbot.waitUntil(lambda: win.docks["lake"].visibleRegion().isEmpty(), timeout=20_000)
+    _draw(win, _loop(r=5000.0))
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
+    assert win.lake_ctl.last_error is None
+    qtbot.waitUntil(lambda: not win.docks["lake"].visibleRegion().isEmpty(), timeout=20_000)  # its tab in front
+    assert win.docks["params"].visibleRegion().isEmpty()
+    wait_idle(qtbot, win)
