@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from PySide6 import QtWidgets
 
 from tests.app.test_modeller import _laid_out
 
@@ -115,8 +116,6 @@ def test_every_toolbar_button_shows_in_a_1024_px_window(qtbot, win):
     """At 1024 px (a small laptop) Pause, Stop, Auto-generate and Fit view were behind the
     toolbar's » (Stop only by its key, Esc): the toolbar says "Open…", "Import…", "Save", the menus
     say it in full."""
-    from PySide6 import QtWidgets
-
     win.resize(1024, 600)
     qtbot.waitUntil(lambda: win.width() == 1024, timeout=20_000)
     tb = win.findChild(QtWidgets.QToolBar, "main-toolbar")
@@ -227,3 +226,16 @@ def test_auto_layout_of_a_drawn_lake_brings_the_lake_panel_to_the_front(qtbot, w
     qtbot.waitUntil(lambda: not win.docks["lake"].visibleRegion().isEmpty(), timeout=20_000)  # its tab in front
     assert win.docks["params"].visibleRegion().isEmpty()
     wait_idle(qtbot, win)
+
+
+def test_the_keyboard_help_fits_a_600_px_screen(qtbot, win):
+    """Help ▸ Keyboard shortcuts was a message box of one column of 35 rows: ~620 px tall under Xvfb
+    (814 offscreen, on a screen of 800), its OK button below a 1024×600 screen.  Two columns, in a
+    window that scrolls when the screen is smaller."""
+    dlg = win.show_shortcuts()
+    qtbot.waitExposed(dlg)
+    screen = win.screen().availableGeometry()
+    assert dlg.height() <= 0.9 * screen.height() and dlg.width() <= min(1000, screen.width()), (dlg.size(), screen)
+    text = dlg.findChild(QtWidgets.QLabel).text()
+    assert "verdict row" in text and "Ctrl+L" in text
+    dlg.close()
