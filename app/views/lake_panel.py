@@ -271,10 +271,16 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             else:
                 stat = f"mean {r.value:.3g}" if r.limit.statistic == "mean" else f"{100 * r.value:.1f} % ok"
                 text, colour = (f"pass ({stat})", "#070") if r.passed else (f"FAIL ({stat})", "#c00")
-            cells = [text, str(r.n_failed), r.limit.label]
+            # a limit on the mean has no misses of its own (its 'miss' was the count over the value,
+            # 653 beside 'pass (mean 1.67)' with efdc): a dash; the tooltip keeps the count
+            miss = str(r.n_failed) if r.limit.statistic == "each" else "–"
+            cells = [text, miss, r.limit.label]
             for c, t in enumerate(cells):
                 it = QtWidgets.QTableWidgetItem(t)
-                it.setToolTip(f"{r.limit.label}: {text}, {r.n_failed} miss")
+                over = "" if r.limit.statistic == "each" else f" (over {r.limit.max:g} each: {r.n_failed})"
+                it.setToolTip(
+                    f"{r.limit.label}: {text}{over}" if over else f"{r.limit.label}: {text}, {r.n_failed} miss"
+                )
                 if c == 0:
                     it.setForeground(QtGui.QBrush(QtGui.QColor(colour)))
                 self.table.setItem(k, c, it)

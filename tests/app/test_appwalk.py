@@ -239,3 +239,17 @@ def test_the_keyboard_help_fits_a_600_px_screen(qtbot, win):
     text = dlg.findChild(QtWidgets.QLabel).text()
     assert "verdict row" in text and "Ctrl+L" in text
     dlg.close()
+
+
+def test_a_limit_on_the_mean_shows_no_misses_beside_its_pass(qtbot, win, tmp_path):
+    """With the efdc preset the row "pass (mean 1.67)" had "653" in its miss column: the cells over
+    the value, which that limit does not count as misses.  A dash now."""
+    _laid_out(qtbot, win, tmp_path, 761811)
+    box = win.lake_quality
+    box.preset.setCurrentText("efdc")
+    rows = [k for k, r in enumerate(box.verdict.results) if r.limit.statistic == "mean"]
+    assert rows
+    for k in rows:
+        assert box.table.item(k, 1).text() == "–"
+    each = [k for k, r in enumerate(box.verdict.results) if r.limit.statistic == "each"]
+    assert [box.table.item(k, 1).text() for k in each] == [str(box.verdict.results[k].n_failed) for k in each]
