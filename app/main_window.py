@@ -510,41 +510,14 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # --------------------------------------------------------------- help
     def show_shortcuts(self) -> QtWidgets.QDialog:
-        """The keys and gestures in two columns, in a window that scrolls and stays open beside the work
-        (a message box of one column was 620-814 px tall: its OK button below a 600 px screen)."""
-        rows = actions.shortcut_rows()
-        half = (len(rows) + 1) // 2
-        cell = "<td><b>{}</b></td><td>&nbsp;&nbsp;{}&nbsp;&nbsp;&nbsp;&nbsp;</td>"
-        lines = []
-        for k in range(half):
-            right = rows[half + k] if half + k < len(rows) else ("", "")
-            lines.append(f"<tr>{cell.format(*rows[k])}{cell.format(*right)}</tr>")
-        label = QtWidgets.QLabel(f"<table>{''.join(lines)}</table>")
-        label.setTextInteractionFlags(QtCore.Qt.TextInteractionFlag.TextSelectableByMouse)
-        label.setWordWrap(True)  # long lines wrap in their column (no sideways scrolling)
-        dlg = QtWidgets.QDialog(self)
-        dlg.setWindowTitle("Keyboard shortcuts")
-        area = QtWidgets.QScrollArea()
-        area.setWidget(label)
-        area.setWidgetResizable(True)
-        ok = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.StandardButton.Ok)
-        ok.accepted.connect(dlg.accept)
-        lay = QtWidgets.QVBoxLayout(dlg)
-        lay.addWidget(area)
-        lay.addWidget(ok)
-        screen = (self.screen() or QtGui.QGuiApplication.primaryScreen()).availableGeometry()
-        width = min(900, int(0.9 * screen.width()))
-        dlg.resize(width, min(label.heightForWidth(width - 60) + 90, int(0.85 * screen.height())))
-        self.shortcuts_dialog = dlg
-        dlg.show()
-        return dlg
+        """Help ▸ Keyboard shortcuts (:func:`app.views.help.shortcuts_dialog`)."""
+        from .views.help import shortcuts_dialog
+
+        self.shortcuts_dialog = shortcuts_dialog(self)
+        return self.shortcuts_dialog
 
     def show_about(self) -> None:
-        import meshcore
+        """Help ▸ About (:func:`app.views.help.show_about`)."""
+        from .views.help import show_about
 
-        QtWidgets.QMessageBox.about(
-            self,
-            "About gcmesh",
-            f"<b>gcmesh</b> {meshcore.__version__}<br>Structured boundary-fitted grids in generalized "
-            "coordinates: algebraic start grid + Thompson–Thames–Mastin / Winslow elliptic smoothing.",
-        )
+        show_about(self)

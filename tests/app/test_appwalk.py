@@ -253,3 +253,11 @@ def test_a_limit_on_the_mean_shows_no_misses_beside_its_pass(qtbot, win, tmp_pat
         assert box.table.item(k, 1).text() == "–"
     each = [k for k, r in enumerate(box.verdict.results) if r.limit.statistic == "each"]
     assert [box.table.item(k, 1).text() for k in each] == [str(box.verdict.results[k].n_failed) for k in each]
+
+
+def test_about_says_what_the_app_does_for_a_lake_and_where_its_log_is(qtbot, win, monkeypatch):
+    """Help ▸ About named the paper's method only: not lakes, nor the log a bug report needs."""
+    shown = []
+    monkeypatch.setattr(QtWidgets.QMessageBox, "about", lambda _parent, _title, text: shown.append(text))
+    win.show_about()
+    assert "Auto layout" in shown[0] and "gcmesh.log" in shown[0]
