@@ -209,7 +209,9 @@ def _warm(layout, warm, stop_event, hold=None):
     msg = f"orthogonal grid from the previous one (full level only), {res.sweeps} sweeps"
     info = SolveInfo(method="orthogonal", converged=True, iterations=res.sweeps, elapsed=res.elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
-    mb = MultiBlockGrid(tuple(res.grids), names, topo.interfaces, "orthogonal", info, topo)
+    mb = MultiBlockGrid(
+        tuple(res.grids), names, topo.interfaces, "orthogonal", _stopped(info) if stopped else info, topo
+    )
     # stopped: no metrics (on a big lake they would only delay the next edit's solve; the document
     # measures a grid it keeps without them)
     moved = BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb)
@@ -218,7 +220,19 @@ def _warm(layout, warm, stop_event, hold=None):
     if stopped or (stop_event is not None and stop_event.is_set()):
         return moved
     final = yield from _cold(layout, stop_event, shown=False, before=(tuple(history), warm_level, res.sweeps))
-    return final if final.grids else moved
+    if final.grids:
+        return final
+    # the remake stopped (Esc, F5 on a grid): the warm grid stays, said to be stopped (it was summed up as
+    # finished: 'orthogonal: 60 sweeps', without the coarse-to-fine remake, its repairs and equalizing)
+    mb = MultiBlockGrid(tuple(res.grids), names, topo.interfaces, "orthogonal", _stopped(info), topo)
+    return BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb)
+
+
+def _stopped(info):
+    """``info`` of a solve that was stopped before its end (``converged`` False, message "stopped")."""
+    import dataclasses
+
+    return dataclasses.replace(info, converged=False, message="stopped")
 
 
 def _metrics(layout, mb):

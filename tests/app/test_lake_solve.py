@@ -126,3 +126,27 @@ def test_an_unheld_warm_solve_never_waits():
     hold.set()
     _drain(solve_layout(lake, warm=warm, hold=hold), items)
     assert any(not ev.grids for ev in items)  # it went on to the final solve by itself
+
+
+def test_a_warm_solve_stopped_in_its_final_remake_returns_its_live_grid_as_stopped():
+    """Esc (or Stop) while F5 remade a grid from the previous one: the remake, stopped, gave no grid,
+    and the warm grid it kept was said to be finished ("orthogonal: 60 sweeps", converged): the
+    status line summed it up as a finished lake grid.  It is "stopped" now, as a cold solve stopped."""
+    lake, warm = _dragged("y junction")
+    stop = threading.Event()
+    items: list = []
+    gen = solve_layout(lake, warm=warm, stop_event=stop)
+    try:
+        while True:
+            ev = next(gen)[1]
+            items.append(ev)
+            if not ev.grids and ev.iteration > 0:  # the remake (unseen) has begun: stop it
+                stop.set()
+    except StopIteration as fin:
+        result = fin.value
+    assert stop.is_set() and result.grids
+    live = next(ev.grids for ev in reversed(items) if ev.grids)
+    for k, g in enumerate(live):  # the warm grid stays
+        np.testing.assert_array_equal(result.grids[k].x, g.x)
+    info = result.multiblock.info
+    assert not info.converged and info.message == "stopped"
