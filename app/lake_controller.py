@@ -298,7 +298,8 @@ class LakeController(QtCore.QObject):
         text = f"{name}: {why}. One block would give a poor grid; Auto layout splits the lake into blocks."
         self.doc.report("info", text)
         box = QtWidgets.QMessageBox(self.win)
-        box.setWindowTitle("A branched lake")
+        # what the message says is poor about one block (it was "A branched lake" over "6 island(s)")
+        box.setWindowTitle("Islands in the lake" if "island" in why and "arm" not in why else "A branched lake")
         box.setIcon(QtWidgets.QMessageBox.Icon.Question)
         box.setText(text)
         box.setModal(False)

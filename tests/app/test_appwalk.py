@@ -261,3 +261,14 @@ def test_about_says_what_the_app_does_for_a_lake_and_where_its_log_is(qtbot, win
     monkeypatch.setattr(QtWidgets.QMessageBox, "about", lambda _parent, _title, text: shown.append(text))
     win.show_about()
     assert "Auto layout" in shown[0] and "gcmesh.log" in shown[0]
+
+
+def test_the_layout_offer_after_importing_a_lake_with_islands_is_not_titled_branched(qtbot, win, tmp_path):
+    """Importing a round lake with islands offered Auto layout in a box titled "A branched lake" over
+    "…: 3 island(s). One block would give a poor grid"."""
+    from tests.app.test_modeller import _metres_lake
+
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761811))
+    box = win.lake_ctl.prompt
+    assert box is not None and "island(s)" in box.text()
+    assert box.windowTitle() == "Islands in the lake"
