@@ -254,6 +254,7 @@ def mesh_outline(
     strict: bool = False,
     thin_arms: bool = False,
     mouths: bool = False,
+    curve: bool = False,
     **options: Any,
 ):
     """A model-ready multiblock grid of a lake outline (projected coordinates, e.g. metres).
@@ -278,6 +279,9 @@ def mesh_outline(
         (:func:`~meshcore.layout.auto_layout`).
     mouths : bool
         Junction chords at the mouths of arms 4–7 cells wide (:func:`~meshcore.layout.auto_layout`).
+    curve : bool
+        The shore between the outline's points as a smooth curve through them, not its straight
+        segments (:mod:`meshcore.layout.curve`; off: measured mixed).
 
     Returns
     -------
@@ -297,6 +301,7 @@ def mesh_outline(
         regular=regular,
         thin_arms=thin_arms,
         mouths=mouths,
+        curve=curve,
     )
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics

@@ -81,6 +81,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="no corner where 3 or 5 blocks meet (what Delft3D domain decomposition couples; implied by .ddb)",
     )
     p.add_argument(
+        "--curve",
+        action="store_true",
+        help="the shore as a smooth curve through the outline's points, not its straight segments "
+        "(outlines with a point every few cells; see docs/lake-grids.md)",
+    )
+    p.add_argument(
         "-o",
         "--output",
         action="append",
@@ -305,7 +311,7 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
     from ..layout import auto_layout
 
     try:
-        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular)
+        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular, curve=args.curve)
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)
         raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None

@@ -37,6 +37,7 @@ import numpy as np
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from .blocks import block_counts
 from .build import layout_pieces
+from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
 from .model import Layout, LayoutBlock
@@ -58,6 +59,7 @@ def auto_layout(
     regular: bool = False,
     thin_arms: bool = False,
     mouths: bool = False,
+    curve: bool = False,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -88,6 +90,10 @@ def auto_layout(
         At junctions of three or four arms up to seven cells wide, each arm's chord at its
         mouth, through the reflex shore corners between the arms (default: just outside the
         junction's inscribed circle; :func:`~.chords.place_chords`).  Off: measured mixed.
+    curve : bool
+        The shore between the outline's points as a smooth curve through them (corners
+        sharper than 60° kept, at most a quarter cell from the straight segments;
+        :mod:`.curve`).  Off (the grid follows the straight segments): measured mixed.
 
     Returns
     -------
@@ -107,6 +113,9 @@ def auto_layout(
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
     more = more + slivers + arms
+    if curve:
+        poly, curved = curved_shore(poly, h)
+        more = more + curved
     shores = shore_at_scale(poly, h)
     if shores.change is not None:
         more.append(shores.change.note())

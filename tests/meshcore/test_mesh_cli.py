@@ -712,3 +712,30 @@ def test_in_world_moves_only_places_by_the_origin():
     )
     assert in_world(msg, SimpleNamespace(origin=(0.0, 0.0))) == msg
     assert in_world(msg, None) == msg
+
+
+def test_curve_draws_the_shore_through_the_points_and_stays_near_them(tmp_path, synthetic_csv):
+    """``--curve``: the grid's shore follows a smooth curve through the outline's points (a note
+    says so). The synthetic lake's 48 points (about two cells apart) lie on an ellipse: the
+    grid's shore nodes get nearer that ellipse than along the straight segments, and stay
+    within half a cell of the outline as given."""
+    x0, y0 = 500_000.0, 5_200_000.0
+    t = np.linspace(0, 2 * np.pi, 20_000)
+    ellipse = shapely.LinearRing(np.column_stack([x0 + 3000 * np.cos(t), y0 + 1800 * np.sin(t)]))
+    shore, _ = _synthetic_rings()
+    given = shapely.LinearRing(np.round(shore, 3))
+    worst = {}
+    for flag in ((), ("--curve",)):
+        out = tmp_path / f"c{len(flag)}.npz"
+        run = mesh(synthetic_csv, "--cell-size", 150, *flag, "-o", out)
+        assert run.rc == 0, run.err
+        assert ("smooth curve through the outline's points" in run.err) == bool(flag)
+        border = np.concatenate(
+            [np.column_stack([g.x[k], g.y[k]]) for g in read_blocks(out).blocks for k in (0, -1)]
+            + [np.column_stack([g.x[:, k], g.y[:, k]]) for g in read_blocks(out).blocks for k in (0, -1)]
+        )
+        on_shore = border[shapely.distance(shapely.points(border), given) < 0.3 * 150]
+        assert len(on_shore) > 50
+        worst[flag] = float(shapely.distance(shapely.points(on_shore), ellipse).max())
+        assert float(shapely.distance(shapely.points(on_shore), given).max()) < 0.5 * 150
+    assert worst[("--curve",)] < 0.5 * worst[()]
