@@ -114,6 +114,7 @@ def iterate_layout(
     hold_ends: bool = False,
     slide_ends: bool = False,
     equalize: bool = True,
+    spacing: bool = False,
     every: int | None = 25,
     level_callback: Callable[[str, Any], Any] | None = None,
     stop_event: Any = None,
@@ -135,6 +136,8 @@ def iterate_layout(
     ``equalize``: after the finest level, the nodes round every interface pair above 2 moved to
     make its two cells alike within bounds on what that may cost elsewhere
     (:func:`~meshcore.orthogonal.equalize.equalize_interfaces`; on by default, ``equalize=False`` skips it).
+    ``spacing``: then the edge lengths along grid lines smoothed in block interiors, guarded
+    (:func:`~meshcore.orthogonal.spacing.smooth_spacing`; off by default, see there).
     ``level_callback(kind, value)`` is called with ``("level", (level, result))`` as each level
     ends and ``("equalize", patches)`` after the equalize step (the patches it kept).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
@@ -166,6 +169,7 @@ def iterate_layout(
     history: list[tuple[int, float]] = []
     stopped = False
     equalized = 0
+    spaced = 0
     for lev, tp in enumerate(tops):
         if lev:
             grids = refine_shore(refine(grids), tp, rings)
@@ -222,6 +226,12 @@ def iterate_layout(
             grids, equalized = equalize_interfaces(tp, grids, rings)
             if level_callback is not None:
                 level_callback("equalize", equalized)
+        if spacing:
+            from .orthogonal.spacing import smooth_spacing
+
+            grids, spaced = smooth_spacing(grids)
+            if level_callback is not None:
+                level_callback("spacing", spaced)
     elapsed = time.perf_counter() - t0
     if stopped:
         msg = "stopped"
@@ -237,6 +247,8 @@ def iterate_layout(
             msg += f"; {fine_repaired} block(s) repaired by the fold-free method on the finest level"
         if equalized:
             msg += f"; {equalized} patch(es) round interface pairs above 2 made alike"
+        if spaced:
+            msg += f"; {spaced} node move(s) smoothing the spacing along grid lines"
     info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology
