@@ -61,7 +61,7 @@ def test_cells_at_an_interface_keep_their_area() -> None:
     for r in radii:
         rr, tt = np.meshgrid(r, t, indexing="ij")
         grids.append(StructuredGrid(rr * np.cos(tt), rr * np.sin(tt)))
-    out, moved = smooth_spacing(grids)
+    out, moved = smooth_spacing(grids, shore_slide=True)
     assert moved > 0
     x0, y0 = np.asarray(grids[1].x), np.asarray(grids[1].y)
     x1, y1 = np.asarray(out[1].x), np.asarray(out[1].y)
