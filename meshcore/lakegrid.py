@@ -142,7 +142,8 @@ def iterate_layout(
     ends and ``("equalize", patches)`` after the equalize step (the patches it kept).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
-    solve with the grids as they are (``info.converged`` False, message "stopped").  Returns
+    solve with the grids as they are (``info.converged`` False, message "stopped"); ``stop_event``
+    set during the equalize step ends that between two patches (the patches kept so far stay).  Returns
     the :class:`~meshcore.multiblock.MultiBlockGrid` (``mode="orthogonal"``).
     """
     from .elliptic import SolverProgress
@@ -223,7 +224,9 @@ def iterate_layout(
         if equalize:
             from .orthogonal.equalize import equalize_interfaces
 
-            grids, equalized = equalize_interfaces(tp, grids, rings)
+            asked = stop_event.is_set if stop_event is not None else None
+            grids, equalized = equalize_interfaces(tp, grids, rings, should_stop=asked)
+            stopped = asked is not None and asked()  # the app's Stop during the step: ends it between patches
             if level_callback is not None:
                 level_callback("equalize", equalized)
         if spacing:

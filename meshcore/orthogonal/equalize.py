@@ -24,8 +24,11 @@ else half the step, a quarter, or nothing.  Measured in ``docs/lake-grids.md`` (
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
+from . import _equalize_kernels
 from .driver import _assemble
 from .shore import arc_lengths, project_to_rings, ring_point
 
@@ -44,6 +47,7 @@ CORNER_ADD = 5.0
 METHOD = "BFGS"
 SLIDE = False  # shore nodes slide too (on 4 nets: the same ratios within 0.2, shore 0.20 -> 0.26 cells)
 EDGE_LOSS = 10  # edge pairs <= 1.2 a patch may lose
+WIDER = 0  # a pair the first patch leaves above LIMIT: a patch of this depth tried too (0: none)
 
 
 class _Tables:
@@ -247,8 +251,6 @@ class _Patch:
 
     def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """The objective and its gradient in ``z`` (compiled: :func:`._equalize_kernels.objective`)."""
-        from . import _equalize_kernels
-
         P = self.positions(z)
         G = np.empty_like(P)
         ok, f = _equalize_kernels.objective(
@@ -337,13 +339,53 @@ class _Patch:
         )
 
 
-def equalize_interfaces(
-    topology, grids, rings, *, limit: float = LIMIT, depth: int = DEPTH, max_patches: int = MAX_PATCHES
-) -> tuple[list, int]:
-    """``(grids, patches)``: the grids with the nodes round every interface pair above ``limit``
-    moved to make the two cells alike (see the module docstring), and how many patches were kept."""
+def _ratio(P: np.ndarray, cells: np.ndarray, pair: np.ndarray) -> float:
+    return float(abs(np.log(abs(_areas(P, cells[pair[:1]])[0]) / abs(_areas(P, cells[pair[1:]])[0]))))
+
+
+def _solve_patch(
+    t: _Tables, P: np.ndarray, seeds: np.ndarray, depth: int, pairs: np.ndarray, shore
+) -> np.ndarray | None:
+    """The node array with the patch of ``depth`` round ``seeds`` moved, or None when no move of
+    it (the optimum, half or a quarter of it) is kept by the checks of the module docstring."""
     from scipy.optimize import minimize
 
+    patch = _Patch(t, P, seeds, depth, pairs, shore)
+    nz = 2 * len(patch.fly) + len(patch.slide)
+    if not nz:
+        return None
+    res = minimize(patch.objective, np.zeros(nz), jac=True, method=METHOD, options={"maxiter": MAX_ITER})
+    before = patch.counts(P)
+    for alpha in (1.0, 0.5, 0.25):
+        Pn = patch.positions(alpha * res.x)
+        after = patch.counts(Pn)
+        better = patch.ratios(Pn).max() < patch.r0.max() - 1e-9
+        ok = (
+            after[0] >= before[0]
+            and after[1] >= before[1]
+            and after[2] >= before[2] - EDGE_LOSS
+            and after[3] >= before[3]
+        )
+        if better and after[4] and ok:
+            return Pn
+    return None
+
+
+def equalize_interfaces(
+    topology,
+    grids,
+    rings,
+    *,
+    limit: float = LIMIT,
+    depth: int = DEPTH,
+    max_patches: int = MAX_PATCHES,
+    should_stop: Callable[[], bool] | None = None,
+) -> tuple[list, int]:
+    """``(grids, patches)``: the grids with the nodes round every interface pair above ``limit``
+    moved to make the two cells alike (see the module docstring), and how many patches were kept.
+
+    ``should_stop``: asked before every patch; when it answers True the step ends there, with the
+    patches kept so far (``iterate_layout`` passes its ``stop_event``: the app's Stop)."""
     from ..quality.interfaces import interface_pairs
 
     pr = interface_pairs(grids)
@@ -358,6 +400,8 @@ def equalize_interfaces(
     tried: set[int] = set()
     kept = 0
     for _ in range(max_patches):
+        if should_stop is not None and should_stop():
+            break
         r = np.abs(np.log(np.abs(_areas(P, t.cells[pairs[:, 0]])) / np.abs(_areas(P, t.cells[pairs[:, 1]]))))
         order = [q for q in np.argsort(-r) if r[q] > np.log(limit) and int(q) not in tried]
         if not order:
@@ -365,26 +409,14 @@ def equalize_interfaces(
         q = int(order[0])
         tried.add(q)
         seeds = np.unique(t.cells[pairs[q]].ravel())
-        patch = _Patch(t, P, seeds, depth, pairs, shore)
-        nz = 2 * len(patch.fly) + len(patch.slide)
-        if not nz:
-            continue
-        res = minimize(patch.objective, np.zeros(nz), jac=True, method=METHOD, options={"maxiter": MAX_ITER})
-        before = patch.counts(P)
-        for alpha in (1.0, 0.5, 0.25):
-            Pn = patch.positions(alpha * res.x)
-            after = patch.counts(Pn)
-            better = patch.ratios(Pn).max() < patch.r0.max() - 1e-9
-            ok = (
-                after[0] >= before[0]
-                and after[1] >= before[1]
-                and after[2] >= before[2] - EDGE_LOSS
-                and after[3] >= before[3]
-            )
-            if better and after[4] and ok:
-                P = Pn
-                kept += 1
-                break
+        Pn = _solve_patch(t, P, seeds, depth, pairs, shore)
+        if WIDER and (Pn is None or _ratio(Pn, t.cells, pairs[q]) > np.log(limit)):
+            Pw = _solve_patch(t, P, seeds, WIDER, pairs, shore)
+            if Pw is not None and (Pn is None or _ratio(Pw, t.cells, pairs[q]) < _ratio(Pn, t.cells, pairs[q])):
+                Pn = Pw
+        if Pn is not None:
+            P = Pn
+            kept += 1
     if not kept:
         return list(grids), 0
     return [g.replaced(x=P[ids, 0], y=P[ids, 1]) for g, ids in zip(grids, m.ids, strict=True)], kept
@@ -393,8 +425,6 @@ def equalize_interfaces(
 def warm_up() -> None:
     """Compile (or load from numba's cache) the objective's kernel with the argument types of
     :meth:`_Patch.objective` (``meshcore._numba_setup.compile_all``)."""
-    from . import _equalize_kernels
-
     i4, i5, i3 = (np.zeros((0, k), np.int64) for k in (4, 5, 3))
     f0, f2, P = np.zeros(0), np.zeros((0, 4)), np.zeros((4, 2))
     _equalize_kernels.objective(P, i4, f0, f2, i4, i4, 0.5, i5, f0, W_COS, i3, f0, W_EDGE, W_JAC, P.copy())

@@ -109,3 +109,51 @@ def test_the_compiled_objective_is_the_numpy_one(solved):
             np.testing.assert_allclose(g, g0, rtol=1e-9, atol=1e-12 * max(1.0, np.abs(g0).max()))
             checked += f0 > 1e-3 * float(z @ z)  # a move whose terms are not only the small regularizer
     assert checked >= 4
+
+
+def test_should_stop_ends_the_step_between_patches(solved):
+    """Asked before every patch: True after the first patch leaves exactly what one patch makes."""
+    mb, rings = solved
+    asked: list[int] = []
+
+    def stop_after_one() -> bool:
+        asked.append(1)
+        return len(asked) > 1
+
+    one, kept1 = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=1)
+    grids, kept = equalize_interfaces(
+        mb.topology, list(mb.grids), rings, limit=1.1, max_patches=6, should_stop=stop_after_one
+    )
+    assert len(asked) == 2
+    assert kept == kept1 == 1
+    for a, b in zip(grids, one, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.y, b.y)
+
+
+class _StopAtTheStep:
+    """A ``stop_event`` set once the last level has ended: a Stop pressed during the equalize step."""
+
+    def __init__(self, levels: int) -> None:
+        self.levels, self.heard = levels, []
+
+    def callback(self, kind: str, value: object) -> None:
+        self.heard.append((kind, value))
+
+    def is_set(self) -> bool:
+        return sum(k == "level" for k, _ in self.heard) == self.levels
+
+
+def test_a_stop_during_the_step_ends_it():
+    lay = auto_layout(testing.channel_network(7, n_branches=4), target_cells=2000, multiple=4)
+    heard: list[tuple[str, object]] = []
+    mesh_layout(lay, callback=lambda kind, value: heard.append((kind, value)))
+    assert heard[-1][0] == "equalize" and heard[-1][1] >= 1  # the step has work on this lake
+    ev = _StopAtTheStep(levels=len(heard) - 1)
+    mb = mesh_layout(lay, callback=ev.callback, stop_event=ev)
+    assert ev.heard[-1] == ("equalize", 0)
+    assert not mb.info.converged and mb.info.message == "stopped"
+    plain = mesh_layout(lay, equalize=False)
+    for a, b in zip(mb.grids, plain.grids, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.y, b.y)
