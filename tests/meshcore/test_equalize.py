@@ -157,3 +157,26 @@ def test_a_stop_during_the_step_ends_it():
     for a, b in zip(mb.grids, plain.grids, strict=True):
         np.testing.assert_array_equal(a.x, b.x)
         np.testing.assert_array_equal(a.y, b.y)
+
+
+def test_a_patch_rejected_at_the_first_edge_weight_is_solved_again_at_the_next(solved, monkeypatch):
+    """``EDGE_WEIGHTS``: a second solve of the same patch only when no move of the first was kept."""
+    from meshcore.orthogonal import equalize as eq
+
+    mb, rings = solved
+    real, heard = eq._solve_patch, []
+
+    def first_rejected(*args):
+        heard.append(args[-1])
+        return None if args[-1] == eq.EDGE_WEIGHTS[0] else real(*args)
+
+    monkeypatch.setattr(eq, "_solve_patch", first_rejected)
+    grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=1)
+    assert heard == list(eq.EDGE_WEIGHTS) and len(heard) == 2
+    assert kept == 1
+    monkeypatch.setattr(eq, "EDGE_WEIGHTS", eq.EDGE_WEIGHTS[1:])
+    monkeypatch.setattr(eq, "_solve_patch", real)
+    last_only, _ = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=1)
+    for a, b in zip(grids, last_only, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.y, b.y)
