@@ -16,7 +16,7 @@ the penalties keeping every block-interior node's ``|cos|`` within what it had o
 report's limits (3°, ``|cos| ≤ 0.02``), every cell corner's deviation within ``CORNER_ADD``
 degrees more than it had (the border nodes the report does not measure: with no bound there the
 optimum kinks the cut and squeezes slivers beside it), consecutive edge ratios along grid lines
-(weight 0.1, and 3.0 in a second solve when no move of the first is kept: ``EDGE_WEIGHTS``),
+(weight 0.03, and 3.0 in a second solve when no move of the first is kept: ``EDGE_WEIGHTS``),
 every corner Jacobian above half of its own, and the moves small.  A patch is kept only when
 its worst pair is lower and inside it no node within 3° or ``|cos| ≤ 0.02`` is lost,
 no interface pair ≤ 2, at most ``EDGE_LOSS`` edge pairs ≤ 1.2, and no corner Jacobian is ≤ 0;
@@ -46,7 +46,7 @@ EDGE = 1.2
 W_COS, W_EDGE, W_JAC = 1e4, 3.0, 10.0
 # the edge-ratio weight of a patch's first solve, and of a second only when no move of the first
 # was kept (session 18: with 3.0 alone this term, not the angles, held most pairs above 2)
-EDGE_WEIGHTS = (0.1, W_EDGE)
+EDGE_WEIGHTS = (0.03, W_EDGE)
 CORNER_ADD = 5.0
 METHOD = "BFGS"
 SLIDE = False  # shore nodes slide too (on 4 nets: the same ratios within 0.2, shore 0.20 -> 0.26 cells)
