@@ -18,6 +18,8 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
   with islands off their tips (the shores of rift and drowned-valley lakes);
 * :func:`dendritic` — a reservoir behind a dam: a main valley whose side valleys branch again,
   narrowing with each order down to arms under two cells wide, long thin ridges between them;
+* :func:`narrow_arms` — a reservoir of many arms 3–6 cells wide meeting 3 or 4 at a junction
+  at varied angles, the last ones tapering to wedges;
 * :func:`resampled` — any of them with its shore sampled densely (10 000+ points) or coarsely
   (20 points): the same water as an outline from another source;
 * :func:`y_junction`, :func:`straight_channel`, :func:`rectangle_with_hole` — the textbook cases.
@@ -36,6 +38,7 @@ import numpy as np
 
 from ._shapes import _clean, _lobed_disc, _placed
 from .archipelago import archipelago
+from .narrow import narrow_arms
 
 __all__ = [
     "archipelago",
@@ -45,6 +48,7 @@ __all__ = [
     "jagged",
     "jagged_cells",
     "lake_with_islands",
+    "narrow_arms",
     "rectangle_with_hole",
     "resampled",
     "small_islands",
