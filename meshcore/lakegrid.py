@@ -270,6 +270,7 @@ def mesh_outline(
     thin_arms: bool = False,
     mouths: bool = False,
     curve: bool = False,
+    wedges: bool = False,
     **options: Any,
 ):
     """A model-ready multiblock grid of a lake outline (projected coordinates, e.g. metres).
@@ -297,6 +298,9 @@ def mesh_outline(
     curve : bool
         The shore between the outline's points as a smooth curve through them, not its straight
         segments (:mod:`meshcore.layout.curve`; off: measured mixed).
+    wedges : bool
+        Two block corners either side of the tip of an arm tapering to a point, none at it
+        (:func:`~meshcore.layout.auto_layout`).
 
     Returns
     -------
@@ -317,6 +321,7 @@ def mesh_outline(
         thin_arms=thin_arms,
         mouths=mouths,
         curve=curve,
+        wedges=wedges,
     )
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics

@@ -60,6 +60,7 @@ def auto_layout(
     thin_arms: bool = False,
     mouths: bool = False,
     curve: bool = False,
+    wedges: bool = False,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -94,6 +95,11 @@ def auto_layout(
         The shore between the outline's points as a smooth curve through them (corners
         sharper than 60° kept, at most a quarter cell from the straight segments;
         :mod:`.curve`).  Off (the grid follows the straight segments): measured mixed.
+    wedges : bool
+        A block ending in a wedge's tip (an arm tapering to a point) gets two corners either side
+        of the tip instead of one at it (:func:`~.corners.wedge_corners`): its grid converges on
+        the tip instead of fanning out from it.  Not in regular layouts.  Off: measured mixed
+        (docs/lake-grids.md).
 
     Returns
     -------
@@ -138,6 +144,7 @@ def auto_layout(
                     scale=scale,
                     thin=thin_arms,
                     mouths=mouths,
+                    wedges=wedges,
                 )
             except TopologyError as exc:
                 first = first or exc
@@ -180,13 +187,18 @@ def _layout(
     scale: float = 1.0,
     thin: bool = False,
     mouths: bool = False,
+    wedges: bool = False,
 ) -> Layout:
     poly = shores.grid
     hl = scale * h  # the layout's geometry; counts at h
-    sk, chords, _, pieces = layout_pieces(shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths)
+    sk, chords, _, pieces = layout_pieces(
+        shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular
+    )
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
-        sk, chords, _, moved = layout_pieces(poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths)
+        sk, chords, _, moved = layout_pieces(
+            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular
+        )
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple)
 

@@ -23,7 +23,7 @@ import numpy as np
 from ..pointindex import PointIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
-from .corners import choose_corners
+from .corners import choose_corners, wedge_corners
 from .fans import fans, unfan
 from .frames import close_frames
 from .regions import partition
@@ -119,13 +119,21 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
 
 
 def layout_pieces(
-    poly, h: float, *, regular: bool = False, normal: bool = True, thin: bool = False, mouths: bool = False
+    poly,
+    h: float,
+    *,
+    regular: bool = False,
+    normal: bool = True,
+    thin: bool = False,
+    mouths: bool = False,
+    wedges: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
     normal; ``thin``: cuts from reflex corners may leave pieces two cells across; ``mouths``:
     junction chords at the arms' mouths, :func:`~.chords.place_chords`; see
-    :func:`~.split.best_split`)."""
+    :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
+    side of it, :func:`~.corners.wedge_corners`)."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -161,8 +169,12 @@ def layout_pieces(
     rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
     rings, forced = _merge_strips(rings, forced, sigma)
     corner_pts = []
+    rim = dense.boundary
     for r, f in zip(rings, forced, strict=True):
-        c, _ = choose_corners(r, sigma, forced=forced_indices(r, f))
+        fi = forced_indices(r, f)
+        c, _ = choose_corners(r, sigma, forced=fi)
+        if wedges:
+            c = wedge_corners(r, c, sigma, shore=shapely.distance(shapely.points(r), rim) < 1e-9 * size, forced=fi)
         corner_pts.append([r[i] for i in c])
     rings = conform(rings, 1e-9 * size)
     pieces = []

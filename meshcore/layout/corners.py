@@ -241,3 +241,70 @@ def set_cost(
         d = np.abs(s - s[c])
         near |= np.minimum(d, total - d) < sigma
     return corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks, arc)
+
+
+#: A corner turning at least this (degrees, at scale) is a wedge's tip: the end of an arm that
+#: tapers to a point (an angle of 60° or less).
+WEDGE_TURN = 120.0
+
+#: ... whose block gets two corners along the shore either side of the tip, as far from it as
+#: makes the end side between them this wide (× ``sigma`` / 1.5: cells), at least a cell from the tip.
+WEDGE_END = 1.0
+
+#: ... and only in a piece at most this many cells wide (twice its area over its perimeter): the
+#: end of an arm.  The tip of a wide bay (`headlands(762600)`, a basin block round it) folded a
+#: cell on its curved side with two corners there.
+WEDGE_WIDTH = 4.0
+
+
+def wedge_corners(ring: np.ndarray, corners, sigma: float, *, shore: np.ndarray, forced=()):
+    """``corners`` of a CCW ring with a wedge's tip among them split in two (or ``corners``).
+
+    A piece ending in a wedge (an arm tapering to a point, its tip turning ≥ :data:`WEDGE_TURN`
+    at ``sigma``) has three sharp corners, the tip and the two ends of the chord across the arm;
+    :func:`choose_corners` puts the fourth on a side, and the block's cells fan out from the
+    tip across the whole wedge.  Here the fourth (the weakest corner, turning under
+    :data:`SHARP` · 2, or one of two corners within a quarter of ``sigma``; not ``forced``) is
+    dropped and the tip is replaced by the two vertices far enough along the shore either side
+    of it to span :data:`WEDGE_END` cells: the tip lies inside a short end side, the grid lines
+    run along the wedge and converge on it (a polar grid).  ``shore`` marks the ring's vertices
+    on the shore: the tip and the end side must be shore (a star's
+    centre turns as much inside the water).
+    """
+    c = [int(i) for i in corners]
+    forced = {int(f) for f in forced}
+    arc = _arclength_closed(ring)
+    s, total = arc
+    t = turning(ring, sigma, arc)
+    tip = max(c, key=lambda i: t[i])
+    if t[tip] < WEDGE_TURN or tip in forced or not shore[tip]:
+        return tuple(c)
+    h = sigma / 1.5
+    x, y = ring[:, 0], ring[:, 1]
+    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    if 2.0 * area / total > WEDGE_WIDTH * h:
+        return tuple(c)
+    # the fourth corner: the weakest, or one of two corners a vertex apart (a chord's end
+    # read twice), the one not forced
+    gap = [min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) for i, j in zip(c, c[1:] + c[:1], strict=True)]
+    k = int(np.argmin(gap))
+    twin = [i for i in (c[k], c[(k + 1) % 4]) if i != tip and i not in forced]
+    if gap[k] < 0.25 * sigma and twin:
+        weak = twin[0]
+    else:
+        weak = min((i for i in c if i != tip), key=lambda i: t[i])
+        if t[weak] >= 2 * SHARP or weak in forced:
+            return tuple(c)
+    d = h * max(1.0, WEDGE_END / (2.0 * math.sin(math.radians(max(180.0 - t[tip], 5.0)) / 2.0)))
+    back = (s[tip] - d) % total
+    ahead = (s[tip] + d) % total
+    ia = int(np.argmin(np.minimum(np.abs(s - back), total - np.abs(s - back))))
+    ib = int(np.argmin(np.minimum(np.abs(s - ahead), total - np.abs(s - ahead))))
+    new = sorted({ia, ib} | (set(c) - {tip, weak}))
+    n = len(ring)
+    # both within the tip's own sides: no other corner between them (round the tip)
+    if len(new) != 4 or any(0 < (k - ia) % n < (ib - ia) % n for k in new if k not in (ia, ib)):
+        return tuple(c)
+    if not 0 < (tip - ia) % n < (ib - ia) % n or not shore[(ia + np.arange((ib - ia) % n + 1)) % n].all():
+        return tuple(c)
+    return tuple(new)
