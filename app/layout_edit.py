@@ -23,6 +23,7 @@ become one.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -385,21 +386,13 @@ def without_cut(layout: Any, k: int) -> Any:
     """``layout`` without its cut line ``k``: the blocks it parted are one block, cornered where it
     turns (:func:`meshcore.layout.edit.layout_from_cuts`); every other block keeps its corners, and
     the cells follow from the layout's cell size."""
-    from shapely.geometry import LineString, Polygon
-
-    from meshcore.layout.edit import layout_from_cuts
+    from shapely.geometry import LineString
 
     mid = LineString(np.asarray(layout.cuts[k], float)).interpolate(0.5, normalized=True)
     tol = 1e-6 * layout.cell_size
-    corners = {}
-    for piece in layout.pieces:
-        ring = Polygon(piece.ring)
-        if ring.boundary.distance(mid) <= tol:  # a block the cut bounds: it joins its neighbour
-            continue
-        q = ring.representative_point()
-        corners[(q.x, q.y)] = [piece.ring[i] for i in piece.corners]
     cuts = [c for j, c in enumerate(layout.cuts) if j != k]
-    return layout_from_cuts(layout.polygon, cuts, cell_size=layout.cell_size, multiple=layout.multiple, corners=corners)
+    # a block the cut bounds joins its neighbour
+    return _recut(layout, cuts, lambda ring: ring.boundary.distance(mid) <= tol)
 
 
 def with_cut(layout: Any, cut: Any) -> Any:
@@ -407,17 +400,26 @@ def with_cut(layout: Any, cut: Any) -> Any:
     blocks it crosses are parted and cornered where their parts turn
     (:func:`meshcore.layout.edit.layout_from_cuts`); every other block keeps its corners, and the
     cells follow from the layout's cell size."""
-    from shapely.geometry import LineString, Polygon
+    from shapely.geometry import LineString
+
+    line = LineString(np.asarray(cut, float))
+    tol = 1e-6 * layout.cell_size
+    cuts = [*layout.cuts, np.asarray(cut, float)]
+    return _recut(layout, cuts, lambda ring: ring.intersection(line).length > tol)
+
+
+def _recut(layout: Any, cuts: list, changed: Callable[[Any], bool]) -> Any:
+    """The layout of ``cuts`` in ``layout``'s water, every block but those ``changed`` (a test on
+    its polygon) keeping its corners."""
+    from shapely.geometry import Polygon
 
     from meshcore.layout.edit import layout_from_cuts
 
-    line = LineString(np.asarray(cut, float))
     corners = {}
     for piece in layout.pieces:
         ring = Polygon(piece.ring)
-        if ring.intersection(line).length > 1e-6 * layout.cell_size:  # a block the new cut parts
+        if changed(ring):
             continue
         q = ring.representative_point()
         corners[(q.x, q.y)] = [piece.ring[i] for i in piece.corners]
-    cuts = [*layout.cuts, np.asarray(cut, float)]
     return layout_from_cuts(layout.polygon, cuts, cell_size=layout.cell_size, multiple=layout.multiple, corners=corners)

@@ -23,26 +23,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..quality.lake import corner_edges, node_cos
+
 __all__ = ["smooth_block", "smooth_spacing"]
 
 SIN3 = float(np.sin(np.radians(3.0)))
 
 
 def _node_cos(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """|cos| at the block-interior nodes, central differences (as the quality metric)."""
-    ax, ay = x[2:, 1:-1] - x[:-2, 1:-1], y[2:, 1:-1] - y[:-2, 1:-1]
-    bx, by = x[1:-1, 2:] - x[1:-1, :-2], y[1:-1, 2:] - y[1:-1, :-2]
-    n = np.hypot(ax, ay) * np.hypot(bx, by)
-    return np.where(n > 0, np.abs(ax * bx + ay * by) / np.where(n > 0, n, 1.0), 1.0)
+    """|cos| at the block-interior nodes (the quality metric's)."""
+    return node_cos(x, y)[1:-1, 1:-1]
 
 
 def _corners(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(4, ni, nj)`` corner Jacobians and |cos| of the corner angles (CCW 00, 10, 11, 01)."""
-    p = [(x[:-1, :-1], y[:-1, :-1]), (x[1:, :-1], y[1:, :-1]), (x[1:, 1:], y[1:, 1:]), (x[:-1, 1:], y[:-1, 1:])]
     jac, cos = [], []
-    for k in range(4):
-        (px, py), (nx, ny), (bx, by) = p[k], p[(k + 1) % 4], p[(k - 1) % 4]
-        ux, uy, vx, vy = nx - px, ny - py, bx - px, by - py
+    for ux, uy, vx, vy in corner_edges(x, y):
         n = np.hypot(ux, uy) * np.hypot(vx, vy)
         jac.append(ux * vy - uy * vx)
         cos.append(np.where(n > 0, np.abs(ux * vx + uy * vy) / np.where(n > 0, n, 1.0), 1.0))

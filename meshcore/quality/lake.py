@@ -48,8 +48,11 @@ __all__ = [
     "Location",
     "Samples",
     "block_metrics",
+    "corner_edges",
+    "corner_jacobians",
     "interface_pairs",
     "lake_metrics",
+    "node_cos",
 ]
 
 #: metric → (what it is measured on, description, unit); "worst" is always the largest value.
@@ -97,7 +100,9 @@ class BlockMetrics:
     folded: np.ndarray  # (ni, nj) bool: a corner Jacobian ≤ 0
 
 
-def _node_cos(x: np.ndarray, y: np.ndarray, periodic: bool) -> np.ndarray:
+def node_cos(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> np.ndarray:
+    """|cos| of the angle between the grid lines at every node (central differences), NaN where
+    it is not defined (block borders; a periodic block's seam wraps); 1 at a collapsed node."""
     cos = np.full(x.shape, np.nan)
     if x.shape[1] < 3 or (x.shape[0] < 3 and not periodic):
         return cos
@@ -131,27 +136,33 @@ def _smoothness(x: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarra
     return sxi, seta
 
 
-def _corner_jacobians(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``(4, ni, nj)`` cross products of the two edges at each corner (CCW: 00, 10, 11, 01)."""
+def corner_edges(x: np.ndarray, y: np.ndarray) -> list[tuple[Any, Any, Any, Any]]:
+    """The two edges at each cell corner (CCW: 00, 10, 11, 01), to the next corner and from the
+    one before: four ``(ux, uy, vx, vy)`` of ``(ni, nj)`` arrays."""
     p = [(x[:-1, :-1], y[:-1, :-1]), (x[1:, :-1], y[1:, :-1]), (x[1:, 1:], y[1:, 1:]), (x[:-1, 1:], y[:-1, 1:])]
     out = []
     for k in range(4):
         (px, py), (nx, ny), (bx, by) = p[k], p[(k + 1) % 4], p[(k - 1) % 4]
-        out.append((nx - px) * (by - py) - (ny - py) * (bx - px))
-    return np.stack(out)
+        out.append((nx - px, ny - py, bx - px, by - py))
+    return out
+
+
+def corner_jacobians(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``(4, ni, nj)`` cross products of the two edges at each corner (CCW: 00, 10, 11, 01)."""
+    return np.stack([ux * vy - uy * vx for ux, uy, vx, vy in corner_edges(x, y)])
 
 
 def block_metrics(grid: StructuredGrid, name: str = "block1") -> BlockMetrics:
     """All per-block arrays of ``grid`` (see the module docstring for the definitions)."""
     x, y = np.asarray(grid.x), np.asarray(grid.y)
-    cos = _node_cos(x, y, grid.periodic)
+    cos = node_cos(x, y, grid.periodic)
     dev = np.degrees(np.arcsin(cos))
     sxi, seta = _smoothness(x, y, grid.periodic)
     lxi = np.hypot(x[1:, :-1] - x[:-1, :-1], y[1:, :-1] - y[:-1, :-1])
     leta = np.hypot(x[:-1, 1:] - x[:-1, :-1], y[:-1, 1:] - y[:-1, :-1])
     area = signed_area(x, y)
     orient = -1.0 if area.sum() < 0 else 1.0  # a mirrored (clockwise) block is judged in its own sense
-    folded = (orient * _corner_jacobians(x, y) <= 0).any(axis=0)
+    folded = (orient * corner_jacobians(x, y) <= 0).any(axis=0)
     return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded)
 
 
