@@ -267,10 +267,7 @@ def mesh_outline(
     levels: int = 2,
     regular: bool = False,
     strict: bool = False,
-    thin_arms: bool = False,
-    mouths: bool = False,
-    curve: bool = False,
-    wedges: bool = False,
+    layout_options: Any = None,
     **options: Any,
 ):
     """A model-ready multiblock grid of a lake outline (projected coordinates, e.g. metres).
@@ -290,17 +287,11 @@ def mesh_outline(
     strict : bool
         Raise :class:`~meshcore.errors.FoldedGridError` if the grid has folded cells
         (otherwise ``info.converged`` is False and the message names them).
-    thin_arms : bool
-        Blocks two cells across at junctions and reflex bends of arms 2–4 cells wide
-        (:func:`~meshcore.layout.auto_layout`).
-    mouths : bool
-        Junction chords at the mouths of arms 4–7 cells wide (:func:`~meshcore.layout.auto_layout`).
-    curve : bool
-        The shore between the outline's points as a smooth curve through them, not its straight
-        segments (:mod:`meshcore.layout.curve`; off: measured mixed).
-    wedges : bool
-        Two block corners either side of the tip of an arm tapering to a point, none at it
-        (:func:`~meshcore.layout.auto_layout`).
+    layout_options : meshcore.layout.LayoutOptions, optional
+        Layout choices that are off by default (thin arms, mouths, curve, wedges; each measured
+        mixed, :class:`~meshcore.layout.LayoutOptions`).
+    **options
+        Passed to :func:`mesh_layout` (the orthogonal stage: ``spacing``, ``callback``, …).
 
     Returns
     -------
@@ -309,7 +300,7 @@ def mesh_outline(
         left out, arms too narrow for a block, a shore smoothed below the cell size, …), each in
         a sentence naming the place; ``info.message`` says how many there are.
     """
-    from .layout import auto_layout
+    from .layout import LayoutOptions, auto_layout
 
     lay = auto_layout(
         outline,
@@ -318,10 +309,7 @@ def mesh_outline(
         target_cells=target_cells,
         multiple=2**levels,
         regular=regular,
-        thin_arms=thin_arms,
-        mouths=mouths,
-        curve=curve,
-        wedges=wedges,
+        options=layout_options or LayoutOptions(),
     )
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics

@@ -81,10 +81,15 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="no corner where 3 or 5 blocks meet (what Delft3D domain decomposition couples; implied by .ddb)",
     )
     p.add_argument(
-        "--curve",
-        action="store_true",
-        help="the shore as a smooth curve through the outline's points, not its straight segments "
-        "(outlines with a point every few cells; see docs/lake-grids.md)",
+        "--layout-option",
+        action="append",
+        default=[],
+        choices=LAYOUT_OPTIONS,
+        metavar="NAME",
+        help="a layout choice that is off by default, repeatable (each measured mixed; docs/lake-grids.md): "
+        "curve = the shore as a smooth curve through the outline's points (outlines with a point every few "
+        "cells), thin-arms = blocks two cells across at junctions of arms 2-4 cells wide, mouths = junction "
+        "cuts at the arms' mouths, wedges = two corners beside the tip of an arm tapering to a point",
     )
     p.add_argument(
         "-o",
@@ -307,18 +312,31 @@ def _notes(notes: Any, frame: Any = None) -> None:
         print(f"meshcore mesh: note: {in_world(n, frame)}", file=sys.stderr)
 
 
-def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
-    from ..layout import auto_layout
+#: ``--layout-option`` names: the fields of :class:`~meshcore.layout.LayoutOptions`, with dashes.
+LAYOUT_OPTIONS = ("curve", "thin-arms", "mouths", "wedges")
 
+
+def layout_options(args):
+    """The :class:`~meshcore.layout.LayoutOptions` that ``--layout-option`` asked for."""
+    from ..layout import LayoutOptions
+
+    return LayoutOptions(**{name.replace("-", "_"): True for name in args.layout_option})
+
+
+def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
+    from ..layout import LayoutOptions, auto_layout
+
+    options = layout_options(args)
     try:
-        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular, curve=args.curve)
+        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular, options=options)
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)
         raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None
     n = len(lay.blocks)
     say(
         f"layout: {n} block{'s' * (n != 1)}, {lay.n_cells:,} cells"
-        f"{' (regular: no 3- or 5-block corners)' if regular else ''}, {say.lap():.1f} s"
+        f"{' (regular: no 3- or 5-block corners)' if regular else ''}"
+        f"{f' (options: {options})' if options != LayoutOptions() else ''}, {say.lap():.1f} s"
     )
     _notes(lay.notes, frame)
     return lay

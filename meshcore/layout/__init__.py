@@ -40,13 +40,24 @@ from .build import layout_pieces
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
-from .model import Layout, LayoutBlock
+from .model import Layout, LayoutBlock, LayoutOptions
 from .outline import interior_cuts
 from .polygon import MIN_ISLAND_CELLS, water_polygon, without_dense_vertices, without_slivers
 from .shore import shore_at_scale, transfer, without_narrow_arms
 from .widen import widen_starved
 
-__all__ = ["Layout", "LayoutBlock", "auto_layout", "layout_from_cuts", "layout_from_outline", "with_cells"]
+#: No layout option on (:class:`LayoutOptions`).
+DEFAULT_OPTIONS = LayoutOptions()
+
+__all__ = [
+    "Layout",
+    "LayoutBlock",
+    "LayoutOptions",
+    "auto_layout",
+    "layout_from_cuts",
+    "layout_from_outline",
+    "with_cells",
+]
 
 
 def auto_layout(
@@ -57,10 +68,7 @@ def auto_layout(
     target_cells: int = DEFAULT_CELLS,
     multiple: int = 1,
     regular: bool = False,
-    thin_arms: bool = False,
-    mouths: bool = False,
-    curve: bool = False,
-    wedges: bool = False,
+    options: LayoutOptions = DEFAULT_OPTIONS,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -83,23 +91,9 @@ def auto_layout(
         Delft3D's domain decomposition can couple.  Where the corners cannot be made to close,
         the layout is returned as it is; :func:`~.frames.frame_defects` of its pieces names
         the islands.
-    thin_arms : bool
-        Cuts from reflex corners may leave blocks two cells across (three by default): the
-        junctions and reflex bends of arms 2–4 cells wide are split instead of gridded as one
-        block round the corner (:data:`.width.THIN_ACROSS`).
-    mouths : bool
-        At junctions of three or four arms up to seven cells wide, each arm's chord at its
-        mouth, through the reflex shore corners between the arms (default: just outside the
-        junction's inscribed circle; :func:`~.chords.place_chords`).  Off: measured mixed.
-    curve : bool
-        The shore between the outline's points as a smooth curve through them (corners
-        sharper than 60° kept, at most a quarter cell from the straight segments;
-        :mod:`.curve`).  Off (the grid follows the straight segments): measured mixed.
-    wedges : bool
-        A block ending in a wedge's tip (an arm tapering to a point) gets two corners either side
-        of the tip instead of one at it (:func:`~.corners.wedge_corners`): its grid converges on
-        the tip instead of fanning out from it.  Not in regular layouts.  Off: measured mixed
-        (docs/lake-grids.md).
+    options : LayoutOptions
+        Layout choices that are off by default (thin arms, mouths, curve, wedges; each measured
+        mixed): :class:`~.model.LayoutOptions`.
 
     Returns
     -------
@@ -119,7 +113,7 @@ def auto_layout(
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
     more = more + slivers + arms
-    if curve:
+    if options.curve:
         poly, curved = curved_shore(poly, h)
         more = more + curved
     shores = shore_at_scale(poly, h)
@@ -142,9 +136,7 @@ def auto_layout(
                     regular=regular,
                     normal=normal,
                     scale=scale,
-                    thin=thin_arms,
-                    mouths=mouths,
-                    wedges=wedges,
+                    options=options,
                 )
             except TopologyError as exc:
                 first = first or exc
@@ -185,11 +177,10 @@ def _layout(
     regular: bool,
     normal: bool,
     scale: float = 1.0,
-    thin: bool = False,
-    mouths: bool = False,
-    wedges: bool = False,
+    options: LayoutOptions = DEFAULT_OPTIONS,
 ) -> Layout:
     poly = shores.grid
+    thin, mouths, wedges = options.thin_arms, options.mouths, options.wedges
     hl = scale * h  # the layout's geometry; counts at h
     sk, chords, _, pieces = layout_pieces(
         shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular

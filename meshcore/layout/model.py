@@ -9,7 +9,38 @@ import numpy as np
 
 from .blocks import Piece
 
-__all__ = ["Layout", "LayoutBlock"]
+__all__ = ["Layout", "LayoutBlock", "LayoutOptions"]
+
+
+@dataclass(frozen=True, slots=True)
+class LayoutOptions:
+    """Layout choices that are off by default, each because it was measured to help one family of
+    lakes and hurt another (the numbers are in ``docs/lake-grids.md``).
+
+    thin_arms
+        Cuts from reflex corners may leave blocks two cells across (three by default): the
+        junctions and reflex bends of arms 2–4 cells wide are split instead of gridded as one
+        block round the corner (:data:`.width.THIN_ACROSS`).
+    mouths
+        At junctions of three or four arms up to seven cells wide, each arm's chord at its mouth,
+        through the reflex shore corners between the arms (default: just outside the junction's
+        inscribed circle; :func:`~.chords.place_chords`).
+    curve
+        The shore between the outline's points as a smooth curve through them (corners sharper
+        than 60° kept, at most a quarter cell from the straight segments; :mod:`.curve`).
+    wedges
+        A block ending in a wedge's tip (an arm tapering to a point) gets two corners either side
+        of the tip instead of one at it (:func:`~.corners.wedge_corners`).  Not in regular layouts.
+    """
+
+    thin_arms: bool = False
+    mouths: bool = False
+    curve: bool = False
+    wedges: bool = False
+
+    def __str__(self) -> str:
+        on = [f.replace("_", " ") for f in ("thin_arms", "mouths", "curve", "wedges") if getattr(self, f)]
+        return ", ".join(on) or "defaults"
 
 
 @dataclass(frozen=True, slots=True)

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, Point, Polygon
 
-from meshcore.layout import auto_layout
+from meshcore.layout import LayoutOptions, auto_layout
 from meshcore.layout.curve import BULGE, CORNER, curve_ring, curved_shore
 
 
@@ -154,7 +154,7 @@ def test_random_rings_give_a_valid_polygon_near_the_outline(n, seed, h):
 
 def test_auto_layout_uses_it_when_asked():
     ring = _polygon_ngon(10, radius=10.0) * [3.0, 1.0]  # an ellipse drawn with 10 points
-    on = auto_layout(ring, cell_size=0.5, curve=True)
+    on = auto_layout(ring, cell_size=0.5, options=LayoutOptions(curve=True))
     off = auto_layout(ring, cell_size=0.5)
     assert any("smooth curve" in n for n in on.notes)
     assert not any("smooth curve" in n for n in off.notes)

@@ -1,4 +1,4 @@
-"""Junction chords at the arms' mouths (``auto_layout(..., mouths=True)``, off by default): at a
+"""Junction chords at the arms' mouths (``auto_layout(..., options=LayoutOptions(mouths=True))``, off by default): at a
 junction of three or four arms 4–7 cells wide each arm's chord lies where the arm meets the
 junction, through the reflex shore corners between the arms, instead of just outside the
 junction's inscribed circle."""

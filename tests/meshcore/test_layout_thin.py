@@ -1,4 +1,4 @@
-"""Arms 2–4 cells wide (``auto_layout(..., thin_arms=True)``): a cut from a reflex corner may
+"""Arms 2–4 cells wide (``auto_layout(..., options=LayoutOptions(thin_arms=True))``): a cut from a reflex corner may
 leave blocks two cells across (:data:`meshcore.layout.width.THIN_ACROSS`), so that no block's
 side runs round the corner of a junction or bend of such arms (its cells fan out from it)."""
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from meshcore import testing
-from meshcore.layout import auto_layout, width
+from meshcore.layout import LayoutOptions, auto_layout, width
 from meshcore.layout.corners import turning
 
 
@@ -47,7 +47,7 @@ def _tee(w_main: float, w_side: float, angle: float, h: float):
 def test_junction_of_thin_arms_is_split(w_main, w_side, angle):
     h = 0.1
     poly = _tee(w_main, w_side, angle, h)
-    lay = auto_layout(poly, cell_size=h, thin_arms=True)
+    lay = auto_layout(poly, cell_size=h, options=LayoutOptions(thin_arms=True))
     assert _wrapped(lay, 60.0) == 0
     assert all(min(b.cells) >= 3 for b in lay.blocks)
     # without it, no cut is admissible there and a block wraps the junction's reflex corner
@@ -70,5 +70,5 @@ def test_dendritic_reservoirs_fewer_blocks_round_reflex_corners():
     for seed in (761001, 761002, 761003):
         poly = testing.dendritic(seed)
         off += _wrapped(auto_layout(poly, target_cells=15000, multiple=4), 90.0)
-        on += _wrapped(auto_layout(poly, target_cells=15000, multiple=4, thin_arms=True), 90.0)
+        on += _wrapped(auto_layout(poly, target_cells=15000, multiple=4, options=LayoutOptions(thin_arms=True)), 90.0)
     assert on <= 0.6 * off

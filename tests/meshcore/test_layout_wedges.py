@@ -2,7 +2,8 @@
 two corners either side of its tip (:func:`meshcore.layout.corners.wedge_corners`), so that its
 grid lines run along the wedge and converge on the tip.  With a corner at the tip and the fourth
 on a side, the cells fanned out from the tip across the whole end block (every node beyond 3°).
-``mesh_outline(..., wedges=True)``: off by default (measured mixed, docs/lake-grids.md)."""
+``mesh_outline(..., layout_options=LayoutOptions(wedges=True))``: off by default (measured mixed,
+docs/lake-grids.md)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import pytest
 
 from meshcore import testing
 from meshcore.lakegrid import mesh_outline
+from meshcore.layout import LayoutOptions
 from meshcore.layout.corners import wedge_corners
 from meshcore.quality import lake_metrics
 
@@ -41,7 +43,7 @@ def test_narrow_arms_with_wedge_ends():
     """`narrow_arms(770000)` (arms 3-6 cells wide, 123 blocks): 88.8 % of the nodes within 3°
     without the option, 92.3 % with it (the option on by default then; its width limit since)."""
     poly = testing.narrow_arms(770000)
-    mb = mesh_outline(poly, target_cells=15000, wedges=True)
+    mb = mesh_outline(poly, target_cells=15000, layout_options=LayoutOptions(wedges=True))
     s = lake_metrics(mb, polygon=poly).summary()
     assert s["folded_cells"] == 0
     assert s["pct_nodes_within_3deg"] >= 90.0

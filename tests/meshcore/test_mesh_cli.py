@@ -715,7 +715,7 @@ def test_in_world_moves_only_places_by_the_origin():
 
 
 def test_curve_draws_the_shore_through_the_points_and_stays_near_them(tmp_path, synthetic_csv):
-    """``--curve``: the grid's shore follows a smooth curve through the outline's points (a note
+    """``--layout-option curve``: the grid's shore follows a smooth curve through the outline's points (a note
     says so). The synthetic lake's 48 points (about two cells apart) lie on an ellipse: the
     grid's shore nodes get nearer that ellipse than along the straight segments, and stay
     within half a cell of the outline as given."""
@@ -725,7 +725,7 @@ def test_curve_draws_the_shore_through_the_points_and_stays_near_them(tmp_path, 
     shore, _ = _synthetic_rings()
     given = shapely.LinearRing(np.round(shore, 3))
     worst = {}
-    for flag in ((), ("--curve",)):
+    for flag in ((), ("--layout-option", "curve")):
         out = tmp_path / f"c{len(flag)}.npz"
         run = mesh(synthetic_csv, "--cell-size", 150, *flag, "-o", out)
         assert run.rc == 0, run.err
@@ -738,4 +738,24 @@ def test_curve_draws_the_shore_through_the_points_and_stays_near_them(tmp_path, 
         assert len(on_shore) > 50
         worst[flag] = float(shapely.distance(shapely.points(on_shore), ellipse).max())
         assert float(shapely.distance(shapely.points(on_shore), given).max()) < 0.5 * 150
-    assert worst[("--curve",)] < 0.5 * worst[()]
+    assert worst[("--layout-option", "curve")] < 0.5 * worst[()]
+
+
+def test_layout_options_name_every_field_and_refuse_others(tmp_path, synthetic_csv):
+    """Every ``--layout-option`` name is a field of LayoutOptions and every field has a name; an
+    unknown name is refused by the parser (exit 2, the choices listed) before any work."""
+    import dataclasses
+    from types import SimpleNamespace
+
+    from meshcore.cli.mesh import LAYOUT_OPTIONS, layout_options
+    from meshcore.layout import LayoutOptions
+
+    fields = {f.name for f in dataclasses.fields(LayoutOptions)}
+    assert {n.replace("-", "_") for n in LAYOUT_OPTIONS} == fields
+    both = layout_options(SimpleNamespace(layout_option=["thin-arms", "wedges"]))
+    assert both == LayoutOptions(thin_arms=True, wedges=True)
+    assert str(both) == "thin arms, wedges" and str(LayoutOptions()) == "defaults"
+    out = tmp_path / "x.npz"
+    run = mesh(synthetic_csv, "--layout-option", "spline", "-o", out)
+    assert run.rc == 2 and "spline" in run.err and "thin-arms" in run.err
+    assert not out.exists()
