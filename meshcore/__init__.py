@@ -55,6 +55,7 @@ __all__ = [
     "EllipticConfig",
     "FoldedGridError",
     "InvalidInputError",
+    "LayoutOptions",
     "LinearSpline",
     "MeshcoreError",
     "MeshcoreWarning",
@@ -99,7 +100,7 @@ __all__ = [
 # (meshcore.io imports nothing heavy either, but keeps optional readers out).
 _LAZY_IO = {"read_points", "read_grid", "read_blocks", "write", "PointSet", "GridSet"}
 # The lake pipeline (shapely, scipy, the layout MILP) is loaded on first use as well.
-_LAZY = {"auto_layout": "layout", "mesh_outline": "lakegrid"}
+_LAZY = {"auto_layout": "layout", "LayoutOptions": "layout", "mesh_outline": "lakegrid"}
 
 
 def __getattr__(name: str):
