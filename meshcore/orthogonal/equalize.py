@@ -247,15 +247,33 @@ class _Patch:
         )
         self.c_allowed = allowed
         self.e_allowed = np.maximum(self.e0, np.log(EDGE) * 0.95)
+        self._local()
+
+    def _local(self) -> None:
+        """The patch's own nodes (those its cells, stencils and pairs touch) numbered from 0: the
+        compiled objective works on them, not on a copy of the whole grid per call (the same
+        numbers: every sum runs over the same terms in the same order)."""
+        used = np.unique(np.concatenate([a.ravel() for a in (self.C, self.cos, self.tri, self.Ca, self.Cb, self.free)]))
+        at = np.full(len(self.P0), -1, np.int64)
+        at[used] = np.arange(len(used))
+        self.l_P0 = self.P0[used]
+        self.l_C, self.l_cos, self.l_tri = at[self.C], at[self.cos], at[self.tri]
+        self.l_Ca, self.l_Cb = at[self.Ca], at[self.Cb]
+        self.l_fly, self.l_slide = at[self.fly], at[self.slide]
+        self.rings_used = np.unique(self.ring_of)
+
+    def _moved(self, P: np.ndarray, fly: np.ndarray, slide: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """``P`` (a copy) with the nodes ``fly`` and ``slide`` moved by ``z``."""
+        P = P.copy()
+        k = 2 * len(fly)
+        P[fly] += self.h * z[:k].reshape(-1, 2)
+        for r in self.rings_used:
+            sel = self.ring_of == r
+            P[slide[sel]] = ring_point(self.rings[r], self.s0[sel] + self.h * z[k:][sel], self.cums[r])
+        return P
 
     def positions(self, z: np.ndarray) -> np.ndarray:
-        P = self.P0.copy()
-        k = 2 * len(self.fly)
-        P[self.fly] += self.h * z[:k].reshape(-1, 2)
-        for r in np.unique(self.ring_of):
-            sel = self.ring_of == r
-            P[self.slide[sel]] = ring_point(self.rings[r], self.s0[sel] + self.h * z[k:][sel], self.cums[r])
-        return P
+        return self._moved(self.P0, self.fly, self.slide, z)
 
     def ratios(self, P: np.ndarray) -> np.ndarray:
         a = np.abs(_areas(P, self.t.cells[self.pairs[:, 0]]))
@@ -264,15 +282,15 @@ class _Patch:
 
     def objective(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """The objective and its gradient in ``z`` (compiled: :func:`._equalize_kernels.objective`)."""
-        P = self.positions(z)
+        P = self._moved(self.l_P0, self.l_fly, self.l_slide, z)
         G = np.empty_like(P)
         ok, f = _equalize_kernels.objective(
-            P, self.C, self.sg, self.J0, self.Ca, self.Cb, float(np.log(AIM)), self.cos, self.c_allowed, W_COS,
-            self.tri, self.e_allowed, self.w_edge, W_JAC, G,
+            P, self.l_C, self.sg, self.J0, self.l_Ca, self.l_Cb, float(np.log(AIM)), self.l_cos, self.c_allowed, W_COS,
+            self.l_tri, self.e_allowed, self.w_edge, W_JAC, G,
         )  # fmt: skip
         if not ok:
             return 1e6, np.zeros_like(z)
-        return f + 1e-3 * float(z @ z), self.chain(G, z) + 2e-3 * z
+        return f + 1e-3 * float(z @ z), self.chain(G, z, self.l_fly, self.l_slide) + 2e-3 * z
 
     def objective_numpy(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """:meth:`objective` in NumPy (the compiled kernel's reference in the tests)."""
@@ -322,20 +340,24 @@ class _Patch:
         gz = self.chain(G, z)
         return f + 1e-3 * float(z @ z), gz + 2e-3 * z
 
-    def chain(self, G: np.ndarray, z: np.ndarray) -> np.ndarray:
-        k = 2 * len(self.fly)
+    def chain(self, G: np.ndarray, z: np.ndarray, fly=None, slide=None) -> np.ndarray:
+        """The gradient in ``z`` from the gradient ``G`` in the nodes (``fly``, ``slide``: their
+        rows in ``G``, default the grid's node ids)."""
+        fly = self.fly if fly is None else fly
+        slide = self.slide if slide is None else slide
+        k = 2 * len(fly)
         out = np.empty_like(z)
-        out[:k] = self.h * G[self.fly].ravel()
-        if len(self.slide):
+        out[:k] = self.h * G[fly].ravel()
+        if len(slide):
             eps = 1e-6 * self.h
-            tang = np.zeros((len(self.slide), 2))
-            for r in np.unique(self.ring_of):
+            tang = np.zeros((len(slide), 2))
+            for r in self.rings_used:
                 sel = self.ring_of == r
                 s = self.s0[sel] + self.h * z[k:][sel]
                 p1 = ring_point(self.rings[r], s + eps, self.cums[r])
                 p0 = ring_point(self.rings[r], s - eps, self.cums[r])
                 tang[sel] = (p1 - p0) / (2 * eps)
-            out[k:] = self.h * (G[self.slide] * tang).sum(1)
+            out[k:] = self.h * (G[slide] * tang).sum(1)
         return out
 
     def counts(self, P: np.ndarray) -> tuple:

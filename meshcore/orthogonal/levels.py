@@ -76,30 +76,39 @@ def refine_shore(grids, topology: MultiBlockTopology, rings: list[np.ndarray]) -
     for b, ids in enumerate(m.ids):
         n1, m1 = ids.shape
         for fixed_i, fixed_j in ((None, 0), (None, m1 - 1), (0, None), (n1 - 1, None)):
-            count = n1 if fixed_i is None else m1
-            for k in range(1, count - 1, 2):
-                idx = [(t, fixed_j) if fixed_i is None else (fixed_i, t) for t in (k - 1, k, k + 1)]
-                if all(m.boundary[ids[ij]] for ij in idx):
-                    where.append((b, idx[1], _column(ids.shape, idx[1], fixed_i, fixed_j)))
-                    ends.append([xs[b][idx[0]], ys[b][idx[0]], xs[b][idx[2]], ys[b][idx[2]]])
+            side = (slice(None), fixed_j) if fixed_i is None else (fixed_i, slice(None))
+            on = m.boundary[ids[side]]
+            ks = np.arange(1, len(on) - 1, 2)
+            ks = ks[on[ks - 1] & on[ks] & on[ks + 1]]  # the new node and both neighbours on the shore
+            for k in ks.tolist():
+                ij = (k, fixed_j) if fixed_i is None else (fixed_i, k)
+                where.append((b, ij, _column(ids.shape, ij, fixed_i, fixed_j)))
+            sx, sy = xs[b][side], ys[b][side]
+            ends.append(np.column_stack([sx[ks - 1], sy[ks - 1], sx[ks + 1], sy[ks + 1]]))
     if not where:
         return list(grids)
-    ends_a = np.asarray(ends)
+    ends_a = np.concatenate(ends)
     n = len(ends_a)
     r12, s12, _ = project_to_rings(rings, np.vstack([ends_a[:, :2], ends_a[:, 2:]]))  # one tree for both ends
     ra, sa, rb, sb = r12[:n], s12[:n], r12[n:], s12[n:]
-    cums = [arc_lengths(r) for r in rings]  # once per ring, not per node
-    for (b, ij, col), r1, s1, r2, s2 in zip(where, ra, sa, rb, sb, strict=True):
+    # halfway along the shore, else elsewhere on the shore between the two (a sharp bend of the
+    # shore between them can leave no convex cell at halfway), each with the new nodes inwards
+    # of it carried along, else towards halfway: every candidate point of one ring at once
+    fractions = np.array([0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9])
+    cands = np.full((n, len(fractions), 2), np.nan)
+    for r in np.unique(ra):
+        sel = np.flatnonzero((ra == r) & (rb == r))
+        if not len(sel):
+            continue
+        total = per[r]
+        d = (sb[sel] - sa[sel]) % total
+        d = np.where(d > total / 2, d - total, d)  # the short way round
+        cands[sel] = ring_point(
+            rings[r], (sa[sel, None] + d[:, None] * fractions).ravel(), arc_lengths(rings[r])
+        ).reshape(len(sel), len(fractions), 2)
+    for (b, ij, col), r1, r2, at in zip(where, ra, rb, cands, strict=True):
         if r1 != r2:
             continue
-        total = per[r1]
-        d = (s2 - s1) % total
-        if d > total / 2:  # the short way round
-            d -= total
-        # halfway along the shore, else elsewhere on the shore between the two (a sharp bend
-        # of the shore between them can leave no convex cell at halfway), each with the new
-        # nodes inwards of it carried along, else towards halfway
-        at = ring_point(rings[r1], s1 + d * np.array([0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9]), cums[r1])
         if not any(_moved_to(xs[b], ys[b], ij, p) for p in at) and not any(
             _carried_to(xs[b], ys[b], ij, col, p) for p in at
         ):
@@ -342,31 +351,34 @@ def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limi
     ys = [np.array(g.y) for g in grids]
     moved = 0
     sides = []  # (block, its side's nodes, which of them are on the shore, where they start in pts)
-    pts: list[tuple[float, float]] = []
+    pts: list[np.ndarray] = []
+    at0 = 0
     for b, ids in enumerate(m.ids):
         n1, m1 = ids.shape
         for fixed_i, fixed_j in ((None, 0), (None, m1 - 1), (0, None), (n1 - 1, None)):
-            count = n1 if fixed_i is None else m1
-            line = [(t, fixed_j) if fixed_i is None else (fixed_i, t) for t in range(count)]
-            on = [bool(m.boundary[ids[ij]]) for ij in line]
-            if sum(on) >= 3:
-                sides.append((b, fixed_i, fixed_j, line, on, len(pts)))
-                pts.extend((float(xs[b][ij]), float(ys[b][ij])) for ij in line)
+            side = (slice(None), fixed_j) if fixed_i is None else (fixed_i, slice(None))
+            on = m.boundary[ids[side]]
+            if on.sum() >= 3:
+                count = len(on)
+                sides.append((b, fixed_i, fixed_j, count, on, at0))
+                pts.append(np.column_stack([xs[b][side], ys[b][side]]))
+                at0 += count
     if not sides:
         return list(grids), 0
-    ring_all, s_all, _ = project_to_rings(rings, np.asarray(pts))  # one tree for every side
+    pts_a = np.concatenate(pts)
+    ring_all, s_all, _ = project_to_rings(rings, pts_a)  # one tree for every side
     per = np.array([c[-1] for c in cums])
-    pts_a = np.asarray(pts)
-    for b, fixed_i, fixed_j, line, on, at0 in sides:
+    for b, fixed_i, fixed_j, count, on, at0 in sides:
         ids = m.ids[b]
-        r_of, s_of = ring_all[at0 : at0 + len(line)], s_all[at0 : at0 + len(line)]
+        r_of, s_of = ring_all[at0 : at0 + count], s_all[at0 : at0 + count]
         # a shore arc of length L between two points c apart strays at most sqrt(L² - c²) / 2
         # from their chord: only edges that could stray more than ``limit`` are looked at
         total = per[r_of[:-1]]
         arc = np.abs((s_of[1:] - s_of[:-1] + 0.5 * total) % total - 0.5 * total)
-        chord = np.hypot(*np.diff(pts_a[at0 : at0 + len(line)], axis=0).T)
+        chord = np.hypot(*np.diff(pts_a[at0 : at0 + count], axis=0).T)
         far = 0.5 * np.sqrt(np.maximum(arc**2 - chord**2, 0.0)) > limit
-        for k in range(1, len(line) - 1):
+        line = [(t, fixed_j) if fixed_i is None else (fixed_i, t) for t in range(count)]
+        for k in range(1, count - 1):
             if not (far[k - 1] or far[k]):
                 continue
             ij = line[k]

@@ -24,14 +24,36 @@ def _segments(rings: list[np.ndarray]):
     return a, b, ring, L, start
 
 
+#: The segments and STR-trees of the last few sets of rings, keyed by their bytes: a lake's
+#: shore rings stay the same through every level of the solve, and :func:`project_to_rings` is
+#: asked about them 10-20 times a lake (shore data, fits, refinement, equalize patches).
+_TREES: dict[bytes, tuple] = {}
+_TREES_KEPT = 4
+
+
+def _tree(rings: list[np.ndarray]):
+    """``(tree, a, b, ring, L, start)`` of ``rings`` (:func:`_segments` and its STR-tree), made once."""
+    import shapely
+
+    rs = [np.ascontiguousarray(r, dtype=float) for r in rings]
+    key = np.array([r.shape for r in rs], dtype=np.int64).tobytes() + b"".join(r.tobytes() for r in rs)
+    hit = _TREES.pop(key, None)
+    if hit is None:
+        a, b, ring, L, start = _segments(rs)
+        hit = (shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1))), a, b, ring, L, start)
+    _TREES[key] = hit  # the most recent last
+    while len(_TREES) > _TREES_KEPT:
+        del _TREES[next(iter(_TREES))]
+    return hit
+
+
 def project_to_rings(rings: list[np.ndarray], pts: np.ndarray):
     """For every point: the index of the nearest ring, the arc length of its nearest point on
     that ring, and the distance (an STR-tree nearest-segment query, then the exact foot)."""
     import shapely
 
     pts = np.asarray(pts, dtype=float).reshape(-1, 2)
-    a, b, ring, L, start = _segments(rings)
-    tree = shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1)))
+    tree, a, b, ring, L, start = _tree(rings)
     seg = tree.query_nearest(shapely.points(pts), return_distance=False, all_matches=False)[1]
     dist, t = feet(a[seg], b[seg], pts)
     return ring[seg], start[seg] + t * L[seg], dist
