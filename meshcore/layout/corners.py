@@ -136,12 +136,16 @@ def bulge_cost(ring: np.ndarray, corners, arc: tuple[np.ndarray, float] | None =
 def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float) -> list[int]:
     """Vertices turning more than ``limit`` that are the largest within ``± sigma`` of arc length."""
     order = np.argsort(-t)
+    tl, sl = t.tolist(), s.tolist()  # Python floats: the same numbers, without NumPy's per-scalar cost
     taken: list[int] = []
-    for i in order:
-        if t[i] < limit:
+    at: list[float] = []
+    for i in order.tolist():
+        if tl[i] < limit:
             break
-        if all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in taken):
-            taken.append(int(i))
+        si = sl[i]
+        if all(min(abs(si - q), total - abs(si - q)) > sigma for q in at):
+            taken.append(i)
+            at.append(si)
     return taken
 
 

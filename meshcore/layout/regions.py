@@ -212,10 +212,12 @@ def _sights(p, k: int, rings, room, cuts, step: int | None = None) -> list:
     ``room`` covers and that cross none of ``cuts``: to the nearest point of each ring (``step``
     None), or to every ``len / step``-th vertex of each (round a bend, where the nearest points
     are out of sight)."""
+    import shapely
     from shapely.geometry import LineString
     from shapely.ops import nearest_points
 
     out = []
+    lines = np.array([LineString(c) for c in cuts], dtype=object) if len(cuts) else None  # once, not per segment
     for j, other in enumerate(rings):
         if j == k:
             continue
@@ -226,7 +228,7 @@ def _sights(p, k: int, rings, room, cuts, step: int | None = None) -> list:
             ends = [tuple(v) for v in verts[:: max(1, len(verts) // step)]]
         for q in ends:
             seg = LineString([p.coords[0], q])
-            if seg.length > 0 and room.covers(seg) and not any(seg.crosses(LineString(c)) for c in cuts):
+            if seg.length > 0 and room.covers(seg) and not (lines is not None and shapely.crosses(seg, lines).any()):
                 out.append((seg.length, np.asarray(seg.coords)))
     return out
 

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .corners import SHARP, choose_corners, turning
+from .corners import SHARP, _edges, choose_corners, turning
 from .width import THIN_CUT
 from .width import too_narrow as _too_narrow
 from .width import width as _width
@@ -49,8 +49,7 @@ def _ray_to_boundary(ring: np.ndarray, v: int, d: np.ndarray):
     n = len(ring)
     c = ring[v]
     a = ring
-    b = np.roll(ring, -1, axis=0)
-    e = b - a
+    e = _edges(ring)  # np.roll(ring, -1, axis=0) - ring
     den = d[0] * e[:, 1] - d[1] * e[:, 0]
     w = a - c
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -84,11 +83,11 @@ def _split_ring(ring: np.ndarray, i: int, k: int, u: float, q: np.ndarray):
     m = len(r)
     if i == j:
         return None
-    a = [r[(i + s) % m] for s in range((j - i) % m + 1)]
-    b = [r[(j + s) % m] for s in range((i - j) % m + 1)]
+    a = r[(i + np.arange((j - i) % m + 1)) % m]
+    b = r[(j + np.arange((i - j) % m + 1)) % m]
     if len(a) < 3 or len(b) < 3:
         return None
-    return np.array(a), np.array(b), r[j].copy()
+    return a, b, r[j].copy()
 
 
 def _snap_to_reflex(ring: np.ndarray, t: np.ndarray, k: int, u: float, q: np.ndarray, tol: float):
@@ -174,12 +173,16 @@ def _normal_cuts(ring: np.ndarray, sigma: float, *, even: bool = False, count: i
 
 def _reflex_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float = -45.0) -> list[int]:
     """Reflex vertices (turning < ``limit`` at scale), the sharpest within ``± sigma`` only."""
+    tl, sl = t.tolist(), s.tolist()  # Python floats: the same numbers, without NumPy's per-scalar cost
     taken: list[int] = []
-    for i in np.argsort(t):
-        if t[i] >= limit:
+    at: list[float] = []
+    for i in np.argsort(t).tolist():
+        if tl[i] >= limit:
             break
-        if all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in taken):
-            taken.append(int(i))
+        si = sl[i]
+        if all(min(abs(si - q), total - abs(si - q)) > sigma for q in at):
+            taken.append(i)
+            at.append(si)
     return taken
 
 
@@ -191,14 +194,15 @@ def _point_along(ring, s, total, at):
 
 
 def _valid(r: np.ndarray) -> bool:
-    from shapely.geometry import Polygon
+    import shapely
 
-    return len(r) >= 3 and Polygon(r).is_valid
+    return len(r) >= 3 and bool(shapely.is_valid(shapely.polygons(r)))
 
 
 def _orient(r: np.ndarray) -> np.ndarray:
     x, y = r[:, 0], r[:, 1]
-    a = 0.5 * (np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    x1, y1 = np.concatenate([x[1:], x[:1]]), np.concatenate([y[1:], y[:1]])  # np.roll(·, -1)
+    a = 0.5 * (np.dot(x, y1) - np.dot(y, x1))
     return r if a > 0 else r[::-1].copy()
 
 

@@ -14,10 +14,10 @@ __all__ = ["THIN_ACROSS", "THIN_CUT", "THIN_WIDTH", "inscribed", "too_narrow", "
 
 def width(ring: np.ndarray) -> float:
     """A width scale of a region: twice its area over its perimeter (exact for long strips)."""
-    from shapely.geometry import Polygon
+    import shapely
 
-    p = Polygon(ring)
-    return 2.0 * p.area / max(p.length, 1e-300)
+    p = shapely.polygons(ring)  # (the Polygon class's own checks cost more than GEOS's area)
+    return 2.0 * float(shapely.area(p)) / max(float(shapely.length(p)), 1e-300)
 
 
 #: With ``thin`` (:func:`~.split.best_split`), a motorcycle cut may leave pieces narrower than
