@@ -95,16 +95,19 @@ def _shore_data(X, Y, m, cells, cnt, rings):
         nbrs[pos[u]].append(int(v))
         nbrs[pos[v]].append(int(u))
     inner = -np.ones(len(nodes), dtype=np.int64)
-    for u, v in zip(a[~bnd_edge], b[~bnd_edge], strict=True):
-        if m.boundary[u] and not m.boundary[v]:
-            inner[pos[u]] = v
-        elif m.boundary[v] and not m.boundary[u]:
-            inner[pos[v]] = u
-        elif m.boundary[u] and m.boundary[v]:  # an interior edge between two shore nodes
-            if cnt[u] == 2:
-                inner[pos[u]] = v
-            if cnt[v] == 2:
-                inner[pos[v]] = u
+    # every interior edge from a shore node inwards (or, between two shore nodes, from one with
+    # two cells), in edge order; a node's last such edge gives its inward neighbour
+    u, v = a[~bnd_edge], b[~bnd_edge]
+    bu, bv = m.boundary[u], m.boundary[v]
+    both = bu & bv  # an interior edge between two shore nodes
+    to_u = (bu & ~bv) | (both & (cnt[u] == 2))
+    to_v = (bv & ~bu) | (both & (cnt[v] == 2))
+    tgt = np.column_stack([np.where(to_u, u, -1), np.where(to_v, v, -1)]).ravel()
+    val = np.column_stack([v, u]).ravel()
+    keep = tgt >= 0
+    tgt, val = tgt[keep][::-1], val[keep][::-1]
+    last = np.unique(tgt, return_index=True)[1]  # the first in reverse: the last in edge order
+    inner[pos[tgt[last]]] = val[last]
     # ring and arc length of every shore node (nearest point of the nearest ring)
     if rings:
         ring_of, s_of, _ = project_to_rings(rings, np.column_stack([X[nodes], Y[nodes]]))
