@@ -9,8 +9,10 @@ Each case runs in a fresh process (after one warm-up run that loads the compiled
 cell size ``sqrt(area / cells)``; a lake file is projected as ``meshcore mesh`` does it.  The
 stages are timed with ``time.process_time`` (CPU of the process: on a shared machine wall time
 says more about the neighbours than about the code) by wrapping the functions of the pipeline:
-the layout's pieces (skeleton, chords, regions, splits, corners), its cell-count program, the
-check of its case, the start grid, the orthogonal levels, the refinement onto the shore.  Prints a
+the layout's pieces (skeleton, chords, regions, splits, corners; the skeleton and the splits also
+on their own rows: a row includes the rows of the stages it calls), its cell-count program, the
+check of its case, the start grid, the orthogonal levels, the refinement onto the shore, the shore
+fits before each level, the equalize step after the last.  Prints a
 Markdown table, one column per case; ``--json OUT`` also writes the numbers.
 """
 
@@ -28,6 +30,8 @@ ROOT = Path(__file__).resolve().parent.parent
 #: (label, module, function): the stages, in the order of the pipeline.  A generator's time is
 #: summed over its steps.
 STAGES = (
+    ("layout: skeleton", "meshcore.layout.build", "skeleton"),
+    ("layout: splits (best_split)", "meshcore.layout.build", "best_split"),
     ("layout: pieces (skeleton, chords, regions, splits, corners)", "meshcore.layout", "layout_pieces"),
     ("layout: cell counts (MILP)", "meshcore.layout", "block_counts"),
     ("layout: case check (topology)", "meshcore.layout", "_check_case"),
@@ -36,7 +40,10 @@ STAGES = (
     ("start grid", "meshcore.lakegrid", "_start"),
     ("fold repair", "meshcore.lakegrid", "_repair_folds"),
     ("refinement onto the shore", "meshcore.orthogonal.levels", "refine_shore"),
+    ("shore fits (fit_ends, fit_bends)", "meshcore.orthogonal.levels", "fit_ends"),
+    ("shore fits (fit_ends, fit_bends)", "meshcore.orthogonal.levels", "fit_bends"),
     ("orthogonal levels", "meshcore.orthogonal", "iterate_orthogonalize"),
+    ("equalize (interface ratios)", "meshcore.orthogonal.equalize", "equalize_interfaces"),
 )
 
 _CHILD = r"""
@@ -109,7 +116,7 @@ def run_case(what: str, cells: int) -> dict:
 
 def table(names: list[str], results: list[dict]) -> str:
     """Markdown: one row per stage, one column per case (CPU seconds)."""
-    labels = [s[0] for s in STAGES] + ["mesh_outline, all"]
+    labels = list(dict.fromkeys(s[0] for s in STAGES)) + ["mesh_outline, all"]
     head = "| stage (CPU s) | " + " | ".join(names) + " |\n|---|" + "---|" * len(names)
     sizes = [f"{r.get('blocks', '–')} / {r.get('cells', '–')}" for r in results]
     rows = ["| blocks / cells | " + " | ".join(sizes) + " |"]
