@@ -508,6 +508,8 @@ def frame_from_table(table: Any) -> Frame | None:
         origin = (float(o[0]), float(o[1]))
     except (TypeError, ValueError, IndexError):
         raise InvalidInputError(f"case crs.origin must be [x0, y0], got {o!r}") from None
+    if not all(math.isfinite(v) and abs(v) <= 1e100 for v in origin):
+        raise InvalidInputError(f"case crs.origin must be finite numbers of at most 1e100, got {list(origin)}")
     return Frame(normalize_crs(table.get("crs")), origin, normalize_crs(table.get("source_crs")))
 
 

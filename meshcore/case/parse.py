@@ -319,6 +319,8 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CaseFileError(f"{source}: invalid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses once per nested array or inline table
+        raise CaseFileError(f"{source}: invalid TOML: arrays or tables nested too deep to read") from None
     check_keys(data, TOP_KEYS, source, error=CaseFileError)
     blocks_raw = data.get("blocks")
     if "outline" in data and blocks_raw is None:
