@@ -47,6 +47,7 @@ __all__ = [
     "is_geographic",
     "lon_span",
     "looks_lonlat",
+    "not_a_map",
     "project",
     "project_arrays",
     "utm_epsg",
@@ -169,6 +170,21 @@ def is_geographic(crs: str | None) -> bool:
     if crs.upper() in _GEOGRAPHIC_ALIASES:
         return True
     return bool(_crs_attribute(crs, lambda c: c.is_geographic))
+
+
+def not_a_map(crs: str | None) -> str | None:
+    """Why ``crs`` cannot hold a 2-D grid (geocentric x, y, z; a height), or None when it can."""
+    if crs is None or crs.upper() in _GEOGRAPHIC_ALIASES:
+        return None
+
+    def why(c: Any) -> str | None:
+        if c.is_geocentric:
+            return "a geocentric CRS (x, y, z from the Earth's centre)"
+        if c.is_vertical and not (c.is_projected or c.is_geographic):
+            return "a vertical CRS (heights)"
+        return None
+
+    return _crs_attribute(crs, why)
 
 
 def is_web_mercator(crs: str | None) -> bool:
@@ -436,6 +452,10 @@ def project_arrays(
             raise InvalidInputError(
                 f"{where}: cannot project to {target}: the points' CRS is unknown (give source_crs / --source-crs)"
             )
+    for c, role in ((src, "the points' CRS"), (target, "the target CRS")):
+        why = not_a_map(c) if c is not None and c != LONLAT else None
+        if why:
+            raise InvalidInputError(f"{where or 'points'}: {role} {c} is {why}, not a map: give a projected CRS")
     if src is not None and is_geographic(src):
         check_lonlat(pts, where=where or "points")
     new = [np.asarray(a, dtype=np.float64).reshape(-1, 2) for a in arrays]

@@ -80,9 +80,26 @@ def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[
         source_crs = LONLAT  # what project would guess: said here, where the app's import reads it too
     local, frame = project(ps, crs, origin=None, source_crs=source_crs)
     src = frame.source_crs
-    if src is not None and (is_geographic(src) or is_web_mercator(src)) and frame.crs is not None and frame.crs != src:
+    projected = src is not None and (is_geographic(src) or is_web_mercator(src)) and frame.crs not in (None, src)
+    if projected or _far_from_origin(local):
         local, frame = project(ps, crs, origin="auto", source_crs=source_crs)
     return local, frame
+
+
+#: Points kept as they are get a local origin only when they lie this many times their extent from
+#: (0, 0): a 2 km lake at 1e9 (5e5 times) made the layout fail with NaN ("All-NaN slice"); UTM
+#: coordinates (about 500 times) keep theirs, as in the app.
+FAR_FROM_ORIGIN = 1e4
+
+
+def _far_from_origin(ps: Any) -> bool:
+    pts = [np.asarray(p.points, dtype=np.float64) for p in ps.polylines if len(p.points)]
+    if not pts:
+        return False
+    allp = np.vstack(pts)
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    size = float(np.hypot(*(hi - lo)))
+    return bool(size > 0 and np.hypot(*(0.5 * (lo + hi))) > FAR_FROM_ORIGIN * size)
 
 
 def lake_rings(ps: Any) -> tuple[np.ndarray, list[np.ndarray], list[str]]:

@@ -47,6 +47,9 @@ from .lakefile import in_world, lake_rings, local_frame, lonlat_order_note
 
 #: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
 MIN_CELLS = 16
+#: Largest coordinate (after the local origin) the pipeline meshes: a circle of radius 1e75 meshes,
+#: one of 1e80 made the layout's triangulation fail (Qhull: "initial simplex is flat"), exit 1.
+MAX_COORDINATE = 1e75
 #: Coarse levels of the grid sequencing (cell counts are multiples of ``2**LEVELS``).
 LEVELS = 2
 
@@ -283,6 +286,12 @@ def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, s
     """The cell size and how it was chosen; refused when the grid would pass the node limit."""
     from .._validation import max_nodes
 
+    big = max(abs(v) for v in poly.bounds)
+    if not big <= MAX_COORDINATE:
+        raise InvalidInputError(
+            f"{args.outline}: coordinates reach {big:.3g}{unit}; meshcore mesh works with coordinates up to "
+            f"{MAX_COORDINATE:.0e}: give the outline in larger units"
+        )
     area = float(poly.area)
     if args.cell_size is not None:
         h, why = float(args.cell_size), "--cell-size"
@@ -423,7 +432,7 @@ def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: An
 
 # ------------------------------------------------------------------ the command
 def run(args: argparse.Namespace) -> int:
-    from ..crs import normalize_crs
+    from ..crs import normalize_crs, not_a_map
     from ..io import write
     from ..quality import check, lake_metrics
 
@@ -431,7 +440,9 @@ def run(args: argparse.Namespace) -> int:
     say = _Say(args.quiet)
     _check_sizes(args)
     if args.crs.strip().lower() not in ("auto", "none", "local"):
-        normalize_crs(args.crs)  # an unknown CRS is refused before the file is read
+        why = not_a_map(normalize_crs(args.crs))  # an unknown CRS is refused before the file is read
+        if why:
+            raise InvalidInputError(f"--crs {args.crs}: {why}; give a projected one (metres)")
     outputs = _check_outputs(args)
     ddb = [p for p, fmt in outputs if fmt.name == "delft3d-dd"]
     regular = bool(args.regular or ddb)

@@ -3,10 +3,12 @@ line naming the file and the problem — no traceback, no output file, nothing s
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from meshcore.cli import main
-from tests.conftest import ROOT
+from meshcore.io import read_blocks
+from tests.conftest import DATA, ROOT
 
 BOTTLE = ROOT / "resources" / "examples" / "bottle-coarse.toml"
 
@@ -41,4 +43,37 @@ def test_a_case_origin_that_is_not_a_finite_number_is_refused(tmp_path, capsys, 
     case, out = tmp_path / "case.toml", tmp_path / "out.vts"
     case.write_text(BOTTLE.read_text() + f'\n[crs]\norigin = {origin}\ncrs = "EPSG:32632"\n')
     _bad(capsys, ["generate", case, "-o", out, "-q"], "case.toml", "origin")
+    assert not out.exists()
+
+
+def _circle_csv(path, radius, centre=0.0, n=40):
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    pts = np.c_[np.cos(t), np.sin(t)] * radius + centre
+    path.write_text("x,y\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in pts))
+    return path
+
+
+def test_a_lake_far_from_the_origin_gets_a_local_origin(tmp_path, capsys):
+    # a 2 km circle at (1e10, 1e10) in plain x, y: exit 1 (the layout's NaN, "All-NaN slice")
+    src, out = _circle_csv(tmp_path / "far.csv", 1000.0, 1e10), tmp_path / "far.vtm"
+    assert main(["mesh", str(src), "-o", str(out), "--cells", "200", "-q"]) in (0, 3), capsys.readouterr().err
+    gs = read_blocks(out)
+    x = np.concatenate([g.x.ravel() for g in gs.blocks]) - 1e10
+    y = np.concatenate([g.y.ravel() for g in gs.blocks]) - 1e10
+    assert np.hypot(x, y).max() < 1000.5 and np.hypot(x, y).max() > 990  # world coordinates, the circle's size
+
+
+def test_coordinates_beyond_what_the_layout_meshes_are_refused(tmp_path, capsys):
+    # a circle of radius 1e80: exit 1 (Qhull "initial simplex is flat" in the layout)
+    src, out = _circle_csv(tmp_path / "huge.csv", 1e80), tmp_path / "huge.vtm"
+    _bad(capsys, ["mesh", src, "-o", out, "--cells", "200", "-q"], "huge.csv", "coordinates reach 1e+80")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(("crs", "kind"), [("EPSG:4978", "geocentric"), ("EPSG:5703", "vertical")])
+@pytest.mark.parametrize("command", ["mesh", "import"])
+def test_a_crs_that_is_not_a_map_is_refused(tmp_path, capsys, crs, kind, command):
+    # EPSG:4978 gave a grid of the lake squashed onto the equator's plane (exit 0)
+    out = tmp_path / ("o.vtm" if command == "mesh" else "o.toml")
+    _bad(capsys, [command, DATA / "lake_zurich_sparse.csv", "-o", out, "--crs", crs], crs, kind)
     assert not out.exists()
