@@ -77,3 +77,21 @@ def test_a_crs_that_is_not_a_map_is_refused(tmp_path, capsys, crs, kind, command
     out = tmp_path / ("o.vtm" if command == "mesh" else "o.toml")
     _bad(capsys, [command, DATA / "lake_zurich_sparse.csv", "-o", out, "--crs", crs], crs, kind)
     assert not out.exists()
+
+
+def test_the_cell_ratio_of_a_shore_of_very_many_points_triangulates_a_thinned_border(monkeypatch):
+    # meshcore import of a 10⁶-point shore spent 69 s in this triangulation (timed out at 60 s)
+    import shapely
+
+    from meshcore import cellratio
+
+    seen = []
+    real = shapely.constrained_delaunay_triangles
+    monkeypatch.setattr(
+        shapely, "constrained_delaunay_triangles", lambda p: seen.append(len(p.exterior.coords)) or real(p)
+    )
+    m = 20_000
+    s = np.linspace(0, 1, m, endpoint=False)
+    loop = np.vstack([np.c_[3 * s, 0 * s], np.c_[3 + 0 * s, s], np.c_[3 - 3 * s, 1 + 0 * s], np.c_[0 * s, 1 - s]])
+    assert round(cellratio.cell_ratio(loop, (0, m, 2 * m, 3 * m)), 6) == 3.0
+    assert seen and seen[0] <= 4 * cellratio.MAX_BORDER_POINTS + 1
