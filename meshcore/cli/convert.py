@@ -25,9 +25,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from ..crs import Frame, normalize_crs
+    from ..errors import InvalidInputError
     from ..io import GridSet, read_blocks, write
 
+    if Path(args.output).resolve() == Path(args.input).resolve():
+        raise InvalidInputError(f"{args.output}: the same file as the input: write to another name")
     gs = read_blocks(args.input, format=args.input_format)
     if args.crs and gs.frame.crs is None:
         gs = GridSet(

@@ -114,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
     from ..spec import BlockSpec
 
     cells = _cells(args.cells)
+    out_path = Path(args.output)
+    if out_path.suffix.lower() != ".toml":  # a typo such as -o lake.csv would overwrite a point file
+        raise InvalidInputError(f"-o {out_path}: a case file ends in .toml")
     specs = {}
     for item in args.border_name:
         b, _, nm = item.partition("=")

@@ -145,7 +145,7 @@ def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
 
     if not (args.output or args.png or args.case):
         raise InvalidInputError("nothing to write: give -o OUT (a grid file), --png FIG or --case LAYOUT.toml")
-    seen: dict[Path, str] = {}
+    seen: dict[Path, str] = {Path(args.outline).resolve(): f"the outline {args.outline}: write to another name"}
     out = []
     for opt, path in [("-o", o) for o in args.output] + ([("--png", args.png)] if args.png else []):
         p = check_output(path, opt, figure=opt == "--png")

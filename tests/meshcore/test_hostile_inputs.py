@@ -95,3 +95,28 @@ def test_the_cell_ratio_of_a_shore_of_very_many_points_triangulates_a_thinned_bo
     loop = np.vstack([np.c_[3 * s, 0 * s], np.c_[3 + 0 * s, s], np.c_[3 - 3 * s, 1 + 0 * s], np.c_[0 * s, 1 - s]])
     assert round(cellratio.cell_ratio(loop, (0, m, 2 * m, 3 * m)), 6) == 3.0
     assert seen and seen[0] <= 4 * cellratio.MAX_BORDER_POINTS + 1
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["import", "{f}", "-o", "{f}"], "a case file ends in .toml"),  # wrote the case over the points
+        (["mesh", "{f}", "-o", "{f}", "--cells", "200", "-q"], "the same file as the outline"),  # the grid's CSV
+    ],
+)
+def test_an_output_over_the_outline_is_refused_and_the_outline_kept(tmp_path, capsys, argv, needle):
+    src = tmp_path / "lake.csv"
+    src.write_bytes((DATA / "lake_zurich_sparse.csv").read_bytes())
+    _bad(capsys, [str(src) if a == "{f}" else a for a in argv], "lake.csv", needle)
+    assert src.read_bytes() == (DATA / "lake_zurich_sparse.csv").read_bytes()
+
+
+def test_convert_refuses_to_write_over_its_input(tmp_path, capsys):
+    from meshcore import StructuredGrid
+    from meshcore.io import write
+
+    xi, eta = np.meshgrid(np.linspace(0, 2, 5), np.linspace(0, 1, 3), indexing="ij")
+    src = write(tmp_path / "g.vts", StructuredGrid(xi, eta))
+    before = src.read_bytes()
+    _bad(capsys, ["convert", src, tmp_path / "." / "g.vts"], "g.vts", "the same file as the input")
+    assert src.read_bytes() == before
