@@ -129,6 +129,10 @@ def _sniff(sample: list[str]) -> tuple[str | None, bool]:
 def _split(line: str, delim: str | None) -> list[str]:
     if delim is None:
         return line.split()
+    if '"' in line and len(delim) == 1:  # a quoted value may hold the delimiter: "1,234.5" is one value
+        import csv
+
+        return [t.strip().strip("'") for t in next(csv.reader([line], delimiter=delim, skipinitialspace=True))]
     return [t.strip().strip('"').strip("'") for t in line.split(delim)]
 
 

@@ -120,3 +120,17 @@ def test_convert_refuses_to_write_over_its_input(tmp_path, capsys):
     before = src.read_bytes()
     _bad(capsys, ["convert", src, tmp_path / "." / "g.vts"], "g.vts", "the same file as the input")
     assert src.read_bytes() == before
+
+
+def test_a_quoted_value_holding_the_delimiter_is_one_value(tmp_path):
+    # "1,234.5","5,678.9" (thousands separators, as spreadsheets export) was read as the points (1, 234.5)
+    # of columns 1 and 2: silently wrong; now each quoted value is one value, refused as no number
+    from meshcore.errors import ReadError
+    from meshcore.io import read_points
+
+    f = tmp_path / "lake.csv"
+    f.write_text('x,y\n"1,234.5","5,678.9"\n"2,234.5","5,678.9"\n"2,234.5","6,678.9"\n')
+    with pytest.raises(ReadError, match=r"lake.csv: line 2: not a number in column 1"):
+        read_points(f)
+    f.write_text('lon,lat\n"8.5","47.2"\n"8.6", "47.2"\n"8.55","47.3"\n')
+    assert read_points(f).polylines[0].points.tolist() == [[8.5, 47.2], [8.6, 47.2], [8.55, 47.3]]
