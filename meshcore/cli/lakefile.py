@@ -64,6 +64,24 @@ def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> s
     )
 
 
+def degrees_note(ps: Any, source_crs: Any = None) -> str | None:
+    """A note when a file said to hold metres (a projected CRS) holds numbers that look like degrees:
+    a GeoJSON labelled EPSG:3857 with lon/lat in it became a lake 0.2 m across, without a word."""
+    from ..crs import is_geographic, looks_lonlat, normalize_crs
+
+    crs = normalize_crs(source_crs) if source_crs is not None else ps.crs
+    if crs is None or is_geographic(crs) or not ps.polylines:
+        return None
+    pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
+    if not looks_lonlat(pts):
+        return None
+    size = float(np.hypot(*(pts.max(axis=0) - pts.min(axis=0))))
+    return (
+        f"{ps.source}: its coordinates look like degrees (longitude, latitude) but are read in {crs}: "
+        f"the lake is {size:.3g} units across; if they are degrees, give --source-crs EPSG:4326"
+    )
+
+
 def local_frame(ps: Any, crs: Any = "auto", *, source_crs: Any = None) -> tuple[Any, Any]:
     """Project a point set for a lake grid: ``(local point set, Frame)``.
 

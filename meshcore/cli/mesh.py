@@ -43,7 +43,7 @@ import numpy as np
 
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from ..errors import InvalidInputError, MeshcoreError
-from .lakefile import in_world, lake_rings, local_frame, lonlat_order_note
+from .lakefile import degrees_note, in_world, lake_rings, local_frame, lonlat_order_note
 
 #: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
 MIN_CELLS = 16
@@ -256,7 +256,10 @@ def _read(args: argparse.Namespace, say: _Say):
         outer, islands, dropped = lake_rings(local)
     except InvalidInputError as exc:  # places in the grid's CRS, as the layout's
         raise InvalidInputError(in_world(str(exc), frame)) from None
-    _notes([n for n in (lonlat_order_note(ps, args.source_crs, args.columns),) if n], frame)
+    _notes(
+        [n for n in (lonlat_order_note(ps, args.source_crs, args.columns), degrees_note(ps, args.source_crs)) if n],
+        frame,
+    )
     _notes(dropped, frame)
     try:
         poly, notes = water_polygon(outer, holes=islands)

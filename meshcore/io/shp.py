@@ -9,6 +9,7 @@ when the ``.dbf`` has one.  The CRS is the ``.prj`` WKT (None without it).
 from __future__ import annotations
 
 import stat
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -70,7 +71,13 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
                 declared = normalize_crs(wkt)
             except InvalidInputError as exc:
                 raise ReadError(f"{prj}: unreadable projection ({exc})") from None
-    with open(path, "rb") as fshp, open(shx, "rb") as fshx, open(dbf, "rb") as fdbf:
+    with (
+        open(path, "rb") as fshp,
+        open(shx, "rb") as fshx,
+        open(dbf, "rb") as fdbf,
+        warnings.catch_warnings(),  # pyshp's header-size warnings printed two lines of its source
+    ):
+        warnings.simplefilter("ignore")
         try:
             reader = shapefile.Reader(shp=fshp, shx=fshx, dbf=fdbf)
         except shapefile.ShapefileException as exc:

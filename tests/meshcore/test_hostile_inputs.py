@@ -134,3 +134,32 @@ def test_a_quoted_value_holding_the_delimiter_is_one_value(tmp_path):
         read_points(f)
     f.write_text('lon,lat\n"8.5","47.2"\n"8.6", "47.2"\n"8.55","47.3"\n')
     assert read_points(f).polylines[0].points.tolist() == [[8.5, 47.2], [8.6, 47.2], [8.55, 47.3]]
+
+
+def test_degrees_in_a_file_said_to_hold_metres_get_a_note(tmp_path, capsys):
+    # a GeoJSON labelled EPSG:3857 holding lon/lat became a lake 0.3 m across, exit 0 without a word
+    import json
+
+    gj = json.loads((DATA / "lake_zurich_sparse.geojson").read_text())
+    gj["crs"] = {"type": "name", "properties": {"name": "EPSG:3857"}}
+    src, out = tmp_path / "lake.geojson", tmp_path / "o.vtm"
+    src.write_text(json.dumps(gj))
+    assert main(["mesh", str(src), "-o", str(out), "--cells", "200", "-q"]) in (0, 3)
+    err = capsys.readouterr().err
+    assert "look like degrees" in err and "EPSG:3857" in err and "--source-crs EPSG:4326" in err, err
+    assert main(["mesh", str(DATA / "lake_zurich_sparse.geojson"), "-o", str(out), "--cells", "200", "-q"]) == 0
+    assert "look like degrees" not in capsys.readouterr().err
+
+
+def test_a_shapefile_of_no_records_is_one_line(tmp_path, capsys):
+    # pyshp's PossiblyCorruptFileHeader warning printed two more lines (its source) before the error
+    shapefile = pytest.importorskip("shapefile")
+    import io
+
+    parts = {s: io.BytesIO() for s in ("shp", "shx", "dbf")}
+    w = shapefile.Writer(**parts, shapeType=shapefile.POLYGON)
+    w.field("name", "C")
+    w.close()
+    for s, b in parts.items():
+        (tmp_path / f"lake.{s}").write_bytes(b.getvalue() + (b" " * 35 if s == "dbf" else b""))  # .dbf too long
+    _bad(capsys, ["import", tmp_path / "lake.shp", "-o", tmp_path / "c.toml"], "lake.shp", "no line or polygon shapes")
