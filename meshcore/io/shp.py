@@ -43,6 +43,7 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     missing = [s for s, p in ((".shx", shx), (".dbf", dbf)) if p is None]
     if missing:
         raise ReadError(f"{path}: the shapefile is incomplete: missing {' and '.join(missing)} next to it")
+    assert shx is not None and dbf is not None  # for mypy: both found above
     for part in (path, shx, dbf, _sibling(path, ".prj")):
         if part is not None and not stat.S_ISREG(part.stat().st_mode):  # a fifo would block the read for ever
             raise ReadError(f"{part}: not a regular file (a device, pipe or socket): give the path of a file")
