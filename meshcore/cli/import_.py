@@ -111,7 +111,9 @@ def run(args: argparse.Namespace) -> int:
     from ..grid import BORDER_NAMES
     from ..io import read_points
     from ..io.outline import guess_cells
+    from ..layout.polygon import water_polygon
     from ..spec import BlockSpec
+    from .lakefile import in_world
 
     cells = _cells(args.cells)
     out_path = Path(args.output)
@@ -147,10 +149,11 @@ def run(args: argparse.Namespace) -> int:
         )
     loop = pl.points
     try:
+        water_polygon(loop)  # the loop crossing itself or of no area is refused here, not by generate
         corners = _corners(args, loop, where)
         cells = cells or guess_cells(loop, corners)
     except InvalidInputError as exc:
-        msg = str(exc)
+        msg = in_world(str(exc), frame)  # places in the file's CRS, as meshcore mesh names them
         raise type(exc)(msg if msg.startswith(where) else f"{where}: {msg}") from None
     name = args.name or re.sub(r"[^\w-]+", "_", pl.name).strip("_") or "lake"
     crs_tbl = frame.as_dict()

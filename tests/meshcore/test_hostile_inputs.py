@@ -163,3 +163,12 @@ def test_a_shapefile_of_no_records_is_one_line(tmp_path, capsys):
     for s, b in parts.items():
         (tmp_path / f"lake.{s}").write_bytes(b.getvalue() + (b" " * 35 if s == "dbf" else b""))  # .dbf too long
     _bad(capsys, ["import", tmp_path / "lake.shp", "-o", tmp_path / "c.toml"], "lake.shp", "no line or polygon shapes")
+
+
+def test_import_refuses_an_outline_that_crosses_itself_naming_the_place(tmp_path, capsys):
+    # a bow tie in lon/lat was written as a case (exit 0); only generate said it crosses itself
+    src, out = tmp_path / "lake.csv", tmp_path / "c.toml"
+    src.write_text("lon,lat\n8.5,47.2\n8.55,47.25\n8.55,47.2\n8.5,47.25\n")
+    err = _bad(capsys, ["import", src, "-o", out], "lake.csv", "crosses itself", "edge from point 1 to 2")
+    assert "near (46" in err  # the place in the grid's CRS (UTM 32N eastings), not local coordinates
+    assert not out.exists()
