@@ -168,6 +168,14 @@ def read_grd(path: Path, **_: Any) -> GridSet:
     Y = a[mmax * nmax :].reshape((nmax, mmax)).T
     if np.any(missing == X) or np.any(missing == Y):
         raise ReadError(f"{path}: grid has missing (inactive) points; only full grids are read")
+    if spherical:  # lon/lat: metres in a file that says Spherical would be read as degrees
+        bad = np.argwhere((np.abs(X) > 360) | (np.abs(Y) > 90))
+        if len(bad):
+            m, nn = (int(v) for v in bad[0])
+            raise ReadError(
+                f"{path}: Coordinate System = Spherical, but node (m={m + 1}, n={nn + 1}) is "
+                f"({X[m, nn]:.6g}, {Y[m, nn]:.6g}), not longitude, latitude: is the grid Cartesian?"
+            )
     _check_enclosure(path, mmax, nmax)
     frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
     return GridSet((grid_from_world(X, Y, (0.0, 0.0), path),), frame, source=str(path))

@@ -172,3 +172,21 @@ def test_import_refuses_an_outline_that_crosses_itself_naming_the_place(tmp_path
     err = _bad(capsys, ["import", src, "-o", out], "lake.csv", "crosses itself", "edge from point 1 to 2")
     assert "near (46" in err  # the place in the grid's CRS (UTM 32N eastings), not local coordinates
     assert not out.exists()
+
+
+def test_a_spherical_grd_of_metres_is_refused_naming_the_node(tmp_path):
+    # Cartesian metres under 'Coordinate System = Spherical' were read as degrees (lon 480000), exit 0
+    from meshcore import StructuredGrid
+    from meshcore.errors import ReadError
+    from meshcore.io import write
+
+    xi, eta = np.meshgrid(np.linspace(0, 2, 6), np.linspace(0, 1, 4), indexing="ij")
+    p = write(tmp_path / "g.grd", StructuredGrid(xi * 1000 + 480000, eta * 1000 + 5240000))
+    text = p.read_text()
+    p.write_text(text.replace("Cartesian", "Spherical"))
+    with pytest.raises(ReadError, match=r"g.grd: Coordinate System = Spherical, but node \(m=1, n=1\)"):
+        read_blocks(p)
+    q = write(tmp_path / "d.grd", StructuredGrid(xi * 0.01 + 8.5, eta * 0.01 + 47.2))
+    q.write_text(q.read_text().replace("Cartesian", "Spherical"))
+    g = read_blocks(q).blocks[0]  # lon/lat in range: read as before
+    assert abs(g.x.min() - 8.5) < 1e-9 and abs(g.y.max() - 47.21) < 1e-9
