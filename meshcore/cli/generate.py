@@ -55,6 +55,23 @@ class _Progress:
             self.shown = False
 
 
+def probe_folder(p: Path, option: str) -> None:
+    """Create and remove a temporary file next to ``p``: a folder that the permission bits call
+    writable may still refuse (``/proc``, a read-only mount as root, a full disk), and an output
+    refused only after the others were written left those behind on an exit 2."""
+    import tempfile
+
+    from ..io._atomic import temp_prefix
+
+    folder = p.parent if str(p.parent) else Path(".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(p), suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise InvalidInputError(f"{option} {p}: cannot write in the folder {folder} ({exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(tmp)
+
+
 def check_output(path: str, option: str, *, blocks: int = 1, figure: bool = False) -> Path:
     """Refuse an output path that cannot be written, before any work is done.
 
@@ -88,6 +105,7 @@ def check_output(path: str, option: str, *, blocks: int = 1, figure: bool = Fals
         raise InvalidInputError(f"{option} {p}: the folder {folder} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise InvalidInputError(f"{option} {p}: cannot write in the folder {folder} (permission denied)")
+    probe_folder(p, option)
     if p.suffix.lower() == ".vtm":  # its blocks go to a folder of its name, which must be its own
         from ..io.vtk_xml import check_block_folder
 

@@ -141,7 +141,7 @@ class _Say:
 def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
     """Every ``-o`` and ``--png`` checked (format, dependency, folder, not given twice)."""
     from ..io import find_format
-    from .generate import check_output
+    from .generate import check_output, probe_folder
 
     if not (args.output or args.png or args.case):
         raise InvalidInputError("nothing to write: give -o OUT (a grid file), --png FIG or --case LAYOUT.toml")
@@ -163,6 +163,7 @@ def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
             raise InvalidInputError(f"--case {p}: {'is a folder' if p.is_dir() else 'its folder does not exist'}")
         if p.resolve() in seen:
             raise InvalidInputError(f"--case {p}: the same file as {seen[p.resolve()]}")
+        probe_folder(p, "--case")
     return out
 
 

@@ -3,6 +3,8 @@ line naming the file and the problem — no traceback, no output file, nothing s
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -190,3 +192,13 @@ def test_a_spherical_grd_of_metres_is_refused_naming_the_node(tmp_path):
     q.write_text(q.read_text().replace("Cartesian", "Spherical"))
     g = read_blocks(q).blocks[0]  # lon/lat in range: read as before
     assert abs(g.x.min() - 8.5) < 1e-9 and abs(g.y.max() - 47.21) < 1e-9
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs /proc (a folder no one can create files in)")
+@pytest.mark.parametrize("late", [["--png", "/proc/f.png"], ["--case", "/proc/c.toml"]])
+def test_an_output_folder_that_refuses_files_is_found_before_any_output_is_written(tmp_path, capsys, late):
+    # /proc passes the permission bits for root: the grid was written, then --png failed (exit 2, o.vtm left)
+    out = tmp_path / "o.vtm"
+    argv = ["mesh", DATA / "lake_zurich_sparse.csv", "-o", out, *late, "--cells", "200", "-q"]
+    _bad(capsys, argv, late[0], "cannot write in the folder /proc")
+    assert not out.exists() and not (tmp_path / "o").exists()
