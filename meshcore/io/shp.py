@@ -66,7 +66,9 @@ def read_points_shp(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     elif prj is not None:
         if prj.stat().st_size > 2**20:
             raise ReadError(f"{prj}: {prj.stat().st_size} bytes is not a projection file")
-        wkt = prj.read_text(errors="replace").strip()
+        raw = prj.read_bytes()  # Windows tools may write a byte order mark (UTF-8 or UTF-16)
+        utf16 = raw[:2] in (b"\xff\xfe", b"\xfe\xff")
+        wkt = raw.decode("utf-16" if utf16 else "utf-8-sig", errors="replace").strip()
         if wkt:
             try:
                 declared = normalize_crs(wkt)

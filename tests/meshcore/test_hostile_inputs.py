@@ -202,3 +202,15 @@ def test_an_output_folder_that_refuses_files_is_found_before_any_output_is_writt
     argv = ["mesh", DATA / "lake_zurich_sparse.csv", "-o", out, *late, "--cells", "200", "-q"]
     _bad(capsys, argv, late[0], "cannot write in the folder /proc")
     assert not out.exists() and not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("encoding", ["utf-8-sig", "utf-16"])
+def test_a_prj_with_a_byte_order_mark_is_read(tmp_path, encoding):
+    # a .prj written with a BOM (Windows tools) was 'unreadable projection' (exit 2)
+    from meshcore.io import read_points
+
+    for suffix in (".shp", ".shx", ".dbf"):
+        (tmp_path / f"w{suffix}").write_bytes((DATA / f"windermere_sparse{suffix}").read_bytes())
+    wkt = (DATA / "windermere_sparse.prj").read_text()
+    (tmp_path / "w.prj").write_bytes(wkt.encode(encoding))
+    assert read_points(tmp_path / "w.shp").crs == "EPSG:4326"
