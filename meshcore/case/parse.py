@@ -364,7 +364,9 @@ def load_case(path: str | Path) -> Case:
     """
     p = Path(path)
     try:  # a regular file of at most MESHCORE_MAX_BYTES (a fifo or /dev/zero would be read for ever)
-        text = read_file_bytes(p, error=CaseFileError).decode("utf-8")
+        raw = read_file_bytes(p, error=CaseFileError)
+        # an editor may save a byte order mark (Notepad: UTF-8 or "Unicode", UTF-16): TOML is UTF-8 without
+        text = raw.decode("utf-16") if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else raw.decode("utf-8-sig")
     except FileNotFoundError:
         raise CaseFileError(f"{p}: case file not found") from None
     except (OSError, UnicodeDecodeError) as exc:

@@ -214,3 +214,13 @@ def test_a_prj_with_a_byte_order_mark_is_read(tmp_path, encoding):
     wkt = (DATA / "windermere_sparse.prj").read_text()
     (tmp_path / "w.prj").write_bytes(wkt.encode(encoding))
     assert read_points(tmp_path / "w.shp").crs == "EPSG:4326"
+
+
+@pytest.mark.parametrize("encoding", ["utf-8-sig", "utf-16"])
+def test_a_case_saved_with_a_byte_order_mark_is_read(tmp_path, encoding):
+    # a case edited in Notepad (UTF-8 with BOM, or "Unicode") was "invalid TOML … line 1, column 1" (exit 2)
+    from meshcore.case import load_case
+
+    case = tmp_path / "case.toml"
+    case.write_bytes(BOTTLE.read_text().encode(encoding))
+    assert load_case(case).blocks[0].name == load_case(BOTTLE).blocks[0].name
