@@ -42,7 +42,14 @@ def read_points_dxf(path: Path, *, crs: Any = None, sagitta: float | None = None
         path.stat().st_size, max_bytes(), what=f"{path}: file size in bytes", env="MESHCORE_MAX_BYTES", error=ReadError
     )
     try:
-        doc = ezdxf.readfile(str(path))
+        with open(path, "rb") as f:
+            bom = f.read(3) == b"\xef\xbb\xbf"  # ezdxf.readfile: "not a DXF file"
+        if bom:
+            import io
+
+            doc = ezdxf.read(io.StringIO(path.read_bytes()[3:].decode("utf-8", errors="replace")))
+        else:
+            doc = ezdxf.readfile(str(path))
     except (DXFError, OSError, UnicodeDecodeError, ValueError) as exc:
         raise ReadError(f"{path}: not a valid DXF file ({type(exc).__name__}: {exc})") from None
     msp = doc.modelspace()

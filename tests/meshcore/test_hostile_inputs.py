@@ -224,3 +224,14 @@ def test_a_case_saved_with_a_byte_order_mark_is_read(tmp_path, encoding):
     case = tmp_path / "case.toml"
     case.write_bytes(BOTTLE.read_text().encode(encoding))
     assert load_case(case).blocks[0].name == load_case(BOTTLE).blocks[0].name
+
+
+def test_a_dxf_with_a_byte_order_mark_is_read(tmp_path):
+    # a DXF saved as UTF-8 with a BOM was "not a valid DXF file (… is not a DXF file.)"
+    from meshcore.io import read_points
+
+    src = DATA / "lake_zurich_sparse_utm32.dxf"
+    f = tmp_path / "lake.dxf"
+    f.write_bytes(b"\xef\xbb\xbf" + src.read_bytes())
+    got, want = read_points(f), read_points(src)
+    assert [p.points.tolist() for p in got.polylines] == [p.points.tolist() for p in want.polylines]
