@@ -86,6 +86,8 @@ def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
         raise ReadError(f"{path}: line {exc.lineno}: invalid JSON ({exc.msg})") from None
     except RecursionError:
         raise ReadError(f"{path}: JSON nested too deeply") from None
+    except ValueError:  # Python refuses integers of more than 4300 digits
+        raise ReadError(f"{path}: a number of thousands of digits: not a coordinate") from None
     if not isinstance(doc, dict) or "type" not in doc:
         raise ReadError(f"{path}: not a GeoJSON object (no 'type')")
     declared = LONLAT

@@ -235,3 +235,15 @@ def test_a_dxf_with_a_byte_order_mark_is_read(tmp_path):
     f.write_bytes(b"\xef\xbb\xbf" + src.read_bytes())
     got, want = read_points(f), read_points(src)
     assert [p.points.tolist() for p in got.polylines] == [p.points.tolist() for p in want.polylines]
+
+
+def test_a_geojson_number_of_thousands_of_digits_is_named_without_python_internals(tmp_path):
+    # the message was Python's "use sys.set_int_max_str_digits() to increase the limit"
+    from meshcore.errors import ReadError
+    from meshcore.io import read_points
+
+    f = tmp_path / "lake.geojson"
+    f.write_text('{"type": "LineString", "coordinates": [[' + "9" * 5000 + ", 1], [2, 3]]}")
+    with pytest.raises(ReadError, match=r"lake.geojson: a number of thousands of digits") as e:
+        read_points(f)
+    assert "sys." not in str(e.value)
