@@ -309,6 +309,11 @@ class IOController(QtCore.QObject):
             # block drawn before (a stray click in Draw) keeps it from being block 0
             after = after.replaced(lake=lake)
         self.editor.replace_project(after, f"Import {name}")
+        if replace and self.doc.path is not None:  # another lake: Save must not write it over the first's file
+            self.doc.report(
+                "info", f"{name} replaces the lake of {self.doc.path.name}: Save asks for a file (the first is kept)"
+            )
+            self.doc.set_path(None)
         self.doc.set_active(k)
         self.win.canvas.fit()
         self.win.set_tool("edit")

@@ -1,0 +1,34 @@
+"""What a third modeller's afternoon in the app (session 19, held-out GSHHG lakes under Xvfb) found,
+each as it went wrong, on generated shapes."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.app.test_modeller import _metres_lake
+
+pytestmark = pytest.mark.gui
+
+
+def test_a_lake_imported_over_a_saved_project_is_not_saved_over_its_file(qtbot, win, tmp_path, monkeypatch):
+    """Open (or save) lake A's project, import lake B over it (B replaces A, one undo step), Ctrl+S:
+    the title bar still named A's file and Save wrote lake B into it without a word; A's project
+    was gone.  Save now asks for a file, offering B's name, and A's file is left as it was."""
+    from PySide6 import QtWidgets
+
+    assert win.io.import_points(_metres_lake(tmp_path / "Tarn.csv", 761901))
+    first = tmp_path / "Tarn.toml"
+    assert win.io.save_to(first)
+    saved = first.read_text()
+    assert win.io.import_points(_metres_lake(tmp_path / "Mere.csv", 761902))
+    asked = []
+
+    def dialog(_parent, _caption, directory, _filter):
+        asked.append(directory)
+        return "", ""
+
+    monkeypatch.setattr(QtWidgets.QFileDialog, "getSaveFileName", dialog)
+    assert not win.io.save()  # the dialog was cancelled
+    assert first.read_text() == saved
+    assert asked == [str(tmp_path / "Mere.toml")]
+    assert "Tarn.toml" not in win.windowTitle()
