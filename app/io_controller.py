@@ -250,7 +250,7 @@ class IOController(QtCore.QObject):
             return False
         block = block_from_points(pts, path.stem)
         self._add_imported(block, frame, path.name, lake=lake, replace=replace)
-        self.remember_dir(path)
+        self.add_recent(path)  # File ▸ Open recent imports it again (and remembers its folder)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"

@@ -32,3 +32,13 @@ def test_a_lake_imported_over_a_saved_project_is_not_saved_over_its_file(qtbot, 
     assert first.read_text() == saved
     assert asked == [str(tmp_path / "Mere.toml")]
     assert "Tarn.toml" not in win.windowTitle()
+
+
+def test_an_imported_lake_file_is_in_open_recent(qtbot, win, tmp_path):
+    """File ▸ Open recent listed saved projects only: the lake file a modeller imported an hour ago
+    had to be found again in the file dialog.  It is listed, and opening it imports it."""
+    src = _metres_lake(tmp_path / "Tarn.csv", 761903)
+    assert win.io.import_points(src)
+    assert win.io.recent()[0] == str(src)
+    texts = [a.text() for a in win.io.recent_menu.actions()]
+    assert str(src) in texts
