@@ -37,7 +37,13 @@ def _logging() -> None:
     """Warnings and errors to stderr; everything from INFO up, with tracebacks, to gcmesh.log."""
     from PySide6 import QtCore
 
-    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    # the terminal's handler has its own level: the "app" logger below passes INFO records (a file that
+    # cannot be read, with its traceback) to every handler of the root, whose level does not stop them
+    terminal = logging.StreamHandler()
+    terminal.setLevel(logging.WARNING)
+    terminal.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    logging.getLogger().addHandler(terminal)
+    logging.getLogger().setLevel(logging.WARNING)
     loc = QtCore.QStandardPaths.StandardLocation.AppDataLocation
     folder = Path(QtCore.QStandardPaths.writableLocation(loc))
     try:

@@ -42,3 +42,36 @@ def test_an_imported_lake_file_is_in_open_recent(qtbot, win, tmp_path):
     assert win.io.recent()[0] == str(src)
     texts = [a.text() for a in win.io.recent_menu.actions()]
     assert str(src) in texts
+
+
+def test_a_file_that_cannot_be_imported_prints_no_traceback_in_the_terminal(qtbot, win, tmp_path, monkeypatch, capsys):
+    """A CSV that is no point file: the dialog said why, and the terminal got the same at INFO level
+    with a full traceback (the "app" logger's INFO records reached the terminal's handler).  The
+    terminal gets warnings and errors only; the log file keeps the traceback."""
+    import logging
+
+    from PySide6 import QtCore
+
+    import app.__main__ as entry
+
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "handlers", [])  # as in a new process (pytest's own are put back after)
+    monkeypatch.setattr(root, "level", root.level)
+    monkeypatch.setattr(logging.getLogger("app"), "level", logging.getLogger("app").level)
+    monkeypatch.setattr(QtCore.QStandardPaths, "writableLocation", lambda _loc: str(tmp_path / "data"))
+    entry._logging()
+    added = list(root.handlers)
+    try:
+        bad = tmp_path / "notes.csv"
+        bad.write_text("hello,world\nfoo\n")
+        assert not win.io.import_points(bad)
+        for h in added:
+            h.flush()
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and "notes.csv" not in err
+        assert "Traceback" in (tmp_path / "data" / "gcmesh.log").read_text()
+        logging.getLogger("app.test").warning("a warning still shows")
+        assert "a warning still shows" in capsys.readouterr().err
+    finally:
+        for h in added:
+            h.close()
