@@ -45,6 +45,11 @@ METRICS = {
 DEVIATION_LEVELS = (0.0, 10.0)
 
 
+#: finished solves the document keeps for undo and redo: back to a layout (or project) a grid was made
+#: for, that grid is shown again instead of nothing (a few MB each for lakes of ~10 000 cells)
+KEPT_SOLVES = 8
+
+
 def _made_of(project: Project):
     """What a project's grid is made of: a lake's grid of its layout alone (the lake's cell size and
     *regular* are settings for the next Auto layout), every other grid of the whole project."""
@@ -111,6 +116,8 @@ class Document:
         #: meshcore LakeMetrics of a lake layout's finished grid (None otherwise)
         self.lake_metrics = None
         self._given_metrics = None  # (MultiBlockGrid, LakeMetrics) measured by the solver worker
+        #: the last :data:`KEPT_SOLVES` finished solves: (project, grids, initial, multiblock, given metrics)
+        self._kept: list[tuple] = []
 
     # ----------------------------------------------------------- project
     @property
@@ -141,6 +148,7 @@ class Document:
             self.multiblock = None
             self.grids_changed.emit()
             self._update_quality()
+        self._restore_kept(project)
         if self.active >= len(project.blocks):
             self.set_active(len(project.blocks) - 1)
         n = len(self.block.points)
@@ -148,6 +156,20 @@ class Document:
             self.set_selection(frozenset(i for i in self.selection if i < n))
         self.stale = not (self.grids and self.solved is not None and _made_of(project) is _made_of(self.solved))
         self.project_changed.emit(project)
+
+    def _restore_kept(self, project: Project) -> None:
+        """An undo or redo back to what a kept solve was made of: its grids become the current ones."""
+        made = _made_of(project)
+        if self.solving or (self.solved is not None and _made_of(self.solved) is made and self.grids):
+            return
+        kept = next((k for k in self._kept if _made_of(k[0]) is made), None)
+        if kept is None:
+            return
+        self.solved, grids, initial, self.multiblock, self._given_metrics = kept
+        self.grids, self.initial = dict(grids), dict(initial)
+        self._final = True
+        self.grids_changed.emit()
+        self._update_quality()
 
     def reset(self, project: Project, path: Path | None = None) -> None:
         """Start over with ``project`` (open/new): grids and selection cleared."""
@@ -161,6 +183,7 @@ class Document:
         self.path = Path(path) if path else None
         self.stale = True
         self.solved = None
+        self._kept = []
         self._update_quality()
         self.opened.emit()
         self.project_changed.emit(project)
@@ -197,12 +220,17 @@ class Document:
         self.solved = project if project is not None else self.project
         self.stale = _made_of(self.solved) is not _made_of(self.project)
         self._final = True
+        made = _made_of(self.solved)
+        self._kept = [k for k in self._kept if _made_of(k[0]) is not made][-(KEPT_SOLVES - 1) :]
+        self._kept.append((self.solved, dict(self.grids), dict(self.initial), multiblock, self._given_metrics))
         self.grids_changed.emit()
         self._update_quality()
 
     def set_multiblock(self, multiblock) -> None:
         """The MultiBlockGrid (connectivity included) of the grids just set."""
         self.multiblock = multiblock
+        if self._kept and self._kept[-1][0] is self.solved:
+            self._kept[-1] = (*self._kept[-1][:3], multiblock, self._kept[-1][4])
 
     def clear_grids(self) -> None:
         self.solved = None

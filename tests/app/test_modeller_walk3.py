@@ -75,3 +75,41 @@ def test_a_file_that_cannot_be_imported_prints_no_traceback_in_the_terminal(qtbo
     finally:
         for h in added:
             h.close()
+
+
+def test_undo_and_redo_bring_back_the_grids_made_for_each_layout(qtbot, win, tmp_path):
+    """Auto layout (gridded), drag a cut end, F5 (gridded again), add a cut line, F5: three grids
+    made.  Ctrl+Z went back through the layouts and showed none of them (a blank lake, "F5 if it
+    is not being made"): each had to be solved again, also after Ctrl+Y to the last one.  Each
+    layout's grid comes back with it, current (not greyed), its verdict with it."""
+    from app.layout_edit import with_cut
+    from tests.app.test_modeller import _laid_out
+    from tests.app.waits import drag_a_cut_end, wait_for, wait_idle
+
+    first = _laid_out(qtbot, win, tmp_path, 761904)
+    made = [(first, dict(win.doc.grids))]
+    drag_a_cut_end(qtbot, win)
+    win.generate()
+    wait_idle(qtbot, win)
+    made.append((win.doc.project, dict(win.doc.grids)))
+    lay = win.doc.project.layout
+    x0, y0, x1, y1 = lay.polygon.bounds
+    cut = [[x0 - 1.0, (y0 + y1) / 2], [x1 + 1.0, (y0 + y1) / 2]]
+    before = win.doc.project
+    win.lake_ctl.edit_layout(lambda: with_cut(lay, cut), "Add cut line")
+    wait_for(qtbot, win, lambda: win.doc.project is not before and not win.lake_ctl.editing)
+    win.generate()
+    wait_idle(qtbot, win)
+    made.append((win.doc.project, dict(win.doc.grids)))
+    assert len({len(g) for _p, g in made}) > 1  # the cut added blocks
+    for project, grids in reversed(made[:-1]):
+        win.stack.undo()
+        assert win.doc.project is project
+        assert win.doc.grids == grids and not win.doc.stale
+        assert win.doc.lake_metrics is not None and "F5" not in win.lake_quality.headline.text()
+        assert win.canvas.grid_curve.opts["pen"].color().name() == "#303030"  # drawn as current, not greyed
+    for project, grids in made[1:]:
+        win.stack.redo()
+        assert win.doc.project is project
+        assert win.doc.grids == grids and not win.doc.stale
+    assert win.io.export_mesh(tmp_path / "last.vtm")
