@@ -229,9 +229,16 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.activated.connect(lambda index: self.go_to_worst(index.row()))
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)
-        # a project without a layout (New, an example) hides the box even when no grid went with it
-        doc.project_changed.connect(lambda _p: self.setVisible(self.doc.project.layout is not None))
+        # a project without a layout (New, an example) hides the box even when no grid went with it; one
+        # with a layout and no grid yet (a laid-out case opened first thing) says F5, not "Auto layout"
+        doc.project_changed.connect(self._project_changed)
         self.refresh()
+
+    def _project_changed(self, _project) -> None:
+        if self.doc.lake_metrics is None:  # its text (cheap); a verdict is redone when the quality changes
+            self.refresh()
+        else:
+            self.setVisible(self.doc.project.layout is not None)
 
     def set_previous(self, on: bool) -> None:
         """Say (or stop saying) that the verdict is of the grid before the last edit."""

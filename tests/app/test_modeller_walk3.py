@@ -113,3 +113,33 @@ def test_undo_and_redo_bring_back_the_grids_made_for_each_layout(qtbot, win, tmp
         assert win.doc.project is project
         assert win.doc.grids == grids and not win.doc.stale
     assert win.io.export_mesh(tmp_path / "last.vtm")
+
+
+def test_a_laid_out_case_opened_first_thing_says_f5_not_auto_layout(qtbot, win, tmp_path):
+    """The app started, File ▸ Open recent of a saved lake layout: the Quality panel's verdict box
+    said "No lake grid yet (Auto layout, then it generates)" — an Auto layout would throw away the
+    layout edited by hand.  It says that F5 makes the grid of this layout."""
+    import shapely
+
+    from app import io_adapter as fio
+    from app.lake import with_layout
+    from meshcore.layout import auto_layout
+
+    assert win.io.import_points(_metres_lake(tmp_path / "Tarn.csv", 761905))
+    lake = win.doc.project.lake
+    laid = with_layout(win.doc.project, lake.replaced(layout=auto_layout(shapely.Polygon(lake.outline, lake.holes))))
+    case = tmp_path / "Tarn.toml"
+    fio.save_project(laid, case)
+    from PySide6 import QtCore
+
+    from app.main_window import MainWindow
+
+    settings = QtCore.QSettings(str(tmp_path / "fresh.ini"), QtCore.QSettings.Format.IniFormat)
+    fresh = MainWindow(settings=settings, recovery=tmp_path / "fresh.gcmesh")
+    fresh.quiet = True
+    qtbot.addWidget(fresh)
+    fresh.show()
+    assert fresh.io.open_path(case)
+    assert fresh.doc.project.layout is not None and not fresh.doc.grids
+    text = fresh.lake_quality.headline.text()
+    assert "Auto layout" not in text and "F5" in text
