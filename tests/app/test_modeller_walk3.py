@@ -143,3 +143,29 @@ def test_a_laid_out_case_opened_first_thing_says_f5_not_auto_layout(qtbot, win, 
     assert fresh.doc.project.layout is not None and not fresh.doc.grids
     text = fresh.lake_quality.headline.text()
     assert "Auto layout" not in text and "F5" in text
+
+
+def test_a_failed_limit_never_reads_100_percent_ok(qtbot, monkeypatch):
+    """The huge lake (12 islands, 14 736 cells) had 4 folded cells: the verdict table read
+    "FAIL (100.0 % ok) | 4 | folded or non-convex cells" — a share of 0.99973 rounded up."""
+    import sys
+    from types import SimpleNamespace
+
+    from app.document import Document
+    from app.views.lake_panel import LakeQualityBox
+    from meshcore.quality.presets import Limit, LimitResult
+
+    doc = Document()
+    box = LakeQualityBox(doc)
+    qtbot.addWidget(box)
+    folded = LimitResult(Limit("folded", 0.5), 14736, 4, 1 - 4 / 14736, False, ())
+    smooth = LimitResult(Limit("smoothness", 1.2, share=0.95), 40000, 1000, 0.975, True, ())
+    metrics = SimpleNamespace(samples={})  # no places to mark
+    preset = SimpleNamespace(name="delft3d")
+    verdict = SimpleNamespace(preset=preset, results=(folded, smooth), passed=False, failed=(folded,), metrics=metrics)
+    summary = {"cells": 14736, "mean_deviation_deg": 4.88, "folded_cells": 4}
+    monkeypatch.setattr(sys.modules["meshcore.quality"], "check", lambda _m, _preset: verdict)
+    doc.lake_metrics = SimpleNamespace(summary=lambda: summary)
+    box.refresh()
+    assert box.table.item(0, 0).text() == "FAIL (99.9 % ok)"
+    assert box.table.item(1, 0).text() == "pass (97.5 % ok)"
