@@ -154,7 +154,8 @@ class IOController(QtCore.QObject):
 
     def suggested_path(self) -> str:
         """What the Save dialog offers: the file saved to, or the project's title (the imported lake's
-        file name) as a .toml in the last folder used, or "untitled.toml" there."""
+        file name) as a .toml in the last folder used, or "untitled.toml" there (the Export dialog
+        offers the same name with its format's suffix)."""
         if self.doc.path is not None:
             return str(self.doc.path)
         stem = re.sub(r'[\\/:*?"<>|]+', "_", self.doc.project.title).strip(" .") or "untitled"
@@ -327,9 +328,9 @@ class IOController(QtCore.QObject):
         filt = ";;".join(f"{d} ({p})" for d, p in fmts)
         want = export_default(self.doc.project)
         first = next((f"{d} ({p})" for d, p in fmts if d.endswith(f"[{want}]")), "")
-        path, chosen = QtWidgets.QFileDialog.getSaveFileName(
-            self._parent(), "Export mesh", self.last_dir(), filt, first
-        )
+        suffix = next((p.split()[0].lstrip("*") for d, p in fmts if d.endswith(f"[{want}]")), "")
+        offer = str(Path(self.suggested_path()).with_suffix(suffix)) if suffix else self.last_dir()
+        path, chosen = QtWidgets.QFileDialog.getSaveFileName(self._parent(), "Export mesh", offer, filt, first)
         if path:
             if not Path(path).suffix:
                 pat = next((p for d, p in fmts if chosen.startswith(d)), "*.vts")

@@ -169,3 +169,23 @@ def test_a_failed_limit_never_reads_100_percent_ok(qtbot, monkeypatch):
     box.refresh()
     assert box.table.item(0, 0).text() == "FAIL (99.9 % ok)"
     assert box.table.item(1, 0).text() == "pass (97.5 % ok)"
+
+
+def test_the_export_dialog_offers_the_lake_file_name(qtbot, win, tmp_path, monkeypatch):
+    """Save offered "<lake>.toml", Export an empty name: every export of every lake was typed.  It
+    offers the lake's name with the suffix of the format it offers first (.ddb for a lake layout)."""
+    from PySide6 import QtWidgets
+
+    from tests.app.test_modeller import _laid_out
+
+    _laid_out(qtbot, win, tmp_path, 761906)
+    offered = []
+
+    def dialog(_parent, _caption, directory, _filter, _first):
+        offered.append(directory)
+        return "", ""
+
+    monkeypatch.setattr(QtWidgets.QFileDialog, "getSaveFileName", dialog)
+    win.io.remember_dir(tmp_path / "out" / "x")
+    win.io.export_dialog()
+    assert offered == [str(tmp_path / "out" / "lake761906.ddb")]
