@@ -271,6 +271,7 @@ class QualityPanel(QtWidgets.QWidget):
             return
         self.hist.show()
         rows = [
+            *([("block", self._block_name())] if self._block_name() else []),
             ("cells (ξ × η)", f"{r.cells[0]} × {r.cells[1]}"),
             ("folded cells", f"{r.n_folded}"),
             ("non-convex cells", f"{r.n_nonconvex}"),
@@ -301,12 +302,20 @@ class QualityPanel(QtWidgets.QWidget):
         self._show_folded()
         self._histogram()
 
+    def _block_name(self) -> str:
+        """The name of the block the report is of, when the project has several (a lake's layout): its
+        "folded cells: none" read as the lake's beside a verdict of 4 folded in another block."""
+        p = self.doc.project
+        return self.doc.block.name if len(p.blocks) > 1 and self.doc.quality is not None else ""
+
     def _show_folded(self) -> None:
         """The list of folded / non-convex cells, or one line saying there are none."""
         n = self.folded.count()
         self.folded.setVisible(n > 0)
+        name = self._block_name()
+        where = f" in {name}" if name else ""
         self.folded_label.setText(
-            "Folded / non-convex cells (click to zoom):" if n else "Folded / non-convex cells: none"
+            f"Folded / non-convex cells{where} (click to zoom):" if n else f"Folded / non-convex cells{where}: none"
         )
 
     def _on_colour(self, label: str) -> None:

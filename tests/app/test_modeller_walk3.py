@@ -189,3 +189,19 @@ def test_the_export_dialog_offers_the_lake_file_name(qtbot, win, tmp_path, monke
     win.io.remember_dir(tmp_path / "out" / "x")
     win.io.export_dialog()
     assert offered == [str(tmp_path / "out" / "lake761906.ddb")]
+
+
+def test_the_block_quality_names_its_block_on_a_lake_of_several(qtbot, win, tmp_path):
+    """On the 12-island lake the verdict said "4 folded" and, under it, the block report "Folded /
+    non-convex cells: none" and "cells 4 × 8": of the active block b0, which nothing said.  The
+    report names its block (and follows the block picked)."""
+    from tests.app.test_modeller import _laid_out
+
+    _laid_out(qtbot, win, tmp_path, 761907)
+    blocks = win.doc.project.blocks
+    assert len(blocks) > 1
+    panel = win.quality_panel
+    for k in (0, 1):
+        win.doc.set_active(k)
+        assert f" in {blocks[k].name}" in panel.folded_label.text()
+        assert (panel.table.item(0, 0).text(), panel.table.item(0, 1).text()) == ("block", blocks[k].name)
