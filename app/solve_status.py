@@ -66,7 +66,12 @@ class SolveStatus(QtCore.QObject):
         junction's cut lines no longer on its block borders), so it is greyed and said to be, with
         its verdict, until a solve makes the new one (F5).  An undo back to the project the grid was
         made for makes it current again (no F5, and it exports)."""
-        if self.solver.auto or self.solver.running or not self.doc.grids:
+        if self.solver.running:
+            return
+        if not self.doc.grids:  # another lake imported, a new layout: the last solve's summary is of nothing here
+            self.label.setText("idle")
+            return
+        if self.solver.auto:
             return
         if not self.doc.stale:
             self.on_final()

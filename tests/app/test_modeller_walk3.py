@@ -205,3 +205,14 @@ def test_the_block_quality_names_its_block_on_a_lake_of_several(qtbot, win, tmp_
         win.doc.set_active(k)
         assert f" in {blocks[k].name}" in panel.folded_label.text()
         assert (panel.table.item(0, 0).text(), panel.table.item(0, 1).text()) == ("block", blocks[k].name)
+
+
+def test_the_solver_label_forgets_the_last_lake_when_another_is_imported(qtbot, win, tmp_path):
+    """A lake gridded, another imported over it (no grid yet): the status bar's solver label kept
+    "orthogonal: 590 sweeps, 8.1 s" of the first lake beside the second's outline."""
+    from tests.app.test_modeller import _laid_out
+
+    _laid_out(qtbot, win, tmp_path, 761908)
+    assert "sweeps" in win.solve_status.label.text()
+    assert win.io.import_points(_metres_lake(tmp_path / "Mere.csv", 761909))
+    assert not win.doc.grids and win.solve_status.label.text() == "idle"
