@@ -294,7 +294,9 @@ class IOController(QtCore.QObject):
             p = p.replaced(
                 blocks=(Block(name="block"),), lake=None, cut_lines=(), crs="", origin=(0.0, 0.0), source_crs=""
             )
-        empty = [k for k, b in enumerate(p.blocks) if len(b.points) == 0 and b.boundary is None]
+        # an empty block, or a stray click's (an open block of a point or two): the file goes there, not
+        # beside it (the stray one stayed in the Blocks panel, "1 points, open", until Auto layout)
+        empty = [k for k, b in enumerate(p.blocks) if len(b.points) < 3 and not b.closed and b.boundary is None]
         if empty:
             k = empty[0]
             after = p.with_block(k, block)

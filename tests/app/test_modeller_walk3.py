@@ -216,3 +216,15 @@ def test_the_solver_label_forgets_the_last_lake_when_another_is_imported(qtbot, 
     assert "sweeps" in win.solve_status.label.text()
     assert win.io.import_points(_metres_lake(tmp_path / "Mere.csv", 761909))
     assert not win.doc.grids and win.solve_status.label.text() == "idle"
+
+
+def test_a_stray_click_before_the_import_leaves_no_block_behind(qtbot, win, tmp_path):
+    """A click on the empty canvas (the Draw tool is on at start) made an open block of one point;
+    the lake imported next became a second block and the first stayed in the Blocks panel as
+    "block · 1 points, open" until an Auto layout.  The lake takes its place (undo brings it back)."""
+    win.editor.add_point((0.0, 0.0))
+    clicked = win.doc.project
+    assert win.io.import_points(_metres_lake(tmp_path / "Tarn.csv", 761910))
+    assert len(win.doc.project.blocks) == 1 and win.doc.project.blocks[0].name == "Tarn"
+    win.stack.undo()
+    assert win.doc.project is clicked
