@@ -143,6 +143,18 @@ def to_local(pd: PointData, frame=None) -> tuple[np.ndarray, object]:
     return _drop_closing(np.asarray(local.polylines[k].points, float)), fr
 
 
+def projection_named(pd: PointData, frame=None) -> str:
+    """What :func:`to_local` projects ``pd`` to, for the lon/lat question: "EPSG:32610, WGS 84 / UTM zone
+    10N" (it said "the UTM zone of the outline"; which one showed only on the axes afterwards)."""
+    from meshcore.crs import crs_name
+
+    try:
+        crs = frame.crs if frame is not None else to_local(pd, None)[1].crs
+        return f"{crs}, {crs_name(crs)}"
+    except (MeshcoreError, ValueError, AttributeError):
+        return frame.crs if frame is not None else "the UTM zone of the outline"
+
+
 def lonlat_to_local(points, frame=None) -> tuple[np.ndarray, object]:
     """Longitude/latitude degrees (``(n, 2)``) to the project's local metric coordinates.
 

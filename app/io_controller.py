@@ -217,7 +217,7 @@ class IOController(QtCore.QObject):
                 self.doc.report("warning", note.replace("give --columns 1 0", "add the header 'lat,lon' to the file"))
         if pd.lonlat:
             if project_lonlat is None and not self.quiet:
-                target = frame.crs if frame is not None else "the UTM zone of the outline"
+                target = fio.projection_named(pd, frame)
                 r = QtWidgets.QMessageBox.question(
                     self._parent(),
                     "Geographic coordinates",

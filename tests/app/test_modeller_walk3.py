@@ -228,3 +228,24 @@ def test_a_stray_click_before_the_import_leaves_no_block_behind(qtbot, win, tmp_
     assert len(win.doc.project.blocks) == 1 and win.doc.project.blocks[0].name == "Tarn"
     win.stack.undo()
     assert win.doc.project is clicked
+
+
+def test_the_lon_lat_question_names_the_utm_zone(qtbot, win, tmp_path, monkeypatch):
+    """ "g180810.kml holds longitude/latitude degrees. Project them to metres (the UTM zone of the
+    outline, …)?" — which zone showed only on the axes after the answer.  The question names it."""
+    from PySide6 import QtWidgets
+
+    from tests.app.test_modeller import _lonlat_lake
+
+    asked = []
+
+    def question(_parent, _title, text, *_a):
+        asked.append(text)
+        return QtWidgets.QMessageBox.StandardButton.Yes
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    monkeypatch.setattr(win, "quiet", False)
+    monkeypatch.setattr(win.lake_ctl, "offer", lambda *_a: None)  # the Auto layout offer: not asked here
+    assert win.io.import_points(_lonlat_lake(tmp_path / "Alp.geojson", 761911, lon=9.0, lat=47.0))
+    assert "EPSG:32632, WGS 84 / UTM zone 32N" in asked[0]
+    assert win.doc.project.crs == "EPSG:32632"
