@@ -452,7 +452,10 @@ class MainWindow(QtWidgets.QMainWindow):
     def dropEvent(self, ev: QtGui.QDropEvent) -> None:
         for url in ev.mimeData().urls():
             if url.isLocalFile():
-                self.io.open_path(Path(url.toLocalFile()))
+                path = Path(url.toLocalFile())
+                # a project replaces the work without undo (as File ▸ Open, which asks); a point file is an import
+                if path.suffix.lower() != ".toml" or self.io.maybe_save():
+                    self.io.open_path(path)
                 break
 
     def closeEvent(self, ev: QtGui.QCloseEvent) -> None:

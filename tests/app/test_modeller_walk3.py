@@ -249,3 +249,36 @@ def test_the_lon_lat_question_names_the_utm_zone(qtbot, win, tmp_path, monkeypat
     assert win.io.import_points(_lonlat_lake(tmp_path / "Alp.geojson", 761911, lon=9.0, lat=47.0))
     assert "EPSG:32632, WGS 84 / UTM zone 32N" in asked[0]
     assert win.doc.project.crs == "EPSG:32632"
+
+
+def _drop(win, path) -> None:
+    from PySide6 import QtCore, QtGui
+
+    mime = QtCore.QMimeData()
+    mime.setUrls([QtCore.QUrl.fromLocalFile(str(path))])
+    buttons, keys = QtCore.Qt.MouseButton.NoButton, QtCore.Qt.KeyboardModifier.NoModifier
+    win.dropEvent(QtGui.QDropEvent(QtCore.QPointF(200, 200), QtCore.Qt.DropAction.CopyAction, mime, buttons, keys))
+
+
+def test_a_project_dropped_on_the_window_asks_about_unsaved_work(qtbot, win, tmp_path, monkeypatch):
+    """File ▸ Open and Open recent ask about unsaved changes; a .toml dropped on the window replaced
+    the work at once, undo history included (a lake laid out and edited for an hour, gone)."""
+    from PySide6 import QtWidgets
+
+    from app import io_adapter as fio
+
+    other = tmp_path / "Other.toml"
+    assert win.io.import_points(_metres_lake(tmp_path / "Other.csv", 761912))
+    fio.save_project(win.doc.project, other)
+    assert win.io.import_points(_metres_lake(tmp_path / "Tarn.csv", 761913))
+    work = win.doc.project
+    asked = []
+
+    def question(_parent, title, _text, *_a):
+        asked.append(title)
+        return QtWidgets.QMessageBox.StandardButton.Cancel
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    monkeypatch.setattr(win, "quiet", False)
+    _drop(win, other)
+    assert asked == ["Unsaved changes"] and win.doc.project is work and win.stack.canUndo()
