@@ -426,7 +426,10 @@ class MainWindow(QtWidgets.QMainWindow):
             g = self.doc.grid
             h = max(g.bounds()[2] - g.bounds()[0], g.bounds()[3] - g.bounds()[1]) / 50 if g is not None else 1.0
         self.canvas.zoom_to_point(where.x, where.y, 4 * h)
-        self.message(f"Worst of {what}: {where}")
+        text = str(where)
+        if what.startswith("folded"):  # its limit "…: none" and a flag for a value read "none: 1 at b8(1,50)"
+            what, text = what.removesuffix(": none"), "a cell at " + text.split(" at ", 1)[-1]
+        self.message(f"Worst of {what}: {text}")
 
     def _misses_for_colours(self, label: str) -> None:
         """Cells coloured by a metric: the misses step aside (they would hide the colours), and back."""

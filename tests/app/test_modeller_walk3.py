@@ -282,3 +282,14 @@ def test_a_project_dropped_on_the_window_asks_about_unsaved_work(qtbot, win, tmp
     monkeypatch.setattr(win, "quiet", False)
     _drop(win, other)
     assert asked == ["Unsaved changes"] and win.doc.project is work and win.stack.canUndo()
+
+
+def test_the_worst_folded_cell_is_named_as_a_cell(qtbot, win):
+    """Double-click on the failed folded-cells limit of the 12-island lake: the status line read
+    "Worst of folded or non-convex cells: none: 1 at b8(1,50) (-5275.8308, 110017.66)"."""
+    from meshcore.quality.lake import Location
+
+    win.show_worst(Location(1.0, "b8", 1, 50, -5275.8308, 110017.66), "folded or non-convex cells: none")
+    assert win._status.text() == "Worst of folded or non-convex cells: a cell at b8(1,50) (-5275.8308, 110017.66)"
+    win.show_worst(Location(0.31, "b2", 4, 5, 10.0, 20.0), "node orthogonality |cos| ≤ 0.02")
+    assert win._status.text() == "Worst of node orthogonality |cos| ≤ 0.02: 0.31 at b2(4,5) (10, 20)"
