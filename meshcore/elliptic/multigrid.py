@@ -61,11 +61,10 @@ by less than ``accel.START_RATE``, each cycle's image is replaced by the combina
 ``ACCEL_DEPTH`` + 1 images whose displacement is least, unless that raises the residual above
 the image's (one more fine defect per mixed cycle) or folds more cells (then the history
 restarts).  Not on point-smoothed grids that could be line-smoothed (their stall is what hands
-them to the lines; see :func:`_cycles`).  Generated one-block shapes at ~24 000 nodes (seeds
+them to the lines) nor with a control (see :func:`_cycles`).  Generated one-block shapes at ~24 000 nodes (seeds
 from 774000, line-smoothed): 38 → 29, 46 → 22, 29 → 17 cycles on channel networks, 27–42 →
 14–19 on jagged Y junctions; CPU 1.42 → 0.99 s in all of the 19 that converge by multigrid (the
-3 others stall with and without mixing).  The wall-controlled examples are bit for bit the same
-(their sources change every cycle: no history to mix).
+3 others stall with and without mixing).
 
 If the iteration diverges (a residual that grows 1000-fold or is not finite),
 the solver restores the start grid and falls back to SOR; if it stalls (less
@@ -172,9 +171,7 @@ COARSEST_LINE_SWEEPS = 48
 #: at 6000 nodes (the 4 of tests/meshcore/test_foldfree_pieces.py, 28 of seeds 777000, 778000)
 #: ``channel_network(0)`` is no longer repaired (2 cells), the other 31 are repaired as before
 #: (from the plain cycles' grid at 2 × the default tolerance it is not repaired either: the
-#: same 2 cells; at 0.25, 0.5, 1, 4 × it is).  And a wall-controlled C-grid whose sources
-#: freeze (tests/meshcore/test_multigrid_wake.py) gets 30× ahead, then circles near 1e-7 where
-#: the plain cycles go on (rate 0.88 against < 0.8 over cycles 50–70): no restart rule for that.
+#: same 2 cells; at 0.25, 0.5, 1, 4 × it is).
 ACCEL, ACCEL_DEPTH, ACCEL_PLAIN_REF = False, 4, True
 #: Levels with fewer nodes than this use the serial kernels even with threads > 1.
 PARALLEL_MIN_NODES = 8192
@@ -902,8 +899,12 @@ def _cycles(state: SolverState, mg: _FAS, r0: float) -> Generator[str, None, boo
     # not on a point-smoothed grid that could be line-smoothed: its stall is what hands it to
     # the lines.  Mixed, such solves kept point smoothing (2-4x the cycles of the plain ones'
     # stall and line cycles, about the same CPU: generated networks and Y junctions at 3000
-    # nodes; mixing them too: -2 to -4 % CPU on 32 generated shapes, within the noise)
-    acc = A.Mixer([state.x, state.y], _folds, ACCEL_DEPTH) if ACCEL and (mg.lines or not mg.line_capable) else None
+    # nodes; mixing them too: -2 to -4 % CPU on 32 generated shapes, within the noise).  Nor with
+    # a control (its sources move every cycle: nothing to mix on the examples, bit for bit the
+    # same; a C-grid whose sources froze got 30x ahead, then circled near 1e-7 where the plain
+    # cycles went on: test_multigrid_wake.test_sources_frozen_the_cgrid_cycle_contracts)
+    mixes = ACCEL and state.sources is None and (mg.lines or not mg.line_capable)
+    acc = A.Mixer([state.x, state.y], _folds, ACCEL_DEPTH) if mixes else None
     last_run["accel"] = acc
     for it in range(1, cfg.max_iterations + 1):
         state.iterations = it
