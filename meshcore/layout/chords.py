@@ -204,7 +204,7 @@ def place_chords(
     ``MOUTH_MAX_WIDTH · min_length`` wide, an arm's junction chord lies at its mouth, where a
     chord as wide as the arm ends on the junction's inscribed circle (through the reflex shore
     corners between the arms); two such chords may meet there.  Off by default: measured mixed
-    (docs/lake-grids.md, Limits).
+    (docs/lake-grids-journal.md).
     """
     import shapely
     from shapely.geometry import LineString

@@ -24,8 +24,8 @@ straight: the shore turns where it was sampled densely);
 * segments shorter than half a cell are at the grid's scale already and stay straight.
 
 Off by default (``auto_layout(..., options=LayoutOptions(curve=True))``,
-``meshcore mesh --layout-option curve``): measured mixed (session 18, docs/lake-grids.md
-## Limits, *Outlines with a point every few cells*).  Grids get
+``meshcore mesh --layout-option curve``): measured mixed (session 18, docs/lake-grids-journal.md
+*Outlines with a point every few cells*).  Grids get
 more orthogonal (GSHHG lakes held out in session 17, 10 000 cells: mean share within 3°
 94.4 → 95.5 %, the worst lake 75.9 → 87.6 %; generated lakes at 15 000 cells: ≥ 90 % within 3°
 in 43 → 45, 42 → 44 and 20 → 23 of 45, 45, 27), but fewer keep every interface ratio ≤ 2

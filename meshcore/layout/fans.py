@@ -16,7 +16,7 @@ widths=(0.5, 3.0))`, 429 folded cells).  No single cut pays there because each p
 cut still needs cuts of its own.  :func:`unfan` splits such a piece with one step of
 look-ahead: every admissible split, its pieces split greedily again, the cheapest result in
 which no piece fans.  Other pieces are left as the greedy split made them (one step of
-look-ahead everywhere helped some lakes and hurt others: ``docs/lake-grids.md``).
+look-ahead everywhere helped some lakes and hurt others: ``docs/lake-grids-journal.md``).
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ __all__ = ["Layout", "LayoutBlock", "LayoutOptions"]
 @dataclass(frozen=True, slots=True)
 class LayoutOptions:
     """Layout choices that are off by default, each because it was measured to help one family of
-    lakes and hurt another (the numbers are in ``docs/lake-grids.md``).
+    lakes and hurt another (the numbers are in ``docs/lake-grids-journal.md``).
 
     thin_arms
         Cuts from reflex corners may leave blocks two cells across (three by default): the

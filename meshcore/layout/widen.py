@@ -46,7 +46,7 @@ MIN_REST = 0.2
 #: corner: the cut leaves the boundary almost along it.  The rest of ``round_lake(1021)``'s
 #: C-shaped block has its corners at 33° and 36° and gets a grid without folds, 96 % of its
 #: nodes within 3°; 20° leaves room below that, and the grids of every split the generated
-#: lakes made are measured in ``docs/lake-grids.md``.
+#: lakes made are measured in ``docs/lake-grids-journal.md``.
 MIN_TIP = 20.0
 #: A cut end where a ring's angle is above this (degrees; it turns by less than 45°) is a point
 #: on one of its sides, not a corner: the band's side bends there.  45° is where

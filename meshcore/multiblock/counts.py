@@ -62,7 +62,7 @@ JUMP_WEIGHT = 1.0
 #: the island-cover weight (:data:`LAND_WEIGHT`) it also took ``lake_with_islands(18)``'s coarsest
 #: level 2.45 cells off the shore; with it, ``lake_with_islands(6)`` (tests/meshcore/
 #: test_layout_folds.py) falls to 73.5 % of nodes within 3° (the test asks 80 %).  Why they lost,
-#: and the cost now paid along block sides only: :data:`STEEP_ACROSS`, docs/lake-grids.md
+#: and the cost now paid along block sides only: :data:`STEEP_ACROSS`, docs/lake-grids-journal.md
 #: ("Crowded shore pieces"); still off: the largest interface ratio and a few lakes get worse.
 STEEP = 3.0
 STEEP_WEIGHT = 0.0

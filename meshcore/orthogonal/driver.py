@@ -18,7 +18,7 @@ elliptic solution) and the shore it lies on, and iterates
    levels can turn the cut's first edge until the corner block's angle is 150–180° — a polar fan
    whose cells are 10–80 times smaller than those across the cut.  Off by default: it removes
    those fans but, holding only the first edge, makes a kink where the drawn cut bends a few
-   cells on, and on 90 generated lakes the two effects cancel (see ``docs/lake-grids.md``);
+   cells on, and on 90 generated lakes the two effects cancel (see ``docs/lake-grids-journal.md``);
 
 until the largest move is below ``tol`` × the median edge length.
 

@@ -4,7 +4,7 @@ interface made alike where the orthogonal solve left them far apart.
 The worst cross-interface pairs of a lake grid are single cells beside a cut's end at a reflex
 shore corner, mostly where the block that has its corner there opens to 150–180° (a polar fan
 whose cells shrink into the corner) and the block whose side passes keeps its cells
-(``docs/lake-grids.md``, *Cell-size jumps across interfaces*).  :func:`equalize_interfaces` takes
+(``docs/lake-grids-journal.md``, *Cell-size jumps across interfaces*).  :func:`equalize_interfaces` takes
 each pair above ``limit``, worst first, and moves the nodes within ``depth - 1`` grid edges of its
 two cells — block-interior and interface nodes (with ``SLIDE`` shore nodes too, along the
 shore); cut ends, block corners and nodes where 3 or 5 blocks meet stay — to minimize (BFGS,
@@ -20,7 +20,7 @@ optimum kinks the cut and squeezes slivers beside it), consecutive edge ratios a
 every corner Jacobian above half of its own, and the moves small.  A patch is kept only when
 its worst pair is lower and inside it no node within 3° or ``|cos| ≤ 0.02`` is lost,
 no interface pair ≤ 2, at most ``EDGE_LOSS`` edge pairs ≤ 1.2, and no corner Jacobian is ≤ 0;
-else half the step, a quarter, or nothing.  Measured in ``docs/lake-grids.md`` (sessions 17, 18).
+else half the step, a quarter, or nothing.  Measured in ``docs/lake-grids-journal.md`` (sessions 17, 18).
 """
 
 from __future__ import annotations

@@ -135,7 +135,7 @@ def test_grids_of_a_jagged_channel_are_orthogonal_and_unfolded(cells, seed):
     mb = mesh_outline(poly)
     m = lake_metrics(mb, polygon=poly)
     assert int(m.values("folded").sum()) == 0
-    if cells <= 1.5:  # teeth of 2.8 cells: 79 % since d3ab72d, 94 % before (docs/lake-grids.md, limits)
+    if cells <= 1.5:  # teeth of 2.8 cells: 79 % since d3ab72d, 94 % before (docs/lake-grids-journal.md, limits)
         assert m.share("deviation", 3.0) >= 0.9
     s = m.summary()
     assert abs(s["area_ratio"] - 1.0) < 0.01

@@ -31,7 +31,7 @@ from tests.meshcore.test_delft3d_dd import node_runs
 shapely = pytest.importorskip("shapely")
 
 #: generated lakes with islands: lobed lakes with three islands (one near the shore) and round
-#: lakes with 1-4 islands (more of them, at 2000, 3000 and 15 000 cells, in docs/lake-grids.md)
+#: lakes with 1-4 islands (more of them, at 2000, 3000 and 15 000 cells, in docs/lake-grids-journal.md)
 CASES = [f"lake_with_islands({s})" for s in range(8)] + [
     f"round_lake({s}, kind={k!r})" for s, k in ((0, "blob"), (1, "arms"), (2, "disc"), (3, "ring"))
 ]

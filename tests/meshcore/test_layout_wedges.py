@@ -3,7 +3,7 @@ two corners either side of its tip (:func:`meshcore.layout.corners.wedge_corners
 grid lines run along the wedge and converge on the tip.  With a corner at the tip and the fourth
 on a side, the cells fanned out from the tip across the whole end block (every node beyond 3°).
 ``mesh_outline(..., layout_options=LayoutOptions(wedges=True))``: off by default (measured mixed,
-docs/lake-grids.md)."""
+docs/lake-grids-journal.md)."""
 
 from __future__ import annotations
 

@@ -193,7 +193,7 @@ def test_stall_waits_while_any_watched_share_still_rises():
     """A share that does not move (``|cos| ≤ 0``: no node) stops the sweeps at the first check
     alone, not while another watched share (``|cos| ≤ 0.02``) still rises: the finest level of a
     lake grid whose 0.02 share stood still over its first 20 sweeps while its 3° share rose
-    stopped there (``docs/lake-grids.md``, *Lakes with many islands*)."""
+    stopped there (``docs/lake-grids-journal.md``, *Lakes with many islands*)."""
     topo, g = _jittered_strip()
     opts = {"max_sweeps": 400, "tol": 0.0, "smooth": 0.0, "size_ratio": None, "stall": 0.001, "stall_every": 10}
     assert orthogonalize(topo, [g], [], stall_limits=(0.0,), **opts).sweeps == 10
