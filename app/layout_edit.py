@@ -43,7 +43,9 @@ __all__ = [
     "place",
     "settled_layout",
     "shore_points",
+    "snapped_cut",
     "with_cut",
+    "with_drawn_cut",
     "without_cut",
 ]
 
@@ -406,6 +408,43 @@ def with_cut(layout: Any, cut: Any) -> Any:
     tol = 1e-6 * layout.cell_size
     cuts = [*layout.cuts, np.asarray(cut, float)]
     return _recut(layout, cuts, lambda ring: ring.intersection(line).length > tol)
+
+
+def snapped_cut(layout: Any, cut: Any, cells: float | None = None) -> tuple[np.ndarray, list[str]]:
+    """A cut drawn by hand over ``layout`` with each end that lands within ``cells`` cells
+    (default :data:`meshcore.layout.edit.SNAP_CELLS`) of a cut end, block corner or shore tip put on
+    it (:func:`meshcore.layout.edit.snap_cut`; an end a few cells off makes a thin wedge block),
+    and a message per snapped end (none: the ends stay where drawn)."""
+    from meshcore.layout.edit import SNAP_CELLS, snap_cut, snap_note, snap_targets
+
+    h = float(layout.cell_size)
+    d = (SNAP_CELLS if cells is None else float(cells)) * h
+    corners = [p for b in layout.blocks for p in b.corners]
+    targets = snap_targets(layout.polygon, layout.cuts, corners)
+    out, snaps = snap_cut(layout.polygon, cut, targets, d, layout.cuts)
+    if not snaps:
+        return np.asarray(cut, float), []
+    return out, [snap_note("Cut line", s, h) for s in snaps]
+
+
+def with_drawn_cut(layout: Any, cut: Any, report: Callable[[str, str], None] | None = None) -> Any:
+    """:func:`with_cut` of a cut drawn by hand, its ends snapped (:func:`snapped_cut`); ``report(level,
+    text)`` gets a message per snapped end.  When the snapped cut gives no layout (a cut put along
+    another one) the cut is taken as drawn, and its error is the one it gives unsnapped."""
+    snapped, notes = snapped_cut(layout, cut)
+    if not notes:
+        return with_cut(layout, cut)
+    try:
+        out = with_cut(layout, snapped)
+    except TopologyError as exc:
+        out = with_cut(layout, cut)
+        if report is not None:
+            report("info", f"Cut line: its ends stay where drawn (snapped, it gives no layout: {exc})")
+        return out
+    for note in notes:
+        if report is not None:
+            report("info", note)
+    return out
 
 
 def _recut(layout: Any, cuts: list, changed: Callable[[Any], bool]) -> Any:

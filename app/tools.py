@@ -302,10 +302,12 @@ class CutTool(Tool):
         if len(self.points) >= 2:
             lay = self.doc.project.layout
             if lay is not None and self.controller is not None:  # it was refused ("change it in the Lake panel")
-                from .layout_edit import with_cut
+                from .layout_edit import with_drawn_cut
 
-                cut = np.array(self.points)
-                self.controller.edit_layout(lambda: with_cut(lay, cut), "Add cut line")
+                # an end a user meant to put on a cut end, corner or tip lands a cell or two off: it
+                # goes onto it (else a thin wedge block); the Messages say where, one undo step as before
+                cut, report = np.array(self.points), self.doc.report
+                self.controller.edit_layout(lambda: with_drawn_cut(lay, cut, report), "Add cut line")
             else:
                 self.editor.add_cut_line(np.array(self.points))
         self.points = []

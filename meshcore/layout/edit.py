@@ -18,7 +18,16 @@ from .blocks import Piece, block_counts, conform
 from .model import Layout, LayoutBlock
 from .outline import _size
 
-__all__ = ["layout_from_cuts", "layout_from_outline", "layout_of_outline", "with_cells"]
+__all__ = [
+    "SNAP_CELLS",
+    "layout_from_cuts",
+    "layout_from_outline",
+    "layout_of_outline",
+    "snap_cut",
+    "snap_note",
+    "snap_targets",
+    "with_cells",
+]
 
 
 def _pieces_of_regions(rings: list[np.ndarray], corner_points: list[list], names: list[str], size: float):
@@ -90,13 +99,115 @@ def layout_of_outline(ob: Any, blocks: Any, *, cell_size: float | None = None, m
     )
 
 
-def layout_from_cuts(polygon: Any, cuts: Any, *, cell_size: float, multiple: int = 1, corners: Any = None):
+#: how near (in cells) a hand-drawn cut's end must land to a cut end, block corner or shore tip to
+#: be put on it (:func:`snap_cut`); measured in session 19 (docs/lake-grids.md, *Editing a layout*)
+SNAP_CELLS = 2.5
+#: a shore vertex is a tip a cut end snaps to where the shore turns by at least this (degrees)
+_TIP_TURN = 30.0
+
+
+def snap_targets(polygon: Any, cuts: Any = (), corners: Any = ()) -> list[tuple[tuple[float, float], str]]:
+    """The places a hand-drawn cut's end snaps to: the ends of ``cuts`` (where they meet the shore or
+    another cut), the ``corners`` (points) and the shore's and islands' vertices where they turn by
+    at least 30° (tips), each with its kind."""
+    from shapely.geometry import LineString, MultiLineString
+
+    out: list[tuple[tuple[float, float], str]] = []
+    cuts = [np.asarray(c, float) for c in cuts]
+    shore = [list(polygon.exterior.coords), *(list(r.coords) for r in polygon.interiors)]
+    for i, c in enumerate(cuts):  # where each cut meets the shore or another cut (drawn past it or not)
+        walls = MultiLineString(shore + [k.tolist() for j, k in enumerate(cuts) if j != i])
+        for e in (0, -1):
+            p = _landing(LineString(c), walls, e)[1]
+            out.append(((float(p.x), float(p.y)), "cut end"))
+    out += [((float(p[0]), float(p[1])), "block corner") for p in corners]
+    rings = [np.asarray(polygon.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in polygon.interiors)]
+    for r in rings:
+        a, b = r - np.roll(r, 1, axis=0), np.roll(r, -1, axis=0) - r
+        turn = np.degrees(np.abs(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], np.sum(a * b, axis=1))))
+        out += [((float(p[0]), float(p[1])), "shore tip") for p in r[turn >= _TIP_TURN]]
+    return out
+
+
+def _landing(line: Any, walls: Any, end: int) -> tuple[float, Any]:
+    """Where end ``end`` (0 or -1) of the drawn ``line`` lands: its crossing of ``walls`` (the shore
+    and the cuts) nearest that end (the water's regions end there: a piece drawn past it dangles),
+    or the end itself when it crosses none; returned as (distance along ``line``, point)."""
+    from shapely.geometry import Point
+
+    hits = line.intersection(walls)
+    pts = [Point(xy) for g in getattr(hits, "geoms", [hits]) if not g.is_empty for xy in g.coords]
+    if not pts:
+        return (0.0 if end == 0 else line.length), Point(line.coords[end])
+    s = [line.project(q) for q in pts]
+    k = int(np.argmin(s)) if end == 0 else int(np.argmax(s))
+    return s[k], pts[k]
+
+
+def snap_cut(polygon: Any, cut: Any, targets: Any, distance: float, cuts: Any = ()) -> tuple[np.ndarray, list]:
+    """A hand-drawn ``cut`` with each end that lands within ``distance`` of one of ``targets``
+    (:func:`snap_targets`) put on the nearest one (cut ends before corners before shore tips; a
+    corner or tip within ``distance`` of a cut end, or a tip of a corner, is none).
+
+    An end lands where the drawn line first meets the shore or one of ``cuts`` (or where it
+    stops, inside the water); the cut returned ends there (what is drawn past it dangles) or, when
+    snapped, on the target.  An end is not put on a target from which the new piece of cut would
+    leave the water.  Returns the cut and, per snapped end, ``(end, landed, target, kind)`` (``end``
+    0 or -1, points ``(x, y)``).
+    """
+    from shapely.geometry import LineString, MultiLineString
+
+    c = np.asarray(cut, float)
+    if len(c) < 2 or distance <= 0 or not len(targets):
+        return c, []
+    line = LineString(c)
+    walls = MultiLineString(
+        [list(polygon.exterior.coords), *(list(r.coords) for r in polygon.interiors)]
+        + [np.asarray(k, float).tolist() for k in cuts]
+    )
+    pts = np.array([t[0] for t in targets], float)
+    rank = np.array([{"cut end": 0, "block corner": 1}.get(t[1], 2) for t in targets], int)
+    # a corner or tip within the distance of a cut end (or a tip of a corner) is no target: an end
+    # put on it would make the wedge it is snapped to avoid (seen at 3 cells: 20 -> 30 of 89 cuts)
+    gap = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
+    shadow = (rank[None, :] < rank[:, None]) & (gap > 1e-9 * distance) & (gap <= distance)
+    keep = ~np.any(shadow, axis=1)
+    pts, rank, targets = pts[keep], rank[keep], [t for t, k in zip(targets, keep, strict=True) if k]
+    water = polygon.buffer(1e-7 * math.sqrt(polygon.area))
+    land = [_landing(line, walls, e) for e in (0, -1)]
+    s_v = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(c, axis=0).T))])
+    inner = c[(s_v > land[0][0]) & (s_v < land[1][0])]
+    out = [np.array(land[0][1].coords), np.array(land[1][1].coords)]  # drawn past the shore or a cut: trimmed
+    snaps = []
+    for k, end in enumerate((0, -1)):
+        q = land[k][1]
+        towards = inner[0 if end == 0 else -1] if len(inner) else np.array(land[1 - k][1].coords[0])
+        d = np.hypot(pts[:, 0] - q.x, pts[:, 1] - q.y)
+        if np.any(d <= 1e-9 * distance):
+            continue  # on a cut end, corner or tip already
+        near = np.flatnonzero(d <= distance)
+        for j in near[np.lexsort((d[near], rank[near]))]:
+            if water.contains(LineString([pts[j], towards])):
+                out[k] = pts[j][None, :]
+                snaps.append((end, (float(q.x), float(q.y)), (float(pts[j, 0]), float(pts[j, 1])), targets[j][1]))
+                break
+    return np.vstack([out[0], inner, out[1]]), snaps
+
+
+def layout_from_cuts(
+    polygon: Any, cuts: Any, *, cell_size: float, multiple: int = 1, corners: Any = None, snap: float = 0.0
+):
     """A layout of hand-drawn cut lines: each region's corners where it turns, cells from ``cell_size``.
 
     ``corners`` optionally maps a region (given by any point inside it) to its four corner
     points; the other regions get :func:`~.corners.choose_corners`.  Raises
     :class:`~meshcore.errors.TopologyError` naming the place where no integer cell counts
     agree round the blocks or a region is not a simple polygon.
+
+    ``snap`` (cells; :data:`SNAP_CELLS` for cuts drawn by hand, default 0: off): each cut's end
+    that lands within ``snap`` cells of an earlier cut's end, a given corner or a shore tip goes
+    onto it (:func:`snap_cut`; an end a few cells off makes a thin wedge block); the layout's
+    ``notes`` say which ends moved and where.
     """
     import shapely
     from shapely.geometry import Point, Polygon
@@ -106,9 +217,10 @@ def layout_from_cuts(polygon: Any, cuts: Any, *, cell_size: float, multiple: int
     from .regions import partition
 
     h = float(cell_size)
-    dense = shapely.segmentize(polygon, h)
-    rings, all_cuts = partition(dense, [np.asarray(c, dtype=float) for c in cuts])
     given = dict(corners or {})
+    cuts, notes = _snapped_cuts(polygon, cuts, [p for cs in given.values() for p in cs], h, snap)
+    dense = shapely.segmentize(polygon, h)
+    rings, all_cuts = partition(dense, cuts)
     corner_pts = []
     for r in rings:
         P = Polygon(r)
@@ -127,7 +239,39 @@ def layout_from_cuts(polygon: Any, cuts: Any, *, cell_size: float, multiple: int
         for pc, c in zip(pieces, cells, strict=True)
     )
     return Layout(
-        polygon=polygon, cell_size=h, cuts=tuple(all_cuts), pieces=tuple(pieces), blocks=blocks, multiple=multiple
+        polygon=polygon,
+        cell_size=h,
+        cuts=tuple(all_cuts),
+        pieces=tuple(pieces),
+        blocks=blocks,
+        multiple=multiple,
+        notes=tuple(notes),
+    )
+
+
+def _snapped_cuts(polygon: Any, cuts: Any, corners: list, h: float, snap_cells: float) -> tuple[list, list[str]]:
+    """``cuts`` with their ends snapped (:func:`snap_cut`) onto the earlier cuts' ends, ``corners``
+    and the shore tips within ``snap_cells`` cells of size ``h``, and a note per snapped end."""
+    distance = snap_cells * h
+    out: list[np.ndarray] = []
+    notes: list[str] = []
+    tips = snap_targets(polygon, (), corners) if distance > 0 else []
+    for i, c in enumerate(cuts):
+        c = np.asarray(c, dtype=float)
+        if distance > 0:
+            c, snaps = snap_cut(polygon, c, snap_targets(polygon, out)[: 2 * len(out)] + tips, distance, out)
+            notes += [snap_note(f"cut {i + 1}", s, h) for s in snaps]
+        out.append(c)
+    return out, notes
+
+
+def snap_note(what: str, s: tuple, cell_size: float) -> str:
+    """What a snap of :func:`snap_cut` did (``s``), for messages: ``what`` names the cut."""
+    end, a, b, kind = s
+    d = math.hypot(b[0] - a[0], b[1] - a[1]) / cell_size
+    return (
+        f"{what}: its {'first' if end == 0 else 'last'} end snapped {d:.2g} cells from ({a[0]:.6g}, {a[1]:.6g}) "
+        f"onto the {kind} at ({b[0]:.6g}, {b[1]:.6g})"
     )
 
 

@@ -1,0 +1,75 @@
+"""The Cut line tool over a laid-out lake: an end landing a cell or two from a cut end snaps onto it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.app.waits import wait_for, wait_idle
+
+pytestmark = pytest.mark.gui
+
+H = 500.0  # cell size (m): the 20 × 10 km lake is 40 × 20 cells
+
+
+def _box_csv(path: Path) -> Path:
+    ring = [(0.0, 0.0), (20000.0, 0.0), (20000.0, 10000.0), (0.0, 10000.0)]
+    path.write_text("x,y\n" + "\n".join(f"{x:.3f},{y:.3f}" for x, y in ring) + "\n")
+    return path
+
+
+def _draw(win, pts) -> None:
+    from PySide6 import QtCore
+
+    win.set_tool("cut")
+    for xy in pts:
+        win.canvas.tool.click(xy)
+    win.canvas.tool.key(QtCore.Qt.Key.Key_Return)
+
+
+def _t_layout(qtbot, win, tmp_path):
+    """The box split by a cut across it (x = 10 km) and a T from the west shore to it (y = 5 km)."""
+    assert win.io.import_points(_box_csv(tmp_path / "box.csv"))
+    win.lake_ctl.set_cell_size(H)
+    _draw(win, [(10000.0, -300.0), (10000.0, 10300.0)])
+    _draw(win, [(-300.0, 5000.0), (10100.0, 5000.0)])
+    win.a_split.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
+    assert win.lake_ctl.last_error is None
+    wait_idle(qtbot, win)
+    return win.doc.project.layout
+
+
+def _junctions(lay) -> list:
+    ends = [c[k] for c in lay.cuts for k in (0, -1)]
+    inside = [e for e in ends if 1.0 < e[0] < 19999.0 and 1.0 < e[1] < 9999.0]
+    return np.unique(np.round(inside, 3), axis=0).tolist()
+
+
+@pytest.mark.parametrize(("off", "snapped"), [(1.5, True), (4.0, False)])
+def test_a_cut_end_near_a_cut_end_snaps_onto_it(qtbot, win, tmp_path, off, snapped):
+    """A cut from the east shore to the first cut, landing 1.5 cells above the T's end there, ends
+    on it (one 4-way junction; the Messages say where); landing 4 cells
+    away it stays where drawn (two T's).  One undo step either way."""
+    lay0 = _t_layout(qtbot, win, tmp_path)
+    assert _junctions(lay0) == [[10000.0, 5000.0]]
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append((level, text)))
+    y = 5000.0 + off * H
+    _draw(win, [(20300.0, y), (9900.0, y)])
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
+    lay = win.doc.project.layout
+    assert win.lake_ctl.edit_error is None and len(lay.blocks) == 4
+    assert win.stack.undoText() == "Add cut line"
+    notes = [t for lv, t in said if "snapped" in t]
+    if snapped:
+        assert _junctions(lay) == [[10000.0, 5000.0]]
+        assert len(notes) == 1 and "(10000, 5000)" in notes[0] and "cut end" in notes[0]
+    else:
+        assert _junctions(lay) == [[10000.0, 5000.0], [10000.0, y]]
+        assert notes == []
+    win.stack.undo()
+    assert win.doc.project.layout is lay0
