@@ -152,8 +152,8 @@ def snap_cut(polygon: Any, cut: Any, targets: Any, distance: float, cuts: Any = 
     An end lands where the drawn line first meets the shore or one of ``cuts`` (or where it
     stops, inside the water); the cut returned ends there (what is drawn past it dangles) or, when
     snapped, on the target.  An end is not put on a target from which the new piece of cut would
-    leave the water.  Returns the cut and, per snapped end, ``(end, landed, target, kind)`` (``end``
-    0 or -1, points ``(x, y)``).
+    leave the water or leave at under 30° to a cut through it (:func:`_sliver`).  Returns the cut
+    and, per snapped end, ``(end, landed, target, kind)`` (``end`` 0 or -1, points ``(x, y)``).
     """
     from shapely.geometry import LineString, MultiLineString
 
@@ -168,7 +168,7 @@ def snap_cut(polygon: Any, cut: Any, targets: Any, distance: float, cuts: Any = 
     pts = np.array([t[0] for t in targets], float)
     rank = np.array([{"cut end": 0, "block corner": 1}.get(t[1], 2) for t in targets], int)
     # a corner or tip within the distance of a cut end (or a tip of a corner) is no target: an end
-    # put on it would make the wedge it is snapped to avoid (seen at 3 cells: 20 -> 30 of 89 cuts)
+    # put on it would make the wedge it is snapped to avoid
     gap = np.hypot(pts[:, None, 0] - pts[None, :, 0], pts[:, None, 1] - pts[None, :, 1])
     shadow = (rank[None, :] < rank[:, None]) & (gap > 1e-9 * distance) & (gap <= distance)
     keep = ~np.any(shadow, axis=1)
@@ -187,11 +187,37 @@ def snap_cut(polygon: Any, cut: Any, targets: Any, distance: float, cuts: Any = 
             continue  # on a cut end, corner or tip already
         near = np.flatnonzero(d <= distance)
         for j in near[np.lexsort((d[near], rank[near]))]:
-            if water.contains(LineString([pts[j], towards])):
+            if water.contains(LineString([pts[j], towards])) and not _sliver(pts[j], towards, cuts, distance):
                 out[k] = pts[j][None, :]
                 snaps.append((end, (float(q.x), float(q.y)), (float(pts[j, 0]), float(pts[j, 1])), targets[j][1]))
                 break
     return np.vstack([out[0], inner, out[1]]), snaps
+
+
+#: a snapped end makes no angle under this (degrees) with a cut through its new place
+_MIN_SNAP_ANGLE = 30.0
+
+
+def _sliver(p: np.ndarray, towards: np.ndarray, cuts: Any, distance: float) -> bool:
+    """True when the cut from ``p`` towards ``towards`` leaves ``p`` at less than 30° to one of the
+    ``cuts`` through ``p``: a near-parallel cut drawn a few cells beside another, one end snapped
+    onto the other's end, would close a sliver block between them."""
+    from shapely.geometry import LineString, Point
+
+    u = np.asarray(towards, float) - p
+    u = u / (np.hypot(*u) or 1.0)
+    for c in cuts:
+        line = LineString(np.asarray(c, float))
+        if line.distance(Point(p)) > 1e-9 * distance:
+            continue
+        s = line.project(Point(p))
+        for t in (s - 0.5 * distance, s + 0.5 * distance):
+            if 0.0 <= t <= line.length:
+                v = np.asarray(line.interpolate(t).coords[0]) - p
+                cos = float(np.dot(u, v)) / (np.hypot(*v) or 1.0)
+                if cos > math.cos(math.radians(_MIN_SNAP_ANGLE)):
+                    return True
+    return False
 
 
 def layout_from_cuts(

@@ -93,3 +93,22 @@ def test_snapping_never_makes_an_invalid_layout(y_b, y_c, x_a, past, tilt):
 def test_no_cut_to_snap_keeps_the_layout(snap):
     lay = layout_from_cuts(BOX, [A], cell_size=H, snap=snap)
     assert len(lay.blocks) == 2 and lay.notes == ()
+
+
+def test_a_tip_next_to_a_cut_end_is_no_target():
+    """An end landing 3.5 cells from A's end on the shore and 2 cells from a shore tip 1.5 cells from
+    A's end stays where drawn: put on the tip it would leave a 1.5-cell wedge beside A."""
+    targets = [*snap_targets(BOX, [A]), ((10.0 + 1.5 * H, 0.0), "shore tip")]
+    c = np.array([[10.0 + 3.5 * H, -0.3], [10.0 + 3.5 * H, 10.3]])
+    out, snaps = snap_cut(BOX, c, targets, SNAP_CELLS * H, [A])
+    assert snaps == []
+    assert out.tolist() == [[10.0 + 3.5 * H, 0.0], [10.0 + 3.5 * H, 10.0]]
+    alone = [((10.0 + 1.5 * H, 0.0), "shore tip")]  # without A's end beside it, the tip is one
+    assert [kind for *_x, kind in snap_cut(BOX, c, alone, SNAP_CELLS * H)[1]] == ["shore tip"]
+
+
+def test_a_cut_drawn_beside_another_does_not_snap_onto_its_ends():
+    """A cut drawn 1 cell beside A, along it, would close a sliver block if its ends went onto A's."""
+    c = np.array([[10.0 + H, -0.3], [10.0 + H, 10.3]])
+    out, snaps = snap_cut(BOX, c, snap_targets(BOX, [A]), SNAP_CELLS * H, [A])
+    assert snaps == [] and out.tolist() == [[10.0 + H, 0.0], [10.0 + H, 10.0]]
