@@ -73,3 +73,35 @@ def test_a_cut_end_near_a_cut_end_snaps_onto_it(qtbot, win, tmp_path, off, snapp
         assert notes == []
     win.stack.undo()
     assert win.doc.project.layout is lay0
+
+
+def test_a_snapped_cut_that_gives_no_layout_is_taken_as_drawn(monkeypatch):
+    """with_drawn_cut: when the snapped cut gives no layout, the cut as drawn is taken and the
+    Messages say its ends stayed; no message of a snap that did not happen."""
+    from shapely.geometry import box
+
+    from app import layout_edit
+    from meshcore.errors import TopologyError
+    from meshcore.layout import layout_from_cuts
+
+    lay = layout_from_cuts(
+        box(0.0, 0.0, 20.0, 10.0),
+        [np.array([[10.0, -0.5], [10.0, 10.5]]), np.array([[-0.5, 5.0], [10.2, 5.0]])],
+        cell_size=0.5,
+    )
+    drawn = np.array([[20.5, 5.75], [9.8, 5.75]])
+    real = layout_edit.with_cut
+
+    def refuse_snapped(layout, cut):
+        if np.any(np.all(np.isclose(np.asarray(cut), [10.0, 5.0]), axis=1)):
+            raise TopologyError("made up")
+        return real(layout, cut)
+
+    said = []
+    assert layout_edit.with_drawn_cut(lay, drawn, lambda lv, t: said.append(t)).cuts[-1][-1].tolist() == [10.0, 5.0]
+    assert len(said) == 1 and "snapped" in said[0]
+    said.clear()
+    monkeypatch.setattr(layout_edit, "with_cut", refuse_snapped)
+    out = layout_edit.with_drawn_cut(lay, drawn, lambda lv, t: said.append(t))
+    assert len(out.blocks) == 4 and np.round(out.cuts[-1][-1], 6).tolist() == [10.0, 5.75]
+    assert len(said) == 1 and "stay where drawn" in said[0] and "made up" in said[0]
