@@ -341,8 +341,7 @@ def coverage(
     d_grid, kg = _directed(gp, sb)
     # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
     # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart
-    spikes = _spikes(water, h)
-    keep = ~shapely.contains_xy(spikes, sp[:, 0], sp[:, 1]) if spikes is not None else np.ones(len(sp), bool)
+    keep = ~_in_spikes(_spikes(water, h), sp)
     d_shore, ks = _directed(sp[keep], gb) if keep.any() else (0.0, 0)
     sp = sp[keep] if keep.any() else sp
     if d_grid >= d_shore:
@@ -390,8 +389,26 @@ def _spikes(poly: Any, h: float) -> Any:
     """Where the shore's spikes of water or land narrower than half a cell lie (what
     :func:`without_spikes` removes, a little widened so that the shore points on their rims fall
     inside), or None."""
+    import shapely
+
     clean = without_spikes(poly, 0.5 * h)
-    return None if clean is None else poly.symmetric_difference(clean).buffer(1e-3 * h)
+    if clean is None:
+        return None
+    # each piece widened on its own: one buffer of the whole difference unions tens of thousands
+    # of pieces on a shore of 10^5 points (62 s); the union of the pieces' buffers is the same set
+    return shapely.buffer(shapely.get_parts(poly.symmetric_difference(clean)), 1e-3 * h)
+
+
+def _in_spikes(pieces: Any, points: np.ndarray) -> np.ndarray:
+    """Which ``points`` lie inside one of the widened spike ``pieces`` (:func:`_spikes`)."""
+    import shapely
+
+    out = np.zeros(len(points), bool)
+    if pieces is None or not len(pieces):
+        return out
+    hit = shapely.STRtree(pieces).query(shapely.points(points), predicate="within")
+    out[hit[0]] = True
+    return out
 
 
 def _without_narrow_arms(poly: Any, h: float) -> Any:
