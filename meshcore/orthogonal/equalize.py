@@ -20,7 +20,11 @@ optimum kinks the cut and squeezes slivers beside it), consecutive edge ratios a
 every corner Jacobian above half of its own, and the moves small.  A patch is kept only when
 its worst pair is lower and inside it no node within 3° or ``|cos| ≤ 0.02`` is lost,
 no interface pair ≤ 2, at most ``EDGE_LOSS`` edge pairs ≤ 1.2, and no corner Jacobian is ≤ 0;
-else half the step, a quarter, or nothing.  Measured in ``docs/lake-grids-journal.md`` (sessions 17, 18).
+else half the step, a quarter, or nothing.  A pair still above ``limit`` after its own patch is
+tried once more with up to ``RUN`` neighbouring pairs above ``AIM`` that touch it (a run along the
+interface, all moving together: its own patch may not lose a neighbour's ratio ≤ 2), solved at the
+first edge weight by :func:`._bfgs.bfgs` (scipy's BFGS update is O(n³) a step: 20 × the lake's
+CPU on those patches).  Measured in ``docs/lake-grids-journal.md`` (sessions 17, 18, 20).
 """
 
 from __future__ import annotations
@@ -51,6 +55,10 @@ CORNER_ADD = 5.0
 METHOD = "BFGS"
 SLIDE = False  # shore nodes slide too (on 4 nets: the same ratios within 0.2, shore 0.20 -> 0.26 cells)
 EDGE_LOSS = 10  # edge pairs <= 1.2 a patch may lose
+RUN_WEIGHTS = EDGE_WEIGHTS[:1]
+RUN_METHOD = "bfgs-n2"
+RUN_DEPTHS = (DEPTH,)  # the run patches' depths, in turn while the pair stays above the limit
+RUN = 8  # a second patch round a pair left above LIMIT: up to RUN neighbouring pairs above AIM with it (0: none)
 
 
 class _Tables:
@@ -375,7 +383,14 @@ class _Patch:
 
 
 def _solve_patch(
-    t: _Tables, P: np.ndarray, seeds: np.ndarray, depth: int, pairs: np.ndarray, shore, w_edge: float
+    t: _Tables,
+    P: np.ndarray,
+    seeds: np.ndarray,
+    depth: int,
+    pairs: np.ndarray,
+    shore,
+    w_edge: float,
+    method: str = METHOD,
 ) -> np.ndarray | None:
     """The node array with the patch of ``depth`` round ``seeds`` moved, or None when no move of
     it (the optimum, half or a quarter of it) is kept by the checks of the module docstring."""
@@ -385,10 +400,15 @@ def _solve_patch(
     nz = 2 * len(patch.fly) + len(patch.slide)
     if not nz:
         return None
-    res = minimize(patch.objective, np.zeros(nz), jac=True, method=METHOD, options={"maxiter": MAX_ITER})
+    if method == "bfgs-n2":  # the run patches: O(n²) updates (._bfgs)
+        from ._bfgs import bfgs
+
+        x = bfgs(patch.objective, np.zeros(nz), maxiter=MAX_ITER)
+    else:
+        x = minimize(patch.objective, np.zeros(nz), jac=True, method=method, options={"maxiter": MAX_ITER}).x
     before = patch.counts(P)
     for alpha in (1.0, 0.5, 0.25):
-        Pn = patch.positions(alpha * res.x)
+        Pn = patch.positions(alpha * x)
         after = patch.counts(Pn)
         better = patch.ratios(Pn).max() < patch.r0.max() - 1e-9
         ok = (
@@ -402,6 +422,53 @@ def _solve_patch(
     return None
 
 
+def _ratios(P: np.ndarray, t: _Tables, pairs: np.ndarray) -> np.ndarray:
+    """``|log A₁/A₂|`` of the cell pairs ``pairs`` (rows of ``t.cells``)."""
+    return np.abs(np.log(np.abs(_areas(P, t.cells[pairs[:, 0]])) / np.abs(_areas(P, t.cells[pairs[:, 1]]))))
+
+
+def _first_kept(
+    t: _Tables,
+    P: np.ndarray,
+    seeds: np.ndarray,
+    depth: int,
+    pairs: np.ndarray,
+    shore,
+    weights=None,
+    method: str | None = None,
+) -> np.ndarray | None:
+    """The patch round ``seeds`` solved at each of ``weights`` (default ``EDGE_WEIGHTS``) in turn,
+    the first kept; ``method``: the minimizer of :func:`_solve_patch` (default ``METHOD``)."""
+    for w_edge in EDGE_WEIGHTS if weights is None else weights:  # the next only when no move was kept
+        if method is None:
+            Pn = _solve_patch(t, P, seeds, depth, pairs, shore, w_edge)
+        else:
+            Pn = _solve_patch(t, P, seeds, depth, pairs, shore, w_edge, method=method)
+        if Pn is not None:
+            return Pn
+    return None
+
+
+def _run_seeds(t: _Tables, pairs: np.ndarray, r: np.ndarray, q: int, run: int) -> np.ndarray:
+    """The nodes of pair ``q``'s cells and of up to ``run`` more pairs above ``AIM`` that touch
+    them along the interface, the largest first (a run of such pairs moves as one: a patch round one
+    of them alone may not lose its neighbours' ratios ≤ 2)."""
+    nodes = np.unique(t.cells[pairs[q]].ravel())
+    if run <= 0:
+        return nodes
+    high = np.flatnonzero(r > np.log(AIM))
+    taken = {q}
+    for _ in range(run):
+        near = np.isin(t.cells[pairs[high]].reshape(len(high), -1), nodes).any(1)
+        new = [int(k) for k in high[near] if int(k) not in taken]
+        if not new:
+            break
+        k = max(new, key=lambda v: r[v])
+        taken.add(k)
+        nodes = np.union1d(nodes, t.cells[pairs[k]].ravel())
+    return nodes
+
+
 def equalize_interfaces(
     topology,
     grids,
@@ -410,10 +477,14 @@ def equalize_interfaces(
     limit: float = LIMIT,
     depth: int = DEPTH,
     max_patches: int = MAX_PATCHES,
+    run: int | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> tuple[list, int]:
     """``(grids, patches)``: the grids with the nodes round every interface pair above ``limit``
     moved to make the two cells alike (see the module docstring), and how many patches were kept.
+
+    ``run``: the most neighbouring pairs the second patch round a pair left above ``limit`` takes
+    with it (default ``RUN``; 0: no second patch, the step of session 18).
 
     ``should_stop``: asked before every patch; when it answers True the step ends there, with the
     patches kept so far (``iterate_layout`` passes its ``stop_event``: the app's Stop)."""
@@ -433,20 +504,28 @@ def equalize_interfaces(
     for _ in range(max_patches):
         if should_stop is not None and should_stop():
             break
-        r = np.abs(np.log(np.abs(_areas(P, t.cells[pairs[:, 0]])) / np.abs(_areas(P, t.cells[pairs[:, 1]]))))
+        r = _ratios(P, t, pairs)
         order = [q for q in np.argsort(-r) if r[q] > np.log(limit) and int(q) not in tried]
         if not order:
             break
         q = int(order[0])
         tried.add(q)
         seeds = np.unique(t.cells[pairs[q]].ravel())
-        for w_edge in EDGE_WEIGHTS:  # the next weight only when no move of the patch was kept
-            Pn = _solve_patch(t, P, seeds, depth, pairs, shore, w_edge)
-            if Pn is not None:
-                break
+        Pn = _first_kept(t, P, seeds, depth, pairs, shore)
         if Pn is not None:
             P = Pn
             kept += 1
+        n_run = RUN if run is None else run
+        for d in RUN_DEPTHS if n_run > 0 else ():
+            if _ratios(P, t, pairs[q : q + 1])[0] <= np.log(limit):
+                break
+            # the pair is still above the limit: its run of neighbours above AIM moves with it
+            wide = _run_seeds(t, pairs, _ratios(P, t, pairs), q, n_run)
+            if len(wide) > len(seeds) or d > depth:
+                Pn = _first_kept(t, P, wide, max(depth, d), pairs, shore, RUN_WEIGHTS, RUN_METHOD)
+                if Pn is not None:
+                    P = Pn
+                    kept += 1
     if not kept:
         return list(grids), 0
     return [g.replaced(x=P[ids, 0], y=P[ids, 1]) for g, ids in zip(grids, m.ids, strict=True)], kept

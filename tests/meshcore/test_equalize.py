@@ -166,9 +166,9 @@ def test_a_patch_rejected_at_the_first_edge_weight_is_solved_again_at_the_next(s
     mb, rings = solved
     real, heard = eq._solve_patch, []
 
-    def first_rejected(*args):
+    def first_rejected(*args, **kw):  # kw: the run patches' minimizer (eq.RUN)
         heard.append(args[-1])
-        return None if args[-1] == eq.EDGE_WEIGHTS[0] else real(*args)
+        return None if args[-1] == eq.EDGE_WEIGHTS[0] else real(*args, **kw)
 
     monkeypatch.setattr(eq, "_solve_patch", first_rejected)
     grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=1)
@@ -180,3 +180,31 @@ def test_a_patch_rejected_at_the_first_edge_weight_is_solved_again_at_the_next(s
     for a, b in zip(grids, last_only, strict=True):
         np.testing.assert_array_equal(a.x, b.x)
         np.testing.assert_array_equal(a.y, b.y)
+
+
+def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved):
+    """``run``: a pair the patch round its own cells leaves above the limit is solved again with up
+    to ``run`` neighbouring pairs above ``AIM`` (their cells' nodes as seeds); the same guarantees."""
+    from meshcore.orthogonal import equalize as E
+
+    mb, rings = solved
+    t = E._Tables(mb.topology, mb.grids)
+    pr = interface_pairs(mb.grids)
+    pairs = np.array([[t.row(a), t.row(b)] for a, b in zip(pr["cell_a"], pr["cell_b"], strict=True)], np.int64)
+    X, Y = _assemble(mb.grids, mb.topology.node_map)
+    r = E._ratios(np.column_stack([X, Y]), t, pairs)
+    q = int(np.argmax(r))
+    own = np.unique(t.cells[pairs[q]].ravel())
+    assert np.array_equal(E._run_seeds(t, pairs, r, q, 0), own)
+    wide = E._run_seeds(t, pairs, r - r.max() + 1.0, q, 8)  # every pair above AIM: the run grows
+    assert set(own) < set(wide.tolist())
+    limit = 1.1
+    grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=limit, max_patches=6, run=8)
+    assert kept >= 1
+    pr1 = interface_pairs(grids)
+    assert pr1["ratio"].max() <= pr["ratio"].max() + 1e-12
+    assert (pr1["ratio"] > limit).sum() <= (pr["ratio"] > limit).sum()
+    assert lake_metrics(grids).summary()["folded_cells"] == 0
+    n0 = sum(int(np.sum(np.nan_to_num(_cos(g), nan=1.0) <= COS3)) for g in mb.grids)
+    n1 = sum(int(np.sum(np.nan_to_num(_cos(g), nan=1.0) <= COS3)) for g in grids)
+    assert n1 >= n0
