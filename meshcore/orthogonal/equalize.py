@@ -22,7 +22,8 @@ its worst pair is lower and inside it no node within 3° or ``|cos| ≤ 0.02`` i
 no interface pair ≤ 2, at most ``EDGE_LOSS`` edge pairs ≤ 1.2, and no corner Jacobian is ≤ 0;
 else half the step, a quarter, or nothing.  A pair still above ``limit`` after its own patch is
 tried once more with up to ``RUN`` neighbouring pairs above ``AIM`` that touch it (a run along the
-interface, all moving together: its own patch may not lose a neighbour's ratio ≤ 2), solved at the
+interface, all moving together: its own patch may not lose a neighbour's ratio ≤ 2), and while
+it stays above, again with its free nodes within 4 edges (``RUN_DEPTHS``); these are solved at the
 first edge weight by :func:`._bfgs.bfgs` (scipy's BFGS update is O(n³) a step: 20 × the lake's
 CPU on those patches).  Measured in ``docs/lake-grids-journal.md`` (sessions 17, 18, 20).
 """
@@ -57,7 +58,7 @@ SLIDE = False  # shore nodes slide too (on 4 nets: the same ratios within 0.2, s
 EDGE_LOSS = 10  # edge pairs <= 1.2 a patch may lose
 RUN_WEIGHTS = EDGE_WEIGHTS[:1]
 RUN_METHOD = "bfgs-n2"
-RUN_DEPTHS = (DEPTH,)  # the run patches' depths, in turn while the pair stays above the limit
+RUN_DEPTHS = (DEPTH, 5)  # the run patches' depths, in turn while the pair stays above the limit
 RUN = 8  # a second patch round a pair left above LIMIT: up to RUN neighbouring pairs above AIM with it (0: none)
 
 

@@ -125,7 +125,7 @@ def test_should_stop_ends_the_step_between_patches(solved):
         mb.topology, list(mb.grids), rings, limit=1.1, max_patches=6, should_stop=stop_after_one
     )
     assert len(asked) == 2
-    assert kept == kept1 == 1
+    assert kept == kept1 >= 1  # one pair's patches: its own, then its run's (equalize.RUN_DEPTHS)
     for a, b in zip(grids, one, strict=True):
         np.testing.assert_array_equal(a.x, b.x)
         np.testing.assert_array_equal(a.y, b.y)
@@ -163,10 +163,11 @@ def test_a_patch_rejected_at_the_first_edge_weight_is_solved_again_at_the_next(s
     """``EDGE_WEIGHTS``: a second solve of the same patch only when no move of the first was kept."""
     from meshcore.orthogonal import equalize as eq
 
+    monkeypatch.setattr(eq, "RUN", 0)  # the pair's own patch only (the runs: the test below)
     mb, rings = solved
     real, heard = eq._solve_patch, []
 
-    def first_rejected(*args, **kw):  # kw: the run patches' minimizer (eq.RUN)
+    def first_rejected(*args, **kw):
         heard.append(args[-1])
         return None if args[-1] == eq.EDGE_WEIGHTS[0] else real(*args, **kw)
 
@@ -182,11 +183,14 @@ def test_a_patch_rejected_at_the_first_edge_weight_is_solved_again_at_the_next(s
         np.testing.assert_array_equal(a.y, b.y)
 
 
-def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved):
+@pytest.mark.parametrize("depths", [(3,), (3, 5)])
+def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved, depths, monkeypatch):
     """``run``: a pair the patch round its own cells leaves above the limit is solved again with up
-    to ``run`` neighbouring pairs above ``AIM`` (their cells' nodes as seeds); the same guarantees."""
+    to ``run`` neighbouring pairs above ``AIM`` (their cells' nodes as seeds), at each of
+    ``RUN_DEPTHS`` while it stays above; the same guarantees."""
     from meshcore.orthogonal import equalize as E
 
+    monkeypatch.setattr(E, "RUN_DEPTHS", depths)
     mb, rings = solved
     t = E._Tables(mb.topology, mb.grids)
     pr = interface_pairs(mb.grids)
