@@ -58,6 +58,7 @@ SLIDE = False  # shore nodes slide too (on 4 nets: the same ratios within 0.2, s
 EDGE_LOSS = 10  # edge pairs <= 1.2 a patch may lose
 RUN_WEIGHTS = EDGE_WEIGHTS[:1]
 RUN_METHOD = "bfgs-n2"
+RUN_SLIDE = False  # shore nodes (not cut ends or corners) slide in the run patches deeper than DEPTH
 RUN_DEPTHS = (DEPTH, 5)  # the run patches' depths, in turn while the pair stays above the limit
 RUN = 8  # a second patch round a pair left above LIMIT: up to RUN neighbouring pairs above AIM with it (0: none)
 
@@ -141,54 +142,6 @@ def _edge_logs(P: np.ndarray, T: np.ndarray) -> np.ndarray:
     l1 = np.hypot(*(P[T[:, 1]] - P[T[:, 0]]).T)
     l2 = np.hypot(*(P[T[:, 2]] - P[T[:, 1]]).T)
     return np.abs(np.log(np.maximum(l1, 1e-300) / np.maximum(l2, 1e-300)))
-
-
-def _area_grad(P: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Signed areas of quads ``C`` and their gradients ``(n, 4, 2)`` in the 4 corners."""
-    d1 = P[C[:, 2]] - P[C[:, 0]]
-    d2 = P[C[:, 3]] - P[C[:, 1]]
-    A = 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    g2 = 0.5 * np.column_stack([d2[:, 1], -d2[:, 0]])
-    g3 = 0.5 * np.column_stack([-d1[:, 1], d1[:, 0]])
-    return A, np.stack([-g2, -g3, g2, g3], axis=1)
-
-
-def _jacobians_grad(P: np.ndarray, C: np.ndarray):
-    """Corner cross products ``(n, 4)`` and their gradients in the next and the previous corner."""
-    Q = P[C]
-    a = np.roll(Q, -1, axis=1) - Q
-    b = np.roll(Q, 1, axis=1) - Q
-    J = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    dJa = np.stack([b[..., 1], -b[..., 0]], -1)
-    dJb = np.stack([-a[..., 1], a[..., 0]], -1)
-    return J, dJa, dJb
-
-
-def _cos_grad(P: np.ndarray, S: np.ndarray):
-    """``|cos|`` at 5-node stencils and its gradient in the two central differences."""
-    a = P[S[:, 1]] - P[S[:, 2]]
-    b = P[S[:, 3]] - P[S[:, 4]]
-    na, nb = np.hypot(*a.T), np.hypot(*b.T)
-    d = (a * b).sum(1)
-    nn = np.maximum(na * nb, 1e-300)
-    c = np.abs(d) / nn
-    sd = np.sign(d)[:, None]
-    dca = sd * b / nn[:, None] - (c / np.maximum(na, 1e-300) ** 2)[:, None] * a
-    dcb = sd * a / nn[:, None] - (c / np.maximum(nb, 1e-300) ** 2)[:, None] * b
-    return c, dca, dcb
-
-
-def _edge_grad(P: np.ndarray, T: np.ndarray):
-    """``|log l1/l2|`` of consecutive edges and its gradient in the 3 nodes."""
-    v1 = P[T[:, 1]] - P[T[:, 0]]
-    v2 = P[T[:, 2]] - P[T[:, 1]]
-    q1 = np.maximum((v1 * v1).sum(1), 1e-300)
-    q2 = np.maximum((v2 * v2).sum(1), 1e-300)
-    u = 0.5 * (np.log(q1) - np.log(q2))
-    sg = np.sign(u)[:, None]
-    g1 = v1 / q1[:, None]
-    g2 = v2 / q2[:, None]
-    return np.abs(u), -sg * g1, sg * (g1 + g2), -sg * g2
 
 
 class _Patch:
@@ -303,51 +256,9 @@ class _Patch:
 
     def objective_numpy(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """:meth:`objective` in NumPy (the compiled kernel's reference in the tests)."""
-        P = self.positions(z)
-        G = np.zeros_like(P)
-        C, sg = self.C, self.sg
-        J, dJa, dJb = _jacobians_grad(P, C)
-        J = sg[:, None] * J
-        if (J <= 0).any():
-            return 1e6, np.zeros_like(z)
-        # cross-interface ratios
-        T = self.t.cells
-        Ca, Cb = T[self.pairs[:, 0]], T[self.pairs[:, 1]]
-        Aa, ga = _area_grad(P, Ca)
-        Ab, gb = _area_grad(P, Cb)
-        u = np.log(np.abs(Aa)) - np.log(np.abs(Ab))
-        ex = np.maximum(np.abs(u) - np.log(AIM), 0.0)
-        f = float(np.sum(ex**2))
-        w = 2 * ex * np.sign(u)
-        np.add.at(G, Ca, (w / Aa)[:, None, None] * ga)
-        np.add.at(G, Cb, -(w / Ab)[:, None, None] * gb)
-        # orthogonality at block-interior nodes
-        c, dca, dcb = _cos_grad(P, self.cos)
-        ex = np.maximum(c - self.c_allowed, 0.0)
-        f += W_COS * float(np.sum(ex**2))
-        w = (2 * W_COS * ex)[:, None]
-        S = self.cos
-        np.add.at(G, S[:, 1], w * dca)
-        np.add.at(G, S[:, 2], -w * dca)
-        np.add.at(G, S[:, 3], w * dcb)
-        np.add.at(G, S[:, 4], -w * dcb)
-        # consecutive edges along grid lines
-        e, d0, d1, d2 = _edge_grad(P, self.tri)
-        ex = np.maximum(e - self.e_allowed, 0.0)
-        f += self.w_edge * float(np.sum(ex**2))
-        w = (2 * self.w_edge * ex)[:, None]
-        for k, d in enumerate((d0, d1, d2)):
-            np.add.at(G, self.tri[:, k], w * d)
-        # corner Jacobians kept above half of theirs
-        ex = np.maximum(0.5 - J / self.J0, 0.0)
-        f += W_JAC * float(np.sum(ex**2))
-        w = -2 * W_JAC * ex / self.J0 * sg[:, None]  # d/dJ_raw
-        Cn, Cp = np.roll(C, -1, axis=1), np.roll(C, 1, axis=1)
-        np.add.at(G, Cn, w[..., None] * dJa)
-        np.add.at(G, Cp, w[..., None] * dJb)
-        np.add.at(G, C, -w[..., None] * (dJa + dJb))
-        gz = self.chain(G, z)
-        return f + 1e-3 * float(z @ z), gz + 2e-3 * z
+        from ._equalize_reference import objective_numpy
+
+        return objective_numpy(self, z)
 
     def chain(self, G: np.ndarray, z: np.ndarray, fly=None, slide=None) -> np.ndarray:
         """The gradient in ``z`` from the gradient ``G`` in the nodes (``fly``, ``slide``: their
@@ -523,7 +434,13 @@ def equalize_interfaces(
             # the pair is still above the limit: its run of neighbours above AIM moves with it
             wide = _run_seeds(t, pairs, _ratios(P, t, pairs), q, n_run)
             if len(wide) > len(seeds) or d > depth:
-                Pn = _first_kept(t, P, wide, max(depth, d), pairs, shore, RUN_WEIGHTS, RUN_METHOD)
+                saved = t.movable
+                if RUN_SLIDE and d > depth:  # shore nodes slide along the shore in the wider patch
+                    t.movable = saved | t.shore
+                try:
+                    Pn = _first_kept(t, P, wide, max(depth, d), pairs, shore, RUN_WEIGHTS, RUN_METHOD)
+                finally:
+                    t.movable = saved
                 if Pn is not None:
                     P = Pn
                     kept += 1

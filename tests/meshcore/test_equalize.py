@@ -183,14 +183,16 @@ def test_a_patch_rejected_at_the_first_edge_weight_is_solved_again_at_the_next(s
         np.testing.assert_array_equal(a.y, b.y)
 
 
-@pytest.mark.parametrize("depths", [(3,), (3, 5)])
-def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved, depths, monkeypatch):
+@pytest.mark.parametrize(("depths", "slide"), [((3,), False), ((3, 5), False), ((3, 5), True)])
+def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved, depths, slide, monkeypatch):
     """``run``: a pair the patch round its own cells leaves above the limit is solved again with up
     to ``run`` neighbouring pairs above ``AIM`` (their cells' nodes as seeds), at each of
-    ``RUN_DEPTHS`` while it stays above; the same guarantees."""
+    ``RUN_DEPTHS`` while it stays above (``RUN_SLIDE``: shore nodes slide along the shore in the
+    wider ones); the same guarantees, and cut ends, corners and stars stay where they were."""
     from meshcore.orthogonal import equalize as E
 
     monkeypatch.setattr(E, "RUN_DEPTHS", depths)
+    monkeypatch.setattr(E, "RUN_SLIDE", slide)
     mb, rings = solved
     t = E._Tables(mb.topology, mb.grids)
     pr = interface_pairs(mb.grids)
@@ -212,3 +214,14 @@ def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved, depths, m
     n0 = sum(int(np.sum(np.nan_to_num(_cos(g), nan=1.0) <= COS3)) for g in mb.grids)
     n1 = sum(int(np.sum(np.nan_to_num(_cos(g), nan=1.0) <= COS3)) for g in grids)
     assert n1 >= n0
+    m = mb.topology.node_map
+    X1, Y1 = _assemble(grids, m)
+    cnt = np.bincount(m.cells.ravel(), minlength=m.n_nodes)
+    moved = np.hypot(X1 - X, Y1 - Y) > 0
+    fixed = (m.boundary & (cnt != 2)) | np.isin(np.arange(m.n_nodes), [c.node for c in m.corners])
+    assert not moved[fixed].any()
+    shore = np.flatnonzero(m.boundary & moved)
+    assert bool(len(shore)) == slide  # shore nodes move in the wider patches only with RUN_SLIDE
+    if len(shore):
+        _, _, d = project_to_rings(rings, np.column_stack([X1[shore], Y1[shore]]))
+        assert d.max() < 1e-9
