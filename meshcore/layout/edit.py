@@ -132,15 +132,22 @@ def snap_targets(polygon: Any, cuts: Any = (), corners: Any = ()) -> list[tuple[
 def _landing(line: Any, walls: Any, end: int) -> tuple[float, Any]:
     """Where end ``end`` (0 or -1) of the drawn ``line`` lands: its crossing of ``walls`` (the shore
     and the cuts) nearest that end (the water's regions end there: a piece drawn past it dangles),
-    or the end itself when it crosses none; returned as (distance along ``line``, point)."""
+    or the end itself when it crosses none, or only once nearer the other end (that one's: a cut
+    drawn from past the shore to short of a cut, session 20; before, both ends went to that
+    crossing and the cut to a point); returned as (distance along ``line``, point)."""
     from shapely.geometry import Point
 
     hits = line.intersection(walls)
     pts = [Point(xy) for g in getattr(hits, "geoms", [hits]) if not g.is_empty for xy in g.coords]
+    own = (0.0 if end == 0 else line.length), Point(line.coords[end])
     if not pts:
-        return (0.0 if end == 0 else line.length), Point(line.coords[end])
+        return own
     s = [line.project(q) for q in pts]
-    k = int(np.argmin(s)) if end == 0 else int(np.argmax(s))
+    lo, hi = int(np.argmin(s)), int(np.argmax(s))
+    if s[hi] - s[lo] <= 1e-9 * line.length:  # one crossing: the nearer end's (the other is in the water)
+        mine = s[lo] <= 0.5 * line.length if end == 0 else s[lo] > 0.5 * line.length
+        return (s[lo], pts[lo]) if mine else own
+    k = lo if end == 0 else hi
     return s[k], pts[k]
 
 
@@ -246,7 +253,7 @@ def layout_from_cuts(
     h = float(cell_size)
     given = dict(corners or {})
     cuts, notes = _snapped_cuts(polygon, cuts, [p for cs in given.values() for p in cs], h, snap)
-    dense = shapely.segmentize(polygon, h)
+    dense, cuts = _shore_ends_in_rings(shapely.segmentize(polygon, h), cuts)
     rings, all_cuts = partition(dense, cuts)
     rings = [_four_vertices(r, h) for r in rings]
     corner_pts = []
@@ -329,6 +336,42 @@ def _shared_shore_ends(polygon: Any, cuts: list, h: float) -> list[np.ndarray]:
         if sum(np.hypot(*(p - q)) <= 1e-6 * h for q in ends) >= 2:
             out.append(p)
     return out
+
+
+def _shore_ends_in_rings(poly: Any, cuts: list) -> tuple[Any, list]:
+    """``poly`` with every cut end on its shore (within 1e-9 of its size) a vertex of its ring, and
+    the cuts whose ends are (a float's width) apart from one such vertex put exactly on it.
+
+    Two cuts ending at one shore point (a cut drawn onto an auto cut's end) otherwise end on each
+    other: :func:`~.regions.snap_to_rings` puts an end on the nearest line, the other cut, whose
+    end is nearer than the shore by 1e-13; the shore is not noded there, and the region beside it
+    touches itself (session 20: the 'not a simple polygon' errors of such cuts)."""
+    from shapely.geometry import Polygon
+
+    from ..segments import feet
+
+    size = math.sqrt(poly.area)
+    eps = 1e-9 * size
+    rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
+    cuts = [np.array(c, float) for c in cuts]
+    for c in cuts:
+        if len(c) < 2:
+            continue
+        for e in (0, -1):
+            q = c[e]
+            for k, r in enumerate(rings):
+                dist, _ = feet(r, np.roll(r, -1, axis=0), q)
+                j = int(np.argmin(dist))
+                if dist[j] > eps:
+                    continue
+                near = np.hypot(*(r - q).T)
+                i = int(np.argmin(near))
+                if near[i] <= eps:
+                    c[e] = r[i]  # onto the vertex there (an earlier cut's end, or the shore's)
+                else:
+                    rings[k] = np.insert(r, j + 1, q, axis=0)
+                break
+    return Polygon(rings[0], rings[1:]), cuts
 
 
 def _four_vertices(ring: np.ndarray, h: float) -> np.ndarray:
