@@ -35,6 +35,7 @@ __all__ = [
     "layout_blocks",
     "looks_branched",
     "read_lake",
+    "split_layout",
     "water",
     "with_layout",
 ]
@@ -159,14 +160,15 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
 
     Runs :func:`meshcore.layout.auto_layout` (seconds on a 10 000-cell lake: call it off the
     GUI thread); with ``cuts`` (cut lines drawn by hand, in any topology: ending on the shore,
-    on other cuts or meeting at a point) :func:`meshcore.layout.layout_from_cuts` makes the
-    blocks between them instead, each with four corners where it turns.  Raises
+    on other cuts or meeting at a point) :func:`split_layout` makes the blocks between them
+    instead, each with four corners where it turns, the cuts' ends snapped as the Cut line tool
+    snaps them over a layout.  Raises
     :class:`~meshcore.MeshcoreError` naming the problem (e.g. the region that cannot be
     four-sided).
     """
     from meshcore.cli.mesh import LEVELS, MIN_CELLS
     from meshcore.errors import InvalidInputError
-    from meshcore.layout import auto_layout, layout_from_cuts
+    from meshcore.layout import auto_layout
 
     poly, _ = water(lake.outline, lake.holes)
     h = cell_size_of(lake)
@@ -178,8 +180,30 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
             f"a cell size of {h:.4g} gives about {est:.2g} cells; give at most {math.sqrt(poly.area / MIN_CELLS):.4g}"
         )
     if cuts:
-        return layout_from_cuts(poly, [np.asarray(c, float) for c in cuts], cell_size=h, multiple=2**LEVELS)
+        return split_layout(poly, [np.asarray(c, float) for c in cuts], h, 2**LEVELS)
     return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular)
+
+
+def split_layout(poly: Any, cuts: list, cell_size: float, multiple: int) -> Any:
+    """The layout of the cut lines drawn by hand (Split into blocks by cut lines): each end that
+    lands within :data:`meshcore.layout.edit.SNAP_CELLS` cells of an earlier cut's end or a shore
+    tip goes onto it, as the Cut line tool over a layout puts it (:func:`app.layout_edit.with_drawn_cut`;
+    an end a cell or two off makes a thin wedge block); the layout's notes (the Messages) say which
+    end moved and where.  When the snapped cuts give no layout, the cuts as drawn do, and a note
+    says so; their error is the one they give unsnapped."""
+    from meshcore.errors import TopologyError
+    from meshcore.layout import layout_from_cuts
+    from meshcore.layout.edit import SNAP_CELLS
+
+    try:
+        lay = layout_from_cuts(poly, cuts, cell_size=cell_size, multiple=multiple, snap=SNAP_CELLS)
+        if lay.notes:
+            lay.topology()  # checked here: a snapped layout the solve cannot read is no layout
+        return lay
+    except TopologyError as exc:
+        plain = layout_from_cuts(poly, cuts, cell_size=cell_size, multiple=multiple)
+        why = f"cut lines: their ends stay where drawn (snapped, they give no layout: {exc})"
+        return replace(plain, notes=(*plain.notes, why))
 
 
 def layout_blocks(layout: Any) -> tuple:
