@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from .blocks import Piece, block_counts, conform
+from .blocks import block_counts
+from .handcut import _countable, _four_vertices, _pieces_of_regions, _shore_ends_in_rings, _where_counts_fail
 from .model import Layout, LayoutBlock
 from .outline import _size
 
@@ -28,18 +29,6 @@ __all__ = [
     "snap_targets",
     "with_cells",
 ]
-
-
-def _pieces_of_regions(rings: list[np.ndarray], corner_points: list[list], names: list[str], size: float):
-    """Conforming pieces of region rings with their corners given as points (inserted if need be)."""
-    rings = conform([np.asarray(r, dtype=float) for r in rings], 1e-9 * size)
-    pieces = []
-    for r, cs, name in zip(rings, corner_points, names, strict=True):
-        named = [int(np.argmin(np.hypot(*(r - np.asarray(c)).T))) for c in cs]
-        idx = sorted(named)  # counter-clockwise along the ring, from the first corner given (sw):
-        idx = idx[idx.index(named[0]) :] + idx[: idx.index(named[0])]  # the piece's sides are the block's
-        pieces.append(Piece(r, (idx[0], idx[1], idx[2], idx[3]), name))
-    return pieces
 
 
 def layout_from_outline(
@@ -256,15 +245,16 @@ def layout_from_cuts(
     dense, cuts = _shore_ends_in_rings(shapely.segmentize(polygon, h), cuts)
     rings, all_cuts = partition(dense, cuts)
     rings = [_four_vertices(r, h) for r in rings]
-    corner_pts = []
-    for r in rings:
+    corner_pts, chosen = [], []
+    for k, r in enumerate(rings):
         P = Polygon(r)
-        mine = [v for k, v in given.items() if P.contains(Point(k))]
+        mine = [v for q, v in given.items() if P.contains(Point(q))]
         if mine:
             corner_pts.append([np.asarray(c, dtype=float) for c in mine[0]])
         else:
             c, _ = choose_corners(r, 1.5 * h)
             corner_pts.append([r[i] for i in c])
+            chosen.append(k)
     names = [f"b{k}" for k in range(len(rings))]
     pieces = _pieces_of_regions(rings, corner_pts, names, _size(polygon))
     try:
@@ -275,7 +265,12 @@ def layout_from_cuts(
     try:
         cells = block_counts(pieces, h, multiple=multiple)
     except TopologyError as exc:
-        raise TopologyError(f"{exc}{_where_counts_fail(polygon, all_cuts, pieces, h, multiple)}") from None
+        again = _countable(rings, corner_pts, chosen, names, h, multiple, _size(polygon))
+        if again is None:
+            raise TopologyError(f"{exc}{_where_counts_fail(polygon, all_cuts, pieces, h, multiple)}") from None
+        pieces = again
+        _check_pieces(polygon, pieces)
+        cells = block_counts(pieces, h, multiple=multiple)
     blocks = tuple(
         LayoutBlock(pc.name, tuple((float(p[0]), float(p[1])) for p in pc.ring[list(pc.corners)]), c)
         for pc, c in zip(pieces, cells, strict=True)
@@ -289,114 +284,6 @@ def layout_from_cuts(
         multiple=multiple,
         notes=tuple(notes),
     )
-
-
-def _where_counts_fail(polygon: Any, cuts: list, pieces: list[Piece], h: float, multiple: int) -> str:
-    """Where no integer cell counts agree: the blocks without any one of which some do (at most
-    three, the smallest first), and the points of the shore where two of ``cuts`` end on their
-    rings; for the message of :func:`layout_from_cuts`."""
-    from shapely.geometry import Polygon
-
-    from ..errors import TopologyError
-
-    if len(pieces) > 60:  # a count per block left out: not for a large layout
-        return ""
-    culprits = []
-    for k in range(len(pieces)):
-        try:
-            block_counts(pieces[:k] + pieces[k + 1 :], h, multiple=multiple, best=False)
-        except TopologyError:
-            continue
-        culprits.append(pieces[k])
-    if not culprits:
-        return ""
-    culprits.sort(key=lambda pc: Polygon(pc.ring).area)
-    where = ", ".join(
-        f"({p.x:.6g}, {p.y:.6g})" for p in (Polygon(pc.ring).representative_point() for pc in culprits[:3])
-    )
-    at = ""
-    shared = _shared_shore_ends(polygon, cuts, h)
-    shared = [p for p in shared if any(np.min(np.hypot(*(pc.ring - p).T)) <= 1e-6 * h for pc in culprits)]
-    if shared:
-        pts = ", ".join(f"({x:.6g}, {y:.6g})" for x, y in shared[:2])
-        at = f"; two cuts end at one shore point there, {pts}: end one 3 or more cells from it, or across the other"
-    return f": no cell counts agree round the block{'s' * (len(culprits) > 1)} near {where}{at}"
-
-
-def _shared_shore_ends(polygon: Any, cuts: list, h: float) -> list[np.ndarray]:
-    """The points on the shore (or an island) where two or more of ``cuts`` end."""
-    from shapely.geometry import Point
-
-    ends = [np.asarray(c, float)[e] for c in cuts for e in (0, -1)]
-    shore = polygon.boundary
-    out: list[np.ndarray] = []
-    for p in ends:
-        if any(np.hypot(*(p - q)) <= 1e-6 * h for q in out) or shore.distance(Point(p)) > 1e-6 * h:
-            continue
-        if sum(np.hypot(*(p - q)) <= 1e-6 * h for q in ends) >= 2:
-            out.append(p)
-    return out
-
-
-def _shore_ends_in_rings(poly: Any, cuts: list) -> tuple[Any, list]:
-    """``poly`` with every cut end on its shore (within 1e-9 of its size) a vertex of its ring, and
-    the cuts whose ends are (a float's width) apart from one such vertex put exactly on it.
-
-    Two cuts ending at one shore point (a cut drawn onto an auto cut's end) otherwise end on each
-    other: :func:`~.regions.snap_to_rings` puts an end on the nearest line, the other cut, whose
-    end is nearer than the shore by 1e-13; the shore is not noded there, and the region beside it
-    touches itself (session 20: the 'not a simple polygon' errors of such cuts)."""
-    from shapely.geometry import Polygon
-
-    from ..segments import feet
-
-    size = math.sqrt(poly.area)
-    eps = 1e-9 * size
-    rings = [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
-    cuts = [np.array(c, float) for c in cuts]
-    for c in cuts:
-        if len(c) < 2:
-            continue
-        for e in (0, -1):
-            q = c[e]
-            for k, r in enumerate(rings):
-                dist, _ = feet(r, np.roll(r, -1, axis=0), q)
-                j = int(np.argmin(dist))
-                if dist[j] > eps:
-                    continue
-                near = np.hypot(*(r - q).T)
-                i = int(np.argmin(near))
-                if near[i] <= eps:
-                    c[e] = r[i]  # onto the vertex there (an earlier cut's end, or the shore's)
-                else:
-                    rings[k] = np.insert(r, j + 1, q, axis=0)
-                break
-    return Polygon(rings[0], rings[1:]), cuts
-
-
-def _four_vertices(ring: np.ndarray, h: float) -> np.ndarray:
-    """A region of three vertices (straight cuts crossing, or a cut and the shore's vertices) with a
-    fourth at the middle of its longest side, a block corner there (:func:`~.corners.choose_corners`
-    takes four of a ring's vertices); the neighbour across that side gets the point as a T
-    (:func:`~.blocks.conform`).  Raises :class:`~meshcore.errors.TopologyError` naming the place when
-    the region is under a cell: a sliver where two cuts cross just before they end (a cut end
-    drawn near another one on the shore, not onto it)."""
-    from ..errors import TopologyError
-
-    if len(ring) >= 4:
-        return ring
-    (ax, ay), (bx, by) = ring[1] - ring[0], ring[-1] - ring[0]
-    area = 0.5 * abs(float(ax * by - ay * bx)) if len(ring) == 3 else 0.0
-    c = ring.mean(axis=0)
-    if area < h * h:
-        raise TopologyError(
-            f"the cut lines leave a three-sided sliver of {area / (h * h):.2g} cells near ({c[0]:.6g}, {c[1]:.6g}) "
-            f"(two cuts crossing just before they end: a cut end drawn near another one, not onto it); "
-            f"put the two ends onto one point or farther apart"
-        )
-    side = np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)
-    k = int(np.argmax(side))
-    return np.insert(ring, k + 1, 0.5 * (ring[k] + ring[(k + 1) % 3]), axis=0)
 
 
 def _snapped_cuts(polygon: Any, cuts: Any, corners: list, h: float, snap_cells: float) -> tuple[list, list[str]]:

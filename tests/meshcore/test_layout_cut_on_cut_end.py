@@ -208,3 +208,13 @@ def test_a_cut_drawn_half_a_cell_from_an_auto_cut_end_and_snapped_onto_it(k):
                 assert re.search(r"\(-?[\d.e+-]+, -?[\d.e+-]+\)", str(exc)), str(exc)
                 continue
             _check_valid(new)
+
+
+@pytest.mark.parametrize(("seed", "kind", "which", "angle"), [(720000, "blob", 1, -50.0)])
+def test_where_no_counts_agree_one_region_is_cornered_again(seed, kind, which, angle):
+    """A cut drawn onto an auto cut's end that crosses an island cut next to it: with each region's
+    corners chosen alone no cell counts agree; one region cornered again (its junctions made its
+    corners) gives a valid layout."""
+    lay = auto_layout(T.round_lake(seed, kind=kind), target_cells=3000)
+    cut = _drawn_from(lay, _shore_ends(lay)[which], angle)
+    _check_valid(_with(lay, cut))
