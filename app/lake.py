@@ -99,12 +99,14 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
     ``pointset`` is the :class:`meshcore.io.PointSet` read from the file; with ``lonlat``
     its degrees go to ``frame`` (the project's) or to the UTM zone of the centroid with a
     round local origin (:func:`meshcore.cli.lakefile.local_frame`).  Open lines touching the
-    shore are dropped with a note (:func:`meshcore.cli.lakefile.lake_rings`).  Raises
-    :class:`~meshcore.MeshcoreError` when the rings are not one lake (an island outside the
-    shore, a ring of fewer than three points).
+    shore are dropped with a note (:func:`meshcore.cli.lakefile.lake_parts`).  A file of several
+    separate parts of water gives the largest part (its shore and islands) and a note naming the
+    parts left out (:func:`several_parts_note`).  Raises :class:`~meshcore.MeshcoreError` when
+    the rings are not water (an island across the shore, parts that overlap, a ring of fewer than
+    three points).
     """
     from meshcore import crs as mcrs
-    from meshcore.cli.lakefile import lake_rings, local_frame
+    from meshcore.cli.lakefile import lake_parts, local_frame
 
     ps = pointset
     if not lonlat and ps.crs and frame is not None and frame.crs and not mcrs.is_geographic(ps.crs):
@@ -115,8 +117,29 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
             ps, frame = mcrs.project(ps, frame.crs, origin=frame.origin, source_crs=src)
         else:  # the rule of ``meshcore mesh``: the same local numbers, the same layout and grid
             ps, frame = local_frame(ps, "auto", source_crs=src)
-    outer, islands, notes = lake_rings(ps)
+    parts, notes = lake_parts(ps)
+    _, outer, islands = parts[0]
+    if len(parts) > 1:
+        notes = [*notes, several_parts_note(parts)]
     return outer, islands, frame, notes
+
+
+def several_parts_note(parts: list) -> str:
+    """What the import of a file of several separate parts of water says: the app grids one lake,
+    the largest part (with its islands); ``meshcore mesh`` grids every part."""
+    from shapely.geometry import Polygon
+
+    def part(k: int) -> str:
+        name, outer, _ = parts[k - 1]
+        p = Polygon(outer)
+        return f"part {k} ({name!r}, area {p.area:.4g}, near ({p.centroid.x:.6g}, {p.centroid.y:.6g}))"
+
+    rest = ", ".join(part(k) for k in range(2, len(parts) + 1))
+    return (
+        f"{len(parts)} separate parts of water: the app grids one lake, so the largest, {part(1)}, is imported "
+        f"with its islands and {rest} {'is' if len(parts) == 2 else 'are'} left out; 'meshcore mesh' grids "
+        f"every part of the file (--part N for some)"
+    )
 
 
 def water(outline: Any, holes: Any = ()) -> Any:

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .cellsize import DEFAULT_CELLS
-from .errors import FoldedGridError
+from .errors import FoldedGridError, InvalidInputError
 from .grid import SolveInfo
 
 if TYPE_CHECKING:
@@ -262,6 +262,7 @@ def mesh_outline(
     outline: Any,
     *,
     holes: Any = (),
+    parts: Any = None,
     cell_size: float | None = None,
     target_cells: int = DEFAULT_CELLS,
     levels: int = 2,
@@ -274,10 +275,14 @@ def mesh_outline(
 
     Parameters
     ----------
-    outline : (n, 2) array_like or shapely Polygon
-        The shore; a Polygon may carry its islands as holes.
+    outline : (n, 2) array_like, shapely Polygon, MultiPolygon or list of Polygons
+        The shore; a Polygon may carry its islands as holes.  Several parts of water (a
+        MultiPolygon, a list of Polygons) are meshed at one cell size into one grid whose blocks
+        are named ``part<k>_…`` (:mod:`meshcore.lakeparts`).
     holes : sequence of (k, 2) array_like
-        Islands.
+        Islands (with several parts: each goes to the part that holds it).
+    parts : sequence of int, optional
+        With several parts: the part numbers to mesh (from 1, largest area first); default all.
     cell_size : float, optional
         Wanted cell size; default ``sqrt(water area / target_cells)``.
     levels : int
@@ -300,8 +305,14 @@ def mesh_outline(
         left out, arms too narrow for a block, a shore smoothed below the cell size, …), each in
         a sentence naming the place; ``info.message`` says how many there are.
     """
+    from .lakeparts import is_several, mesh_parts
     from .layout import LayoutOptions, auto_layout
 
+    if is_several(outline):
+        opts = dict(levels=levels, regular=regular, strict=strict, layout_options=layout_options, **options)
+        return mesh_parts(outline, holes=holes, parts=parts, cell_size=cell_size, target_cells=target_cells, **opts)
+    if parts is not None:
+        raise InvalidInputError("parts= is for water in several parts (a MultiPolygon or a list of Polygons)")
     lay = auto_layout(
         outline,
         holes=holes,

@@ -19,9 +19,11 @@ __all__ = [
     "RINGS_MAY_BE_OPEN",
     "in_world",
     "is_lonlat",
+    "lake_parts",
     "lake_rings",
     "local_frame",
     "lonlat_order_note",
+    "scale_note",
     "without_lines_on_the_shore",
 ]
 
@@ -134,6 +136,64 @@ def lake_rings(ps: Any) -> tuple[np.ndarray, list[np.ndarray], list[str]]:
     kept, notes = without_lines_on_the_shore(ps)
     outer, islands = water_from_points(kept)
     return np.asarray(outer, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in islands], notes
+
+
+def lake_parts(ps: Any) -> tuple[list[tuple[str, np.ndarray, list[np.ndarray]]], list[str]]:
+    """The separate parts of the water, ``[(name, shore, islands), ...]`` largest first, and notes:
+    :func:`lake_rings` for files of several parts (a lake split at a dam, several placemarks;
+    :func:`~meshcore.layout.polygon.water_parts_from_points`)."""
+    from ..layout.polygon import water_parts_from_points
+
+    kept, notes = without_lines_on_the_shore(ps)
+    parts = [
+        (name, np.asarray(o, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in isl])
+        for name, o, isl in water_parts_from_points(kept)
+    ]
+    return parts, notes
+
+
+#: A lon/lat lake whose scale in the grid's CRS is off by more than this somewhere on its shore gets
+#: a note: UTM keeps its scale within 0.1 % inside its own 6° zone (0.9996 on the central meridian,
+#: 1.00098 at 3° from it on the equator), so a lake inside one zone never gets the note and one that
+#: reaches well beyond the zone of its centroid does.
+SCALE_ERROR = 1e-3
+
+
+def scale_note(ps: Any, frame: Any) -> str | None:
+    """A note when the projection distorts a lon/lat lake by more than :data:`SCALE_ERROR`.
+
+    The scale factor of ``frame.crs`` (pyproj ``Proj.get_factors``: the meridional scale, which
+    for a conformal projection such as UTM is the scale in every direction) at every shore point;
+    the note gives the worst, where it is and the lake's width in longitude.
+    """
+    import pyproj
+
+    from ..crs import is_geographic
+
+    src, crs = frame.source_crs, frame.crs
+    if not src or not crs or not is_geographic(src) or is_geographic(crs):
+        return None
+    pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    if not len(pts):
+        return None
+    try:
+        lonlat = pyproj.Transformer.from_crs(src, "EPSG:4326", always_xy=True)
+        lon, lat = lonlat.transform(pts[:, 0], pts[:, 1])
+        k = np.asarray(pyproj.Proj(crs).get_factors(lon, lat).meridional_scale, dtype=np.float64)
+    except Exception:  # a note only: a CRS pyproj cannot give factors for says nothing
+        return None
+    err = np.abs(k - 1.0)
+    if not np.isfinite(err).any() or np.nanmax(err) <= SCALE_ERROR:
+        return None
+    i = int(np.nanargmax(err))
+    span = float(np.ptp(np.unwrap(np.radians(lon)))) * 180.0 / np.pi
+    return (
+        f"{ps.source}: the lake spans {span:.3g}° of longitude; in {crs} its scale is off by up to "
+        f"{100 * err[i]:.2g} % (at lon {lon[i]:.5g}, lat {lat[i]:.5g}; UTM keeps within 0.1 % inside its 6° "
+        f"zone): the grid's lengths and areas are that far from the ground's there; give --crs a projection "
+        f"made for the lake's extent (e.g. a Lambert conformal conic or an equidistant projection centred on it)"
+    )
 
 
 #: Point files in which an island's ring may be written without its closing point: an open

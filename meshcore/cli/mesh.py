@@ -6,7 +6,9 @@ The whole of :func:`meshcore.mesh_outline` from the command line::
 
 1. **read** OUTLINE (any point file: CSV/TXT, KML/KMZ, GeoJSON, shapefile, DXF).  The ring
    with the largest area is the shore; every other ring must lie inside it and is an island
-   (GeoJSON interior rings, KML ``innerBoundaryIs``, shapefile holes, extra CSV rings).
+   (GeoJSON interior rings, KML ``innerBoundaryIs``, shapefile holes, extra CSV rings); a ring
+   outside every shore is a separate part of the water (a MultiPolygon, several placemarks):
+   every part is meshed at one cell size into one grid (:mod:`.mesh_parts`, ``--part N``).
    Lon/lat is projected to the UTM zone of the centroid, or to ``--crs``, relative to a round
    local origin (:func:`meshcore.crs.project`'s ``origin="auto"``, what the app does on
    import): the layout and the grid are computed in these local coordinates, so that the app
@@ -32,18 +34,16 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import io
 import math
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from ..errors import InvalidInputError, MeshcoreError
-from .lakefile import degrees_note, in_world, lake_rings, local_frame, lonlat_order_note
+from .lakefile import degrees_note, in_world, lake_parts, local_frame, lonlat_order_note, scale_note
+from .mesh_figure import figure as _figure
 
 #: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
 MIN_CELLS = 16
@@ -58,7 +58,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     from ..quality import PRESETS
 
     p.add_argument(
-        "outline", help="lake outline (.csv .txt .kml .kmz .gpx .geojson .shp .dxf); inner rings are islands"
+        "outline",
+        help="lake outline (.csv .txt .kml .kmz .gpx .geojson .shp .dxf); inner rings are islands, "
+        "separate rings separate parts of the water (each meshed, blocks named part<k>_…)",
     )
     size = p.add_mutually_exclusive_group()
     size.add_argument("--cell-size", type=float, metavar="H", help="cell size in the grid's CRS units (metres)")
@@ -118,7 +120,26 @@ def add_args(p: argparse.ArgumentParser) -> None:
         default="blocks",
         help="figure: one colour per block (default) or cells coloured by deviation from 90°",
     )
+    p.add_argument(
+        "--part",
+        action="append",
+        type=part_numbers,
+        metavar="N",
+        help="a file of several separate water parts (listed while reading, largest first): mesh part N "
+        "only (repeatable, or a list: --part 1,3); default every part",
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress and no quality table")
+
+
+def part_numbers(text: str) -> list[int]:
+    """``--part 2`` or ``--part 1,3``: part numbers (from 1)."""
+    try:
+        out = [int(t) for t in text.replace(" ", "").split(",") if t]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: part numbers from 1, e.g. 2 or 1,3") from None
+    if not out or min(out) < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: part numbers from 1, e.g. 2 or 1,3")
+    return out
 
 
 class _Say:
@@ -254,14 +275,17 @@ def _read(args: argparse.Namespace, say: _Say):
             f"{args.outline}: coordinates in degrees ({frame.crs}); give --crs auto or a projected EPSG code"
         )
     try:
-        outer, islands, dropped = lake_rings(local)
+        parts, dropped = lake_parts(local)
     except InvalidInputError as exc:  # places in the grid's CRS, as the layout's
         raise InvalidInputError(in_world(str(exc), frame)) from None
-    _notes(
-        [n for n in (lonlat_order_note(ps, args.source_crs, args.columns), degrees_note(ps, args.source_crs)) if n],
-        frame,
-    )
+    said = (lonlat_order_note(ps, args.source_crs, args.columns), degrees_note(ps, args.source_crs))
+    _notes([n for n in (*said, scale_note(ps, frame)) if n], frame)
     _notes(dropped, frame)
+    if len(parts) > 1 or args.part:  # several parts of water: meshcore.cli.mesh_parts
+        from .mesh_parts import read_parts
+
+        return read_parts(args, parts, frame, say), frame
+    _, outer, islands = parts[0]
     try:
         poly, notes = water_polygon(outer, holes=islands)
     except InvalidInputError as exc:
@@ -375,70 +399,9 @@ def _grid(lay, say: _Say):
     return mesh_layout(lay, levels=LEVELS, callback=level)
 
 
-# ------------------------------------------------------------------ figure
-#: Resolution of the ``--png`` figure (dots per inch).
-DPI = 150
-
-
-def _figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any) -> None:
-    """One colour per block, or cells coloured by the largest deviation from 90° at their nodes."""
-    import matplotlib
-    from matplotlib.collections import LineCollection
-    from matplotlib.figure import Figure
-
-    from ..grid import BORDER_NAMES
-    from ..io import atomic_write_bytes
-    from ..plot import line_alpha
-
-    xs = np.concatenate([np.ravel(g.x) for g in mb.grids])
-    ys = np.concatenate([np.ravel(g.y) for g in mb.grids])
-    w, h = float(np.ptp(xs)) or 1.0, float(np.ptp(ys)) or 1.0
-    s = 8.0 / max(w, h)
-    fig = Figure(figsize=(max(4.0, w * s + 1.5), max(4.0, h * s + 0.8)))
-    ax = fig.add_subplot()
-    blocks = matplotlib.colormaps["tab10"].colors
-    mesh = None
-    n_cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
-    # grid lines fade where cells are a few pixels wide (a fine grid or a long river at this size
-    # was a black band hiding the blocks' colours and the deviations), as on the app's canvas
-    alpha = line_alpha(math.sqrt(poly.area / max(n_cells, 1)) * s * DPI)
-    for k, g in enumerate(mb.grids):
-        x, y = np.asarray(g.x), np.asarray(g.y)
-        if colour == "deviation":
-            d = metrics.blocks[k].deviation
-            corners = np.stack([d[:-1, :-1], d[1:, :-1], d[1:, 1:], d[:-1, 1:]])
-            with np.errstate(all="ignore"):
-                c = np.where(np.isnan(corners).all(axis=0), np.nan, np.nanmax(corners, axis=0))
-            mesh = ax.pcolormesh(x, y, c, cmap="magma_r", vmin=0.0, vmax=10.0, shading="flat")
-            line = "0.35"
-        else:
-            line = blocks[k % len(blocks)]
-        segs = [np.column_stack([x[i], y[i]]) for i in range(x.shape[0])]
-        segs += [np.column_stack([x[:, j], y[:, j]]) for j in range(x.shape[1])]
-        ax.add_collection(LineCollection(segs, colors=[line], linewidths=0.3, alpha=alpha))
-        ax.add_collection(LineCollection([g.border(b) for b in BORDER_NAMES], colors=[line], linewidths=0.9))
-    for ring in [poly.exterior, *poly.interiors]:
-        r = np.asarray(ring.coords)
-        ax.plot(r[:, 0], r[:, 1], color="k", lw=0.8)
-    if mesh is not None:
-        fig.colorbar(mesh, ax=ax, extend="max", shrink=0.8, label="deviation from 90° at the cell's nodes [°]")
-    ax.set_aspect("equal")
-    ax.autoscale_view()
-    ax.ticklabel_format(useOffset=False, style="plain")
-    unit = f" [m, {frame.crs}]" if frame.crs else ""
-    ax.set_xlabel(f"x{unit}")
-    ax.set_ylabel(f"y{unit}")
-    ax.set_title(f"{len(mb.grids)} blocks, {n_cells:,} cells", fontsize=10)
-    buf = io.BytesIO()
-    fig.savefig(buf, format=path.suffix.lower().lstrip("."), dpi=DPI, bbox_inches="tight")
-    atomic_write_bytes(path, buf.getvalue())
-
-
 # ------------------------------------------------------------------ the command
 def run(args: argparse.Namespace) -> int:
     from ..crs import normalize_crs, not_a_map
-    from ..io import write
-    from ..quality import check, lake_metrics
 
     t_start = time.perf_counter()
     say = _Say(args.quiet)
@@ -453,6 +416,10 @@ def run(args: argparse.Namespace) -> int:
     if ddb and not args.regular:
         say(f"{ddb[0]}: Delft3D domain decomposition couples no 3- or 5-block corners: using --regular")
     poly, frame = _read(args, say)
+    if not hasattr(poly, "exterior"):  # water in several parts
+        from .mesh_parts import run_parts
+
+        return run_parts(args, poly, frame, say, outputs, regular, t_start)
     unit = " m" if frame.crs else ""
     h, how = _cell_size(args, poly, unit)
     say(f"water area {poly.area / 1e6:.4g} km², {how}" if frame.crs else f"water area {poly.area:.6g}, {how}")
@@ -478,6 +445,15 @@ def run(args: argparse.Namespace) -> int:
 
         save_case(layout_case(lay, crs=frame, description=f"made by meshcore mesh from {args.outline}"), args.case)
         say(f"wrote {args.case} (the layout: edit it and run 'meshcore generate {args.case}')")
+    return finish(args, mb, poly, frame, h, outputs, say, t_start)
+
+
+def finish(args, mb, poly, frame, h: float, outputs, say: _Say, t_start: float, per_part: Any = None) -> int:
+    """World coordinates, quality, outputs, figure, table and exit code (``per_part(mb, poly)``:
+    lines printed before the table, for water in several parts)."""
+    from ..io import write
+    from ..quality import check, lake_metrics
+
     mb, poly, frame = _world(dataclasses.replace(mb, frame=frame), poly, frame)
     m = lake_metrics(mb, polygon=poly, cell_size=h)
     n_folded = int(m.values("folded").sum())
@@ -489,6 +465,8 @@ def run(args: argparse.Namespace) -> int:
         _figure(Path(args.png), mb, poly, frame, args.colour, m)
         say(f"wrote {args.png}")
     if not args.quiet:
+        for line in per_part(mb, poly) if per_part is not None else ():
+            print(line)
         print(m.table())
         for name in dict.fromkeys(args.preset or ()):
             print("\n" + check(m, name).table())

@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..quality.coverage import MIN_ISLAND_CELLS, island_width, without_spikes
 
-__all__ = ["MIN_ISLAND_CELLS", "water_polygon", "without_dense_vertices"]
+__all__ = ["MIN_ISLAND_CELLS", "water_parts_from_points", "water_polygon", "without_dense_vertices"]
 
 
 def _ring(points: Any, what: str) -> np.ndarray:
@@ -266,10 +266,36 @@ def without_dense_vertices(poly: Any, h: float) -> tuple[Any, list[str]]:
 
 
 def water_from_points(pointset: Any):
-    """Outline and islands from the polylines of a point file (projected already).
+    """Outline and islands from the polylines of a point file (projected already): one lake.
 
     The ring with the largest area is the shore; every other ring must lie inside it (an
-    island).  Returns ``(outline, islands)`` as arrays.
+    island).  Returns ``(outline, islands)`` as arrays.  A file of several separate water parts
+    (:func:`water_parts_from_points`) is refused naming the second part; ``meshcore mesh`` and
+    :func:`meshcore.mesh_outline` mesh every part.
+    """
+    parts = water_parts_from_points(pointset)
+    if len(parts) > 1:
+        (oname, _, _), (name, p, _) = parts[0], parts[1]
+        from shapely.geometry import Polygon
+
+        c = Polygon(p).representative_point()  # the place tells rings of one name apart (a MultiGeometry's)
+        raise InvalidInputError(
+            f"{pointset.source or 'points'}: {name!r} near ({c.x:.6g}, {c.y:.6g}) lies outside the outline "
+            f"{oname!r} — a second part of the water ({len(parts)} in all): one lake here (islands are rings "
+            f"inside the shore); 'meshcore mesh' meshes every part (--part N for some)"
+        )
+    return parts[0][1], parts[0][2]
+
+
+def water_parts_from_points(pointset: Any) -> list[tuple[str, np.ndarray, list[np.ndarray]]]:
+    """The separate parts of the water in the polylines of a point file (projected already).
+
+    Rings are taken largest first: a ring inside a part's shore is an island of that part, a ring
+    outside every part is a part of its own (a lake split at a dam or causeway, a reservoir and a
+    pond, several placemarks).  Returns ``[(name, shore, islands), ...]``, the largest part
+    first.  A ring whose boundary crosses or touches a part's shore is an error naming both and
+    the place: an island across the shore, or two parts that overlap or touch (they are one water:
+    draw them as one outline, or keep them apart).
     """
     from shapely.geometry import Polygon
 
@@ -281,23 +307,28 @@ def water_from_points(pointset: Any):
     if not rings:
         raise InvalidInputError(f"{pointset.source or 'points'}: no outline")
     rings.sort(key=lambda t: -t[0])
-    _, oname, outer = rings[0]
-    shell = Polygon(outer).buffer(0)
-    islands = []
-    for _, name, p in rings[1:]:
+    parts: list[tuple[str, np.ndarray, list[np.ndarray]]] = []
+    shells: list[Any] = []
+    for _, name, p in rings:
         ring = Polygon(p)
-        if ring.boundary.intersects(shell.boundary):
-            c = ring.boundary.intersection(shell.boundary).representative_point()
-            raise InvalidInputError(
-                f"{pointset.source or 'points'}: {name!r} crosses the shore of {oname!r} near "
-                f"({c.x:.6g}, {c.y:.6g}) — an island must lie inside the shore (a ring that reaches the "
-                f"land is part of the shore: draw it into the outline)"
-            )
-        if not shell.contains(ring.representative_point()):
-            c = ring.representative_point()  # the place tells rings of one name apart (a MultiGeometry's)
-            raise InvalidInputError(
-                f"{pointset.source or 'points'}: {name!r} near ({c.x:.6g}, {c.y:.6g}) lies outside the outline "
-                f"{oname!r} — one lake per file (islands are rings inside the shore)"
-            )
-        islands.append(p)
-    return outer, islands
+        for (oname, _, islands), shell in zip(parts, shells, strict=True):
+            if ring.boundary.intersects(shell.boundary):
+                c = ring.boundary.intersection(shell.boundary).representative_point()
+                if shell.contains(ring.representative_point()):
+                    raise InvalidInputError(
+                        f"{pointset.source or 'points'}: {name!r} crosses the shore of {oname!r} near "
+                        f"({c.x:.6g}, {c.y:.6g}) — an island must lie inside the shore (a ring that reaches "
+                        f"the land is part of the shore: draw it into the outline)"
+                    )
+                raise InvalidInputError(
+                    f"{pointset.source or 'points'}: the water parts {oname!r} and {name!r} overlap or touch "
+                    f"near ({c.x:.6g}, {c.y:.6g}) — separate parts must lie apart (parts that meet are one "
+                    f"water: draw them as one outline)"
+                )
+            if shell.contains(ring.representative_point()):
+                islands.append(p)
+                break
+        else:
+            parts.append((name, p, []))
+            shells.append(ring.buffer(0))
+    return parts

@@ -79,7 +79,7 @@ def test_a_file_that_is_not_one_lake_imports_its_largest_line(qtbot, win, tmp_pa
     win.doc.reported.connect(lambda _level, text: said.append(text))
     assert win.io.import_points(src)
     np.testing.assert_allclose(win.doc.project.blocks[0].points, big, atol=0.01)
-    assert any("largest line" in text for text in said)
+    assert any("the largest, part 1" in text and "left out" in text for text in said)
 
 
 def test_the_save_dialog_offers_the_lake_file_name_and_the_case_is_titled_by_it(qtbot, win, tmp_path, monkeypatch):

@@ -72,14 +72,16 @@ def test_a_file_that_is_not_one_lake_says_why(win, tmp_path):
     win.doc.reported.connect(lambda level, text: said.append((level, text)))
     f = tmp_path / "two.csv"
     rows = [f"{x},{y},A" for x, y in zip(2000 * np.cos(T), 1000 * np.sin(T), strict=True)]
-    rows += [f"{x + 9000},{y},B" for x, y in zip(2000 * np.cos(T), 1000 * np.sin(T), strict=True)]
+    rows += [f"{x + 9000},{y},B" for x, y in zip(1000 * np.cos(T), 500 * np.sin(T), strict=True)]  # the smaller
     f.write_text("x,y,name\n" + "\n".join(rows) + "\n")
     assert win.io.import_points(f)
-    assert win.doc.project.lake is None
-    # was: only a log line; meshcore mesh refuses the file with this reason
-    assert any(
-        level == "warning" and "two.csv: not read as a lake" in t and "outside the outline" in t for level, t in said
-    )
+    # was: no lake ("not read as a lake … one lake per file"), the largest line imported as a plain block;
+    # now the largest part is the lake and the Messages say which part was left out and how to grid it
+    lake = win.doc.project.lake
+    assert lake is not None and np.ptp(lake.outline[:, 0]) == pytest.approx(4000, rel=1e-3)
+    assert np.max(lake.outline[:, 0]) < 5000  # part A (x about 0), not B (x about 9000)
+    said = [t for level, t in said if level == "warning" and t.startswith("two.csv: 2 separate parts of water")]
+    assert len(said) == 1 and "part 2 ('B'" in said[0] and "left out" in said[0] and "meshcore mesh" in said[0]
 
 
 def test_degrees_without_a_header_warn_of_the_column_order(win, tmp_path):

@@ -499,10 +499,10 @@ def test_a_vtm_whose_block_folder_holds_the_input_is_refused_before_the_solve(tm
     [
         ("x,y\n0,0\n4000,0\nabc,2000\n0,2000\n", ("bad.csv", "line 4")),
         ("x,y\n0,0\n4000,2000\n4000,0\n0,2000\n", ("bad.csv", "crosses itself", "point")),  # a bow tie
-        (
-            "x,y,ring\n0,0,shore\n4000,0,shore\n4000,2000,shore\n0,2000,shore\n"
-            "5000,0,other\n6000,0,other\n6000,1000,other\n",
-            ("bad.csv", "'other'", "outside the outline"),
+        (  # a second ring reaching into the shore: two parts of water that overlap (was: a second lake)
+            "x,y,ring\n0,0,shore\n4000,0,shore\n4000,2000,shore\n0,2000,shore\n0,0,shore\n"
+            "3500,500,other\n6000,500,other\n6000,1000,other\n3500,500,other\n",
+            ("bad.csv", "'shore' and 'other' overlap or touch near (4000,"),
         ),
         (  # an island drawn across the shore: named, with the place where it crosses
             "x,y,ring\n0,0,shore\n4000,0,shore\n4000,2000,shore\n0,2000,shore\n"
@@ -510,7 +510,7 @@ def test_a_vtm_whose_block_folder_holds_the_input_is_refused_before_the_solve(tm
             ("bad.csv", "'isle' crosses the shore of 'shore' near (4000, 1200)"),
         ),
     ],
-    ids=["not-a-number", "bow-tie", "second-lake", "island-across-the-shore"],
+    ids=["not-a-number", "bow-tie", "overlapping-parts", "island-across-the-shore"],
 )
 def test_bad_outline_file(tmp_path, text, needles):
     f = tmp_path / "bad.csv"

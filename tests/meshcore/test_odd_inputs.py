@@ -333,11 +333,23 @@ def test_two_lakes_of_one_name_are_told_apart_by_place(tmp_path, capsys):
         '<kml xmlns="http://www.opengis.net/kml/2.2"><Placemark><name>lakes</name><MultiGeometry>'
         f"{poly(0.0)}{poly(0.2)}</MultiGeometry></Placemark></kml>"
     )
-    assert cli.main(["mesh", str(f), "-o", str(tmp_path / "g.vtm")]) == 2
+    # was exit 2, "one lake per file" (the place in the grid's CRS); now both are meshed, listed with
+    # their centroids in the file's coordinates (lon/lat), which tell them apart
+    assert cli.main(["mesh", str(f), "--cells", "300", "-o", str(tmp_path / "g.vtm"), "-q"]) == 0
     err = capsys.readouterr().err
-    # was: "'lakes' lies outside the outline 'lakes'"; the place in the grid's CRS (UTM metres, not local)
-    m = re.search(r"'lakes' near \(([\d.]+), ([\d.]+)\) lies outside the outline 'lakes'", err)
-    assert m and 450_000 < float(m[1]) < 500_000 and 5_200_000 < float(m[2]) < 5_300_000, err
+    assert err == "", err
+    assert cli.main(["mesh", str(f), "--cells", "300", "-o", str(tmp_path / "g.vtm")]) == 0
+    err = capsys.readouterr().err
+    assert "part 1: 'lakes', area" in err and "part 2: 'lakes', area" in err
+    assert len(re.findall(r"centroid lon 8\.50000, lat 47\.30000|centroid lon 8\.70000, lat 47\.30000", err)) == 2, err
+    # the app's one-lake reading names the second part by its place
+    from meshcore.errors import InvalidInputError
+    from meshcore.layout.polygon import water_from_points
+
+    with pytest.raises(
+        InvalidInputError, match=r"'lakes' near \(8\.[57]\d*, 47\.3\d*\) lies outside the outline 'lakes'"
+    ):
+        water_from_points(read_points(f))
 
 
 def test_no_column_order_note_for_a_shapefile_without_prj(tmp_path):
