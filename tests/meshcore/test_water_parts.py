@@ -9,7 +9,7 @@ import json
 import numpy as np
 import pytest
 
-from tests.meshcore.test_mesh_cli import _refused, mesh, vtm_blocks
+from tests.meshcore.test_mesh_cli import _refused, cgns_blocks, mesh, plot3d_blocks, vtm_blocks
 
 shapely = pytest.importorskip("shapely")
 pyproj = pytest.importorskip("pyproj")
@@ -63,7 +63,8 @@ def test_a_multipolygon_geojson_gives_a_grid_of_every_part(tmp_path):
         "coordinates": [[closed(WEST), closed(WEST_ISLE)], [closed(EAST), closed(EAST_ISLE)]],
     }
     f.write_text(json.dumps({"type": "Feature", "properties": {"name": "mp"}, "geometry": geom}))
-    run = mesh(f, "--cells", 800, "-o", tmp_path / "g.vtm", "-o", tmp_path / "g.ddb", "--regular")
+    outs = [tmp_path / f"g.{s}" for s in ("vtm", "ddb", "cgns", "xyz")]
+    run = mesh(f, "--cells", 800, *(a for o in outs for a in ("-o", o)), "--regular")
     assert run.rc == 0, run.err
     assert "2 separate parts of water" in run.err
     assert "part 1: 'mp 1', area" in run.err and "centroid lon 8.49" in run.err
@@ -80,6 +81,13 @@ def test_a_multipolygon_geojson_gives_a_grid_of_every_part(tmp_path):
     h = np.sqrt(sum(p.area for p in water.values()) / 800)
     for name, xy in zip(names, blocks, strict=True):
         assert inside([xy], water[name.split("_")[0]], 0.5 * h), name
+    crs, cg = cgns_blocks(tmp_path / "g.cgns")  # every part in the CGNS and PLOT3D files too, node for node
+    assert crs == "EPSG:32632"
+    for other in (cg, plot3d_blocks(tmp_path / "g.xyz")):
+        assert len(other) == len(blocks)
+        for (x, y), (X, Y) in zip(other, blocks, strict=True):
+            np.testing.assert_array_equal(x, X)
+            np.testing.assert_array_equal(y, Y)
     dd = read_dd(tmp_path / "g.ddb")
     assert sorted(dd.blocks.block_names) == sorted(names)
     assert dd.interfaces and all(i.a.block.split("_")[0] == i.b.block.split("_")[0] for i in dd.interfaces)
