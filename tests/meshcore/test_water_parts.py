@@ -141,8 +141,15 @@ def test_csv_rings_islands_go_to_their_part_and_a_part_too_small_is_left_out(tmp
             ("pond", ellipse(0, 4000, 70, 70, 16)),  # 140 m across, cells of ~100 m
         ],
     )
-    run = mesh(f, "--cell-size", 100, "-o", tmp_path / "g.vtm", "--png", tmp_path / "g.png")
+    run = mesh(
+        f, "--cell-size", 100, "-o", tmp_path / "g.vtm", "--png", tmp_path / "g.png", "--case", tmp_path / "L.toml"
+    )
     assert run.rc == 0, run.err
+    # a case holds one lake: one per part meshed, each generating that part's blocks again
+    assert sorted(p.name for p in tmp_path.glob("L*.toml")) == ["L_part1.toml", "L_part2.toml"]
+    from meshcore.case import generate_case, load_case
+
+    again = generate_case(load_case(tmp_path / "L_part2.toml"))
     # the water of the part (its island's 0.19 km² taken off), its centroid in the file's coordinates
     assert "part 2: 'side', area 4.50531e+06, centroid (7991.67, 0), 1 island" in run.err
     note = [ln for ln in run.err.splitlines() if "part 3 ('pond')" in ln]
@@ -150,6 +157,7 @@ def test_csv_rings_islands_go_to_their_part_and_a_part_too_small_is_left_out(tmp
     names = block_names(tmp_path / "g.vtm")
     assert {n.split("_")[0] for n in names} == {"part1", "part2"}
     side = [xy for n, xy in zip(names, vtm_blocks(tmp_path / "g.vtm"), strict=True) if n.startswith("part2_")]
+    assert len(again.grids) == len(side) and {f"part2_{n}" for n in again.names} <= set(names)
     isle = shapely.Polygon(ellipse(8200, 0, 300, 200))
     assert inside(side, shapely.Polygon(ellipse(8000, 0, 1500, 1000)), 50.0)
     pts = shapely.points(np.vstack([np.column_stack([x.ravel(), y.ravel()]) for x, y in side]))
