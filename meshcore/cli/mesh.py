@@ -448,12 +448,17 @@ def run(args: argparse.Namespace) -> int:
     return finish(args, mb, poly, frame, h, outputs, say, t_start)
 
 
-def finish(args, mb, poly, frame, h: float, outputs, say: _Say, t_start: float, per_part: Any = None) -> int:
+def finish(
+    args, mb, poly, frame, h: float, outputs, say: _Say, t_start: float, per_part: Any = None, left_out=()
+) -> int:
     """World coordinates, quality, outputs, figure, table and exit code (``per_part(mb, poly)``:
-    lines printed before the table, for water in several parts)."""
+    lines printed before the table, ``left_out``: parts drawn dashed, for water in several parts)."""
+    from shapely import affinity
+
     from ..io import write
     from ..quality import check, lake_metrics
 
+    left_out = [affinity.translate(p, *frame.origin) for p in left_out]
     mb, poly, frame = _world(dataclasses.replace(mb, frame=frame), poly, frame)
     m = lake_metrics(mb, polygon=poly, cell_size=h)
     n_folded = int(m.values("folded").sum())
@@ -462,7 +467,7 @@ def finish(args, mb, poly, frame, h: float, outputs, say: _Say, t_start: float, 
         write(p, mb, crs=frame)
         say(f"wrote {p}")
     if args.png:
-        _figure(Path(args.png), mb, poly, frame, args.colour, m)
+        _figure(Path(args.png), mb, poly, frame, args.colour, m, left_out)
         say(f"wrote {args.png}")
     if not args.quiet:
         for line in per_part(mb, poly) if per_part is not None else ():

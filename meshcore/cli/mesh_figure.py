@@ -15,7 +15,7 @@ __all__ = ["DPI", "figure"]
 DPI = 150
 
 
-def figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any) -> None:
+def figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any, left_out: Any = ()) -> None:
     """One colour per block, or cells coloured by the largest deviation from 90° at their nodes."""
     import matplotlib
     from matplotlib.collections import LineCollection
@@ -55,6 +55,10 @@ def figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any
     for ring in (r for p in getattr(poly, "geoms", [poly]) for r in (p.exterior, *p.interiors)):
         r = np.asarray(ring.coords)
         ax.plot(r[:, 0], r[:, 1], color="k", lw=0.8)
+    for p in left_out:  # parts of the water left out (too small): their shores dashed
+        for ring in (p.exterior, *p.interiors):
+            r = np.asarray(ring.coords)
+            ax.plot(r[:, 0], r[:, 1], color="0.4", lw=0.8, ls="--")
     if mesh is not None:
         fig.colorbar(mesh, ax=ax, extend="max", shrink=0.8, label="deviation from 90° at the cell's nodes [°]")
     ax.set_aspect("equal")

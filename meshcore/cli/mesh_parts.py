@@ -218,4 +218,5 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
             save_case(layout_case(lay, crs=frame, description=what), path)
             say(f"wrote {path} (part {k}'s layout: edit it and run 'meshcore generate {path}')")
     poly = shapely.MultiPolygon([p for _, p in kept]) if len(kept) > 1 else kept[0][1]
-    return finish(args, mb, poly, frame, h, outputs, say, t_start, per_part=_per_part(water, kept, h))
+    out = [p for k, p in enumerate(water.polygons, 1) if k not in dict(kept) and (not asked or k in asked)]
+    return finish(args, mb, poly, frame, h, outputs, say, t_start, per_part=_per_part(water, kept, h), left_out=out)
