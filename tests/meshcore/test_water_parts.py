@@ -224,3 +224,29 @@ def test_a_lake_wider_than_its_utm_zone_gets_one_note_naming_crs(tmp_path):
     assert f"EPSG:{zone}" in notes[0] and pct == pytest.approx(100 * (k - 1), rel=0.05) and pct > 5
     small = PointSet((Polyline("lake", ellipse(20.5, 10.0, 0.5, 0.2)),), "EPSG:4326")
     assert scale_note(small, Frame("EPSG:32634", (0.0, 0.0), "EPSG:4326")) is None and SCALE_ERROR == 1e-3
+
+
+def test_a_shapefile_of_two_lake_records_gives_both_parts(tmp_path):
+    """A national lake layer's two records (one with a hole): two parts, the hole the island of the
+    first, both meshed."""
+    import contextlib
+
+    shp = pytest.importorskip("shapefile")
+
+    north, hole, south = ellipse(0, 0, 3000, 1500)[::-1], ellipse(800, 0, 300, 200), ellipse(8000, 0, 1500, 1000)[::-1]
+    with contextlib.ExitStack() as files:  # pyshp's Writer leaves the .dbf it opens unclosed
+        f = {e: files.enter_context(open(tmp_path / f"lakes.{e}", "wb")) for e in ("shp", "shx", "dbf")}
+        with shp.Writer(shapeType=shp.POLYGON, **f) as w:
+            w.field("name", "C")
+            w.poly([closed(north), closed(hole)])
+            w.record("North basin")
+            w.poly([closed(south)])
+            w.record("South basin")
+    run = mesh(tmp_path / "lakes.shp", "--cells", 600, "-o", tmp_path / "g.vtm")
+    assert run.rc == 0, run.err
+    assert "part 1: 'North basin" in run.err and "1 island" in run.err and "part 2: 'South basin'" in run.err
+    names = block_names(tmp_path / "g.vtm")
+    assert {n.split("_")[0] for n in names} == {"part1", "part2"}
+    first = [xy for n, xy in zip(names, vtm_blocks(tmp_path / "g.vtm"), strict=True) if n.startswith("part1_")]
+    pts = shapely.points(np.vstack([np.column_stack([x.ravel(), y.ravel()]) for x, y in first]))
+    assert not shapely.contains(shapely.Polygon(hole).buffer(-50.0), pts).any()
