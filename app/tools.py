@@ -302,12 +302,13 @@ class CutTool(Tool):
         if len(self.points) >= 2:
             lay = self.doc.project.layout
             if lay is not None and self.controller is not None:  # it was refused ("change it in the Lake panel")
+                from .block_names import names_kept
                 from .layout_edit import with_drawn_cut
 
                 # an end a user meant to put on a cut end, corner or tip lands a cell or two off: it
                 # goes onto it (else a thin wedge block); the Messages say where, one undo step as before
                 cut, report = np.array(self.points), self.doc.report
-                self.controller.edit_layout(lambda: with_drawn_cut(lay, cut, report), "Add cut line")
+                self.controller.edit_layout(lambda: names_kept(lay, with_drawn_cut(lay, cut, report)), "Add cut line")
             else:
                 self.editor.add_cut_line(np.array(self.points))
         self.points = []
@@ -424,10 +425,11 @@ class LayoutTool(Tool):
         if was is not lay or h is None or h.kind not in ("end", "cut"):
             self.status("Delete a cut line: point at its end or one of its points (ringed), then Del")
             return True
+        from .block_names import names_kept
         from .layout_edit import without_cut
 
-        k = h.cut
-        self.controller.edit_layout(lambda: without_cut(lay, k), "Delete cut line")
+        k = h.cut  # the blocks the cut did not bound keep their names
+        self.controller.edit_layout(lambda: names_kept(lay, without_cut(lay, k)), "Delete cut line")
         self._hovered = None  # the ringed end goes with its cut: no ring left until the mouse moves
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
