@@ -26,6 +26,10 @@ MANY_MISSES = 1000
 LABEL_ROOM = 2.0
 #: full symbol sizes (pixels) of the cut ends and the block corners
 _FULL = {"cut_ends": 9.0, "corners": 8.0}
+#: their fills, and their outlines when drawn hollow (a cell on screen smaller than the symbol: the
+#: filled symbols hid the cells at an arm's end, where corners and cut ends gather)
+_FILL = {"cut_ends": "#fff", "corners": "#ffd700"}
+_HOLLOW_PEN = {"cut_ends": pg.mkPen(CUT_COLOUR, width=1.5), "corners": pg.mkPen("#b8860b", width=1.5)}
 
 
 def _block_polygons(layout) -> list:
@@ -66,11 +70,11 @@ class LakeOverlay:
         self.cuts = pg.PlotCurveItem(pen=pg.mkPen(CUT_COLOUR, width=2.5), connect="finite")
         self.cuts.setZValue(7)
         self.cut_ends = Scatter(
-            size=_FULL["cut_ends"], symbol="o", pen=pg.mkPen(CUT_COLOUR, width=1.5), brush=pg.mkBrush("#fff")
+            size=_FULL["cut_ends"], symbol="o", pen=pg.mkPen(CUT_COLOUR, width=1.5), brush=pg.mkBrush(_FILL["cut_ends"])
         )
         self.cut_ends.setZValue(24)
         self.corners = Scatter(
-            size=_FULL["corners"], symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush("#ffd700")
+            size=_FULL["corners"], symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush(_FILL["corners"])
         )
         self.corners.setZValue(23)
         self.misses = Scatter(size=5, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 170))
@@ -98,6 +102,8 @@ class LakeOverlay:
         self._label_pixel = 0.0  # the pixel size the levels were chosen for
         self._marker_spacing = np.inf  # typical distance between the corners and cut ends (model units)
         self._marker_scale = 1.0  # their size now, a share of the full size
+        self._cell_size = 0.0  # the layout's cell size (model units): markers wider than a cell are hollow
+        self.markers_hollow = False  # drawn as outlines, the grid showing through
         self._labels_due = None  # a layout whose labels are made when they are shown again
 
     # ------------------------------------------------------------ drawing
@@ -119,8 +125,10 @@ class LakeOverlay:
             set_points(self.cut_ends, None)
             set_points(self.corners, None)
             self._marker_spacing = np.inf
+            self._cell_size = 0.0
             self._set_labels([], np.zeros((0, 2)))
             return
+        self._cell_size = float(layout.cell_size)
         cuts = [np.asarray(c, float) for c in layout.cuts]
         set_polylines(self.cuts, cuts)
         ends = [c[[0, -1]] for c in cuts if len(c) >= 2]
@@ -246,6 +254,15 @@ class LakeOverlay:
                     item.setSize(size * scale)
         for name in _FULL:
             getattr(self, name).setVisible(self.markers_visible and scale > 0)
+        # a cell on screen narrower than the symbols: outlines only, the cells under them stay in sight
+        hollow = self._cell_size / pixel < full * scale if pixel > 0 else False
+        if hollow != self.markers_hollow:
+            self.markers_hollow = hollow
+            for name in _FULL:
+                item = getattr(self, name)
+                item.setBrush(None if hollow else pg.mkBrush(_FILL[name]))
+                if name == "corners":  # a thin black square would read as a grid cell
+                    item.setPen(_HOLLOW_PEN[name] if hollow else pg.mkPen("#000", width=1))
 
     def set_misses(self, points: np.ndarray | None) -> None:
         """Ring the places that miss the chosen quality preset (None: none).

@@ -70,3 +70,29 @@ def test_a_cut_edit_leaves_the_names_of_the_blocks_it_did_not_touch(qtbot, win, 
     same = [n for n, c in before.items() if c in after.values()]
     assert same and all(after.get(n) == before[n] for n in same)
     assert set(after) <= set(before)  # the joined block has the name of one of the two it joined
+
+
+def test_corners_and_cut_ends_let_the_grid_show_where_cells_are_smaller_than_they(qtbot, win):
+    """The whole lake in view (held-out g181803, 10 000 cells): the yellow corner squares and white
+    cut-end circles, each wider than two or three cells on screen, hid the grid at every arm's end
+    (where they gather).  A cell on screen narrower than them: they are drawn as outlines; zoomed in
+    to a few cells, filled as before."""
+    from PySide6 import QtCore
+
+    from tests.app.test_canvas_lod import _laid_out as channels
+
+    lay = channels(win, seed=762021, cells=10_000)
+    items = win.canvas.lake_items
+    h = lay.cell_size
+    win.canvas.fit()
+    assert items.corners.isVisible() or items.cut_ends.isVisible()
+    assert h / win.canvas.pixel() < 8.0  # cells smaller than the corner squares
+    for name in ("corners", "cut_ends"):
+        item = getattr(items, name)
+        if item.isVisible():
+            assert item.opts["brush"].style() == QtCore.Qt.BrushStyle.NoBrush
+    c = np.asarray(lay.blocks[0].corners[0], float)
+    win.canvas.zoom_to((c[0] - 3 * h, c[1] - 3 * h, c[0] + 3 * h, c[1] + 3 * h), margin=0)
+    assert h / win.canvas.pixel() > 8.0
+    assert items.corners.isVisible() and items.corners.opts["brush"].style() != QtCore.Qt.BrushStyle.NoBrush
+    assert items.cut_ends.opts["brush"].style() != QtCore.Qt.BrushStyle.NoBrush
