@@ -498,6 +498,7 @@ class LayoutTool(Tool):
             return
         self._last_xy = xy
         before, shore = self._parts, shore_points(base) if h.kind == "shore" else None
+        report = self.doc.report
 
         def make():  # in the layout worker: the GUI thread only places the handle (most steps are dropped)
             from meshcore.errors import InvalidInputError
@@ -507,7 +508,12 @@ class LayoutTool(Tool):
             parts = moved_parts(before, h.xy, q, tol, shore=shore)
             if shore is not None and not _shore_moved(before, parts):
                 raise InvalidInputError("this shore point is not on the layout's shore: it cannot be dragged")
-            return settled_layout(base, parts, steps) if final else moved_layout(base, parts, steps)
+            if not final:
+                return moved_layout(base, parts, steps)
+            from .drag_cells import cells_followed
+
+            # the steps kept every block's cells; at the end they follow a block the drag stretched
+            return cells_followed(base, settled_layout(base, parts, steps), report)
 
         what = KIND_NAMES[h.kind]
         self.controller.edit_layout(make, f"Move {what}", merge_key=("layout", self._drag), shore=h.kind == "shore")

@@ -96,3 +96,50 @@ def test_corners_and_cut_ends_let_the_grid_show_where_cells_are_smaller_than_the
     assert h / win.canvas.pixel() > 8.0
     assert items.corners.isVisible() and items.corners.opts["brush"].style() != QtCore.Qt.BrushStyle.NoBrush
     assert items.cut_ends.opts["brush"].style() != QtCore.Qt.BrushStyle.NoBrush
+
+
+def test_a_long_drag_of_a_cut_end_lets_the_stretched_blocks_cells_follow(qtbot, win):
+    """A cut end of a ring lake's two-block layout dragged 40° round the shore: both blocks kept their
+    cell counts, one block's cells along the ring stretched, the other's squeezed, with nothing said
+    (under Xvfb: a drag of 70° left 40×72 and 40×204).  At the end of the drag the cells of a block
+    the drag stretched or squeezed by more than a fifth follow the cell size, the Messages say so,
+    and one undo step brings the layout of before back."""
+    from app.drag_cells import STRETCH, cell_lengths
+    from app.lake import Lake, compute_layout
+    from app.layout_edit import handles
+    from meshcore import testing
+
+    poly = testing.round_lake(762031, kind="ring", radius=2000.0)
+    lake = Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        target_cells=3000,
+    )
+    lake = lake.replaced(layout=compute_layout(lake))
+    win.lake_ctl.generate_after = False
+    win.editor.set_lake(lake, "Auto layout")
+    lay0 = win.doc.project.layout
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append(text))
+    win.set_tool("layout")
+    tool = win.canvas.tool
+    end = max((h for h in handles(lay0) if h.kind == "end"), key=lambda h: np.hypot(*h.xy))  # on the shore
+    a0, r = np.arctan2(end.xy[1], end.xy[0]), np.hypot(*end.xy)
+    path = [(r * np.cos(a0 + t), r * np.sin(a0 + t)) for t in np.radians(np.linspace(0, 40, 9))]
+    n = win.stack.count()
+    assert tool.drag("start", path[0], end.xy)
+    for p in path[1:]:
+        tool.drag("move", p, end.xy)
+        qtbot.wait(20)
+    tool.drag("finish", path[-1], end.xy)
+    wait_for(qtbot, win, lambda: not win.lake_ctl.editing and win.doc.project.layout is not lay0)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert win.lake_ctl.edit_error is None
+    assert [b.cells for b in lay1.blocks] != [b.cells for b in lay0.blocks]
+    ratio = cell_lengths(lay1) / cell_lengths(lay0)
+    assert np.all(np.abs(np.log(ratio)) <= np.log1p(STRETCH) + 0.1)  # no block's cells stretched much now
+    assert any("Cells follow the drag" in t for t in said)
+    assert win.stack.count() == n + 1
+    win.stack.undo()
+    assert win.doc.project.layout is lay0
