@@ -1,6 +1,7 @@
 """The main window: composition of canvas, docks, menus, toolbar and status bar.
 
-It builds the parts and connects them; the logic lives elsewhere: the
+It builds the parts and connects them (its frame: title, drops, close, size, help in
+:mod:`app.window_frame`); the logic lives elsewhere: the
 document (:mod:`app.document`) holds the state the views draw, edits are undo
 commands (:mod:`app.commands`, :mod:`app.tools`), files go through the I/O
 controller (:mod:`app.io_controller`), the background image through
@@ -10,7 +11,6 @@ every action comes from the table in :mod:`app.actions`.
 
 from __future__ import annotations
 
-import contextlib
 import logging
 from pathlib import Path
 
@@ -33,18 +33,17 @@ from .solve_status import SolveStatus
 from .solver_controller import SolverController
 from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, LayoutTool, PanTool
 from .views.canvas import Canvas
-from .views.docks import fit_docks, narrowable, scrolled
+from .views.docks import narrowable, scrolled
 from .views.lake_panel import LakePanel, LakeQualityBox
 from .views.messages import ElidedLabel, MessagePanel
 from .views.panels import BlocksPanel, ConvergencePanel, ParamsPanel, QualityPanel
+from .window_frame import APP_NAME, WindowFrame
 
 __all__ = ["MainWindow"]
 
 log = logging.getLogger(__name__)
 
-APP_NAME = "gcmesh"
 DEFAULT_SIZE = (1400, 880)
-VIEW_TOGGLES = ("grid_lines", "markers")  # checkable View actions remembered between sessions
 
 
 def default_recovery_path() -> Path:
@@ -53,8 +52,8 @@ def default_recovery_path() -> Path:
     return Path(QtCore.QStandardPaths.writableLocation(loc)) / "recovery.toml"
 
 
-class MainWindow(QtWidgets.QMainWindow):
-    """The gcmesh main window."""
+class MainWindow(WindowFrame, QtWidgets.QMainWindow):
+    """The gcmesh main window (its frame: :class:`app.window_frame.WindowFrame`)."""
 
     def __init__(
         self,
@@ -438,92 +437,3 @@ class MainWindow(QtWidgets.QMainWindow):
         if coloured and self.lake_quality.verdict is not None and not self.lake_quality.verdict.passed:
             key = self.a_misses.shortcut().toString(QtGui.QKeySequence.SequenceFormat.NativeText)
             self.message(f"Cells coloured by {label}; the preset's misses are hidden — View ▸ Preset misses ({key})")
-
-    # ------------------------------------------------------------- window
-    def _update_title(self, *_a) -> None:
-        try:
-            clean = self.stack.isClean()
-        except RuntimeError:  # the stack is gone while the window is being destroyed
-            return
-        name = self.doc.path.name if self.doc.path else (self.doc.project.title or "untitled")
-        self.setWindowTitle(f"{name}{'' if clean else ' *'} — {APP_NAME}")
-
-    def dragEnterEvent(self, ev: QtGui.QDragEnterEvent) -> None:
-        if ev.mimeData().hasUrls():
-            ev.acceptProposedAction()
-
-    def dropEvent(self, ev: QtGui.QDropEvent) -> None:
-        for url in ev.mimeData().urls():
-            if url.isLocalFile():
-                path = Path(url.toLocalFile())
-                # a project replaces the work without undo (as File ▸ Open, which asks); a point file is an import
-                if path.suffix.lower() != ".toml" or self.io.maybe_save():
-                    self.io.open_path(path)
-                break
-
-    def closeEvent(self, ev: QtGui.QCloseEvent) -> None:
-        if not self.io.maybe_save():
-            ev.ignore()
-            return
-        self.solver.shutdown()
-        self.io.shutdown()
-        self.settings.setValue("geometry", self.saveGeometry())
-        self.settings.setValue("window_state", self.saveState())
-        for key in VIEW_TOGGLES:
-            self.settings.setValue(f"view/{key}", self.actions[key].isChecked())
-        ev.accept()
-
-    def resizeEvent(self, ev: QtGui.QResizeEvent) -> None:
-        super().resizeEvent(ev)
-        QtCore.QTimer.singleShot(0, self, lambda: fit_docks(self, self.canvas, self.docks.values()))
-
-    def showEvent(self, ev: QtGui.QShowEvent) -> None:
-        super().showEvent(ev)
-        if not self._shown:  # the window frame is known now: fit it, decoration included
-            self._shown = True
-            if self.fit_on_show:
-                QtCore.QTimer.singleShot(0, self.fit_to_screen)
-
-    def fit_to_screen(self) -> None:
-        """Keep the whole window (docks and status bar included) on its screen."""
-        screen = self.screen() or QtGui.QGuiApplication.primaryScreen()
-        if screen is None:
-            return
-        avail = screen.availableGeometry()
-        frame = self.frameGeometry().size() - self.geometry().size()  # the window manager's decoration
-        w = min(self.width(), avail.width() - frame.width())
-        h = min(self.height(), avail.height() - frame.height())
-        if (w, h) != (self.width(), self.height()):
-            self.resize(w, h)
-        x = min(max(self.x(), avail.left()), avail.right() - self.frameGeometry().width() + 1)
-        y = min(max(self.y(), avail.top()), avail.bottom() - self.frameGeometry().height() + 1)
-        if (x, y) != (self.x(), self.y()):
-            self.move(max(x, avail.left()), max(y, avail.top()))
-
-    def _restore_layout(self) -> None:
-        """Window size and dock layout from the last session (if any)."""
-        geom = self.settings.value("geometry")
-        state = self.settings.value("window_state")
-        with contextlib.suppress(TypeError):
-            if geom is not None:
-                self.restoreGeometry(geom)
-            if state is not None:
-                self.restoreState(state)
-        for key in VIEW_TOGGLES:
-            on = self.settings.value(f"view/{key}", None)
-            if on is not None and (str(on).lower() == "true") != self.actions[key].isChecked():
-                self.actions[key].trigger()
-
-    # --------------------------------------------------------------- help
-    def show_shortcuts(self) -> QtWidgets.QDialog:
-        """Help ▸ Keyboard shortcuts (:func:`app.views.help.shortcuts_dialog`)."""
-        from .views.help import shortcuts_dialog
-
-        self.shortcuts_dialog = shortcuts_dialog(self)
-        return self.shortcuts_dialog
-
-    def show_about(self) -> None:
-        """Help ▸ About (:func:`app.views.help.show_about`)."""
-        from .views.help import show_about
-
-        show_about(self)

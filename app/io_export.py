@@ -1,0 +1,146 @@
+"""File ▸ Export mesh and Export figure: the dialogs, the checks before writing (folded cells, a
+Delft3D domain decomposition that cannot be coupled) and the writes.
+
+:class:`ExportMixin` is a part of :class:`app.io_controller.IOController` (a mixin: it uses the
+controller's ``win``, ``doc``, ``quiet``, ``_parent``, ``suggested_path``, ``last_dir`` and
+``remember_dir``); meshes are written by :mod:`app.io_adapter` over ``meshcore.io``.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+from PySide6 import QtWidgets
+
+from meshcore import MeshcoreError
+
+from . import io_adapter as fio
+
+__all__ = ["ExportMixin", "export_default"]
+
+log = logging.getLogger(__name__)
+
+
+def export_default(project) -> str:
+    """The format the export dialog offers first: Delft3D domain decomposition for a lake layout of
+    several blocks (what lake modellers export), VTK multiblock for other cases of several blocks, VTK
+    structured grid for one block (it offered PLOT3D, the first format meshcore writes)."""
+    n = len(project.blocks)
+    if project.layout is not None and n > 1:
+        return "delft3d-dd"
+    return "vtm" if n > 1 else "vts"
+
+
+class ExportMixin:
+    """Export mesh and Export figure of the window's :class:`~app.io_controller.IOController`."""
+
+    def export_dialog(self) -> None:
+        if not self.doc.grids:
+            self.win.message("Nothing to export yet: generate a grid first (F5)")
+            return
+        fmts = fio.mesh_formats()
+        filt = ";;".join(f"{d} ({p})" for d, p in fmts)
+        want = export_default(self.doc.project)
+        first = next((f"{d} ({p})" for d, p in fmts if d.endswith(f"[{want}]")), "")
+        suffix = next((p.split()[0].lstrip("*") for d, p in fmts if d.endswith(f"[{want}]")), "")
+        offer = str(Path(self.suggested_path()).with_suffix(suffix)) if suffix else self.last_dir()
+        path, chosen = QtWidgets.QFileDialog.getSaveFileName(self._parent(), "Export mesh", offer, filt, first)
+        if path:
+            if not Path(path).suffix:
+                pat = next((p for d, p in fmts if chosen.startswith(d)), "*.vts")
+                path += pat.split()[0].lstrip("*")
+            self.export_mesh(Path(path))
+
+    def export_mesh(self, path: Path) -> bool:
+        """Write the grids (a multiblock result with its connectivity) with meshcore.io."""
+        grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
+        mb = self.doc.multiblock
+        p = self.doc.project
+        frame = fio.project_frame(p)
+        if p.layout is not None and (mb is None or self.doc.stale or self.doc.solving):
+            self.win.message("The lake grid is not finished: generate it (F5) and export when it is done", error=True)
+            return False
+        if not self._folds_confirmed():
+            return False
+        try:
+            if mb is not None and (p.multiblock is not None or p.layout is not None) and not self.doc.stale:
+                fio.write_mesh(path, mb, frame)
+            else:
+                fio.write_mesh(path, grids, frame)
+        except (MeshcoreError, OSError) as exc:
+            if self._offer_regular(path, exc):
+                return False
+            self.win.error("Cannot export mesh", exc)
+            return False
+        self.remember_dir(path)
+        self.win.message(f"Exported {len(grids)} block(s) to {path}")
+        return True
+
+    def _folds_confirmed(self) -> bool:
+        """A grid with folded or non-convex cells (a lake's, or any block's): warn (and ask, unless quiet)
+        before writing it; the warning names the blocks."""
+        from meshcore.quality import quality
+
+        m = self.doc.lake_metrics
+        names = [b.name for b in self.doc.project.blocks]
+        if m is not None:
+            bad = [(b.name, int(np.sum(b.folded))) for b in m.blocks]
+        else:  # every block the export writes (a hand-made case, one block)
+            bad = []
+            for k, g in sorted(self.doc.grids.items()):
+                r = quality(g)
+                bad.append((names[k] if k < len(names) else f"block {k + 1}", max(r.n_folded, r.n_nonconvex)))
+        bad = [(name, n) for name, n in bad if n]
+        n = sum(k for _name, k in bad)
+        if not n:
+            return True
+        where = ", ".join(f"{name}: {k}" for name, k in bad[:8]) + (", …" if len(bad) > 8 else "")
+        text = f"The grid has {n} folded or non-convex cell(s) ({where}); a model may refuse it"
+        self.doc.report("warning", text)
+        if self.quiet:
+            return True
+        b = QtWidgets.QMessageBox.StandardButton
+        r = QtWidgets.QMessageBox.question(self._parent(), "Folded cells", f"{text}.\n\nExport anyway?", b.Yes | b.No)
+        return r == b.Yes
+
+    def _offer_regular(self, path: Path, exc: BaseException) -> bool:
+        """A .ddb that Delft3D cannot couple (3- or 5-block corners): offer a regular layout instead."""
+        lay = self.doc.project.layout
+        if lay is None or Path(path).suffix.lower() != ".ddb" or self.doc.project.lake.regular:
+            return False
+        if len(lay.blocks) < 2:  # nothing to couple: the error says to write a .grd (no layout helps)
+            return False
+        text = (
+            f"Cannot export {Path(path).name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
+            "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"
+        )
+        self.win.message(text, error=True)
+        if not self.quiet:
+            b = QtWidgets.QMessageBox.StandardButton
+            r = QtWidgets.QMessageBox.question(
+                self._parent(), "Delft3D domain decomposition", f"{text}.\n\nMake a regular layout now?", b.Yes | b.No
+            )
+            if r == b.Yes:
+                self.win.lake_ctl.auto_layout(regular=True)
+        return True
+
+    def figure_dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self._parent(), "Export figure", self.last_dir(), "PNG image (*.png);;SVG vector (*.svg)"
+        )
+        if path:
+            if not Path(path).suffix:
+                path += ".png"
+            self.export_figure(path)
+
+    def export_figure(self, path) -> bool:
+        try:
+            self.win.canvas.export_image(str(path))
+        except Exception as exc:  # pyqtgraph's exporters raise anything
+            log.exception("cannot export the figure %s", path)
+            self.win.error("Cannot export figure", exc)
+            return False
+        self.win.message(f"Saved figure {path}")
+        return True
