@@ -143,3 +143,21 @@ def test_a_long_drag_of_a_cut_end_lets_the_stretched_blocks_cells_follow(qtbot, 
     assert win.stack.count() == n + 1
     win.stack.undo()
     assert win.doc.project.layout is lay0
+
+
+def test_the_worst_place_of_a_limit_brings_its_blocks_numbers(qtbot, win, tmp_path):
+    """Double-click a failed limit: the view zoomed to its worst place (b4 on held-out g181803), but
+    the block table under the verdict went on showing b0's numbers ('min Jacobian ratio 0.3766',
+    'cells 8 × 8'), the block active before.  The worst place's block is the active block now."""
+    from meshcore.quality.lake import Location
+
+    _laid_out(qtbot, win, tmp_path, 762011)
+    names = [b.name for b in win.doc.project.blocks]
+    assert len(names) > 2 and win.doc.active == 0
+    k = len(names) - 1
+    lay = win.doc.project.layout
+    x, y = np.mean(np.asarray(lay.blocks[k].corners, float), axis=0)
+    win.lake_quality.go_to.emit(Location(0.5, names[k], 1, 1, float(x), float(y)), "node orthogonality")
+    assert win.doc.active == k
+    assert win.doc.block.name == names[k]
+    assert win.doc.grids and win.doc.grid is win.doc.grids[k]  # the block table shows its grid
