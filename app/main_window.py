@@ -37,7 +37,7 @@ from .views.docks import narrowable, scrolled
 from .views.lake_panel import LakePanel, LakeQualityBox
 from .views.messages import ElidedLabel, MessagePanel
 from .views.panels import BlocksPanel, ConvergencePanel, ParamsPanel, QualityPanel
-from .window_frame import APP_NAME, WindowFrame
+from .window_frame import APP_NAME, PRESET_KEY, WindowFrame
 
 __all__ = ["MainWindow"]
 
@@ -218,6 +218,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.lake_quality.misses.connect(self.canvas.lake_items.set_misses)
         self.lake_quality.table.clicked.connect(lambda _i: self.show_misses(True))  # a limit picked: show where
         self.lake_quality.go_to.connect(self.show_worst)
+        # the model a modeller grids for stays chosen in the next session (it went back to delft3d)
+        self.lake_quality.preset.currentTextChanged.connect(lambda t: self.settings.setValue(PRESET_KEY, t))
         self.doc.colour_changed.connect(self._misses_for_colours)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)

@@ -15,10 +15,11 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from .views.docks import fit_docks
 
-__all__ = ["APP_NAME", "VIEW_TOGGLES", "WindowFrame"]
+__all__ = ["APP_NAME", "PRESET_KEY", "VIEW_TOGGLES", "WindowFrame"]
 
 APP_NAME = "gcmesh"
 VIEW_TOGGLES = ("grid_lines", "markers")  # checkable View actions remembered between sessions
+PRESET_KEY = "quality/preset"  # the lake quality preset chosen last (settings key)
 
 
 class WindowFrame:
@@ -85,7 +86,7 @@ class WindowFrame:
             self.move(max(x, avail.left()), max(y, avail.top()))
 
     def _restore_layout(self) -> None:
-        """Window size and dock layout from the last session (if any)."""
+        """Window size, dock layout, View toggles and quality preset from the last session (if any)."""
         geom = self.settings.value("geometry")
         state = self.settings.value("window_state")
         with contextlib.suppress(TypeError):
@@ -97,6 +98,10 @@ class WindowFrame:
             on = self.settings.value(f"view/{key}", None)
             if on is not None and (str(on).lower() == "true") != self.actions[key].isChecked():
                 self.actions[key].trigger()
+        preset = self.settings.value(PRESET_KEY, None)
+        box = self.lake_quality.preset
+        if preset is not None and box.findText(str(preset)) >= 0:
+            box.setCurrentText(str(preset))
 
     # --------------------------------------------------------------- help
     def show_shortcuts(self) -> QtWidgets.QDialog:

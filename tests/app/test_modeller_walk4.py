@@ -161,3 +161,22 @@ def test_the_worst_place_of_a_limit_brings_its_blocks_numbers(qtbot, win, tmp_pa
     assert win.doc.active == k
     assert win.doc.block.name == names[k]
     assert win.doc.grids and win.doc.grid is win.doc.grids[k]  # the block table shows its grid
+
+
+def test_the_quality_preset_chosen_stays_chosen_after_a_restart(qtbot, win, tmp_path):
+    """efdc picked in the Quality dock, the app quit and started again, the project reopened: the
+    verdict was delft3d's again (the preset was not remembered, as the View toggles are)."""
+    from PySide6 import QtCore
+
+    from app.main_window import MainWindow
+
+    box = win.lake_quality.preset
+    assert box.currentText() != "efdc"
+    box.setCurrentText("efdc")
+    assert win.close()
+    settings = QtCore.QSettings(str(tmp_path / "settings.ini"), QtCore.QSettings.Format.IniFormat)
+    again = MainWindow(settings=settings, recovery=tmp_path / "recovery2.gcmesh")
+    again.quiet = True
+    qtbot.addWidget(again)
+    assert again.lake_quality.preset.currentText() == "efdc"
+    again.solver.shutdown(msecs=10_000)
