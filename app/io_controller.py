@@ -246,13 +246,14 @@ class IOController(ExportMixin, QtCore.QObject):
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
-        isl = f" and {len(lake.holes)} island(s)" if lake is not None and lake.holes else ""
+        n_isl = len(lake.holes) if lake is not None else 0
+        isl = f" and {n_isl} island{'s' * (n_isl != 1)}" if n_isl else ""  # it said "1 island(s)"
         self.win.message(
             f"Imported {len(pts)} points{isl} from {path.name}{projected}; corners chosen "
             f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
         )
         if lake is not None and looks_branched(lake.outline, lake.holes):
-            why = f"{len(lake.holes)} island(s)" if lake.holes else "the water has arms or bends"
+            why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
             self.win.show_lake()
             self.win.lake_ctl.offer(path.name, why)
         return True

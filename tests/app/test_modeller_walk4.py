@@ -180,3 +180,24 @@ def test_the_quality_preset_chosen_stays_chosen_after_a_restart(qtbot, win, tmp_
     qtbot.addWidget(again)
     assert again.lake_quality.preset.currentText() == "efdc"
     again.solver.shutdown(msecs=10_000)
+
+
+def test_a_lake_with_one_island_is_said_to_have_one_island(qtbot, win, tmp_path, monkeypatch):
+    """A generated ring lake imported: the status bar and the Auto layout offer said '1 island(s)'."""
+    from meshcore import testing
+
+    poly = testing.round_lake(762051, kind="ring", radius=2000.0)
+    rings = [poly.exterior, *poly.interiors]
+    lines = ["x,y"]
+    for k, ring in enumerate(rings):
+        lines += [""] * bool(k) + [f"{x:.2f},{y:.2f}" for x, y in ring.coords]
+    path = tmp_path / "ring.csv"
+    path.write_text("\n".join(lines) + "\n")
+    said = []
+    shown = win.message
+    monkeypatch.setattr(win, "message", lambda text, **kw: (said.append(text), shown(text, **kw)))
+    assert win.io.import_points(path)
+    assert len(win.doc.project.lake.holes) == 1
+    box = win.lake_ctl.prompt
+    assert box is not None and "1 island." in box.text() and "island(s)" not in box.text()
+    assert any("and 1 island from" in t for t in said)
