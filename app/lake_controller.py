@@ -239,7 +239,9 @@ class LakeController(QtCore.QObject):
                 lake = lake.replaced(outline=np.asarray(poly.exterior.coords)[:-1], holes=rings)
             self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
             self.layout_done.emit(layout)
-            if key is None:  # one edit (a cut deleted, a block's cells): the status line says the new layout
+            # one edit (a cut deleted, a block's cells), or a drag's last layout: the status line says the
+            # new layout (after a drag it went on showing the grid of before's cell count)
+            if key is None or (not self._dragging and self._pending is None):
                 n = len(layout.blocks)
                 self.win.message(f"{text}: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells (Ctrl+Z undoes it)")
         if err is not None and self._pending is None:  # a refusal only counts for the last request

@@ -365,7 +365,8 @@ class LayoutTool(Tool):
     shortcut = "Y"
     tip = (
         "Layout: drag a cut line's end along the shore, a cut's point, a junction, a block corner or a shore point; "
-        "the layout follows (cells kept) and, with auto-generate, the grid; Del deletes the cut line pointed at"
+        "the layout follows (its cells kept; at the end, a block stretched by over a fifth gets new ones) and, "
+        "with auto-generate, the grid; Del deletes the cut line pointed at"
     )
     controller = None  # the window's LakeController (it computes new layouts off the GUI thread)
 

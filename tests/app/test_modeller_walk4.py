@@ -140,6 +140,8 @@ def test_a_long_drag_of_a_cut_end_lets_the_stretched_blocks_cells_follow(qtbot, 
     ratio = cell_lengths(lay1) / cell_lengths(lay0)
     assert np.all(np.abs(np.log(ratio)) <= np.log1p(STRETCH) + 0.1)  # no block's cells stretched much now
     assert any("Cells follow the drag" in t for t in said)
+    n_cells = f"{lay1.n_cells:,} cells"
+    assert n_cells in win._status.text() and win._status.text().startswith("Move cut end")  # not the old count
     assert win.stack.count() == n + 1
     win.stack.undo()
     assert win.doc.project.layout is lay0
