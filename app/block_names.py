@@ -32,6 +32,15 @@ def _corners_key(corners: Any, tol: float) -> tuple:
     return tuple(np.round(np.asarray(corners, float).ravel() / tol).astype(np.int64).tolist())
 
 
+def _polygon(ring: Any) -> Any:
+    """A block's region as a valid shapely polygon (a ring that touches itself made valid)."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    poly = Polygon(np.asarray(ring, float))
+    return poly if poly.is_valid else shapely.make_valid(poly)
+
+
 def _fresh(used: set[str]) -> str:
     nums = [int(m.group(1)) for n in used if (m := re.fullmatch(r"b(\d+)", n))]
     name = f"b{max(nums, default=-1) + 1}"
@@ -42,18 +51,15 @@ def _fresh(used: set[str]) -> str:
 def names_kept(before: Any, after: Any) -> Any:
     """``after`` (a :class:`meshcore.layout.Layout` made by editing ``before``) with the block names
     of ``before`` where the blocks are the same (see the module's text), its blocks in name order."""
-    from shapely.geometry import Polygon
-
     tol = 1e-6 * float(before.cell_size)
     old = {_corners_key(b.corners, tol): b.name for b in before.blocks}
     names: list[str | None] = [old.get(_corners_key(b.corners, tol)) for b in after.blocks]
     used = {n for n in names if n is not None}
-    gone = [(k, Polygon(p.ring)) for k, (p, b) in enumerate(zip(before.pieces, before.blocks, strict=True))]
-    gone = [(before.blocks[k].name, poly) for k, poly in gone if before.blocks[k].name not in used]
+    gone = [(b.name, _polygon(p.ring)) for p, b in zip(before.pieces, before.blocks, strict=True) if b.name not in used]
     new = [k for k, n in enumerate(names) if n is None]
     claims = []  # (overlap area, block k of after, name of a changed block of before)
     for k in new:
-        poly = Polygon(after.pieces[k].ring)
+        poly = _polygon(after.pieces[k].ring)
         for name, was in gone:
             area = poly.intersection(was).area
             if area > 0:

@@ -203,3 +203,25 @@ def test_a_lake_with_one_island_is_said_to_have_one_island(qtbot, win, tmp_path,
     box = win.lake_ctl.prompt
     assert box is not None and "1 island." in box.text() and "island(s)" not in box.text()
     assert any("and 1 island from" in t for t in said)
+
+
+def test_block_names_are_kept_when_a_changed_block_touches_itself():
+    """A layout's piece can be a ring that touches itself (the canvas makes such pieces valid to draw
+    them); the overlap test of the names (shapely's intersection) raised GEOSException on one, and
+    the cut edit ended as 'internal error'.  Such a block is made valid first."""
+    from app.block_names import names_kept
+    from meshcore.layout.blocks import Piece
+    from meshcore.layout.model import Layout, LayoutBlock
+
+    def lay(rings_names):
+        pieces = tuple(Piece(np.asarray(r, float), (0, 1, 2, 3), n) for r, n in rings_names)
+        blocks = tuple(LayoutBlock(n, tuple(map(tuple, np.asarray(r, float)[:4])), (4, 4)) for r, n in rings_names)
+        return Layout(polygon=None, cell_size=1.0, cuts=(), pieces=pieces, blocks=blocks)
+
+    square = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    before = lay([(square, "b0"), ([(1, 0), (3, 0), (3, 2), (1, 2)], "b1")])
+    bow = [(1, 0), (3, 2), (3, 0), (1, 2)]  # b1 changed: its ring crosses itself at (2, 1)
+    after = lay([(bow, "b0"), (square, "b1")])  # named in the order found
+    out = names_kept(before, after)
+    assert [b.name for b in out.blocks] == ["b0", "b1"]  # the square keeps b0, the changed block b1
+    assert np.array_equal(out.pieces[0].ring, np.asarray(square, float))
