@@ -400,6 +400,25 @@ def _grid(lay, say: _Say):
 
 
 # ------------------------------------------------------------------ the command
+def guarded(args: argparse.Namespace, frame: Any, make):
+    """``make()``, its errors told in the grid's CRS (:func:`in_world`); None after an error that is a
+    bug of the pipeline, not bad input (one line on stderr, exit 1 for the caller)."""
+    try:
+        return make()
+    except MeshcoreError as exc:
+        msg = in_world(str(exc), frame)
+        if msg == str(exc):
+            raise
+        raise type(exc)(msg) from None
+    except Exception as exc:
+        print(
+            f"meshcore mesh: internal error while making the grid of {args.outline} "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); please report it with the file",
+            file=sys.stderr,
+        )
+        return None
+
+
 def run(args: argparse.Namespace) -> int:
     from ..crs import normalize_crs, not_a_map
 
@@ -424,22 +443,16 @@ def run(args: argparse.Namespace) -> int:
     h, how = _cell_size(args, poly, unit)
     say(f"water area {poly.area / 1e6:.4g} km², {how}" if frame.crs else f"water area {poly.area:.6g}, {how}")
     say.lap()
-    try:
+
+    def make():
         lay = _layout(args, poly, h, regular, say, frame)
         _check_blocks(outputs, lay)
-        mb = _grid(lay, say)
-    except MeshcoreError as exc:
-        msg = in_world(str(exc), frame)
-        if msg == str(exc):
-            raise
-        raise type(exc)(msg) from None
-    except Exception as exc:  # a bug of the pipeline, not bad input: one line, exit 1
-        print(
-            f"meshcore mesh: internal error while making the grid of {args.outline} "
-            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); please report it with the file",
-            file=sys.stderr,
-        )
+        return lay, _grid(lay, say)
+
+    made = guarded(args, frame, make)
+    if made is None:
         return 1
+    lay, mb = made
     if args.case:  # the layout in its local frame (the case's [crs] table holds the origin)
         from ..case import layout_case, save_case
 

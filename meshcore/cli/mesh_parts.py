@@ -12,12 +12,11 @@ cells is left out with a note.  The quality table is printed per part and for th
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..errors import InvalidInputError, MeshcoreError
+from ..errors import InvalidInputError
 from .lakefile import in_world
 
 __all__ = ["WaterParts", "read_parts", "run_parts"]
@@ -173,7 +172,7 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
     import shapely
 
     from ..lakeparts import join_grids, select_parts
-    from .mesh import _cell_size, _grid, _notes, finish
+    from .mesh import _cell_size, _grid, _notes, finish, guarded
 
     unit = " m" if frame.crs else ""
     total = shapely.MultiPolygon(list(water.polygons))
@@ -189,26 +188,20 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
     if asked:
         say(f"meshing part{'s' * (len(kept) != 1)} {', '.join(str(k) for k, _ in kept)} of {len(water.polygons)}")
     say.lap()
-    try:
+
+    def make():
         lays = _layouts(args, water, kept, h, regular, say, frame)
         _check_blocks(outputs, kept, lays)
         results = []
         for (k, _), lay in zip(kept, lays, strict=True):
             say(f"part {k}:")
             results.append((k, _grid(lay, say)))
-        mb = join_grids(results, notes)
-    except MeshcoreError as exc:
-        msg = in_world(str(exc), frame)
-        if msg == str(exc):
-            raise
-        raise type(exc)(msg) from None
-    except Exception as exc:  # a bug of the pipeline, not bad input: one line, exit 1
-        print(
-            f"meshcore mesh: internal error while making the grid of {args.outline} "
-            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); please report it with the file",
-            file=sys.stderr,
-        )
+        return lays, join_grids(results, notes)
+
+    made = guarded(args, frame, make)
+    if made is None:
         return 1
+    lays, mb = made
     if args.case:  # one case per part: a case holds one lake
         from ..case import layout_case, save_case
 

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.app.drawing import box_csv, draw_cut
 from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
@@ -14,27 +13,12 @@ pytestmark = pytest.mark.gui
 H = 500.0  # cell size (m): the 20 × 10 km lake is 40 × 20 cells
 
 
-def _box_csv(path: Path) -> Path:
-    ring = [(0.0, 0.0), (20000.0, 0.0), (20000.0, 10000.0), (0.0, 10000.0)]
-    path.write_text("x,y\n" + "\n".join(f"{x:.3f},{y:.3f}" for x, y in ring) + "\n")
-    return path
-
-
-def _draw(win, pts) -> None:
-    from PySide6 import QtCore
-
-    win.set_tool("cut")
-    for xy in pts:
-        win.canvas.tool.click(xy)
-    win.canvas.tool.key(QtCore.Qt.Key.Key_Return)
-
-
 def _t_layout(qtbot, win, tmp_path):
     """The box split by a cut across it (x = 10 km) and a T from the west shore to it (y = 5 km)."""
-    assert win.io.import_points(_box_csv(tmp_path / "box.csv"))
+    assert win.io.import_points(box_csv(tmp_path / "box.csv"))
     win.lake_ctl.set_cell_size(H)
-    _draw(win, [(10000.0, -300.0), (10000.0, 10300.0)])
-    _draw(win, [(-300.0, 5000.0), (10100.0, 5000.0)])
+    draw_cut(win, [(10000.0, -300.0), (10000.0, 10300.0)])
+    draw_cut(win, [(-300.0, 5000.0), (10100.0, 5000.0)])
     win.a_split.trigger()
     wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
     assert win.lake_ctl.last_error is None
@@ -58,7 +42,7 @@ def test_a_cut_end_near_a_cut_end_snaps_onto_it(qtbot, win, tmp_path, off, snapp
     said = []
     win.doc.reported.connect(lambda level, text: said.append((level, text)))
     y = 5000.0 + off * H
-    _draw(win, [(20300.0, y), (9900.0, y)])
+    draw_cut(win, [(20300.0, y), (9900.0, y)])
     wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
     wait_idle(qtbot, win)
     lay = win.doc.project.layout

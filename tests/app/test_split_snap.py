@@ -2,31 +2,15 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.app.drawing import box_csv, draw_cut
 from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
 H = 500.0  # cell size (m): the 20 × 10 km lake is 40 × 20 cells
-
-
-def _box_csv(path: Path) -> Path:
-    ring = [(0.0, 0.0), (20000.0, 0.0), (20000.0, 10000.0), (0.0, 10000.0)]
-    path.write_text("x,y\n" + "\n".join(f"{x:.3f},{y:.3f}" for x, y in ring) + "\n")
-    return path
-
-
-def _draw(win, pts) -> None:
-    from PySide6 import QtCore
-
-    win.set_tool("cut")
-    for xy in pts:
-        win.canvas.tool.click(np.asarray(xy, float))
-    win.canvas.tool.key(QtCore.Qt.Key.Key_Return)
 
 
 @pytest.mark.parametrize(("off", "snapped"), [(1.5, True), (4.0, False)])
@@ -35,12 +19,12 @@ def test_split_snaps_a_cut_end_near_another_cut_end(qtbot, win, tmp_path, off, s
     of its end, slanting to the east shore: at 1.5 cells the second starts on the first's end (a
     three-cut junction on the shore; the Messages say what moved), at 4 cells where drawn.  The
     split is one undo step, which brings the drawn cut lines back."""
-    assert win.io.import_points(_box_csv(tmp_path / "box.csv"))
+    assert win.io.import_points(box_csv(tmp_path / "box.csv"))
     win.lake_ctl.set_cell_size(H)
-    _draw(win, [(10000.0, -300.0), (10000.0, 10300.0)])
+    draw_cut(win, [(10000.0, -300.0), (10000.0, 10300.0)])
     x0 = 10000.0 + off * H
     d = np.array([20000.0 - x0, 6000.0])
-    _draw(win, [np.array([x0, 0.0]) - 0.05 * d, np.array([20000.0, 6000.0]) + 0.03 * d])
+    draw_cut(win, [np.array([x0, 0.0]) - 0.05 * d, np.array([20000.0, 6000.0]) + 0.03 * d])
     drawn = win.doc.project.cut_lines
     said = []
     win.doc.reported.connect(lambda level, text: said.append((level, text)))
