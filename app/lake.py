@@ -189,7 +189,7 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
     :class:`~meshcore.MeshcoreError` naming the problem (e.g. the region that cannot be
     four-sided).
     """
-    from meshcore.cli.mesh import LEVELS, MIN_CELLS
+    from meshcore.cli.mesh_steps import LEVELS, MIN_CELLS
     from meshcore.errors import InvalidInputError
     from meshcore.layout import auto_layout
 

@@ -61,7 +61,7 @@ def _cli_lake_layout(path: Path):
 
 
 def cli_lake_seconds(path: Path, repeats: int):
-    from meshcore.cli.mesh import LEVELS
+    from meshcore.cli.mesh_steps import LEVELS
     from meshcore.lakegrid import mesh_layout
     from meshcore.quality import lake_metrics
 

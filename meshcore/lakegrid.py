@@ -310,7 +310,9 @@ def mesh_outline(
 
     if is_several(outline):
         opts = dict(levels=levels, regular=regular, strict=strict, layout_options=layout_options, **options)
-        return mesh_parts(outline, holes=holes, parts=parts, cell_size=cell_size, target_cells=target_cells, **opts)
+        return mesh_parts(
+            outline, mesh_outline, holes=holes, parts=parts, cell_size=cell_size, target_cells=target_cells, **opts
+        )
     if parts is not None:
         raise InvalidInputError("parts= is for water in several parts (a MultiPolygon or a list of Polygons)")
     lay = auto_layout(

@@ -204,6 +204,7 @@ def part_grids(mb: Any) -> dict[int, Any]:
 
 def mesh_parts(
     outline: Any,
+    mesh_one: Any,
     *,
     holes: Any = (),
     parts: Any = None,
@@ -213,13 +214,13 @@ def mesh_parts(
 ) -> Any:
     """:func:`meshcore.mesh_outline` of water in several parts (see the module docstring).
 
-    ``parts``: the part numbers (from 1, largest first) to mesh, None for all; ``options`` as for
-    :func:`~meshcore.lakegrid.mesh_outline` (``strict`` raises when any part has folded cells).
+    ``mesh_one``: :func:`~meshcore.lakegrid.mesh_outline`, called for every part (passed in by it:
+    this module sits below the pipeline); ``parts``: the part numbers (from 1, largest first) to
+    mesh, None for all; ``options`` as for ``mesh_one`` (``strict`` raises when any part has folded
+    cells).
     """
-    from .lakegrid import mesh_outline
-
     polys = water_parts(outline, holes)
     h = float(cell_size) if cell_size is not None else default_cell_size(sum(p.area for p in polys), target_cells)
     kept, notes = select_parts(polys, parts, h)
-    results = [(k, mesh_outline(p, cell_size=h, **options)) for k, p in kept]
+    results = [(k, mesh_one(p, cell_size=h, **options)) for k, p in kept]
     return join_grids(results, notes)

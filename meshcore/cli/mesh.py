@@ -33,25 +33,25 @@ not converge, 1 an internal error of the pipeline (one line; please report it).
 from __future__ import annotations
 
 import argparse
-import dataclasses
-import math
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
-from ..cellsize import DEFAULT_CELLS, default_cell_size
-from ..errors import InvalidInputError, MeshcoreError
+from ..cellsize import DEFAULT_CELLS
+from ..errors import InvalidInputError
 from .lakefile import degrees_note, in_world, lake_parts, local_frame, lonlat_order_note, scale_note
-from .mesh_figure import figure as _figure
-
-#: Fewest cells asked for (``--cells``, or the cell size's ``area / H²``).
-MIN_CELLS = 16
-#: Largest coordinate (after the local origin) the pipeline meshes: a circle of radius 1e75 meshes,
-#: one of 1e80 made the layout's triangulation fail (Qhull: "initial simplex is flat"), exit 1.
-MAX_COORDINATE = 1e75
-#: Coarse levels of the grid sequencing (cell counts are multiples of ``2**LEVELS``).
-LEVELS = 2
+from .mesh_steps import (
+    LAYOUT_OPTIONS,
+    MIN_CELLS,
+    _cell_size,
+    _crs_label,
+    _grid,
+    _layout,
+    _notes,
+    _Say,
+    finish,
+    guarded,
+)
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -142,22 +142,6 @@ def part_numbers(text: str) -> list[int]:
     return out
 
 
-class _Say:
-    """Progress lines on stderr (nothing with ``-q``)."""
-
-    def __init__(self, quiet: bool) -> None:
-        self.quiet = quiet
-        self.t0 = time.perf_counter()
-
-    def __call__(self, msg: str) -> None:
-        if not self.quiet:
-            print(msg, file=sys.stderr, flush=True)
-
-    def lap(self) -> float:
-        t, self.t0 = self.t0, time.perf_counter()
-        return self.t0 - t
-
-
 # ------------------------------------------------------------------ checks before any work
 def _check_outputs(args: argparse.Namespace) -> list[tuple[Path, Any]]:
     """Every ``-o`` and ``--png`` checked (format, dependency, folder, not given twice)."""
@@ -239,19 +223,6 @@ def _dry_run_ddb(p: Path, lay: Any) -> None:
             raise InvalidInputError(f"-o {p}: {msg} (write .vtm, .cgns or .xyz instead)") from None
 
 
-# ------------------------------------------------------------------ stages
-def _crs_label(crs: str | None) -> str:
-    if crs is None:
-        return "no CRS: the grid keeps the file's coordinates"
-    from ..crs import crs_name
-
-    try:
-        name = f" ({crs_name(crs)})"
-    except Exception:  # a label only: the CRS itself was checked by meshcore.crs
-        name = ""
-    return f"grid CRS {crs}{name}"
-
-
 def _read(args: argparse.Namespace, say: _Say):
     """The water polygon in local coordinates of the grid's CRS, and its frame (CRS and origin).
 
@@ -298,127 +269,6 @@ def _read(args: argparse.Namespace, say: _Say):
     return poly, frame
 
 
-def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
-    """The grid, the water and the frame in world coordinates (origin added, frame origin 0)."""
-    from shapely import affinity
-
-    ox, oy = frame.origin
-    if ox == 0.0 and oy == 0.0:
-        return mb, poly, frame
-    grids = tuple(g.replaced(x=g.x + ox, y=g.y + oy) for g in mb.grids)
-    world = dataclasses.replace(frame, origin=(0.0, 0.0))
-    return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
-
-
-def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:
-    """The cell size and how it was chosen; refused when the grid would pass the node limit."""
-    from .._validation import max_nodes
-
-    big = max(abs(v) for v in poly.bounds)
-    if not big <= MAX_COORDINATE:
-        raise InvalidInputError(
-            f"{args.outline}: coordinates reach {big:.3g}{unit}; meshcore mesh works with coordinates up to "
-            f"{MAX_COORDINATE:.0e}: give the outline in larger units"
-        )
-    area = float(poly.area)
-    if args.cell_size is not None:
-        h, why = float(args.cell_size), "--cell-size"
-    else:
-        n = args.cells or DEFAULT_CELLS
-        h = default_cell_size(area, n)
-        why = f"sqrt(water area / {n})"
-    est = area / h / h  # not area / h², which underflows to 0 for h ≈ 1e-200
-    if est > max_nodes():
-        raise InvalidInputError(
-            f"{args.outline}: {why} {h:.4g}{unit} gives about {est:,.0f} cells; the limit is "
-            f"{max_nodes():,} nodes (set MESHCORE_MAX_NODES to raise it)"
-        )
-    if est < MIN_CELLS:
-        raise InvalidInputError(
-            f"{args.outline}: {why} {h:.4g}{unit} gives about {est:.2g} cells for a water area of "
-            f"{area:.4g}{unit + '²' if unit else ''}; give a cell size of at most "
-            f"{math.sqrt(area / MIN_CELLS):.4g}{unit}"
-        )
-    return h, f"cell size {h:.4g}{unit} ({why}, about {est:,.0f} cells)"
-
-
-def _notes(notes: Any, frame: Any = None) -> None:
-    """What the pipeline changed in the water (islands joined or too small): shown even with -q
-    (places in the grid's CRS: :func:`in_world`)."""
-    for n in notes:
-        print(f"meshcore mesh: note: {in_world(n, frame)}", file=sys.stderr)
-
-
-#: ``--layout-option`` names: the fields of :class:`~meshcore.layout.LayoutOptions`, with dashes.
-LAYOUT_OPTIONS = ("curve", "thin-arms", "mouths", "wedges")
-
-
-def layout_options(args):
-    """The :class:`~meshcore.layout.LayoutOptions` that ``--layout-option`` asked for."""
-    from ..layout import LayoutOptions
-
-    return LayoutOptions(**{name.replace("-", "_"): True for name in args.layout_option})
-
-
-def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
-    from ..layout import LayoutOptions, auto_layout
-
-    options = layout_options(args)
-    try:
-        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular, options=options)
-    except InvalidInputError as exc:
-        msg = in_world(str(exc), frame)
-        raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None
-    n = len(lay.blocks)
-    say(
-        f"layout: {n} block{'s' * (n != 1)}, {lay.n_cells:,} cells"
-        f"{' (regular: no 3- or 5-block corners)' if regular else ''}"
-        f"{f' (options: {options})' if options != LayoutOptions() else ''}, {say.lap():.1f} s"
-    )
-    _notes(lay.notes, frame)
-    return lay
-
-
-def _grid(lay, say: _Say):
-    from ..lakegrid import mesh_layout
-
-    n_levels = LEVELS + 1
-
-    def level(kind: str, value: Any) -> None:
-        if kind == "equalize":
-            say(f"interfaces: {value} patch(es) of cells more than 2× apart across a cut made alike, {say.lap():.1f} s")
-            return
-        if kind != "level":
-            return
-        lev, res = value
-        f = 2 ** (LEVELS - lev)
-        cells = sum(g.cells[0] * g.cells[1] for g in res.grids)
-        scale = f"cells ÷ {f}" if f > 1 else "full"
-        say(f"grid level {lev + 1}/{n_levels} ({scale}, {cells:,} cells): {res.sweeps} sweeps, {say.lap():.1f} s")
-
-    return mesh_layout(lay, levels=LEVELS, callback=level)
-
-
-# ------------------------------------------------------------------ the command
-def guarded(args: argparse.Namespace, frame: Any, make):
-    """``make()``, its errors told in the grid's CRS (:func:`in_world`); None after an error that is a
-    bug of the pipeline, not bad input (one line on stderr, exit 1 for the caller)."""
-    try:
-        return make()
-    except MeshcoreError as exc:
-        msg = in_world(str(exc), frame)
-        if msg == str(exc):
-            raise
-        raise type(exc)(msg) from None
-    except Exception as exc:
-        print(
-            f"meshcore mesh: internal error while making the grid of {args.outline} "
-            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); please report it with the file",
-            file=sys.stderr,
-        )
-        return None
-
-
 def run(args: argparse.Namespace) -> int:
     from ..crs import normalize_crs, not_a_map
 
@@ -459,42 +309,3 @@ def run(args: argparse.Namespace) -> int:
         save_case(layout_case(lay, crs=frame, description=f"made by meshcore mesh from {args.outline}"), args.case)
         say(f"wrote {args.case} (the layout: edit it and run 'meshcore generate {args.case}')")
     return finish(args, mb, poly, frame, h, outputs, say, t_start)
-
-
-def finish(
-    args, mb, poly, frame, h: float, outputs, say: _Say, t_start: float, per_part: Any = None, left_out=()
-) -> int:
-    """World coordinates, quality, outputs, figure, table and exit code (``per_part(mb, poly)``:
-    lines printed before the table, ``left_out``: parts drawn dashed, for water in several parts)."""
-    from shapely import affinity
-
-    from ..io import write
-    from ..quality import check, lake_metrics
-
-    left_out = [affinity.translate(p, *frame.origin) for p in left_out]
-    mb, poly, frame = _world(dataclasses.replace(mb, frame=frame), poly, frame)
-    m = lake_metrics(mb, polygon=poly, cell_size=h)
-    n_folded = int(m.values("folded").sum())
-    say(f"quality: {n_folded} folded cells, mean deviation from 90° {m.mean('deviation'):.2f}°, {say.lap():.1f} s")
-    for p, _ in outputs:
-        write(p, mb, crs=frame)
-        say(f"wrote {p}")
-    if args.png:
-        _figure(Path(args.png), mb, poly, frame, args.colour, m, left_out)
-        say(f"wrote {args.png}")
-    if not args.quiet:
-        for line in per_part(mb, poly) if per_part is not None else ():
-            print(line)
-        print(m.table())
-        for name in dict.fromkeys(args.preset or ()):
-            print("\n" + check(m, name).table())
-        print(f"\n{len(mb.grids)} blocks, {m.summary()['cells']:,} cells in {time.perf_counter() - t_start:.1f} s")
-    for w in m.coverage.warnings():  # islands lost or cut across: shown even with -q
-        print(f"meshcore mesh: warning: {w}", file=sys.stderr)
-    lost = len(m.coverage.islands_lost)
-    if n_folded or not mb.converged or lost:
-        why = f"{n_folded} folded or non-convex cells" if n_folded else "the solver did not converge"
-        why = why if n_folded or not mb.converged else f"{lost} island(s) under the grid"
-        print(f"meshcore mesh: warning: {why} (exit code 3)", file=sys.stderr)
-        return 3
-    return 0

@@ -58,7 +58,7 @@ def read_parts(args: Any, parts: list, frame: Any, say: Any) -> WaterParts:
 
     from ..lakeparts import water_parts
     from ..layout.polygon import water_polygon
-    from .mesh import _crs_label, _notes
+    from .mesh_steps import _crs_label, _notes
 
     names, polys = [], []
     for k, (name, outer, islands) in enumerate(parts, 1):
@@ -87,7 +87,7 @@ def read_parts(args: Any, parts: list, frame: Any, say: Any) -> WaterParts:
 
 def _layouts(args: Any, water: WaterParts, kept: list, h: float, regular: bool, say: Any, frame: Any) -> list:
     from ..layout import auto_layout
-    from .mesh import LEVELS, _notes, layout_options
+    from .mesh_steps import LEVELS, _notes, layout_options
 
     lays = []
     for k, p in kept:
@@ -172,7 +172,7 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
     import shapely
 
     from ..lakeparts import join_grids, select_parts
-    from .mesh import _cell_size, _grid, _notes, finish, guarded
+    from .mesh_steps import _cell_size, _grid, _notes, finish, guarded
 
     unit = " m" if frame.crs else ""
     total = shapely.MultiPolygon(list(water.polygons))

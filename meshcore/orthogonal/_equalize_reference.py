@@ -56,11 +56,9 @@ def _edge_grad(P: np.ndarray, T: np.ndarray):
     return np.abs(u), -sg * g1, sg * (g1 + g2), -sg * g2
 
 
-def objective_numpy(patch, z: np.ndarray) -> tuple[float, np.ndarray]:
+def objective_numpy(patch, z: np.ndarray, *, AIM: float, W_COS: float, W_JAC: float) -> tuple[float, np.ndarray]:
     """``_Patch.objective`` of :mod:`.equalize` in NumPy for ``patch`` (the compiled
-    kernel's reference in the tests)."""
-    from .equalize import AIM, W_COS, W_JAC
-
+    kernel's reference in the tests), with that module's constants ``AIM``, ``W_COS``, ``W_JAC``."""
     P = patch.positions(z)
     G = np.zeros_like(P)
     C, sg = patch.C, patch.sg

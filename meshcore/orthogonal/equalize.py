@@ -258,7 +258,7 @@ class _Patch:
         """:meth:`objective` in NumPy (the compiled kernel's reference in the tests)."""
         from ._equalize_reference import objective_numpy
 
-        return objective_numpy(self, z)
+        return objective_numpy(self, z, AIM=AIM, W_COS=W_COS, W_JAC=W_JAC)
 
     def chain(self, G: np.ndarray, z: np.ndarray, fly=None, slide=None) -> np.ndarray:
         """The gradient in ``z`` from the gradient ``G`` in the nodes (``fly``, ``slide``: their

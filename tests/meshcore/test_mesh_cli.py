@@ -747,7 +747,7 @@ def test_layout_options_name_every_field_and_refuse_others(tmp_path, synthetic_c
     import dataclasses
     from types import SimpleNamespace
 
-    from meshcore.cli.mesh import LAYOUT_OPTIONS, layout_options
+    from meshcore.cli.mesh_steps import LAYOUT_OPTIONS, layout_options
     from meshcore.layout import LayoutOptions
 
     fields = {f.name for f in dataclasses.fields(LayoutOptions)}
