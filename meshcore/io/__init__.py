@@ -198,6 +198,22 @@ for _f in (
         crs=True,
     ),
     Format(
+        "delft3d-single",
+        (".grd",),
+        "Delft3D single domain: the blocks merged into one .grd with inactive points (+ .enc)",
+        writer="delft3d_single:write_grd_single",
+        crs=True,
+        multiblock=True,
+    ),
+    Format(
+        "efdc",
+        (".inp",),
+        "EFDC/EFDC+ grid: cell.inp, celllt.inp, dxdy.inp, lxly.inp, corners.inp (-o DIR/cell.inp)",
+        writer="efdc:write_efdc",
+        crs=True,
+        multiblock=True,
+    ),
+    Format(
         "delft3d-dd",
         (".ddb",),
         "Delft3D-FLOW domain decomposition (.grd + .enc per block, .ddb couplings)",

@@ -1,0 +1,171 @@
+r"""Delft3D-4 single domain: the blocks merged into ONE RGFGRID ``.grd`` with inactive points, and its ``.enc``.
+
+``write("lake.grd", mbgrid, format="delft3d-single")`` (``meshcore mesh … -o lake.grd
+--single``) places the blocks in one index space (:mod:`meshcore.multiblock.indexspace`:
+every block an offset and an orientation, shared interface nodes on the same index node)
+and writes
+
+``lake.grd``
+    the merged grid in the layout of :mod:`.delft3d` (RGFGRID's: ``Coordinate System``,
+    ``Missing Value``, ``MMAX NMAX``, ``0 0 0``, the ETA rows of x then of y, 5 values a
+    line).  Index nodes no block has (land, the water round an island, the columns
+    between parts) hold RGFGRID's missing value, ``-9.99999000000000024E+02``
+    (-999.999, the value RGFGRID writes in the header and at inactive points);
+``lake.enc``
+    the computational grid enclosure: closed polygons of water-level point indices
+    ``(m, n)`` (cell ``(m, n)`` has the depth points ``m-1 … m``, ``n-1 … n``; 1-based),
+    one point per change of direction, each polygon closed by repeating its first point.
+    The first polygon is the outer enclosure, the next ones the internal enclosures
+    (islands), as the Delft3D-FLOW manual (appendix A, "computational grid enclosure")
+    describes.  A cell is active when it lies strictly inside the outer polygon and not
+    inside or on an internal one; the polygons run through the centres of the inactive
+    cells next to the water (half a cell outside the water's cell edges), so the active
+    cells are exactly the cells of the blocks.  For a full grid this gives the enclosure
+    of :mod:`.delft3d`, ``(1,1) (MMAX+1,1) (MMAX+1,NMAX+1) (1,NMAX+1) (1,1)``.
+
+A cell whose four corners are active points but which no block has (water a ring of
+blocks closes round, an island one cell wide in index space) is left out by the
+enclosure.  An island one cell across in index space gives a degenerate internal
+polygon (a line or a point), which still marks its cells inactive.
+
+Refused (:class:`~meshcore.errors.WriteError`, the place named): a layout that does not
+fit one index space (a ring of blocks round an island whose cell counts do not add up,
+3- or 5-block corners, arms that fold onto each other in index space: write a ``.ddb``
+instead), and water in several parts (one outer enclosure only: write each part with
+``--part``).  The two files are written as a set (:mod:`._atomic`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import WriteError
+from ._atomic import atomic_paths
+from ._base import GridSet
+from .delft3d import _rows
+
+__all__ = ["MISSING_VALUE", "enclosure_polygons", "merged", "write_grd_single"]
+
+#: RGFGRID's missing value (header and inactive points).
+MISSING_VALUE = -999.999
+
+
+def merged(gs: GridSet, path: Any = "") -> Any:
+    """The blocks of ``gs`` in one index space (:class:`~meshcore.multiblock.indexspace.IndexSpace`),
+    an :class:`~meshcore.multiblock.indexspace.EmbeddingError` turned into a
+    :class:`~meshcore.errors.WriteError` naming ``path``."""
+    from ..multiblock.indexspace import EmbeddingError, embed
+
+    try:
+        return embed(gs.blocks, gs.block_names)
+    except EmbeddingError as exc:
+        raise WriteError(
+            f"{path}: {exc}; a single-domain grid needs every block in one index space: write a .ddb "
+            f"(Delft3D domain decomposition) or .vtm/.cgns instead"
+        ) from None
+
+
+def _trace(water: np.ndarray) -> list[list[tuple[int, int, int, int]]]:
+    """Closed loops of the water cells' outer edges, water on the left: ``(x, y, dx, dy)`` per edge.
+
+    Vertices are index nodes (cell ``(I, J)`` spans nodes ``I … I+1``, ``J … J+1``).  Where two
+    water cells touch at a corner only, the loop turns left, so they stay apart.
+    """
+    w = np.pad(water, 1)
+    out: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for I, J in zip(*np.nonzero(water), strict=True):
+        a, b = int(I) + 1, int(J) + 1  # padded
+        x, y = int(I), int(J)
+        if not w[a, b - 1]:
+            out.setdefault((x, y), []).append((1, 0))
+        if not w[a + 1, b]:
+            out.setdefault((x + 1, y), []).append((0, 1))
+        if not w[a, b + 1]:
+            out.setdefault((x + 1, y + 1), []).append((-1, 0))
+        if not w[a - 1, b]:
+            out.setdefault((x, y + 1), []).append((0, -1))
+    loops = []
+    while out:
+        start = next(iter(out))
+        v, d = start, out[start][0]
+        loop = []
+        while True:
+            out[v].remove(d)
+            if not out[v]:
+                del out[v]
+            loop.append((v[0], v[1], d[0], d[1]))
+            v = (v[0] + d[0], v[1] + d[1])
+            if v == start or v not in out:
+                break
+            left, straight, right = (-d[1], d[0]), d, (d[1], -d[0])
+            d = next(c for c in (left, straight, right) if c in out[v])
+        loops.append(loop)
+    return loops
+
+
+def enclosure_polygons(water: np.ndarray) -> list[list[tuple[int, int]]]:
+    """The enclosure polygons (water-level point indices, closed) of the water cells, outer first."""
+    outer, inner = _polygons(water)
+    return outer + inner
+
+
+def _polygons(water: np.ndarray) -> tuple[list[list[tuple[int, int]]], list[list[tuple[int, int]]]]:
+    """(outer polygons: anticlockwise, internal ones: the rest), each closed."""
+    polys = []
+    for loop in _trace(water):
+        pts = []
+        for k, (x, y, dx, dy) in enumerate(loop):
+            pdx, pdy = loop[k - 1][2:]
+            if (pdx, pdy) == (dx, dy):
+                continue
+            # the vertex moved half a cell out along both edges' outward normals (water on the left)
+            cx = x + 0.5 * (pdy + dy) - 0.5
+            cy = y + 0.5 * (-pdx - dx) - 0.5
+            pts.append((round(cx) + 2, round(cy) + 2))
+        pts = [p for k, p in enumerate(pts) if p != pts[k - 1]] or pts[:1]
+        area = sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(pts, pts[1:] + pts[:1], strict=True))
+        polys.append((area, pts + [pts[0]]))
+    return [p for a, p in polys if a > 0], [p for a, p in polys if a <= 0]
+
+
+def _grd_text(gs: GridSet, x: np.ndarray, y: np.ndarray, lonlat: bool) -> str:
+    ok = np.isfinite(x)
+    if lonlat:
+        X, Y = gs.frame.to_lonlat(np.where(ok, x, 0.0), np.where(ok, y, 0.0))
+    else:
+        X, Y = gs.frame.to_world(np.where(ok, x, 0.0), np.where(ok, y, 0.0))
+    X = np.where(ok, X, MISSING_VALUE)
+    Y = np.where(ok, Y, MISSING_VALUE)
+    mmax, nmax = X.shape
+    head = ["* Deltares, Delft3D-RGFGRID grid written by meshcore (gcmesh): blocks merged into one domain"]
+    if gs.frame.crs and not lonlat:
+        head.append(f"* Projection: {gs.frame.crs}")
+    head += [
+        f"Coordinate System = {'Spherical' if lonlat else 'Cartesian'}",
+        f"Missing Value     = {MISSING_VALUE:25.17E}",
+        f"{mmax:8d}{nmax:8d}",
+        " 0 0 0",
+    ]
+    return "\n".join(head + _rows("x", X) + _rows("y", Y)) + "\n"
+
+
+def write_grd_single(path: Path, gs: GridSet, *, lonlat: bool = False, **_: Any) -> None:
+    """Write the blocks of ``gs`` as one Delft3D grid with inactive points and its enclosure."""
+    path = Path(path)
+    space = merged(gs, path)
+    outer, inner = _polygons(space.water)
+    n_outer = len(outer)
+    if space.n_components > 1 or n_outer != 1:
+        raise WriteError(
+            f"{path}: the water is in {max(space.n_components, n_outer)} parts (or cells that touch at a "
+            f"corner only), and a Delft3D enclosure has one outer polygon: write each part with --part, "
+            f"or the parts as a .vtm"
+        )
+    text = _grd_text(gs, space.x, space.y, lonlat)
+    enc = "".join(f"{m:6d}{n:6d}\n" for poly in outer + inner for m, n in poly)
+    with atomic_paths([path.with_suffix(".enc"), path]) as (tmp_enc, tmp_grd):
+        tmp_grd.write_text(text, encoding="ascii")
+        tmp_enc.write_text(enc, encoding="ascii")
