@@ -17,7 +17,9 @@ The whole of :func:`meshcore.mesh_outline` from the command line::
    output holds world coordinates of that CRS (metres, the origin added when writing).
 2. **layout** — :func:`meshcore.layout.auto_layout` at the cell size ``--cell-size`` (default
    ``sqrt(water area / 10 000)``, or ``/ --cells``); a ``.ddb`` output asks for a layout
-   without 3- or 5-block corners (``--regular``), the only kind Delft3D can couple.
+   without 3- or 5-block corners (``--regular``), the only kind Delft3D can couple; so do
+   ``-o X.grd --single`` (Delft3D single domain) and ``-o DIR/cell.inp`` (EFDC), whose blocks
+   must fit one index space (:mod:`meshcore.multiblock.indexspace`; checked before the solve).
 3. **grid** — :func:`meshcore.lakegrid.mesh_layout`, coarse to fine over three levels.
 4. **quality** — :func:`meshcore.quality.lake_metrics` against the water polygon, and the
    verdict of each ``--preset``.
@@ -86,6 +88,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="no corner where 3 or 5 blocks meet (what Delft3D domain decomposition couples; implied by .ddb)",
     )
     p.add_argument(
+        "--single",
+        action="store_true",
+        help="-o OUT.grd: the blocks merged into one Delft3D grid with inactive points (+ .enc), for a "
+        "single-domain model (implies --regular; refused, exit 2, when the layout does not fit one index space)",
+    )
+    p.add_argument(
         "--layout-option",
         action="append",
         default=[],
@@ -102,7 +110,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="OUT",
-        help="grid file, repeatable: .vtm .cgns .xyz (PLOT3D) .ddb (Delft3D DD) .npz .su2 .msh .csv "
+        help="grid file, repeatable: .vtm .cgns .xyz (PLOT3D) .ddb (Delft3D DD) .grd with --single (Delft3D "
+        "single domain) DIR/cell.inp (EFDC) .npz .su2 .msh .csv "
         "(at least one of -o, --png, --case)",
     )
     p.add_argument("--png", metavar="FIG", help="draw the grid to this figure (.png .svg .pdf)")
@@ -181,6 +190,17 @@ def _check_sizes(args: argparse.Namespace) -> None:
         validate_count(args.cells, name="--cells", minimum=MIN_CELLS)
 
 
+def _single(args: argparse.Namespace, outputs: list[tuple[Path, Any]]) -> list[tuple[Path, Any]]:
+    """``--single``: every ``.grd`` output becomes the merged single-domain grid."""
+    from ..io import FORMATS
+
+    if not getattr(args, "single", False):
+        return outputs
+    if not any(fmt.name == "delft3d" for _, fmt in outputs):
+        raise InvalidInputError("--single merges the blocks into one Delft3D grid: give -o OUT.grd")
+    return [(p, FORMATS["delft3d-single"] if fmt.name == "delft3d" else fmt) for p, fmt in outputs]
+
+
 def _check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
     """Refuse, before the solve, an output that cannot hold this layout.
 
@@ -199,9 +219,15 @@ def _check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
             if n_blocks < 2:
                 raise InvalidInputError(f"-o {p}: the layout is one block; write it as .grd, not as a .ddb")
             _dry_run_ddb(p, lay)
+        if fmt.name in SINGLE_DOMAIN:
+            _dry_run_ddb(p, lay, fmt.name)
 
 
-def _dry_run_ddb(p: Path, lay: Any) -> None:
+#: Formats that need every block in one index space (:mod:`meshcore.multiblock.indexspace`).
+SINGLE_DOMAIN = ("delft3d-single", "efdc")
+
+
+def _dry_run_ddb(p: Path, lay: Any, format: str | None = None) -> None:
     import tempfile
 
     from ..algebraic import tfi
@@ -213,11 +239,13 @@ def _dry_run_ddb(p: Path, lay: Any) -> None:
     with tempfile.TemporaryDirectory(prefix="meshcore-mesh-") as d:
         trial = Path(d) / p.name
         try:
-            write(trial, grids, block_names=[b.name for b in topo.blocks])
+            write(trial, grids, format, block_names=[b.name for b in topo.blocks])
         except WriteError as exc:
             from ..layout.frames import frame_defects
 
             msg = str(exc).replace(f"{trial}: ", "").replace(str(trial), str(p))
+            if format in SINGLE_DOMAIN:
+                raise InvalidInputError(f"-o {p}: {msg}") from None
             where = "; ".join(d.note() for d in frame_defects(list(lay.pieces)))
             msg += f"; here {where}" if where else ""
             raise InvalidInputError(f"-o {p}: {msg} (write .vtm, .cgns or .xyz instead)") from None
@@ -279,11 +307,14 @@ def run(args: argparse.Namespace) -> int:
         why = not_a_map(normalize_crs(args.crs))  # an unknown CRS is refused before the file is read
         if why:
             raise InvalidInputError(f"--crs {args.crs}: {why}; give a projected one (metres)")
-    outputs = _check_outputs(args)
+    outputs = _single(args, _check_outputs(args))
     ddb = [p for p, fmt in outputs if fmt.name == "delft3d-dd"]
-    regular = bool(args.regular or ddb)
+    one = [p for p, fmt in outputs if fmt.name in SINGLE_DOMAIN]
+    regular = bool(args.regular or ddb or one)
     if ddb and not args.regular:
         say(f"{ddb[0]}: Delft3D domain decomposition couples no 3- or 5-block corners: using --regular")
+    elif one and not args.regular:
+        say(f"{one[0]}: one index space has no 3- or 5-block corners: using --regular")
     poly, frame = _read(args, say)
     if not hasattr(poly, "exterior"):  # water in several parts
         from .mesh_parts import run_parts

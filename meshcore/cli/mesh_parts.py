@@ -120,10 +120,10 @@ def _check_blocks(outputs: list, kept: list, lays: list) -> None:
                 f"-o {p}: the {fmt.name} format holds one block and the parts have {n_blocks}; "
                 f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh"
             )
-        if fmt.name != "delft3d-dd":
+        if fmt.name not in ("delft3d-dd", "delft3d-single", "efdc"):
             continue
         single = [k for (k, _), lay in zip(kept, lays, strict=True) if len(lay.blocks) == 1]
-        if single:
+        if single and fmt.name == "delft3d-dd":
             k = single[0]
             others = ",".join(str(j) for j, _ in kept if j != k)
             raise InvalidInputError(
@@ -139,10 +139,11 @@ def _check_blocks(outputs: list, kept: list, lays: list) -> None:
         with tempfile.TemporaryDirectory(prefix="meshcore-mesh-") as d:
             trial = Path(d) / p.name
             try:
-                write(trial, grids, block_names=names)
+                write(trial, grids, fmt.name, block_names=names)
             except WriteError as exc:
                 msg = str(exc).replace(f"{trial}: ", "").replace(str(trial), str(p))
-                raise InvalidInputError(f"-o {p}: {msg} (write .vtm, .cgns or .xyz instead)") from None
+                also = " (write .vtm, .cgns or .xyz instead)" if fmt.name == "delft3d-dd" else ""
+                raise InvalidInputError(f"-o {p}: {msg}{also}") from None
 
 
 def _per_part(water: WaterParts, kept: list, h: float):

@@ -194,8 +194,8 @@ def finish(
     m = lake_metrics(mb, polygon=poly, cell_size=h)
     n_folded = int(m.values("folded").sum())
     say(f"quality: {n_folded} folded cells, mean deviation from 90° {m.mean('deviation'):.2f}°, {say.lap():.1f} s")
-    for p, _ in outputs:
-        write(p, mb, crs=frame)
+    for p, fmt in outputs:
+        write(p, mb, fmt.name, crs=frame)
         say(f"wrote {p}")
     if args.png:
         _figure(Path(args.png), mb, poly, frame, args.colour, m, left_out)

@@ -62,10 +62,7 @@ def merged(gs: GridSet, path: Any = "") -> Any:
     try:
         return embed(gs.blocks, gs.block_names)
     except EmbeddingError as exc:
-        raise WriteError(
-            f"{path}: {exc}; a single-domain grid needs every block in one index space: write a .ddb "
-            f"(Delft3D domain decomposition) or .vtm/.cgns instead"
-        ) from None
+        raise WriteError(f"{path}: {exc}; write a .ddb (domain decomposition) or .vtm instead") from None
 
 
 def _trace(water: np.ndarray) -> list[list[tuple[int, int, int, int]]]:

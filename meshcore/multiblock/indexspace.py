@@ -184,20 +184,16 @@ def _swapped(c):
 
 def _mismatch(blocks, names, c, have: Placement, want: Placement) -> str:
     where = _where(blocks[c.a], c.border_a, (c.start_a + c.stop_a) // 2)
-    head = (
-        f"the blocks cannot be placed in one index space: the interface {names[c.a]}.{c.border_a} ↔ "
-        f"{names[c.b]}.{c.border_b} near {where} "
-    )
+    head = f"the blocks do not fit one index space: {names[c.a]}.{c.border_a} ↔ {names[c.b]}.{c.border_b} near {where} "
     if have.rotation != want.rotation:
         return head + (
-            f"turns block {names[c.b]!r} differently from the way round through the other blocks (a corner "
-            f"where 3 or 5 blocks meet, or a ring of blocks round an island whose index directions come back "
-            f"turned)"
+            f"turns block {names[c.b]!r} unlike the way round (a corner where 3 or 5 blocks meet, or a ring "
+            f"round an island whose index directions come back turned)"
         )
     d = np.array(want.offset) - np.array(have.offset)
     return head + (
-        f"puts block {names[c.b]!r} {abs(int(d[0])) + abs(int(d[1]))} cells away from where the way round through "
-        f"the other blocks puts it (a ring of blocks round an island whose cell counts do not add up)"
+        f"puts block {names[c.b]!r} {abs(int(d[0])) + abs(int(d[1]))} cells away from the way round (a ring of "
+        f"blocks round an island whose cell counts do not add up)"
     )
 
 
@@ -247,9 +243,9 @@ def _fill(blocks, names, placements, shape, tol) -> tuple[np.ndarray, np.ndarray
             i, j = (int(v) for v in np.argwhere(bad)[0])
             other = names[int(node_owner[gi[i, j], gj[i, j]])]
             raise EmbeddingError(
-                f"the blocks cannot be placed in one index space: blocks {other!r} and {names[k]!r} both reach index "
-                f"node ({int(gi[i, j])}, {int(gj[i, j])}) but at different places (near ({g.x[i, j]:.8g}, "
-                f"{g.y[i, j]:.8g})): the layout folds back onto itself in index space"
+                f"the blocks do not fit one index space: {other!r} and {names[k]!r} reach index node "
+                f"({int(gi[i, j])}, {int(gj[i, j])}) at two places (near ({g.x[i, j]:.8g}, {g.y[i, j]:.8g})): "
+                f"the layout folds back onto itself in index space"
             )
         x[gi, gj], y[gi, gj] = g.x, g.y
         node_owner[gi, gj] = np.where(seen, node_owner[gi, gj], k)
@@ -259,9 +255,9 @@ def _fill(blocks, names, placements, shape, tol) -> tuple[np.ndarray, np.ndarray
         if taken.any():
             i, j = (int(v) for v in np.argwhere(taken)[0])
             raise EmbeddingError(
-                f"the blocks cannot be placed in one index space: blocks {names[int(owner[ci[i, j], cj[i, j]])]!r} and "
-                f"{names[k]!r} both claim index cell ({int(ci[i, j])}, {int(cj[i, j])}) (near ({g.x[i, j]:.8g}, "
-                f"{g.y[i, j]:.8g})): the layout folds back onto itself in index space"
+                f"the blocks do not fit one index space: {names[int(owner[ci[i, j], cj[i, j]])]!r} and {names[k]!r} "
+                f"claim index cell ({int(ci[i, j])}, {int(cj[i, j])}) (near ({g.x[i, j]:.8g}, {g.y[i, j]:.8g})): "
+                f"the layout folds back onto itself in index space"
             )
         owner[ci, cj] = k
     return x, y, owner

@@ -1,0 +1,98 @@
+"""``meshcore mesh … -o lake.grd --single`` and ``-o DIR/cell.inp``: the blocks in one index space,
+end to end (the files read back by the parsers of ``test_single_domain``), and the exit 2 with
+nothing written when the layout does not fit one index space."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from meshcore.io import read_blocks
+from meshcore.testing import round_lake
+from tests.meshcore.test_mesh_cli import _synthetic_rings, mesh
+from tests.meshcore.test_single_domain import active_cells, read_efdc, read_enc, read_grd_with_missing
+
+
+def csv(path, rings) -> None:
+    rows = [f"{x:.4f},{y:.4f},r{k}" for k, ring in enumerate(rings) for x, y in ring]
+    path.write_text("x,y,ring\n" + "\n".join(rows) + "\n")
+
+
+@pytest.fixture
+def round_csv(tmp_path):
+    """A generated round lake without islands (seed from a base nobody used), in metres."""
+    poly = round_lake(812355, n_islands=0)
+    f = tmp_path / "round.csv"
+    csv(f, [300.0 * np.asarray(poly.exterior.coords)[:-1]])
+    return f
+
+
+def test_single_domain_and_efdc_end_to_end(tmp_path, round_csv):
+    out = tmp_path / "run"
+    out.mkdir()
+    run = mesh(
+        round_csv,
+        "--cells",
+        2000,
+        "-o",
+        tmp_path / "r.grd",
+        "--single",
+        "-o",
+        out / "cell.inp",
+        "-o",
+        tmp_path / "r.npz",
+    )
+    assert run.rc == 0, run.err
+    assert "using --regular" in run.err
+    blocks = read_blocks(tmp_path / "r.npz").blocks
+    n_cells = sum(g.cells[0] * g.cells[1] for g in blocks)
+    X, Y, missing = read_grd_with_missing(tmp_path / "r.grd")
+    act = active_cells(read_enc(tmp_path / "r.enc"), *X.shape)
+    assert int(act.sum()) == n_cells
+    valid = np.not_equal(X, missing)
+    pts = np.round(np.column_stack([X[valid], Y[valid]]), 6)
+    ref = np.round(np.concatenate([g.points for g in blocks]), 6)
+    assert {tuple(p) for p in pts} == {tuple(p) for p in ref}
+    types, dxdy, lxly, corners = read_efdc(out)
+    assert int((types == 5).sum()) == n_cells == len(dxdy) == len(lxly) == len(corners)
+    assert sorted(os.listdir(out)) == sorted(["cell.inp", "celllt.inp", "dxdy.inp", "lxly.inp", "corners.inp"])
+
+
+def test_a_layout_that_does_not_fit_is_refused_before_the_solve(tmp_path):
+    """A lake with an island: the regular layout's ring round it does not add up in cell counts
+    (as on most generated lakes with islands): exit 2, one line naming the place, no file."""
+    shore, island = _synthetic_rings()
+    src = tmp_path / "isle.csv"
+    csv(src, [shore, island])
+    for out in (tmp_path / "i.grd", tmp_path / "cell.inp"):
+        extra = ("--single",) if out.suffix == ".grd" else ()
+        run = mesh(src, "--cells", 2000, "-o", out, *extra, "-o", tmp_path / "i.vtm")
+        assert run.rc == 2, run.err
+        last = run.err.strip().splitlines()[-1]
+        assert str(out) in last and "one index space" in last and ".ddb" in last
+        assert "grid level" not in run.err
+        assert sorted(os.listdir(tmp_path)) == ["isle.csv"]
+
+
+def test_single_needs_a_grd(tmp_path, round_csv):
+    run = mesh(round_csv, "--cells", 2000, "-o", tmp_path / "r.vtm", "--single")
+    assert run.rc == 2 and "--single" in run.err and ".grd" in run.err
+
+
+def test_water_in_two_parts(tmp_path):
+    """EFDC holds parts side by side (land between them); a Delft3D enclosure has one outer polygon."""
+    t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    src = tmp_path / "two.csv"
+    csv(src, [np.c_[3000 * np.cos(t), 1500 * np.sin(t)], np.c_[9000 + 1500 * np.cos(t), 1000 * np.sin(t)]])
+    run = mesh(src, "--cells", 2000, "-o", tmp_path / "cell.inp", "-o", tmp_path / "two.npz")
+    assert run.rc == 0, run.err
+    types, dxdy, _, _ = read_efdc(tmp_path)
+    n_cells = sum(g.cells[0] * g.cells[1] for g in read_blocks(tmp_path / "two.npz").blocks)
+    assert int((types == 5).sum()) == len(dxdy) == n_cells
+    water_columns = (types == 5).any(axis=1)
+    assert (np.diff(water_columns.astype(int)) != 0).sum() == 4  # two runs of water columns, land between
+    run = mesh(src, "--cells", 2000, "-o", tmp_path / "two.grd", "--single")
+    assert run.rc == 2 and "2 parts" in run.err.strip().splitlines()[-1]
+    assert not (tmp_path / "two.grd").exists()
