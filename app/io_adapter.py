@@ -350,10 +350,11 @@ def mesh_formats() -> list[tuple[str, str]]:
     return out
 
 
-def write_mesh(path, grids, frame=None) -> None:
-    """Write the block grid(s) (a list, or a MultiBlockGrid) with :func:`meshcore.io.write`."""
+def write_mesh(path, grids, frame=None, format=None) -> None:
+    """Write the block grid(s) (a list, or a MultiBlockGrid) with :func:`meshcore.io.write`
+    (``format``: a format name, else the suffix decides)."""
     from meshcore.io import write
 
     if isinstance(grids, (list, tuple)):
         grids = grids[0] if len(grids) == 1 else list(grids)
-    write(Path(path), grids, crs=frame)
+    write(Path(path), grids, format, crs=frame)

@@ -33,6 +33,20 @@ def export_default(project) -> str:
     return "vtm" if n > 1 else "vts"
 
 
+def chosen_format(chosen: str, path: Path) -> str | None:
+    """The format name of a dialog filter ``"… [name] (*.x)"`` when it shares the path's suffix with
+    another format (``.grd``: one block, or the blocks merged into one domain), else ``None``."""
+    import re
+
+    from meshcore.io import FORMATS
+
+    m = re.search(r"\[([\w-]+)\]", chosen)
+    fmt = FORMATS.get(m.group(1)) if m else None
+    if fmt is None or path.suffix.lower() not in fmt.suffixes:
+        return None
+    return fmt.name if sum(path.suffix.lower() in f.suffixes for f in FORMATS.values() if f.writer) > 1 else None
+
+
 class ExportMixin:
     """Export mesh and Export figure of the window's :class:`~app.io_controller.IOController`."""
 
@@ -51,10 +65,11 @@ class ExportMixin:
             if not Path(path).suffix:
                 pat = next((p for d, p in fmts if chosen.startswith(d)), "*.vts")
                 path += pat.split()[0].lstrip("*")
-            self.export_mesh(Path(path))
+            self.export_mesh(Path(path), chosen_format(chosen, Path(path)))
 
-    def export_mesh(self, path: Path) -> bool:
-        """Write the grids (a multiblock result with its connectivity) with meshcore.io."""
+    def export_mesh(self, path: Path, format: str | None = None) -> bool:
+        """Write the grids (a multiblock result with its connectivity) with meshcore.io
+        (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
         grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
         mb = self.doc.multiblock
         p = self.doc.project
@@ -66,9 +81,9 @@ class ExportMixin:
             return False
         try:
             if mb is not None and (p.multiblock is not None or p.layout is not None) and not self.doc.stale:
-                fio.write_mesh(path, mb, frame)
+                fio.write_mesh(path, mb, frame, format)
             else:
-                fio.write_mesh(path, grids, frame)
+                fio.write_mesh(path, grids, frame, format)
         except (MeshcoreError, OSError) as exc:
             if self._offer_regular(path, exc):
                 return False

@@ -208,7 +208,7 @@ for _f in (
     Format(
         "efdc",
         (".inp",),
-        "EFDC/EFDC+ grid: cell.inp, celllt.inp, dxdy.inp, lxly.inp, corners.inp (-o DIR/cell.inp)",
+        "EFDC/EFDC+ grid: cell.inp and, next to it, celllt.inp, dxdy.inp, lxly.inp, corners.inp",
         writer="efdc:write_efdc",
         crs=True,
         multiblock=True,
