@@ -42,6 +42,7 @@ from typing import Any
 from ..cellsize import DEFAULT_CELLS
 from ..errors import InvalidInputError
 from .lakefile import degrees_note, in_world, lake_parts, local_frame, lonlat_order_note, scale_note
+from .mesh_outputs import SINGLE_DOMAIN, check_blocks, single_outputs
 from .mesh_steps import (
     LAYOUT_OPTIONS,
     MIN_CELLS,
@@ -190,67 +191,7 @@ def _check_sizes(args: argparse.Namespace) -> None:
         validate_count(args.cells, name="--cells", minimum=MIN_CELLS)
 
 
-def _single(args: argparse.Namespace, outputs: list[tuple[Path, Any]]) -> list[tuple[Path, Any]]:
-    """``--single``: every ``.grd`` output becomes the merged single-domain grid."""
-    from ..io import FORMATS
-
-    if not getattr(args, "single", False):
-        return outputs
-    if not any(fmt.name == "delft3d" for _, fmt in outputs):
-        raise InvalidInputError("--single merges the blocks into one Delft3D grid: give -o OUT.grd")
-    return [(p, FORMATS["delft3d-single"] if fmt.name == "delft3d" else fmt) for p, fmt in outputs]
-
-
-def _check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
-    """Refuse, before the solve, an output that cannot hold this layout.
-
-    A ``.ddb`` is written once, from the algebraic grids of the layout's blocks, into a
-    temporary folder: the couplings (and whether Delft3D can orient them) depend on the
-    layout only, so the real write after the solve cannot fail on them.
-    """
-    n_blocks = len(lay.blocks)
-    for p, fmt in outputs:
-        if n_blocks > 1 and not fmt.multiblock:
-            raise InvalidInputError(
-                f"-o {p}: the {fmt.name} format holds one block and the layout has {n_blocks}; "
-                f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh"
-            )
-        if fmt.name == "delft3d-dd":
-            if n_blocks < 2:
-                raise InvalidInputError(f"-o {p}: the layout is one block; write it as .grd, not as a .ddb")
-            _dry_run_ddb(p, lay)
-        if fmt.name in SINGLE_DOMAIN:
-            _dry_run_ddb(p, lay, fmt.name)
-
-
-#: Formats that need every block in one index space (:mod:`meshcore.multiblock.indexspace`).
-SINGLE_DOMAIN = ("delft3d-single", "efdc")
-
-
-def _dry_run_ddb(p: Path, lay: Any, format: str | None = None) -> None:
-    import tempfile
-
-    from ..algebraic import tfi
-    from ..errors import WriteError
-    from ..io import write
-
-    topo = lay.topology()
-    grids = [tfi(b.borders) for b in topo.blocks]
-    with tempfile.TemporaryDirectory(prefix="meshcore-mesh-") as d:
-        trial = Path(d) / p.name
-        try:
-            write(trial, grids, format, block_names=[b.name for b in topo.blocks])
-        except WriteError as exc:
-            from ..layout.frames import frame_defects
-
-            msg = str(exc).replace(f"{trial}: ", "").replace(str(trial), str(p))
-            if format in SINGLE_DOMAIN:
-                raise InvalidInputError(f"-o {p}: {msg}") from None
-            where = "; ".join(d.note() for d in frame_defects(list(lay.pieces)))
-            msg += f"; here {where}" if where else ""
-            raise InvalidInputError(f"-o {p}: {msg} (write .vtm, .cgns or .xyz instead)") from None
-
-
+# ------------------------------------------------------------------ stages
 def _read(args: argparse.Namespace, say: _Say):
     """The water polygon in local coordinates of the grid's CRS, and its frame (CRS and origin).
 
@@ -307,7 +248,7 @@ def run(args: argparse.Namespace) -> int:
         why = not_a_map(normalize_crs(args.crs))  # an unknown CRS is refused before the file is read
         if why:
             raise InvalidInputError(f"--crs {args.crs}: {why}; give a projected one (metres)")
-    outputs = _single(args, _check_outputs(args))
+    outputs = single_outputs(args, _check_outputs(args))
     ddb = [p for p, fmt in outputs if fmt.name == "delft3d-dd"]
     one = [p for p, fmt in outputs if fmt.name in SINGLE_DOMAIN]
     regular = bool(args.regular or ddb or one)
@@ -327,7 +268,7 @@ def run(args: argparse.Namespace) -> int:
 
     def make():
         lay = _layout(args, poly, h, regular, say, frame)
-        _check_blocks(outputs, lay)
+        check_blocks(outputs, lay)
         return lay, _grid(lay, say)
 
     made = guarded(args, frame, make)

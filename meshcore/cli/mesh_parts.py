@@ -106,7 +106,7 @@ def _layouts(args: Any, water: WaterParts, kept: list, h: float, regular: bool, 
 
 
 def _check_blocks(outputs: list, kept: list, lays: list) -> None:
-    """As :func:`meshcore.cli.mesh._check_blocks`, for the blocks of every part together."""
+    """As :func:`meshcore.cli.mesh_outputs.check_blocks`, for the blocks of every part together."""
     import tempfile
 
     from ..algebraic import tfi
