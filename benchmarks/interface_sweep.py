@@ -104,6 +104,8 @@ def run_one(expr: str, cells: int, options: dict | None = None) -> dict:
         "cell_size": hl,
         "aspect": m.max("aspect_ratio"),
         "cpu": cpu,
+        "min_block": int(min(min(g.cells) for g in mb.grids)),  # ≥ 3 each way wanted
+        "cells_ratio": float(sum(g.cells[0] * g.cells[1] for g in mb.grids) * hl**2 / poly.area),
     }
 
 

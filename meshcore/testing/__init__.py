@@ -20,6 +20,9 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
   narrowing with each order down to arms under two cells wide, long thin ridges between them;
 * :func:`narrow_arms` — a reservoir of many arms 3–6 cells wide meeting 3 or 4 at a junction
   at varied angles, the last ones tapering to wedges;
+* :func:`meander`, :func:`meander_bars`, :func:`confluence`, :func:`estuary` — rivers: a
+  sine-generated meandering reach (loops nearly cut off), the same with mid-channel bars, two
+  meandering rivers joining, an estuary funnel with side creeks (:mod:`meshcore.testing.rivers`);
 * :func:`resampled` — any of them with its shore sampled densely (10 000+ points) or coarsely
   (20 points): the same water as an outline from another source;
 * :func:`y_junction`, :func:`straight_channel`, :func:`rectangle_with_hole` — the textbook cases.
@@ -39,15 +42,20 @@ import numpy as np
 from ._shapes import _clean, _lobed_disc, _placed
 from .archipelago import archipelago
 from .narrow import narrow_arms
+from .rivers import confluence, estuary, meander, meander_bars
 
 __all__ = [
     "archipelago",
     "channel_network",
+    "confluence",
     "dendritic",
+    "estuary",
     "headlands",
     "jagged",
     "jagged_cells",
     "lake_with_islands",
+    "meander",
+    "meander_bars",
     "narrow_arms",
     "rectangle_with_hole",
     "resampled",
