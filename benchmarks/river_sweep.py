@@ -8,7 +8,8 @@ bars ``base + 100 + k``, confluence ``base + 200 + k``, estuary ``base + 300 + k
 distance (cells), the fewest cells of a block either way (≥ 3 wanted), the cells over area / H²,
 CPU; then how many shapes meet each target, per family::
 
-    python benchmarks/river_sweep.py [--base 810000] [--seeds 10] [--cells 10000] [--only meander] [--json OUT]
+    python benchmarks/river_sweep.py [--base 810000] [--seeds 10] [--cells 10000] [--only meander]
+        [--options JSON] [--json OUT]
 """
 
 from __future__ import annotations
@@ -50,9 +51,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--cells", type=int, default=10000)
     ap.add_argument("--only", help="comma-separated families")
+    ap.add_argument("--options", default="{}", help="more options of mesh_outline as JSON")
     ap.add_argument("--json", help="write the results here")
     a = ap.parse_args(argv)
-    print(f"rivers, seeds from {a.base}, {a.cells} cells\n")
+    options = json.loads(a.options)
+    if isinstance(options.get("layout_options"), dict):  # {"layout_options": {"mouths": true}}
+        from meshcore.layout.model import LayoutOptions
+
+        options["layout_options"] = LayoutOptions(**options["layout_options"])
+    print(f"rivers, seeds from {a.base}, {a.cells} cells{', ' + a.options if options else ''}\n")
     print(
         "| shape | blocks | folded | ≤ 3° % | mean ° | e ≤ 1.2 % | max ratio | shore | min block | cells/(A/H²) ",
         end="",
@@ -63,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     for name, (fam, expr) in cases(a.base, a.seeds, a.only).items():
         t = time.process_time()
         try:
-            r = interface_sweep.run_one(expr, a.cells)
+            r = interface_sweep.run_one(expr, a.cells, options)
         except MeshcoreError as exc:
             r = {"clear_error": str(exc)[:300]}
             print(f"| {name} | error (clear): {r['clear_error']} |", flush=True)
@@ -98,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         )
     if a.json:
         with open(a.json, "w", encoding="utf-8") as f:
-            json.dump({"base": a.base, "cells": a.cells, "results": res}, f, indent=1)
+            json.dump({"base": a.base, "cells": a.cells, "options": a.options, "results": res}, f, indent=1)
     return 0
 
 
