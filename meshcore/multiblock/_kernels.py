@@ -178,7 +178,7 @@ def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out,
 
 
 @njit(cache=True, nogil=True)
-def line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, ptr, axis):  # pragma: no cover - compiled
+def line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, ptr, axis, omega=1.0):  # pragma: no cover - compiled
     """Line Gauss–Seidel sweep of ``u − T(u) = f`` over block lines (``fx, fy`` empty: ``f = 0``).
 
     Line ``L`` is the nodes ``lnodes[ptr[L]:ptr[L + 1]]`` in order along its block axis
@@ -190,7 +190,9 @@ def line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, ptr, axis):  # pragma: no cover -
     are frozen at the current values and the tridiagonal system
     ``u_t − c_t (u_{t−1} + u_{t+1}) = f_t + T_t − c_t (u_{t−1} + u_{t+1})|current``
     (``c = α/den`` along ξ, ``γ/den`` along η) is solved exactly (Thomas algorithm), for x and y.
-    Returns the largest displacement (``inf`` if a node is NaN).
+    With ``omega`` ≠ 1 every line moves ``omega`` of the way to its solution (damped: a line
+    solved with frozen coefficients overshoots where cells are nearly folded; the retry of
+    :func:`.solver._smooth`).  Returns the largest displacement (``inf`` if a node is NaN).
     """
     use_f = fx.size > 0
     m_max = 0
@@ -251,8 +253,14 @@ def line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, ptr, axis):  # pragma: no cover -
             p = pp[t]
             dx = bx[t] - x[p]
             dy = by[t] - y[p]
-            x[p] = bx[t]
-            y[p] = by[t]
+            if omega == 1.0:
+                x[p] = bx[t]
+                y[p] = by[t]
+            else:
+                dx *= omega
+                dy *= omega
+                x[p] += dx
+                y[p] += dy
             d = dx * dx + dy * dy
             if not d <= dmax:  # a NaN makes the measure inf (never 'converged')
                 dmax = d if d == d else np.inf

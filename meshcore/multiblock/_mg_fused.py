@@ -80,9 +80,10 @@ def _f(fb, m, col):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover - compiled
+def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps, line_omega):  # pragma: no cover - compiled
     """``steps`` smoothing steps on one level: point sweep, lines along ξ (even steps) or along η
-    (odd steps), border sweeps, sweeps over the band next to the fixed boundary."""
+    (odd steps; damped by ``line_omega``), border sweeps, sweeps over the band next to the fixed
+    boundary."""
     x, y, fx, fy = _f(fb, m, C_X), _f(fb, m, C_Y), _f(fb, m, C_FX), _f(fb, m, C_FY)
     nodes = ib[m[C_NODES] : m[C_NODES] + m[C_NREG]]
     nbr = ib[m[C_NBR] : m[C_NBR] + 8 * m[C_NREG]].reshape((m[C_NREG], 8))
@@ -100,9 +101,9 @@ def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps):  # pragma: no cover -
     for step in range(steps):
         table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_n, irr_p, ring, 1.0)
         if step % 2 == 0:
-            line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, lptr[: nl0 + 1], axis[:nl0])
+            line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, lptr[: nl0 + 1], axis[:nl0], line_omega)
         else:
-            line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, lptr[nl0:], axis[nl0:])
+            line_sweep_rhs(x, y, fx, fy, lnodes, lnbr, lptr[nl0:], axis[nl0:], line_omega)
         for _ in range(border_sweeps):
             table_sweep_rhs(x, y, fx, fy, nodes[nint:], nbr[nint:], irr_n, irr_p, ring, 1.0)
         for _ in range(band_sweeps):
@@ -205,12 +206,15 @@ def _correct(fb, ib, fine, co):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def vcycle(fb, ib, meta, k0, pre, post, border_sweeps, band_sweeps, c_min, c_reduction, c_max):  # pragma: no cover
-    """One FAS V(``pre``, ``post``) cycle from level ``k0`` (its ``x, y, f`` set in ``fb``)."""
+def vcycle(
+    fb, ib, meta, k0, pre, post, border_sweeps, band_sweeps, c_min, c_reduction, c_max, line_omega
+):  # pragma: no cover
+    """One FAS V(``pre``, ``post``) cycle from level ``k0`` (its ``x, y, f`` set in ``fb``); the line
+    sweeps damped by ``line_omega`` (1: undamped)."""
     last = meta.shape[0] - 1
     for k in range(k0, last):
         m = meta[k]
-        _smooth(fb, ib, m, pre, border_sweeps, band_sweeps)
+        _smooth(fb, ib, m, pre, border_sweeps, band_sweeps, line_omega)
         rx, ry = _f(fb, m, C_RX), _f(fb, m, C_RY)
         rx[:] = 0.0
         ry[:] = 0.0
@@ -219,4 +223,4 @@ def vcycle(fb, ib, meta, k0, pre, post, border_sweeps, band_sweeps, c_min, c_red
     _coarsest(fb, ib, meta[last], c_min, c_reduction, c_max)
     for k in range(last - 1, k0 - 1, -1):
         _correct(fb, ib, meta[k], meta[k + 1])
-        _smooth(fb, ib, meta[k], post, border_sweeps, band_sweeps)
+        _smooth(fb, ib, meta[k], post, border_sweeps, band_sweeps, line_omega)

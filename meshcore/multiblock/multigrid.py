@@ -134,12 +134,12 @@ ACCEL, ACCEL_DEPTH, ACCEL_PLAIN_REF = False, 4, True
 last_run: dict = {}
 
 
-def _smooth(lv: Level, x, y, fx, fy, steps: int) -> None:
-    """``steps`` smoothing steps: point sweep, line sweep along ξ (even steps) or η (odd steps),
-    border and band sweeps."""
+def _smooth(lv: Level, x, y, fx, fy, steps: int, line_omega: float = 1.0) -> None:
+    """``steps`` smoothing steps: point sweep, line sweep along ξ (even steps) or η (odd steps;
+    damped by ``line_omega``), border and band sweeps."""
     for step in range(steps):
         _kernels.table_sweep_rhs(x, y, fx, fy, *lv.args, 1.0)
-        _kernels.line_sweep_rhs(x, y, fx, fy, *lv.lines[step % 2])
+        _kernels.line_sweep_rhs(x, y, fx, fy, *lv.lines[step % 2], line_omega)
         for _ in range(BORDER_SWEEPS):
             _kernels.table_sweep_rhs(x, y, fx, fy, *lv.border, 1.0)
         for _ in range(BAND_SWEEPS):
@@ -169,7 +169,7 @@ def _defect_after(lv: Level, x, y, zero, rx, ry, moved: np.ndarray) -> float:
     return math.sqrt(d2) if d2 == d2 else math.inf
 
 
-def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy) -> None:
+def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float = 1.0) -> None:
     """One V-cycle from level ``k``, kernel by kernel (the reference of :func:`_cycle`)."""
     lv = lvs[k]
     if k == len(lvs) - 1:
@@ -184,7 +184,7 @@ def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy) -> None:
                 if r <= COARSEST_REDUCTION * r0:
                     break
         return
-    _smooth(lv, x, y, fx, fy, PRE)
+    _smooth(lv, x, y, fx, fy, PRE, line_omega)
     rx, ry = np.zeros(lv.n), np.zeros(lv.n)
     _kernels.table_defect(x, y, fx, fy, *lv.args, rx, ry)
     co = lvs[k + 1]
@@ -197,10 +197,10 @@ def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy) -> None:
     fcx[~co.free] = 0.0
     fcy[~co.free] = 0.0
     ux, uy = vx.copy(), vy.copy()
-    _cycle_reference(lvs, k + 1, ux, uy, fcx, fcy)
+    _cycle_reference(lvs, k + 1, ux, uy, fcx, fcy, line_omega)
     x += co.P @ (ux - vx)
     y += co.P @ (uy - vy)
-    _smooth(lv, x, y, fx, fy, POST)
+    _smooth(lv, x, y, fx, fy, POST, line_omega)
 
 
 def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -269,7 +269,7 @@ def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return fb, ib, meta
 
 
-def _cycle(lvs: list[Level], k: int, x, y, fx, fy) -> None:
+def _cycle(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float = 1.0) -> None:
     """One V-cycle from level ``k`` in one compiled call (:func:`._mg_fused.vcycle`)."""
     lv0 = lvs[0]
     if lv0.packed is None:
@@ -282,13 +282,24 @@ def _cycle(lvs: list[Level], k: int, x, y, fx, fy) -> None:
     for col, a in ((F.C_X, x), (F.C_Y, y), (F.C_FX, fx), (F.C_FY, fy)):
         fb[m[col] : m[col] + n] = a
     _fused.vcycle(
-        fb, ib, meta, k, PRE, POST, BORDER_SWEEPS, BAND_SWEEPS, COARSEST_SWEEPS, COARSEST_REDUCTION, COARSEST_MAX_SWEEPS
+        fb,
+        ib,
+        meta,
+        k,
+        PRE,
+        POST,
+        BORDER_SWEEPS,
+        BAND_SWEEPS,
+        COARSEST_SWEEPS,
+        COARSEST_REDUCTION,
+        COARSEST_MAX_SWEEPS,
+        float(line_omega),
     )
     x[:] = fb[m[F.C_X] : m[F.C_X] + n]
     y[:] = fb[m[F.C_Y] : m[F.C_Y] + n]
 
 
-def _fmg(lvs: list[Level], x, y) -> None:
+def _fmg(lvs: list[Level], x, y, line_omega: float = 1.0) -> None:
     """Full-multigrid start: the start grid injected into every level, the coarsest level solved,
     then on each finer level the coarse change interpolated (``u_h ← u_h + P (u_H − R̂ u_h)``) and
     one V-cycle from that level, up to ``x, y`` (in place)."""
@@ -303,7 +314,7 @@ def _fmg(lvs: list[Level], x, y) -> None:
             xs[k] += co.P @ (xs[k + 1] - x0[k + 1])
             ys[k] += co.P @ (ys[k + 1] - y0[k + 1])
         zero = np.zeros(lvs[k].n)
-        _cycle(lvs, k, xs[k], ys[k], zero, zero)
+        _cycle(lvs, k, xs[k], ys[k], zero, zero, line_omega)
 
 
 def iterate_fas(
@@ -314,6 +325,7 @@ def iterate_fas(
     max_cycles: int,
     give_up_rate: float | None = None,
     lvs: list | None = None,
+    line_omega: float = 1.0,
 ):
     """V-cycles on the global arrays ``x, y`` (in place) until the Jacobi residual ≤ ``tol``.
 
@@ -322,7 +334,7 @@ def iterate_fas(
     ``"stop"`` to stop).  ``give_up_rate``: stop with message ``"slow"`` when,
     from the third cycle on, the defect falls by less than this factor per
     cycle (geometric mean of the last two cycles) — the caller then continues
-    with SOR.
+    with SOR.  ``line_omega``: damping of the line sweeps (1: none; :data:`RETRY_LINE_OMEGA`).
 
     Returns ``(cycles, residual, history, message, n_levels)``.
     """
@@ -340,11 +352,11 @@ def iterate_fas(
         if r <= tol:
             return it - 1, r, history, "", len(lvs)
         if it == 1 and FMG_START:
-            _fmg(lvs, x, y)
+            _fmg(lvs, x, y, line_omega)
         else:
             if acc is not None:
                 acc.before(history)
-            _cycle(lvs, 0, x, y, zero, zero)
+            _cycle(lvs, 0, x, y, zero, zero, line_omega)
         r = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
         if HOT_SWEEPS and tol < r < math.inf:
             swept = _hot_sweeps(lv, x, y, rx, ry)

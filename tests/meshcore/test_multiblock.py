@@ -854,7 +854,7 @@ def test_auto_retries_multigrid_with_one_level_fewer_before_sor(monkeypatch, rec
     assert depth >= 3
     real, seen = multigrid.iterate_fas, []
 
-    def slow_when_deep(x, y, topo_, tol, max_cycles, give_up_rate=None, lvs=None):
+    def slow_when_deep(x, y, topo_, tol, max_cycles, give_up_rate=None, lvs=None, line_omega=1.0):
         seen.append(len(lvs))
         if len(lvs) == depth:  # two cycles, then "slow"
             yield 1, 1.0
@@ -873,8 +873,39 @@ def test_auto_retries_multigrid_with_one_level_fewer_before_sor(monkeypatch, rec
         assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-7 * topo.size
     seen.clear()  # no retry for engine="multigrid", and none when disabled: SOR
     monkeypatch.setattr(solver, "RETRY_FEWER_LEVELS", 0)
+    monkeypatch.setattr(solver, "RETRY_LINE_OMEGA", 1.0)
     sor = solve_multiblock(topo, tolerance=1e-10)
     assert seen == [depth] and sor.converged and sor.info.method == "smooth/blocks-sor after 2 multigrid cycles"
+
+
+def test_auto_retries_with_damped_lines_before_sor(monkeypatch, rect):
+    """engine="auto": when the undamped cycles are slow with the whole hierarchy and without its
+    coarsest level, the multigrid starts over once more with all levels and its line sweeps damped
+    (solver.RETRY_LINE_OMEGA) before SOR; that solve reaches the grid of the undamped cycles."""
+    from meshcore.multiblock import multigrid, solver
+    from meshcore.multiblock.hierarchy import levels
+
+    X, Y = curved_rectangle(64, 32)
+    topo = four_blocks(X, Y, 32, 16)
+    depth = len(levels(topo))
+    assert depth >= 3
+    real, seen = multigrid.iterate_fas, []
+
+    def slow_unless_damped(x, y, topo_, tol, max_cycles, give_up_rate=None, lvs=None, line_omega=1.0):
+        seen.append((len(lvs), line_omega, give_up_rate))
+        if line_omega == 1.0:
+            yield 1, 1.0
+            return 1, 1.0, [(0, 1.0), (1, 1.0)], "slow", len(lvs)
+        return (yield from real(x, y, topo_, tol, max_cycles, give_up_rate, lvs, line_omega))
+
+    monkeypatch.setattr(multigrid, "iterate_fas", slow_unless_damped)
+    mb = solve_multiblock(topo, tolerance=1e-10)
+    omega, rate = solver.RETRY_LINE_OMEGA, solver.RETRY_GIVE_UP_RATE
+    assert seen == [(depth, 1.0, 0.5), (depth - 1, 1.0, 0.5), (depth, omega, rate)] and omega < 1.0
+    assert mb.converged and mb.info.method == f"smooth/multigrid({depth} levels, damped lines)"
+    ref = solve_multiblock(topo, tolerance=1e-10, engine="multigrid")
+    for g, k in zip(mb, ref, strict=True):
+        assert np.hypot(g.x - k.x, g.y - k.y).max() < 1e-7 * topo.size
 
 
 @pytest.mark.slow
@@ -891,6 +922,19 @@ def test_generated_lake_whose_coarsest_level_stalls_converges_by_multigrid():
     n = len(levels(topo))
     mb = solve_multiblock(topo, tolerance=1e-9)
     assert mb.converged and mb.info.method == f"smooth/multigrid({n - 1} levels)", mb.info.method
+
+
+@pytest.mark.slow
+def test_generated_layout_whose_cycles_stall_converges_by_damped_multigrid():
+    """A generated layout (headlands(861006), 31 blocks, ~16 000 nodes): the undamped cycles stall
+    (rate ~0.9) and, without the coarsest level, diverge; the solve fell back to SOR (4 275
+    sweeps).  engine="auto" now retries with damped lines and converges by multigrid."""
+    from meshcore.layout import auto_layout
+    from meshcore.testing import headlands
+
+    topo = auto_layout(headlands(861006), target_cells=15000, multiple=4).topology()
+    mb = solve_multiblock(topo)
+    assert mb.converged and mb.info.method.startswith("smooth/multigrid("), mb.info.method
 
 
 def test_hot_spot_sweeps_save_cycles_and_keep_the_grid(monkeypatch):
@@ -1407,9 +1451,9 @@ def test_fused_cycle_equals_the_kernel_by_kernel_cycle(make, rect):
     z = np.zeros(m.n_nodes)
     xr, yr = x.copy(), y.copy()
     x0 = x.copy()
-    for _ in range(2):
-        multigrid._cycle(lvs, 0, x, y, z, z)
-        multigrid._cycle_reference(lvs, 0, xr, yr, z, z)
+    for omega in (1.0, 1.0, 0.8):  # the damped lines of the retry (solver.RETRY_LINE_OMEGA) too
+        multigrid._cycle(lvs, 0, x, y, z, z, omega)
+        multigrid._cycle_reference(lvs, 0, xr, yr, z, z, omega)
         assert np.abs(x - xr).max() <= 1e-12 * topo.size and np.abs(y - yr).max() <= 1e-12 * topo.size
     assert np.abs(x - x0).max() > 1e-3 * topo.size  # the cycles moved the grid
 
@@ -1468,8 +1512,8 @@ def test_a_nan_grid_is_never_reported_converged(rect, monkeypatch):
     node = int(topo.node_map.nodes[3])
     real = multigrid._cycle
 
-    def poisoned(lvs, k, x, y, fx, fy):
-        real(lvs, k, x, y, fx, fy)
+    def poisoned(lvs, k, x, y, fx, fy, line_omega=1.0):
+        real(lvs, k, x, y, fx, fy, line_omega)
         if k == 0:
             x[node] = np.nan
 
@@ -1575,12 +1619,15 @@ def test_sor_after_a_slow_multigrid_starts_from_the_start_grid(monkeypatch):
     cycles' grid: the result is the SOR grid to the bit (a generated lake's coarsest level,
     round_lake(1, blob), ended far off from the cycles' grid: 1290 folded cells at the end)."""
     import meshcore.multiblock.multigrid as mg
+    import meshcore.multiblock.solver as solver
 
     X, Y = curved_rectangle(64, 32)
     monkeypatch.setattr(mg, "AUTO_GIVE_UP_RATE", 0.0)  # every multigrid is "slow" after 3 cycles
+    monkeypatch.setattr(solver, "RETRY_GIVE_UP_RATE", 0.0)  # the damped retry's too
     auto = solve_multiblock(four_blocks(X, Y, 32, 16), tolerance=1e-12)
-    # 3 cycles with every level, 3 with one level fewer (solver.RETRY_FEWER_LEVELS), then SOR
-    assert "multigrid was slow" in auto.info.message and auto.info.method.startswith("smooth/blocks-sor after 6")
+    # 3 cycles with every level, 3 with one level fewer (solver.RETRY_FEWER_LEVELS), 3 with damped
+    # lines (solver.RETRY_LINE_OMEGA), then SOR
+    assert "multigrid was slow" in auto.info.message and auto.info.method.startswith("smooth/blocks-sor after 9")
     sor = solve_multiblock(four_blocks(X, Y, 32, 16), tolerance=1e-12, engine="blocks")
     assert auto.converged and sor.converged
     for a, b in zip(auto, sor, strict=True):
