@@ -25,7 +25,7 @@ from . import io_adapter as fio
 from . import recovery
 from .examples import load_example
 from .io_export import ExportMixin, export_default
-from .lake import Lake, looks_branched, read_lake, water
+from .lake import Lake, looks_branched, read_lake, read_lake_parts, water
 from .project import Block, Project, block_from_points
 
 __all__ = ["MAX_RECENT", "IOController", "export_default"]
@@ -185,8 +185,12 @@ class IOController(ExportMixin, QtCore.QObject):
         if path:
             self.import_points(Path(path))
 
-    def import_points(self, path: Path, *, project_lonlat: bool | None = None) -> bool:
-        """Read points as a new closed block with automatic corners (undoable)."""
+    def import_points(self, path: Path, *, project_lonlat: bool | None = None, part: int | None = None) -> bool:
+        """Read points as a new closed block with automatic corners (undoable).
+
+        A lake file of several separate parts of water opens part ``part`` (1: the largest); with
+        ``None`` a dialog asks which (:class:`app.parts_dialog.PartsDialog`; quiet: the largest).
+        """
         path = Path(path)
         try:
             pd = fio.read_points(path)
@@ -234,22 +238,29 @@ class IOController(ExportMixin, QtCore.QObject):
             except (MeshcoreError, ValueError) as exc:
                 self.win.error("Cannot project coordinates", exc)
                 return False
-        lake = self._read_lake(pd, frame, lonlat=bool(pd.lonlat and project_lonlat is not False))
+        lake, (k_part, n_parts) = self._read_lake(
+            pd, frame, lonlat=bool(pd.lonlat and project_lonlat is not False), part=part
+        )
+        if k_part == 0:  # the parts dialog cancelled: nothing imported
+            self.win.message(f"Import of {path.name} cancelled")
+            return False
         if lake is not None:
             pts = lake.outline
         if len(pts) < 4:
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
-        block = block_from_points(pts, path.stem)
-        self._add_imported(block, frame, path.name, lake=lake, replace=replace)
+        stem = f"{path.stem}_part{k_part}" if n_parts > 1 else path.stem  # as meshcore mesh --case names it
+        block = block_from_points(pts, stem)
+        self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=stem)
         self.add_recent(path)  # File ▸ Open recent imports it again (and remembers its folder)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
         n_isl = len(lake.holes) if lake is not None else 0
         isl = f" and {n_isl} island{'s' * (n_isl != 1)}" if n_isl else ""  # it said "1 island(s)"
+        which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
         self.win.message(
-            f"Imported {len(pts)} points{isl} from {path.name}{projected}; corners chosen "
+            f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
             f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
         )
         if lake is not None and looks_branched(lake.outline, lake.holes):
@@ -258,27 +269,46 @@ class IOController(ExportMixin, QtCore.QObject):
             self.win.lake_ctl.offer(path.name, why)
         return True
 
-    def _read_lake(self, pd, frame, *, lonlat: bool):
-        """The lake (shore and islands) of the file's rings, in the frame of the imported block; None if none."""
+    def _read_lake(self, pd, frame, *, lonlat: bool, part: int | None = None):
+        """The lake (shore and islands) of the file's rings, in the frame of the imported block (None
+        if none), and (the part opened, the number of parts): part 0 when the parts dialog was
+        cancelled."""
         if pd.pointset is None:
-            return None
+            return None, (1, 1)
         try:
-            outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat)
+            parts, _fr, notes = read_lake_parts(pd.pointset, frame, lonlat=lonlat)
+            metres = not (pd.lonlat and not lonlat)  # lon/lat kept as degrees: areas in degrees²
+            k = 1 if len(parts) == 1 else part if part is not None else self.choose_part(pd.path, parts, metres)
+            if k == 0:
+                return None, (0, len(parts))
+            outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat, part=k, metres=metres)
         except (MeshcoreError, ValueError) as exc:  # meshcore mesh refuses the file: say why here too
             self.doc.report(
                 "warning",
                 f"{Path(pd.path).name}: not read as a lake ({exc}); its largest line is imported as one block",
             )
-            return None
+            return None, (1, 1)
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
             notes = notes + water(outer, islands)[1]
         except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring
             log.info("%s: the water polygon: %s", pd.path, exc)
         for note in notes:  # what meshcore mesh prints as notes
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
-        return Lake(outline=outer, holes=tuple(islands))
+        return Lake(outline=outer, holes=tuple(islands)), (k, len(parts))
 
-    def _add_imported(self, block: Block, frame, name: str, *, lake=None, replace: bool = False) -> None:
+    def choose_part(self, path, parts: list, metres: bool = True) -> int:
+        """The part of the water to open (from 1, largest first), asked in a dialog; 0: cancelled.
+        Quiet (tests, scripts): the largest, as ``meshcore mesh --part 1``."""
+        if self.quiet:
+            return 1
+        from .parts_dialog import PartsDialog
+
+        dlg = PartsDialog(Path(path).name, parts, metres=metres, parent=self._parent())
+        return dlg.chosen() if dlg.exec() == QtWidgets.QDialog.DialogCode.Accepted else 0
+
+    def _add_imported(
+        self, block: Block, frame, name: str, *, lake=None, replace: bool = False, title: str | None = None
+    ) -> None:
         """Put an imported block into the first empty block (or add it), as one undo step; with
         ``replace`` (a project holding a lake) it replaces the lake, its layout, cuts and frame."""
         p = self.doc.project
@@ -296,7 +326,7 @@ class IOController(ExportMixin, QtCore.QObject):
             after = p.replaced(blocks=(*p.blocks, block))
             k = len(after.blocks) - 1
         if replace or not p.title:  # the case's title (and the Save dialog's name) is the lake's file name
-            after = after.replaced(title=Path(name).stem)
+            after = after.replaced(title=title or Path(name).stem)
         if frame is not None and frame.crs:
             after = after.replaced(crs=frame.crs, origin=tuple(frame.origin), source_crs=frame.source_crs or "")
         if lake is not None and after.layout is None and (k == 0 or p.lake is None):

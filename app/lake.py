@@ -29,12 +29,15 @@ from meshcore import MeshcoreError
 __all__ = [
     "BRANCHED_FILL",
     "Lake",
+    "area_text",
     "cell_size_of",
     "compute_layout",
     "default_cell_size",
     "layout_blocks",
     "looks_branched",
+    "part_area",
     "read_lake",
+    "read_lake_parts",
     "split_layout",
     "water",
     "with_layout",
@@ -93,18 +96,33 @@ class Lake:
 
 
 # ------------------------------------------------------------------ reading
-def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tuple[np.ndarray, list, Any, list[str]]:
+def read_lake(
+    pointset: Any, frame: Any = None, *, lonlat: bool = False, part: int = 1, metres: bool = True
+) -> tuple[np.ndarray, list, Any, list[str]]:
     """Shore, islands, frame and notes of a point file's rings, by the rules of ``meshcore mesh``.
 
     ``pointset`` is the :class:`meshcore.io.PointSet` read from the file; with ``lonlat``
     its degrees go to ``frame`` (the project's) or to the UTM zone of the centroid with a
     round local origin (:func:`meshcore.cli.lakefile.local_frame`).  Open lines touching the
     shore are dropped with a note (:func:`meshcore.cli.lakefile.lake_parts`).  A file of several
-    separate parts of water gives the largest part (its shore and islands) and a note naming the
-    parts left out (:func:`several_parts_note`).  Raises :class:`~meshcore.MeshcoreError` when
-    the rings are not water (an island across the shore, parts that overlap, a ring of fewer than
-    three points).
+    separate parts of water gives part ``part`` (1: the largest; its shore and islands) and a
+    note naming the parts left out (:func:`several_parts_note`).  Raises
+    :class:`~meshcore.MeshcoreError` when the rings are not water (an island across the shore,
+    parts that overlap, a ring of fewer than three points).
     """
+    parts, frame, notes = read_lake_parts(pointset, frame, lonlat=lonlat)
+    if not 1 <= part <= len(parts):
+        raise MeshcoreError(f"part {part} asked for; the file has {len(parts)} part{'s' * (len(parts) != 1)} of water")
+    _, outer, islands = parts[part - 1]
+    if len(parts) > 1:
+        notes = [*notes, several_parts_note(parts, part, metres=metres)]
+    return outer, islands, frame, notes
+
+
+def read_lake_parts(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tuple[list, Any, list[str]]:
+    """The separate parts of water of a point file, ``[(name, shore, islands), ...]`` largest first
+    (numbered from 1 in that order, as ``meshcore mesh`` numbers them), the frame and the notes;
+    projected as :func:`read_lake` says."""
     from meshcore import crs as mcrs
     from meshcore.cli.lakefile import lake_parts, local_frame
 
@@ -118,27 +136,42 @@ def read_lake(pointset: Any, frame: Any = None, *, lonlat: bool = False) -> tupl
         else:  # the rule of ``meshcore mesh``: the same local numbers, the same layout and grid
             ps, frame = local_frame(ps, "auto", source_crs=src)
     parts, notes = lake_parts(ps)
-    _, outer, islands = parts[0]
-    if len(parts) > 1:
-        notes = [*notes, several_parts_note(parts)]
-    return outer, islands, frame, notes
+    return parts, frame, notes
 
 
-def several_parts_note(parts: list) -> str:
-    """What the import of a file of several separate parts of water says: the app grids one lake,
-    the largest part (with its islands); ``meshcore mesh`` grids every part."""
+def part_area(part: Any) -> float:
+    """Water area of a part ``(name, shore, islands)`` of :func:`read_lake_parts` (islands taken out)."""
     from shapely.geometry import Polygon
 
-    def part(k: int) -> str:
-        name, outer, _ = parts[k - 1]
-        p = Polygon(outer)
-        return f"part {k} ({name!r}, area {p.area:.4g}, near ({p.centroid.x:.6g}, {p.centroid.y:.6g}))"
+    _, outer, islands = part
+    return float(Polygon(outer).area - sum(Polygon(h).area for h in islands))
 
-    rest = ", ".join(part(k) for k in range(2, len(parts) + 1))
+
+def area_text(area: float, metres: bool = True) -> str:
+    """An area as a modeller reads it: km² from 1 km² up, else hectares (model units² without metres)."""
+    if not metres:
+        return f"{area:.4g} units²"
+    return f"{area / 1e6:,.3g} km²" if area >= 1e6 else f"{area / 1e4:,.3g} ha"
+
+
+def several_parts_note(parts: list, chosen: int = 1, *, metres: bool = True) -> str:
+    """What the import of a file of several separate parts of water says: the app grids one lake,
+    part ``chosen`` (with its islands); ``meshcore mesh`` grids every part."""
+
+    def part(k: int) -> str:
+        from shapely.geometry import Polygon
+
+        name, outer, _ = parts[k - 1]
+        c = Polygon(outer).centroid
+        return f"part {k} ({name!r}, {area_text(part_area(parts[k - 1]), metres)}, near ({c.x:.6g}, {c.y:.6g}))"
+
+    rest = [k for k in range(1, len(parts) + 1) if k != chosen]
+    left = ", ".join(part(k) for k in rest)
+    who = f"the largest, {part(1)}" if chosen == 1 else part(chosen)
     return (
-        f"{len(parts)} separate parts of water: the app grids one lake, so the largest, {part(1)}, is imported "
-        f"with its islands and {rest} {'is' if len(parts) == 2 else 'are'} left out; 'meshcore mesh' grids "
-        f"every part of the file (--part N for some)"
+        f"{len(parts)} separate parts of water: the app grids one lake, so {who} is imported "
+        f"with its islands and {left} {'is' if len(rest) == 1 else 'are'} left out (File ▸ Import again to "
+        f"open another); 'meshcore mesh' grids every part of the file into one grid (--part N for some)"
     )
 
 

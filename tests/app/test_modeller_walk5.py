@@ -1,0 +1,121 @@
+"""What a fifth modeller's walk through the app (session 21, under Xvfb) found, each as it went
+wrong, on generated shapes: water in several parts first (a reservoir split by a causeway)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+pytestmark = pytest.mark.gui
+
+
+def _ellipse(cx: float, cy: float, rx: float, ry: float, n: int = 48) -> list:
+    ring = [[cx + rx * math.cos(2 * math.pi * k / n), cy + ry * math.sin(2 * math.pi * k / n)] for k in range(n)]
+    return [*ring, ring[0]]
+
+
+def _reservoir(tmp_path, fmt: str = "kml"):
+    """A reservoir split by a causeway, in lon/lat: a larger upper basin with an island and a
+    smaller lower basin; as one KML of two placemarks or one GeoJSON MultiPolygon."""
+    upper = _ellipse(10.0, 46.02, 0.03, 0.012)
+    island = _ellipse(10.005, 46.021, 0.004, 0.002, 24)[::-1]
+    lower = _ellipse(10.01, 45.995, 0.018, 0.009)
+    if fmt == "geojson":
+        geom = {"type": "MultiPolygon", "coordinates": [[upper, island], [lower]]}
+        feat = {"type": "Feature", "properties": {"name": "Causeway"}, "geometry": geom}
+        path = tmp_path / "reservoir.geojson"
+        path.write_text(json.dumps({"type": "FeatureCollection", "features": [feat]}))
+        return path
+
+    def ring(r):
+        return " ".join(f"{x},{y},0" for x, y in r)
+
+    def placemark(name, outer, holes=()):
+        inner = "".join(
+            f"<innerBoundaryIs><LinearRing><coordinates>{ring(h)}</coordinates></LinearRing></innerBoundaryIs>"
+            for h in holes
+        )
+        return (
+            f"<Placemark><name>{name}</name><Polygon><outerBoundaryIs><LinearRing><coordinates>{ring(outer)}"
+            f"</coordinates></LinearRing></outerBoundaryIs>{inner}</Polygon></Placemark>"
+        )
+
+    path = tmp_path / "reservoir.kml"
+    path.write_text(
+        '<?xml version="1.0" encoding="UTF-8"?><kml xmlns="http://www.opengis.net/kml/2.2"><Document>'
+        f"{placemark('Lower basin', lower)}{placemark('Upper basin', upper, [island])}</Document></kml>"
+    )
+    return path
+
+
+def test_the_parts_dialog_lists_every_part_by_name_and_area_largest_first(qtbot, tmp_path):
+    """A file of two parts of water: the dialog's table has a row per part, numbered as
+    ``meshcore mesh --part`` numbers them (largest first), with its name, water area in km² and
+    islands; the largest is chosen at first, another by selecting its row."""
+    from app.lake import read_lake_parts
+    from app.parts_dialog import PartsDialog
+    from meshcore.io import read_points
+
+    parts, _frame, _ = read_lake_parts(read_points(_reservoir(tmp_path)), lonlat=True)
+    dlg = PartsDialog("reservoir.kml", parts)
+    qtbot.addWidget(dlg)
+    t = dlg.table
+    rows = [[t.item(r, c).text() for c in range(t.columnCount())] for r in range(t.rowCount())]
+    assert [r[:2] for r in rows] == [["1", "Upper basin"], ["2", "Lower basin"]]
+    assert [r[3] for r in rows] == ["1", "0"]  # the island is the upper basin's
+    areas = [float(r[2].split()[0]) for r in rows]
+    assert all(r[2].endswith("km²") for r in rows) and areas[0] > areas[1] > 0.5
+    assert dlg.chosen() == 1
+    t.selectRow(1)
+    assert dlg.chosen() == 2
+
+
+@pytest.mark.parametrize("fmt", ["kml", "geojson"])
+def test_importing_water_in_two_parts_asks_which_part_and_opens_it(qtbot, win, tmp_path, monkeypatch, fmt):
+    """Was: the app imported the largest part and said in Messages which were left out; the lower
+    basin could not be opened at all.  Now a dialog lists the parts and the one chosen is the
+    project's lake (its shore, no island), titled as ``meshcore mesh --case`` names its case
+    (``reservoir_part2``); one undo step takes it back, and Cancel imports nothing."""
+    from app.parts_dialog import PartsDialog
+
+    path = _reservoir(tmp_path, fmt)
+    asked = []
+
+    def pick_second(dlg):
+        asked.append(dlg.table.rowCount())
+        dlg.table.selectRow(1)
+        return PartsDialog.DialogCode.Accepted
+
+    monkeypatch.setattr(PartsDialog, "exec", pick_second)
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append(text))
+    win.quiet = False
+    before = win.doc.project
+    assert win.io.import_points(path, project_lonlat=True)
+    assert asked == [2]
+    lake = win.doc.project.lake
+    assert lake is not None and len(lake.holes) == 0  # the lower basin: the island is the upper's
+    area = shapely.Polygon(lake.outline).area  # pi * 1.39 km * 1.00 km: 4.4 km² (the upper 9.7)
+    assert 3.5e6 < area < 5.5e6
+    assert win.doc.project.title == "reservoir_part2"
+    assert any("so part 2 (" in t and "part 1 (" in t and "is left out" in t for t in said), said
+    win.stack.undo()
+    assert win.doc.project is before or win.doc.project.lake is None
+    win.quiet = True  # no more modal questions (the Auto layout offer for the island below)
+
+    # the largest part by asking for part 1; Cancel leaves the project as it is
+    assert win.io.import_points(path, project_lonlat=True, part=1)
+    assert len(win.doc.project.lake.holes) == 1
+    upper = win.doc.project
+    monkeypatch.setattr(PartsDialog, "exec", lambda dlg: PartsDialog.DialogCode.Rejected)
+    win.quiet = False
+    try:
+        assert not win.io.import_points(path, project_lonlat=True)
+    finally:
+        win.quiet = True  # Close must not ask to save
+    assert win.doc.project is upper
+    assert np.isfinite(win.doc.project.lake.outline).all()
