@@ -16,11 +16,16 @@ from operator import attrgetter
 
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from .tools import TOOLS
+from .layout_tools import CutTool, LayoutTool
+from .tools import CornersTool, DrawTool, EditTool, PanTool
 
 __all__ = ["ACTIONS", "GESTURES", "ActionSpec", "build", "shortcut_rows"]
 
 K = QtGui.QKeySequence.StandardKey
+
+#: The tools on the toolbar and in the Tools menu, in their order (calibrate is started from the
+#: background's menu).
+TOOLS = (PanTool, DrawTool, EditTool, CornersTool, CutTool, LayoutTool)
 
 
 @dataclass(frozen=True, slots=True)

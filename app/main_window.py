@@ -3,7 +3,7 @@
 It builds the parts and connects them (its frame: title, drops, close, size, help in
 :mod:`app.window_frame`); the logic lives elsewhere: the
 document (:mod:`app.document`) holds the state the views draw, edits are undo
-commands (:mod:`app.commands`, :mod:`app.tools`), files go through the I/O
+commands (:mod:`app.commands`, :mod:`app.tools`, :mod:`app.layout_tools`), files go through the I/O
 controller (:mod:`app.io_controller`), the background image through
 :mod:`app.background`, the solver through :mod:`app.solver_controller`, and
 every action comes from the table in :mod:`app.actions`.
@@ -28,10 +28,11 @@ from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
 from .lake_controller import LakeController
+from .layout_tools import CutTool, LayoutTool
 from .project import Project, boundary_to_loop
 from .solve_status import SolveStatus
 from .solver_controller import SolverController
-from .tools import CalibrateTool, CornersTool, CutTool, DrawTool, EditTool, LayoutTool, PanTool
+from .tools import CalibrateTool, CornersTool, DrawTool, EditTool, PanTool
 from .views.canvas import Canvas
 from .views.docks import narrowable, scrolled
 from .views.lake_panel import LakePanel, LakeQualityBox
