@@ -8,6 +8,7 @@ kept in the project, saved in the case file and passed to every exporter.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -317,11 +318,21 @@ def project_from_layout_case(case) -> Project:
     lake = Lake(
         outline=np.asarray(poly.exterior.coords)[:-1],
         holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
-        cell_size=float(layout.cell_size),
+        cell_size=_cell_size_read(float(layout.cell_size), poly.area),
         layout=layout,
     )
     base = Project(solver=case.solver, title=case.title, **_frame_fields(case_frame(case)))
     return with_layout(base, lake)
+
+
+def _cell_size_read(h: float, area: float) -> float | None:
+    """The lake's cell size as a case file gives it back: None ("auto", the Lake panel's about
+    10 000 cells) when it is the automatic size of that water to 9 digits.  The case holds the
+    layout's size only, so a project saved with "auto" came back as "32.3 m" and kept that size
+    when the shore was dragged or the water changed."""
+    from .lake import default_cell_size
+
+    return None if math.isclose(h, default_cell_size(area), rel_tol=1e-9) else h
 
 
 def save_project(project: Project, path) -> None:

@@ -119,3 +119,40 @@ def test_importing_water_in_two_parts_asks_which_part_and_opens_it(qtbot, win, t
         win.quiet = True  # Close must not ask to save
     assert win.doc.project is upper
     assert np.isfinite(win.doc.project.lake.outline).all()
+
+
+def _laid_out_project(seed: int, cell_size=None):
+    """A generated lake with islands (metres) laid out at ``cell_size`` (None: auto), no grid."""
+    from app.lake import Lake, compute_layout, with_layout
+    from app.project import Project
+    from meshcore import testing
+
+    poly = shapely.affinity.scale(testing.lake_with_islands(seed), 300, 300, origin=(0, 0))
+    lake = Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        cell_size=cell_size,
+    )
+    return with_layout(Project(title="walk5"), lake.replaced(layout=compute_layout(lake)))
+
+
+@pytest.mark.parametrize("cell_size", [None, 61.0])
+def test_a_reopened_project_keeps_the_cell_size_auto(qtbot, win, tmp_path, cell_size):
+    """A lake laid out with the cell size "auto (≈10 000 cells)", saved and opened again: the
+    Lake panel said "32.3 m" (the layout's size, all a case file holds), so a shore dragged
+    or an island added after kept that size instead of following the water.  Now a size that
+    is the water's automatic one comes back as auto; a size the user typed stays typed."""
+    from app.io_adapter import save_project
+    from app.views.lake_panel import AUTO_TEXT
+
+    if win.solver.auto:
+        win.a_auto.trigger()  # no solve needed: the panel and the lake are what is looked at
+    path = tmp_path / "walk5.toml"
+    save_project(_laid_out_project(850_011, cell_size), path)
+    assert win.io.open_path(path)
+    lake = win.doc.project.lake
+    assert lake is not None and lake.layout is not None
+    assert lake.cell_size == cell_size
+    win.show_lake()
+    text = win.lake_panel.cell_size.text()
+    assert (text == AUTO_TEXT) == (cell_size is None), text
