@@ -193,9 +193,9 @@ class LakeQualityBox(QtWidgets.QGroupBox):
     """A model's limits (Delft3D, EFDC, …) against the lake grid: pass/fail per limit.
 
     ``misses`` carries the places that miss the selected limit (the canvas rings them); a new
-    verdict selects its first failed limit.  A double-click (or Enter) on a failed limit sends its
-    worst place by ``go_to`` (the window zooms to it): the worst cell could be found only by
-    scanning hundreds of orange dots.
+    verdict selects its first failed limit.  A click (or Enter) on a failed limit sends its worst
+    place by ``go_to`` (the window zooms to it): the worst cell could be found only by scanning
+    hundreds of orange dots.
     """
 
     misses = QtCore.Signal(object)
@@ -225,13 +225,17 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.verticalHeader().setDefaultSectionSize(20)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setToolTip(
-            "select a limit: the places that miss it are marked by orange dots on the canvas; "
-            "double-click it (or Enter): zoom to the worst"
+            "click a limit: the places that miss it are marked by orange dots on the canvas and the "
+            "view goes to the worst (Enter too)"
         )
         lay.addWidget(self.table)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.SingleSelection)
         self.table.itemSelectionChanged.connect(self._row_selected)
+        # a click on a failed limit goes to its worst place (a new user clicked, saw dots somewhere
+        # and did not guess that a double-click would go there); Enter (activated) too.  Only the
+        # user's click: a new verdict selects its first failed limit without moving the view
+        self.table.clicked.connect(lambda index: self.go_to_worst(index.row()))
         self.table.activated.connect(lambda index: self.go_to_worst(index.row()))
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)

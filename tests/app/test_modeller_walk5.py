@@ -156,3 +156,29 @@ def test_a_reopened_project_keeps_the_cell_size_auto(qtbot, win, tmp_path, cell_
     win.show_lake()
     text = win.lake_panel.cell_size.text()
     assert (text == AUTO_TEXT) == (cell_size is None), text
+
+
+def test_one_click_on_a_failed_limit_goes_to_its_worst_place(qtbot, win, tmp_path):
+    """A new user clicked a failed limit of the verdict once: orange dots appeared somewhere, the
+    view stayed; going to the worst place needed a double-click nobody guessed.  One click goes
+    there now (the window zooms to it, its block active); a new verdict selecting its first failed
+    limit by itself does not move the view."""
+    from PySide6 import QtCore
+
+    from tests.app.test_modeller import _laid_out
+
+    _laid_out(qtbot, win, tmp_path, 850_021)
+    box = win.lake_quality
+    v = box.verdict
+    assert v is not None
+    rows = [k for k, r in enumerate(v.results) if r.passed is False and r.worst]
+    assert rows  # a coarse grid (20 cells to the square root of the area) misses delft3d's limits
+    sent = []
+    box.go_to.connect(lambda where, what: sent.append((where, what)))
+    win.doc.quality_changed.emit()  # a verdict again: the first failed limit selected, no move
+    assert sent == []
+    rect = box.table.visualRect(box.table.model().index(rows[-1], 2))
+    qtbot.mouseClick(box.table.viewport(), QtCore.Qt.MouseButton.LeftButton, pos=rect.center())
+    assert len(sent) == 1 and sent[0][1] == v.results[rows[-1]].limit.label
+    names = [b.name for b in win.doc.project.blocks]
+    assert win.doc.active == names.index(sent[0][0].block)
