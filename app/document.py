@@ -22,6 +22,11 @@ from .project import Block, Project
 __all__ = ["METRICS", "Document"]
 
 
+def _same_blocks(a, b) -> bool:
+    """Two lake layouts of the same blocks by name (their cells may differ)."""
+    return a is not None and b is not None and [x.name for x in a.blocks] == [y.name for y in b.blocks]
+
+
 def _layout_shape(layout) -> tuple | None:
     """What a lake layout's grids depend on in shape: the blocks' names and cells."""
     return None if layout is None else tuple((b.name, tuple(b.cells)) for b in layout.blocks)
@@ -100,6 +105,9 @@ class Document:
         self.grids: dict[int, StructuredGrid] = {}
         self.initial: dict[int, StructuredGrid] = {}
         self.stale: bool = False  # the grids on screen are not of the project (an edit since their solve)
+        #: the lake grid of before an edit that gave the same blocks other cells (a drag whose cells
+        #: followed it, a block's cells set): not of any block now, drawn greyed until a solve's grids
+        self.before_grids: dict[int, StructuredGrid] = {}
         #: the project the final grids were made for: an undo back to it makes them current again
         self.solved: Project | None = None
         self.selection: frozenset[int] = frozenset()
@@ -143,6 +151,10 @@ class Document:
                 and k < min(len(project.blocks), len(old.blocks))
                 and project.blocks[k] is old.blocks[k]
             }
+            if not keep and _same_blocks(old.layout, project.layout):  # new cells, the same blocks
+                self.before_grids = dict(self.grids) or self.before_grids
+            else:
+                self.before_grids = {}
             self.grids = {k: g for k, g in self.grids.items() if k in keep}
             self.initial = {k: g for k, g in self.initial.items() if k in keep}
             self.multiblock = None
@@ -167,6 +179,7 @@ class Document:
             return
         self.solved, grids, initial, self.multiblock, self._given_metrics = kept
         self.grids, self.initial = dict(grids), dict(initial)
+        self.before_grids = {}
         self._final = True
         self.grids_changed.emit()
         self._update_quality()
@@ -174,6 +187,7 @@ class Document:
     def reset(self, project: Project, path: Path | None = None) -> None:
         """Start over with ``project`` (open/new): grids and selection cleared."""
         self.grids = {}
+        self.before_grids = {}
         self.initial = {}
         self.multiblock = None
         self._final = False
@@ -195,6 +209,7 @@ class Document:
     # ------------------------------------------------------------- grids
     def set_grid(self, index: int, grid: StructuredGrid, *, final: bool = False) -> None:
         self.grids[index] = grid
+        self.before_grids = {}
         if final:
             self.stale = False
             self.solved = self.project
@@ -214,6 +229,7 @@ class Document:
         another (an edit made while it solved) they stay marked as of before the edit."""
         self._given_metrics = (multiblock, metrics) if metrics is not None else None
         self.grids = dict(grids)
+        self.before_grids = {}
         if initial is not None:
             self.initial = dict(initial)
         self.multiblock = multiblock
@@ -235,6 +251,7 @@ class Document:
     def clear_grids(self) -> None:
         self.solved = None
         self.grids = {}
+        self.before_grids = {}
         self.initial = {}
         self.multiblock = None
         self._final = False

@@ -68,7 +68,9 @@ class SolveStatus(QtCore.QObject):
         made for makes it current again (no F5, and it exports)."""
         if self.solver.running:
             return
-        if not self.doc.grids:  # another lake imported, a new layout: the last solve's summary is of nothing here
+        if (
+            not self.doc.grids and not self.doc.before_grids
+        ):  # another lake, a new layout: the summary is of nothing here
             self.label.setText("idle")
             return
         if self.solver.auto:

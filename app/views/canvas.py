@@ -340,8 +340,9 @@ class Canvas(pg.PlotWidget):
             self.selected_item.setData([], [])
 
     def refresh_grids(self) -> None:
-        """Draw the document's grids; while solving, the colouring of the old grid is hidden."""
-        self.set_grids(self.doc.grids)
+        """Draw the document's grids (none: the grid of before an edit that gave the blocks new cells,
+        greyed); while solving, the colouring of the old grid is hidden."""
+        self.set_grids(self.doc.grids or self.doc.before_grids)
         if self.doc.solving and self.quality_item is not None:
             self.set_quality(None, None)
         self.lake_items.set_solving(self.doc.solving)

@@ -182,3 +182,47 @@ def test_one_click_on_a_failed_limit_goes_to_its_worst_place(qtbot, win, tmp_pat
     assert len(sent) == 1 and sent[0][1] == v.results[rows[-1]].limit.label
     names = [b.name for b in win.doc.project.blocks]
     assert win.doc.active == names.index(sent[0][0].block)
+
+
+def test_the_grid_of_before_stays_greyed_when_a_drag_gives_blocks_new_cells(qtbot, win):
+    """Auto-generate off, a cut end of a ring lake dragged 40° round: at the drag's end the cells of
+    the stretched blocks follow the cell size, and the grid on screen vanished (the document drops
+    grids whose blocks changed cells) — the user had nothing to compare the new layout with.  The
+    grid of before stays drawn, greyed, until F5 makes the new one; an export still refuses it."""
+    from app.lake import Lake, compute_layout
+    from app.layout_edit import handles
+    from meshcore import testing
+    from tests.app.waits import wait_for, wait_idle
+
+    poly = testing.round_lake(850_031, kind="ring", radius=2000.0)
+    lake = Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        target_cells=3000,
+    )
+    win.editor.set_lake(lake.replaced(layout=compute_layout(lake)), "Auto layout")
+    assert not win.solver.auto
+    win.a_generate.trigger()
+    wait_for(qtbot, win, lambda: bool(win.doc.grids) and not win.doc.solving and not win.doc.stale)
+    wait_idle(qtbot, win)
+    lay0 = win.doc.project.layout
+    drawn = len(win.canvas.grid_curve.xData)
+    assert drawn > 0
+    win.set_tool("layout")
+    tool = win.canvas.tool
+    end = max((h for h in handles(lay0) if h.kind == "end"), key=lambda h: np.hypot(*h.xy))  # on the shore
+    a0, r = np.arctan2(end.xy[1], end.xy[0]), np.hypot(*end.xy)
+    path = [(r * np.cos(a0 + t), r * np.sin(a0 + t)) for t in np.radians(np.linspace(0, 40, 9))]
+    assert tool.drag("start", path[0], end.xy)
+    for p in path[1:]:
+        tool.drag("move", p, end.xy)
+        qtbot.wait(20)
+    tool.drag("finish", path[-1], end.xy)
+    wait_for(qtbot, win, lambda: not win.lake_ctl.editing and win.doc.project.layout is not lay0)
+    wait_idle(qtbot, win)
+    lay1 = win.doc.project.layout
+    assert [b.cells for b in lay1.blocks] != [b.cells for b in lay0.blocks]  # the cells followed the drag
+    assert not win.doc.grids  # no grid of this layout yet
+    assert len(win.canvas.grid_curve.xData) == drawn  # the grid of before, still drawn
+    assert win.canvas.grid_curve.opts["pen"].color().name() == "#b0b0b0"  # greyed
+    assert "before the edit" in win.solve_status.label.text()
