@@ -6,7 +6,8 @@ block's cells stretched or squeezed: a cut end dragged a fifth of the way round 
 block's cells 1.6 times as long as the cell size and the other's 0.8 times, with the counts as they
 were and nothing said.  :func:`cells_followed` gives the drag's last layout the cells of the cell
 size for each block whose cells the drag made more than :data:`STRETCH` longer or shorter (the other
-blocks keep theirs, a block's count set by hand too) and says which changed, or why they could not.
+blocks keep theirs, a block's count set by hand too) and says which changed, or why they could not;
+a total that changes by more than :data:`CELLS_WARN` is a warning with both counts.
 """
 
 from __future__ import annotations
@@ -17,10 +18,14 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["STRETCH", "cell_lengths", "cells_followed"]
+__all__ = ["CELLS_WARN", "STRETCH", "cell_lengths", "cells_followed"]
 
 #: a block's cells follow the cell size when the drag made them this much longer or shorter (a share)
 STRETCH = 0.2
+
+#: the total cells changing by more than this share at a drag's end is a warning (the solve's time,
+#: the model's time step and the output files follow the count; it was an info line among others)
+CELLS_WARN = 0.2
 
 
 def _along(ring: np.ndarray, a: int, b: int) -> float:
@@ -81,4 +86,11 @@ def cells_followed(base: Any, layout: Any, report: Callable[[str, str], None] | 
         ]
         if changed:
             report("info", f"Cells follow the drag (its blocks' cells had stretched): {', '.join(changed)}")
+        n0, n1 = layout.n_cells, out.n_cells
+        if n0 and abs(n1 / n0 - 1.0) > CELLS_WARN:
+            report(
+                "warning",
+                f"The drag changes the grid from {n0:,} to {n1:,} cells ({100 * (n1 / n0 - 1):+.0f} %): the cells "
+                f"of {names} follow the cell size (Ctrl+Z undoes the drag; the Lake panel sets a block's cells)",
+            )
     return out

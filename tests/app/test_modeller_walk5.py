@@ -226,3 +226,42 @@ def test_the_grid_of_before_stays_greyed_when_a_drag_gives_blocks_new_cells(qtbo
     assert len(win.canvas.grid_curve.xData) == drawn  # the grid of before, still drawn
     assert win.canvas.grid_curve.opts["pen"].color().name() == "#b0b0b0"  # greyed
     assert "before the edit" in win.solve_status.label.text()
+
+
+def test_a_drag_that_changes_the_cell_count_much_says_so_as_a_warning(qtbot, win):
+    """A cut end of a ring lake dragged 40° round: at the drag's end the stretched blocks' cells
+    followed the cell size and the grid went from 3,072 to 3,840 cells, said only as an info line
+    among others ('Cells follow the drag ...: b0 16×148 → 20×132, ...').  A change of the total by
+    more than a fifth is a warning now, with both counts and the change."""
+    from app.lake import Lake, compute_layout
+    from app.layout_edit import handles
+    from meshcore import testing
+    from tests.app.waits import wait_for, wait_idle
+
+    poly = testing.round_lake(850_033, kind="ring", radius=2000.0)
+    lake = Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        target_cells=3000,
+    )
+    win.lake_ctl.generate_after = False
+    win.editor.set_lake(lake.replaced(layout=compute_layout(lake)), "Auto layout")
+    lay0 = win.doc.project.layout
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append((level, text)))
+    win.set_tool("layout")
+    tool = win.canvas.tool
+    end = max((h for h in handles(lay0) if h.kind == "end"), key=lambda h: np.hypot(*h.xy))  # on the shore
+    a0, r = np.arctan2(end.xy[1], end.xy[0]), np.hypot(*end.xy)
+    path = [(r * np.cos(a0 + t), r * np.sin(a0 + t)) for t in np.radians(np.linspace(0, 40, 9))]
+    assert tool.drag("start", path[0], end.xy)
+    for p in path[1:]:
+        tool.drag("move", p, end.xy)
+        qtbot.wait(20)
+    tool.drag("finish", path[-1], end.xy)
+    wait_for(qtbot, win, lambda: not win.lake_ctl.editing and win.doc.project.layout is not lay0)
+    wait_idle(qtbot, win)
+    n0, n1 = lay0.n_cells, win.doc.project.layout.n_cells
+    assert abs(n1 / n0 - 1) > 0.2  # the case: a large change (app.drag_cells.CELLS_WARN)
+    warned = [t for level, t in said if level == "warning" and f"from {n0:,} to {n1:,} cells" in t]
+    assert len(warned) == 1 and f"({100 * (n1 / n0 - 1):+.0f} %)" in warned[0], said
