@@ -14,7 +14,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from .items import Scatter, set_points, set_polylines
 
-__all__ = ["LakeOverlay", "block_label_points"]
+__all__ = ["LakeOverlay", "block_label_points", "left_out_islands"]
 
 CUT_COLOUR = "#9467bd"
 SHORE_COLOUR = "#1f5fa8"
@@ -57,6 +57,25 @@ def block_label_points(layout, polygons=None) -> np.ndarray:
     return np.asarray(out, float).reshape(-1, 2)
 
 
+def left_out_islands(holes, layout) -> list[int]:
+    """Indices of the islands ``layout`` left out (its water covers them: narrower than two cells)."""
+    if layout is None or not len(holes):
+        return []
+    from shapely.geometry import Polygon
+    from shapely.prepared import prep
+
+    water = prep(layout.polygon)
+    out = []
+    for k, h in enumerate(holes):
+        try:
+            inside = len(h) >= 3 and water.contains(Polygon(h).representative_point())
+        except Exception:  # a ring shapely cannot make a polygon of: drawn as shore, as before
+            inside = False
+        if inside:
+            out.append(k)
+    return out
+
+
 class LakeOverlay:
     """The lake's items on a canvas (a :class:`pyqtgraph.PlotWidget`)."""
 
@@ -67,6 +86,12 @@ class LakeOverlay:
         self.shore.setZValue(4)
         # drawn again only when the shore or the view changes, not with every frame of a drag (as the grid)
         self.shore.setCacheMode(QtWidgets.QGraphicsItem.CacheMode.DeviceCoordinateCache)
+        # islands the layout left out (narrower than two cells): dashed, under the grid's lines, as
+        # ``meshcore mesh --png`` draws them; drawn as shore they sat over the grid as if it went round them
+        self.left_out = pg.PlotCurveItem(
+            pen=pg.mkPen(SHORE_COLOUR, width=1, style=QtCore.Qt.PenStyle.DashLine), connect="finite"
+        )
+        self.left_out.setZValue(-1)
         self.cuts = pg.PlotCurveItem(pen=pg.mkPen(CUT_COLOUR, width=2.5), connect="finite")
         self.cuts.setZValue(7)
         self.cut_ends = Scatter(
@@ -83,7 +108,7 @@ class LakeOverlay:
         self.misses.setZValue(31)
         self.drag_point = Scatter(size=13, symbol="o", pen=pg.mkPen("#d62728", width=2), brush=None)
         self.drag_point.setZValue(43)
-        for it in (self.shore, self.cuts, self.cut_ends, self.corners, self.misses, self.drag_point):
+        for it in (self.shore, self.left_out, self.cuts, self.cut_ends, self.corners, self.misses, self.drag_point):
             canvas.addItem(it)
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.labels: list[pg.TextItem] = []
@@ -112,10 +137,13 @@ class LakeOverlay:
         lake = project.lake
         if lake is None:
             set_polylines(self.shore, [])
+            set_polylines(self.left_out, [])
             self._draw_layout(None)
             return
-        rings = [lake.outline, *lake.holes]
+        out = left_out_islands(lake.holes, lake.layout)
+        rings = [lake.outline, *(h for k, h in enumerate(lake.holes) if k not in out)]
         set_polylines(self.shore, [np.vstack([r, r[:1]]) for r in rings if len(r)])
+        set_polylines(self.left_out, [np.vstack([lake.holes[k], lake.holes[k][:1]]) for k in out])
         self._draw_layout(lake.layout)
 
     def _draw_layout(self, layout) -> None:

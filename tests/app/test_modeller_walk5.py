@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 import shapely
+from PySide6 import QtCore
 
 pytestmark = pytest.mark.gui
 
@@ -163,8 +164,6 @@ def test_one_click_on_a_failed_limit_goes_to_its_worst_place(qtbot, win, tmp_pat
     view stayed; going to the worst place needed a double-click nobody guessed.  One click goes
     there now (the window zooms to it, its block active); a new verdict selecting its first failed
     limit by itself does not move the view."""
-    from PySide6 import QtCore
-
     from tests.app.test_modeller import _laid_out
 
     _laid_out(qtbot, win, tmp_path, 850_021)
@@ -265,3 +264,25 @@ def test_a_drag_that_changes_the_cell_count_much_says_so_as_a_warning(qtbot, win
     assert abs(n1 / n0 - 1) > 0.2  # the case: a large change (app.drag_cells.CELLS_WARN)
     warned = [t for level, t in said if level == "warning" and f"from {n0:,} to {n1:,} cells" in t]
     assert len(warned) == 1 and f"({100 * (n1 / n0 - 1):+.0f} %)" in warned[0], said
+
+
+def test_an_island_the_layout_left_out_is_drawn_dashed_under_the_grid(qtbot, win, tmp_path):
+    """An island narrower than two cells is left out by the layout (a note says so), but the canvas
+    drew it as shore, over the grid, as if the grid went round it (seen on a generated archipelago).
+    Now the shore is the outline and the islands the grid goes round; a left-out island is a dashed
+    ring under the grid's lines."""
+    from tests.app.test_lake import _thin_island_lake, lay_out
+
+    lay = lay_out(qtbot, win, _thin_island_lake(tmp_path / "thin.geojson"), cell_size=500.0)
+    lake = win.doc.project.lake
+    assert len(lake.holes) == 2 and len(lay.polygon.interiors) == 1  # the needle left out
+    items = win.canvas.lake_items
+
+    def rings(item) -> int:
+        y = item.yData
+        return 0 if y is None else int(np.isnan(y).sum())
+
+    assert rings(items.shore) == 2  # the shore and the island the grid goes round
+    assert rings(items.left_out) == 1
+    assert items.left_out.opts["pen"].style() == QtCore.Qt.PenStyle.DashLine
+    assert items.left_out.zValue() < win.canvas.grid_curve.zValue()
