@@ -269,8 +269,10 @@ class LakeQualityBox(QtWidgets.QGroupBox):
                 else "The verdict follows when the grid of this layout is made (F5 if it is not being made)."
             )
             self.table.setRowCount(0)
+            self.table.hide()  # an empty table (its header, an empty box) stood under the text
             self.misses.emit(None)
             return
+        self.table.show()
         v = check(m, self.preset.currentText())
         self.verdict = v
         s = m.summary()

@@ -286,3 +286,19 @@ def test_an_island_the_layout_left_out_is_drawn_dashed_under_the_grid(qtbot, win
     assert rings(items.left_out) == 1
     assert items.left_out.opts["pen"].style() == QtCore.Qt.PenStyle.DashLine
     assert items.left_out.zValue() < win.canvas.grid_curve.zValue()
+
+
+def test_the_verdict_table_is_hidden_while_there_is_no_verdict(qtbot, win, tmp_path):
+    """A laid-out lake opened with no grid yet (or with auto-generate off after Auto layout): the
+    Quality dock said "The verdict follows when the grid of this layout is made" above an empty
+    verdict table (its header, an empty box).  The table shows when there is a verdict."""
+    from app.io_adapter import save_project
+
+    if win.solver.auto:
+        win.a_auto.trigger()
+    path = tmp_path / "walk5.toml"
+    save_project(_laid_out_project(850_051), path)
+    assert win.io.open_path(path)
+    box = win.lake_quality
+    assert not box.isHidden() and "verdict follows" in box.headline.text()
+    assert box.table.isHidden()
