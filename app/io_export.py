@@ -70,6 +70,10 @@ class ExportMixin:
     def export_mesh(self, path: Path, format: str | None = None) -> bool:
         """Write the grids (a multiblock result with its connectivity) with meshcore.io
         (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
+        if path.suffix.lower() == ".inp" and path.name.lower() != "cell.inp":
+            path = self._efdc_cell_inp(path)
+            if path is None:
+                return False
         grids = [self.doc.grids[k] for k in sorted(self.doc.grids)]
         mb = self.doc.multiblock
         p = self.doc.project
@@ -92,6 +96,24 @@ class ExportMixin:
         self.remember_dir(path)
         self.win.message(f"Exported {len(grids)} block(s) to {path}")
         return True
+
+    def _efdc_cell_inp(self, path: Path) -> Path | None:
+        """EFDC reads its grid from files of fixed names (``cell.inp`` and four beside it): a name the
+        user typed (``lake.inp``) becomes ``cell.inp`` in its folder; files of those names already
+        there are replaced only when the user says so (None: not confirmed)."""
+        from meshcore.io.efdc import FILES
+
+        target = path.with_name("cell.inp")
+        there = [n for n in FILES if (path.parent / n).exists()]
+        text = f"EFDC reads its grid from files of fixed names: writing {', '.join(FILES)} into {path.parent}"
+        if there and not self.quiet:
+            b = QtWidgets.QMessageBox.StandardButton
+            ask = f"{text}.\n\n{', '.join(there)} already exist there. Replace them?"
+            if QtWidgets.QMessageBox.question(self._parent(), "EFDC files", ask, b.Yes | b.No) != b.Yes:
+                self.win.message("EFDC export cancelled: nothing written")
+                return None
+        self.doc.report("info", text + (f" (replacing {', '.join(there)})" if there else ""))
+        return target
 
     def _folds_confirmed(self) -> bool:
         """A grid with folded or non-convex cells (a lake's, or any block's): warn (and ask, unless quiet)
