@@ -57,16 +57,23 @@ def _grd_text(gs: GridSet, k: int = 0, *, lonlat: bool = False) -> tuple[str, in
     else:
         X, Y = gs.world(k)
     mmax, nmax = X.shape
-    head = ["* Deltares, Delft3D-RGFGRID grid written by meshcore (gcmesh)"]
-    if gs.frame.crs and not lonlat:
-        head.append(f"* Projection: {gs.frame.crs}")
+    return grd_text(X, Y, gs.frame.crs, lonlat, MISSING), mmax, nmax
+
+
+def grd_text(X: np.ndarray, Y: np.ndarray, crs: Any, lonlat: bool, missing: float, title: str = "") -> str:
+    """The text of an RGFGRID ``.grd`` of the node arrays ``X``, ``Y`` (MMAX × NMAX) with ``missing``
+    in the header (``title``: added to the first comment line)."""
+    mmax, nmax = X.shape
+    head = ["* Deltares, Delft3D-RGFGRID grid written by meshcore (gcmesh)" + title]
+    if crs and not lonlat:
+        head.append(f"* Projection: {crs}")
     head += [
         f"Coordinate System = {'Spherical' if lonlat else 'Cartesian'}",
-        f"Missing Value     = {MISSING:25.17E}",
+        f"Missing Value     = {missing:25.17E}",
         f"{mmax:8d}{nmax:8d}",
         " 0 0 0",
     ]
-    return "\n".join(head + _rows("x", X) + _rows("y", Y)) + "\n", mmax, nmax
+    return "\n".join(head + _rows("x", X) + _rows("y", Y)) + "\n"
 
 
 def _enc_text(mmax: int, nmax: int) -> str:

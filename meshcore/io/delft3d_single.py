@@ -45,7 +45,7 @@ import numpy as np
 from ..errors import WriteError
 from ._atomic import atomic_paths
 from ._base import GridSet
-from .delft3d import _rows
+from .delft3d import grd_text
 
 __all__ = ["MISSING_VALUE", "enclosure_polygons", "merged", "write_grd_single"]
 
@@ -136,17 +136,7 @@ def _grd_text(gs: GridSet, x: np.ndarray, y: np.ndarray, lonlat: bool) -> str:
         X, Y = gs.frame.to_world(np.where(ok, x, 0.0), np.where(ok, y, 0.0))
     X = np.where(ok, X, MISSING_VALUE)
     Y = np.where(ok, Y, MISSING_VALUE)
-    mmax, nmax = X.shape
-    head = ["* Deltares, Delft3D-RGFGRID grid written by meshcore (gcmesh): blocks merged into one domain"]
-    if gs.frame.crs and not lonlat:
-        head.append(f"* Projection: {gs.frame.crs}")
-    head += [
-        f"Coordinate System = {'Spherical' if lonlat else 'Cartesian'}",
-        f"Missing Value     = {MISSING_VALUE:25.17E}",
-        f"{mmax:8d}{nmax:8d}",
-        " 0 0 0",
-    ]
-    return "\n".join(head + _rows("x", X) + _rows("y", Y)) + "\n"
+    return grd_text(X, Y, gs.frame.crs, lonlat, MISSING_VALUE, ": blocks merged into one domain")
 
 
 def write_grd_single(path: Path, gs: GridSet, *, lonlat: bool = False, **_: Any) -> None:

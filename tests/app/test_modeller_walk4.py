@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import shapely
 
+from tests.app.drawing import drag_shore_end_round
 from tests.app.test_modeller import _laid_out
 from tests.app.waits import wait_for, wait_idle
 
@@ -106,7 +107,6 @@ def test_a_long_drag_of_a_cut_end_lets_the_stretched_blocks_cells_follow(qtbot, 
     and one undo step brings the layout of before back."""
     from app.drag_cells import STRETCH, cell_lengths
     from app.lake import Lake, compute_layout
-    from app.layout_edit import handles
     from meshcore import testing
 
     poly = testing.round_lake(762031, kind="ring", radius=2000.0)
@@ -121,19 +121,8 @@ def test_a_long_drag_of_a_cut_end_lets_the_stretched_blocks_cells_follow(qtbot, 
     lay0 = win.doc.project.layout
     said = []
     win.doc.reported.connect(lambda level, text: said.append(text))
-    win.set_tool("layout")
-    tool = win.canvas.tool
-    end = max((h for h in handles(lay0) if h.kind == "end"), key=lambda h: np.hypot(*h.xy))  # on the shore
-    a0, r = np.arctan2(end.xy[1], end.xy[0]), np.hypot(*end.xy)
-    path = [(r * np.cos(a0 + t), r * np.sin(a0 + t)) for t in np.radians(np.linspace(0, 40, 9))]
     n = win.stack.count()
-    assert tool.drag("start", path[0], end.xy)
-    for p in path[1:]:
-        tool.drag("move", p, end.xy)
-        qtbot.wait(20)
-    tool.drag("finish", path[-1], end.xy)
-    wait_for(qtbot, win, lambda: not win.lake_ctl.editing and win.doc.project.layout is not lay0)
-    wait_idle(qtbot, win)
+    drag_shore_end_round(qtbot, win, lay0)
     lay1 = win.doc.project.layout
     assert win.lake_ctl.edit_error is None
     assert [b.cells for b in lay1.blocks] != [b.cells for b in lay0.blocks]

@@ -11,6 +11,8 @@ import pytest
 import shapely
 from PySide6 import QtCore
 
+from tests.app.drawing import drag_shore_end_round
+
 pytestmark = pytest.mark.gui
 
 
@@ -189,7 +191,6 @@ def test_the_grid_of_before_stays_greyed_when_a_drag_gives_blocks_new_cells(qtbo
     grids whose blocks changed cells) — the user had nothing to compare the new layout with.  The
     grid of before stays drawn, greyed, until F5 makes the new one; an export still refuses it."""
     from app.lake import Lake, compute_layout
-    from app.layout_edit import handles
     from meshcore import testing
     from tests.app.waits import wait_for, wait_idle
 
@@ -207,18 +208,7 @@ def test_the_grid_of_before_stays_greyed_when_a_drag_gives_blocks_new_cells(qtbo
     lay0 = win.doc.project.layout
     drawn = len(win.canvas.grid_curve.xData)
     assert drawn > 0
-    win.set_tool("layout")
-    tool = win.canvas.tool
-    end = max((h for h in handles(lay0) if h.kind == "end"), key=lambda h: np.hypot(*h.xy))  # on the shore
-    a0, r = np.arctan2(end.xy[1], end.xy[0]), np.hypot(*end.xy)
-    path = [(r * np.cos(a0 + t), r * np.sin(a0 + t)) for t in np.radians(np.linspace(0, 40, 9))]
-    assert tool.drag("start", path[0], end.xy)
-    for p in path[1:]:
-        tool.drag("move", p, end.xy)
-        qtbot.wait(20)
-    tool.drag("finish", path[-1], end.xy)
-    wait_for(qtbot, win, lambda: not win.lake_ctl.editing and win.doc.project.layout is not lay0)
-    wait_idle(qtbot, win)
+    drag_shore_end_round(qtbot, win, lay0)
     lay1 = win.doc.project.layout
     assert [b.cells for b in lay1.blocks] != [b.cells for b in lay0.blocks]  # the cells followed the drag
     assert not win.doc.grids  # no grid of this layout yet
@@ -233,9 +223,7 @@ def test_a_drag_that_changes_the_cell_count_much_says_so_as_a_warning(qtbot, win
     among others ('Cells follow the drag ...: b0 16×148 → 20×132, ...').  A change of the total by
     more than a fifth is a warning now, with both counts and the change."""
     from app.lake import Lake, compute_layout
-    from app.layout_edit import handles
     from meshcore import testing
-    from tests.app.waits import wait_for, wait_idle
 
     poly = testing.round_lake(850_033, kind="ring", radius=2000.0)
     lake = Lake(
@@ -248,18 +236,7 @@ def test_a_drag_that_changes_the_cell_count_much_says_so_as_a_warning(qtbot, win
     lay0 = win.doc.project.layout
     said = []
     win.doc.reported.connect(lambda level, text: said.append((level, text)))
-    win.set_tool("layout")
-    tool = win.canvas.tool
-    end = max((h for h in handles(lay0) if h.kind == "end"), key=lambda h: np.hypot(*h.xy))  # on the shore
-    a0, r = np.arctan2(end.xy[1], end.xy[0]), np.hypot(*end.xy)
-    path = [(r * np.cos(a0 + t), r * np.sin(a0 + t)) for t in np.radians(np.linspace(0, 40, 9))]
-    assert tool.drag("start", path[0], end.xy)
-    for p in path[1:]:
-        tool.drag("move", p, end.xy)
-        qtbot.wait(20)
-    tool.drag("finish", path[-1], end.xy)
-    wait_for(qtbot, win, lambda: not win.lake_ctl.editing and win.doc.project.layout is not lay0)
-    wait_idle(qtbot, win)
+    drag_shore_end_round(qtbot, win, lay0)
     n0, n1 = lay0.n_cells, win.doc.project.layout.n_cells
     assert abs(n1 / n0 - 1) > 0.2  # the case: a large change (app.drag_cells.CELLS_WARN)
     warned = [t for level, t in said if level == "warning" and f"from {n0:,} to {n1:,} cells" in t]

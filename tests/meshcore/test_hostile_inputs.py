@@ -11,18 +11,9 @@ import pytest
 from meshcore.cli import main
 from meshcore.io import read_blocks
 from tests.conftest import DATA, ROOT
+from tests.meshcore.test_cli_bad_input import _bad
 
 BOTTLE = ROOT / "resources" / "examples" / "bottle-coarse.toml"
-
-
-def _bad(capsys, argv, *needles):
-    rc = main([str(a) for a in argv])
-    err = capsys.readouterr().err
-    assert rc == 2, err
-    assert err.count("\n") == 1 and "Traceback" not in err, err
-    for n in needles:
-        assert n in err, (n, err)
-    return err
 
 
 @pytest.mark.parametrize(
