@@ -179,6 +179,19 @@ def guarded(args: argparse.Namespace, frame: Any, make):
         return None
 
 
+def _beside(p: Path, fmt: str) -> str:
+    """The files a format writes beside ``p``, as the end of the "wrote" line."""
+    if fmt == "efdc":
+        from ..io.efdc import FILES
+
+        return f" and {', '.join(FILES[1:])} beside it"
+    if fmt == "delft3d-dd":
+        return f" and a .grd and .enc of every block beside it ({p.stem}_*)"
+    if fmt in ("delft3d", "delft3d-single") and p.with_suffix(".enc").exists():
+        return f" and {p.with_suffix('.enc').name}"
+    return ""
+
+
 def finish(
     args, mb, poly, frame, h: float, outputs, say: _Say, t_start: float, per_part: Any = None, left_out=()
 ) -> int:
@@ -196,7 +209,7 @@ def finish(
     say(f"quality: {n_folded} folded cells, mean deviation from 90° {m.mean('deviation'):.2f}°, {say.lap():.1f} s")
     for p, fmt in outputs:
         write(p, mb, fmt.name, crs=frame)
-        say(f"wrote {p}")
+        say(f"wrote {p}{_beside(p, fmt.name)}")
     if args.png:
         _figure(Path(args.png), mb, poly, frame, args.colour, m, left_out)
         say(f"wrote {args.png}")

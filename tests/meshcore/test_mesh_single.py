@@ -58,6 +58,9 @@ def test_single_domain_and_efdc_end_to_end(tmp_path, round_csv):
     types, dxdy, lxly, corners = read_efdc(out)
     assert int((types == 5).sum()) == n_cells == len(dxdy) == len(lxly) == len(corners)
     assert sorted(os.listdir(out)) == sorted(["cell.inp", "celllt.inp", "dxdy.inp", "lxly.inp", "corners.inp"])
+    # the progress names every file written, not only the one given
+    assert f"wrote {out / 'cell.inp'} and celllt.inp, dxdy.inp, lxly.inp, corners.inp beside it" in run.err
+    assert f"wrote {tmp_path / 'r.grd'} and r.enc" in run.err
 
 
 def test_a_layout_that_does_not_fit_is_refused_before_the_solve(tmp_path):
