@@ -12,6 +12,7 @@ couple of seconds of work.
 
 from __future__ import annotations
 
+import json
 import logging
 import re
 import time
@@ -185,11 +186,15 @@ class IOController(ExportMixin, QtCore.QObject):
         if path:
             self.import_points(Path(path))
 
-    def import_points(self, path: Path, *, project_lonlat: bool | None = None, part: int | None = None) -> bool:
+    def import_points(
+        self, path: Path, *, project_lonlat: bool | None = None, part: int | None = None, again: bool = False
+    ) -> bool:
         """Read points as a new closed block with automatic corners (undoable).
 
         A lake file of several separate parts of water opens part ``part`` (1: the largest); with
-        ``None`` a dialog asks which (:class:`app.parts_dialog.PartsDialog`; quiet: the largest).
+        ``None`` (or a part the file no longer has) a dialog asks which
+        (:class:`app.parts_dialog.PartsDialog`; quiet: the largest).  ``again``: File ▸ Open recent
+        (``part`` the one opened last time: the message says so).
         """
         path = Path(path)
         try:
@@ -238,6 +243,7 @@ class IOController(ExportMixin, QtCore.QObject):
             except (MeshcoreError, ValueError) as exc:
                 self.win.error("Cannot project coordinates", exc)
                 return False
+        asked_part = part
         lake, (k_part, n_parts) = self._read_lake(
             pd, frame, lonlat=bool(pd.lonlat and project_lonlat is not False), part=part
         )
@@ -252,13 +258,16 @@ class IOController(ExportMixin, QtCore.QObject):
         stem = f"{path.stem}_part{k_part}" if n_parts > 1 else path.stem  # as meshcore mesh --case names it
         block = block_from_points(pts, stem)
         self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=stem)
-        self.add_recent(path)  # File ▸ Open recent imports it again (and remembers its folder)
+        # File ▸ Open recent imports it again (the same part of water) and remembers its folder
+        self.add_recent(path, part=k_part if n_parts > 1 else None)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
         n_isl = len(lake.holes) if lake is not None else 0
         isl = f" and {n_isl} island{'s' * (n_isl != 1)}" if n_isl else ""  # it said "1 island(s)"
         which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
+        if n_parts > 1 and again and asked_part == k_part:
+            which = f" (part {k_part} of {n_parts}, the one opened last time: File ▸ Import asks for another)"
         self.win.message(
             f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
             f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
@@ -276,9 +285,14 @@ class IOController(ExportMixin, QtCore.QObject):
         if pd.pointset is None:
             return None, (1, 1)
         try:
-            parts, _fr, notes = read_lake_parts(pd.pointset, frame, lonlat=lonlat)
+            parts, fr, notes = read_lake_parts(pd.pointset, frame, lonlat=lonlat)
             metres = not (pd.lonlat and not lonlat)  # lon/lat kept as degrees: areas in degrees²
-            k = 1 if len(parts) == 1 else part if part is not None else self.choose_part(pd.path, parts, metres)
+            if len(parts) == 1:
+                k = 1
+            elif part is not None and 1 <= part <= len(parts):
+                k = part
+            else:  # asked, or remembered from a file that has fewer parts now
+                k = self.choose_part(pd.path, parts, metres, frame=fr, lonlat=bool(pd.lonlat))
             if k == 0:
                 return None, (0, len(parts))
             outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat, part=k, metres=metres)
@@ -296,14 +310,14 @@ class IOController(ExportMixin, QtCore.QObject):
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
         return Lake(outline=outer, holes=tuple(islands)), (k, len(parts))
 
-    def choose_part(self, path, parts: list, metres: bool = True) -> int:
+    def choose_part(self, path, parts: list, metres: bool = True, *, frame=None, lonlat: bool = False) -> int:
         """The part of the water to open (from 1, largest first), asked in a dialog; 0: cancelled.
         Quiet (tests, scripts): the largest, as ``meshcore mesh --part 1``."""
         if self.quiet:
             return 1
         from .parts_dialog import PartsDialog
 
-        dlg = PartsDialog(Path(path).name, parts, metres=metres, parent=self._parent())
+        dlg = PartsDialog(Path(path).name, parts, metres=metres, frame=frame, lonlat=lonlat, parent=self._parent())
         return dlg.chosen() if dlg.exec() == QtWidgets.QDialog.DialogCode.Accepted else 0
 
     def _add_imported(
@@ -350,11 +364,34 @@ class IOController(ExportMixin, QtCore.QObject):
     def remember_dir(self, path: Path) -> None:
         self.settings.setValue("last_dir", str(Path(path).parent))
 
-    def add_recent(self, path: Path) -> None:
-        rec = [str(path)] + [p for p in self.recent() if p != str(path)]
-        self.settings.setValue("recent", rec[:MAX_RECENT])
+    def add_recent(self, path: Path, *, part: int | None = None) -> None:
+        """First in File ▸ Open recent; ``part``: the part of water opened of a file of several,
+        opened again from there without asking (the record's "recent_parts")."""
+        rec = ([str(path)] + [p for p in self.recent() if p != str(path)])[:MAX_RECENT]
+        self.settings.setValue("recent", rec)
+        parts = {p: k for p, k in self.recent_parts().items() if p in rec and p != str(path)}
+        if part is not None:
+            parts[str(path)] = int(part)
+        self.settings.setValue("recent_parts", json.dumps(parts))
         self.remember_dir(path)
         self.refresh_recent()
+
+    def recent_parts(self) -> dict[str, int]:
+        """The part of water opened last of each recent file of several parts (path: part from 1)."""
+        try:
+            v = json.loads(str(self.settings.value("recent_parts", "{}") or "{}"))
+            return {str(p): int(k) for p, k in v.items()} if isinstance(v, dict) else {}
+        except (ValueError, TypeError, AttributeError):  # a record written by hand or broken: none
+            return {}
+
+    def open_recent(self, path: str) -> bool:
+        """File ▸ Open recent: the file again (a file of several parts of water: the part opened last)."""
+        if not self.maybe_save():
+            return False
+        part = self.recent_parts().get(str(path))
+        if part is None or Path(path).suffix.lower() == ".toml":
+            return self.open_path(path)
+        return self.import_points(Path(path), part=part, again=True)
 
     def recent(self) -> list[str]:
         v = self.settings.value("recent", [])
@@ -368,7 +405,7 @@ class IOController(ExportMixin, QtCore.QObject):
         self.recent_menu.clear()
         rec = self.recent()
         for p in rec:
-            self.recent_menu.addAction(p, lambda p=p: self.maybe_save() and self.open_path(p))
+            self.recent_menu.addAction(p, lambda p=p: self.open_recent(p))
         self.recent_menu.setEnabled(bool(rec))
 
     # ---------------------------------------------------------- autosave

@@ -11,24 +11,72 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 from PySide6 import QtCore, QtWidgets
 
 from .lake import area_text, part_area
 
-__all__ = ["PartsDialog", "part_rows"]
+__all__ = ["PartsDialog", "crs_unit", "near_header", "part_centres", "part_rows"]
 
 
-def part_rows(parts: list, *, metres: bool = True) -> list[tuple[str, str, str, str, str]]:
-    """Rows of the table: number, name, water area, islands, centre (``parts`` as
-    :func:`app.lake.read_lake_parts` gives them)."""
+def crs_unit(crs: str | None) -> str:
+    """The unit of a projected CRS's x axis as a modeller writes it ("m", "ft", "US survey foot");
+    "m" for none (the app takes plain numbers as metres, as its areas in km² do)."""
+    if not crs:
+        return "m"
+    from meshcore.crs import proj_call
+
+    def unit():
+        import pyproj
+
+        return pyproj.CRS.from_user_input(crs).axis_info[0].unit_name
+
+    try:
+        name = str(proj_call(unit))
+    except Exception:  # an unknown CRS: its numbers said without a unit
+        return "units"
+    return {"metre": "m", "meter": "m", "foot": "ft", "kilometre": "km"}.get(name, name)
+
+
+def part_centres(parts: list, frame: Any = None, *, lonlat: bool = False, metres: bool = True):
+    """Where each part lies, in the numbers the user knows the file by, and their unit: the
+    file's longitude/latitude for a lon/lat file (``lonlat``; projected or kept as degrees,
+    ``metres`` False), else the CRS's own coordinates (the local ones plus the frame's origin)
+    in the CRS's unit.  ``[(x, y), ...], "lon/lat" | unit``."""
     from shapely.geometry import Polygon
 
+    local = np.array([Polygon(outer).centroid.coords[0] for _name, outer, _isl in parts], float).reshape(-1, 2)
+    if not metres:  # lon/lat kept as degrees: the parts are in degrees already
+        return [tuple(c) for c in local], "lon/lat"
+    if lonlat and frame is not None and frame.crs:
+        try:
+            lon, lat = frame.to_lonlat(local[:, 0], local[:, 1])
+            return list(zip(np.atleast_1d(lon).tolist(), np.atleast_1d(lat).tolist(), strict=True)), "lon/lat"
+        except Exception:  # PROJ refused: the projected numbers below, with their unit
+            pass
+    if frame is not None:
+        x, y = frame.to_world(local[:, 0], local[:, 1])
+        local = np.column_stack([x, y])
+    return [tuple(c) for c in local], crs_unit(getattr(frame, "crs", None))
+
+
+def part_rows(
+    parts: list, *, metres: bool = True, frame: Any = None, lonlat: bool = False
+) -> list[tuple[str, str, str, str, str]]:
+    """Rows of the table: number, name, water area, islands, centre (``parts`` as
+    :func:`app.lake.read_lake_parts` gives them; the centre as :func:`part_centres` says)."""
+    centres, _unit = part_centres(parts, frame, lonlat=lonlat, metres=metres)
     rows = []
-    for k, part in enumerate(parts, start=1):
-        name, outer, islands = part
-        c = Polygon(outer).centroid
-        rows.append((str(k), str(name), area_text(part_area(part), metres), str(len(islands)), f"{c.x:.6g}, {c.y:.6g}"))
+    for k, (part, (x, y)) in enumerate(zip(parts, centres, strict=True), start=1):
+        name, _outer, islands = part
+        rows.append((str(k), str(name), area_text(part_area(part), metres), str(len(islands)), f"{x:.6g}, {y:.6g}"))
     return rows
+
+
+def near_header(unit: str) -> str:
+    """The heading of the centre column, with its unit (it had none: metres of a local origin,
+    degrees or feet looked alike)."""
+    return "near (lon, lat)" if unit == "lon/lat" else f"near (x, y), {unit}"
 
 
 class PartsDialog(QtWidgets.QDialog):
@@ -36,7 +84,18 @@ class PartsDialog(QtWidgets.QDialog):
 
     HEADERS = ("part", "name", "water area", "islands", "near (x, y)")
 
-    def __init__(self, file_name: str, parts: list, *, metres: bool = True, parent: Any = None) -> None:
+    def __init__(
+        self,
+        file_name: str,
+        parts: list,
+        *,
+        metres: bool = True,
+        frame: Any = None,
+        lonlat: bool = False,
+        parent: Any = None,
+    ) -> None:
+        """``frame``: the frame the parts are in (:func:`app.lake.read_lake_parts`); ``lonlat``:
+        the file holds longitude/latitude (the centres are shown in it)."""
         super().__init__(parent)
         self.setWindowTitle("Several parts of water")
         text = QtWidgets.QLabel(
@@ -46,13 +105,14 @@ class PartsDialog(QtWidgets.QDialog):
         )
         text.setWordWrap(True)
         self.table = QtWidgets.QTableWidget(len(parts), len(self.HEADERS), self)
-        self.table.setHorizontalHeaderLabels(self.HEADERS)
+        _centres, unit = part_centres(parts[:1], frame, lonlat=lonlat, metres=metres)
+        self.table.setHorizontalHeaderLabels([*self.HEADERS[:-1], near_header(unit)])
         self.table.verticalHeader().setVisible(False)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         right = QtCore.Qt.AlignmentFlag.AlignRight | QtCore.Qt.AlignmentFlag.AlignVCenter
-        for r, row in enumerate(part_rows(parts, metres=metres)):
+        for r, row in enumerate(part_rows(parts, metres=metres, frame=frame, lonlat=lonlat)):
             for c, value in enumerate(row):
                 item = QtWidgets.QTableWidgetItem(value)
                 if c in (0, 2, 3):

@@ -1,0 +1,129 @@
+"""Small things a lake modeller trips over (session 21b): the unit of where each part of water
+lies, Open recent of a file of several parts, and the export of a single-domain grid."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from tests.app.test_modeller_walk5 import _ellipse, _reservoir
+
+pytestmark = pytest.mark.gui
+
+
+def _two_basins(tmp_path, x0: float = 0.0, y0: float = 0.0, crs: str | None = None):
+    """Two basins in metres: a CSV of two rings (no CRS), or a GeoJSON MultiPolygon in ``crs``."""
+    big = _ellipse(x0 + 5000.0, y0 + 3000.0, 2500.0, 1000.0)
+    small = _ellipse(x0 + 5500.0, y0 + 500.0, 1200.0, 600.0)
+    if crs is None:
+        path = tmp_path / "basins.csv"
+        rings = ["\n".join(f"{x},{y}" for x, y in r) for r in (big, small)]
+        path.write_text("> big\n" + rings[0] + "\n> small\n" + rings[1] + "\n")
+        return path
+    geom = {"type": "MultiPolygon", "coordinates": [[big], [small]]}
+    path = tmp_path / "basins.geojson"
+    feat = {"type": "Feature", "properties": {"name": "Basins"}, "geometry": geom}
+    legacy = {"type": "name", "properties": {"name": crs}}
+    path.write_text(json.dumps({"type": "FeatureCollection", "crs": legacy, "features": [feat]}))
+    return path
+
+
+def _near(dlg):
+    t = dlg.table
+    head = t.horizontalHeaderItem(t.columnCount() - 1).text()
+    xy = [[float(v) for v in t.item(r, t.columnCount() - 1).text().split(",")] for r in range(t.rowCount())]
+    return head, np.array(xy)
+
+
+def test_the_parts_dialog_says_in_what_unit_each_part_lies(qtbot, tmp_path):
+    """Was "near (x, y)" with no unit, and for a lon/lat file the numbers were metres from the
+    project's local origin (the upper basin "near -1.2e+03, 2.3e+03"), which the user finds in
+    neither the file nor a map.  Now: a lon/lat file's parts in lon/lat, a file in metres in its
+    own numbers with "m"."""
+    from app.lake import read_lake_parts
+    from app.parts_dialog import PartsDialog
+    from meshcore.io import read_points
+
+    parts, frame, _ = read_lake_parts(read_points(_reservoir(tmp_path)), lonlat=True)
+    dlg = PartsDialog("reservoir.kml", parts, frame=frame, lonlat=True)
+    qtbot.addWidget(dlg)
+    head, xy = _near(dlg)
+    assert head == "near (lon, lat)"
+    np.testing.assert_allclose(xy, [[10.0, 46.02], [10.01, 45.995]], atol=2e-3)  # the ellipses' centres
+    # lon/lat kept as degrees (not projected): the same numbers, areas not in km²
+    parts, frame, _ = read_lake_parts(read_points(_reservoir(tmp_path)), lonlat=False)
+    dlg = PartsDialog("reservoir.kml", parts, metres=False, frame=frame, lonlat=True)
+    qtbot.addWidget(dlg)
+    assert _near(dlg)[0] == "near (lon, lat)"
+    # plain metres: the file's own numbers, in m
+    parts, frame, _ = read_lake_parts(read_points(_two_basins(tmp_path)))
+    dlg = PartsDialog("basins.csv", parts, frame=frame)
+    qtbot.addWidget(dlg)
+    head, xy = _near(dlg)
+    assert head == "near (x, y), m"
+    np.testing.assert_allclose(xy, [[5000.0, 3000.0], [5500.0, 500.0]], atol=20.0)
+    # a projected CRS, in a frame of a local origin (as a project in that CRS has it): the CRS's numbers
+    from meshcore.crs import Frame
+
+    frame = Frame("EPSG:32632", (600_000.0, 5_000_000.0))
+    pts = read_points(_two_basins(tmp_path, 600_000.0, 5_000_000.0, crs="urn:ogc:def:crs:EPSG::32632"))
+    parts, frame, _ = read_lake_parts(pts, frame)
+    dlg = PartsDialog("basins.geojson", parts, frame=frame)
+    qtbot.addWidget(dlg)
+    head, xy = _near(dlg)
+    assert head == "near (x, y), m"
+    np.testing.assert_allclose(xy, [[605_000.0, 5_003_000.0], [605_500.0, 5_000_500.0]], atol=20.0)
+
+
+def test_the_unit_of_a_projected_crs_is_its_own(qtbot):
+    from app.parts_dialog import crs_unit, near_header
+
+    assert crs_unit("EPSG:32632") == "m"
+    assert crs_unit("EPSG:2227") == "US survey foot"  # California zone 3, ftUS
+    assert near_header(crs_unit(None)) == "near (x, y), m"
+
+
+def test_open_recent_opens_the_part_chosen_last_time(qtbot, win, tmp_path, monkeypatch):
+    """Was: File ▸ Open recent on a file of several parts asked which part every time (and a user
+    who always works on the lower basin chose it every time).  Now the recent-files record keeps the
+    part chosen per file and Open recent opens it directly; File ▸ Import still asks."""
+    from PySide6 import QtWidgets
+
+    from app.parts_dialog import PartsDialog
+
+    path = _two_basins(tmp_path)
+    asked = []
+
+    def pick_second(dlg):
+        asked.append(dlg.table.rowCount())
+        dlg.table.selectRow(1)
+        return PartsDialog.DialogCode.Accepted
+
+    monkeypatch.setattr(PartsDialog, "exec", pick_second)
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", lambda *a: QtWidgets.QMessageBox.StandardButton.Discard)
+    win.quiet = False
+    try:
+        assert win.io.import_points(path)
+        assert asked == [2] and win.doc.project.title == "basins_part2"
+        win.io.add_recent(tmp_path / "other.csv")  # another file opened since: the record keeps the part
+        win.io.set_project(type(win.doc.project)())
+        recent = {a.text(): a for a in win.io.recent_menu.actions()}
+        recent[str(path)].trigger()
+        assert asked == [2], "Open recent asked again"
+        assert win.doc.project.title == "basins_part2"
+        assert "opened last time" in win._status.text()
+        # File ▸ Import asks (the dialog still reachable); the part chosen there is the one remembered
+        monkeypatch.setattr(QtWidgets.QFileDialog, "getOpenFileName", lambda *a, **k: (str(path), ""))
+        monkeypatch.setattr(PartsDialog, "exec", lambda dlg: PartsDialog.DialogCode.Accepted)  # the largest
+        win.io.import_dialog()
+        assert win.doc.project.title == "basins_part1"
+        assert win.io.recent_parts()[str(path)] == 1
+        # a part the file no longer has: asked again, not an error
+        win.settings.setValue("recent_parts", json.dumps({str(path): 5}))
+        monkeypatch.setattr(PartsDialog, "exec", pick_second)
+        assert win.io.open_recent(str(path))
+        assert asked == [2, 2] and win.doc.project.title == "basins_part2"
+    finally:
+        win.quiet = True
