@@ -89,7 +89,7 @@ class ExportMixin:
             else:
                 fio.write_mesh(path, grids, frame, format)
         except (MeshcoreError, OSError) as exc:
-            if self._offer_regular(path, exc):
+            if self._offer_regular(path, exc, format):
                 return False
             self.win.error("Cannot export mesh", exc)
             return False
@@ -142,22 +142,46 @@ class ExportMixin:
         r = QtWidgets.QMessageBox.question(self._parent(), "Folded cells", f"{text}.\n\nExport anyway?", b.Yes | b.No)
         return r == b.Yes
 
-    def _offer_regular(self, path: Path, exc: BaseException) -> bool:
-        """A .ddb that Delft3D cannot couple (3- or 5-block corners): offer a regular layout instead."""
+    def _offer_regular(self, path: Path, exc: BaseException, format: str | None = None) -> bool:
+        """A .ddb that Delft3D cannot couple, or a single-domain grid (Delft3D .grd of the blocks
+        merged, EFDC) whose layout does not fit one index space (3- or 5-block corners): the writer's
+        error and a regular layout offered instead; a lake with islands fits no single domain even
+        laid out regular, so that is said instead of the offer."""
         lay = self.doc.project.layout
-        if lay is None or Path(path).suffix.lower() != ".ddb" or self.doc.project.lake.regular:
+        suffix = Path(path).suffix.lower()
+        # a single domain refused for its index space (not for water in parts, or a folder it cannot write)
+        single = (format == "delft3d-single" or suffix == ".inp") and "one index space" in str(exc)
+        if lay is None or not (single or suffix == ".ddb") or len(lay.blocks) < 2:
+            return False  # one block: nothing to couple, the error says to write a .grd (no layout helps)
+        name = Path(path).name
+        if single and len(getattr(lay.polygon, "interiors", ())):
+            self.win.error(
+                "Cannot export mesh",
+                f"{name}: {exc}. A lake with islands does not fit one index space (a Delft3D single domain, "
+                "EFDC), not even laid out regular: the cell counts round an island do not add up. Export a .ddb "
+                "(Delft3D domain decomposition) or .vtm instead",
+            )
+            return True
+        if self.doc.project.lake.regular:  # the regular layout did not fit either: the writer's error says why
             return False
-        if len(lay.blocks) < 2:  # nothing to couple: the error says to write a .grd (no layout helps)
-            return False
-        text = (
-            f"Cannot export {Path(path).name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
-            "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"
-        )
+        if single:
+            title = "One index space"
+            text = (
+                f"Cannot export {name}: {exc}. One index space (a Delft3D single domain, EFDC) fits no corner where "
+                "3 or 5 blocks meet: Lake ▸ Auto layout, regular makes a layout without them, which fits when the "
+                "lake's arms do not fold onto each other (then export again)"
+            )
+        else:
+            title = "Delft3D domain decomposition"
+            text = (
+                f"Cannot export {name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
+                "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"
+            )
         self.win.message(text, error=True)
         if not self.quiet:
             b = QtWidgets.QMessageBox.StandardButton
             r = QtWidgets.QMessageBox.question(
-                self._parent(), "Delft3D domain decomposition", f"{text}.\n\nMake a regular layout now?", b.Yes | b.No
+                self._parent(), title, f"{text}.\n\nMake a regular layout now?", b.Yes | b.No
             )
             if r == b.Yes:
                 self.win.lake_ctl.auto_layout(regular=True)

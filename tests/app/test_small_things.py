@@ -127,3 +127,84 @@ def test_open_recent_opens_the_part_chosen_last_time(qtbot, win, tmp_path, monke
         assert asked == [2, 2] and win.doc.project.title == "basins_part2"
     finally:
         win.quiet = True
+
+
+def _csv_of(tmp_path, name, polygon, scale=1000.0):
+    """A lake (shapely polygon, islands as holes) as a CSV of rings in metres."""
+    rings = [polygon.exterior, *polygon.interiors]
+    text = "".join(
+        f"> ring{k}\n" + "\n".join(f"{x * scale},{y * scale}" for x, y in r.coords) + "\n" for k, r in enumerate(rings)
+    )
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _asked(monkeypatch, answer):
+    from PySide6 import QtWidgets
+
+    asked = []
+
+    def question(parent, title, text, *a):
+        asked.append((title, text))
+        return answer
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    monkeypatch.setattr(QtWidgets.QMessageBox, "warning", lambda parent, title, text: asked.append((title, text)))
+    return asked
+
+
+def test_a_single_domain_export_that_does_not_fit_offers_a_regular_layout(qtbot, win, tmp_path, monkeypatch):
+    """Was: Export mesh as a Delft3D single domain (.grd, the "[delft3d-single]" filter) or EFDC
+    (.inp) of a layout with a 3- or 5-block corner showed the writer's error only; the regular layout
+    that fits was offered for a .ddb alone.  Now the error and the offer, which makes the layout."""
+    from PySide6 import QtWidgets
+
+    from meshcore import testing
+    from tests.app.test_lake import lay_out
+    from tests.app.waits import wait_for, wait_idle
+
+    lay_out(qtbot, win, _csv_of(tmp_path, "y.csv", testing.y_junction()), cell_size=100.0)
+    m = win.doc.project.layout.topology().node_map
+    assert any(c.free and c.valence != 4 for c in m.corners)  # the star: no single index space
+    for name, fmt in [("y.grd", "delft3d-single"), ("cell.inp", None)]:
+        assert not win.io.export_mesh(tmp_path / name, fmt)
+        said = win._status.text()
+        assert "one index space" in said and "Auto layout, regular" in said, said
+        assert not (tmp_path / name).exists()
+    win.quiet = False
+    asked = _asked(monkeypatch, QtWidgets.QMessageBox.StandardButton.Yes)
+    try:
+        assert not win.io.export_mesh(tmp_path / "y.grd", "delft3d-single")
+    finally:
+        win.quiet = True
+    assert len(asked) == 1 and "Make a regular layout now?" in asked[0][1]
+    wait_for(qtbot, win, lambda: win.doc.project.lake.regular and win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    if not win.io.export_mesh(tmp_path / "y.grd", "delft3d-single"):  # regular, it may still fold: said so
+        assert "Cannot export" in win._status.text() and "Make a regular" not in win._status.text()
+
+
+def test_a_lake_with_islands_is_told_it_fits_no_single_domain_not_offered_a_layout(qtbot, win, tmp_path, monkeypatch):
+    """A lake with islands fits no single index space, laid out regular or not: the export says so
+    (and names the formats that take it) instead of offering a regular layout that fails too.  (Was:
+    the writer's error alone, which did not say that no layout of this lake fits.)"""
+    from PySide6 import QtWidgets
+
+    from meshcore import testing
+    from tests.app.test_lake import lay_out
+
+    lake = testing.lake_with_islands(3, n_islands=2)
+    lay_out(qtbot, win, _csv_of(tmp_path, "isl.csv", lake), cell_size=500.0)
+    assert len(win.doc.project.layout.polygon.interiors) >= 1  # (one may be left out: too narrow)
+    win.quiet = False
+    asked = _asked(monkeypatch, QtWidgets.QMessageBox.StandardButton.Yes)
+    try:
+        assert not win.io.export_mesh(tmp_path / "cell.inp")
+    finally:
+        win.quiet = True
+    said = win._status.text()
+    assert "one index space" in said and "with islands does not fit" in said and "not even laid out regular" in said
+    assert ".ddb" in said, said
+    assert [t for t, _ in asked] == ["Cannot export mesh"]  # the error shown, no layout offered
+    assert not win.lake_ctl.busy and not win.doc.project.lake.regular
