@@ -323,20 +323,21 @@ def typical_spacing(points: np.ndarray, *, along: bool = False) -> float:
     return float(np.median(d[:, 1]))
 
 
-def label_levels(at: np.ndarray, half: np.ndarray, fits: np.ndarray, order) -> np.ndarray:
+def label_levels(at: np.ndarray, half: np.ndarray, fits: np.ndarray, order, taken=None) -> np.ndarray:
     """Level of detail of labels: which text each label shows, so that none overlaps another.
 
     ``at`` (n, 2) are the labels' centres, ``half`` (n, L, 2) the half width and height of each of
     a label's L texts (most detailed first, in model units: their screen size times the pixel size),
     ``fits`` (n, L) whether that text lies inside the label's own region (a block) on screen.
     Labels are placed in ``order`` (most important first); each shows its most detailed text that
-    fits and overlaps no label already placed.  Returns the text index per label, −1 for hidden.
+    fits and overlaps no label already placed, nor a box of ``taken`` ((m, 4): x0, y0, x1, y1 of
+    other labels drawn there).  Returns the text index per label, −1 for hidden.
     """
     at = np.asarray(at, float).reshape(-1, 2)
     half = np.asarray(half, float).reshape(len(at), -1, 2)
     fits = np.asarray(fits, bool).reshape(half.shape[:2])
     out = np.full(len(at), -1, dtype=int)
-    placed = np.zeros((0, 4))  # x0, y0, x1, y1 of the labels shown
+    placed = np.zeros((0, 4)) if taken is None else np.asarray(taken, float).reshape(-1, 4)  # the labels shown
     for k in order:
         for lev in range(half.shape[1]):
             if not fits[k, lev]:

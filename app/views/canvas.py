@@ -69,6 +69,8 @@ class Canvas(pg.PlotWidget):
         for it in self.getPlotItem().items:
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self._label_at: dict[str, tuple[float, float, float]] = {}
+        #: the border labels shown, (x0, y0, x1, y1) in model units: the block labels keep clear of them
+        self.border_label_boxes = np.zeros((0, 4))
         self.markers_visible = True
         # level of detail of the point markers: their typical spacing (model units), their size shown
         self._spacing: dict[str, float] = {"points": np.inf, "other": np.inf}
@@ -143,8 +145,10 @@ class Canvas(pg.PlotWidget):
             a.hide()
             self.addItem(a)
             self.border_arrows[name] = a
-            t = pg.TextItem("", color=col, anchor=(0.5, 0.5))
-            t.setZValue(12)
+            # on a white ground, above the block labels (25): a lake block's inner border has its label
+            # over the next block's grid lines, which crossed it out, and under a block label, which hid it
+            t = pg.TextItem("", color=col, anchor=(0.5, 0.5), fill=pg.mkBrush(255, 255, 255, 210))
+            t.setZValue(26)
             f = QtGui.QFont()
             f.setBold(True)
             t.setFont(f)
@@ -330,6 +334,17 @@ class Canvas(pg.PlotWidget):
             roomy = length / px >= max(r.width(), 3 * 14.0)  # the label's width, three arrow heads
             t.setVisible(self.markers_visible and roomy)
             self.border_arrows[name].setVisible(self.markers_visible and roomy)
+        boxes = []
+        for name in self._label_at:
+            t = self.border_labels[name]
+            if t.isVisible():
+                r, p = t.textItem.boundingRect(), t.pos()
+                hw, hh = 0.5 * r.width() * px, 0.5 * r.height() * px
+                boxes.append((p.x() - hw, p.y() - hh, p.x() + hw, p.y() + hh))
+        boxes = np.array(boxes, float).reshape(-1, 4)
+        if boxes.shape != self.border_label_boxes.shape or not np.allclose(boxes, self.border_label_boxes):
+            self.border_label_boxes = boxes
+            self.lake_items.apply_level_of_detail(force=True)  # the block labels round the new ones
 
     def refresh_selection(self) -> None:
         pts = self.doc.block.points

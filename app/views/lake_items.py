@@ -255,7 +255,9 @@ class LakeOverlay:
             fits = self._label_px[:, :, 0] > 0
         from ..geometry import label_levels
 
-        levels = label_levels(self._label_at, half, fits, self._label_order)
+        # the active block's border labels are drawn above: a block label keeps clear of them
+        taken = getattr(self.canvas, "border_label_boxes", None)
+        levels = label_levels(self._label_at, half, fits, self._label_order, taken=taken)
         shown = []
         for k, (t, lev) in enumerate(zip(self.labels, levels, strict=False)):
             if lev != self._label_level[k]:

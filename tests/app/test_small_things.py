@@ -208,3 +208,61 @@ def test_a_lake_with_islands_is_told_it_fits_no_single_domain_not_offered_a_layo
     assert ".ddb" in said, said
     assert [t for t, _ in asked] == ["Cannot export mesh"]  # the error shown, no layout offered
     assert not win.lake_ctl.busy and not win.doc.project.lake.regular
+
+
+def test_the_active_blocks_border_labels_stand_out_from_the_grid_and_block_labels(qtbot, win, tmp_path):
+    """Seen under Xvfb on a generated lake of 8 blocks: the label of the active block's inner border
+    ("bottom · 73") lay over the next block's grid lines, which crossed it out, and a block label
+    ("60×48", drawn above it) hid it at a zoomed-out view.  Now on a white ground, above the block
+    labels, which keep clear of it (a shorter text, or none, where it lies)."""
+    from meshcore import testing
+    from tests.app.test_lake import lay_out
+
+    lay_out(qtbot, win, _csv_of(tmp_path, "isl.csv", testing.lake_with_islands(800123, n_islands=2)))
+    c = win.canvas
+    c.fit()
+    qtbot.wait(50)
+    shown = [t for t in c.border_labels.values() if t.isVisible() and t.textItem.toPlainText()]
+    assert shown
+    top = max(t.zValue() for t in c.lake_items.labels)
+    for t in shown:
+        assert t.fill.color().alpha() >= 180 and t.fill.color().lightness() > 240
+        assert t.zValue() > top
+    # at every zoom, no block label shown overlaps a border label shown
+    vb = c.getPlotItem().getViewBox()
+
+    def box(t):
+        r, p, px = t.textItem.boundingRect(), t.pos(), c.pixel()
+        return np.array(
+            [
+                p.x() - 0.5 * r.width() * px,
+                p.y() - 0.5 * r.height() * px,
+                p.x() + 0.5 * r.width() * px,
+                p.y() + 0.5 * r.height() * px,
+            ]
+        )
+
+    overlaps = 0
+    for k in range(6):
+        if k:
+            vb.scaleBy((1.6, 1.6))
+        qtbot.wait(50)
+        borders = [box(t) for t in c.border_labels.values() if t.isVisible() and t.textItem.toPlainText()]
+        blocks = [box(t) for t in c.lake_items.labels if t.isVisible() and t.textItem.toPlainText()]
+        for a in borders:
+            for b in blocks:
+                overlaps += bool(a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3])
+    assert overlaps == 0
+
+
+def test_label_levels_keep_clear_of_boxes_taken():
+    from app.geometry import label_levels
+
+    at = np.array([[0.0, 0.0], [10.0, 0.0]])
+    half = np.array([[[2.0, 1.0], [1.0, 0.5]], [[2.0, 1.0], [1.0, 0.5]]])
+    fits = np.ones((2, 2), bool)
+    assert list(label_levels(at, half, fits, [0, 1])) == [0, 0]
+    taken = np.array([[1.5, -3.0, 5.0, 3.0]])  # over the right of the first label's long text
+    assert list(label_levels(at, half, fits, [0, 1], taken=taken)) == [1, 0]
+    taken = np.array([[-5.0, -5.0, 5.0, 5.0]])  # over the whole first label
+    assert list(label_levels(at, half, fits, [0, 1], taken=taken)) == [-1, 0]
