@@ -32,10 +32,13 @@ __all__ = [
     "area_text",
     "cell_size_of",
     "compute_layout",
+    "crs_unit",
     "default_cell_size",
     "layout_blocks",
     "looks_branched",
+    "near_header",
     "part_area",
+    "part_centres",
     "read_lake",
     "read_lake_parts",
     "split_layout",
@@ -115,7 +118,7 @@ def read_lake(
         raise MeshcoreError(f"part {part} asked for; the file has {len(parts)} part{'s' * (len(parts) != 1)} of water")
     _, outer, islands = parts[part - 1]
     if len(parts) > 1:
-        notes = [*notes, several_parts_note(parts, part, metres=metres)]
+        notes = [*notes, several_parts_note(parts, part, metres=metres, frame=frame, lonlat=lonlat or not metres)]
     return outer, islands, frame, notes
 
 
@@ -154,16 +157,68 @@ def area_text(area: float, metres: bool = True) -> str:
     return f"{area / 1e6:,.3g} km²" if area >= 1e6 else f"{area / 1e4:,.3g} ha"
 
 
-def several_parts_note(parts: list, chosen: int = 1, *, metres: bool = True) -> str:
+def crs_unit(crs: str | None) -> str:
+    """The unit of a projected CRS's x axis as a modeller writes it ("m", "ft", "US survey foot");
+    "m" for none (the app takes plain numbers as metres, as its areas in km² do)."""
+    if not crs:
+        return "m"
+    from meshcore.crs import proj_call
+
+    def unit():
+        import pyproj
+
+        return pyproj.CRS.from_user_input(crs).axis_info[0].unit_name
+
+    try:
+        name = str(proj_call(unit))
+    except Exception:  # an unknown CRS: its numbers said without a unit
+        return "units"
+    return {"metre": "m", "meter": "m", "foot": "ft", "kilometre": "km"}.get(name, name)
+
+
+def part_centres(parts: list, frame: Any = None, *, lonlat: bool = False, metres: bool = True):
+    """Where each part lies, in the numbers the user knows the file by, and their unit: the
+    file's longitude/latitude for a lon/lat file (``lonlat``; projected or kept as degrees,
+    ``metres`` False), else the CRS's own coordinates (the local ones plus the frame's origin)
+    in the CRS's unit.  ``[(x, y), ...], "lon/lat" | unit``."""
+    from shapely.geometry import Polygon
+
+    local = np.array([Polygon(outer).centroid.coords[0] for _name, outer, _isl in parts], float).reshape(-1, 2)
+    if not metres:  # lon/lat kept as degrees: the parts are in degrees already
+        return [tuple(c) for c in local], "lon/lat"
+    if lonlat and frame is not None and frame.crs:
+        try:
+            lon, lat = frame.to_lonlat(local[:, 0], local[:, 1])
+            return list(zip(np.atleast_1d(lon).tolist(), np.atleast_1d(lat).tolist(), strict=True)), "lon/lat"
+        except Exception:  # PROJ refused: the projected numbers below, with their unit
+            pass
+    if frame is not None:
+        x, y = frame.to_world(local[:, 0], local[:, 1])
+        local = np.column_stack([x, y])
+    return [tuple(c) for c in local], crs_unit(getattr(frame, "crs", None))
+
+
+def near_header(unit: str) -> str:
+    """The heading of the centre column, with its unit (it had none: metres of a local origin,
+    degrees or feet looked alike)."""
+    return "near (lon, lat)" if unit == "lon/lat" else f"near (x, y), {unit}"
+
+
+def several_parts_note(
+    parts: list, chosen: int = 1, *, metres: bool = True, frame: Any = None, lonlat: bool = False
+) -> str:
     """What the import of a file of several separate parts of water says: the app grids one lake,
-    part ``chosen`` (with its islands); ``meshcore mesh`` grids every part."""
+    part ``chosen`` (with its islands); ``meshcore mesh`` grids every part.  Where each part lies as
+    :func:`part_centres` says (``frame``, ``lonlat``: the parts' frame, a lon/lat file)."""
+    centres, unit = part_centres(parts, frame, lonlat=lonlat, metres=metres)
+    where = "lon/lat " if unit == "lon/lat" else ""
+    unit = "" if unit == "lon/lat" else f" {unit}"
 
     def part(k: int) -> str:
-        from shapely.geometry import Polygon
-
-        name, outer, _ = parts[k - 1]
-        c = Polygon(outer).centroid
-        return f"part {k} ({name!r}, {area_text(part_area(parts[k - 1]), metres)}, near ({c.x:.6g}, {c.y:.6g}))"
+        name, x, y = parts[k - 1][0], *centres[k - 1]
+        return (
+            f"part {k} ({name!r}, {area_text(part_area(parts[k - 1]), metres)}, near {where}({x:.6g}, {y:.6g}){unit})"
+        )
 
     rest = [k for k in range(1, len(parts) + 1) if k != chosen]
     left = ", ".join(part(k) for k in rest)

@@ -11,53 +11,11 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
 from PySide6 import QtCore, QtWidgets
 
-from .lake import area_text, part_area
+from .lake import area_text, near_header, part_area, part_centres
 
-__all__ = ["PartsDialog", "crs_unit", "near_header", "part_centres", "part_rows"]
-
-
-def crs_unit(crs: str | None) -> str:
-    """The unit of a projected CRS's x axis as a modeller writes it ("m", "ft", "US survey foot");
-    "m" for none (the app takes plain numbers as metres, as its areas in km² do)."""
-    if not crs:
-        return "m"
-    from meshcore.crs import proj_call
-
-    def unit():
-        import pyproj
-
-        return pyproj.CRS.from_user_input(crs).axis_info[0].unit_name
-
-    try:
-        name = str(proj_call(unit))
-    except Exception:  # an unknown CRS: its numbers said without a unit
-        return "units"
-    return {"metre": "m", "meter": "m", "foot": "ft", "kilometre": "km"}.get(name, name)
-
-
-def part_centres(parts: list, frame: Any = None, *, lonlat: bool = False, metres: bool = True):
-    """Where each part lies, in the numbers the user knows the file by, and their unit: the
-    file's longitude/latitude for a lon/lat file (``lonlat``; projected or kept as degrees,
-    ``metres`` False), else the CRS's own coordinates (the local ones plus the frame's origin)
-    in the CRS's unit.  ``[(x, y), ...], "lon/lat" | unit``."""
-    from shapely.geometry import Polygon
-
-    local = np.array([Polygon(outer).centroid.coords[0] for _name, outer, _isl in parts], float).reshape(-1, 2)
-    if not metres:  # lon/lat kept as degrees: the parts are in degrees already
-        return [tuple(c) for c in local], "lon/lat"
-    if lonlat and frame is not None and frame.crs:
-        try:
-            lon, lat = frame.to_lonlat(local[:, 0], local[:, 1])
-            return list(zip(np.atleast_1d(lon).tolist(), np.atleast_1d(lat).tolist(), strict=True)), "lon/lat"
-        except Exception:  # PROJ refused: the projected numbers below, with their unit
-            pass
-    if frame is not None:
-        x, y = frame.to_world(local[:, 0], local[:, 1])
-        local = np.column_stack([x, y])
-    return [tuple(c) for c in local], crs_unit(getattr(frame, "crs", None))
+__all__ = ["PartsDialog", "part_rows"]
 
 
 def part_rows(
@@ -71,12 +29,6 @@ def part_rows(
         name, _outer, islands = part
         rows.append((str(k), str(name), area_text(part_area(part), metres), str(len(islands)), f"{x:.6g}, {y:.6g}"))
     return rows
-
-
-def near_header(unit: str) -> str:
-    """The heading of the centre column, with its unit (it had none: metres of a local origin,
-    degrees or feet looked alike)."""
-    return "near (lon, lat)" if unit == "lon/lat" else f"near (x, y), {unit}"
 
 
 class PartsDialog(QtWidgets.QDialog):

@@ -52,6 +52,11 @@ def test_the_parts_dialog_says_in_what_unit_each_part_lies(qtbot, tmp_path):
     head, xy = _near(dlg)
     assert head == "near (lon, lat)"
     np.testing.assert_allclose(xy, [[10.0, 46.02], [10.01, 45.995]], atol=2e-3)  # the ellipses' centres
+    # and the note in Messages on import names them the same way
+    from app.lake import read_lake
+
+    note = read_lake(read_points(_reservoir(tmp_path)), lonlat=True, part=2)[3][-1]
+    assert "part 1 ('Upper basin'" in note and "near lon/lat (10, 46.02" in note, note
     # lon/lat kept as degrees (not projected): the same numbers, areas not in km²
     parts, frame, _ = read_lake_parts(read_points(_reservoir(tmp_path)), lonlat=False)
     dlg = PartsDialog("reservoir.kml", parts, metres=False, frame=frame, lonlat=True)
@@ -78,7 +83,7 @@ def test_the_parts_dialog_says_in_what_unit_each_part_lies(qtbot, tmp_path):
 
 
 def test_the_unit_of_a_projected_crs_is_its_own(qtbot):
-    from app.parts_dialog import crs_unit, near_header
+    from app.lake import crs_unit, near_header
 
     assert crs_unit("EPSG:32632") == "m"
     assert crs_unit("EPSG:2227") == "US survey foot"  # California zone 3, ftUS
