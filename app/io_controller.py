@@ -259,7 +259,7 @@ class IOController(ExportMixin, QtCore.QObject):
         block = block_from_points(pts, stem)
         self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=stem)
         # File ▸ Open recent imports it again (the same part of water) and remembers its folder
-        self.add_recent(path, part=k_part if n_parts > 1 else None)
+        self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)
         projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
@@ -364,34 +364,45 @@ class IOController(ExportMixin, QtCore.QObject):
     def remember_dir(self, path: Path) -> None:
         self.settings.setValue("last_dir", str(Path(path).parent))
 
-    def add_recent(self, path: Path, *, part: int | None = None) -> None:
+    def add_recent(self, path: Path, *, part: int | None = None, lonlat: bool | None = None) -> None:
         """First in File ▸ Open recent; ``part``: the part of water opened of a file of several,
-        opened again from there without asking (the record's "recent_parts")."""
+        ``lonlat``: the answer to "project lon/lat to metres?", both used again from there without
+        asking (the records "recent_parts" and "recent_lonlat")."""
         rec = ([str(path)] + [p for p in self.recent() if p != str(path)])[:MAX_RECENT]
         self.settings.setValue("recent", rec)
-        parts = {p: k for p, k in self.recent_parts().items() if p in rec and p != str(path)}
-        if part is not None:
-            parts[str(path)] = int(part)
-        self.settings.setValue("recent_parts", json.dumps(parts))
+        for key, value, kind in (("recent_parts", part, int), ("recent_lonlat", lonlat, bool)):
+            kept = {p: v for p, v in self._recent_record(key, kind).items() if p in rec and p != str(path)}
+            if value is not None:
+                kept[str(path)] = kind(value)
+            self.settings.setValue(key, json.dumps(kept))
         self.remember_dir(path)
         self.refresh_recent()
 
-    def recent_parts(self) -> dict[str, int]:
-        """The part of water opened last of each recent file of several parts (path: part from 1)."""
+    def _recent_record(self, key: str, kind) -> dict:
         try:
-            v = json.loads(str(self.settings.value("recent_parts", "{}") or "{}"))
-            return {str(p): int(k) for p, k in v.items()} if isinstance(v, dict) else {}
+            v = json.loads(str(self.settings.value(key, "{}") or "{}"))
+            return {str(p): kind(k) for p, k in v.items()} if isinstance(v, dict) else {}
         except (ValueError, TypeError, AttributeError):  # a record written by hand or broken: none
             return {}
 
+    def recent_parts(self) -> dict[str, int]:
+        """The part of water opened last of each recent file of several parts (path: part from 1)."""
+        return self._recent_record("recent_parts", int)
+
+    def recent_lonlat(self) -> dict[str, bool]:
+        """Whether each recent lon/lat file was projected to metres when imported last (path: answer)."""
+        return self._recent_record("recent_lonlat", bool)
+
     def open_recent(self, path: str) -> bool:
-        """File ▸ Open recent: the file again (a file of several parts of water: the part opened last)."""
+        """File ▸ Open recent: the file again (a file of several parts of water: the part opened last;
+        lon/lat: projected or not as the user answered last)."""
         if not self.maybe_save():
             return False
         part = self.recent_parts().get(str(path))
-        if part is None or Path(path).suffix.lower() == ".toml":
+        lonlat = self.recent_lonlat().get(str(path))
+        if (part is None and lonlat is None) or Path(path).suffix.lower() == ".toml":
             return self.open_path(path)
-        return self.import_points(Path(path), part=part, again=True)
+        return self.import_points(Path(path), part=part, project_lonlat=lonlat, again=True)
 
     def recent(self) -> list[str]:
         v = self.settings.value("recent", [])

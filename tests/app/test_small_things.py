@@ -271,3 +271,35 @@ def test_label_levels_keep_clear_of_boxes_taken():
     assert list(label_levels(at, half, fits, [0, 1], taken=taken)) == [1, 0]
     taken = np.array([[-5.0, -5.0, 5.0, 5.0]])  # over the whole first label
     assert list(label_levels(at, half, fits, [0, 1], taken=taken)) == [-1, 0]
+
+
+def test_open_recent_of_a_lon_lat_file_does_not_ask_to_project_again(qtbot, win, tmp_path, monkeypatch):
+    """Was: File ▸ Open recent on a lon/lat lake asked "Project them to metres?" every time.  The
+    answer given at its import is kept with the recent file and used again; File ▸ Import asks."""
+    from PySide6 import QtWidgets
+
+    path = tmp_path / "pond.csv"
+    ring = [(10.0, 46.0), (10.02, 46.0), (10.02, 46.01), (10.0, 46.01)]
+    path.write_text("lon,lat\n" + "".join(f"{x},{y}\n" for x, y in ring))
+    asked = []
+
+    def question(_parent, title, *_a, **_k):
+        asked.append(title)
+        b = QtWidgets.QMessageBox.StandardButton
+        return b.Yes if title == "Geographic coordinates" else b.Discard
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    win.quiet = False
+    try:
+        assert win.io.import_points(path)
+        assert asked.count("Geographic coordinates") == 1
+        crs = win.doc.project.crs
+        assert crs and "326" in str(crs)  # projected to the UTM zone (32632)
+        win.io.set_project(type(win.doc.project)())
+        assert win.io.open_recent(str(path))
+        assert asked.count("Geographic coordinates") == 1, "Open recent asked again"
+        assert win.doc.project.crs == crs
+        win.io.import_points(path)  # File ▸ Import: asked
+        assert asked.count("Geographic coordinates") == 2
+    finally:
+        win.quiet = True
