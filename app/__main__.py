@@ -76,6 +76,9 @@ def quality_label(text: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from meshcore._heap import keep_freed_memory
+
+    keep_freed_memory()
     parser = _parser()
     args = parser.parse_args(argv)
     if args.quality:

@@ -80,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code (see the module docstring)."""
+    from .._heap import keep_freed_memory
+
+    keep_freed_memory()
     try:
         parser = build_parser()  # imports every subcommand (numba kernels among them): seconds
     except KeyboardInterrupt:
