@@ -267,6 +267,7 @@ def mesh_outline(
     target_cells: int = DEFAULT_CELLS,
     levels: int = 2,
     regular: bool = False,
+    single: bool = False,
     strict: bool = False,
     layout_options: Any = None,
     **options: Any,
@@ -289,6 +290,9 @@ def mesh_outline(
         Coarse levels of the grid sequencing (cell counts are multiples of ``2**levels``).
     regular : bool
         Only nodes where four blocks meet (for Delft3D domain decomposition).
+    single : bool
+        A regular layout whose cell counts also close every ring of blocks round an island in one
+        ``(I, J)`` index space (Delft3D single domain, EFDC; :mod:`meshcore.multiblock.closure`).
     strict : bool
         Raise :class:`~meshcore.errors.FoldedGridError` if the grid has folded cells
         (otherwise ``info.converged`` is False and the message names them).
@@ -309,7 +313,9 @@ def mesh_outline(
     from .layout import LayoutOptions, auto_layout
 
     if is_several(outline):
-        opts = dict(levels=levels, regular=regular, strict=strict, layout_options=layout_options, **options)
+        opts = dict(
+            levels=levels, regular=regular, single=single, strict=strict, layout_options=layout_options, **options
+        )
         return mesh_parts(
             outline, mesh_outline, holes=holes, parts=parts, cell_size=cell_size, target_cells=target_cells, **opts
         )
@@ -322,6 +328,7 @@ def mesh_outline(
         target_cells=target_cells,
         multiple=2**levels,
         regular=regular,
+        single=single,
         options=layout_options or LayoutOptions(),
     )
     mb = mesh_layout(lay, levels=levels, **options)

@@ -252,6 +252,7 @@ def run(args: argparse.Namespace) -> int:
     ddb = [p for p, fmt in outputs if fmt.name == "delft3d-dd"]
     one = [p for p, fmt in outputs if fmt.name in SINGLE_DOMAIN]
     regular = bool(args.regular or ddb or one)
+    args.single_space = bool(one)  # the layout's counts close every ring in one index space
     if ddb and not args.regular:
         say(f"{ddb[0]}: Delft3D domain decomposition couples no 3- or 5-block corners: using --regular")
     elif one and not args.regular:

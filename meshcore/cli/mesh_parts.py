@@ -92,7 +92,14 @@ def _layouts(args: Any, water: WaterParts, kept: list, h: float, regular: bool, 
     lays = []
     for k, p in kept:
         try:
-            lay = auto_layout(p, cell_size=h, multiple=2**LEVELS, regular=regular, options=layout_options(args))
+            lay = auto_layout(
+                p,
+                cell_size=h,
+                multiple=2**LEVELS,
+                regular=regular,
+                single=getattr(args, "single_space", False),
+                options=layout_options(args),
+            )
         except InvalidInputError as exc:
             raise InvalidInputError(in_world(f"{args.outline}: part {k}: {exc}", frame)) from None
         nb = len(lay.blocks)

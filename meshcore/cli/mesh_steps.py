@@ -125,7 +125,14 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
 
     options = layout_options(args)
     try:
-        lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=regular, options=options)
+        lay = auto_layout(
+            poly,
+            cell_size=h,
+            multiple=2**LEVELS,
+            regular=regular,
+            single=getattr(args, "single_space", False),
+            options=options,
+        )
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)
         raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None

@@ -68,6 +68,7 @@ def auto_layout(
     target_cells: int = DEFAULT_CELLS,
     multiple: int = 1,
     regular: bool = False,
+    single: bool = False,
     options: LayoutOptions = DEFAULT_OPTIONS,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
@@ -91,6 +92,10 @@ def auto_layout(
         Delft3D's domain decomposition can couple.  Where the corners cannot be made to close,
         the layout is returned as it is; :func:`~.frames.frame_defects` of its pieces names
         the islands.
+    single : bool
+        A regular layout whose cell counts also close every ring of blocks round an island in one
+        ``(I, J)`` index space (:func:`~meshcore.multiblock.closure.closure_rows`): what a
+        single-domain grid (Delft3D ``.grd``, EFDC) needs.  Implies ``regular``.
     options : LayoutOptions
         Layout choices that are off by default (thin arms, mouths, curve, wedges; each measured
         mixed): :class:`~.model.LayoutOptions`.
@@ -105,6 +110,7 @@ def auto_layout(
     InvalidInputError
         A polygon that crosses itself, islands outside the water, …, naming the place.
     """
+    regular = regular or single
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
     poly, dense = without_dense_vertices(poly, h)
@@ -134,6 +140,7 @@ def auto_layout(
                     notes + more,
                     multiple=multiple,
                     regular=regular,
+                    single=single,
                     normal=normal,
                     scale=scale,
                     options=options,
@@ -148,13 +155,19 @@ def auto_layout(
                     f"keep the asked size): at the cell size itself {why}"
                 )
                 lay = dataclasses.replace(lay, notes=(*lay.notes, note))
-            elif regular and frame_defects(list(lay.pieces)):
+            elif regular and frame_defects(list(lay.pieces), single=single):
                 kept = kept or lay  # the other splits may close up: tried next, this one if not
                 continue
             return lay
         if kept is not None:
             return kept
     assert first is not None
+    if single:
+        why = str(first).removeprefix("automatic layout: ")
+        raise TopologyError(
+            f"automatic layout: no layout found whose blocks fit one index space (Delft3D single domain, "
+            f"EFDC): {why}; write a .ddb (domain decomposition) or .vtm instead"
+        ) from None
     raise first
 
 
@@ -176,22 +189,24 @@ def _layout(
     multiple: int,
     regular: bool,
     normal: bool,
+    single: bool = False,
     scale: float = 1.0,
     options: LayoutOptions = DEFAULT_OPTIONS,
 ) -> Layout:
     poly = shores.grid
     thin, mouths, wedges = options.thin_arms, options.mouths, options.wedges
     hl = scale * h  # the layout's geometry; counts at h
+    wedges = wedges and not regular
     sk, chords, _, pieces = layout_pieces(
-        shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular
+        shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, single=single
     )
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
         sk, chords, _, moved = layout_pieces(
-            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular
+            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, single=single
         )
     pieces = moved
-    cells = block_counts(pieces, h, multiple=multiple)
+    cells = block_counts(pieces, h, multiple=multiple, closed=single)
 
     def made(pieces, cells) -> Layout:
         blocks = tuple(
@@ -208,6 +223,7 @@ def _layout(
             skeleton=sk,
             chords=tuple(chords),
             notes=tuple(notes) + _cells_note(pieces, cells, h),
+            single=single,
         )
         _check_case(lay)
         return lay

@@ -153,15 +153,18 @@ def block_counts(
     multiple: int = 1,
     block_cells: dict[int, tuple[int, int]] | None = None,
     best: bool = True,
+    closed: bool = False,
 ) -> list[tuple[int, int]]:
     """The cells ``(ni, nj)`` of every piece for ``cell_size``: integer counts that agree across
     every interface, closest to the cell size (:func:`~meshcore.multiblock.counts.solve_counts`;
     ``block_cells``: pieces whose cells are given; ``best=False``: any counts that agree, to see
-    whether there are any).  Raises :class:`TopologyError` when there are none."""
-    return _counts(_line_work(pieces), pieces, cell_size, min_cells, multiple, block_cells, best)[0]
+    whether there are any; ``closed``: the rings round islands close in one index space as well,
+    :func:`~meshcore.multiblock.closure.closure_rows`).  Raises :class:`TopologyError` when there
+    are none."""
+    return _counts(_line_work(pieces), pieces, cell_size, min_cells, multiple, block_cells, best, closed)[0]
 
 
-def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
+def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, closed=False):
     side_chains, chain_pts, chain_users = _chains_of(pieces, work)
     for key, users in chain_users.items():
         if len(users) > 2:
@@ -174,6 +177,12 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     sides = [tuple([index[k] for k in side_chains[(pi, s)]] for s in BORDERS) for pi in range(len(pieces))]
     pts, on_shore = [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys]
+    equal = None
+    if closed:
+        from ..multiblock.closure import closure_rows
+
+        corners = [work[2][n] for n in work[0]]
+        equal = closure_rows(sides, [(k[0], k[-1]) for k in keys], corners, names=work[0])
     # targets rounded to 1e-6 cells: the program has many equally good counts, and lengths that
     # differ in the last bits (an outline shifted by a round number) must not choose among them
     counts = solve_counts(
@@ -185,5 +194,6 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best):
         best=best,
         least=shore_least(pts, on_shore, cell_size, multiple) if best else None,
         least_weight=least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None,
+        equal=equal,
     )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts

@@ -25,7 +25,7 @@ from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners, wedge_corners
 from .fans import fans, unfan
-from .frames import close_frames
+from .frames import close_frames, frame_defects
 from .regions import partition
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, forced_indices
@@ -127,13 +127,15 @@ def layout_pieces(
     thin: bool = False,
     mouths: bool = False,
     wedges: bool = False,
+    single: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
     normal; ``thin``: cuts from reflex corners may leave pieces two cells across; ``mouths``:
     junction chords at the arms' mouths, :func:`~.chords.place_chords`; see
     :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
-    side of it, :func:`~.corners.wedge_corners`)."""
+    side of it, :func:`~.corners.wedge_corners`; ``single``: with ``regular``, every island's ring of
+    blocks turns once, :data:`~.frames.ONE_TURN`, so that it can close in one index space)."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -183,7 +185,7 @@ def layout_pieces(
         pieces.append(Piece(r, idx))
     _check_pieces(poly, pieces)
     if regular:  # every island's ring of blocks closes up (Delft3D's domain decomposition)
-        pieces, cuts = _closed(pieces, cuts, h, size, sigma)
+        pieces, cuts = _closed(pieces, cuts, h, size, sigma, single)
     else:
         pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
@@ -224,7 +226,7 @@ def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: floa
     return out, cuts
 
 
-def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float):
+def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float, single: bool = False):
     """The pieces with corners that close up round every island (:func:`~.frames.close_frames`),
     the first choice whose cells can be counted; the pieces as they are when there is none
     (their layout is valid, Delft3D's domain decomposition cannot couple it)."""
@@ -233,12 +235,22 @@ def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float
     # corners costed by the turning their cells see first; when no such choice can be counted,
     # those costed at sigma (lake_with_islands(4) at 1500 cells: closed only by the latter)
     for own in (True, False):
-        for closed in close_frames(pieces, sigma, own=own):
+        for closed in close_frames(pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3):
             try:
-                return _make_countable(closed, cuts, h, size)
+                got = _make_countable(closed, cuts, h, size)
             except TopologyError:
                 continue
+            if not single or _countable(got[0], h, closed=True):
+                return got
+    if single and not frame_defects(pieces, single=True) and _countable(pieces, h, closed=True):
+        return pieces, cuts
     return _make_countable(pieces, cuts, h, size)
+
+
+#: Corner choices tried per island set-up for a single index space (``single``): a choice whose
+#: rings turn once can still have no counts that close them (a ring whose blocks' own sides tie
+#: its two sides to different lengths); the next choice differs in at least one piece.
+SINGLE_TRIES = 8
 
 
 def _welded(rings: list[np.ndarray], forced: list[tuple], eps: float):
@@ -287,12 +299,12 @@ def _check_pieces(poly, pieces: list[Piece]) -> None:
         )
 
 
-def _countable(pieces: list[Piece], h: float) -> bool:
+def _countable(pieces: list[Piece], h: float, closed: bool = False) -> bool:
     from ..errors import TopologyError
     from .blocks import block_counts
 
     try:
-        block_counts(pieces, h, best=False)
+        block_counts(pieces, h, best=False, closed=closed)
     except TopologyError:
         return False
     return True

@@ -111,20 +111,37 @@ def _vertices(pieces: list[Piece]) -> _Vertices:
     return _Vertices(ix, m, c, loop)
 
 
-def _island_turns(v: _Vertices) -> dict[int, int]:
-    """Quarter turns (mod 4) of the frame round every island loop."""
+def _island_turns(v: _Vertices, single: bool = False) -> dict[int, int]:
+    """Quarter turns (mod 4) of the frame round every island loop; ``single``: how far ``C − 2E``
+    is from :data:`ONE_TURN` (not mod 4)."""
     out: dict[int, int] = {}
     for k in range(1, int(v.loop.max(initial=0)) + 1):
         on = v.loop == k
-        out[k] = int((v.c[on].sum() - 2 * (v.m[on] - 1).sum()) % 4)
+        turns = int(v.c[on].sum() - 2 * (v.m[on] - 1).sum())
+        lone = int(((v.m == 1) & (v.c > 0) & on).sum())  # a block's corner alone on the island
+        out[k] = abs(turns - ONE_TURN) + lone if single else turns % 4
     return out
 
 
-def frame_defects(pieces: list[Piece]) -> list[FrameDefect]:
-    """The islands and inner nodes round which the blocks' index frames do not close up."""
+#: ``C − 2E`` round an island whose ring of blocks closes in one ``(I, J)`` index space: the ring
+#: turns once round the island there (the eight blocks of a 3 × 3 lattice round its middle cell:
+#: 12 corners and 8 cut ends on the hole).  0 (≡ 0 mod 4, enough for Delft3D's domain
+#: decomposition) is a ring of blocks that runs straight in index space and never comes back
+#: (an O-grid's), −8 one that winds twice.  Every vertex adds ``c − 2(m − 1)``: −1 where the
+#: island's hole in index space has a corner, +1 where one block alone has a corner on the island
+#: (the hole turns back there).  With ``single`` no such lone corner is allowed either: the hole is
+#: then a rectangle whose sides are whole chains; with one, the counts that close the ring could
+#: give the hole no width (seen: a block wrapped round an island's end, the block across it
+#: placed on top of it in index space: "reach index node at two places").
+ONE_TURN = -4
+
+
+def frame_defects(pieces: list[Piece], *, single: bool = False) -> list[FrameDefect]:
+    """The islands and inner nodes round which the blocks' index frames do not close up
+    (``single``: islands whose ring does not turn once, :data:`ONE_TURN`, as one index space needs)."""
     v = _vertices(pieces)
     out = []
-    for k, turn in _island_turns(v).items():
+    for k, turn in _island_turns(v, single).items():
         if turn:
             p = v.index.points[np.flatnonzero(v.loop == k)[0]]
             out.append(FrameDefect("island", (float(p[0]), float(p[1])), turn))
@@ -237,19 +254,23 @@ def _candidates(
     return list(options.items())
 
 
-def close_frames(pieces: list[Piece], sigma: float, *, tries: int = 3, own: bool = True) -> Iterator[list[Piece]]:
+def close_frames(
+    pieces: list[Piece], sigma: float, *, tries: int = 3, own: bool = True, single: bool = False
+) -> Iterator[list[Piece]]:
     """The pieces with corners re-chosen so that every island and inner node closes up
     (:func:`frame_defects` empty): up to ``tries`` choices, the one of least corner cost first
     (a caller that cannot count the cells of one takes the next).  Yields nothing when the
     pieces close already or when no moves of one corner per piece make them close.  ``own``:
     corners cost the turning their cells see (:func:`_own_turning`); False: the turning at
-    ``sigma`` (a fallback: its choices close some layouts whose ``own`` ones cannot be counted)."""
+    ``sigma`` (a fallback: its choices close some layouts whose ``own`` ones cannot be counted);
+    ``single``: every island's ``C − 2E`` is :data:`ONE_TURN` (one index space), not any multiple of 4."""
     from scipy.optimize import Bounds, LinearConstraint, milp
 
-    if not frame_defects(pieces):
+    defects = frame_defects(pieces, single=single)
+    if not defects:
         return
     v = _vertices(pieces)
-    bad = {i for d in frame_defects(pieces) if d.kind == "node" for i in v.index.find([d.where]).tolist()}
+    bad = {i for d in defects if d.kind == "node" for i in v.index.find([d.where]).tolist()}
     movable = [k for k, ids in enumerate(v.index.ids) if (v.loop[ids] > 0).any() or bool(bad & set(ids.tolist()))]
     cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma, own) for k in movable}
     cols = [(k, cs, cost) for k in movable for cs, cost in cand[k]]
@@ -284,12 +305,19 @@ def close_frames(pieces: list[Piece], sigma: float, *, tries: int = 3, own: bool
             float(2 * (v.m[on] - 1).sum() - fixed_c[on].sum()),
             z,
         )
-    cost = np.concatenate([[col[2] for col in cols], np.zeros(nz)])
-    big = 4.0 * len(v.m)
-    lb = np.concatenate([np.zeros(nx), np.full(nz, -big)])
-    ub = np.concatenate([np.ones(nx), np.full(nz, big)])
     cuts: list[np.ndarray] = []
     hi: list[float] = []
+    if single:  # no block has a corner alone on an island (see ONE_TURN)
+        for i in np.flatnonzero((v.loop > 0) & (v.m == 1)).tolist():
+            if touched.get(i) or fixed_c[i] > 0:
+                r = np.zeros(nx + nz)
+                np.add.at(r, touched.get(i, []), 1.0)
+                cuts.append(r)
+                hi.append(float(-fixed_c[i]))
+    cost = np.concatenate([[col[2] for col in cols], np.zeros(nz)])
+    big = 4.0 * len(v.m)
+    lb = np.concatenate([np.zeros(nx), np.full(nz, ONE_TURN / 4 if single else -big)])
+    ub = np.concatenate([np.ones(nx), np.full(nz, ONE_TURN / 4 if single else big)])
     for _ in range(tries):
         low = np.array(want + [-np.inf] * len(cuts), dtype=float)
         res = milp(

@@ -58,7 +58,8 @@ class Layout:
 
     ``polygon`` is the water (a shapely Polygon, islands as holes, after cleaning),
     ``cuts`` the cut lines (chords across arms and the splits inside junctions), ``pieces``
-    the regions with their corners, ``blocks`` their names, corners and cell counts.
+    the regions with their corners, ``blocks`` their names, corners and cell counts;
+    ``single``: the cell counts close every ring of blocks in one index space (``auto_layout(single=True)``).
     """
 
     polygon: Any
@@ -70,6 +71,7 @@ class Layout:
     skeleton: Any = field(default=None, repr=False)
     chords: tuple = field(default=(), repr=False)
     notes: tuple[str, ...] = ()
+    single: bool = False
     _topology: Any = field(default=None, init=False, repr=False, compare=False)  # made once
 
     @property

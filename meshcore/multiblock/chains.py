@@ -194,11 +194,14 @@ def _chain_counts(
     cell_size: float | None,
     keep: Mapping[tuple[str, str], Sequence[int]] | None = None,
     rings: Mapping[str, np.ndarray] | None = None,
+    corners: Mapping[str, Sequence[Any]] | None = None,
 ) -> dict[Key, int]:
     """Cells per chain: the integer program of :func:`~.counts.solve_counts` with every block's cells
     given; when it has no solution, the step-by-step count names the block and border at fault.
     ``keep``: counts per block side taken instead of the program's while they still fit (:func:`_kept`);
-    ``rings``: the blocks' regions, for :func:`~.shorecells.least_weights`."""
+    ``rings``: the blocks' regions, for :func:`~.shorecells.least_weights`; ``corners`` (each
+    block's four corner keys): the counts also close every ring of blocks in one index space
+    (:func:`~.closure.closure_rows`)."""
     from .counts import solve_counts
     from .shorecells import least_weights, shore_least
 
@@ -207,7 +210,7 @@ def _chain_counts(
     implied = counts.implied()
     if implied is not None and counts.complete(implied):  # the cells fix every chain: the only solution
         return {k: int(implied[k]) for k in keys}
-    kept = None if keep is None else _kept(counts, keep)
+    kept = None if keep is None or corners is not None else _kept(counts, keep)
     if kept is not None:
         return {k: kept[k] for k in keys}
     index = {k: i for i, k in enumerate(keys)}
@@ -228,12 +231,26 @@ def _chain_counts(
         targets = np.round(length / float(cell_size), 6)  # as the layout's counts (meshcore.layout.blocks)
     sides = [tuple([index[k] for k in side_chains[(s.name, side)]] for side in SIDES) for s in specs]
     cells = {bi: (int(s.cells[0]), int(s.cells[1])) for bi, s in enumerate(specs)}
+    equal = None
+    if corners is not None:
+        from .closure import closure_rows
+
+        equal = closure_rows(
+            sides, [(k[0], k[-1]) for k in keys], [corners[s.name] for s in specs], names=[s.name for s in specs]
+        )
     pts, on_shore = [chain_pts[k] for k in keys], [len(chain_users[k]) == 1 for k in keys]
     try:
         least = None if cell_size is None else shore_least(pts, on_shore, cell_size, multiple)
         weight = None if least is None or rings is None else least_weights(pts, on_shore, list(rings.values()))
         n = solve_counts(
-            targets, sides, min_cells=1, multiple=multiple, block_cells=cells, least=least, least_weight=weight
+            targets,
+            sides,
+            min_cells=1,
+            multiple=multiple,
+            block_cells=cells,
+            least=least,
+            least_weight=weight,
+            equal=equal,
         )
     except TopologyError:
         _Counts(specs, side_chains, chain_pts, chain_users, multiple).solve()  # names the conflict
@@ -279,6 +296,7 @@ def chain_topology(
     check_geometry: bool = True,
     cell_size: float | None = None,
     keep: Mapping[tuple[str, str], Sequence[int]] | None = None,
+    single: bool = False,
 ) -> tuple[MultiBlockTopology, dict[tuple[str, str], tuple[int, ...]]]:
     """The topology of blocks on regions, and the cells of the chains of every block side
     (``(block, side) →`` counts in the side's order).
@@ -291,10 +309,13 @@ def chain_topology(
     Where a side has several chains, its cells are shared among them as
     :func:`~.counts.solve_counts` does: closest to ``length / cell_size`` (default: each
     side's own cell size), integer and consistent round every block.  ``keep`` (such counts of
-    the layout before an edit) is taken instead where it still fits every side.
+    the layout before an edit) is taken instead where it still fits every side.  ``single``: the
+    counts also close every ring of blocks in one index space (:mod:`.closure`).
     """
     sides, chain_pts, chain_users = side_chains(specs, rings, corners, breaks)
-    count = _chain_counts(specs, sides, chain_pts, chain_users, multiple, cell_size, keep, rings)
+    count = _chain_counts(
+        specs, sides, chain_pts, chain_users, multiple, cell_size, keep, rings, corners if single else None
+    )
     nodes = {key: _resample(chain_pts[key], count[key]) for key in chain_pts}
     offsets: dict[tuple[str, str, Key], tuple[int, int]] = {}
     blocks = [_block(s, sides, nodes, corners[s.name], offsets) for s in specs]

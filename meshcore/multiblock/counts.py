@@ -205,6 +205,7 @@ def solve_counts(
     best: bool = True,
     least: Sequence[float] | np.ndarray | None = None,
     least_weight: Sequence[float] | np.ndarray | None = None,
+    equal: np.ndarray | None = None,
 ) -> np.ndarray:
     """Integer counts per chain.
 
@@ -234,6 +235,9 @@ def solve_counts(
     least_weight : sequence of float, optional
         Per chain, that cost per missing cell instead (:data:`LAND_WEIGHT` where the coarse
         chords would cross an island, :func:`~.shorecells.least_weights`).
+    equal : (m, chains) array, optional
+        Rows ``A`` with ``A @ counts = 0`` required as well: the rings of
+        :func:`~.closure.closure_rows` (one index space).
 
     Raises
     ------
@@ -256,7 +260,9 @@ def solve_counts(
     for given in (fixed or {}).values():
         if given % m:
             raise TopologyError(f"a fixed count {given} is not a multiple of {m}")
-    if SEARCH and block_cells and len(block_cells) == nb:  # few solutions: the best of them, no HiGHS
+    if equal is not None and not len(equal):
+        equal = None
+    if SEARCH and block_cells and len(block_cells) == nb and equal is None:  # few solutions: the best of them, no HiGHS
         search_cost = (
             objective(t, sides, jumps, short, weights, steep_w) if best else (lambda counts: np.zeros(len(counts)))
         )
@@ -337,6 +343,8 @@ def solve_counts(
                 for c in side:
                     r[c] += m
                 add(r, float(want), float(want))
+    for a in () if equal is None else equal:  # Σ a_c n_c = 0, i.e. Σ a_c k_c = 0
+        add({int(c): float(a[c]) for c in np.flatnonzero(a)}, 0.0, 0.0)
     for p, (ca, ta, cb, tb) in enumerate(jumps):
         w = min(ta, tb)
         for (c1, t1), (c2, t2) in (((ca, ta), (cb, tb)), ((cb, tb), (ca, ta))):

@@ -393,6 +393,7 @@ def from_outline(
     multiple: int = 1,
     cell_size: float | None = None,
     keep_cells: Mapping[tuple[str, str], Sequence[int]] | None = None,
+    single: bool = False,
 ) -> OutlineBlocks:
     """Split a closed outline by cut lines into four-sided blocks glued by interfaces.
 
@@ -424,6 +425,9 @@ def from_outline(
         where a block side has several parts, their cells are kept while they still fit,
         without the integer program that shares them (a drag's steps are quicker).  The
         program's shares can differ: a layout to keep is made without ``keep_cells``.
+    single : bool
+        The cells of a side's parts also close every ring of blocks in one ``(I, J)`` index
+        space (:mod:`.closure`): a single-domain grid's (Delft3D ``.grd``, EFDC).
 
     Returns
     -------
@@ -471,7 +475,15 @@ def from_outline(
     # with islands the blocks leave holes by design; the regions were checked above (they are the
     # water exactly, each is one block)
     topo, side_cells = chain_topology(
-        specs, sides, block_corners, breaks, multiple, check_geometry=not islands, cell_size=cell_size, keep=keep_cells
+        specs,
+        sides,
+        block_corners,
+        breaks,
+        multiple,
+        check_geometry=not islands,
+        cell_size=cell_size,
+        keep=keep_cells,
+        single=single,
     )
     return OutlineBlocks(
         topology=topo,

@@ -18,7 +18,18 @@ from meshcore.multiblock.counts import solve_counts
 
 
 def _objective(
-    t, sides, n, *, min_cells=3, multiple=1, least=None, least_weight=None, block_cells=None, fixed=None, best=True
+    t,
+    sides,
+    n,
+    *,
+    min_cells=3,
+    multiple=1,
+    least=None,
+    least_weight=None,
+    block_cells=None,
+    fixed=None,
+    best=True,
+    equal=None,
 ):
     """The program's objective at integer counts ``n`` (rows: candidates), ``inf`` where a
     constraint fails: the docstring's terms, each written out per candidate."""
@@ -28,6 +39,8 @@ def _objective(
     ok = np.all(n % m == 0, axis=1) & np.all(n >= m, axis=1)
     for c, v in (fixed or {}).items():
         ok &= n[:, c] == v
+    if equal is not None and len(equal):  # the rings of one index space (meshcore.multiblock.closure)
+        ok &= np.all(np.abs(n @ np.asarray(equal).T) < 1e-9, axis=1)
     obj = -1e-3 * n.sum(axis=1) + 0.25 * np.abs(n - t).sum(axis=1)
     for bi, (bottom, right, top, left) in enumerate(sides):
         for a, b in ((bottom, top), (left, right)):
