@@ -253,9 +253,28 @@ def iterate_layout(
         if spaced:
             msg += f"; {spaced} node move(s) smoothing the spacing along grid lines"
     info = SolveInfo(method="orthogonal", converged=not stopped, iterations=total, elapsed=elapsed, message=msg)
+    grids = _block_infos(grids, info)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology
     return MultiBlockGrid(tuple(grids), names, tp.interfaces, "orthogonal", info, tp, notes=tuple(layout.notes))
+
+
+def _block_infos(grids, info: SolveInfo) -> list:
+    """Each block's grid with the orthogonal solve's info (its blocks kept the start solve's, whose
+    fold-free repair of a sliver block could report 'no fold-free grid found' for a block the levels
+    then made fold-free: ``meshcore generate`` of a lake case exited 3 on a grid with no folded cell);
+    a block with folded or non-convex cells left is not converged, and says how many."""
+    import dataclasses
+
+    from .quality.lake import block_metrics
+
+    out = []
+    for g in grids:
+        n = int(block_metrics(g).folded.sum())
+        msg = info.message if not n else f"{info.message}; {n} folded or non-convex cell(s) left in this block"
+        done = dataclasses.replace(info, converged=info.converged and not n, message=msg)
+        out.append(dataclasses.replace(g, info=done))
+    return out
 
 
 def mesh_outline(
