@@ -139,6 +139,14 @@ ACTIONS: tuple[ActionSpec, ...] = (
         menu="&Lake",
     ),
     ActionSpec(
+        "auto_layout_single",
+        "Auto layout, &one index space (EFDC, Delft3D single domain)",
+        "auto_layout_single",
+        tip="a regular layout whose rings of blocks round islands close in one (I, J) index space: what EFDC "
+        "and a Delft3D single-domain grid need",
+        menu="&Lake",
+    ),
+    ActionSpec(
         "clear_layout",
         "&Clear layout",
         "editor.clear_layout",

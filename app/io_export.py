@@ -145,8 +145,8 @@ class ExportMixin:
     def _offer_regular(self, path: Path, exc: BaseException, format: str | None = None) -> bool:
         """A .ddb that Delft3D cannot couple, or a single-domain grid (Delft3D .grd of the blocks
         merged, EFDC) whose layout does not fit one index space (3- or 5-block corners): the writer's
-        error and a regular layout offered instead; a lake with islands fits no single domain even
-        laid out regular, so that is said instead of the offer."""
+        error and a regular layout offered instead (for a single domain, a layout for one index space:
+        its rings round islands closed, ``auto_layout(single=True)``)."""
         lay = self.doc.project.layout
         suffix = Path(path).suffix.lower()
         # a single domain refused for its index space (not for water in parts, or a folder it cannot write)
@@ -154,22 +154,16 @@ class ExportMixin:
         if lay is None or not (single or suffix == ".ddb") or len(lay.blocks) < 2:
             return False  # one block: nothing to couple, the error says to write a .grd (no layout helps)
         name = Path(path).name
-        if single and len(getattr(lay.polygon, "interiors", ())):
-            self.win.error(
-                "Cannot export mesh",
-                f"{name}: {exc}. A lake with islands does not fit one index space (a Delft3D single domain, "
-                "EFDC), not even laid out regular: the cell counts round an island do not add up. Export a .ddb "
-                "(Delft3D domain decomposition) or .vtm instead",
-            )
-            return True
-        if self.doc.project.lake.regular:  # the regular layout did not fit either: the writer's error says why
+        lake = self.doc.project.lake
+        if lake.single or (lake.regular and not single):  # made for it and still refused: the error says why
             return False
         if single:
             title = "One index space"
             text = (
                 f"Cannot export {name}: {exc}. One index space (a Delft3D single domain, EFDC) fits no corner where "
-                "3 or 5 blocks meet: Lake ▸ Auto layout, regular makes a layout without them, which fits when the "
-                "lake's arms do not fold onto each other (then export again)"
+                "3 or 5 blocks meet, and its rings of blocks round islands must close: a layout made for it "
+                "(regular, the rings' cell counts closed) fits when the lake's arms do not fold onto each other "
+                "(then export again)"
             )
         else:
             title = "Delft3D domain decomposition"
@@ -180,11 +174,10 @@ class ExportMixin:
         self.win.message(text, error=True)
         if not self.quiet:
             b = QtWidgets.QMessageBox.StandardButton
-            r = QtWidgets.QMessageBox.question(
-                self._parent(), title, f"{text}.\n\nMake a regular layout now?", b.Yes | b.No
-            )
+            what = "a layout for one index space" if single else "a regular layout"
+            r = QtWidgets.QMessageBox.question(self._parent(), title, f"{text}.\n\nMake {what} now?", b.Yes | b.No)
             if r == b.Yes:
-                self.win.lake_ctl.auto_layout(regular=True)
+                self.win.lake_ctl.auto_layout(**({"single": True} if single else {"regular": True}))
         return True
 
     def figure_dialog(self) -> None:

@@ -63,7 +63,8 @@ class Lake:
 
     ``outline`` is the shore and ``holes`` the islands (local model coordinates);
     ``cell_size`` the wanted cell size (None: about :data:`target_cells` cells);
-    ``regular`` asks for a layout without 3- or 5-block corners (Delft3D DD);
+    ``regular`` asks for a layout without 3- or 5-block corners (Delft3D DD); ``single`` one whose
+    rings of blocks round islands also close in one index space (Delft3D single domain, EFDC);
     ``layout`` is the :class:`meshcore.layout.Layout` (None until Auto layout).
     """
 
@@ -72,6 +73,7 @@ class Lake:
     cell_size: float | None = None
     target_cells: int = 10_000
     regular: bool = False
+    single: bool = False
     layout: Any = None
 
     def __post_init__(self) -> None:
@@ -95,7 +97,7 @@ class Lake:
     __hash__ = None  # type: ignore[assignment]
 
     def _settings(self) -> tuple:
-        return (self.cell_size, self.target_cells, self.regular)
+        return (self.cell_size, self.target_cells, self.regular, self.single)
 
 
 # ------------------------------------------------------------------ reading
@@ -292,7 +294,7 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
         )
     if cuts:
         return split_layout(poly, [np.asarray(c, float) for c in cuts], h, 2**LEVELS)
-    return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular)
+    return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single)
 
 
 def split_layout(poly: Any, cuts: list, cell_size: float, multiple: int) -> Any:

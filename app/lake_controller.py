@@ -114,18 +114,24 @@ class LakeController(QtCore.QObject):
     def set_regular(self, on: bool) -> None:
         lake = self.lake()
         if lake is not None and bool(on) != lake.regular:
-            self.editor.set_lake(lake.replaced(regular=bool(on)), "Regular layout" if on else "Any layout")
+            kw = {"regular": True} if on else {"regular": False, "single": False}
+            self.editor.set_lake(lake.replaced(**kw), "Regular layout" if on else "Any layout")
 
     # ------------------------------------------------------- auto layout
-    def auto_layout(self, *, regular: bool | None = None) -> bool:
-        """Compute the layout of the lake in a worker; it is set (undoable) and gridded when done."""
+    def auto_layout(self, *, regular: bool | None = None, single: bool | None = None) -> bool:
+        """Compute the layout of the lake in a worker; it is set (undoable) and gridded when done
+        (``single``: a regular layout whose rings round islands close in one index space)."""
         lake = self.lake()
         if lake is None:
             self.win.message("Auto layout needs a lake: import an outline (Ctrl+I) or draw and close a loop")
             return False
         if regular is not None:
-            lake = lake.replaced(regular=bool(regular))
+            lake = lake.replaced(regular=bool(regular), single=False)  # Delft3D DD: any multiple of 4 turns
+        if single is not None:
+            lake = lake.replaced(single=bool(single), regular=bool(single) or lake.regular)
         kind = "regular layout (no 3- or 5-block corners)" if lake.regular else "layout"
+        if lake.single:
+            kind = "layout for one index space (Delft3D single domain, EFDC)"
         return self._start(lake, None, f"Computing the block {kind} of the lake…")
 
     def split_by_cuts(self, cuts) -> bool:

@@ -347,8 +347,9 @@ def moved_layout(base: Any, parts: dict, steps: DragSteps | None = None) -> Any:
         snap=topology_snap(base.polygon),
         cell_size=base.cell_size,
         keep_cells=keep,
+        single=base.single,
     )
-    lay = layout_of_outline(ob, parts["blocks"], cell_size=base.cell_size, multiple=base.multiple)
+    lay = layout_of_outline(ob, parts["blocks"], cell_size=base.cell_size, multiple=base.multiple, single=base.single)
     before = [(b.name, tuple(b.cells)) for b in base.blocks]
     after = [(b.name, tuple(b.cells)) for b in lay.blocks]
     if len(after) != len(before):

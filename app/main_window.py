@@ -359,6 +359,10 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         """Auto layout without 3- or 5-block corners (what Delft3D domain decomposition couples)."""
         self.lake_ctl.auto_layout(regular=True)
 
+    def auto_layout_single(self) -> None:
+        """Auto layout for one index space (EFDC, Delft3D single domain): regular, rings closed."""
+        self.lake_ctl.auto_layout(single=True)
+
     def show_lake(self) -> None:
         """Bring the Lake dock to the front."""
         self.docks["lake"].show()

@@ -202,6 +202,7 @@ def _lake_state(lake) -> dict | None:
         "cell_size": lake.cell_size,
         "target_cells": lake.target_cells,
         "regular": lake.regular,
+        "single": lake.single,
     }
 
 
@@ -212,6 +213,7 @@ def _with_lake(project: Project, d: Mapping) -> Project:
         "cell_size": d.get("cell_size"),
         "target_cells": int(d.get("target_cells", 10_000)),
         "regular": bool(d.get("regular", False)),
+        "single": bool(d.get("single", False)),
     }
     if project.lake is not None:  # the case held the layout: only the settings come from here
         return project.replaced(lake=project.lake.replaced(**settings))

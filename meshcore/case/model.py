@@ -94,7 +94,9 @@ class OutlineSection:
     points; cut and corner points are outline indices or ``(x, y)`` pairs.  ``holes``: islands,
     inline rings of ``(x, y)`` points (cuts may end on them); ``cell_size``: the cell size the
     layout was made for (shares a side's cells among its parts; the orthogonal mode's shore
-    sampling).  See :func:`meshcore.multiblock.from_outline` and ``crs`` in :data:`OUTLINE_CRS`.
+    sampling); ``single``: the cells of a side's parts also close every ring of blocks in one index
+    space (a layout made for a Delft3D single domain or EFDC).  See
+    :func:`meshcore.multiblock.from_outline` and ``crs`` in :data:`OUTLINE_CRS`.
     """
 
     points: str | np.ndarray
@@ -106,9 +108,12 @@ class OutlineSection:
     multiple: int = 1
     holes: tuple[np.ndarray, ...] = ()
     cell_size: float | None = None
+    single: bool = False
 
     def __post_init__(self) -> None:
         put = object.__setattr__
+        if not isinstance(self.single, bool):
+            raise InvalidInputError(f"single must be true or false, got {self.single!r}")
         holes = []
         for k, h in enumerate(self.holes):
             a = np.array(h, dtype=np.float64)

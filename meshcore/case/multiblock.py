@@ -24,6 +24,7 @@ Two ways to describe the blocks:
     cuts = [[15, 200], [[-122.3, 40.7], [-122.2, 40.8]]]   # outline indices or points
     snap = 10.0                  # optional snap distance (model units)
     multiple = 2                 # optional: every shared part gets a multiple of 2 cells (multigrid)
+    single = true                # optional: counts that close every ring in one index space (EFDC)
 
     [[outline.blocks]]
     name = "main"
@@ -152,7 +153,14 @@ def _outline_topology_frame(case: Case) -> tuple[MultiBlockTopology, Any]:
     o = case.outline
     try:
         topo = from_outline(
-            xy, cuts=cuts, blocks=blocks, holes=holes, snap=o.snap, multiple=o.multiple, cell_size=o.cell_size
+            xy,
+            cuts=cuts,
+            blocks=blocks,
+            holes=holes,
+            snap=o.snap,
+            multiple=o.multiple,
+            cell_size=o.cell_size,
+            single=o.single,
         ).topology
     except InvalidInputError as exc:
         raise type(exc)(f"{case.source}: {exc}") from None
@@ -176,7 +184,7 @@ def case_layout(case: Case) -> Any:
     o = case.outline
     try:
         return layout_from_outline(
-            xy, cuts=cuts, blocks=blocks, holes=holes, cell_size=o.cell_size, multiple=o.multiple
+            xy, cuts=cuts, blocks=blocks, holes=holes, cell_size=o.cell_size, multiple=o.multiple, single=o.single
         )
     except InvalidInputError as exc:
         raise type(exc)(f"{case.source}: {exc}") from None
@@ -299,6 +307,7 @@ def layout_case(layout: Any, *, title: str = "", description: str = "", crs: Any
         multiple=layout.multiple,
         holes=tuple(parts["holes"]),
         cell_size=float(layout.cell_size),
+        single=bool(getattr(layout, "single", False)),
     )
     table = None
     if crs is not None and getattr(crs, "crs", None) is not None:

@@ -85,6 +85,8 @@ def _outline_table(o: OutlineSection) -> dict[str, Any]:
         t["multiple"] = o.multiple
     if o.cell_size is not None:
         t["cell_size"] = o.cell_size
+    if o.single:
+        t["single"] = True
     if o.holes:
         t["holes"] = [np.asarray(h).tolist() for h in o.holes]
     t["blocks"] = [

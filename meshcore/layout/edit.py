@@ -39,20 +39,22 @@ def layout_from_outline(
     holes: Any = (),
     cell_size: float | None = None,
     multiple: int = 1,
+    single: bool = False,
 ):
     """A :class:`~meshcore.layout.Layout` from a shore, islands, cut lines and blocks (corners, cells).
 
     The inputs are those of :func:`meshcore.multiblock.from_outline`, whose checks name the
     block, cut or island at fault; ``cell_size`` (default: the mean size of the blocks' cells)
-    sets how densely the orthogonal smoother samples the shore.
+    sets how densely the orthogonal smoother samples the shore; ``single``: a layout for one index
+    space (its rings' counts closed, :mod:`meshcore.multiblock.closure`).
     """
     from ..multiblock.outline import from_outline
 
-    ob = from_outline(outline, holes=holes, cuts=cuts, blocks=blocks, multiple=multiple)
-    return layout_of_outline(ob, blocks, cell_size=cell_size, multiple=multiple)
+    ob = from_outline(outline, holes=holes, cuts=cuts, blocks=blocks, multiple=multiple, single=single)
+    return layout_of_outline(ob, blocks, cell_size=cell_size, multiple=multiple, single=single)
 
 
-def layout_of_outline(ob: Any, blocks: Any, *, cell_size: float | None = None, multiple: int = 1):
+def layout_of_outline(ob: Any, blocks: Any, *, cell_size: float | None = None, multiple: int = 1, single: bool = False):
     """The :class:`~meshcore.layout.Layout` of ``ob`` (a :func:`meshcore.multiblock.from_outline`
     of ``blocks``): its regions become the pieces, in the order of ``blocks``."""
     from ..multiblock.outline import BlockOutline
@@ -85,6 +87,7 @@ def layout_of_outline(ob: Any, blocks: Any, *, cell_size: float | None = None, m
         blocks=tuple(lblocks[k] for k in perm),
         multiple=multiple,
         notes=tuple(notes),
+        single=single,
     )
 
 

@@ -175,7 +175,7 @@ def test_a_single_domain_export_that_does_not_fit_offers_a_regular_layout(qtbot,
     for name, fmt in [("y.grd", "delft3d-single"), ("cell.inp", None)]:
         assert not win.io.export_mesh(tmp_path / name, fmt)
         said = win._status.text()
-        assert "one index space" in said and "Auto layout, regular" in said, said
+        assert "one index space" in said and "a layout made for it" in said, said
         assert not (tmp_path / name).exists()
     win.quiet = False
     asked = _asked(monkeypatch, QtWidgets.QMessageBox.StandardButton.Yes)
@@ -183,36 +183,41 @@ def test_a_single_domain_export_that_does_not_fit_offers_a_regular_layout(qtbot,
         assert not win.io.export_mesh(tmp_path / "y.grd", "delft3d-single")
     finally:
         win.quiet = True
-    assert len(asked) == 1 and "Make a regular layout now?" in asked[0][1]
-    wait_for(qtbot, win, lambda: win.doc.project.lake.regular and win.doc.project.layout is not None)
+    assert len(asked) == 1 and "Make a layout for one index space now?" in asked[0][1]
+    wait_for(qtbot, win, lambda: win.doc.project.lake.single and win.doc.project.layout is not None)
     wait_idle(qtbot, win)
-    if not win.io.export_mesh(tmp_path / "y.grd", "delft3d-single"):  # regular, it may still fold: said so
-        assert "Cannot export" in win._status.text() and "Make a regular" not in win._status.text()
+    assert win.doc.project.lake.regular and win.doc.project.layout.single
+    if not win.io.export_mesh(tmp_path / "y.grd", "delft3d-single"):  # made for it, it may still fold: said so
+        assert "Cannot export" in win._status.text() and "Make a" not in win._status.text()
 
 
-def test_a_lake_with_islands_is_told_it_fits_no_single_domain_not_offered_a_layout(qtbot, win, tmp_path, monkeypatch):
-    """A lake with islands fits no single index space, laid out regular or not: the export says so
-    (and names the formats that take it) instead of offering a regular layout that fails too.  (Was:
-    the writer's error alone, which did not say that no layout of this lake fits.)"""
+def test_a_lake_with_islands_is_offered_a_layout_for_one_index_space(qtbot, win, tmp_path, monkeypatch):
+    """EFDC of a lake with islands: the default layout does not fit one index space; the export says
+    why and offers a layout made for it (regular, each island's ring closed: ``single``), which EFDC
+    then takes.  (Session 21: told that no layout of a lake with islands fits, nothing offered.)"""
     from PySide6 import QtWidgets
 
     from meshcore import testing
     from tests.app.test_lake import lay_out
+    from tests.app.waits import wait_for, wait_idle
 
-    lake = testing.lake_with_islands(3, n_islands=2)
-    lay_out(qtbot, win, _csv_of(tmp_path, "isl.csv", lake), cell_size=500.0)
-    assert len(win.doc.project.layout.polygon.interiors) >= 1  # (one may be left out: too narrow)
+    lake = testing.lake_with_islands(927000, n_islands=2, lobes=4)
+    h = 1000.0 * (lake.area / 15000) ** 0.5  # _csv_of's metres
+    lay_out(qtbot, win, _csv_of(tmp_path, "isl.csv", lake), cell_size=h)
+    assert len(win.doc.project.layout.polygon.interiors) == 2
     win.quiet = False
     asked = _asked(monkeypatch, QtWidgets.QMessageBox.StandardButton.Yes)
     try:
         assert not win.io.export_mesh(tmp_path / "cell.inp")
     finally:
         win.quiet = True
-    said = win._status.text()
-    assert "one index space" in said and "with islands does not fit" in said and "not even laid out regular" in said
-    assert ".ddb" in said, said
-    assert [t for t, _ in asked] == ["Cannot export mesh"]  # the error shown, no layout offered
-    assert not win.lake_ctl.busy and not win.doc.project.lake.regular
+    assert [t for t, _ in asked] == ["One index space"], asked
+    said = asked[0][1]
+    assert "rings of blocks round islands" in said and said.endswith("Make a layout for one index space now?"), said
+    wait_for(qtbot, win, lambda: win.doc.project.lake.single and win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    assert win.io.export_mesh(tmp_path / "cell.inp"), win._status.text()
+    assert (tmp_path / "cell.inp").exists() and (tmp_path / "dxdy.inp").exists()
 
 
 def test_the_active_blocks_border_labels_stand_out_from_the_grid_and_block_labels(qtbot, win, tmp_path):
@@ -303,3 +308,25 @@ def test_open_recent_of_a_lon_lat_file_does_not_ask_to_project_again(qtbot, win,
         assert asked.count("Geographic coordinates") == 2
     finally:
         win.quiet = True
+
+
+def test_lake_menu_makes_a_layout_for_one_index_space_and_recovery_keeps_it(qtbot, win, tmp_path):
+    """Lake ▸ Auto layout, one index space: the lake's setting and its layout say so, Auto layout
+    again keeps it (until Auto layout, regular or the Regular box off), and the recovery state holds it."""
+    from app import recovery
+    from meshcore import testing
+    from tests.app.test_lake import lay_out
+    from tests.app.waits import wait_for, wait_idle
+
+    lay_out(qtbot, win, _csv_of(tmp_path, "y.csv", testing.y_junction()), cell_size=100.0)
+    assert not win.doc.project.lake.single and not win.doc.project.layout.single
+    win.a_auto_layout_single.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.lake.single and win.doc.project.layout.single)
+    wait_idle(qtbot, win)
+    assert win.doc.project.lake.regular
+    state = recovery._lake_state(win.doc.project.lake)
+    assert state["single"] and recovery._with_lake(win.doc.project.replaced(lake=None), state).lake.single
+    win.a_auto_layout_regular.trigger()
+    wait_for(qtbot, win, lambda: not win.doc.project.lake.single and win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    assert win.doc.project.lake.regular and not win.doc.project.layout.single
