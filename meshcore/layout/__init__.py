@@ -160,6 +160,12 @@ def auto_layout(
                 continue
             return lay
         if kept is not None:
+            if single:  # a single index space cannot hold it: say where, before the grid is made
+                d = frame_defects(list(kept.pieces), single=True)[0]
+                raise TopologyError(
+                    f"automatic layout: no layout found whose blocks fit one index space (Delft3D single "
+                    f"domain, EFDC): {d.note()}; write a .ddb (domain decomposition) or .vtm instead"
+                )
             return kept
     assert first is not None
     if single:

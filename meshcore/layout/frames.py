@@ -49,7 +49,8 @@ __all__ = ["FrameDefect", "close_frames", "frame_defects"]
 @dataclass(frozen=True, slots=True)
 class FrameDefect:
     """A loop of blocks whose index frame comes back turned by ``turn`` quarter turns:
-    round an island (``kind == "island"``, ``where`` a point of its shore) or round a node
+    round an island (``kind == "island"``, ``where`` a point of its shore; ``"ring"``: with
+    ``single``, a ring round an island that does not turn exactly once) or round a node
     inside the water where blocks do not meet four corners to four (``kind == "node"``)."""
 
     kind: str
@@ -58,6 +59,13 @@ class FrameDefect:
 
     def note(self) -> str:
         x, y = self.where
+        if self.kind == "ring":
+            return (
+                f"the ring of blocks round the island at ({x:.8g}, {y:.8g}) cannot close in one index space: "
+                f"it does not turn exactly once round it (a block with a corner alone on the island, a cut "
+                f"ending on it without a block corner, or the block corners on it minus twice the cut ends "
+                f"there not {ONE_TURN})"
+            )
         if self.kind == "island":
             return (
                 f"the blocks round the island at ({x:.8g}, {y:.8g}) come back turned by {self.turn} quarter "
@@ -118,8 +126,9 @@ def _island_turns(v: _Vertices, single: bool = False) -> dict[int, int]:
     for k in range(1, int(v.loop.max(initial=0)) + 1):
         on = v.loop == k
         turns = int(v.c[on].sum() - 2 * (v.m[on] - 1).sum())
-        lone = int(((v.m == 1) & (v.c > 0) & on).sum())  # a block's corner alone on the island
-        out[k] = abs(turns - ONE_TURN) + lone if single else turns % 4
+        each = v.c[on] - 2 * (v.m[on] - 1)  # what every vertex adds
+        odd = int(((each != 0) & (each != -1)).sum())  # a lone corner (+1), a cut end passed by both (-2)
+        out[k] = abs(turns - ONE_TURN) + odd if single else turns % 4
     return out
 
 
@@ -129,10 +138,11 @@ def _island_turns(v: _Vertices, single: bool = False) -> dict[int, int]:
 #: decomposition) is a ring of blocks that runs straight in index space and never comes back
 #: (an O-grid's), −8 one that winds twice.  Every vertex adds ``c − 2(m − 1)``: −1 where the
 #: island's hole in index space has a corner, +1 where one block alone has a corner on the island
-#: (the hole turns back there).  With ``single`` no such lone corner is allowed either: the hole is
-#: then a rectangle whose sides are whole chains; with one, the counts that close the ring could
-#: give the hole no width (seen: a block wrapped round an island's end, the block across it
-#: placed on top of it in index space: "reach index node at two places").
+#: (the hole turns back there), −2 where a cut ends on the island and neither block has a corner
+#: (the hole folds back on itself).  With ``single`` every vertex adds 0 or −1: the hole is then a
+#: rectangle whose sides are whole chains; with a +1 or a −2 the counts that close the ring could
+#: give the hole no width (seen: a block wrapped round an island's end, the block across it placed
+#: on top of it in index space: "reach index node at two places").
 ONE_TURN = -4
 
 
@@ -144,7 +154,7 @@ def frame_defects(pieces: list[Piece], *, single: bool = False) -> list[FrameDef
     for k, turn in _island_turns(v, single).items():
         if turn:
             p = v.index.points[np.flatnonzero(v.loop == k)[0]]
-            out.append(FrameDefect("island", (float(p[0]), float(p[1])), turn))
+            out.append(FrameDefect("ring" if single else "island", (float(p[0]), float(p[1])), turn))
     q = 2 * v.m - v.c
     for i in np.flatnonzero((v.loop < 0) & (q != 4)):
         p = v.index.points[i]
@@ -306,20 +316,21 @@ def close_frames(
             z,
         )
     cuts: list[np.ndarray] = []
+    lo: list[float] = []
     hi: list[float] = []
-    if single:  # no block has a corner alone on an island (see ONE_TURN)
-        for i in np.flatnonzero((v.loop > 0) & (v.m == 1)).tolist():
-            if touched.get(i) or fixed_c[i] > 0:
-                r = np.zeros(nx + nz)
-                np.add.at(r, touched.get(i, []), 1.0)
-                cuts.append(r)
-                hi.append(float(-fixed_c[i]))
+    if single:  # every island vertex adds 0 or -1 (see ONE_TURN): c in [2(m - 1) - 1, 2(m - 1)]
+        for i in np.flatnonzero(v.loop > 0).tolist():
+            r = np.zeros(nx + nz)
+            np.add.at(r, touched.get(i, []), 1.0)
+            cuts.append(r)
+            lo.append(float(2 * (v.m[i] - 1) - 1 - fixed_c[i]))
+            hi.append(float(2 * (v.m[i] - 1) - fixed_c[i]))
     cost = np.concatenate([[col[2] for col in cols], np.zeros(nz)])
     big = 4.0 * len(v.m)
     lb = np.concatenate([np.zeros(nx), np.full(nz, ONE_TURN / 4 if single else -big)])
     ub = np.concatenate([np.ones(nx), np.full(nz, ONE_TURN / 4 if single else big)])
     for _ in range(tries):
-        low = np.array(want + [-np.inf] * len(cuts), dtype=float)
+        low = np.array(want + lo + [-np.inf] * (len(cuts) - len(lo)), dtype=float)
         res = milp(
             cost,
             constraints=LinearConstraint(np.array(rows + cuts), low, np.array(want + hi, dtype=float)),

@@ -16,7 +16,7 @@ from meshcore import testing
 from meshcore.algebraic import tfi
 from meshcore.errors import MeshcoreError
 from meshcore.io import read_blocks
-from meshcore.layout import auto_layout
+from meshcore.layout import auto_layout, frames
 from meshcore.layout import blocks as B
 from meshcore.layout.frames import frame_defects
 from meshcore.multiblock.closure import closure_rows
@@ -75,18 +75,22 @@ def test_rows_vanish_where_the_blocks_embed_and_not_where_a_ring_is_off(expr):
 
 @pytest.mark.parametrize("expr", SHAPES[2:])
 def test_single_layouts_close_their_rings(expr):
-    """With ``single`` the islands' rings turn once and the counts close them, or the layout is refused."""
+    """With ``single`` the islands' rings turn once, every island a four-cornered hole in index space,
+    the counts close them and the blocks fit one index space; or the layout is refused, saying so."""
     shore, holes = rings(eval(expr))
     try:
         lay = auto_layout(shore, holes=holes, target_cells=15000, multiple=4, single=True)
     except MeshcoreError as exc:
         assert "one index space" in str(exc)
         return
-    if frame_defects(list(lay.pieces), single=True):
-        return  # kept as it is (no corners turn once): the output check refuses it, tested elsewhere
+    assert not frame_defects(list(lay.pieces), single=True)
+    v = frames._vertices(list(lay.pieces))
+    for k in range(1, int(v.loop.max()) + 1):  # every island: a hole of four corners in index space
+        each = v.c[v.loop == k] - 2 * (v.m[v.loop == k] - 1)
+        assert set(each.tolist()) <= {0, -1} and each.sum() == frames.ONE_TURN
     rows, counts = rows_and_counts(lay)
     assert not len(rows) or np.all(rows @ counts == 0)
-    assert "cells away" not in embeds(lay)
+    assert embeds(lay) == ""
 
 
 def test_efdc_grid_of_a_lake_with_two_islands(tmp_path):
