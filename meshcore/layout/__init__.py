@@ -181,14 +181,22 @@ def _layout(
 ) -> Layout:
     poly = shores.grid
     thin, mouths, wedges = options.thin_arms, options.mouths, options.wedges
+    tees = options.tees and regular
     hl = scale * h  # the layout's geometry; counts at h
     sk, chords, _, pieces = layout_pieces(
-        shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular
+        shores.layout,
+        hl,
+        regular=regular,
+        normal=normal,
+        thin=thin,
+        mouths=mouths,
+        wedges=wedges and not regular,
+        tees=tees,
     )
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
         sk, chords, _, moved = layout_pieces(
-            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular
+            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges and not regular, tees=tees
         )
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple)
