@@ -103,7 +103,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="a layout choice that is off by default, repeatable (each measured mixed; docs/lake-grids.md): "
         "curve = the shore as a smooth curve through the outline's points (outlines with a point every few "
         "cells), thin-arms = blocks two cells across at junctions of arms 2-4 cells wide, mouths = junction "
-        "cuts at the arms' mouths, wedges = two corners beside the tip of an arm tapering to a point",
+        "cuts at the arms' mouths, wedges = two corners beside the tip of an arm tapering to a point, "
+        "tees = junctions of regular (.ddb) layouts split as a T",
     )
     p.add_argument(
         "-o",

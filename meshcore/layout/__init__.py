@@ -201,15 +201,24 @@ def _layout(
 ) -> Layout:
     poly = shores.grid
     thin, mouths, wedges = options.thin_arms, options.mouths, options.wedges
+    tees = options.tees and regular
     hl = scale * h  # the layout's geometry; counts at h
     wedges = wedges and not regular
     sk, chords, _, pieces = layout_pieces(
-        shores.layout, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, single=single
+        shores.layout,
+        hl,
+        regular=regular,
+        normal=normal,
+        thin=thin,
+        mouths=mouths,
+        wedges=wedges,
+        tees=tees,
+        single=single,
     )
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
         sk, chords, _, moved = layout_pieces(
-            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, single=single
+            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, tees=tees, single=single
         )
     pieces = moved
     cells = block_counts(pieces, h, multiple=multiple, closed=single)

@@ -29,6 +29,7 @@ from .frames import close_frames, frame_defects
 from .regions import partition
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, forced_indices
+from .tee import tee
 
 __all__ = ["layout_pieces"]
 
@@ -127,6 +128,7 @@ def layout_pieces(
     thin: bool = False,
     mouths: bool = False,
     wedges: bool = False,
+    tees: bool = False,
     single: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
@@ -134,8 +136,9 @@ def layout_pieces(
     normal; ``thin``: cuts from reflex corners may leave pieces two cells across; ``mouths``:
     junction chords at the arms' mouths, :func:`~.chords.place_chords`; see
     :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
-    side of it, :func:`~.corners.wedge_corners`; ``single``: with ``regular``, every island's ring of
-    blocks turns once, :data:`~.frames.ONE_TURN`, so that it can close in one index space)."""
+    side of it, :func:`~.corners.wedge_corners`; ``tees``: junctions of regular layouts may be split
+    as a T, :mod:`.tee`; ``single``: with ``regular``, every island's ring of blocks turns once,
+    :data:`~.frames.ONE_TURN`, so that it can close in one index space)."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -160,6 +163,7 @@ def layout_pieces(
             regular=regular,
             normal=normal,
             thin=here,
+            tee=tee if tees and regular else None,
         )
         if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
             pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here)

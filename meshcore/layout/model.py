@@ -31,15 +31,21 @@ class LayoutOptions:
     wedges
         A block ending in a wedge's tip (an arm tapering to a point) gets two corners either side
         of the tip instead of one at it (:func:`~.corners.wedge_corners`).  Not in regular layouts.
+    tees
+        Regular layouts only: a junction is also offered as a T (:mod:`.tee`: a straight cut
+        between two of its reflex corners, a stem from a third reflex corner or the opposite shore
+        meeting it at right angles), kept where its pieces, split on, cost less than the greedy
+        split's.
     """
 
     thin_arms: bool = False
     mouths: bool = False
     curve: bool = False
     wedges: bool = False
+    tees: bool = False
 
     def __str__(self) -> str:
-        on = [f.replace("_", " ") for f in ("thin_arms", "mouths", "curve", "wedges") if getattr(self, f)]
+        on = [f.replace("_", " ") for f in ("thin_arms", "mouths", "curve", "wedges", "tees") if getattr(self, f)]
         return ", ".join(on) or "defaults"
 
 

@@ -217,6 +217,7 @@ def best_split(
     regular: bool = False,
     normal: bool = True,
     thin: bool = False,
+    tee=None,
 ):
     """Pieces and cuts (segments) of a greedy split of ``ring`` (maybe none).
 
@@ -229,6 +230,9 @@ def best_split(
     blocks meet (Delft3D's domain decomposition couples grid lines of the same direction only).
     ``normal=False``: no cuts along the shore's normal (the splits of earlier versions).
     ``thin``: motorcycle cuts may leave pieces two cells across (:data:`.width.THIN_ACROSS`).
+    ``tee`` (where ``center`` is given): a function ``(ring, center, sigma, min_width)`` giving one
+    more split, :func:`.tee.tee` in regular layouts with ``LayoutOptions(tees=True)``, kept when its
+    pieces, split on, cost less than those of the cheapest other split.
     """
     base = region_cost(ring, sigma, forced)
     if depth <= 0 or base <= _GOOD:
@@ -239,14 +243,36 @@ def best_split(
         # last resort (a round basin): cuts along the shore's normal from evenly spaced points
         more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
         best = min(more + options, key=lambda o: o[2]) if more else best
-    if best is None or best[2] >= base - _GOOD:
+    t = (
+        tee(ring, np.asarray(center, float), sigma, min_width)
+        if tee and center is not None and not len(forced)
+        else None
+    )
+    if (best is None or best[2] >= base - _GOOD) and (t is None or t[2] >= base - _GOOD):
         return [(ring, tuple(forced))], [], base
-    pieces, cuts, _ = best
+    kw = {
+        "sigma": sigma,
+        "min_width": min_width,
+        "depth": depth - 1,
+        "regular": regular,
+        "normal": normal,
+        "thin": thin,
+    }
+    out = _split_on(best, **kw) if best is not None and best[2] < base - _GOOD else None
+    if t is not None and t[2] < base - _GOOD:  # a T where its pieces, split on, cost less in all
+        alt = _split_on(t, **kw)
+        if out is None or alt[2] < out[2]:
+            out = alt
+    assert out is not None
+    return out
+
+
+def _split_on(option, **kw):
+    """``(pieces, cuts, cost)`` of ``option`` with every piece split again by :func:`best_split`."""
+    pieces, cuts, _ = option
     out_p, out_c, total = [], list(cuts), 0.0
     for pc, fc in pieces:
-        pp, cc, c = best_split(
-            pc, sigma=sigma, min_width=min_width, depth=depth - 1, forced=fc, regular=regular, normal=normal, thin=thin
-        )
+        pp, cc, c = best_split(pc, forced=fc, **kw)
         out_p += pp
         out_c += cc
         total += c
