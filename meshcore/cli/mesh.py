@@ -52,6 +52,7 @@ from .mesh_steps import (
     _layout,
     _notes,
     _Say,
+    check_not_a_line,
     finish,
     guarded,
 )
@@ -263,6 +264,7 @@ def run(args: argparse.Namespace) -> int:
         return run_parts(args, poly, frame, say, outputs, regular, t_start)
     unit = " m" if frame.crs else ""
     h, how = _cell_size(args, poly, unit)
+    check_not_a_line(args, poly, h, unit, frame)
     say(f"water area {poly.area / 1e6:.4g} km², {how}" if frame.crs else f"water area {poly.area:.6g}, {how}")
     say.lap()
 

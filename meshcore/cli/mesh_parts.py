@@ -173,7 +173,7 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
     import shapely
 
     from ..lakeparts import join_grids, select_parts
-    from .mesh_steps import _cell_size, _grid, _notes, finish, guarded
+    from .mesh_steps import _cell_size, _grid, _notes, check_not_a_line, finish, guarded
 
     unit = " m" if frame.crs else ""
     total = shapely.MultiPolygon(list(water.polygons))
@@ -185,6 +185,8 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
         kept, notes = select_parts(list(water.polygons), asked, h, water.names)
     except InvalidInputError as exc:
         raise InvalidInputError(in_world(f"{args.outline}: {exc}", frame)) from None
+    for _, p in kept:
+        check_not_a_line(args, p, h, unit, frame)
     _notes(notes, frame)
     if asked:
         say(f"meshing part{'s' * (len(kept) != 1)} {', '.join(str(k) for k, _ in kept)} of {len(water.polygons)}")
