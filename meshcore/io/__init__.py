@@ -270,8 +270,9 @@ def find_format(path: Any, format: str | None = None, *, role: str) -> Format:
             return f
     can = sorted({s for f in FORMATS.values() if getattr(f, attr) for s in f.suffixes})
     verb = {"write": "write", "grid": "read grids from", "points": "read points from"}[role]
+    what = f"{suffix} files" if suffix else "a file without a suffix"
     raise (WriteError if role == "write" else ReadError)(
-        f"{path}: cannot {verb} {suffix or 'files without a suffix'} files (known suffixes: {' '.join(can)})"
+        f"{path}: cannot {verb} {what} (known suffixes: {' '.join(can)})"
     )
 
 

@@ -406,7 +406,10 @@ def read_points_csv(
     if declared == LONLAT:
         for pl in polylines:
             check_lonlat(pl.points, where=f"{path}: {pl.name}")
-    return PointSet(tuple(polylines), declared, str(path))
+    meta = {}
+    if lay.header is not None and max(lay.ix, lay.iy) < len(lay.header):  # the names the x, y columns have
+        meta["columns"] = (lay.header[lay.ix], lay.header[lay.iy], lay.ix, lay.iy)
+    return PointSet(tuple(polylines), declared, str(path), meta)
 
 
 def _one_ring_split_by_blank_lines(

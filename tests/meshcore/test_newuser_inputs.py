@@ -17,3 +17,63 @@ def test_lonlat_points_on_a_line_but_for_their_decimals_are_refused_naming_the_p
     err = _bad(capsys, ["mesh", src, "-o", out, "--cells", "200", "-q"], "line.csv", "on one line", "--cell-size")
     assert "across at its widest (near (7" in err  # the place, in the grid's UTM metres
     assert not out.exists()
+
+
+def _kml(placemarks: str) -> str:
+    return f'<kml xmlns="http://www.opengis.net/kml/2.2"><Document>{placemarks}</Document></kml>'
+
+
+def _placemark(name: str, kind: str, pts) -> str:
+    c = " ".join(f"{lo},{la},0" for lo, la in pts)
+    geom = (
+        f"<Polygon><outerBoundaryIs><LinearRing><coordinates>{c}</coordinates></LinearRing></outerBoundaryIs></Polygon>"
+        if kind == "ring"
+        else f"<LineString><coordinates>{c}</coordinates></LineString>"
+    )
+    return f"<Placemark><name>{name}</name>{geom}</Placemark>"
+
+
+def test_an_open_line_far_from_the_lake_is_not_said_to_be_in_the_water(tmp_path):
+    from meshcore.cli.lakefile import without_lines_on_the_shore
+    from meshcore.io import read_points
+
+    t = np.linspace(0, 2 * np.pi, 24)
+    lake = np.c_[8.5 + 0.02 * np.cos(t), 47.3 + 0.01 * np.sin(t)]
+    ferry = [(8.49, 47.3), (8.51, 47.3)]  # across the water
+    road = [(9.5, 47.3), (9.6, 47.35)]  # 75 km east, on land
+    f = tmp_path / "lake.kml"
+    f.write_text(
+        _kml(_placemark("lake", "ring", lake) + _placemark("ferry", "line", ferry) + _placemark("road", "line", road))
+    )
+    kept, notes = without_lines_on_the_shore(read_points(f))
+    assert kept.names == ("lake",)
+    # was: "'ferry', 'road': open lines in the water (a path, not a ring), not an island: ignored"
+    assert notes == [
+        "'ferry': an open line in the water (a path, not a ring), not an island: ignored",
+        "'road': an open line outside the shore (a path, not a ring), not an island: ignored",
+    ]
+
+
+def test_a_file_without_a_suffix_is_named_in_plain_words(tmp_path, capsys):
+    src = tmp_path / "shore"
+    src.write_text("x,y\n0,0\n1000,0\n1000,1000\n")
+    err = _bad(
+        capsys,
+        ["mesh", src, "-o", tmp_path / "g.vtm", "-q"],
+        "shore: cannot read points from a file without a suffix (known suffixes: .csv",
+    )
+    assert "suffix files" not in err  # was: "from files without a suffix files"
+
+
+def test_the_lonlat_order_note_of_a_y_x_header_names_the_columns_as_the_header_does(tmp_path):
+    from meshcore.cli.lakefile import lonlat_order_note
+    from meshcore.io import read_points
+
+    t = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    f = tmp_path / "yx.csv"
+    f.write_text("Y,X\n" + "".join(f"{47.3 + 0.01 * np.sin(a):.6f},{8.5 + 0.02 * np.cos(a):.6f}\n" for a in t))
+    ps = read_points(f)
+    assert 8.4 < ps.polylines[0].points[:, 0].min() < 8.5  # X is the longitude, as the header says
+    # was: "no header says which column is which ... give --columns 1 0" (which swapped them)
+    note = lonlat_order_note(ps)
+    assert "the header says 'x', 'y'" in note and "--columns 0 1" in note and "no header" not in note
