@@ -18,6 +18,7 @@ from typing import Any
 
 from ..errors import InvalidInputError
 from .lakefile import in_world
+from .mesh_outputs import one_block_only
 
 __all__ = ["WaterParts", "read_parts", "run_parts"]
 
@@ -116,10 +117,7 @@ def _check_blocks(outputs: list, kept: list, lays: list) -> None:
     n_blocks = sum(len(lay.blocks) for lay in lays)
     for p, fmt in outputs:
         if n_blocks > 1 and not fmt.multiblock:
-            raise InvalidInputError(
-                f"-o {p}: the {fmt.name} format holds one block and the parts have {n_blocks}; "
-                f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh"
-            )
+            raise InvalidInputError(one_block_only(p, fmt, f"the parts have {n_blocks}", single=False))
         if fmt.name not in ("delft3d-dd", "delft3d-single", "efdc"):
             continue
         single = [k for (k, _), lay in zip(kept, lays, strict=True) if len(lay.blocks) == 1]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshcore.cli import main
 from tests.meshcore.test_cli_bad_input import _bad
 
 
@@ -77,3 +78,20 @@ def test_the_lonlat_order_note_of_a_y_x_header_names_the_columns_as_the_header_d
     # was: "no header says which column is which ... give --columns 1 0" (which swapped them)
     note = lonlat_order_note(ps)
     assert "the header says 'x', 'y'" in note and "--columns 0 1" in note and "no header" not in note
+
+
+def test_a_grd_of_a_lake_of_several_blocks_is_told_of_single(tmp_path, capsys):
+    src, out = tmp_path / "oval.csv", tmp_path / "oval.grd"
+    t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    src.write_text("x,y\n" + "".join(f"{6000 * np.cos(a):.3f},{1500 * np.sin(a):.3f}\n" for a in t))
+    # was: "write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh", the way to one Delft3D grid unsaid
+    _bad(
+        capsys,
+        ["mesh", src, "-o", out, "--cells", "300", "-q"],
+        "oval.grd",
+        "the delft3d format holds one block",
+        "--single",
+    )
+    assert not out.exists()
+    assert main(["mesh", str(src), "-o", str(out), "--cells", "300", "-q", "--single"]) == 0
+    assert out.exists() and out.with_suffix(".enc").exists()
