@@ -103,31 +103,18 @@ def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, s
 
 
 def check_not_a_line(args: argparse.Namespace, poly: Any, h: float, unit: str, frame: Any = None) -> None:
-    """Refuse water narrower where it is widest than the cell size its own area gave.
-
-    With the cell size from the area (``sqrt(area / cells)``) that happens only when the outline
-    is more than ``cells`` times longer than it is wide: points on (almost) one line, such as
-    lon/lat on a line but for the rounding of their decimals.  The layout had nothing to put a
-    block in (an internal error after a minute and a half).  A cell size given with
-    ``--cell-size`` is the user's and is kept (a channel narrower than a cell still gets blocks).
-    """
+    """Refuse water narrower where it is widest than the cell size its own area gave
+    (:func:`meshcore.lakeparts.on_one_line`: the layout had nothing to put a block in, an internal
+    error after a minute and a half).  A cell size given with ``--cell-size`` is the user's and is
+    kept (a channel narrower than a cell still gets blocks)."""
     if args.cell_size is not None:
         return
-    from ..lakeparts import part_width
+    from ..lakeparts import on_one_line
 
-    width, c = part_width(poly, h)
-    if width >= h:
-        return
-    long = poly.length / 2.0
-    raise InvalidInputError(
-        in_world(
-            f"{args.outline}: the water is {width:.3g}{unit} across at its widest (near ({c.x:.6g}, {c.y:.6g})) "
-            f"and about {long:.4g}{unit} long: its points lie (almost) on one line, {long / max(width, 1e-300):,.0f} "
-            f"times longer than wide, narrower than the cell size {h:.3g}{unit} its area gives; if it is water, "
-            f"give --cell-size (at most {width / 3:.3g}{unit} for 3 cells across)",
-            frame,
-        )
-    )
+    why = on_one_line(poly, h, unit)
+    if why:
+        why = why.replace("give a cell size of", "give a --cell-size of")
+        raise InvalidInputError(in_world(f"{args.outline}: {why}", frame))
 
 
 def _notes(notes: Any, frame: Any = None) -> None:
