@@ -4,6 +4,7 @@ grid of the water in the file, or exit 2 and one line naming the file and the pl
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from meshcore.cli import main
 from tests.meshcore.test_cli_bad_input import _bad
@@ -95,3 +96,35 @@ def test_a_grd_of_a_lake_of_several_blocks_is_told_of_single(tmp_path, capsys):
     assert not out.exists()
     assert main(["mesh", str(src), "-o", str(out), "--cells", "300", "-q", "--single"]) == 0
     assert out.exists() and out.with_suffix(".enc").exists()
+
+
+@pytest.mark.parametrize("decl", ['<?xml version="1.0" encoding="UTF-8"?>\n', '<?xml version="1.0"?>\n', ""])
+def test_a_kml_whose_name_was_saved_as_latin_1_is_read(tmp_path, decl):
+    from meshcore.io import read_points
+
+    t = np.linspace(0, 2 * np.pi, 24)
+    ring = " ".join(f"{8.5 + 0.02 * np.cos(a):.6f},{47.3 + 0.01 * np.sin(a):.6f},0" for a in t)
+    f = tmp_path / "see.kml"
+    text = (
+        f'{decl}<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark><name>Zürichsee Ufer</name>'
+        f"<Polygon><outerBoundaryIs><LinearRing><coordinates>{ring}</coordinates></LinearRing></outerBoundaryIs>"
+        "</Polygon></Placemark></Document></kml>"
+    )
+    f.write_bytes(text.encode("latin-1"))  # an 8-bit editor's save: 'ü' as one byte
+    ps = read_points(f)  # was: "line 1: not well-formed XML (not well-formed (invalid token) ...)"
+    assert ps.names == ("Zürichsee Ufer",) and len(ps.polylines[0].points) == 23
+
+
+def test_a_kml_declaring_another_encoding_is_read_in_it(tmp_path):
+    from meshcore.io import read_points
+
+    t = np.linspace(0, 2 * np.pi, 24)
+    ring = " ".join(f"{8.5 + 0.02 * np.cos(a):.6f},{47.3 + 0.01 * np.sin(a):.6f},0" for a in t)
+    f = tmp_path / "see.kml"
+    text = (
+        '<?xml version="1.0" encoding="ISO-8859-1"?>\n<kml xmlns="http://www.opengis.net/kml/2.2"><Document>'
+        f"<Placemark><name>Zürichsee</name><Polygon><outerBoundaryIs><LinearRing><coordinates>{ring}"
+        "</coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark></Document></kml>"
+    )
+    f.write_bytes(text.encode("latin-1"))
+    assert read_points(f).names == ("Zürichsee",)
