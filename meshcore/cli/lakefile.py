@@ -67,9 +67,11 @@ def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> s
             f"{ps.source}: the header says {x!r}, {y!r}, not longitude, latitude: read {x!r} as the "
             f"longitude, {y!r} as the latitude; if {x!r} holds the latitude, give --columns {iy} {ix}"
         )
+    ix, iy = ps.meta.get("xy_columns", (0, 1))
+    which = "the first column" if ix == 0 else f"column {ix} (from 0)"
     return (
         f"{ps.source}: no header says which column is which: read as longitude, latitude "
-        f"(x, y); if the first column is the latitude, give --columns 1 0"
+        f"(x, y); if {which} is the latitude, give --columns {iy} {ix}"
     )
 
 

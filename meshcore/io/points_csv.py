@@ -186,6 +186,7 @@ class _Layout:
         self.lonlat = False
         self.dms = False  # a value was read in degrees, minutes, seconds: lon/lat
         self.name_col: int | None = None
+        self.more_numeric: list[int] = []
         self.ix, self.iy = self._columns(path, columns, t)
         if self.ix == self.iy:
             raise ReadError(f"{path}: x and y are the same column ({self.ix})")
@@ -230,6 +231,7 @@ class _Layout:
                 f"has {len(numeric)} number(s)"
                 + (f" (the header {_show(' '.join(header))} names no x/y or lon/lat columns)" if header else "")
             )
+        self.more_numeric = numeric[2:] if header is None else []  # x, y of "n x y": a point number first
         return numeric[0], numeric[1]
 
 
@@ -388,6 +390,11 @@ def read_points_csv(
         # "fid,x,y"), not the name of polylines of one point each
         lay.name_col = None
         pts, groups = _rows(path, text, lay)
+    if lay.more_numeric and len(pts) > 2 and np.all(np.diff(pts[:, 0]) == 1.0):
+        # no header, and the first column counts the rows 1, 2, 3 … (a point number, "n lon lat"): no
+        # ring has x rising by one at every point; x, y are the next two (was: the number read as x)
+        lay.ix, lay.iy = lay.iy, lay.more_numeric[0]
+        pts, groups = _rows(path, text, lay)
     if not groups:
         raise ReadError(f"{path}: no data rows after the header")
     groups = _one_ring_split_by_blank_lines(pts, groups)
@@ -406,7 +413,7 @@ def read_points_csv(
     if declared == LONLAT:
         for pl in polylines:
             check_lonlat(pl.points, where=f"{path}: {pl.name}")
-    meta = {}
+    meta: dict = {"xy_columns": (lay.ix, lay.iy)}
     if lay.header is not None and max(lay.ix, lay.iy) < len(lay.header):  # the names the x, y columns have
         meta["columns"] = (lay.header[lay.ix], lay.header[lay.iy], lay.ix, lay.iy)
     return PointSet(tuple(polylines), declared, str(path), meta)

@@ -128,3 +128,26 @@ def test_a_kml_declaring_another_encoding_is_read_in_it(tmp_path):
     )
     f.write_bytes(text.encode("latin-1"))
     assert read_points(f).names == ("Zürichsee",)
+
+
+@pytest.mark.parametrize("sep", [",", " ", "\t"])
+def test_a_headerless_point_number_column_is_not_read_as_x(tmp_path, sep):
+    from meshcore.cli.lakefile import lonlat_order_note
+    from meshcore.io import read_points
+
+    t = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    lon, lat = 8.5 + 0.02 * np.cos(t), 47.3 + 0.01 * np.sin(t)
+    f = tmp_path / "n_lat_lon.txt"
+    f.write_text("".join(f"{k + 1}{sep}{b:.6f}{sep}{a:.6f}\n" for k, (a, b) in enumerate(zip(lon, lat, strict=True))))
+    ps = read_points(f)
+    # was: the point number read as x (1 … 24 against the latitude: "the outline crosses itself")
+    np.testing.assert_allclose(ps.polylines[0].points, np.c_[lat, lon], atol=1e-6)
+    assert "give --columns 2 1" in lonlat_order_note(ps)  # the swap that reads it right
+
+
+def test_a_headerless_first_column_that_is_not_a_count_stays_x(tmp_path):
+    from meshcore.io import read_points
+
+    f = tmp_path / "xyz.txt"
+    f.write_text("0 0 5\n4000 0 6\n4000 2000 7\n0 2000 8\n")
+    np.testing.assert_allclose(read_points(f).polylines[0].points, [[0, 0], [4000, 0], [4000, 2000], [0, 2000]])
