@@ -151,3 +151,14 @@ def test_a_headerless_first_column_that_is_not_a_count_stays_x(tmp_path):
     f = tmp_path / "xyz.txt"
     f.write_text("0 0 5\n4000 0 6\n4000 2000 7\n0 2000 8\n")
     np.testing.assert_allclose(read_points(f).polylines[0].points, [[0, 0], [4000, 0], [4000, 2000], [0, 2000]])
+
+
+def test_an_island_touching_the_shore_at_a_point_is_said_to_touch_it(tmp_path, capsys):
+    src = tmp_path / "touch.csv"
+    shore = [(0, 0), (4000, 0), (4000, 2000), (0, 2000)]
+    isle = [(2000, 0), (2400, 600), (1600, 600), (2000, 0)]  # one corner on the shore's bottom edge
+    src.write_text(
+        "x,y,ring\n" + "".join(f"{x},{y},shore\n" for x, y in shore) + "".join(f"{x},{y},isle\n" for x, y in isle)
+    )
+    # was: "'isle' crosses the shore", for a ring inside the water that only reaches it
+    _bad(capsys, ["mesh", src, "-o", tmp_path / "t.vtm", "-q"], "'isle' touches the shore of 'shore' near (2000, 0)")
