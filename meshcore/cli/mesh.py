@@ -246,7 +246,10 @@ def run(args: argparse.Namespace) -> int:
     say = _Say(args.quiet)
     _check_sizes(args)
     if args.crs.strip().lower() not in ("auto", "none", "local"):
-        why = not_a_map(normalize_crs(args.crs))  # an unknown CRS is refused before the file is read
+        try:  # an unknown CRS is refused before the file is read
+            why = not_a_map(normalize_crs(args.crs))
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"--crs {args.crs}: {str(exc).removeprefix('crs: ')}") from None
         if why:
             raise InvalidInputError(f"--crs {args.crs}: {why}; give a projected one (metres)")
     outputs = single_outputs(args, _check_outputs(args))

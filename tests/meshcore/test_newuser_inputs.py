@@ -162,3 +162,16 @@ def test_an_island_touching_the_shore_at_a_point_is_said_to_touch_it(tmp_path, c
     )
     # was: "'isle' crosses the shore", for a ring inside the water that only reaches it
     _bad(capsys, ["mesh", src, "-o", tmp_path / "t.vtm", "-q"], "'isle' touches the shore of 'shore' near (2000, 0)")
+
+
+def test_crs_of_a_file_of_metres_that_does_not_say_its_crs_tells_source_crs(tmp_path, capsys):
+    src = tmp_path / "utm.csv"
+    src.write_text("x,y\n240000,4719000\n244000,4719000\n244000,4721000\n240000,4721000\n")
+    # was: "the points' CRS is unknown (give source_crs / --source-crs)"
+    _bad(capsys, ["mesh", src, "--crs", "EPSG:32633", "-o", tmp_path / "g.vtm", "-q"], "--source-crs EPSG:32633")
+    # was: "crs: unknown CRS ..." (no option named)
+    _bad(
+        capsys,
+        ["mesh", src, "--crs", "EPSG:9999999", "-o", tmp_path / "g.vtm", "-q"],
+        "--crs EPSG:9999999: unknown CRS",
+    )
