@@ -175,3 +175,24 @@ def test_crs_of_a_file_of_metres_that_does_not_say_its_crs_tells_source_crs(tmp_
         ["mesh", src, "--crs", "EPSG:9999999", "-o", tmp_path / "g.vtm", "-q"],
         "--crs EPSG:9999999: unknown CRS",
     )
+
+
+@pytest.mark.parametrize(
+    ("body", "needle"),
+    [
+        (
+            "<NetworkLink><name>lakes</name><Link><href>http://example.com/lakes.kml</href></Link></NetworkLink>",
+            "network link to 'http://example.com/lakes.kml'",
+        ),
+        (
+            "<GroundOverlay><Icon><href>map.png</href></Icon><LatLonBox><north>42.7</north><south>42.5</south>"
+            "<east>12.0</east><west>11.8</west></LatLonBox></GroundOverlay>",
+            "image overlays (a picture, no outline)",
+        ),
+    ],
+)
+def test_a_kml_without_shapes_says_what_it_holds_instead(tmp_path, capsys, body, needle):
+    src = tmp_path / "saved.kml"
+    src.write_text(f'<?xml version="1.0" encoding="UTF-8"?><kml xmlns="http://www.opengis.net/kml/2.2">{body}</kml>')
+    # was: "no coordinates: none of 0 placemark(s) has a LineString ..." and nothing on why
+    _bad(capsys, ["mesh", src, "-o", tmp_path / "g.vtm", "-q"], "saved.kml: no coordinates", needle)
