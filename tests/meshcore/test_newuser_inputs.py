@@ -196,3 +196,11 @@ def test_a_kml_without_shapes_says_what_it_holds_instead(tmp_path, capsys, body,
     src.write_text(f'<?xml version="1.0" encoding="UTF-8"?><kml xmlns="http://www.opengis.net/kml/2.2">{body}</kml>')
     # was: "no coordinates: none of 0 placemark(s) has a LineString ..." and nothing on why
     _bad(capsys, ["mesh", src, "-o", tmp_path / "g.vtm", "-q"], "saved.kml: no coordinates", needle)
+
+
+def test_a_figure_of_an_unknown_suffix_lists_the_figure_suffixes(tmp_path, capsys):
+    src = tmp_path / "lake.csv"
+    src.write_text("x,y\n0,0\n4000,0\n4000,2000\n0,2000\n")
+    # was: "cannot write .jpg files (known suffixes: .cgns .csv .ddb .g .grd .inp ...)"
+    err = _bad(capsys, ["mesh", src, "--png", tmp_path / "look.jpg", "-q"], "--png", "look.jpg: expected a figure file")
+    assert ".cgns" not in err
