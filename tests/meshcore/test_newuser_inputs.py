@@ -204,3 +204,20 @@ def test_a_figure_of_an_unknown_suffix_lists_the_figure_suffixes(tmp_path, capsy
     # was: "cannot write .jpg files (known suffixes: .cgns .csv .ddb .g .grd .inp ...)"
     err = _bad(capsys, ["mesh", src, "--png", tmp_path / "look.jpg", "-q"], "--png", "look.jpg: expected a figure file")
     assert ".cgns" not in err
+
+
+@pytest.mark.parametrize("part", [".dbf", ".shx", ".prj"])
+def test_a_shapefile_opened_by_another_of_its_files_names_the_shp(tmp_path, capsys, part):
+    for suffix in (".shp", ".shx", ".dbf", ".prj"):
+        (tmp_path / f"lake{suffix}").write_bytes(b"x")
+    # was: "cannot read points from .dbf files (known suffixes: ...)"
+    _bad(capsys, ["mesh", tmp_path / f"lake{part}", "-o", tmp_path / "g.vtm", "-q"], "give its .shp", "lake.shp")
+
+
+def test_a_topojson_file_is_named_as_such(tmp_path, capsys):
+    src = tmp_path / "lake.json"
+    src.write_text(
+        '{"type":"Topology","objects":{"lake":{"type":"Polygon","arcs":[[0]]}},"arcs":[[[0,0],[1,0],[0,1]]]}'
+    )
+    # was: "unsupported geometry type 'Topology'"
+    _bad(capsys, ["mesh", src, "-o", tmp_path / "g.vtm", "-q"], "TopoJSON", "convert it to GeoJSON")
