@@ -213,8 +213,10 @@ class IOController(ExportMixin, QtCore.QObject):
             from meshcore.cli.lakefile import lonlat_order_note
 
             note = lonlat_order_note(pd.pointset)
-            if note:  # as meshcore mesh notes it (its --columns 1 0: a header "lat,lon" in the file here)
-                self.doc.report("warning", note.replace("give --columns 1 0", "add the header 'lat,lon' to the file"))
+            if note:  # as meshcore mesh notes it (its --columns: a header "lat,lon" in the file here)
+                note = note.replace("give --columns 1 0", "add the header 'lat,lon' to the file")
+                note = re.sub(r"give --columns \d+ \d+", "name the columns 'lat' and 'lon' in the file's header", note)
+                self.doc.report("warning", note)
         if pd.lonlat:
             if project_lonlat is None and not self.quiet:
                 target = fio.projection_named(pd, frame)

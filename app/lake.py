@@ -292,6 +292,12 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
         raise InvalidInputError(
             f"a cell size of {h:.4g} gives about {est:.2g} cells; give at most {math.sqrt(poly.area / MIN_CELLS):.4g}"
         )
+    if lake.cell_size is None:  # points on (almost) one line: nothing to lay out (was: 90 s, "All-NaN slice")
+        from meshcore.lakeparts import on_one_line
+
+        why = on_one_line(poly, h, " m")
+        if why:
+            raise InvalidInputError(why.replace("give a cell size of", "set the cell size (Lake panel) to"))
     if cuts:
         return split_layout(poly, [np.asarray(c, float) for c in cuts], h, 2**LEVELS)
     return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single)

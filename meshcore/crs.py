@@ -450,7 +450,8 @@ def project_arrays(
         target = normalize_crs(crs)
         if src is None:
             raise InvalidInputError(
-                f"{where}: cannot project to {target}: the points' CRS is unknown (give source_crs / --source-crs)"
+                f"{where}: cannot project to {target}: the points' CRS is unknown, the file does not say it (give "
+                f"it with --source-crs, source_crs= in Python: --source-crs {target} if they are in it already)"
             )
     for c, role in ((src, "the points' CRS"), (target, "the target CRS")):
         why = not_a_map(c) if c is not None and c != LONLAT else None

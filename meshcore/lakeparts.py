@@ -35,7 +35,16 @@ import numpy as np
 from .cellsize import DEFAULT_CELLS, default_cell_size
 from .errors import InvalidInputError
 
-__all__ = ["MIN_PART_CELLS", "is_several", "join_grids", "part_grids", "part_of", "select_parts", "water_parts"]
+__all__ = [
+    "MIN_PART_CELLS",
+    "is_several",
+    "join_grids",
+    "on_one_line",
+    "part_grids",
+    "part_of",
+    "select_parts",
+    "water_parts",
+]
 
 #: A part fewer than this many cells across where it is widest is left out (with a note): the
 #: layout needs blocks of at least 3 cells each way, and a grid 1–2 cells across is no model of
@@ -100,6 +109,26 @@ def part_width(poly: Any, cell_size: float) -> tuple[float, Any]:
 
     c = polylabel(poly, tolerance=max(0.05 * cell_size, 1e-12 * max(poly.length, 1e-300)))
     return 2.0 * float(poly.boundary.distance(c)), c
+
+
+def on_one_line(poly: Any, cell_size: float, unit: str = "") -> str | None:
+    """Why water is no water at ``cell_size``, or None: narrower where it is widest than one cell.
+
+    With the cell size from the area (``sqrt(area / cells)``) that happens only when the outline
+    is more than ``cells`` times longer than it is wide: points on (almost) one line, such as
+    lon/lat on a line but for the rounding of their decimals, where the layout has nothing to
+    put a block in.  The text names the widest place and the cell size that gives 3 cells there.
+    """
+    width, c = part_width(poly, cell_size)
+    if width >= cell_size:
+        return None
+    long = poly.length / 2.0
+    return (
+        f"the water is {width:.3g}{unit} across at its widest (near ({c.x:.6g}, {c.y:.6g})) and about "
+        f"{long:.4g}{unit} long: its points lie (almost) on one line, {long / max(width, 1e-300):,.0f} times longer "
+        f"than wide, narrower than the cell size {cell_size:.3g}{unit} its area gives; if it is water, give a cell "
+        f"size of at most {width / 3:.3g}{unit} (3 cells across)"
+    )
 
 
 def select_parts(

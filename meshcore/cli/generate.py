@@ -89,6 +89,8 @@ def check_output(path: str, option: str, *, blocks: int = 1, figure: bool = Fals
     try:
         fmt = find_format(p, None, role="write")
     except WriteError as exc:
+        if figure:  # the figure suffixes, not every grid format's (was: '.cgns .csv .ddb ...' for --png x.jpg)
+            raise InvalidInputError(f"{option} {p}: expected a figure file (.png, .svg or .pdf)") from None
         raise InvalidInputError(f"{option} {exc}") from None
     if figure and fmt.name != "figure":
         raise InvalidInputError(f"{option} {p}: expected a figure file (.png, .svg or .pdf)")

@@ -60,9 +60,18 @@ def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> s
     pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
     if np.abs(pts[:, 0]).max() > 90:
         return None
+    named = ps.meta.get("columns")
+    if named:  # a header of x, y (or easting, northing ...): it names the columns but not lon/lat
+        x, y, ix, iy = named
+        return (
+            f"{ps.source}: the header says {x!r}, {y!r}, not longitude, latitude: read {x!r} as the "
+            f"longitude, {y!r} as the latitude; if {x!r} holds the latitude, give --columns {iy} {ix}"
+        )
+    ix, iy = ps.meta.get("xy_columns", (0, 1))
+    which = "the first column" if ix == 0 else f"column {ix} (from 0)"
     return (
         f"{ps.source}: no header says which column is which: read as longitude, latitude "
-        f"(x, y); if the first column is the latitude, give --columns 1 0"
+        f"(x, y); if {which} is the latitude, give --columns {iy} {ix}"
     )
 
 
@@ -222,21 +231,29 @@ def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
     keep: list[Any] = []
     touching: list[Any] = []
     inside: list[Any] = []
+    outside: list[Any] = []
+    water = shapely.Polygon(shore.points)
     for pl in ps.polylines:
         if pl is shore or pl.closed or len(pl.points) < 2:  # a single point: named later
             keep.append(pl)
         elif shapely.LineString(pl.points).intersects(ring):
             touching.append(pl)
+        elif not paths:
+            keep.append(pl)
         else:
-            (inside if paths else keep).append(pl)
+            (inside if water.contains(shapely.Point(pl.points[0])) else outside).append(pl)
     notes = []
-    for dropped, where in ((touching, "touching the shore"), (inside, "in the water (a path, not a ring)")):
+    for dropped, where in (
+        (touching, "touching the shore"),
+        (inside, "in the water (a path, not a ring)"),
+        (outside, "outside the shore (a path, not a ring)"),
+    ):
         lines = [pl for pl in dropped if pl.orientation != "points"]
         if lines:
             names = ", ".join(repr(pl.name) for pl in lines)
             what = "an open line" if len(lines) == 1 else "open lines"
             notes.append(f"{names}: {what} {where}, not an island: ignored")
-    for pl in (pl for pl in touching + inside if pl.orientation == "points"):
+    for pl in (pl for pl in touching + inside + outside if pl.orientation == "points"):
         notes.append(f"{pl.name!r}: {len(pl.points)} single points (placemarks, pins), not a line or a ring: ignored")
     return (ps.with_points(keep, ps.crs), notes) if notes else (ps, [])
 

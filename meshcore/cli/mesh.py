@@ -52,6 +52,7 @@ from .mesh_steps import (
     _layout,
     _notes,
     _Say,
+    check_not_a_line,
     finish,
     guarded,
 )
@@ -246,7 +247,10 @@ def run(args: argparse.Namespace) -> int:
     say = _Say(args.quiet)
     _check_sizes(args)
     if args.crs.strip().lower() not in ("auto", "none", "local"):
-        why = not_a_map(normalize_crs(args.crs))  # an unknown CRS is refused before the file is read
+        try:  # an unknown CRS is refused before the file is read
+            why = not_a_map(normalize_crs(args.crs))
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"--crs {args.crs}: {str(exc).removeprefix('crs: ')}") from None
         if why:
             raise InvalidInputError(f"--crs {args.crs}: {why}; give a projected one (metres)")
     outputs = single_outputs(args, _check_outputs(args))
@@ -265,6 +269,7 @@ def run(args: argparse.Namespace) -> int:
         return run_parts(args, poly, frame, say, outputs, regular, t_start)
     unit = " m" if frame.crs else ""
     h, how = _cell_size(args, poly, unit)
+    check_not_a_line(args, poly, h, unit, frame)
     say(f"water area {poly.area / 1e6:.4g} km², {how}" if frame.crs else f"water area {poly.area:.6g}, {how}")
     say.lap()
 

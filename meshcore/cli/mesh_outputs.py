@@ -30,6 +30,20 @@ def single_outputs(args: argparse.Namespace, outputs: list[tuple[Path, Any]]) ->
     return [(p, FORMATS["delft3d-single"] if fmt.name == "delft3d" else fmt) for p, fmt in outputs]
 
 
+def one_block_only(p: Path, fmt: Any, blocks: str, single: bool = True) -> str:
+    """The message for ``-o p`` of a one-block format and a grid of several blocks (``blocks``
+    says how many); a Delft3D ``.grd`` of one lake is told of ``--single``, which merges them."""
+    also = (
+        "; or add --single for one Delft3D grid of the blocks merged (with inactive points and its .enc)"
+        if fmt.name == "delft3d" and single
+        else ""
+    )
+    return (
+        f"-o {p}: the {fmt.name} format holds one block and {blocks}; "
+        f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh{also}"
+    )
+
+
 def check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
     """Refuse, before the solve, an output that cannot hold this layout.
 
@@ -40,10 +54,7 @@ def check_blocks(outputs: list[tuple[Path, Any]], lay: Any) -> None:
     n_blocks = len(lay.blocks)
     for p, fmt in outputs:
         if n_blocks > 1 and not fmt.multiblock:
-            raise InvalidInputError(
-                f"-o {p}: the {fmt.name} format holds one block and the layout has {n_blocks}; "
-                f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh"
-            )
+            raise InvalidInputError(one_block_only(p, fmt, f"the layout has {n_blocks}"))
         if fmt.name == "delft3d-dd":
             if n_blocks < 2:
                 raise InvalidInputError(f"-o {p}: the layout is one block; write it as .grd, not as a .ddb")

@@ -18,6 +18,7 @@ from typing import Any
 
 from ..errors import InvalidInputError
 from .lakefile import in_world
+from .mesh_outputs import one_block_only
 
 __all__ = ["WaterParts", "read_parts", "run_parts"]
 
@@ -123,10 +124,7 @@ def _check_blocks(outputs: list, kept: list, lays: list) -> None:
     n_blocks = sum(len(lay.blocks) for lay in lays)
     for p, fmt in outputs:
         if n_blocks > 1 and not fmt.multiblock:
-            raise InvalidInputError(
-                f"-o {p}: the {fmt.name} format holds one block and the parts have {n_blocks}; "
-                f"write .vtm, .cgns, .xyz, .ddb, .npz, .su2 or .msh"
-            )
+            raise InvalidInputError(one_block_only(p, fmt, f"the parts have {n_blocks}", single=False))
         if fmt.name not in ("delft3d-dd", "delft3d-single", "efdc"):
             continue
         single = [k for (k, _), lay in zip(kept, lays, strict=True) if len(lay.blocks) == 1]
@@ -180,7 +178,7 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
     import shapely
 
     from ..lakeparts import join_grids, select_parts
-    from .mesh_steps import _cell_size, _grid, _notes, finish, guarded
+    from .mesh_steps import _cell_size, _grid, _notes, check_not_a_line, finish, guarded
 
     unit = " m" if frame.crs else ""
     total = shapely.MultiPolygon(list(water.polygons))
@@ -192,6 +190,8 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
         kept, notes = select_parts(list(water.polygons), asked, h, water.names)
     except InvalidInputError as exc:
         raise InvalidInputError(in_world(f"{args.outline}: {exc}", frame)) from None
+    for _, p in kept:
+        check_not_a_line(args, p, h, unit, frame)
     _notes(notes, frame)
     if asked:
         say(f"meshing part{'s' * (len(kept) != 1)} {', '.join(str(k) for k, _ in kept)} of {len(water.polygons)}")

@@ -102,6 +102,21 @@ def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, s
     return h, f"cell size {h:.4g}{unit} ({why}, about {est:,.0f} cells)"
 
 
+def check_not_a_line(args: argparse.Namespace, poly: Any, h: float, unit: str, frame: Any = None) -> None:
+    """Refuse water narrower where it is widest than the cell size its own area gave
+    (:func:`meshcore.lakeparts.on_one_line`: the layout had nothing to put a block in, an internal
+    error after a minute and a half).  A cell size given with ``--cell-size`` is the user's and is
+    kept (a channel narrower than a cell still gets blocks)."""
+    if args.cell_size is not None:
+        return
+    from ..lakeparts import on_one_line
+
+    why = on_one_line(poly, h, unit)
+    if why:
+        why = why.replace("give a cell size of", "give a --cell-size of")
+        raise InvalidInputError(in_world(f"{args.outline}: {why}", frame))
+
+
 def _notes(notes: Any, frame: Any = None) -> None:
     """What the pipeline changed in the water (islands joined or too small): shown even with -q
     (places in the grid's CRS: :func:`in_world`)."""

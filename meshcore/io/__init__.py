@@ -242,6 +242,10 @@ for _f in (
     register_format(_f)
 
 
+#: The files beside a shapefile's ``.shp`` (attributes, index, projection, code page, spatial index).
+_SHAPEFILE_PARTS = (".dbf", ".shx", ".prj", ".cpg", ".sbn", ".sbx", ".qix", ".qmd")
+
+
 def find_format(path: Any, format: str | None = None, *, role: str) -> Format:
     """The :class:`Format` for ``path`` (by suffix) or ``format`` (by name).
 
@@ -269,9 +273,13 @@ def find_format(path: Any, format: str | None = None, *, role: str) -> Format:
         if getattr(f, attr):
             return f
     can = sorted({s for f in FORMATS.values() if getattr(f, attr) for s in f.suffixes})
+    shp = Path(str(path)).with_suffix(".shp")
+    if role == "points" and suffix in _SHAPEFILE_PARTS and shp.exists():
+        raise ReadError(f"{path}: one of the files of a shapefile: give its .shp ({shp})")
     verb = {"write": "write", "grid": "read grids from", "points": "read points from"}[role]
+    what = f"{suffix} files" if suffix else "a file without a suffix"
     raise (WriteError if role == "write" else ReadError)(
-        f"{path}: cannot {verb} {suffix or 'files without a suffix'} files (known suffixes: {' '.join(can)})"
+        f"{path}: cannot {verb} {what} (known suffixes: {' '.join(can)})"
     )
 
 

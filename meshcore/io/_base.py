@@ -9,6 +9,7 @@ leaves nothing behind.
 from __future__ import annotations
 
 import contextlib
+import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -232,8 +233,28 @@ def parse_xml(data: bytes, where: str, *, kind: str):
             f"{where}: refused: the XML declares a DTD or entities ({type(exc).__name__}); {kind} files never need them"
         ) from None
     except ParseError as exc:
+        latin1 = _latin1_as_utf8(data)
+        if latin1 is not None:  # Latin-1 text saved without a declaration saying so (XML's default is UTF-8)
+            try:
+                return fromstring(latin1, forbid_dtd=True, forbid_entities=True, forbid_external=True)
+            except ParseError:
+                pass
         line = getattr(exc, "position", (None,))[0]
         raise ReadError(one_line(f"{where}: line {line}: not well-formed XML ({exc})")) from None
+
+
+def _latin1_as_utf8(data: bytes) -> bytes | None:
+    """``data`` re-encoded from Latin-1 to UTF-8 when it is not UTF-8 and its XML declaration names
+    no encoding or UTF-8 (a name edited in an 8-bit editor: 'ä' as one byte); None otherwise (the
+    parse error stands)."""
+    decl = data[:200].lstrip(b"\xef\xbb\xbf").lstrip().split(b"?>", 1)[0].lower()
+    if decl.startswith(b"<?xml") and b"encoding" in decl and not re.search(rb"encoding\s*=\s*[\"']utf-?8[\"']", decl):
+        return None
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("latin-1").encode("utf-8")
+    return None
 
 
 def read_bytes(path: Path, *, limit: int | None = None) -> bytes:

@@ -68,6 +68,11 @@ def _geometry(geom: Any, name: str, where: str, out: list[Polyline]) -> None:
         pts = _coords([c] if t == "Point" else c, where)
         out.append(Polyline(name, pts))  # gathered below
         object.__setattr__(out[-1], "orientation", "point")
+    elif t == "Topology":  # TopoJSON: arcs shared between shapes, not GeoJSON coordinates
+        raise ReadError(
+            f"{where}: a TopoJSON file (type 'Topology'), not GeoJSON: convert it to GeoJSON first "
+            "(e.g. mapshaper -o format=geojson, or ogr2ogr -f GeoJSON)"
+        )
     else:
         raise ReadError(f"{where}: unsupported geometry type {t!r}")
 

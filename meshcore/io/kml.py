@@ -43,6 +43,22 @@ def _parse_xml(data: bytes, where: str):
     return parse_xml(data, where, kind="KML")
 
 
+def _what_else(root: Any) -> str:
+    """What a KML without shapes holds instead, for the message: a network link (the shapes are in
+    the file it links to) or image overlays (a picture, no outline)."""
+    for el in root.iter():
+        if _local(el.tag) == "NetworkLink":
+            href = next((h.text or "" for h in el.iter() if _local(h.tag) == "href"), "").strip()
+            where = f" {href[:200]!r}" if href else ""
+            return (
+                f"; it holds a network link to{where}: the shapes are in the file it links to (in Google Earth, "
+                "open the link and save the places it shows: right-click ▸ Save Place As…, .kml)"
+            )
+    if any(_local(el.tag) in ("GroundOverlay", "ScreenOverlay", "PhotoOverlay") for el in root.iter()):
+        return "; it holds image overlays (a picture, no outline): draw the shore on it as a path or polygon"
+    return ""
+
+
 _SPLIT = re.compile(r"\s+")
 
 
@@ -164,7 +180,7 @@ def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
     if not merged:
         raise ReadError(
             f"{where}: no coordinates: none of {n_marks} placemark(s) has a LineString, "
-            f"LinearRing, Polygon, gx:Track or two or more Points"
+            f"LinearRing, Polygon, gx:Track or two or more Points{_what_else(root)}"
         )
     declared = normalize_crs(crs) if crs is not None else LONLAT
     if declared == LONLAT:

@@ -13,8 +13,9 @@
   polylines (unless it changes on every row: then it numbers the points);
   otherwise the first two numeric columns are x, y;
 * several polylines are separated by blank lines or GMT-style ``> name`` lines
-  (runs that only blank lines separate and that close together, none by itself,
-  are one ring cut by stray blank lines).
+  (runs that only blank lines separate and that close together, none by itself, or
+  join end to start with no gap longer than their longest step, are one ring cut by
+  stray blank lines).
 
 A ring whose last point repeats the first is marked closed and the repeated
 point dropped.
@@ -185,6 +186,7 @@ class _Layout:
         self.lonlat = False
         self.dms = False  # a value was read in degrees, minutes, seconds: lon/lat
         self.name_col: int | None = None
+        self.more_numeric: list[int] = []
         self.ix, self.iy = self._columns(path, columns, t)
         if self.ix == self.iy:
             raise ReadError(f"{path}: x and y are the same column ({self.ix})")
@@ -229,6 +231,7 @@ class _Layout:
                 f"has {len(numeric)} number(s)"
                 + (f" (the header {_show(' '.join(header))} names no x/y or lon/lat columns)" if header else "")
             )
+        self.more_numeric = numeric[2:] if header is None else []  # x, y of "n x y": a point number first
         return numeric[0], numeric[1]
 
 
@@ -387,6 +390,11 @@ def read_points_csv(
         # "fid,x,y"), not the name of polylines of one point each
         lay.name_col = None
         pts, groups = _rows(path, text, lay)
+    if lay.more_numeric and len(pts) > 2 and np.all(np.diff(pts[:, 0]) == 1.0):
+        # no header, and the first column counts the rows 1, 2, 3 … (a point number, "n lon lat"): no
+        # ring has x rising by one at every point; x, y are the next two (was: the number read as x)
+        lay.ix, lay.iy = lay.iy, lay.more_numeric[0]
+        pts, groups = _rows(path, text, lay)
     if not groups:
         raise ReadError(f"{path}: no data rows after the header")
     groups = _one_ring_split_by_blank_lines(pts, groups)
@@ -405,7 +413,10 @@ def read_points_csv(
     if declared == LONLAT:
         for pl in polylines:
             check_lonlat(pl.points, where=f"{path}: {pl.name}")
-    return PointSet(tuple(polylines), declared, str(path))
+    meta: dict = {"xy_columns": (lay.ix, lay.iy)}
+    if lay.header is not None and max(lay.ix, lay.iy) < len(lay.header):  # the names the x, y columns have
+        meta["columns"] = (lay.header[lay.ix], lay.header[lay.iy], lay.ix, lay.iy)
+    return PointSet(tuple(polylines), declared, str(path), meta)
 
 
 def _one_ring_split_by_blank_lines(
@@ -416,13 +427,23 @@ def _one_ring_split_by_blank_lines(
     Runs that blank lines alone separate (no names), none a ring by itself, whose last point
     closes on the first run's first point: one ring.  Read apart, the first piece was a ring of
     its own (a CSV ring may omit its closing point) and the rest lines dropped as touching it.
+    A ring written without its closing point, cut so, is one ring too when every run has two
+    points or more and every gap (from a run's last point to the next run's first, and from the
+    last point back to the first) is no longer than the longest step inside the runs: read
+    apart, the largest piece was the shore and the rest dropped with a note, the lake cut short.
     """
     if len(groups) < 2 or any(g[1] is not None or g[2] is not None for g in groups):
         return groups
     ends = [g[0] for g in groups[1:]] + [len(pts)]
     if any(np.array_equal(pts[g[0]], pts[e - 1]) for g, e in zip(groups, ends, strict=True)):
         return groups
-    return groups[:1] if np.array_equal(pts[0], pts[-1]) else groups
+    if np.array_equal(pts[0], pts[-1]):
+        return groups[:1]
+    if any(e - g[0] < 2 for g, e in zip(groups, ends, strict=True)):
+        return groups
+    step = max(float(np.hypot(*np.diff(pts[g[0] : e], axis=0).T).max()) for g, e in zip(groups, ends, strict=True))
+    gaps = pts[[g[0] for g in groups[1:]] + [0]] - pts[[e - 1 for e in ends]]
+    return groups[:1] if float(np.hypot(*gaps.T).max()) <= step else groups
 
 
 def _find(header: list[str], names: set[str]) -> int | None:

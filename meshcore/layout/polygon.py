@@ -315,10 +315,11 @@ def water_parts_from_points(pointset: Any) -> list[tuple[str, np.ndarray, list[n
             if ring.boundary.intersects(shell.boundary):
                 c = ring.boundary.intersection(shell.boundary).representative_point()
                 if shell.contains(ring.representative_point()):
+                    inside = ring.difference(shell).area <= 1e-9 * ring.area  # on the shore from inside
                     raise InvalidInputError(
-                        f"{pointset.source or 'points'}: {name!r} crosses the shore of {oname!r} near "
-                        f"({c.x:.6g}, {c.y:.6g}) — an island must lie inside the shore (a ring that reaches "
-                        f"the land is part of the shore: draw it into the outline)"
+                        f"{pointset.source or 'points'}: {name!r} {'touches' if inside else 'crosses'} the "
+                        f"shore of {oname!r} near ({c.x:.6g}, {c.y:.6g}) — an island must lie inside the shore, "
+                        f"clear of it (a ring that reaches the land is part of the shore: draw it into the outline)"
                     )
                 raise InvalidInputError(
                     f"{pointset.source or 'points'}: the water parts {oname!r} and {name!r} overlap or touch "

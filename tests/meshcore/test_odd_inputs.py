@@ -49,6 +49,30 @@ def test_rings_apart_stay_apart(tmp_path):
     assert [len(pl) for pl in read_points(f).polylines] == [4, 3]
 
 
+def _oval(n, cx=0.0, cy=0.0, a=4000.0, b=2000.0):
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.c_[cx + a * np.cos(t), cy + b * np.sin(t)]
+
+
+@pytest.mark.parametrize("cut", [(20,), (5, 40), (58,)])
+def test_a_ring_without_its_closing_point_cut_by_blank_lines_is_one_ring(tmp_path, cut):
+    ring = _oval(60)
+    rows = [",".join(f"{v:.3f}" for v in p) for p in ring]
+    for k in sorted(cut, reverse=True):
+        rows.insert(k, "")
+    f = tmp_path / "open_blank.csv"
+    f.write_text("x,y\n" + "\n".join(rows) + "\n")
+    (pl,) = read_points(f).polylines
+    np.testing.assert_allclose(pl.points, ring, atol=1e-3)
+
+
+def test_open_rings_apart_stay_apart(tmp_path):
+    shore, island = _oval(60), _oval(12, 500.0, 0.0, 600.0, 400.0)[::-1]
+    f = tmp_path / "open_rings.csv"
+    f.write_text("x,y\n" + "\n\n".join("\n".join(f"{x:.3f},{y:.3f}" for x, y in r) for r in (shore, island)) + "\n")
+    assert [len(pl) for pl in read_points(f).polylines] == [60, 12]
+
+
 def test_a_one_point_piece_says_blank_lines_split(tmp_path):
     f = tmp_path / "b.csv"
     f.write_text("x,y\n0,0\n\n4000,0\n4000,2000\n0,2000\n")
