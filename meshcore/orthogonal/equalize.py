@@ -369,6 +369,8 @@ def _run_seeds(t: _Tables, pairs: np.ndarray, r: np.ndarray, q: int, run: int) -
     if run <= 0:
         return nodes
     high = np.flatnonzero(r > np.log(AIM))
+    if not len(high):  # no pair above AIM (q itself lies between the step's limit and AIM)
+        return nodes
     taken = {q}
     for _ in range(run):
         near = np.isin(t.cells[pairs[high]].reshape(len(high), -1), nodes).any(1)

@@ -225,3 +225,19 @@ def test_a_run_of_pairs_moves_as_one_patch_and_loses_no_target(solved, depths, s
     if len(shore):
         _, _, d = project_to_rings(rings, np.column_stack([X1[shore], Y1[shore]]))
         assert d.max() < 1e-9
+
+
+def test_a_run_without_pairs_above_aim_is_the_pair_alone():
+    """Seen on a new machine (numpy 2.4, scipy 1.17, shapely 2.2): the worst pair lay between the
+    step's limit and ``AIM``, no pair above ``AIM`` was left to join it, and the run's search
+    reshaped an empty selection ("cannot reshape array of size 0"): two tests above failed."""
+    from types import SimpleNamespace
+
+    from meshcore.orthogonal.equalize import AIM, _run_seeds
+
+    t = SimpleNamespace(cells=np.arange(16).reshape(4, 4))  # 4 cells of 4 nodes
+    pairs = np.array([[0, 1], [2, 3]])
+    r = np.full(2, 0.5 * np.log(AIM))  # both below AIM
+    assert _run_seeds(t, pairs, r, 0, 3).tolist() == list(range(8))
+    r[1] = 2 * np.log(AIM)  # the other pair above AIM but apart: not joined
+    assert _run_seeds(t, pairs, r, 0, 3).tolist() == list(range(8))
