@@ -63,20 +63,38 @@ def test_single_domain_and_efdc_end_to_end(tmp_path, round_csv):
     assert f"wrote {tmp_path / 'r.grd'} and r.enc" in run.err
 
 
-def test_a_layout_that_does_not_fit_is_refused_before_the_solve(tmp_path):
-    """A lake with an island: the regular layout's ring round it does not add up in cell counts
-    (as on most generated lakes with islands): exit 2, one line naming the place, no file."""
+def test_a_lake_with_an_island_fits_one_index_space(tmp_path):
+    """Refused until session 22 (the regular layout's ring round the island did not add up in cell
+    counts): the layout for one index space closes it, and both single-domain files are written."""
     shore, island = _synthetic_rings()
     src = tmp_path / "isle.csv"
     csv(src, [shore, island])
+    out = tmp_path / "efdc"
+    out.mkdir()
+    run = mesh(src, "--cells", 2000, "-o", tmp_path / "i.grd", "--single", "-o", out / "cell.inp")
+    assert run.rc == 0, run.err
+    types, dxdy, _, _ = read_efdc(out)
+    assert int((types == 5).sum()) == len(dxdy) > 1000
+    assert (tmp_path / "i.grd").exists() and (tmp_path / "i.enc").exists()
+
+
+def test_a_layout_that_does_not_fit_is_refused_before_the_solve(tmp_path):
+    """A branched channel whose arms fold onto each other in index space: exit 2, one line naming
+    the output and the place, no file."""
+    from meshcore import testing
+
+    poly = testing.channel_network(812354, n_branches=3)
+    src = tmp_path / "net.csv"
+    csv(src, [300.0 * np.asarray(poly.exterior.coords)[:-1]])
     for out in (tmp_path / "i.grd", tmp_path / "cell.inp"):
         extra = ("--single",) if out.suffix == ".grd" else ()
         run = mesh(src, "--cells", 2000, "-o", out, *extra, "-o", tmp_path / "i.vtm")
         assert run.rc == 2, run.err
         last = run.err.strip().splitlines()[-1]
         assert str(out) in last and "one index space" in last and ".ddb" in last
+        assert "folds back onto itself" in last
         assert "grid level" not in run.err
-        assert sorted(os.listdir(tmp_path)) == ["isle.csv"]
+        assert sorted(os.listdir(tmp_path)) == ["net.csv"]
 
 
 def test_single_needs_a_grd(tmp_path, round_csv):
