@@ -149,9 +149,11 @@ def run(args: argparse.Namespace) -> int:
         )
     loop = pl.points
     try:
-        water_polygon(loop)  # the loop crossing itself or of no area is refused here, not by generate
+        poly, _ = water_polygon(loop)  # the loop crossing itself or of no area is refused here, not by generate
         corners = _corners(args, loop, where)
-        cells = cells or guess_cells(loop, corners)
+        if not cells:
+            cells = guess_cells(loop, corners)
+            _not_a_line(poly, cells, " m" if frame.crs else "")
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)  # places in the file's CRS, as meshcore mesh names them
         raise type(exc)(msg if msg.startswith(where) else f"{where}: {msg}") from None
@@ -170,3 +172,18 @@ def run(args: argparse.Namespace) -> int:
         f"cells {list(cells)}"
     )
     return 0
+
+
+def _not_a_line(poly, cells, unit: str) -> None:
+    """Refuse a loop narrower where it is widest than the cells guessed for it (points on one line
+    but for their rounding: a block a few centimetres wide, which ``generate`` then solved); cells
+    given with ``--cells`` are the user's."""
+    import math
+
+    from ..errors import InvalidInputError
+    from ..lakeparts import on_one_line
+
+    why = on_one_line(poly, math.sqrt(poly.area / (cells[0] * cells[1])), unit)
+    if why:
+        why = why.split("; if it is water")[0].replace("its area gives", "the guessed cells give")
+        raise InvalidInputError(f"{why}; if it is water, give --cells NI NJ with at least 3 cells across")

@@ -221,3 +221,16 @@ def test_a_topojson_file_is_named_as_such(tmp_path, capsys):
     )
     # was: "unsupported geometry type 'Topology'"
     _bad(capsys, ["mesh", src, "-o", tmp_path / "g.vtm", "-q"], "TopoJSON", "convert it to GeoJSON")
+
+
+def test_import_of_points_on_a_line_is_refused_unless_cells_are_given(tmp_path, capsys):
+    """``meshcore import`` of the same points wrote a one-block case 4 cm wide that ``generate``
+    solved (session 22's sweep, left then); now exit 2 naming the place, no case file; with
+    ``--cells`` the user's block is written."""
+    src, out = tmp_path / "line.csv", tmp_path / "line.toml"
+    lon = 11.9 + 0.001 * np.arange(20)
+    src.write_text("lon,lat\n" + "".join(f"{a:.6f},42.600000\n" for a in lon))
+    err = _bad(capsys, ["import", src, "-o", out], "line.csv", "on one line", "--cells")
+    assert "across at its widest (near (7" in err
+    assert not out.exists()
+    assert main(["import", str(src), "-o", str(out), "--cells", "40", "2"]) == 0 and out.exists()
