@@ -324,9 +324,11 @@ def test_lake_menu_makes_a_layout_for_one_index_space_and_recovery_keeps_it(qtbo
     wait_for(qtbot, win, lambda: win.doc.project.lake.single and win.doc.project.layout.single)
     wait_idle(qtbot, win)
     assert win.doc.project.lake.regular
+    assert "for one index space" in win.lake_panel.summary.text()
     state = recovery._lake_state(win.doc.project.lake)
     assert state["single"] and recovery._with_lake(win.doc.project.replaced(lake=None), state).lake.single
     win.a_auto_layout_regular.trigger()
     wait_for(qtbot, win, lambda: not win.doc.project.lake.single and win.doc.project.layout is not None)
     wait_idle(qtbot, win)
     assert win.doc.project.lake.regular and not win.doc.project.layout.single
+    assert "index space" not in win.lake_panel.summary.text()
