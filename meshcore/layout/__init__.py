@@ -158,6 +158,11 @@ def auto_layout(
             elif regular and frame_defects(list(lay.pieces), single=single):
                 kept = kept or lay  # the other splits may close up: tried next, this one if not
                 continue
+            if single:  # arms that fold onto each other in index space: another scale may not
+                why = _folds_in_index_space(lay)
+                if why:
+                    first = first or TopologyError(why)
+                    continue
             return lay
         if kept is not None:
             if single:  # a single index space cannot hold it: say where, before the grid is made
@@ -175,6 +180,19 @@ def auto_layout(
             f"EFDC): {why}; write a .ddb (domain decomposition) or .vtm instead"
         ) from None
     raise first
+
+
+def _folds_in_index_space(lay: Layout) -> str | None:
+    """Why the blocks of ``lay`` (their start grids) do not fit one index space, or None."""
+    from ..algebraic import tfi
+    from ..multiblock.indexspace import EmbeddingError, embed
+
+    topo = lay.topology()
+    try:
+        embed([tfi(b.borders) for b in topo.blocks], [b.name for b in topo.blocks])
+    except EmbeddingError as exc:
+        return str(exc)
+    return None
 
 
 #: When no layout at the cell size has agreeing counts (or no cut from an island stays in

@@ -79,11 +79,11 @@ def test_a_lake_with_an_island_fits_one_index_space(tmp_path):
 
 
 def test_a_layout_that_does_not_fit_is_refused_before_the_solve(tmp_path):
-    """A branched channel whose arms fold onto each other in index space: exit 2, one line naming
-    the output and the place, no file."""
+    """A branched channel whose arms fold onto each other in index space at every scale the layout
+    tries: exit 2, one line naming the file and the place, no file written."""
     from meshcore import testing
 
-    poly = testing.channel_network(812354, n_branches=3)
+    poly = testing.channel_network(812352, n_branches=5)
     src = tmp_path / "net.csv"
     csv(src, [300.0 * np.asarray(poly.exterior.coords)[:-1]])
     for out in (tmp_path / "i.grd", tmp_path / "cell.inp"):
@@ -91,7 +91,7 @@ def test_a_layout_that_does_not_fit_is_refused_before_the_solve(tmp_path):
         run = mesh(src, "--cells", 2000, "-o", out, *extra, "-o", tmp_path / "i.vtm")
         assert run.rc == 2, run.err
         last = run.err.strip().splitlines()[-1]
-        assert str(out) in last and "one index space" in last and ".ddb" in last
+        assert str(src) in last and "one index space" in last and ".ddb" in last
         assert "folds back onto itself" in last
         assert "grid level" not in run.err
         assert sorted(os.listdir(tmp_path)) == ["net.csv"]
