@@ -159,9 +159,9 @@ def auto_layout(
                 kept = kept or lay  # the other splits may close up: tried next, this one if not
                 continue
             if single:  # arms that fold onto each other in index space: another scale may not
-                why = _folds_in_index_space(lay)
-                if why:
-                    first = first or TopologyError(why)
+                folds = _folds_in_index_space(lay)
+                if folds:
+                    first = first or TopologyError(folds)
                     continue
             return lay
         if kept is not None:
