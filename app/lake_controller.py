@@ -183,7 +183,7 @@ class LakeController(QtCore.QObject):
             self.editor.set_lake(lake.replaced(layout=layout), "Auto layout")
         for note in layout.notes:  # what meshcore mesh prints as notes (the Lake panel counts them)
             self.doc.report("info", f"layout: {note}")
-        kind = " for one index space" if getattr(layout, "single", False) else ""
+        kind = " for one index space" if layout.single else ""
         self.win.message(
             f"Layout{kind}: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells at {layout.cell_size:.4g} m — "
             "generating the orthogonal grid (Ctrl+Z undoes the layout)"

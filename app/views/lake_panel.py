@@ -117,7 +117,7 @@ class LakePanel(QtWidgets.QWidget):
         h = lake.cell_size if lake is not None else None
         if h is not None and not math.isclose(h, lay.cell_size, rel_tol=1e-6):  # set since: not applied yet
             notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m"
-        kind = " for one index space (EFDC, Delft3D single domain)" if getattr(lay, "single", False) else ""
+        kind = " for one index space (EFDC, Delft3D single domain)" if lay.single else ""
         self.summary.setText(f"{n} block{'s' * (n != 1)}{kind}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m{notes}")
         self.summary.setToolTip("\n\n".join(lay.notes))
         self.table.setRowCount(n)

@@ -307,7 +307,7 @@ def layout_case(layout: Any, *, title: str = "", description: str = "", crs: Any
         multiple=layout.multiple,
         holes=tuple(parts["holes"]),
         cell_size=float(layout.cell_size),
-        single=bool(getattr(layout, "single", False)),
+        single=layout.single,
     )
     table = None
     if crs is not None and getattr(crs, "crs", None) is not None:

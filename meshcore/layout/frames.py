@@ -125,8 +125,8 @@ def _island_turns(v: _Vertices, single: bool = False) -> dict[int, int]:
     out: dict[int, int] = {}
     for k in range(1, int(v.loop.max(initial=0)) + 1):
         on = v.loop == k
-        turns = int(v.c[on].sum() - 2 * (v.m[on] - 1).sum())
         each = v.c[on] - 2 * (v.m[on] - 1)  # what every vertex adds
+        turns = int(each.sum())
         odd = int(((each != 0) & (each != -1)).sum())  # a lone corner (+1), a cut end passed by both (-2)
         out[k] = abs(turns - ONE_TURN) + odd if single else turns % 4
     return out

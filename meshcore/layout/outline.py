@@ -122,7 +122,7 @@ def outline_blocks(layout: Any):
         multiple=layout.multiple,
         snap=topology_snap(layout.polygon),
         cell_size=layout.cell_size,
-        single=getattr(layout, "single", False),
+        single=layout.single,
     )
 
 

@@ -55,6 +55,18 @@ def _reservoir(tmp_path, fmt: str = "kml"):
     return path
 
 
+def pick_part(row: int, asked: list[int]):
+    """A stand-in for the parts dialog's ``exec``: notes how many parts it listed, picks ``row``."""
+    from app.parts_dialog import PartsDialog
+
+    def pick(dlg):
+        asked.append(dlg.table.rowCount())
+        dlg.table.selectRow(row)
+        return PartsDialog.DialogCode.Accepted
+
+    return pick
+
+
 def test_the_parts_dialog_lists_every_part_by_name_and_area_largest_first(qtbot, tmp_path):
     """A file of two parts of water: the dialog's table has a row per part, numbered as
     ``meshcore mesh --part`` numbers them (largest first), with its name, water area in km² and
@@ -86,14 +98,8 @@ def test_importing_water_in_two_parts_asks_which_part_and_opens_it(qtbot, win, t
     from app.parts_dialog import PartsDialog
 
     path = _reservoir(tmp_path, fmt)
-    asked = []
-
-    def pick_second(dlg):
-        asked.append(dlg.table.rowCount())
-        dlg.table.selectRow(1)
-        return PartsDialog.DialogCode.Accepted
-
-    monkeypatch.setattr(PartsDialog, "exec", pick_second)
+    asked: list[int] = []
+    monkeypatch.setattr(PartsDialog, "exec", pick_part(1, asked))
     said = []
     win.doc.reported.connect(lambda level, text: said.append(text))
     win.quiet = False

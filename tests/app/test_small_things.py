@@ -97,15 +97,11 @@ def test_open_recent_opens_the_part_chosen_last_time(qtbot, win, tmp_path, monke
     from PySide6 import QtWidgets
 
     from app.parts_dialog import PartsDialog
+    from tests.app.test_modeller_walk5 import pick_part
 
     path = _two_basins(tmp_path)
-    asked = []
-
-    def pick_second(dlg):
-        asked.append(dlg.table.rowCount())
-        dlg.table.selectRow(1)
-        return PartsDialog.DialogCode.Accepted
-
+    asked: list[int] = []
+    pick_second = pick_part(1, asked)
     monkeypatch.setattr(PartsDialog, "exec", pick_second)
     monkeypatch.setattr(QtWidgets.QMessageBox, "question", lambda *a: QtWidgets.QMessageBox.StandardButton.Discard)
     win.quiet = False
