@@ -34,14 +34,21 @@ if TYPE_CHECKING:
 __all__ = ["iterate_layout", "mesh_layout", "mesh_outline"]
 
 
-def _shore_rings(layout, step: float) -> list[np.ndarray]:
-    """The shore the nodes slide along: the rings as the layout's pieces have them (every vertex a
-    block has on the shore), a vertex every ``step`` at most.
+def _shore_rings(poly, step: float) -> list[np.ndarray]:
+    import shapely
+
+    dense = shapely.segmentize(poly, step)
+    return [np.asarray(dense.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in dense.interiors)]
+
+
+def _layout_shore(layout):
+    """The shore the nodes slide along: the water as the layout's pieces have it (every vertex a
+    block has on the shore; outline counter-clockwise, islands clockwise, as ``layout.polygon``).
 
     Taken from the pieces, not from ``layout.polygon``: the case file of a layout writes this shore
     (:func:`~meshcore.layout.outline.outline_parts`), so a layout read back from it slides its nodes
     along the same vertices and gives the same grid to the last bit (from the polygon, the two
-    rings followed the same lines through different vertices, and the rounding moved a repaired
+    shores followed the same lines through different vertices, and the rounding moved a repaired
     sliver by 0.12 cells on Shasta at 15 000 cells)."""
     import shapely
     from shapely.geometry.polygon import orient
@@ -49,8 +56,7 @@ def _shore_rings(layout, step: float) -> list[np.ndarray]:
     from .layout.outline import shore_of
 
     outer, holes = shore_of(list(layout.pieces))
-    dense = shapely.segmentize(orient(shapely.Polygon(outer, holes)), step)
-    return [np.asarray(dense.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in dense.interiors)]
+    return orient(shapely.Polygon(outer, holes), 1.0)
 
 
 def _repair_folds(grids: list) -> tuple[list, int]:
@@ -175,7 +181,7 @@ def iterate_layout(
     g0 = initial_grids(tops[0])  # the start's first guess, and the layout's lines for untangle
     grids, how = _start(tops[0], start, g0)
     grids, repaired = _repair_folds(grids)
-    rings = _shore_rings(layout, layout.cell_size / 4)
+    rings = _shore_rings(_layout_shore(layout), layout.cell_size / 4)
     grids, untangled = untangle(tops[0], grids, layout=g0, rings=rings if slide_ends else None)
     total = 0
     fitted = 0
