@@ -319,6 +319,8 @@ def coverage(
     """Coverage of ``polygon`` (shapely, or an outer ring plus ``holes``) by the grid."""
     import shapely
 
+    from ..layout.polygon import DENSE_TOLERANCE, without_dense_vertices
+
     poly = as_polygon(polygon, holes)
     union = _areal(shapely.union_all([_block_region(g, b.folded) for g, b in zip(grids, block_metrics, strict=True)]))
     n_cells = sum(g.cells[0] * g.cells[1] for g in grids)
@@ -331,17 +333,25 @@ def coverage(
     gp, sp = _boundary_points(gb, step), _boundary_points(sb, step)
     d_grid_given, _ = _directed(gp, sb)
     d_given, _ = _directed(sp, gb)
+    # the arms and spikes below are found on the shore the layout worked on: an outline with far
+    # more vertices than cells is simplified first, as the layout does (a shore of 120 000 points
+    # took 37 s of buffers here); the distances stay measured to the outline as given
+    simple, _ = without_dense_vertices(poly, h)
+    slack = 0.0 if simple is poly else DENSE_TOLERANCE * h
     # the dead-end arms narrower than two cells, which the layout leaves out on purpose
     # (:func:`meshcore.layout.shore.without_narrow_arms`, its rule at this cell size, with a note):
     # measured against the water without them, whose shore crosses their mouths
-    water = _without_narrow_arms(poly, h)
-    if water is not poly:
+    water = _without_narrow_arms(simple, h)
+    if water is not simple:
+        water = water if simple is poly else _cut_off(poly, simple.difference(water), slack)
         sb = shapely.union_all(_islands(water, union, h)[1])
         sp = _boundary_points(sb, step)
+    else:
+        water = poly
     d_grid, kg = _directed(gp, sb)
     # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
     # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart
-    keep = ~_in_spikes(_spikes(water, h), sp)
+    keep = ~_in_spikes(_spikes(water if simple is poly else without_dense_vertices(water, h)[0], h, slack), sp)
     d_shore, ks = _directed(sp[keep], gb) if keep.any() else (0.0, 0)
     sp = sp[keep] if keep.any() else sp
     if d_grid >= d_shore:
@@ -385,10 +395,10 @@ def without_spikes(poly: Any, width: float) -> Any:
     return clean
 
 
-def _spikes(poly: Any, h: float) -> Any:
+def _spikes(poly: Any, h: float, slack: float = 0.0) -> Any:
     """Where the shore's spikes of water or land narrower than half a cell lie (what
     :func:`without_spikes` removes, a little widened so that the shore points on their rims fall
-    inside), or None."""
+    inside, and by ``slack`` more: how far the outline may lie from ``poly``), or None."""
     import shapely
 
     clean = without_spikes(poly, 0.5 * h)
@@ -396,7 +406,7 @@ def _spikes(poly: Any, h: float) -> Any:
         return None
     # each piece widened on its own: one buffer of the whole difference unions tens of thousands
     # of pieces on a shore of 10^5 points (62 s); the union of the pieces' buffers is the same set
-    return shapely.buffer(shapely.get_parts(poly.symmetric_difference(clean)), 1e-3 * h)
+    return shapely.buffer(shapely.get_parts(poly.symmetric_difference(clean)), 1e-3 * h + slack)
 
 
 def _in_spikes(pieces: Any, points: np.ndarray) -> np.ndarray:
@@ -409,6 +419,21 @@ def _in_spikes(pieces: Any, points: np.ndarray) -> np.ndarray:
     hit = shapely.STRtree(pieces).query(shapely.points(points), predicate="within")
     out[hit[0]] = True
     return out
+
+
+def _cut_off(poly: Any, arms: Any, slack: float) -> Any:
+    """``poly`` without the ``arms`` found on its simplified shore (widened by ``slack``, how far
+    that shore may lie from ``poly``'s, so that no strip of an arm's rim stays), or ``poly`` where
+    that would not leave one polygon with its islands."""
+    import shapely
+
+    cut = poly.difference(shapely.buffer(arms, slack))
+    cut = shapely.make_valid(cut) if not cut.is_valid else cut
+    if cut.geom_type == "MultiPolygon":  # crumbs of the outline's wiggles beyond the widened arms
+        cut = max(cut.geoms, key=lambda g: g.area)
+    if cut.geom_type != "Polygon" or len(cut.interiors) != len(poly.interiors):
+        return poly
+    return cut
 
 
 def _without_narrow_arms(poly: Any, h: float) -> Any:

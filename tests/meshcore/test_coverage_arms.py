@@ -55,3 +55,24 @@ def test_boundary_points_are_bounded_whatever_the_step():
     near = shapely.box(0.0, 0.0, 1.0, 1.0).exterior
     pts = _boundary_points(near, 0.1)
     assert len(pts) == 41 and np.allclose(np.hypot(*np.diff(pts, axis=0).T), 0.1)
+
+
+def test_a_dense_outline_is_measured_as_the_layout_saw_it(arm_lake):
+    """An outline traced far below the cell size (here ~60 vertices a cell, a wiggle of 0.005
+    cells on each): the layout simplifies it (a note), and so does the search for arms and spikes
+    (found on that shore, its buffers cost seconds on 10⁵ vertices), while the distances stay
+    measured to the outline as given: the arm is measured apart as on the plain outline, and
+    the wiggles are not spikes."""
+    poly, mb = arm_lake
+    h = default_cell_size(poly.area, CELLS)
+    plain = lake_metrics(mb, polygon=poly, cell_size=h).coverage
+    ring = np.asarray(shapely.segmentize(poly.exterior, h / 60).coords)[:-1]
+    rng = np.random.default_rng(5)
+    ring = ring + rng.uniform(-0.005 * h, 0.005 * h, ring.shape)
+    dense = shapely.Polygon(ring)
+    assert dense.is_valid and len(ring) > 50 * dense.length / h
+    cov = lake_metrics(mb, polygon=dense, cell_size=h).coverage
+    assert cov.hausdorff_as_given == pytest.approx(plain.hausdorff_as_given, abs=0.01 * h)
+    assert cov.hausdorff_cells <= 0.5  # the arm left out as on the plain outline
+    assert cov.hausdorff == pytest.approx(plain.hausdorff, abs=0.06 * h)  # the mouth within the slack
+    assert cov.area_ratio == pytest.approx(plain.area_ratio, rel=1e-4)
