@@ -228,3 +228,21 @@ def test_iterate_layout_yields_grids_and_stops_on_request(y_layout):
 def test_cell_size_default_is_the_mean_cell():
     lay = layout_from_outline(SQUARE, cuts=RING_CUTS, blocks=RING_BLOCKS, holes=[ISLAND])
     assert lay.cell_size == pytest.approx(math.sqrt(15.0 / (4 * 32)))
+
+
+def test_point_arrays_are_written_exactly_and_a_non_finite_one_refused():
+    """A shore of many points is written as a whole array (the app's autosave of a traced lake):
+    every float read back to the last bit, and a NaN anywhere in it refused by name."""
+    from meshcore.case.write import _clean, _toml_value
+
+    rng = np.random.default_rng(3)
+    pts = rng.normal(5e5, 1e4, (2000, 2))
+    text = "p = " + _toml_value(_clean(pts))
+    import tomllib
+
+    back = np.asarray(tomllib.loads(text)["p"])
+    np.testing.assert_array_equal(back, pts)
+    assert _clean(np.arange(3)) == [0, 1, 2] and _clean(np.array([True])) == [True]
+    pts[1234, 1] = np.nan
+    with pytest.raises(CaseFileError, match="non-finite number"):
+        _clean(pts)
