@@ -209,10 +209,10 @@ class IOController(ExportMixin, QtCore.QObject):
         # none for metres); otherwise the points join the project in its frame (a background traced)
         replace = self.doc.project.lake is not None
         frame = None if replace else fio.project_frame(self.doc.project)
-        if pd.lonlat and pd.pointset is not None:
-            from meshcore.cli.lakefile import lonlat_order_note
+        if pd.pointset is not None:
+            from meshcore.cli.lakefile import lonlat_order_note, swapped_degrees_note
 
-            note = lonlat_order_note(pd.pointset)
+            note = lonlat_order_note(pd.pointset) if pd.lonlat else swapped_degrees_note(pd.pointset)
             if note:  # as meshcore mesh notes it (its --columns: a header "lat,lon" in the file here)
                 note = note.replace("give --columns 1 0", "add the header 'lat,lon' to the file")
                 note = re.sub(r"give --columns \d+ \d+", "name the columns 'lat' and 'lon' in the file's header", note)

@@ -412,11 +412,22 @@ def read_points_csv(
     declared = normalize_crs(crs) if crs is not None else (LONLAT if lay.lonlat or lay.dms else None)
     if declared == LONLAT:
         for pl in polylines:
-            check_lonlat(pl.points, where=f"{path}: {pl.name}")
+            check_lonlat(pl.points, where=f"{path}: {pl.name}", swapped=_swap_hint(lay))
     meta: dict = {"xy_columns": (lay.ix, lay.iy)}
     if lay.header is not None and max(lay.ix, lay.iy) < len(lay.header):  # the names the x, y columns have
         meta["columns"] = (lay.header[lay.ix], lay.header[lay.iy], lay.ix, lay.iy)
     return PointSet(tuple(polylines), declared, str(path), meta)
+
+
+def _swap_hint(lay: _Layout) -> str:
+    """What to change when a lon/lat file holds latitude, longitude: its header, or the columns."""
+    if lay.header is None or max(lay.ix, lay.iy) >= len(lay.header):
+        return f"; if so, give the columns in the other order ({lay.iy}, {lay.ix} from 0)"
+    x, y = lay.header[lay.ix], lay.header[lay.iy]
+    return (
+        f"; the header (line {lay.header_line}) says {x!r}, {y!r}: if column {lay.ix + 1} holds "
+        f"latitudes, write it the other way round ({y},{x})"
+    )
 
 
 def _one_ring_split_by_blank_lines(

@@ -33,3 +33,27 @@ def test_the_lonlat_order_note_of_a_y_x_header_tells_no_command_line_option(win,
     assert win.io.import_points(f, project_lonlat=True)
     notes = [t for t in seen if "the header says" in t]
     assert notes and all("--columns" not in t for t in notes), seen  # the app has no --columns
+
+
+def test_a_lonlat_header_over_latitude_longitude_values_is_refused_not_read_as_metres(win, tmp_path):
+    f = tmp_path / "shasta.csv"
+    lon, lat = -122.4 + 0.05 * np.cos(T), 40.8 + 0.03 * np.sin(T)
+    f.write_text("lon,lat\n" + "".join(f"{b:.6f},{a:.6f}\n" for a, b in zip(lon, lat, strict=True)))
+    seen = []
+    win.doc.reported.connect(lambda level, text: seen.append((level, text)))
+    # was: imported "as local metres: its numbers are no longitude/latitude", a lake 0.1 m across
+    assert not win.io.import_points(f, project_lonlat=True)
+    assert win.doc.project.lake is None
+    errors = [t for lv, t in seen if lv == "error"]
+    assert errors and "look like latitude, longitude" in errors[0] and "(lat,lon)" in errors[0], seen
+
+
+def test_headerless_latitude_longitude_degrees_are_noted_with_what_to_change_in_the_file(win, tmp_path):
+    f = tmp_path / "shasta.csv"
+    lon, lat = -122.4 + 0.05 * np.cos(T), 40.8 + 0.03 * np.sin(T)
+    f.write_text("".join(f"{b:.6f},{a:.6f}\n" for a, b in zip(lon, lat, strict=True)))
+    seen = []
+    win.doc.reported.connect(lambda level, text: seen.append((level, text)))
+    assert win.io.import_points(f, project_lonlat=True)
+    notes = [t for lv, t in seen if "latitude, longitude" in t]
+    assert notes and "header 'lat,lon'" in notes[0] and "--columns" not in notes[0], seen
