@@ -254,7 +254,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         if lake is not None:
             pts = lake.outline
-        if len(pts) < 4:
+        # a lake of three points (a triangle) is water that Auto layout grids, as meshcore mesh does; its
+        # block gets no corners (three points cannot be four) until points are added
+        if len(pts) < (3 if lake is not None else 4):
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
         stem = f"{path.stem}_part{k_part}" if n_parts > 1 else path.stem  # as meshcore mesh --case names it
@@ -270,10 +272,16 @@ class IOController(ExportMixin, QtCore.QObject):
         which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
         if n_parts > 1 and again and asked_part == k_part:
             which = f" (part {k_part} of {n_parts}, the one opened last time: File ▸ Import asks for another)"
-        self.win.message(
-            f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
-            f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
-        )
+        if block.corners is None:  # a triangle: no four corners; the lake's layout grids it
+            self.win.message(
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; too few for four corners "
+                f"— Lake ▸ Auto layout splits it into blocks and grids it"
+            )
+        else:
+            self.win.message(
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
+                f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
+            )
         if lake is not None and looks_branched(lake.outline, lake.holes):
             why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
             self.win.show_lake()

@@ -156,6 +156,8 @@ def run(args: argparse.Namespace) -> int:
             _not_a_line(poly, cells, " m" if frame.crs else "")
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)  # places in the file's CRS, as meshcore mesh names them
+        if len(loop) == 3:  # a triangle has no four corners; meshcore mesh (and the app's Auto layout) grid it
+            msg += "; meshcore mesh grids a lake of 3 points in blocks of its own (or add a point)"
         raise type(exc)(msg if msg.startswith(where) else f"{where}: {msg}") from None
     name = args.name or re.sub(r"[^\w-]+", "_", pl.name).strip("_") or "lake"
     crs_tbl = frame.as_dict()

@@ -35,6 +35,53 @@ def test_the_lonlat_order_note_of_a_y_x_header_tells_no_command_line_option(win,
     assert notes and all("--columns" not in t for t in notes), seen  # the app has no --columns
 
 
+# a triangle lake, 4 × 3 km (metres) and the same in lon/lat near Zurich
+TRIANGLE = [(0.0, 0.0), (4000.0, 0.0), (2000.0, 3000.0)]
+
+
+@pytest.mark.parametrize("lonlat", [False, True])
+def test_a_triangle_lake_imports_and_auto_layout_grids_it_as_meshcore_mesh_does(qtbot, win, tmp_path, lonlat):
+    from tests.app.waits import wait_for, wait_idle
+
+    f = tmp_path / "tri.csv"
+    if lonlat:
+        f.write_text("lon,lat\n8.500000,47.300000\n8.560000,47.300000\n8.530000,47.340000\n")
+    else:
+        f.write_text("x,y\n" + "".join(f"{x},{y}\n" for x, y in TRIANGLE))
+    seen = []
+    win.doc.reported.connect(lambda level, text: seen.append((level, text)))
+    # was: "Cannot import points: tri.csv: needs at least 4 points, found 3" (meshcore mesh grids it)
+    assert win.io.import_points(f, project_lonlat=True), (win._status.text(), seen)
+    lake = win.doc.project.lake
+    assert lake is not None and len(lake.outline) >= 3
+    win.lake_ctl.auto_layout()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or win.lake_ctl.last_error is not None)
+    wait_idle(qtbot, win)
+    assert win.lake_ctl.last_error is None
+    assert len(win.doc.grids) == len(win.doc.project.blocks) > 1  # every block gridded
+
+
+def test_a_clicked_triangle_is_laid_out_and_gridded_and_generate_says_how(qtbot, win):
+    from PySide6 import QtCore
+
+    from tests.app.waits import wait_for, wait_idle
+
+    win.set_tool("draw")
+    for xy in TRIANGLE:
+        win.canvas.tool.click(np.asarray(xy, float))
+    win.canvas.tool.key(QtCore.Qt.Key.Key_Return)
+    assert win.doc.block.closed and len(win.doc.block.points) == 3
+    win.generate()  # F5: no four corners on three points; says what grids it
+    assert "Auto layout" in win._status.text(), win._status.text()
+    win.auto_corners()
+    assert "Auto layout" in win._status.text(), win._status.text()
+    win.lake_ctl.auto_layout()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or win.lake_ctl.last_error is not None)
+    wait_idle(qtbot, win)
+    assert win.lake_ctl.last_error is None
+    assert len(win.doc.grids) == len(win.doc.project.blocks) > 1
+
+
 def test_a_lonlat_header_over_latitude_longitude_values_is_refused_not_read_as_metres(win, tmp_path):
     f = tmp_path / "shasta.csv"
     lon, lat = -122.4 + 0.05 * np.cos(T), 40.8 + 0.03 * np.sin(T)

@@ -234,3 +234,12 @@ def test_import_of_points_on_a_line_is_refused_unless_cells_are_given(tmp_path, 
     assert "across at its widest (near (7" in err
     assert not out.exists()
     assert main(["import", str(src), "-o", str(out), "--cells", "40", "2"]) == 0 and out.exists()
+
+
+def test_import_of_a_triangle_says_that_meshcore_mesh_grids_it(tmp_path, capsys):
+    src, out = tmp_path / "tri.csv", tmp_path / "tri.toml"
+    src.write_text("x,y\n0,0\n4000,0\n2000,3000\n")
+    # was: "needs at least 4 points, got 3" only; meshcore mesh (and the app's Auto layout) grid it
+    _bad(capsys, ["import", src, "-o", out], "tri.csv", "needs at least 4 points, got 3", "meshcore mesh grids")
+    assert not out.exists()
+    assert main(["mesh", str(src), "-o", str(tmp_path / "tri.vtm"), "--cells", "300", "-q"]) == 0
