@@ -314,8 +314,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return None, (1, 1)
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
             notes = notes + water(outer, islands)[1]
-        except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring
-            log.info("%s: the water polygon: %s", pd.path, exc)
+        except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring: said now
+            # (was only logged: the user saw the corners' "reflex vertex (interior angle 307°)" of a bow tie)
+            notes = [*notes, f"{exc} — meshcore mesh refuses it; fix the outline (Edit tool) before Auto layout"]
         for note in notes:  # what meshcore mesh prints as notes
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
         return Lake(outline=outer, holes=tuple(islands)), (k, len(parts))

@@ -147,6 +147,14 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"meshcore import: warning: {where}: the grid covers {len(islands)} island(s) ({listed})", file=sys.stderr
         )
+    others = [p for p in local.polylines if p is not pl and p.closed and all(p is not i for i in islands)]
+    if others and not args.polyline:  # was: left out without a word (a second lake, a ring across the shore)
+        listed = ", ".join(repr(p.name) for p in others[:3]) + (" …" if len(others) > 3 else "")
+        print(
+            f"meshcore import: note: {where} is imported (the ring of most points, one block); {len(others)} other "
+            f"ring(s) outside it or across its shore left out ({listed}); meshcore mesh reads every ring",
+            file=sys.stderr,
+        )
     loop = pl.points
     try:
         poly, _ = water_polygon(loop)  # the loop crossing itself or of no area is refused here, not by generate

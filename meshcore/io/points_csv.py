@@ -404,6 +404,8 @@ def read_points_csv(
     for (start, gname, sname, lineno), end in zip(groups, ends, strict=True):
         name = gname or sname or (base if len(groups) == 1 else f"{base} {len(polylines) + 1}")
         if end - start < 2:
+            if len(groups) == 1:  # the whole file (was: "(a blank line starts a new polyline)" with none in it)
+                raise ReadError(f"{path}: only 1 point (line {lineno}); an outline needs 3 or more")
             raise ReadError(
                 f"{path}: polyline {name!r} (line {lineno}) has only {end - start} point"
                 + (" (a blank line starts a new polyline)" if gname is None and sname is None else "")

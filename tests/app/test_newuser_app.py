@@ -104,3 +104,14 @@ def test_headerless_latitude_longitude_degrees_are_noted_with_what_to_change_in_
     assert win.io.import_points(f, project_lonlat=True)
     notes = [t for lv, t in seen if "latitude, longitude" in t]
     assert notes and "header 'lat,lon'" in notes[0] and "--columns" not in notes[0], seen
+
+
+def test_a_bow_tie_outline_is_said_to_cross_itself_on_import(win, tmp_path):
+    f = tmp_path / "bowtie.csv"
+    f.write_text("x,y\n0,0\n4000,3000\n4000,0\n0,3000\n")
+    seen = []
+    win.doc.reported.connect(lambda level, text: seen.append((level, text)))
+    assert win.io.import_points(f, project_lonlat=True)
+    # was: only the corners' "reflex vertex (interior angle 307°)"; Auto layout said why later
+    crossing = [t for lv, t in seen if lv == "warning" and "crosses itself" in t]
+    assert crossing and "bowtie.csv" in crossing[0] and "point 1 to 2" in crossing[0], seen
