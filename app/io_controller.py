@@ -38,6 +38,18 @@ DEBOUNCE_MS = 1000
 MAX_DELAY_S = 2.0
 
 
+def _centroid(points) -> tuple[float, float]:
+    """The centroid of a ring (its mean point when it has no area)."""
+    import numpy as np
+    import shapely
+
+    poly = shapely.Polygon(np.asarray(points, float))
+    if poly.is_valid and poly.area > 0:
+        return float(poly.centroid.x), float(poly.centroid.y)
+    x, y = np.asarray(points, float).mean(axis=0)
+    return float(x), float(y)
+
+
 class IOController(ExportMixin, QtCore.QObject):
     """File operations of a :class:`~app.main_window.MainWindow`.
 
@@ -264,7 +276,10 @@ class IOController(ExportMixin, QtCore.QObject):
         self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=stem)
         # File ▸ Open recent imports it again (the same part of water) and remembers its folder
         self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)
-        projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
+        projected = ""
+        if frame is not None and pd.lonlat:  # where it lands: a lon, lat header over lat, lon values shows here
+            lon, lat = _centroid(pd.points)
+            projected = f" (centroid lon {lon:.5f}, lat {lat:.5f}; projected to {frame.crs})"
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
         n_isl = len(lake.holes) if lake is not None else 0

@@ -70,6 +70,9 @@ class ExportMixin:
     def export_mesh(self, path: Path, format: str | None = None) -> bool:
         """Write the grids (a multiblock result with its connectivity) with meshcore.io
         (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
+        if not self.doc.grids:  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
+            self.win.message("Nothing to export yet: generate a grid first (F5)", error=True)
+            return False
         if path.suffix.lower() == ".inp" and path.name.lower() != "cell.inp":
             path = self._efdc_cell_inp(path)
             if path is None:

@@ -115,3 +115,19 @@ def test_a_bow_tie_outline_is_said_to_cross_itself_on_import(win, tmp_path):
     # was: only the corners' "reflex vertex (interior angle 307°)"; Auto layout said why later
     crossing = [t for lv, t in seen if lv == "warning" and "crosses itself" in t]
     assert crossing and "bowtie.csv" in crossing[0] and "point 1 to 2" in crossing[0], seen
+
+
+def test_the_import_message_of_degrees_says_where_the_lake_lands(win, tmp_path):
+    # Bolsena (lon 11.93, lat 42.59) written lat, lon under a lon,lat header: both within ±90, nothing
+    # to refuse; the message's centroid (lon 42.59, lat 11.93) shows the lake is not where it should be
+    f = tmp_path / "bolsena.csv"
+    f.write_text("lon,lat\n" + "".join(f"{42.59 + 0.05 * np.sin(a):.6f},{11.93 + 0.06 * np.cos(a):.6f}\n" for a in T))
+    assert win.io.import_points(f, project_lonlat=True)
+    assert "centroid lon 42.59000, lat 11.93000; projected to EPSG:32638" in win._status.text(), win._status.text()
+
+
+def test_export_without_a_grid_says_there_is_nothing_to_export(win, tmp_path):
+    out = tmp_path / "lake.grd"
+    # was (called directly, as app.bench does): "expected a StructuredGrid, a list of them or ... got list"
+    assert not win.io.export_mesh(out, "delft3d-single")
+    assert "Nothing to export yet" in win._status.text() and not out.exists()
