@@ -232,10 +232,12 @@ class IOController(ExportMixin, QtCore.QObject):
         if pd.lonlat:
             if project_lonlat is None and not self.quiet:
                 target = fio.projection_named(pd, frame)
+                lon, lat = _centroid(pd.points)  # where the lake lands (a lon, lat header over lat, lon values)
                 r = QtWidgets.QMessageBox.question(
                     self._parent(),
                     "Geographic coordinates",
-                    f"{path.name} holds longitude/latitude degrees.\n\nProject them to metres "
+                    f"{path.name} holds longitude/latitude degrees (centroid lon {lon:.5f}, lat {lat:.5f})."
+                    f"\n\nProject them to metres "
                     f"({target}, relative to a round local origin)? Grids in degrees are distorted.",
                 )
                 project_lonlat = r == QtWidgets.QMessageBox.StandardButton.Yes

@@ -131,3 +131,21 @@ def test_export_without_a_grid_says_there_is_nothing_to_export(win, tmp_path):
     # was (called directly, as app.bench does): "expected a StructuredGrid, a list of them or ... got list"
     assert not win.io.export_mesh(out, "delft3d-single")
     assert "Nothing to export yet" in win._status.text() and not out.exists()
+
+
+def test_the_lon_lat_question_says_where_the_lake_is(win, tmp_path, monkeypatch):
+    from PySide6 import QtWidgets
+
+    asked = []
+
+    def question(_parent, _title, text, *_a):
+        asked.append(text)
+        return QtWidgets.QMessageBox.StandardButton.Yes
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    monkeypatch.setattr(win, "quiet", False)
+    monkeypatch.setattr(win.lake_ctl, "offer", lambda *_a: None)
+    f = tmp_path / "bolsena.csv"  # written lat, lon under a lon,lat header: the question shows lon 42.6
+    f.write_text("lon,lat\n" + "".join(f"{42.59 + 0.05 * np.sin(a):.6f},{11.93 + 0.06 * np.cos(a):.6f}\n" for a in T))
+    assert win.io.import_points(f)
+    assert "(centroid lon 42.59000, lat 11.93000)" in asked[0], asked
