@@ -162,17 +162,16 @@ class ExportMixin:
             return False
         if single:
             title = "One index space"
+            # the writer's message says why and where (was followed by the same reasons again: ten lines)
             text = (
-                f"Cannot export {name}: {exc}. One index space (a Delft3D single domain, EFDC) fits no corner where "
-                "3 or 5 blocks meet, and its rings of blocks round islands must close: a layout made for it "
-                "(regular, the rings' cell counts closed) fits when the lake's arms do not fold onto each other "
-                "(then export again)"
+                f"Cannot export {name}: {exc}. Or a layout made for it: regular, its rings of blocks round islands "
+                "closed (it fits one index space unless the lake's arms fold onto each other); then export again"
             )
         else:
             title = "Delft3D domain decomposition"
             text = (
-                f"Cannot export {name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
-                "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"
+                f"Cannot export {name}: {exc}. Or a regular layout (Lake ▸ Auto layout, regular), which Delft3D "
+                "can couple; then export again"
             )
         self.win.message(text, error=True)
         if not self.quiet:

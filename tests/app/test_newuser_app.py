@@ -149,3 +149,18 @@ def test_the_lon_lat_question_says_where_the_lake_is(win, tmp_path, monkeypatch)
     f.write_text("lon,lat\n" + "".join(f"{42.59 + 0.05 * np.sin(a):.6f},{11.93 + 0.06 * np.cos(a):.6f}\n" for a in T))
     assert win.io.import_points(f)
     assert "(centroid lon 42.59000, lat 11.93000)" in asked[0], asked
+
+
+def test_an_export_the_layout_cannot_take_says_its_reasons_once(qtbot, win, tmp_path):
+    from meshcore import testing
+    from tests.app.test_lake import lay_out
+
+    shore = 1000.0 * np.asarray(testing.y_junction().exterior.coords)[:-1]  # a star at the junction
+    src = tmp_path / "y.csv"
+    np.savetxt(src, shore, delimiter=",", header="x,y", comments="")
+    lay_out(qtbot, win, src, cell_size=100.0)
+    for name, fmt in [("y.ddb", None), ("y.grd", "delft3d-single")]:
+        assert not win.io.export_mesh(tmp_path / name, fmt)
+        said = win._status.text()
+        # was: the writer's reasons, then the same again ("… couples no corner where 3 or 5 blocks meet")
+        assert said.count("3 or 5 blocks meet") == 1 and "then export again" in said, said
