@@ -267,8 +267,8 @@ def check_lonlat(points: np.ndarray, *, where: str, swapped: str = "") -> None:
         msg = f"{where}: point {k + 1} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range [-180, 180] × [-90, 90]"
         if looks_swapped(p):
             msg = (
-                f"{where}: point {k + 1} ({p[k, 0]:g}, {p[k, 1]:g}) is no longitude, latitude: the values look "
-                f"like latitude, longitude (every first one within ±90){swapped}"
+                f"{where}: point {k + 1} (read as lon {p[k, 0]:g}, lat {p[k, 1]:g}) is no longitude, latitude: the "
+                f"values look like latitude, longitude (every longitude read within ±90, latitudes beyond){swapped}"
             )
         raise ReadError(msg)
 

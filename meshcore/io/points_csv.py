@@ -425,10 +425,13 @@ def _swap_hint(lay: _Layout) -> str:
     """What to change when a lon/lat file holds latitude, longitude: its header, or the columns."""
     if lay.header is None or max(lay.ix, lay.iy) >= len(lay.header):
         return f"; if so, give the columns in the other order ({lay.iy}, {lay.ix} from 0)"
-    x, y = lay.header[lay.ix], lay.header[lay.iy]
+    names = list(lay.header)
+    x, y = names[lay.ix], names[lay.iy]
+    names[lay.ix], names[lay.iy] = y, x
+    sep = lay.delim if lay.delim and lay.delim != "\t" else ("\t" if lay.delim else " ")
     return (
-        f"; the header (line {lay.header_line}) says {x!r}, {y!r}: if column {lay.ix + 1} holds "
-        f"latitudes, write it the other way round ({y},{x})"
+        f"; the header (line {lay.header_line}) names column {lay.ix + 1} {x!r} and column {lay.iy + 1} {y!r}: "
+        f"if column {lay.ix + 1} holds latitudes, write the header {sep.join(names)!r}"
     )
 
 

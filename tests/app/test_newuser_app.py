@@ -92,7 +92,7 @@ def test_a_lonlat_header_over_latitude_longitude_values_is_refused_not_read_as_m
     assert not win.io.import_points(f, project_lonlat=True)
     assert win.doc.project.lake is None
     errors = [t for lv, t in seen if lv == "error"]
-    assert errors and "look like latitude, longitude" in errors[0] and "(lat,lon)" in errors[0], seen
+    assert errors and "look like latitude, longitude" in errors[0] and "the header 'lat,lon'" in errors[0], seen
 
 
 def test_headerless_latitude_longitude_degrees_are_noted_with_what_to_change_in_the_file(win, tmp_path):

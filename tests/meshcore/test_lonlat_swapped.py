@@ -22,14 +22,27 @@ def _csv(path, header: str, first, second) -> None:
     )
 
 
-@pytest.mark.parametrize("header", ["lon,lat", "longitude,latitude", "Lon,Lat"])
-def test_a_lonlat_header_over_latitude_longitude_values_is_refused_naming_the_swap(tmp_path, capsys, header):
+@pytest.mark.parametrize(
+    ("header", "values", "column", "fixed"),
+    [
+        ("lon,lat", "lat,lon", 1, "lat,lon"),
+        ("longitude,latitude", "lat,lon", 1, "latitude,longitude"),
+        ("Lon,Lat", "lat,lon", 1, "lat,lon"),
+        ("lat,lon", "lon,lat", 2, "lon,lat"),  # the header says lat first, the values are lon first
+        ("id,lon,lat", "id,lat,lon", 2, "id,lat,lon"),
+    ],
+)
+def test_a_lonlat_header_over_latitude_longitude_values_is_refused_naming_the_swap(
+    tmp_path, capsys, header, values, column, fixed
+):
     src, out = tmp_path / "shasta.csv", tmp_path / "g.vtm"
-    _csv(src, header, LAT, LON)
+    cols = {"lat": LAT, "lon": LON, "id": np.arange(len(T))}
+    src.write_text(
+        header + "\n" + "".join(",".join(f"{cols[c][k]:.6f}" for c in values.split(",")) + "\n" for k in range(len(T)))
+    )
     # was: "point 1 (40.8, -122.39) is outside the lon/lat range" and nothing on why
-    err = _bad(capsys, ["mesh", src, "-o", out, "-q"], "shasta.csv", "point 1 (", "look like latitude, longitude")
-    x, y = header.lower().split(",")
-    assert f"the header (line 1) says {x!r}, {y!r}" in err and f"({y},{x})" in err
+    err = _bad(capsys, ["mesh", src, "-o", out, "-q"], "shasta.csv", "point 1 (read as lon 40.", "look like latitude")
+    assert f"if column {column} holds latitudes, write the header {fixed!r}" in err, err
     assert not out.exists()
 
 
