@@ -126,6 +126,15 @@ def run(args: argparse.Namespace) -> int:
             raise InvalidInputError(f"--border-name expects BORDER=NAME with BORDER in {BORDER_NAMES}, got {item!r}")
         specs[b] = BorderSpec(name=nm)
     ps = read_points(args.points, columns=args.columns, crs=args.source_crs)
+    from .lakefile import lonlat_order_note, swapped_degrees_note
+
+    said = (
+        lonlat_order_note(ps, args.source_crs, args.columns),
+        swapped_degrees_note(ps, args.source_crs, args.columns),
+    )
+    for note in said:
+        if note:  # as meshcore mesh says them (was: none here, a swapped file imported in silence)
+            print(f"meshcore import: note: {note}", file=sys.stderr)
     local, frame = project(ps, None if args.crs.lower() == "none" else args.crs, source_crs=args.source_crs)
     if args.polyline:
         pl = local[args.polyline] if args.polyline in local.names else None

@@ -92,3 +92,15 @@ def test_the_read_line_of_a_lonlat_file_says_where_the_lake_lands(tmp_path, caps
     assert main(["mesh", str(src), "-o", str(tmp_path / "a.vtm"), "--cells", "200"]) == 0
     err = capsys.readouterr().err
     assert "centroid lon 42.59000, lat 11.93000; grid CRS EPSG:32638" in err, err
+
+
+def test_import_notes_latitude_longitude_degrees_as_mesh_does(tmp_path, capsys):
+    src = tmp_path / "shasta.csv"
+    _csv(src, "", LAT, LON)
+    assert main(["import", str(src), "-o", str(tmp_path / "a.toml")]) == 0
+    err = capsys.readouterr().err
+    # was: imported without a word, a case in the file's numbers ("no CRS, origin (40.8, -122.3)")
+    assert "meshcore import: note:" in err and "look like latitude, longitude degrees" in err, err
+    assert main(["import", str(src), "-o", str(tmp_path / "b.toml"), "--columns", "1", "0"]) == 0
+    out = capsys.readouterr()
+    assert "EPSG:32610" in out.out and "latitude, longitude" not in out.err, out
