@@ -76,7 +76,7 @@ def _read_metres_or_raise(path: Path, exc: Exception):
     range: read again as local metres without a CRS, with a note; the error (without the command line's
     flag, which the app has no use for) when it still cannot be read or its numbers are degrees."""
     from meshcore import io as mio
-    from meshcore.crs import looks_lonlat
+    from meshcore.crs import looks_lonlat, looks_swapped
 
     try:
         ps = mio.read_points(path, crs="local")
@@ -87,7 +87,8 @@ def _read_metres_or_raise(path: Path, exc: Exception):
     out = (np.abs(pts[:, 0]) > 180) | (np.abs(pts[:, 1]) > 90)
     # degrees with a few wrong numbers (a typo) stay an error naming the first wrong point
     typo = out.any() and out.mean() < 0.1 and looks_lonlat(pts[~out])
-    if ps is None or not out.any() or typo:
+    # latitude, longitude under a lon/lat header (or in GeoJSON): the error says so; was read as metres
+    if ps is None or not out.any() or typo or looks_swapped(pts):
         raise ReadError(str(exc).split(" — GeoJSON positions are lon/lat")[0]) from None
     k = int(np.flatnonzero(out)[0])
     note = (

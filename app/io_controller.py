@@ -38,6 +38,18 @@ DEBOUNCE_MS = 1000
 MAX_DELAY_S = 2.0
 
 
+def _centroid(points) -> tuple[float, float]:
+    """The centroid of a ring (its mean point when it has no area)."""
+    import numpy as np
+    import shapely
+
+    poly = shapely.Polygon(np.asarray(points, float))
+    if poly.is_valid and poly.area > 0:
+        return float(poly.centroid.x), float(poly.centroid.y)
+    x, y = np.asarray(points, float).mean(axis=0)
+    return float(x), float(y)
+
+
 class IOController(ExportMixin, QtCore.QObject):
     """File operations of a :class:`~app.main_window.MainWindow`.
 
@@ -209,10 +221,10 @@ class IOController(ExportMixin, QtCore.QObject):
         # none for metres); otherwise the points join the project in its frame (a background traced)
         replace = self.doc.project.lake is not None
         frame = None if replace else fio.project_frame(self.doc.project)
-        if pd.lonlat and pd.pointset is not None:
-            from meshcore.cli.lakefile import lonlat_order_note
+        if pd.pointset is not None:
+            from meshcore.cli.lakefile import lonlat_order_note, swapped_degrees_note
 
-            note = lonlat_order_note(pd.pointset)
+            note = lonlat_order_note(pd.pointset) if pd.lonlat else swapped_degrees_note(pd.pointset)
             if note:  # as meshcore mesh notes it (its --columns: a header "lat,lon" in the file here)
                 note = note.replace("give --columns 1 0", "add the header 'lat,lon' to the file")
                 note = re.sub(r"give --columns \d+ \d+", "name the columns 'lat' and 'lon' in the file's header", note)
@@ -220,10 +232,12 @@ class IOController(ExportMixin, QtCore.QObject):
         if pd.lonlat:
             if project_lonlat is None and not self.quiet:
                 target = fio.projection_named(pd, frame)
+                lon, lat = _centroid(pd.points)  # where the lake lands (a lon, lat header over lat, lon values)
                 r = QtWidgets.QMessageBox.question(
                     self._parent(),
                     "Geographic coordinates",
-                    f"{path.name} holds longitude/latitude degrees.\n\nProject them to metres "
+                    f"{path.name} holds longitude/latitude degrees (centroid lon {lon:.5f}, lat {lat:.5f})."
+                    f"\n\nProject them to metres "
                     f"({target}, relative to a round local origin)? Grids in degrees are distorted.",
                 )
                 project_lonlat = r == QtWidgets.QMessageBox.StandardButton.Yes
@@ -254,7 +268,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         if lake is not None:
             pts = lake.outline
-        if len(pts) < 4:
+        # a lake of three points (a triangle) is water that Auto layout grids, as meshcore mesh does; its
+        # block gets no corners (three points cannot be four) until points are added
+        if len(pts) < (3 if lake is not None else 4):
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
         stem = f"{path.stem}_part{k_part}" if n_parts > 1 else path.stem  # as meshcore mesh --case names it
@@ -262,7 +278,10 @@ class IOController(ExportMixin, QtCore.QObject):
         self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=stem)
         # File ▸ Open recent imports it again (the same part of water) and remembers its folder
         self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)
-        projected = f" (projected to {frame.crs})" if frame is not None and pd.lonlat else ""
+        projected = ""
+        if frame is not None and pd.lonlat:  # where it lands: a lon, lat header over lat, lon values shows here
+            lon, lat = _centroid(pd.points)
+            projected = f" (centroid lon {lon:.5f}, lat {lat:.5f}; projected to {frame.crs})"
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
         n_isl = len(lake.holes) if lake is not None else 0
@@ -270,10 +289,16 @@ class IOController(ExportMixin, QtCore.QObject):
         which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
         if n_parts > 1 and again and asked_part == k_part:
             which = f" (part {k_part} of {n_parts}, the one opened last time: File ▸ Import asks for another)"
-        self.win.message(
-            f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
-            f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
-        )
+        if block.corners is None:  # a triangle: no four corners; the lake's layout grids it
+            self.win.message(
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; too few for four corners "
+                f"— Lake ▸ Auto layout splits it into blocks and grids it"
+            )
+        else:
+            self.win.message(
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
+                f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
+            )
         if lake is not None and looks_branched(lake.outline, lake.holes):
             why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
             self.win.show_lake()
@@ -306,8 +331,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return None, (1, 1)
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
             notes = notes + water(outer, islands)[1]
-        except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring
-            log.info("%s: the water polygon: %s", pd.path, exc)
+        except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring: said now
+            # (was only logged: the user saw the corners' "reflex vertex (interior angle 307°)" of a bow tie)
+            notes = [*notes, f"{exc} — meshcore mesh refuses it; fix the outline (Edit tool) before Auto layout"]
         for note in notes:  # what meshcore mesh prints as notes
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
         return Lake(outline=outer, holes=tuple(islands)), (k, len(parts))

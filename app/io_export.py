@@ -70,6 +70,9 @@ class ExportMixin:
     def export_mesh(self, path: Path, format: str | None = None) -> bool:
         """Write the grids (a multiblock result with its connectivity) with meshcore.io
         (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
+        if not self.doc.grids:  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
+            self.win.message("Nothing to export yet: generate a grid first (F5)", error=True)
+            return False
         if path.suffix.lower() == ".inp" and path.name.lower() != "cell.inp":
             path = self._efdc_cell_inp(path)
             if path is None:
@@ -159,17 +162,16 @@ class ExportMixin:
             return False
         if single:
             title = "One index space"
+            # the writer's message says why and where (was followed by the same reasons again: ten lines)
             text = (
-                f"Cannot export {name}: {exc}. One index space (a Delft3D single domain, EFDC) fits no corner where "
-                "3 or 5 blocks meet, and its rings of blocks round islands must close: a layout made for it "
-                "(regular, the rings' cell counts closed) fits when the lake's arms do not fold onto each other "
-                "(then export again)"
+                f"Cannot export {name}: {exc}. Or a layout made for it: regular, its rings of blocks round islands "
+                "closed (it fits one index space unless the lake's arms fold onto each other); then export again"
             )
         else:
             title = "Delft3D domain decomposition"
             text = (
-                f"Cannot export {name}: {exc}. Delft3D domain decomposition couples no corner where 3 or "
-                "5 blocks meet: Lake ▸ Auto layout, regular makes a layout it can write (then export again)"
+                f"Cannot export {name}: {exc}. Or a regular layout (Lake ▸ Auto layout, regular), which Delft3D "
+                "can couple; then export again"
             )
         self.win.message(text, error=True)
         if not self.quiet:

@@ -43,6 +43,8 @@ __all__ = ["TOLERANCE", "LakeProgress", "layout_topology", "level_labels", "solv
 TOLERANCE = 1e-5
 #: sweeps between two snapshots of a warm solve (the canvas redraws after each)
 WARM_EVERY = 2
+#: seconds between looks at the stop event while a held warm solve waits for the end of a drag
+HOLD_POLL_S = 0.5
 #: most sweeps of the full level from the previous grid (the live frames of an edit) before the grid is
 #: made again coarse to fine (what the final grid of an edit is)
 WARM_SWEEPS = 60
@@ -216,7 +218,11 @@ def _warm(layout, warm, stop_event, hold=None):
     # measures a grid it keeps without them)
     moved = BlockResult(grids=dict(enumerate(res.grids)), initial=starts, multiblock=mb)
     if not stopped and hold is not None:
-        hold.wait()  # a drag goes on: its next step restarts the solve (no CPU time spent meanwhile)
+        # a drag goes on: its next step restarts the solve (no CPU time spent meanwhile).  Every stop sets
+        # the hold too; one that did not is seen within HOLD_POLL_S: the worker never waits without a bound
+        while not hold.wait(HOLD_POLL_S):
+            if stop_event is not None and stop_event.is_set():
+                break
     if stopped or (stop_event is not None and stop_event.is_set()):
         return moved
     final = yield from _cold(layout, stop_event, shown=False, before=(tuple(history), warm_level, res.sweeps))

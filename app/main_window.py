@@ -301,7 +301,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
     def auto_corners(self) -> None:
         b = self.doc.block
         if not b.closed or len(b.points) < 4:
-            self.message("Auto corners needs a closed loop of at least 4 points")
+            lay = " (Lake ▸ Auto layout grids a closed loop of 3)" if b.closed and len(b.points) == 3 else ""
+            self.message(f"Auto corners needs a closed loop of at least 4 points{lay}")
             return
         try:
             c = guess_corners(b.points)
@@ -375,6 +376,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
                 hint = "draw a boundary first"
             elif not b.closed:
                 hint = "close the loop first (double-click or Enter)"
+            elif len(b.points) < 4:  # three points: no four corners, but water Auto layout grids
+                hint = "a loop of 3 points has no four corners: Lake ▸ Auto layout grids it, or add a point"
             else:
                 hint = "pick four corners (Corners tool) or use Auto corners (A)"
             self.message(f"Nothing to generate yet: {hint}")

@@ -47,6 +47,7 @@ __all__ = [
     "is_geographic",
     "lon_span",
     "looks_lonlat",
+    "looks_swapped",
     "not_a_map",
     "project",
     "project_arrays",
@@ -252,15 +253,34 @@ def looks_lonlat(points: Any) -> bool:
     return bool((frac > 1e-6).any())
 
 
-def check_lonlat(points: np.ndarray, *, where: str) -> None:
-    """Raise :class:`ReadError` naming the first point outside lon/lat range."""
+def check_lonlat(points: np.ndarray, *, where: str, swapped: str = "") -> None:
+    """Raise :class:`ReadError` naming the first point outside lon/lat range.
+
+    When the points are latitude, longitude instead (every first value within ±90, and read
+    the other way round they look like degrees, :func:`looks_swapped`), the message says so,
+    followed by ``swapped`` (what to change in the file: its header, its format's order).
+    """
     p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     bad = (np.abs(p[:, 0]) > 180) | (np.abs(p[:, 1]) > 90)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise ReadError(
-            f"{where}: point {k + 1} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range [-180, 180] × [-90, 90]"
-        )
+        msg = f"{where}: point {k + 1} ({p[k, 0]:g}, {p[k, 1]:g}) is outside the lon/lat range [-180, 180] × [-90, 90]"
+        if looks_swapped(p):
+            msg = (
+                f"{where}: point {k + 1} (read as lon {p[k, 0]:g}, lat {p[k, 1]:g}) is no longitude, latitude: the "
+                f"values look like latitude, longitude (every longitude read within ±90, latitudes beyond){swapped}"
+            )
+        raise ReadError(msg)
+
+
+def looks_swapped(points: Any) -> bool:
+    """Degrees written latitude, longitude: out of the lon/lat range as written (a second value
+    beyond ±90), and read the other way round they look like degrees (:func:`looks_lonlat`: in
+    range and a lake's extent, so a mistyped latitude among lon, lat points is no swap)."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    if p.size == 0 or not np.isfinite(p).all() or not (np.abs(p[:, 1]) > 90).any():
+        return False
+    return looks_lonlat(p[:, ::-1])
 
 
 def utm_epsg(lon: float, lat: float) -> int:

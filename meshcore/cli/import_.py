@@ -126,6 +126,15 @@ def run(args: argparse.Namespace) -> int:
             raise InvalidInputError(f"--border-name expects BORDER=NAME with BORDER in {BORDER_NAMES}, got {item!r}")
         specs[b] = BorderSpec(name=nm)
     ps = read_points(args.points, columns=args.columns, crs=args.source_crs)
+    from .lakefile import lonlat_order_note, swapped_degrees_note
+
+    said = (
+        lonlat_order_note(ps, args.source_crs, args.columns),
+        swapped_degrees_note(ps, args.source_crs, args.columns),
+    )
+    for note in said:
+        if note:  # as meshcore mesh says them (was: none here, a swapped file imported in silence)
+            print(f"meshcore import: note: {note}", file=sys.stderr)
     local, frame = project(ps, None if args.crs.lower() == "none" else args.crs, source_crs=args.source_crs)
     if args.polyline:
         pl = local[args.polyline] if args.polyline in local.names else None
@@ -147,6 +156,14 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"meshcore import: warning: {where}: the grid covers {len(islands)} island(s) ({listed})", file=sys.stderr
         )
+    others = [p for p in local.polylines if p is not pl and p.closed and all(p is not i for i in islands)]
+    if others and not args.polyline:  # was: left out without a word (a second lake, a ring across the shore)
+        listed = ", ".join(repr(p.name) for p in others[:3]) + (" …" if len(others) > 3 else "")
+        print(
+            f"meshcore import: note: {where} is imported (the ring of most points, one block); {len(others)} other "
+            f"ring(s) outside it or across its shore left out ({listed}); meshcore mesh reads every ring",
+            file=sys.stderr,
+        )
     loop = pl.points
     try:
         poly, _ = water_polygon(loop)  # the loop crossing itself or of no area is refused here, not by generate
@@ -156,6 +173,8 @@ def run(args: argparse.Namespace) -> int:
             _not_a_line(poly, cells, " m" if frame.crs else "")
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)  # places in the file's CRS, as meshcore mesh names them
+        if len(loop) == 3:  # a triangle has no four corners; meshcore mesh (and the app's Auto layout) grid it
+            msg += "; meshcore mesh grids a lake of 3 points in blocks of its own (or add a point)"
         raise type(exc)(msg if msg.startswith(where) else f"{where}: {msg}") from None
     name = args.name or re.sub(r"[^\w-]+", "_", pl.name).strip("_") or "lake"
     crs_tbl = frame.as_dict()

@@ -2,6 +2,7 @@
 
 * :func:`is_lonlat` — does a point set hold degrees (declared, or every point looks like them)?
 * :func:`lonlat_order_note` — a note when headerless degrees could be in either column order;
+* :func:`swapped_degrees_note` — a note when a file of no CRS holds latitude, longitude degrees;
 * :func:`local_frame` — project degrees (and Web Mercator) to the grid's CRS about a round origin;
 * :func:`without_lines_on_the_shore`, :func:`lake_rings` — the shore, the islands, and the open
   lines that are neither (an inlet drawn on the shore, a ferry route, pins), dropped with notes;
@@ -24,6 +25,7 @@ __all__ = [
     "local_frame",
     "lonlat_order_note",
     "scale_note",
+    "swapped_degrees_note",
     "without_lines_on_the_shore",
 ]
 
@@ -72,6 +74,27 @@ def lonlat_order_note(ps: Any, source_crs: Any = None, columns: Any = None) -> s
     return (
         f"{ps.source}: no header says which column is which: read as longitude, latitude "
         f"(x, y); if {which} is the latitude, give --columns {iy} {ix}"
+    )
+
+
+def swapped_degrees_note(ps: Any, source_crs: Any = None, columns: Any = None) -> str | None:
+    """A note when a file that says nothing of its CRS holds degrees in latitude, longitude order
+    (:func:`meshcore.crs.looks_swapped`: a headerless or ``x,y`` CSV of "40.7375,-122.445"): read as
+    x, y they are no degrees, and the grid kept the file's numbers, a lake 0.1 units across, without
+    a word.  (A file that says lon/lat, by its header or format, is refused naming the swap.)"""
+    from ..crs import looks_swapped
+
+    if source_crs is not None or columns is not None or ps.crs is not None or not ps.polylines:
+        return None
+    pts = np.vstack([np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in ps.polylines])
+    if not looks_swapped(pts):
+        return None
+    ix, iy = ps.meta.get("xy_columns", (0, 1))
+    named = ps.meta.get("columns")
+    cols = f" (the header's {named[0]!r}, {named[1]!r})" if named else ""
+    return (
+        f"{ps.source}: its numbers look like latitude, longitude degrees (every first value within ±90, the "
+        f"second beyond), read as x, y{cols} without a CRS; if they are degrees, give --columns {iy} {ix}"
     )
 
 

@@ -41,7 +41,15 @@ from typing import Any
 
 from ..cellsize import DEFAULT_CELLS
 from ..errors import InvalidInputError
-from .lakefile import degrees_note, in_world, lake_parts, local_frame, lonlat_order_note, scale_note
+from .lakefile import (
+    degrees_note,
+    in_world,
+    lake_parts,
+    local_frame,
+    lonlat_order_note,
+    scale_note,
+    swapped_degrees_note,
+)
 from .mesh_outputs import SINGLE_DOMAIN, check_blocks, single_outputs
 from .mesh_steps import (
     LAYOUT_OPTIONS,
@@ -220,7 +228,11 @@ def _read(args: argparse.Namespace, say: _Say):
         parts, dropped = lake_parts(local)
     except InvalidInputError as exc:  # places in the grid's CRS, as the layout's
         raise InvalidInputError(in_world(str(exc), frame)) from None
-    said = (lonlat_order_note(ps, args.source_crs, args.columns), degrees_note(ps, args.source_crs))
+    said = (
+        lonlat_order_note(ps, args.source_crs, args.columns),
+        swapped_degrees_note(ps, args.source_crs, args.columns),
+        degrees_note(ps, args.source_crs),
+    )
     _notes([n for n in (*said, scale_note(ps, frame)) if n], frame)
     _notes(dropped, frame)
     if len(parts) > 1 or args.part:  # several parts of water: meshcore.cli.mesh_parts
@@ -235,9 +247,23 @@ def _read(args: argparse.Namespace, say: _Say):
     n_isl = len(islands)
     where = f" from {frame.source_crs}" if frame.source_crs and frame.source_crs != frame.crs else ""
     isl = f"{n_isl} island{'s' * (n_isl != 1)} ({sum(len(r) for r in islands)} points)" if n_isl else "no islands"
-    say(f"read {args.outline}: shore of {len(outer)} points, {isl}; {_crs_label(frame.crs)}{where}")
+    at = _centred(poly, frame)
+    say(f"read {args.outline}: shore of {len(outer)} points, {isl}{at}; {_crs_label(frame.crs)}{where}")
     _notes(notes, frame)
     return poly, frame
+
+
+def _centred(poly: Any, frame: Any) -> str:
+    """The centroid ", centroid lon …, lat …" of a file of degrees: where the lake lands, which shows a file whose
+    header says lon, lat over latitude, longitude values (both within ±90: a lake elsewhere)."""
+    from ..crs import is_geographic
+
+    if not (frame.source_crs and frame.crs and is_geographic(frame.source_crs)):
+        return ""
+    from .mesh_parts import _user_place
+
+    c = poly.centroid
+    return f", centroid {_user_place(c.x, c.y, frame, poly.length)}"
 
 
 def run(args: argparse.Namespace) -> int:

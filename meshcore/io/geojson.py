@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import check_allocation, max_points
-from ..crs import LONLAT, check_lonlat, normalize_crs
+from ..crs import LONLAT, check_lonlat, looks_swapped, normalize_crs
 from ..errors import InvalidInputError, ReadError
 from ._base import PointSet, Polyline, decode_text, make_polyline, merge_point_runs, read_bytes
 
@@ -132,8 +132,14 @@ def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     try:
         if declared == LONLAT:
             for pl in merged:
-                check_lonlat(pl.points, where=f"{path}: {pl.name}")
+                check_lonlat(
+                    pl.points,
+                    where=f"{path}: {pl.name}",
+                    swapped="; GeoJSON positions are [longitude, latitude]: write them in that order",
+                )
     except (InvalidInputError, ReadError) as exc:
+        if any(looks_swapped(pl.points) for pl in merged):  # the message names the order
+            raise ReadError(str(exc)) from None
         hint = "GeoJSON positions are lon/lat; for projected coordinates give their CRS: --source-crs EPSG:nnnn"
         raise ReadError(f"{exc} — {hint}") from None
     return PointSet(tuple(merged), declared, str(path))

@@ -185,7 +185,11 @@ def _from_xml(data: bytes, where: str, stem: str, crs: Any) -> PointSet:
     declared = normalize_crs(crs) if crs is not None else LONLAT
     if declared == LONLAT:
         for pl in merged:
-            check_lonlat(pl.points, where=f"{where}: {pl.name}")
+            check_lonlat(
+                pl.points,
+                where=f"{where}: {pl.name}",
+                swapped="; KML coordinates are longitude,latitude[,altitude]: write them in that order",
+            )
     return PointSet(tuple(merged), declared, where)
 
 

@@ -404,6 +404,8 @@ def read_points_csv(
     for (start, gname, sname, lineno), end in zip(groups, ends, strict=True):
         name = gname or sname or (base if len(groups) == 1 else f"{base} {len(polylines) + 1}")
         if end - start < 2:
+            if len(groups) == 1:  # the whole file (was: "(a blank line starts a new polyline)" with none in it)
+                raise ReadError(f"{path}: only 1 point (line {lineno}); an outline needs 3 or more")
             raise ReadError(
                 f"{path}: polyline {name!r} (line {lineno}) has only {end - start} point"
                 + (" (a blank line starts a new polyline)" if gname is None and sname is None else "")
@@ -412,11 +414,25 @@ def read_points_csv(
     declared = normalize_crs(crs) if crs is not None else (LONLAT if lay.lonlat or lay.dms else None)
     if declared == LONLAT:
         for pl in polylines:
-            check_lonlat(pl.points, where=f"{path}: {pl.name}")
+            check_lonlat(pl.points, where=f"{path}: {pl.name}", swapped=_swap_hint(lay))
     meta: dict = {"xy_columns": (lay.ix, lay.iy)}
     if lay.header is not None and max(lay.ix, lay.iy) < len(lay.header):  # the names the x, y columns have
         meta["columns"] = (lay.header[lay.ix], lay.header[lay.iy], lay.ix, lay.iy)
     return PointSet(tuple(polylines), declared, str(path), meta)
+
+
+def _swap_hint(lay: _Layout) -> str:
+    """What to change when a lon/lat file holds latitude, longitude: its header, or the columns."""
+    if lay.header is None or max(lay.ix, lay.iy) >= len(lay.header):
+        return f"; if so, give the columns in the other order ({lay.iy}, {lay.ix} from 0)"
+    names = list(lay.header)
+    x, y = names[lay.ix], names[lay.iy]
+    names[lay.ix], names[lay.iy] = y, x
+    sep = lay.delim if lay.delim and lay.delim != "\t" else ("\t" if lay.delim else " ")
+    return (
+        f"; the header (line {lay.header_line}) names column {lay.ix + 1} {x!r} and column {lay.iy + 1} {y!r}: "
+        f"if column {lay.ix + 1} holds latitudes, write the header {sep.join(names)!r}"
+    )
 
 
 def _one_ring_split_by_blank_lines(

@@ -150,3 +150,24 @@ def test_a_warm_solve_stopped_in_its_final_remake_returns_its_live_grid_as_stopp
         np.testing.assert_array_equal(result.grids[k].x, g.x)
     info = result.multiblock.info
     assert not info.converged and info.message == "stopped"
+
+
+class _StopWithoutHold(_Hold):
+    """A hold never set, and a stop that comes while the solve waits on it without setting it."""
+
+    def wait(self, timeout=None) -> bool:
+        assert timeout is not None, "a held solve waits without a bound"  # was: hold.wait()
+        self.waits.append(len(self.yielded))
+        self.stop.set()
+        return False
+
+
+def test_a_held_warm_solve_waits_with_a_bound_and_sees_a_stop_that_left_the_hold_unset():
+    lake, warm = _dragged("y junction")
+    items: list = []
+    stop = threading.Event()
+    hold = _StopWithoutHold(items, stop=stop)
+    result = _drain(solve_layout(lake, warm=warm, stop_event=stop, hold=hold), items)
+    assert len(hold.waits) == 1 and hold.waits[0] == len(items)  # stopped at the wait: nothing after it
+    for k, g in enumerate(items[-1].grids):  # the live grid is the result, as with a stop that sets the hold
+        np.testing.assert_array_equal(result.grids[k].x, g.x)

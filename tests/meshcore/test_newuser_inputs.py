@@ -234,3 +234,35 @@ def test_import_of_points_on_a_line_is_refused_unless_cells_are_given(tmp_path, 
     assert "across at its widest (near (7" in err
     assert not out.exists()
     assert main(["import", str(src), "-o", str(out), "--cells", "40", "2"]) == 0 and out.exists()
+
+
+def test_import_of_a_triangle_says_that_meshcore_mesh_grids_it(tmp_path, capsys):
+    src, out = tmp_path / "tri.csv", tmp_path / "tri.toml"
+    src.write_text("x,y\n0,0\n4000,0\n2000,3000\n")
+    # was: "needs at least 4 points, got 3" only; meshcore mesh (and the app's Auto layout) grid it
+    _bad(capsys, ["import", src, "-o", out], "tri.csv", "needs at least 4 points, got 3", "meshcore mesh grids")
+    assert not out.exists()
+    assert main(["mesh", str(src), "-o", str(tmp_path / "tri.vtm"), "--cells", "300", "-q"]) == 0
+
+
+def test_a_file_of_one_point_says_so_without_a_blank_line_it_does_not_have(tmp_path, capsys):
+    src = tmp_path / "one.csv"
+    src.write_text("lon,lat\n8.5,47.3\n")
+    # was: "polyline 'one' (line 2) has only 1 point (a blank line starts a new polyline)"
+    err = _bad(capsys, ["mesh", src, "-o", tmp_path / "g.vtm"], "one.csv: only 1 point (line 2)", "3 or more")
+    assert "blank line" not in err
+    two = tmp_path / "two.csv"
+    two.write_text("x,y\n0,0\n1000,0\n1000,1000\n\n5000,5000\n")  # a stray point after a blank line: still said
+    _bad(capsys, ["mesh", two, "-o", tmp_path / "g.vtm"], "(line 6) has only 1 point (a blank line starts")
+
+
+def test_import_names_the_rings_it_leaves_out(tmp_path, capsys):
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    north = np.c_[8.5 + 0.05 * np.cos(t), 47.3 + 0.03 * np.sin(t)]
+    south = np.c_[8.5 + 0.04 * np.cos(t[::2]), 47.2 + 0.02 * np.sin(t[::2])]
+    src, out = tmp_path / "two.kml", tmp_path / "two.toml"
+    src.write_text(_kml(_placemark("north", "ring", north) + _placemark("south", "ring", south)))
+    assert main(["import", str(src), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    # was: 'south' left out without a word
+    assert "'north' is imported" in err and "left out ('south')" in err, err
