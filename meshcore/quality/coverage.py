@@ -336,7 +336,7 @@ def coverage(
     # the arms and spikes below are found on the shore the layout worked on: an outline with far
     # more vertices than cells is simplified first, as the layout does (a shore of 120 000 points
     # took 37 s of buffers here); the distances stay measured to the outline as given
-    simple, _ = without_dense_vertices(poly, h)
+    simple = without_dense_vertices(poly, h)[0] if poly.geom_type == "Polygon" else poly  # parts: as given
     slack = 0.0 if simple is poly else DENSE_TOLERANCE * h
     # the dead-end arms narrower than two cells, which the layout leaves out on purpose
     # (:func:`meshcore.layout.shore.without_narrow_arms`, its rule at this cell size, with a note):
