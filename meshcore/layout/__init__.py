@@ -44,6 +44,7 @@ from .model import Layout, LayoutBlock, LayoutOptions
 from .outline import interior_cuts
 from .polygon import MIN_ISLAND_CELLS, water_polygon, without_dense_vertices, without_slivers
 from .shore import shore_at_scale, transfer, without_narrow_arms
+from .tipends import counted_without_tip_fans
 from .widen import widen_starved
 
 #: No layout option on (:class:`LayoutOptions`).
@@ -239,7 +240,10 @@ def _layout(
             poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, tees=tees, single=single
         )
     pieces = moved
-    cells = block_counts(pieces, h, multiple=multiple, closed=single)
+    if regular:
+        cells = block_counts(pieces, h, multiple=multiple, closed=single)
+    else:  # (with tipends.SLIDE: a block side crowding its cells into an island's tip, a cut's end slid onto it)
+        pieces, cells = counted_without_tip_fans(pieces, h, hl, multiple=multiple)
 
     def made(pieces, cells) -> Layout:
         blocks = tuple(
