@@ -9,7 +9,8 @@ per level, columns ``C_*``: offsets into the buffers and sizes), built once per
 hierarchy by :func:`.hierarchy.pack`.  :func:`vcycle` runs exactly the
 operations of the Python driver in the same order (the same table kernels of
 :mod:`._kernels`, the transfers as CSR products summed in the same order), so
-both give the same iterates (the test oracle compares them).
+both give the same iterates (the test oracle compares them).  Gathered ids are read as unsigned
+indices (:func:`._kernels._u`).
 
 Level ``k`` holds its node values ``x, y, f_x, f_y, r_x, r_y, v_x, v_y``
 (``v``: the injected finer values a coarse level started from), its table
@@ -24,7 +25,7 @@ import math
 
 from numba import njit
 
-from ._kernels import line_sweep_rhs, table_defect, table_sweep_rhs
+from ._kernels import _u, line_sweep_rhs, table_defect, table_sweep_rhs
 
 __all__ = ["META_COLS", "vcycle"]
 
@@ -160,8 +161,8 @@ def _restrict_to(fb, ib, fine, co):  # pragma: no cover - compiled
     rval = fb[co[C_RVAL] : co[C_RVAL] + co[C_RNZ]]
     n = co[C_N]
     for i in range(n):
-        vx[i] = xf[inj[i]]
-        vy[i] = yf[inj[i]]
+        vx[i] = xf[_u(inj[i])]
+        vy[i] = yf[_u(inj[i])]
         dx[i] = 0.0
         dy[i] = 0.0
         fx[i] = 0.0
@@ -175,8 +176,8 @@ def _restrict_to(fb, ib, fine, co):  # pragma: no cover - compiled
         sx = 0.0
         sy = 0.0
         for q in range(rptr[i], rptr[i + 1]):
-            sx += rval[q] * rxf[ridx[q]]
-            sy += rval[q] * ryf[ridx[q]]
+            sx += rval[q] * rxf[_u(ridx[q])]
+            sy += rval[q] * ryf[_u(ridx[q])]
         fx[i] = -dx[i] + scale[i] * sx
         fy[i] = -dy[i] + scale[i] * sy
 
@@ -199,8 +200,8 @@ def _correct(fb, ib, fine, co):  # pragma: no cover - compiled
         sx = 0.0
         sy = 0.0
         for q in range(pptr[i], pptr[i + 1]):
-            sx += pval[q] * ex[pidx[q]]
-            sy += pval[q] * ey[pidx[q]]
+            sx += pval[q] * ex[_u(pidx[q])]
+            sy += pval[q] * ey[_u(pidx[q])]
         xf[i] += sx
         yf[i] += sy
 

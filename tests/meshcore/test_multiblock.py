@@ -1458,6 +1458,36 @@ def test_fused_cycle_equals_the_kernel_by_kernel_cycle(make, rect):
     assert np.abs(x - x0).max() > 1e-3 * topo.size  # the cycles moved the grid
 
 
+@pytest.mark.parametrize("make", ["star5", "four_blocks", "layout"])
+def test_every_id_the_kernels_gather_is_a_node_of_its_level(make):
+    """The table kernels index with unsigned ids (``_kernels._u``: no test for a negative index,
+    faster), so a negative id in a table would read outside the node array where it used to wrap
+    around: every id of every level's tables (point, lines, border, band, hot-spot rows, the
+    irregular rings, the injection and the transfers) lies in ``0 … n − 1``."""
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock.hierarchy import hot_rows, levels
+
+    if make == "star5":
+        topo = star(5, 9)
+    elif make == "four_blocks":
+        topo = four_blocks(*curved_rectangle(40, 16), 22, 8)
+    else:
+        topo = auto_layout(testing.lake_with_islands(938211), target_cells=1500, multiple=4).topology()
+    lvs = levels(topo)
+    assert len(lvs) >= 2
+    for k, lv in enumerate(lvs):
+        nodes, nbr, irr_n, _, ring = lv.args
+        tables = [nodes, nbr, irr_n, ring, *lv.lines[0][:2], *lv.lines[1][:2], *lv.border[:2], *lv.band[:2]]
+        tables += list(hot_rows(lv, np.flatnonzero(lv.free)[:3], 2)[:2])
+        if k > 0:  # P: finer × this level, R and the injection: ids of the finer level
+            tables.append(lv.P.indices)
+            for t in (lv.R.indices, lv.inj):
+                assert t.min() >= 0 and t.max() < lvs[k - 1].n
+        for t in tables:
+            assert t.size == 0 or (t.min() >= 0 and t.max() < lv.n)
+
+
 @pytest.mark.parametrize("make", ["star5", "four_blocks", "odd"])
 def test_sparse_transfers_match_the_blockwise_reference(make, rect):
     """The global sparse P and R equal the block-by-block interpolation and its normalised
