@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..cellsize import DEFAULT_CELLS, default_cell_size
+from . import tipends
 from .blocks import block_counts
 from .build import layout_pieces
 from .curve import curved_shore
@@ -240,7 +241,7 @@ def _layout(
             poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, tees=tees, single=single
         )
     pieces = moved
-    if regular:
+    if regular or not tipends.SLIDE:
         cells = block_counts(pieces, h, multiple=multiple, closed=single)
     else:  # (with tipends.SLIDE: a block side crowding its cells into an island's tip, a cut's end slid onto it)
         pieces, cells = counted_without_tip_fans(pieces, h, hl, multiple=multiple)

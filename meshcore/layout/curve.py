@@ -3,7 +3,7 @@ r"""The shore between an outline's vertices as a smooth curve.
 An outline from Google Earth, GSHHG or a digitised map is a polygon whose vertices are a
 few cells apart (the GSHHG lakes at 10 000 cells: a vertex every 1.5–12 cells, turning by
 10° at the median and 20–65° at the 90th percentile), and a dense outline simplified at
-the grid's scale (:func:`~.polygon.without_dense_vertices`) becomes one.  Its straight
+the grid's scale (:func:`~.shore.without_dense_vertices`) becomes one.  Its straight
 segments are not the shore: they are chords between points measured on it.  A grid that
 follows them has a kink at every vertex, and an orthogonal grid cannot be orthogonal on both
 sides of a kink: its lines wave where the vertices are 1.5–3 cells apart.

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..quality.coverage import MIN_ISLAND_CELLS, island_width, without_spikes
+from .shore import without_dense_vertices  # (their home before)
 
 __all__ = ["MIN_ISLAND_CELLS", "water_parts_from_points", "water_polygon", "without_dense_vertices"]
 
@@ -238,40 +239,6 @@ def _largest_spikes(poly: Any, clean: Any, width: float, n: int = 3) -> str:
         _, c = island_width(g, 0.05 * width)
         said.append(f"{what} {0.5 * g.length:.3g} long near ({c.x:.6g}, {c.y:.6g})")
     return "; the largest: " + ", ".join(said) + " (the grid covers land and leaves out water there)"
-
-
-#: A shore with more vertices than this per cell length is simplified before the layout ...
-DENSE = 2.0
-#: ... to within this share of a cell of the outline (Douglas–Peucker at half of it: GEOS may
-#: also drop a ring's first point, which can double the distance).
-DENSE_TOLERANCE = 0.05
-
-
-def without_dense_vertices(poly: Any, h: float) -> tuple[Any, list[str]]:
-    """The water with its shore simplified to within ``0.05 h`` of the outline when it has more
-    than two vertices per cell length (an outline traced or resampled far below the cell size),
-    and a note; ``poly`` itself otherwise, or when the simplified polygon would not be valid.
-
-    Every step of the layout works at the scale of the cells (the shore sampled at ``h/2``,
-    corners read at ``1.5 h``) but carries every vertex it is given: a shore sampled at ``h/10``
-    makes the layout ten times slower and its blocks no better.  The grid then follows the
-    simplified shore, at most ``0.05`` cells from the outline.
-    """
-    import shapely
-    from shapely.geometry.polygon import orient
-
-    n = len(poly.exterior.coords) - 1 + sum(len(r.coords) - 1 for r in poly.interiors)
-    if h <= 0 or n <= DENSE * poly.length / h:
-        return poly, []
-    simple = shapely.simplify(poly, 0.5 * DENSE_TOLERANCE * h, preserve_topology=True)
-    if simple.geom_type != "Polygon" or len(simple.interiors) != len(poly.interiors) or not simple.is_valid:
-        return poly, []
-    m = len(simple.exterior.coords) - 1 + sum(len(r.coords) - 1 for r in simple.interiors)
-    note = (
-        f"shore simplified from {n} to {m} vertices (it had {n * h / poly.length:.2g} per cell length), "
-        f"within {DENSE_TOLERANCE:g} cells of the outline"
-    )
-    return orient(simple, 1.0), [note]
 
 
 def water_from_points(pointset: Any):

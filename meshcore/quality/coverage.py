@@ -319,7 +319,7 @@ def coverage(
     """Coverage of ``polygon`` (shapely, or an outer ring plus ``holes``) by the grid."""
     import shapely
 
-    from ..layout.polygon import DENSE_TOLERANCE, without_dense_vertices
+    from ..layout.shore import DENSE_TOLERANCE, without_dense_vertices
 
     poly = as_polygon(polygon, holes)
     union = _areal(shapely.union_all([_block_region(g, b.folded) for g, b in zip(grids, block_metrics, strict=True)]))

@@ -10,7 +10,7 @@ import shapely
 
 from meshcore import testing
 from meshcore.layout import auto_layout
-from meshcore.layout.polygon import DENSE_TOLERANCE, without_dense_vertices
+from meshcore.layout.shore import DENSE_TOLERANCE, without_dense_vertices
 
 
 def _vertices(poly) -> int:
