@@ -9,6 +9,7 @@ import pytest
 import shapely
 
 from meshcore import testing
+from tests.app.waits import answer_questions
 
 pytestmark = pytest.mark.gui
 
@@ -115,8 +116,6 @@ def test_the_recovery_prompt_says_what_it_restores(qtbot, win, tmp_path, monkeyp
     the file (or the lake), its islands and blocks, and when it was autosaved."""
     import time
 
-    from PySide6 import QtWidgets
-
     from app import recovery
     from app.lake import with_layout
     from meshcore.layout import auto_layout
@@ -127,13 +126,7 @@ def test_the_recovery_prompt_says_what_it_restores(qtbot, win, tmp_path, monkeyp
     layout = auto_layout(shapely.Polygon(lake.outline, lake.holes))
     project = with_layout(win.doc.project, lake.replaced(layout=layout))
     recovery.write(project, win.io.recovery_path, tmp_path / "tarn-case.toml")
-    asked = []
-
-    def question(_parent, _title, text, *_a):
-        asked.append(text)
-        return QtWidgets.QMessageBox.StandardButton.No
-
-    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    asked = answer_questions(monkeypatch, "No")
     assert not win.io.offer_recovery()
     (text,) = asked
     n = len(lake.holes)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from tests.app.test_modeller import _metres_lake
+from tests.app.waits import answer_questions
 
 pytestmark = pytest.mark.gui
 
@@ -233,17 +234,10 @@ def test_a_stray_click_before_the_import_leaves_no_block_behind(qtbot, win, tmp_
 def test_the_lon_lat_question_names_the_utm_zone(qtbot, win, tmp_path, monkeypatch):
     """ "g180810.kml holds longitude/latitude degrees. Project them to metres (the UTM zone of the
     outline, …)?" — which zone showed only on the axes after the answer.  The question names it."""
-    from PySide6 import QtWidgets
 
     from tests.app.test_modeller import _lonlat_lake
 
-    asked = []
-
-    def question(_parent, _title, text, *_a):
-        asked.append(text)
-        return QtWidgets.QMessageBox.StandardButton.Yes
-
-    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    asked = answer_questions(monkeypatch)
     monkeypatch.setattr(win, "quiet", False)
     monkeypatch.setattr(win.lake_ctl, "offer", lambda *_a: None)  # the Auto layout offer: not asked here
     assert win.io.import_points(_lonlat_lake(tmp_path / "Alp.geojson", 761911, lon=9.0, lat=47.0))

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.app.waits import answer_questions
+
 pytestmark = pytest.mark.gui
 
 T = np.linspace(0, 2 * np.pi, 24, endpoint=False)
@@ -134,15 +136,8 @@ def test_export_without_a_grid_says_there_is_nothing_to_export(win, tmp_path):
 
 
 def test_the_lon_lat_question_says_where_the_lake_is(win, tmp_path, monkeypatch):
-    from PySide6 import QtWidgets
 
-    asked = []
-
-    def question(_parent, _title, text, *_a):
-        asked.append(text)
-        return QtWidgets.QMessageBox.StandardButton.Yes
-
-    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    asked = answer_questions(monkeypatch)
     monkeypatch.setattr(win, "quiet", False)
     monkeypatch.setattr(win.lake_ctl, "offer", lambda *_a: None)
     f = tmp_path / "bolsena.csv"  # written lat, lon under a lon,lat header: the question shows lon 42.6

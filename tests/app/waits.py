@@ -103,3 +103,18 @@ def drag_a_cut_end(qtbot, win, reach: float = 1.0) -> None:
     tool.drag("finish", tuple(path[-1]), end.xy)
     wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
     wait_idle(qtbot, win)
+
+
+def answer_questions(monkeypatch, answer: str = "Yes") -> list[str]:
+    """Every ``QMessageBox.question`` answered ``answer`` (a StandardButton name) without a dialog;
+    returns the list their texts are appended to, in the order asked."""
+    from PySide6 import QtWidgets
+
+    asked: list[str] = []
+
+    def question(_parent, _title, text, *_a):
+        asked.append(text)
+        return getattr(QtWidgets.QMessageBox.StandardButton, answer)
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    return asked
