@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..boundary import signed_area
 from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
 from ..multiblock.shorecells import least_weights, shore_least
@@ -221,10 +222,5 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
 def _cells_share(pieces, sides, counts: np.ndarray, cell_size: float) -> float:
     """The layout's cells over the water's area in cells of ``cell_size`` (1: as asked)."""
     cells = sum(float(counts[s[0]].sum() * counts[s[3]].sum()) for s in sides)
-    area = sum(abs(_ring_area(pc.ring)) for pc in pieces)
+    area = sum(abs(signed_area(pc.ring)) for pc in pieces)
     return cells * cell_size**2 / area if area > 0 else 1.0
-
-
-def _ring_area(ring: np.ndarray) -> float:
-    x, y = np.asarray(ring, dtype=float).T
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))

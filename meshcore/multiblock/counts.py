@@ -113,6 +113,16 @@ SHORT_JUMPS = False
 STEEP_ACROSS = False
 
 
+def _block_targets(t: np.ndarray, sides) -> np.ndarray:
+    """Each block's wanted count per direction, order ``(b0 ξ, b0 η, b1 ξ, …)``: the mean of its
+    two opposite sides' targets."""
+    out = np.empty(2 * len(sides))
+    for bi, (bottom, right, top, left) in enumerate(sides):
+        for d, (a, b) in enumerate(((bottom, top), (left, right))):
+            out[2 * bi + d] = 0.5 * (t[list(a)].sum() + t[list(b)].sum())
+    return out
+
+
 def _block_weights(t: np.ndarray, sides, area: bool = False) -> np.ndarray:
     """Weight of each block's ``|N − T|`` term per direction, order ``(b0 ξ, b0 η, b1 ξ, …)``: 1
     each, or with ``area`` in proportion to the block's cells in the other direction (its share
@@ -127,11 +137,7 @@ def _block_weights(t: np.ndarray, sides, area: bool = False) -> np.ndarray:
     nb = len(sides)
     if not area or not nb:
         return np.ones(2 * nb)
-    mean = np.empty(2 * nb)
-    for bi, (bottom, right, top, left) in enumerate(sides):
-        for d, (a, b) in enumerate(((bottom, top), (left, right))):
-            mean[2 * bi + d] = 0.5 * (t[list(a)].sum() + t[list(b)].sum())
-    other = mean.reshape(-1, 2)[:, ::-1].reshape(-1)  # the block's cells in the other direction
+    other = _block_targets(t, sides).reshape(-1, 2)[:, ::-1].reshape(-1)  # cells in the other direction
     other = np.maximum(other, 1e-9)
     return other / other.mean()
 
@@ -192,11 +198,10 @@ def objective(
     :mod:`.countsearch`, which minimises it; the sums over chains are matrices made once (a
     layout of 37 blocks: ~300 pairs)."""
     nc, nb, npair = len(t), len(sides), len(jumps)
-    across, mean = np.zeros((nc, 2 * nb)), np.zeros(2 * nb)  # a block's count in each direction
-    for bi, (bottom, right, top, left) in enumerate(sides):
-        for d, (a, b) in enumerate(((bottom, top), (left, right))):
+    across, mean = np.zeros((nc, 2 * nb)), _block_targets(t, sides)  # a block's count in each direction
+    for bi, (bottom, _, _, left) in enumerate(sides):
+        for d, a in enumerate((bottom, left)):
             np.add.at(across[:, 2 * bi + d], list(a), 1.0)
-            mean[2 * bi + d] = 0.5 * (t[list(a)].sum() + t[list(b)].sum())
     dens1, dens2, w = np.zeros((nc, npair)), np.zeros((nc, npair)), np.zeros(npair)  # densities that meet
     for p, (ca, ta, cb, tb) in enumerate(jumps):
         np.add.at(dens1[:, p], ca, 1.0 / ta)
@@ -359,6 +364,7 @@ def solve_counts(
 
     for c in range(n):
         absdev(n + c, [c], t[c])
+    wanted = _block_targets(t, sides)
     for bi, (bottom, right, top, left) in enumerate(sides):
         for d, (a, b) in enumerate(((bottom, top), (left, right))):
             r = row()
@@ -367,7 +373,7 @@ def solve_counts(
             for c in b:
                 r[c] -= m
             add(r, 0.0, 0.0)
-            absdev(2 * n + 2 * bi + d, list(a), 0.5 * (t[list(a)].sum() + t[list(b)].sum()))
+            absdev(2 * n + 2 * bi + d, list(a), wanted[2 * bi + d])
         for side in (bottom, right, top, left):
             r = row()
             for c in side:

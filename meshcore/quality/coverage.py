@@ -341,17 +341,16 @@ def coverage(
     # the dead-end arms narrower than two cells, which the layout leaves out on purpose
     # (:func:`meshcore.layout.shore.without_narrow_arms`, its rule at this cell size, with a note):
     # measured against the water without them, whose shore crosses their mouths
-    water = _without_narrow_arms(simple, h)
-    if water is not simple:
-        water = water if simple is poly else _cut_off(poly, simple.difference(water), slack)
+    found = _without_narrow_arms(simple, h)  # on the layout's shore
+    if found is not simple:
+        water = found if simple is poly else _cut_off(poly, simple.difference(found), slack)
         sb = shapely.union_all(_islands(water, union, h)[1])
         sp = _boundary_points(sb, step)
-    else:
-        water = poly
     d_grid, kg = _directed(gp, sb)
     # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
-    # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart
-    keep = ~_in_spikes(_spikes(water if simple is poly else without_dense_vertices(water, h)[0], h, slack), sp)
+    # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart, found on the
+    # layout's shore as well (``slack`` wider)
+    keep = ~_in_spikes(_spikes(found, h, slack), sp)
     d_shore, ks = _directed(sp[keep], gb) if keep.any() else (0.0, 0)
     sp = sp[keep] if keep.any() else sp
     if d_grid >= d_shore:
