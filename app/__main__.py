@@ -161,8 +161,9 @@ def main(argv: list[str] | None = None) -> int:
 def solve_as_opened(app, win, timeout_s: float | None = None) -> bool:
     """``--solve``: the grid of what was opened, until it is done; False if not done in ``timeout_s``.
 
-    A lake whose import offered Auto layout (arms or islands) is laid out first, as the offer's
-    button does; one block over such a lake would be a poor grid, or cover its islands.  The
+    A lake whose import offered Auto layout (a lake on the map, or water with islands or arms) is
+    laid out first, as the offer's button does and as ``meshcore mesh`` does; one block over it
+    would be far from a model grid (~20° off orthogonal on a compact lake), or cover its islands.  The
     layout and the grid may take minutes on a busy machine: the default wait is
     :data:`SOLVE_TIMEOUT_S` for both together.
     """

@@ -203,6 +203,10 @@ class IOController(ExportMixin, QtCore.QObject):
     ) -> bool:
         """Read points as a new closed block with automatic corners (undoable).
 
+        A lake outline on the map (lon/lat, or a CRS the file declares) or water with islands or arms
+        gets Auto layout offered (:meth:`app.lake_controller.LakeController.offer`; ``--solve`` takes
+        it); plain numbers without a CRS of a compact shape (a duct, an airfoil) stay one block.
+
         A lake file of several separate parts of water opens part ``part`` (1: the largest); with
         ``None`` (or a part the file no longer has) a dialog asks which
         (:class:`app.parts_dialog.PartsDialog`; quiet: the largest).  ``again``: File ▸ Open recent
@@ -289,20 +293,31 @@ class IOController(ExportMixin, QtCore.QObject):
         which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
         if n_parts > 1 and again and asked_part == k_part:
             which = f" (part {k_part} of {n_parts}, the one opened last time: File ▸ Import asks for another)"
+        branched = lake is not None and looks_branched(lake.outline, lake.holes)
+        # a lake on the map (lon/lat, or a CRS the file declares) is water to model: its grid is the layout
+        # meshcore mesh makes (one block with automatic corners was ~20° off orthogonal on a compact lake);
+        # plain numbers without a CRS (a duct, an airfoil, a shape of the paper) stay one block
+        on_map = lake is not None and bool(pd.lonlat or pd.pointset.crs)
+        offered = branched or on_map
         if block.corners is None:  # a triangle: no four corners; the lake's layout grids it
             self.win.message(
                 f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; too few for four corners "
                 f"— Lake ▸ Auto layout splits it into blocks and grids it"
+            )
+        elif offered:
+            self.win.message(
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; Lake ▸ Auto layout (Ctrl+L) "
+                f"lays the lake out in blocks for a model grid; F5 now grids it as one block (automatic corners)"
             )
         else:
             self.win.message(
                 f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; corners chosen "
                 f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
             )
-        if lake is not None and looks_branched(lake.outline, lake.holes):
+        if offered:
             why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
             self.win.show_lake()
-            self.win.lake_ctl.offer(path.name, why)
+            self.win.lake_ctl.offer(path.name, why if branched else None)
         return True
 
     def _read_lake(self, pd, frame, *, lonlat: bool, part: int | None = None):

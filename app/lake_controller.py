@@ -302,13 +302,24 @@ class LakeController(QtCore.QObject):
         return self._edit_worker is not None or self._pending is not None
 
     # ------------------------------------------------------------- offer
-    def offer(self, name: str, why: str) -> None:
-        """After importing a branched lake: say why one block is poor, offer Auto layout (non-modal)."""
-        text = f"{name}: {why}. One block would give a poor grid; Auto layout splits the lake into blocks."
+    def offer(self, name: str, why: str | None) -> None:
+        """After importing a lake: say why one block is poor, offer Auto layout (non-modal).
+        ``why``: what makes one block poor (islands, arms); None: a compact lake outline, whose one
+        block with automatic corners is still far from a model grid."""
+        if why is None:
+            text = (
+                f"{name}: a lake outline. One block with automatic corners is far from a model grid "
+                "(cells well off orthogonal); Auto layout lays the lake out in blocks, as meshcore mesh does."
+            )
+        else:
+            text = f"{name}: {why}. One block would give a poor grid; Auto layout splits the lake into blocks."
         self.doc.report("info", text)
         box = QtWidgets.QMessageBox(self.win)
         # what the message says is poor about one block (it was "A branched lake" over "6 island(s)")
-        box.setWindowTitle("Islands in the lake" if "island" in why and "arm" not in why else "A branched lake")
+        if why is None:
+            box.setWindowTitle("A lake outline")
+        else:
+            box.setWindowTitle("Islands in the lake" if "island" in why and "arm" not in why else "A branched lake")
         box.setIcon(QtWidgets.QMessageBox.Icon.Question)
         box.setText(text)
         box.setModal(False)

@@ -1,0 +1,70 @@
+"""A lake outline gets the layout ``meshcore mesh`` gives, also when it is compact and has no islands;
+a point file of plain numbers (a duct, an airfoil) stays one block."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from PySide6 import QtWidgets
+
+from app.__main__ import solve_as_opened
+from meshcore import testing
+from tests.app.waits import wait_idle
+
+pytestmark = pytest.mark.gui
+
+
+def _lonlat_lake(path, seed: int, lon0: float = 9.2, lat0: float = 45.8):
+    """A compact generated lake without islands, a few km across, as a lon/lat GeoJSON polygon."""
+    poly = testing.round_lake(seed, kind="blob", radius=1500.0)  # its shore alone
+    xy = np.asarray(poly.exterior.coords, float)
+    lat = lat0 + xy[:, 1] / 111_320.0
+    lon = lon0 + xy[:, 0] / (111_320.0 * math.cos(math.radians(lat0)))
+    ring = [[float(a), float(b)] for a, b in zip(lon, lat, strict=True)]
+    geometry = {"type": "Polygon", "coordinates": [ring]}
+    feature = {"type": "Feature", "properties": {"name": "lake"}, "geometry": geometry}
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    return path
+
+
+def test_a_compact_lake_gets_auto_layout_offered_and_solve_lays_it_out(qtbot, win, tmp_path):
+    """``python -m app LAKE --solve`` gridded a compact lake without islands as one block with
+    automatic corners (~22° mean deviation on a set-10 lake) where ``meshcore mesh`` lays it out."""
+    from app.lake import looks_branched
+
+    path = _lonlat_lake(tmp_path / "lake.geojson", 864213)
+    assert win.io.import_points(path, project_lonlat=True)
+    p = win.doc.project
+    assert p.lake is not None and not p.lake.holes and not looks_branched(p.lake.outline)
+    box = win.lake_ctl.prompt
+    assert box is not None and box.windowTitle() == "A lake outline" and "meshcore mesh" in box.text()
+    win.lake_panel.cell_size.setValue(150.0)  # ~300 cells: a quick grid
+    win.lake_panel.cell_size.editingFinished.emit()
+    assert solve_as_opened(QtWidgets.QApplication.instance(), win)
+    wait_idle(qtbot, win)
+    lay = win.doc.project.layout
+    assert lay is not None and len(lay.blocks) > 1
+    assert len(win.doc.grids) == len(lay.blocks) == len(win.doc.project.blocks)
+    # the layout is one undo step: Ctrl+Z gives the one block back, with the imported shore
+    win.stack.undo()
+    assert win.doc.project.layout is None and len(win.doc.project.blocks) == 1
+    np.testing.assert_array_equal(win.doc.block.points, win.doc.project.lake.outline)
+
+
+def test_a_point_file_of_plain_numbers_stays_one_block(qtbot, win, tmp_path):
+    """A compact shape in plain numbers without a CRS (a duct, an airfoil's box) is no lake on the
+    map: no offer, and ``--solve`` grids the one block with automatic corners, as before."""
+    t = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+    ring = np.c_[2.0 * np.cos(t) + 0.3 * np.cos(3 * t), np.sin(t)]  # a rounded duct section
+    path = tmp_path / "duct.csv"
+    path.write_text("x,y\n" + "\n".join(f"{x:.6f},{y:.6f}" for x, y in ring) + "\n")
+    assert win.io.import_points(path)
+    assert win.lake_ctl.prompt is None
+    assert solve_as_opened(QtWidgets.QApplication.instance(), win)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is None and len(win.doc.project.blocks) == 1
+    assert list(win.doc.grids) == [0]
+
