@@ -212,11 +212,39 @@ def _frame_fields(frame) -> dict:
 def project_from_case(case) -> Project:
     from meshcore.crs import frame_from_case
 
-    return Project(
+    project = Project(
         blocks=tuple(_editable(b) for b in case.blocks),
         solver=case.solver,
         title=case.title,
         **_frame_fields(frame_from_case(case)),
+    )
+    if case.lake is not None and len(project.blocks) == 1:  # a lake saved before Auto layout: its islands
+        project = project.replaced(lake=_lake_of(case.lake))
+    return project
+
+
+def lake_section(lake):
+    """The ``[lake]`` table of a project's lake (:class:`meshcore.case.LakeSection`): the water as
+    imported and the Lake panel's settings; None without a lake."""
+    if lake is None:
+        return None
+    from meshcore.case import LakeSection
+
+    return LakeSection(
+        shore=lake.outline, islands=lake.holes, cell_size=lake.cell_size, regular=lake.regular, single=lake.single
+    )
+
+
+def _lake_of(section, layout=None):
+    from .lake import Lake
+
+    return Lake(
+        outline=section.shore,
+        holes=section.islands,
+        cell_size=section.cell_size,
+        regular=section.regular,
+        single=section.single,
+        layout=layout,
     )
 
 
@@ -229,7 +257,9 @@ def project_to_case(project: Project):
         raise ValueError("nothing to save yet: no block has a closed boundary with four corners")
     frame = project_frame(project)
     crs = frame.as_dict() if frame is not None else None
-    return Case(blocks=blocks, title=project.title, solver=project.solver, crs=crs)
+    # a lake not laid out yet: the one block, and the water (islands) and settings in [lake] (they were lost)
+    lake = lake_section(project.lake) if len(blocks) == 1 else None
+    return Case(blocks=blocks, title=project.title, solver=project.solver, crs=crs, lake=lake)
 
 
 def load_project(path) -> Project:
@@ -305,7 +335,8 @@ def _layout_case(project: Project):
     from meshcore.case import layout_case
 
     case = layout_case(project.layout, title=project.title, crs=project_frame(project))
-    return case.replaced(solver=project.solver, path=None)
+    # the water as imported and the settings in [lake]: it opens again as such
+    return case.replaced(solver=project.solver, path=None, lake=lake_section(project.lake))
 
 
 def project_from_layout_case(case) -> Project:
@@ -315,6 +346,10 @@ def project_from_layout_case(case) -> Project:
     from .lake import Lake, with_layout
 
     layout = case_layout(case)
+    base = Project(solver=case.solver, title=case.title, **_frame_fields(case_frame(case)))
+    if case.lake is not None:  # the water as imported (a case the app saved) and the Lake panel's settings
+        return with_layout(base, _lake_of(case.lake, layout))
+    # else the water as the layout has it (every vertex its blocks put on the shore)
     poly = layout.polygon
     lake = Lake(
         outline=np.asarray(poly.exterior.coords)[:-1],
@@ -322,7 +357,6 @@ def project_from_layout_case(case) -> Project:
         cell_size=_cell_size_read(float(layout.cell_size), poly.area),
         layout=layout,
     )
-    base = Project(solver=case.solver, title=case.title, **_frame_fields(case_frame(case)))
     return with_layout(base, lake)
 
 

@@ -47,7 +47,16 @@ list the valid ones.  Example (the paper's bottle, refinement 1)::
 
 Multiblock cases add ``[multiblock]``, ``[[interfaces]]`` or ``[outline]``
 (:mod:`meshcore.case.multiblock`); a top-level ``crs`` table records the
-coordinate frame (written by ``meshcore import``).
+coordinate frame (written by ``meshcore import``).  A ``[lake]`` table (the app's
+*Save project*) holds the water the case was made from, as imported, and its layout
+settings; the generator does not read it::
+
+    [lake]
+    shore = [[0, 0], [900, 0], [900, 400], [0, 400]]   # the shore as imported (model units)
+    islands = [[[300, 150], [400, 150], [350, 250]]]   # optional: island rings
+    cell_size = 25.0              # optional (absent: the automatic size)
+    regular = true                # optional: no 3- or 5-block corners (Delft3D DD)
+    single = true                 # optional: a layout for one index space
 
 Modules: :mod:`.model` (the frozen :class:`Case` and its sections),
 :mod:`.parse` (TOML → Case), :mod:`.write` (Case → TOML),
@@ -56,7 +65,7 @@ Modules: :mod:`.model` (the frozen :class:`Case` and its sections),
 settings :class:`meshcore.SolverSpec`.
 """
 
-from .model import Case, InterfaceEntry, MultiblockSection, OutlineSection
+from .model import Case, InterfaceEntry, LakeSection, MultiblockSection, OutlineSection
 from .multiblock import case_frame, case_layout, case_topology, cut_case, layout_case, outline_points, topology_case
 from .parse import load_case, loads_case, xy_pairs
 from .run import case_solver, generate_case, iterate_multiblock_case
@@ -65,6 +74,7 @@ from .write import case_to_dict, dumps_case, save_case
 __all__ = [
     "Case",
     "InterfaceEntry",
+    "LakeSection",
     "MultiblockSection",
     "OutlineSection",
     "case_frame",

@@ -22,6 +22,7 @@ __all__ = [
     "START_CHOICES",
     "Case",
     "InterfaceEntry",
+    "LakeSection",
     "MultiblockSection",
     "OutlineSection",
     "outline_point",
@@ -184,13 +185,68 @@ class OutlineSection:
     __hash__ = None  # type: ignore[assignment]
 
 
+def _ring(points: Any, where: str) -> np.ndarray:
+    a = np.array(points, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != 2 or len(a) < 3:
+        raise InvalidInputError(f"{where}: expected a ring of at least 3 [x, y] pairs, got shape {a.shape}")
+    if not np.isfinite(a).all():
+        raise InvalidInputError(f"{where}: a coordinate is not a finite number")
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LakeSection:
+    """``[lake]``: the water a case was made from, as imported, and how to lay it out again.
+
+    ``shore`` and ``islands`` are rings of ``[x, y]`` in the case's coordinates, as the outline
+    file gave them (an ``[outline]`` case's own shore carries every vertex its blocks put on it;
+    a one-block case has no islands at all); ``cell_size`` (None: the automatic size),
+    ``regular`` and ``single`` are the layout settings (``meshcore mesh --cell-size``,
+    ``--regular``, a layout for one index space).  Written by the app's *Save project*, so that
+    a reopened lake is the one imported; ``meshcore generate`` grids the blocks and does not read it.
+    """
+
+    shore: np.ndarray
+    islands: tuple[np.ndarray, ...] = ()
+    cell_size: float | None = None
+    regular: bool = False
+    single: bool = False
+
+    def __post_init__(self) -> None:
+        put = object.__setattr__
+        put(self, "shore", _ring(self.shore, "shore"))
+        put(self, "islands", tuple(_ring(h, f"islands[{k}]") for k, h in enumerate(self.islands)))
+        if self.cell_size is not None:
+            size = float(self.cell_size)
+            if not (np.isfinite(size) and size > 0):
+                raise InvalidInputError(f"cell_size must be a positive number, got {self.cell_size!r}")
+            put(self, "cell_size", size)
+        for name in ("regular", "single"):
+            if not isinstance(getattr(self, name), bool):
+                raise InvalidInputError(f"{name} must be true or false, got {getattr(self, name)!r}")
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, LakeSection):
+            return NotImplemented
+        return (
+            np.array_equal(self.shore, other.shore)
+            and len(self.islands) == len(other.islands)
+            and all(np.array_equal(a, b) for a, b in zip(self.islands, other.islands, strict=True))
+            and (self.cell_size, self.regular, self.single) == (other.cell_size, other.regular, other.single)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
 @dataclass(frozen=True, eq=False)
 class Case:
     """A whole case: blocks, solver settings and the optional multiblock sections.
 
     ``crs`` is the top-level ``crs`` table (``crs``, ``origin``, ``source_crs``,
     ``source``; :func:`meshcore.crs.frame_from_case`).  A case is *multiblock*
-    when it has a ``[multiblock]`` table, ``[[interfaces]]`` or an ``[outline]``.
+    when it has a ``[multiblock]`` table, ``[[interfaces]]`` or an ``[outline]``.  ``lake``: the
+    water the case was made from (:class:`LakeSection`; not read by the generator).
     """
 
     blocks: tuple[BlockSpec, ...] = ()
@@ -201,6 +257,7 @@ class Case:
     multiblock: MultiblockSection | None = None
     interfaces: tuple[InterfaceEntry, ...] = ()
     outline: OutlineSection | None = None
+    lake: LakeSection | None = None
     path: Path | None = None
 
     def __post_init__(self) -> None:

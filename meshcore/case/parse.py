@@ -22,7 +22,7 @@ from ..errors import CaseFileError, InvalidInputError, MeshcoreError
 from ..grid import BORDER_NAMES
 from ..multiblock.outline import BlockOutline
 from ..spec import REPAIR_CHOICES, BlockSpec, SolverSpec
-from .model import Case, InterfaceEntry, MultiblockSection, OutlineSection, outline_point
+from .model import Case, InterfaceEntry, LakeSection, MultiblockSection, OutlineSection, outline_point
 
 __all__ = ["load_case", "loads_case", "read_point_file", "xy_pairs"]
 
@@ -287,10 +287,10 @@ def _corners(value: Any, where: str) -> tuple:
         raise CaseFileError(f"{where}: {exc}") from None
 
 
-def _holes(value: Any, where: str) -> tuple:
+def _holes(value: Any, where: str, name: str = "holes") -> tuple:
     if not isinstance(value, list):
-        raise CaseFileError(f"{where} holes must be a list of rings (lists of [x, y] points)")
-    return tuple(xy_pairs(r, f"{where} holes[{k}]") for k, r in enumerate(value))
+        raise CaseFileError(f"{where} {name} must be a list of rings (lists of [x, y] points)")
+    return tuple(xy_pairs(r, f"{where} {name}[{k}]") for k, r in enumerate(value))
 
 
 def parse_outline(tbl: Any, src: str) -> OutlineSection:
@@ -308,6 +308,24 @@ def parse_outline(tbl: Any, src: str) -> OutlineSection:
             "points": lambda v, w: v if isinstance(v, str) else xy_pairs(v, f"{where} points"),
             "blocks": lambda v, w: _outline_blocks(v, src),
             "holes": lambda v, w: _holes(v, where),
+        },
+    )
+
+
+def parse_lake(tbl: Any, src: str) -> LakeSection:
+    """The ``[lake]`` table: the water as imported and its layout settings."""
+    where = f"{src}: [lake]"
+    if not isinstance(tbl, Mapping):
+        raise CaseFileError(f"{where} must be a table")
+    return from_table(
+        LakeSection,
+        tbl,
+        where=where,
+        error=CaseFileError,
+        required=("shore",),
+        convert={
+            "shore": lambda v, w: xy_pairs(v, f"{where} shore"),
+            "islands": lambda v, w: _holes(v, where, "islands"),
         },
     )
 
@@ -345,6 +363,7 @@ def loads_case(text: str, *, base: Path | None = None, source: str = "<case>") -
         multiblock=parse_multiblock(data["multiblock"], source) if "multiblock" in data else None,
         interfaces=parse_interfaces(data.get("interfaces", []), source),
         outline=parse_outline(data["outline"], source) if "outline" in data else None,
+        lake=parse_lake(data["lake"], source) if "lake" in data else None,
     )
     if case.settings.mode == "orthogonal" and case.outline is None:
         raise CaseFileError(f'{source}: [multiblock] mode = "orthogonal" needs an [outline] section (the shore)')

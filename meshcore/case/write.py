@@ -124,6 +124,11 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         ]
     if case.outline is not None:
         out["outline"] = _outline_table(case.outline)
+    if case.lake is not None:
+        lk = case.lake
+        out["lake"] = {"shore": lk.shore} | ({"islands": [np.asarray(h) for h in lk.islands]} if lk.islands else {})
+        out["lake"] |= {"cell_size": lk.cell_size} if lk.cell_size is not None else {}
+        out["lake"] |= {k: True for k in ("regular", "single") if getattr(lk, k)}
     if case.blocks:
         out["blocks"] = [_block_table(b) for b in case.blocks]
     return _clean(out)

@@ -12,7 +12,7 @@ from PySide6 import QtWidgets
 
 from app.__main__ import solve_as_opened
 from meshcore import testing
-from tests.app.waits import wait_idle
+from tests.app.waits import wait_for, wait_idle
 
 pytestmark = pytest.mark.gui
 
@@ -68,3 +68,67 @@ def test_a_point_file_of_plain_numbers_stays_one_block(qtbot, win, tmp_path):
     assert win.doc.project.layout is None and len(win.doc.project.blocks) == 1
     assert list(win.doc.grids) == [0]
 
+
+def test_a_saved_lake_reopens_with_the_outline_imported(qtbot, win, tmp_path):
+    """Save, then reopen: the lake's shore and islands came back with every vertex the layout's
+    blocks put on them (a 40-point shore as ~390 points), and Clear layout or a new Auto layout
+    started from those.  The case holds the water as imported (``[lake]``)."""
+    from app.lake import default_cell_size, water
+    from tests.app.test_modeller import _metres_lake
+
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 873311))
+    lake = win.doc.project.lake
+    assert lake.holes
+    win.lake_panel.cell_size.setValue(default_cell_size(water(lake.outline, lake.holes)[0].area, 500))
+    win.lake_panel.cell_size.editingFinished.emit()
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None or bool(win.lake_ctl.last_error))
+    wait_idle(qtbot, win)
+    lake, lay = win.doc.project.lake, win.doc.project.layout
+    assert lay is not None and len(lay.blocks) > 1 and len(win.doc.grids) == len(lay.blocks)
+    before = {k: (g.x.copy(), g.y.copy()) for k, g in win.doc.grids.items()}
+    path = tmp_path / "lake.toml"
+    assert win.io.save_to(path)
+    assert win.io.open_path(path)
+    back = win.doc.project.lake
+    np.testing.assert_array_equal(back.outline, lake.outline)
+    assert len(back.holes) == len(lake.holes)
+    for a, b in zip(back.holes, lake.holes, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert back.cell_size == lake.cell_size
+    got = win.doc.project.layout
+    assert [(b.name, b.cells, b.corners) for b in got.blocks] == [(b.name, b.cells, b.corners) for b in lay.blocks]
+    win.generate()
+    wait_idle(qtbot, win)
+    assert sorted(win.doc.grids) == sorted(before)
+    for k, (x, y) in before.items():
+        np.testing.assert_allclose(win.doc.grids[k].x, x, rtol=0, atol=1e-9 * np.ptp(x))
+        np.testing.assert_allclose(win.doc.grids[k].y, y, rtol=0, atol=1e-9 * np.ptp(y))
+    # Clear layout: the one block of the shore as imported
+    win.a_clear_layout.trigger()
+    assert win.doc.project.layout is None
+    np.testing.assert_array_equal(win.doc.block.points, lake.outline)
+
+
+def test_a_lake_saved_before_auto_layout_keeps_its_islands_and_settings(qtbot, win, tmp_path):
+    """Import a lake with islands, set the cell size and "regular", save, reopen: the case held the
+    one block only, and the project came back without islands, cell size or the lake itself."""
+    from tests.app.test_modeller import _metres_lake
+
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 873377))
+    win.lake_ctl.set_cell_size(250.0)
+    win.lake_ctl.set_regular(True)
+    lake = win.doc.project.lake
+    assert lake.holes and lake.layout is None and len(win.doc.project.blocks) == 1
+    path = tmp_path / "lake.toml"
+    assert win.io.save_to(path)
+    assert win.io.open_path(path)
+    back = win.doc.project.lake
+    assert back is not None and back.layout is None
+    np.testing.assert_array_equal(back.outline, lake.outline)
+    assert len(back.holes) == len(lake.holes)
+    for a, b in zip(back.holes, lake.holes, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert (back.cell_size, back.regular, back.single) == (250.0, True, False)
+    np.testing.assert_array_equal(win.doc.block.points, win.doc.project.blocks[0].points)
+    assert len(win.doc.project.blocks) == 1

@@ -168,6 +168,31 @@ def test_layout_case_text_round_trip_and_the_same_grid(y_layout):
         np.testing.assert_allclose(a.y, b.y, rtol=0, atol=1e-9)
 
 
+def test_the_lake_table_round_trips_and_generate_ignores_it(y_layout):
+    """``[lake]``: the water the case was made from as imported (the app's shore and islands) and
+    its layout settings, written exactly and read back; the grid is that of the layout alone."""
+    from meshcore.case import LakeSection
+
+    shore = np.asarray(testing.y_junction().exterior.coords)[:-1]
+    plain = generate_case(loads_case(dumps_case(layout_case(y_layout))))
+    lake = LakeSection(shore=shore, islands=(ISLAND,), cell_size=0.25, regular=True)
+    case = layout_case(y_layout).replaced(lake=lake)
+    back = loads_case(dumps_case(case))
+    assert back.lake == lake and back.lake.cell_size == 0.25 and back.lake.regular and not back.lake.single
+    np.testing.assert_array_equal(back.lake.shore, shore)
+    mb = generate_case(back)
+    for a, b in zip(mb.grids, plain.grids, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.y, b.y)
+    text = dumps_case(case)
+    with pytest.raises(CaseFileError, match=r"\[lake\].*islands\[0\]"):
+        loads_case(text.replace("islands = [", "islands = [[[1, 2]], ", 1))
+    with pytest.raises(CaseFileError, match=r"\[lake\].*cell_size"):
+        loads_case(text.replace("cell_size = 0.25", "cell_size = -1.0", 1))
+    with pytest.raises(CaseFileError, match=r"\[lake\].*colour"):
+        loads_case(text.replace("[lake]\n", "[lake]\ncolour = 1\n", 1))
+
+
 def test_an_edited_case_generates_again(y_layout):
     case = layout_case(y_layout)
     text = dumps_case(case)
