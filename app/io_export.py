@@ -177,10 +177,49 @@ class ExportMixin:
         if not self.quiet:
             b = QtWidgets.QMessageBox.StandardButton
             what = "a layout for one index space" if single else "a regular layout"
-            r = QtWidgets.QMessageBox.question(self._parent(), title, f"{text}.\n\nMake {what} now?", b.Yes | b.No)
+            ask = f"{text}.\n\nMake {what} now? {name} is written when its grid is done."
+            r = QtWidgets.QMessageBox.question(self._parent(), title, ask, b.Yes | b.No)
             if r == b.Yes:
-                self.win.lake_ctl.auto_layout(**({"single": True} if single else {"regular": True}))
+                self._export_when_done(path, format)
+                if not self.win.lake_ctl.auto_layout(**({"single": True} if single else {"regular": True})):
+                    self._pending_export = None
         return True
+
+    # ------------------------------------------- the export after a new layout
+    _pending_export: tuple | None = None  # (path, format, phase): the export waiting for a layout's grid
+
+    def _export_when_done(self, path: Path, format: str | None) -> None:
+        """Write ``path`` when the layout just asked for is made and gridded (the user said Yes to
+        "Make a regular layout now?"; was: the layout and its grid, then File ▸ Export again, the
+        file name typed again).  A layout refused, or a grid stopped or failed: nothing written, said."""
+        if self._pending_export is None and not getattr(self, "_export_hooked", False):
+            self._export_hooked = True
+            self.win.lake_ctl.layout_done.connect(self._pending_layout_done)
+            self.win.solver.finished.connect(self._pending_grid_done)
+        self._pending_export = (Path(path), format, "layout")
+
+    def _pending_layout_done(self, layout) -> None:
+        if self._pending_export is None or self._pending_export[2] != "layout":
+            return
+        path, format, _ = self._pending_export
+        if layout is None:  # the layout's own error is in the messages
+            self._pending_export = None
+            self.win.message(f"{path.name} not written: no new layout", error=True)
+            return
+        self._pending_export = (path, format, "grid")
+
+    def _pending_grid_done(self, result) -> None:
+        if self._pending_export is None or self._pending_export[2] != "grid":
+            return
+        if result is None and self.win.solver.running:  # a solve stopped before this one started
+            return
+        path, format, _ = self._pending_export
+        self._pending_export = None
+        if result is None or self.doc.stale or self.doc.multiblock is None:
+            why = "the grid was not finished — export again when it is"
+            self.win.message(f"{path.name} not written: {why}", error=True)
+            return
+        self.export_mesh(path, format)
 
     def figure_dialog(self) -> None:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(
