@@ -181,6 +181,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         elif name in ("undo", "redo"):
             make = self.stack.createUndoAction if name == "undo" else self.stack.createRedoAction
             a = make(self, spec.text)
+            a.triggered.connect(lambda _c=False, n=name: self._say_undone(n))
         elif name == "recent":
             self.recent_menu = self.io.recent_menu = menu.addMenu(spec.text)
             return None
@@ -194,6 +195,14 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             raise KeyError(f"no placeholder {name!r} in the window")
         menu.addAction(a)
         return a
+
+    def _say_undone(self, name: str) -> None:
+        """The status line says what Ctrl+Z (or Ctrl+Y) just did: it went on showing the message of
+        before (an undone Auto layout of 85 blocks under "Exported 85 block(s) to …")."""
+        text = self.stack.redoText() if name == "undo" else self.stack.undoText()
+        if text:
+            again = "Ctrl+Y redoes it" if name == "undo" else "Ctrl+Z undoes it"
+            self.message(f"{'Undone' if name == 'undo' else 'Redone'}: {text} ({again})")
 
     def _examples_menu(self, m: QtWidgets.QMenu) -> None:
         m.addSection("Paper cases")

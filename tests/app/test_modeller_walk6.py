@@ -48,3 +48,16 @@ def test_a_ddb_refused_is_written_once_the_regular_layout_asked_for_is_gridded(q
     assert sum(g.cells[0] * g.cells[1] for g in back.blocks) == lay.n_cells
     assert win._status.text().startswith("Exported")
 
+
+def test_undo_and_redo_say_what_they_did(qtbot, win, tmp_path):
+    """Ctrl+Z after Auto layout took the layout back and the status line kept the message of before
+    (here "Exported … .vtm"): what was undone showed only in the Undo history dock."""
+    lay_out(qtbot, win, _y_lake(tmp_path), cell_size=100.0)
+    assert win.io.export_mesh(tmp_path / "y.vtm")
+    win.a_undo.trigger()
+    assert win.doc.project.layout is None
+    assert win._status.text() == "Undone: Auto layout (Ctrl+Y redoes it)"
+    win.a_redo.trigger()
+    assert win.doc.project.layout is not None
+    assert win._status.text() == "Redone: Auto layout (Ctrl+Z undoes it)"
+    wait_idle(qtbot, win)
