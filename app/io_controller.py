@@ -306,8 +306,8 @@ class IOController(ExportMixin, QtCore.QObject):
             )
         elif offered:
             self.win.message(
-                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; Lake ▸ Auto layout (Ctrl+L) "
-                f"lays the lake out in blocks for a model grid; F5 now grids it as one block (automatic corners)"
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; Auto layout (Ctrl+L) lays "
+                f"it out in blocks for a model grid (F5 alone: one block, automatic corners)"
             )
         else:
             self.win.message(
