@@ -310,7 +310,9 @@ def run(args: argparse.Namespace) -> int:
     lay, mb = made
     if args.case:  # the layout in its local frame (the case's [crs] table holds the origin)
         from ..case import layout_case, save_case
+        from .mesh_steps import lake_table
 
-        save_case(layout_case(lay, crs=frame, description=f"made by meshcore mesh from {args.outline}"), args.case)
+        case = layout_case(lay, crs=frame, description=f"made by meshcore mesh from {args.outline}")
+        save_case(case.replaced(lake=lake_table(args, poly, h, regular)), args.case)
         say(f"wrote {args.case} (the layout: edit it and run 'meshcore generate {args.case}')")
     return finish(args, mb, poly, frame, h, outputs, say, t_start)

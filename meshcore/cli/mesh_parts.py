@@ -212,11 +212,13 @@ def run_parts(args: Any, water: WaterParts, frame: Any, say: Any, outputs: list,
     lays, mb = made
     if args.case:  # one case per part: a case holds one lake
         from ..case import layout_case, save_case
+        from .mesh_steps import lake_table
 
-        for (k, _), lay in zip(kept, lays, strict=True):
+        for (k, part), lay in zip(kept, lays, strict=True):
             path = Path(args.case).with_name(f"{Path(args.case).stem}_part{k}.toml")
             what = f"made by meshcore mesh from part {k} ({water.names[k - 1]!r}) of {args.outline}"
-            save_case(layout_case(lay, crs=frame, description=what), path)
+            case = layout_case(lay, crs=frame, description=what).replaced(lake=lake_table(args, part, h, regular))
+            save_case(case, path)
             say(f"wrote {path} (part {k}'s layout: edit it and run 'meshcore generate {path}')")
     poly = shapely.MultiPolygon([p for _, p in kept]) if len(kept) > 1 else kept[0][1]
     out = [p for k, p in enumerate(water.polygons, 1) if k not in dict(kept) and (not asked or k in asked)]

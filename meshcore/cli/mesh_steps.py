@@ -70,6 +70,24 @@ def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
     return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
 
 
+def lake_table(args: argparse.Namespace, poly: Any, h: float, regular: bool) -> Any:
+    """The ``[lake]`` table of a ``--case`` file (:class:`meshcore.case.LakeSection`): the water the
+    layout was made of (shore, islands: the case's own shore carries every vertex its blocks put on
+    it) and the settings, so the app reopens the lake as read and lays it out again alike.  The cell
+    size is kept when given (``--cell-size`` or ``--cells``), else "automatic"."""
+    import numpy as np
+
+    from ..case import LakeSection
+
+    return LakeSection(
+        shore=np.asarray(poly.exterior.coords)[:-1],
+        islands=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        cell_size=None if args.cell_size is None and not args.cells else float(h),
+        regular=bool(regular),
+        single=bool(getattr(args, "single_space", False)),
+    )
+
+
 def _cell_size(args: argparse.Namespace, poly: Any, unit: str) -> tuple[float, str]:
     """The cell size and how it was chosen; refused when the grid would pass the node limit."""
     from .._validation import max_nodes

@@ -630,6 +630,10 @@ def test_case_file_of_the_layout_generates_the_same_grid_and_can_be_edited(tmp_p
     assert run.rc == 0, run.err
     case = load_case(tmp_path / "lay.toml")
     assert case.settings.mode == "orthogonal" and len(case.outline.holes) == 1  # the island
+    # the water as read, for the app ([lake]): the shore of the file, not the layout's (every block vertex)
+    shore, _island = _synthetic_rings()
+    assert len(case.lake.shore) == len(shore) < len(case.outline.points) and len(case.lake.islands) == 1
+    assert case.lake.cell_size is not None and not case.lake.regular  # --cells 400
     o, e = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
         rc = main(["generate", str(tmp_path / "lay.toml"), "-o", str(tmp_path / "g.npz")])
