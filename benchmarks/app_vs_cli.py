@@ -53,7 +53,9 @@ def _cli_lake_layout(path: Path):
 
     from meshcore.cli import mesh
 
-    ns = argparse.Namespace(outline=str(path), crs="auto", source_crs=None, columns=None, cell_size=None, cells=None)
+    parser = argparse.ArgumentParser()
+    mesh.add_args(parser)  # every option at its default, as the command line gives them
+    ns = parser.parse_args([str(path)])
     say = mesh._Say(quiet=True)
     poly, _frame = mesh._read(ns, say)
     h, _ = mesh._cell_size(ns, poly, "")
