@@ -97,6 +97,7 @@ def run_one(expr: str, cells: int, options: dict | None = None) -> dict:
         "places": kinds,
         "folded": s["folded_cells"],
         "within3": s["pct_nodes_within_3deg"],
+        "cos02": s["pct_nodes_cos_le_0.02"],
         "mean_dev": s["mean_deviation_deg"],
         "pairs12": s["pct_smoothness_le_1.2"],
         "shore": s["hausdorff_cells"],

@@ -46,6 +46,7 @@ from .outline import interior_cuts
 from .polygon import MIN_ISLAND_CELLS, water_polygon, without_dense_vertices, without_slivers
 from .shore import shore_at_scale, transfer, without_narrow_arms
 from .tipends import counted_without_tip_fans
+from .tipsplit import counted_with_tip_splits
 from .widen import widen_starved
 
 #: No layout option on (:class:`LayoutOptions`).
@@ -241,8 +242,10 @@ def _layout(
             poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, tees=tees, single=single
         )
     pieces = moved
-    if regular or not tipends.SLIDE:
+    if regular:
         cells = block_counts(pieces, h, multiple=multiple, closed=single)
+    elif not tipends.SLIDE:  # (with tipsplit.SPLIT: a block side crowding a short piece of shore, split there)
+        pieces, cells = counted_with_tip_splits(pieces, h, multiple=multiple)
     else:  # (with tipends.SLIDE: a block side crowding its cells into an island's tip, a cut's end slid onto it)
         pieces, cells = counted_without_tip_fans(pieces, h, hl, multiple=multiple)
 

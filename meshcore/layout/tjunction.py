@@ -53,8 +53,10 @@ def _at_fraction(line: np.ndarray, f: float):
     return k, t, line[k] + t * (line[k + 1] - line[k])
 
 
-def _split(pc: Piece, v: int):
-    """Split ``pc`` by a straight cut from its vertex ``v`` across to the opposite side."""
+def _split(pc: Piece, v: int, wide: float = 0.0):
+    """Split ``pc`` by a straight cut from its vertex ``v`` across to the opposite side (at the
+    same fraction of it; ``wide``: the cut's far end at least this far along the opposite side
+    from its corner nearer ``v``, where that side is long enough: a strip as wide at both ends)."""
     from shapely.geometry import LineString, Polygon
 
     r, c = pc.ring, list(pc.corners)
@@ -65,7 +67,12 @@ def _split(pc: Piece, v: int):
     f = s_this[(v - c[side]) % n] / s_this[-1]
     opp_a, opp_b = c[(side + 2) % 4], c[(side + 3) % 4]
     opp = _arc(r, opp_a, opp_b)  # runs the other way: fraction 1 − f
-    k, t, q = _at_fraction(opp, 1.0 - f)
+    u = 1.0 - f
+    if wide > 0.0:
+        L_opp = float(np.hypot(*np.diff(opp, axis=0).T).sum())
+        if 2.0 * wide < L_opp:  # the fraction from the nearer corner, at least wide / L_opp
+            u = max(u, wide / L_opp) if f >= 0.5 else min(u, 1.0 - wide / L_opp)
+    k, t, q = _at_fraction(opp, u)
     poly = Polygon(r)
     room = poly.buffer(1e-9 * math.sqrt(poly.area))
     cut = np.array([r[v], q])
