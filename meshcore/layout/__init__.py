@@ -118,7 +118,8 @@ def auto_layout(
     h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
     poly, dense = without_dense_vertices(poly, h)
     poly, more = water_polygon(poly, drop_islands_below=MIN_ISLAND_CELLS * h)
-    poly, gaps = without_island_gaps(poly, h)  # islands too close for a block between them: joined
+    # islands too close for a block between them: joined (unless asked not to)
+    poly, gaps = (poly, []) if options.islands_apart else without_island_gaps(poly, h)
     more = dense + more + gaps
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
