@@ -41,6 +41,7 @@ from .build import layout_pieces
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
+from .islandgaps import without_island_gaps
 from .model import Layout, LayoutBlock, LayoutOptions
 from .outline import interior_cuts
 from .polygon import MIN_ISLAND_CELLS, water_polygon, without_dense_vertices, without_slivers
@@ -118,7 +119,9 @@ def auto_layout(
     h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
     poly, dense = without_dense_vertices(poly, h)
     poly, more = water_polygon(poly, drop_islands_below=MIN_ISLAND_CELLS * h)
-    more = dense + more
+    # islands too close for a block between them: joined (unless asked not to)
+    poly, gaps = (poly, []) if options.islands_apart else without_island_gaps(poly, h)
+    more = dense + more + gaps
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
     more = more + slivers + arms

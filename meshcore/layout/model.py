@@ -36,6 +36,10 @@ class LayoutOptions:
         between two of its reflex corners, a stem from a third reflex corner or the opposite shore
         meeting it at right angles), kept where its pieces, split on, cost less than the greedy
         split's.
+    islands_apart
+        Islands less than three cells apart stay apart (by default they are joined into one, the
+        water between given up with a note: :mod:`.islandgaps`); the layout then cuts blocks a
+        cell or two across between them.
     """
 
     thin_arms: bool = False
@@ -43,9 +47,14 @@ class LayoutOptions:
     curve: bool = False
     wedges: bool = False
     tees: bool = False
+    islands_apart: bool = False
 
     def __str__(self) -> str:
-        on = [f.replace("_", " ") for f in ("thin_arms", "mouths", "curve", "wedges", "tees") if getattr(self, f)]
+        on = [
+            f.replace("_", " ")
+            for f in ("thin_arms", "mouths", "curve", "wedges", "tees", "islands_apart")
+            if getattr(self, f)
+        ]
         return ", ".join(on) or "defaults"
 
 

@@ -27,7 +27,11 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   line can follow a spike without folding a cell, an arm gets cells hundreds of
   times longer than wide), so ``hausdorff`` leaves the shore points on them out
   (the arms by the layout's rule: pass its cell size); the table shows both
-  where they differ;
+  where they differ.  Islands the layout joins, closer than
+  :data:`~meshcore.layout.islandgaps.GAP_CELLS` cells to each other or
+  :data:`~meshcore.layout.islandgaps.SHORE_GAP_CELLS` to the shore
+  (:func:`meshcore.layout.islandgaps.without_island_gaps`, with a note naming the
+  water given up), are measured the same way: by the rim of the joined land;
 * ``island_cells`` — cells whose centre lies on land: inside an island the
   grid goes round (a narrow end of it that a block side cut across, say), or
   beyond the outer shore (across a narrow peninsula) — per island (its number;
@@ -346,6 +350,12 @@ def coverage(
         water = found if simple is poly else _cut_off(poly, simple.difference(found), slack)
         sb = shapely.union_all(_islands(water, union, h)[1])
         sp = _boundary_points(sb, step)
+    # islands closer than the layout keeps apart, joined with a note (to each other or to the
+    # shore, :func:`meshcore.layout.islandgaps.without_island_gaps`): measured against the joined land
+    joined = _joined_islands(found if found is not simple else poly, h)
+    if joined is not None:
+        sb = shapely.union_all(_islands(joined, union, h)[1])
+        sp = _boundary_points(sb, step)
     d_grid, kg = _directed(gp, sb)
     # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
     # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart, found on the
@@ -369,6 +379,21 @@ def coverage(
         island_cells=_cells_on(poly, land, grids, h),
         hausdorff_as_given=max(d_grid_given, d_given),
     )
+
+
+def _joined_islands(water: Any, h: float) -> Any:
+    """The water with the islands the layout keeps joined as it joins them, or None when it joins none."""
+    if water.geom_type != "Polygon" or not len(water.interiors):
+        return None
+    from shapely.geometry import Polygon
+
+    from ..layout.islandgaps import without_island_gaps
+
+    wide = [
+        r for r in water.interiors if island_width(Polygon(r), 0.01 * MIN_ISLAND_CELLS * h)[0] >= MIN_ISLAND_CELLS * h
+    ]
+    out, notes = without_island_gaps(Polygon(water.exterior, wide), h)  # the islands the layout keeps
+    return out if notes else None
 
 
 def without_spikes(poly: Any, width: float) -> Any:

@@ -11,6 +11,8 @@ the automatic layout and the lake grids are tested on many shapes nobody tuned a
 * :func:`lake_with_islands` — a lobed lake with islands, some close to the shore;
 * :func:`archipelago` — a round lake with many polygonal islands a few cells across, some in
   narrow passages between each other and the shore;
+* :func:`island_clusters` — a round lake whose islands lie in clusters, gaps 0.3–5 cells
+  between them and to the shore (the skerries of Finnish and Canadian lakes);
 * :func:`small_islands` — islands from a third of a cell to five cells across, thin, bent,
   near the shore and each other;
 * :func:`spiral` — a channel wound round more than once;
@@ -40,7 +42,7 @@ import math
 import numpy as np
 
 from ._shapes import _clean, _lobed_disc, _placed
-from .archipelago import archipelago
+from .archipelago import archipelago, island_clusters
 from .narrow import narrow_arms
 from .rivers import confluence, estuary, meander, meander_bars
 
@@ -51,6 +53,7 @@ __all__ = [
     "dendritic",
     "estuary",
     "headlands",
+    "island_clusters",
     "jagged",
     "jagged_cells",
     "lake_with_islands",

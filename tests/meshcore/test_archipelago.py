@@ -61,11 +61,12 @@ def test_the_finest_level_does_not_stop_while_its_3_degree_share_rises():
     3° rose (64.2 → 68.9 %); the stall test watched the first alone and stopped there (69.6 %
     of nodes within 3°).  Watching both, it sweeps on (83 %)."""
     from meshcore.lakegrid import mesh_layout
-    from meshcore.layout import auto_layout
+    from meshcore.layout import LayoutOptions, auto_layout
     from meshcore.quality import lake_metrics
 
     poly = testing.archipelago(701003, n_islands=40)
-    lay = auto_layout(poly, target_cells=10_000, multiple=4)
+    # the layout of then: islands under three cells apart not joined (session 24 joins them)
+    lay = auto_layout(poly, target_cells=10_000, multiple=4, options=LayoutOptions(islands_apart=True))
 
     def within3(**options):
         mb = mesh_layout(lay, levels=2, **options)
