@@ -33,7 +33,8 @@ STAGES = (
     ("layout: skeleton", "meshcore.layout.build", "skeleton"),
     ("layout: splits (best_split)", "meshcore.layout.build", "best_split"),
     ("layout: pieces (skeleton, chords, regions, splits, corners)", "meshcore.layout", "layout_pieces"),
-    ("layout: cell counts (MILP)", "meshcore.layout", "block_counts"),
+    ("layout: cell counts (MILP)", "meshcore.layout", "block_counts"),  # regular layouts
+    ("layout: cell counts (MILP)", "meshcore.layout.tipsplit", "block_counts"),  # the others
     ("layout: case check (topology)", "meshcore.layout", "_check_case"),
     ("layout, all", "meshcore.layout", "auto_layout"),
     ("coarse topologies", "meshcore.orthogonal.levels", "coarsen_topology"),
