@@ -18,7 +18,12 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gcmesh", description="gcmesh: structured boundary-fitted grids")
     p.add_argument("file", nargs="?", help="a project (.toml case file) or a boundary point file")
     p.add_argument("--example", metavar="NAME", help="open a bundled example (see the Examples menu)")
-    p.add_argument("--solve", action="store_true", help="generate the grid after opening")
+    p.add_argument(
+        "--solve",
+        action="store_true",
+        help="generate the grid after opening (a lake outline is laid out first; lon/lat degrees are "
+        "projected without asking)",
+    )
     p.add_argument(
         "--quality",
         metavar="METRIC",
@@ -132,7 +137,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.example:
         opened = win.io.open_example(args.example, confirm=False)
     elif args.file:
-        opened = win.io.open_path(Path(args.file))
+        # --solve asks for a grid: lon/lat degrees are projected as the question's default would (no dialog)
+        opened = win.io.open_path(Path(args.file), project_lonlat=True if args.solve else None)
     if not opened and (args.solve or args.screenshot):
         return 2
     # opened by hand (a double-clicked file): the window stays, the error in its message panel

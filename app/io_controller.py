@@ -122,11 +122,12 @@ class IOController(ExportMixin, QtCore.QObject):
         if path:
             self.open_path(path)
 
-    def open_path(self, path) -> bool:
-        """Open a case file, or import a point file (by suffix)."""
+    def open_path(self, path, *, project_lonlat: bool | None = None) -> bool:
+        """Open a case file, or import a point file (by suffix; ``project_lonlat`` as for
+        :meth:`import_points`: None asks whether to project lon/lat degrees)."""
         path = Path(path)
         if path.suffix.lower() != ".toml":
-            return self.import_points(path)
+            return self.import_points(path, project_lonlat=project_lonlat)
         try:
             project = fio.load_project(path)
         except (MeshcoreError, OSError) as exc:

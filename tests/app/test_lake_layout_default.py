@@ -54,6 +54,26 @@ def test_a_compact_lake_gets_auto_layout_offered_and_solve_lays_it_out(qtbot, wi
     np.testing.assert_array_equal(win.doc.block.points, win.doc.project.lake.outline)
 
 
+def test_opened_for_solve_a_lonlat_lake_is_projected_without_a_question(qtbot, win, tmp_path, monkeypatch):
+    """``python -m app LAKE --solve`` stopped at "Project them to metres?" (the run waited for a
+    click); opened for a solve the degrees are projected as that question's default does."""
+    from app import io_adapter as fio
+    from tests.app.waits import answer_questions
+
+    win.quiet = False  # as a user's window: questions are asked (answered here without a dialog)
+    asked = answer_questions(monkeypatch, "No")
+    path = _lonlat_lake(tmp_path / "lake.geojson", 864214)
+    assert win.io.open_path(path, project_lonlat=True)
+    assert asked == []
+    pts = win.doc.project.lake.outline
+    assert np.ptp(pts[:, 0]) > 1000.0  # metres across a lake a few km wide, not degrees
+    frame = fio.project_frame(win.doc.project)
+    assert frame is not None and str(frame.crs).startswith("EPSG:326")
+    # opened by hand (no --solve) the user is still asked
+    win.io.set_project(type(win.doc.project)())
+    assert win.io.open_path(path) and len(asked) == 1 and "metres" in asked[0]
+
+
 def test_a_point_file_of_plain_numbers_stays_one_block(qtbot, win, tmp_path):
     """A compact shape in plain numbers without a CRS (a duct, an airfoil's box) is no lake on the
     map: no offer, and ``--solve`` grids the one block with automatic corners, as before."""
