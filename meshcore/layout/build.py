@@ -228,7 +228,6 @@ def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float
 
     raw = _raw_turning(r)
     n = len(r)
-
     corners = {int(i) for i in c}
 
     def straight(i: int) -> bool:  # straight for STRAIGHT cells either side, or up to the next corner
@@ -242,7 +241,8 @@ def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float
                     break
         return True
 
-    flat = [i for i in c if i not in set(forced) and straight(i)]
+    held = {int(f) for f in forced}
+    flat = [i for i in c if i not in held and straight(i)]
     if len(flat) != 1 or on_shore.all() or not on_shore.any():
         return tuple(c)
     start = int(np.flatnonzero(on_shore)[0])

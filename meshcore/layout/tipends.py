@@ -91,9 +91,12 @@ def counted_without_tip_fans(pieces: list[Piece], h: float, hl: float, *, multip
         return pieces, cells
 
 
-def _jumps(pieces: list[Piece], h: float, multiple: int):
-    """The cells of every piece and the points where a block side's cells jump by :data:`TIP_JUMP`
-    or more between a cut and a piece of shore (point keys)."""
+def cut_beside_shore(pieces: list[Piece], h: float, multiple: int):
+    """The cells of every piece and, for every place where a block side passes from a cut to a
+    piece of shore (consecutive chains of the side, one shared, one not), ``(piece, cut, shore)``:
+    each chain as ``(length, spacing of its cells, meeting point keys)`` (the side's counts as
+    :func:`~.blocks.block_counts` gives them).  Shared by :func:`_jumps` and
+    :func:`.tipsplit.crowded`."""
     from ..pointindex import point_key
     from .blocks import BORDERS, _chains_of, _counts, _line_work
 
@@ -104,20 +107,33 @@ def _jumps(pieces: list[Piece], h: float, multiple: int):
     index = {k: i for i, k in enumerate(keys)}
     length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
     spacing = length / np.maximum(np.asarray(counts, dtype=float), 1.0)
-    crowded: set = set()
 
     def ends(c: int) -> set:
         p = chain_pts[keys[c]]
         return {point_key(p[0]), point_key(p[-1])}
 
+    places = []
     for pi in range(len(pieces)):
         for side in BORDERS:
             chain = [index[k] for k in sides[(pi, side)]]
             for c1, c2 in itertools.pairwise(chain):
-                if (len(users[keys[c1]]) == 1) == (len(users[keys[c2]]) == 1):
+                shore1, shore2 = len(users[keys[c1]]) == 1, len(users[keys[c2]]) == 1
+                if shore1 == shore2:
                     continue  # not a cut beside a piece of shore
-                if max(spacing[c1] / spacing[c2], spacing[c2] / spacing[c1]) >= TIP_JUMP:
-                    crowded |= ends(c1) & ends(c2)  # the point where they meet
+                cut, shore = (c2, c1) if shore1 else (c1, c2)
+                at = ends(c1) & ends(c2)  # the point where they meet
+                places.append((pi, (length[cut], spacing[cut], at), (length[shore], spacing[shore], at)))
+    return cells, places
+
+
+def _jumps(pieces: list[Piece], h: float, multiple: int):
+    """The cells of every piece and the points where a block side's cells jump by :data:`TIP_JUMP`
+    or more between a cut and a piece of shore (point keys)."""
+    cells, places = cut_beside_shore(pieces, h, multiple)
+    crowded: set = set()
+    for _pi, (_, s_cut, at), (_, s_shore, _) in places:
+        if max(s_cut / s_shore, s_shore / s_cut) >= TIP_JUMP:
+            crowded |= at
     return cells, crowded
 
 

@@ -22,11 +22,9 @@ OFF by default (:data:`SPLIT`; journal *Blocks split at crowded tips*).
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
-from .blocks import BORDERS, Piece, _chains_of, _counts, _line_work, block_counts, conform
+from .blocks import Piece, _chains_of, block_counts, conform
 from .corners import _raw_turning
 
 __all__ = ["counted_with_tip_splits"]
@@ -65,33 +63,22 @@ def crowded(pieces: list[Piece], h: float, multiple: int):
     place where a block side passes a cut's end onto a piece of shore that its counts crowd
     (largest jump first)."""
     from ..pointindex import point_key
+    from .tipends import cut_beside_shore
 
-    work = _line_work(pieces)
-    cells, counts = _counts(work, pieces, h, 3, multiple, None, True)
-    sides, chain_pts, users = _chains_of(pieces, work)
-    keys = list(chain_pts)
-    index = {k: i for i, k in enumerate(keys)}
-    length = np.array([float(np.hypot(*np.diff(chain_pts[k], axis=0).T).sum()) for k in keys])
-    spacing = length / np.maximum(np.asarray(counts, dtype=float), 1.0)
+    cells, places = cut_beside_shore(pieces, h, multiple)
     least = MIN_SHARE * max(3, multiple)
     out = []
-    for pi, pc in enumerate(pieces):
-        pos = {point_key(p): i for i, p in enumerate(pc.ring)}
-        for side in BORDERS:
-            chain = [index[k] for k in sides[(pi, side)]]
-            for c1, c2 in itertools.pairwise(chain):
-                shore1, shore2 = len(users[keys[c1]]) == 1, len(users[keys[c2]]) == 1
-                if shore1 == shore2:
-                    continue  # not a cut beside a piece of shore
-                cut, shore = (c2, c1) if shore1 else (c1, c2)
-                if not least * h <= length[shore] <= MAX_PIECE * h or length[cut] <= length[shore]:
-                    continue
-                jump = spacing[cut] / spacing[shore]
-                if jump < TIP_JUMP:
-                    continue
-                p1, p2 = chain_pts[keys[c1]], chain_pts[keys[c2]]
-                at = {point_key(p1[0]), point_key(p1[-1])} & {point_key(p2[0]), point_key(p2[-1])}
-                out += [(float(jump), pi, pos[k], float(length[shore])) for k in at if k in pos]
+    pos_of: dict[int, dict] = {}
+    for pi, (l_cut, s_cut, at), (l_shore, s_shore, _) in places:
+        if not least * h <= l_shore <= MAX_PIECE * h or l_cut <= l_shore:
+            continue
+        jump = s_cut / s_shore
+        if jump < TIP_JUMP:
+            continue
+        if pi not in pos_of:
+            pos_of[pi] = {point_key(p): i for i, p in enumerate(pieces[pi].ring)}
+        pos = pos_of[pi]
+        out += [(float(jump), pi, pos[k], float(l_shore)) for k in at if k in pos]
     out.sort(key=lambda t: -t[0])
     return cells, out
 

@@ -17,7 +17,7 @@ from shapely.geometry import Polygon
 
 from meshcore import testing
 from meshcore.layout import auto_layout, tipsplit
-from tests.meshcore.test_layout_tips import JUMP, _worst_tip_jump
+from tests.meshcore.test_layout_tips import JUMP, _worst_tip_jump, assert_tiles_the_water
 
 #: Generated lakes whose layouts (without the split) had a block side with its border edges at
 #: an island's tip 17.6×, 15.3×, 9.6× and 20.0× apart.
@@ -50,13 +50,7 @@ def test_no_side_left_crowded_where_a_split_can_be_made(layout):
 
 
 def test_the_blocks_still_tile_the_water(layout):
-    total = 0.0
-    for pc in layout.pieces:
-        P = Polygon(pc.ring)
-        assert P.is_valid and P.exterior.is_ccw
-        assert len(set(pc.corners)) == 4
-        total += P.area
-    assert total == pytest.approx(layout.polygon.area, rel=1e-9)
+    assert_tiles_the_water(layout)
     assert len({pc.name for pc in layout.pieces}) == len(layout.pieces)
 
 
