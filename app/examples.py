@@ -1,8 +1,8 @@
 """The Examples menu: the paper's cases (``resources/examples/*.toml``) and real lakes.
 
-Lakes (``app/resources/*.csv``, lon/lat) are projected to UTM metres, given
-corners and cell counts by :func:`app.project.block_from_points` (the choice
-of ``meshcore import``).
+Lakes (``app/resources/*.csv``, lon/lat) open as a lake file does (File ▸ Import): projected to
+UTM metres, with the lake's shore kept for Auto layout, which is offered (``--solve`` takes it);
+:func:`lake_file` names the file, the app's import reads it.
 """
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from .io_adapter import load_project, read_points, to_local
-from .project import Project, block_from_points
+from .io_adapter import load_project
+from .project import Project
 
-__all__ = ["EXAMPLE_DIRS", "LAKES", "example_names", "load_example"]
+__all__ = ["EXAMPLE_DIRS", "LAKES", "example_names", "lake_file", "load_example"]
 
 _HERE = Path(__file__).resolve().parent
 EXAMPLE_DIRS = (
@@ -42,24 +42,14 @@ def example_names() -> list[str]:
     return [*_case_files(), *[k for k, (f, _t) in LAKES.items() if (_HERE / "resources" / f).exists()]]
 
 
-def lake_project(csv_path: Path, title: str = "", cells: int = 48) -> Project:
-    """A lake: projected shoreline, auto corners, cells by shape."""
-    pd = read_points(csv_path)
-    if pd.lonlat:
-        pts, frame = to_local(pd)
-        crs, origin, src = frame.crs or "", frame.origin, frame.source_crs or ""
-    else:
-        pts, crs, origin, src = pd.points, "", (0.0, 0.0), ""
-    block = block_from_points(pts, csv_path.stem, total=cells, minimum=12)  # a dozen cells across narrow lakes
-    return Project(blocks=(block,), crs=crs, origin=origin, source_crs=src, title=title)
+def lake_file(name: str) -> Path | None:
+    """The outline file of lake example ``name`` (None for the paper's cases)."""
+    return _HERE / "resources" / LAKES[name][0] if name in LAKES else None
 
 
-def load_example(name: str) -> tuple[Project, Path | None]:
-    """The project of example ``name`` and its case file (None for lakes)."""
+def load_example(name: str) -> tuple[Project, Path]:
+    """The project of case example ``name`` and its case file (lakes: :func:`lake_file`)."""
     cases = _case_files()
     if name in cases:
         return load_project(cases[name]), cases[name]
-    if name in LAKES:
-        f, title = LAKES[name]
-        return lake_project(_HERE / "resources" / f, title), None
     raise KeyError(f"unknown example {name!r}; known: {', '.join(example_names())}")

@@ -24,7 +24,7 @@ from meshcore import MeshcoreError
 
 from . import io_adapter as fio
 from . import recovery
-from .examples import load_example
+from .examples import LAKES, lake_file, load_example
 from .io_export import ExportMixin, export_default
 from .lake import Lake, looks_branched, read_lake, read_lake_parts, water
 from .project import Block, Project, block_from_points
@@ -140,8 +140,18 @@ class IOController(ExportMixin, QtCore.QObject):
         return True
 
     def open_example(self, name: str, *, confirm: bool = True) -> bool:
+        """Open a bundled example; a lake opens as its file imported (Auto layout offered), its
+        import not an undo step (the example is where the history starts)."""
         if confirm and not self.maybe_save():
             return False
+        lake = lake_file(name)
+        if lake is not None:  # it opened as one block with automatic corners, ~20° off orthogonal
+            self.set_project(Project(), None)
+            if not self.import_points(lake, project_lonlat=True, recent=False, title=LAKES[name][1]):
+                return False
+            self.stack.clear()
+            self.stack.setClean()
+            return True
         try:
             project, _path = load_example(name)
         except (MeshcoreError, OSError, KeyError) as exc:
@@ -200,7 +210,14 @@ class IOController(ExportMixin, QtCore.QObject):
             self.import_points(Path(path))
 
     def import_points(
-        self, path: Path, *, project_lonlat: bool | None = None, part: int | None = None, again: bool = False
+        self,
+        path: Path,
+        *,
+        project_lonlat: bool | None = None,
+        part: int | None = None,
+        again: bool = False,
+        recent: bool = True,
+        title: str | None = None,
     ) -> bool:
         """Read points as a new closed block with automatic corners (undoable).
 
@@ -211,7 +228,8 @@ class IOController(ExportMixin, QtCore.QObject):
         A lake file of several separate parts of water opens part ``part`` (1: the largest); with
         ``None`` (or a part the file no longer has) a dialog asks which
         (:class:`app.parts_dialog.PartsDialog`; quiet: the largest).  ``again``: File ▸ Open recent
-        (``part`` the one opened last time: the message says so).
+        (``part`` the one opened last time: the message says so).  ``recent``: File ▸ Open recent
+        lists it; ``title``: the project's (default: the file's name).
         """
         path = Path(path)
         try:
@@ -280,9 +298,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         stem = f"{path.stem}_part{k_part}" if n_parts > 1 else path.stem  # as meshcore mesh --case names it
         block = block_from_points(pts, stem)
-        self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=stem)
-        # File ▸ Open recent imports it again (the same part of water) and remembers its folder
-        self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)
+        self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=title or stem)
+        if recent:  # File ▸ Open recent imports it again (the same part of water) and remembers its folder
+            self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)
         projected = ""
         if frame is not None and pd.lonlat:  # where it lands: a lon, lat header over lat, lon values shows here
             lon, lat = _centroid(pd.points)

@@ -152,3 +152,31 @@ def test_a_lake_saved_before_auto_layout_keeps_its_islands_and_settings(qtbot, w
     assert (back.cell_size, back.regular, back.single) == (250.0, True, False)
     np.testing.assert_array_equal(win.doc.block.points, win.doc.project.blocks[0].points)
     assert len(win.doc.project.blocks) == 1
+
+
+@pytest.mark.parametrize("name", ["windermere"])
+def test_a_lake_example_opens_as_a_lake_and_solve_lays_it_out(qtbot, win, name):
+    """Examples ▸ a real lake opened as one block with automatic corners (no shore kept for Auto
+    layout, none offered): ``--example windermere --solve`` gave one fanned block.  It now opens as
+    its file imported: the lake kept, Auto layout offered, no undo step (the example is where the
+    history starts), nothing in File ▸ Open recent; the solve lays it out."""
+    from shapely.geometry import Polygon
+
+    from app.examples import LAKES
+
+    recent_before = win.io.recent()
+    assert win.io.open_example(name, confirm=False)
+    p = win.doc.project
+    assert p.lake is not None and len(p.blocks) == 1 and p.crs.startswith("EPSG:326")
+    assert p.title == LAKES[name][1]
+    assert win.lake_ctl.prompt is not None
+    assert win.stack.count() == 0 and win.stack.isClean()
+    assert win.io.recent() == recent_before
+    area = Polygon(p.lake.outline).area
+    win.lake_panel.cell_size.setValue(float(np.sqrt(area / 600.0)))  # ~600 cells: a quick grid
+    win.lake_panel.cell_size.editingFinished.emit()
+    assert solve_as_opened(QtWidgets.QApplication.instance(), win)
+    wait_idle(qtbot, win)
+    lay = win.doc.project.layout
+    assert lay is not None and len(lay.blocks) > 1
+    assert len(win.doc.grids) == len(lay.blocks)
