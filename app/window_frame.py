@@ -15,10 +15,13 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from .views.docks import fit_docks
 
-__all__ = ["APP_NAME", "PRESET_KEY", "VIEW_TOGGLES", "WindowFrame"]
+__all__ = ["APP_NAME", "PRESET_KEY", "REMEMBERED_TOGGLES", "VIEW_TOGGLES", "WindowFrame"]
 
 APP_NAME = "gcmesh"
 VIEW_TOGGLES = ("grid_lines", "markers")  # checkable View actions remembered between sessions
+# every checkable action remembered between sessions → its settings key (Generate ▸ Auto-generate on
+# edit too: a modeller who works with the grid following every drag had to turn it on each time)
+REMEMBERED_TOGGLES = {**{k: f"view/{k}" for k in VIEW_TOGGLES}, "auto": "generate/auto"}
 PRESET_KEY = "quality/preset"  # the lake quality preset chosen last (settings key)
 
 
@@ -54,8 +57,8 @@ class WindowFrame:
         self.io.shutdown()
         self.settings.setValue("geometry", self.saveGeometry())
         self.settings.setValue("window_state", self.saveState())
-        for key in VIEW_TOGGLES:
-            self.settings.setValue(f"view/{key}", self.actions[key].isChecked())
+        for action, key in REMEMBERED_TOGGLES.items():
+            self.settings.setValue(key, self.actions[action].isChecked())
         ev.accept()
 
     def resizeEvent(self, ev: QtGui.QResizeEvent) -> None:
@@ -86,7 +89,8 @@ class WindowFrame:
             self.move(max(x, avail.left()), max(y, avail.top()))
 
     def _restore_layout(self) -> None:
-        """Window size, dock layout, View toggles and quality preset from the last session (if any)."""
+        """Window size, dock layout, View toggles, auto-generate and quality preset from the last
+        session (if any)."""
         geom = self.settings.value("geometry")
         state = self.settings.value("window_state")
         with contextlib.suppress(TypeError):
@@ -94,10 +98,10 @@ class WindowFrame:
                 self.restoreGeometry(geom)
             if state is not None:
                 self.restoreState(state)
-        for key in VIEW_TOGGLES:
-            on = self.settings.value(f"view/{key}", None)
-            if on is not None and (str(on).lower() == "true") != self.actions[key].isChecked():
-                self.actions[key].trigger()
+        for action, key in REMEMBERED_TOGGLES.items():
+            on = self.settings.value(key, None)
+            if on is not None and (str(on).lower() == "true") != self.actions[action].isChecked():
+                self.actions[action].trigger()
         preset = self.settings.value(PRESET_KEY, None)
         box = self.lake_quality.preset
         if preset is not None and box.findText(str(preset)) >= 0:

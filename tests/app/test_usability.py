@@ -131,6 +131,28 @@ def test_the_window_fits_its_screen_and_remembers_its_size(qtbot, tmp_path):
     assert (w2.width(), w2.height()) == (700, 600)
 
 
+def test_auto_generate_is_remembered_between_sessions(qtbot, tmp_path):
+    """Generate ▸ Auto-generate on edit (the grid follows every drag) went back to off in every new
+    window: a modeller who works with it on had to find it again each session."""
+    from app.main_window import MainWindow
+
+    settings = QtCore.QSettings(str(tmp_path / "s.ini"), QtCore.QSettings.Format.IniFormat)
+    w = MainWindow(settings=settings, recovery=tmp_path / "r.toml")
+    qtbot.addWidget(w)
+    assert not w.solver.auto and not w.a_auto.isChecked()  # off the first time
+    w.a_auto.trigger()
+    assert w.solver.auto
+    w.close()
+    w2 = MainWindow(settings=settings, recovery=tmp_path / "r.toml")
+    qtbot.addWidget(w2)
+    assert w2.solver.auto and w2.a_auto.isChecked()
+    w2.a_auto.trigger()  # and off again when it was left off
+    w2.close()
+    w3 = MainWindow(settings=settings, recovery=tmp_path / "r.toml")
+    qtbot.addWidget(w3)
+    assert not w3.solver.auto and not w3.a_auto.isChecked()
+
+
 # --------------------------------------------------------------- keyboard
 def test_focus_returns_to_the_canvas_after_an_edit(qtbot, win):
     win.io.open_example("bottle-coarse", confirm=False)
