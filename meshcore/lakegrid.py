@@ -130,6 +130,7 @@ def iterate_layout(
     shore_smooth: float = 0.15,
     size_ratio: tuple[float, float] | None = (1.15, 2.0),
     hold_ends: bool = False,
+    end_ratio: float | None = None,
     slide_ends: bool = False,
     equalize: bool = True,
     spacing: bool = False,
@@ -147,6 +148,8 @@ def iterate_layout(
     :func:`~meshcore.orthogonal.iterate_orthogonalize`; None: always ``sweeps[-1]``).
     ``hold_ends``: keep the lines leaving cut ends at reflex shore corners near their angles
     (:func:`~meshcore.orthogonal.iterate_orthogonalize`; off by default, see there).
+    ``end_ratio``: cut ends on the shore where both blocks have a corner slide until their two
+    shore edges differ by this ratio (:func:`~meshcore.orthogonal.iterate_orthogonalize`; off).
     ``slide_ends``: block corners and cut ends of cells still non-convex slide along the shore
     (:func:`~meshcore.orthogonal.untangle.untangle` given the shore rings; off by default: on fresh
     generated lakes it removed the one folded cell of ``rough net`` 158200 and 263202 but gave
@@ -215,6 +218,7 @@ def iterate_layout(
             shore_smooth=shore_smooth,
             size_ratio=size_ratio,
             hold_ends=hold_ends,
+            end_ratio=end_ratio,
             stall=stall if lev == len(tops) - 1 else None,
             stall_limits=STALL_LIMITS if stall_limits is None else tuple(stall_limits),
         )

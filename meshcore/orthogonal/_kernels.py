@@ -382,6 +382,7 @@ def shore_sweep(
     bz,
     relax,
     across,
+    blo,
 ):
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours, pulled
@@ -389,8 +390,9 @@ def shore_sweep(
     ``lo`` (state ``bz`` per free node, as in :func:`_target`) — and never so far that they
     differ by more than ``lo``.  Next to a cut line's end on the shore (``across[k]``: the shore
     node beyond that end, before and after, or -1) the arc to the end also stays within ``lo`` of
-    the arc beyond it (where both limits cannot hold, halfway between them); returns the largest
-    move."""
+    the arc beyond it (where both limits cannot hold, halfway between them).  ``blo[f]`` is the
+    ratio that free node ``f`` keeps instead of ``lo`` (larger at a cut's end where both blocks
+    have a corner: its two arcs lie in two blocks); returns the largest move."""
     big = 0.0
     before = np.empty(16)
     after = np.empty(16)
@@ -416,7 +418,8 @@ def shore_sweep(
         # the node stays far enough from both neighbours that its two arcs differ by at most
         # ``lo`` (the smoothness limit): sliding to the foot of the perpendicular, shore nodes
         # next to an obtuse block corner otherwise crowd into it, each arc 1.7 times the next
-        margin = (sn - sp) * max(0.1, 1.0 / (1.0 + lo))
+        lk = blo[f]  # ``lo``, or more at a cut's end where both blocks have a corner
+        margin = (sn - sp) * max(0.1, 1.0 / (1.0 + lk))
         wa, wb = sp + margin, sn - margin
         # next to a cut line's end (``across``: the shore node beyond it), the edge to that end
         # within ``lo`` of the edge beyond it: the first cells on the two sides of the cut alike
@@ -432,7 +435,7 @@ def shore_sweep(
         # a pull to the middle keeps the spacing: a little, more where the spacing jumps
         a1, a2 = s - sp, sn - s
         if a1 > 0.0 and a2 > 0.0:
-            bz[f] += relax * (_ramp(a1, a2, lo, hi) - bz[f])
+            bz[f] += relax * (_ramp(a1, a2, lk, max(hi, 1.01 * lk)) - bz[f])
         m = mu + (1.0 - mu) * bz[f]
         sf = (1.0 - m) * sf + m * 0.5 * (sp + sn)
         # the shore between a node and its neighbours must stay within ``gap`` of the straight

@@ -132,6 +132,15 @@ def _shore_data(X, Y, m, cells, cnt, rings):
     return nodes, inner, prev, nxt, ring_of, s_of, free
 
 
+def _end_limits(cells, cell_block, cptr, bn, fidx, lo, end_ratio):
+    """Per free shore node, the ratio its two shore edges may reach: ``lo``, or ``end_ratio`` at a
+    cut's end on the shore where both blocks have a corner (its two cells in two blocks)."""
+    order = np.argsort(cells.reshape(-1), kind="stable") // 4
+    p = bn[fidx]
+    two = cell_block[order[cptr[p]]] != cell_block[order[cptr[p] + 1]]
+    return np.where(two, max(lo, end_ratio), lo).astype(np.float64)
+
+
 def _across_cut_ends(bn, bprev, bnext, free, cnt) -> np.ndarray:
     """``(len(bn), 2)``: for a free shore node next to a cut line's end on the shore (a fixed
     node with three or more cells), the shore node beyond that end (before it, after it), else -1.
@@ -301,6 +310,7 @@ def iterate_orthogonalize(
     size_ratio: tuple[float, float] | None = (1.2, 2.0),
     size_relax: float = 0.05,
     hold_ends: bool = False,
+    end_ratio: float | None = None,
     stall: float | None = None,
     stall_every: int = 20,
     stall_limits: tuple[float, ...] = STALL_LIMITS,
@@ -312,6 +322,14 @@ def iterate_orthogonalize(
 
     ``hold_ends``: keep the lines leaving cut ends at reflex shore corners near their angles
     (step 3 of the module docstring).
+
+    ``end_ratio``: a cut's end on the shore where both blocks have a corner (a shore node of two
+    cells, one in each block) may slide until its two shore edges differ by this ratio (other shore
+    nodes: ``size_ratio[0]``).  No edge pair of the smoothness metric spans such an end; held to
+    ``size_ratio[0]`` it hardly slides and the cut keeps the angle the coarse levels left it.  Off
+    (None) by default: 2 squares those cuts and raises the share of nodes with ``|cos| ≤ 0.02`` on
+    lakes of 50-100 blocks, but the first shore cells either side differ more and a lake here and
+    there loses every interface ratio ≤ 2 (``docs/lake-grids-journal.md``, session 25).
 
     ``stall``: also stop (``converged`` True) when, over ``stall_every`` sweeps, the share of
     regular nodes with ``|cos|`` at most each of ``stall_limits`` (:func:`orthogonal_share`;
@@ -342,6 +360,7 @@ def iterate_orthogonalize(
     R, S, roff = _ring_tables(rings) if rings else (np.zeros((1, 2)), np.zeros(2), np.zeros(2, dtype=np.int64))
     fidx = np.flatnonzero(free).astype(np.int64)
     across = _across_cut_ends(bn, bprev, bnext, free, cnt)
+    blo = _end_limits(cells, m.cell_block, cptr, bn, fidx, lo, lo if end_ratio is None else end_ratio)
     fans = _cut_end_fans(cells, m.cell_block, m.boundary, bn, free, cnt) if hold_ends and rings else None
     bz = np.zeros(len(fidx))
     edge = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
@@ -394,6 +413,7 @@ def iterate_orthogonalize(
             bz,
             size_relax,
             across,
+            blo,
         )
         d3 = _kernels.hold_fans(X, Y, *fans, cptr, ncells, jmin, FAN_LEAST, FAN_SLACK, lo) if fans is not None else 0.0
         d = max(d1, d2, d3) / h
