@@ -35,6 +35,16 @@ MOUTH_MAX_DEGREE = 4
 MOUTH_MAX_WIDTH = 3.5
 MOUTH_MARGIN = 0.05
 
+#: A chord end this many cells (``min_length / 2``) or less from an outline vertex where the
+#: shore turns by :data:`SNAP_TURN` degrees or more goes onto that vertex.  A ray hit a hair
+#: from a corner of a few-point outline (0.02 m down a side of a hand-drawn polygon, 2e-4 cells)
+#: left a block a side piece far shorter than a cell that turns as much as the corner: a cell
+#: edge of 6e-5 cells and a fan of four cells there.  Only a hair: ends within half a cell were
+#: moved on many generated lakes (0.01-0.5 cells from a vertex), each move reshuffled the layout
+#: downstream, and the reshuffles were mixed (``dendritic 998803``: 2 folded cells).
+SNAP = 0.01
+SNAP_TURN = 30.0
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Chord:
@@ -213,6 +223,7 @@ def place_chords(
     chords: list[Chord] = []
     room = poly.buffer(1e-9 * math.sqrt(poly.area))  # the water, a hair wider (cuts end on the shore)
     shapely.prepare(room)
+    corners = _sharp_vertices(poly, SNAP_TURN)
     for k, br in enumerate(sk.branches):
         s_all = _arclength(br.points)
         L = s_all[-1]
@@ -271,7 +282,7 @@ def place_chords(
                     picks.append((i, "passage"))
                     score[np.abs(s - s[i]) < L / 3.0] = np.inf
         for i, kind in picks:
-            chords.append(Chord(k, float(s[i]), ends[i].copy(), kind))
+            chords.append(Chord(k, float(s[i]), _snapped(ends[i], corners, room, 0.5 * SNAP * min_length), kind))
     # drop chords that cross or crowd an earlier one (junction and tip chords first).  Two
     # chords crowd each other when they come closer than a quarter of the SHORTER one: the
     # zone between them is at most as wide as that chord's channel.  (A quarter of the chord
@@ -289,6 +300,36 @@ def place_chords(
         kept.append(c)
         lines.append(ls)
     return kept
+
+
+def _sharp_vertices(poly, turn: float) -> np.ndarray:
+    """The vertices (m, 2) of ``poly``'s rings where the shore turns by ``turn`` degrees or more."""
+    out = []
+    for ring in (poly.exterior, *poly.interiors):
+        r = np.asarray(ring.coords)[:-1]
+        a, b = r - np.roll(r, 1, axis=0), np.roll(r, -1, axis=0) - r
+        t = np.degrees(np.abs(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))))
+        out.append(r[t >= turn])
+    return np.vstack(out) if out else np.empty((0, 2))
+
+
+def _snapped(ends: np.ndarray, corners: np.ndarray, room, tol: float) -> np.ndarray:
+    """The chord ``ends`` (2, 2) with each end within ``tol`` of a sharp vertex (``corners``)
+    moved onto the nearest one, when the chord stays in the water (``room``)."""
+    import shapely
+
+    out = ends.copy()
+    if not len(corners):
+        return out
+    for e in range(2):
+        d = np.hypot(*(corners - ends[e]).T)
+        j = int(np.argmin(d))
+        if 0.0 < d[j] <= tol:
+            moved = out.copy()
+            moved[e] = corners[j]
+            if shapely.covers(room, shapely.linestrings(moved)):
+                out = moved
+    return out
 
 
 def _clash(c: Chord, ls, k: Chord, o) -> bool:
