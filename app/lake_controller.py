@@ -183,6 +183,8 @@ class LakeController(QtCore.QObject):
             self.editor.set_lake(lake.replaced(layout=layout), "Auto layout")
         for note in layout.notes:  # what meshcore mesh prints as notes (the Lake panel counts them)
             self.doc.report("info", f"layout: {note}")
+        for note in layout.details:  # each island a note above sums up
+            self.doc.report("info", f"layout (detail): {note}")
         kind = " for one index space" if layout.single else ""
         self.win.message(
             f"Layout{kind}: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells at {layout.cell_size:.4g} m — "

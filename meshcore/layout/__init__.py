@@ -44,7 +44,14 @@ from .frames import frame_defects
 from .islandgaps import without_island_gaps
 from .model import Layout, LayoutBlock, LayoutOptions
 from .outline import interior_cuts
-from .polygon import MIN_ISLAND_CELLS, water_polygon, without_dense_vertices, without_slivers
+from .polygon import (
+    MIN_ISLAND_CELLS,
+    LeftOutIsland,
+    summarised_islands,
+    water_polygon,
+    without_dense_vertices,
+    without_slivers,
+)
 from .shore import shore_at_scale, transfer, without_narrow_arms
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
@@ -118,7 +125,9 @@ def auto_layout(
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
     poly, dense = without_dense_vertices(poly, h)
-    poly, more = water_polygon(poly, drop_islands_below=MIN_ISLAND_CELLS * h)
+    dropped: list[LeftOutIsland] = []
+    poly, more = water_polygon(poly, drop_islands_below=MIN_ISLAND_CELLS * h, left_out=dropped)
+    more, details = summarised_islands(more, dropped, MIN_ISLAND_CELLS * h, poly.area)
     # islands too close for a block between them: joined (unless asked not to)
     poly, gaps = (poly, []) if options.islands_apart else without_island_gaps(poly, h)
     more = dense + more + gaps
@@ -169,7 +178,7 @@ def auto_layout(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
-            return lay
+            return dataclasses.replace(lay, details=tuple(details)) if details else lay
         if kept is not None:
             if single:  # a single index space cannot hold it: say where, before the grid is made
                 d = frame_defects(list(kept.pieces), single=True)[0]
@@ -177,7 +186,7 @@ def auto_layout(
                     f"automatic layout: no layout found whose blocks fit one index space (Delft3D single "
                     f"domain, EFDC): {d.note()}; write a .ddb (domain decomposition) or .vtm instead"
                 )
-            return kept
+            return dataclasses.replace(kept, details=tuple(details)) if details else kept
     assert first is not None
     if single:
         why = str(first).removeprefix("automatic layout: ")

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ..pointindex import PointIndex
+from ..segments import SegmentIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners, wedge_corners
@@ -175,11 +176,11 @@ def layout_pieces(
     rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
     rings, forced = _merge_strips(rings, forced, sigma)
     corner_pts = []
-    rim = dense.boundary
+    rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
     for r, f in zip(rings, forced, strict=True):
         fi = forced_indices(r, f)
         c, _ = choose_corners(r, sigma, forced=fi)
-        on_shore = shapely.distance(shapely.points(r), rim) < 1e-9 * size
+        on_shore = rim.near(r, 1e-9 * size)
         if wedges:
             c = wedge_corners(r, c, sigma, shore=on_shore, forced=fi)
         elif c is not None and not regular:
@@ -271,11 +272,13 @@ def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float
 
 def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
     """The mean of the skeleton's junctions inside ``ring`` (a star split's centre), or None."""
-    from shapely.geometry import Point, Polygon
+    import shapely
 
-    P = Polygon(ring)
-    inside = [j for j in junctions if P.contains(Point(j))]
-    return np.mean(inside, axis=0) if inside else None
+    if not len(junctions):
+        return None
+    js = np.asarray(junctions, dtype=float).reshape(-1, 2)
+    inside = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])]
+    return np.mean(inside, axis=0) if len(inside) else None
 
 
 def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: float, normal: bool, thin: bool):

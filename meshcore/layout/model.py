@@ -74,7 +74,9 @@ class Layout:
     ``polygon`` is the water (a shapely Polygon, islands as holes, after cleaning),
     ``cuts`` the cut lines (chords across arms and the splits inside junctions), ``pieces``
     the regions with their corners, ``blocks`` their names, corners and cell counts;
-    ``single``: the cell counts close every ring of blocks in one index space (``auto_layout(single=True)``).
+    ``single``: the cell counts close every ring of blocks in one index space (``auto_layout(single=True)``);
+    ``details``: the notes that one of ``notes`` sums up (each island left out as too narrow, when
+    there are many: :func:`~.polygon.summarised_islands`).
     """
 
     polygon: Any
@@ -87,6 +89,7 @@ class Layout:
     chords: tuple = field(default=(), repr=False)
     notes: tuple[str, ...] = ()
     single: bool = False
+    details: tuple[str, ...] = ()
     _topology: Any = field(default=None, init=False, repr=False, compare=False)  # made once
 
     @property

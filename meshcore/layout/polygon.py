@@ -18,11 +18,14 @@ the place):
   its width) kept, 2 of 10 (default layout) and 4 of 10 (``regular``) had grid cells over
   them, the ends narrower than two cells folded into one block side; of those at least two
   cells across, 2 of 22 and 0 of 22.
+  From :data:`SUMMARY_FROM` such islands on, :func:`summarised_islands` makes their notes one
+  (the count, the largest, the cell size that keeps them all; each island's note kept apart).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -31,7 +34,14 @@ from ..errors import InvalidInputError
 from ..quality.coverage import MIN_ISLAND_CELLS, island_width, without_spikes
 from .shore import without_dense_vertices  # (their home before)
 
-__all__ = ["MIN_ISLAND_CELLS", "water_parts_from_points", "water_polygon", "without_dense_vertices"]
+__all__ = [
+    "MIN_ISLAND_CELLS",
+    "LeftOutIsland",
+    "summarised_islands",
+    "water_parts_from_points",
+    "water_polygon",
+    "without_dense_vertices",
+]
 
 
 def _ring(points: Any, what: str) -> np.ndarray:
@@ -116,8 +126,23 @@ def _crossing(ring: np.ndarray, what: str) -> None:
     raise InvalidInputError(f"{what} crosses itself ({shapely.is_valid_reason(shapely.Polygon(ring))})")
 
 
-def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 0.0):
-    """A valid shapely Polygon of the water and a list of notes about what was changed."""
+@dataclass(frozen=True, slots=True)
+class LeftOutIsland:
+    """An island :func:`water_polygon` left out as too narrow: its number, width where widest, area,
+    a point of it, and its note."""
+
+    number: int
+    width: float
+    area: float
+    where: tuple[float, float]
+    note: str
+
+
+def water_polygon(
+    outline: Any, *, holes: Any = (), drop_islands_below: float = 0.0, left_out: list[LeftOutIsland] | None = None
+):
+    """A valid shapely Polygon of the water and a list of notes about what was changed (``left_out``:
+    the islands narrower than ``drop_islands_below`` are added to it as well)."""
     from shapely.geometry import Polygon
     from shapely.geometry.polygon import orient
 
@@ -191,6 +216,8 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
                     f"{drop_islands_below:.3g} (two cells): too narrow for the grid to go round it, left out "
                     f"(the grid covers it); a cell size of at most {width / 2:.3g} would keep it"
                 )
+                if left_out is not None:
+                    left_out.append(LeftOutIsland(k + 1, float(width), float(isl.area), (c.x, c.y), notes[-1]))
                 continue
         rings.append(r)
         kept.append(isl)
@@ -201,6 +228,42 @@ def water_polygon(outline: Any, *, holes: Any = (), drop_islands_below: float = 
 
         raise InvalidInputError(f"the water polygon is not valid ({shapely.is_valid_reason(poly)}, near that point)")
     return poly, notes
+
+
+#: From this many islands left out as too narrow, their notes are one (:func:`summarised_islands`).
+SUMMARY_FROM = 4
+
+
+def summarised_islands(
+    notes: list[str], left_out: list[LeftOutIsland], limit: float, water: float
+) -> tuple[list[str], list[str]]:
+    """``notes`` with the notes of the ``left_out`` islands (narrower than ``limit``; ``water``: the
+    water's area) made one, where
+    there are :data:`SUMMARY_FROM` of them or more, and those islands' own notes (else ``notes``
+    as they are and no details).  A lake with dozens of islets read as dozens of lines that all
+    say the same; the one says how many, which is the largest, and the cell size that keeps
+    every one of them."""
+    if len(left_out) < SUMMARY_FROM:
+        return list(notes), []
+    own = {isl.note for isl in left_out}
+    big = max(left_out, key=lambda isl: isl.area)
+    keep = min(isl.width for isl in left_out) / 2
+    total = sum(isl.area for isl in left_out)
+    summary = (
+        f"{len(left_out)} islands are less than {limit:.3g} (two cells) across at their widest: too narrow "
+        f"for the grid to go round them, left out (the grid covers them: {100 * total / water:.2g} % of the "
+        f"water's area); the largest, island {big.number} near ({big.where[0]:.6g}, {big.where[1]:.6g}), is "
+        f"{big.width:.3g} across (area {big.area:.3g}); a cell size of at most {keep:.3g} would keep them all "
+        f"(each island: the layout's details, Messages in the app)"
+    )
+    out: list[str] = []
+    for n in notes:
+        if n in own:
+            if summary not in out:
+                out.append(summary)
+            continue
+        out.append(n)
+    return out, [isl.note for isl in left_out]
 
 
 def without_slivers(poly: Any, width: float) -> tuple[Any, list[str]]:

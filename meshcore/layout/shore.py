@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ..segments import nearest_on_polyline
+from ..segments import SegmentIndex
 
 __all__ = ["DENSE", "DENSE_TOLERANCE", "ShoreChange", "shore_at_scale", "wiggle", "without_dense_vertices"]
 
@@ -132,7 +132,7 @@ def _gauss(ring: np.ndarray, s: np.ndarray, total: float, sigma: np.ndarray) -> 
     if smax <= 0:
         return ring.copy()
     step = float(np.min(ds[ds > 0], initial=total / n))
-    k = min(n // 2, math.ceil(3.0 * smax / max(step, 1e-300)) + 1)
+    k = min(n // 2, math.ceil(3.0 * smax / max(step, 1e-300)) + 1, _reach(s, total, sigma))
     num = np.zeros_like(ring)
     den = np.zeros(n)
     sig = np.where(sigma > 0, sigma, 1.0)
@@ -145,6 +145,22 @@ def _gauss(ring: np.ndarray, s: np.ndarray, total: float, sigma: np.ndarray) -> 
         num += w[:, None] * ring[j]
         den += w
     return num / den[:, None]
+
+
+#: Beyond this many widths ``exp(-x²/2)`` is exactly 0 in double precision (from 38.6 on).
+_NO_WEIGHT = 40.0
+
+
+def _reach(s: np.ndarray, total: float, sigma: np.ndarray) -> int:
+    """An offset beyond which every vertex's weight in :func:`_gauss` is exactly zero, either way
+    round the ring: offsets past it add zeros (a ring with one short edge reached all round
+    itself, quadratic in its vertices)."""
+    n = len(s)
+    ext = np.concatenate([s - total, s, s + total])
+    r = _NO_WEIGHT * np.maximum(sigma, 0.0)
+    ahead = np.searchsorted(ext, s + r, side="right") - (n + np.arange(n))
+    back = (n + np.arange(n)) - np.searchsorted(ext, s - r, side="left")
+    return int(max(ahead.max(), back.max())) + 2
 
 
 @dataclass(frozen=True, slots=True)
@@ -336,7 +352,7 @@ def transfer(pieces: list, shores: Shores) -> list | None:
     at = {(float(p[0]), float(p[1])): dst[k][i] for k, r in enumerate(src) for i, p in enumerate(r)}
     x0, y0, x1, y1 = shores.layout.bounds
     eps = 1e-7 * math.hypot(x1 - x0, y1 - y0)
-    boundary = shores.layout.boundary
+    index = SegmentIndex(src)
     out = []
     for pc in pieces:
         ring = np.array(pc.ring, dtype=float)
@@ -346,9 +362,8 @@ def transfer(pieces: list, shores: Shores) -> list | None:
             if q is not None:
                 ring[i] = q
         if todo:
-            d = shapely.distance(shapely.points(ring[todo]), boundary)
-            for i in np.asarray(todo)[d <= eps]:
-                ring[i] = _moved(pc.ring[i], src, dst)
+            for i in np.asarray(todo)[index.near(ring[todo], eps, within=True)]:
+                ring[i] = _moved(pc.ring[i], index, dst)
         out.append(Piece(ring, pc.corners, pc.name))
     polys = [Polygon(p.ring) for p in out]
     if not all(p.is_valid for p in polys):
@@ -365,14 +380,9 @@ def _rings(poly) -> list[np.ndarray]:
     return [np.asarray(poly.exterior.coords)[:-1], *(np.asarray(r.coords)[:-1] for r in poly.interiors)]
 
 
-def _moved(q: np.ndarray, src: list[np.ndarray], dst: list[np.ndarray]) -> np.ndarray:
-    """A point on an edge of one of the rings ``src``: the same point of the edge in ``dst``."""
-    best: tuple[float, int, int, float] = (math.inf, 0, 0, 0.0)
-    for k, r in enumerate(src):
-        dist, i, t = nearest_on_polyline(r, q, closed=True)
-        if dist < best[0]:
-            best = (dist, k, i, t)
-    _, k, i, u = best
+def _moved(q: np.ndarray, src: SegmentIndex, dst: list[np.ndarray]) -> np.ndarray:
+    """A point on an edge of one of the rings of ``src``: the same point of the edge in ``dst``."""
+    _, k, i, u = src.nearest(q)
     r = dst[k]
     return r[i] + u * (r[(i + 1) % len(r)] - r[i])
 

@@ -195,18 +195,30 @@ def objective(
     at its value, with ``jumps`` from :func:`_jump_pairs` and ``short`` the ``(chain, least)``
     pairs (``weights``: the cost per missing cell of each, default :data:`LEAST_WEIGHT`; ``steep_w``:
     each pair's :data:`STEEP_WEIGHT`, default that for every pair).  For
-    :mod:`.countsearch`, which minimises it; the sums over chains are matrices made once (a
-    layout of 37 blocks: ~300 pairs)."""
+    :mod:`.countsearch`, which minimises it; the sums over chains are sparse matrices made once
+    (a layout of 37 blocks: ~300 pairs; dense, a layout of 250 blocks spent a second on its zeros)."""
+    from scipy.sparse import csr_array
+
     nc, nb, npair = len(t), len(sides), len(jumps)
-    across, mean = np.zeros((nc, 2 * nb)), _block_targets(t, sides)  # a block's count in each direction
+    mean = _block_targets(t, sides)  # a block's count in each direction
+    rows: list[int] = []
+    cols: list[int] = []
     for bi, (bottom, _, _, left) in enumerate(sides):
         for d, a in enumerate((bottom, left)):
-            np.add.at(across[:, 2 * bi + d], list(a), 1.0)
-    dens1, dens2, w = np.zeros((nc, npair)), np.zeros((nc, npair)), np.zeros(npair)  # densities that meet
+            rows += [2 * bi + d] * len(a)
+            cols += [int(c) for c in a]
+    across = csr_array((np.ones(len(rows)), (rows, cols)), shape=(2 * nb, nc))  # duplicates add up
+    w = np.zeros(npair)
+    d1: tuple[list[float], list[int], list[int]] = ([], [], [])
+    d2: tuple[list[float], list[int], list[int]] = ([], [], [])
     for p, (ca, ta, cb, tb) in enumerate(jumps):
-        np.add.at(dens1[:, p], ca, 1.0 / ta)
-        np.add.at(dens2[:, p], cb, 1.0 / tb)
+        for (v, r, c), chains, tt in ((d1, ca, ta), (d2, cb, tb)):
+            v += [1.0 / tt] * len(chains)
+            r += [p] * len(chains)
+            c += [int(x) for x in chains]
         w[p] = min(ta, tb)
+    dens1 = csr_array((d1[0], (d1[1], d1[2])), shape=(npair, nc))  # densities that meet
+    dens2 = csr_array((d2[0], (d2[1], d2[2])), shape=(npair, nc))
     held = np.array([c for c, _ in short], dtype=int)
     want = np.array([v for _, v in short], dtype=float)
     per = np.full(len(short), LEAST_WEIGHT) if weights is None else np.asarray(weights, dtype=float)
@@ -214,13 +226,13 @@ def objective(
 
     def cost(n: np.ndarray) -> np.ndarray:
         n = np.atleast_2d(n).astype(float)
-        x1, x2 = n @ dens1, n @ dens2
+        x1, x2 = (dens1 @ n.T).T, (dens2 @ n.T).T
         excess = np.maximum(0.0, w * np.maximum(x1 - JUMP * x2, x2 - JUMP * x1))
         steep = np.maximum(0.0, w * np.maximum(x1 - STEEP * x2, x2 - STEEP * x1))
         return (
             -1e-3 * n.sum(axis=1)
             + 0.25 * np.abs(n - t).sum(axis=1)
-            + (bw * np.abs(n @ across - mean)).sum(axis=1)
+            + (bw * np.abs((across @ n.T).T - mean)).sum(axis=1)
             + JUMP_WEIGHT * excess.sum(axis=1)
             + (steep * (STEEP_WEIGHT if steep_w is None else steep_w)).sum(axis=1)
             + (per * np.maximum(0.0, want - n[:, held])).sum(axis=1)

@@ -456,18 +456,20 @@ def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtb
     assert items.misses.opts["size"] < 5 and items.misses.opts["brush"].color().alpha() < 170
 
 
-def _thin_island_lake(path, h: float = 500.0):
-    """A round lake (lon/lat, 20 cells of ``h`` metres in radius) with an island 1.2 cells wide (the
-    layout leaves it out) and one 4 cells wide."""
+def _thin_island_lake(path, h: float = 500.0, needles: int = 1):
+    """A round lake (lon/lat, 20 cells of ``h`` metres in radius) with ``needles`` islands 1.2 cells
+    wide (the layout leaves them out) and one 4 cells wide."""
     import json
 
     from shapely import affinity
     from shapely.geometry import LineString, Point, Polygon, mapping
 
     lake = Point(0, 0).buffer(20 * h, quad_segs=32)
-    needle = LineString([(-5 * h, 0), (5 * h, 0)]).buffer(0.6 * h, quad_segs=8)
+    thin = [
+        LineString([(-5 * h, -6 * k * h), (5 * h, -6 * k * h)]).buffer(0.6 * h, quad_segs=8) for k in range(needles)
+    ]
     blob = Point(8 * h, 8 * h).buffer(2.0 * h, quad_segs=8)
-    metres = Polygon(lake.exterior, [needle.exterior, blob.exterior])
+    metres = Polygon(lake.exterior, [*(n.exterior for n in thin), blob.exterior])
     lat = 46.0  # degrees of a metre there: the widths change by < 1 % in UTM
     poly = affinity.affine_transform(metres, [1 / (111_320 * math.cos(math.radians(lat))), 0, 0, 1 / 111_320, 9.0, lat])
     path.write_text(json.dumps({"type": "Feature", "properties": {}, "geometry": mapping(poly)}))
@@ -492,6 +494,18 @@ def test_layout_notes_reach_the_message_panel_and_the_status_line(qtbot, win, tm
     summary = win.lake_panel.summary
     assert f"{k} note{'s' * (k != 1)} on the water" in summary.text()
     assert all(note in summary.toolTip() for note in lay.notes)
+
+
+def test_many_left_out_islands_one_note_and_each_in_the_message_panel(qtbot, win, tmp_path):
+    """Four islands too narrow for the grid: one note for them all, and each island's own note
+    (``Layout.details``) in the message panel."""
+    src = _thin_island_lake(tmp_path / "thin4.geojson", needles=4)
+    lay = lay_out(qtbot, win, src, cell_size=500.0)
+    assert len(lay.polygon.interiors) == 1 and len(lay.details) == 4
+    assert sum("islands are less than" in n for n in lay.notes) == 1
+    shown = [t for _lv, t in win.messages_panel.messages()]
+    for note in lay.details:
+        assert f"layout (detail): {note}" in shown
 
 
 def test_islands_under_the_grid_are_warned_of(qtbot, win, tmp_path, monkeypatch):

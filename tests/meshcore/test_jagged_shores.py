@@ -201,3 +201,36 @@ def test_the_grid_of_a_basin_with_a_narrow_arm_has_no_folds():
     m = lake_metrics(mb, polygon=poly)
     assert int(m.values("folded").sum()) == 0
     assert m.share("deviation", 3.0) >= 0.9
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_gauss_leaves_out_only_zero_weights(seed):
+    """``_gauss`` stops where every weight is exactly zero: the same rings, bit for bit, as the sum
+    over every offset its step allows (a ring with one short edge: all the way round)."""
+    from meshcore.layout import shore
+
+    rng = np.random.default_rng(seed + 861100)
+    n = int(rng.integers(40, 600))
+    ds = rng.uniform(0.5, 1.5, n)
+    k = int(rng.integers(n - 1))
+    ds[k : k + 2] = 1e-4  # two short edges: the step allows every offset (n // 2 either way)
+    s = np.concatenate([[0.0], np.cumsum(ds)[:-1]])
+    total = float(ds.sum())
+    edge = np.diff(np.append(s, total))
+    dsv = 0.5 * (edge + np.roll(edge, 1))  # as _gauss weighs the vertices
+    ring = rng.normal(size=(n, 2)) * 10 + 1e4
+    sigma = rng.choice([0.0, 1.0, 2.5, 4.0], n)
+    sigma[0] = 3.0
+    want = np.zeros_like(ring)
+    den = np.zeros(n)
+    for o in range(-(n // 2), n // 2 + 1):  # the sum without the reach
+        idx = np.arange(n) + o
+        j = idx % n
+        d = s[j] + total * (idx // n) - s
+        w = np.exp(-0.5 * (d / np.where(sigma > 0, sigma, 1.0)) ** 2) * dsv[j]
+        w = np.where(sigma > 0, w, 1.0 if o == 0 else 0.0)
+        want += w[:, None] * ring[j]
+        den += w
+    want /= den[:, None]
+    assert 3.0 * sigma.max() / dsv.min() > n // 2 > shore._reach(s, total, sigma)
+    assert np.array_equal(shore._gauss(ring, s, total, sigma), want)
