@@ -306,12 +306,12 @@ def place_chords(
 
 def _sharp_vertices(poly, turn: float) -> np.ndarray:
     """The vertices (m, 2) of ``poly``'s rings where the shore turns by ``turn`` degrees or more."""
+    from .corners import _raw_turning
+
     out = []
     for ring in (poly.exterior, *poly.interiors):
         r = np.asarray(ring.coords)[:-1]
-        a, b = r - np.roll(r, 1, axis=0), np.roll(r, -1, axis=0) - r
-        t = np.degrees(np.abs(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))))
-        out.append(r[t >= turn])
+        out.append(r[np.abs(_raw_turning(r)) >= turn])
     return np.vstack(out) if out else np.empty((0, 2))
 
 
