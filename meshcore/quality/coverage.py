@@ -26,8 +26,10 @@ r"""Does the grid cover the water?  Area of the union of cells and shoreline dis
   :func:`meshcore.layout.shore.without_narrow_arms`, each with a note: no grid
   line can follow a spike without folding a cell, an arm gets cells hundreds of
   times longer than wide), so ``hausdorff`` leaves the shore points on them out
-  (the arms by the layout's rule: pass its cell size); the table shows both
-  where they differ.  Islands the layout joins, closer than
+  (the arms by the layout's rule: pass its cell size, found as the layout finds them: on the
+  shore without its spikes); a grid point counts as near as the nearer of the shore as given
+  and the shore these rules make, and the lines the rules draw (an arm's mouth) count only where
+  the grid stops short of them; the table shows both where they differ.  Islands the layout joins, closer than
   :data:`~meshcore.layout.islandgaps.GAP_CELLS` cells to each other or
   :data:`~meshcore.layout.islandgaps.SHORE_GAP_CELLS` to the shore
   (:func:`meshcore.layout.islandgaps.without_island_gaps`, with a note naming the
@@ -285,6 +287,13 @@ def _areal(geom: Any) -> Any:
 
 def _directed(points: np.ndarray, lines: Any) -> tuple[float, int]:
     """Largest distance from ``points`` to the segments of ``lines``, and its index."""
+    dist = _distances(points, lines)
+    k = int(np.argmax(dist))
+    return float(dist[k]), k
+
+
+def _distances(points: np.ndarray, lines: Any) -> np.ndarray:
+    """Distance from each of ``points`` to the nearest segment of ``lines``."""
     import shapely
 
     segs = []
@@ -294,9 +303,10 @@ def _directed(points: np.ndarray, lines: Any) -> tuple[float, int]:
     seg = np.concatenate(segs)
     seg = seg[np.any(seg[:, 0] != seg[:, 1], axis=1)]
     tree = shapely.STRtree(shapely.linestrings(seg))
-    _, dist = tree.query_nearest(shapely.points(points), return_distance=True, all_matches=False)
-    k = int(np.argmax(dist))
-    return float(dist[k]), k
+    idx, dist = tree.query_nearest(shapely.points(points), return_distance=True, all_matches=False)
+    out = np.empty(len(points))
+    out[idx[0]] = dist
+    return out
 
 
 #: The most points :func:`_boundary_points` puts on a boundary (a grid flung far beyond its lake
@@ -333,9 +343,11 @@ def coverage(
         raise InvalidInputError(f"cell_size must be positive, got {h}")
     covered, rims, land = _islands(poly, union, h)
     gb, sb = union.boundary, shapely.union_all(rims)
+    given = sb
     step = h / 10.0
     gp, sp = _boundary_points(gb, step), _boundary_points(sb, step)
-    d_grid_given, _ = _directed(gp, sb)
+    to_given = _distances(gp, sb)
+    d_grid_given = float(to_given.max())
     d_given, _ = _directed(sp, gb)
     # the arms and spikes below are found on the shore the layout worked on: an outline with far
     # more vertices than cells is simplified first, as the layout does (a shore of 120 000 points
@@ -344,23 +356,37 @@ def coverage(
     slack = 0.0 if simple is poly else DENSE_TOLERANCE * h
     # the dead-end arms narrower than two cells, which the layout leaves out on purpose
     # (:func:`meshcore.layout.shore.without_narrow_arms`, its rule at this cell size, with a note):
-    # measured against the water without them, whose shore crosses their mouths
-    found = _without_narrow_arms(simple, h)  # on the layout's shore
-    if found is not simple:
+    # measured against the water without them, whose shore crosses their mouths; found as the
+    # layout finds them, on the shore without its spikes (below): a Z-shaped sliver of land and
+    # water narrower than half a cell is smoothed out there, not left out as an arm
+    despiked = without_spikes(simple, 0.5 * h) or simple
+    found = _without_narrow_arms(despiked, h)  # on the layout's shore
+    if found is not despiked:
         water = found if simple is poly else _cut_off(poly, simple.difference(found), slack)
         sb = shapely.union_all(_islands(water, union, h)[1])
         sp = _boundary_points(sb, step)
     # islands closer than the layout keeps apart, joined with a note (to each other or to the
     # shore, :func:`meshcore.layout.islandgaps.without_island_gaps`): measured against the joined land
-    joined = _joined_islands(found if found is not simple else poly, h)
+    joined = _joined_islands(found if found is not despiked else poly, h)
     if joined is not None:
         sb = shapely.union_all(_islands(joined, union, h)[1])
         sp = _boundary_points(sb, step)
-    d_grid, kg = _directed(gp, sb)
+    # a grid point is as near the shore as the nearer of the two: the shore as given or the one
+    # the rules above make (a sliver of water the layout smooths out first may read as a narrow
+    # arm here; the grid that covers part of it follows the shore as given there)
+    to_shore = np.minimum(to_given, _distances(gp, sb))
+    kg = int(np.argmax(to_shore))
+    d_grid = float(to_shore[kg])
     # the shore's spikes narrower than half a cell, which the layout smooths out on purpose
     # (:func:`meshcore.layout.polygon.without_slivers`, with a note): measured apart, found on the
     # layout's shore as well (``slack`` wider)
-    keep = ~_in_spikes(_spikes(found, h, slack), sp)
+    keep = ~_in_spikes(_spikes(simple, h, slack), sp)
+    if sb is not given:
+        # the lines the rules draw (an arm's mouth, the water between joined islands) are not
+        # shore: they count only where the grid stops short of them, not where it covers water
+        # beyond them (a sliver the layout smoothed into its water that reads as an arm here)
+        drawn = _distances(sp, given) > 1e-6 * h
+        keep &= ~(drawn & shapely.contains_xy(union, sp[:, 0], sp[:, 1]))
     d_shore, ks = _directed(sp[keep], gb) if keep.any() else (0.0, 0)
     sp = sp[keep] if keep.any() else sp
     if d_grid >= d_shore:
