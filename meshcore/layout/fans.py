@@ -38,6 +38,14 @@ FAN_BULGE = 3.0
 FAN_PAIRS = 8.0
 BULGING = 1.2
 
+#: ... and a piece one of whose sides runs back on itself — measured along the line between its
+#: corners — by more than this share of that line's length and by more than :data:`BACK_CELLS`
+#: cells beyond what its opposite side does: the side goes round a tip of land into a pocket of
+#: water and out again (a peninsula the block wraps), and the grid lines from the opposite side
+#: crowd into the tip (a channel that winds, or a spiral, winds both sides alike).
+WRAP_BACK = 0.5
+BACK_CELLS = 3.0
+
 
 def _pairs(ring: np.ndarray, corners) -> float:
     """The smaller of the two ratios of opposite sides between ``corners``."""
@@ -58,7 +66,33 @@ def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     if corners is None or not math.isfinite(cost):
         return False
     R = bulge_ratio(ring, corners)
-    return R >= FAN_BULGE or (R >= BULGING and _pairs(ring, corners) >= FAN_PAIRS)
+    return R >= FAN_BULGE or (R >= BULGING and _pairs(ring, corners) >= FAN_PAIRS) or _wraps(ring, corners, sigma)
+
+
+def _wraps(ring: np.ndarray, corners, sigma: float) -> bool:
+    """True when a side between two of ``corners`` runs back on itself further than its
+    opposite side does (:data:`WRAP_BACK`)."""
+    h = sigma / 1.5  # (the layout's sigma: 1.5 cells)
+    c = sorted(int(i) for i in corners)
+    if len(c) != 4:
+        return False
+    n = len(ring)
+    sides = [ring[(c[k] + np.arange((c[(k + 1) % 4] - c[k]) % n + 1)) % n] for k in range(4)]
+    for k in range(4):
+        chord = sides[k][-1] - sides[k][0]
+        length = math.hypot(*chord)
+        if length == 0:
+            continue
+        u = chord / length
+        extra = _back(sides[k] @ u) - _back(sides[(k + 2) % 4][::-1] @ u)
+        if extra > max(WRAP_BACK * length, BACK_CELLS * h):
+            return True
+    return False
+
+
+def _back(q: np.ndarray) -> float:
+    """How far the positions ``q`` along a line fall back from the furthest reached before."""
+    return float(np.max(np.maximum.accumulate(q) - q))
 
 
 def unfan(ring: np.ndarray, *, sigma: float, min_width: float, center=None, depth: int = 3, **kw):

@@ -86,3 +86,78 @@ def test_these_lakes_have_no_folded_cells_and_keep_their_islands(name):
     assert m.coverage.islands_lost == ()
     assert s["hausdorff_cells"] < 1.0  # main: 7.3, 17.5, ...
     assert math.isfinite(s["pct_nodes_within_3deg"]) and s["pct_nodes_within_3deg"] >= 90.0
+
+
+def _pocket_ring(depth: float) -> tuple[np.ndarray, list[int]]:
+    """A basin 20 × 12 cells whose west side is a peninsula 1 cell thick reaching 16 cells east
+    from (0, 8), with a pocket of water under it ``depth`` cells deep; corners at the peninsula's
+    root, the basin's east corners and its north-west corner: the side from the root runs east
+    round the tip, back west into the pocket and east again."""
+    west = 16.0 - depth
+    ring = np.array(
+        [(0, 8), (16, 8), (16.6, 7.5), (16, 7), (west, 7), (west, 0), (20, 0), (20, 12), (0, 12)],
+        float,
+    )
+    return ring, [0, 6, 7, 8]
+
+
+def test_a_side_that_runs_back_round_a_tip_fans():
+    """The measure of :func:`meshcore.layout.fans._wraps` (independent of the layout): a block
+    whose side runs back round a peninsula (held-out GSHHG lake at 10 000 cells: one block of
+    84 × 24 cells round a peninsula's tip, 86 % of nodes within 3°; split, 97 %)."""
+    from meshcore.layout.fans import _wraps
+
+    sigma = 1.5  # one cell = 1
+    ring, corners = _pocket_ring(depth=15.0)
+    assert _wraps(ring, corners, sigma)
+    # a shallow pocket (back 3 cells against a 21.5-cell side) does not
+    ring, corners = _pocket_ring(depth=3.0)
+    assert not _wraps(ring, corners, sigma)
+    # a channel that winds (a U round a peninsula, both banks alike) does not either
+    t = np.linspace(0.0, np.pi, 40)
+    outer = np.column_stack([10 + 6 * np.sin(t), 6 * np.cos(t)])
+    inner = np.column_stack([10 + 2 * np.sin(t), 2 * np.cos(t)])[::-1]
+    u = np.vstack([[(0, 6)], outer, [(0, -6), (0, -2)], inner, [(0, 2)]])
+    u = u if Polygon(u).exterior.is_ccw else u[::-1]
+    ids = [int(np.argmin(np.hypot(*(u - p).T))) for p in ((0, 6), (0, -6), (0, -2), (0, 2))]
+    assert not _wraps(u, ids, sigma)
+    # nor a spiral channel as one block (the generated spiral's layout)
+    lay = auto_layout(testing.spiral(turns=2.5, width=0.7, gap=1.2), target_cells=4000, multiple=4)
+    assert not any(_wraps(p.ring, p.corners, 1.5 * lay.cell_size) for p in lay.pieces)
+
+
+def _runs_back(ring: np.ndarray, corners) -> float:
+    """The most any side runs back along the line between its corners beyond what its opposite
+    side does, over that line's length."""
+    c = sorted(corners)
+    n = len(ring)
+    sides = [ring[[(c[k] + j) % n for j in range((c[(k + 1) % 4] - c[k]) % n + 1)]] for k in range(4)]
+    worst = 0.0
+    for k in range(4):
+        chord = sides[k][-1] - sides[k][0]
+        u = chord / np.linalg.norm(chord)
+        own, opp = sides[k] @ u, sides[(k + 2) % 4][::-1] @ u
+        back = max(own[: i + 1].max() - own[i] for i in range(len(own)))
+        back_opp = max(opp[: i + 1].max() - opp[i] for i in range(len(opp)))
+        worst = max(worst, (back - back_opp) / np.linalg.norm(chord))
+    return worst
+
+
+WRAPPED = "testing.headlands(1030600, n=6)"  # fresh_sweep --more base 1030000, 15 000 cells
+
+
+def test_no_block_runs_round_a_peninsula():
+    lay = auto_layout(eval(WRAPPED), target_cells=15000, multiple=4)
+    # main: one block ran from a headland's root round its tip and back (0.8 of its side's span)
+    assert max(_runs_back(np.asarray(pc.ring), pc.corners) for pc in lay.pieces) < 0.5
+
+
+@pytest.mark.slow
+def test_the_peninsula_block_no_longer_folds():
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.quality import lake_metrics
+
+    poly = eval(WRAPPED)
+    s = lake_metrics(mesh_outline(poly, target_cells=15000), polygon=poly).summary()
+    assert s["folded_cells"] == 0  # main: 77, its grid across the headland (shore 18 cells off)
+    assert s["hausdorff_cells"] < 1.0
