@@ -25,11 +25,11 @@ from ..segments import SegmentIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners, wedge_corners
-from .fans import fans, unfan
+from .fans import fans, unfan, wraps
 from .frames import close_frames, frame_defects
 from .regions import partition
 from .skeleton import Skeleton, skeleton
-from .split import _GOOD, best_split, forced_indices
+from .split import _GOOD, best_split, forced_indices, region_cost
 from .tee import tee
 
 __all__ = ["layout_pieces"]
@@ -283,11 +283,13 @@ def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
 
 def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: float, normal: bool, thin: bool):
     """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece that fans
-    (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be (the split's
+    (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be, and every piece with a
+    side round a tip of land (:func:`~.fans.wraps`) where that split costs less (the split's
     ``min_width``, ``normal`` and ``thin`` as the region's)."""
     out: list = []
     for ring, fc in pieces:
-        if len(fc) or not fans(ring, sigma):
+        fan = not len(fc) and fans(ring, sigma)
+        if len(fc) or not (fan or wraps(ring, sigma)):
             out.append((ring, fc))
             continue
         got = unfan(
@@ -297,7 +299,10 @@ def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: floa
             center=_junction_centre(ring, junctions),
             normal=normal,
             thin=thin,
+            wrapped=not fan,
         )
+        if got is not None and not fan and sum(region_cost(r, sigma, f) for r, f in got[0]) >= region_cost(ring, sigma):
+            got = None  # a C round a thin peninsula grids well: split only where that costs less
         if got is None:
             out.append((ring, fc))
             continue

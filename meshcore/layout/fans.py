@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["BULGING", "FAN_BULGE", "FAN_PAIRS", "fans", "unfan"]
+__all__ = ["BULGING", "FAN_BULGE", "FAN_PAIRS", "fans", "unfan", "wraps"]
 
 #: A piece whose chosen corners give :func:`~.corners.bulge_ratio` at least this fans.  On the
 #: 73 generated shapes of `fresh_sweep.py` base 791000 (both sets) every piece was below 2.6
@@ -66,7 +66,22 @@ def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     if corners is None or not math.isfinite(cost):
         return False
     R = bulge_ratio(ring, corners)
-    return R >= FAN_BULGE or (R >= BULGING and _pairs(ring, corners) >= FAN_PAIRS) or _wraps(ring, corners, sigma)
+    return R >= FAN_BULGE or (R >= BULGING and _pairs(ring, corners) >= FAN_PAIRS)
+
+
+def wraps(ring: np.ndarray, sigma: float, forced=()) -> bool:
+    """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) has a
+    side that runs round a tip of land and back (:data:`WRAP_BACK`).  Such a piece is split
+    only where :func:`unfan`'s split costs less than the piece (:func:`~.build._unfanned`): the
+    greedy split keeps it because no single cut pays, yet one cut and the splits after it may;
+    where they do not, the block is a C round a thin peninsula, which grids well."""
+    from .corners import choose_corners
+    from .split import forced_indices
+
+    corners, cost = choose_corners(ring, sigma, forced=forced_indices(ring, forced))
+    if corners is None or not math.isfinite(cost):
+        return False
+    return _wraps(ring, corners, sigma)
 
 
 def _wraps(ring: np.ndarray, corners, sigma: float) -> bool:
@@ -95,12 +110,15 @@ def _back(q: np.ndarray) -> float:
     return float(np.max(np.maximum.accumulate(q) - q))
 
 
-def unfan(ring: np.ndarray, *, sigma: float, min_width: float, center=None, depth: int = 3, **kw):
+def unfan(
+    ring: np.ndarray, *, sigma: float, min_width: float, center=None, depth: int = 3, wrapped: bool = False, **kw
+):
     """``(pieces, cuts)`` of a split of a fanning piece ``ring`` in which no piece fans, or None.
 
     Every admissible split of :func:`~.split._options` (and the shore-normal cuts from evenly
     spaced points of the last resort) is followed by the greedy split of its pieces
-    (``depth`` − 1 levels); the cheapest result without a fanning piece is returned.
+    (``depth`` − 1 levels); the cheapest result without a fanning piece (``wrapped``: nor one
+    with a side round a tip, :func:`wraps`) is returned.
     ``kw``: ``regular``, ``normal``, ``thin`` of :func:`~.split.best_split`.
     """
     from .split import _cut_options, _normal_cuts, _options, best_split
@@ -126,7 +144,7 @@ def unfan(ring: np.ndarray, *, sigma: float, min_width: float, center=None, dept
             out_p += pp
             out_c += cc
             total += c
-        if any(not len(f) and fans(p, sigma) for p, f in out_p):
+        if any(not len(f) and (fans(p, sigma) or (wrapped and wraps(p, sigma))) for p, f in out_p):
             continue
         if best is None or total < best[2]:
             best = (out_p, out_c, total)
