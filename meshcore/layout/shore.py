@@ -133,18 +133,24 @@ def _gauss(ring: np.ndarray, s: np.ndarray, total: float, sigma: np.ndarray) -> 
         return ring.copy()
     step = float(np.min(ds[ds > 0], initial=total / n))
     k = min(n // 2, math.ceil(3.0 * smax / max(step, 1e-300)) + 1, _reach(s, total, sigma))
-    num = np.zeros_like(ring)
-    den = np.zeros(n)
+    # the ring, its arc lengths and weights continued k vertices either way (vertex i + o of the
+    # ring is row i + o + k of these; slices, not gathers: the same sums, in half the time)
+    wrap = np.r_[n - k : n, 0:n, 0:k]
+    s_ext = np.concatenate([s[n - k :] - total, s, s[:k] + total])  # s[j] ± total, as it was summed
+    ds_ext, x_ext, y_ext = ds[wrap], ring[wrap, 0], ring[wrap, 1]
+    num_x, num_y, den = np.zeros(n), np.zeros(n), np.zeros(n)
     sig = np.where(sigma > 0, sigma, 1.0)
+    flat = bool((sigma > 0).all())
     for o in range(-k, k + 1):
-        idx = np.arange(n) + o
-        j = idx % n
-        d = s[j] + total * (idx // n) - s  # arc length from vertex i to vertex i + o
-        w = np.exp(-0.5 * (d / sig) ** 2) * ds[j]
-        w = np.where(sigma > 0, w, 1.0 if o == 0 else 0.0)
-        num += w[:, None] * ring[j]
+        a = slice(k + o, k + o + n)
+        d = s_ext[a] - s  # arc length from vertex i to vertex i + o
+        w = np.exp(-0.5 * (d / sig) ** 2) * ds_ext[a]
+        if not flat:
+            w = np.where(sigma > 0, w, 1.0 if o == 0 else 0.0)
+        num_x += w * x_ext[a]
+        num_y += w * y_ext[a]
         den += w
-    return num / den[:, None]
+    return np.column_stack([num_x / den, num_y / den])
 
 
 #: Beyond this many widths ``exp(-x²/2)`` is exactly 0 in double precision (from 38.6 on).

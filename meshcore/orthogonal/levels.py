@@ -452,15 +452,29 @@ def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit
             old = [(X[v], Y[v]) for v in nodes]
             around = np.unique(np.concatenate([mesh.around(v) for v in nodes]))
             before = _score(X, Y, cells, around)
+            bad = _bad_corners(X, Y, cells[around])
             for t, v in enumerate(nodes):
                 w = 1.0 - t / len(nodes)
                 X[v], Y[v] = old[t][0] + w * (at[0] - here[0]), old[t][1] + w * (at[1] - here[1])
-            if _score(X, Y, cells, around)[0] >= before[0]:  # no cell around made non-convex
+            # no cell around made non-convex, nor more corners of a cell that was already
+            if _score(X, Y, cells, around)[0] >= before[0] and _bad_corners(X, Y, cells[around]) <= bad:
                 moved += 1
                 break
             for v, (px, py) in zip(nodes, old, strict=True):
                 X[v], Y[v] = px, py
     return mesh.grids(grids), moved
+
+
+def _bad_corners(X, Y, cells) -> int:
+    """How many corners of ``cells`` are not convex (corner Jacobian ``≤ 0``).  A move that keeps the
+    count of bad cells can still add bad corners to a cell that was bad already: Saimaa's block b114
+    (a block corner with both sides on the shore, non-convex on the coarsest level, 2 × 2 cells) had
+    its corner put on a land tip where the water turns beyond 180°, and no free node could make
+    that cell convex again on any level (the per-block repair keeps the shore fixed): it went out
+    folded."""
+    from .untangle import _corner_jacobians
+
+    return int((_corner_jacobians(X, Y, cells) <= 0).sum())
 
 
 def _cut_line(mesh, n: int) -> list[int]:

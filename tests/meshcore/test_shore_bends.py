@@ -98,6 +98,43 @@ def test_a_block_corner_short_of_a_tip_goes_onto_it():
     assert not len(bad_cells(*_assemble([out], topo.node_map), topo.node_map.cells))
 
 
+def _bad_corners(topo, grids) -> int:
+    m = topo.node_map
+    X, Y = _assemble(grids, m)
+    p = m.cells
+    q, r = np.roll(p, -1, axis=1), np.roll(p, 1, axis=1)
+    return int((((X[q] - X[p]) * (Y[r] - Y[p]) - (Y[q] - Y[p]) * (X[r] - X[p])) <= 0).sum())
+
+
+def test_a_block_corner_is_not_put_on_a_land_tip_its_cell_cannot_go_round():
+    # Saimaa's block b114 on the coarsest level (cells of 4, here 1 fine cell = 1): its corner
+    # (0, 0) has both sides on the shore and its cell is already non-convex there (the corner's
+    # edge to (2.44, 1.39) cuts across a land tip at (0.92, 2.13)); the tip is the ring vertex
+    # where the corner's edges leave the shore least, but on it the corner's angle in its one
+    # cell is reflex: three shore nodes, no free node can make that cell convex on any level and
+    # the grid went out folded.  The move may not add a non-convex corner.
+    X = np.array([[1.34, 3.4, 6.39], [-0.08, 1.07, 2.44], [-1.2, -0.53, 0.0]])
+    Y = np.array([[5.34, 2.84, 1.47], [2.49, 1.95, 1.39], [-0.25, -0.52, 0.0]])
+    topo, g = _one_block(X, Y)
+    tip = [
+        (0.17, 0.39),
+        (0.27, 0.8),
+        (0.38, 1.33),
+        (0.46, 1.69),
+        (0.62, 1.99),
+        (0.92, 2.13),
+        (1.31, 2.06),
+        (1.89, 1.75),
+    ]
+    shore = [(1.34, 5.34), (-0.08, 2.49), (-1.2, -0.25), (-0.53, -0.52), (0.0, 0.0), *tip, (2.44, 1.39), (6.39, 1.47)]
+    rings = _ring([*shore, (3.4, 2.84)], step=0.25)
+    before = _bad_corners(topo, [g])
+    assert before == 1
+    (out,), _ = fit_ends([g], topo, rings, SHORE_GAP * 4)
+    assert _bad_corners(topo, [out]) <= before
+    assert np.hypot(out.x[2, 2] - 0.92, out.y[2, 2] - 2.13) > 0.5  # not on the tip
+
+
 def test_nothing_moves_where_the_grid_follows_the_shore():
     X, Y = np.meshgrid(np.linspace(0.0, 4.0, 9), np.linspace(0.0, 1.0, 5), indexing="ij")
     topo, g = _one_block(X, Y)
