@@ -466,3 +466,48 @@ def corner_jacobians(x, y):
                 ux, uy = cx[ta] - cx[t], cy[ta] - cy[t]
                 out[t, ci, cj] = ux * (cy[tb] - cy[t]) - uy * (cx[tb] - cx[t])
     return out
+
+
+@njit(cache=True, nogil=True)
+def untangle(x, y, nodes, cells, exempt, eps, eps_floor, tol, inner, max_outer, periodic):
+    """The untangling loop of :func:`meshcore.foldfree.minimise.minimise` (its steps one for one,
+    kept here so that a piece's hundreds of ε steps make no Python calls): at each ε up to
+    ``inner`` sweeps until the energy stalls, then ε shrinks by the rule of Garanzha et al.
+    Returns ``(least corner Jacobian, sweeps)``."""
+    sweeps = 0
+    e_prev, _ = patch_stats(x, y, cells, eps, exempt)
+    dmin = -_INF
+    e = e_prev
+    for _outer in range(max_outer):
+        e_in = e_prev
+        for _ in range(inner):
+            d = sweep(x, y, nodes, eps, _INF, 1.0, periodic)
+            sweeps += 1
+            e, dmin = patch_stats(x, y, cells, eps, exempt)
+            if d <= tol or dmin > 0.0 or e_in - e <= 1e-3 * e:
+                break
+            e_in = e
+        if dmin > 0.0:
+            break
+        sigma = max(1.0 - e / e_prev, 0.1)
+        chi = 0.5 * (dmin + math.sqrt(eps * eps + dmin * dmin))
+        mu = (1.0 - sigma) * chi
+        eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
+        eps = max(eps, eps_floor)
+        if eps < 1e-4 * abs(dmin):
+            break  # stagnated: ε has vanished next to the worst inverted corner
+        e_prev, _ = patch_stats(x, y, cells, eps, exempt)
+    return dmin, sweeps
+
+
+@njit(cache=True, nogil=True)
+def barrier_sweeps(x, y, nodes, tol, max_sweeps, omega, periodic):
+    """Up to ``max_sweeps`` ε = 0 sweeps (over-relaxed by ``omega``), until no node moves more
+    than ``tol``; the sweeps made."""
+    sweeps = 0
+    for _ in range(max_sweeps):
+        d = sweep(x, y, nodes, 0.0, _INF, omega, periodic)
+        sweeps += 1
+        if d <= tol:
+            break
+    return sweeps

@@ -36,39 +36,14 @@ def minimise(
     """
     inner = _INNER if inner is None else inner
     sweeps = 0
-    step = np.inf
     _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
     if dmin <= 0.0:
         eps_floor = 1e-12 * _median_area(x, y, cells)
         eps = max(math.sqrt(0.04 * dmin * dmin), eps_floor)
-        e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
-        for _outer in range(max_outer):
-            # minimise at this ε until the energy stalls (≤ inner sweeps)
-            e_in = e_prev
-            for _ in range(inner):
-                d = _kernels.sweep(x, y, nodes, eps, step, 1.0, periodic)
-                sweeps += 1
-                e, dmin = _kernels.patch_stats(x, y, cells, eps, exempt)
-                if d <= tol or dmin > 0.0 or e_in - e <= 1e-3 * e:
-                    break
-                e_in = e
-            if dmin > 0.0:
-                break
-            sigma = max(1.0 - e / e_prev, 0.1)
-            chi = 0.5 * (dmin + math.sqrt(eps * eps + dmin * dmin))
-            mu = (1.0 - sigma) * chi
-            eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
-            eps = max(eps, eps_floor)
-            if eps < 1e-4 * abs(dmin):
-                break  # stagnated: ε has vanished next to the worst inverted corner
-            e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
+        dmin, sweeps = _kernels.untangle(x, y, nodes, cells, exempt, eps, eps_floor, tol, inner, max_outer, periodic)
         if dmin <= 0.0:
             return False, sweeps
-    for _ in range(max_sweeps):
-        d = _kernels.sweep(x, y, nodes, 0.0, step, omega, periodic)
-        sweeps += 1
-        if d <= tol:
-            break
+    sweeps += _kernels.barrier_sweeps(x, y, nodes, tol, max_sweeps, omega, periodic)
     _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
     return dmin > 0.0, sweeps
 
