@@ -87,6 +87,7 @@ def patches(
     inner: int | None = None,
     periodic: bool = False,
     max_radius: int | None = None,
+    give_up_early: bool = False,
 ) -> tuple[bool, int, int]:
     """Barrier minimisation on patches around ``bad``, each connected patch on its own.
 
@@ -99,6 +100,9 @@ def patches(
     locally no longer makes every other one grow with it, and the cost
     follows the size of the pieces, not of the block.  Returns
     ``(ok, free nodes, sweeps)``; on failure the repaired pieces stay.
+    ``give_up_early``: return ``ok = False`` as soon as the failure is certain (a piece given up,
+    or failed at the last radius), the other pieces untried (for a caller that then discards the
+    grid).
     """
     ni, nj = bad.shape
     r = max(1, int(radius))
@@ -110,13 +114,18 @@ def patches(
         whole = r >= max(ni, nj)
         mask = np.ones_like(bad) if whole else _dilate(todo, r, periodic)
         failed = np.zeros_like(bad)
+        last = whole or (max_radius is not None and 2 * r > max_radius)
         for piece in [mask] if whole else _components(mask, periodic):
             if max_fraction < 1.0 and piece.sum() > max_fraction * piece.size:
                 given_up |= piece & todo
+                if give_up_early:
+                    return False, nfree, total
                 continue
             nodes = _nodes_of(piece, periodic)
             if nodes.size == 0:
                 given_up |= piece & todo
+                if give_up_early:
+                    return False, nfree, total
                 continue
             cells = _touched_cells(nodes, (ni, nj), periodic)
             h = _median_edge(x, y, cells)
@@ -139,6 +148,8 @@ def patches(
                 if periodic:
                     x[-1, :], y[-1, :] = x[0, :], y[0, :]
                 failed |= piece
+                if give_up_early and last:
+                    return False, nfree, total
         if whole:
             given_up |= failed
         todo = invalid_cells(x, y, ex_bits) & ~given_up
