@@ -184,6 +184,11 @@ def compile_all() -> float:
     g = StructuredGrid(folded, Y)
     repair(g, strict=False)
     smooth(g, strict=False, max_sweeps=20)
+    # a fold whose patch is small enough to be tried: the untangling loop (its own kernel)
+    s17 = np.linspace(0.0, 1.0, 17)
+    X17, Y17 = np.meshgrid(2.0 * s17, s17, indexing="ij")
+    X17[8, 8] = X17[10, 8]
+    repair(StructuredGrid(X17, Y17), strict=False)
 
     def block(name, a, b):
         from .boundary import Borders

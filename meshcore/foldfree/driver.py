@@ -63,6 +63,7 @@ converged.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -409,9 +410,9 @@ def _multilevel(
         x[-1, :], y[-1, :] = x[0, :], y[0, :]
     # patches no wider than the transplant: a seam they cannot repair (the coarse start's rows
     # follow arms where the kept grid's did not) is the whole coarse start's case
-    ok, nf, sw = patches(
-        x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=radius, max_fraction=0.3, max_radius=TRANSPLANT, **opts
-    )
+    placed = (x.copy(), y.copy())
+    transplant = {"radius": radius, "max_fraction": 0.3, "max_radius": TRANSPLANT, **opts}
+    ok, nf, sw = patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, give_up_early=True, **transplant)
     total += sw
     if ok:
         # relax the seam between the coarse start and the kept grid: barrier sweeps around the region
@@ -419,10 +420,14 @@ def _multilevel(
             total += _relax(x, y, _dilate(region, SEAM, grid.periodic), ex_bits, opts)
         path.append("transplant")
         return True, nfree + nf, total
-    now = int(invalid_cells(x, y, ex_bits).sum())
-    if now < best[0]:
-        best = (now, x.copy(), y.copy())
-    return _whole_start(x, y, x2, y2, ex_bits, radius, opts, nfree, total, best, path)
+
+    def finished() -> tuple[int, np.ndarray, np.ndarray]:
+        # the failed transplant with all its pieces tried: the grid kept if the whole start fails too
+        xf, yf = placed[0].copy(), placed[1].copy()
+        patches(xf, yf, invalid_cells(xf, yf, ex_bits), ex_bits, **transplant)
+        return int(invalid_cells(xf, yf, ex_bits).sum()), xf, yf
+
+    return _whole_start(x, y, x2, y2, ex_bits, radius, opts, nfree, total, best, path, finished)
 
 
 def _whole_start(
@@ -437,10 +442,12 @@ def _whole_start(
     total: int,
     best: tuple,
     path: list[str],
+    transplant: Callable[[], tuple[int, np.ndarray, np.ndarray]] | None = None,
 ) -> tuple[bool, int, int]:
     """Step (2) of :func:`_multilevel`: the whole coarse start ``x2, y2``, its bad cells repaired
-    locally, the block relaxed; on failure ``x, y`` become ``best`` (``(bad cells, x, y)``) unless
-    the coarse start has fewer bad cells."""
+    locally, the block relaxed; on failure ``x, y`` become ``best`` (``(bad cells, x, y)``, or the
+    failed transplant's grid ``transplant()`` if that has fewer) unless the coarse start has fewer
+    bad cells."""
     x[...], y[...] = x2, y2
     ok, _, sw = patches(x, y, invalid_cells(x, y, ex_bits), ex_bits, radius=radius, max_fraction=0.3, **opts)
     total += sw
@@ -450,6 +457,10 @@ def _whole_start(
         path.append("coarse")
         return True, len(_nodes_of(whole, opts["periodic"])), total + _relax(x, y, whole, ex_bits, opts)
     now = int(invalid_cells(x, y, ex_bits).sum())
+    if transplant is not None:
+        tried = transplant()
+        if tried[0] < best[0]:
+            best = tried
     if now >= best[0]:
         x[...], y[...] = best[1], best[2]
     return False, nfree, total

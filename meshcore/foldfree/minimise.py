@@ -36,39 +36,14 @@ def minimise(
     """
     inner = _INNER if inner is None else inner
     sweeps = 0
-    step = np.inf
     _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
     if dmin <= 0.0:
         eps_floor = 1e-12 * _median_area(x, y, cells)
         eps = max(math.sqrt(0.04 * dmin * dmin), eps_floor)
-        e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
-        for _outer in range(max_outer):
-            # minimise at this ε until the energy stalls (≤ inner sweeps)
-            e_in = e_prev
-            for _ in range(inner):
-                d = _kernels.sweep(x, y, nodes, eps, step, 1.0, periodic)
-                sweeps += 1
-                e, dmin = _kernels.patch_stats(x, y, cells, eps, exempt)
-                if d <= tol or dmin > 0.0 or e_in - e <= 1e-3 * e:
-                    break
-                e_in = e
-            if dmin > 0.0:
-                break
-            sigma = max(1.0 - e / e_prev, 0.1)
-            chi = 0.5 * (dmin + math.sqrt(eps * eps + dmin * dmin))
-            mu = (1.0 - sigma) * chi
-            eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
-            eps = max(eps, eps_floor)
-            if eps < 1e-4 * abs(dmin):
-                break  # stagnated: ε has vanished next to the worst inverted corner
-            e_prev, _ = _kernels.patch_stats(x, y, cells, eps, exempt)
+        dmin, sweeps = _kernels.untangle(x, y, nodes, cells, exempt, eps, eps_floor, tol, inner, max_outer, periodic)
         if dmin <= 0.0:
             return False, sweeps
-    for _ in range(max_sweeps):
-        d = _kernels.sweep(x, y, nodes, 0.0, step, omega, periodic)
-        sweeps += 1
-        if d <= tol:
-            break
+    sweeps += _kernels.barrier_sweeps(x, y, nodes, tol, max_sweeps, omega, periodic)
     _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
     return dmin > 0.0, sweeps
 
@@ -112,6 +87,7 @@ def patches(
     inner: int | None = None,
     periodic: bool = False,
     max_radius: int | None = None,
+    give_up_early: bool = False,
 ) -> tuple[bool, int, int]:
     """Barrier minimisation on patches around ``bad``, each connected patch on its own.
 
@@ -124,6 +100,9 @@ def patches(
     locally no longer makes every other one grow with it, and the cost
     follows the size of the pieces, not of the block.  Returns
     ``(ok, free nodes, sweeps)``; on failure the repaired pieces stay.
+    ``give_up_early``: return ``ok = False`` as soon as the failure is certain (a piece given up,
+    or failed at the last radius), the other pieces untried (for a caller that then discards the
+    grid).
     """
     ni, nj = bad.shape
     r = max(1, int(radius))
@@ -135,13 +114,18 @@ def patches(
         whole = r >= max(ni, nj)
         mask = np.ones_like(bad) if whole else _dilate(todo, r, periodic)
         failed = np.zeros_like(bad)
+        last = whole or (max_radius is not None and 2 * r > max_radius)
         for piece in [mask] if whole else _components(mask, periodic):
             if max_fraction < 1.0 and piece.sum() > max_fraction * piece.size:
                 given_up |= piece & todo
+                if give_up_early:
+                    return False, nfree, total
                 continue
             nodes = _nodes_of(piece, periodic)
             if nodes.size == 0:
                 given_up |= piece & todo
+                if give_up_early:
+                    return False, nfree, total
                 continue
             cells = _touched_cells(nodes, (ni, nj), periodic)
             h = _median_edge(x, y, cells)
@@ -164,6 +148,8 @@ def patches(
                 if periodic:
                     x[-1, :], y[-1, :] = x[0, :], y[0, :]
                 failed |= piece
+                if give_up_early and last:
+                    return False, nfree, total
         if whole:
             given_up |= failed
         todo = invalid_cells(x, y, ex_bits) & ~given_up

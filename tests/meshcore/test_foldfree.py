@@ -116,16 +116,16 @@ def test_trial_energy_is_the_full_evaluations_energy(eps, periodic):
 @pytest.mark.parametrize("periodic", [False, True])
 def test_the_sweep_forms_give_the_node_energy_here_and_at_trial_points(eps, periodic):
     # the sweep takes each node's triangle forms (F quadratic, D affine in the node) once: the
-    # energy, gradient and Hessian from them are node_local's bit for bit, and a trial point's
-    # energy from them is node_local's there up to rounding, with the same verdict on inverted
+    # energy, gradient and Hessian from them are node_local's (up to rounding: summed in another
+    # order), and so is a trial point's energy from them, with the same verdict on inverted
     # triangles (at points that invert some of them)
     x, y = random_grid(ni=9, nj=6, amp=0.2, seed=21)
     if periodic:
         x[-1, :], y[-1, :] = x[0, :], y[0, :]
     rng = np.random.default_rng(22)
     ref, out, there = np.empty(6), np.empty(6), np.empty(6)
-    cx, cy = np.empty(4), np.empty(4)
-    forms = np.empty((12, 7))
+    cx, cy = np.empty(9), np.empty(9)
+    forms = np.empty((7, 12))
     verdicts = set()
     for i in range(0 if periodic else 1, x.shape[0] - 1):
         for j in range(1, x.shape[1] - 1):
@@ -135,8 +135,8 @@ def test_the_sweep_forms_give_the_node_energy_here_and_at_trial_points(eps, peri
             assert _kernels._form_local(forms, n, eps, out) == ok
             if not ok:
                 continue
-            np.testing.assert_array_equal(out, ref)
-            assert _kernels._form_energy(forms, n, 0.0, 0.0, eps) == ref[0]
+            np.testing.assert_allclose(out, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+            assert _kernels._form_energy(forms, n, 0.0, 0.0, eps) == pytest.approx(ref[0], rel=1e-12)
             for scale in (0.05, 0.3):
                 dx, dy = scale * rng.standard_normal(2)
                 ok = _kernels.node_local(x, y, i, j, x[i, j] + dx, y[i, j] + dy, eps, there, periodic)

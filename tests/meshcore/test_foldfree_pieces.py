@@ -118,6 +118,50 @@ def test_pieces_grow_no_wider_than_max_radius(monkeypatch):
     assert not ok and max(abs(i - 60).max() for i in tried) > 8 + 1
 
 
+def test_a_transplant_that_must_fail_stops_at_its_first_failed_piece(monkeypatch):
+    # two places no patch within the transplant's radius repairs (top-border nodes below the
+    # bottom border): give_up_early gives the same verdict once the failure is certain (the first
+    # piece failed at the last radius), the second piece untried then; where every piece
+    # succeeds (a node pushed across its neighbour) it returns the same grid
+    import meshcore.foldfree.minimise as mm
+
+    x, y = _rectangle(120, 20)
+    y[30, -1] = -1.0  # tried first (column order)
+    y[90, -1] = -1.0
+    bad = invalid_cells(x, y)
+    tried = []
+    real = mm.minimise
+
+    def spy(x, y, nodes, *args, **kw):
+        tried.append(nodes[:, 0].copy())
+        return real(x, y, nodes, *args, **kw)
+
+    monkeypatch.setattr(mm, "minimise", spy)
+    opts = {"tolerance": 1e-4, "max_sweeps": 50, "radius": 2, "max_fraction": 0.3, "max_radius": 8}
+    ex = np.zeros(bad.shape, dtype=np.uint8)
+    full = mm.patches(x.copy(), y.copy(), bad, ex, **opts)
+    n_full = len(tried)
+    near_90 = sum(abs(i - 90).max() <= 8 + 1 for i in tried)
+    tried.clear()
+    early = mm.patches(x.copy(), y.copy(), bad, ex, give_up_early=True, **opts)
+    assert not full[0] and not early[0]
+    assert len(tried) == n_full - 1  # radius 2, 4, 8 for the first place, 2, 4 for the second
+    assert abs(tried[-1] - 30).max() <= 8 + 1
+    assert sum(abs(i - 90).max() <= 8 + 1 for i in tried) == near_90 - 1
+    # a repairable place: the same grid either way
+    x, y = _rectangle(120, 20)
+    x[90, 10] += 0.4
+    bad = invalid_cells(x, y)
+    assert bad.any()
+    grids = []
+    for early_stop in (False, True):
+        xc, yc = x.copy(), y.copy()
+        assert mm.patches(xc, yc, bad, ex, give_up_early=early_stop, **opts)[0]
+        grids.append((xc, yc))
+    np.testing.assert_array_equal(grids[0][0], grids[1][0])
+    np.testing.assert_array_equal(grids[0][1], grids[1][1])
+
+
 @pytest.mark.parametrize(("wide", "seam"), [(True, False), (True, True), (False, False)])
 def test_a_coarse_level_goes_to_the_whole_start_when_the_level_below_needed_it(monkeypatch, wide, seam):
     # the coarse start's own repair needed its whole coarse start ("wide"): on a coarse level
