@@ -135,7 +135,8 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         self.set_project(project, path)
         self.add_recent(path)
-        self.win.set_tool("edit")
+        # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
+        self.win.set_tool("layout" if project.layout is not None else "edit")
         self.win.message(f"Opened {path.name}: press F5 to generate")
         return True
 

@@ -23,7 +23,7 @@ from . import actions
 from . import geometry as geo
 from . import io_adapter as fio
 from .background import BackgroundController
-from .commands import Editor, SetBlockOptions
+from .commands import LAYOUT_HINT, Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
@@ -204,6 +204,13 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             again = "Ctrl+Y redoes it" if name == "undo" else "Ctrl+Z undoes it"
             self.message(f"{'Undone' if name == 'undo' else 'Redone'}: {text} ({again})")
 
+    def _keep_in_sight(self, _index: int = 0) -> None:
+        """After an undo or redo the project may lie wholly outside the view: the view fits it (an
+        import undone left the view on the other lake, the canvas empty: the lake looked lost)."""
+        bounds = self.doc.project.bounds()
+        if bounds is not None and not self.canvas.shows_any_of(bounds):
+            self.canvas.fit()
+
     def _examples_menu(self, m: QtWidgets.QMenu) -> None:
         m.addSection("Paper cases")
         for name in example_names():
@@ -234,6 +241,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
         self.stack.cleanChanged.connect(self._update_title)
+        self.stack.indexChanged.connect(self._keep_in_sight)
 
     # ------------------------------------------------------------ status
     def message(self, text: str, *, error: bool = False) -> None:
@@ -302,9 +310,15 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
     def delete_selection(self) -> None:
         if self.canvas.tool is not None and self.canvas.tool.delete():  # a cut line, with the Layout tool
             return
+        if self.doc.project.layout is not None:  # Edit ▸ Delete did nothing, silently, on a laid-out lake
+            self.message(LAYOUT_HINT)
+            return
         self.editor.delete_points(self.doc.selection)
 
     def select_all(self) -> None:
+        if self.doc.project.layout is not None:  # a layout's blocks have no points to select
+            self.message(LAYOUT_HINT)
+            return
         self.doc.set_selection(range(len(self.doc.block.points)))
 
     def auto_corners(self) -> None:

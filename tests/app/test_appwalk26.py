@@ -54,3 +54,45 @@ def test_an_outline_that_crosses_itself_is_not_offered_auto_layout(qtbot, win, t
     assert win.lake_ctl.prompt is None
     status = win._status.text()
     assert "crosses itself" in status and "point 1" in status and "Auto layout" in status
+
+
+def test_undo_of_an_import_shows_the_lake_again(qtbot, win, tmp_path):
+    """An outline imported over a lake fits the view to it; Ctrl+Z brought the lake back but the
+    view stayed on the other outline, far away: an empty canvas, the lake looked lost."""
+    _laid_out(qtbot, win, tmp_path, 862602)
+    lake = win.doc.project.bounds()
+    far = tmp_path / "far.csv"
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    far.write_text("x,y\n" + "\n".join(f"{5e6 + 800 * np.cos(a):.2f},{800 * np.sin(a):.2f}" for a in t) + "\n")
+    assert win.io.import_points(far)
+    assert not win.canvas.shows_any_of(lake)
+    win.stack.undo()
+    assert win.canvas.shows_any_of(lake)
+    win.stack.redo()
+    assert win.canvas.shows_any_of(win.doc.project.bounds())
+
+
+def test_a_laid_out_lake_says_which_tool_edits_it(qtbot, win, tmp_path):
+    """A saved lake layout reopened in the Edit tool: a click said "use Block ▸ Convert to loop to
+    edit points", which then refused ("These blocks are the lake's layout ..."); Select all and
+    Delete did nothing and said nothing.  The Layout tool (Y) drags its points: each says so, and
+    the project reopens in it."""
+    from app.commands import LAYOUT_HINT
+
+    _laid_out(qtbot, win, tmp_path, 862603)
+    win.set_tool("edit")
+    x0, y0, x1, y1 = win.doc.project.bounds()
+    win.canvas.tool.click(((x0 + x1) / 2, (y0 + y1) / 2))
+    assert win._status.text() == LAYOUT_HINT and "Layout tool" in LAYOUT_HINT
+    win.message("")
+    win.a_select_all.trigger()
+    assert win._status.text() == LAYOUT_HINT
+    win.message("")
+    win.a_delete.trigger()
+    assert win._status.text() == LAYOUT_HINT
+    win.message("")
+    win.convert_to_loop()
+    assert win._status.text() == LAYOUT_HINT
+    assert win.io.save_to(tmp_path / "lake.toml")
+    assert win.io.open_path(tmp_path / "lake.toml")
+    assert win.canvas.tool.name == "layout"
