@@ -457,10 +457,12 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         if not h > 0:
             g = self.doc.grid
             h = max(g.bounds()[2] - g.bounds()[0], g.bounds()[3] - g.bounds()[1]) / 50 if g is not None else 1.0
-        self.canvas.zoom_to_point(where.x, where.y, 4 * h)
         names = [b.name for b in self.doc.project.blocks]
         if where.block in names:  # its block's numbers in the Quality panel, its row in Blocks
             self.doc.set_active(names.index(where.block))
+        # after the block is made active: its quality, drawn anew, clears the canvas's ring (the worst
+        # place of a block not active was zoomed to but not ringed: a user could not tell which node)
+        self.canvas.zoom_to_point(where.x, where.y, 4 * h)
         text = str(where)
         if what.startswith("folded"):  # its limit "…: none" and a flag for a value read "none: 1 at b8(1,50)"
             what, text = what.removesuffix(": none"), "a cell at " + text.split(" at ", 1)[-1]

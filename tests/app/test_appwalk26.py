@@ -96,3 +96,21 @@ def test_a_laid_out_lake_says_which_tool_edits_it(qtbot, win, tmp_path):
     assert win.io.save_to(tmp_path / "lake.toml")
     assert win.io.open_path(tmp_path / "lake.toml")
     assert win.canvas.tool.name == "layout"
+
+
+def test_the_worst_place_of_a_failed_limit_is_ringed_in_a_block_not_active(qtbot, win, tmp_path):
+    """A click on a failed limit zoomed to its worst place and made its block the active one; the
+    active block's quality, drawn anew, cleared the ring: a fan of thin cells on screen and no way
+    to tell which node was the worst."""
+    _laid_out(qtbot, win, tmp_path, 862604)
+    box = win.lake_quality
+    names = [b.name for b in win.doc.project.blocks]
+    rows = [k for k, r in enumerate(box.verdict.results) if r.passed is False and r.worst]
+    assert rows
+    for row in rows:
+        worst = box.verdict.results[row].worst[0]
+        win.doc.set_active(next(k for k, n in enumerate(names) if n != worst.block))
+        box.table.activated.emit(box.table.model().index(row, 0))
+        assert names[win.doc.active] == worst.block
+        assert list(win.canvas.highlight_item.data["x"]) == [worst.x]
+        assert list(win.canvas.highlight_item.data["y"]) == [worst.y]
