@@ -114,3 +114,21 @@ def test_the_worst_place_of_a_failed_limit_is_ringed_in_a_block_not_active(qtbot
         assert names[win.doc.active] == worst.block
         assert list(win.canvas.highlight_item.data["x"]) == [worst.x]
         assert list(win.canvas.highlight_item.data["y"]) == [worst.y]
+
+
+def test_the_active_block_is_in_sight_in_the_blocks_panel(qtbot, win, tmp_path):
+    """A worst place (or a click on the canvas) made b20 of a 76-block lake active: the Blocks
+    panel showed b0 … b14, the active block expanded out of sight below."""
+    from app.views.panels import BlocksPanel
+
+    _laid_out(qtbot, win, tmp_path, 862605)
+    tree = BlocksPanel(win.doc)
+    qtbot.addWidget(tree)
+    tree.setFixedSize(300, 70)  # room for a few rows only
+    tree.show()
+    qtbot.waitExposed(tree)
+    n = len(win.doc.project.blocks)
+    assert n >= 4
+    for k in (n - 1, 0, n - 2):
+        win.doc.set_active(k)
+        assert tree.viewport().rect().intersects(tree.visualItemRect(tree.topLevelItem(k)))
