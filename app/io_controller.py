@@ -137,7 +137,10 @@ class IOController(ExportMixin, QtCore.QObject):
         self.add_recent(path)
         # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
         self.win.set_tool("layout" if project.layout is not None else "edit")
-        self.win.message(f"Opened {path.name}: press F5 to generate")
+        if self.win.solver.auto and any(b.ready for b in project.blocks):  # it said "press F5" as it solved
+            self.win.message(f"Opened {path.name}: generating its grid (auto-generate on)")
+        else:
+            self.win.message(f"Opened {path.name}: press F5 to generate")
         return True
 
     def open_example(self, name: str, *, confirm: bool = True) -> bool:

@@ -132,3 +132,18 @@ def test_the_active_block_is_in_sight_in_the_blocks_panel(qtbot, win, tmp_path):
     for k in (n - 1, 0, n - 2):
         win.doc.set_active(k)
         assert tree.viewport().rect().intersects(tree.visualItemRect(tree.topLevelItem(k)))
+
+
+def test_a_project_opened_with_auto_generate_on_does_not_say_press_f5(qtbot, win, tmp_path):
+    """Auto-generate on (remembered): a saved lake opened, its grid being made, and the status line
+    said "Opened lake.toml: press F5 to generate"."""
+    _laid_out(qtbot, win, tmp_path, 862606)
+    assert win.io.save_to(tmp_path / "lake.toml")
+    win.a_auto.trigger()
+    assert win.io.open_path(tmp_path / "lake.toml")
+    assert "F5" not in win._status.text() and "generating" in win._status.text()
+    wait_idle(qtbot, win)
+    assert not win.doc.stale and win.doc.grids
+    win.a_auto.trigger()  # off: F5 makes the grid
+    assert win.io.open_path(tmp_path / "lake.toml")
+    assert "press F5" in win._status.text()
