@@ -3,6 +3,8 @@ exported, saved, reopened, broken files): each as it went wrong, on generated sh
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -43,8 +45,6 @@ def test_an_outline_that_crosses_itself_is_not_offered_auto_layout(qtbot, win, t
     """A lon/lat outline that crosses itself: the import said in Messages that meshcore mesh refuses
     it (fix it first), and at once offered Auto layout ("lays the lake out in blocks"), whose
     button then failed with the same crossing.  Now no offer; the status line says why."""
-    import json
-
     t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     ring = np.c_[10 + 0.05 * np.sin(t), 60 + 0.03 * np.sin(2 * t)].tolist()
     path = tmp_path / "eight.geojson"
@@ -147,3 +147,25 @@ def test_a_project_opened_with_auto_generate_on_does_not_say_press_f5(qtbot, win
     win.a_auto.trigger()  # off: F5 makes the grid
     assert win.io.open_path(tmp_path / "lake.toml")
     assert "press F5" in win._status.text()
+
+
+def test_a_bad_point_in_a_kml_or_geojson_is_counted_from_1(qtbot, win, tmp_path):
+    """Messages count points from 1 (CSV lines, crossing edges): a KML's bad second tuple was
+    "coordinate tuple 1", a GeoJSON's bad third position "feature 0 (feature 1) ring 0: position 2"."""
+    ring = [(10.0, 60.0), (10.1, 60.0), (10.1, 60.1), (10.0, 60.1), (10.0, 60.0)]
+    coords = " ".join(f"{x},{y},0" for x, y in ring).replace("10.1,60.0,0", "10.1,,0")
+    kml = tmp_path / "bad.kml"
+    kml.write_text(
+        '<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark><name>shore</name><Polygon>'
+        f"<outerBoundaryIs><LinearRing><coordinates>{coords}</coordinates></LinearRing></outerBoundaryIs>"
+        "</Polygon></Placemark></Document></kml>"
+    )
+    assert not win.io.import_points(kml, project_lonlat=True)
+    assert "placemark 1 (shore) outerBoundaryIs: coordinate tuple 2 '10.1,,0'" in win._status.text()
+    good = {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+    bad = {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [[*ring]]}}
+    bad["geometry"]["coordinates"][0][2] = ["x", 60.1]
+    gj = tmp_path / "bad.geojson"
+    gj.write_text(json.dumps({"type": "FeatureCollection", "features": [good, bad]}))
+    assert not win.io.import_points(gj, project_lonlat=True)
+    assert "feature 2 (feature 2) ring 1: position 3 is not a list of numbers" in win._status.text()
