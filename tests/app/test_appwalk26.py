@@ -53,7 +53,9 @@ def test_an_outline_that_crosses_itself_is_not_offered_auto_layout(qtbot, win, t
     assert win.doc.project.lake is not None  # imported, to be fixed by hand
     assert win.lake_ctl.prompt is None
     status = win._status.text()
-    assert "crosses itself" in status and "point 1" in status and "Auto layout" in status
+    assert "crosses itself" in status and "Auto layout" in status
+    # both edges by their two points (the second was "the edge from point 20")
+    assert "the edge from point 1 to 2 meets the edge from point 20 to 21" in status
 
 
 def test_undo_of_an_import_shows_the_lake_again(qtbot, win, tmp_path):
