@@ -171,3 +171,20 @@ def test_a_bad_point_in_a_kml_or_geojson_is_counted_from_1(qtbot, win, tmp_path)
     gj.write_text(json.dumps({"type": "FeatureCollection", "features": [good, bad]}))
     assert not win.io.import_points(gj, project_lonlat=True)
     assert "feature 2 (feature 2) ring 1: position 3 is not a list of numbers" in win._status.text()
+
+
+def test_export_after_an_edit_says_the_grid_on_screen_is_of_before_it(qtbot, win, tmp_path):
+    """Auto-generate off, a block given other cells (or a drag that stretched one): the grid of
+    before stays on screen, greyed; File ▸ Export mesh said "Nothing to export yet: generate a grid
+    first (F5)" over it."""
+    _laid_out(qtbot, win, tmp_path, 862607)
+    assert not win.solver.auto
+    ni, nj = win.doc.project.layout.blocks[0].cells
+    win.lake_ctl.set_block_cells(0, (ni + 4, nj))
+    wait_idle(qtbot, win)
+    assert win.doc.before_grids and not win.doc.grids  # the greyed grid of before the edit
+    win.io.export_dialog()
+    text = win._status.text()
+    assert "Nothing to export" not in text and "before the last edit" in text and "F5" in text
+    assert not win.io.export_mesh(tmp_path / "lake.vtm")
+    assert "before the last edit" in win._status.text() and not (tmp_path / "lake.vtm").exists()
