@@ -242,6 +242,10 @@ class IOController(ExportMixin, QtCore.QObject):
             self.win.error("Cannot import points", exc)
             return False
         pts = pd.points
+        if len(pts) < 3:  # no lake, no block: one error (it also warned "not read as a lake (needs at least 3
+            # distinct points); its largest line is imported as one block", and nothing was imported)
+            self.win.error("Cannot import points", f"{path}: needs at least 3 points, found {len(pts)}")
+            return False
         if pd.note:  # metres in a lon/lat format: read as local metres (the app has no --source-crs)
             self.doc.report("warning", pd.note)
         # a lake's project gets a new lake, in the file's own frame (the UTM zone of a lon/lat outline,

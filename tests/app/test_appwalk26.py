@@ -188,3 +188,14 @@ def test_export_after_an_edit_says_the_grid_on_screen_is_of_before_it(qtbot, win
     assert "Nothing to export" not in text and "before the last edit" in text and "F5" in text
     assert not win.io.export_mesh(tmp_path / "lake.vtm")
     assert "before the last edit" in win._status.text() and not (tmp_path / "lake.vtm").exists()
+
+
+def test_a_file_of_two_points_is_one_error(qtbot, win, tmp_path):
+    """A CSV of two points: a warning that it was "not read as a lake ...; its largest line is
+    imported as one block", then the error that it needs 4 points — and nothing imported."""
+    said = []
+    win.doc.reported.connect(lambda level, text: said.append((level, text)))
+    f = tmp_path / "two.csv"
+    f.write_text("x,y\n0,0\n1,1\n")
+    assert not win.io.import_points(f)
+    assert len(said) == 1 and said[0][0] == "error" and "needs at least 3 points, found 2" in said[0][1]
