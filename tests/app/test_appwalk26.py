@@ -33,7 +33,8 @@ def test_undo_back_to_a_gridded_lake_after_a_failed_solve_shows_its_grid_as_curr
     assert win.solver.auto
     assert win.io.import_points(_eight(tmp_path / "eight.csv"))
     wait_idle(qtbot, win)
-    assert win.solver.last_error  # the eight cannot be gridded
+    assert win.solver.last_error  # the eight cannot be gridded: where, its points counted from 1
+    assert "the edge from point" in win.solver.last_error and "segment" not in win.solver.last_error
     win.stack.undo()
     wait_idle(qtbot, win)
     assert win.doc.project is solved and win.doc.grids == grids and not win.doc.stale
