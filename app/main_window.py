@@ -205,10 +205,16 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             self.message(f"{'Undone' if name == 'undo' else 'Redone'}: {text} ({again})")
 
     def _keep_in_sight(self, _index: int = 0) -> None:
-        """After an undo or redo the project may lie wholly outside the view: the view fits it (an
-        import undone left the view on the other lake, the canvas empty: the lake looked lost)."""
-        bounds = self.doc.project.bounds()
-        if bounds is not None and not self.canvas.shows_any_of(bounds):
+        """After an undo or redo of another lake (an import: another title or frame) or one that leaves
+        the project wholly outside the view, the view fits it (an import undone left the view on the
+        other lake, the canvas empty: the lake looked lost)."""
+        p, seen = self.doc.project, self._in_sight
+        self._in_sight = p
+        other = seen is not None and (
+            (p.crs, p.origin) != (seen.crs, seen.origin) or bool(p.title and seen.title and p.title != seen.title)
+        )
+        bounds = p.bounds()
+        if bounds is not None and (other or not self.canvas.shows_any_of(bounds)):
             self.canvas.fit()
 
     def _examples_menu(self, m: QtWidgets.QMenu) -> None:
@@ -241,7 +247,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
         self.stack.cleanChanged.connect(self._update_title)
+        self._in_sight = None  # the project the view was last kept on (_keep_in_sight)
         self.stack.indexChanged.connect(self._keep_in_sight)
+        self.doc.opened.connect(lambda: setattr(self, "_in_sight", self.doc.project))
 
     # ------------------------------------------------------------ status
     def message(self, text: str, *, error: bool = False) -> None:

@@ -75,6 +75,27 @@ def test_undo_of_an_import_shows_the_lake_again(qtbot, win, tmp_path):
     assert win.canvas.shows_any_of(win.doc.project.bounds())
 
 
+def test_undo_of_an_import_in_another_frame_fits_the_lake_back(qtbot, win, tmp_path):
+    """The walk's case: Lake g180632 (UTM 35N) and a small outline imported over it (UTM 32N, its
+    local origin elsewhere); undo left the view on the small outline's few kilometres round the
+    local origin, inside the lake's bounding box but showing none of it."""
+    import shapely
+
+    _laid_out(qtbot, win, tmp_path, 862608)
+    lake = win.doc.project.bounds()
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    small = tmp_path / "small.geojson"
+    ring = [[10 + 0.002 * np.cos(a), 60 + 0.001 * np.sin(a)] for a in t]
+    small.write_text(json.dumps({"type": "Polygon", "coordinates": [[*ring, ring[0]]]}))
+    assert win.io.import_points(small, project_lonlat=True)
+    (x0, x1), (y0, y1) = win.canvas._vb.viewRange()
+    win.stack.undo()
+    (u0, u1), (v0, v1) = win.canvas._vb.viewRange()
+    assert (u0, u1, v0, v1) != (x0, x1, y0, y1)
+    view = shapely.box(u0, v0, u1, v1)
+    assert view.contains(shapely.box(*lake))  # fitted: the whole lake in sight
+
+
 def test_a_laid_out_lake_says_which_tool_edits_it(qtbot, win, tmp_path):
     """A saved lake layout reopened in the Edit tool: a click said "use Block ▸ Convert to loop to
     edit points", which then refused ("These blocks are the lake's layout ..."); Select all and
