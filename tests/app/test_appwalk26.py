@@ -221,3 +221,43 @@ def test_a_file_of_two_points_is_one_error(qtbot, win, tmp_path):
     f.write_text("x,y\n0,0\n1,1\n")
     assert not win.io.import_points(f)
     assert len(said) == 1 and said[0][0] == "error" and "needs at least 3 points, found 2" in said[0][1]
+
+
+def test_a_file_opened_after_a_crash_does_not_lose_the_autosaved_work(qtbot, win, tmp_path, monkeypatch):
+    """The app crashed with unsaved edits (autosaved); started again on a file (a double-click,
+    ``gcmesh lake.toml``) it opened the file without offering the autosave, and the first edit
+    autosaved over it: the lost session's work was gone for good.  Now the autosave is offered first."""
+    from PySide6 import QtWidgets
+
+    from app.__main__ import open_at_start
+    from app.main_window import MainWindow
+
+    assert win.io.open_example("bottle-coarse", confirm=False)
+    assert win.io.save_to(tmp_path / "bottle.toml")
+    win.editor.set_block_options(weights=(0.3, 0.7))  # the unsaved edit of the session that crashed
+    win.io.autosave()
+    crashed = win.doc.project
+
+    def started(answer):  # a window started after the crash, as main() starts it on a file
+        w = MainWindow(settings=win.settings, recovery=win.io.recovery_path)
+        w.quiet = True
+        qtbot.addWidget(w)
+        asked = []
+
+        def question(*a, **k):
+            asked.append(a[1])
+            return answer
+
+        monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+        assert open_at_start(w, file=str(tmp_path / "bottle.toml"))
+        return w, asked
+
+    w, asked = started(QtWidgets.QMessageBox.StandardButton.Yes)
+    assert asked == ["Recover project"] and w.doc.project == crashed and not w.stack.isClean()
+    assert "bottle.toml was not opened" in w._status.text()
+    w.io.autosave()  # still the crashed work in the autosave
+    w.stack.setClean()  # (a clean close: the autosave goes)
+    win.io.autosave()
+    w, asked = started(QtWidgets.QMessageBox.StandardButton.No)  # declined: the file opens
+    assert asked == ["Recover project"] and w.doc.path == tmp_path / "bottle.toml"
+    assert w.doc.project != crashed
