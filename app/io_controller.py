@@ -569,6 +569,8 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         self.set_project(project, path)
         self.stack.resetClean()  # restored work counts as unsaved
+        if project.layout is not None:  # a lake's layout is edited with the Layout tool (it stayed in Draw)
+            self.win.set_tool("layout")
         return True
 
     def shutdown(self) -> None:

@@ -261,3 +261,20 @@ def test_a_file_opened_after_a_crash_does_not_lose_the_autosaved_work(qtbot, win
     w, asked = started(QtWidgets.QMessageBox.StandardButton.No)  # declined: the file opens
     assert asked == ["Recover project"] and w.doc.path == tmp_path / "bottle.toml"
     assert w.doc.project != crashed
+
+
+def test_a_restored_lake_layout_is_in_the_layout_tool(qtbot, win, tmp_path, monkeypatch):
+    """A laid-out lake restored after a crash came back in the Draw tool (the window's first)."""
+    from PySide6 import QtWidgets
+
+    from app.main_window import MainWindow
+
+    _laid_out(qtbot, win, tmp_path, 862609)
+    win.io.autosave()
+    w = MainWindow(settings=win.settings, recovery=win.io.recovery_path)
+    w.quiet = True
+    qtbot.addWidget(w)
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", lambda *a, **k: QtWidgets.QMessageBox.StandardButton.Yes)
+    assert w.io.offer_recovery() and w.doc.project.layout is not None
+    assert w.canvas.tool.name == "layout"
+    w.stack.setClean()
