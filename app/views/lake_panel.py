@@ -136,6 +136,10 @@ class LakePanel(QtWidgets.QWidget):
             self.block_label.setText("cells")
             return
         b = lay.blocks[self.doc.active]
+        if self.table.rowCount() > self.doc.active and self.table.currentRow() != self.doc.active:
+            # its row too (a worst place made b18 active: the table went on showing b0 selected)
+            self.table.setCurrentCell(self.doc.active, 0)
+            self.table.scrollToItem(self.table.item(self.doc.active, 0))
         self.block_label.setText(f"{b.name}:")
         for w, v in ((self.ni, b.cells[0]), (self.nj, b.cells[1])):
             w.setSingleStep(lay.multiple)

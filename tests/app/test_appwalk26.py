@@ -156,6 +156,8 @@ def test_the_active_block_is_in_sight_in_the_blocks_panel(qtbot, win, tmp_path):
     for k in (n - 1, 0, n - 2):
         win.doc.set_active(k)
         assert tree.viewport().rect().intersects(tree.visualItemRect(tree.topLevelItem(k)))
+        # the Lake panel's table selects its row (it went on showing b0 selected under "b18: 24 44 Set")
+        assert win.lake_panel.table.currentRow() == k
 
 
 def test_a_project_opened_with_auto_generate_on_does_not_say_press_f5(qtbot, win, tmp_path):
