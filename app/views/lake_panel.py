@@ -284,6 +284,10 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         n_fail = len(v.failed)
         word = "PASS" if v.passed else f"FAIL ({n_fail} of {len(v.results)} limits missed)"
         before = "<i>Grid of before the last edit</i> (F5 makes the new one) — " if self.previous else ""
+        info = getattr(self.doc.multiblock, "info", None)
+        if not before and info is not None and not info.converged and info.message == "stopped":
+            # Stop (Esc): said once in the status line (a button's tip replaced it); the verdict read as final
+            before = "<i>Grid stopped before it was finished</i> (F5 makes it again) — "
         self.headline.setText(
             f"{before}<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
             f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded"

@@ -280,3 +280,18 @@ def test_a_restored_lake_layout_is_in_the_layout_tool(qtbot, win, tmp_path, monk
     assert w.io.offer_recovery() and w.doc.project.layout is not None
     assert w.canvas.tool.name == "layout"
     w.stack.setClean()
+
+
+def test_the_verdict_of_a_stopped_lake_grid_says_it_was_stopped(qtbot, win, tmp_path):
+    """Stop (Esc) on a lake grid: the status line said "stopped before it was finished" once (the
+    Stop button's tip replaced it at once); the Quality panel's verdict read as of a finished grid."""
+    import copy
+    import dataclasses
+
+    _laid_out(qtbot, win, tmp_path, 862610)
+    mb = win.doc.multiblock
+    assert "stopped" not in win.lake_quality.headline.text()
+    info = dataclasses.replace(mb.info, converged=False, message="stopped")
+    stopped = dataclasses.replace(mb, info=info)
+    win.doc.set_grids({k: copy.copy(g) for k, g in win.doc.grids.items()}, multiblock=stopped)  # as a solve sets them
+    assert "stopped before it was finished" in win.lake_quality.headline.text()
