@@ -348,6 +348,9 @@ class IOController(ExportMixin, QtCore.QObject):
                 f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
             )
         if offered:
+            # auto-generate: not the one block the offer calls poor (its grid covered the islands, its
+            # repairs filled Messages, a big lake's solve ran on while the user chose Auto layout); F5 makes it
+            self.win.solver.skip_auto()
             why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
             self.win.show_lake()
             self.win.lake_ctl.offer(path.name, why if branched else None)

@@ -295,3 +295,20 @@ def test_the_verdict_of_a_stopped_lake_grid_says_it_was_stopped(qtbot, win, tmp_
     stopped = dataclasses.replace(mb, info=info)
     win.doc.set_grids({k: copy.copy(g) for k, g in win.doc.grids.items()}, multiblock=stopped)  # as a solve sets them
     assert "stopped before it was finished" in win.lake_quality.headline.text()
+
+
+def test_a_lake_offered_auto_layout_is_not_gridded_as_one_block_by_auto_generate(qtbot, win, tmp_path):
+    """Auto-generate on, a lake with an island imported: beside the offer ("One block would give a
+    poor grid; Auto layout splits the lake into blocks") the one block was solved at once — its grid
+    drawn across the island, "351 non-convex cells (88 folded); repaired ..." in Messages."""
+    from tests.app.test_modeller import _metres_lake
+
+    win.a_auto.trigger()
+    assert win.solver.auto
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 862611))
+    assert win.lake_ctl.prompt is not None and win.doc.project.lake.holes
+    wait_idle(qtbot, win)
+    assert not win.doc.grids and not win.solver.running
+    win.generate()  # F5 still makes it
+    wait_idle(qtbot, win)
+    assert win.doc.grids
