@@ -312,3 +312,26 @@ def test_a_lake_offered_auto_layout_is_not_gridded_as_one_block_by_auto_generate
     win.generate()  # F5 still makes it
     wait_idle(qtbot, win)
     assert win.doc.grids
+
+
+def test_the_auto_layout_offer_goes_with_its_lake(qtbot, win, tmp_path):
+    """The offer is a window of its own (non-modal): after another import (one not offered), an
+    undo of the import or File ▸ New it stayed open, and its button laid out the lake there then."""
+    from tests.app.test_modeller import _metres_lake
+
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 862612))
+    assert win.lake_ctl.prompt is not None
+    win.stack.undo()
+    assert win.lake_ctl.prompt is None
+    win.stack.redo()  # (no offer again: the redo is not an import)
+    assert win.io.import_points(_metres_lake(tmp_path / "lake2.csv", 862613))
+    assert win.lake_ctl.prompt is not None
+    assert win.io.import_points(_eight(tmp_path / "eight.csv"))  # crosses itself: not offered
+    assert win.lake_ctl.prompt is None
+    assert win.io.import_points(_metres_lake(tmp_path / "lake3.csv", 862614))
+    assert win.lake_ctl.prompt is not None
+    win.lake_ctl.set_cell_size(123.0)  # the same lake: the offer stays
+    assert win.lake_ctl.prompt is not None
+    win.stack.setClean()
+    win.io.new_project()
+    assert win.lake_ctl.prompt is None
