@@ -278,6 +278,10 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             self.misses.emit(None)
             return
         self.table.show()
+        rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []
+        # the limit the user chose stays chosen (a click on the second went to its worst place in another
+        # block; that block's quality, made active, selected the first again: its misses on the canvas)
+        chosen = (self.verdict.preset.name, rows[0].row()) if rows else None
         v = check(m, self.preset.currentText())
         self.verdict = v
         s = m.summary()
@@ -320,6 +324,9 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.setMinimumHeight(head + 21 * min(len(v.results), 1))
         self.table.setMaximumHeight(head + 21 * len(v.results))
         first = next((k for k, r in enumerate(v.results) if r.passed is False), None)
+        kept = chosen is not None and chosen[0] == v.preset.name and 0 <= chosen[1] < len(v.results)
+        if kept and v.results[chosen[1]].passed is False:
+            first = chosen[1]
         if first is None:
             self.table.clearSelection()
             self.misses.emit(None)

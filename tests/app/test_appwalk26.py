@@ -335,3 +335,27 @@ def test_the_auto_layout_offer_goes_with_its_lake(qtbot, win, tmp_path):
     win.stack.setClean()
     win.io.new_project()
     assert win.lake_ctl.prompt is None
+
+
+def test_the_limit_clicked_stays_chosen_when_its_worst_place_is_in_another_block(qtbot, win, tmp_path):
+    """A click on the second failed limit: the view went to its worst place and made that block
+    active; the block's quality, drawn anew, selected the first failed limit again, and the canvas
+    showed that limit's misses under the status line of the one clicked."""
+    from app.views.lake_panel import miss_points
+
+    _laid_out(qtbot, win, tmp_path, 862604)
+    box = win.lake_quality
+    box.preset.setCurrentText("delft3d")
+    failed = [k for k, r in enumerate(box.verdict.results) if r.passed is False and r.worst]
+    assert len(failed) >= 2
+    row = failed[1]
+    shown = []
+    box.misses.connect(lambda pts: shown.append(pts))
+    names = [b.name for b in win.doc.project.blocks]
+    worst = box.verdict.results[row].worst[0]
+    win.doc.set_active(next(k for k, n in enumerate(names) if n != worst.block))
+    box.table.selectRow(row)
+    box.table.clicked.emit(box.table.model().index(row, 0))
+    assert names[win.doc.active] == worst.block
+    assert [r.row() for r in box.table.selectionModel().selectedRows()] == [row]
+    assert shown and np.array_equal(shown[-1], miss_points(box.verdict, row))
