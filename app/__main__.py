@@ -131,14 +131,7 @@ def main(argv: list[str] | None = None) -> int:
     app.processEvents()
     startup = time.perf_counter() - t0
     win.message(f"Ready in {startup:.2f} s. " + win._status.text())
-    if not args.screenshot and not args.file and not args.example:
-        win.io.offer_recovery()
-    opened = True
-    if args.example:
-        opened = win.io.open_example(args.example, confirm=False)
-    elif args.file:
-        # --solve asks for a grid: lon/lat degrees are projected as the question's default would (no dialog)
-        opened = win.io.open_path(Path(args.file), project_lonlat=True if args.solve else None)
+    opened = open_at_start(win, file=args.file, example=args.example, solve=args.solve, screenshot=args.screenshot)
     if not opened and (args.solve or args.screenshot):
         return 2
     # opened by hand (a double-clicked file): the window stays, the error in its message panel
@@ -162,6 +155,25 @@ def main(argv: list[str] | None = None) -> int:
     code = app.exec()
     warm.join(timeout=60)
     return code
+
+
+def open_at_start(win, *, file=None, example=None, solve: bool = False, screenshot=None) -> bool:
+    """Open what the command line names (an example, a file), and after a crash offer the autosaved
+    project back — also when a file is opened by hand: a file double-clicked after a crash was
+    opened without the offer, and its first edit autosaved over the lost session's work.  Restored,
+    the file is not opened (the status line names it).  False: the file or example did not open."""
+    if example:
+        return win.io.open_example(example, confirm=False)
+    if not screenshot and not (file and solve) and win.io.offer_recovery():
+        if file:
+            win.message(
+                f"Restored the autosaved project of the last session; {Path(file).name} was not opened "
+                "(File ▸ Open project opens it)"
+            )
+        return True
+    if file:  # --solve asks for a grid: lon/lat degrees are projected as the question's default would (no dialog)
+        return win.io.open_path(Path(file), project_lonlat=True if solve else None)
+    return True
 
 
 def solve_as_opened(app, win, timeout_s: float | None = None) -> bool:

@@ -21,6 +21,7 @@ from .project import Block, Project
 
 __all__ = [
     "DRAWN_TITLE",
+    "LAYOUT_HINT",
     "AddBlock",
     "AddCutLine",
     "AddPoint",
@@ -39,6 +40,14 @@ __all__ = [
 ]
 
 _MERGE_ID = 4711
+
+
+#: what edits the blocks of a lake's layout (said where a block tool cannot: Edit, Convert to loop, Delete)
+LAYOUT_HINT = (
+    "These blocks are the lake's layout: drag its shore points, cut ends, junctions and corners with the "
+    "Layout tool (Y); the Lake panel sets cells and cell size (Auto layout lays it out again); "
+    "Lake ▸ Clear layout gives the shore back as one loop of points"
+)
 
 
 class ProjectCommand(QUndoCommand):
@@ -157,10 +166,7 @@ class Editor:
             )
             return True
         if self.doc.project.layout is not None:
-            self.doc.message.emit(
-                "These blocks are the lake's layout: change it in the Lake panel (cell size, Auto layout), "
-                "or Clear layout (Lake menu) to edit the shore"
-            )
+            self.doc.message.emit(LAYOUT_HINT)
             return True
         return False
 

@@ -135,8 +135,12 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         self.set_project(project, path)
         self.add_recent(path)
-        self.win.set_tool("edit")
-        self.win.message(f"Opened {path.name}: press F5 to generate")
+        # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
+        self.win.set_tool("layout" if project.layout is not None else "edit")
+        if self.win.solver.auto and any(b.ready for b in project.blocks):  # it said "press F5" as it solved
+            self.win.message(f"Opened {path.name}: generating its grid (auto-generate on)")
+        else:
+            self.win.message(f"Opened {path.name}: press F5 to generate")
         return True
 
     def open_example(self, name: str, *, confirm: bool = True) -> bool:
@@ -238,6 +242,10 @@ class IOController(ExportMixin, QtCore.QObject):
             self.win.error("Cannot import points", exc)
             return False
         pts = pd.points
+        if len(pts) < 3:  # no lake, no block: one error (it also warned "not read as a lake (needs at least 3
+            # distinct points); its largest line is imported as one block", and nothing was imported)
+            self.win.error("Cannot import points", f"{path}: needs at least 3 points, found {len(pts)}")
+            return False
         if pd.note:  # metres in a lon/lat format: read as local metres (the app has no --source-crs)
             self.doc.report("warning", pd.note)
         # a lake's project gets a new lake, in the file's own frame (the UTM zone of a lon/lat outline,
@@ -283,7 +291,7 @@ class IOController(ExportMixin, QtCore.QObject):
                 self.win.error("Cannot project coordinates", exc)
                 return False
         asked_part = part
-        lake, (k_part, n_parts) = self._read_lake(
+        lake, (k_part, n_parts), refused = self._read_lake(
             pd, frame, lonlat=bool(pd.lonlat and project_lonlat is not False), part=part
         )
         if k_part == 0:  # the parts dialog cancelled: nothing imported
@@ -312,13 +320,19 @@ class IOController(ExportMixin, QtCore.QObject):
         which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
         if n_parts > 1 and again and asked_part == k_part:
             which = f" (part {k_part} of {n_parts}, the one opened last time: File ▸ Import asks for another)"
-        branched = lake is not None and looks_branched(lake.outline, lake.holes)
+        # water the layout refuses (an outline that crosses itself): no Auto layout offered, only to fail
+        branched = lake is not None and not refused and looks_branched(lake.outline, lake.holes)
         # a lake on the map (lon/lat, or a CRS the file declares) is water to model: its grid is the layout
         # meshcore mesh makes (one block with automatic corners was ~20° off orthogonal on a compact lake);
         # plain numbers without a CRS (a duct, an airfoil, a shape of the paper) stay one block
         on_map = lake is not None and bool(pd.lonlat or pd.pointset.crs)
-        offered = branched or on_map
-        if block.corners is None:  # a triangle: no four corners; the lake's layout grids it
+        offered = (branched or on_map) and not refused
+        if refused:
+            self.win.message(
+                f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; {refused} — Auto layout "
+                "cannot lay it out: fix the outline (Edit tool) first"
+            )
+        elif block.corners is None:  # a triangle: no four corners; the lake's layout grids it
             self.win.message(
                 f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; too few for four corners "
                 f"— Lake ▸ Auto layout splits it into blocks and grids it"
@@ -334,6 +348,9 @@ class IOController(ExportMixin, QtCore.QObject):
                 f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
             )
         if offered:
+            # auto-generate: not the one block the offer calls poor (its grid covered the islands, its
+            # repairs filled Messages, a big lake's solve ran on while the user chose Auto layout); F5 makes it
+            self.win.solver.skip_auto()
             why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
             self.win.show_lake()
             self.win.lake_ctl.offer(path.name, why if branched else None)
@@ -341,10 +358,10 @@ class IOController(ExportMixin, QtCore.QObject):
 
     def _read_lake(self, pd, frame, *, lonlat: bool, part: int | None = None):
         """The lake (shore and islands) of the file's rings, in the frame of the imported block (None
-        if none), and (the part opened, the number of parts): part 0 when the parts dialog was
-        cancelled."""
+        if none), (the part opened, the number of parts): part 0 when the parts dialog was
+        cancelled, and why the layout would refuse its water (None: it would not)."""
         if pd.pointset is None:
-            return None, (1, 1)
+            return None, (1, 1), None
         try:
             parts, fr, notes = read_lake_parts(pd.pointset, frame, lonlat=lonlat)
             metres = not (pd.lonlat and not lonlat)  # lon/lat kept as degrees: areas in degrees²
@@ -355,22 +372,24 @@ class IOController(ExportMixin, QtCore.QObject):
             else:  # asked, or remembered from a file that has fewer parts now
                 k = self.choose_part(pd.path, parts, metres, frame=fr, lonlat=bool(pd.lonlat))
             if k == 0:
-                return None, (0, len(parts))
+                return None, (0, len(parts)), None
             outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat, part=k, metres=metres)
         except (MeshcoreError, ValueError) as exc:  # meshcore mesh refuses the file: say why here too
             self.doc.report(
                 "warning",
                 f"{Path(pd.path).name}: not read as a lake ({exc}); its largest line is imported as one block",
             )
-            return None, (1, 1)
+            return None, (1, 1), None
+        refused = None
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
             notes = notes + water(outer, islands)[1]
         except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring: said now
             # (was only logged: the user saw the corners' "reflex vertex (interior angle 307°)" of a bow tie)
+            refused = str(exc)
             notes = [*notes, f"{exc} — meshcore mesh refuses it; fix the outline (Edit tool) before Auto layout"]
         for note in notes:  # what meshcore mesh prints as notes
             self.doc.report("warning", f"{Path(pd.path).name}: {note}")
-        return Lake(outline=outer, holes=tuple(islands)), (k, len(parts))
+        return Lake(outline=outer, holes=tuple(islands)), (k, len(parts)), refused
 
     def choose_part(self, path, parts: list, metres: bool = True, *, frame=None, lonlat: bool = False) -> int:
         """The part of the water to open (from 1, largest first), asked in a dialog; 0: cancelled.
@@ -553,6 +572,8 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         self.set_project(project, path)
         self.stack.resetClean()  # restored work counts as unsaved
+        if project.layout is not None:  # a lake's layout is edited with the Layout tool (it stayed in Draw)
+            self.win.set_tool("layout")
         return True
 
     def shutdown(self) -> None:

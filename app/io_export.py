@@ -47,12 +47,20 @@ def chosen_format(chosen: str, path: Path) -> str | None:
     return fmt.name if sum(path.suffix.lower() in f.suffixes for f in FORMATS.values() if f.writer) > 1 else None
 
 
+_NOTHING_YET = "Nothing to export yet: generate a grid first (F5)"
+#: the greyed grid on screen after an edit with auto-generate off (it said "Nothing to export yet")
+_BEFORE_EDIT = (
+    "The grid on screen (greyed) is of before the last edit, not of this layout: F5 makes the grid of "
+    "this layout, then export"
+)
+
+
 class ExportMixin:
     """Export mesh and Export figure of the window's :class:`~app.io_controller.IOController`."""
 
     def export_dialog(self) -> None:
         if not self.doc.grids:
-            self.win.message("Nothing to export yet: generate a grid first (F5)")
+            self.win.message(_NOTHING_YET if not self.doc.before_grids else _BEFORE_EDIT)
             return
         fmts = fio.mesh_formats()
         filt = ";;".join(f"{d} ({p})" for d, p in fmts)
@@ -71,7 +79,7 @@ class ExportMixin:
         """Write the grids (a multiblock result with its connectivity) with meshcore.io
         (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
         if not self.doc.grids:  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
-            self.win.message("Nothing to export yet: generate a grid first (F5)", error=True)
+            self.win.message(_NOTHING_YET if not self.doc.before_grids else _BEFORE_EDIT, error=True)
             return False
         if path.suffix.lower() == ".inp" and path.name.lower() != "cell.inp":
             path = self._efdc_cell_inp(path)

@@ -71,6 +71,8 @@ class LakeController(QtCore.QObject):
         self._worker = None
         self.generate_after = True  # start the grid when a layout is set
         self.prompt: QtWidgets.QMessageBox | None = None  # the offer after importing a branched lake
+        self._prompt_shore = None  # the shore the offer is for: another lake closes it (_other_lake)
+        self.doc.project_changed.connect(self._other_lake)
         self.last_error: str | None = None
         self._edit_worker = None
         self._pending = None  # (make, text, merge key, shore) of the newest layout edit not yet computed
@@ -330,8 +332,19 @@ class LakeController(QtCore.QObject):
         go.clicked.connect(lambda: self.auto_layout())
         self.close_prompt()
         self.prompt = box
+        lake = self.doc.project.lake
+        self._prompt_shore = lake.outline if lake is not None else None
         if not getattr(self.win, "quiet", False):
             box.show()
+
+    def _other_lake(self, project) -> None:
+        """Another lake (File ▸ New, Open, an import not offered, its undo): the offer goes with its
+        lake (it stayed open, and its button laid out whatever lake was there then)."""
+        if self.prompt is None:
+            return
+        shore = project.lake.outline if project.lake is not None else None
+        if shore is None or self._prompt_shore is None or not np.array_equal(shore, self._prompt_shore):
+            self.close_prompt()
 
     def close_prompt(self) -> None:
         if self.prompt is not None:

@@ -23,7 +23,7 @@ from . import actions
 from . import geometry as geo
 from . import io_adapter as fio
 from .background import BackgroundController
-from .commands import Editor, SetBlockOptions
+from .commands import LAYOUT_HINT, Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
@@ -204,6 +204,19 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             again = "Ctrl+Y redoes it" if name == "undo" else "Ctrl+Z undoes it"
             self.message(f"{'Undone' if name == 'undo' else 'Redone'}: {text} ({again})")
 
+    def _keep_in_sight(self, _index: int = 0) -> None:
+        """After an undo or redo of another lake (an import: another title or frame) or one that leaves
+        the project wholly outside the view, the view fits it (an import undone left the view on the
+        other lake, the canvas empty: the lake looked lost)."""
+        p, seen = self.doc.project, self._in_sight
+        self._in_sight = p
+        other = seen is not None and (
+            (p.crs, p.origin) != (seen.crs, seen.origin) or bool(p.title and seen.title and p.title != seen.title)
+        )
+        bounds = p.bounds()
+        if bounds is not None and (other or not self.canvas.shows_any_of(bounds)):
+            self.canvas.fit()
+
     def _examples_menu(self, m: QtWidgets.QMenu) -> None:
         m.addSection("Paper cases")
         for name in example_names():
@@ -234,6 +247,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
         self.stack.cleanChanged.connect(self._update_title)
+        self._in_sight = None  # the project the view was last kept on (_keep_in_sight)
+        self.stack.indexChanged.connect(self._keep_in_sight)
+        self.doc.opened.connect(lambda: setattr(self, "_in_sight", self.doc.project))
 
     # ------------------------------------------------------------ status
     def message(self, text: str, *, error: bool = False) -> None:
@@ -302,9 +318,15 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
     def delete_selection(self) -> None:
         if self.canvas.tool is not None and self.canvas.tool.delete():  # a cut line, with the Layout tool
             return
+        if self.doc.project.layout is not None:  # Edit ▸ Delete did nothing, silently, on a laid-out lake
+            self.message(LAYOUT_HINT)
+            return
         self.editor.delete_points(self.doc.selection)
 
     def select_all(self) -> None:
+        if self.doc.project.layout is not None:  # a layout's blocks have no points to select
+            self.message(LAYOUT_HINT)
+            return
         self.doc.set_selection(range(len(self.doc.block.points)))
 
     def auto_corners(self) -> None:
@@ -443,10 +465,12 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         if not h > 0:
             g = self.doc.grid
             h = max(g.bounds()[2] - g.bounds()[0], g.bounds()[3] - g.bounds()[1]) / 50 if g is not None else 1.0
-        self.canvas.zoom_to_point(where.x, where.y, 4 * h)
         names = [b.name for b in self.doc.project.blocks]
         if where.block in names:  # its block's numbers in the Quality panel, its row in Blocks
             self.doc.set_active(names.index(where.block))
+        # after the block is made active: its quality, drawn anew, clears the canvas's ring (the worst
+        # place of a block not active was zoomed to but not ringed: a user could not tell which node)
+        self.canvas.zoom_to_point(where.x, where.y, 4 * h)
         text = str(where)
         if what.startswith("folded"):  # its limit "…: none" and a flag for a value read "none: 1 at b8(1,50)"
             what, text = what.removesuffix(": none"), "a cell at " + text.split(" at ", 1)[-1]

@@ -73,10 +73,10 @@ class SolveStatus(QtCore.QObject):
         ):  # another lake, a new layout: the summary is of nothing here
             self.label.setText("idle")
             return
-        if self.solver.auto:
-            return
-        if not self.doc.stale:
+        if not self.doc.stale:  # (auto-generate on too: after a failed solve the grid was greyed)
             self.on_final()
+            return
+        if self.solver.auto:
             return
         self._show_previous(True)
         self.label.setText("grid of before the edit (F5 makes the new one)")

@@ -125,7 +125,13 @@ class SolverController(QtCore.QObject):
         if self.auto and self.doc.stale:
             self._debounce.start()
 
+    def skip_auto(self) -> None:
+        """The auto-generate solve due for the edit just made does not start (F5 starts it)."""
+        self._debounce.stop()
+
     def _on_project_changed(self, _project) -> None:
+        if not self.running:  # the last solve's error was of the project before this edit (an undo
+            self.last_error = None  # back to a gridded one: its grid is current, not held back as failed)
         if self.auto and self.doc.stale:  # not for an edit the grid is not made of (a lake's cell size)
             self._debounce.start()
 

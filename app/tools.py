@@ -18,6 +18,7 @@ import numpy as np
 from PySide6 import QtCore
 
 from . import geometry as geo
+from .commands import LAYOUT_HINT
 
 __all__ = ["CalibrateTool", "CornersTool", "DrawTool", "EditTool", "PanTool", "Tool"]
 
@@ -154,6 +155,9 @@ class EditTool(Tool):
 
     def click(self, xy, modifiers=None) -> bool:
         b = self.doc.block
+        if self.doc.project.layout is not None:  # not "Convert to loop", which refuses a layout's block
+            self.status(LAYOUT_HINT)
+            return True
         if b.boundary is not None:
             self.status("This block is given by four border polylines; use Block ▸ Convert to loop to edit points")
             return True
@@ -174,6 +178,9 @@ class EditTool(Tool):
 
     def drag(self, phase, xy, start, modifiers=None) -> bool:
         b = self.doc.block
+        if phase == "start" and self.doc.project.layout is not None:  # no points to drag or box-select
+            self.status(LAYOUT_HINT)
+            return False
         if phase == "start":
             k = geo.nearest_point(b.points, start, self.tol()) if b.boundary is None else None
             if k is not None:

@@ -346,8 +346,8 @@ def check_self_intersection(
                 continue
         c = inter.centroid
         raise BoundaryError(
-            f"boundary intersects itself near ({c.x:.6g}, {c.y:.6g}): segment {ka}–{ka + 1} "
-            f"of the {na} border crosses segment {kb}–{kb + 1} of the {nb} border"
+            f"boundary intersects itself near ({c.x:.6g}, {c.y:.6g}): the edge from point {ka + 1} to {ka + 2} "
+            f"of the {na} border crosses the edge from point {kb + 1} to {kb + 2} of the {nb} border"
         )
 
 

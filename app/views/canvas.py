@@ -225,6 +225,12 @@ class Canvas(pg.PlotWidget):
             xRange=(x0 - margin * w, x1 + margin * w), yRange=(y0 - margin * h, y1 + margin * h), padding=0
         )
 
+    def shows_any_of(self, bounds) -> bool:
+        """True when the view shows some of ``bounds`` (x0, y0, x1, y1)."""
+        (vx0, vx1), (vy0, vy1) = self._vb.viewRange()
+        x0, y0, x1, y1 = bounds
+        return x0 <= vx1 and x1 >= vx0 and y0 <= vy1 and y1 >= vy0
+
     def fit(self) -> None:
         """Show the outline, the grids and the background image."""
         boxes = [self.doc.project.bounds(), *(g.bounds() for g in self.doc.grids.values())]

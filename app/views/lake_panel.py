@@ -136,6 +136,10 @@ class LakePanel(QtWidgets.QWidget):
             self.block_label.setText("cells")
             return
         b = lay.blocks[self.doc.active]
+        if self.table.rowCount() > self.doc.active and self.table.currentRow() != self.doc.active:
+            # its row too (a worst place made b18 active: the table went on showing b0 selected)
+            self.table.setCurrentCell(self.doc.active, 0)
+            self.table.scrollToItem(self.table.item(self.doc.active, 0))
         self.block_label.setText(f"{b.name}:")
         for w, v in ((self.ni, b.cells[0]), (self.nj, b.cells[1])):
             w.setSingleStep(lay.multiple)
@@ -274,12 +278,20 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             self.misses.emit(None)
             return
         self.table.show()
+        rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []
+        # the limit the user chose stays chosen (a click on the second went to its worst place in another
+        # block; that block's quality, made active, selected the first again: its misses on the canvas)
+        chosen = (self.verdict.preset.name, rows[0].row()) if rows else None
         v = check(m, self.preset.currentText())
         self.verdict = v
         s = m.summary()
         n_fail = len(v.failed)
         word = "PASS" if v.passed else f"FAIL ({n_fail} of {len(v.results)} limits missed)"
         before = "<i>Grid of before the last edit</i> (F5 makes the new one) — " if self.previous else ""
+        info = getattr(self.doc.multiblock, "info", None)
+        if not before and info is not None and not info.converged and info.message == "stopped":
+            # Stop (Esc): said once in the status line (a button's tip replaced it); the verdict read as final
+            before = "<i>Grid stopped before it was finished</i> (F5 makes it again) — "
         self.headline.setText(
             f"{before}<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
             f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded"
@@ -312,6 +324,9 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.setMinimumHeight(head + 21 * min(len(v.results), 1))
         self.table.setMaximumHeight(head + 21 * len(v.results))
         first = next((k for k, r in enumerate(v.results) if r.passed is False), None)
+        kept = chosen is not None and chosen[0] == v.preset.name and 0 <= chosen[1] < len(v.results)
+        if kept and v.results[chosen[1]].passed is False:
+            first = chosen[1]
         if first is None:
             self.table.clearSelection()
             self.misses.emit(None)

@@ -74,6 +74,9 @@ class BlocksPanel(QtWidgets.QTreeWidget):
                 c.setData(0, QtCore.Qt.ItemDataRole.UserRole, ("border", k, border))
                 it.addChild(c)
             it.setExpanded(k == self.doc.active)
+        active = self.topLevelItem(min(self.doc.active, self.topLevelItemCount() - 1))
+        if active is not None:  # a lake's worst place in b20 of 76 made it active out of sight, at the list's top
+            self.scrollToItem(active)
         self.blockSignals(False)
 
     def _clicked(self, item, _col) -> None:

@@ -31,7 +31,7 @@ def _coords(c: Any, where: str) -> np.ndarray:
             or len(pos) < 2
             or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in pos)
         ):
-            raise ReadError(f"{where}: position {k} is not a list of numbers: {str(pos)[:40]}")
+            raise ReadError(f"{where}: position {k + 1} is not a list of numbers: {str(pos)[:40]}")
         dims.add(len(pos))
     if len(dims) > 1:
         raise ReadError(f"{where}: mixed dimensions {sorted(dims)} among positions")
@@ -52,18 +52,17 @@ def _geometry(geom: Any, name: str, where: str, out: list[Polyline]) -> None:
             raise ReadError(f"{where}: Polygon without rings")
         for k, ring in enumerate(c):
             nm = name if k == 0 else f"{name} hole {k}"
-            out.append(make_polyline(nm, _coords(ring, f"{where} ring {k}"), closed=True, where=where))
+            out.append(make_polyline(nm, _coords(ring, f"{where} ring {k + 1}"), closed=True, where=where))
     elif t in ("MultiLineString", "MultiPolygon"):
         if not isinstance(c, list):
             raise ReadError(f"{where}: {t} coordinates must be a list")
         sub = t.removeprefix("Multi")
         for k, part in enumerate(c):
-            _geometry(
-                {"type": sub, "coordinates": part}, f"{name} {k + 1}" if len(c) > 1 else name, f"{where} part {k}", out
-            )
+            nm = f"{name} {k + 1}" if len(c) > 1 else name
+            _geometry({"type": sub, "coordinates": part}, nm, f"{where} part {k + 1}", out)
     elif t == "GeometryCollection":
         for k, g in enumerate(geom.get("geometries") or []):
-            _geometry(g, f"{name} {k + 1}", f"{where} geometry {k}", out)
+            _geometry(g, f"{name} {k + 1}", f"{where} geometry {k + 1}", out)
     elif t in ("Point", "MultiPoint"):
         pts = _coords([c] if t == "Point" else c, where)
         out.append(Polyline(name, pts))  # gathered below
@@ -118,13 +117,13 @@ def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
     out: list[Polyline] = []
     for k, f in enumerate(feats):
         if not isinstance(f, dict):
-            raise ReadError(f"{path}: feature {k} is not an object")
+            raise ReadError(f"{path}: feature {k + 1} is not an object")
         props = f.get("properties") or {}
         name = None
         if isinstance(props, dict):
             name = props.get("name") or props.get("Name") or props.get("NAME")
         name = str(name or f.get("id") or (path.stem if len(feats) == 1 else f"feature {k + 1}"))
-        _geometry(f.get("geometry"), name, f"{path}: feature {k} ({name})", out)
+        _geometry(f.get("geometry"), name, f"{path}: feature {k + 1} ({name})", out)
     # consecutive Point features form one polyline (points picked by hand)
     merged = merge_point_runs(out, f"{path.stem} points", str(path))
     if not merged:

@@ -37,7 +37,7 @@ def _points(elems: list[Any], where: str) -> np.ndarray:
         try:
             pts.append((float(lon), float(lat)))  # type: ignore[arg-type]
         except (TypeError, ValueError):
-            raise ReadError(f"{where}: point {k}: lat={lat!r} lon={lon!r} is not a pair of numbers") from None
+            raise ReadError(f"{where}: point {k + 1}: lat={lat!r} lon={lon!r} is not a pair of numbers") from None
     return np.array(pts, dtype=np.float64).reshape(-1, 2)
 
 

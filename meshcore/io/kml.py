@@ -81,13 +81,13 @@ def _coordinates(text: str | None, where: str) -> np.ndarray:
     for k, tup in enumerate(_SPLIT.split(text.strip())):
         vals = tup.split(",")
         if len(vals) not in (2, 3):
-            raise ReadError(f"{where}: coordinate tuple {k} {tup[:40]!r} is not lon,lat[,alt]")
+            raise ReadError(f"{where}: coordinate tuple {k + 1} {tup[:40]!r} is not lon,lat[,alt]")
         try:
             pts.append((float(vals[0]), float(vals[1])))
             if len(vals) == 3:
                 float(vals[2])
         except ValueError:
-            raise ReadError(f"{where}: coordinate tuple {k} {tup[:40]!r} is not numeric") from None
+            raise ReadError(f"{where}: coordinate tuple {k + 1} {tup[:40]!r} is not numeric") from None
     return np.array(pts, dtype=np.float64)
 
 
@@ -143,7 +143,7 @@ def _track(elem, where: str) -> np.ndarray:
                 raise ValueError
             pts.append((float(vals[0]), float(vals[1])))
         except ValueError:
-            raise ReadError(f"{where}: gx:coord {k} {(c.text or '')[:40]!r} is not 'lon lat [alt]'") from None
+            raise ReadError(f"{where}: gx:coord {k + 1} {(c.text or '')[:40]!r} is not 'lon lat [alt]'") from None
     if not pts:
         raise ReadError(f"{where}: no <gx:coord>")
     return np.array(pts, dtype=np.float64)

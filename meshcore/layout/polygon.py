@@ -121,7 +121,7 @@ def _crossing(ring: np.ndarray, what: str) -> None:
         x = shapely.intersection(segs[i], segs[j]).representative_point()
         raise InvalidInputError(
             f"{what} crosses itself: the edge from point {i + 1} to {i % n + 2 if i + 1 < n else 1} "
-            f"meets the edge from point {j + 1} near ({x.x:.6g}, {x.y:.6g})"
+            f"meets the edge from point {j + 1} to {j + 2 if j + 1 < n else 1} near ({x.x:.6g}, {x.y:.6g})"
         )
     raise InvalidInputError(f"{what} crosses itself ({shapely.is_valid_reason(shapely.Polygon(ring))})")
 

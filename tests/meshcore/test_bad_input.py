@@ -56,7 +56,10 @@ def test_reversed_border_is_reported():
 
 def test_self_intersecting_boundary():
     t = np.array([[0.0, 1.0], [1.0, -0.5], [2.0, 1.0]])
-    with pytest.raises(BoundaryError, match=r"intersects itself near .* bottom border crosses segment"):
+    # points counted from 1 along each border, as every message counts them (was "segment 0–1")
+    with pytest.raises(
+        BoundaryError, match=r"intersects itself near .* the edge from point 2 to 3 of the bottom border crosses"
+    ):
         gen(t=t, cells=(4, 2))
 
 

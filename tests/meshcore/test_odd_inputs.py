@@ -97,7 +97,7 @@ def test_kml_gx_track_is_a_line(tmp_path):
     assert ps.crs == "EPSG:4326" and ps.names == ("shore walk",)
     np.testing.assert_allclose(ps.polylines[0].points, LONLAT)
     f.write_text(f.read_text().replace(f"{LONLAT[2][0]} {LONLAT[2][1]} 312", "8.5,47.3"))
-    with pytest.raises(ReadError, match=r"placemark 1 \(shore walk\) gx:Track: gx:coord 2 '8.5,47.3'"):
+    with pytest.raises(ReadError, match=r"placemark 1 \(shore walk\) gx:Track: gx:coord 3 '8.5,47.3'"):
         read_points(f)
 
 
@@ -122,7 +122,7 @@ def test_gpx_tracks_routes_and_waypoints(tmp_path):
     [
         ("<metadata/>", "no track, route or two or more waypoints"),
         ('<trk><name>t</name><trkseg><trkpt lat="47" lon="8"/></trkseg></trk>', "trk 't': has 1 point(s)"),
-        ('<trk><trkseg><trkpt lat="47" lon="x"/><trkpt lat="47" lon="8"/></trkseg></trk>', "point 0: lat='47' lon='x'"),
+        ('<trk><trkseg><trkpt lat="47" lon="x"/><trkpt lat="47" lon="8"/></trkseg></trk>', "point 1: lat='47' lon='x'"),
         ('<rte><rtept lat="95" lon="8"/><rtept lat="47" lon="8"/></rte>', "outside the lon/lat range"),
     ],
 )
