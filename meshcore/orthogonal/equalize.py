@@ -316,10 +316,6 @@ def _solve_patch(
         from ._bfgs import bfgs
 
         x = bfgs(patch.objective, np.zeros(nz), maxiter=MAX_ITER)
-    elif method == "BFGS":  # scipy's BFGS, the same steps without its wrappers (._bfgs)
-        from ._bfgs import scipy_bfgs
-
-        x = scipy_bfgs(patch.objective, np.zeros(nz), maxiter=MAX_ITER)
     else:
         x = minimize(patch.objective, np.zeros(nz), jac=True, method=method, options={"maxiter": MAX_ITER}).x
     before = patch.counts(P)

@@ -45,36 +45,3 @@ def test_a_wall_of_refused_points_is_not_crossed():
 def test_a_zero_gradient_returns_the_start():
     x0 = np.array([1.0, 2.0])
     assert np.array_equal(bfgs(lambda v: (0.0, np.zeros(2)), x0, maxiter=10), x0)
-
-
-def _scipy(fun, x0, maxiter):
-    return minimize(fun, x0, jac=True, method="BFGS", options={"maxiter": maxiter}).x
-
-
-def test_scipy_bfgs_is_scipys_to_the_last_bit():
-    """scipy_bfgs (the equalize step's patches) takes scipy's steps without its wrappers: the same point
-    bit for bit on Rosenbrock, random quadratics, a wall of refused points and a few iterations cut short."""
-    from meshcore.orthogonal._bfgs import scipy_bfgs
-
-    rng = np.random.default_rng(1011001)
-    cases = [(lambda v: (rosen(v), rosen_der(v)), np.array([-1.2, 1.0, -0.5, 0.8]), k) for k in (3, 40, 2000)]
-    for n in (2, 7, 25):
-        M = rng.normal(size=(n, n))
-        A, b = M @ M.T + 0.1 * np.eye(n), rng.normal(size=n)
-        cases.append(
-            (
-                lambda v, A=A, b=b: (0.5 * v @ A @ v - b @ v + 0.1 * np.sum(v**4), A @ v - b + 0.4 * v**3),
-                rng.normal(size=n),
-                300,
-            )
-        )
-
-    def wall(x):
-        if x[0] > 0.5:
-            return 1e6, np.zeros_like(x)
-        return float((x[0] - 2.0) ** 2 + x[1] ** 2), np.array([2 * (x[0] - 2.0), 2 * x[1]])
-
-    cases.append((wall, np.array([0.0, 1.0]), 100))
-    cases.append((lambda v: (0.0, np.zeros(2)), np.array([1.0, 2.0]), 10))
-    for fun, x0, maxiter in cases:
-        assert np.array_equal(scipy_bfgs(fun, x0, maxiter=maxiter), _scipy(fun, x0, maxiter))
