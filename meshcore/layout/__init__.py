@@ -38,6 +38,7 @@ from ..cellsize import DEFAULT_CELLS, default_cell_size
 from . import tipends
 from .blocks import block_counts
 from .build import layout_pieces
+from .choice import chosen
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
@@ -178,6 +179,21 @@ def auto_layout(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
+            if scale == 1.0 and not regular:  # drawn at neighbouring scales: the best coarse grid (.choice)
+
+                def at_scale(s: float, normal: bool = normal) -> Layout:
+                    return _layout(
+                        shores,
+                        h,
+                        notes + more,
+                        multiple=multiple,
+                        regular=False,
+                        normal=normal,
+                        scale=s,
+                        options=options,
+                    )
+
+                lay = chosen(lay, at_scale)
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
         if kept is not None:
             if single:  # a single index space cannot hold it: say where, before the grid is made
