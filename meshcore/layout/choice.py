@@ -23,7 +23,7 @@ from collections.abc import Callable
 from ..errors import MeshcoreError
 from .model import Layout
 
-__all__ = ["MARGIN", "MAX_BLOCKS", "SCALES", "chosen", "coarse_reading"]
+__all__ = ["MARGIN", "MAX_BLOCKS", "SCALES", "chosen"]
 
 #: The other scales (× the cell size) the layout is drawn at, in the order tried.
 SCALES = (1.07, 0.93)
@@ -37,44 +37,19 @@ MARGIN = 0.1
 MAX_BLOCKS = 150
 
 
-class _Coarsest(Exception):
-    """Carries the coarsest level's grids out of the solve (no more levels are needed)."""
-
-    def __init__(self, grids) -> None:
-        super().__init__("coarsest level")
-        self.grids = grids
-
-
-def coarse_reading(lay: Layout) -> tuple[float, float]:
-    """The mean deviation from 90° (degrees) of the block-interior nodes of ``lay``'s grid on
-    the coarsest level of :func:`~meshcore.lakegrid.mesh_layout` (cells ``lay.multiple`` × the
-    size), and the largest cross-interface cell-area ratio there."""
-    from ..lakegrid import mesh_layout
-    from ..quality import lake_metrics
-
-    def stop(kind: str, value) -> None:
-        if kind == "level":
-            raise _Coarsest(value[1].grids)
-
-    try:
-        grids = mesh_layout(lay, callback=stop).grids  # (no coarse level: the only one)
-    except _Coarsest as done:
-        grids = done.grids
-    s = lake_metrics(list(grids)).summary()
-    d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
-    return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
-
-
-def chosen(first: Layout, at_scale: Callable[[float], Layout]) -> Layout:
+def chosen(
+    first: Layout, at_scale: Callable[[float], Layout], reading: Callable[[Layout], tuple[float, float]]
+) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
-    :data:`SCALES`, whose coarse grid (:func:`coarse_reading`) deviates least from 90° on
+    :data:`SCALES`, whose coarse grid deviates least from 90° on
     average, if that is at most ``1 - MARGIN`` of ``first``'s and its largest interface ratio
-    is no larger than ``first``'s.  A scale whose layout or coarse solve fails is passed over;
+    is no larger than ``first``'s (``reading``: those two numbers of a layout's coarse grid,
+    :func:`meshcore.lakegrid.coarse_reading`).  A scale whose layout or coarse solve fails is passed over;
     so is every other scale when ``first``'s coarse solve fails."""
     if first.multiple < 4 or len(first.blocks) > MAX_BLOCKS:
         return first
     try:
-        dev0, ratio0 = coarse_reading(first)
+        dev0, ratio0 = reading(first)
     except MeshcoreError:
         return first
     if dev0 == float("inf"):  # no interior node to read
@@ -87,7 +62,7 @@ def chosen(first: Layout, at_scale: Callable[[float], Layout]) -> Layout:
             if lay.blocks in seen:
                 continue
             seen.append(lay.blocks)
-            dev, ratio = coarse_reading(lay)
+            dev, ratio = reading(lay)
         except MeshcoreError:
             continue
         if dev < score and ratio <= ratio0:

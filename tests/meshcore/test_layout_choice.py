@@ -7,7 +7,7 @@ import pytest
 
 import meshcore.layout as layout_pkg
 from meshcore import testing
-from meshcore.lakegrid import mesh_layout
+from meshcore.lakegrid import coarse_reading, mesh_layout
 from meshcore.layout import auto_layout
 from meshcore.quality import lake_metrics
 
@@ -47,7 +47,7 @@ def test_the_layout_with_the_most_orthogonal_coarse_grid_is_kept(monkeypatch, se
     from meshcore.layout import choice
 
     poly = testing.channel_network(seed, n_branches=6)
-    got = _coarse(auto_layout(poly, target_cells=3000, multiple=4))
+    got = _coarse(auto_layout(poly, target_cells=3000, multiple=4, reading=coarse_reading))
     first, *others = [_coarse(_alone(monkeypatch, poly, s, 3000)) for s in (1.0, 1.07, 0.93)]
     # better by the margin, interface ratios no larger
     fit = [d for d, r in others if d < (1 - choice.MARGIN) * first[0] and r <= first[1]]
@@ -62,20 +62,25 @@ def test_regular_layouts_and_large_layouts_are_kept_as_drawn(monkeypatch):
     poly = testing.channel_network(1030002, n_branches=6)
     alone = _alone(monkeypatch, poly, 1.0, 3000)
     monkeypatch.setattr(choice, "MAX_BLOCKS", len(alone.blocks) - 1)
-    assert auto_layout(poly, target_cells=3000, multiple=4).blocks == alone.blocks
+    assert auto_layout(poly, target_cells=3000, multiple=4, reading=coarse_reading).blocks == alone.blocks
     monkeypatch.undo()
     with monkeypatch.context() as m:
         m.setattr(choice, "SCALES", ())
         regular = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
-    assert auto_layout(poly, target_cells=3000, multiple=4, regular=True).blocks == regular.blocks
+    assert (
+        auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=coarse_reading).blocks == regular.blocks
+    )
+    # without a reading (the default) the layout at the cell size itself
+    assert auto_layout(poly, target_cells=3000, multiple=4).blocks == alone.blocks
 
 
-def test_a_layout_no_other_scale_changes_is_not_solved_again(monkeypatch):
-    from meshcore.layout import choice
-
+def test_a_layout_no_other_scale_changes_is_not_solved_again():
     calls = []
-    real = choice.coarse_reading
-    monkeypatch.setattr(choice, "coarse_reading", lambda lay: calls.append(lay) or real(lay))
-    lay = auto_layout(testing.straight_channel(10.0, 1.0), cell_size=0.1, multiple=4)
+    lay = auto_layout(
+        testing.straight_channel(10.0, 1.0),
+        cell_size=0.1,
+        multiple=4,
+        reading=lambda lay: calls.append(lay) or coarse_reading(lay),
+    )
     assert len(lay.blocks) == 1
     assert len(calls) == 1  # the same single block at every scale: scored once
