@@ -3,16 +3,17 @@ r"""Among layouts drawn at neighbouring scales, the one whose coarsest grid is m
 A large jagged basin is split greedily (:mod:`.split`): which star, spokes and cuts win depends
 on where the chords fall and on the scale at which corners are read, all multiples of the cell
 size, so a slightly other cell size gives another layout and, on lakes of 60–90 blocks, grids
-from 65 to 93 % of nodes within 3° (held-out g180632 between 8 000 and 20 000 cells).  No
-number of the layout itself (its corner cost, the blocks' side ratios or corner angles) told
-the good ones from the bad (docs/lake-grids-journal.md), but the coarsest level of the
-orthogonal solve (cells of ``multiple`` × the size, a few percent of the solve's time) does:
-the mean deviation from 90° of its block-interior nodes ranks the final grids of the same lake.
+from 65 to 93 % of nodes within 3° (held-out g180632 between 8 000 and 20 000 cells).  The
+blocks' side ratios, corner angles and cell aspects hardly told the good layouts from the bad
+(Spearman +0.1 to +0.2 within a lake; docs/lake-grids-journal.md), the coarsest level of the
+orthogonal solve (cells of ``multiple`` × the size, 0.1–0.3 s) does: the mean deviation from
+90° of its block-interior nodes ranks the final grids of the same lake (+0.76, −0.96 on g180632).
 
 :func:`chosen` draws the layout again at :data:`SCALES` × the cell size (the geometry only:
 the cells keep the asked size, as :data:`~meshcore.layout.LAYOUT_SCALES`), solves the coarsest
-level of each layout that differs, and keeps the one with the smallest deviation (the layout at
-the cell size itself on ties).  Layouts of more than :data:`MAX_BLOCKS` blocks are kept as drawn
+level of each layout that differs, and keeps the one with the smallest deviation if that is
+:data:`MARGIN` below the first's and its largest interface ratio there is no larger (else the
+layout at the cell size itself).  Layouts of more than :data:`MAX_BLOCKS` blocks are kept as drawn
 (each other scale costs a layout: Saimaa's takes 10 s).
 """
 
