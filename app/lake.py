@@ -300,7 +300,11 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
             raise InvalidInputError(why.replace("give a cell size of", "set the cell size (Lake panel) to"))
     if cuts:
         return split_layout(poly, [np.asarray(c, float) for c in cuts], h, 2**LEVELS)
-    return auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single)
+    from meshcore.lakegrid import coarse_reading
+
+    return auto_layout(
+        poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single, reading=coarse_reading
+    )
 
 
 def split_layout(poly: Any, cuts: list, cell_size: float, multiple: int) -> Any:

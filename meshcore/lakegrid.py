@@ -31,7 +31,7 @@ from .grid import SolveInfo
 if TYPE_CHECKING:
     from .elliptic import SolverProgress
 
-__all__ = ["iterate_layout", "mesh_layout", "mesh_outline"]
+__all__ = ["coarse_reading", "iterate_layout", "mesh_layout", "mesh_outline"]
 
 
 def _shore_rings(poly, step: float) -> list[np.ndarray]:
@@ -114,6 +114,34 @@ def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **
     from ._generators import drain
 
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
+
+
+class _Coarsest(Exception):
+    """Carries the coarsest level's grids out of the solve (no more levels are needed)."""
+
+    def __init__(self, grids) -> None:
+        super().__init__("coarsest level")
+        self.grids = grids
+
+
+def coarse_reading(layout) -> tuple[float, float]:
+    """The mean deviation from 90° (degrees) of the block-interior nodes of ``layout``'s grid on
+    the coarsest level of :func:`mesh_layout` (cells ``layout.multiple`` × the size), and the
+    largest cross-interface cell-area ratio there: what :func:`~meshcore.layout.auto_layout`
+    (``reading=``) compares layouts drawn at neighbouring scales by (:mod:`meshcore.layout.choice`)."""
+    from .quality import lake_metrics
+
+    def stop(kind: str, value) -> None:
+        if kind == "level":
+            raise _Coarsest(value[1].grids)
+
+    try:
+        grids = mesh_layout(layout, callback=stop).grids  # (no coarse level: the only one)
+    except _Coarsest as done:
+        grids = done.grids
+    s = lake_metrics(list(grids)).summary()
+    d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
+    return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
 
 
 def iterate_layout(
@@ -371,6 +399,7 @@ def mesh_outline(
         regular=regular,
         single=single,
         options=layout_options or LayoutOptions(),
+        reading=coarse_reading,
     )
     mb = mesh_layout(lay, levels=levels, **options)
     from .quality.lake import block_metrics

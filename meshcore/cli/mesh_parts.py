@@ -87,6 +87,7 @@ def read_parts(args: Any, parts: list, frame: Any, say: Any) -> WaterParts:
 
 
 def _layouts(args: Any, water: WaterParts, kept: list, h: float, regular: bool, say: Any, frame: Any) -> list:
+    from ..lakegrid import coarse_reading
     from ..layout import auto_layout
     from .mesh_steps import LEVELS, _notes, layout_options
 
@@ -100,6 +101,7 @@ def _layouts(args: Any, water: WaterParts, kept: list, h: float, regular: bool, 
                 regular=regular,
                 single=getattr(args, "single_space", False),
                 options=layout_options(args),
+                reading=coarse_reading,
             )
         except InvalidInputError as exc:
             raise InvalidInputError(in_world(f"{args.outline}: part {k}: {exc}", frame)) from None

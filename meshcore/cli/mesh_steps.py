@@ -154,6 +154,7 @@ def layout_options(args):
 
 
 def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
+    from ..lakegrid import coarse_reading
     from ..layout import LayoutOptions, auto_layout
 
     options = layout_options(args)
@@ -165,6 +166,7 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
             regular=regular,
             single=getattr(args, "single_space", False),
             options=options,
+            reading=coarse_reading,
         )
     except InvalidInputError as exc:
         msg = in_world(str(exc), frame)

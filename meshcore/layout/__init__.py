@@ -30,6 +30,7 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -38,6 +39,7 @@ from ..cellsize import DEFAULT_CELLS, default_cell_size
 from . import tipends
 from .blocks import block_counts
 from .build import layout_pieces
+from .choice import chosen
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
@@ -81,6 +83,7 @@ def auto_layout(
     regular: bool = False,
     single: bool = False,
     options: LayoutOptions = DEFAULT_OPTIONS,
+    reading: Callable[[Layout], tuple[float, float]] | None = None,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -110,6 +113,12 @@ def auto_layout(
     options : LayoutOptions
         Layout choices that are off by default (thin arms, mouths, curve, wedges; each measured
         mixed): :class:`~.model.LayoutOptions`.
+    reading : callable, optional
+        A layout's coarse grid read as (mean deviation from 90°, largest interface ratio)
+        (:func:`meshcore.lakegrid.coarse_reading`, as :func:`meshcore.mesh_outline` and
+        ``meshcore mesh`` pass): with it a default (not regular) layout is drawn again at
+        neighbouring scales and the one whose coarse grid is clearly more orthogonal is kept
+        (:mod:`.choice`).
 
     Returns
     -------
@@ -178,6 +187,23 @@ def auto_layout(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
+            if (
+                scale == 1.0 and not regular and reading is not None
+            ):  # drawn at neighbouring scales: the best coarse grid (.choice)
+
+                def at_scale(s: float, normal: bool = normal) -> Layout:
+                    return _layout(
+                        shores,
+                        h,
+                        notes + more,
+                        multiple=multiple,
+                        regular=False,
+                        normal=normal,
+                        scale=s,
+                        options=options,
+                    )
+
+                lay = chosen(lay, at_scale, reading)
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
         if kept is not None:
             if single:  # a single index space cannot hold it: say where, before the grid is made
