@@ -30,6 +30,7 @@ How it works (the method, its reasons and its limits are in ``docs/lake-grids.md
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from typing import Any
 
@@ -153,22 +154,13 @@ def auto_layout(
 
     first = None
     kept = None  # a regular layout whose blocks do not close up round an island (.frames)
+    draw = functools.partial(_layout, shores, h, notes + more, multiple=multiple, single=single, options=options)
     for scale in LAYOUT_SCALES:
         # the cuts along the shore's normal can leave T-junctions no integer counts satisfy:
         # the layout without them (the splits of earlier versions) next
         for normal in (True, False):
             try:
-                lay = _layout(
-                    shores,
-                    h,
-                    notes + more,
-                    multiple=multiple,
-                    regular=regular,
-                    single=single,
-                    normal=normal,
-                    scale=scale,
-                    options=options,
-                )
+                lay = draw(regular=regular, normal=normal, scale=scale)
             except TopologyError as exc:
                 first = first or exc
                 continue
@@ -187,23 +179,8 @@ def auto_layout(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
-            if (
-                scale == 1.0 and not regular and reading is not None
-            ):  # drawn at neighbouring scales: the best coarse grid (.choice)
-
-                def at_scale(s: float, normal: bool = normal) -> Layout:
-                    return _layout(
-                        shores,
-                        h,
-                        notes + more,
-                        multiple=multiple,
-                        regular=False,
-                        normal=normal,
-                        scale=s,
-                        options=options,
-                    )
-
-                lay = chosen(lay, at_scale, reading)
+            if scale == 1.0 and not regular and reading is not None:  # the best coarse grid of three scales
+                lay = chosen(lay, lambda s, n=normal: draw(regular=False, normal=n, scale=s), reading)
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
         if kept is not None:
             if single:  # a single index space cannot hold it: say where, before the grid is made

@@ -91,6 +91,19 @@ def test_the_failure_names_each_place():
     assert "2 cell(s) at i 44–45, j 19 by the top border, around (11.375, 3.375)" in r.message
 
 
+def _spied(monkeypatch, mm) -> list:
+    """The first columns of the nodes every call of ``mm.minimise`` gets, as it goes."""
+    tried: list = []
+    real = mm.minimise
+
+    def spy(x, y, nodes, *args, **kw):
+        tried.append(nodes[:, 0].copy())
+        return real(x, y, nodes, *args, **kw)
+
+    monkeypatch.setattr(mm, "minimise", spy)
+    return tried
+
+
 def test_pieces_grow_no_wider_than_max_radius(monkeypatch):
     # a top-border node pulled below the bottom border: no patch repairs it; with max_radius the
     # pieces tried stay within that many cells of it (the coarse start's case), without it they
@@ -100,14 +113,7 @@ def test_pieces_grow_no_wider_than_max_radius(monkeypatch):
     x, y = _rectangle(120, 20)
     y[60, -1] = -1.0
     bad = invalid_cells(x, y)
-    tried = []
-    real = mm.minimise
-
-    def spy(x, y, nodes, *args, **kw):
-        tried.append(nodes[:, 0].copy())
-        return real(x, y, nodes, *args, **kw)
-
-    monkeypatch.setattr(mm, "minimise", spy)
+    tried = _spied(monkeypatch, mm)
     opts = {"tolerance": 1e-4, "max_sweeps": 50}
     ex = np.zeros(bad.shape, dtype=np.uint8)
     ok, _, _ = mm.patches(x.copy(), y.copy(), bad, ex, radius=2, max_fraction=0.3, max_radius=8, **opts)
@@ -129,14 +135,7 @@ def test_a_transplant_that_must_fail_stops_at_its_first_failed_piece(monkeypatch
     y[30, -1] = -1.0  # tried first (column order)
     y[90, -1] = -1.0
     bad = invalid_cells(x, y)
-    tried = []
-    real = mm.minimise
-
-    def spy(x, y, nodes, *args, **kw):
-        tried.append(nodes[:, 0].copy())
-        return real(x, y, nodes, *args, **kw)
-
-    monkeypatch.setattr(mm, "minimise", spy)
+    tried = _spied(monkeypatch, mm)
     opts = {"tolerance": 1e-4, "max_sweeps": 50, "radius": 2, "max_fraction": 0.3, "max_radius": 8}
     ex = np.zeros(bad.shape, dtype=np.uint8)
     full = mm.patches(x.copy(), y.copy(), bad, ex, **opts)
