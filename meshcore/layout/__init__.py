@@ -180,7 +180,11 @@ def auto_layout(
                     first = first or TopologyError(folds)
                     continue
             if scale == 1.0 and not regular and reading is not None:  # the best coarse grid of three scales
-                lay = chosen(lay, lambda s, n=normal: draw(regular=False, normal=n, scale=s), reading)
+
+                def at_scale(s: float, n: bool = normal) -> Layout:
+                    return draw(regular=False, normal=n, scale=s)
+
+                lay = chosen(lay, at_scale, reading)
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
         if kept is not None:
             if single:  # a single index space cannot hold it: say where, before the grid is made
