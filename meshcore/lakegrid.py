@@ -116,14 +116,6 @@ def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
 
 
-class _Coarsest(Exception):
-    """Carries the coarsest level's grids out of the solve (no more levels are needed)."""
-
-    def __init__(self, grids) -> None:
-        super().__init__("coarsest level")
-        self.grids = grids
-
-
 def coarse_reading(layout) -> tuple[float, float]:
     """The mean deviation from 90° (degrees) of the block-interior nodes of ``layout``'s grid on
     the coarsest level of :func:`mesh_layout` (cells ``layout.multiple`` × the size), and the
@@ -131,14 +123,7 @@ def coarse_reading(layout) -> tuple[float, float]:
     (``reading=``) compares layouts drawn at neighbouring scales by (:mod:`meshcore.layout.choice`)."""
     from .quality import lake_metrics
 
-    def stop(kind: str, value) -> None:
-        if kind == "level":
-            raise _Coarsest(value[1].grids)
-
-    try:
-        grids = mesh_layout(layout, callback=stop).grids  # (no coarse level: the only one)
-    except _Coarsest as done:
-        grids = done.grids
+    grids = mesh_layout(layout, callback=lambda kind, _: "stop" if kind == "level" else None).grids
     s = lake_metrics(list(grids)).summary()
     d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
     return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
@@ -188,7 +173,8 @@ def iterate_layout(
     ``spacing``: then the edge lengths along grid lines smoothed in block interiors, guarded
     (:func:`~meshcore.orthogonal.spacing.smooth_spacing`; off by default, see there).
     ``level_callback(kind, value)`` is called with ``("level", (level, result))`` as each level
-    ends and ``("equalize", patches)`` after the equalize step (the patches it kept).
+    ends (returning ``"stop"`` ends the solve there, as ``"stop"`` sent does) and
+    ``("equalize", patches)`` after the equalize step (the patches it kept).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped"); ``stop_event``
@@ -263,8 +249,8 @@ def iterate_layout(
             res = fin.value
         grids = list(res.grids)
         total += res.sweeps
-        if level_callback is not None:
-            level_callback("level", (lev, res))
+        if level_callback is not None and level_callback("level", (lev, res)) == "stop":
+            stopped = True  # (no more levels wanted: the grids of this one)
         if stopped:
             break
     if not stopped:
