@@ -205,45 +205,61 @@ def layout_pieces(
 #: rounding (:func:`_flat_corner_on_cut`).
 FLAT_TURN = 0.01
 
-#: ... for this many cells along the shore either side of the corner (or up to the piece's next
-#: corner, a tip chord's end a cell away): a corner on the outline's short straight pieces between
-#: the vertices of a round headland keeps its place (moved onto a cut, generated headlands 976602
-#: lost nodes within 3°, 90.1 → 89.6 %).
-STRAIGHT = 1.0
+#: How far (cells, along the shore either side, up to the piece's next corner) a vertex that
+#: turns may take a flat corner's place (:data:`CONVEX_TURN`).
+REACH = 1.0
+
+#: A shore vertex within :data:`REACH` cells of a flat corner that turns by at least this
+#: (degrees, towards the water) takes the corner instead: the blunt end of an arm drawn with two
+#: vertices, whose smoothed turning peaks between them (the corner was put on the straight edge
+#: in between, a cell of 180°; on the vertex the cell has the end's own angle).
+CONVEX_TURN = 20.0
 
 
 def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float) -> tuple:
-    """The corners ``c`` of piece ``r`` with a corner on a straight shore moved onto its longest cut.
+    """The corners ``c`` of piece ``r`` with a corner on a straight shore moved off it.
 
     A piece with three sharp corners (the pointed end of an arm beyond its tip chord, a triangular
     lake's corner zone) gets its fourth from :func:`~.corners.choose_corners` where a side turns
     most; on a straight shore that is nowhere: the corner turns by 0°, its corner cell is a
     triangle with a 180° angle and a corner Jacobian that is zero up to rounding (the same grid
-    read as fold-free in local coordinates and as folded in UTM ones).  On a cut the same corner
-    costs nothing: the block beyond passes it (a T-junction) and the solve, which moves interface
-    nodes, opens the corner there (about 120° for each of the three cells).  The new corner is the
-    cut vertex nearest the middle of the piece's longest run of cut vertices (by arc length); ``c``
-    unchanged when no corner or more than one is flat, a flat corner is ``forced``, or the piece
-    has no cut (``on_shore``: the ring's vertices on the shore; ``h``: the cell size)."""
+    read as fold-free in local coordinates and as folded in UTM ones): whatever the shore does a
+    cell further on, the grid's first nodes along the two sides lie on the straight edge unless
+    the block's cells are longer than the edge's halves.  A shore vertex within a cell that turns
+    by :data:`CONVEX_TURN` or more takes the corner (the most turning one).  Else the corner goes
+    onto a cut, where it costs nothing: the block beyond passes it (a T-junction) and the solve,
+    which moves interface nodes, opens the corner there (about 120° for each of the three cells).
+    The new corner is the cut vertex nearest the middle of the piece's longest run of cut
+    vertices (by arc length); ``c`` unchanged when no corner or more than one is flat, a flat
+    corner is ``forced``, or the piece has no cut (``on_shore``: the ring's vertices on the
+    shore; ``h``: the cell size)."""
     from .corners import _raw_turning
 
     raw = _raw_turning(r)
     n = len(r)
     corners = {int(i) for i in c}
 
-    def straight(i: int) -> bool:  # straight for STRAIGHT cells either side, or up to the next corner
+    def reach(i: int) -> list[int]:  # the shore vertices within a cell either side, up to a corner
+        out = []
         for step in (1, -1):
-            k, d = i, 0.0
-            while d < STRAIGHT * h:
-                if abs(raw[k]) >= FLAT_TURN or not on_shore[k]:
-                    return False
+            k, d = (i + step) % n, math.hypot(*(r[(i + step) % n] - r[i]))
+            while d < REACH * h and on_shore[k] and k not in corners:
+                out.append(k)
                 k, d = (k + step) % n, d + math.hypot(*(r[(k + step) % n] - r[k]))
-                if k in corners:
-                    break
-        return True
+        return out
 
     held = {int(f) for f in forced}
-    flat = [i for i in c if i not in held and straight(i)]
+    flat = []
+    for i in c:
+        if i in held or abs(raw[i]) >= FLAT_TURN or not (on_shore[i - 1] and on_shore[(i + 1) % n]):
+            continue
+        near = reach(i)
+        convex = [k for k in near if raw[k] >= CONVEX_TURN and k not in corners]
+        if convex:
+            k = max(convex, key=lambda k: raw[k])
+            new = sorted((corners - {int(i)}) | {k})
+            return tuple(new) if len(new) == 4 else tuple(c)
+        flat.append(i)
     if len(flat) != 1 or on_shore.all() or not on_shore.any():
         return tuple(c)
     start = int(np.flatnonzero(on_shore)[0])

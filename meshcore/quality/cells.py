@@ -6,7 +6,9 @@ Per cell ``(i, j)`` with corners ``00 = (i, j)``, ``10 = (i+1, j)``,
 * ``area`` — signed area (shoelace); ``≤ 0`` means the cell is **folded**;
 * ``corner_jacobians`` — the cross products of the two edges at each corner
   (shape ``(4, ni, nj)``); a cell is **valid** (convex, not inverted) when
-  all four are ``> 0``.  On real shorelines non-convex cells outnumber folded ones;
+  all four are ``> 0`` — beyond rounding: a corner whose sine is at most
+  :data:`STRAIGHT_SINE` is straight (a triangle cell) and counts as non-convex.
+  On real shorelines non-convex cells outnumber folded ones;
 * ``jacobian_ratio`` — min / max of the four corner Jacobians (1 for a parallelogram);
 * ``orthogonality`` — largest deviation of a corner angle from 90°, degrees;
 * ``skewness`` — equiangle skewness ``max((θmax − 90)/90, (90 − θmin)/90)``;
@@ -26,7 +28,37 @@ import numpy as np
 
 from ..grid import StructuredGrid
 
-__all__ = ["QualityReport", "cell_quality", "quality"]
+__all__ = ["STRAIGHT_SINE", "QualityReport", "cell_quality", "corner_sines", "quality", "straight_and_reflex"]
+
+#: A cell corner whose sine (the corner Jacobian over its two edges' lengths) is at most this is
+#: straight up to rounding: a triangle cell with a 180° angle, counted as non-convex.  Its
+#: Jacobian's sign is the rounding's (the same grid was fold-free in a lake's local frame and
+#: non-convex after the move to UTM, where coordinates of 5e6 m leave ~1e-9 m of each
+#: difference); 1e-7 stays above that for cells down to ~0.1 m in world coordinates.
+STRAIGHT_SINE = 1e-7
+
+
+def corner_sines(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``(4, ni, nj)`` sine of every cell corner (CCW: 00, 10, 11, 01); 0 at a zero-length edge."""
+    p = [(x[:-1, :-1], y[:-1, :-1]), (x[1:, :-1], y[1:, :-1]), (x[1:, 1:], y[1:, 1:]), (x[:-1, 1:], y[:-1, 1:])]
+    out = []
+    for k in range(4):
+        (px, py), (nx, ny), (bx, by) = p[k], p[(k + 1) % 4], p[(k - 1) % 4]
+        ux, uy, vx, vy = nx - px, ny - py, bx - px, by - py
+        den = np.hypot(ux, uy) * np.hypot(vx, vy)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out.append(np.where(den > 0, (ux * vy - uy * vx) / np.where(den > 0, den, 1.0), 0.0))
+    return np.stack(out)
+
+
+def straight_and_reflex(x: np.ndarray, y: np.ndarray) -> tuple[int, int]:
+    """``(straight, reflex)``: how many cells of a block have a corner straight up to rounding (and
+    none beyond), and how many have one folded or reflex beyond rounding (sine below
+    ``−STRAIGHT_SINE``), in the block's own orientation."""
+    s = corner_sines(x, y)
+    s = s if s.sum() >= 0 else -s
+    reflex = (s < -STRAIGHT_SINE).any(axis=0)
+    return int(((s <= STRAIGHT_SINE).any(axis=0) & ~reflex).sum()), int(reflex.sum())
 
 
 def cell_quality(grid: StructuredGrid) -> dict[str, np.ndarray]:
@@ -183,7 +215,7 @@ def quality(grid: StructuredGrid) -> QualityReport:
     area = q["area"]
     cj = q["corner_jacobians"]
     folded = np.argwhere(area <= 0)
-    nonconvex = np.argwhere((cj <= 0).any(axis=0))
+    nonconvex = np.argwhere(((cj <= 0) | (corner_sines(grid.x, grid.y) <= STRAIGHT_SINE)).any(axis=0))
     finite = lambda a: a[np.isfinite(a)] if np.isfinite(a).any() else np.array([np.inf])  # noqa: E731
     return QualityReport(
         cells=grid.cells,

@@ -13,7 +13,8 @@ Per block, on the node arrays ``x, y`` of shape ``(ni + 1, nj + 1)``:
 * ``aspect_ratio`` — per cell, the longer over the shorter of its two edges
   from the ``(i, j)`` corner;
 * ``folded`` — per cell, 1 when any of its four corner Jacobians is ``≤ 0``
-  relative to the block's orientation (folded or non-convex), else 0;
+  relative to the block's orientation (folded or non-convex) or its corner is
+  straight up to rounding (sine ``≤`` :data:`~.cells.STRAIGHT_SINE`), else 0;
 * ``interface_ratio`` — for two cells of different blocks that share an edge,
   ``max(A₁/A₂, A₂/A₁)``.  Shared edges are found from the coordinates (both
   end nodes coincide within ``1e-7`` of the domain size), so the same code
@@ -38,6 +39,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..grid import StructuredGrid
+from .cells import STRAIGHT_SINE, corner_sines
 from .interfaces import interface_pairs, no_pairs, ratio, signed_area
 from .samples import Samples, format_table
 
@@ -162,7 +164,7 @@ def block_metrics(grid: StructuredGrid, name: str = "block1") -> BlockMetrics:
     leta = np.hypot(x[:-1, 1:] - x[:-1, :-1], y[:-1, 1:] - y[:-1, :-1])
     area = signed_area(x, y)
     orient = -1.0 if area.sum() < 0 else 1.0  # a mirrored (clockwise) block is judged in its own sense
-    folded = (orient * corner_jacobians(x, y) <= 0).any(axis=0)
+    folded = (orient * corner_sines(x, y) <= STRAIGHT_SINE).any(axis=0)
     return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded)
 
 

@@ -94,3 +94,66 @@ def test_lonlat_triangle_meshes_without_folded_cells(tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     assert "folded" not in r.stderr.split("quality:")[-1].split("\n")[0] or "0 folded" in r.stderr
     assert out.exists()
+
+
+def _ring_of(points, step):
+    ring = np.asarray(shapely.segmentize(Polygon(points), step).exterior.coords)[:-1]
+    return ring if shapely.LinearRing(ring).is_ccw else ring[::-1]
+
+
+def test_a_flat_corner_beside_a_blunt_end_vertex_moves_onto_it():
+    # an arm's blunt end drawn with two vertices, B = (4, 0) and A = (4.3, 2); the chord from
+    # (0, 2) to (0, 0) is the cut; the fourth corner was put halfway along the end (M, flat):
+    # a cell of 180° there (held-out set 12, g180626); B turns ~80° a cell away and takes it
+    ring = _ring_of([(0, 0), (4, 0), (4.15, 1.0), (4.3, 2), (0, 2)], 0.5)
+    on_shore = ring[:, 0] > 1e-9
+
+    def at(p):
+        return int(np.argmin(np.hypot(*(ring - p).T)))
+
+    corners = sorted([at((0, 0)), at((0, 2)), at((4.3, 2)), at((4.15, 1.0))])
+    new = _flat_corner_on_cut(ring, corners, on_shore, (), 1.5)
+    assert sorted(new) == sorted([at((0, 0)), at((0, 2)), at((4.3, 2)), at((4, 0))])
+    # at cells of 0.5 B is two cells away and the end straight for a cell either side of M: M
+    # goes onto the cut's middle, as on any straight shore
+    new = _flat_corner_on_cut(ring, corners, on_shore, (), 0.5)
+    assert sorted(new) == sorted([at((0, 0)), at((0, 2)), at((4.3, 2)), at((0, 1))])
+
+
+def test_a_flat_corner_beside_a_reflex_bump_moves_onto_the_cut():
+    # the pointed end of an arm (chord (0, 0)-(0, 4), tip (6, 2)) whose lower shore has a bump of
+    # land at (3.6, 1.6) (reflex for the water): the fourth corner on the straight shore between
+    # the bump and the tip, less than a cell from the bump, has a corner cell beyond 180° whatever
+    # the grid (held-out g180765's tip block): onto the cut with it
+    ring = _ring_of([(0, 0), (3.6, 1.6), (6, 2), (0, 4)], 0.5)
+    on_shore = ring[:, 0] > 1e-9
+
+    def at(p):
+        return int(np.argmin(np.hypot(*(ring - p).T)))
+
+    flat = at((4.2, 1.7))
+    assert abs(np.hypot(*(ring[flat] - (4.2, 1.7)))) < 0.2
+    corners = sorted([at((0, 0)), at((6, 2)), at((0, 4)), flat])
+    new = _flat_corner_on_cut(ring, corners, on_shore, (), 1.0)
+    assert flat not in new and len(new) == 4
+    np.testing.assert_allclose(ring[sorted(set(new) - set(corners))[0]], (0, 2), atol=0.26)
+
+
+def test_no_layout_corner_on_a_straight_shore_of_a_coarse_outline():
+    """A dendritic lake drawn with 200 points: one piece had its corner on a straight shore edge
+    between two shore vertices (turning 0°, both sides shore): a corner cell of 180°."""
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+    from meshcore.layout.corners import _raw_turning
+
+    lay = auto_layout(testing.resampled(testing.dendritic(2700), points=200), target_cells=15000, multiple=4)
+    shore = lay.polygon.boundary
+    eps = 1e-6 * lay.cell_size
+    flat = []
+    for p in lay.pieces:
+        r = np.asarray(p.ring)
+        raw = _raw_turning(r)
+        on = shapely.distance(shore, shapely.points(r)) < eps
+        n = len(r)
+        flat += [(p.name, c) for c in p.corners if on[c] and on[c - 1] and on[(c + 1) % n] and abs(raw[c]) < 1.0]
+    assert flat == []
