@@ -165,7 +165,8 @@ class LakePanel(QtWidgets.QWidget):
 
 
 def miss_points(verdict, row: int | None = None) -> np.ndarray:
-    """``(k, 2)`` places (nodes, cells, edge pairs) that miss a failed limit (only limit ``row`` if given)."""
+    """``(k, 3)`` places (nodes, cells, edge pairs) that miss a failed limit (only limit ``row`` if given):
+    x, y and how far beyond the limit (the value over the limit; NaN where the value is not a number)."""
     m = verdict.metrics
     out = []
     results = verdict.results if row is None else verdict.results[row : row + 1]
@@ -176,8 +177,10 @@ def miss_points(verdict, row: int | None = None) -> np.ndarray:
         if s is None or not len(s) or r.limit.statistic != "each":
             continue
         bad = ~(s.values <= r.limit.max)
-        out.append(np.column_stack([s.x[bad], s.y[bad]]))
-    return np.vstack(out) if out else np.zeros((0, 2))
+        v = np.asarray(s.values, float)[bad]
+        over = v / r.limit.max if r.limit.max > 0 else v - r.limit.max
+        out.append(np.column_stack([s.x[bad], s.y[bad], over]))
+    return np.vstack(out) if out else np.zeros((0, 3))
 
 
 def ok_percent(fraction: float) -> str:
@@ -230,8 +233,9 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.verticalHeader().setDefaultSectionSize(20)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setToolTip(
-            "click a limit: the places that miss it are marked by orange dots on the canvas and the "
-            "view goes to the worst (Enter too)"
+            "click a limit: the places that miss it are marked on the canvas (orange: the worst in each "
+            "patch of the screen, so the grid stays in sight; ringed red: the worst of all) and the view "
+            "goes to the worst (Enter too)"
         )
         lay.addWidget(self.table)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)

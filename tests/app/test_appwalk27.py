@@ -1,0 +1,46 @@
+"""What the session-27 walk through the app found, and the items the session-26 walk left: each as
+it went wrong, on generated shapes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.gui
+
+
+def _show(qtbot, canvas, lo: float, hi: float) -> None:
+    canvas.setRange(xRange=(lo, hi), yRange=(lo, hi), padding=0)
+    qtbot.wait(20)
+
+
+def test_many_misses_keep_the_grid_in_sight_and_ring_the_worst(qtbot, win):
+    """A preset missed at most nodes (59 % of a lake's nodes beyond Delft3D's |cos| <= 0.02) was one
+    orange dot per miss: the lake turned orange, no grid under it, and which place was worst could
+    not be told.  Now at most one mark per patch of the screen, the worst miss there; every patch
+    with a miss has its mark; the worst of all is ringed; zoomed in, every miss has its own."""
+    from app.views.miss_marks import PATCH_PX
+
+    rng = np.random.default_rng(270501)
+    pts = np.column_stack([rng.uniform(0, 1000, (20000, 2)), rng.uniform(1.0, 3.0, 20000)])
+    pts[4321, 2] = 40.0  # the worst place, by far
+    c, items = win.canvas, win.canvas.lake_items
+    _show(qtbot, c, 0.0, 1000.0)
+    win.lake_quality.misses.emit(pts)
+    drawn = np.column_stack(items.misses.getData())
+    patch = PATCH_PX * c.pixel()
+    key = lambda a: [tuple(k) for k in np.floor(a[:, :2] / patch).astype(int)]  # noqa: E731
+    assert len(set(key(drawn))) == len(drawn)  # one mark per patch
+    assert set(key(drawn)) == set(key(pts))  # every patch with a miss has one
+    assert len(drawn) < 0.2 * len(pts)
+    worst_in = {}
+    for k, b in zip(key(pts), pts[:, 2], strict=True):
+        worst_in[k] = max(worst_in.get(k, -np.inf), b)
+    row = {tuple(p): b for p, b in zip(map(tuple, pts[:, :2]), pts[:, 2], strict=True)}
+    assert all(row[tuple(p)] == worst_in[k] for p, k in zip(map(tuple, drawn), key(drawn), strict=True))
+    ring = np.column_stack(items.miss_marks.worst.getData())
+    np.testing.assert_array_equal(ring, pts[[4321], :2])
+    _show(qtbot, c, 0.0, 20.0)  # zoomed in: patches smaller than the spacing of the misses
+    drawn = {tuple(p) for p in np.column_stack(items.misses.getData())}
+    inside = pts[(pts[:, :2] <= 20.0).all(axis=1), :2]
+    assert len(inside) and {tuple(p) for p in inside} <= drawn
