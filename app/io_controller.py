@@ -135,6 +135,11 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         self.set_project(project, path)
         self.add_recent(path)
+        lay = project.layout
+        for note in lay.notes if lay is not None else ():  # the Lake panel counts them: said in full again
+            self.doc.report("info", f"layout: {note}")
+        for note in lay.details if lay is not None else ():
+            self.doc.report("info", f"layout (detail): {note}")
         # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
         self.win.set_tool("layout" if project.layout is not None else "edit")
         if self.win.solver.auto and any(b.ready for b in project.blocks):  # it said "press F5" as it solved

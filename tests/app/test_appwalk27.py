@@ -44,3 +44,27 @@ def test_many_misses_keep_the_grid_in_sight_and_ring_the_worst(qtbot, win):
     drawn = {tuple(p) for p in np.column_stack(items.misses.getData())}
     inside = pts[(pts[:, :2] <= 20.0).all(axis=1), :2]
     assert len(inside) and {tuple(p) for p in inside} <= drawn
+
+
+def test_the_layout_notes_come_back_with_a_saved_project(qtbot, win, tmp_path):
+    """An island narrower than two cells left out by Auto layout: its notes were in the Lake panel
+    and the Messages, but the saved project (its [outline] blocks, the water in [lake]) reopened
+    without them — the panel said no note, and nothing told why the island had no grid round it."""
+    from tests.app.test_lake import _thin_island_lake, lay_out
+
+    lay = lay_out(qtbot, win, _thin_island_lake(tmp_path / "thin.geojson", needles=4), cell_size=500.0)
+    assert lay.notes and lay.details  # four needles: one note for all, each its detail
+    assert win.io.save_to(tmp_path / "thin.toml")
+    win.messages_panel.clear()
+    assert win.io.open_path(tmp_path / "thin.toml")
+    again = win.doc.project.layout
+    assert again.notes == lay.notes and again.details == lay.details
+    k = len(lay.notes)
+    assert f"{k} note{'s' * (k != 1)} on the water" in win.lake_panel.summary.text()
+    shown = [t for _lv, t in win.messages_panel.messages()]
+    assert all(f"layout: {n}" in shown for n in lay.notes)
+    assert all(f"layout (detail): {n}" in shown for n in lay.details)
+    # the case file still grids with meshcore (which does not read [lake]) and reads back the same
+    from meshcore.case import load_case
+
+    assert load_case(tmp_path / "thin.toml").lake.notes == lay.notes
