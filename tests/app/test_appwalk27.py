@@ -68,3 +68,17 @@ def test_the_layout_notes_come_back_with_a_saved_project(qtbot, win, tmp_path):
     from meshcore.case import load_case
 
     assert load_case(tmp_path / "thin.toml").lake.notes == lay.notes
+
+
+def test_an_island_ring_outside_the_shore_is_refused_naming_it(qtbot, win, tmp_path):
+    """A KML whose innerBoundaryIs ring lies outside its outerBoundaryIs was read as a lake of two
+    parts (the parts dialog offered the "island" as water of its own).  Now the import is refused
+    with the ring named (file, placemark, ring, its first point) and the project is unchanged."""
+    from tests.meshcore.test_hole_rings import OUTSIDE, _kml
+
+    before = win.doc.project
+    path = _kml(tmp_path / "lake.kml", [OUTSIDE])
+    assert not win.io.import_points(path, project_lonlat=True)
+    assert win.doc.project is before
+    said = [t for lv, t in win.messages_panel.messages() if lv == "error"]
+    assert any(str(path) in t and "innerBoundaryIs ring 1 ('lake hole 1')" in t and "point 1 at (" in t for t in said)
