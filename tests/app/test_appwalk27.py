@@ -82,3 +82,28 @@ def test_an_island_ring_outside_the_shore_is_refused_naming_it(qtbot, win, tmp_p
     assert win.doc.project is before
     said = [t for lv, t in win.messages_panel.messages() if lv == "error"]
     assert any(str(path) in t and "innerBoundaryIs ring 1 ('lake hole 1')" in t and "point 1 at (" in t for t in said)
+
+
+def test_the_message_count_is_of_the_grid_now_not_of_grids_before(qtbot, win):
+    """A "Cannot generate" (or a lake grid's folded cells) counted as an error; the next grid was made
+    without a fault and the panel still read "1 error(s)" — and after File > New as well.  Errors
+    and warnings of an earlier grid or project stay listed, greyed, and are no longer counted."""
+    from tests.app.waits import wait_idle
+
+    panel = win.messages_panel
+    assert win.io.open_example("bottle-coarse", confirm=False)
+    win.doc.report("error", "Cannot generate: the boundary crosses itself")
+    win.doc.report("warning", "block: corner on a reflex vertex")
+    win.doc.report("info", "layout: a note")
+    n_err = sum(lv == "error" for lv, _t in panel.messages())
+    assert n_err and panel.count.text().startswith(f"{n_err} error(s), ")
+    win.generate()
+    wait_idle(qtbot, win)
+    assert win.doc.grids and not win.solver.last_error
+    assert panel.count.text().startswith("0 error(s), ")
+    assert "earlier" in panel.count.text()
+    assert ("error", "Cannot generate: the boundary crosses itself") in panel.messages()  # still listed
+    win.doc.report("error", "Cannot export: disk full")  # a new error counts
+    assert panel.count.text().startswith("1 error(s)")
+    win.io.new_project()
+    assert panel.count.text().startswith("0 error(s), 0 warning(s)")
