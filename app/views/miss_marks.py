@@ -17,10 +17,8 @@ from .items import Scatter, set_points
 
 __all__ = ["PATCH_PX", "MissMarks", "thin_misses"]
 
-#: one mark per square of this many screen pixels (a dot of 5 px covers at most a sixth of it)
+#: one mark per square of this many screen pixels (a dot of 6 px covers at most a quarter of it)
 PATCH_PX = 12.0
-#: more marks than this on screen: drawn smaller and fainter (a very large screen)
-MANY_MARKS = 1000
 
 
 def thin_misses(points: np.ndarray, badness: np.ndarray, patch: float) -> np.ndarray:
@@ -50,7 +48,7 @@ class MissMarks:
 
     def __init__(self, canvas) -> None:
         self.canvas = canvas
-        self.dots = Scatter(size=5, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 170))
+        self.dots = Scatter(size=6, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 200))
         self.dots.setZValue(31)
         self.worst = Scatter(size=15, symbol="o", pen=pg.mkPen("#d62728", width=2.5), brush=None)
         self.worst.setZValue(32)
@@ -59,7 +57,7 @@ class MissMarks:
         self.shown = np.zeros(0, dtype=int)  # indices into points of the marks drawn
         self.over_colours = False
         self._patch = 0.0  # the patch size (model units) the marks were thinned for
-        self._style: tuple | None = None
+        self._style: bool | None = None
 
     def items(self) -> tuple:
         return (self.dots, self.worst)
@@ -90,19 +88,19 @@ class MissMarks:
         self._restyle()
 
     def _restyle(self) -> None:
-        many = len(self.shown) > MANY_MARKS
-        key = (self.over_colours, many)
-        if key == self._style:
+        """One size at any count: thinned to one per patch, the marks cannot crowd (a faint 3-px style
+        for over 1000 marks left the 65 in a zoomed view unseen at the grid's crossings)."""
+        if self.over_colours == self._style:
             return
-        self._style = key
+        self._style = self.over_colours
         if self.over_colours:
-            self.dots.setPen(pg.mkPen(0, 0, 0, 110 if many else 200, width=1))
+            self.dots.setPen(pg.mkPen(0, 0, 0, 200, width=1))
             self.dots.setBrush(None)
-            self.dots.setSize(4 if many else 6)
+            self.dots.setSize(6)
         else:
             self.dots.setPen(None)
-            self.dots.setBrush(pg.mkBrush(255, 127, 14, 110 if many else 170))
-            self.dots.setSize(3 if many else 5)
+            self.dots.setBrush(pg.mkBrush(255, 127, 14, 200))
+            self.dots.setSize(6)
 
     def set_visible(self, on: bool) -> None:
         for it in self.items():
