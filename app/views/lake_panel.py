@@ -86,6 +86,7 @@ class LakePanel(QtWidgets.QWidget):
         self.button.clicked.connect(lambda: self.ctl.auto_layout())
         self.split.clicked.connect(lambda: self.ctl.win.split_by_cuts())
         controller.busy_changed.connect(self._busy)
+        controller.ticked.connect(self._ticked)
         doc.project_changed.connect(lambda _p: self.refresh())
         self.refresh()
 
@@ -162,6 +163,9 @@ class LakePanel(QtWidgets.QWidget):
         self.button.setEnabled(not busy)
         self.split.setEnabled(not busy and self.doc.project.layout is None and bool(self.doc.project.cut_lines))
         self.button.setText("Computing the layout…" if busy else "Auto layout")
+
+    def _ticked(self, seconds: int) -> None:
+        self.button.setText(f"Computing the layout… {seconds} s")
 
 
 def miss_points(verdict, row: int | None = None) -> np.ndarray:
