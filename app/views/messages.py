@@ -47,7 +47,9 @@ class MessagePanel(QtWidgets.QWidget):
         self.list.setMinimumHeight(60)
         lay.addWidget(self.list, 1)
         row = QtWidgets.QHBoxLayout()
-        self.count = QtWidgets.QLabel()
+        # shortened with "…" when the dock is narrow: "(1 earlier, greyed)" widened the panel past its
+        # dock, the Clear button out of sight
+        self.count = ElidedLabel()
         row.addWidget(self.count, 1)
         copy = QtWidgets.QPushButton("Copy")
         copy.setToolTip("copy the selected messages (all when none is selected)")
@@ -126,8 +128,8 @@ class MessagePanel(QtWidgets.QWidget):
             text += f" ({self._earlier} earlier, greyed)"
         self.count.setText(text)
         self.count.setToolTip(
-            "errors and warnings since the last grid was made (or the project opened); those of earlier "
-            "grids stay listed, greyed"
+            f"{text}: errors and warnings since the last grid was made (or the project opened); those of "
+            "earlier grids stay listed, greyed"
         )
 
 

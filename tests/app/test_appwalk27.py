@@ -94,6 +94,7 @@ def test_the_message_count_is_of_the_grid_now_not_of_grids_before(qtbot, win):
     from tests.app.waits import wait_idle
 
     panel = win.messages_panel
+    narrow = panel.minimumSizeHint().width()
     assert win.io.open_example("bottle-coarse", confirm=False)
     win.doc.report("error", "Cannot generate: the boundary crosses itself")
     win.doc.report("warning", "block: corner on a reflex vertex")
@@ -105,6 +106,8 @@ def test_the_message_count_is_of_the_grid_now_not_of_grids_before(qtbot, win):
     assert win.doc.grids and not win.solver.last_error
     assert panel.count.text().startswith("0 error(s), ")
     assert "earlier" in panel.count.text()
+    # the longer count is shortened with "…" in a narrow dock, not widening it (Clear went out of sight)
+    assert panel.minimumSizeHint().width() <= narrow
     assert ("error", "Cannot generate: the boundary crosses itself") in panel.messages()  # still listed
     win.doc.report("error", "Cannot export: disk full")  # a new error counts
     assert panel.count.text().startswith("1 error(s)")
