@@ -278,7 +278,12 @@ class LakeController(QtCore.QObject):
                 self.win.message(f"{text}: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells (Ctrl+Z undoes it)")
         if err is not None and self._pending is None:  # a refusal only counts for the last request
             self.edit_error = err
-            self.win.message(f"Cannot change the layout: {err}", error=True)
+            if self._dragging and key is not None:
+                # a step of a drag still on: the status line says why not here; Messages get the refusal
+                # only if the drag ends there (one drag over a bay put six errors in Messages, red)
+                self.win.message(f"Not here: {err} — the layout of the last good place stays")
+            else:
+                self.win.message(f"Cannot change the layout: {err}", error=True)
             if layout is None:
                 self.layout_done.emit(None)
         self._next_edit()

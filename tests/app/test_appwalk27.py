@@ -144,3 +144,33 @@ def test_a_long_layout_counts_its_seconds(qtbot, win, tmp_path, monkeypatch):
     wait_idle(qtbot, win)
     assert not win.lake_ctl._ticker.isActive() and win.lake_panel.button.text() == "Auto layout"
     assert not win._status.text().startswith("Computing")
+
+
+def test_refused_steps_of_a_drag_are_not_errors_when_it_ends_on_a_good_place(qtbot, win, tmp_path, monkeypatch):
+    """A cut end dragged over a bay (g180718, auto-generate on): every step whose cut left the water was
+    an error in Messages ("Cannot change the layout: cut 18 leaves the water…", six for one drag, the
+    status line red), though the drag ended where the layout was good.  Mid-drag the status line
+    says why not there; only a drag that ends refused is an error."""
+    import app.layout_edit as le
+    from app.layout_edit import handles
+    from tests.app.test_modeller import _laid_out
+    from tests.app.waits import wait_for, wait_idle
+
+    _laid_out(qtbot, win, tmp_path, 270503)
+    win.messages_panel.clear()
+    lay0 = win.doc.project.layout
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    x0, _y0, x1, y1 = lay0.polygon.bounds
+    far = (x1 + (x1 - x0), y1)
+    tool, place = win.canvas.tool, le.place
+    assert tool is win.tools["layout"] and tool.drag("start", end.xy, end.xy)
+    monkeypatch.setattr(le, "place", lambda *a, **k: far)  # the steps go far off the shore: refused
+    for f in (0.3, 0.6, 0.9):
+        tool.drag("move", (end.xy[0] + f * lay0.cell_size, end.xy[1]), end.xy)
+        wait_for(qtbot, win, lambda: not win.lake_ctl.editing)
+        assert win.lake_ctl.edit_error and win._status.text().startswith("Not here: ")
+    monkeypatch.setattr(le, "place", place)
+    tool.drag("finish", end.xy, end.xy)  # back where it began: a good place
+    wait_idle(qtbot, win)
+    assert win.lake_ctl.edit_error is None
+    assert not [t for lv, t in win.messages_panel.messages() if lv == "error"]
