@@ -90,6 +90,8 @@ class IOController(ExportMixin, QtCore.QObject):
         self.doc.reset(project, path)
         self.win.canvas.fit()
         self.stack.setClean()
+        if project.layout is not None:  # a lake's layout: its blocks and cells in front, not one block's ξ, η
+            self.win.show_lake()
 
     def maybe_save(self) -> bool:
         """Ask about unsaved changes; False when the user cancels."""

@@ -174,3 +174,18 @@ def test_refused_steps_of_a_drag_are_not_errors_when_it_ends_on_a_good_place(qtb
     wait_idle(qtbot, win)
     assert win.lake_ctl.edit_error is None
     assert not [t for lv, t in win.messages_panel.messages() if lv == "error"]
+
+
+def test_a_laid_out_lake_opens_with_the_lake_panel_in_front(qtbot, win, tmp_path):
+    """A saved lake project opened (from the command line, after Parameters was last in front) or
+    restored after a crash showed the Parameters panel — one block's ξ, η, which the layout locks —
+    over the Lake panel with its blocks, cells and cell size."""
+    from tests.app.test_modeller import _laid_out
+
+    _laid_out(qtbot, win, tmp_path, 270504)
+    assert win.io.save_to(tmp_path / "lake.toml")
+    win.docks["params"].raise_()
+    qtbot.waitUntil(lambda: win.docks["lake"].visibleRegion().isEmpty(), timeout=20_000)
+    assert win.io.open_path(tmp_path / "lake.toml")
+    qtbot.waitUntil(lambda: not win.docks["lake"].visibleRegion().isEmpty(), timeout=20_000)  # its tab in front
+    assert win.docks["params"].visibleRegion().isEmpty()
