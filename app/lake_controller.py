@@ -26,6 +26,9 @@ __all__ = ["EDIT_GAP_S", "LakeController"]
 #: seconds between the starts of two layouts of a drag (the grid re-solves from each; see
 #: LakeController.edit_layout): five a second, each left a few smoothed frames of the grid
 EDIT_GAP_S = 0.2
+#: Auto layout of more cells than this asks first (20 x the default 10 000): the layout and its grid
+#: take minutes and cannot be stopped half way (a cell size of 20 m typed for 200: 3.7 million cells)
+LARGE_LAYOUT = 200_000
 
 log = logging.getLogger(__name__)
 
@@ -139,10 +142,37 @@ class LakeController(QtCore.QObject):
             lake = lake.replaced(regular=bool(regular), single=False)  # Delft3D DD: any multiple of 4 turns
         if single is not None:
             lake = lake.replaced(single=bool(single), regular=bool(single) or lake.regular)
+        if not self._large_ok(lake):
+            return False
         kind = "regular layout (no 3- or 5-block corners)" if lake.regular else "layout"
         if lake.single:
             kind = "layout for one index space (Delft3D single domain, EFDC)"
         return self._start(lake, None, f"Computing the block {kind} of the lake…")
+
+    def _large_ok(self, lake: Lake) -> bool:
+        """True unless the layout would have over :data:`LARGE_LAYOUT` cells and the user says no (no dialog
+        when quiet: refused, said in the status line)."""
+        from .lake import expected_cells
+
+        n = expected_cells(lake)
+        if n <= LARGE_LAYOUT:
+            return True
+        text = (
+            f"About {n:,} cells at {lake.cell_size:.4g} m ({n / 10_000:.0f}× the default): the layout and its grid "
+            "take minutes (they cannot be stopped half way) and much memory."
+        )
+        if not self.win.quiet:
+            ask = QtWidgets.QMessageBox.question(
+                self.win,
+                "Auto layout",
+                f"{text}\n\nLay out the lake at this cell size?",
+                QtWidgets.QMessageBox.StandardButton.Yes | QtWidgets.QMessageBox.StandardButton.No,
+                QtWidgets.QMessageBox.StandardButton.No,
+            )
+            if ask == QtWidgets.QMessageBox.StandardButton.Yes:
+                return True
+        self.win.message(f"Auto layout not started: {text} Set a larger cell size in the Lake panel.")
+        return False
 
     def split_by_cuts(self, cuts) -> bool:
         """Blocks between the cut lines drawn by hand, in any topology (worker; set undoable, then gridded).

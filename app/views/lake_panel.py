@@ -117,7 +117,9 @@ class LakePanel(QtWidgets.QWidget):
         notes = f" — {k} note{'s' * (k != 1)} on the water (Messages)" if k else ""
         h = lake.cell_size if lake is not None else None
         if h is not None and not math.isclose(h, lay.cell_size, rel_tol=1e-6):  # set since: not applied yet
-            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m"
+            from ..lake import expected_cells
+
+            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m (about {expected_cells(lake):,} cells)"
         kind = " for one index space (EFDC, Delft3D single domain)" if lay.single else ""
         self.summary.setText(f"{n} block{'s' * (n != 1)}{kind}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m{notes}")
         self.summary.setToolTip("\n\n".join(lay.notes))

@@ -189,3 +189,30 @@ def test_a_laid_out_lake_opens_with_the_lake_panel_in_front(qtbot, win, tmp_path
     assert win.io.open_path(tmp_path / "lake.toml")
     qtbot.waitUntil(lambda: not win.docks["lake"].visibleRegion().isEmpty(), timeout=20_000)  # its tab in front
     assert win.docks["params"].visibleRegion().isEmpty()
+
+
+def test_a_cell_size_for_millions_of_cells_asks_before_the_layout(qtbot, win, tmp_path):
+    """20 m typed for a lake of 1 500 km² (200 meant): Auto layout started on 3.7 million cells, the
+    button counting seconds, nothing to stop it.  Over 200 000 cells it asks first (quiet: refused,
+    said with the count); the Lake panel gives the count of a cell size set but not applied."""
+    import shapely
+
+    from app.lake_controller import LARGE_LAYOUT
+    from tests.app.test_modeller import _laid_out
+
+    _laid_out(qtbot, win, tmp_path, 270505)
+    lake = win.doc.project.lake
+    area = shapely.Polygon(lake.outline, lake.holes).area
+    h = (area / (3 * LARGE_LAYOUT)) ** 0.5  # about 600 000 cells
+    win.lake_ctl.set_cell_size(h)
+    assert "(about 6" in win.lake_panel.summary.text() and "cells)" in win.lake_panel.summary.text()
+    before = win.doc.project.layout
+    assert not win.lake_ctl.auto_layout()
+    assert not win.lake_ctl.busy and win.doc.project.layout is before
+    assert win._status.text().startswith("Auto layout not started: About 6")
+    win.lake_ctl.set_cell_size(1.5 * before.cell_size)  # a few hundred cells: laid out without a question
+    assert win.lake_ctl.auto_layout()
+    from tests.app.waits import wait_idle
+
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is not before
