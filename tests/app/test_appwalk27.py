@@ -216,3 +216,24 @@ def test_a_cell_size_for_millions_of_cells_asks_before_the_layout(qtbot, win, tm
 
     wait_idle(qtbot, win)
     assert win.doc.project.layout is not before
+
+
+def test_undo_of_auto_layout_does_not_solve_a_lake_with_islands_as_one_block(qtbot, win, tmp_path):
+    """Auto-generate on, a lake with islands laid out; undo of Auto layout (Undo history) went back to
+    the imported one block and solved it: a grid across the islands, the one the import's offer calls
+    poor (the import itself no longer solves it).  It stays ungridded and says why; F5 still makes it."""
+    from tests.app.test_lake import _thin_island_lake, lay_out
+    from tests.app.waits import wait_idle
+
+    lay_out(qtbot, win, _thin_island_lake(tmp_path / "thin.geojson"), cell_size=500.0)
+    win.a_auto.trigger()
+    assert win.solver.auto
+    win.stack.undo()  # the Auto layout
+    wait_idle(qtbot, win)
+    p = win.doc.project
+    assert p.layout is None and len(p.lake.holes) == 2
+    assert not win.solver.running and win.doc.stale and "Auto layout (Ctrl+L)" in win._status.text()
+    win.generate()  # F5: the one block all the same
+    assert win.solver.running
+    wait_idle(qtbot, win)
+    win.a_auto.trigger()
