@@ -87,6 +87,9 @@ class Document:
     reported(str, str)
         A problem or a note worth keeping: level ("info", "warning", "error") and the full text
         (the message panel lists them; the status bar shows only the latest line).
+    superseded()
+        A new grid was made (or the project started over): the errors and warnings reported
+        before it are of an earlier grid — the message panel keeps them, greyed, uncounted.
     """
 
     project_changed = Signal(object)
@@ -99,6 +102,7 @@ class Document:
     colour_changed = Signal(str)
     opened = Signal()
     reported = Signal(str, str)
+    superseded = Signal()
 
     def __init__(self, project: Project | None = None) -> None:
         self.project: Project = project or Project()

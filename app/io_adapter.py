@@ -8,6 +8,7 @@ kept in the project, saved in the case file and passed to every exporter.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -230,8 +231,15 @@ def lake_section(lake):
         return None
     from meshcore.case import LakeSection
 
+    lay = lake.layout  # what the layout changed in the water: the saved blocks cannot tell it again
     return LakeSection(
-        shore=lake.outline, islands=lake.holes, cell_size=lake.cell_size, regular=lake.regular, single=lake.single
+        shore=lake.outline,
+        islands=lake.holes,
+        cell_size=lake.cell_size,
+        regular=lake.regular,
+        single=lake.single,
+        notes=lay.notes if lay is not None else (),
+        details=lay.details if lay is not None else (),
     )
 
 
@@ -346,6 +354,8 @@ def project_from_layout_case(case) -> Project:
     from .lake import Lake, with_layout
 
     layout = case_layout(case)
+    if case.lake is not None and (case.lake.notes or case.lake.details):  # lost on reopening: Lake panel, Messages
+        layout = dataclasses.replace(layout, notes=case.lake.notes, details=case.lake.details)
     base = Project(solver=case.solver, title=case.title, **_frame_fields(case_frame(case)))
     if case.lake is not None:  # the water as imported (a case the app saved) and the Lake panel's settings
         return with_layout(base, _lake_of(case.lake, layout))

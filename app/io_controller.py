@@ -90,6 +90,8 @@ class IOController(ExportMixin, QtCore.QObject):
         self.doc.reset(project, path)
         self.win.canvas.fit()
         self.stack.setClean()
+        if project.layout is not None:  # a lake's layout: its blocks and cells in front, not one block's ξ, η
+            self.win.show_lake()
 
     def maybe_save(self) -> bool:
         """Ask about unsaved changes; False when the user cancels."""
@@ -135,6 +137,11 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         self.set_project(project, path)
         self.add_recent(path)
+        lay = project.layout
+        for note in lay.notes if lay is not None else ():  # the Lake panel counts them: said in full again
+            self.doc.report("info", f"layout: {note}")
+        for note in lay.details if lay is not None else ():
+            self.doc.report("info", f"layout (detail): {note}")
         # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
         self.win.set_tool("layout" if project.layout is not None else "edit")
         if self.win.solver.auto and any(b.ready for b in project.blocks):  # it said "press F5" as it solved

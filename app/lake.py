@@ -34,6 +34,7 @@ __all__ = [
     "compute_layout",
     "crs_unit",
     "default_cell_size",
+    "expected_cells",
     "layout_blocks",
     "looks_branched",
     "near_header",
@@ -150,6 +151,14 @@ def part_area(part: Any) -> float:
 
     _, outer, islands = part
     return float(Polygon(outer).area - sum(Polygon(h).area for h in islands))
+
+
+def expected_cells(lake: Any) -> int:
+    """About how many cells a layout of ``lake`` has: its water area over the cell size squared (the
+    automatic size gives about 10 000)."""
+    area = part_area(("", lake.outline, lake.holes)) if len(lake.outline) >= 3 else 0.0
+    h = lake.cell_size if lake.cell_size else default_cell_size(area) if area > 0 else 0.0
+    return round(area / h**2) if h > 0 and area > 0 else 0
 
 
 def area_text(area: float, metres: bool = True) -> str:

@@ -26,6 +26,9 @@ __all__ = ["EDIT_GAP_S", "LakeController"]
 #: seconds between the starts of two layouts of a drag (the grid re-solves from each; see
 #: LakeController.edit_layout): five a second, each left a few smoothed frames of the grid
 EDIT_GAP_S = 0.2
+#: Auto layout of more cells than this asks first (20 x the default 10 000): the layout and its grid
+#: take minutes and cannot be stopped half way (a cell size of 20 m typed for 200: 3.7 million cells)
+LARGE_LAYOUT = 200_000
 
 log = logging.getLogger(__name__)
 
@@ -62,6 +65,7 @@ class LakeController(QtCore.QObject):
 
     layout_done = QtCore.Signal(object)  # the Layout, or None when it failed
     busy_changed = QtCore.Signal(bool)
+    ticked = QtCore.Signal(int)  # seconds a layout has been computing (each second)
 
     def __init__(self, window) -> None:
         super().__init__(window)
@@ -69,6 +73,13 @@ class LakeController(QtCore.QObject):
         self.doc = window.doc
         self.editor = window.editor
         self._worker = None
+        # while a layout is computed (20-30 s for a branched lake of 20 000 cells, the layout drawn at
+        # three scales): the status line counts the seconds; a still "Computing…" read as a hang
+        self._ticker = QtCore.QTimer(self)
+        self._ticker.setInterval(1000)
+        self._ticker.timeout.connect(self._tick)
+        self._busy_text = ""
+        self._busy_since = 0.0
         self.generate_after = True  # start the grid when a layout is set
         self.prompt: QtWidgets.QMessageBox | None = None  # the offer after importing a branched lake
         self._prompt_shore = None  # the shore the offer is for: another lake closes it (_other_lake)
@@ -131,10 +142,37 @@ class LakeController(QtCore.QObject):
             lake = lake.replaced(regular=bool(regular), single=False)  # Delft3D DD: any multiple of 4 turns
         if single is not None:
             lake = lake.replaced(single=bool(single), regular=bool(single) or lake.regular)
+        if not self._large_ok(lake):
+            return False
         kind = "regular layout (no 3- or 5-block corners)" if lake.regular else "layout"
         if lake.single:
             kind = "layout for one index space (Delft3D single domain, EFDC)"
         return self._start(lake, None, f"Computing the block {kind} of the lake…")
+
+    def _large_ok(self, lake: Lake) -> bool:
+        """True unless the layout would have over :data:`LARGE_LAYOUT` cells and the user says no (no dialog
+        when quiet: refused, said in the status line)."""
+        from .lake import expected_cells
+
+        n = expected_cells(lake)
+        if n <= LARGE_LAYOUT:
+            return True
+        text = (
+            f"About {n:,} cells at {lake.cell_size:.4g} m ({n / 10_000:.0f}× the default): the layout and its grid "
+            "take minutes (they cannot be stopped half way) and much memory."
+        )
+        if not self.win.quiet:
+            ask = QtWidgets.QMessageBox.question(
+                self.win,
+                "Auto layout",
+                f"{text}\n\nLay out the lake at this cell size?",
+                QtWidgets.QMessageBox.StandardButton.Yes | QtWidgets.QMessageBox.StandardButton.No,
+                QtWidgets.QMessageBox.StandardButton.No,
+            )
+            if ask == QtWidgets.QMessageBox.StandardButton.Yes:
+                return True
+        self.win.message(f"Auto layout not started: {text} Set a larger cell size in the Lake panel.")
+        return False
 
     def split_by_cuts(self, cuts) -> bool:
         """Blocks between the cut lines drawn by hand, in any topology (worker; set undoable, then gridded).
@@ -163,12 +201,24 @@ class LakeController(QtCore.QObject):
         self._worker = worker
         self.busy_changed.emit(True)
         self.win.message(text)
+        self._busy_text, self._busy_since = text, time.monotonic()
+        self._ticker.start()
         worker.start()
         return True
+
+    def _tick(self) -> None:
+        """The seconds the layout has taken so far, in the status line and the Auto layout button."""
+        if self._worker is None:
+            self._ticker.stop()
+            return
+        k = int(time.monotonic() - self._busy_since)
+        self.win.message(f"{self._busy_text} {k} s")
+        self.ticked.emit(k)
 
     def _on_returned(self, value, cuts=None) -> None:
         lake, layout, err = value
         self._worker = None
+        self._ticker.stop()
         self.busy_changed.emit(False)
         if layout is None:
             self.last_error = err
@@ -200,6 +250,7 @@ class LakeController(QtCore.QObject):
 
     def _on_errored(self, exc) -> None:
         self._worker = None
+        self._ticker.stop()
         self.busy_changed.emit(False)
         log.error("the layout worker failed", exc_info=exc)
         self.last_error = str(exc)
@@ -257,7 +308,12 @@ class LakeController(QtCore.QObject):
                 self.win.message(f"{text}: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells (Ctrl+Z undoes it)")
         if err is not None and self._pending is None:  # a refusal only counts for the last request
             self.edit_error = err
-            self.win.message(f"Cannot change the layout: {err}", error=True)
+            if self._dragging and key is not None:
+                # a step of a drag still on: the status line says why not here; Messages get the refusal
+                # only if the drag ends there (one drag over a bay put six errors in Messages, red)
+                self.win.message(f"Not here: {err} — the layout of the last good place stays")
+            else:
+                self.win.message(f"Cannot change the layout: {err}", error=True)
             if layout is None:
                 self.layout_done.emit(None)
         self._next_edit()

@@ -133,6 +133,16 @@ class SolverController(QtCore.QObject):
         if not self.running:  # the last solve's error was of the project before this edit (an undo
             self.last_error = None  # back to a gridded one: its grid is current, not held back as failed)
         if self.auto and self.doc.stale:  # not for an edit the grid is not made of (a lake's cell size)
+            p = self.doc.project
+            if p.lake is not None and p.layout is None and len(p.lake.holes) and len(p.blocks) == 1:
+                # a lake with islands as one block: its grid goes across the islands, the grid the import's
+                # Auto layout offer calls poor (an undo of Auto layout solved it, repairs and all); F5 makes it
+                self._debounce.stop()
+                self.doc.message.emit(
+                    "Auto-generate leaves a lake with islands as one block ungridded: Auto layout (Ctrl+L), "
+                    "or F5 for the one block"
+                )
+                return
             self._debounce.start()
 
     def start(self) -> bool:

@@ -13,14 +13,13 @@ import pyqtgraph as pg
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from .items import Scatter, set_points, set_polylines
+from .miss_marks import MissMarks
 
 __all__ = ["LakeOverlay", "block_label_points", "left_out_islands"]
 
 CUT_COLOUR = "#9467bd"
 SHORE_COLOUR = "#1f5fa8"
 MISS_COLOUR = "#ff7f0e"
-#: more places that miss a preset than this: drawn smaller and fainter
-MANY_MISSES = 1000
 #: a label may stick out of its block when the block's area is at least this many times the label's
 #: (half of a long arm's block stays in sight, and its cell counts are read at full view)
 LABEL_ROOM = 2.0
@@ -102,13 +101,22 @@ class LakeOverlay:
             size=_FULL["corners"], symbol="s", pen=pg.mkPen("#000", width=1), brush=pg.mkBrush(_FILL["corners"])
         )
         self.corners.setZValue(23)
-        self.misses = Scatter(size=5, symbol="o", pen=None, brush=pg.mkBrush(255, 127, 14, 170))
+        # the places that miss a preset: the worst per patch of the screen, the worst of all ringed
+        self.miss_marks = MissMarks(canvas)
+        self.misses = self.miss_marks.dots
         self.misses_on = True  # View ▸ Preset misses (off by itself while a metric colours the cells)
         self.misses_over_colours = False  # cells coloured: the misses are drawn as thin rings
-        self.misses.setZValue(31)
         self.drag_point = Scatter(size=13, symbol="o", pen=pg.mkPen("#d62728", width=2), brush=None)
         self.drag_point.setZValue(43)
-        for it in (self.shore, self.left_out, self.cuts, self.cut_ends, self.corners, self.misses, self.drag_point):
+        for it in (
+            self.shore,
+            self.left_out,
+            self.cuts,
+            self.cut_ends,
+            self.corners,
+            *self.miss_marks.items(),
+            self.drag_point,
+        ):
             canvas.addItem(it)
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
         self.labels: list[pg.TextItem] = []
@@ -234,6 +242,7 @@ class LakeOverlay:
 
         pixel = self.canvas.pixel()
         self._size_markers(pixel)
+        self.miss_marks.update()
         n = len(self._label_texts)
         if n == 0 or not (self.labels_on and self.markers_visible):
             self.shown_labels = []
@@ -295,18 +304,17 @@ class LakeOverlay:
                     item.setPen(_HOLLOW_PEN[name] if hollow else pg.mkPen("#000", width=1))
 
     def set_misses(self, points: np.ndarray | None) -> None:
-        """Ring the places that miss the chosen quality preset (None: none).
+        """Mark the places that miss the chosen quality preset (None: none): ``(k, 2)``, or ``(k, 3)``
+        with how far each is beyond its limit (:class:`~app.views.miss_marks.MissMarks` thins them).
 
         The same points again are not set again (a refresh selects the first failed limit and
-        reports it twice; thousands of scatter points take a tenth of a second each time).
+        reports it twice; thousands of points take a tenth of a second each time).
         """
         old = getattr(self, "_misses_shown", None)
         if old is not None and points is not None and old.shape == np.shape(points) and np.array_equal(old, points):
             return
         self._misses_shown = None if points is None else np.array(points, float)
-        self._misses_many = points is not None and len(points) > MANY_MISSES
-        self._style_misses()
-        set_points(self.misses, points)
+        self.miss_marks.set(points)
 
     def set_drag_point(self, xy) -> None:
         """Ring the handle being dragged where it will go (None: no drag)."""
@@ -347,23 +355,7 @@ class LakeOverlay:
         """Filled orange dots on a plain grid; thin dark rings over coloured cells (the colour shows through)."""
         if bool(over_colours) != self.misses_over_colours:
             self.misses_over_colours = bool(over_colours)
-            self._style_misses()
-
-    def _style_misses(self) -> None:
-        """Dots, or rings over colours; smaller and fainter when there are many (they would paint the lake orange)."""
-        many = getattr(self, "_misses_many", False)
-        key = (self.misses_over_colours, many)
-        if key == getattr(self, "_misses_style", None):
-            return
-        self._misses_style = key
-        if self.misses_over_colours:
-            self.misses.setPen(pg.mkPen(0, 0, 0, 110 if many else 200, width=1))
-            self.misses.setBrush(None)
-            self.misses.setSize(4 if many else 6)
-        else:
-            self.misses.setPen(None)
-            self.misses.setBrush(pg.mkBrush(255, 127, 14, 110 if many else 170))
-            self.misses.setSize(3 if many else 5)
+            self.miss_marks.set_over_colours(self.misses_over_colours)
 
     def _show_misses(self) -> None:
-        self.misses.setVisible(self.misses_on and not getattr(self, "_solving", False))
+        self.miss_marks.set_visible(self.misses_on and not getattr(self, "_solving", False))

@@ -86,6 +86,7 @@ class LakePanel(QtWidgets.QWidget):
         self.button.clicked.connect(lambda: self.ctl.auto_layout())
         self.split.clicked.connect(lambda: self.ctl.win.split_by_cuts())
         controller.busy_changed.connect(self._busy)
+        controller.ticked.connect(self._ticked)
         doc.project_changed.connect(lambda _p: self.refresh())
         self.refresh()
 
@@ -116,7 +117,9 @@ class LakePanel(QtWidgets.QWidget):
         notes = f" — {k} note{'s' * (k != 1)} on the water (Messages)" if k else ""
         h = lake.cell_size if lake is not None else None
         if h is not None and not math.isclose(h, lay.cell_size, rel_tol=1e-6):  # set since: not applied yet
-            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m"
+            from ..lake import expected_cells
+
+            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m (about {expected_cells(lake):,} cells)"
         kind = " for one index space (EFDC, Delft3D single domain)" if lay.single else ""
         self.summary.setText(f"{n} block{'s' * (n != 1)}{kind}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m{notes}")
         self.summary.setToolTip("\n\n".join(lay.notes))
@@ -163,9 +166,13 @@ class LakePanel(QtWidgets.QWidget):
         self.split.setEnabled(not busy and self.doc.project.layout is None and bool(self.doc.project.cut_lines))
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
+    def _ticked(self, seconds: int) -> None:
+        self.button.setText(f"Computing the layout… {seconds} s")
+
 
 def miss_points(verdict, row: int | None = None) -> np.ndarray:
-    """``(k, 2)`` places (nodes, cells, edge pairs) that miss a failed limit (only limit ``row`` if given)."""
+    """``(k, 3)`` places (nodes, cells, edge pairs) that miss a failed limit (only limit ``row`` if given):
+    x, y and how far beyond the limit (the value over the limit; NaN where the value is not a number)."""
     m = verdict.metrics
     out = []
     results = verdict.results if row is None else verdict.results[row : row + 1]
@@ -176,8 +183,10 @@ def miss_points(verdict, row: int | None = None) -> np.ndarray:
         if s is None or not len(s) or r.limit.statistic != "each":
             continue
         bad = ~(s.values <= r.limit.max)
-        out.append(np.column_stack([s.x[bad], s.y[bad]]))
-    return np.vstack(out) if out else np.zeros((0, 2))
+        v = np.asarray(s.values, float)[bad]
+        over = v / r.limit.max if r.limit.max > 0 else v - r.limit.max
+        out.append(np.column_stack([s.x[bad], s.y[bad], over]))
+    return np.vstack(out) if out else np.zeros((0, 3))
 
 
 def ok_percent(fraction: float) -> str:
@@ -230,8 +239,9 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.verticalHeader().setDefaultSectionSize(20)
         self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setToolTip(
-            "click a limit: the places that miss it are marked by orange dots on the canvas and the "
-            "view goes to the worst (Enter too)"
+            "click a limit: the places that miss it are marked on the canvas (orange: the worst in each "
+            "patch of the screen, so the grid stays in sight; ringed red: the worst of all) and the view "
+            "goes to the worst (Enter too)"
         )
         lay.addWidget(self.table)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)

@@ -19,6 +19,8 @@ __all__ = ["ElidedLabel", "MessagePanel"]
 
 _COLOURS = {"info": "#333333", "warning": "#a05a00", "error": "#b00000"}
 _SIGNS = {"info": "ℹ", "warning": "⚠", "error": "✖"}
+_EARLIER = QtCore.Qt.ItemDataRole.UserRole + 1  # an item's flag: of an earlier grid or project
+_EARLIER_COLOUR = "#9a9a9a"
 
 
 class MessagePanel(QtWidgets.QWidget):
@@ -45,7 +47,9 @@ class MessagePanel(QtWidgets.QWidget):
         self.list.setMinimumHeight(60)
         lay.addWidget(self.list, 1)
         row = QtWidgets.QHBoxLayout()
-        self.count = QtWidgets.QLabel()
+        # shortened with "…" when the dock is narrow: "(1 earlier, greyed)" widened the panel past its
+        # dock, the Clear button out of sight
+        self.count = ElidedLabel()
         row.addWidget(self.count, 1)
         copy = QtWidgets.QPushButton("Copy")
         copy.setToolTip("copy the selected messages (all when none is selected)")
@@ -56,11 +60,14 @@ class MessagePanel(QtWidgets.QWidget):
         row.addWidget(clear)
         lay.addLayout(row)
         doc.reported.connect(self.add)
-        self._levels: collections.Counter[str] = collections.Counter()  # level -> listed messages
+        doc.superseded.connect(self.mark_earlier)
+        doc.opened.connect(self.mark_earlier)
+        self._levels: collections.Counter[str] = collections.Counter()  # level -> listed current messages
+        self._earlier = 0  # errors and warnings listed of an earlier grid or project (greyed, not counted)
         self._update_count()
 
     def add(self, level: str, text: str) -> None:
-        """List ``text`` (newest first; the same message again only refreshes its time)."""
+        """List ``text`` (newest first; the same message again only refreshes its time, current again)."""
         if self.list.count() and self.list.item(0).data(QtCore.Qt.ItemDataRole.UserRole) == (level, text):
             self._take(0)
         it = QtWidgets.QListWidgetItem(f"{_SIGNS.get(level, '')} {time.strftime('%H:%M:%S')}  {text}")
@@ -82,11 +89,31 @@ class MessagePanel(QtWidgets.QWidget):
     def clear(self) -> None:
         self.list.clear()
         self._levels.clear()
+        self._earlier = 0
+        self._update_count()
+
+    def mark_earlier(self) -> None:
+        """The errors and warnings listed so far are of an earlier grid or project: greyed, no longer
+        counted (a grid made after "Cannot generate", or with its folded cells gone, still read
+        "1 error(s)").  Notes (info) stay as they are: a layout's notes hold for the new grid too."""
+        for k in range(self.list.count()):
+            it = self.list.item(k)
+            level = it.data(QtCore.Qt.ItemDataRole.UserRole)[0]
+            if level == "info" or it.data(_EARLIER):
+                continue
+            it.setData(_EARLIER, True)
+            it.setForeground(QtGui.QBrush(QtGui.QColor(_EARLIER_COLOUR)))
+            it.setToolTip(f"(of an earlier grid or project) {it.data(QtCore.Qt.ItemDataRole.UserRole)[1]}")
+            self._levels[level] -= 1
+            self._earlier += 1
         self._update_count()
 
     def _take(self, row: int) -> None:
         it = self.list.takeItem(row)
-        self._levels[it.data(QtCore.Qt.ItemDataRole.UserRole)[0]] -= 1
+        if it.data(_EARLIER):
+            self._earlier -= 1
+        else:
+            self._levels[it.data(QtCore.Qt.ItemDataRole.UserRole)[0]] -= 1
 
     def copy(self) -> None:
         items = self.list.selectedItems() or [self.list.item(k) for k in range(self.list.count())]
@@ -96,7 +123,14 @@ class MessagePanel(QtWidgets.QWidget):
         """The counts of the listed messages, kept as they come and go (reading every item back for each
         new message took ~4 ms of the GUI thread at the end of every solve once the list was full)."""
         n_err, n_warn = self._levels["error"], self._levels["warning"]
-        self.count.setText(f"{n_err} error(s), {n_warn} warning(s)" if self.list.count() else "no messages")
+        text = f"{n_err} error(s), {n_warn} warning(s)" if self.list.count() else "no messages"
+        if self._earlier:
+            text += f" ({self._earlier} earlier, greyed)"
+        self.count.setText(text)
+        self.count.setToolTip(
+            f"{text}: errors and warnings since the last grid was made (or the project opened); those of "
+            "earlier grids stay listed, greyed"
+        )
 
 
 class ElidedLabel(QtWidgets.QLabel):

@@ -203,8 +203,10 @@ class LakeSection:
     file gave them (an ``[outline]`` case's own shore carries every vertex its blocks put on it;
     a one-block case has no islands at all); ``cell_size`` (None: the automatic size),
     ``regular`` and ``single`` are the layout settings (``meshcore mesh --cell-size``,
-    ``--regular``, a layout for one index space).  Written by the app's *Save project*, so that
-    a reopened lake is the one imported; ``meshcore generate`` grids the blocks and does not read it.
+    ``--regular``, a layout for one index space).  ``notes`` and ``details`` are what the layout
+    changed in the water (an island left out, a shore smoothed; :attr:`meshcore.layout.Layout.notes`):
+    the case's blocks cannot tell them again.  Written by the app's *Save project*, so that a
+    reopened lake is the one imported; ``meshcore generate`` grids the blocks and does not read it.
     """
 
     shore: np.ndarray
@@ -212,6 +214,8 @@ class LakeSection:
     cell_size: float | None = None
     regular: bool = False
     single: bool = False
+    notes: tuple[str, ...] = ()
+    details: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         put = object.__setattr__
@@ -225,6 +229,11 @@ class LakeSection:
         for name in ("regular", "single"):
             if not isinstance(getattr(self, name), bool):
                 raise InvalidInputError(f"{name} must be true or false, got {getattr(self, name)!r}")
+        for name in ("notes", "details"):
+            texts = getattr(self, name)
+            if isinstance(texts, str) or not all(isinstance(t, str) for t in texts):
+                raise InvalidInputError(f"{name} must be a list of strings, got {texts!r}")
+            put(self, name, tuple(texts))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, LakeSection):
@@ -234,6 +243,7 @@ class LakeSection:
             and len(self.islands) == len(other.islands)
             and all(np.array_equal(a, b) for a, b in zip(self.islands, other.islands, strict=True))
             and (self.cell_size, self.regular, self.single) == (other.cell_size, other.regular, other.single)
+            and (self.notes, self.details) == (other.notes, other.details)
         )
 
     __hash__ = None  # type: ignore[assignment]

@@ -326,8 +326,16 @@ def parse_lake(tbl: Any, src: str) -> LakeSection:
         convert={
             "shore": lambda v, w: xy_pairs(v, f"{where} shore"),
             "islands": lambda v, w: _holes(v, where, "islands"),
+            "notes": lambda v, w: _texts(v, f"{where} notes"),
+            "details": lambda v, w: _texts(v, f"{where} details"),
         },
     )
+
+
+def _texts(value: Any, where: str) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(t, str) for t in value):
+        raise CaseFileError(f"{where} must be a list of strings")
+    return tuple(value)
 
 
 # ---------------------------------------------------------------- the case

@@ -129,6 +129,7 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         out["lake"] = {"shore": lk.shore} | ({"islands": [np.asarray(h) for h in lk.islands]} if lk.islands else {})
         out["lake"] |= {"cell_size": lk.cell_size} if lk.cell_size is not None else {}
         out["lake"] |= {k: True for k in ("regular", "single") if getattr(lk, k)}
+        out["lake"] |= {k: list(getattr(lk, k)) for k in ("notes", "details") if getattr(lk, k)}
     if case.blocks:
         out["blocks"] = [_block_table(b) for b in case.blocks]
     return _clean(out)

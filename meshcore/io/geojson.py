@@ -17,6 +17,7 @@ from .._validation import check_allocation, max_points
 from ..crs import LONLAT, check_lonlat, looks_swapped, normalize_crs
 from ..errors import InvalidInputError, ReadError
 from ._base import PointSet, Polyline, decode_text, make_polyline, merge_point_runs, read_bytes
+from ._holes import check_holes_inside
 
 __all__ = ["read_points_geojson"]
 
@@ -50,9 +51,14 @@ def _geometry(geom: Any, name: str, where: str, out: list[Polyline]) -> None:
     elif t == "Polygon":
         if not isinstance(c, list) or not c:
             raise ReadError(f"{where}: Polygon without rings")
+        rings = []
         for k, ring in enumerate(c):
             nm = name if k == 0 else f"{name} hole {k}"
-            out.append(make_polyline(nm, _coords(ring, f"{where} ring {k + 1}"), closed=True, where=where))
+            rings.append(
+                (f"interior ring {k} (ring {k + 1} of the Polygon, {nm!r})", _coords(ring, f"{where} ring {k + 1}"))
+            )
+            out.append(make_polyline(nm, rings[-1][1], closed=True, where=where))
+        check_holes_inside(rings[0][1], rings[1:], where, "exterior ring (ring 1)")
     elif t in ("MultiLineString", "MultiPolygon"):
         if not isinstance(c, list):
             raise ReadError(f"{where}: {t} coordinates must be a list")

@@ -26,6 +26,7 @@ from .._validation import check_allocation, max_points
 from ..crs import LONLAT, check_lonlat, normalize_crs
 from ..errors import ReadError
 from ._base import PointSet, Polyline, make_polyline, merge_point_runs, parse_xml, read_bytes
+from ._holes import check_holes_inside
 
 __all__ = ["KMZ_LIMIT", "read_points_kml", "read_points_kmz"]
 
@@ -107,6 +108,7 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
             out.append(make_polyline(name, _coordinates(c, f"{where} LineString"), closed=None, where=where))
         elif tag == "Polygon":
             k = 0
+            outer, holes = None, []
             for bnd in child:
                 btag = _local(bnd.tag)
                 if btag not in ("outerBoundaryIs", "innerBoundaryIs"):
@@ -116,9 +118,15 @@ def _placemark_geoms(elem, name: str, where: str, out: list[Polyline]) -> None:
                         continue
                     c = _find_child(ring, "coordinates")
                     nm = name if btag == "outerBoundaryIs" else f"{name} hole {k + 1}"
+                    pts = _coordinates(c, f"{where} {btag}")
                     if btag == "innerBoundaryIs":
                         k += 1
-                    out.append(make_polyline(nm, _coordinates(c, f"{where} {btag}"), closed=True, where=where))
+                        holes.append((f"innerBoundaryIs ring {k} ({nm!r})", pts))
+                    elif outer is None:
+                        outer = pts
+                    out.append(make_polyline(nm, pts, closed=True, where=where))
+            if outer is not None:
+                check_holes_inside(outer, holes, where, "outerBoundaryIs ring")
         elif tag == "LinearRing":
             c = _find_child(child, "coordinates")
             out.append(make_polyline(name, _coordinates(c, f"{where} LinearRing"), closed=True, where=where))

@@ -449,11 +449,12 @@ def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtb
     from app.views.lake_panel import miss_points, worst_miss
 
     v = win.lake_quality.verdict
-    shown = pts if worst_miss(v, 0) is None else miss_points(v, 0)
-    np.testing.assert_array_equal(np.column_stack(items.misses.getData()), shown)
-    # thousands of misses (a poor hand layout): smaller and fainter, not an orange lake
+    shown = pts if worst_miss(v, 0) is None else miss_points(v, 0)[:, :2]
+    drawn = np.column_stack(items.misses.getData())  # the worst per patch of the screen (test_appwalk27)
+    assert len(drawn) and {tuple(p) for p in drawn} <= {tuple(p) for p in shown}
+    # thousands of misses (a poor hand layout): one mark per patch of the screen, not an orange lake
     win.lake_quality.misses.emit(np.random.default_rng(0).uniform(0, 1000, (5000, 2)))
-    assert items.misses.opts["size"] < 5 and items.misses.opts["brush"].color().alpha() < 170
+    assert 0 < len(items.misses.getData()[0]) < 5000
 
 
 def _thin_island_lake(path, h: float = 500.0, needles: int = 1):
