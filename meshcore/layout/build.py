@@ -81,10 +81,8 @@ def _merged(a: np.ndarray, b: np.ndarray):
 def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
     """Join neighbouring pieces whose union is a good four-sided block and no worse than the
     two (a straight or gently curved arm cut by chords becomes one block again)."""
-    from .corners import choose_corners
-
     rings, forced = list(rings), list(forced)
-    cost = [choose_corners(r, sigma)[1] for r in rings]
+    cost = [region_cost(r, sigma) for r in rings]  # (most costed by the splits already)
     box = [np.r_[r.min(axis=0), r.max(axis=0)] for r in rings]
     seen: dict[tuple[int, int], tuple] = {}  # (id a, id b) → (a, b, union, its cost): each pair once
 
@@ -92,7 +90,7 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
         k = (id(rings[i]), id(rings[j]))
         if k not in seen:
             m = _merged(rings[i], rings[j])
-            seen[k] = (rings[i], rings[j], m, None if m is None else choose_corners(m, sigma)[1])
+            seen[k] = (rings[i], rings[j], m, None if m is None else region_cost(m, sigma))
         return seen[k][2:]
 
     changed = True
