@@ -108,6 +108,9 @@ def over_island(chain: np.ndarray, islands) -> bool:
     p = np.asarray(chain, dtype=float)
     if len(p) < 3 or islands is None or islands.is_empty:
         return False
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    if not shapely.intersects(islands, shapely.box(lo[0], lo[1], hi[0], hi[1])):
+        return False  # no island near (the test below, a polygon made valid, costs a layout 2–4 %)
     between = shapely.make_valid(shapely.Polygon(p))
     area = between.area
     return area > 0.0 and shapely.intersection(between, islands).area > 0.5 * area
@@ -123,6 +126,8 @@ def least_weights(chains, on_shore, regions) -> np.ndarray:
     from .counts import LAND_WEIGHT, LEAST_WEIGHT
 
     islands = shapely.union_all(islands_of(regions)) if any(on_shore) else None
+    if islands is not None:
+        shapely.prepare(islands)  # (tested against every shore chain)
     return np.array(
         [LAND_WEIGHT if s and over_island(c, islands) else LEAST_WEIGHT for c, s in zip(chains, on_shore, strict=True)],
         dtype=float,
