@@ -495,9 +495,7 @@ def _bad_corners(X, Y, cells) -> int:
     from .untangle import _NEXT, _PREV, _corner_jacobians
 
     px, py = X[cells], Y[cells]
-    den = np.hypot(X[cells][:, _NEXT] - px, Y[cells][:, _NEXT] - py) * np.hypot(
-        X[cells][:, _PREV] - px, Y[cells][:, _PREV] - py
-    )
+    den = np.hypot(px[:, _NEXT] - px, py[:, _NEXT] - py) * np.hypot(px[:, _PREV] - px, py[:, _PREV] - py)
     return int((_corner_jacobians(X, Y, cells) <= STRAIGHT_SINE * den).sum())
 
 
