@@ -489,8 +489,7 @@ def _bad_corners(X, Y, cells) -> int:
     that cell convex again on any level (the per-block repair keeps the shore fixed): it went out
     folded.  A corner straight up to rounding (sine ``≤`` :data:`~meshcore.quality.cells.STRAIGHT_SINE`)
     is bad too: a block corner moved along a straight shore (``estuary(8)`` at 4 000 cells, past
-    the bend it sat on) has a corner cell of 180°, a triangle the lake's quality counts as
-    non-convex."""
+    the bend it sat on) has a corner cell of 180°, a triangle (the lake's quality reports it)."""
     from ..quality.cells import STRAIGHT_SINE
     from .untangle import _NEXT, _PREV, _corner_jacobians
 

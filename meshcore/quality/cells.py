@@ -6,8 +6,9 @@ Per cell ``(i, j)`` with corners ``00 = (i, j)``, ``10 = (i+1, j)``,
 * ``area`` — signed area (shoelace); ``≤ 0`` means the cell is **folded**;
 * ``corner_jacobians`` — the cross products of the two edges at each corner
   (shape ``(4, ni, nj)``); a cell is **valid** (convex, not inverted) when
-  all four are ``> 0`` — beyond rounding: a corner whose sine is at most
-  :data:`STRAIGHT_SINE` is straight (a triangle cell) and counts as non-convex.
+  all four are ``> 0`` — up to rounding: a corner whose sine is within
+  :data:`STRAIGHT_SINE` of 0 is **straight** (a triangle cell with a 180°
+  angle), reported apart and not counted non-convex, whatever the frame.
   On real shorelines non-convex cells outnumber folded ones;
 * ``jacobian_ratio`` — min / max of the four corner Jacobians (1 for a parallelogram);
 * ``orthogonality`` — largest deviation of a corner angle from 90°, degrees;
@@ -28,18 +29,20 @@ import numpy as np
 
 from ..grid import StructuredGrid
 
-__all__ = ["STRAIGHT_SINE", "QualityReport", "cell_quality", "corner_sines", "quality", "straight_and_reflex"]
+__all__ = ["STRAIGHT_SINE", "QualityReport", "cell_quality", "corner_sines", "quality"]
 
-#: A cell corner whose sine (the corner Jacobian over its two edges' lengths) is at most this is
-#: straight up to rounding: a triangle cell with a 180° angle, counted as non-convex.  Its
-#: Jacobian's sign is the rounding's (the same grid was fold-free in a lake's local frame and
-#: non-convex after the move to UTM, where coordinates of 5e6 m leave ~1e-9 m of each
-#: difference); 1e-7 stays above that for cells down to ~0.1 m in world coordinates.
+#: A cell corner whose sine (the corner Jacobian over its two edges' lengths) is within this of 0
+#: is straight up to rounding: a triangle cell with a 180° angle.  Its Jacobian's sign is the
+#: rounding's (the same grid was fold-free in a lake's local frame and non-convex after the move
+#: to UTM, where coordinates of 5e6 m leave ~1e-9 m of each difference); 1e-7 stays above that for
+#: cells down to ~0.1 m in world coordinates.  Straight corners are reported apart, neither
+#: convex nor folded (:mod:`meshcore.quality.lake`'s ``straight``).
 STRAIGHT_SINE = 1e-7
 
 
 def corner_sines(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``(4, ni, nj)`` sine of every cell corner (CCW: 00, 10, 11, 01); 0 at a zero-length edge."""
+    """``(4, ni, nj)`` sine of every cell corner (CCW: 00, 10, 11, 01); −1 at a zero-length edge
+    (a collapsed cell counts as folded)."""
     p = [(x[:-1, :-1], y[:-1, :-1]), (x[1:, :-1], y[1:, :-1]), (x[1:, 1:], y[1:, 1:]), (x[:-1, 1:], y[:-1, 1:])]
     out = []
     for k in range(4):
@@ -47,18 +50,8 @@ def corner_sines(x: np.ndarray, y: np.ndarray) -> np.ndarray:
         ux, uy, vx, vy = nx - px, ny - py, bx - px, by - py
         den = np.hypot(ux, uy) * np.hypot(vx, vy)
         with np.errstate(divide="ignore", invalid="ignore"):
-            out.append(np.where(den > 0, (ux * vy - uy * vx) / np.where(den > 0, den, 1.0), 0.0))
+            out.append(np.where(den > 0, (ux * vy - uy * vx) / np.where(den > 0, den, 1.0), -1.0))
     return np.stack(out)
-
-
-def straight_and_reflex(x: np.ndarray, y: np.ndarray) -> tuple[int, int]:
-    """``(straight, reflex)``: how many cells of a block have a corner straight up to rounding (and
-    none beyond), and how many have one folded or reflex beyond rounding (sine below
-    ``−STRAIGHT_SINE``), in the block's own orientation."""
-    s = corner_sines(x, y)
-    s = s if s.sum() >= 0 else -s
-    reflex = (s < -STRAIGHT_SINE).any(axis=0)
-    return int(((s <= STRAIGHT_SINE).any(axis=0) & ~reflex).sum()), int(reflex.sum())
 
 
 def cell_quality(grid: StructuredGrid) -> dict[str, np.ndarray]:
@@ -213,9 +206,8 @@ def quality(grid: StructuredGrid) -> QualityReport:
     """
     q = cell_quality(grid)
     area = q["area"]
-    cj = q["corner_jacobians"]
     folded = np.argwhere(area <= 0)
-    nonconvex = np.argwhere(((cj <= 0) | (corner_sines(grid.x, grid.y) <= STRAIGHT_SINE)).any(axis=0))
+    nonconvex = np.argwhere((corner_sines(grid.x, grid.y) < -STRAIGHT_SINE).any(axis=0))
     finite = lambda a: a[np.isfinite(a)] if np.isfinite(a).any() else np.array([np.inf])  # noqa: E731
     return QualityReport(
         cells=grid.cells,

@@ -12,9 +12,12 @@ Per block, on the node arrays ``x, y`` of shape ``(ni + 1, nj + 1)``:
   (RGFGRID: 1.1–1.2);
 * ``aspect_ratio`` — per cell, the longer over the shorter of its two edges
   from the ``(i, j)`` corner;
-* ``folded`` — per cell, 1 when any of its four corner Jacobians is ``≤ 0``
-  relative to the block's orientation (folded or non-convex) or its corner is
-  straight up to rounding (sine ``≤`` :data:`~.cells.STRAIGHT_SINE`), else 0;
+* ``folded`` — per cell, 1 when any of its four corner Jacobians is ``< 0``
+  relative to the block's orientation beyond rounding (folded or non-convex:
+  a corner sine below ``−``:data:`~.cells.STRAIGHT_SINE`), else 0;
+* ``straight`` — per cell, 1 when it is not folded and a corner is straight up
+  to rounding (a triangle with a 180° angle: its Jacobian's sign would be the
+  rounding's, read one way in local and the other in world coordinates);
 * ``interface_ratio`` — for two cells of different blocks that share an edge,
   ``max(A₁/A₂, A₂/A₁)``.  Shared edges are found from the coordinates (both
   end nodes coincide within ``1e-7`` of the domain size), so the same code
@@ -64,6 +67,7 @@ METRICS: dict[str, tuple[str, str, str]] = {
     "smoothness": ("edge pairs", "consecutive edge-length ratio", ""),
     "aspect_ratio": ("cells", "aspect ratio", ""),
     "folded": ("cells", "folded or non-convex (1) cells", ""),
+    "straight": ("cells", "cells with a straight (180°) corner (1)", ""),
     "interface_ratio": ("cell pairs", "cross-interface cell-area ratio", ""),
     "area_error": ("grid", "|grid area / polygon area − 1|", ""),
     "shore_distance": ("grid", "Hausdorff distance grid boundary ↔ shoreline", " cells"),
@@ -99,7 +103,8 @@ class BlockMetrics:
     smooth_eta: np.ndarray  # (ni+1, nj+1): the same along η
     aspect_ratio: np.ndarray  # (ni, nj)
     area: np.ndarray  # (ni, nj) signed area, positive in the block's orientation
-    folded: np.ndarray  # (ni, nj) bool: a corner Jacobian ≤ 0
+    folded: np.ndarray  # (ni, nj) bool: a corner Jacobian < 0 beyond rounding
+    straight: np.ndarray  # (ni, nj) bool: not folded, a corner straight up to rounding
 
 
 def node_cos(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> np.ndarray:
@@ -164,8 +169,10 @@ def block_metrics(grid: StructuredGrid, name: str = "block1") -> BlockMetrics:
     leta = np.hypot(x[:-1, 1:] - x[:-1, :-1], y[:-1, 1:] - y[:-1, :-1])
     area = signed_area(x, y)
     orient = -1.0 if area.sum() < 0 else 1.0  # a mirrored (clockwise) block is judged in its own sense
-    folded = (orient * corner_sines(x, y) <= STRAIGHT_SINE).any(axis=0)
-    return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded)
+    sines = orient * corner_sines(x, y)
+    folded = np.asarray((sines < -STRAIGHT_SINE).any(axis=0))
+    straight = np.asarray((sines <= STRAIGHT_SINE).any(axis=0)) & ~folded
+    return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded, straight)
 
 
 def _names(obj: Any, n: int) -> tuple[str, ...]:
@@ -240,6 +247,9 @@ def _samples(grids: Sequence[StructuredGrid], bms: Sequence[BlockMetrics], pairs
         ),
         "folded": _collect(
             "folded", [(k, b.folded.astype(float), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
+        ),
+        "straight": _collect(
+            "straight", [(k, b.straight.astype(float), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
         ),
     }
     ca = pairs["cell_a"]
@@ -329,6 +339,7 @@ class LakeMetrics:
             "max_aspect_ratio": self.max("aspect_ratio"),
             "mean_aspect_ratio": self.mean("aspect_ratio"),
             "folded_cells": int(self.values("folded").sum()),
+            "straight_angle_cells": int(self.values("straight").sum()),
             "interface_cell_pairs": len(self.values("interface_ratio")),
             "max_interface_ratio": self.max("interface_ratio"),
         }
@@ -373,6 +384,9 @@ class LakeMetrics:
             ),
             ("folded or non-convex cells", str(n_folded), w("folded") if n_folded else ""),
         ]
+        n_straight = int(self.values("straight").sum())
+        if n_straight:  # triangles: not folded, but no model grid wants them
+            rows.append(("cells with a straight (180°) corner", str(n_straight), w("straight")))
         if len(self.values("interface_ratio")):
             rows.append(("cross-interface area ratio max", f"{self.max('interface_ratio'):.3g}", w("interface_ratio")))
         if self.coverage is not None:

@@ -343,7 +343,8 @@ def test_docstring_examples_run():
 def test_a_straight_cell_corner_counts_alike_in_local_and_world_coordinates():
     """A cell corner at 180° (three nodes on one straight shore) has a Jacobian that is zero up to
     rounding: held-out lake g180765's tip block read as fold-free in its local frame and as
-    non-convex in UTM (``meshcore mesh`` exit 3).  It is non-convex in both frames."""
+    non-convex in UTM (``meshcore mesh`` exit 3).  In both frames it is one straight-angle cell,
+    not folded."""
     from meshcore.quality.cells import quality as cell_report
     from meshcore.quality.lake import block_metrics
 
@@ -351,13 +352,14 @@ def test_a_straight_cell_corner_counts_alike_in_local_and_world_coordinates():
     for _ in range(40):
         xi, eta = np.meshgrid(np.arange(4.0), np.arange(4.0), indexing="ij")
         x, y = 150.0 * xi, 150.0 * eta
-        d = rng.normal(size=2)
-        d /= np.hypot(*d)
-        t = rng.uniform(50, 200, 2)  # nodes (1, 0) and (0, 1) on one line through node (0, 0)
-        x[1, 0], y[1, 0] = x[0, 0] + t[0] * d[0], y[0, 0] + t[0] * d[1]
-        x[0, 1], y[0, 1] = x[0, 0] - t[1] * d[0], y[0, 0] - t[1] * d[1]
-        counts = set()
+        x[1, 0], x[0, 1], y[0, 1] = rng.uniform(50, 150), -rng.uniform(20, 100), 0.0  # (1,0), (0,0), (0,1) on y = 0
+        c, s = np.cos(th := rng.uniform(0, 2 * np.pi)), np.sin(th)
+        x, y = c * x - s * y, s * x + c * y
+        seen = set()
         for off in ((0.0, 0.0), (rng.uniform(2e5, 8e5), rng.uniform(1e6, 9e6))):
             g = StructuredGrid(x + off[0], y + off[1])
-            counts.add((int(block_metrics(g).folded[0, 0]), bool(cell_report(g).nonconvex.tolist().count([0, 0]))))
-        assert counts == {(1, True)}
+            b = block_metrics(g)
+            m = lake_metrics([g]).summary()
+            seen.add((bool(b.folded[0, 0]), bool(b.straight[0, 0]), m["folded_cells"], m["straight_angle_cells"]))
+            seen.add(("cells", [0, 0] in cell_report(g).nonconvex.tolist()))
+        assert seen == {(False, True, 0, 1), ("cells", False)}

@@ -117,21 +117,12 @@ def test_corners_moved_to_close_the_frames_are_bends_of_their_own(expr):
 def test_closed_up_regular_grids_have_no_folded_cells(expr):
     # before: 4 folded cells each, all at corners moved beside a cut's end
     from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
 
     lay = _regular(expr, 2000)  # what mesh_outline(..., regular=True) lays out
     assert not frame_defects(list(lay.pieces))
     mb = mesh_layout(lay, levels=2)
-    assert _reflex(mb) == 0
-
-
-def _reflex(mb) -> int:
-    """Cells folded or reflex beyond rounding.  Not counted: corner cells of 180° (a block corner
-    on a straight shore), which the lake quality counts as non-convex since session 27 and which
-    the closed-up frames still make (1–2 on these lakes; the default layouts move such corners,
-    ``layout.build._flat_corner_on_cut``, the regular ones do not: docs/lake-grids.md, Limits)."""
-    from meshcore.quality.cells import straight_and_reflex
-
-    return sum(straight_and_reflex(np.asarray(g.x), np.asarray(g.y))[1] for g in mb.grids)
+    assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
 
 
 #: lakes whose closed-up regular layouts at 15 000 cells gave one block two sides a fraction of a
@@ -168,10 +159,11 @@ def test_closing_the_frames_gives_no_block_two_sides_a_fraction_of_a_cell_long(c
 def test_closed_up_regular_grid_of_a_lake_with_islands_has_no_folded_cells_at_15000_cells(case):
     # before (d234237): 51 and 2 folded cells, where a block had two sides under a cell long
     from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
 
     lay = _regular(*case)
     mb = mesh_layout(lay, levels=2)
-    assert _reflex(mb) == 0
+    assert int(lake_metrics(mb, polygon=lay.polygon).values("folded").sum()) == 0
 
 
 # ------------------------------------------------------------------ the holonomy itself
