@@ -10,8 +10,6 @@ program arranges that).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..multiblock.topology import Block, Interface, MultiBlockTopology, Side
@@ -403,20 +401,6 @@ def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limi
     return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)], moved
 
 
-#: The least turning (degrees) of the shore at the vertex a block corner with both sides on the
-#: shore (one cell there) is moved to by :func:`fit_ends`: on a straighter vertex the corner cell
-#: opens towards 180° (on a straight shore it is a triangle: ``estuary(8)`` at 4 000 cells, whose
-#: corner beside a notch of the shore went past the notch onto a straight edge).
-CORNER_TURN = 20.0
-
-
-def _turn_at(ring: np.ndarray, at: np.ndarray) -> float:
-    """The turning (degrees, unsigned) of closed ``ring`` at its vertex nearest ``at``."""
-    j = int(np.argmin(np.hypot(*(ring - at).T)))
-    a, b = ring[j] - ring[j - 1], ring[(j + 1) % len(ring)] - ring[j]
-    return abs(math.degrees(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b)))
-
-
 def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit: float) -> tuple[list, int]:
     """``(grids, moved)``: :func:`fit_bends` for the shore nodes the smoother holds fixed — block
     corners and cut lines' ends on the shore (one, three or more cells) — moved, with every block
@@ -453,7 +437,7 @@ def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit
             continue
         trio = np.column_stack([X[trios[k]], Y[trios[k]]])
         at, _ = _better(rings[r], cums[r], s_all[3 * k : 3 * k + 3], trio, limit)
-        if at is not None and (cnt[n] != 1 or _turn_at(rings[r], at) >= CORNER_TURN):
+        if at is not None:
             todo.append((n, trio[1], at))
     if not todo:
         return list(grids), 0
@@ -488,8 +472,8 @@ def _bad_corners(X, Y, cells) -> int:
     its corner put on a land tip where the water turns beyond 180°, and no free node could make
     that cell convex again on any level (the per-block repair keeps the shore fixed): it went out
     folded.  A corner straight up to rounding (sine ``≤`` :data:`~meshcore.quality.cells.STRAIGHT_SINE`)
-    is bad too: a block corner moved along a straight shore (``estuary(8)`` at 4 000 cells, past
-    the bend it sat on) has a corner cell of 180°, a triangle (the lake's quality reports it)."""
+    is bad too: a block corner moved onto a straight piece of shore makes its corner cell a
+    triangle (the lake's quality reports such cells)."""
     from ..quality.cells import STRAIGHT_SINE
     from .untangle import _NEXT, _PREV, _corner_jacobians
 
