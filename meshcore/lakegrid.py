@@ -212,7 +212,7 @@ def iterate_layout(
         # shore edges that cut across a bend (coarse edges, midpoints of the refinement, a cut end
         # short of a tip): their node put on the bend, for the shore sweep to keep there
         gap = SHORE_GAP * layout.cell_size * 2 ** (len(tops) - 1 - lev)
-        grids, n = fit_ends(grids, tp, rings, gap)
+        grids, n = fit_ends(grids, tp, rings, gap, fine=layout.cell_size)
         fitted += n
         grids, n = fit_bends(grids, tp, rings, gap)
         fitted += n

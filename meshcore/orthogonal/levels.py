@@ -401,7 +401,29 @@ def fit_bends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limi
     return [g.replaced(x=x, y=y) for g, x, y in zip(grids, xs, ys, strict=True)], moved
 
 
-def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit: float) -> tuple[list, int]:
+#: The least turning (degrees) of the shore within half a finest cell of the place a block corner
+#: with both sides on the shore (one cell there) is moved to by :func:`fit_ends`: on a straighter
+#: place its finest corner cell is a triangle (``estuary(8)`` at 4 000 cells: a corner beside a
+#: notch went past it onto a straight edge).  Summed over the ring's vertices there, for a ring
+#: densified finer than a cell turns only at its own vertices.
+CORNER_TURN = 20.0
+
+
+def _turning_near(ring: np.ndarray, cum: np.ndarray, at: np.ndarray, reach: float) -> float:
+    """The turning (degrees) of closed ``ring`` summed over its vertices within ``reach`` (arc
+    length) of its vertex nearest ``at``; ``cum`` its :func:`arc_lengths`."""
+    j = int(np.argmin(np.hypot(*(ring - at).T)))
+    total = cum[-1]
+    d = np.abs(cum[:-1] - cum[j])
+    near = np.flatnonzero(np.minimum(d, total - d) <= reach)
+    a = ring[near] - ring[near - 1]
+    b = ring[(near + 1) % len(ring)] - ring[near]
+    return float(np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))).sum())
+
+
+def fit_ends(
+    grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit: float, fine: float | None = None
+) -> tuple[list, int]:
     """``(grids, moved)``: :func:`fit_bends` for the shore nodes the smoother holds fixed — block
     corners and cut lines' ends on the shore (one, three or more cells) — moved, with every block
     around them, to the ring vertex between their two shore neighbours where their two edges leave
@@ -437,8 +459,11 @@ def fit_ends(grids, topology: MultiBlockTopology, rings: list[np.ndarray], limit
             continue
         trio = np.column_stack([X[trios[k]], Y[trios[k]]])
         at, _ = _better(rings[r], cums[r], s_all[3 * k : 3 * k + 3], trio, limit)
-        if at is not None:
-            todo.append((n, trio[1], at))
+        if at is None:
+            continue
+        if fine is not None and cnt[n] == 1 and abs(_turning_near(rings[r], cums[r], at, 0.5 * fine)) < CORNER_TURN:
+            continue  # a block corner onto a straight piece of shore: its finest cell a triangle
+        todo.append((n, trio[1], at))
     if not todo:
         return list(grids), 0
     mesh = _Mesh(topology, grids)  # the incidence tables, only where an end moves

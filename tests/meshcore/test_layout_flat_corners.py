@@ -157,3 +157,16 @@ def test_no_layout_corner_on_a_straight_shore_of_a_coarse_outline():
         n = len(r)
         flat += [(p.name, c) for c in p.corners if on[c] and on[c - 1] and on[(c + 1) % n] and abs(raw[c]) < 1.0]
     assert flat == []
+
+
+def test_the_shore_fit_does_not_slide_a_block_corner_onto_a_straight_edge():
+    """``estuary(8)`` at 4 000 cells: the shore fit (`fit_ends`) moved a one-cell block corner from
+    its 90° bend past a notch of the shore onto a straight edge, where the coarse level's edges
+    followed the shore best; on the finest level its corner cell was a triangle."""
+    from meshcore import testing
+    from meshcore.quality import lake_metrics
+
+    poly = testing.estuary(8)
+    s = lake_metrics(mesh_outline(poly, target_cells=4000), polygon=poly).summary()
+    assert s["straight_angle_cells"] == 0
+    assert s["folded_cells"] == 0
