@@ -412,13 +412,12 @@ CORNER_TURN = 20.0
 def _turning_near(ring: np.ndarray, cum: np.ndarray, at: np.ndarray, reach: float) -> float:
     """The turning (degrees) of closed ``ring`` summed over its vertices within ``reach`` (arc
     length) of its vertex nearest ``at``; ``cum`` its :func:`arc_lengths`."""
+    from ..layout.corners import _raw_turning
+
     j = int(np.argmin(np.hypot(*(ring - at).T)))
-    total = cum[-1]
     d = np.abs(cum[:-1] - cum[j])
-    near = np.flatnonzero(np.minimum(d, total - d) <= reach)
-    a = ring[near] - ring[near - 1]
-    b = ring[(near + 1) % len(ring)] - ring[near]
-    return float(np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))).sum())
+    near = np.minimum(d, cum[-1] - d) <= reach
+    return float(_raw_turning(ring)[near].sum())
 
 
 def fit_ends(
