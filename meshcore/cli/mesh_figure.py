@@ -62,6 +62,7 @@ def figure(path: Path, mb: Any, poly: Any, frame: Any, colour: str, metrics: Any
     if mesh is not None:
         fig.colorbar(mesh, ax=ax, extend="max", shrink=0.8, label="deviation from 90° at the cell's nodes [°]")
     ax.set_aspect("equal")
+    ax.use_sticky_edges = False  # pcolormesh pins the limits to the cells: no margin
     ax.margins(0.02)  # the shore's extreme points not on the frame (it read as a clipped grid)
     ax.autoscale_view()
     ax.ticklabel_format(useOffset=False, style="plain")
