@@ -84,11 +84,13 @@ def _cases(only: list[str] | None) -> list[tuple[str, str]]:
     return out
 
 
-def _run(what: str, cells: int, timeout: float) -> dict:
+def _run(what: str, cells: int, timeout: float, *, child: str = _CHILD, args: tuple[str, ...] = ()) -> dict:
+    """``child`` (a script printing ``RESULT {json}``) run on ``what`` and ``cells`` (then ``args``)
+    in a fresh process: its result, or ``{"error": …}``."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     try:
         r = subprocess.run(
-            [sys.executable, "-c", _CHILD, what, str(cells)],
+            [sys.executable, "-c", child, what, str(cells), *args],
             capture_output=True,
             text=True,
             timeout=timeout,

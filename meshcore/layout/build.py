@@ -16,6 +16,7 @@ nothing depends on the units or on a particular lake.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -26,7 +27,7 @@ from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners, wedge_corners
 from .fans import fans, unfan, wraps
-from .frames import close_frames, frame_defects
+from .frames import close_frames, corner_flaws, frame_defects, straight_corners
 from .regions import partition
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, forced_indices, region_cost
@@ -179,10 +180,11 @@ def layout_pieces(
         fi = forced_indices(r, f)
         c, _ = choose_corners(r, sigma, forced=fi)
         on_shore = rim.near(r, 1e-9 * size)
-        if wedges:
-            c = wedge_corners(r, c, sigma, shore=on_shore, forced=fi)
-        elif c is not None and not regular:
-            c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5)
+        w = wedge_corners(r, c, sigma, shore=on_shore, forced=fi) if wedges and c is not None else c
+        if w is not None and tuple(w) != tuple(c):
+            c = w
+        elif c is not None:  # (regular layouts: no T-junction, only onto a vertex that turns)
+            c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5, onto_cut=not regular)
         corner_pts.append([r[i] for i in c])
     rings = conform(rings, 1e-9 * size)
     pieces = []
@@ -214,7 +216,7 @@ REACH = 1.0
 CONVEX_TURN = 20.0
 
 
-def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float) -> tuple:
+def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float, *, onto_cut: bool = True) -> tuple:
     """The corners ``c`` of piece ``r`` with a corner on a straight shore moved off it.
 
     A piece with three sharp corners (the pointed end of an arm beyond its tip chord, a triangular
@@ -230,7 +232,8 @@ def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float
     The new corner is the cut vertex nearest the middle of the piece's longest run of cut
     vertices (by arc length); ``c`` unchanged when no corner or more than one is flat, a flat
     corner is ``forced``, or the piece has no cut (``on_shore``: the ring's vertices on the
-    shore; ``h``: the cell size)."""
+    shore; ``h``: the cell size).  ``onto_cut`` False (regular layouts, whose blocks meet four
+    corners to four: no T-junction): only onto a vertex that turns."""
     from .corners import _raw_turning
 
     raw = _raw_turning(r)
@@ -258,7 +261,7 @@ def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float
             new = sorted((corners - {int(i)}) | {k})
             return tuple(new) if len(new) == 4 else tuple(c)
         flat.append(i)
-    if len(flat) != 1 or on_shore.all() or not on_shore.any():
+    if not onto_cut or len(flat) != 1 or on_shore.all() or not on_shore.any():
         return tuple(c)
     start = int(np.flatnonzero(on_shore)[0])
     runs: list[list[int]] = []  # each stretch of cut vertices with the shore vertex either side
@@ -328,22 +331,51 @@ def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: floa
 def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float, single: bool = False):
     """The pieces with corners that close up round every island (:func:`~.frames.close_frames`),
     the first choice whose cells can be counted; the pieces as they are when there is none
-    (their layout is valid, Delft3D's domain decomposition cannot couple it)."""
-    from ..errors import TopologyError
+    (their layout is valid, Delft3D's domain decomposition cannot couple it).
 
+    Where that choice moves a corner onto a vertex of a straight shore (a corner cell of 180°,
+    :func:`~.frames.straight_corners`), the corners are chosen again with moves onto bends of
+    their own only, then onto vertices that turn (:func:`~.frames._bends`), and such a choice
+    is taken when it has fewer straight corners and no more corners beside a sharper bend or
+    blocks with two sides under ``sigma`` (:func:`~.frames.corner_flaws`); else the first
+    choice stays.  Not with ``single``: five generated lakes with islands at 10 000 cells lost
+    their straight cells (5 → 0) but three lost 4–8 points of nodes within 3° or got interface
+    ratios of 2.7 and 5.7 (docs/lake-grids-journal.md, session 28)."""
     # corners costed by the turning their cells see first; when no such choice can be counted,
     # those costed at sigma (lake_with_islands(4) at 1500 cells: closed only by the latter)
     for own in (True, False):
-        for closed in close_frames(pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3):
-            try:
-                got = _make_countable(closed, cuts, h, size)
-            except TopologyError:
+        got = _first_countable(pieces, cuts, h, size, sigma, single, own, 0)
+        if got is None:
+            continue
+        straight, borrowed, short = corner_flaws(got[0], sigma)
+        if single or straight <= len(straight_corners(pieces)):  # (single: measured worse, see below)
+            return got
+        for bends, own_ in itertools.product((2, 1), (own, not own)):
+            other = _first_countable(pieces, cuts, h, size, sigma, single, own_, bends)
+            if other is None:
                 continue
-            if not single or _countable(got[0], h, closed=True):
-                return got
+            s, b, k = corner_flaws(other[0], sigma)
+            if s < straight and b <= borrowed and k <= short:  # no corner beside a bend, no short block end instead
+                return other
+        return got
     if single and not frame_defects(pieces, single=True) and _countable(pieces, h, closed=True):
         return pieces, cuts
     return _make_countable(pieces, cuts, h, size)
+
+
+def _first_countable(pieces, cuts, h: float, size: float, sigma: float, single: bool, own: bool, bends: int):
+    """The first choice of :func:`~.frames.close_frames` (``own``, ``bends``) whose cells can be
+    counted (with ``single``, in one index space), as ``(pieces, cuts)``; None if there is none."""
+    from ..errors import TopologyError
+
+    for closed in close_frames(pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3, bends=bends):
+        try:
+            got = _make_countable(closed, cuts, h, size)
+        except TopologyError:
+            continue
+        if not single or _countable(got[0], h, closed=True):
+            return got
+    return None
 
 
 #: Corner choices tried per island set-up for a single index space (``single``): a choice whose

@@ -261,6 +261,19 @@ WEDGE_END = 1.0
 WEDGE_WIDTH = 4.0
 
 
+#: The least turning (degrees, between its two edges, towards the water) of a shore vertex that
+#: takes a block corner moved there (a wedge's end, :func:`wedge_corners`; a corner that closes a
+#: regular layout's frames, :mod:`.frames`): at a vertex of a straight edge the block's corner
+#: cell has an angle of 180° (a triangle; :data:`~meshcore.quality.cells.STRAIGHT_SINE`),
+#: whatever the shore does a fraction of a cell further on.
+OWN_TURN = 1.0
+
+
+#: ... and each of the two corners goes to the nearest vertex turning by :data:`OWN_TURN` or
+#: more within this fraction of that distance of it, if there is one.
+WEDGE_SLACK = 0.5
+
+
 def wedge_corners(ring: np.ndarray, corners, sigma: float, *, shore: np.ndarray, forced=()):
     """``corners`` of a CCW ring with a wedge's tip among them split in two (or ``corners``).
 
@@ -271,9 +284,13 @@ def wedge_corners(ring: np.ndarray, corners, sigma: float, *, shore: np.ndarray,
     :data:`SHARP` · 2, or one of two corners within a quarter of ``sigma``; not ``forced``) is
     dropped and the tip is replaced by the two vertices far enough along the shore either side
     of it to span :data:`WEDGE_END` cells: the tip lies inside a short end side, the grid lines
-    run along the wedge and converge on it (a polar grid).  ``shore`` marks the ring's vertices
-    on the shore: the tip and the end side must be shore (a star's
-    centre turns as much inside the water).
+    run along the wedge and converge on it (a polar grid).  Each of the two goes to the nearest
+    vertex turning by :data:`OWN_TURN` or more within :data:`WEDGE_SLACK` of that distance: at
+    a vertex of a straight flank the corner cell is a triangle with a 180° angle (on straight
+    flanks there is none, and the corners are put there all the same: left, see
+    docs/lake-grids-journal.md).
+    ``shore`` marks the ring's vertices on the shore: the tip and the end side must be shore (a
+    star's centre turns as much inside the water).
     """
     c = [int(i) for i in corners]
     forced = {int(f) for f in forced}
@@ -300,10 +317,14 @@ def wedge_corners(ring: np.ndarray, corners, sigma: float, *, shore: np.ndarray,
         if t[weak] >= 2 * SHARP or weak in forced:
             return tuple(c)
     d = h * max(1.0, WEDGE_END / (2.0 * math.sin(math.radians(max(180.0 - t[tip], 5.0)) / 2.0)))
-    back = (s[tip] - d) % total
-    ahead = (s[tip] + d) % total
-    ia = int(np.argmin(np.minimum(np.abs(s - back), total - np.abs(s - back))))
-    ib = int(np.argmin(np.minimum(np.abs(s - ahead), total - np.abs(s - ahead))))
+    raw = _raw_turning(ring)
+
+    def placed(along: np.ndarray) -> int:  # the vertex nearest d from the tip, one that turns if any
+        near = np.abs(along - d)
+        ok = np.flatnonzero((near <= WEDGE_SLACK * d) & (raw >= OWN_TURN))
+        return int(ok[np.argmin(near[ok])]) if len(ok) else int(np.argmin(near))
+
+    ia, ib = placed((s[tip] - s) % total), placed((s - s[tip]) % total)
     new = sorted({ia, ib} | (set(c) - {tip, weak}))
     n = len(ring)
     # both within the tip's own sides: no other corner between them (round the tip)

@@ -18,11 +18,12 @@ from meshcore.quality import lake_metrics
 
 
 def test_a_wedge_tip_is_split_between_two_corners():
-    # a strip 5 wide ending in a wedge of 30° (tip at vertex 3 of the dense ring), cut by a chord
+    # a strip 5 wide ending in a wedge of 30°, cut by a chord; its flanks turn by 1.4° at 1.5 from
+    # the tip (on straight flanks the corners stay: test_layout_straight_corners.py)
     import shapely
     from shapely.geometry import Polygon
 
-    poly = Polygon([(0, -2.5), (10, -2.5), (19.33, 0), (10, 2.5), (0, 2.5)])
+    poly = Polygon([(0, -2.5), (10, -2.5), (17.89, -0.42), (19.33, 0), (17.89, 0.42), (10, 2.5), (0, 2.5)])
     ring = np.asarray(shapely.segmentize(poly, 0.5).exterior.coords)[:-1]
     tip = int(np.argmax(ring[:, 0]))
     corners = sorted([0, int(np.argmin(np.hypot(*(ring - (10, -2.5)).T))), tip, len(ring) - 1])
