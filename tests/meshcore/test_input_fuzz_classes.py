@@ -94,3 +94,59 @@ def test_an_unknown_crs_option_names_the_option(tmp_path, capsys, argv, needle):
     err = capsys.readouterr().err
     assert rc == 2 and needle in err and err.count("\n") == 1, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ring.csv"]
+
+
+_SLOW_WRITE = """
+import sys, time
+from pathlib import Path
+import meshcore.io.native as native
+from meshcore.io._atomic import atomic_path
+from meshcore.cli import main
+
+def slow(path, gs, **kw):  # a write that the signal reaches half done
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(b"half")
+        Path(sys.argv[1]).touch()
+        time.sleep(300)
+
+native.write_npz = slow
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("sig", "code"), [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_signal_during_a_write_leaves_nothing(tmp_path, sig, code):
+    """Ctrl-C, and SIGTERM (``timeout``, job schedulers: was the default death, exit -15, the
+    half-written temporary left beside the output), end the run with nothing written."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    f = tmp_path / "ring.csv"
+    f.write_text("x,y\n0,0\n100,0\n100,80\n0,80\n")
+    out, ready = tmp_path / "out", tmp_path / "ready"
+    out.mkdir()
+    script = tmp_path / "run.py"
+    script.write_text(_SLOW_WRITE)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    argv = [sys.executable, str(script), str(ready), "mesh", str(f), "--cells", "64", "-o", str(out / "g.npz"), "-q"]
+    proc = subprocess.Popen(
+        argv, env=env, stderr=subprocess.PIPE, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)
+    )
+    try:
+        for _ in range(6000):
+            if ready.exists() or proc.poll() is not None:
+                break
+            time.sleep(0.1)
+        assert ready.exists(), proc.stderr.read().decode() if proc.poll() is not None else "no write"
+        proc.send_signal(getattr(signal, sig))
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == code, err.decode()
+    assert "Traceback" not in err.decode() and err.decode().count("\n") == 1, err.decode()
+    assert list(out.iterdir()) == []
