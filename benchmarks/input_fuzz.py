@@ -111,6 +111,7 @@ def geometries(rng: np.random.Generator) -> dict[str, Geo]:
     g["two_lakes_overlap"] = Geo([[shore], [blob(rng, 80, 2000, (1000, 0))]])
     g["scale_1e7"] = Geo([[shore * 3e3]])
     g["scale_1e-6"] = Geo([[shore * 3e-10]])
+    g["scale_1e-300"] = Geo([[shore * 1e-303]])
     g["offset_1e9"] = Geo([[shore + 1e9]])
     g["offset_1e15"] = Geo([[shore + 1e15]])
     g["thin_sliver"] = Geo([[np.array([[0, 0], [100000, 0], [100000, 0.5], [0, 0.5]])]])

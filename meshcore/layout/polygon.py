@@ -278,10 +278,16 @@ def water_polygon(
         kept.append(isl)
         boxes = np.vstack([boxes, b])
     poly = orient(Polygon(outer, rings), 1.0)
-    if not poly.is_valid or poly.area <= 1e-12 * size * size:
+    if not poly.is_valid:
         import shapely
 
         raise InvalidInputError(f"the water polygon is not valid ({shapely.is_valid_reason(poly)}, near that point)")
+    if poly.area <= 1e-12 * size * size:  # (was: "not valid (Valid Geometry, near that point)")
+        tiny = "; its coordinates are too small for double precision: scale them up" if size < 1e-100 else ""
+        raise InvalidInputError(
+            f"the outline encloses no area to grid (area {poly.area:.3g} within an extent of {size:.3g}, "
+            f"near ({outer[0][0]:.6g}, {outer[0][1]:.6g})){tiny}"
+        )
     return poly, notes
 
 

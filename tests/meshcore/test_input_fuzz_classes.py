@@ -150,3 +150,14 @@ def test_a_signal_during_a_write_leaves_nothing(tmp_path, sig, code):
     assert proc.returncode == code, err.decode()
     assert "Traceback" not in err.decode() and err.decode().count("\n") == 1, err.decode()
     assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200])
+def test_an_outline_too_small_for_doubles_says_so(tmp_path, capsys, scale):
+    """Was: "the water polygon is not valid (Valid Geometry, near that point)" (its area underflows to 0)."""
+    f = tmp_path / "tiny.csv"
+    f.write_text("x,y\n" + "".join(f"{x * scale},{y * scale}\n" for x, y in [(0, 0), (3, 0), (3, 2), (0, 2)]))
+    assert main(["mesh", str(f), "-o", str(tmp_path / "g.vtm")]) == 2
+    err = capsys.readouterr().err
+    assert "tiny.csv: the outline encloses no area to grid" in err and "too small for double precision" in err, err
+    assert "Valid Geometry" not in err and err.count("\n") == 1
