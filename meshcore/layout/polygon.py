@@ -127,10 +127,12 @@ def _is_back(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> bool:
 
 def _retraced(ring: np.ndarray, what: str, dropped: list[np.ndarray]) -> None:
     """Raise: the ring only goes out and comes back (its spikes dropped, fewer than 3 points are left)."""
-    far = max(dropped, key=lambda q: float(np.hypot(*(q - ring[0]))))
+    pts = np.vstack([ring, *dropped])  # every point of the ring: its two ends are the far-apart ones
+    a = pts[np.argmax(np.hypot(*(pts - pts.mean(axis=0)).T))]
+    b = pts[np.argmax(np.hypot(*(pts - a).T))]
     raise InvalidInputError(
         f"{what} goes out and comes back along itself, enclosing no water: from near "
-        f"({ring[0][0]:.6g}, {ring[0][1]:.6g}) out to near ({far[0]:.6g}, {far[1]:.6g}) and back"
+        f"({a[0]:.6g}, {a[1]:.6g}) to near ({b[0]:.6g}, {b[1]:.6g}) and back"
     )
 
 

@@ -25,8 +25,9 @@ def _retrace(n: int) -> np.ndarray:
 def test_a_ring_that_retraces_itself_is_named_as_such(n):
     """Was: dropping one tip per round (5000 points: seconds, 40 000: a minute, 10^5: a hang), then
     "crosses itself: the edge from point 1 to 2 …" about points of what was left."""
-    with pytest.raises(InvalidInputError, match="comes back along itself, enclosing no water"):
+    with pytest.raises(InvalidInputError, match="comes back along itself, enclosing no water") as e:
         water_polygon(_retrace(n))
+    assert "near (0, 0)" in str(e.value) and "near (3000, 130.058)" in str(e.value)  # the path's two ends
 
 
 @pytest.mark.parametrize("depth", [3, 40])
