@@ -878,7 +878,8 @@ def run_case(case: Case, root: Path, timeout: float) -> Result:
 
 def _names_place(argv: list[str], msg: str) -> bool:
     """The error line names an input or output file of the run, an option, or an argument."""
-    names = [Path(a).name for a in argv[1:] if "/" in a or "." in a]
+    paths = [Path(a) for a in argv[1:] if "/" in a or "." in a]
+    names = [p.name for p in paths] + [f"{p.stem}." for p in paths]  # a file beside it too (.prj of a .shp)
     return any(n and n in msg for n in names) or " --" in msg or "-o " in msg or "argument" in msg
 
 
