@@ -857,8 +857,8 @@ def run_case(case: Case, root: Path, timeout: float) -> Result:
     elif rc == 1:
         r.why = "exit 1 (internal error)"
     elif case.sigint_after:
-        want = 130 if case.signal == signal.SIGINT else -case.signal
-        r.verdict, r.why = ("ok", "interrupted cleanly") if rc == want and not files else ("BAD", "")
+        want = (130,) if case.signal == signal.SIGINT else (143, -case.signal)  # 143: handled, -15: killed
+        r.verdict, r.why = ("ok", "interrupted cleanly") if rc in want and not files else ("BAD", "")
         r.why = r.why or f"after signal {case.signal}: exit {rc}, files {files}"
     elif rc == 2:
         if files:
