@@ -670,10 +670,10 @@ def raw_cases(rng: np.random.Generator) -> list[Case]:
     big = blob(rng, 400, 30000)
     add("sigint during solve", "signal", lambda d: ["mesh", str(write_csv(Geo([[big]]), d / "in")), "--cells", "60000",
                                                  "-o", str(d / "out" / "g.vtm"), "-o", str(d / "out" / "g.npz")],
-        sigint_after=25.0)  # fmt: skip
+        sigint_after=8.0)  # fmt: skip
     add("sigterm during solve", "signal", lambda d: ["mesh", str(write_csv(Geo([[big]]), d / "in")), "--cells", "60000",
                                                   "-o", str(d / "out" / "g.vtm")],
-        sigint_after=25.0, signal=signal.SIGTERM)  # fmt: skip
+        sigint_after=8.0, signal=signal.SIGTERM)  # fmt: skip
     return c
 
 
@@ -829,11 +829,13 @@ def run_case(case: Case, root: Path, timeout: float) -> Result:
         preexec_fn=_default_sigint,  # a harness started with & ignores SIGINT, and so would its children
     )
     timed_out = False
+    signalled = False
     if case.sigint_after:
         try:
             proc.wait(case.sigint_after)
         except subprocess.TimeoutExpired:
             proc.send_signal(case.signal)
+            signalled = True
     try:
         out, err = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -856,6 +858,8 @@ def run_case(case: Case, root: Path, timeout: float) -> Result:
         r.why = "traceback"
     elif rc == 1:
         r.why = "exit 1 (internal error)"
+    elif case.sigint_after and not signalled:
+        r.verdict, r.why = "skip", f"finished before the signal ({case.sigint_after:.0f} s)"
     elif case.sigint_after:
         want = (130,) if case.signal == signal.SIGINT else (143, -case.signal)  # 143: handled, -15: killed
         r.verdict, r.why = ("ok", "interrupted cleanly") if rc in want and not files else ("BAD", "")
