@@ -4,7 +4,9 @@ Subcommands live in one module each with ``add_args(parser)`` and
 ``run(args) -> int``.  Exit codes: 0 success/converged, 2 bad input (one line
 on stderr, no traceback, no partial output), 3 solved but not converged, 1 an
 internal error (a bug; one line too, ``MESHCORE_DEBUG=1`` shows the traceback),
-130 interrupted.
+130 interrupted (Ctrl-C), 143 terminated (SIGTERM, what ``timeout`` and job
+schedulers send: taken as an interruption, so a write in progress removes its
+temporaries as on Ctrl-C).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import os
 import platform
 import sys
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from ..errors import MeshcoreError
 
@@ -78,16 +80,38 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that what is being written is cleaned up."""
+
+
+def _terminate(signum: int, frame: Any) -> NoReturn:
+    raise _Terminated
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code (see the module docstring)."""
+    import signal
+    import threading
+
+    own = threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+    if own:
+        signal.signal(signal.SIGTERM, _terminate)
+    try:
+        return _main(argv)
+    finally:
+        if own:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     from .._heap import keep_freed_memory
 
     keep_freed_memory()
     try:
         parser = build_parser()  # imports every subcommand (numba kernels among them): seconds
-    except KeyboardInterrupt:
-        print("meshcore: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        print(f"meshcore: {'terminated' if isinstance(exc, _Terminated) else 'interrupted'}", file=sys.stderr)
+        return 143 if isinstance(exc, _Terminated) else 130
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a usage error (already printed as one line)
@@ -100,9 +124,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MeshcoreError as exc:
         print(f"meshcore {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        print(f"meshcore {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        term = isinstance(exc, _Terminated)
+        print(f"meshcore {args.command}: {'terminated' if term else 'interrupted'}", file=sys.stderr)
+        return 143 if term else 130
     except (OSError, ValueError) as exc:  # anything else a user can cause (paths, numbers)
         print(f"meshcore {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -125,8 +125,11 @@ def run(args: argparse.Namespace) -> int:
         if b not in BORDER_NAMES or not nm:
             raise InvalidInputError(f"--border-name expects BORDER=NAME with BORDER in {BORDER_NAMES}, got {item!r}")
         specs[b] = BorderSpec(name=nm)
+    from .lakefile import check_crs_option, lonlat_order_note, swapped_degrees_note
+
+    check_crs_option(args.source_crs, "--source-crs")
+    check_crs_option(args.crs, "--crs")
     ps = read_points(args.points, columns=args.columns, crs=args.source_crs)
-    from .lakefile import lonlat_order_note, swapped_degrees_note
 
     said = (
         lonlat_order_note(ps, args.source_crs, args.columns),

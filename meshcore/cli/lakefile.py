@@ -6,7 +6,8 @@
 * :func:`local_frame` — project degrees (and Web Mercator) to the grid's CRS about a round origin;
 * :func:`without_lines_on_the_shore`, :func:`lake_rings` — the shore, the islands, and the open
   lines that are neither (an inlet drawn on the shore, a ferry route, pins), dropped with notes;
-* :func:`in_world` — a message's places ``near (x, y)`` moved from the local frame to the CRS.
+* :func:`in_world` — a message's places ``near (x, y)`` moved from the local frame to the CRS;
+* :func:`check_crs_option` — a ``--crs`` / ``--source-crs`` value refused before any file is read.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 
 __all__ = [
     "RINGS_MAY_BE_OPEN",
+    "check_crs_option",
     "in_world",
     "is_lonlat",
     "lake_parts",
@@ -28,6 +30,19 @@ __all__ = [
     "swapped_degrees_note",
     "without_lines_on_the_shore",
 ]
+
+
+def check_crs_option(value: Any, option: str) -> None:
+    """Raise one error naming ``option`` when ``value`` is no CRS PROJ knows (None, auto, none, local pass)."""
+    from ..crs import normalize_crs
+    from ..errors import InvalidInputError
+
+    if value is None or str(value).strip().lower() in ("auto", "none", "local"):
+        return
+    try:
+        normalize_crs(value)
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{option} {value}: {str(exc).removeprefix('crs: ')}") from None
 
 
 def is_lonlat(ps: Any, source_crs: Any = None) -> bool:

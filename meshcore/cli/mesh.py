@@ -42,6 +42,7 @@ from typing import Any
 from ..cellsize import DEFAULT_CELLS
 from ..errors import InvalidInputError
 from .lakefile import (
+    check_crs_option,
     degrees_note,
     in_world,
     lake_parts,
@@ -280,6 +281,7 @@ def run(args: argparse.Namespace) -> int:
             raise InvalidInputError(f"--crs {args.crs}: {str(exc).removeprefix('crs: ')}") from None
         if why:
             raise InvalidInputError(f"--crs {args.crs}: {why}; give a projected one (metres)")
+    check_crs_option(args.source_crs, "--source-crs")
     outputs = single_outputs(args, _check_outputs(args))
     ddb = [p for p, fmt in outputs if fmt.name == "delft3d-dd"]
     one = [p for p, fmt in outputs if fmt.name in SINGLE_DOMAIN]

@@ -112,6 +112,11 @@ def read_points_geojson(path: Path, *, crs: Any = None, **_: Any) -> PointSet:
                 declared = f"EPSG:{code}"
     if crs is not None:
         declared = normalize_crs(crs)
+    elif declared != LONLAT:  # checked here, where the file is named (was: when the points were projected)
+        try:
+            normalize_crs(declared)
+        except InvalidInputError as exc:
+            raise ReadError(f"{path}: its 'crs' member names {nm!r}: {str(exc).removeprefix('crs: ')}") from None
     if doc["type"] == "FeatureCollection":
         feats = doc.get("features")
         if not isinstance(feats, list):
