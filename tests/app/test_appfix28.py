@@ -39,3 +39,46 @@ def test_an_outline_with_a_ring_twice_imports_the_lake_once_with_a_note(qtbot, w
     (note,) = [t for t in said if "same ring" in t]
     assert note.startswith("lake.geojson: 'lake hole ") and "read once" in note
     assert not any("pond" in t or "not read as a lake" in t for t in said), said
+
+
+def test_the_export_dialog_opens_in_the_last_export_folder_else_the_projects_else_the_imports(
+    qtbot, win, tmp_path, monkeypatch
+):
+    """It opened in the folder the outline was imported from (or the case file's), also after the
+    user had exported elsewhere: now the last export's folder (remembered in the settings), else the
+    project file's, else the import folder."""
+    from PySide6 import QtWidgets
+
+    from tests.app.test_modeller import _laid_out, _metres_lake
+
+    src, proj, out = (tmp_path / d for d in ("src", "proj", "out"))
+    for d in (src, proj, out):
+        d.mkdir()
+    offered: list[str] = []
+
+    def dialog(_parent, _caption, directory, *_filters):
+        offered.append(directory)
+        return "", ""
+
+    monkeypatch.setattr(QtWidgets.QFileDialog, "getSaveFileName", dialog)
+    _laid_out(qtbot, win, src, 761906)
+    win.io.export_dialog()
+    assert offered.pop() == str(src / "lake761906.ddb")  # the import folder: nothing else yet
+    assert win.io.save_to(proj / "case.toml")
+    win.io.export_dialog()
+    assert offered.pop() == str(proj / "case.ddb")  # the project file's folder
+    assert win.io.export_mesh(out / "case.vtm")
+    win.io.export_dialog()
+    assert offered.pop() == str(out / "case.ddb")  # the last export's (was: the project file's)
+    win.io.figure_dialog()
+    assert offered.pop() == str(out)
+    assert win.io.import_points(_metres_lake(src / "second.csv", 761907))  # another lake, from src again
+    assert win.doc.path is None and win.io.last_dir() == str(src)
+    win.lake_ctl.set_cell_size(win.doc.project.lake.cell_size or 200.0)
+    win.a_auto_layout.trigger()
+    wait_idle(qtbot, win)
+    win.io.export_dialog()
+    assert offered.pop() == str(out / "second.ddb")  # remembered in the settings (was: src, the import's)
+    out.rename(tmp_path / "gone")  # a folder no longer there: the next in the order
+    win.io.export_dialog()
+    assert offered.pop() == str(src / "second.ddb")
