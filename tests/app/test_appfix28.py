@@ -82,3 +82,38 @@ def test_the_export_dialog_opens_in_the_last_export_folder_else_the_projects_els
     out.rename(tmp_path / "gone")  # a folder no longer there: the next in the order
     win.io.export_dialog()
     assert offered.pop() == str(src / "second.ddb")
+
+
+@pytest.mark.parametrize("how", ["auto-generate", "F5"])
+def test_redo_of_auto_layout_brings_its_grid_back_without_a_new_solve(qtbot, win, tmp_path, how):
+    """Undo of Auto layout starts the one block's solve (auto-generate on, or F5); a Redo while it ran
+    solved the layout again from scratch (the document skipped its kept grid while a solve ran).  Now
+    the redo shows the layout's grid as it was, current, and the one block's solve is dropped."""
+    from tests.app.waits import wait_for
+
+    t = np.linspace(0, 2 * np.pi, 80, endpoint=False)
+    ring = np.column_stack([3000 * np.cos(t) + 400 * np.cos(3 * t), 1500 * np.sin(t)])
+    assert win.io.import_points(_geojson(tmp_path / "lake.geojson", [ring]), project_lonlat=True)
+    wait_idle(qtbot, win)
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    laid, grids = win.doc.project, {k: g.x.copy() for k, g in win.doc.grids.items()}
+    assert len(grids) == len(laid.blocks) > 1 and not win.doc.stale
+    starts: list[object] = []
+    win.solver.state_changed.connect(lambda s: starts.append(win.doc.project) if s == "running" else None)
+    win.solver.set_auto(how == "auto-generate")
+    win.io.stack.undo()
+    if how == "F5":
+        win.generate()
+    wait_for(qtbot, win, lambda: win.doc.solving)  # the one block's solve runs
+    assert win.doc.project.layout is None and len(starts) == 1
+    win.io.stack.redo()
+    assert win.doc.project is laid and not win.doc.stale  # at once, while the one block's solve stops
+    wait_idle(qtbot, win)
+    assert len(starts) == 1, "the redo started a solve"
+    assert win.doc.project is laid and not win.doc.stale and win.doc.multiblock is not None
+    assert set(win.doc.grids) == set(grids)
+    for k, x in grids.items():
+        assert np.array_equal(win.doc.grids[k].x, x)
+    assert "orthogonal" in win.solve_status.label.text()  # the lake grid's summary, not "stopped"
