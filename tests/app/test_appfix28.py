@@ -117,3 +117,53 @@ def test_redo_of_auto_layout_brings_its_grid_back_without_a_new_solve(qtbot, win
     for k, x in grids.items():
         assert np.array_equal(win.doc.grids[k].x, x)
     assert "orthogonal" in win.solve_status.label.text()  # the lake grid's summary, not "stopped"
+
+
+def test_the_auto_layout_offer_is_a_bar_above_the_canvas_clear_of_the_lake(qtbot, win, tmp_path):
+    """The offer was a message box in the middle of the window, over the lake and its islands.  It is a
+    strip above the canvas now: the canvas below it shows the whole lake; Esc declines it, Enter takes
+    it (the Auto layout button has the focus)."""
+    from PySide6 import QtCore, QtWidgets
+
+    from tests.app.test_modeller import _metres_lake
+
+    win.quiet = False  # the offer is shown (quiet: made, not shown)
+    win.activateWindow()
+    try:
+        assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761811))
+    finally:
+        win.quiet = True  # (closing the window would ask to save)
+    bar = win.lake_ctl.prompt
+    assert bar is not None and "island" in bar.text()
+    qtbot.waitUntil(bar.isVisible)
+    top_left = bar.mapTo(win, QtCore.QPoint(0, 0))
+    on_window = QtCore.QRect(top_left, bar.size())
+    canvas = QtCore.QRect(win.canvas.mapTo(win, QtCore.QPoint(0, 0)), win.canvas.size())
+    assert not on_window.intersects(canvas) and on_window.bottom() < canvas.top()
+    (vx0, vx1), (vy0, vy1) = win.canvas._vb.viewRange()
+    shore = win.doc.project.lake.outline
+    assert vx0 <= shore[:, 0].min() and shore[:, 0].max() <= vx1
+    assert vy0 <= shore[:, 1].min() and shore[:, 1].max() <= vy1
+    go, later = bar.buttons()
+    assert go.text() == "Auto layout" and later.text() == "Not now"
+    qtbot.waitUntil(lambda: QtWidgets.QApplication.focusWidget() is go)
+    qtbot.keyClick(go, QtCore.Qt.Key.Key_Escape)  # declined: no layout, the keys go back to the canvas
+    assert win.lake_ctl.prompt is None and not win.lake_ctl.busy and win.doc.project.layout is None
+    assert QtWidgets.QApplication.focusWidget() is win.canvas
+    win.quiet = False
+    try:
+        assert win.io.import_points(_metres_lake(tmp_path / "again.csv", 761812))
+    finally:
+        win.quiet = True
+    go = win.lake_ctl.prompt.buttons()[0]
+    qtbot.waitUntil(lambda: QtWidgets.QApplication.focusWidget() is go)
+    win.lake_ctl.set_cell_size(np.sqrt(abs(_area(win.doc.project.lake.outline))) / 20)  # a quick grid
+    qtbot.keyClick(go, QtCore.Qt.Key.Key_Return)  # taken: Auto layout runs
+    assert win.lake_ctl.busy or win.doc.project.layout is not None
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is not None and win.lake_ctl.prompt is None
+
+
+def _area(ring):
+    x, y = np.asarray(ring, float).T
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
