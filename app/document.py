@@ -130,6 +130,8 @@ class Document:
         self._given_metrics = None  # (MultiBlockGrid, LakeMetrics) measured by the solver worker
         #: the last :data:`KEPT_SOLVES` finished solves: (project, grids, initial, multiblock, given metrics)
         self._kept: list[tuple] = []
+        #: the project an undo or redo brought a kept solve back for (None once a solve or an open replaced it)
+        self.restored: Project | None = None
 
     # ----------------------------------------------------------- project
     @property
@@ -174,13 +176,18 @@ class Document:
         self.project_changed.emit(project)
 
     def _restore_kept(self, project: Project) -> None:
-        """An undo or redo back to what a kept solve was made of: its grids become the current ones."""
+        """An undo or redo back to what a kept solve was made of: its grids become the current ones.
+
+        Also while a solve runs (of the project before the undo; the solver drops it when it sees
+        :attr:`restored`): an undo of Auto layout started the one block's solve (auto-generate on),
+        and a redo while it ran solved the layout again from scratch (its grid was kept)."""
         made = _made_of(project)
-        if self.solving or (self.solved is not None and _made_of(self.solved) is made and self.grids):
+        if self.solved is not None and _made_of(self.solved) is made and self.grids and not self.solving:
             return
         kept = next((k for k in self._kept if _made_of(k[0]) is made), None)
         if kept is None:
             return
+        self.restored = project
         self.solved, grids, initial, self.multiblock, self._given_metrics = kept
         self.grids, self.initial = dict(grids), dict(initial)
         self.before_grids = {}
@@ -202,6 +209,7 @@ class Document:
         self.stale = True
         self.solved = None
         self._kept = []
+        self.restored = None
         self._update_quality()
         self.opened.emit()
         self.project_changed.emit(project)
@@ -232,6 +240,7 @@ class Document:
         its LakeMetrics if the worker measured them) of ``project`` (default: the current one); of
         another (an edit made while it solved) they stay marked as of before the edit."""
         self._given_metrics = (multiblock, metrics) if metrics is not None else None
+        self.restored = None
         self.grids = dict(grids)
         self.before_grids = {}
         if initial is not None:
@@ -254,6 +263,7 @@ class Document:
 
     def clear_grids(self) -> None:
         self.solved = None
+        self.restored = None
         self.grids = {}
         self.before_grids = {}
         self.initial = {}

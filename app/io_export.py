@@ -2,8 +2,8 @@
 Delft3D domain decomposition that cannot be coupled) and the writes.
 
 :class:`ExportMixin` is a part of :class:`app.io_controller.IOController` (a mixin: it uses the
-controller's ``win``, ``doc``, ``quiet``, ``_parent``, ``suggested_path``, ``last_dir`` and
-``remember_dir``); meshes are written by :mod:`app.io_adapter` over ``meshcore.io``.
+controller's ``win``, ``doc``, ``quiet``, ``settings``, ``_parent``, ``suggested_path``, ``last_dir``
+and ``remember_dir``); meshes are written by :mod:`app.io_adapter` over ``meshcore.io``.
 """
 
 from __future__ import annotations
@@ -55,8 +55,30 @@ _BEFORE_EDIT = (
 )
 
 
+#: the settings key of the folder of the last export (mesh or figure)
+EXPORT_DIR = "last_export_dir"
+
+
 class ExportMixin:
     """Export mesh and Export figure of the window's :class:`~app.io_controller.IOController`."""
+
+    def export_dir(self) -> str:
+        """The folder the Export dialogs open in: the last export's (remembered in the settings),
+        else the project file's, else the last folder used (the outline's, after an import).
+
+        It opened in the folder the outline was imported from: a modeller keeps the lake's outline
+        with the source data and writes grids elsewhere, and found that folder offered every time."""
+        last = str(self.settings.value(EXPORT_DIR, "") or "")
+        if last and Path(last).is_dir():
+            return last
+        if self.doc.path is not None:
+            return str(Path(self.doc.path).parent)
+        return self.last_dir()
+
+    def remember_export(self, path: Path) -> None:
+        """The folder the next Export dialog opens in (:meth:`export_dir`)."""
+        self.settings.setValue(EXPORT_DIR, str(Path(path).parent))
+        self.remember_dir(path)
 
     def export_dialog(self) -> None:
         if not self.doc.grids:
@@ -67,7 +89,8 @@ class ExportMixin:
         want = export_default(self.doc.project)
         first = next((f"{d} ({p})" for d, p in fmts if d.endswith(f"[{want}]")), "")
         suffix = next((p.split()[0].lstrip("*") for d, p in fmts if d.endswith(f"[{want}]")), "")
-        offer = str(Path(self.suggested_path()).with_suffix(suffix)) if suffix else self.last_dir()
+        stem = Path(self.suggested_path()).stem
+        offer = str(Path(self.export_dir()) / f"{stem}{suffix}") if suffix else self.export_dir()
         path, chosen = QtWidgets.QFileDialog.getSaveFileName(self._parent(), "Export mesh", offer, filt, first)
         if path:
             if not Path(path).suffix:
@@ -104,7 +127,7 @@ class ExportMixin:
                 return False
             self.win.error("Cannot export mesh", exc)
             return False
-        self.remember_dir(path)
+        self.remember_export(path)
         self.win.message(f"Exported {len(grids)} block(s) to {path}")
         return True
 
@@ -231,7 +254,7 @@ class ExportMixin:
 
     def figure_dialog(self) -> None:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self._parent(), "Export figure", self.last_dir(), "PNG image (*.png);;SVG vector (*.svg)"
+            self._parent(), "Export figure", self.export_dir(), "PNG image (*.png);;SVG vector (*.svg)"
         )
         if path:
             if not Path(path).suffix:
@@ -245,5 +268,6 @@ class ExportMixin:
             log.exception("cannot export the figure %s", path)
             self.win.error("Cannot export figure", exc)
             return False
+        self.remember_export(Path(path))
         self.win.message(f"Saved figure {path}")
         return True

@@ -4,7 +4,7 @@
 superqt function worker), then sets the layout by one undoable command
 (:meth:`app.commands.Editor.set_lake`) and starts the grid.  Settings (cell size, regular)
 are undoable edits of the project's :class:`~app.lake.Lake`.  After importing a branched
-outline it offers Auto layout in a non-modal box (never shown with ``window.quiet``).
+outline it offers Auto layout in a strip above the canvas (never shown with ``window.quiet``).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from meshcore import MeshcoreError
 
 from .lake import Lake, compute_layout
 from .lake_solve import layout_topology
+from .views.offer_bar import OfferBar
 
 __all__ = ["EDIT_GAP_S", "LakeController"]
 
@@ -81,7 +82,7 @@ class LakeController(QtCore.QObject):
         self._busy_text = ""
         self._busy_since = 0.0
         self.generate_after = True  # start the grid when a layout is set
-        self.prompt: QtWidgets.QMessageBox | None = None  # the offer after importing a branched lake
+        self.prompt: OfferBar | None = None  # the offer after importing a branched lake
         self._prompt_shore = None  # the shore the offer is for: another lake closes it (_other_lake)
         self.doc.project_changed.connect(self._other_lake)
         self.last_error: str | None = None
@@ -374,24 +375,24 @@ class LakeController(QtCore.QObject):
         else:
             text = f"{name}: {why}. One block would give a poor grid; Auto layout splits the lake into blocks."
         self.doc.report("info", text)
-        box = QtWidgets.QMessageBox(self.win)
         # what the message says is poor about one block (it was "A branched lake" over "6 island(s)")
         if why is None:
-            box.setWindowTitle("A lake outline")
+            title = "A lake outline"
         else:
-            box.setWindowTitle("Islands in the lake" if "island" in why and "arm" not in why else "A branched lake")
-        box.setIcon(QtWidgets.QMessageBox.Icon.Question)
-        box.setText(text)
-        box.setModal(False)
-        go = box.addButton("Auto layout", QtWidgets.QMessageBox.ButtonRole.AcceptRole)
-        box.addButton("Not now", QtWidgets.QMessageBox.ButtonRole.RejectRole)
+            title = "Islands in the lake" if "island" in why and "arm" not in why else "A branched lake"
+        # a strip above the canvas (a message box in the middle of the window covered the lake it is about)
+        bar = OfferBar(title, f"{text} (Ctrl+L; Esc: not now)", self.win)
+        go = bar.addButton("Auto layout")
+        bar.addButton("Not now").clicked.connect(self.close_prompt)
         go.clicked.connect(lambda: self.auto_layout())
         self.close_prompt()
-        self.prompt = box
+        self.prompt = bar
         lake = self.doc.project.lake
         self._prompt_shore = lake.outline if lake is not None else None
-        if not getattr(self.win, "quiet", False):
-            box.show()
+        if getattr(self.win, "quiet", False):
+            bar.hide()
+        else:
+            self.win.place_offer(bar)
 
     def _other_lake(self, project) -> None:
         """Another lake (File ▸ New, Open, an import not offered, its undo): the offer goes with its
@@ -404,6 +405,9 @@ class LakeController(QtCore.QObject):
 
     def close_prompt(self) -> None:
         if self.prompt is not None:
+            focus = QtWidgets.QApplication.focusWidget()
+            if focus is not None and self.prompt.isAncestorOf(focus):  # the keys go back to the canvas
+                self.win.canvas.setFocus()
             self.prompt.close()
             self.prompt.deleteLater()
             self.prompt = None

@@ -80,7 +80,13 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self._centres = (None, None)  # (grid, its cell centres) for the hover read-out
         self.canvas = Canvas(self.doc)
         self.canvas.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
-        self.setCentralWidget(self.canvas)
+        # the canvas under a strip for offers (place_offer): an offer over the canvas covered the lake
+        central = QtWidgets.QWidget()
+        self._central = QtWidgets.QVBoxLayout(central)
+        self._central.setContentsMargins(0, 0, 0, 0)
+        self._central.setSpacing(0)
+        self._central.addWidget(self.canvas, 1)
+        self.setCentralWidget(central)
         self._status = ElidedLabel()
         self._coords = QtWidgets.QLabel()
         self.statusBar().addWidget(self._status, 1)
@@ -394,6 +400,11 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
     def auto_layout_single(self) -> None:
         """Auto layout for one index space (EFDC, Delft3D single domain): regular, rings closed."""
         self.lake_ctl.auto_layout(single=True)
+
+    def place_offer(self, bar: QtWidgets.QWidget) -> None:
+        """Show an offer (:class:`app.views.offer_bar.OfferBar`) in the strip above the canvas."""
+        self._central.insertWidget(0, bar)
+        bar.show()
 
     def show_lake(self) -> None:
         """Bring the Lake dock to the front."""

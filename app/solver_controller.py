@@ -92,9 +92,11 @@ class SolverController(QtCore.QObject):
         self.state = "idle"
         self.t_start = 0.0
         self.t_done = 0.0
+        self._t_before = (0.0, 0.0)
         self.last_result = None
         self.last_error: str | None = None
         self._restart_pending = False
+        self._dropped = False  # the running solve is of no use now (an undo or redo brought a kept grid back)
         self._project = None  # the project the running solve was started for
         self._resume_wanted = False  # a resume waits for the worker to take its pause
         self.gui_thread = QtCore.QThread.currentThread()
@@ -132,6 +134,8 @@ class SolverController(QtCore.QObject):
     def _on_project_changed(self, _project) -> None:
         if not self.running:  # the last solve's error was of the project before this edit (an undo
             self.last_error = None  # back to a gridded one: its grid is current, not held back as failed)
+        elif self.doc.restored is self.doc.project and self._project is not self.doc.project:
+            self._drop()  # an undo or redo back to a grid the document kept: the solve of before it is of no use
         if self.auto and self.doc.stale:  # not for an edit the grid is not made of (a lake's cell size)
             p = self.doc.project
             if p.lake is not None and p.layout is None and len(p.lake.holes) and len(p.blocks) == 1:
@@ -184,6 +188,7 @@ class SolverController(QtCore.QObject):
         worker.errored.connect(self._on_errored)
         worker.finished.connect(self._on_finished)
         self._worker = worker
+        self._t_before = (self.t_start, self.t_done)  # the times said again if this solve is dropped
         self.t_start = time.perf_counter()
         self._last_flush, self._proc_cpu = self.t_start, time.process_time()
         if self._full_rate():  # the first frame at once (a drag's redraw does not wait)
@@ -201,6 +206,17 @@ class SolverController(QtCore.QObject):
         self.live = bool(on)
         if not self.live and not self._debounce.isActive() and self._hold is not None:
             self._hold.set()
+
+    def _drop(self) -> None:
+        """Stop the running solve and throw its frames and grids away: the document shows a kept grid of
+        the project now (Redo of Auto layout while the undo's solve of the one block ran: that solve went
+        on, then the layout was solved again from scratch, though its grid was kept)."""
+        self._dropped = True
+        self._debounce.stop()
+        self._timer.stop()
+        self._latest = {}
+        self._dirty = False
+        self.stop()
 
     def stop(self) -> None:
         """Ask the solver to stop; it returns the current grid at the next sweep."""
@@ -293,7 +309,7 @@ class SolverController(QtCore.QObject):
     def _on_yielded(self, value) -> None:
         self._check_thread()
         run, k, event = value
-        if run != self._run:
+        if run != self._run or self._dropped:
             return
         if isinstance(event, StartGrid):
             self._algebraic[k] = event.algebraic
@@ -391,8 +407,17 @@ class SolverController(QtCore.QObject):
             return
         self._timer.stop()
         self._worker = None
-        self.t_done = time.perf_counter()
         self._drawn = False
+        if self._dropped:  # its grids are of no project shown now (_drop): another solve, or none
+            self._dropped = False
+            if self._restart_pending:
+                self.start()
+                return
+            self.t_start, self.t_done = self._t_before  # (the status line's time: not of the solve dropped)
+            self._set_state("idle")
+            self.finished.emit(None)
+            return
+        self.t_done = time.perf_counter()
         if self._restart_pending:
             # an edit arrived while solving: keep this iterate as the warm start, go again
             if result is not None:

@@ -91,14 +91,15 @@ def _per_level(value, lev: int) -> float:
 START_ITERATIONS = 2000
 
 
-def _start(topo, how: str, g0: list | None = None):
+def _start(topo, how: str, g0: list | None = None, stop_event: Any = None):
     """A start grid on the coarsest level: the algebraic (TFI) grids relaxed as one grid
-    (``g0``: those grids, :func:`~meshcore.multiblock.initial_grids`, if made already)."""
+    (``g0``: those grids, :func:`~meshcore.multiblock.initial_grids`, if made already; ``stop_event``
+    set ends the Winslow solve with its grids as they are)."""
     from .multiblock import initial_grids, solve_multiblock
     from .orthogonal import orthogonalize
 
     if how == "winslow":
-        mb = solve_multiblock(topo, max_iterations=START_ITERATIONS, initial=g0)
+        mb = solve_multiblock(topo, max_iterations=START_ITERATIONS, initial=g0, stop_event=stop_event)
         return list(mb.grids), f"multiblock Winslow ({mb.info.message})"
     g0 = initial_grids(topo) if g0 is None else g0
     res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4, size_ratio=None)
@@ -196,10 +197,16 @@ def iterate_layout(
     factor = 2**levels
     tops = [coarsen_topology(topo, 2**k) if k else topo for k in range(levels, -1, -1)]
     g0 = initial_grids(tops[0])  # the start's first guess, and the layout's lines for untangle
-    grids, how = _start(tops[0], start, g0)
-    grids, repaired = _repair_folds(grids)
+    # stop_event is looked at between the steps too: on a lake of 1.7 million cells the start solve (it
+    # did not look), the repairs and the untangling before the first sweep took half a minute after a Stop
+    asked = stop_event.is_set if stop_event is not None else (lambda: False)
+    grids, how = _start(tops[0], start, g0, stop_event)
+    repaired = untangled = 0
+    if not asked():
+        grids, repaired = _repair_folds(grids)
     rings = _shore_rings(_layout_shore(layout), layout.cell_size / 4)
-    grids, untangled = untangle(tops[0], grids, layout=g0, rings=rings if slide_ends else None)
+    if not asked():
+        grids, untangled = untangle(tops[0], grids, layout=g0, rings=rings if slide_ends else None)
     total = 0
     fitted = 0
     history: list[tuple[int, float]] = []
@@ -207,6 +214,9 @@ def iterate_layout(
     equalized = 0
     spaced = 0
     for lev, tp in enumerate(tops):
+        if asked():  # before the next level's refinement, fits and untangling (the grids of the last one)
+            stopped = True
+            break
         if lev:
             grids = refine_shore(refine(grids), tp, rings)
         # shore edges that cut across a bend (coarse edges, midpoints of the refinement, a cut end
@@ -260,9 +270,9 @@ def iterate_layout(
         if equalize:
             from .orthogonal.equalize import equalize_interfaces
 
-            asked = stop_event.is_set if stop_event is not None else None
-            grids, equalized = equalize_interfaces(tp, grids, rings, should_stop=asked)
-            stopped = asked is not None and asked()  # the app's Stop during the step: ends it between patches
+            should_stop = asked if stop_event is not None else None
+            grids, equalized = equalize_interfaces(tp, grids, rings, should_stop=should_stop)
+            stopped = asked()  # the app's Stop during the step: ends it between patches
             if level_callback is not None:
                 level_callback("equalize", equalized)
         if spacing:

@@ -6,6 +6,8 @@
 * :func:`local_frame` — project degrees (and Web Mercator) to the grid's CRS about a round origin;
 * :func:`without_lines_on_the_shore`, :func:`lake_rings` — the shore, the islands, and the open
   lines that are neither (an inlet drawn on the shore, a ferry route, pins), dropped with notes;
+* :func:`without_repeated_rings` — a ring the file holds twice (a duplicated feature or hole, a
+  ``ring`` id written twice over) read once, with a note naming both;
 * :func:`in_world` — a message's places ``near (x, y)`` moved from the local frame to the CRS;
 * :func:`check_crs_option` — a ``--crs`` / ``--source-crs`` value refused before any file is read.
 """
@@ -29,6 +31,7 @@ __all__ = [
     "scale_note",
     "swapped_degrees_note",
     "without_lines_on_the_shore",
+    "without_repeated_rings",
 ]
 
 
@@ -180,9 +183,10 @@ def lake_rings(ps: Any) -> tuple[np.ndarray, list[np.ndarray], list[str]]:
     """
     from ..layout.polygon import water_from_points
 
-    kept, notes = without_lines_on_the_shore(ps)
+    once, repeats = without_repeated_rings(ps)
+    kept, notes = without_lines_on_the_shore(once)
     outer, islands = water_from_points(kept)
-    return np.asarray(outer, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in islands], notes
+    return np.asarray(outer, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in islands], repeats + notes
 
 
 def lake_parts(ps: Any) -> tuple[list[tuple[str, np.ndarray, list[np.ndarray]]], list[str]]:
@@ -191,12 +195,13 @@ def lake_parts(ps: Any) -> tuple[list[tuple[str, np.ndarray, list[np.ndarray]]],
     :func:`~meshcore.layout.polygon.water_parts_from_points`)."""
     from ..layout.polygon import water_parts_from_points
 
-    kept, notes = without_lines_on_the_shore(ps)
+    once, repeats = without_repeated_rings(ps)
+    kept, notes = without_lines_on_the_shore(once)
     parts = [
         (name, np.asarray(o, dtype=np.float64), [np.asarray(r, dtype=np.float64) for r in isl])
         for name, o, isl in water_parts_from_points(kept)
     ]
-    return parts, notes
+    return parts, repeats + notes
 
 
 #: A lon/lat lake whose scale in the grid's CRS is off by more than this somewhere on its shore gets
@@ -294,6 +299,88 @@ def without_lines_on_the_shore(ps: Any) -> tuple[Any, list[str]]:
     for pl in (pl for pl in touching + inside + outside if pl.orientation == "points"):
         notes.append(f"{pl.name!r}: {len(pl.points)} single points (placemarks, pins), not a line or a ring: ignored")
     return (ps.with_points(keep, ps.crs), notes) if notes else (ps, [])
+
+
+def _once_round(p: np.ndarray, tol: float) -> np.ndarray:
+    """A ring's points without repeats in a row and without its closing point, and, when the points
+    go round the same ring more than once (a CSV ``ring`` id written twice over), one round of it."""
+    keep = np.r_[True, np.hypot(*np.diff(p, axis=0).T) > tol]
+    p = p[keep]
+    while len(p) > 3 and np.hypot(*(p[-1] - p[0])) <= tol:
+        p = p[:-1]
+    n = len(p)
+    for m in range(3, n // 2 + 1):
+        if n % m == 0 and np.abs(p - np.roll(p, -m, axis=0)).max() <= tol:
+            return p[:m]
+    return p
+
+
+def _same_ring(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    """Do two rings (:func:`_once_round`) go through the same points, from any start, either way round?"""
+    if len(a) != len(b) or np.abs(a.min(axis=0) - b.min(axis=0)).max() > tol:
+        return False
+    d = np.hypot(*(b - a[0]).T)
+    for k in np.flatnonzero(d <= tol).tolist():
+        rolled = np.roll(b, -k, axis=0)
+        if np.abs(rolled - a).max() <= tol or np.abs(np.roll(rolled[::-1], 1, axis=0) - a).max() <= tol:
+            return True
+    return False
+
+
+def without_repeated_rings(ps: Any) -> tuple[Any, list[str]]:
+    """Each ring of the file once: ``(kept, notes)``, a note per ring left out naming it and the ring
+    it repeats.
+
+    A ring the file holds twice — a hole copied in a GeoJSON polygon, a feature or placemark
+    exported twice, a CSV ``ring`` written twice (under two ids, or twice over under one) — has one
+    meaning: that ring.  Read twice, an island repeated was "a pond on an island" (left out with a
+    note that said so) and a shore repeated an island touching the shore (refused); both copies are
+    the same points (to 1e-9 of the file's extent, from any start point, either way round), so the
+    first is kept and the repeat left out, with a note, rather than refusing a file whose water is
+    plain.  Rings that differ anywhere are left to the lake's checks (an island across another or
+    across the shore is named there).
+    """
+    import shapely
+
+    pls = list(ps.polylines)
+    pts = [np.asarray(pl.points, dtype=np.float64).reshape(-1, 2) for pl in pls]
+    allp = np.vstack(pts) if pts else np.zeros((0, 2))
+    if len(allp) < 3:
+        return ps, []
+    tol = 1e-9 * float(np.ptp(allp, axis=0).max())
+    ringy = str(ps.source).lower().endswith(RINGS_MAY_BE_OPEN)
+    rounds = [
+        _once_round(p, tol) if (pl.closed or ringy) and len(p) >= 3 else None for pl, p in zip(pls, pts, strict=True)
+    ]
+    area = [abs(shapely.Polygon(r).area) if r is not None and len(r) >= 3 else 0.0 for r in rounds]
+    shore = int(np.argmax(np.asarray(area) >= (1 - 1e-9) * max(area)))  # the first of the largest (to rounding)
+    notes: list[str] = []
+    kept: list[Any] = []
+    firsts: list[int] = []
+    changed = False
+    for k, (pl, r) in enumerate(zip(pls, rounds, strict=True)):
+        if r is None or len(r) < 3:
+            kept.append(pl)
+            continue
+        j = next((j for j in firsts if _same_ring(rounds[j], r, tol)), None)  # type: ignore[arg-type]
+        if j is not None:
+            what = f"the shore {pls[j].name!r}" if j == shore else f"{pls[j].name!r}"
+            notes.append(
+                f"{pl.name!r} is the same ring as {what} ({len(r)} points): a ring drawn twice, "
+                f"read once — {pl.name!r} left out"
+            )
+            changed = True
+            continue
+        firsts.append(k)
+        if len(r) < len(pts[k]) - 1 and len(r) * 2 <= len(pts[k]):
+            notes.append(
+                f"{pl.name!r} goes round its ring {len(pts[k]) // len(r)} times ({len(pts[k])} points, "
+                f"{len(r)} in one round): a ring written twice over, read once"
+            )
+            pl = type(pl)(pl.name, r, True, pl.orientation or "")
+            changed = True
+        kept.append(pl)
+    return (ps.with_points(kept, ps.crs), notes) if changed else (ps, [])
 
 
 _NEAR = re.compile(r"near \((-?\d[\d.]*(?:e[+-]?\d+)?), (-?\d[\d.]*(?:e[+-]?\d+)?)\)")

@@ -221,7 +221,9 @@ def _smooth(
         for lvs, give_up, omega in attempts:
             if len(lvs) <= 1:
                 break
-            damped = {} if omega == 1.0 else {"line_omega": omega}
+            damped: dict[str, Any] = {} if omega == 1.0 else {"line_omega": omega}
+            if rep.stop_event is not None:  # looked at inside the full-multigrid start too
+                damped["should_stop"] = rep.stop_event.is_set
             fas = iterate_fas(x, y, topology, tol, cfg.max_iterations - mg_cycles, give_up, lvs, **damped)
             iters, r, history, message, n_levels = yield from rep.run(fas, "smooth/multigrid", shown(x, y), mg_cycles)
             mg_history += [(mg_cycles + i, v) for i, v in history[bool(mg_history) :]]
