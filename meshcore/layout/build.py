@@ -26,8 +26,9 @@ from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners, wedge_corners
 from .fans import fans, unfan, wraps
-from .frames import close_frames, frame_defects
+from .frames import _vertices, close_frames, frame_defects
 from .regions import partition
+from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, forced_indices, region_cost
 from .tee import tee
@@ -129,6 +130,7 @@ def layout_pieces(
     wedges: bool = False,
     tees: bool = False,
     single: bool = False,
+    ring: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
@@ -137,7 +139,8 @@ def layout_pieces(
     :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
     side of it, :func:`~.corners.wedge_corners`; ``tees``: junctions of regular layouts may be split
     as a T, :mod:`.tee`; ``single``: with ``regular``, every island's ring of blocks turns once,
-    :data:`~.frames.ONE_TURN`, so that it can close in one index space)."""
+    :data:`~.frames.ONE_TURN`, so that it can close in one index space; ``ring``: every island gets
+    at least four cut ends, :func:`~.ringcuts.ring_cuts`, without which its ring cannot turn once)."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -145,53 +148,66 @@ def layout_pieces(
     chords = place_chords(poly, sk, min_length=2 * h, mouths=mouths)
     dense = shapely.segmentize(poly, h)
     sigma = 1.5 * h
-    regions, cuts = partition(dense, [_densify(c.points, h) for c in chords], sigma)
     junctions = sk.nodes[sk.degree() >= 3]
     # thin pieces only in regions that no island bounds (:data:`~.width.THIN_CUT`)
     islands = shapely.union_all([shapely.LinearRing(r.coords) for r in dense.interiors]) if thin else None
-    rings: list[np.ndarray] = []
-    forced: list[tuple] = []
-    for r in regions:
-        P = Polygon(r)
-        here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
-        pieces, new_cuts, _ = best_split(
-            r,
-            sigma=sigma,
-            min_width=3 * h,
-            center=_junction_centre(r, junctions),
-            regular=regular,
-            normal=normal,
-            thin=here,
-            tee=tee if tees and regular else None,
-        )
-        if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
-            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here)
-        rings += [p for p, _ in pieces]
-        forced += [f for _, f in pieces]
-        cuts += new_cuts
     size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
-    rings, forced = _welded(rings, forced, 1e-9 * size)
-    rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
-    rings, forced = _merge_strips(rings, forced, sigma)
-    corner_pts = []
-    rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
-    for r, f in zip(rings, forced, strict=True):
-        fi = forced_indices(r, f)
-        c, _ = choose_corners(r, sigma, forced=fi)
-        on_shore = rim.near(r, 1e-9 * size)
-        if wedges:
-            c = wedge_corners(r, c, sigma, shore=on_shore, forced=fi)
-        elif c is not None and not regular:
-            c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5)
-        corner_pts.append([r[i] for i in c])
-    rings = conform(rings, 1e-9 * size)
-    pieces = []
-    for r, cs in zip(rings, corner_pts, strict=True):
-        idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
-        pieces.append(Piece(r, idx))
+
+    def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
+        regions, cuts = partition(dense, lines, sigma)
+        rings: list[np.ndarray] = []
+        forced: list[tuple] = []
+        for r in regions:
+            P = Polygon(r)
+            here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
+            pieces, new_cuts, _ = best_split(
+                r,
+                sigma=sigma,
+                min_width=3 * h,
+                center=_junction_centre(r, junctions),
+                regular=regular,
+                normal=normal,
+                thin=here,
+                tee=tee if tees and regular else None,
+            )
+            if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
+                pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here)
+            rings += [p for p, _ in pieces]
+            forced += [f for _, f in pieces]
+            cuts += new_cuts
+        rings, forced = _welded(rings, forced, 1e-9 * size)
+        rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
+        rings, forced = _merge_strips(rings, forced, sigma)
+        corner_pts = []
+        rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
+        for r, f in zip(rings, forced, strict=True):
+            fi = forced_indices(r, f)
+            c, _ = choose_corners(r, sigma, forced=fi)
+            on_shore = rim.near(r, 1e-9 * size)
+            if wedges:
+                c = wedge_corners(r, c, sigma, shore=on_shore, forced=fi)
+            elif c is not None and not regular:
+                c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5)
+            corner_pts.append([r[i] for i in c])
+        rings = conform(rings, 1e-9 * size)
+        pieces = []
+        for r, cs in zip(rings, corner_pts, strict=True):
+            idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
+            pieces.append(Piece(r, idx))
+        return pieces, cuts
+
+    lines = [_densify(c.points, h) for c in chords]
+    pieces, cuts = made(lines)
+    for _ in range(RING_ROUNDS if ring else 0):  # islands with fewer than four cut ends: more cuts
+        v = _vertices(pieces)
+        more = ring_cuts(dense, cuts, sigma, ends=v.index.points[(v.loop > 0) & (v.m >= 2)])
+        if not more:
+            break
+        lines = lines + more
+        pieces, cuts = made(lines)
     _check_pieces(poly, pieces)
     if regular:  # every island's ring of blocks closes up (Delft3D's domain decomposition)
-        pieces, cuts = _closed(pieces, cuts, h, size, sigma, single)
+        pieces, cuts = _closed(pieces, cuts, h, size, sigma, single, ring)
     else:
         pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
@@ -325,16 +341,20 @@ def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: floa
     return out, cuts
 
 
-def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float, single: bool = False):
+def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float, single: bool = False, ring=False):
     """The pieces with corners that close up round every island (:func:`~.frames.close_frames`),
     the first choice whose cells can be counted; the pieces as they are when there is none
-    (their layout is valid, Delft3D's domain decomposition cannot couple it)."""
+    (their layout is valid, Delft3D's domain decomposition cannot couple it).  ``ring`` (with
+    ``single``, the fallback of :func:`layout_pieces`): new corners may also turn less than
+    :data:`~.frames._LEAST_TURN` (:data:`RING_LEAST_TURN`)."""
     from ..errors import TopologyError
 
     # corners costed by the turning their cells see first; when no such choice can be counted,
     # those costed at sigma (lake_with_islands(4) at 1500 cells: closed only by the latter)
+    least = {"least": RING_LEAST_TURN} if single and ring else {}
     for own in (True, False):
-        for closed in close_frames(pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3):
+        tries = SINGLE_TRIES if single else 3
+        for closed in close_frames(pieces, sigma, own=own, single=single, tries=tries, **least):
             try:
                 got = _make_countable(closed, cuts, h, size)
             except TopologyError:
@@ -344,6 +364,18 @@ def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float
     if single and not frame_defects(pieces, single=True) and _countable(pieces, h, closed=True):
         return pieces, cuts
     return _make_countable(pieces, cuts, h, size)
+
+
+#: Rounds of :func:`~.ringcuts.ring_cuts` in the fallback for one index space (``ring``): the
+#: layout is drawn again with the new cuts, and an island whose cuts a strip merge or a split
+#: took away (two cuts a few cells apart at an island near the shore) gets more.
+RING_ROUNDS = 3
+
+#: The least turning (degrees) of a new block corner in the fallback for one index space
+#: (``ring``): any vertex where blocks meet, and the sharpest shore bends of a piece whatever they
+#: turn, the corner cost choosing among them.  GSHHG lake g180753 (one island near its shore,
+#: 10 000 cells): its ring turned once only with a corner at a cut end turning 10–15°.
+RING_LEAST_TURN = 0.0
 
 
 #: Corner choices tried per island set-up for a single index space (``single``): a choice whose

@@ -216,13 +216,13 @@ def _own_turning(ring: np.ndarray, sigma: float, t: np.ndarray, s: np.ndarray, t
 
 
 def _candidates(
-    pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float, own: bool = True
+    pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float, own: bool = True, least: float = _LEAST_TURN
 ) -> list[tuple[tuple[int, ...], float]]:
     """``(corners, cost)`` of the piece's current corners (0) and of every move of one or two
     corners to other vertices where blocks meet (a cut end, a T) or the shore bends (the rise
     of :func:`~.corners.set_cost`, plus :data:`_CHANGE` per corner).
 
-    A new corner turns by at least :data:`_LEAST_TURN`; shore bends are taken one per ``sigma``
+    A new corner turns by at least ``least`` (:data:`_LEAST_TURN`); shore bends are taken one per ``sigma``
     of arc length, the sharpest first; the costs are read with the turning the corner cells
     see (:func:`_own_turning`; with ``own`` False, the turning at ``sigma``); a choice that
     makes a side shorter than ``sigma`` costs :data:`_SHORT` more.
@@ -237,7 +237,7 @@ def _candidates(
     def apart(i: int, others) -> bool:
         return all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in others)
 
-    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & (t >= _LEAST_TURN))
+    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & (t >= least))
     bends: list[int] = []
     for i in shore[np.argsort(-t[shore])]:
         if apart(int(i), bends):
@@ -253,7 +253,7 @@ def _candidates(
 
     had = short(here)
     options = {here: 0.0}
-    to = sorted(({int(i) for i in meet if t[i] >= _LEAST_TURN} | set(bends)) - set(here))
+    to = sorted(({int(i) for i in meet if t[i] >= least} | set(bends)) - set(here))
     for k in range(1, _MOVES + 1):
         for a in itertools.combinations(here, k):
             for b in itertools.combinations(to, k):
@@ -265,7 +265,13 @@ def _candidates(
 
 
 def close_frames(
-    pieces: list[Piece], sigma: float, *, tries: int = 3, own: bool = True, single: bool = False
+    pieces: list[Piece],
+    sigma: float,
+    *,
+    tries: int = 3,
+    own: bool = True,
+    single: bool = False,
+    least: float = _LEAST_TURN,
 ) -> Iterator[list[Piece]]:
     """The pieces with corners re-chosen so that every island and inner node closes up
     (:func:`frame_defects` empty): up to ``tries`` choices, the one of least corner cost first
@@ -273,7 +279,9 @@ def close_frames(
     pieces close already or when no moves of one corner per piece make them close.  ``own``:
     corners cost the turning their cells see (:func:`_own_turning`); False: the turning at
     ``sigma`` (a fallback: its choices close some layouts whose ``own`` ones cannot be counted);
-    ``single``: every island's ``C − 2E`` is :data:`ONE_TURN` (one index space), not any multiple of 4."""
+    ``single``: every island's ``C − 2E`` is :data:`ONE_TURN` (one index space), not any multiple of 4;
+    ``least``: the least turning of a new corner (:data:`_LEAST_TURN`; lower: a fallback for rings
+    that close in no other way)."""
     from scipy.optimize import Bounds, LinearConstraint, milp
 
     defects = frame_defects(pieces, single=single)
@@ -282,7 +290,7 @@ def close_frames(
     v = _vertices(pieces)
     bad = {i for d in defects if d.kind == "node" for i in v.index.find([d.where]).tolist()}
     movable = [k for k, ids in enumerate(v.index.ids) if (v.loop[ids] > 0).any() or bool(bad & set(ids.tolist()))]
-    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma, own) for k in movable}
+    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma, own, least) for k in movable}
     cols = [(k, cs, cost) for k in movable for cs, cost in cand[k]]
     islands = sorted(_island_turns(v))
     nx, nz = len(cols), len(islands)
