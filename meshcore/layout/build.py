@@ -79,10 +79,19 @@ def _merged(a: np.ndarray, b: np.ndarray):
     return out if len(out) >= 4 and Polygon(out).is_valid else None
 
 
-def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
+def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float, keep=None):
     """Join neighbouring pieces whose union is a good four-sided block and no worse than the
-    two (a straight or gently curved arm cut by chords becomes one block again)."""
+    two (a straight or gently curved arm cut by chords becomes one block again); ``keep``: a
+    function of a point that says whether two pieces that share it stay apart (a cut end on an
+    island, in the fallback for one index space: joined, the ring of blocks round the island
+    loses the cut end :mod:`.ringcuts` made for it)."""
     rings, forced = list(rings), list(forced)
+
+    def kept(i: int, j: int) -> bool:
+        return keep is not None and any(
+            keep(p) for p in {*map(tuple, rings[i].tolist())} & {*map(tuple, rings[j].tolist())}
+        )
+
     cost = [region_cost(r, sigma) for r in rings]  # (most costed by the splits already)
     box = [np.r_[r.min(axis=0), r.max(axis=0)] for r in rings]
     seen: dict[tuple[int, int], tuple] = {}  # (id a, id b) → (a, b, union, its cost): each pair once
@@ -104,7 +113,7 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
             lo, hi = boxes[i + 1 :, :2], boxes[i + 1 :, 2:]
             meets = ~((boxes[i, :2] > hi).any(axis=1) | (lo > boxes[i, 2:]).any(axis=1))
             for j in (i + 1 + np.flatnonzero(meets)).tolist():
-                if forced[i] or forced[j]:
+                if forced[i] or forced[j] or kept(i, j):
                     continue
                 m, c = union(i, j)
                 if m is None:
@@ -152,6 +161,10 @@ def layout_pieces(
     # thin pieces only in regions that no island bounds (:data:`~.width.THIN_CUT`)
     islands = shapely.union_all([shapely.LinearRing(r.coords) for r in dense.interiors]) if thin else None
     size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
+    holes = shapely.union_all([shapely.LinearRing(r.coords) for r in dense.interiors])
+
+    def on_island(p) -> bool:
+        return bool(shapely.dwithin(holes, shapely.Point(p), 1e-9 * size))
 
     def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
         regions, cuts = partition(dense, lines, sigma)
@@ -177,7 +190,7 @@ def layout_pieces(
             cuts += new_cuts
         rings, forced = _welded(rings, forced, 1e-9 * size)
         rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
-        rings, forced = _merge_strips(rings, forced, sigma)
+        rings, forced = _merge_strips(rings, forced, sigma, keep=on_island if ring else None)
         corner_pts = []
         rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
         for r, f in zip(rings, forced, strict=True):
