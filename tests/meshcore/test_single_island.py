@@ -10,10 +10,12 @@ from shapely.geometry import Point
 
 from meshcore import testing
 from meshcore.algebraic import tfi
+from meshcore.lakegrid import mesh_outline
 from meshcore.layout import auto_layout
 from meshcore.layout.frames import frame_defects
 from meshcore.layout.ringcuts import ring_cuts
 from meshcore.multiblock.indexspace import embed
+from meshcore.quality.lake import block_metrics
 
 
 def _fits_one_index_space(lay) -> None:
@@ -22,7 +24,8 @@ def _fits_one_index_space(lay) -> None:
     embed([tfi(b.borders) for b in topo.blocks], [b.name for b in topo.blocks])  # raises if it does not fit
 
 
-# round_lake(0..2, 4) and lake_with_islands(8) with one island were refused before the fallback
+# round_lake(0, 1, 4), lake_with_islands(8) with one island and the annulus round_lake(1, "ring")
+# were refused before the fallback
 # (session 28, 10 000 cells: their rings turned twice or half; islands near the shore with two
 # or three cut ends); lake_with_islands(0) fitted already
 @pytest.mark.slow
@@ -34,12 +37,23 @@ def _fits_one_index_space(lay) -> None:
         pytest.param(testing.round_lake(4, n_islands=1), id="round_lake(4)"),
         pytest.param(testing.lake_with_islands(8, n_islands=1), id="lake_with_islands(8)"),
         pytest.param(testing.lake_with_islands(0, n_islands=1), id="lake_with_islands(0)"),
+        pytest.param(testing.round_lake(1, kind="ring"), id="ring(1)"),
     ],
 )
 def test_one_island_fits_one_index_space(poly):
     lay = auto_layout(poly, target_cells=10_000, multiple=4, single=True)
     assert len(poly.interiors) == 1
     _fits_one_index_space(lay)
+
+
+@pytest.mark.slow
+def test_annulus_gets_a_single_domain_grid():
+    # a disc with one large island: refused before the fallback (no counts closed the two blocks)
+    poly = testing.round_lake(0, kind="ring")
+    mb = mesh_outline(poly, target_cells=2000, single=True)
+    embed(list(mb.grids), [f"b{k}" for k in range(len(mb.grids))])  # the solved grid, in one index space
+    assert sum(int(block_metrics(g).folded.sum()) for g in mb.grids) == 0
+    assert len(mb.grids) >= 4  # a frame of blocks round the island, each cut end a corner of its hole
 
 
 def test_ring_cuts_give_an_island_four_spread_ends():
