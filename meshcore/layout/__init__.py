@@ -152,9 +152,43 @@ def auto_layout(
         more.append(shores.change.note())
     from ..errors import TopologyError
 
+    # single: when no layout fits, the layouts again with four cut ends on every island (.ringcuts)
+    first = kept = None
+    for ring in (False, True) if single else (False,):
+        draw = functools.partial(
+            _layout, shores, h, notes + more, multiple=multiple, single=single, options=options, ring=ring
+        )
+        lay, error, closing = _first_fit(draw, regular=regular, single=single, reading=reading)
+        if lay is not None:
+            return dataclasses.replace(lay, details=tuple(details)) if details else lay
+        first, kept = first or error, kept or closing
+    if kept is not None:
+        if single:  # a single index space cannot hold it: say where, before the grid is made
+            d = frame_defects(list(kept.pieces), single=True)[0]
+            raise TopologyError(
+                f"automatic layout: no layout found whose blocks fit one index space (Delft3D single "
+                f"domain, EFDC): {d.note()}; write a .ddb (domain decomposition) or .vtm instead"
+            )
+        return dataclasses.replace(kept, details=tuple(details)) if details else kept
+    assert first is not None
+    if single:
+        why = str(first).removeprefix("automatic layout: ")
+        raise TopologyError(
+            f"automatic layout: no layout found whose blocks fit one index space (Delft3D single domain, "
+            f"EFDC): {why}; write a .ddb (domain decomposition) or .vtm instead"
+        ) from None
+    raise first
+
+
+def _first_fit(draw, *, regular: bool, single: bool, reading) -> tuple[Layout | None, Exception | None, Layout | None]:
+    """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
+    shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, a regular
+    layout whose blocks do not close up round an island or None)`` (the scales after the one that
+    drew it are not tried)."""
+    from ..errors import TopologyError
+
     first = None
     kept = None  # a regular layout whose blocks do not close up round an island (.frames)
-    draw = functools.partial(_layout, shores, h, notes + more, multiple=multiple, single=single, options=options)
     for scale in LAYOUT_SCALES:
         # the cuts along the shore's normal can leave T-junctions no integer counts satisfy:
         # the layout without them (the splits of earlier versions) next
@@ -185,23 +219,10 @@ def auto_layout(
                     return draw(regular=False, normal=n, scale=s)
 
                 lay = chosen(lay, at_scale, reading)
-            return dataclasses.replace(lay, details=tuple(details)) if details else lay
+            return lay, None, None
         if kept is not None:
-            if single:  # a single index space cannot hold it: say where, before the grid is made
-                d = frame_defects(list(kept.pieces), single=True)[0]
-                raise TopologyError(
-                    f"automatic layout: no layout found whose blocks fit one index space (Delft3D single "
-                    f"domain, EFDC): {d.note()}; write a .ddb (domain decomposition) or .vtm instead"
-                )
-            return dataclasses.replace(kept, details=tuple(details)) if details else kept
-    assert first is not None
-    if single:
-        why = str(first).removeprefix("automatic layout: ")
-        raise TopologyError(
-            f"automatic layout: no layout found whose blocks fit one index space (Delft3D single domain, "
-            f"EFDC): {why}; write a .ddb (domain decomposition) or .vtm instead"
-        ) from None
-    raise first
+            return None, first, kept
+    return None, first, None
 
 
 def _folds_in_index_space(lay: Layout) -> str | None:
@@ -238,28 +259,26 @@ def _layout(
     single: bool = False,
     scale: float = 1.0,
     options: LayoutOptions = DEFAULT_OPTIONS,
+    ring: bool = False,
 ) -> Layout:
     poly = shores.grid
     thin, mouths, wedges = options.thin_arms, options.mouths, options.wedges
     tees = options.tees and regular
     hl = scale * h  # the layout's geometry; counts at h
     wedges = wedges and not regular
-    sk, chords, _, pieces = layout_pieces(
-        shores.layout,
-        hl,
-        regular=regular,
-        normal=normal,
-        thin=thin,
-        mouths=mouths,
-        wedges=wedges,
-        tees=tees,
-        single=single,
-    )
+    kw = {
+        "regular": regular,
+        "normal": normal,
+        "thin": thin,
+        "mouths": mouths,
+        "wedges": wedges,
+        "tees": tees,
+        "single": single,
+    }
+    sk, chords, _, pieces = layout_pieces(shores.layout, hl, ring=ring, **kw)
     moved = transfer(pieces, shores)
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
-        sk, chords, _, moved = layout_pieces(
-            poly, hl, regular=regular, normal=normal, thin=thin, mouths=mouths, wedges=wedges, tees=tees, single=single
-        )
+        sk, chords, _, moved = layout_pieces(poly, hl, ring=ring, **kw)
     pieces = moved
     if regular:
         cells = block_counts(pieces, h, multiple=multiple, closed=single)

@@ -27,8 +27,9 @@ from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import choose_corners, wedge_corners
 from .fans import fans, unfan, wraps
-from .frames import close_frames, corner_flaws, frame_defects, straight_corners
+from .frames import _vertices, close_frames, corner_flaws, frame_defects, straight_corners
 from .regions import partition
+from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, forced_indices, region_cost
 from .tee import tee
@@ -79,10 +80,19 @@ def _merged(a: np.ndarray, b: np.ndarray):
     return out if len(out) >= 4 and Polygon(out).is_valid else None
 
 
-def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
+def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float, keep=None):
     """Join neighbouring pieces whose union is a good four-sided block and no worse than the
-    two (a straight or gently curved arm cut by chords becomes one block again)."""
+    two (a straight or gently curved arm cut by chords becomes one block again); ``keep``: a
+    function of a point that says whether two pieces that share it stay apart (a cut end on an
+    island, in the fallback for one index space: joined, the ring of blocks round the island
+    loses the cut end :mod:`.ringcuts` made for it)."""
     rings, forced = list(rings), list(forced)
+
+    def kept(i: int, j: int) -> bool:
+        return keep is not None and any(
+            keep(p) for p in {*map(tuple, rings[i].tolist())} & {*map(tuple, rings[j].tolist())}
+        )
+
     cost = [region_cost(r, sigma) for r in rings]  # (most costed by the splits already)
     box = [np.r_[r.min(axis=0), r.max(axis=0)] for r in rings]
     seen: dict[tuple[int, int], tuple] = {}  # (id a, id b) → (a, b, union, its cost): each pair once
@@ -104,7 +114,7 @@ def _merge_strips(rings: list[np.ndarray], forced: list[tuple], sigma: float):
             lo, hi = boxes[i + 1 :, :2], boxes[i + 1 :, 2:]
             meets = ~((boxes[i, :2] > hi).any(axis=1) | (lo > boxes[i, 2:]).any(axis=1))
             for j in (i + 1 + np.flatnonzero(meets)).tolist():
-                if forced[i] or forced[j]:
+                if forced[i] or forced[j] or kept(i, j):
                     continue
                 m, c = union(i, j)
                 if m is None:
@@ -130,6 +140,7 @@ def layout_pieces(
     wedges: bool = False,
     tees: bool = False,
     single: bool = False,
+    ring: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
@@ -138,7 +149,8 @@ def layout_pieces(
     :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
     side of it, :func:`~.corners.wedge_corners`; ``tees``: junctions of regular layouts may be split
     as a T, :mod:`.tee`; ``single``: with ``regular``, every island's ring of blocks turns once,
-    :data:`~.frames.ONE_TURN`, so that it can close in one index space)."""
+    :data:`~.frames.ONE_TURN`, so that it can close in one index space; ``ring``: every island gets
+    at least four cut ends, :func:`~.ringcuts.ring_cuts`, without which its ring cannot turn once)."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -146,54 +158,71 @@ def layout_pieces(
     chords = place_chords(poly, sk, min_length=2 * h, mouths=mouths)
     dense = shapely.segmentize(poly, h)
     sigma = 1.5 * h
-    regions, cuts = partition(dense, [_densify(c.points, h) for c in chords], sigma)
     junctions = sk.nodes[sk.degree() >= 3]
     # thin pieces only in regions that no island bounds (:data:`~.width.THIN_CUT`)
     islands = shapely.union_all([shapely.LinearRing(r.coords) for r in dense.interiors]) if thin else None
-    rings: list[np.ndarray] = []
-    forced: list[tuple] = []
-    for r in regions:
-        P = Polygon(r)
-        here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
-        pieces, new_cuts, _ = best_split(
-            r,
-            sigma=sigma,
-            min_width=3 * h,
-            center=_junction_centre(r, junctions),
-            regular=regular,
-            normal=normal,
-            thin=here,
-            tee=tee if tees and regular else None,
-        )
-        if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
-            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here)
-        rings += [p for p, _ in pieces]
-        forced += [f for _, f in pieces]
-        cuts += new_cuts
     size = math.hypot(*np.subtract(*np.reshape(poly.bounds, (2, 2))[::-1]))
-    rings, forced = _welded(rings, forced, 1e-9 * size)
-    rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
-    rings, forced = _merge_strips(rings, forced, sigma)
-    corner_pts = []
-    rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
-    for r, f in zip(rings, forced, strict=True):
-        fi = forced_indices(r, f)
-        c, _ = choose_corners(r, sigma, forced=fi)
-        on_shore = rim.near(r, 1e-9 * size)
-        w = wedge_corners(r, c, sigma, shore=on_shore, forced=fi) if wedges and c is not None else c
-        if w is not None and tuple(w) != tuple(c):
-            c = w
-        elif c is not None:  # (regular layouts: no T-junction, only onto a vertex that turns)
-            c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5, onto_cut=not regular)
-        corner_pts.append([r[i] for i in c])
-    rings = conform(rings, 1e-9 * size)
-    pieces = []
-    for r, cs in zip(rings, corner_pts, strict=True):
-        idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
-        pieces.append(Piece(r, idx))
+    holes = shapely.union_all([shapely.LinearRing(r.coords) for r in dense.interiors])
+
+    def on_island(p) -> bool:
+        return bool(shapely.dwithin(holes, shapely.Point(p), 1e-9 * size))
+
+    def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
+        regions, cuts = partition(dense, lines, sigma)
+        rings: list[np.ndarray] = []
+        forced: list[tuple] = []
+        for r in regions:
+            P = Polygon(r)
+            here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
+            pieces, new_cuts, _ = best_split(
+                r,
+                sigma=sigma,
+                min_width=3 * h,
+                center=_junction_centre(r, junctions),
+                regular=regular,
+                normal=normal,
+                thin=here,
+                tee=tee if tees and regular else None,
+            )
+            if not regular:  # (regular layouts: not measured; their blocks round islands are re-cornered)
+                pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here)
+            rings += [p for p, _ in pieces]
+            forced += [f for _, f in pieces]
+            cuts += new_cuts
+        rings, forced = _welded(rings, forced, 1e-9 * size)
+        rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
+        rings, forced = _merge_strips(rings, forced, sigma, keep=on_island if ring else None)
+        corner_pts = []
+        rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
+        for r, f in zip(rings, forced, strict=True):
+            fi = forced_indices(r, f)
+            c, _ = choose_corners(r, sigma, forced=fi)
+            on_shore = rim.near(r, 1e-9 * size)
+            w = wedge_corners(r, c, sigma, shore=on_shore, forced=fi) if wedges and c is not None else c
+            if w is not None and tuple(w) != tuple(c):
+                c = w
+            elif c is not None:  # (regular layouts: no T-junction, only onto a vertex that turns)
+                c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5, onto_cut=not regular)
+            corner_pts.append([r[i] for i in c])
+        rings = conform(rings, 1e-9 * size)
+        pieces = []
+        for r, cs in zip(rings, corner_pts, strict=True):
+            idx = tuple(sorted(int(np.argmin(np.hypot(*(r - c).T))) for c in cs))
+            pieces.append(Piece(r, idx))
+        return pieces, cuts
+
+    lines = [_densify(c.points, h) for c in chords]
+    pieces, cuts = made(lines)
+    for _ in range(RING_ROUNDS if ring else 0):  # islands with fewer than four cut ends: more cuts
+        v = _vertices(pieces)
+        more = ring_cuts(dense, cuts, sigma, ends=v.index.points[(v.loop > 0) & (v.m >= 2)])
+        if not more:
+            break
+        lines = lines + more
+        pieces, cuts = made(lines)
     _check_pieces(poly, pieces)
     if regular:  # every island's ring of blocks closes up (Delft3D's domain decomposition)
-        pieces, cuts = _closed(pieces, cuts, h, size, sigma, single)
+        pieces, cuts = _closed(pieces, cuts, h, size, sigma, single, ring)
     else:
         pieces, cuts = _make_countable(pieces, cuts, h, size)
     pieces = [Piece(p.ring, p.corners, f"b{k}") for k, p in enumerate(pieces)]
@@ -328,10 +357,12 @@ def _unfanned(pieces: list, cuts: list, junctions, sigma: float, min_width: floa
     return out, cuts
 
 
-def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float, single: bool = False):
+def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float, single: bool = False, ring=False):
     """The pieces with corners that close up round every island (:func:`~.frames.close_frames`),
     the first choice whose cells can be counted; the pieces as they are when there is none
-    (their layout is valid, Delft3D's domain decomposition cannot couple it).
+    (their layout is valid, Delft3D's domain decomposition cannot couple it).  ``ring`` (with
+    ``single``, the fallback of :func:`layout_pieces`): new corners may also turn less than
+    :data:`~.frames._LEAST_TURN` (:data:`RING_LEAST_TURN`).
 
     Where that choice moves a corner onto a vertex of a straight shore (a corner cell of 180°,
     :func:`~.frames.straight_corners`), the corners are chosen again with moves onto bends of
@@ -343,15 +374,16 @@ def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float
     ratios of 2.7 and 5.7 (docs/lake-grids-journal.md, session 28)."""
     # corners costed by the turning their cells see first; when no such choice can be counted,
     # those costed at sigma (lake_with_islands(4) at 1500 cells: closed only by the latter)
+    least = {"least": RING_LEAST_TURN} if single and ring else {}
     for own in (True, False):
-        got = _first_countable(pieces, cuts, h, size, sigma, single, own, 0)
+        got = _first_countable(pieces, cuts, h, size, sigma, single, own, 0, least)
         if got is None:
             continue
         straight, borrowed, short = corner_flaws(got[0], sigma)
         if single or straight <= len(straight_corners(pieces)):  # (single: measured worse, see below)
             return got
         for bends, own_ in itertools.product((2, 1), (own, not own)):
-            other = _first_countable(pieces, cuts, h, size, sigma, single, own_, bends)
+            other = _first_countable(pieces, cuts, h, size, sigma, single, own_, bends, least)
             if other is None:
                 continue
             s, b, k = corner_flaws(other[0], sigma)
@@ -363,12 +395,17 @@ def _closed(pieces: list[Piece], cuts: list, h: float, size: float, sigma: float
     return _make_countable(pieces, cuts, h, size)
 
 
-def _first_countable(pieces, cuts, h: float, size: float, sigma: float, single: bool, own: bool, bends: int):
+def _first_countable(
+    pieces, cuts, h: float, size: float, sigma: float, single: bool, own: bool, bends: int, least: dict | None = None
+):
     """The first choice of :func:`~.frames.close_frames` (``own``, ``bends``) whose cells can be
-    counted (with ``single``, in one index space), as ``(pieces, cuts)``; None if there is none."""
+    counted (with ``single``, in one index space), as ``(pieces, cuts)``; None if there is none
+    (``least``: :func:`~.frames.close_frames`' least turning of a new corner, if given)."""
     from ..errors import TopologyError
 
-    for closed in close_frames(pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3, bends=bends):
+    for closed in close_frames(
+        pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3, bends=bends, **(least or {})
+    ):
         try:
             got = _make_countable(closed, cuts, h, size)
         except TopologyError:
@@ -376,6 +413,18 @@ def _first_countable(pieces, cuts, h: float, size: float, sigma: float, single: 
         if not single or _countable(got[0], h, closed=True):
             return got
     return None
+
+
+#: Rounds of :func:`~.ringcuts.ring_cuts` in the fallback for one index space (``ring``): the
+#: layout is drawn again with the new cuts, and an island whose cuts a strip merge or a split
+#: took away (two cuts a few cells apart at an island near the shore) gets more.
+RING_ROUNDS = 3
+
+#: The least turning (degrees) of a new block corner in the fallback for one index space
+#: (``ring``): any vertex where blocks meet, and the sharpest shore bends of a piece whatever they
+#: turn, the corner cost choosing among them.  GSHHG lake g180753 (one island near its shore,
+#: 10 000 cells): its ring turned once only with a corner at a cut end turning 10–15°.
+RING_LEAST_TURN = 0.0
 
 
 #: Corner choices tried per island set-up for a single index space (``single``): a choice whose

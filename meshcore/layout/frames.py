@@ -285,13 +285,13 @@ def _bends(
 
 
 def _candidates(
-    pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float, own: bool = True, level: int = 0
+    pc: Piece, ids: np.ndarray, v: _Vertices, sigma: float, own: bool = True, level: int = 0, least: float = _LEAST_TURN
 ) -> list[tuple[tuple[int, ...], float]]:
     """``(corners, cost)`` of the piece's current corners (0) and of every move of one or two
     corners to other vertices where blocks meet (a cut end, a T) or the shore bends (the rise
     of :func:`~.corners.set_cost`, plus :data:`_CHANGE` per corner).
 
-    A new corner turns by at least :data:`_LEAST_TURN`; shore bends (of ``level``,
+    A new corner turns by at least ``least`` (:data:`_LEAST_TURN`); shore bends (of ``level``,
     :func:`_bends`) are taken one per ``sigma`` of arc
     length, the sharpest first; the costs are read with the turning the corner cells
     see (:func:`_own_turning`; with ``own`` False, the turning at ``sigma``); a choice that
@@ -307,7 +307,7 @@ def _candidates(
     def apart(i: int, others) -> bool:
         return all(min(abs(s[i] - s[j]), total - abs(s[i] - s[j])) > sigma for j in others)
 
-    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & (t >= _LEAST_TURN))
+    shore = np.flatnonzero((v.loop[ids] >= 0) & (v.m[ids] == 1) & (t >= least))
     shore = shore[_bends(ring, shore, s, total, sigma, level)]
     bends: list[int] = []
     for i in shore[np.argsort(-t[shore])]:
@@ -324,7 +324,7 @@ def _candidates(
 
     had = short(here)
     options = {here: 0.0}
-    to = sorted(({int(i) for i in meet if t[i] >= _LEAST_TURN} | set(bends)) - set(here))
+    to = sorted(({int(i) for i in meet if t[i] >= least} | set(bends)) - set(here))
     for k in range(1, _MOVES + 1):
         for a in itertools.combinations(here, k):
             for b in itertools.combinations(to, k):
@@ -343,6 +343,7 @@ def close_frames(
     own: bool = True,
     single: bool = False,
     bends: int = 0,
+    least: float = _LEAST_TURN,
 ) -> Iterator[list[Piece]]:
     """The pieces with corners re-chosen so that every island and inner node closes up
     (:func:`frame_defects` empty): up to ``tries`` choices, the one of least corner cost first
@@ -352,7 +353,8 @@ def close_frames(
     ``sigma`` (a fallback: its choices close some layouts whose ``own`` ones cannot be counted);
     ``single``: every island's ``C − 2E`` is :data:`ONE_TURN` (one index space), not any multiple of 4;
     ``bends``: which shore vertices a corner may move to (:func:`_bends`: 0 every bend at ``sigma``,
-    1 those that turn themselves, 2 bends of their own)."""
+    1 those that turn themselves, 2 bends of their own); ``least``: the least turning of a new
+    corner (:data:`_LEAST_TURN`; lower: a fallback for rings that close in no other way)."""
     from scipy.optimize import Bounds, LinearConstraint, milp
 
     defects = frame_defects(pieces, single=single)
@@ -361,7 +363,7 @@ def close_frames(
     v = _vertices(pieces)
     bad = {i for d in defects if d.kind == "node" for i in v.index.find([d.where]).tolist()}
     movable = [k for k, ids in enumerate(v.index.ids) if (v.loop[ids] > 0).any() or bool(bad & set(ids.tolist()))]
-    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma, own, bends) for k in movable}
+    cand = {k: _candidates(pieces[k], v.index.ids[k], v, sigma, own, bends, least) for k in movable}
     cols = [(k, cs, cost) for k in movable for cs, cost in cand[k]]
     islands = sorted(_island_turns(v))
     nx, nz = len(cols), len(islands)
