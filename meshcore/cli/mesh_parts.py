@@ -103,8 +103,8 @@ def _layouts(args: Any, water: WaterParts, kept: list, h: float, regular: bool, 
                 options=layout_options(args),
                 reading=coarse_reading,
             )
-        except InvalidInputError as exc:
-            raise InvalidInputError(in_world(f"{args.outline}: part {k}: {exc}", frame)) from None
+        except InvalidInputError as exc:  # its places go to the grid's CRS in guarded(), once
+            raise InvalidInputError(f"{args.outline}: part {k}: {exc}") from None
         nb = len(lay.blocks)
         say(
             f"part {k} ({water.names[k - 1]!r}): layout: {nb} block{'s' * (nb != 1)}, {lay.n_cells:,} cells, "

@@ -168,8 +168,8 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
             options=options,
             reading=coarse_reading,
         )
-    except InvalidInputError as exc:
-        msg = in_world(str(exc), frame)
+    except InvalidInputError as exc:  # its places go to the grid's CRS in guarded(), once
+        msg = str(exc)
         raise InvalidInputError(msg if msg.startswith(str(args.outline)) else f"{args.outline}: {msg}") from None
     n = len(lay.blocks)
     say(

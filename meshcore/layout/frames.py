@@ -61,14 +61,14 @@ class FrameDefect:
         x, y = self.where
         if self.kind == "ring":
             return (
-                f"the ring of blocks round the island at ({x:.8g}, {y:.8g}) cannot close in one index space: "
+                f"the ring of blocks round the island near ({x:.8g}, {y:.8g}) cannot close in one index space: "
                 f"it does not turn exactly once round it (a block with a corner alone on the island, a cut "
                 f"ending on it without a block corner, or the block corners on it minus twice the cut ends "
                 f"there not {ONE_TURN})"
             )
         if self.kind == "island":
             return (
-                f"the blocks round the island at ({x:.8g}, {y:.8g}) come back turned by {self.turn} quarter "
+                f"the blocks round the island near ({x:.8g}, {y:.8g}) come back turned by {self.turn} quarter "
                 f"turn{'s' if self.turn > 1 else ''} (their corners on it minus twice the cut ends there "
                 f"is not a multiple of 4)"
             )

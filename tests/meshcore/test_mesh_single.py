@@ -117,3 +117,26 @@ def test_water_in_two_parts(tmp_path):
     run = mesh(src, "--cells", 2000, "-o", tmp_path / "two.grd", "--single")
     assert run.rc == 2 and "2 parts" in run.err.strip().splitlines()[-1]
     assert not (tmp_path / "two.grd").exists()
+
+
+def test_a_refusal_names_its_place_in_the_files_coordinates(monkeypatch):
+    """The layout's refusal names its place in the grid's CRS once: the local frame's origin was
+    added twice (the layout step and the command's guard), so a held-out lake near northing
+    5.49e6 was said to fold near 1.098e7."""
+    import argparse
+    from types import SimpleNamespace
+
+    import meshcore.layout
+    from meshcore.cli import mesh_steps
+    from meshcore.errors import InvalidInputError, TopologyError
+
+    def refuse(*a, **k):
+        raise TopologyError("automatic layout: the blocks fold back near (10.5, -20.25)")
+
+    monkeypatch.setattr(meshcore.layout, "auto_layout", refuse)
+    args = argparse.Namespace(outline="lake.kml", layout_option=[], single_space=True)
+    frame = SimpleNamespace(origin=(500_000.0, 5_400_000.0), crs="EPSG:32618")
+    with pytest.raises(InvalidInputError) as got:
+        mesh_steps.guarded(args, frame, lambda: mesh_steps._layout(args, None, 1.0, True, print, frame))
+    assert "near (500010.5, 5399979.75)" in str(got.value), got.value
+    assert str(got.value).startswith("lake.kml: ")
