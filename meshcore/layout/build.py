@@ -263,9 +263,9 @@ def _flat_corner_on_cut(r: np.ndarray, c, on_shore: np.ndarray, forced, h: float
     corner is ``forced``, or the piece has no cut (``on_shore``: the ring's vertices on the
     shore; ``h``: the cell size).  ``onto_cut`` False (regular layouts, whose blocks meet four
     corners to four: no T-junction): only onto a vertex that turns."""
-    from .corners import _raw_turning
+    from .corners import raw_turning
 
-    raw = _raw_turning(r)
+    raw = raw_turning(r)
     n = len(r)
     corners = {int(i) for i in c}
 

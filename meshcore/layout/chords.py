@@ -306,12 +306,12 @@ def place_chords(
 
 def _sharp_vertices(poly, turn: float) -> np.ndarray:
     """The vertices (m, 2) of ``poly``'s rings where the shore turns by ``turn`` degrees or more."""
-    from .corners import _raw_turning
+    from .corners import raw_turning
 
     out = []
     for ring in (poly.exterior, *poly.interiors):
         r = np.asarray(ring.coords)[:-1]
-        out.append(r[np.abs(_raw_turning(r)) >= turn])
+        out.append(r[np.abs(raw_turning(r)) >= turn])
     return np.vstack(out) if out else np.empty((0, 2))
 
 

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-__all__ = ["bulge_ratio", "choose_corners", "corner_cost", "set_cost", "turning"]
+__all__ = ["bulge_ratio", "choose_corners", "corner_cost", "raw_turning", "set_cost", "turning"]
 
 #: A vertex turning more than this (degrees, at scale) counts as a sharp feature.
 SHARP = 30.0
@@ -68,7 +68,7 @@ def turning(ring: np.ndarray, sigma: float, arc: tuple[np.ndarray, float] | None
     return ang
 
 
-def _raw_turning(ring: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
+def raw_turning(ring: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
     """Turning angle (degrees) at every vertex between its two edges (``d``: :func:`_edges`)."""
     b = _edges(ring) if d is None else d
     a = np.concatenate([b[-1:], b[:-1]])
@@ -198,7 +198,7 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     arc = _arclength_closed(ring, d)
     s, total = arc
     t = turning(ring, sigma, arc)
-    raw = _raw_turning(ring, d)
+    raw = raw_turning(ring, d)
     forced = sorted({int(f) for f in forced})
     tt = t.copy()
     tt[forced] = 1e9  # forced first
@@ -317,7 +317,7 @@ def wedge_corners(ring: np.ndarray, corners, sigma: float, *, shore: np.ndarray,
         if t[weak] >= 2 * SHARP or weak in forced:
             return tuple(c)
     d = h * max(1.0, WEDGE_END / (2.0 * math.sin(math.radians(max(180.0 - t[tip], 5.0)) / 2.0)))
-    raw = _raw_turning(ring)
+    raw = raw_turning(ring)
 
     def placed(along: np.ndarray) -> int:  # the vertex nearest d from the tip, one that turns if any
         near = np.abs(along - d)

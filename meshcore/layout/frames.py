@@ -41,7 +41,7 @@ import numpy as np
 
 from ..pointindex import PointIndex
 from .blocks import Piece
-from .corners import OWN_TURN, SHARP, _raw_turning, set_cost, turning
+from .corners import OWN_TURN, SHARP, raw_turning, set_cost, turning
 
 __all__ = ["FrameDefect", "close_frames", "corner_flaws", "frame_defects", "straight_corners"]
 
@@ -169,7 +169,7 @@ def straight_corners(pieces: list[Piece]) -> list[tuple[float, float]]:
     v = _vertices(pieces)
     out = []
     for ids, pc in zip(v.index.ids, pieces, strict=True):
-        raw = _raw_turning(pc.ring)
+        raw = raw_turning(pc.ring)
         n = len(ids)
         for i in pc.corners:
             near = ids[[i - 1, i, (i + 1) % n]]
@@ -240,7 +240,7 @@ def _own_turning(ring: np.ndarray, sigma: float, t: np.ndarray, s: np.ndarray, t
     no other move closes the frames (excluded, 11 of 62 generated island lakes no longer
     closed, against 1).
     """
-    raw = _raw_turning(ring)
+    raw = raw_turning(ring)
     seen = np.where(t > 0, np.minimum(t, np.maximum(turning(ring, sigma / 3), 0.0)), t)
     for i in np.flatnonzero(seen > 0):
         d = np.abs(s - s[i])
@@ -275,7 +275,7 @@ def _bends(
     """
     if level <= 0:
         return np.ones(len(at), dtype=bool)
-    raw = _raw_turning(ring)
+    raw = raw_turning(ring)
     out = raw[at] >= OWN_TURN if own else np.ones(len(at), dtype=bool)
     if level >= 2:
         for k, i in enumerate(np.asarray(at, dtype=int).tolist()):

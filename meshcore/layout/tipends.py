@@ -34,7 +34,7 @@ import numpy as np
 
 from ..pointindex import PointIndex
 from .blocks import Piece
-from .corners import SHARP, _raw_turning
+from .corners import SHARP, raw_turning
 
 __all__ = ["counted_without_tip_fans", "slide_tip_ends"]
 
@@ -61,7 +61,7 @@ LEAST_ANGLE = 20.0
 
 def _angles(ring: np.ndarray) -> np.ndarray:
     """Interior angle (degrees) of a counter-clockwise ring at every vertex."""
-    return 180.0 - _raw_turning(ring)
+    return 180.0 - raw_turning(ring)
 
 
 def _step(n: int, i: int, d: int) -> int:

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .blocks import Piece, _chains_of, block_counts, conform
-from .corners import _raw_turning
+from .corners import raw_turning
 
 __all__ = ["counted_with_tip_splits"]
 
@@ -55,7 +55,7 @@ ROUNDS = 6
 
 
 def _angles(ring: np.ndarray) -> np.ndarray:
-    return 180.0 - _raw_turning(ring)
+    return 180.0 - raw_turning(ring)
 
 
 def crowded(pieces: list[Piece], h: float, multiple: int):

@@ -412,12 +412,12 @@ CORNER_TURN = 20.0
 def _turning_near(ring: np.ndarray, cum: np.ndarray, at: np.ndarray, reach: float) -> float:
     """The turning (degrees) of closed ``ring`` summed over its vertices within ``reach`` (arc
     length) of its vertex nearest ``at``; ``cum`` its :func:`arc_lengths`."""
-    from ..layout.corners import _raw_turning
+    from ..layout.corners import raw_turning
 
     j = int(np.argmin(np.hypot(*(ring - at).T)))
     d = np.abs(cum[:-1] - cum[j])
     near = np.minimum(d, cum[-1] - d) <= reach
-    return float(_raw_turning(ring)[near].sum())
+    return float(raw_turning(ring)[near].sum())
 
 
 def fit_ends(

@@ -144,7 +144,7 @@ def test_no_layout_corner_on_a_straight_shore_of_a_coarse_outline():
     between two shore vertices (turning 0°, both sides shore): a corner cell of 180°."""
     from meshcore import testing
     from meshcore.layout import auto_layout
-    from meshcore.layout.corners import _raw_turning
+    from meshcore.layout.corners import raw_turning
 
     lay = auto_layout(testing.resampled(testing.dendritic(2700), points=200), target_cells=15000, multiple=4)
     shore = lay.polygon.boundary
@@ -152,7 +152,7 @@ def test_no_layout_corner_on_a_straight_shore_of_a_coarse_outline():
     flat = []
     for p in lay.pieces:
         r = np.asarray(p.ring)
-        raw = _raw_turning(r)
+        raw = raw_turning(r)
         on = shapely.distance(shore, shapely.points(r)) < eps
         n = len(r)
         flat += [(p.name, c) for c in p.corners if on[c] and on[c - 1] and on[(c + 1) % n] and abs(raw[c]) < 1.0]

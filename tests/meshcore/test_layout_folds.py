@@ -18,7 +18,7 @@ from shapely.geometry.polygon import orient
 
 from meshcore import testing
 from meshcore.layout import auto_layout
-from meshcore.layout.corners import _raw_turning, turning
+from meshcore.layout.corners import raw_turning, turning
 
 
 def _two_islands(gap: float = 1.0, r2: float = 0.5):
@@ -70,7 +70,7 @@ def test_block_corners_are_where_the_boundary_bends(make):
     lay = auto_layout(make(), target_cells=4000)
     for pc in lay.pieces:
         t = turning(pc.ring, 1.5 * lay.cell_size)
-        raw = _raw_turning(pc.ring)
+        raw = raw_turning(pc.ring)
         for c in pc.corners:
             if t[c] >= 45.0:
                 assert raw[c] > 0.0, (pc.name, pc.ring[c])

@@ -24,7 +24,7 @@ from meshcore.io import write
 from meshcore.io.delft3d_dd import read_dd
 from meshcore.layout import auto_layout
 from meshcore.layout.blocks import Piece
-from meshcore.layout.corners import SHARP, _arclength_closed, _raw_turning
+from meshcore.layout.corners import SHARP, _arclength_closed, raw_turning
 from meshcore.layout.frames import frame_defects
 from tests.meshcore.test_delft3d_dd import node_runs
 
@@ -104,7 +104,7 @@ def test_corners_moved_to_close_the_frames_are_bends_of_their_own(expr):
     assert not frame_defects(list(lay.pieces))
     sigma = 1.5 * lay.cell_size
     for pc in lay.pieces:
-        raw = _raw_turning(pc.ring)
+        raw = raw_turning(pc.ring)
         s, total = _arclength_closed(pc.ring)
         for c in pc.corners:
             d = np.abs(s - s[c])
@@ -183,7 +183,7 @@ def _square_ring(extra: bool) -> list[Piece]:
 def test_frame_defects_counts_corners_and_cut_ends_round_an_island():
     assert frame_defects(_square_ring(False)) == []  # 8 corners on the island, 4 cut ends: 8 − 2·4 = 0
     (d,) = frame_defects(_square_ring(True))  # 9 corners: a quarter turn
-    assert d.kind == "island" and d.turn == 1 and "island at" in d.note()
+    assert d.kind == "island" and d.turn == 1 and "island near" in d.note()
     island = shapely.Polygon([(1, 1), (2, 1), (2, 2), (1, 2)])
     assert island.exterior.distance(shapely.Point(d.where)) < 1e-12
 

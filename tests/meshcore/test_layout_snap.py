@@ -10,7 +10,7 @@ import pytest
 
 from meshcore import segments, testing
 from meshcore.layout import regions
-from meshcore.layout.corners import _arclength_closed, _edges, _raw_turning, bulge_ratio, choose_corners, turning
+from meshcore.layout.corners import _arclength_closed, _edges, bulge_ratio, choose_corners, raw_turning, turning
 
 
 def _reference(rings, cuts, eps):
@@ -117,4 +117,4 @@ def test_corner_helpers_given_the_arc_lengths_are_the_same(seed):
         picks, cost = choose_corners(ring, sigma)
         assert np.isfinite(cost) and len(picks) == 4
         assert bulge_ratio(ring, picks, arc) == bulge_ratio(ring, picks)
-    assert np.array_equal(_raw_turning(ring, d), _raw_turning(ring))
+    assert np.array_equal(raw_turning(ring, d), raw_turning(ring))

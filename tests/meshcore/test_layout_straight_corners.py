@@ -17,7 +17,7 @@ import pytest
 
 from meshcore import testing
 from meshcore.layout import auto_layout
-from meshcore.layout.corners import OWN_TURN, _raw_turning, wedge_corners
+from meshcore.layout.corners import OWN_TURN, raw_turning, wedge_corners
 from meshcore.layout.frames import frame_defects
 
 shapely = pytest.importorskip("shapely")
@@ -33,7 +33,7 @@ def _straight_corners(lay) -> list[tuple[str, tuple[float, float]]]:
         ring = pc.ring
         for c in pc.corners:
             trio = ring[[c - 1, c, (c + 1) % len(ring)]]
-            if max(shapely.distance(shapely.points(trio), shore)) < eps and _raw_turning(ring)[c] < OWN_TURN:
+            if max(shapely.distance(shapely.points(trio), shore)) < eps and raw_turning(ring)[c] < OWN_TURN:
                 found.append((pc.name, tuple(ring[c].tolist())))
     return found
 
@@ -93,7 +93,7 @@ def test_wedge_corners_go_where_the_flanks_turn():
     ring, corners, tip = _wedge(bend=2.0)
     new = wedge_corners(ring, corners, 1.5, shore=np.ones(len(ring), bool))
     assert tip not in new and len(set(new)) == 4
-    raw = _raw_turning(ring)
+    raw = raw_turning(ring)
     a, b = sorted(set(new) - {0, len(ring) - 1})
     assert a < tip < b
     assert raw[a] >= OWN_TURN and raw[b] >= OWN_TURN
