@@ -41,7 +41,7 @@ import numpy as np
 
 from ..pointindex import PointIndex
 from .blocks import Piece
-from .corners import OWN_TURN, SHARP, raw_turning, set_cost, turning
+from .corners import OWN_TURN, SHARP, _arclength_closed, raw_turning, set_cost, turning
 
 __all__ = ["FrameDefect", "close_frames", "corner_flaws", "frame_defects", "straight_corners"]
 
@@ -187,8 +187,7 @@ def corner_flaws(pieces: list[Piece], sigma: float) -> tuple[int, int, int]:
     straight = len(straight_corners(pieces))
     borrowed = short = 0
     for pc in pieces:
-        s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pc.ring, axis=0).T))])
-        total = s[-1] + float(np.hypot(*(pc.ring[0] - pc.ring[-1])))
+        s, total = _arclength_closed(pc.ring)
         cs = sorted(pc.corners)
         borrowed += int((~_bends(pc.ring, np.asarray(cs), s, total, sigma, 2, own=False)).sum())
         pos = s[cs]
