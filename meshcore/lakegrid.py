@@ -98,12 +98,39 @@ def _start(topo, how: str, g0: list | None = None, stop_event: Any = None):
     from .multiblock import initial_grids, solve_multiblock
     from .orthogonal import orthogonalize
 
+    g0 = initial_grids(topo) if g0 is None else g0
+    note = ""
     if how == "winslow":
         mb = solve_multiblock(topo, max_iterations=START_ITERATIONS, initial=g0, stop_event=stop_event)
-        return list(mb.grids), f"multiblock Winslow ({mb.info.message})"
-    g0 = initial_grids(topo) if g0 is None else g0
+        grids = list(mb.grids)
+        stopped = stop_event is not None and stop_event.is_set()
+        if mb.info.converged or stopped or not escaped(grids, g0):
+            return grids, f"multiblock Winslow ({mb.info.message})"
+        note = f"; the multiblock Winslow start left the lake's extent ({mb.info.message})"
     res = orthogonalize(topo, g0, [], max_sweeps=300, smooth=1.0, omega=1.5, guard=False, tol=1e-4, size_ratio=None)
-    return list(res.grids), f"algebraic grids relaxed as one grid ({res.sweeps} sweeps)"
+    return list(res.grids), f"algebraic grids relaxed as one grid ({res.sweeps} sweeps){note}"
+
+
+#: How far (a share of the extent of the start's algebraic grids) a node of the Winslow start may
+#: lie outside that extent before the start counts as diverged (:func:`escaped`).
+ESCAPE_MARGIN = 0.01
+
+
+def escaped(grids: list, g0: list) -> bool:
+    """Whether a node of ``grids`` lies outside the bounding box of the algebraic grids ``g0`` (whose
+    borders are the blocks' borders) by more than :data:`ESCAPE_MARGIN` of its size.  Winslow's
+    equations obey a maximum principle: their solution stays in the convex hull of its borders, so
+    a start that leaves it diverged (a multiblock SOR that blew up on a tangled coarse level)."""
+    lo = np.min([np.min(np.stack([np.asarray(g.x), np.asarray(g.y)]), axis=(1, 2)) for g in g0], axis=0)
+    hi = np.max([np.max(np.stack([np.asarray(g.x), np.asarray(g.y)]), axis=(1, 2)) for g in g0], axis=0)
+    pad = ESCAPE_MARGIN * float(np.max(hi - lo))
+    for g in grids:
+        x, y = np.asarray(g.x), np.asarray(g.y)
+        if not (np.isfinite(x).all() and np.isfinite(y).all()):
+            return True
+        if x.min() < lo[0] - pad or x.max() > hi[0] + pad or y.min() < lo[1] - pad or y.max() > hi[1] + pad:
+            return True
+    return False
 
 
 def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **options: Any):

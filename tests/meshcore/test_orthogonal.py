@@ -3,6 +3,7 @@ no folds, and the whole lake pipeline on synthetic water bodies."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -230,6 +231,47 @@ def test_the_start_grids_solve_stops_at_its_iteration_cap(monkeypatch):
     monkeypatch.setattr(lg, "START_ITERATIONS", 2000)
     _, how = lg._start(topo, "winslow")
     assert "(converged" in how
+
+
+def test_a_start_that_leaves_the_lake_is_replaced_by_the_relaxed_algebraic_one(monkeypatch):
+    """Winslow's solution stays within its borders' hull (a maximum principle); a multiblock SOR
+    that blew up on a tangled coarse level left it (generated headlands, regular layout: nodes 8
+    lake widths out, 2215 folded cells in the final grid).  Such a start is dropped for the
+    algebraic grids relaxed as one grid; a start that did not converge but stayed inside is kept."""
+    import meshcore.lakegrid as lg
+    from meshcore import multiblock, testing
+    from meshcore.layout import auto_layout
+
+    topo = auto_layout(testing.y_junction(), target_cells=600).topology()
+    g0 = multiblock.initial_grids(topo)
+    assert not lg.escaped(g0, g0)
+    real = multiblock.solve_multiblock
+
+    def blown_up(*args, **kw):
+        mb = real(*args, **dict(kw, max_iterations=1))
+        far = [g.replaced(x=np.asarray(g.x) + 10.0 * (k == 1)) for k, g in enumerate(mb.grids)]
+        return dataclasses.replace(mb, grids=tuple(far))
+
+    assert lg.escaped(blown_up(topo, initial=g0).grids, g0)
+    monkeypatch.setattr(multiblock, "solve_multiblock", blown_up)
+    grids, how = lg._start(topo, "winslow", g0)
+    assert how.startswith("algebraic grids relaxed as one grid") and "left the lake's extent" in how
+    assert not lg.escaped(grids, g0)
+    monkeypatch.setattr(lg, "START_ITERATIONS", 1)
+    monkeypatch.setattr(multiblock, "solve_multiblock", real)
+    grids, how = lg._start(topo, "winslow", g0)  # not converged, still inside: kept
+    assert how.startswith("multiblock Winslow (not converged")
+
+
+def test_escaped_reads_non_finite_nodes_as_out():
+    import meshcore.lakegrid as lg
+
+    g = StructuredGrid(*np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 4), indexing="ij"))
+    bad = np.asarray(g.x).copy()
+    bad[2, 2] = np.nan
+    assert lg.escaped([StructuredGrid(bad, np.asarray(g.y))], [g])
+    inside = np.asarray(g.x) * 1.005  # within ESCAPE_MARGIN of the extent
+    assert not lg.escaped([StructuredGrid(inside, np.asarray(g.y))], [g])
 
 
 def test_the_ring_search_from_a_hint_is_the_bisection():
