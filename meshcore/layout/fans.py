@@ -144,6 +144,10 @@ def unfan(
             out_p += pp
             out_c += cc
             total += c
+            if best is not None and total >= best[2]:
+                break  # (costs ≥ 0: this option's pieces cost no less than the best's)
+        if best is not None and total >= best[2]:
+            continue
         if any(not len(f) and (fans(p, sigma) or (wrapped and wraps(p, sigma))) for p, f in out_p):
             continue
         if best is None or total < best[2]:

@@ -257,11 +257,13 @@ def best_split(
     base = region_cost(ring, sigma, forced)
     if depth <= 0 or base <= _GOOD:
         return [(ring, tuple(forced))], [], base
-    options = _options(ring, sigma, min_width, center, forced, regular, normal, thin)
+    # only an option cheaper than base - _GOOD is applied: cuts that cost more are not costed in full
+    options = _options(ring, sigma, min_width, center, forced, regular, normal, thin, bound=base - _GOOD)
     best = min(options, key=lambda o: o[2]) if options else None
     if (best is None or best[2] >= base - _GOOD) and normal and not len(forced):
         # last resort (a round basin): cuts along the shore's normal from evenly spaced points
-        more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
+        bound = base - _GOOD if best is None else min(best[2], base - _GOOD)
+        more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width, bound=bound)
         best = min(more + options, key=lambda o: o[2]) if more else best
     t = (
         tee(ring, np.asarray(center, float), sigma, min_width)
@@ -299,27 +301,41 @@ def _split_on(option, **kw):
     return out_p, out_c, total
 
 
-def _cut_options(cuts, sigma: float, min_width: float, thin: bool = False) -> list:
+def _cut_options(cuts, sigma: float, min_width: float, thin: bool = False, bound: float | None = None) -> list:
     """``(pieces, cuts, cost)`` of the admissible single cuts among ``cuts`` (``thin``:
-    :data:`.width.THIN_ACROSS` for cuts at most :data:`.width.THIN_CUT` × ``min_width`` long)."""
+    :data:`.width.THIN_ACROSS` for cuts at most :data:`.width.THIN_CUT` × ``min_width`` long).
+
+    With ``bound`` (the cost of the cheapest option found before, or inf) only the options that
+    may be the cheapest of a split's options (the first of the cheapest wins): a cut whose first
+    piece alone costs more than ``bound`` or than an earlier cut here is left out without costing
+    its second piece (costs are sums of non-negative terms, so its pieces cost more in all)."""
     out = []
     for a, b, seg in cuts:
         a, b = _orient(a), _orient(b)
         here = thin and math.hypot(*(seg[-1] - seg[0])) <= THIN_CUT * min_width
         if _too_narrow(a, min_width, here) or _too_narrow(b, min_width, here) or not (_valid(a) and _valid(b)):
             continue
-        out.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
+        ca = region_cost(a, sigma)
+        if bound is not None and ca > bound:
+            continue
+        cost = ca + region_cost(b, sigma)
+        out.append(([(a, ()), (b, ())], [seg], cost))
+        if bound is not None and cost < bound:
+            bound = cost
     return out
 
 
-def _options(ring, sigma, min_width, center, forced, regular, normal, thin=False) -> list:
+def _options(ring, sigma, min_width, center, forced, regular, normal, thin=False, *, bound: float | None = None):
     """Every admissible split of ``ring``: motorcycle cuts (``thin``: :data:`.width.THIN_ACROSS`),
     normal cuts from its bays, the star from ``center``, the butterfly (none for a piece with
-    ``forced`` corners)."""
+    ``forced`` corners).  With ``bound``: of the cuts only those that may be the first cheapest
+    option and cost at most ``bound`` (:func:`_cut_options`)."""
     if len(forced):
         return []
-    options = _cut_options(_motorcycle_cuts(ring, sigma), sigma, min_width, thin)
-    options += _cut_options(_normal_cuts(ring, sigma) if normal else [], sigma, min_width)
+    options = _cut_options(_motorcycle_cuts(ring, sigma), sigma, min_width, thin, bound=bound)
+    if bound is not None:
+        bound = min([bound] + [o[2] for o in options])
+    options += _cut_options(_normal_cuts(ring, sigma) if normal else [], sigma, min_width, bound=bound)
     if center is not None and not regular:
         star = _star(ring, np.asarray(center, float), sigma, min_width)
         if star is not None:
@@ -393,6 +409,10 @@ def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
                 pieces += sub
                 extra += sp
                 cost += c
+                if best is not None and cost >= best[2]:  # (costs ≥ 0: this star costs no less)
+                    break
+            if best is not None and cost >= best[2]:
+                continue
             if min(_width(p) for p in pieces) < min_width:
                 continue
             if not all(Polygon(p).is_valid for p in pieces):
@@ -471,7 +491,10 @@ def _far_spoke(sp0: np.ndarray, arc: np.ndarray, sp1: np.ndarray, sigma: float, 
         p1 = _orient(np.array([*sp[:-1], q, *tail, *sp1[-2:0:-1]]))
         if min(_width(p0), _width(p1)) < min_width or not (_valid(p0) and _valid(p1)):
             continue
-        split = region_cost(p0, sigma) + region_cost(p1, sigma)
+        c0 = region_cost(p0, sigma)
+        if c0 >= best[2]:  # (costs ≥ 0: the two cost no less)
+            continue
+        split = c0 + region_cost(p1, sigma)
         if split < best[2]:
             best = ([p0, p1], [sp], split)
     return best
