@@ -136,8 +136,11 @@ def bulge_cost(ring: np.ndarray, corners, arc: tuple[np.ndarray, float] | None =
     return SIDE_WEIGHT * math.log(R) ** 2 if R > 1.0 else 0.0
 
 
-def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float) -> list[int]:
-    """Vertices turning more than ``limit`` that are the largest within ``± sigma`` of arc length."""
+def _sharp_peaks(
+    t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float, most: int | None = None
+) -> list[int]:
+    """Vertices turning more than ``limit`` that are the largest within ``± sigma`` of arc length,
+    the most turning first (``most``: only the first that many)."""
     order = np.argsort(-t)
     tl, sl = t.tolist(), s.tolist()  # Python floats: the same numbers, without NumPy's per-scalar cost
     taken: list[int] = []
@@ -146,9 +149,15 @@ def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit
         if tl[i] < limit:
             break
         si = sl[i]
-        if all(min(abs(si - q), total - abs(si - q)) > sigma for q in at):
+        for q in at:
+            d = abs(si - q)
+            if not min(d, total - d) > sigma:
+                break
+        else:
             taken.append(i)
             at.append(si)
+            if most is not None and len(taken) >= most:
+                break
     return taken
 
 
@@ -185,6 +194,15 @@ def _where_it_bends(raw: np.ndarray, s: np.ndarray, total: float, i: int, reach:
     return j if raw[j] > max(raw[i], SHARP) else i
 
 
+def _where_they_bend(raw: np.ndarray, s: np.ndarray, total: float, picks: list[int], reach: float) -> list[int]:
+    """:func:`_where_it_bends` of every vertex of ``picks``, in one pass (the same numbers)."""
+    if not picks:
+        return []
+    d = np.abs(s[None, :] - s[picks][:, None])
+    j = np.argmax(np.where(np.minimum(d, total - d) <= reach, raw[None, :], -np.inf), axis=1).tolist()
+    return [jk if raw[jk] > max(raw[i], SHARP) else i for i, jk in zip(picks, j, strict=True)]
+
+
 def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     """The four corner indices (increasing, counter-clockwise) of a CCW ring, and their cost.
 
@@ -205,8 +223,9 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     forced = sorted({int(f) for f in forced})
     tt = t.copy()
     tt[forced] = 1e9  # forced first
-    picks = _sharp_peaks(tt, s, total, min(sigma, 0.1 * total), 45.0)[:4]
-    picks = [p if p in forced else _where_it_bends(raw, s, total, p, 0.5 * sigma) for p in picks]
+    picks = _sharp_peaks(tt, s, total, min(sigma, 0.1 * total), 45.0, most=4)
+    moved = _where_they_bend(raw, s, total, picks, 0.5 * sigma)
+    picks = [p if p in forced else m for p, m in zip(picks, moved, strict=True)]
     if len(picks) < 4:
         picks = sorted(picks)
         missing = 4 - len(picks)
