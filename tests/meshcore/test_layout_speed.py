@@ -15,7 +15,6 @@ import pytest
 from meshcore import testing
 from meshcore.layout import fans, split
 from meshcore.layout.corners import (
-    SHARP,
     _arclength_closed,
     _sharp_peaks,
     _where_it_bends,
@@ -62,16 +61,14 @@ def _set_cost_ref(ring, sigma, picks):
 
 
 def _sharp_peaks_ref(t, s, total, sigma, limit):
-    order = np.argsort(-t)
-    tl, sl = t.tolist(), s.tolist()
-    taken, at = [], []
-    for i in order.tolist():
-        if tl[i] < limit:
+    """The peaks as the plain code took them (every vertex compared with every peak taken)."""
+    taken: list[int] = []
+    for i in np.argsort(-t).tolist():
+        if t[i] < limit:
             break
-        si = sl[i]
-        if all(min(abs(si - q), total - abs(si - q)) > sigma for q in at):
+        gaps = [abs(float(s[i]) - float(s[j])) for j in taken]
+        if all(min(g, total - g) > sigma for g in gaps):
             taken.append(i)
-            at.append(si)
     return taken
 
 
@@ -100,7 +97,8 @@ def test_corner_helpers_match_the_plain_code(seed):
             assert _sharp_peaks(t, s, total, sigma, limit, most=4) == full[:4]
         some = [int(i) for i in rng.choice(len(ring), 5, replace=False)]
         for reach in (0.0, 0.5 * sigma, 2 * sigma):
-            assert _where_they_bend(raw, s, total, some, reach) == [_where_it_bends(raw, s, total, i, reach) for i in some]
+            one_by_one = [_where_it_bends(raw, s, total, i, reach) for i in some]
+            assert _where_they_bend(raw, s, total, some, reach) == one_by_one
         table = split._along_table(ring, s, total)
         for at in rng.uniform(-2 * total, 2 * total, 6):
             assert np.array_equal(split._point_along(ring, s, total, at, table), _point_along_ref(ring, s, total, at))
