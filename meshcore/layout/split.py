@@ -29,7 +29,7 @@ from .width import THIN_CUT
 from .width import too_narrow as _too_narrow
 from .width import width as _width
 
-__all__ = ["best_split", "region_cost"]
+__all__ = ["best_split", "corners_of", "region_cost"]
 
 
 def region_cost(ring: np.ndarray, sigma: float, forced=()) -> float:
