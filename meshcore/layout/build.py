@@ -25,13 +25,13 @@ from ..pointindex import PointIndex
 from ..segments import SegmentIndex
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
-from .corners import choose_corners, wedge_corners
+from .corners import wedge_corners
 from .fans import fans, unfan, wraps
 from .frames import _vertices, close_frames, corner_flaws, frame_defects, straight_corners
 from .regions import partition
 from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
-from .split import _GOOD, best_split, forced_indices, region_cost
+from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
 
 __all__ = ["layout_pieces"]
@@ -196,7 +196,7 @@ def layout_pieces(
         rim = SegmentIndex([np.asarray(r.coords)[:-1] for r in (dense.exterior, *dense.interiors)])
         for r, f in zip(rings, forced, strict=True):
             fi = forced_indices(r, f)
-            c, _ = choose_corners(r, sigma, forced=fi)
+            c, _ = corners_of(r, sigma, fi)
             on_shore = rim.near(r, 1e-9 * size)
             w = wedge_corners(r, c, sigma, shore=on_shore, forced=fi) if wedges and c is not None else c
             if w is not None and tuple(w) != tuple(c):

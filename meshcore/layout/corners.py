@@ -52,18 +52,21 @@ def turning(ring: np.ndarray, sigma: float, arc: tuple[np.ndarray, float] | None
     (along the ring) to the vertex, after it the chord to the point ``sigma`` ahead.
     ``arc``: the ring's :func:`_arclength_closed`, if made already.
     """
+    ring = np.asarray(ring, dtype=float)
     s, total = _arclength_closed(ring) if arc is None else arc
     sigma = min(sigma, 0.25 * total)
     xs = np.concatenate([s - total, s, s + total])
-    xp = np.vstack([ring, ring, ring])
-
-    def at(q):
-        return np.column_stack([np.interp(q, xs, xp[:, 0]), np.interp(q, xs, xp[:, 1])])
-
-    back = at(s - sigma)
-    ahead = at(s + sigma)
-    a = ring - back
-    b = ahead - ring
+    n = len(s)
+    # the points sigma behind and ahead of every vertex, in one interpolation per coordinate
+    q = np.concatenate([s - sigma, s + sigma])
+    x = np.interp(q, xs, np.concatenate([ring[:, 0], ring[:, 0], ring[:, 0]]))
+    y = np.interp(q, xs, np.concatenate([ring[:, 1], ring[:, 1], ring[:, 1]]))
+    a = np.empty((n, 2))
+    b = np.empty((n, 2))
+    np.subtract(ring[:, 0], x[:n], out=a[:, 0])  # ring - back
+    np.subtract(ring[:, 1], y[:n], out=a[:, 1])
+    np.subtract(x[n:], ring[:, 0], out=b[:, 0])  # ahead - ring
+    np.subtract(y[n:], ring[:, 1], out=b[:, 1])
     ang = np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
     return ang
 
@@ -133,8 +136,11 @@ def bulge_cost(ring: np.ndarray, corners, arc: tuple[np.ndarray, float] | None =
     return SIDE_WEIGHT * math.log(R) ** 2 if R > 1.0 else 0.0
 
 
-def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float) -> list[int]:
-    """Vertices turning more than ``limit`` that are the largest within ``± sigma`` of arc length."""
+def _sharp_peaks(
+    t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit: float, most: int | None = None
+) -> list[int]:
+    """Vertices turning more than ``limit`` that are the largest within ``± sigma`` of arc length,
+    the most turning first (``most``: only the first that many)."""
     order = np.argsort(-t)
     tl, sl = t.tolist(), s.tolist()  # Python floats: the same numbers, without NumPy's per-scalar cost
     taken: list[int] = []
@@ -143,9 +149,15 @@ def _sharp_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limit
         if tl[i] < limit:
             break
         si = sl[i]
-        if all(min(abs(si - q), total - abs(si - q)) > sigma for q in at):
+        for q in at:
+            d = abs(si - q)
+            if not min(d, total - d) > sigma:
+                break
+        else:
             taken.append(i)
             at.append(si)
+            if most is not None and len(taken) >= most:
+                break
     return taken
 
 
@@ -177,9 +189,18 @@ def _where_it_bends(raw: np.ndarray, s: np.ndarray, total: float, i: int, reach:
     one vertex off it has a straight or reflex angle in the grid (its corner cell cannot be
     convex)."""
     d = np.abs(s - s[i])
-    near = np.flatnonzero(np.minimum(d, total - d) <= reach)
-    j = int(near[np.argmax(raw[near])])
+    # the first vertex of the largest turn among those within reach (i is one of them)
+    j = int(np.argmax(np.where(np.minimum(d, total - d) <= reach, raw, -np.inf)))
     return j if raw[j] > max(raw[i], SHARP) else i
+
+
+def _where_they_bend(raw: np.ndarray, s: np.ndarray, total: float, picks: list[int], reach: float) -> list[int]:
+    """:func:`_where_it_bends` of every vertex of ``picks``, in one pass (the same numbers)."""
+    if not picks:
+        return []
+    d = np.abs(s[None, :] - s[picks][:, None])
+    j = np.argmax(np.where(np.minimum(d, total - d) <= reach, raw[None, :], -np.inf), axis=1).tolist()
+    return [jk if raw[jk] > max(raw[i], SHARP) else i for i, jk in zip(picks, j, strict=True)]
 
 
 def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
@@ -202,8 +223,9 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     forced = sorted({int(f) for f in forced})
     tt = t.copy()
     tt[forced] = 1e9  # forced first
-    picks = _sharp_peaks(tt, s, total, min(sigma, 0.1 * total), 45.0)[:4]
-    picks = [p if p in forced else _where_it_bends(raw, s, total, p, 0.5 * sigma) for p in picks]
+    picks = _sharp_peaks(tt, s, total, min(sigma, 0.1 * total), 45.0, most=4)
+    moved = _where_they_bend(raw, s, total, picks, 0.5 * sigma)
+    picks = [p if p in forced else m for p, m in zip(picks, moved, strict=True)]
     if len(picks) < 4:
         picks = sorted(picks)
         missing = 4 - len(picks)
@@ -240,10 +262,8 @@ def set_cost(
     arc = _arclength_closed(ring) if arc is None else arc
     t = turning(ring, sigma, arc) if t is None else t
     s, total = arc
-    near = np.zeros(len(ring), dtype=bool)
-    for c in picks:
-        d = np.abs(s - s[c])
-        near |= np.minimum(d, total - d) < sigma
+    d = np.abs(s[None, :] - s[list(picks)][:, None])
+    near = (np.minimum(d, total - d) < sigma).any(axis=0)
     return corner_cost(t, picks, near) + side_cost(s, total, picks) + bulge_cost(ring, picks, arc)
 
 

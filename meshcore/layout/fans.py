@@ -59,10 +59,10 @@ def _pairs(ring: np.ndarray, corners) -> float:
 
 def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) fans."""
-    from .corners import bulge_ratio, choose_corners
-    from .split import forced_indices
+    from .corners import bulge_ratio
+    from .split import corners_of, forced_indices
 
-    corners, cost = choose_corners(ring, sigma, forced=forced_indices(ring, forced))
+    corners, cost = corners_of(ring, sigma, forced_indices(ring, forced))
     if corners is None or not math.isfinite(cost):
         return False
     R = bulge_ratio(ring, corners)
@@ -75,10 +75,9 @@ def wraps(ring: np.ndarray, sigma: float, forced=()) -> bool:
     only where :func:`unfan`'s split costs less than the piece (:func:`~.build._unfanned`): the
     greedy split keeps it because no single cut pays, yet one cut and the splits after it may;
     where they do not, the block is a C round a thin peninsula, which grids well."""
-    from .corners import choose_corners
-    from .split import forced_indices
+    from .split import corners_of, forced_indices
 
-    corners, cost = choose_corners(ring, sigma, forced=forced_indices(ring, forced))
+    corners, cost = corners_of(ring, sigma, forced_indices(ring, forced))
     if corners is None or not math.isfinite(cost):
         return False
     return _wraps(ring, corners, sigma)
@@ -127,10 +126,16 @@ def unfan(
     options = _options(ring, sigma, min_width, center, (), regular, normal, thin)
     if normal:
         options += _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
+    # the options in order of their own cost (their pieces unsplit), so that a cheap result is found
+    # early and the look-ahead of options that cannot beat it stops; the result is the option of
+    # least total cost, the first in ``options`` among equals, as in that order
     best = None
-    for pieces, cuts, _ in options:
+    for k in sorted(range(len(options)), key=lambda i: options[i][2]):
+        pieces, cuts, _ = options[k]
         out_p, out_c, total = [], list(cuts), 0.0
         for pc, fc in pieces:
+            if best is not None and (total > best[2] or (total == best[2] and k > best[3])):
+                break  # (costs ≥ 0: this option cannot come before the best)
             pp, cc, c = best_split(
                 pc,
                 sigma=sigma,
@@ -144,8 +149,9 @@ def unfan(
             out_p += pp
             out_c += cc
             total += c
-        if any(not len(f) and (fans(p, sigma) or (wrapped and wraps(p, sigma))) for p, f in out_p):
-            continue
-        if best is None or total < best[2]:
-            best = (out_p, out_c, total)
+        else:
+            if any(not len(f) and (fans(p, sigma) or (wrapped and wraps(p, sigma))) for p, f in out_p):
+                continue
+            if best is None or total < best[2] or (total == best[2] and k < best[3]):
+                best = (out_p, out_c, total, k)
     return None if best is None else best[:2]

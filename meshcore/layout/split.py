@@ -29,31 +29,39 @@ from .width import THIN_CUT
 from .width import too_narrow as _too_narrow
 from .width import width as _width
 
-__all__ = ["best_split", "region_cost"]
+__all__ = ["best_split", "corners_of", "region_cost"]
 
 
 def region_cost(ring: np.ndarray, sigma: float, forced=()) -> float:
     """The corner cost of ``ring`` (``forced``: points that must be corners).
 
-    Remembered for the last :data:`_COSTS_KEPT` rings: a split's pieces are costed among its
-    options and again as the regions split on, and the same cut comes back among the options of
-    the pieces of other cuts (a sixth of the calls on held-out lakes)."""
-    fi = forced_indices(ring, forced)
+    Remembered for the last :data:`_COSTS_KEPT` rings (:func:`corners_of`): a split's pieces are
+    costed among its options and again as the regions split on, and the same cut comes back among
+    the options of the pieces of other cuts (a sixth of the calls on held-out lakes)."""
+    return corners_of(ring, sigma, forced_indices(ring, forced))[1]
+
+
+def corners_of(ring: np.ndarray, sigma: float, forced=()) -> tuple:
+    """:func:`~.corners.choose_corners` ``(corners, cost)`` of ``ring`` with the vertex indices
+    ``forced``, remembered for the last :data:`_COSTS_KEPT` rings (keyed by a 128-bit digest of
+    the ring, ``sigma`` and ``forced``): the splits cost the same rings again and again, and
+    :func:`~.fans.fans`, :func:`~.fans.wraps` and the final corners read the rings they costed."""
+    fi = tuple(int(i) for i in forced)
     data = np.ascontiguousarray(ring, dtype=float).tobytes()
-    key = (hashlib.blake2b(data, digest_size=16).digest(), len(data), float(sigma), tuple(fi))
-    cost = _costs.get(key)
-    if cost is None:
-        cost = choose_corners(ring, sigma, forced=fi)[1]
+    key = (hashlib.blake2b(data, digest_size=16).digest(), len(data), float(sigma), fi)
+    got = _costs.get(key)
+    if got is None:
+        got = choose_corners(ring, sigma, forced=list(fi))
         if len(_costs) >= _COSTS_KEPT:
             _costs.clear()
-        _costs[key] = cost
-    return cost
+        _costs[key] = got
+    return got
 
 
-#: How many rings' costs :func:`region_cost` remembers (then it starts again; a layout of 75
-#: blocks costs ~2 000 rings at each scale; keyed by a 128-bit digest of the ring, not the ring).
+#: How many rings' corners and costs :func:`corners_of` remembers (then it starts again; a layout
+#: of 75 blocks costs ~2 000 rings at each scale; keyed by a 128-bit digest of the ring, not the ring).
 _COSTS_KEPT = 20_000
-_costs: dict[tuple, float] = {}
+_costs: dict[tuple, tuple] = {}
 
 
 def forced_indices(ring: np.ndarray, points) -> list[int]:
@@ -64,12 +72,13 @@ def forced_indices(ring: np.ndarray, points) -> list[int]:
     return [i for i, q in enumerate(ring) if (float(q[0]), float(q[1])) in keys]
 
 
-def _ray_to_boundary(ring: np.ndarray, v: int, d: np.ndarray):
-    """First crossing of the ray from vertex ``v`` along ``d`` with the ring's other edges."""
+def _ray_to_boundary(ring: np.ndarray, v: int, d: np.ndarray, e: np.ndarray | None = None):
+    """First crossing of the ray from vertex ``v`` along ``d`` with the ring's other edges
+    (``e``: the ring's edges, :func:`~.corners._edges`, if made already)."""
     n = len(ring)
     c = ring[v]
     a = ring
-    e = _edges(ring)  # np.roll(ring, -1, axis=0) - ring
+    e = _edges(ring) if e is None else e  # np.roll(ring, -1, axis=0) - ring
     den = d[0] * e[:, 1] - d[1] * e[:, 0]
     w = a - c
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -96,7 +105,7 @@ def _split_ring(ring: np.ndarray, i: int, k: int, u: float, q: np.ndarray):
         j = (k + 1) % n
         r = ring
     else:
-        r = np.insert(ring, k + 1, q, axis=0)
+        r = np.concatenate([ring[: k + 1], np.reshape(q, (1, 2)), ring[k + 1 :]])  # np.insert(ring, k + 1, q, axis=0)
         j = k + 1
         if i > k:
             i += 1
@@ -126,17 +135,19 @@ def _motorcycle_cuts(ring: np.ndarray, sigma: float):
     """Candidate cuts ``(piece_a, piece_b, segment)`` from every reflex vertex, both directions."""
     t = turning(ring, sigma)
     w = _width(ring)
+    e = _edges(ring)
     out = []
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
     total = s[-1] + math.hypot(*(ring[0] - ring[-1]))
+    table = _along_table(ring, s, total)
     for v in _reflex_peaks(t, s, total, sigma):
-        back = _point_along(ring, s, total, s[v] - sigma)
-        ahead = _point_along(ring, s, total, s[v] + sigma)
+        back = _point_along(ring, s, total, s[v] - sigma, table)
+        ahead = _point_along(ring, s, total, s[v] + sigma, table)
         for d in (ring[v] - back, ring[v] - ahead):
             nd = math.hypot(*d)
             if nd == 0:
                 continue
-            hit = _ray_to_boundary(ring, v, d / nd)
+            hit = _ray_to_boundary(ring, v, d / nd, e)
             if hit is None:
                 continue
             k, u, q = hit
@@ -168,21 +179,23 @@ def _normal_cuts(ring: np.ndarray, sigma: float, *, even: bool = False, count: i
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(ring, axis=0).T))])
     total = s[-1] + math.hypot(*(ring[0] - ring[-1]))
     t = turning(ring, sigma)
+    e = _edges(ring)
     starts = [] if even else _reflex_peaks(tb, s, total, big, limit=-20.0)
     if even:
         at = np.minimum(np.searchsorted(s, np.linspace(0.0, total, count, endpoint=False)), len(ring) - 1)
         starts = sorted({int(v) for v in at})
+    table = _along_table(ring, s, total)
     out = []
     for v in starts:
         if abs(t[v]) > SHARP:
             continue  # a corner: a cut from it makes no right angles (reflex: motorcycle cuts)
-        back = _point_along(ring, s, total, s[v] - sigma)
-        ahead = _point_along(ring, s, total, s[v] + sigma)
+        back = _point_along(ring, s, total, s[v] - sigma, table)
+        ahead = _point_along(ring, s, total, s[v] + sigma, table)
         d = ahead - back
         nd = math.hypot(*d)
         if nd == 0:
             continue
-        hit = _ray_to_boundary(ring, v, np.array([-d[1], d[0]]) / nd)
+        hit = _ray_to_boundary(ring, v, np.array([-d[1], d[0]]) / nd, e)
         if hit is None:
             continue
         res = _split_ring(ring, v, *hit)
@@ -206,17 +219,25 @@ def _reflex_peaks(t: np.ndarray, s: np.ndarray, total: float, sigma: float, limi
     return taken
 
 
-def _point_along(ring, s, total, at):
+def _point_along(ring, s, total, at, table=None):
+    """The point at arc length ``at`` (cyclic) along ``ring`` (``s``: arc length at its vertices,
+    ``total``: its perimeter; ``table``: :func:`_along_table` of these, if made already)."""
     at = at % total
+    xs, x, y = _along_table(ring, s, total) if table is None else table
+    return np.array([np.interp(at, xs, x), np.interp(at, xs, y)])
+
+
+def _along_table(ring, s, total):
+    """``(arc lengths, x, y)`` of ``ring`` closed (its first vertex again at ``total``)."""
     xs = np.concatenate([s, [total]])
-    xp = np.vstack([ring, ring[:1]])
-    return np.array([np.interp(at, xs, xp[:, 0]), np.interp(at, xs, xp[:, 1])])
+    return xs, np.concatenate([ring[:, 0], ring[:1, 0]]), np.concatenate([ring[:, 1], ring[:1, 1]])
 
 
-def _valid(r: np.ndarray) -> bool:
+def _valid(r: np.ndarray, poly=None) -> bool:
+    """True if ``r`` is a valid polygon (``poly``: ``shapely.polygons(r)``, if made already)."""
     import shapely
 
-    return len(r) >= 3 and bool(shapely.is_valid(shapely.polygons(r)))
+    return len(r) >= 3 and bool(shapely.is_valid(shapely.polygons(r) if poly is None else poly))
 
 
 def _orient(r: np.ndarray) -> np.ndarray:
@@ -257,11 +278,13 @@ def best_split(
     base = region_cost(ring, sigma, forced)
     if depth <= 0 or base <= _GOOD:
         return [(ring, tuple(forced))], [], base
-    options = _options(ring, sigma, min_width, center, forced, regular, normal, thin)
+    # only an option cheaper than base - _GOOD is applied: cuts that cost more are not costed in full
+    options = _options(ring, sigma, min_width, center, forced, regular, normal, thin, bound=base - _GOOD)
     best = min(options, key=lambda o: o[2]) if options else None
     if (best is None or best[2] >= base - _GOOD) and normal and not len(forced):
         # last resort (a round basin): cuts along the shore's normal from evenly spaced points
-        more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
+        bound = base - _GOOD if best is None else min(best[2], base - _GOOD)
+        more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width, bound=bound)
         best = min(more + options, key=lambda o: o[2]) if more else best
     t = (
         tee(ring, np.asarray(center, float), sigma, min_width)
@@ -299,27 +322,47 @@ def _split_on(option, **kw):
     return out_p, out_c, total
 
 
-def _cut_options(cuts, sigma: float, min_width: float, thin: bool = False) -> list:
+def _cut_options(cuts, sigma: float, min_width: float, thin: bool = False, bound: float | None = None) -> list:
     """``(pieces, cuts, cost)`` of the admissible single cuts among ``cuts`` (``thin``:
-    :data:`.width.THIN_ACROSS` for cuts at most :data:`.width.THIN_CUT` × ``min_width`` long)."""
+    :data:`.width.THIN_ACROSS` for cuts at most :data:`.width.THIN_CUT` × ``min_width`` long).
+
+    With ``bound`` (the cost of the cheapest option found before, or inf) only the options that
+    may be the cheapest of a split's options (the first of the cheapest wins): a cut whose first
+    piece alone costs more than ``bound`` or than an earlier cut here is left out without costing
+    its second piece (costs are sums of non-negative terms, so its pieces cost more in all)."""
+    import shapely
+
     out = []
     for a, b, seg in cuts:
         a, b = _orient(a), _orient(b)
         here = thin and math.hypot(*(seg[-1] - seg[0])) <= THIN_CUT * min_width
-        if _too_narrow(a, min_width, here) or _too_narrow(b, min_width, here) or not (_valid(a) and _valid(b)):
+        pa = shapely.polygons(a)  # each piece's polygon made once for its width and validity
+        if _too_narrow(a, min_width, here, pa):
             continue
-        out.append(([(a, ()), (b, ())], [seg], region_cost(a, sigma) + region_cost(b, sigma)))
+        pb = shapely.polygons(b)
+        if _too_narrow(b, min_width, here, pb) or not (_valid(a, pa) and _valid(b, pb)):
+            continue
+        ca = region_cost(a, sigma)
+        if bound is not None and ca > bound:
+            continue
+        cost = ca + region_cost(b, sigma)
+        out.append(([(a, ()), (b, ())], [seg], cost))
+        if bound is not None and cost < bound:
+            bound = cost
     return out
 
 
-def _options(ring, sigma, min_width, center, forced, regular, normal, thin=False) -> list:
+def _options(ring, sigma, min_width, center, forced, regular, normal, thin=False, *, bound: float | None = None):
     """Every admissible split of ``ring``: motorcycle cuts (``thin``: :data:`.width.THIN_ACROSS`),
     normal cuts from its bays, the star from ``center``, the butterfly (none for a piece with
-    ``forced`` corners)."""
+    ``forced`` corners).  With ``bound``: of the cuts only those that may be the first cheapest
+    option and cost at most ``bound`` (:func:`_cut_options`)."""
     if len(forced):
         return []
-    options = _cut_options(_motorcycle_cuts(ring, sigma), sigma, min_width, thin)
-    options += _cut_options(_normal_cuts(ring, sigma) if normal else [], sigma, min_width)
+    options = _cut_options(_motorcycle_cuts(ring, sigma), sigma, min_width, thin, bound=bound)
+    if bound is not None:
+        bound = min([bound] + [o[2] for o in options])
+    options += _cut_options(_normal_cuts(ring, sigma) if normal else [], sigma, min_width, bound=bound)
     if center is not None and not regular:
         star = _star(ring, np.asarray(center, float), sigma, min_width)
         if star is not None:
@@ -393,6 +436,10 @@ def _star(ring: np.ndarray, center: np.ndarray, sigma: float, min_width: float):
                 pieces += sub
                 extra += sp
                 cost += c
+                if best is not None and cost >= best[2]:  # (costs ≥ 0: this star costs no less)
+                    break
+            if best is not None and cost >= best[2]:
+                continue
             if min(_width(p) for p in pieces) < min_width:
                 continue
             if not all(Polygon(p).is_valid for p in pieces):
@@ -440,6 +487,7 @@ def _far_spoke(sp0: np.ndarray, arc: np.ndarray, sp1: np.ndarray, sigma: float, 
     of one symmetric junction, drawn between chords placed on a sampled skeleton, differ by more
     than that margin in cost, and some were split, some not).  Returns ``(pieces, extra spokes, cost)``.
     """
+    import shapely
     from shapely.geometry import LineString, Polygon
 
     c = sp0[0]
@@ -469,9 +517,13 @@ def _far_spoke(sp0: np.ndarray, arc: np.ndarray, sp1: np.ndarray, sigma: float, 
         tail = arc[k + 1 :]
         p0 = _orient(np.array([*sp0[:-1], *head, q, *sp[-2:0:-1]]))
         p1 = _orient(np.array([*sp[:-1], q, *tail, *sp1[-2:0:-1]]))
-        if min(_width(p0), _width(p1)) < min_width or not (_valid(p0) and _valid(p1)):
+        q0, q1 = shapely.polygons(p0), shapely.polygons(p1)
+        if min(_width(p0, q0), _width(p1, q1)) < min_width or not (_valid(p0, q0) and _valid(p1, q1)):
             continue
-        split = region_cost(p0, sigma) + region_cost(p1, sigma)
+        c0 = region_cost(p0, sigma)
+        if c0 >= best[2]:  # (costs ≥ 0: the two cost no less)
+            continue
+        split = c0 + region_cost(p1, sigma)
         if split < best[2]:
             best = ([p0, p1], [sp], split)
     return best

@@ -12,11 +12,12 @@ import numpy as np
 __all__ = ["THIN_ACROSS", "THIN_CUT", "THIN_WIDTH", "inscribed", "too_narrow", "width"]
 
 
-def width(ring: np.ndarray) -> float:
-    """A width scale of a region: twice its area over its perimeter (exact for long strips)."""
+def width(ring: np.ndarray, poly=None) -> float:
+    """A width scale of a region: twice its area over its perimeter (exact for long strips);
+    ``poly``: ``shapely.polygons(ring)``, if made already."""
     import shapely
 
-    p = shapely.polygons(ring)  # (the Polygon class's own checks cost more than GEOS's area)
+    p = shapely.polygons(ring) if poly is None else poly  # (the Polygon class's checks cost more than GEOS's area)
     return 2.0 * float(shapely.area(p)) / max(float(shapely.length(p)), 1e-300)
 
 
@@ -54,9 +55,10 @@ def inscribed(ring: np.ndarray, tol: float) -> float:
     return island_width(p, tol)[0] if p.is_valid else 0.0
 
 
-def too_narrow(ring: np.ndarray, min_width: float, thin: bool = False) -> bool:
-    """True if a piece ``ring`` is narrower than ``min_width`` (see :data:`THIN_ACROSS` for ``thin``)."""
-    w = width(ring)
+def too_narrow(ring: np.ndarray, min_width: float, thin: bool = False, poly=None) -> bool:
+    """True if a piece ``ring`` is narrower than ``min_width`` (see :data:`THIN_ACROSS` for ``thin``;
+    ``poly``: ``shapely.polygons(ring)``, if made already)."""
+    w = width(ring, poly)
     if w >= min_width:
         return False
     if not thin or w < THIN_WIDTH * min_width:
