@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.optimize import minimize, rosen, rosen_der
 
 from meshcore.orthogonal._bfgs import bfgs
@@ -63,6 +64,7 @@ def _bfgs_numpy_update(fun, x0, maxiter):
         mod._update = saved
 
 
+@pytest.mark.kernel
 def test_the_compiled_update_is_the_numpy_expression_bit_for_bit():
     from meshcore.orthogonal._bfgs import _update
 
@@ -79,6 +81,7 @@ def test_the_compiled_update_is_the_numpy_expression_bit_for_bit():
     assert np.array_equal(H, H.T)
 
 
+@pytest.mark.kernel
 def test_a_solve_follows_the_numpy_update_exactly():
     x0 = np.array([-1.2, 1.0, -0.5, 0.8, 0.3, -0.7])
     fun = lambda v: (rosen(v), rosen_der(v))  # noqa: E731
