@@ -62,6 +62,7 @@ KERNEL_MODULES = (
     "foldfree/_kernels.py",
     "orthogonal/_kernels.py",
     "orthogonal/_equalize_kernels.py",
+    "orthogonal/_bfgs.py",
 )
 STAMP_NAME = "gcmesh-kernels.stamp"
 

@@ -453,7 +453,10 @@ def equalize_interfaces(
 
 def warm_up() -> None:
     """Compile (or load from numba's cache) the objective's kernel with the argument types of
-    :meth:`_Patch.objective` (``meshcore._numba_setup.compile_all``)."""
+    :meth:`_Patch.objective`, and the run patches' BFGS update (``meshcore._numba_setup.compile_all``)."""
     i4, i5, i3 = (np.zeros((0, k), np.int64) for k in (4, 5, 3))
     f0, f2, P = np.zeros(0), np.zeros((0, 4)), np.zeros((4, 2))
     _equalize_kernels.objective(P, i4, f0, f2, i4, i4, 0.5, i5, f0, W_COS, i3, f0, W_EDGE, W_JAC, P.copy())
+    from ._bfgs import _update  # the run patches' BFGS update
+
+    _update(np.eye(2), np.ones(2), np.ones(2), 1.0, 2.0)

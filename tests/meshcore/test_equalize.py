@@ -241,3 +241,33 @@ def test_a_run_without_pairs_above_aim_is_the_pair_alone():
     assert _run_seeds(t, pairs, r, 0, 3).tolist() == list(range(8))
     r[1] = 2 * np.log(AIM)  # the other pair above AIM but apart: not joined
     assert _run_seeds(t, pairs, r, 0, 3).tolist() == list(range(8))
+
+
+def test_the_run_patches_are_the_same_with_the_compiled_update_and_their_solves_are_bounded(solved, monkeypatch):
+    """Every pair above the limit worked on (a constructed outlier: limit 1.1, most of the grid's
+    pairs): at most ``len(EDGE_WEIGHTS) + len(RUN_DEPTHS)`` solves a pair, and the run patches'
+    BFGS (``._bfgs``, its inverse-Hessian update compiled) gives the grids the NumPy update gave."""
+    from meshcore.orthogonal import _bfgs
+    from meshcore.orthogonal import equalize as eq
+
+    mb, rings = solved
+    real, solves = eq._solve_patch, []
+
+    def counted(*args, **kw):
+        solves.append(args[3])  # the depth
+        return real(*args, **kw)
+
+    monkeypatch.setattr(eq, "_solve_patch", counted)
+    grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=3)
+    assert kept >= 1 and max(solves) == 5  # the deeper run patches were solved
+    assert len(solves) <= 3 * (len(eq.EDGE_WEIGHTS) + len(eq.RUN_DEPTHS))
+
+    def numpy_update(H, s, Hy, c, sy):
+        H += c * np.outer(s, s) - (np.outer(Hy, s) + np.outer(s, Hy)) / sy
+
+    monkeypatch.setattr(_bfgs, "_update", numpy_update)
+    again, kept2 = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=3)
+    assert kept2 == kept
+    for a, b in zip(grids, again, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.y, b.y)
