@@ -263,6 +263,22 @@ def test_a_start_that_leaves_the_lake_is_replaced_by_the_relaxed_algebraic_one(m
     assert how.startswith("multiblock Winslow (not converged")
 
 
+@pytest.mark.slow
+def test_a_regular_layout_whose_start_blew_up_still_gives_a_grid_inside_the_lake():
+    """Generated headlands, regular layout (the `.ddb` path), 10 000 cells: the coarse Winslow
+    start's SOR blew up (nodes 8 lake widths out; 2 215 folded cells in the grid on main)."""
+    from meshcore.lakegrid import mesh_outline
+
+    poly = testing.headlands(991100, n=6)
+    mb = mesh_outline(poly, target_cells=10000, regular=True)
+    x0, y0, x1, y1 = poly.bounds
+    pad = 1e-6 * max(x1 - x0, y1 - y0)
+    for g in mb.grids:
+        assert np.asarray(g.x).min() >= x0 - pad and np.asarray(g.x).max() <= x1 + pad
+        assert np.asarray(g.y).min() >= y0 - pad and np.asarray(g.y).max() <= y1 + pad
+    assert lake_metrics(mb, polygon=poly).summary()["folded_cells"] == 0
+
+
 def test_escaped_reads_non_finite_nodes_as_out():
     import meshcore.lakegrid as lg
 
