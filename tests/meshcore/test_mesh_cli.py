@@ -12,6 +12,7 @@ import contextlib
 import dataclasses
 import io
 import json
+import re
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -763,3 +764,28 @@ def test_layout_options_name_every_field_and_refuse_others(tmp_path, synthetic_c
     run = mesh(synthetic_csv, "--layout-option", "spline", "-o", out)
     assert run.rc == 2 and "spline" in run.err and "thin-arms" in run.err
     assert not out.exists()
+
+
+def test_a_layout_of_many_small_blocks_names_the_cells_that_would_give_them_more(tmp_path, synthetic_csv):
+    """Lakes of many arms at the cells asked have blocks a few cells across, whose grids miss the
+    edge-pair target (session 29); the command says so and names a --cells, and leaves the cells
+    to the user. A coarse grid of a few blocks gets no such hint."""
+    from meshcore import testing
+    from meshcore.cli.mesh_steps import MANY_BLOCKS, SMALL_BLOCKS
+
+    net = tmp_path / "net.csv"
+    ring = np.asarray(testing.channel_network(5, n_branches=12).exterior.coords)[:-1] * 1000.0
+    net.write_text("x,y,ring\n" + "\n".join(f"{x:.3f},{y:.3f},shore" for x, y in ring) + "\n")
+    hints = []
+    for f, cells in ((net, 3000), (synthetic_csv, 400)):
+        run = mesh(f, "--cells", cells, "-o", tmp_path / "s.npz")
+        assert run.rc == 0, run.err
+        n, c = (int(v.replace(",", "")) for v in re.search(r"layout: (\d+) blocks, ([\d,]+) cells", run.err).groups())
+        hint = re.search(r"hint: (\d+) blocks of (\d+) cells on average.* --cells (\d+) gives", run.err)
+        assert (hint is not None) == (n >= MANY_BLOCKS and c < SMALL_BLOCKS * n), run.err
+        hints.append(hint is not None)
+        if hint:
+            assert int(hint[1]) == n and int(hint[2]) == c // n
+            assert int(hint[3]) >= SMALL_BLOCKS * n > c
+    assert hints == [True, False]  # the network of 12 arms, the 3-block lake
+    assert "hint:" not in mesh(net, "--cells", 3000, "-o", tmp_path / "s.npz", "-q").err
