@@ -12,9 +12,9 @@ import contextlib
 import dataclasses
 import io
 import json
-import re
 import math
 import os
+import re
 import xml.etree.ElementTree as ET
 from collections import Counter
 from pathlib import Path
