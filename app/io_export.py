@@ -161,7 +161,7 @@ class ExportMixin:
         else:  # every block the export writes (a hand-made case, one block)
             bad = []
             for k, g in sorted(self.doc.grids.items()):
-                r = quality(g)
+                r = self.doc.quality if g is self.doc.quality_grid and self.doc.quality is not None else quality(g)
                 bad.append((names[k] if k < len(names) else f"block {k + 1}", max(r.n_folded, r.n_nonconvex)))
         bad = [(name, n) for name, n in bad if n]
         n = sum(k for _name, k in bad)

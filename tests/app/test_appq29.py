@@ -1,0 +1,141 @@
+"""Large grids in the app without freezes (session 29): the quality of a large grid is measured in a
+worker thread, and its result is taken only while it is of the grid shown."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from tests.app.waits import wait_for, wait_idle
+
+pytestmark = pytest.mark.gui
+
+
+@pytest.fixture
+def measured(monkeypatch):
+    """Every grid counts as large (measured in the worker); ``threads`` lists the threads the quality
+    reports were made in; the measures whose numbers (from 0) are in ``hold`` wait for ``gate``."""
+    import app.document as document
+
+    real = document.quality
+    seen = {"threads": [], "gate": threading.Event(), "hold": set(), "started": threading.Event(), "made": {}}
+
+    def quality(g):
+        n = len(seen["threads"])
+        seen["threads"].append(threading.current_thread())
+        if n in seen["hold"]:
+            seen["started"].set()
+            assert seen["gate"].wait(60), "the test never let the measure go on"
+        report = real(g)
+        seen["made"][id(report)] = g
+        return report
+
+    monkeypatch.setattr(document, "ASYNC_CELLS", 1)
+    monkeypatch.setattr(document, "quality", quality)
+    return seen
+
+
+def test_a_large_grids_quality_is_measured_in_a_worker_and_fills_the_panel_in(qtbot, win, measured):
+    """The quality report of a grid of 1.75 million cells took 5-7 s of the window's thread after the solve;
+    now a worker measures it: the panel says so meanwhile, then shows the report, and the status line
+    gets its summary."""
+    win.io.open_example("bottle-coarse", confirm=False)
+    measured["hold"].add(len(measured["threads"]))
+    win.generate()
+    wait_for(qtbot, win, lambda: not win.solver.running and measured["started"].is_set())
+    assert win.doc.measuring and win.doc.quality is None and win.doc.grid is not None
+    assert win.quality_panel.table.rowCount() == 0
+    assert "Measuring" in win.quality_panel.folded_label.text()
+    assert "measuring its quality" in win._status.text()
+    measured["gate"].set()
+    wait_idle(qtbot, win)
+    assert not win.doc.measuring and win.doc.quality is not None and win.doc.quality_grid is win.doc.grid
+    assert win.quality_panel.table.rowCount() > 5
+    assert "measuring" not in win._status.text() and "Grid" in win._status.text()
+    assert measured["threads"] and threading.main_thread() not in measured["threads"]
+
+
+@pytest.mark.parametrize("then", ["re-solve", "open another"])
+def test_a_measure_of_an_older_grid_never_replaces_the_newer_one(qtbot, win, measured, then):
+    """The user solves again (or opens another case) while the last grid is measured: when that measure
+    ends, its report is thrown away; the document shows the new grid's report (or none)."""
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    first = win.doc.grid
+    assert win.doc.quality is not None and win.doc.quality_grid is first
+    measured["hold"].add(len(measured["threads"]))  # the next measure waits
+    win.generate()  # a warm start: a new grid of the same shape
+    wait_for(qtbot, win, lambda: not win.solver.running and measured["started"].is_set())
+    held = win.doc.quality_grid
+    assert held is not None and held is not first and win.doc.measuring
+    if then == "re-solve":
+        win.generate()
+        wait_for(qtbot, win, lambda: not win.solver.running)
+    else:
+        win.io.open_example("annulus-sector", confirm=False)
+    newer = win.doc.quality_grid
+    assert newer is not held
+    shown = []  # the reports the document showed from here on: the grids they were made of
+    win.doc.quality_changed.connect(lambda: shown.append(measured["made"].get(id(win.doc.quality))))
+    measured["gate"].set()
+    wait_idle(qtbot, win)
+    assert win.doc.quality_grid is newer and not win.doc.measuring
+    assert all(g is newer for g in shown)  # never the held one (the grids may be equal: "is")
+    assert bool(shown) == (then == "re-solve")
+    if then == "re-solve":
+        assert newer is win.doc.grid and win.doc.quality is not None and win.doc.quality.cells == newer.cells
+        assert win.measurer.runs >= 3  # the held measure ran to its end (thrown away), the newer one after it
+        assert win.quality_panel.table.rowCount() > 5
+    else:
+        assert newer is None and win.doc.quality is None and not win.doc.grids
+        assert win.quality_panel.table.rowCount() == 0
+
+
+def test_stop_on_a_coarse_level_leaves_no_grid_and_the_coarse_one_greyed(qtbot, win, tmp_path, monkeypatch):
+    """Stop while a lake grid is on a coarse level: the solve returns no grid (the coarse ones are never a
+    result).  The frames of that level were kept as the final grids ("Grid 8×12 cells: converged" of a block
+    of 16×24, its quality measured, exported so, not stale).  Now: no grid of the layout (nothing measured or
+    exported, the project stale), the last coarse frames drawn greyed, the status line says so; F5 makes it."""
+    import app.solver_controller as sc
+    from app.lake_solve import LakeProgress
+    from app.results import ALL_BLOCKS, BlockResult
+    from meshcore import StructuredGrid
+    from meshcore.multiblock import initial_grids
+    from tests.app.test_modeller import _metres_lake
+
+    real = sc.solve_project
+
+    def coarse_then_stopped(project, *, warm, stop_event, smooth, hold):
+        """A lake solve whose Stop lands on the level of half the cells (as app.lake_solve ends it)."""
+        full = initial_grids(project.layout.topology())
+        half = tuple(StructuredGrid(x=g.x[::2, ::2], y=g.y[::2, ::2]) for g in full)
+        progress = LakeProgress(5, 0.1, 1e-5, None, 0.1, "orthogonal", ((5, 0.1),), half, ((0, "cells ÷2"),))
+        while not stop_event.is_set():  # a live frame every 0.05 s until Stop
+            yield ALL_BLOCKS, progress
+            stop_event.wait(0.05)
+        return BlockResult(grids={}, initial={})
+
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761811))
+    wait_idle(qtbot, win)
+    monkeypatch.setattr(sc, "solve_project", coarse_then_stopped)
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None and win.solver.running and bool(win.doc.grids))
+    laid = win.doc.project
+    cells = [tuple(b.cells) for b in laid.layout.blocks]
+    assert [g.cells for g in win.doc.grids.values()] == [(a // 2, b // 2) for a, b in cells]  # a coarse frame
+    win.a_stop.trigger()
+    wait_idle(qtbot, win)
+    doc = win.doc
+    assert doc.project is laid and not doc.grids and doc.stale and doc.quality is None and doc.multiblock is None
+    assert len(doc.before_grids) == len(cells)  # drawn greyed
+    assert win.canvas._grid_colour == "#b0b0b0" and len(win.canvas.grid_curve.xData) > 0
+    assert "coarse level (cells ÷2): no grid" in win.solve_status.label.text()
+    assert "no grid of this layout" in win._status.text() and "F5" in win._status.text()
+    assert not win.io.export_mesh(tmp_path / "out.vtm") and not (tmp_path / "out.vtm").exists()
+    monkeypatch.setattr(sc, "solve_project", real)
+    win.generate()
+    wait_idle(qtbot, win)
+    assert [g.cells for _k, g in sorted(doc.grids.items())] == cells and not doc.stale and not doc.before_grids
+    assert win.canvas._grid_colour == "#303030" and doc.lake_metrics is not None
