@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import threading
 
+import numpy as np
 import pytest
 
 from tests.app.waits import wait_for, wait_idle
@@ -139,3 +140,69 @@ def test_stop_on_a_coarse_level_leaves_no_grid_and_the_coarse_one_greyed(qtbot, 
     wait_idle(qtbot, win)
     assert [g.cells for _k, g in sorted(doc.grids.items())] == cells and not doc.stale and not doc.before_grids
     assert win.canvas._grid_colour == "#303030" and doc.lake_metrics is not None
+
+
+def _drawn_edges(canvas) -> set:
+    """The segments the canvas draws, as pairs of rounded end points."""
+    x, y = canvas.grid_curve.xData, canvas.grid_curve.yData
+    p = np.round(np.column_stack([x, y]), 6)
+    return {(tuple(a), tuple(b)) for a, b in zip(p[0::2], p[1::2], strict=True)}
+
+
+def test_a_grid_of_many_cells_is_drawn_in_part_and_every_cell_where_zoomed_in(qtbot, win):
+    """Every cell edge of a grid of 1.75 million cells was drawn every frame (2-4 s of the window's thread,
+    the first frame 3-10 s).  Now a grid of more than MAX_DRAWN_CELLS cells is drawn every few lines (its
+    borders always); zoomed in on a part of few enough cells, every edge there is drawn; a small grid is
+    drawn whole.  The document keeps the whole grid."""
+    from app.views import canvas as cv
+    from meshcore import StructuredGrid
+
+    def grid(n):
+        i, j = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij")
+        return StructuredGrid(x=i + 0.1 * np.sin(j / 7), y=j)
+
+    c = win.canvas
+    small = grid(100)
+    win.doc.set_grids({0: small})
+    assert len(c.grid_curve.xData) == 2 * (2 * 100 * 101)  # every edge: two ends each
+    n = 600
+    big = grid(n)
+    assert n * n > cv.MAX_DRAWN_CELLS
+    win.doc.set_grids({0: big})
+    c.fit()
+    qtbot.wait(2 * cv.WINDOW_DELAY_MS)
+    edges = _drawn_edges(c)
+    assert len(edges) <= 2 * (cv.MAX_DRAWN_CELLS + 2 * n)  # about the budget, not the 721 200 edges of the grid
+    x, y = np.round(big.x, 6), np.round(big.y, 6)
+    ends = {p for e in edges for p in e}
+    border = [(x[i, j], y[i, j]) for i, j in ((0, 0), (0, n), (n, 0), (n, n), (n, n // 2 + 1), (n // 2 + 1, 0))]
+    assert all(p in ends for p in border)  # the four borders are drawn lines (an odd index: not every other)
+    inner = ((x[301, 151], y[301, 151]), (x[302, 151], y[302, 151]))  # off the drawn lines (odd i, odd j)
+    assert inner not in edges
+    c.zoom_to((290.0, 140.0, 320.0, 170.0), margin=0.0)  # 30 x 30 cells in view
+    qtbot.waitUntil(lambda: inner in _drawn_edges(c), timeout=10_000)
+    assert win.doc.grids[0] is big
+    c.fit()
+    qtbot.waitUntil(lambda: inner not in _drawn_edges(c), timeout=10_000)
+
+
+def test_the_colouring_of_a_grid_of_many_cells_merges_cells_and_keeps_the_worst(qtbot, win):
+    """Coloured by a quality measure, a grid of 1.75 million cells froze the window for about a minute
+    (pyqtgraph paints each cell as a polygon from Python).  Now more than MAX_COLOURED_CELLS cells are
+    merged for the colouring, each merged cell showing the largest value of its cells."""
+    from app.views import canvas as cv
+    from meshcore import StructuredGrid
+
+    n = 400
+    i, j = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0), indexing="ij")
+    x = i + 0.2 * np.sin(j / 5) * np.exp(-(((i - 123) / 3) ** 2 + ((j - 77) / 3) ** 2))  # one skewed spot
+    big = StructuredGrid(x=x, y=j)
+    win.doc.set_grids({0: big})
+    wait_for(qtbot, win, lambda: win.doc.quality is not None)
+    win.doc.set_colour_by("skewness")
+    z = win.canvas.quality_item.z
+    assert z.size <= cv.MAX_COLOURED_CELLS < n * n
+    worst = np.nanmax(win.doc.quality.arrays["skewness"])
+    assert np.nanmax(z) == pytest.approx(worst)  # the skewed spot is seen
+    win.doc.set_colour_by("none")
+    assert win.canvas.quality_item is None
