@@ -49,7 +49,7 @@ class Measurer(QtCore.QObject):
 
     def _start(self, job: Callable[[], object], done: Callable[[object], None]) -> None:
         self.runs += 1
-        worker = create_worker(_run, job, _start_thread=False)
+        worker = create_worker(_run, job, _start_thread=False, _ignore_errors=True)  # errors: logged below
         result: list = [None]
         worker.returned.connect(lambda value: result.__setitem__(0, value))
         worker.errored.connect(lambda exc: log.error("measuring the grid failed", exc_info=exc))

@@ -139,7 +139,7 @@ class SolveStatus(QtCore.QObject):
         self.label.setText("error")
 
     def on_finished(self, result) -> None:
-        if result is not None and not self.solver.last_error:
+        if result is not None and not self.solver.last_error and not self.solver.stopped_coarse:
             # a grid was made: "Cannot generate" and the folded cells of the grid before are not of it (the
             # message panel's count kept them: "1 error(s)" beside a grid without a fault)
             self.doc.superseded.emit()
