@@ -47,6 +47,8 @@ METRICS = {
     # over every block of a lake grid (as ``meshcore mesh --colour deviation`` draws it)
     DEVIATION: ("deviation", "magma_r"),
 }
+#: the metrics whose worst cells are their smallest values (cells merged for colouring show their smallest)
+LOW_IS_WORSE = frozenset({"Jacobian ratio"})
 #: the colour range of :data:`DEVIATION` (degrees; above it, the top colour)
 DEVIATION_LEVELS = (0.0, 10.0)
 

@@ -211,23 +211,27 @@ def drawn_lines(shapes, max_cells: int, windows: dict | None = None) -> list[tup
     return out
 
 
-def coarse_cells(x, y, values, step: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def coarse_cells(x, y, values, step: int, *, low: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The cells of a grid (nodes ``x``, ``y``; a value per cell) merged ``step`` × ``step`` for colouring:
     the nodes of every ``step``-th line (:func:`lattice`, the borders kept) and per merged cell the largest
-    of its cells' values (the worst of a quality measure stays seen; NaN where all are NaN).
+    of its cells' values (``low``: the smallest): the worst of a quality measure stays seen; NaN where
+    all are NaN.
 
     >>> v = np.arange(16.0).reshape(4, 4); v[1, 2] = np.nan
     >>> xc, yc, vc = coarse_cells(*np.meshgrid(np.arange(5.0), np.arange(5.0), indexing="ij"), v, 2)
     >>> xc.shape, vc.tolist()
     ((3, 3), [[5.0, 7.0], [13.0, 15.0]])
+    >>> coarse_cells(xc, yc, vc, 2, low=True)[2].tolist()
+    [[5.0]]
     """
     ni, nj = np.shape(x)
     ii, jj = lattice(ni, step), lattice(nj, step)
-    v = np.asarray(values, float)
+    sign = -1.0 if low else 1.0
+    v = sign * np.asarray(values, float)
     v = np.where(np.isnan(v), -np.inf, v)
     v = np.maximum.reduceat(np.maximum.reduceat(v, ii[:-1], axis=0), jj[:-1], axis=1)
     v[np.isneginf(v)] = np.nan
-    return np.asarray(x)[np.ix_(ii, jj)], np.asarray(y)[np.ix_(ii, jj)], v
+    return np.asarray(x)[np.ix_(ii, jj)], np.asarray(y)[np.ix_(ii, jj)], sign * v
 
 
 def in_view(grids, lines, rect) -> dict[int, tuple[int, int, int, int]]:

@@ -389,14 +389,14 @@ class Canvas(pg.PlotWidget):
 
     def refresh_quality(self) -> None:
         """Colour the cells and mark the folded ones as the document says."""
-        from ..document import DEVIATION, DEVIATION_LEVELS
+        from ..document import DEVIATION, DEVIATION_LEVELS, LOW_IS_WORSE
 
         layers = self.doc.colour_layers()
         label = self.doc.colour_by if layers else ""
         grid, values = layers[0] if layers else (None, None)
         kw = {"levels": DEVIATION_LEVELS, "cmap": "magma_r"} if label == DEVIATION else {}
         try:
-            self.set_quality(grid, values, label=label, more=layers[1:], **kw)
+            self.set_quality(grid, values, label=label, more=layers[1:], low=label in LOW_IS_WORSE, **kw)
         except Exception:  # a drawing problem must not kill the window
             log.exception("cannot colour the cells by %s", label)
             self.doc.message.emit(f"cannot colour cells by {label} (details in the log)")
@@ -555,10 +555,12 @@ class Canvas(pg.PlotWidget):
         cmap: str = "viridis",
         label: str = "",
         more=(),
+        low: bool = False,
     ) -> None:
         """Colour the cells of ``grid`` by ``values`` (shape (ni, nj)); None hides it.
 
-        ``more``: further ``(grid, values)`` pairs coloured on the same scale (the other blocks).
+        ``more``: further ``(grid, values)`` pairs coloured on the same scale (the other blocks); ``low``: the
+        smallest values are the worst (cells merged for colouring show their smallest, else their largest).
         """
         for old in ([self.quality_item] if self.quality_item is not None else []) + self.quality_items:
             self.removeItem(old)
@@ -583,7 +585,7 @@ class Canvas(pg.PlotWidget):
         def mesh(g, w):
             x, y = g.x, g.y
             if step > 1:  # pyqtgraph paints each cell as a polygon from Python: merged cells, the worst value
-                x, y, w = geo.coarse_cells(x, y, w, step)
+                x, y, w = geo.coarse_cells(x, y, w, step, low=low)
             w = np.nan_to_num(np.where(np.isfinite(w), w, np.nan), nan=levels[1])
             it = pg.PColorMeshItem(
                 x, y, w, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False

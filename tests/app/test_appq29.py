@@ -192,7 +192,8 @@ def test_a_grid_of_many_cells_is_drawn_in_part_and_every_cell_where_zoomed_in(qt
 def test_the_colouring_of_a_grid_of_many_cells_merges_cells_and_keeps_the_worst(qtbot, win):
     """Coloured by a quality measure, a grid of 1.75 million cells froze the window for about a minute
     (pyqtgraph paints each cell as a polygon from Python).  Now more than MAX_COLOURED_CELLS cells are
-    merged for the colouring, each merged cell showing the largest value of its cells."""
+    merged for the colouring, each merged cell showing the worst value of its cells (the largest; the
+    smallest of the Jacobian ratio)."""
     from app.views import canvas as cv
     from meshcore import StructuredGrid
 
@@ -207,6 +208,9 @@ def test_the_colouring_of_a_grid_of_many_cells_merges_cells_and_keeps_the_worst(
     assert z.size <= cv.MAX_COLOURED_CELLS < n * n
     worst = np.nanmax(win.doc.quality.arrays["skewness"])
     assert np.nanmax(z) == pytest.approx(worst)  # the skewed spot is seen
+    win.doc.set_colour_by("Jacobian ratio")  # its worst cells are its smallest values
+    z = win.canvas.quality_item.z
+    assert np.nanmin(z) == pytest.approx(np.nanmin(win.doc.quality.arrays["jacobian_ratio"]))
     win.doc.set_colour_by("none")
     assert win.canvas.quality_item is None
 
