@@ -88,7 +88,9 @@ class Canvas(pg.PlotWidget):
         self._bg_transform = (1.0, 0.0, 0.0, 0.0)
         self._vb.sigRangeChanged.connect(self._place_labels)
         self._vb.sigRangeChanged.connect(self._apply_level_of_detail)
-        self._vb.sigRangeChanged.connect(lambda *_a: self._window_timer.start() if self._partial() else None)
+        self._vb.sigRangeChanged.connect(
+            lambda *_a: self._window_timer.start() if self._partial() or self._colour is not None else None
+        )
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
         doc.project_changed.connect(self.refresh_boundary)
         doc.project_changed.connect(self.lake_items.refresh)
@@ -112,6 +114,8 @@ class Canvas(pg.PlotWidget):
 
         self.quality_item: pg.PColorMeshItem | None = None  # the active block's colouring
         self.quality_items: list[pg.PColorMeshItem] = []  # the other blocks' (a lake coloured by deviation)
+        self.quality_window_items: list[pg.PColorMeshItem] = []  # the cells in view of a merged colouring, one by one
+        self._colour: tuple | None = None  # (layers, step, levels, colour map) of a colouring drawn merged
         self.colorbar: pg.ColorBarItem | None = None
 
         # every cell edge once, drawn as line segments (faster to paint than polylines)
@@ -474,7 +478,10 @@ class Canvas(pg.PlotWidget):
         )
 
     def _update_windows(self) -> None:
-        """The parts of a grid drawn in part that are in view: drawn with every line their cells allow."""
+        """The parts of a grid drawn in part that are in view: drawn with every line their cells allow (and
+        of a colouring drawn merged, coloured cell by cell)."""
+        if self._colour is not None:
+            self._colour_window()
         if not self._shown or not self._partial():
             return
         (x0, x1), (y0, y1) = self._vb.viewRange()
@@ -565,6 +572,8 @@ class Canvas(pg.PlotWidget):
         for old in ([self.quality_item] if self.quality_item is not None else []) + self.quality_items:
             self.removeItem(old)
         self.quality_item, self.quality_items = None, []
+        self._colour = None
+        self._colour_window()
         if grid is None or values is None:
             if self.colorbar is not None:
                 self.colorbar.hide()
@@ -586,14 +595,7 @@ class Canvas(pg.PlotWidget):
             x, y = g.x, g.y
             if step > 1:  # pyqtgraph paints each cell as a polygon from Python: merged cells, the worst value
                 x, y, w = geo.coarse_cells(x, y, w, step, low=low)
-            w = np.nan_to_num(np.where(np.isfinite(w), w, np.nan), nan=levels[1])
-            it = pg.PColorMeshItem(
-                x, y, w, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
-            )
-            it.setZValue(-10)
-            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
-            self.addItem(it)
-            return it
+            return self._mesh(x, y, w, levels, cm, -10)
 
         item = mesh(grid, v)
         self.quality_item = item
@@ -607,6 +609,42 @@ class Canvas(pg.PlotWidget):
             self.colorbar.setImageItem(item)
             self.colorbar.getAxis("left").setLabel(label)  # where ColorBarItem puts the label of a vertical bar
             self.colorbar.show()
+        if step > 1:  # zoomed in on few enough cells, they are coloured one by one over the merged ones
+            self._colour = ([(grid, v), *more], step, levels, cm)
+            self._colour_window()
+
+    def _mesh(self, x, y, w, levels, cm, z: float):
+        """A colour mesh of cells (nodes ``x``, ``y``; values ``w``) on the canvas."""
+        w = np.nan_to_num(np.where(np.isfinite(w), w, np.nan), nan=levels[1])
+        it = pg.PColorMeshItem(
+            x, y, w, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
+        )
+        it.setZValue(z)
+        it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+        self.addItem(it)
+        return it
+
+    def _colour_window(self) -> None:
+        """The cells in view of a colouring drawn merged, each coloured by its own value when there are at
+        most :data:`MAX_COLOURED_CELLS` of them (over the merged ones); none otherwise."""
+        for old in self.quality_window_items:
+            self.removeItem(old)
+        self.quality_window_items = []
+        if self._colour is None:
+            return
+        layers, step, levels, cm = self._colour
+        (x0, x1), (y0, y1) = self._vb.viewRange()
+        boxes = []
+        for g, w in layers:
+            ni, nj = g.shape
+            box = geo.in_view([g], [(0, geo.lattice(ni, step), geo.lattice(nj, step))], (x0, y0, x1, y1))
+            if box:
+                boxes.append((g, w, box[0]))
+        if not boxes or sum((i1 - i0) * (j1 - j0) for _g, _w, (i0, i1, j0, j1) in boxes) > MAX_COLOURED_CELLS:
+            return
+        for g, w, (i0, i1, j0, j1) in boxes:
+            x, y = np.asarray(g.x)[i0 : i1 + 1, j0 : j1 + 1], np.asarray(g.y)[i0 : i1 + 1, j0 : j1 + 1]
+            self.quality_window_items.append(self._mesh(x, y, np.asarray(w)[i0:i1, j0:j1], levels, cm, -9.5))
 
     def set_background(self, image: np.ndarray | None, transform=None) -> None:
         """Show an RGB(A) image (row 0 = bottom row) placed by the similarity ``transform``."""

@@ -193,7 +193,7 @@ def test_the_colouring_of_a_grid_of_many_cells_merges_cells_and_keeps_the_worst(
     """Coloured by a quality measure, a grid of 1.75 million cells froze the window for about a minute
     (pyqtgraph paints each cell as a polygon from Python).  Now more than MAX_COLOURED_CELLS cells are
     merged for the colouring, each merged cell showing the worst value of its cells (the largest; the
-    smallest of the Jacobian ratio)."""
+    smallest of the Jacobian ratio); zoomed in on few enough cells, those are coloured one by one."""
     from app.views import canvas as cv
     from meshcore import StructuredGrid
 
@@ -208,6 +208,17 @@ def test_the_colouring_of_a_grid_of_many_cells_merges_cells_and_keeps_the_worst(
     assert z.size <= cv.MAX_COLOURED_CELLS < n * n
     worst = np.nanmax(win.doc.quality.arrays["skewness"])
     assert np.nanmax(z) == pytest.approx(worst)  # the skewed spot is seen
+    c = win.canvas
+    c.zoom_to((0.0, 0.0, float(n), float(n)))  # the whole grid in view (a margin round it): merged only
+    qtbot.waitUntil(lambda: not c.quality_window_items, timeout=10_000)
+    c.zoom_to((110.0, 65.0, 135.0, 90.0), margin=0.0)  # the spot, ~25 x 25 cells: coloured one by one
+    qtbot.waitUntil(lambda: bool(c.quality_window_items), timeout=10_000)
+    fine = c.quality_window_items[0].z
+    assert fine.size < cv.MAX_COLOURED_CELLS and np.nanmax(fine) == pytest.approx(worst)
+    skew = win.doc.quality.arrays["skewness"]
+    assert np.isin(np.round(fine, 9), np.round(skew, 9)).all()  # the cells' own values, not merged ones
+    c.zoom_to((0.0, 0.0, float(n), float(n)))
+    qtbot.waitUntil(lambda: not c.quality_window_items, timeout=10_000)
     win.doc.set_colour_by("Jacobian ratio")  # its worst cells are its smallest values
     z = win.canvas.quality_item.z
     assert np.nanmin(z) == pytest.approx(np.nanmin(win.doc.quality.arrays["jacobian_ratio"]))
