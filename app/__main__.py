@@ -140,6 +140,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.solve:
         if not solve_as_opened(app, win):
             print(f"gcmesh: --solve: not finished after {SOLVE_TIMEOUT_S:.0f} s; {win._status.text()}", file=sys.stderr)
+        win.measurer.wait()  # a large grid's quality, measured in a worker (the screenshot shows it)
         app.processEvents()
         if args.quality:
             win.quality_panel.metric.setCurrentText(args.quality)

@@ -175,7 +175,7 @@ ACTIONS: tuple[ActionSpec, ...] = (
         "&Stop",
         "solver.stop",
         ("Esc",),
-        "stop the solver (keeps the current grid)",
+        "stop the solver (keeps the current grid; a lake grid stopped on a coarse level: none, that one greyed)",
         "&Generate",
         toolbar=4.3,
         enabled=False,

@@ -10,6 +10,7 @@ subscribe to its signals and draw it; edits go through undo commands
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -46,9 +47,17 @@ METRICS = {
     # over every block of a lake grid (as ``meshcore mesh --colour deviation`` draws it)
     DEVIATION: ("deviation", "magma_r"),
 }
+#: the metrics whose worst cells are their smallest values (cells merged for colouring show their smallest)
+LOW_IS_WORSE = frozenset({"Jacobian ratio"})
 #: the colour range of :data:`DEVIATION` (degrees; above it, the top colour)
 DEVIATION_LEVELS = (0.0, 10.0)
 
+
+#: a grid (with the lake grid its metrics are measured over) of at least this many cells is measured off the
+#: GUI thread when the app gives the document a runner (:attr:`Document.measure_async`): the quality report
+#: costs ~1.5 µs of CPU per cell, a lake's metrics with their coverage more (a single block of 1.75 million
+#: cells froze the window for 5-7 s after its solve)
+ASYNC_CELLS = 50_000
 
 #: finished solves the document keeps for undo and redo: back to a layout (or project) a grid was made
 #: for, that grid is shown again instead of nothing (a few MB each for lakes of ~10 000 cells)
@@ -79,7 +88,8 @@ class Document:
     message(str)
         A human-readable status message (errors included).
     quality_changed()
-        :attr:`quality` changed (a solve finished, started, or another block became active).
+        :attr:`quality` changed (a solve finished, started, or another block became active), or a
+        measure of a large grid began (:attr:`measuring` True, :attr:`quality` None) or ended.
     colour_changed(str)
         The metric the cells are coloured by changed (a key of :data:`METRICS`).
     opened()
@@ -122,6 +132,12 @@ class Document:
         #: the meshcore QualityReport of the active block's final grid (None while solving)
         self.quality = None
         self.quality_grid: StructuredGrid | None = None  # the grid ``quality`` describes
+        #: ``run(job, done)``: runs ``job()`` off the GUI thread and calls ``done(its value)`` (or ``done(None)``
+        #: if it failed) in the GUI thread; None (the default, scripts): every grid is measured at once
+        self.measure_async: Callable[[Callable[[], object], Callable[[object], None]], None] | None = None
+        #: the quality of :attr:`quality_grid` is being measured (:attr:`quality` is None until it is)
+        self.measuring = False
+        self._measure_token = 0  # a measure's result is taken only while no newer grid came
         self.colour_by: str = "none"
         self.solving: bool = False
         self._final: bool = False  # the grids are the result of a finished solve
@@ -261,6 +277,21 @@ class Document:
         if self._kept and self._kept[-1][0] is self.solved:
             self._kept[-1] = (*self._kept[-1][:3], multiblock, self._kept[-1][4])
 
+    def set_stopped_coarse(self, frames: dict[int, StructuredGrid]) -> None:
+        """A lake solve stopped before its full level: no grid of the layout (nothing to measure or
+        export; the project is stale: F5 makes its grid).  Its last coarse frames (``frames``; none: what
+        was drawn greyed before stays) are drawn greyed, as the grid of before an edit is."""
+        self.solved = None
+        self.restored = None
+        self.grids = {}
+        self.initial = {}
+        self.before_grids = dict(frames) or self.before_grids
+        self.multiblock = None
+        self._final = False
+        self.stale = True
+        self.grids_changed.emit()
+        self._update_quality()
+
     def clear_grids(self) -> None:
         self.solved = None
         self.restored = None
@@ -294,22 +325,52 @@ class Document:
         if g is self.quality_grid:
             return
         self.quality_grid = g
-        self.quality = quality(g) if g is not None else None
-        self.lake_metrics = self._lake_metrics() if g is not None else None
+        self._measure_token += 1
+        token = self._measure_token
+        if g is None:
+            self.quality, self.lake_metrics, self.measuring = None, None, False
+        else:
+            job, cells = self._measure_job(g)
+            if self.measure_async is not None and cells >= ASYNC_CELLS:
+                self.quality, self.lake_metrics, self.measuring = None, None, True
+                self.measure_async(job, lambda value: self._measured(token, value))
+            else:
+                self.measuring = False
+                self.quality, self.lake_metrics = job()
         self.quality_changed.emit()
 
-    def _lake_metrics(self):
-        """The lake modellers' metrics of a lake layout's grid, against the water polygon."""
-        lay = self.project.layout
-        mb = self.multiblock
+    def _measure_job(self, g: StructuredGrid) -> tuple[Callable[[], tuple], int]:
+        """``(job, cells)``: the measure of grid ``g`` (its quality report and, of a lake layout's grid,
+        the lake metrics) as a function of what the document holds now, and how many cells it measures."""
+        lay, mb, given = self.project.layout, self.multiblock, self._given_metrics
         if lay is None or mb is None or len(mb.grids) != len(lay.blocks):
-            return None
-        given = self._given_metrics
-        if given is not None and given[0] is mb:
-            return given[1]
-        from meshcore.quality import lake_metrics
+            lake = None
+        elif given is not None and given[0] is mb:
+            lake = given[1]
+        else:
+            lake = mb  # measured in the job
+        measure_lake = lake is not None and lake is mb
+        cells = g.cells[0] * g.cells[1]
+        if measure_lake:
+            cells += sum(b.cells[0] * b.cells[1] for b in mb.grids)
 
-        return lake_metrics(mb, polygon=lay.polygon, cell_size=lay.cell_size)
+        def job() -> tuple:
+            m = lake
+            if measure_lake:
+                from meshcore.quality import lake_metrics
+
+                m = lake_metrics(mb, polygon=lay.polygon, cell_size=lay.cell_size)
+            return quality(g), m
+
+        return job, cells
+
+    def _measured(self, token: int, value) -> None:
+        """A measure made off the GUI thread: taken only if no newer grid came since it began."""
+        if token != self._measure_token:
+            return
+        self.measuring = False
+        self.quality, self.lake_metrics = value if value is not None else (None, None)
+        self.quality_changed.emit()
 
     def set_colour_by(self, label: str) -> None:
         """Colour the cells by the metric ``label`` (a key of :data:`METRICS`)."""

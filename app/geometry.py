@@ -159,6 +159,101 @@ def edge_pairs(shapes) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros(0, dtype=np.intp)
 
 
+def lattice(n: int, step: int, start: int = 0) -> np.ndarray:
+    """Every ``step``-th index of ``start … start + n - 1``, the last one always.
+
+    >>> lattice(7, 3).tolist(), lattice(4, 1, start=2).tolist()
+    ([0, 3, 6], [2, 3, 4, 5])
+    >>> lattice(8, 3).tolist()
+    [0, 3, 6, 7]
+    """
+    idx = np.arange(0, n, max(1, int(step)))
+    if idx[-1] != n - 1:
+        idx = np.append(idx, n - 1)
+    return idx + start
+
+
+def drawn_lines(shapes, max_cells: int, windows: dict | None = None) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """The grid lines a frame draws of grids of node ``shapes``: ``(grid, rows, columns)`` node indices.
+
+    Every line when the grids have at most ``max_cells`` cells; more: every ``s``-th line of each grid
+    (its borders always, through every node), ``s`` the smallest step that keeps them within
+    ``max_cells`` (on screen such cells are a pixel or less: the lines drawn are the grid's shape).
+    ``windows``: ``{grid: (i0, i1, j0, j1)}``, the node boxes in view, drawn besides at the step their
+    cells allow (every line when they have at most ``max_cells``): zoomed in, every cell there.
+
+    >>> [(k, len(i), len(j)) for k, i, j in drawn_lines([(11, 11)], 100)]
+    [(0, 11, 11)]
+    >>> [(k, len(i), len(j)) for k, i, j in drawn_lines([(101, 101)], 100)]
+    [(0, 11, 11), (0, 1, 101), (0, 1, 101), (0, 101, 1), (0, 101, 1)]
+    >>> [(k, int(i[0]), int(i[-1]), len(i)) for k, i, j in drawn_lines([(101, 101)], 100, {0: (20, 30, 40, 50)})][-1]
+    (0, 20, 30, 11)
+    """
+    total = sum((ni - 1) * (nj - 1) for ni, nj in shapes)
+    if total <= max_cells:
+        return [(k, np.arange(ni), np.arange(nj)) for k, (ni, nj) in enumerate(shapes)]
+    step = int(np.ceil(np.sqrt(total / max_cells)))
+    out = [(k, lattice(ni, step), lattice(nj, step)) for k, (ni, nj) in enumerate(shapes)]
+    for k, (ni, nj) in enumerate(shapes):  # the borders through every node (a shore is where one looks)
+        rows, cols = np.arange(ni), np.arange(nj)
+        out += [
+            (k, np.array([0]), cols),
+            (k, np.array([ni - 1]), cols),
+            (k, rows, np.array([0])),
+            (k, rows, np.array([nj - 1])),
+        ]
+    if windows:
+        cells = sum((i1 - i0) * (j1 - j0) for i0, i1, j0, j1 in windows.values())
+        fine = max(1, int(np.ceil(np.sqrt(cells / max_cells))))
+        if fine < step:
+            for k, (i0, i1, j0, j1) in sorted(windows.items()):
+                out.append((k, lattice(i1 - i0 + 1, fine, i0), lattice(j1 - j0 + 1, fine, j0)))
+    return out
+
+
+def coarse_cells(x, y, values, step: int, *, low: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cells of a grid (nodes ``x``, ``y``; a value per cell) merged ``step`` × ``step`` for colouring:
+    the nodes of every ``step``-th line (:func:`lattice`, the borders kept) and per merged cell the largest
+    of its cells' values (``low``: the smallest): the worst of a quality measure stays seen; NaN where
+    all are NaN.
+
+    >>> v = np.arange(16.0).reshape(4, 4); v[1, 2] = np.nan
+    >>> xc, yc, vc = coarse_cells(*np.meshgrid(np.arange(5.0), np.arange(5.0), indexing="ij"), v, 2)
+    >>> xc.shape, vc.tolist()
+    ((3, 3), [[5.0, 7.0], [13.0, 15.0]])
+    >>> coarse_cells(xc, yc, vc, 2, low=True)[2].tolist()
+    [[5.0]]
+    """
+    ni, nj = np.shape(x)
+    ii, jj = lattice(ni, step), lattice(nj, step)
+    sign = -1.0 if low else 1.0
+    v = sign * np.asarray(values, float)
+    v = np.where(np.isnan(v), -np.inf, v)
+    v = np.maximum.reduceat(np.maximum.reduceat(v, ii[:-1], axis=0), jj[:-1], axis=1)
+    v[np.isneginf(v)] = np.nan
+    return np.asarray(x)[np.ix_(ii, jj)], np.asarray(y)[np.ix_(ii, jj)], sign * v
+
+
+def in_view(grids, lines, rect) -> dict[int, tuple[int, int, int, int]]:
+    """``{grid: (i0, i1, j0, j1)}``: the node boxes of ``grids`` in ``rect`` ``(x0, y0, x1, y1)``, found on
+    the lines drawn (``lines`` of :func:`drawn_lines`, one coarse lattice per grid first) and widened
+    by one of their steps; a grid wholly in view is left out (its coarse lines are all there is to see)."""
+    x0, y0, x1, y1 = rect
+    out = {}
+    for k, ii, jj in lines[: len(grids)]:
+        g = grids[k]
+        x, y = np.asarray(g.x)[np.ix_(ii, jj)], np.asarray(g.y)[np.ix_(ii, jj)]
+        inside = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)
+        if not inside.any() or inside.all():
+            continue
+        a, b = np.nonzero(inside.any(axis=1))[0][[0, -1]]
+        c, d = np.nonzero(inside.any(axis=0))[0][[0, -1]]
+        a, c = max(a - 1, 0), max(c - 1, 0)
+        b, d = min(b + 1, len(ii) - 1), min(d + 1, len(jj) - 1)
+        out[k] = (int(ii[a]), int(ii[b]), int(jj[c]), int(jj[d]))
+    return out
+
+
 def grid_segments(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Every cell edge of a grid once, as start/end pairs (for ``connect="pairs"``).
 

@@ -29,6 +29,7 @@ from .examples import LAKES, example_names
 from .io_controller import IOController
 from .lake_controller import LakeController
 from .layout_tools import CutTool, LayoutTool
+from .measure import Measurer
 from .project import Project, boundary_to_loop
 from .solve_status import SolveStatus
 from .solver_controller import SolverController
@@ -73,6 +74,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.quiet = False  # True: no modal dialogs (tests, screenshots); errors go to the status bar
         self.settings = settings or QtCore.QSettings("gcmesh", "gcmesh")
         self.doc = Document()
+        self.measurer = Measurer(self)  # a large grid's quality is measured in a worker thread
+        self.doc.measure_async = self.measurer
         self.stack = QtGui.QUndoStack(self)
         self.editor = Editor(self.doc, self.stack)
         self.solver = SolverController(self.doc, self)

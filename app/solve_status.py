@@ -41,6 +41,7 @@ class SolveStatus(QtCore.QObject):
         self._label_timer.setSingleShot(True)
         self._label_timer.timeout.connect(self._show_label)
         self._last_history: tuple | None = None  # (history, tolerance, levels) of the last multiblock snapshot
+        self._due: set[str] = set()  # "summary", "notes": said once the large grid's quality is measured
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
         self.doc.opened.connect(self.on_opened)
@@ -49,6 +50,7 @@ class SolveStatus(QtCore.QObject):
         self.solver.error.connect(self.on_error)
         self.solver.progress.connect(self.on_progress)
         self.solver.finished.connect(self.on_finished)
+        self.doc.quality_changed.connect(self.on_measured)
 
     def reset(self) -> None:
         """A solve is about to start."""
@@ -137,24 +139,43 @@ class SolveStatus(QtCore.QObject):
         self.label.setText("error")
 
     def on_finished(self, result) -> None:
-        if result is not None and not self.solver.last_error:
+        if result is not None and not self.solver.last_error and not self.solver.stopped_coarse:
             # a grid was made: "Cannot generate" and the folded cells of the grid before are not of it (the
             # message panel's count kept them: "1 error(s)" beside a grid without a fault)
             self.doc.superseded.emit()
         if result is not None and self.doc.project.multiblock is not None:
             self.doc.set_multiblock(getattr(result, "multiblock", None))
         self.on_final()
-        if self.doc.stale:  # an edit came while it solved (auto-generate off): the grid of before it
-            self.on_edited(self.doc.project)
+        if self.doc.stale and not self.solver.stopped_coarse:  # an edit came while it solved (auto-generate
+            self.on_edited(self.doc.project)  # off): the grid of before it
         if result is not None and not self.solver.last_error:
             self.report_notes()
 
+    def on_measured(self) -> None:
+        """A large grid's quality, measured in a worker (:attr:`Document.measuring`), came: what waited
+        for it (the summary with its folded cells or mean deviation, the lake grid's notes) is said now."""
+        if self.doc.measuring or not self._due:
+            return
+        due, self._due = self._due, set()
+        if self.solver.running or self.doc.quality is None:  # another solve, or another grid, came first
+            return
+        if "summary" in due:
+            self.on_final()
+        if "notes" in due:
+            self.report_notes()
+
     def on_final(self) -> None:
-        """The solve ended (or another block became active): the summary of the active grid."""
+        """The solve ended (or another block became active): the summary of the active grid (said again
+        when the quality of a large grid, measured in a worker, comes)."""
         g = self.doc.grid
         if self.solver.running or self.solver.last_error:
             return
+        if self.doc.measuring:
+            self._due.add("summary")
         self._show_previous(False)
+        if g is None and self.solver.stopped_coarse and self.doc.project.layout is not None:
+            self._coarse_final()
+            return
         if g is None:
             self.label.setText("idle")
             return
@@ -171,6 +192,8 @@ class SolveStatus(QtCore.QObject):
         warn = f" — {r.n_folded} FOLDED cells (red ×)" if r is not None and r.n_folded else ""
         if info.method.endswith("+foldfree") and info.message:
             warn += " — invalid cells repaired (what was done: View ▸ Messages)"
+        if self.doc.measuring:
+            warn += " — measuring its quality…"
         self.label.setText(f"{info.method}: {state}, {info.iterations} iterations, {dt * 1000:.0f} ms")
         self.win.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}")
 
@@ -189,14 +212,34 @@ class SolveStatus(QtCore.QObject):
         folded = int(m.values("folded").sum()) if m is not None else 0
         warn = f" — {folded} FOLDED or non-convex cells" if folded else ""
         mean = f", mean deviation from 90° {m.mean('deviation'):.2f}°" if m is not None else ""
+        if m is None and self.doc.measuring:
+            mean = " — measuring its quality…"
         what = "Lake grid, stopped before it was finished (F5 makes it again)" if stopped else "Lake grid"
         self.win.message(f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
+
+    def _coarse_final(self) -> None:
+        """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed."""
+        frames, blocks = self.doc.before_grids, self.doc.project.layout.blocks
+        k = next(iter(frames), None)
+        level = f"cells ÷{round(blocks[k].cells[0] / frames[k].cells[0])}" if k is not None and k < len(blocks) else ""
+        if self._last_history is not None:
+            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        shown = bool(self.doc.before_grids)
+        self._show_previous(shown)
+        self.label.setText(f"stopped on a coarse level{f' ({level})' if level else ''}: no grid")
+        grey = f"the greyed grid is a coarse level's ({level}), not the layout's" if shown else "nothing was drawn"
+        self.win.message(f"Lake grid stopped before its full level: no grid of this layout ({grey}); F5 makes it")
 
     def report_notes(self) -> None:
         """Repairs, corner advice and other notes of the solver, in full, in the message panel."""
         blocks = self.doc.project.blocks
         mb = self.doc.multiblock
+        if self.solver.stopped_coarse:  # no grid: nothing of it to note
+            return
         if self.doc.project.layout is not None and mb is not None:
+            if self.doc.measuring:  # its coverage warnings: once measured
+                self._due.add("notes")
+                return
             self.doc.report("info", f"lake grid: {mb.info.message}")
             m = self.doc.lake_metrics
             cov = getattr(m, "coverage", None)

@@ -95,6 +95,8 @@ class SolverController(QtCore.QObject):
         self._t_before = (0.0, 0.0)
         self.last_result = None
         self.last_error: str | None = None
+        #: the last lake solve was stopped before its full level: no grid of the layout (its coarse frames greyed)
+        self.stopped_coarse = False
         self._restart_pending = False
         self._dropped = False  # the running solve is of no use now (an undo or redo brought a kept grid back)
         self._project = None  # the project the running solve was started for
@@ -166,6 +168,7 @@ class SolverController(QtCore.QObject):
         self._restart_pending = False
         self._run += 1
         self.last_error = None
+        self.stopped_coarse = False
         warm = {}
         for k, g in self.doc.grids.items():
             a = self.doc.initial.get(k)
@@ -438,6 +441,9 @@ class SolverController(QtCore.QObject):
             self.finished.emit(None)
             return
         self._flush(draw=False)  # its progress (the convergence history ends on it), not a frame
+        if self._project.layout is not None and not result.grids:
+            self._stopped_coarse(result)
+            return
         grids = dict(self.doc.grids)
         grids.update(result.grids)
         initial = dict(self.doc.initial)
@@ -451,6 +457,19 @@ class SolverController(QtCore.QObject):
         self.last_result = result
         for w in result.warnings:  # what meshcore warned about (e.g. dropped duplicate points)
             self.doc.report("warning", w)
+        self._set_state("idle")
+        self.finished.emit(result)
+
+    def _stopped_coarse(self, result) -> None:
+        """A lake solve stopped before its full level (``app.lake_solve`` returns no grid then): its coarse
+        frames were kept as the final grids, neither stale nor greyed ("Grid 8×12 cells: converged" of a
+        block of 16×24, measured and exported so).  Now the document holds no grid of the layout and draws
+        the last coarse frames greyed; the status says so (F5 makes the grid)."""
+        cells = {k: tuple(b.cells) for k, b in enumerate(self._project.layout.blocks)}
+        frames = {k: g for k, g in self.doc.grids.items() if k in self._smoothed and g.cells != cells.get(k)}
+        self.stopped_coarse = True
+        self.doc.set_stopped_coarse(frames)
+        self.last_result = result
         self._set_state("idle")
         self.finished.emit(result)
 

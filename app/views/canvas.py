@@ -42,6 +42,16 @@ _OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
 _MARKER_FULL = {"points": 7.0, "other": 5.0}
 
 
+#: the most cells a frame draws every line of; a larger grid is drawn every few lines, and the part in view in full
+#: once it has no more (at 1000 pixels across, ~400 x 400 cells: 2.5 pixels each, which the lines' fading hides)
+MAX_DRAWN_CELLS = 150_000
+#: the most cells the quality colouring paints (each is a polygon painted from Python, ~30 µs: a grid of
+#: 1.75 million cells coloured froze the window for ~1 min); more are merged, showing the worst value of each
+MAX_COLOURED_CELLS = 40_000
+#: milliseconds a zoom or pan must pause before the part in view of a grid drawn in part is drawn in full
+WINDOW_DELAY_MS = 150
+
+
 class Canvas(pg.PlotWidget):
     """The drawing area.  ``tool`` receives mouse events in model coordinates."""
 
@@ -78,6 +88,9 @@ class Canvas(pg.PlotWidget):
         self._bg_transform = (1.0, 0.0, 0.0, 0.0)
         self._vb.sigRangeChanged.connect(self._place_labels)
         self._vb.sigRangeChanged.connect(self._apply_level_of_detail)
+        self._vb.sigRangeChanged.connect(
+            lambda *_a: self._window_timer.start() if self._partial() or self._colour is not None else None
+        )
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
         doc.project_changed.connect(self.refresh_boundary)
         doc.project_changed.connect(self.lake_items.refresh)
@@ -101,6 +114,8 @@ class Canvas(pg.PlotWidget):
 
         self.quality_item: pg.PColorMeshItem | None = None  # the active block's colouring
         self.quality_items: list[pg.PColorMeshItem] = []  # the other blocks' (a lake coloured by deviation)
+        self.quality_window_items: list[pg.PColorMeshItem] = []  # the cells in view of a merged colouring, one by one
+        self._colour: tuple | None = None  # (layers, step, levels, colour map) of a colouring drawn merged
         self.colorbar: pg.ColorBarItem | None = None
 
         # every cell edge once, drawn as line segments (faster to paint than polylines)
@@ -115,6 +130,14 @@ class Canvas(pg.PlotWidget):
         # the GUI thread per mouse move; a new grid costs ~2 ms more)
         self.grid_curve.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
         self._edges: tuple = ((), np.zeros(0, dtype=np.intp))  # (grid shapes, their edges' node indices)
+        #: the lines drawn (``app.geometry.drawn_lines``) of the shapes and view windows in ``_edges[0]``
+        self._lines: list = []
+        self._shown: list = []  # the grids drawn (a zoom of a grid drawn in part draws it again)
+        self._windows: tuple = ((), {})  # (grid shapes, their node boxes in view) of a grid drawn in part
+        self._window_timer = QtCore.QTimer(self)  # the boxes in view, once a zoom or pan has paused
+        self._window_timer.setSingleShot(True)
+        self._window_timer.setInterval(WINDOW_DELAY_MS)
+        self._window_timer.timeout.connect(self._update_windows)
         self.addItem(self.grid_curve)
         self._grid_colour = "#303030"
         self._cell_size = 0.0  # typical cell size of the grids (model units), for the level of detail
@@ -370,14 +393,14 @@ class Canvas(pg.PlotWidget):
 
     def refresh_quality(self) -> None:
         """Colour the cells and mark the folded ones as the document says."""
-        from ..document import DEVIATION, DEVIATION_LEVELS
+        from ..document import DEVIATION, DEVIATION_LEVELS, LOW_IS_WORSE
 
         layers = self.doc.colour_layers()
         label = self.doc.colour_by if layers else ""
         grid, values = layers[0] if layers else (None, None)
         kw = {"levels": DEVIATION_LEVELS, "cmap": "magma_r"} if label == DEVIATION else {}
         try:
-            self.set_quality(grid, values, label=label, more=layers[1:], **kw)
+            self.set_quality(grid, values, label=label, more=layers[1:], low=label in LOW_IS_WORSE, **kw)
         except Exception:  # a drawing problem must not kill the window
             log.exception("cannot colour the cells by %s", label)
             self.doc.message.emit(f"cannot colour cells by {label} (details in the log)")
@@ -411,28 +434,63 @@ class Canvas(pg.PlotWidget):
 
     def set_grids(self, grids: dict[int, StructuredGrid]) -> None:
         """Draw all block grids as one curve of line segments: every frame one gather of the grids' nodes
-        by the edges' node indices (:func:`app.geometry.edge_pairs`, made again only when a shape changes)."""
+        by the edges' node indices (:func:`app.geometry.edge_pairs`, made again only when a shape changes).
+
+        Grids of more than :data:`MAX_DRAWN_CELLS` cells are drawn in part (:func:`app.geometry.drawn_lines`):
+        every few lines, and every line of the part in view once it has few enough cells (a grid of 1.75
+        million cells took 2-4 s of the GUI thread per frame, its first one 3-10 s)."""
         self._show_background_grid(not grids)
+        self._shown = list(grids.values())
         if not grids:
             self.grid_curve.setData([], [])
             self._edges = ((), np.zeros(0, dtype=np.intp))
+            self._lines = []
             self._cell_size, self._sized_shapes = 0.0, ()
             return
         shapes = tuple(g.shape for g in grids.values())
-        if shapes != self._edges[0]:
-            self._edges = (shapes, geo.edge_pairs(shapes))
+        windows = self._windows[1] if self._windows[0] == shapes else {}
+        key = (shapes, tuple(sorted(windows.items())))
+        if key != self._edges[0]:
+            self._lines = geo.drawn_lines(shapes, MAX_DRAWN_CELLS, windows)
+            self._edges = (key, geo.edge_pairs([(len(i), len(j)) for _k, i, j in self._lines]))
         pairs = self._edges[1]
-        if len(grids) == 1:
-            g = next(iter(grids.values()))
-            x, y = np.asarray(g.x, float).ravel(), np.asarray(g.y, float).ravel()
+        gs = self._shown
+        if not self._partial() and len(grids) == 1:
+            x, y = np.asarray(gs[0].x, float).ravel(), np.asarray(gs[0].y, float).ravel()
+        elif not self._partial():
+            x = np.concatenate([np.asarray(g.x, float).ravel() for g in gs])
+            y = np.concatenate([np.asarray(g.y, float).ravel() for g in gs])
         else:
-            x = np.concatenate([np.asarray(g.x, float).ravel() for g in grids.values()])
-            y = np.concatenate([np.asarray(g.y, float).ravel() for g in grids.values()])
+            x = np.concatenate([np.asarray(gs[k].x, float)[np.ix_(i, j)].ravel() for k, i, j in self._lines])
+            y = np.concatenate([np.asarray(gs[k].y, float)[np.ix_(i, j)].ravel() for k, i, j in self._lines])
         self.grid_curve.setData(x[pairs], y[pairs], connect="pairs", skipFiniteCheck=True)
         if shapes != self._sized_shapes:  # the cell size only moves with the shape (cheap enough anyway)
             self._sized_shapes = shapes
             self._cell_size = geo.typical_cell_size(grids.values())
             self._apply_level_of_detail()
+            if self._partial():
+                self._window_timer.start()
+
+    def _partial(self) -> bool:
+        """The grids are drawn in part (too many cells for every line)."""
+        return len(self._lines) > len(self._shown) or any(
+            len(i) < g.shape[0] or len(j) < g.shape[1] for (_k, i, j), g in zip(self._lines, self._shown, strict=False)
+        )
+
+    def _update_windows(self) -> None:
+        """The parts of a grid drawn in part that are in view: drawn with every line their cells allow (and
+        of a colouring drawn merged, coloured cell by cell)."""
+        if self._colour is not None:
+            self._colour_window()
+        if not self._shown or not self._partial():
+            return
+        (x0, x1), (y0, y1) = self._vb.viewRange()
+        shapes = tuple(g.shape for g in self._shown)
+        coarse = self._lines[: len(self._shown)]
+        windows = geo.in_view(self._shown, coarse, (x0, y0, x1, y1))
+        if (shapes, windows) != self._windows:
+            self._windows = (shapes, windows)
+            self.set_grids(dict(enumerate(self._shown)))
 
     def _show_background_grid(self, on: bool) -> None:
         """The faint coordinate grid behind an outline; off under a grid (its axes would then repaint,
@@ -504,14 +562,18 @@ class Canvas(pg.PlotWidget):
         cmap: str = "viridis",
         label: str = "",
         more=(),
+        low: bool = False,
     ) -> None:
         """Colour the cells of ``grid`` by ``values`` (shape (ni, nj)); None hides it.
 
-        ``more``: further ``(grid, values)`` pairs coloured on the same scale (the other blocks).
+        ``more``: further ``(grid, values)`` pairs coloured on the same scale (the other blocks); ``low``: the
+        smallest values are the worst (cells merged for colouring show their smallest, else their largest).
         """
         for old in ([self.quality_item] if self.quality_item is not None else []) + self.quality_items:
             self.removeItem(old)
         self.quality_item, self.quality_items = None, []
+        self._colour = None
+        self._colour_window()
         if grid is None or values is None:
             if self.colorbar is not None:
                 self.colorbar.hide()
@@ -526,15 +588,14 @@ class Canvas(pg.PlotWidget):
         if cmap.endswith("_r"):
             cm.reverse()
 
+        cells = sum(np.size(w) for w in (v, *(w for _g, w in more)))
+        step = int(np.ceil(np.sqrt(cells / MAX_COLOURED_CELLS))) if cells > MAX_COLOURED_CELLS else 1
+
         def mesh(g, w):
-            w = np.nan_to_num(np.where(np.isfinite(w), w, np.nan), nan=levels[1])
-            it = pg.PColorMeshItem(
-                g.x, g.y, w, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
-            )
-            it.setZValue(-10)
-            it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
-            self.addItem(it)
-            return it
+            x, y = g.x, g.y
+            if step > 1:  # pyqtgraph paints each cell as a polygon from Python: merged cells, the worst value
+                x, y, w = geo.coarse_cells(x, y, w, step, low=low)
+            return self._mesh(x, y, w, levels, cm, -10)
 
         item = mesh(grid, v)
         self.quality_item = item
@@ -548,6 +609,42 @@ class Canvas(pg.PlotWidget):
             self.colorbar.setImageItem(item)
             self.colorbar.getAxis("left").setLabel(label)  # where ColorBarItem puts the label of a vertical bar
             self.colorbar.show()
+        if step > 1:  # zoomed in on few enough cells, they are coloured one by one over the merged ones
+            self._colour = ([(grid, v), *more], step, levels, cm)
+            self._colour_window()
+
+    def _mesh(self, x, y, w, levels, cm, z: float):
+        """A colour mesh of cells (nodes ``x``, ``y``; values ``w``) on the canvas."""
+        w = np.nan_to_num(np.where(np.isfinite(w), w, np.nan), nan=levels[1])
+        it = pg.PColorMeshItem(
+            x, y, w, colorMap=cm, levels=levels, enableAutoLevels=False, edgecolors=None, antialiasing=False
+        )
+        it.setZValue(z)
+        it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
+        self.addItem(it)
+        return it
+
+    def _colour_window(self) -> None:
+        """The cells in view of a colouring drawn merged, each coloured by its own value when there are at
+        most :data:`MAX_COLOURED_CELLS` of them (over the merged ones); none otherwise."""
+        for old in self.quality_window_items:
+            self.removeItem(old)
+        self.quality_window_items = []
+        if self._colour is None:
+            return
+        layers, step, levels, cm = self._colour
+        (x0, x1), (y0, y1) = self._vb.viewRange()
+        boxes = []
+        for g, w in layers:
+            ni, nj = g.shape
+            box = geo.in_view([g], [(0, geo.lattice(ni, step), geo.lattice(nj, step))], (x0, y0, x1, y1))
+            if box:
+                boxes.append((g, w, box[0]))
+        if not boxes or sum((i1 - i0) * (j1 - j0) for _g, _w, (i0, i1, j0, j1) in boxes) > MAX_COLOURED_CELLS:
+            return
+        for g, w, (i0, i1, j0, j1) in boxes:
+            x, y = np.asarray(g.x)[i0 : i1 + 1, j0 : j1 + 1], np.asarray(g.y)[i0 : i1 + 1, j0 : j1 + 1]
+            self.quality_window_items.append(self._mesh(x, y, np.asarray(w)[i0:i1, j0:j1], levels, cm, -9.5))
 
     def set_background(self, image: np.ndarray | None, transform=None) -> None:
         """Show an RGB(A) image (row 0 = bottom row) placed by the similarity ``transform``."""

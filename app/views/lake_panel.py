@@ -281,6 +281,8 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             self.headline.setText(
                 "No lake grid yet (Auto layout, then it generates)."
                 if self.doc.project.layout is None
+                else "Measuring the grid: the verdict follows."
+                if self.doc.measuring
                 else "The verdict follows when the grid of this layout is made (F5 if it is not being made)."
             )
             self.table.setRowCount(0)

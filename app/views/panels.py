@@ -271,6 +271,8 @@ class QualityPanel(QtWidgets.QWidget):
             self.table.setRowCount(0)
             self.hist_curve.setData([0, 1], [0])
             self.hist.hide()
+            if self.doc.measuring:  # a large grid, measured in a worker: the report fills in when it is
+                self.folded_label.setText("Measuring the grid's quality…")
             return
         self.hist.show()
         rows = [

@@ -24,9 +24,16 @@ POLL_MS = 100
 
 
 def idle(win) -> bool:
-    """Nothing being computed: no layout, no layout edit, no solve, no solve about to start."""
+    """Nothing being computed: no layout, no layout edit, no solve, no solve about to start, no measure, no export."""
     lake = win.lake_ctl
-    return not (lake.busy or lake.editing or win.solver.running or win.solver._debounce.isActive())
+    return not (
+        lake.busy
+        or lake.editing
+        or win.solver.running
+        or win.solver._debounce.isActive()
+        or win.measurer.busy
+        or win.io.exporting
+    )
 
 
 def _signals(win) -> list:
@@ -38,6 +45,7 @@ def _signals(win) -> list:
         win.lake_ctl.layout_done,
         win.doc.grids_changed,
         win.doc.project_changed,
+        win.doc.quality_changed,
     ]
 
 
