@@ -17,6 +17,7 @@ from PySide6 import QtCore, QtWidgets
 from superqt.utils import create_worker
 
 from meshcore import MeshcoreError
+from meshcore.cellsize import SMALL_BLOCKS, finer_for_small_blocks
 
 from .lake import Lake, compute_layout
 from .lake_solve import layout_topology
@@ -238,6 +239,14 @@ class LakeController(QtCore.QObject):
             self.doc.report("info", f"layout: {note}")
         for note in layout.details:  # each island a note above sums up
             self.doc.report("info", f"layout (detail): {note}")
+        finer = finer_for_small_blocks(n, layout.n_cells, layout.cell_size)
+        if finer is not None:  # (meshcore mesh says it too, in --cells)
+            self.doc.report(
+                "info",
+                f"layout: {n} blocks of {layout.n_cells // n} cells on average: arms only a few cells across "
+                f"grid less smoothly (edge pairs, angles); a cell size of {finer[1]:.4g} m (about {finer[0]:,} "
+                f"cells) gives each block about {SMALL_BLOCKS}",
+            )
         kind = " for one index space" if layout.single else ""
         self.win.message(
             f"Layout{kind}: {n} block{'s' * (n != 1)}, {layout.n_cells:,} cells at {layout.cell_size:.4g} m — "

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ..cellsize import DEFAULT_CELLS, default_cell_size
+from ..cellsize import DEFAULT_CELLS, SMALL_BLOCKS, default_cell_size, finer_for_small_blocks
 from ..errors import InvalidInputError, MeshcoreError
 from .lakefile import in_world
 from .mesh_figure import figure as _figure
@@ -177,24 +177,14 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
         f"{' (regular: no 3- or 5-block corners)' if regular else ''}"
         f"{f' (options: {options})' if options != LayoutOptions() else ''}, {say.lap():.1f} s"
     )
-    if n >= MANY_BLOCKS and lay.n_cells < SMALL_BLOCKS * n:
-        more = -(-SMALL_BLOCKS * n // 1000) * 1000
+    finer = finer_for_small_blocks(n, lay.n_cells, lay.cell_size)
+    if finer is not None:
         say(
             f"hint: {n} blocks of {lay.n_cells // n} cells on average: arms only a few cells across grid "
-            f"less smoothly (edge pairs, angles); --cells {more} gives each block about {SMALL_BLOCKS}"
+            f"less smoothly (edge pairs, angles); --cells {finer[0]} gives each block about {SMALL_BLOCKS}"
         )
     _notes(lay.notes, frame)
     return lay
-
-
-#: Blocks of fewer cells than this on average (a lake of many arms at the cells asked): ``meshcore
-#: mesh`` names the ``--cells`` that would give them this many.  On dev sets 13 and 14 at 10 000
-#: cells the share of edge pairs ≤ 1.2 fell with the blocks: ≤ 20 blocks 98–100 %, 51–58 blocks
-#: ~95 %, 88–94 blocks 88–91 %; the same lakes at 1.5× the cells met the target (journal,
-#: session 29).  Advice only: the cells are the user's (their model's run time).  Only for layouts
-#: of :data:`MANY_BLOCKS` or more (a coarse grid of a few blocks is a choice, not a lake of arms).
-SMALL_BLOCKS = 256
-MANY_BLOCKS = 20
 
 
 def _grid(lay, say: _Say):

@@ -237,3 +237,26 @@ def test_undo_of_auto_layout_does_not_solve_a_lake_with_islands_as_one_block(qtb
     assert win.solver.running
     wait_idle(qtbot, win)
     win.a_auto.trigger()
+
+
+def test_a_layout_of_many_small_blocks_says_what_cell_size_gives_them_more(qtbot, win, tmp_path):
+    """What `meshcore mesh` hints (lakes of many arms: blocks a few cells across miss the edge-pair
+    target), the app says in its Messages after Auto layout, in its own terms (a cell size)."""
+    import shapely
+
+    from meshcore import testing
+    from meshcore.cellsize import SMALL_BLOCKS, finer_for_small_blocks
+    from tests.app.test_lake import lay_out
+
+    ring = np.asarray(testing.channel_network(5, n_branches=12).exterior.coords)[:-1] * 1000.0
+    net = tmp_path / "net.csv"
+    net.write_text("x,y,ring\n" + "\n".join(f"{x:.3f},{y:.3f},shore" for x, y in ring) + "\n")
+    win.lake_ctl.generate_after = False
+    h = float(np.sqrt(shapely.Polygon(ring).area / 3000))
+    lay = lay_out(qtbot, win, net, cell_size=h)
+    finer = finer_for_small_blocks(len(lay.blocks), lay.n_cells, lay.cell_size)
+    assert finer is not None  # 20 blocks of ~158 cells (the CLI's test: the same network at 3000 cells)
+    said = [t for _lv, t in win.messages_panel.messages() if "cells on average" in t]
+    assert len(said) == 1 and f"a cell size of {finer[1]:.4g} m" in said[0] and f"about {SMALL_BLOCKS}" in said[0]
+    h2 = float(np.sqrt(shapely.Polygon(ring).area / finer[0]))
+    assert abs(finer[1] - h2) / h2 < 0.12  # the cell size named gives about the cells named

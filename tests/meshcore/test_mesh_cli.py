@@ -771,7 +771,7 @@ def test_a_layout_of_many_small_blocks_names_the_cells_that_would_give_them_more
     edge-pair target (session 29); the command says so and names a --cells, and leaves the cells
     to the user. A coarse grid of a few blocks gets no such hint."""
     from meshcore import testing
-    from meshcore.cli.mesh_steps import MANY_BLOCKS, SMALL_BLOCKS
+    from meshcore.cellsize import MANY_BLOCKS, SMALL_BLOCKS
 
     net = tmp_path / "net.csv"
     ring = np.asarray(testing.channel_network(5, n_branches=12).exterior.coords)[:-1] * 1000.0
