@@ -161,3 +161,20 @@ def test_the_peninsula_block_no_longer_folds():
     s = lake_metrics(mesh_outline(poly, target_cells=15000), polygon=poly).summary()
     assert s["folded_cells"] == 0  # main: 77, its grid across the headland (shore 18 cells off)
     assert s["hausdorff_cells"] < 1.0
+
+
+def test_regular_layouts_split_a_block_round_a_peninsulas_tip_too():
+    """A regular layout (`.ddb`, `--regular`) kept a block whose lines wrap a peninsula's tip
+    (GSHHG lake 181060, 10 000 cells: 79.6 % of nodes within 3°, a cell of aspect ratio 1 264);
+    split as default layouts split it, 97.1 %."""
+    from meshcore.cli.lakefile import local_frame
+    from meshcore.io import read_points
+    from meshcore.layout.fans import _wraps
+    from meshcore.layout.polygon import water_from_points, water_polygon
+    from tests.conftest import ROOT
+
+    ps, _ = local_frame(read_points(ROOT / "tests" / "data" / "gshhg_g181060.geojson"), "auto")
+    outer, islands = water_from_points(ps)
+    poly, _ = water_polygon(outer, holes=islands)
+    lay = auto_layout(poly, target_cells=10000, multiple=4, regular=True)
+    assert not any(_wraps(p.ring, p.corners, 1.5 * lay.cell_size) for p in lay.pieces)
