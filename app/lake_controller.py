@@ -17,7 +17,7 @@ from PySide6 import QtCore, QtWidgets
 from superqt.utils import create_worker
 
 from meshcore import MeshcoreError
-from meshcore.cellsize import SMALL_BLOCKS, finer_for_small_blocks
+from meshcore.cellsize import SMALL_BLOCKS, finer_for_small_blocks, small_blocks_reason
 
 from .lake import Lake, compute_layout
 from .lake_solve import layout_topology
@@ -243,9 +243,8 @@ class LakeController(QtCore.QObject):
         if finer is not None:  # (meshcore mesh says it too, in --cells)
             self.doc.report(
                 "info",
-                f"layout: {n} blocks of {layout.n_cells // n} cells on average: arms only a few cells across "
-                f"grid less smoothly (edge pairs, angles); a cell size of {finer[1]:.4g} m (about {finer[0]:,} "
-                f"cells) gives each block about {SMALL_BLOCKS}",
+                f"layout: {small_blocks_reason(n, layout.n_cells)}; a cell size of {finer[1]:.4g} m (about "
+                f"{finer[0]:,} cells) gives each block about {SMALL_BLOCKS}",
             )
         kind = " for one index space" if layout.single else ""
         self.win.message(

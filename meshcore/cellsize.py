@@ -10,7 +10,14 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["DEFAULT_CELLS", "MANY_BLOCKS", "SMALL_BLOCKS", "default_cell_size", "finer_for_small_blocks"]
+__all__ = [
+    "DEFAULT_CELLS",
+    "MANY_BLOCKS",
+    "SMALL_BLOCKS",
+    "default_cell_size",
+    "finer_for_small_blocks",
+    "small_blocks_reason",
+]
 
 #: Cells of a lake's default grid: ``cell size = sqrt(water area / DEFAULT_CELLS)`` (a grid a
 #: hydrodynamic model runs in minutes, fine enough to resolve the arms of a lake tens of km long).
@@ -47,3 +54,12 @@ def finer_for_small_blocks(blocks: int, cells: int, cell_size: float) -> tuple[i
         return None
     more = -(-SMALL_BLOCKS * blocks // 1000) * 1000
     return more, float(f"{cell_size * math.sqrt(cells / more):.3g}")
+
+
+def small_blocks_reason(blocks: int, cells: int) -> str:
+    """Why a layout of ``blocks`` blocks and ``cells`` cells that :func:`finer_for_small_blocks`
+    flags grids less smoothly (the words ``meshcore mesh`` and the app share)."""
+    return (
+        f"{blocks} blocks of {cells // blocks} cells on average: arms only a few cells across grid less "
+        "smoothly (edge pairs, angles)"
+    )

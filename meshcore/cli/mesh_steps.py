@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ..cellsize import DEFAULT_CELLS, SMALL_BLOCKS, default_cell_size, finer_for_small_blocks
+from ..cellsize import DEFAULT_CELLS, SMALL_BLOCKS, default_cell_size, finer_for_small_blocks, small_blocks_reason
 from ..errors import InvalidInputError, MeshcoreError
 from .lakefile import in_world
 from .mesh_figure import figure as _figure
@@ -179,10 +179,7 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
     )
     finer = finer_for_small_blocks(n, lay.n_cells, lay.cell_size)
     if finer is not None:
-        say(
-            f"hint: {n} blocks of {lay.n_cells // n} cells on average: arms only a few cells across grid "
-            f"less smoothly (edge pairs, angles); --cells {finer[0]} gives each block about {SMALL_BLOCKS}"
-        )
+        say(f"hint: {small_blocks_reason(n, lay.n_cells)}; --cells {finer[0]} gives each block about {SMALL_BLOCKS}")
     _notes(lay.notes, frame)
     return lay
 
