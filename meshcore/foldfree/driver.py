@@ -132,7 +132,7 @@ EARLY_START = True
 #: the first coarse level (Shasta, 58 ms) and hundreds of SOR sweeps below.  repair() on 79 saved
 #: Winslow grids (8 real lakes at 24 000 nodes, 70 generated one-block shapes at 6000 and 24 000;
 #: session 30, benchmarks/RESULTS.md): 58 repaired either way (one generated network lost, one
-#: gained), CPU -10 % to -20 % on the branched lakes.
+#: gained), CPU -8 % to -16 % on the branched lakes.
 COARSE_SOLVE = False
 
 __all__ = [
