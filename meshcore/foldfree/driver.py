@@ -31,7 +31,7 @@ a failed one gets them back and grows (``r`` doubles) until it covers 30 %
 of the block or, when a coarse start can follow, is :data:`TRANSPLANT` cells
 wide, so one fold that cannot be repaired locally does not drag the
 others along.  For the cells still bad, a *multilevel start*: every second
-grid line gives a coarse grid, which is solved (Winslow) and repaired (the
+grid line of the given grid gives a coarse grid, which is repaired (the
 same steps, recursively); its bilinear prolongation is convex inside every
 convex coarse cell (iso-lines of a bilinear map are straight, so a fine
 corner Jacobian is the bilinear Jacobian times the index steps), and only
@@ -125,6 +125,15 @@ SKIP_TRANSPLANT = ("coarse", "whole")
 #: tries its transplant), otherwise the wider patches and the transplant follow as before.
 #: Session 16, measured in benchmarks/RESULTS.md (real lakes as one block).
 EARLY_START = True
+#: Solve the coarse grid of the multilevel start (every second grid line) for Winslow before it is
+#: repaired.  Off: the coarse grid is the given grid's own lines.  Those lines are a converged
+#: elliptic solution already (the finer one: the given grid, or the level above), and the coarse
+#: grid only starts the finer one; re-solving it on the branched lakes took 104 multigrid cycles at
+#: the first coarse level (Shasta, 58 ms) and hundreds of SOR sweeps below.  repair() on 79 saved
+#: Winslow grids (8 real lakes at 24 000 nodes, 70 generated one-block shapes at 6000 and 24 000;
+#: session 30, benchmarks/RESULTS.md): 58 repaired either way (one generated network lost, one
+#: gained), CPU -8 % to -16 % on the branched lakes.
+COARSE_SOLVE = False
 
 __all__ = [
     "BoundaryCorner",
@@ -469,7 +478,8 @@ def _whole_start(
 def _coarse_start(
     grid: StructuredGrid, skip: bool = True, path: list[str] | None = None
 ) -> tuple[np.ndarray, np.ndarray, bool] | None:
-    """Multilevel start: every second grid line, Winslow + repair there, bilinear prolongation;
+    """Multilevel start: every second grid line (of the grid as it is, see :data:`COARSE_SOLVE`),
+    repaired there, bilinear prolongation;
     ``(x, y, wide)``, ``wide``: the coarse grid's repair was one of :data:`SKIP_TRANSPLANT`
     (``skip``: its coarse levels may skip their transplant; ``path`` gets ``"skip"`` if one did).
 
@@ -479,12 +489,14 @@ def _coarse_start(
     fine cells near the boundary (whose nodes are the true, finer boundary)
     and across coarse-cell edges may need a local repair afterwards.
     """
-    from ..elliptic import solve
-
     ni, nj = grid.cells
     ic = np.unique(np.r_[np.arange(0, ni + 1, 2), ni])
     jc = np.unique(np.r_[np.arange(0, nj + 1, 2), nj])
-    gc = solve(StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)], periodic=grid.periodic))
+    gc = StructuredGrid(grid.x[np.ix_(ic, jc)], grid.y[np.ix_(ic, jc)], periodic=grid.periodic)
+    if COARSE_SOLVE:
+        from ..elliptic import solve
+
+        gc = solve(gc)
     below: list[str] = []
     res = _repair(gc, whole=True, path=below, skip=skip)
     if path is not None and "skip" in below:

@@ -115,7 +115,10 @@ def patches(
         mask = np.ones_like(bad) if whole else _dilate(todo, r, periodic)
         failed = np.zeros_like(bad)
         last = whole or (max_radius is not None and 2 * r > max_radius)
-        for piece in [mask] if whole else _components(mask, periodic):
+        pieces = [mask] if whole else _components(mask, periodic)
+        if give_up_early and last:  # the widest piece first: the likeliest to fail, which ends the call
+            pieces.sort(key=lambda m: -int(m.sum()))
+        for piece in pieces:
             if max_fraction < 1.0 and piece.sum() > max_fraction * piece.size:
                 given_up |= piece & todo
                 if give_up_early:

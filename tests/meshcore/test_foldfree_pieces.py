@@ -219,3 +219,56 @@ def test_the_coarse_start_decides_after_one_round_of_patches(monkeypatch, wide):
     wider = any(r == 4 for r, _ in calls)
     assert wider is not wide
     assert res.ok and not invalid_cells(res.grid.x, res.grid.y).any()
+
+
+COARSE_SHAPES = {
+    # (shape, nodes): the first needs the whole coarse start on the given grid, the second a transplant
+    "network-826003": (lambda: testing.channel_network(826003, n_branches=6), 3000),
+    "estuary-826001": (lambda: testing.estuary(826001), 1500),
+}
+
+
+@pytest.mark.parametrize("name", sorted(COARSE_SHAPES))
+@pytest.mark.parametrize("solve", [False, True])
+def test_the_coarse_start_from_the_grids_own_lines_repairs_as_the_solved_one(monkeypatch, name, solve):
+    # the coarse grids of the multilevel start are every second line of the given grid, not
+    # re-solved (COARSE_SOLVE off); both starts repair these shapes
+    import meshcore.elliptic
+    import meshcore.foldfree.driver as dr
+
+    make, nodes = COARSE_SHAPES[name]
+    g = one_block(make(), nodes)
+    monkeypatch.setattr(dr, "COARSE_SOLVE", solve)
+    calls = []
+    real = meshcore.elliptic.solve
+    monkeypatch.setattr(meshcore.elliptic, "solve", lambda grid, *a, **k: calls.append(1) or real(grid, *a, **k))
+    path: list[str] = []
+    res = dr._repair(g, whole=False, path=path)
+    assert res.ok and res.invalid_before > 0 and not invalid_cells(res.grid.x, res.grid.y).any()
+    assert path[-1] in ("coarse", "transplant")
+    assert bool(calls) == solve
+
+
+def test_a_transplant_that_gives_up_early_fails_as_the_full_one():
+    # patches(give_up_early=True) tries the last round's widest piece first; it fails where the
+    # patches with every piece tried fail, and repairs the same grid where they succeed
+    from meshcore.foldfree.minimise import patches
+
+    ni, nj = 40, 30
+    xs, ys = np.meshgrid(np.arange(ni + 1.0), np.arange(nj + 1.0), indexing="ij")
+    for broken in (False, True):  # kinks that can be undone; and two border nodes swapped, which cannot
+        x, y = xs.copy(), ys.copy()
+        for i, j in ((8, 8), (30, 20), (20, 12), (21, 13)):
+            x[i, j] += 1.6
+        if broken:
+            x[5, 0], x[6, 0] = x[6, 0], x[5, 0]
+        bad = invalid_cells(x, y)
+        ex = np.zeros((ni, nj), np.uint8)
+        kw = {"radius": 2, "max_fraction": 0.3, "max_radius": 8, "tolerance": 1e-4, "max_sweeps": 100}
+        a = (x.copy(), y.copy())
+        b = (x.copy(), y.copy())
+        ok_full = patches(*a, bad, ex, **kw)[0]
+        ok_early = patches(*b, bad, ex, give_up_early=True, **kw)[0]
+        assert bad.any() and ok_full == ok_early == (not broken)
+        if ok_full:
+            assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
