@@ -424,15 +424,20 @@ def _joined_islands(water: Any, h: float) -> Any:
 
 def without_spikes(poly: Any, width: float) -> Any:
     """``poly`` without its spikes of water or land narrower than ``width`` (a morphological opening
-    and closing with mitred corners), or None where that changes nothing or more than the spikes
-    (splits the water, joins an island to the shore, or moves 1 % of its area).  The layout smooths
-    them out (:func:`meshcore.layout.polygon.without_slivers`, half a cell), the shore distance
-    measures them apart (:func:`coverage`)."""
+    and closing with mitred corners, what they change kept within ``width / 2`` of the shore), or
+    None where that changes nothing or more than the spikes (splits the water, joins an island to
+    the shore, or moves 1 % of its area).  The layout smooths them out
+    (:func:`meshcore.layout.polygon.without_slivers`, half a cell), the shore distance measures
+    them apart (:func:`coverage`)."""
     if width <= 0:
         return None
     r = 0.5 * width
     opts = {"join_style": "mitre", "mitre_limit": 10.0}
     clean = poly.buffer(-r, **opts).buffer(r, **opts).buffer(r, **opts).buffer(-r, **opts)
+    changed = poly.symmetric_difference(clean)
+    cut = _within_reach(poly, clean, changed, r)
+    if cut is not clean:
+        clean, changed = cut, poly.symmetric_difference(cut)
     if (
         clean.geom_type != "Polygon"
         or len(clean.interiors) != len(poly.interiors)
@@ -440,9 +445,55 @@ def without_spikes(poly: Any, width: float) -> Any:
         or not clean.is_valid
     ):
         return None
-    if poly.symmetric_difference(clean).area <= 1e-9 * poly.area:
+    if changed.area <= 1e-9 * poly.area:
         return None
     return clean
+
+
+#: How far beyond ``r`` a point :func:`without_spikes` adds or takes may lie from the water or the
+#: land before it is given back: rounding, and the mitres' corners within a disk's reach.
+REACH_SLACK = 0.02
+
+
+def _within_reach(poly: Any, clean: Any, changed: Any, r: float) -> Any:
+    """``clean`` (``poly`` opened and closed by ``r``; ``changed``: the symmetric difference of the
+    two) with what it changed kept within ``r`` of the shore.
+
+    A closing with a disk of radius ``r`` adds only points within ``r`` of the water (the disk
+    centred on an added point meets the water), an opening takes only points within ``r`` of the
+    land.  The mitred buffers of :func:`without_spikes` keep the shore's corners sharp, but at a
+    sharp corner beside a notch their mitres reach farther: on a held-out lake a spike of land
+    3.3 ``r`` long became water (the grid covered it, 0.76 cells beyond the shore).  Each piece
+    whose outline strays beyond the reach is cut back to it: the part farther than the reach from
+    the water is land again (or, for a piece the opening took, farther from the land is water)."""
+    import shapely
+
+    reach = (1.0 + REACH_SLACK) * r
+    parts = [g for g in shapely.get_parts(changed) if g.geom_type == "Polygon" and g.area > 0.0]
+    if not parts:
+        return clean
+    # how far each piece's outline strays from the shore (its farthest vertex: the pieces are
+    # narrow, a mitre's reach ends in a vertex); one nearest-segment query for all
+    rim, which = shapely.get_coordinates(shapely.get_exterior_ring(parts), return_index=True)
+    stray = np.zeros(len(parts))
+    np.maximum.at(stray, which, _distances(rim, poly.boundary))
+    out = clean
+    for k in np.flatnonzero(stray > reach):
+        g = parts[k]
+        inside = g.point_on_surface()
+        added = not poly.contains(inside)  # land the closing covers, else water the opening takes
+        x0, y0, x1, y1 = g.bounds
+        # the water (land added) or the land (water taken) near the piece: the box lies two
+        # reaches beyond the piece, so its own rim is never within reach of it
+        near = shapely.box(x0, y0, x1, y1).buffer(2.0 * reach, join_style="mitre")
+        side = near.intersection(poly) if added else near.difference(poly)
+        far = g.difference(side.buffer(reach))
+        if not far.is_empty and far.area > 0.0:
+            # a hair wider: where the piece's rim runs on along the shore's line (a mitre beyond
+            # a corner), the cut alone left a sliver of no width out to the mitre's tip
+            far = far.buffer(1e-6 * r, join_style="mitre")
+            out = out.difference(far) if added else out.union(far)
+    return out
 
 
 def _spikes(poly: Any, h: float, slack: float = 0.0) -> Any:

@@ -43,3 +43,41 @@ def test_a_z_shaped_sliver_is_measured_apart_like_a_spike():
         got = lake_metrics(mesh_outline(poly, cell_size=h), polygon=poly, cell_size=h).coverage
         assert got.hausdorff_as_given >= 0.4 * frac * h  # the teeth are there, as given
         assert got.hausdorff <= 0.3 * h, (frac, length, chirality, got.hausdorff / h, got.where)
+
+
+def _stray(poly, clean, h: float) -> float:
+    """How far, in quarter cells, the farthest vertex ``clean`` added or took lies from the shore."""
+    d = poly.symmetric_difference(clean)
+    return float(shapely.distance(shapely.points(shapely.get_coordinates(d)), poly.boundary).max()) / (0.25 * h)
+
+
+def test_a_mitre_beside_a_notch_does_not_carry_the_water_onto_land():
+    """A shore that turns back on itself twice (a land wedge of 26° beside a water corner of 45°,
+    as on a GSHHG lake): the mitred closing drew a spike of water 3.2 r out over the land, and the
+    grid covered it 0.76 cells beyond the shore.  A closing with a disk adds nothing farther than
+    r from the water."""
+    ring = [(-4080, -13530), (-3790, -14005), (-3470, -14357), (-3555, -14323), (-3515, -14417)]
+    ring += [(-2850, -14810), (0, -14810), (0, -11000), (-4080, -11000)]
+    p = shapely.Polygon(ring)
+    h = 206.26
+    clean = cv.without_spikes(p, 0.5 * h)
+    assert clean is not None and clean.is_valid
+    assert _stray(p, clean, h) <= 1.0 + cv.REACH_SLACK + 1e-3
+
+
+def test_what_the_spikes_rule_changes_stays_within_its_reach_of_the_shore():
+    """Sharp tips and notches of generated shores (mitres clipped at their limit): whatever the
+    opening and closing of half a cell take or add lies within a quarter cell of the shore."""
+    for poly, cells in [
+        (testing.dendritic(501703), 15000),
+        (testing.dendritic(503703), 10000),
+        (testing.headlands(502605, n=6), 3000),
+        (testing.small_islands(502850, n_islands=10), 15000),
+        (testing.channel_network(503003, n_branches=6), 3000),
+    ]:
+        h = math.sqrt(poly.area / cells)
+        clean = cv.without_spikes(poly, 0.5 * h)
+        if clean is None:
+            continue
+        assert clean.is_valid and len(clean.interiors) == len(poly.interiors)
+        assert _stray(poly, clean, h) <= 1.0 + cv.REACH_SLACK + 1e-3, (poly, cells)
