@@ -31,7 +31,7 @@ from .grid import SolveInfo
 if TYPE_CHECKING:
     from .elliptic import SolverProgress
 
-__all__ = ["coarse_reading", "iterate_layout", "mesh_layout", "mesh_outline"]
+__all__ = ["CoarseReadings", "coarse_reading", "iterate_layout", "mesh_layout", "mesh_outline"]
 
 
 def _shore_rings(poly, step: float) -> list[np.ndarray]:
@@ -144,17 +144,84 @@ def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
 
 
+class CoarseReadings:
+    """:func:`coarse_reading` that holds each layout's solve after its coarse level: the grid of the
+    layout then chosen (:meth:`mesh`) goes on from there instead of solving that level again (the
+    same steps, the same grid; the layout's first reading and its grid were two solves of its coarse
+    level).  ``levels`` as :func:`mesh_layout` will be given them.
+
+    >>> from meshcore import testing
+    >>> from meshcore.layout import auto_layout
+    >>> readings = CoarseReadings(levels=2)
+    >>> lay = auto_layout(testing.y_junction(), target_cells=800, multiple=4, reading=readings)
+    >>> held, fresh = readings.mesh(lay), mesh_layout(lay, levels=2)
+    >>> all(np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y) for a, b in zip(held.grids, fresh.grids))
+    True
+    """
+
+    def __init__(self, levels: int | None = None) -> None:
+        self.levels = levels
+        self._held: list[tuple[Any, Any, Any, list]] = []  # (layout, paused solve, coarse level, callback box)
+
+    def __call__(self, layout) -> tuple[float, float]:
+        """:func:`coarse_reading` of ``layout``, its solve held."""
+        first: list = []
+        box: list = [None]  # the callback of :meth:`mesh`, for the levels after the first
+
+        def level(kind: str, value: Any) -> Any:
+            if kind == "level" and not first:
+                first.append(value)
+                return "pause"
+            return box[0](kind, value) if box[0] is not None else None
+
+        gen = iterate_layout(layout, levels=self.levels, level_callback=level, every=None)
+        try:
+            next(gen)
+        except StopIteration as fin:  # one level: nothing to hold
+            grids = fin.value.grids
+        else:
+            grids = first[0][1].grids
+            self._held.append((layout, gen, first[0], box))
+        return _reading(grids)
+
+    def mesh(self, layout, *, callback: Callable[[str, Any], Any] | None = None, **options: Any):
+        """:func:`mesh_layout` of ``layout`` (``levels`` as given to this object); a solve held for it
+        goes on (only without other ``options``: the readings were solved with the defaults)."""
+        from ._generators import drain
+
+        for k, (lay, gen, done, box) in enumerate(self._held):
+            if not options and _same_layout(lay, layout):
+                del self._held[k]
+                if callback is not None:
+                    box[0] = callback
+                    if callback("level", done) == "stop":
+                        return drain(gen, lambda _: "stop")
+                return drain(gen)
+        return mesh_layout(layout, levels=self.levels, callback=callback, **options)
+
+
+def _same_layout(a, b) -> bool:
+    """``b`` is ``a``, or ``a`` with other ``details`` (:func:`dataclasses.replace` keeps the other fields)."""
+    import dataclasses
+
+    return a is b or all(getattr(a, f.name) is getattr(b, f.name) for f in dataclasses.fields(a) if f.name != "details")
+
+
+def _reading(grids) -> tuple[float, float]:
+    from .quality import lake_metrics
+
+    s = lake_metrics(list(grids)).summary()
+    d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
+    return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
+
+
 def coarse_reading(layout) -> tuple[float, float]:
     """The mean deviation from 90° (degrees) of the block-interior nodes of ``layout``'s grid on
     the coarsest level of :func:`mesh_layout` (cells ``layout.multiple`` × the size), and the
     largest cross-interface cell-area ratio there: what :func:`~meshcore.layout.auto_layout`
     (``reading=``) compares layouts drawn at neighbouring scales by (:mod:`meshcore.layout.choice`)."""
-    from .quality import lake_metrics
-
     grids = mesh_layout(layout, callback=lambda kind, _: "stop" if kind == "level" else None).grids
-    s = lake_metrics(list(grids)).summary()
-    d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
-    return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
+    return _reading(grids)
 
 
 def iterate_layout(
@@ -201,7 +268,8 @@ def iterate_layout(
     ``spacing``: then the edge lengths along grid lines smoothed in block interiors, guarded
     (:func:`~meshcore.orthogonal.spacing.smooth_spacing`; off by default, see there).
     ``level_callback(kind, value)`` is called with ``("level", (level, result))`` as each level
-    ends (returning ``"stop"`` ends the solve there, as ``"stop"`` sent does) and
+    ends (returning ``"stop"`` ends the solve there, as ``"stop"`` sent does; ``"pause"`` yields
+    the level's grids, then goes on or stops as told by what is sent) and
     ``("equalize", patches)`` after the equalize step (the patches it kept).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
@@ -286,7 +354,13 @@ def iterate_layout(
             res = fin.value
         grids = list(res.grids)
         total += res.sweeps
-        if level_callback is not None and level_callback("level", (lev, res)) == "stop":
+        said = level_callback("level", (lev, res)) if level_callback is not None else None
+        if said == "pause":  # held here (:class:`CoarseReadings`); what is sent next goes on or stops
+            held = time.perf_counter()
+            change = history[-1][1] if history else 0.0
+            said = yield SolverProgress(total, change, tol, None, held - t0, "orthogonal", tuple(history), tuple(grids))
+            t0 += time.perf_counter() - held  # (the elapsed time: the solve's own)
+        if said == "stop":
             stopped = True  # (no more levels wanted: the grids of this one)
         if stopped:
             break
@@ -413,6 +487,7 @@ def mesh_outline(
         )
     if parts is not None:
         raise InvalidInputError("parts= is for water in several parts (a MultiPolygon or a list of Polygons)")
+    readings = CoarseReadings(levels=levels)  # the chosen layout's coarse level solved once
     lay = auto_layout(
         outline,
         holes=holes,
@@ -422,9 +497,9 @@ def mesh_outline(
         regular=regular,
         single=single,
         options=layout_options or LayoutOptions(),
-        reading=coarse_reading,
+        reading=readings,
     )
-    mb = mesh_layout(lay, levels=levels, **options)
+    mb = readings.mesh(lay, **options)
     from .quality.lake import block_metrics
 
     if mb.notes:

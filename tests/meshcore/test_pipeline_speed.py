@@ -2,7 +2,8 @@
 
 Each reference below is the code as it was before (the test oracle): the nearest shore ring of a cut
 end measured only where its bounding box could be nearer (:func:`meshcore.multiblock.outline._nearest_ring`),
-an island's second cut read only up to the candidate taken (:func:`meshcore.layout.regions._first_apart`).
+an island's second cut read only up to the candidate taken (:func:`meshcore.layout.regions._first_apart`),
+and the chosen layout's grid going on from its coarse reading (:class:`meshcore.lakegrid.CoarseReadings`).
 """
 
 from __future__ import annotations
@@ -10,7 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from meshcore.layout import regions
+from meshcore import testing
+from meshcore.lakegrid import CoarseReadings, coarse_reading, mesh_layout, mesh_outline
+from meshcore.layout import auto_layout, regions
 from meshcore.multiblock.outline import _nearest_ring
 from meshcore.segments import nearest_on_polyline
 
@@ -80,3 +83,44 @@ def test_first_apart_takes_what_the_full_lists_took(seed, monkeypatch):
     got = regions._first_apart(more, None, None, 1.0, [], away)
     assert got is want
     assert len(calls) <= full
+
+
+def _grids_equal(a, b) -> bool:
+    return len(a.grids) == len(b.grids) and all(
+        np.array_equal(g.x, h.x) and np.array_equal(g.y, h.y) for g, h in zip(a.grids, b.grids, strict=True)
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "poly",
+    [testing.lake_with_islands(5, n_islands=3), testing.channel_network(3, n_branches=4)],
+    ids=["islands", "net"],
+)
+def test_held_coarse_solve_gives_the_grid_of_a_fresh_one(poly):
+    """The layout and grid of :func:`mesh_outline` (the chosen layout's coarse level held) are those of
+    the plain steps: :func:`auto_layout` with :func:`coarse_reading`, then :func:`mesh_layout`; a
+    callback sees the same levels with the same grids."""
+    lay = auto_layout(poly, target_cells=2000, multiple=4, reading=coarse_reading)
+    seen_fresh, seen_held = [], []
+
+    def log(into):
+        def cb(kind, value):
+            into.append((kind, value[0], [g.x.copy() for g in value[1].grids]) if kind == "level" else (kind, value))
+
+        return cb
+
+    fresh = mesh_layout(lay, levels=2, callback=log(seen_fresh))
+    readings = CoarseReadings(levels=2)
+    lay2 = auto_layout(poly, target_cells=2000, multiple=4, reading=readings)
+    assert lay2.blocks == lay.blocks
+    n = len(readings._held)
+    held = readings.mesh(lay2, callback=log(seen_held))
+    assert len(readings._held) == n - 1  # the held solve went on
+    assert _grids_equal(held, fresh)
+    assert held.info.iterations == fresh.info.iterations and held.info.message == fresh.info.message
+    assert [s[:2] for s in seen_held] == [s[:2] for s in seen_fresh]
+    for a, b in zip(seen_held, seen_fresh, strict=True):
+        if a[0] == "level":
+            assert all(np.array_equal(x, y) for x, y in zip(a[2], b[2], strict=True))
+    assert _grids_equal(mesh_outline(poly, target_cells=2000), fresh)
