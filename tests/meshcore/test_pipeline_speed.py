@@ -3,7 +3,8 @@
 Each reference below is the code as it was before (the test oracle): the nearest shore ring of a cut
 end measured only where its bounding box could be nearer (:func:`meshcore.multiblock.outline._nearest_ring`),
 an island's second cut read only up to the candidate taken (:func:`meshcore.layout.regions._first_apart`),
-and the chosen layout's grid going on from its coarse reading (:class:`meshcore.lakegrid.CoarseReadings`).
+the chosen layout's grid going on from its coarse reading (:class:`meshcore.lakegrid.CoarseReadings`),
+and the block SOR engine's copies as one gather and one scatter a sweep (:mod:`meshcore.multiblock.sor`).
 """
 
 from __future__ import annotations
@@ -124,3 +125,95 @@ def test_held_coarse_solve_gives_the_grid_of_a_fresh_one(poly):
         if a[0] == "level":
             assert all(np.array_equal(x, y) for x, y in zip(a[2], b[2], strict=True))
     assert _grids_equal(mesh_outline(poly, target_cells=2000), fresh)
+
+
+class _BlockEngineRef:
+    """The block SOR engine as it was: each block's own array, two copies per block a sweep."""
+
+    def __init__(self, x, y, m) -> None:
+        from meshcore.elliptic import _kernels as bk
+
+        self.bk = bk
+        self.x, self.y = x, y
+        self.e = np.zeros((0, 0))
+        k0 = m.n_interior
+        self.args = (m.nodes[k0:], m.nbr[k0:], m.irr_nodes, m.irr_ptr, m.irr_ring)
+        self.bx = [np.ascontiguousarray(x[ids]) for ids in m.ids]
+        self.by = [np.ascontiguousarray(y[ids]) for ids in m.ids]
+        needed = np.zeros(m.n_nodes, dtype=bool)
+        needed[self.args[1].ravel()] = True
+        needed[m.irr_ring] = True
+        self.ring, self.frame = [], []
+        for ids in m.ids:
+            flat = ids.ravel()
+            inner = np.zeros(ids.shape, dtype=bool)
+            inner[1:-1, 1:-1] = True
+            li = np.flatnonzero(inner.ravel() & needed[flat])
+            self.ring.append((li, flat[li]))
+            fr = np.flatnonzero(~inner.ravel())
+            self.frame.append((fr, flat[fr]))
+        self.ids = m.ids
+
+    def sweep(self, omega: float) -> float:
+        from meshcore.multiblock import _kernels
+
+        d = 0.0
+        for bx, by, (li, gi) in zip(self.bx, self.by, self.ring, strict=True):
+            if bx.shape[0] > 2 and bx.shape[1] > 2:
+                d = max(d, self.bk.sweep4(bx, by, self.e, self.e, omega, False))
+            self.x[gi] = bx.reshape(-1)[li]
+            self.y[gi] = by.reshape(-1)[li]
+        d = max(d, float(_kernels.table_sweep(self.x, self.y, *self.args, omega)))
+        for bx, by, (fr, gf) in zip(self.bx, self.by, self.frame, strict=True):
+            bx.reshape(-1)[fr] = self.x[gf]
+            by.reshape(-1)[fr] = self.y[gf]
+        return d
+
+    def residual(self) -> float:
+        from meshcore.multiblock import _kernels
+
+        r = float(_kernels.table_residual(self.x, self.y, *self.args))
+        for bx, by in zip(self.bx, self.by, strict=True):
+            r = max(r, float(self.bk.jacobi_residual(bx, by, self.e, self.e, False)))
+        return r
+
+    def save(self):
+        return ([b.copy() for b in self.bx], [b.copy() for b in self.by], self.x.copy(), self.y.copy())
+
+    def restore(self, saved) -> None:
+        for b, s in zip(self.bx, saved[0], strict=True):
+            b[...] = s
+        for b, s in zip(self.by, saved[1], strict=True):
+            b[...] = s
+        self.x[...] = saved[2]
+        self.y[...] = saved[3]
+
+    def finish(self) -> None:
+        for bx, by, ids in zip(self.bx, self.by, self.ids, strict=True):
+            self.x[ids] = bx
+            self.y[ids] = by
+
+    def grids(self, ids):
+        return [(bx.copy(), by.copy()) for bx, by in zip(self.bx, self.by, strict=True)]
+
+
+@pytest.mark.parametrize(
+    "poly",
+    [testing.lake_with_islands(7, n_islands=4), testing.channel_network(11, n_branches=6), testing.y_junction()],
+    ids=["islands", "net", "y"],
+)
+def test_block_sor_engine_gives_the_plain_engines_grids(poly, monkeypatch):
+    """The start solve of a layout's coarse level (omega reduced on the way or not) with the block
+    engine, bit for bit as the engine that kept each block's array apart; its sweeps and residuals too."""
+    from meshcore.multiblock import solve_multiblock, sor
+    from meshcore.multiblock import solver as mb_solver
+    from meshcore.orthogonal.levels import coarsen_topology
+
+    lay = auto_layout(poly, target_cells=1500, multiple=4)
+    for topo in (lay.topology(), coarsen_topology(lay.topology(), 4)):
+        got = solve_multiblock(topo, mode="smooth", engine="blocks")
+        monkeypatch.setattr(mb_solver, "sor_engine", lambda x, y, m, engine="blocks": _BlockEngineRef(x, y, m))
+        want = solve_multiblock(topo, mode="smooth", engine="blocks")
+        monkeypatch.setattr(mb_solver, "sor_engine", sor.sor_engine)
+        assert _grids_equal(got, want)
+        assert got.info.iterations == want.info.iterations and got.info.message == want.info.message
