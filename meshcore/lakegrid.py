@@ -133,28 +133,36 @@ def escaped(grids: list, g0: list) -> bool:
     return False
 
 
-def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **options: Any):
+def mesh_layout(
+    layout, *, callback: Callable[[str, Any], Any] | None = None, readings: CoarseReadings | None = None, **options: Any
+):
     """The orthogonal multiblock grid of a :class:`~meshcore.layout.Layout`.
 
     The options are those of :func:`iterate_layout`; ``callback("level", (level, result))``
-    is called after each level (coarse first).
+    is called after each level (coarse first).  ``readings``: the :class:`CoarseReadings` that
+    chose ``layout`` (:func:`~meshcore.layout.auto_layout`'s ``reading``): its solve held after
+    the coarse level goes on, the same grid without solving that level again.
     """
     from ._generators import drain
 
+    if readings is not None:
+        mb = readings.resumed(layout, callback, options)
+        if mb is not None:
+            return mb
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
 
 
 class CoarseReadings:
     """:func:`coarse_reading` that holds each layout's solve after its coarse level: the grid of the
-    layout then chosen (:meth:`mesh`) goes on from there instead of solving that level again (the
-    same steps, the same grid; the layout's first reading and its grid were two solves of its coarse
-    level).  ``levels`` as :func:`mesh_layout` will be given them.
+    layout then chosen (``mesh_layout(layout, readings=...)``) goes on from there instead of solving
+    that level again (the same steps, the same grid; the layout's first reading and its grid were
+    two solves of its coarse level).  ``levels``: as :func:`mesh_layout` will be given them.
 
     >>> from meshcore import testing
     >>> from meshcore.layout import auto_layout
     >>> readings = CoarseReadings(levels=2)
     >>> lay = auto_layout(testing.y_junction(), target_cells=800, multiple=4, reading=readings)
-    >>> held, fresh = readings.mesh(lay), mesh_layout(lay, levels=2)
+    >>> held, fresh = mesh_layout(lay, levels=2, readings=readings), mesh_layout(lay, levels=2)
     >>> all(np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y) for a, b in zip(held.grids, fresh.grids))
     True
     """
@@ -184,20 +192,24 @@ class CoarseReadings:
             self._held.append((layout, gen, first[0], box))
         return _reading(grids)
 
-    def mesh(self, layout, *, callback: Callable[[str, Any], Any] | None = None, **options: Any):
-        """:func:`mesh_layout` of ``layout`` (``levels`` as given to this object); a solve held for it
-        goes on (only without other ``options``: the readings were solved with the defaults)."""
-        from ._generators import drain
-
+    def resumed(self, layout, callback: Callable[[str, Any], Any] | None, options: dict[str, Any]):
+        """The grid of ``layout`` from its held solve (``callback`` told of its coarse level first), or
+        None: none held for it, or ``options`` (of :func:`mesh_layout`) other than ``levels`` as
+        given to this object (the readings were solved with the defaults)."""
+        if options != {"levels": self.levels}:
+            return None
         for k, (lay, gen, done, box) in enumerate(self._held):
-            if not options and _same_layout(lay, layout):
+            if _same_layout(lay, layout):
                 del self._held[k]
-                if callback is not None:
-                    box[0] = callback
-                    if callback("level", done) == "stop":
-                        return drain(gen, lambda _: "stop")
-                return drain(gen)
-        return mesh_layout(layout, levels=self.levels, callback=callback, **options)
+                box[0] = callback
+                said = callback("level", done) if callback is not None else None
+                try:
+                    gen.send("stop" if said == "stop" else None)  # (no more yields: it runs to the end)
+                    while True:
+                        gen.send(None)
+                except StopIteration as fin:
+                    return fin.value
+        return None
 
 
 def _same_layout(a, b) -> bool:
@@ -499,7 +511,7 @@ def mesh_outline(
         options=layout_options or LayoutOptions(),
         reading=readings,
     )
-    mb = readings.mesh(lay, **options)
+    mb = mesh_layout(lay, levels=levels, readings=readings, **options)
     from .quality.lake import block_metrics
 
     if mb.notes:

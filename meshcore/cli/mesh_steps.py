@@ -203,9 +203,7 @@ def _grid(lay, say: _Say, readings: Any = None):
         scale = f"cells ÷ {f}" if f > 1 else "full"
         say(f"grid level {lev + 1}/{n_levels} ({scale}, {cells:,} cells): {res.sweeps} sweeps, {say.lap():.1f} s")
 
-    if readings is not None:
-        return readings.mesh(lay, callback=level)
-    return mesh_layout(lay, levels=LEVELS, callback=level)
+    return mesh_layout(lay, levels=LEVELS, callback=level, readings=readings)
 
 
 # ------------------------------------------------------------------ the command

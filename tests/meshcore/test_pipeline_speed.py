@@ -116,7 +116,7 @@ def test_held_coarse_solve_gives_the_grid_of_a_fresh_one(poly):
     lay2 = auto_layout(poly, target_cells=2000, multiple=4, reading=readings)
     assert lay2.blocks == lay.blocks
     n = len(readings._held)
-    held = readings.mesh(lay2, callback=log(seen_held))
+    held = mesh_layout(lay2, levels=2, callback=log(seen_held), readings=readings)
     assert len(readings._held) == n - 1  # the held solve went on
     assert _grids_equal(held, fresh)
     assert held.info.iterations == fresh.info.iterations and held.info.message == fresh.info.message
@@ -125,6 +125,15 @@ def test_held_coarse_solve_gives_the_grid_of_a_fresh_one(poly):
         if a[0] == "level":
             assert all(np.array_equal(x, y) for x, y in zip(a[2], b[2], strict=True))
     assert _grids_equal(mesh_outline(poly, target_cells=2000), fresh)
+    readings = CoarseReadings(levels=2)  # a callback that stops at the coarse level: that level's grid
+    lay3 = auto_layout(poly, target_cells=2000, multiple=4, reading=readings)
+
+    def stop(kind, value):
+        return "stop" if kind == "level" else None
+
+    got = mesh_layout(lay3, levels=2, callback=stop, readings=readings)
+    want = mesh_layout(lay, levels=2, callback=stop)
+    assert _grids_equal(got, want) and got.info.message == want.info.message == "stopped"
 
 
 class _BlockEngineRef:
