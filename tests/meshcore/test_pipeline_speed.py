@@ -9,12 +9,15 @@ and the block SOR engine's copies as one gather and one scatter a sweep (:mod:`m
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
 from meshcore import testing
 from meshcore.lakegrid import CoarseReadings, coarse_reading, mesh_layout, mesh_outline
 from meshcore.layout import auto_layout, regions
+from meshcore.multiblock import sor
 from meshcore.multiblock.outline import _nearest_ring
 from meshcore.segments import nearest_on_polyline
 
@@ -136,32 +139,22 @@ def test_held_coarse_solve_gives_the_grid_of_a_fresh_one(poly):
     assert _grids_equal(got, want) and got.info.message == want.info.message == "stopped"
 
 
-class _BlockEngineRef:
-    """The block SOR engine as it was: each block's own array, two copies per block a sweep."""
+class _BlockEngineRef(sor._BlockEngine):
+    """The block SOR engine as it was: each block's own array, two copies per block a sweep (its
+    residual, finish and grids, which read the block arrays, are the engine's)."""
 
     def __init__(self, x, y, m) -> None:
-        from meshcore.elliptic import _kernels as bk
-
-        self.bk = bk
-        self.x, self.y = x, y
-        self.e = np.zeros((0, 0))
-        k0 = m.n_interior
-        self.args = (m.nodes[k0:], m.nbr[k0:], m.irr_nodes, m.irr_ptr, m.irr_ring)
+        super().__init__(x, y, m)  # the kernels, the tables and which nodes each sweep copies
         self.bx = [np.ascontiguousarray(x[ids]) for ids in m.ids]
         self.by = [np.ascontiguousarray(y[ids]) for ids in m.ids]
-        needed = np.zeros(m.n_nodes, dtype=bool)
-        needed[self.args[1].ravel()] = True
-        needed[m.irr_ring] = True
-        self.ring, self.frame = [], []
-        for ids in m.ids:
-            flat = ids.ravel()
-            inner = np.zeros(ids.shape, dtype=bool)
-            inner[1:-1, 1:-1] = True
-            li = np.flatnonzero(inner.ravel() & needed[flat])
-            self.ring.append((li, flat[li]))
-            fr = np.flatnonzero(~inner.ravel())
-            self.frame.append((fr, flat[fr]))
-        self.ids = m.ids
+        start = np.cumsum([0] + [ids.size for ids in m.ids])
+
+        def per_block(pair):
+            at, node = pair
+            inside = [(at >= a) & (at < b) for a, b in itertools.pairwise(start)]
+            return [(at[k] - a, node[k]) for a, k in zip(start, inside, strict=False)]
+
+        self.ring, self.frame = per_block(self.ring), per_block(self.frame)
 
     def sweep(self, omega: float) -> float:
         from meshcore.multiblock import _kernels
@@ -178,14 +171,6 @@ class _BlockEngineRef:
             by.reshape(-1)[fr] = self.y[gf]
         return d
 
-    def residual(self) -> float:
-        from meshcore.multiblock import _kernels
-
-        r = float(_kernels.table_residual(self.x, self.y, *self.args))
-        for bx, by in zip(self.bx, self.by, strict=True):
-            r = max(r, float(self.bk.jacobi_residual(bx, by, self.e, self.e, False)))
-        return r
-
     def save(self):
         return ([b.copy() for b in self.bx], [b.copy() for b in self.by], self.x.copy(), self.y.copy())
 
@@ -197,14 +182,6 @@ class _BlockEngineRef:
         self.x[...] = saved[2]
         self.y[...] = saved[3]
 
-    def finish(self) -> None:
-        for bx, by, ids in zip(self.bx, self.by, self.ids, strict=True):
-            self.x[ids] = bx
-            self.y[ids] = by
-
-    def grids(self, ids):
-        return [(bx.copy(), by.copy()) for bx, by in zip(self.bx, self.by, strict=True)]
-
 
 @pytest.mark.parametrize(
     "poly",
@@ -214,7 +191,7 @@ class _BlockEngineRef:
 def test_block_sor_engine_gives_the_plain_engines_grids(poly, monkeypatch):
     """The start solve of a layout's coarse level (omega reduced on the way or not) with the block
     engine, bit for bit as the engine that kept each block's array apart; its sweeps and residuals too."""
-    from meshcore.multiblock import solve_multiblock, sor
+    from meshcore.multiblock import solve_multiblock
     from meshcore.multiblock import solver as mb_solver
     from meshcore.orthogonal.levels import coarsen_topology
 
