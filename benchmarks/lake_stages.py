@@ -31,11 +31,15 @@ ROOT = Path(__file__).resolve().parent.parent
 #: summed over its steps.
 STAGES = (
     ("layout: skeleton", "meshcore.layout.build", "skeleton"),
+    ("layout: chords", "meshcore.layout.build", "place_chords"),
+    ("layout: regions (island cuts)", "meshcore.layout.build", "partition"),
     ("layout: splits (best_split)", "meshcore.layout.build", "best_split"),
+    ("layout: fans split (unfan)", "meshcore.layout.build", "unfan"),
     ("layout: pieces (skeleton, chords, regions, splits, corners)", "meshcore.layout", "layout_pieces"),
     ("layout: cell counts (MILP)", "meshcore.layout", "block_counts"),  # regular layouts
     ("layout: cell counts (MILP)", "meshcore.layout.tipsplit", "block_counts"),  # the others
     ("layout: case check (topology)", "meshcore.layout", "_check_case"),
+    ("layout: coarse readings (choice of scale)", "meshcore.lakegrid", "coarse_reading"),
     ("layout, all", "meshcore.layout", "auto_layout"),
     ("coarse topologies", "meshcore.orthogonal.levels", "coarsen_topology"),
     ("start grid", "meshcore.lakegrid", "_start"),

@@ -31,7 +31,7 @@ from .grid import SolveInfo
 if TYPE_CHECKING:
     from .elliptic import SolverProgress
 
-__all__ = ["coarse_reading", "iterate_layout", "mesh_layout", "mesh_outline"]
+__all__ = ["CoarseReadings", "coarse_reading", "iterate_layout", "mesh_layout", "mesh_outline"]
 
 
 def _shore_rings(poly, step: float) -> list[np.ndarray]:
@@ -133,15 +133,98 @@ def escaped(grids: list, g0: list) -> bool:
     return False
 
 
-def mesh_layout(layout, *, callback: Callable[[str, Any], Any] | None = None, **options: Any):
+def mesh_layout(
+    layout, *, callback: Callable[[str, Any], Any] | None = None, readings: CoarseReadings | None = None, **options: Any
+):
     """The orthogonal multiblock grid of a :class:`~meshcore.layout.Layout`.
 
     The options are those of :func:`iterate_layout`; ``callback("level", (level, result))``
-    is called after each level (coarse first).
+    is called after each level (coarse first).  ``readings``: the :class:`CoarseReadings` that
+    chose ``layout`` (:func:`~meshcore.layout.auto_layout`'s ``reading``): its solve held after
+    the coarse level goes on, the same grid without solving that level again.
     """
     from ._generators import drain
 
+    if readings is not None:
+        mb = readings.resumed(layout, callback, options)
+        if mb is not None:
+            return mb
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
+
+
+class CoarseReadings:
+    """:func:`coarse_reading` that holds each layout's solve after its coarse level: the grid of the
+    layout then chosen (``mesh_layout(layout, readings=...)``) goes on from there instead of solving
+    that level again (the same steps, the same grid; the layout's first reading and its grid were
+    two solves of its coarse level).  ``levels``: as :func:`mesh_layout` will be given them.
+
+    >>> from meshcore import testing
+    >>> from meshcore.layout import auto_layout
+    >>> readings = CoarseReadings(levels=2)
+    >>> lay = auto_layout(testing.y_junction(), target_cells=800, multiple=4, reading=readings)
+    >>> held, fresh = mesh_layout(lay, levels=2, readings=readings), mesh_layout(lay, levels=2)
+    >>> all(np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y) for a, b in zip(held.grids, fresh.grids))
+    True
+    """
+
+    def __init__(self, levels: int | None = None) -> None:
+        self.levels = levels
+        self._held: list[tuple[Any, Any, Any, list]] = []  # (layout, paused solve, coarse level, callback box)
+
+    def __call__(self, layout) -> tuple[float, float]:
+        """:func:`coarse_reading` of ``layout``, its solve held."""
+        first: list = []
+        box: list = [None]  # the callback of :meth:`mesh`, for the levels after the first
+
+        def level(kind: str, value: Any) -> Any:
+            if kind == "level" and not first:
+                first.append(value)
+                return "pause"
+            return box[0](kind, value) if box[0] is not None else None
+
+        gen = iterate_layout(layout, levels=self.levels, level_callback=level, every=None)
+        try:
+            next(gen)
+        except StopIteration as fin:  # one level: nothing to hold
+            grids = fin.value.grids
+        else:
+            grids = first[0][1].grids
+            self._held.append((layout, gen, first[0], box))
+        return _reading(grids)
+
+    def resumed(self, layout, callback: Callable[[str, Any], Any] | None, options: dict[str, Any]):
+        """The grid of ``layout`` from its held solve (``callback`` told of its coarse level first), or
+        None: none held for it, or ``options`` (of :func:`mesh_layout`) other than ``levels`` as
+        given to this object (the readings were solved with the defaults)."""
+        if options != {"levels": self.levels}:
+            return None
+        for k, (lay, gen, done, box) in enumerate(self._held):
+            if _same_layout(lay, layout):
+                del self._held[k]
+                box[0] = callback
+                said = callback("level", done) if callback is not None else None
+                try:
+                    gen.send("stop" if said == "stop" else None)  # (no more yields: it runs to the end)
+                    while True:
+                        gen.send(None)
+                except StopIteration as fin:
+                    return fin.value
+        return None
+
+
+def _same_layout(a, b) -> bool:
+    """``b`` is ``a``, or ``a`` with other ``details`` (:func:`dataclasses.replace` keeps the other fields)."""
+    import dataclasses
+
+    return a is b or all(getattr(a, f.name) is getattr(b, f.name) for f in dataclasses.fields(a) if f.name != "details")
+
+
+def _reading(grids) -> tuple[float, float]:
+    from .quality import lake_metrics
+
+    s = lake_metrics(list(grids)).summary()
+    d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
+    return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
 
 
 def coarse_reading(layout) -> tuple[float, float]:
@@ -149,12 +232,8 @@ def coarse_reading(layout) -> tuple[float, float]:
     the coarsest level of :func:`mesh_layout` (cells ``layout.multiple`` × the size), and the
     largest cross-interface cell-area ratio there: what :func:`~meshcore.layout.auto_layout`
     (``reading=``) compares layouts drawn at neighbouring scales by (:mod:`meshcore.layout.choice`)."""
-    from .quality import lake_metrics
-
     grids = mesh_layout(layout, callback=lambda kind, _: "stop" if kind == "level" else None).grids
-    s = lake_metrics(list(grids)).summary()
-    d, r = s["mean_deviation_deg"], s["max_interface_ratio"]
-    return (float("inf") if d is None else float(d)), (1.0 if r is None else float(r))
+    return _reading(grids)
 
 
 def iterate_layout(
@@ -201,7 +280,8 @@ def iterate_layout(
     ``spacing``: then the edge lengths along grid lines smoothed in block interiors, guarded
     (:func:`~meshcore.orthogonal.spacing.smooth_spacing`; off by default, see there).
     ``level_callback(kind, value)`` is called with ``("level", (level, result))`` as each level
-    ends (returning ``"stop"`` ends the solve there, as ``"stop"`` sent does) and
+    ends (returning ``"stop"`` ends the solve there, as ``"stop"`` sent does; ``"pause"`` yields
+    the level's grids, then goes on or stops as told by what is sent) and
     ``("equalize", patches)`` after the equalize step (the patches it kept).
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
@@ -286,7 +366,13 @@ def iterate_layout(
             res = fin.value
         grids = list(res.grids)
         total += res.sweeps
-        if level_callback is not None and level_callback("level", (lev, res)) == "stop":
+        said = level_callback("level", (lev, res)) if level_callback is not None else None
+        if said == "pause":  # held here (:class:`CoarseReadings`); what is sent next goes on or stops
+            held = time.perf_counter()
+            change = history[-1][1] if history else 0.0
+            said = yield SolverProgress(total, change, tol, None, held - t0, "orthogonal", tuple(history), tuple(grids))
+            t0 += time.perf_counter() - held  # (the elapsed time: the solve's own)
+        if said == "stop":
             stopped = True  # (no more levels wanted: the grids of this one)
         if stopped:
             break
@@ -413,6 +499,7 @@ def mesh_outline(
         )
     if parts is not None:
         raise InvalidInputError("parts= is for water in several parts (a MultiPolygon or a list of Polygons)")
+    readings = CoarseReadings(levels=levels)  # the chosen layout's coarse level solved once
     lay = auto_layout(
         outline,
         holes=holes,
@@ -422,9 +509,9 @@ def mesh_outline(
         regular=regular,
         single=single,
         options=layout_options or LayoutOptions(),
-        reading=coarse_reading,
+        reading=readings,
     )
-    mb = mesh_layout(lay, levels=levels, **options)
+    mb = mesh_layout(lay, levels=levels, readings=readings, **options)
     from .quality.lake import block_metrics
 
     if mb.notes:

@@ -54,6 +54,7 @@ from .lakefile import (
 from .mesh_outputs import SINGLE_DOMAIN, check_blocks, single_outputs
 from .mesh_steps import (
     LAYOUT_OPTIONS,
+    LEVELS,
     MIN_CELLS,
     _cell_size,
     _crs_label,
@@ -303,9 +304,12 @@ def run(args: argparse.Namespace) -> int:
     say.lap()
 
     def make():
-        lay = _layout(args, poly, h, regular, say, frame)
+        from ..lakegrid import CoarseReadings
+
+        readings = CoarseReadings(levels=LEVELS)  # the chosen layout's coarse level solved once
+        lay = _layout(args, poly, h, regular, say, frame, readings)
         check_blocks(outputs, lay)
-        return lay, _grid(lay, say)
+        return lay, _grid(lay, say, readings)
 
     made = guarded(args, frame, make)
     if made is None:

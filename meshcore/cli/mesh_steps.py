@@ -153,7 +153,9 @@ def layout_options(args):
     return LayoutOptions(**{name.replace("-", "_"): True for name in args.layout_option})
 
 
-def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
+def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None, readings: Any = None):
+    """The automatic layout (``readings``: a :class:`~meshcore.lakegrid.CoarseReadings` of ``LEVELS``
+    levels, for :func:`_grid` to go on from the chosen layout's coarse level)."""
     from ..lakegrid import coarse_reading
     from ..layout import LayoutOptions, auto_layout
 
@@ -166,7 +168,7 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
             regular=regular,
             single=getattr(args, "single_space", False),
             options=options,
-            reading=coarse_reading,
+            reading=coarse_reading if readings is None else readings,
         )
     except InvalidInputError as exc:  # its places go to the grid's CRS in guarded(), once
         msg = str(exc)
@@ -184,7 +186,7 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None):
     return lay
 
 
-def _grid(lay, say: _Say):
+def _grid(lay, say: _Say, readings: Any = None):
     from ..lakegrid import mesh_layout
 
     n_levels = LEVELS + 1
@@ -201,7 +203,7 @@ def _grid(lay, say: _Say):
         scale = f"cells ÷ {f}" if f > 1 else "full"
         say(f"grid level {lev + 1}/{n_levels} ({scale}, {cells:,} cells): {res.sweeps} sweeps, {say.lap():.1f} s")
 
-    return mesh_layout(lay, levels=LEVELS, callback=level)
+    return mesh_layout(lay, levels=LEVELS, callback=level, readings=readings)
 
 
 # ------------------------------------------------------------------ the command

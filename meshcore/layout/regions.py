@@ -246,10 +246,32 @@ def _second_cut(first, hole, rings, cand, to_vertices, earlier, sigma):
     if others and not apart:  # every nearest-point cut lies beside one: the rings' vertices
         more = sorted(to_vertices(), key=lambda t: t[0])
         more = [(L, seg) for L, seg in more if not LineString(seg).intersects(line)]
-        apart = [seg for _, seg in _apart(_without_wedges(more, hole, rings, sigma) or more, beside, 2 * sigma)]
-        good = [seg for seg in apart if away(seg)]
+        pick = _first_apart(more, hole, rings, sigma, beside, away)
+        if pick is not None:
+            return pick
     far = good or apart or far or others
     return far[0] if far else None
+
+
+def _first_apart(more: list, hole, rings, sigma: float, beside, away):
+    """What ``good or apart`` of :func:`_second_cut`'s fallback begins with — the first of ``more``
+    (those without a wedge, :func:`_without_wedges`, if any) that keeps ``2 sigma`` from ``beside``
+    and leaves from the far half (``away``), else the first that keeps the gap — or None; each
+    candidate's angles and gaps read only until that one (the whole list was read before)."""
+    for wedges in (True, False):
+        first = None
+        kept = False  # some candidate without a wedge
+        for cand in more:
+            if wedges and not _without_wedges([cand], hole, rings, sigma):
+                continue
+            kept = True
+            if _apart([cand], beside, 2 * sigma):
+                if away(cand[1]):
+                    return cand[1]
+                first = first if first is not None else cand[1]
+        if kept or not wedges:
+            return first
+    return None
 
 
 def _sights(p, k: int, rings, room, cuts, step: int | None = None) -> list:

@@ -160,18 +160,37 @@ def _nearest_on_cuts(cut_list: list[np.ndarray], k: int, q: np.ndarray) -> tuple
     return float(dist[i]), others[j], i - int(starts[j]), float(t[i])
 
 
+def _nearest_ring(rings: list[np.ndarray], boxes: list, q: np.ndarray) -> tuple[tuple[float, int, float], str, int]:
+    """``((distance, segment, t), "outline", ring)``: :func:`nearest_on_polyline` of ``q`` on the
+    first ring at the least distance, as ``min`` over all of them; a ring whose bounding box
+    (``boxes``) is farther than the best so far (by more than rounding) is not measured: none of
+    its points can be nearer."""
+    best: tuple[tuple[float, int, float], str, int] | None = None
+    for ri, r in enumerate(rings):
+        if best is not None:
+            lo, hi = boxes[ri]
+            gap = np.maximum(np.maximum(lo - q, q - hi), 0.0)
+            if math.hypot(gap[0], gap[1]) > best[0][0] * (1.0 + 1e-9):
+                continue
+        got = nearest_on_polyline(r, q, True)
+        if best is None or got[0] < best[0][0]:
+            best = (got, "outline", ri)
+    assert best is not None
+    return best
+
+
 def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: float, eps: float) -> list[np.ndarray]:
     """Move every cut end onto the outline, an island or another cut, inserting the point there;
     returns the shore rings (outline first, then the islands)."""
     rings = list(rings)
     on_ring = [set(point_keys(r)) for r in rings]
+    boxes = [(r.min(axis=0), r.max(axis=0)) for r in rings]
     for k in range(len(cut_list)):
         for end in (0, -1):
             q = cut_list[k][end]
             if any(point_key(q) in v for v in on_ring):
                 continue  # a vertex of the shore already: it would snap onto itself
-            near = ((nearest_on_polyline(r, q, True), "outline", ri) for ri, r in enumerate(rings))
-            best = min(near, key=lambda b: b[0][0])
+            best = _nearest_ring(rings, boxes, q)
             dist, m, seg, t = _nearest_on_cuts(cut_list, k, q)
             if dist < best[0][0]:
                 best = ((dist, seg, t), "cut", m)
@@ -185,6 +204,7 @@ def _snap_cut_ends(rings: list[np.ndarray], cut_list: list[np.ndarray], snap: fl
             if kind == "outline":
                 rings[m], p = _insert(rings[m], seg, t, True, eps)
                 on_ring[m].add(point_key(p))
+                boxes[m] = (rings[m].min(axis=0), rings[m].max(axis=0))
             else:
                 cut_list[m], p = _insert(cut_list[m], seg, t, False, eps)
             cut_list[k][end] = p

@@ -64,33 +64,41 @@ class _BlockEngine:
         self.e = np.zeros((0, 0))
         k0 = m.n_interior
         self.args = (m.nodes[k0:], m.nbr[k0:], m.irr_nodes, m.irr_ptr, m.irr_ring)
-        self.bx = [np.ascontiguousarray(x[ids]) for ids in m.ids]
-        self.by = [np.ascontiguousarray(y[ids]) for ids in m.ids]
+        # the blocks' arrays: views into one buffer, so the copies between them and the global
+        # arrays are one gather and one scatter a sweep, not two per block
+        start = np.cumsum([0] + [ids.size for ids in m.ids])
+        self.fx = np.concatenate([x[ids].ravel() for ids in m.ids])
+        self.fy = np.concatenate([y[ids].ravel() for ids in m.ids])
+        self.bx = [self.fx[a : a + ids.size].reshape(ids.shape) for a, ids in zip(start, m.ids, strict=False)]
+        self.by = [self.fy[a : a + ids.size].reshape(ids.shape) for a, ids in zip(start, m.ids, strict=False)]
         needed = np.zeros(m.n_nodes, dtype=bool)
         needed[self.args[1].ravel()] = True
         needed[m.irr_ring] = True
-        self.ring, self.frame = [], []
-        for ids in m.ids:
+        ring, frame = [], []  # (place in the buffer, node) of each block's needed interior, of its frame
+        for a, ids in zip(start, m.ids, strict=False):
             flat = ids.ravel()
             inner = np.zeros(ids.shape, dtype=bool)
             inner[1:-1, 1:-1] = True
             li = np.flatnonzero(inner.ravel() & needed[flat])
-            self.ring.append((li, flat[li]))
+            ring.append((a + li, flat[li]))
             fr = np.flatnonzero(~inner.ravel())
-            self.frame.append((fr, flat[fr]))
+            frame.append((a + fr, flat[fr]))
+        self.ring = (np.concatenate([r[0] for r in ring]), np.concatenate([r[1] for r in ring]))
+        self.frame = (np.concatenate([f[0] for f in frame]), np.concatenate([f[1] for f in frame]))
         self.ids = m.ids
 
     def sweep(self, omega: float) -> float:
         d = 0.0
-        for bx, by, (li, gi) in zip(self.bx, self.by, self.ring, strict=True):
+        for bx, by in zip(self.bx, self.by, strict=True):
             if bx.shape[0] > 2 and bx.shape[1] > 2:
                 d = max(d, self.bk.sweep4(bx, by, self.e, self.e, omega, False))
-            self.x[gi] = bx.reshape(-1)[li]
-            self.y[gi] = by.reshape(-1)[li]
+        li, gi = self.ring  # (each block's interior nodes are its own: the order of the copies is free)
+        self.x[gi] = self.fx[li]
+        self.y[gi] = self.fy[li]
         d = max(d, float(_kernels.table_sweep(self.x, self.y, *self.args, omega)))
-        for bx, by, (fr, gf) in zip(self.bx, self.by, self.frame, strict=True):
-            bx.reshape(-1)[fr] = self.x[gf]
-            by.reshape(-1)[fr] = self.y[gf]
+        fr, gf = self.frame
+        self.fx[fr] = self.x[gf]
+        self.fy[fr] = self.y[gf]
         return d
 
     def residual(self) -> float:
@@ -100,13 +108,11 @@ class _BlockEngine:
         return r
 
     def save(self):
-        return ([b.copy() for b in self.bx], [b.copy() for b in self.by], self.x.copy(), self.y.copy())
+        return (self.fx.copy(), self.fy.copy(), self.x.copy(), self.y.copy())
 
     def restore(self, saved) -> None:
-        for b, s in zip(self.bx, saved[0], strict=True):
-            b[...] = s
-        for b, s in zip(self.by, saved[1], strict=True):
-            b[...] = s
+        self.fx[...] = saved[0]
+        self.fy[...] = saved[1]
         self.x[...] = saved[2]
         self.y[...] = saved[3]
 
