@@ -60,7 +60,7 @@ from meshcore.lakegrid import mesh_outline
 from meshcore.layout.polygon import water_from_points, water_polygon
 
 what, cells, stages = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3])
-spent, depth = {}, {}
+spent, depth = {label: 0.0 for label, _, _ in stages}, {}  # a stage the case never reaches: 0
 
 def timed(label, f):
     if inspect.isgeneratorfunction(f):
