@@ -390,7 +390,8 @@ def shore_sweep(
     ``lo`` (state ``bz`` per free node, as in :func:`_target`) — and never so far that they
     differ by more than ``lo``.  Next to a cut line's end on the shore (``across[k]``: the shore
     node beyond that end, before and after, or -1) the arc to the end also stays within ``lo`` of
-    the arc beyond it (where both limits cannot hold, halfway between them).  ``blo[f]`` is the
+    the arc beyond it (where both limits cannot hold, halfway between them, but never nearer
+    either neighbour than a tenth of the arc between the two).  ``blo[f]`` is the
     ratio that free node ``f`` keeps instead of ``lo`` (larger at a cut's end where both blocks
     have a corner: its two arcs lie in two blocks); returns the largest move."""
     big = 0.0
@@ -429,6 +430,12 @@ def shore_sweep(
         if across[k, 1] >= 0:
             out = (bs[across[k, 1]] - sn) % total
             wa, wb = _window(wa, wb, sn - out * lo, sn - out / lo)
+        # and never nearer a neighbour than a tenth of the arc between them: where the two ends'
+        # limits cannot both hold, halfway between them can lie beyond a neighbour — past a cut's
+        # end, from where the next sweep's arc runs the other way round the ring
+        edge = 0.1 * (sn - sp)
+        wa = min(max(wa, sp + edge), sn - edge)
+        wb = min(max(wb, sp + edge), sn - edge)
         q = binner[k]
         hint = _segment(S, s0, n, s % total)  # the node's own segment: the searches below start there
         sf = _foot(R, S, r0, s0, n, X[q], Y[q], wa, wb, hint)

@@ -384,3 +384,41 @@ def test_no_block_corner_opens_into_a_fan_at_a_cut_end(make):
             worst = max(worst, float(d[corner[fptr[k] : fptr[k + 1] - 1]].max(initial=0.0)))
     assert 0 < worst < 140
     assert lake_metrics(mb, polygon=poly).values("folded").sum() == 0
+
+
+@pytest.mark.parametrize("beyond_next", [4.0, 8.0, 20.0])
+def test_a_shore_node_between_two_cut_ends_never_passes_a_neighbour(beyond_next):
+    # A free shore node (x = 2) between two fixed cut ends (x = 1 and 3) keeps its edge to each
+    # end within ``lo`` of the edge beyond it: 1 before, ``beyond_next`` after.  Those two limits
+    # cannot both hold; halfway between them lay beyond the node's own neighbour at x = 1, and a
+    # node past a cut's end measures its arcs the other way round the ring and may end anywhere
+    # on it (generated `lake_with_islands(955300, n_islands=6, lobes=4)`: a coarse node round an
+    # island's corner, the grid 1.19 cells over the island).
+    from meshcore.orthogonal import driver
+
+    cols = np.array([0.0, 1.0, 2.0, 3.0, 3.0 + beyond_next])
+    x, y = np.meshgrid(cols, np.arange(3.0), indexing="ij")
+    topo, g = _one_block(x, y)
+    m = topo.node_map
+    X, Y = driver._assemble([g], m)
+    cells = m.cells.astype(np.int64)
+    cptr, ncells, cnt = driver._node_cells(cells, m.n_nodes)
+    ring = np.array([[-10.0, 0.0], [40.0, 0.0], [40.0, -5.0], [-10.0, -5.0]])  # the shore y = 0, x from -10
+    bn, binner, bprev, bnext, bring, bs, free = driver._shore_data(X, Y, m, cells, cnt, [ring])
+    at = {(round(X[p], 6), round(Y[p], 6)): i for i, p in enumerate(bn)}
+    k, before, after = at[(2.0, 0.0)], at[(0.0, 0.0)], at[(3.0 + beyond_next, 0.0)]
+    assert free[k] and (bprev[k], bnext[k]) == (at[(1.0, 0.0)], at[(3.0, 0.0)])
+    across = -np.ones((len(bn), 2), dtype=np.int64)
+    across[k] = before, after
+    R, S, roff = driver._ring_tables([ring])
+    jmin = np.full(m.n_nodes, 1e-3)  # the fold guard's floor (cells of area >= 1 here)
+    lo, hi = 1.15, 2.0
+    bz = np.zeros(1)
+    p = bn[k]
+    for _ in range(30):
+        _kernels.shore_sweep(
+            X, Y, np.array([k]), bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells,
+            1.0, 0.15, 0.25, jmin, lo, hi, bz, 0.05, across, np.array([lo]),
+        )  # fmt: skip
+        assert Y[p] == 0.0  # on the shore
+        assert 1.0 + 0.1 * 2.0 - 1e-9 <= X[p] <= 3.0 - 0.1 * 2.0 + 1e-9  # within its own arc, a tenth from either end
