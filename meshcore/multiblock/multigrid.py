@@ -204,11 +204,20 @@ def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float =
     _smooth(lv, x, y, fx, fy, POST, line_omega)
 
 
-def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def pack(lvs: list[Level], index_dtype: Any = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(fb, ib, meta)``: the levels in the flat buffers of :mod:`._mg_fused` (node values zero).
 
     Every array is copied once, into its place in the buffers (a list of parts concatenated
-    copied the 22 MB of a 46 000-node hierarchy twice: 12 → 4 ms, measured)."""
+    copied the 22 MB of a 46 000-node hierarchy twice: 12 → 4 ms, measured).
+
+    ``ib`` holds ids and pointers (each below the length of the array it indexes, so below
+    the larger buffer's size) as ``index_dtype``; None: int32 when they fit, else int64.  The
+    tables in int32 are half the bytes the sweeps stream through per node (the finest level's
+    neighbour table and its copy in line order: 5.9 → 2.9 MB at 46 000 nodes); the same ids, so
+    the same iterates.  One V-cycle, min of 40, int64 → int32 in one process at load ~7:
+    refined Shasta example (45 849 nodes) 18.6 → 8.5 ms, the four lake layouts of
+    ``benchmarks/robust.py`` (15 000–17 000 nodes) −12 to −21 %, the fine example (11 725) −6 %,
+    the coarse (3 063) the same (measured)."""
     F = _typed_fused
     meta = np.zeros((len(lvs), F.META_COLS), dtype=np.int64)
     parts: tuple[list, list] = ([], [])  # (offset, array or None for zeros) of ints, floats
@@ -262,7 +271,9 @@ def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         put(F.C_RIDX, R.indices)
         for col, a in ((F.C_SCALE, lv.scale), (F.C_PVAL, P.data), (F.C_RVAL, R.data)):
             put(col, a, True)
-    ib, fb = np.empty(sizes[0], dtype=np.int64), np.zeros(sizes[1])
+    if index_dtype is None:
+        index_dtype = np.int32 if max(sizes) < 2**31 else np.int64
+    ib, fb = np.empty(sizes[0], dtype=index_dtype), np.zeros(sizes[1])
     for buf, ps in ((ib, parts[0]), (fb, parts[1])):
         for off, a in ps:
             if a is not None:
@@ -295,6 +306,7 @@ def _cycle(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float = 1.0) -> N
         COARSEST_REDUCTION,
         COARSEST_MAX_SWEEPS,
         float(line_omega),
+        bool(fx.any() or fy.any()),  # f = 0 (every cycle of the solver): not read on level k
     )
     x[:] = fb[m[F.C_X] : m[F.C_X] + n]
     y[:] = fb[m[F.C_Y] : m[F.C_Y] + n]
