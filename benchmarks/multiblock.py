@@ -17,11 +17,15 @@ Run from the repository root (serial kernels; timings are best of ``--repeat``):
 4. Where the multiblock CLI's time goes (``--stages``): CPU time per stage of
    ``generate_case`` on the Shasta examples (and refined 2×), min of ``--repeat``
    runs with the multigrid set-up built in each (as in a new process).
+5. Where a multiblock solve's time goes against one block (``--cycles``): per topology
+   the cycles and rates, set-up, full-multigrid start, one V-cycle, the finest level's
+   smoothing fused against its kernels one by one, and the square's solve per cycle.
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import sys
 import time
@@ -270,22 +274,115 @@ def stages(repeat: int, quick: bool) -> None:
     print()
 
 
+def cycle_costs(repeat: int, quick: bool) -> None:
+    """Where a multiblock solve's time goes against one block of the same node count (section 5):
+    per topology the cycles and their rates, the first solve and a re-solve, the set-up
+    (``levels()``, ``pack``), the full-multigrid start, one V-cycle, the finest level's four
+    smoothing steps in the fused cycle against its kernels called one by one (with the level's own
+    int64 tables: the two differ where the tables do not stay in the cache), and one block's solve
+    per cycle (the wavy square of robust.py).  CPU time, min of the repeats."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import robust
+    from run import wavy_square
+
+    from meshcore.case import generate_case, load_case
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock import _kernels as mk
+    from meshcore.multiblock import _mg_fused as fused
+    from meshcore.multiblock import hierarchy
+    from meshcore.multiblock import multigrid as mg
+    from meshcore.multiblock.result import assemble
+
+    def cpu(fn, n: int) -> float:
+        return min(_cpu_once(fn) for _ in range(n))
+
+    topos = []
+    for name, k in [("shasta-multiblock-coarse", 1)] + (
+        [] if quick else [("shasta-multiblock-fine", 1), ("shasta-multiblock-fine", 2)]
+    ):
+        case = load_case(ROOT / "resources" / "examples" / f"{name}.toml")
+        case = robust._refined(case, k) if k > 1 else case
+        topos.append(
+            (
+                name[18:] + (f" ×{k}" if k > 1 else ""),
+                generate_case(case, config=case.solver.replaced(threads=1)).topology,
+            )
+        )
+    for lake in robust.LAYOUT_LAKES[:1] if quick else robust.LAYOUT_LAKES:
+        shore = robust.outline(dict(robust.LAKES)[lake])
+        topos.append((f"{lake} layout", auto_layout(shore, target_cells=robust.LAYOUT_CELLS, multiple=4).topology()))
+    print("## 5. where a multiblock solve's time goes, CPU ms (min of the repeats)\n")
+    print(
+        "| topology | blocks | nodes | cycles: rates | first | re-solve | levels | pack | FMG | V-cycle (ns/node) "
+        "| finest 4 steps: fused / kernels | one block: solve, cycles, ns/node/cycle |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+    def row(label: str, topo) -> None:
+        n = topo.node_map.n_nodes
+        first = cpu(lambda: (hierarchy._CACHE.clear(), solve_multiblock(topo, threads=1)), repeat)
+        again = cpu(lambda: solve_multiblock(topo, threads=1), repeat)
+        h = [r for _, r in solve_multiblock(topo, threads=1).info.residual_history]
+        rates = " ".join(f"{b / a:.2f}" for a, b in itertools.pairwise(h))
+        t_lv = cpu(lambda: (hierarchy._CACHE.clear(), hierarchy.levels(topo)), repeat)
+        lvs = hierarchy.levels(topo)
+        t_pack = cpu(lambda: mg.pack(lvs), repeat)
+        x, y = assemble(initial_grids(topo), topo.node_map)
+        t_fmg = cpu(lambda: mg._fmg(lvs, x.copy(), y.copy()), repeat)
+        mg._fmg(lvs, x, y)
+        z = np.zeros(n)
+        t_cyc = cpu(lambda: mg._cycle(lvs, 0, x.copy(), y.copy(), z, z), 5 * repeat)
+        fb, ib, meta = mg._packed(lvs)
+        m0, lv, e = meta[0], lvs[0], np.zeros(0)
+        xf, yf = fused._f(fb, m0, fused.C_X), fused._f(fb, m0, fused.C_Y)
+        steps = cpu(lambda: fused._smooth(fb, ib, m0, 4, mg.BORDER_SWEEPS, mg.BAND_SWEEPS, 1.0, False), 5 * repeat)
+        sweep = [
+            cpu(lambda t=t: mk.table_sweep_rhs(xf, yf, e, e, *t, 1.0), 5 * repeat)
+            for t in (lv.args, lv.border, lv.band)
+        ]
+        lines = [cpu(lambda t=t: mk.line_sweep_rhs(xf, yf, e, e, *t, 1.0), 5 * repeat) for t in lv.lines]
+        alone = 4 * sweep[0] + 2 * sum(lines) + 4 * (mg.BORDER_SWEEPS * sweep[1] + mg.BAND_SWEEPS * sweep[2])
+        sq = wavy_square(round(math.sqrt(n)) - 1)
+        t_sq = cpu(lambda: meshcore.solve(sq, threads=1), repeat)
+        its = max(meshcore.solve(sq, threads=1).info.iterations, 1)
+        ms = [f"{1e3 * t:.2f}" for t in (first, again, t_lv, t_pack, t_fmg)]
+        print(
+            f"| {label} | {len(topo.blocks)} | {n} | {len(h) - 1}: {rates} | "
+            + " | ".join(ms)
+            + f" | {1e3 * t_cyc:.2f} "
+            f"({1e9 * t_cyc / n:.0f}) | {1e3 * steps:.2f} / {1e3 * alone:.2f} | {1e3 * t_sq:.2f}, {its}, "
+            f"{1e9 * t_sq / its / n:.0f} |"
+        )
+
+    for label, topo in topos:
+        row(label, topo)
+    print()
+
+
+def _cpu_once(fn) -> float:
+    t = time.process_time()
+    fn()
+    return time.process_time() - t
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="small sizes only")
     ap.add_argument("--stages", action="store_true", help="only the CLI's stages (section 4)")
+    ap.add_argument("--cycles", action="store_true", help="only where a solve's time goes (section 5)")
     a = ap.parse_args()
     print(f"numba threading layer: {bk.threading_layer()}; serial kernels; best of {a.repeat}\n")
     meshcore.elliptic.warmup()
-    if a.stages:
-        stages(a.repeat, a.quick)
+    if a.stages or a.cycles:
+        (stages if a.stages else cycle_costs)(a.repeat, a.quick)
         return
     sizes = [(128, 64)] if a.quick else [(128, 64), (256, 128), (512, 256)]
     per_sweep(a.repeat, sizes)
     whole_solves(a.repeat, [(64, 32)] if a.quick else [(128, 64), (256, 128), (512, 256)])
     lake(a.repeat, a.quick)
     stages(a.repeat, a.quick)
+    cycle_costs(a.repeat, a.quick)
 
 
 if __name__ == "__main__":

@@ -153,7 +153,9 @@ def table_sweep_rhs(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, omeg
 
 @njit(cache=True, nogil=True)
 def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out, ry_out):  # pragma: no cover
-    """Defect ``r = f − (u − T(u))`` at every free node (other entries untouched); returns max |r|."""
+    """Defect ``r = f − (u − T(u))`` at every free node (other entries untouched); returns max |r|
+    (``fx, fy`` empty: ``f = 0``, not read)."""
+    use_f = fx.size > 0
     dmax = 0.0
     for k in range(nodes.shape[0]):
         p = _u(nodes[k])
@@ -162,8 +164,12 @@ def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out,
             rx_out[p] = 0.0
             ry_out[p] = 0.0
             continue
-        dx = rx / den + fx[p] - x[p]
-        dy = ry / den + fy[p] - y[p]
+        if use_f:
+            dx = rx / den + fx[p] - x[p]
+            dy = ry / den + fy[p] - y[p]
+        else:
+            dx = rx / den - x[p]
+            dy = ry / den - y[p]
         rx_out[p] = dx
         ry_out[p] = dy
         m = dx * dx + dy * dy
@@ -177,8 +183,12 @@ def table_defect(x, y, fx, fy, nodes, nbr, irr_nodes, irr_ptr, irr_ring, rx_out,
             sx += x[_u(irr_ring[r])]
             sy += y[_u(irr_ring[r])]
         c = 1.0 / (irr_ptr[k + 1] - irr_ptr[k])
-        dx = sx * c + fx[p] - x[p]
-        dy = sy * c + fy[p] - y[p]
+        if use_f:
+            dx = sx * c + fx[p] - x[p]
+            dy = sy * c + fy[p] - y[p]
+        else:
+            dx = sx * c - x[p]
+            dy = sy * c - y[p]
         rx_out[p] = dx
         ry_out[p] = dy
         m = dx * dx + dy * dy

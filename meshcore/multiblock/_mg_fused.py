@@ -6,7 +6,8 @@ layout the dispatch (and scipy's sparse products) cost as much as the
 arithmetic.  Here every level of a hierarchy lives in two flat buffers
 (``ib`` indices, ``fb`` floats), described by a level table ``meta`` (one row
 per level, columns ``C_*``: offsets into the buffers and sizes), built once per
-hierarchy by :func:`.hierarchy.pack`.  :func:`vcycle` runs exactly the
+hierarchy by :func:`.multigrid.pack` (``ib`` in int32 when the ids fit: half the bytes the
+sweeps stream through).  :func:`vcycle` runs exactly the
 operations of the Python driver in the same order (the same table kernels of
 :mod:`._kernels`, the transfers as CSR products summed in the same order), so
 both give the same iterates (the test oracle compares them).  Gathered ids are read as unsigned
@@ -81,11 +82,13 @@ def _f(fb, m, col):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps, line_omega):  # pragma: no cover - compiled
+def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps, line_omega, use_f=True):  # pragma: no cover
     """``steps`` smoothing steps on one level: point sweep, lines along ξ (even steps) or along η
     (odd steps; damped by ``line_omega``), border sweeps, sweeps over the band next to the fixed
-    boundary."""
+    boundary (``use_f`` false: the level's ``f`` is zero and not read)."""
     x, y, fx, fy = _f(fb, m, C_X), _f(fb, m, C_Y), _f(fb, m, C_FX), _f(fb, m, C_FY)
+    if not use_f:
+        fx, fy = fx[:0], fy[:0]
     nodes = ib[m[C_NODES] : m[C_NODES] + m[C_NREG]]
     nbr = ib[m[C_NBR] : m[C_NBR] + 8 * m[C_NREG]].reshape((m[C_NREG], 8))
     irr_n = ib[m[C_IRRN] : m[C_IRRN] + m[C_NIRR]]
@@ -208,20 +211,25 @@ def _correct(fb, ib, fine, co):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def vcycle(
-    fb, ib, meta, k0, pre, post, border_sweeps, band_sweeps, c_min, c_reduction, c_max, line_omega
+    fb, ib, meta, k0, pre, post, border_sweeps, band_sweeps, c_min, c_reduction, c_max, line_omega, f0=True
 ):  # pragma: no cover
     """One FAS V(``pre``, ``post``) cycle from level ``k0`` (its ``x, y, f`` set in ``fb``); the line
-    sweeps damped by ``line_omega`` (1: undamped)."""
+    sweeps damped by ``line_omega`` (1: undamped).  ``f0`` false: level ``k0``'s ``f`` is zero (the
+    solver's cycles and full-multigrid start) and its sweeps and defect do not read it."""
     last = meta.shape[0] - 1
     for k in range(k0, last):
         m = meta[k]
-        _smooth(fb, ib, m, pre, border_sweeps, band_sweeps, line_omega)
+        use_f = f0 or k > k0
+        _smooth(fb, ib, m, pre, border_sweeps, band_sweeps, line_omega, use_f)
         rx, ry = _f(fb, m, C_RX), _f(fb, m, C_RY)
         rx[:] = 0.0
         ry[:] = 0.0
-        _defect(fb, ib, m, _f(fb, m, C_X), _f(fb, m, C_Y), _f(fb, m, C_FX), _f(fb, m, C_FY), rx, ry)
+        fx, fy = _f(fb, m, C_FX), _f(fb, m, C_FY)
+        if not use_f:
+            fx, fy = fx[:0], fy[:0]
+        _defect(fb, ib, m, _f(fb, m, C_X), _f(fb, m, C_Y), fx, fy, rx, ry)
         _restrict_to(fb, ib, m, meta[k + 1])
     _coarsest(fb, ib, meta[last], c_min, c_reduction, c_max)
     for k in range(last - 1, k0 - 1, -1):
         _correct(fb, ib, meta[k], meta[k + 1])
-        _smooth(fb, ib, meta[k], post, border_sweeps, band_sweeps, line_omega)
+        _smooth(fb, ib, meta[k], post, border_sweeps, band_sweeps, line_omega, f0 or k > k0)

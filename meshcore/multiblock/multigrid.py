@@ -204,11 +204,20 @@ def _cycle_reference(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float =
     _smooth(lv, x, y, fx, fy, POST, line_omega)
 
 
-def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def pack(lvs: list[Level], index_dtype: Any = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(fb, ib, meta)``: the levels in the flat buffers of :mod:`._mg_fused` (node values zero).
 
     Every array is copied once, into its place in the buffers (a list of parts concatenated
-    copied the 22 MB of a 46 000-node hierarchy twice: 12 → 4 ms, measured)."""
+    copied the 22 MB of a 46 000-node hierarchy twice: 12 → 4 ms, measured).
+
+    ``ib`` holds ids and pointers (each below the length of the array it indexes, so below
+    the larger buffer's size) as ``index_dtype``; None: int32 when they fit, else int64.  The
+    tables in int32 are half the bytes the sweeps stream through per node (the finest level's
+    neighbour table and its copy in line order: 5.9 → 2.9 MB at 46 000 nodes); the same ids, so
+    the same iterates.  One V-cycle, min of 40, int64 → int32 in one process at load ~7:
+    refined Shasta example (45 849 nodes) 18.6 → 8.5 ms, the four lake layouts of
+    ``benchmarks/robust.py`` (15 000–17 000 nodes) −12 to −21 %, the fine example (11 725) −6 %,
+    the coarse (3 063) the same (measured)."""
     F = _typed_fused
     meta = np.zeros((len(lvs), F.META_COLS), dtype=np.int64)
     parts: tuple[list, list] = ([], [])  # (offset, array or None for zeros) of ints, floats
@@ -262,7 +271,9 @@ def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         put(F.C_RIDX, R.indices)
         for col, a in ((F.C_SCALE, lv.scale), (F.C_PVAL, P.data), (F.C_RVAL, R.data)):
             put(col, a, True)
-    ib, fb = np.empty(sizes[0], dtype=np.int64), np.zeros(sizes[1])
+    if index_dtype is None:
+        index_dtype = np.int32 if max(sizes) < 2**31 else np.int64
+    ib, fb = np.empty(sizes[0], dtype=index_dtype), np.zeros(sizes[1])
     for buf, ps in ((ib, parts[0]), (fb, parts[1])):
         for off, a in ps:
             if a is not None:
@@ -270,14 +281,30 @@ def pack(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return fb, ib, meta
 
 
-def _cycle(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float = 1.0) -> None:
-    """One V-cycle from level ``k`` in one compiled call (:func:`._mg_fused.vcycle`)."""
+def _packed(lvs: list[Level]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`pack` of ``lvs``, kept with the finest level (one packing per depth: the solver may
+    retry with fewer levels)."""
     lv0 = lvs[0]
     if lv0.packed is None:
         lv0.packed = {}
-    if len(lvs) not in lv0.packed:  # one packing per depth (the solver may retry with fewer levels)
+    if len(lvs) not in lv0.packed:
         lv0.packed[len(lvs)] = pack(lvs)
-    fb, ib, meta = lv0.packed[len(lvs)]
+    return lv0.packed[len(lvs)]
+
+
+def _full_defect(lvs: list[Level], x, y, rx, ry) -> float:
+    """The finest level's largest defect with ``f = 0`` (``rx, ry`` filled at the free nodes):
+    :func:`._kernels.table_defect` of its table as packed for the cycles (the same rows in the same
+    order, so the same value; the int32 copy the cycles just streamed through, where the level's
+    own int64 table costs a tenth of a cycle at 16 000 nodes under load, measured)."""
+    fb, ib, meta = _packed(lvs)
+    e = np.zeros(0)
+    return float(_fused._defect(fb, ib, meta[0], x, y, e, e, rx, ry))
+
+
+def _cycle(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float = 1.0) -> None:
+    """One V-cycle from level ``k`` in one compiled call (:func:`._mg_fused.vcycle`)."""
+    fb, ib, meta = _packed(lvs)
     m, n = meta[k], lvs[k].n
     F = _typed_fused
     for col, a in ((F.C_X, x), (F.C_Y, y), (F.C_FX, fx), (F.C_FY, fy)):
@@ -295,6 +322,7 @@ def _cycle(lvs: list[Level], k: int, x, y, fx, fy, line_omega: float = 1.0) -> N
         COARSEST_REDUCTION,
         COARSEST_MAX_SWEEPS,
         float(line_omega),
+        bool(fx.any() or fy.any()),  # f = 0 (every cycle of the solver): not read on level k
     )
     x[:] = fb[m[F.C_X] : m[F.C_X] + n]
     y[:] = fb[m[F.C_Y] : m[F.C_Y] + n]
@@ -349,7 +377,7 @@ def iterate_fas(
     lv = lvs[0]
     zero = np.zeros(lv.n)
     rx, ry = np.zeros(lv.n), np.zeros(lv.n)
-    r = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
+    r = _full_defect(lvs, x, y, rx, ry)
     history = [(0, r)]
     best, saved = r, (x.copy(), y.copy())
     cells = topo.node_map.cells
@@ -361,23 +389,23 @@ def iterate_fas(
         if it == 1 and FMG_START:
             _fmg(lvs, x, y, line_omega, should_stop)
             if should_stop is not None and should_stop():
-                r = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
+                r = _full_defect(lvs, x, y, rx, ry)
                 history.append((it, r))
                 return it, r, history, "stopped", len(lvs)
         else:
             if acc is not None:
                 acc.before(history)
             _cycle(lvs, 0, x, y, zero, zero, line_omega)
-        r = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
+        r = _full_defect(lvs, x, y, rx, ry)
         if HOT_SWEEPS and tol < r < math.inf:
             swept = _hot_sweeps(lv, x, y, rx, ry)
             r = _defect_after(lv, x, y, zero, rx, ry, swept[0])
         if acc is not None and acc.after(functools.partial(float, r) if ACCEL_PLAIN_REF else None, tol):
-            r_mixed = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
+            r_mixed = _full_defect(lvs, x, y, rx, ry)
             if acc.keep(r_mixed):
                 r = r_mixed
             elif not ACCEL_PLAIN_REF:
-                r = float(_kernels.table_defect(x, y, zero, zero, *lv.args, rx, ry))
+                r = _full_defect(lvs, x, y, rx, ry)
         history.append((it, r))
         if (yield it, r) == "stop":
             return it, r, history, "stopped", len(lvs)

@@ -1462,6 +1462,43 @@ def test_fused_cycle_equals_the_kernel_by_kernel_cycle(make, rect):
     assert np.abs(x - x0).max() > 1e-3 * topo.size  # the cycles moved the grid
 
 
+@pytest.mark.kernel
+def test_fused_cycle_same_iterates_with_int32_tables_and_an_unread_zero_f():
+    """The packed tables in int32 (the default when they fit) and level ``k0``'s ``f = 0`` left
+    unread (``vcycle(..., f0=False)``, what :func:`.multigrid._cycle` passes for the solver's
+    cycles) give the iterates of int64 tables with ``f`` read, bit for bit (the same ids, the
+    same arithmetic; ``x + 0 − u`` is ``x − u``), from the finest level and from a coarse one."""
+    from meshcore import testing
+    from meshcore.layout import auto_layout
+    from meshcore.multiblock import _mg_fused as F
+    from meshcore.multiblock import multigrid
+    from meshcore.multiblock.hierarchy import levels
+    from meshcore.multiblock.result import assemble
+
+    topo = auto_layout(testing.lake_with_islands(938211), target_cells=1500, multiple=4).topology()
+    lvs = levels(topo)
+    assert len(lvs) >= 3
+    x0, y0 = assemble(meshcore.multiblock.initial_grids(topo), topo.node_map)
+    wide = multigrid.pack(lvs, np.int64)
+    narrow = multigrid.pack(lvs)
+    assert narrow[1].dtype == np.int32 and np.array_equal(narrow[1], wide[1])
+    for k0 in (0, 1):
+        xk, yk = x0, y0
+        for co in lvs[1 : k0 + 1]:
+            xk, yk = xk[co.inj], yk[co.inj]
+        out = []
+        for (fb, ib, meta), f0 in ((wide, True), (narrow, True), (narrow, False)):
+            fb = fb.copy()
+            mk, n = meta[k0], lvs[k0].n
+            fb[mk[F.C_X] : mk[F.C_X] + n], fb[mk[F.C_Y] : mk[F.C_Y] + n] = xk, yk
+            fb[mk[F.C_FX] : mk[F.C_FX] + n], fb[mk[F.C_FY] : mk[F.C_FY] + n] = 0.0, 0.0
+            for _ in range(2):
+                F.vcycle(fb, ib, meta, k0, 2, 2, 2, 2, 20, 1e-3, 100, 1.0, f0)
+            out.append(fb[mk[F.C_X] : mk[F.C_X] + n].copy())
+        assert np.abs(out[0] - xk).max() > 1e-3 * topo.size  # the cycles moved the grid
+        assert np.array_equal(out[0], out[1]) and np.array_equal(out[0], out[2])
+
+
 @pytest.mark.parametrize("make", ["star5", "four_blocks", "layout"])
 def test_every_id_the_kernels_gather_is_a_node_of_its_level(make):
     """The table kernels index with unsigned ids (``_kernels._u``: no test for a negative index,
