@@ -22,8 +22,9 @@ __all__ = ["ExportMixin", "export_default"]
 
 log = logging.getLogger(__name__)
 
-#: grids of at least this many cells (all blocks) are written in a worker thread: the window stays
-#: responsive (1.75 million cells: a .vtm took 26 s of the GUI thread, EFDC files 128 s, at load 20)
+#: grids of at least this many cells (all blocks) are written in a child process, waited for in a worker
+#: thread: the window stays responsive (1.75 million cells: a .vtm took 26 s of the GUI thread, EFDC files
+#: 128 s, at load 20; written in a worker thread the writers' long calls held the GIL: 1.4 s stalls)
 EXPORT_ASYNC_CELLS = 200_000
 
 
@@ -138,11 +139,14 @@ class ExportMixin:
         return True
 
     def _export_in_worker(self, path: Path, what, frame, format: str | None, n: int, cells: int) -> bool:
-        """Write a large grid in a worker thread (the grids are immutable: an edit meanwhile does not change
-        what is written; meshcore writes atomically: the file is complete or absent).  True: started."""
+        """Write a large grid in a child process (:mod:`app.write_process`), waited for in a worker thread
+        (the grids are immutable: an edit meanwhile does not change what is written; meshcore writes
+        atomically: the file is complete or absent).  True: started."""
         from superqt.utils import create_worker
 
-        worker = create_worker(fio.write_mesh, path, what, frame, format, _start_thread=False, _ignore_errors=True)
+        from .write_process import write_in_process
+
+        worker = create_worker(write_in_process, path, what, frame, format, _start_thread=False, _ignore_errors=True)
         failed: list = []
         worker.errored.connect(failed.append)
         worker.finished.connect(lambda: self._export_ended(worker, path, n, failed, format))

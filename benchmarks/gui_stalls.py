@@ -140,6 +140,8 @@ def steps(total: int, names: list[str]) -> None:
     if "export" in names:
         measure("export .vtm", lambda: win.io.export_mesh(tmp / "out.vtm"))
         measure("export EFDC", lambda: win.io.export_mesh(tmp / "cell.inp"))
+        measure("export Delft3D .grd", lambda: win.io.export_mesh(tmp / "out.grd"))
+        print("written:", sorted(p.name for p in tmp.iterdir() if p.suffix in (".vtm", ".inp", ".grd", ".enc")))
     win.solver.shutdown()
     win.close()
 

@@ -1,0 +1,136 @@
+"""The app as a lake modeller uses it (session 31): a stopped re-solve keeps the grid shown, a large
+export written in a child process (the window's thread never waits for the writer)."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.app.test_appq29 import coarse_then_stopped
+from tests.app.waits import wait_for, wait_idle
+
+pytestmark = pytest.mark.gui
+
+
+def _laid_out_and_solved(qtbot, win, tmp_path):
+    """A generated lake with islands imported, laid out and solved; the window's document."""
+    from tests.app.test_modeller import _metres_lake
+
+    assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761811))
+    wait_idle(qtbot, win)
+    win.a_auto_layout.trigger()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    return win.doc
+
+
+@pytest.mark.slow
+def test_a_re_solve_stopped_on_a_coarse_level_keeps_the_finished_grid(qtbot, win, tmp_path, monkeypatch):
+    """F5 on a finished lake grid, a cold solve, stopped on its coarse level: the grid the user had stays,
+    finished, with its quality, and exports.  Before: the document dropped it ("no grid of this layout",
+    the coarse frames greyed, nothing to export): the user lost the grid they saw."""
+    import app.solver_controller as sc
+
+    doc = _laid_out_and_solved(qtbot, win, tmp_path)
+    grids, mb = dict(doc.grids), doc.multiblock
+    assert grids and mb is not None and not doc.stale and doc.lake_metrics is not None
+    monkeypatch.setattr(sc, "solve_project", coarse_then_stopped)
+    win.generate()
+    wait_for(qtbot, win, lambda: win.solver.running and _progressing(win))
+    assert all(doc.grids[k] is g for k, g in grids.items())  # the coarse frames never replaced it on screen
+    win.a_stop.trigger()
+    wait_idle(qtbot, win)
+    assert doc.grids == grids and all(doc.grids[k] is g for k, g in grids.items())
+    assert doc.multiblock is mb and not doc.stale and not doc.before_grids
+    assert doc.quality is not None and doc.lake_metrics is not None  # its quality back in the panel
+    assert win.canvas._grid_colour == "#303030"  # drawn as a finished grid, not greyed
+    assert "grid of before kept" in win.solve_status.label.text()
+    assert "no grid" not in win._status.text() and "stays" in win._status.text()
+    assert win.io.export_mesh(tmp_path / "out.vtm") and (tmp_path / "out.vtm").exists()
+
+
+@pytest.mark.slow
+def test_a_re_solve_of_new_cells_stopped_on_a_coarse_level_keeps_the_grid_of_before_greyed(
+    qtbot, win, tmp_path, monkeypatch
+):
+    """A block's cells changed (a cold solve of the new cells), stopped on its coarse level: the grid of
+    before the edit, greyed, stays on screen through the coarse level and after the Stop, said so.  Before:
+    the coarse frames replaced it on screen and after the Stop it was gone (the greyed grid a coarse one)."""
+    import app.solver_controller as sc
+
+    doc = _laid_out_and_solved(qtbot, win, tmp_path)
+    grids = dict(doc.grids)
+    blk = doc.project.layout.blocks[0]
+    monkeypatch.setattr(sc, "solve_project", coarse_then_stopped)
+    win.lake_ctl.set_block_cells(0, (blk.cells[0] + 4, blk.cells[1]))
+    wait_for(qtbot, win, lambda: doc.project.layout.blocks[0].cells != blk.cells)
+    win.generate()
+    wait_for(qtbot, win, lambda: win.solver.running and _progressing(win))
+    qtbot.wait(200)  # a few coarse frames came
+    assert not doc.grids and doc.before_grids == grids  # the grid of before stays drawn, greyed
+    win.a_stop.trigger()
+    wait_idle(qtbot, win)
+    assert not doc.grids and doc.stale and doc.before_grids == grids
+    assert all(doc.before_grids[k] is g for k, g in grids.items())
+    assert win.canvas._grid_colour == "#b0b0b0" and len(win.canvas.grid_curve.xData) > 0
+    assert "coarse level (cells ÷2): no grid" in win.solve_status.label.text()
+    assert "greyed grid is of before the last edit" in win._status.text()
+
+
+def _progressing(win) -> bool:
+    from app.results import ALL_BLOCKS
+
+    return ALL_BLOCKS in win.solver._latest
+
+
+@pytest.fixture
+def child_writes(monkeypatch):
+    """Every grid counts as large (written in a child process); ``calls`` lists the child commands run."""
+    import subprocess
+
+    import app.io_export as ie
+    import app.write_process as wp
+
+    calls: list = []
+    real = subprocess.run
+
+    def run(cmd, *args, **kw):
+        calls.append(list(cmd))
+        return real(cmd, *args, **kw)
+
+    monkeypatch.setattr(ie, "EXPORT_ASYNC_CELLS", 1)
+    monkeypatch.setattr(wp.subprocess, "run", run)
+    return calls
+
+
+def test_a_large_export_is_written_by_a_child_process_and_reads_back(qtbot, win, tmp_path, child_writes):
+    """A large grid's export was written in a worker thread whose writer held the GIL (a 1.75 million-cell
+    .vtm stalled the window 1.4 s, EFDC 2 s): now a child process writes it; the file reads back as the
+    grid, the status line says it was exported."""
+    from meshcore.io import read_grid
+
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    out = tmp_path / "out.vts"
+    assert win.io.export_mesh(out)
+    assert win.io.exporting
+    wait_for(qtbot, win, lambda: not win.io.exporting)
+    assert [c[1:] for c in child_writes] == [["-m", "app.write_process"]]
+    (g,) = read_grid(out)
+    assert g.shape == win.doc.grid.shape
+    assert abs(g.x - win.doc.grid.x).max() < 1e-9 and abs(g.y - win.doc.grid.y).max() < 1e-9
+    assert f"Exported 1 block(s) to {out}" in win._status.text()
+
+
+def test_a_large_export_the_child_cannot_write_says_why_and_writes_nothing(qtbot, win, tmp_path, child_writes):
+    """The writer's error in the child (a folder that is a file) comes back as the app's error message."""
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    (tmp_path / "afile").write_text("not a folder")
+    out = tmp_path / "afile" / "out.vts"
+    assert win.io.export_mesh(out)
+    wait_for(qtbot, win, lambda: not win.io.exporting)
+    assert child_writes
+    assert "Cannot export mesh" in win._status.text() and "out.vts" in win._status.text()
+    assert not out.exists() and [p.name for p in tmp_path.iterdir() if p.name.startswith("out")] == []
