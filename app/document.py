@@ -292,6 +292,18 @@ class Document:
         self.grids_changed.emit()
         self._update_quality()
 
+    def shows_final_of(self, project: Project) -> bool:
+        """The grids on screen are the finished grid of ``project`` (its layout's, for a lake): not stale,
+        made of what it is made of."""
+        return bool(self.grids) and self.solved is not None and _made_of(self.solved) is _made_of(project)
+
+    def keep_final(self) -> None:
+        """A solve stopped before it made a grid (a lake's coarse level): the finished grid shown before it
+        is still the document's (its quality, withdrawn while the solve ran, comes back)."""
+        self._final = True
+        self.stale = False
+        self._update_quality()
+
     def clear_grids(self) -> None:
         self.solved = None
         self.restored = None

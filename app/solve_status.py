@@ -173,7 +173,7 @@ class SolveStatus(QtCore.QObject):
         if self.doc.measuring:
             self._due.add("summary")
         self._show_previous(False)
-        if g is None and self.solver.stopped_coarse and self.doc.project.layout is not None:
+        if self.solver.stopped_coarse and self.doc.project.layout is not None and (g is None or self.solver.kept_grid):
             self._coarse_final()
             return
         if g is None:
@@ -218,16 +218,24 @@ class SolveStatus(QtCore.QObject):
         self.win.message(f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
 
     def _coarse_final(self) -> None:
-        """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed."""
-        frames, blocks = self.doc.before_grids, self.doc.project.layout.blocks
-        k = next(iter(frames), None)
-        level = f"cells ÷{round(blocks[k].cells[0] / frames[k].cells[0])}" if k is not None and k < len(blocks) else ""
+        """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed
+        (or the finished grid shown before that solve, kept)."""
+        level = self.solver.coarse_level
         if self._last_history is not None:
             self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        if self.solver.kept_grid:
+            self.label.setText("stopped on a coarse level: the grid of before kept")
+            self.win.message(
+                "Lake grid stopped before its full level: the finished grid of before stays (F5 solves again)"
+            )
+            return
         shown = bool(self.doc.before_grids)
         self._show_previous(shown)
         self.label.setText(f"stopped on a coarse level{f' ({level})' if level else ''}: no grid")
-        grey = f"the greyed grid is a coarse level's ({level}), not the layout's" if shown else "nothing was drawn"
+        if self.solver.coarse_drawn:
+            grey = f"the greyed grid is a coarse level's ({level}), not the layout's"
+        else:  # the grid of before an edit of the cells, left on screen through the coarse levels
+            grey = "the greyed grid is of before the last edit" if shown else "nothing was drawn"
         self.win.message(f"Lake grid stopped before its full level: no grid of this layout ({grey}); F5 makes it")
 
     def report_notes(self) -> None:
