@@ -134,3 +134,31 @@ def test_a_large_export_the_child_cannot_write_says_why_and_writes_nothing(qtbot
     assert child_writes
     assert "Cannot export mesh" in win._status.text() and "out.vts" in win._status.text()
     assert not out.exists() and [p.name for p in tmp_path.iterdir() if p.name.startswith("out")] == []
+
+
+def test_an_outline_of_many_points_gets_its_markers_only_once_they_are_shown(qtbot, win, tmp_path):
+    """Importing a 40 000-point outline built a scatter marker for every point (0.5 s of the window's thread
+    under cProfile) though, zoomed out, the markers are hidden (they would touch: the outline is its line).
+    Now a hidden marker item of more than MARKERS_AT_ONCE points gets them once it is shown (zoomed in)."""
+    import numpy as np
+
+    from app.views.canvas import MARKERS_AT_ONCE
+
+    t = np.linspace(0, 2 * np.pi, 12000, endpoint=False)
+    r = 1000 * (1 + 0.3 * np.sin(7 * t))
+    csv = tmp_path / "big.csv"
+    csv.write_text("x,y\n" + "\n".join(f"{a:.3f},{b:.3f}" for a, b in np.c_[r * np.cos(t), r * np.sin(t)]) + "\n")
+    assert win.io.import_points(csv)
+    wait_idle(qtbot, win)
+    qtbot.wait(50)
+    c = win.canvas
+    assert len(win.doc.block.points) == 12000 > MARKERS_AT_ONCE
+    assert not c.points_item.isVisible() and len(c.points_item.data) == 0  # zoomed out: hidden, not built
+    x, y = win.doc.block.points[0]
+    c.zoom_to((x - 5, y - 5, x + 5, y + 5))
+    wait_for(qtbot, win, lambda: c.points_item.isVisible() and len(c.points_item.data) == 12000)
+    small = tmp_path / "small.csv"  # a few points: given at once, hidden or not (as before)
+    small.write_text("x,y\n0,0\n10,0\n10,10\n0,10\n")
+    assert win.io.import_points(small)
+    qtbot.wait(50)
+    assert len(c.points_item.data) == 4
