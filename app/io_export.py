@@ -85,9 +85,21 @@ class ExportMixin:
         self.settings.setValue(EXPORT_DIR, str(Path(path).parent))
         self.remember_dir(path)
 
+    def _why_not(self) -> str | None:
+        """Why the grid on screen cannot be exported now (None: it can)."""
+        doc = self.doc
+        if not doc.grids:
+            return _NOTHING_YET if not doc.before_grids else _BEFORE_EDIT
+        if doc.project.layout is not None and (doc.multiblock is None or doc.stale or doc.solving):
+            if doc.stale and not doc.solving:  # a cut moved with auto-generate off: the grid is of before it
+                return _BEFORE_EDIT  # (it said "not finished: generate it" of a finished grid, greyed)
+            return "The lake grid is not finished: generate it (F5) and export when it is done"
+        return None
+
     def export_dialog(self) -> None:
-        if not self.doc.grids:
-            self.win.message(_NOTHING_YET if not self.doc.before_grids else _BEFORE_EDIT)
+        why = self._why_not()
+        if why is not None:  # said before the file dialog (the dialog came first, then this as an error)
+            self.win.message(why)
             return
         fmts = fio.mesh_formats()
         filt = ";;".join(f"{d} ({p})" for d, p in fmts)
@@ -106,8 +118,9 @@ class ExportMixin:
     def export_mesh(self, path: Path, format: str | None = None) -> bool:
         """Write the grids (a multiblock result with its connectivity) with meshcore.io
         (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
-        if not self.doc.grids:  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
-            self.win.message(_NOTHING_YET if not self.doc.before_grids else _BEFORE_EDIT, error=True)
+        why = self._why_not()  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
+        if why is not None:
+            self.win.message(why, error=True)
             return False
         if path.suffix.lower() == ".inp" and path.name.lower() != "cell.inp":
             path = self._efdc_cell_inp(path)
@@ -117,9 +130,6 @@ class ExportMixin:
         mb = self.doc.multiblock
         p = self.doc.project
         frame = fio.project_frame(p)
-        if p.layout is not None and (mb is None or self.doc.stale or self.doc.solving):
-            self.win.message("The lake grid is not finished: generate it (F5) and export when it is done", error=True)
-            return False
         if getattr(self, "_export_worker", None) is not None:
             self.win.message("An export is being written: export again when it is done", error=True)
             return False

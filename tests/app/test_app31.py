@@ -162,3 +162,31 @@ def test_an_outline_of_many_points_gets_its_markers_only_once_they_are_shown(qtb
     assert win.io.import_points(small)
     qtbot.wait(50)
     assert len(c.points_item.data) == 4
+
+
+@pytest.mark.slow
+def test_export_of_the_grid_of_before_a_cut_moved_says_so_before_the_file_dialog(qtbot, win, tmp_path, monkeypatch):
+    """A cut end dragged with auto-generate off: the grid on screen (greyed) is of before the edit.  File ▸
+    Export opened the file dialog, then said "The lake grid is not finished: generate it (F5)" of a finished
+    grid.  Now it says the grid is of before the last edit, before any dialog; after F5 the export writes."""
+    from PySide6 import QtWidgets
+
+    from tests.app.waits import drag_a_cut_end
+
+    dialogs: list = []
+    monkeypatch.setattr(
+        QtWidgets.QFileDialog, "getSaveFileName", lambda *a, **k: dialogs.append(a) or (str(tmp_path / "g.vtm"), "")
+    )
+    doc = _laid_out_and_solved(qtbot, win, tmp_path)
+    assert not win.solver.auto
+    drag_a_cut_end(qtbot, win)
+    assert doc.stale and doc.grids
+    win.io.export_dialog()
+    assert not dialogs and "of before the last edit" in win._status.text() and "F5" in win._status.text()
+    assert not win.io.export_mesh(tmp_path / "x.vtm") and "not finished" not in win._status.text()
+    assert not (tmp_path / "x.vtm").exists()
+    win.generate()
+    wait_idle(qtbot, win)
+    win.io.export_dialog()
+    wait_idle(qtbot, win)
+    assert len(dialogs) == 1 and (tmp_path / "g.vtm").exists()
