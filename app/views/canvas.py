@@ -10,6 +10,7 @@ and the tool overlay (rubber band / rubber line).
 
 from __future__ import annotations
 
+import copy
 import logging
 
 import numpy as np
@@ -611,7 +612,8 @@ class Canvas(pg.PlotWidget):
             if levels[0] == levels[1]:
                 levels = (levels[0] - 0.5, levels[1] + 0.5)
         cm = pg.colormap.get(cmap.removesuffix("_r"))
-        if cmap.endswith("_r"):
+        if cmap.endswith("_r"):  # a copy: pyqtgraph hands out one cached map, and reverse() turns it in place
+            cm = copy.deepcopy(cm)  # (every other colouring had its colours upside down: after an undo, a redo)
             cm.reverse()
 
         cells = sum(np.size(w) for w in (v, *(w for _g, w in more)))

@@ -190,3 +190,35 @@ def test_export_of_the_grid_of_before_a_cut_moved_says_so_before_the_file_dialog
     win.io.export_dialog()
     wait_idle(qtbot, win)
     assert len(dialogs) == 1 and (tmp_path / "g.vtm").exists()
+
+
+def test_colouring_by_deviation_again_keeps_its_colours_the_right_way_up(qtbot, win):
+    """Deviation from 90° is coloured light (0°) to dark (10°).  pyqtgraph hands out one cached colour map
+    and the canvas reversed it in place: every other colouring (after an undo, a redo, colouring off and on)
+    had it upside down, a good grid drawn black (seen walking g181404 under Xvfb)."""
+    import pyqtgraph as pg
+
+    from app.document import DEVIATION
+
+    win.io.open_example("bottle-coarse", confirm=False)
+    win.generate()
+    wait_idle(qtbot, win)
+    ends = []
+    for _ in range(3):
+        win.doc.set_colour_by(DEVIATION)
+        wait_idle(qtbot, win)
+        cm = win.canvas.colorbar.colorMap()
+        ends.append((_rgb(cm, 0.0), _rgb(cm, 1.0)))
+        win.doc.set_colour_by("none")
+        wait_idle(qtbot, win)
+    low, high = ends[0]
+    assert sum(low) > sum(high)  # light at 0°, dark at the top of the scale
+    assert ends == [ends[0]] * 3
+    magma = pg.colormap.get("magma")
+    assert sum(_rgb(magma, 0.0)) < sum(_rgb(magma, 1.0))  # the cached map untouched
+
+
+def _rgb(cm, at: float) -> tuple[int, int, int]:
+    """The colour of map ``cm`` at ``at`` (0-1) as integer red, green, blue."""
+    r, g, b, _a = (int(c) for c in cm.map(at, mode="byte"))
+    return r, g, b
