@@ -139,7 +139,8 @@ class SolveStatus(QtCore.QObject):
         self.label.setText("error")
 
     def on_finished(self, result) -> None:
-        if result is not None and not self.solver.last_error and not self.solver.stopped_coarse:
+        made = not (self.solver.last_error or self.solver.stopped_coarse or self.solver.kept_grid)
+        if result is not None and made:
             # a grid was made: "Cannot generate" and the folded cells of the grid before are not of it (the
             # message panel's count kept them: "1 error(s)" beside a grid without a fault)
             self.doc.superseded.emit()
@@ -173,7 +174,10 @@ class SolveStatus(QtCore.QObject):
         if self.doc.measuring:
             self._due.add("summary")
         self._show_previous(False)
-        if self.solver.stopped_coarse and self.doc.project.layout is not None and (g is None or self.solver.kept_grid):
+        if self.solver.kept_grid and self.doc.project.layout is not None:
+            self._kept_final()
+            return
+        if g is None and self.solver.stopped_coarse and self.doc.project.layout is not None:
             self._coarse_final()
             return
         if g is None:
@@ -217,18 +221,19 @@ class SolveStatus(QtCore.QObject):
         what = "Lake grid, stopped before it was finished (F5 makes it again)" if stopped else "Lake grid"
         self.win.message(f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
 
+    def _kept_final(self) -> None:
+        """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept."""
+        if self._last_history is not None:
+            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        where = " on a coarse level" if self.solver.stopped_coarse else ""
+        self.label.setText(f"stopped{where}: the grid of before kept")
+        self.win.message(f"Lake grid solve stopped{where}: the finished grid of before stays (F5 solves again)")
+
     def _coarse_final(self) -> None:
-        """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed
-        (or the finished grid shown before that solve, kept)."""
+        """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed."""
         level = self.solver.coarse_level
         if self._last_history is not None:
             self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
-        if self.solver.kept_grid:
-            self.label.setText("stopped on a coarse level: the grid of before kept")
-            self.win.message(
-                "Lake grid stopped before its full level: the finished grid of before stays (F5 solves again)"
-            )
-            return
         shown = bool(self.doc.before_grids)
         self._show_previous(shown)
         self.label.setText(f"stopped on a coarse level{f' ({level})' if level else ''}: no grid")
@@ -242,7 +247,7 @@ class SolveStatus(QtCore.QObject):
         """Repairs, corner advice and other notes of the solver, in full, in the message panel."""
         blocks = self.doc.project.blocks
         mb = self.doc.multiblock
-        if self.solver.stopped_coarse:  # no grid: nothing of it to note
+        if self.solver.stopped_coarse or self.solver.kept_grid:  # no new grid: nothing of it to note
             return
         if self.doc.project.layout is not None and mb is not None:
             if self.doc.measuring:  # its coverage warnings: once measured

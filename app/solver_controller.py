@@ -49,6 +49,14 @@ MAX_FRAME_GAP = 1.0
 FRAME_COST = 0.005
 
 
+def _stopped(result) -> bool:
+    """A lake solve's result that was stopped: no grid (a coarse level), or its grid said to be stopped."""
+    if result is None:
+        return False
+    info = getattr(getattr(result, "multiblock", None), "info", None)
+    return not result.grids or (info is not None and not info.converged and info.message == "stopped")
+
+
 def _run(run_id, project, warm, stop_event, smooth, hold=None):
     """The worker body: tag every item with the run id; errors become results."""
     gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth, hold=hold)
@@ -455,6 +463,16 @@ class SolverController(QtCore.QObject):
             self.finished.emit(None)
             return
         self._flush(draw=False)  # its progress (the convergence history ends on it), not a frame
+        if self._project.layout is not None and _stopped(result) and self.doc.final_of(self._project) is not None:
+            # F5 on a finished lake grid, then Stop: that grid stays (a grid of a few sweeps "stopped before it
+            # was finished" replaced it, or on a coarse level no grid was left: the user lost the one they had)
+            self.stopped_coarse = not result.grids
+            self.kept_grid = True
+            self.doc.restore_final(self._project)
+            self.last_result = result
+            self._set_state("idle")
+            self.finished.emit(result)
+            return
         if self._project.layout is not None and not result.grids:
             self._stopped_coarse(result)
             return
@@ -487,15 +505,9 @@ class SolverController(QtCore.QObject):
         levels = getattr(last, "levels", ())
         self.coarse_level = "cells " + levels[-1][1].removeprefix("cells ") if levels else ""
         self.coarse_drawn = any(g.cells != cells.get(k) for k, g in self.doc.grids.items() if k in self._smoothed)
-        if earlier and not self._smoothed and self.doc.shows_final_of(self._project):
-            # F5 on a finished lake grid, stopped cold on a coarse level: that grid stays, finished (it was
-            # dropped for the greyed coarse frames: the user lost the grid they had, with its quality)
-            self.kept_grid = True
-            self.doc.keep_final()
-        else:
-            frames = {k: g for k, g in self.doc.grids.items() if k in self._smoothed and g.cells != cells.get(k)}
-            # an earlier grid still on screen stays drawn (greyed) with the coarse frames of the other blocks
-            self.doc.set_stopped_coarse(earlier | frames)
+        frames = {k: g for k, g in self.doc.grids.items() if k in self._smoothed and g.cells != cells.get(k)}
+        # an earlier grid still on screen stays drawn (greyed) with the coarse frames of the other blocks
+        self.doc.set_stopped_coarse(earlier | frames)
         self.last_result = result
         self._set_state("idle")
         self.finished.emit(result)
