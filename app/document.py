@@ -28,6 +28,12 @@ def _same_blocks(a, b) -> bool:
     return a is not None and b is not None and [x.name for x in a.blocks] == [y.name for y in b.blocks]
 
 
+def _finished(multiblock) -> bool:
+    """A kept solve's MultiBlockGrid is of a solve that ran to its end (None: a solve without one)."""
+    info = getattr(multiblock, "info", None)
+    return info is None or info.converged or info.message != "stopped"
+
+
 def _layout_shape(layout) -> tuple | None:
     """What a lake layout's grids depend on in shape: the blocks' names and cells."""
     return None if layout is None else tuple((b.name, tuple(b.cells)) for b in layout.blocks)
@@ -291,6 +297,30 @@ class Document:
         self.stale = True
         self.grids_changed.emit()
         self._update_quality()
+
+    def final_of(self, project: Project) -> tuple | None:
+        """The kept solve of what ``project`` is made of (a lake: its layout) that ran to its end (not
+        stopped), when the project shown is made of the same; else None."""
+        made = _made_of(project)
+        if _made_of(self.project) is not made:
+            return None
+        return next((k for k in self._kept if _made_of(k[0]) is made and _finished(k[3])), None)
+
+    def restore_final(self, project: Project) -> bool:
+        """A solve of ``project`` stopped (F5 on its finished grid, then Stop): that finished grid is the
+        document's again, with its quality (the stopped one replaced it, or none was left).  False: none."""
+        kept = self.final_of(project)
+        if kept is None:
+            return False
+        self.solved, grids, initial, self.multiblock, self._given_metrics = kept
+        self.grids, self.initial = dict(grids), dict(initial)
+        self.before_grids = {}
+        self.restored = None
+        self._final = True
+        self.stale = False
+        self.grids_changed.emit()
+        self._update_quality()
+        return True
 
     def clear_grids(self) -> None:
         self.solved = None

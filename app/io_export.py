@@ -22,8 +22,9 @@ __all__ = ["ExportMixin", "export_default"]
 
 log = logging.getLogger(__name__)
 
-#: grids of at least this many cells (all blocks) are written in a worker thread: the window stays
-#: responsive (1.75 million cells: a .vtm took 26 s of the GUI thread, EFDC files 128 s, at load 20)
+#: grids of at least this many cells (all blocks) are written in a child process, waited for in a worker
+#: thread: the window stays responsive (1.75 million cells: a .vtm took 26 s of the GUI thread, EFDC files
+#: 128 s, at load 20; written in a worker thread the writers' long calls held the GIL: 1.4 s stalls)
 EXPORT_ASYNC_CELLS = 200_000
 
 
@@ -84,9 +85,21 @@ class ExportMixin:
         self.settings.setValue(EXPORT_DIR, str(Path(path).parent))
         self.remember_dir(path)
 
+    def _why_not(self) -> str | None:
+        """Why the grid on screen cannot be exported now (None: it can)."""
+        doc = self.doc
+        if not doc.grids:
+            return _NOTHING_YET if not doc.before_grids else _BEFORE_EDIT
+        if doc.project.layout is not None and (doc.multiblock is None or doc.stale or doc.solving):
+            if doc.stale and not doc.solving:  # a cut moved with auto-generate off: the grid is of before it
+                return _BEFORE_EDIT  # (it said "not finished: generate it" of a finished grid, greyed)
+            return "The lake grid is not finished: generate it (F5) and export when it is done"
+        return None
+
     def export_dialog(self) -> None:
-        if not self.doc.grids:
-            self.win.message(_NOTHING_YET if not self.doc.before_grids else _BEFORE_EDIT)
+        why = self._why_not()
+        if why is not None:  # said before the file dialog (the dialog came first, then this as an error)
+            self.win.message(why)
             return
         fmts = fio.mesh_formats()
         filt = ";;".join(f"{d} ({p})" for d, p in fmts)
@@ -105,8 +118,9 @@ class ExportMixin:
     def export_mesh(self, path: Path, format: str | None = None) -> bool:
         """Write the grids (a multiblock result with its connectivity) with meshcore.io
         (``format``: the format chosen in the dialog, when the suffix alone does not say it)."""
-        if not self.doc.grids:  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
-            self.win.message(_NOTHING_YET if not self.doc.before_grids else _BEFORE_EDIT, error=True)
+        why = self._why_not()  # as the dialog says (was, called directly: "expected a StructuredGrid ... got list")
+        if why is not None:
+            self.win.message(why, error=True)
             return False
         if path.suffix.lower() == ".inp" and path.name.lower() != "cell.inp":
             path = self._efdc_cell_inp(path)
@@ -116,9 +130,6 @@ class ExportMixin:
         mb = self.doc.multiblock
         p = self.doc.project
         frame = fio.project_frame(p)
-        if p.layout is not None and (mb is None or self.doc.stale or self.doc.solving):
-            self.win.message("The lake grid is not finished: generate it (F5) and export when it is done", error=True)
-            return False
         if getattr(self, "_export_worker", None) is not None:
             self.win.message("An export is being written: export again when it is done", error=True)
             return False
@@ -138,11 +149,14 @@ class ExportMixin:
         return True
 
     def _export_in_worker(self, path: Path, what, frame, format: str | None, n: int, cells: int) -> bool:
-        """Write a large grid in a worker thread (the grids are immutable: an edit meanwhile does not change
-        what is written; meshcore writes atomically: the file is complete or absent).  True: started."""
+        """Write a large grid in a child process (:mod:`app.write_process`), waited for in a worker thread
+        (the grids are immutable: an edit meanwhile does not change what is written; meshcore writes
+        atomically: the file is complete or absent).  True: started."""
         from superqt.utils import create_worker
 
-        worker = create_worker(fio.write_mesh, path, what, frame, format, _start_thread=False, _ignore_errors=True)
+        from .write_process import write_in_process
+
+        worker = create_worker(write_in_process, path, what, frame, format, _start_thread=False, _ignore_errors=True)
         failed: list = []
         worker.errored.connect(failed.append)
         worker.finished.connect(lambda: self._export_ended(worker, path, n, failed, format))

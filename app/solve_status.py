@@ -139,7 +139,8 @@ class SolveStatus(QtCore.QObject):
         self.label.setText("error")
 
     def on_finished(self, result) -> None:
-        if result is not None and not self.solver.last_error and not self.solver.stopped_coarse:
+        made = not (self.solver.last_error or self.solver.stopped_coarse or self.solver.kept_grid)
+        if result is not None and made:
             # a grid was made: "Cannot generate" and the folded cells of the grid before are not of it (the
             # message panel's count kept them: "1 error(s)" beside a grid without a fault)
             self.doc.superseded.emit()
@@ -173,6 +174,9 @@ class SolveStatus(QtCore.QObject):
         if self.doc.measuring:
             self._due.add("summary")
         self._show_previous(False)
+        if self.solver.kept_grid and self.doc.project.layout is not None:
+            self._kept_final()
+            return
         if g is None and self.solver.stopped_coarse and self.doc.project.layout is not None:
             self._coarse_final()
             return
@@ -217,24 +221,33 @@ class SolveStatus(QtCore.QObject):
         what = "Lake grid, stopped before it was finished (F5 makes it again)" if stopped else "Lake grid"
         self.win.message(f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
 
+    def _kept_final(self) -> None:
+        """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept."""
+        if self._last_history is not None:
+            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        where = " on a coarse level" if self.solver.stopped_coarse else ""
+        self.label.setText(f"stopped{where}: the grid of before kept")
+        self.win.message(f"Lake grid solve stopped{where}: the finished grid of before stays (F5 solves again)")
+
     def _coarse_final(self) -> None:
         """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed."""
-        frames, blocks = self.doc.before_grids, self.doc.project.layout.blocks
-        k = next(iter(frames), None)
-        level = f"cells ÷{round(blocks[k].cells[0] / frames[k].cells[0])}" if k is not None and k < len(blocks) else ""
+        level = self.solver.coarse_level
         if self._last_history is not None:
             self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
         shown = bool(self.doc.before_grids)
         self._show_previous(shown)
         self.label.setText(f"stopped on a coarse level{f' ({level})' if level else ''}: no grid")
-        grey = f"the greyed grid is a coarse level's ({level}), not the layout's" if shown else "nothing was drawn"
+        if self.solver.coarse_drawn:
+            grey = f"the greyed grid is a coarse level's ({level}), not the layout's"
+        else:  # the grid of before an edit of the cells, left on screen through the coarse levels
+            grey = "the greyed grid is of before the last edit" if shown else "nothing was drawn"
         self.win.message(f"Lake grid stopped before its full level: no grid of this layout ({grey}); F5 makes it")
 
     def report_notes(self) -> None:
         """Repairs, corner advice and other notes of the solver, in full, in the message panel."""
         blocks = self.doc.project.blocks
         mb = self.doc.multiblock
-        if self.solver.stopped_coarse:  # no grid: nothing of it to note
+        if self.solver.stopped_coarse or self.solver.kept_grid:  # no new grid: nothing of it to note
             return
         if self.doc.project.layout is not None and mb is not None:
             if self.doc.measuring:  # its coverage warnings: once measured

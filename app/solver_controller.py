@@ -49,6 +49,14 @@ MAX_FRAME_GAP = 1.0
 FRAME_COST = 0.005
 
 
+def _stopped(result) -> bool:
+    """A lake solve's result that was stopped: no grid (a coarse level), or its grid said to be stopped."""
+    if result is None:
+        return False
+    info = getattr(getattr(result, "multiblock", None), "info", None)
+    return not result.grids or (info is not None and not info.converged and info.message == "stopped")
+
+
 def _run(run_id, project, warm, stop_event, smooth, hold=None):
     """The worker body: tag every item with the run id; errors become results."""
     gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth, hold=hold)
@@ -97,6 +105,10 @@ class SolverController(QtCore.QObject):
         self.last_error: str | None = None
         #: the last lake solve was stopped before its full level: no grid of the layout (its coarse frames greyed)
         self.stopped_coarse = False
+        #: that stopped solve left the finished grid shown before it (F5 on it, stopped on a coarse level)
+        self.kept_grid = False
+        #: the level it stopped on ("cells ÷2") and whether its frames were drawn (else the grid of before)
+        self.coarse_level, self.coarse_drawn = "", False
         self._restart_pending = False
         self._dropped = False  # the running solve is of no use now (an undo or redo brought a kept grid back)
         self._project = None  # the project the running solve was started for
@@ -169,6 +181,7 @@ class SolverController(QtCore.QObject):
         self._run += 1
         self.last_error = None
         self.stopped_coarse = False
+        self.kept_grid = False
         warm = {}
         for k, g in self.doc.grids.items():
             a = self.doc.initial.get(k)
@@ -362,8 +375,9 @@ class SolverController(QtCore.QObject):
         for k, event in self._latest.items():
             if k == ALL_BLOCKS and isinstance(event, SolverProgress):  # a multiblock solve: every block
                 for i, g in enumerate(event.grids):
-                    # a coarse level of a lake grid never replaces an earlier solve's grid on screen
-                    if i in self._smoothed or not self._showing_other(i, g):
+                    # a coarse level of a lake grid never replaces an earlier solve's grid on screen (nor the
+                    # greyed grid of before an edit of the cells: a Stop on that level left a coarse grid)
+                    if i in self._smoothed or not (self._showing_other(i, g) or self._covers_earlier(i, g)):
                         self.doc.grids[i] = g
                         self._smoothed.add(i)
                         drawn = True
@@ -396,6 +410,14 @@ class SolverController(QtCore.QObject):
         """True when block ``k`` already shows a grid of this shape (from an earlier solve)."""
         old = self.doc.grids.get(k)
         return old is not None and old.shape == grid.shape
+
+    def _covers_earlier(self, k: int, grid: StructuredGrid) -> bool:
+        """True when ``grid`` is a coarse level's frame of lake block ``k`` and the greyed grid of before an
+        edit is on screen (no grid of this project yet): it would replace that grid with a coarse one."""
+        lay = self._project.layout
+        if lay is None or self.doc.grids or k not in self.doc.before_grids or k >= len(lay.blocks):
+            return False
+        return grid.cells != tuple(lay.blocks[k].cells)
 
     def _showing_other(self, k: int, grid: StructuredGrid) -> bool:
         """True when block ``k`` shows a grid of another shape (from an earlier solve)."""
@@ -441,6 +463,16 @@ class SolverController(QtCore.QObject):
             self.finished.emit(None)
             return
         self._flush(draw=False)  # its progress (the convergence history ends on it), not a frame
+        if self._project.layout is not None and _stopped(result) and self.doc.final_of(self._project) is not None:
+            # F5 on a finished lake grid, then Stop: that grid stays (a grid of a few sweeps "stopped before it
+            # was finished" replaced it, or on a coarse level no grid was left: the user lost the one they had)
+            self.stopped_coarse = not result.grids
+            self.kept_grid = True
+            self.doc.restore_final(self._project)
+            self.last_result = result
+            self._set_state("idle")
+            self.finished.emit(result)
+            return
         if self._project.layout is not None and not result.grids:
             self._stopped_coarse(result)
             return
@@ -466,9 +498,16 @@ class SolverController(QtCore.QObject):
         block of 16×24, measured and exported so).  Now the document holds no grid of the layout and draws
         the last coarse frames greyed; the status says so (F5 makes the grid)."""
         cells = {k: tuple(b.cells) for k, b in enumerate(self._project.layout.blocks)}
-        frames = {k: g for k, g in self.doc.grids.items() if k in self._smoothed and g.cells != cells.get(k)}
+        # an earlier grid the coarse frames never replaced on screen (of another shape): what the user saw
+        earlier = {k: g for k, g in self.doc.grids.items() if k not in self._smoothed}
         self.stopped_coarse = True
-        self.doc.set_stopped_coarse(frames)
+        last = self._latest.get(ALL_BLOCKS)
+        levels = getattr(last, "levels", ())
+        self.coarse_level = "cells " + levels[-1][1].removeprefix("cells ") if levels else ""
+        self.coarse_drawn = any(g.cells != cells.get(k) for k, g in self.doc.grids.items() if k in self._smoothed)
+        frames = {k: g for k, g in self.doc.grids.items() if k in self._smoothed and g.cells != cells.get(k)}
+        # an earlier grid still on screen stays drawn (greyed) with the coarse frames of the other blocks
+        self.doc.set_stopped_coarse(earlier | frames)
         self.last_result = result
         self._set_state("idle")
         self.finished.emit(result)

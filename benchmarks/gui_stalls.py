@@ -5,6 +5,7 @@ with TOTAL cells along its longer side (1500: 1 752 000 cells), in an off-screen
 
     python benchmarks/gui_stalls.py solve TOTAL STOP_AT [--before]
     python benchmarks/gui_stalls.py steps TOTAL STEP...      (STEP: import draw colour export)
+    python benchmarks/gui_stalls.py restop CELLS STOP_AT
 
 ``solve``: Generate, Stop after STOP_AT seconds (0: let it finish), then wait until the quality report is
 in; prints the longest gaps of the heartbeat (the GUI thread's stalls) and the longest one from Stop on.
@@ -12,6 +13,9 @@ in; prints the longest gaps of the heartbeat (the GUI thread's stalls) and the l
 None).  ``steps``: the stall of each step: import of a 40 000-point outline and Auto layout, the drawing
 and measure of the grid, colouring it by skewness and back, export to .vtm and EFDC.  Timings are wall
 time on a shared machine: compare runs made side by side.  Session 29 numbers: ``benchmarks/RESULTS.md``.
+``restop``: a generated lake with islands laid out at about CELLS cells and solved; one block's cells
+changed (a cold solve), Stop after STOP_AT seconds (on a coarse level): what the canvas shows after the
+Stop (the grid of before the edit, or a coarse level's frames) and the longest stall from Stop on.
 """
 
 from __future__ import annotations
@@ -140,6 +144,47 @@ def steps(total: int, names: list[str]) -> None:
     if "export" in names:
         measure("export .vtm", lambda: win.io.export_mesh(tmp / "out.vtm"))
         measure("export EFDC", lambda: win.io.export_mesh(tmp / "cell.inp"))
+        measure("export Delft3D .grd", lambda: win.io.export_mesh(tmp / "out.grd"))
+        print("written:", sorted(p.name for p in tmp.iterdir() if p.suffix in (".vtm", ".inp", ".grd", ".enc")))
+    win.solver.shutdown()
+    win.close()
+
+
+def restop(cells: int, stop_at: float) -> None:
+    import math
+
+    import shapely
+
+    from meshcore import testing
+
+    _app, win, beats, _heart, tmp = _window()
+    poly = shapely.affinity.scale(testing.lake_with_islands(1), 300, 300, origin=(0, 0))
+    rows = ["x,y"]
+    for k, ring in enumerate([poly.exterior, *poly.interiors]):
+        rows += [""] * bool(k) + [f"{x:.2f},{y:.2f}" for x, y in ring.coords]
+    csv = tmp / "lake.csv"
+    csv.write_text("\n".join(rows) + "\n")
+    win.io.import_points(csv)
+    win.lake_ctl.set_cell_size(math.sqrt(poly.area / cells))
+    win.a_auto_layout.trigger()
+    _run_until(lambda: win.doc.project.layout is not None and not win.solver.running and not win.measurer.busy, 900)
+    old = dict(win.doc.grids)
+    print(f"{sum(g.cells[0] * g.cells[1] for g in old.values()):,} cells in {len(old)} blocks solved", flush=True)
+    blk = win.doc.project.layout.blocks[0]
+    win.lake_ctl.set_block_cells(0, (blk.cells[0] + 4, blk.cells[1]))
+    _run_until(lambda: win.doc.project.layout.blocks[0].cells != blk.cells and not win.lake_ctl.editing, 300)
+    win.generate()
+    _run_until(lambda: False, stop_at)
+    t0 = time.perf_counter()
+    win.a_stop.trigger()
+    _run_until(lambda: not win.solver.running and not win.measurer.busy, 300)
+    b = np.array([t0, *(x for x in beats if x > t0)])
+    shown = win.doc.grids or win.doc.before_grids
+    kept = bool(shown) and all(shown.get(k) is g for k, g in old.items())
+    what = "the grid of before the edit" if kept else "coarse frames"
+    n = sum(g.cells[0] * g.cells[1] for g in shown.values())
+    print(f"after Stop ({win.solve_status.label.text()}): shown {what}, {n:,} cells, greyed {not win.doc.grids}")
+    print(f"longest stall from Stop on: {np.diff(b).max():.2f} s, Stop took {time.perf_counter() - t0:.1f} s")
     win.solver.shutdown()
     win.close()
 
@@ -148,6 +193,8 @@ if __name__ == "__main__":
     args = sys.argv[1:]
     if args[:1] == ["solve"]:
         solve(int(args[1]), float(args[2]), "--before" in args)
+    elif args[:1] == ["restop"]:
+        restop(int(args[1]), float(args[2]))
     elif args[:1] == ["steps"]:
         steps(int(args[1]), args[2:])
     else:

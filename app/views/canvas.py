@@ -10,6 +10,7 @@ and the tool overlay (rubber band / rubber line).
 
 from __future__ import annotations
 
+import copy
 import logging
 
 import numpy as np
@@ -40,6 +41,8 @@ CORNER_LABELS = ("SW", "SE", "NE", "NW")
 _OUTWARD = {"bottom": -1.0, "right": -1.0, "top": 1.0, "left": 1.0}
 #: the point scatters' full symbol sizes (pixels), as made in Canvas._make_point_items
 _MARKER_FULL = {"points": 7.0, "other": 5.0}
+#: boundary points a hidden marker item is given at once; more wait until it is shown (zoomed in)
+MARKERS_AT_ONCE = 2000
 
 
 #: the most cells a frame draws every line of; a larger grid is drawn every few lines, and the part in view in full
@@ -85,6 +88,8 @@ class Canvas(pg.PlotWidget):
         # level of detail of the point markers: their typical spacing (model units), their size shown
         self._spacing: dict[str, float] = {"points": np.inf, "other": np.inf}
         self._marker_sizes: dict[str, float] = {}
+        self._marker_points: dict[str, np.ndarray | None] = {}  # the points each marker item shows when shown
+        self._marker_given: set[str] = set()  # the marker items that hold their points
         self._bg_transform = (1.0, 0.0, 0.0, 0.0)
         self._vb.sigRangeChanged.connect(self._place_labels)
         self._vb.sigRangeChanged.connect(self._apply_level_of_detail)
@@ -281,7 +286,7 @@ class Canvas(pg.PlotWidget):
         op = [b.points for b in others if len(b.points)]
         if not multiblock:
             op += [np.vstack(b.boundary) for b in others if b.boundary is not None]
-        set_points(self.other_points_item, np.vstack(op) if op else None)
+        self._set_markers("other", np.vstack(op) if op else None)
         self._spacing["other"] = min((geo.typical_spacing(p, along=True) for p in op), default=np.inf)
         loops = []
         # a lake layout's blocks are its shore and cuts, drawn by the lake overlay: a dashed copy of every
@@ -334,7 +339,7 @@ class Canvas(pg.PlotWidget):
         else:
             solved_together = self.doc.project.multiblock is not None or self.doc.project.layout is not None
             disp = None if solved_together else np.vstack(block.boundary)
-        set_points(self.points_item, disp)
+        self._set_markers("points", disp)
         self._spacing["points"] = geo.typical_spacing(disp, along=True) if disp is not None else np.inf
         if block.corners is not None and block.boundary is None and all(c < len(pts) for c in block.corners):
             cp = pts[list(block.corners)]
@@ -515,6 +520,13 @@ class Canvas(pg.PlotWidget):
         if self.grid_curve.opts["pen"].color() != colour:
             self.grid_curve.setPen(pg.mkPen(colour, width=1, cosmetic=True))
 
+    def _set_markers(self, name: str, points) -> None:
+        """The boundary points of marker item ``name`` ("points", "other"), handed to it when it is shown
+        (:meth:`_size_markers`): a scatter item of 40 000 points took 0.5 s of the import of such an
+        outline, shown zoomed out as its line only (its markers hidden where they would touch)."""
+        self._marker_points[name] = points
+        self._marker_given.discard(name)
+
     def _size_markers(self) -> None:
         """Shrink the boundary points where they crowd on screen, hide them where they would touch
         (:func:`app.geometry.marker_size`): a zoomed-out outline of thousands of points is its line."""
@@ -526,7 +538,22 @@ class Canvas(pg.PlotWidget):
                 self._marker_sizes[name] = size
                 if size > 0:
                     item.setSize(size)
-            item.setVisible(self.markers_visible and size > 0)
+            shown = self.markers_visible and size > 0
+            pts = self._marker_points.get(name)
+            if name not in self._marker_given:
+                if pts is None or len(pts) <= MARKERS_AT_ONCE:
+                    set_points(item, pts)
+                    self._marker_given.add(name)
+                elif shown:  # after this event-loop pass: an import zooms to the new outline right after drawing it
+                    QtCore.QTimer.singleShot(0, self._give_markers)
+            item.setVisible(shown)
+
+    def _give_markers(self) -> None:
+        """Hand the marker items that are shown the points they wait for (:meth:`_set_markers`)."""
+        for name, item in (("points", self.points_item), ("other", self.other_points_item)):
+            if name not in self._marker_given and item.isVisible():
+                set_points(item, self._marker_points.get(name))
+                self._marker_given.add(name)
 
     def set_grid_visible(self, on: bool) -> None:
         """Show or hide the grid lines (View ▸ Grid lines)."""
@@ -585,7 +612,8 @@ class Canvas(pg.PlotWidget):
             if levels[0] == levels[1]:
                 levels = (levels[0] - 0.5, levels[1] + 0.5)
         cm = pg.colormap.get(cmap.removesuffix("_r"))
-        if cmap.endswith("_r"):
+        if cmap.endswith("_r"):  # a copy: pyqtgraph hands out one cached map, and reverse() turns it in place
+            cm = copy.deepcopy(cm)  # (every other colouring had its colours upside down: after an undo, a redo)
             cm.reverse()
 
         cells = sum(np.size(w) for w in (v, *(w for _g, w in more)))

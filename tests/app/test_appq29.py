@@ -94,29 +94,31 @@ def test_a_measure_of_an_older_grid_never_replaces_the_newer_one(qtbot, win, mea
         assert win.quality_panel.table.rowCount() == 0
 
 
+def coarse_then_stopped(project, *, warm, stop_event, smooth, hold):
+    """A lake solve whose Stop lands on the level of half the cells (as app.lake_solve ends it)."""
+    from app.lake_solve import LakeProgress
+    from app.results import ALL_BLOCKS, BlockResult
+    from meshcore import StructuredGrid
+    from meshcore.multiblock import initial_grids
+
+    full = initial_grids(project.layout.topology())
+    half = tuple(StructuredGrid(x=g.x[::2, ::2], y=g.y[::2, ::2]) for g in full)
+    progress = LakeProgress(5, 0.1, 1e-5, None, 0.1, "orthogonal", ((5, 0.1),), half, ((0, "cells ÷2"),))
+    while not stop_event.is_set():  # a live frame every 0.05 s until Stop
+        yield ALL_BLOCKS, progress
+        stop_event.wait(0.05)
+    return BlockResult(grids={}, initial={})
+
+
 def test_stop_on_a_coarse_level_leaves_no_grid_and_the_coarse_one_greyed(qtbot, win, tmp_path, monkeypatch):
     """Stop while a lake grid is on a coarse level: the solve returns no grid (the coarse ones are never a
     result).  The frames of that level were kept as the final grids ("Grid 8×12 cells: converged" of a block
     of 16×24, its quality measured, exported so, not stale).  Now: no grid of the layout (nothing measured or
     exported, the project stale), the last coarse frames drawn greyed, the status line says so; F5 makes it."""
     import app.solver_controller as sc
-    from app.lake_solve import LakeProgress
-    from app.results import ALL_BLOCKS, BlockResult
-    from meshcore import StructuredGrid
-    from meshcore.multiblock import initial_grids
     from tests.app.test_modeller import _metres_lake
 
     real = sc.solve_project
-
-    def coarse_then_stopped(project, *, warm, stop_event, smooth, hold):
-        """A lake solve whose Stop lands on the level of half the cells (as app.lake_solve ends it)."""
-        full = initial_grids(project.layout.topology())
-        half = tuple(StructuredGrid(x=g.x[::2, ::2], y=g.y[::2, ::2]) for g in full)
-        progress = LakeProgress(5, 0.1, 1e-5, None, 0.1, "orthogonal", ((5, 0.1),), half, ((0, "cells ÷2"),))
-        while not stop_event.is_set():  # a live frame every 0.05 s until Stop
-            yield ALL_BLOCKS, progress
-            stop_event.wait(0.05)
-        return BlockResult(grids={}, initial={})
 
     assert win.io.import_points(_metres_lake(tmp_path / "lake.csv", 761811))
     wait_idle(qtbot, win)
@@ -230,19 +232,19 @@ def test_a_large_grid_is_exported_in_a_worker_and_said_when_written(qtbot, win, 
     """Writing a grid of 1.75 million cells held the window (a .vtm 26 s, EFDC files 128 s at load 20).
     Now a grid of EXPORT_ASYNC_CELLS or more is written in a worker: the status says it is being written,
     then that it was (or why not); a second export meanwhile is refused, not lost."""
-    import app.io_adapter as fio
     import app.io_export as ie
+    import app.write_process as wp
     from meshcore import StructuredGrid
     from meshcore.io import read
 
-    real, threads, gate = fio.write_mesh, [], threading.Event()
+    real, threads, gate = wp.write_in_process, [], threading.Event()
 
-    def write_mesh(*args):
+    def write_in_process(*args):  # waited for in the worker (session 31: it runs a child process that writes)
         threads.append(threading.current_thread())
         assert gate.wait(60)
         return real(*args)
 
-    monkeypatch.setattr(fio, "write_mesh", write_mesh)
+    monkeypatch.setattr(wp, "write_in_process", write_in_process)
     monkeypatch.setattr(ie, "EXPORT_ASYNC_CELLS", 1000)
     i, j = np.meshgrid(np.arange(41.0), np.arange(31.0), indexing="ij")
     win.doc.set_grids({0: StructuredGrid(x=i + 0.1 * np.sin(j), y=j)})
