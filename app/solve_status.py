@@ -100,7 +100,10 @@ class SolveStatus(QtCore.QObject):
             if snap.history and now - self._history_at >= HISTORY_EVERY and not self.solver.live:
                 self._history_at = now
                 self.conv.set_history(list(snap.history), snap.tolerance, levels)
-            self._label_text = f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}"
+            if levels:  # a lake grid: the words of its convergence plot (sweeps, the largest move / cell)
+                self._label_text = f"lake grid: sweep {snap.iteration}, largest move {snap.residual:.2e} of a cell"
+            else:
+                self._label_text = f"multiblock: iteration {snap.iteration}, residual {snap.residual:.2e}"
             wait = self._label_at + LABEL_EVERY - now
             if wait <= 0:
                 self._show_label()

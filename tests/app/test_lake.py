@@ -424,6 +424,9 @@ def test_convergence_plot_marks_the_levels_and_misses_step_aside_for_colours(qtb
     # fast level may pass between two redraws; a clean clone's CI saw none on "÷2")
     assert seen
     assert conv.getAxis("bottom").labelText == "sweep"
+    # the status label in the plot's words (it said "iteration …, residual …" of a lake's sweeps)
+    assert win.solve_status._label_text.startswith("lake grid: sweep ")
+    assert "largest move" in win.solve_status._label_text and "residual" not in win.solve_status._label_text
 
     from PySide6 import QtCore
 
