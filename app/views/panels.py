@@ -112,6 +112,7 @@ class ConvergencePanel(pg.PlotWidget):
         self.levels: tuple[tuple[int, str], ...] = ()  # the marked levels: (first sweep, name)
         self._ranges: tuple | None = None  # the x and y ranges shown (step_ranges)
         self.setMinimumHeight(120)
+        self._show_empty()
         for ax in ("left", "bottom"):
             axis = self.getAxis(ax)
             axis.enableAutoSIPrefix(False)
@@ -175,9 +176,17 @@ class ConvergencePanel(pg.PlotWidget):
         self.curve.setData([], [])
         self.tol_line.hide()
         self._set_levels(())
-        self._ranges = None  # the next history sets them
+        self._show_empty()
+
+    def _show_empty(self) -> None:
+        """The axes of an empty plot: whole decades (pyqtgraph's default, one decade, labelled its
+        minor ticks 2 … 9 in a crowd) and sweeps from 0; the next history sets the ranges."""
+        self._ranges = None
+        self.setRange(xRange=EMPTY_RANGES[0], yRange=EMPTY_RANGES[1], padding=0.02)
 
 
+#: the ranges of an empty convergence plot: iterations 0-10, residuals 1e-6 … 1 (log10)
+EMPTY_RANGES = ((0.0, 10.0), (-6.0, 0.0))
 #: the steps of the iteration axis's end, times a power of ten (each at most 1.5 × the one before)
 X_STEPS = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
 #: the smallest heights of the Quality panel's table and histogram: with a lake's verdict above

@@ -112,3 +112,22 @@ def test_a_new_point_within_the_ranges_does_not_draw_the_axes_again(qtbot):
     conv.set_history(h[:16], 1e-6)  # past 15: the iteration axis ends on 20
     qtbot.wait(50)
     assert drawn()[1] is not before[1]
+
+
+def test_an_empty_convergence_plot_shows_decades(qtbot):
+    """Before any solve, and after its history is cleared, the residual axis spans whole decades
+    (1e-6 … 1): pyqtgraph's default, one decade, labelled its minor ticks 2 … 9 in a crowd."""
+    from app.views.panels import EMPTY_RANGES, ConvergencePanel
+
+    panel = ConvergencePanel()
+    qtbot.addWidget(panel)
+
+    def decades() -> float:
+        y0, y1 = panel.viewRange()[1]
+        return y1 - y0
+
+    assert decades() >= EMPTY_RANGES[1][1] - EMPTY_RANGES[1][0] == 6.0
+    panel.set_history([(1, 0.5), (2, 0.4)], 0.3)  # less than a decade: the history's own range
+    assert decades() < 3.0
+    panel.clear_history()
+    assert decades() >= 6.0
