@@ -82,13 +82,22 @@ def _f(fb, m, col):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _rhs(fb, m, use_f):  # pragma: no cover - compiled
+    """The level's ``f`` (x and y), or empty views when it is zero and not to be read (the table
+    kernels then leave it out)."""
+    fx, fy = _f(fb, m, C_FX), _f(fb, m, C_FY)
+    if use_f:
+        return fx, fy
+    return fx[:0], fy[:0]
+
+
+@njit(cache=True, nogil=True)
 def _smooth(fb, ib, m, steps, border_sweeps, band_sweeps, line_omega, use_f=True):  # pragma: no cover
     """``steps`` smoothing steps on one level: point sweep, lines along ξ (even steps) or along η
     (odd steps; damped by ``line_omega``), border sweeps, sweeps over the band next to the fixed
     boundary (``use_f`` false: the level's ``f`` is zero and not read)."""
-    x, y, fx, fy = _f(fb, m, C_X), _f(fb, m, C_Y), _f(fb, m, C_FX), _f(fb, m, C_FY)
-    if not use_f:
-        fx, fy = fx[:0], fy[:0]
+    x, y = _f(fb, m, C_X), _f(fb, m, C_Y)
+    fx, fy = _rhs(fb, m, use_f)
     nodes = ib[m[C_NODES] : m[C_NODES] + m[C_NREG]]
     nbr = ib[m[C_NBR] : m[C_NBR] + 8 * m[C_NREG]].reshape((m[C_NREG], 8))
     irr_n = ib[m[C_IRRN] : m[C_IRRN] + m[C_NIRR]]
@@ -224,9 +233,7 @@ def vcycle(
         rx, ry = _f(fb, m, C_RX), _f(fb, m, C_RY)
         rx[:] = 0.0
         ry[:] = 0.0
-        fx, fy = _f(fb, m, C_FX), _f(fb, m, C_FY)
-        if not use_f:
-            fx, fy = fx[:0], fy[:0]
+        fx, fy = _rhs(fb, m, use_f)
         _defect(fb, ib, m, _f(fb, m, C_X), _f(fb, m, C_Y), fx, fy, rx, ry)
         _restrict_to(fb, ib, m, meta[k + 1])
     _coarsest(fb, ib, meta[last], c_min, c_reduction, c_max)
