@@ -42,7 +42,7 @@ BULGING = 1.2
 #: by about the product: a polar fan whose short sides are unequally short).
 #: `round_lake(955400, kind='blob', n_islands=5)` at 15 000 cells: the east lobe as one block from a
 #: small island's side, ``R`` 1.24, sides 6.0× and 8.1× apart (49), 1 299 nodes beyond 3°; on the
-#: 52 generated shapes of `fresh_sweep.py` base 946000 (both sets) every other piece of ``R`` ≥ 1.2
+#: 72 generated shapes of `fresh_sweep.py` base 946000 (both sets) every other piece of ``R`` ≥ 1.2
 #: had a product below 20.
 FAN_AREA = 32.0
 
