@@ -447,7 +447,7 @@ def _welded(rings: list[np.ndarray], forced: list[tuple], eps: float):
         w = weld([r], eps)  # the ring alone first: drops its own repeated points
         if not w:
             continue
-        out_r.append(w[0])
+        out_r.append(_despiked(w[0]))
         out_f.append(f)
     allw = weld(out_r, eps)
     if len(allw) != len(out_r):  # a ring collapsed only against the others: keep them as they are
@@ -459,6 +459,32 @@ def _welded(rings: list[np.ndarray], forced: list[tuple], eps: float):
             f = tuple(tuple(r[i]) for i in np.atleast_1d(k))
         fixed.append(f)
     return allw, fixed
+
+
+#: A ring vertex whose two edges run back along each other (the sine of the angle between them
+#: below this) is the tip of a spike of no width: dropped (:func:`_despiked`).
+SPIKE_SINE = 1e-9
+
+
+def _despiked(r: np.ndarray) -> np.ndarray:
+    """``r`` without vertices where the ring turns straight back (a spike of no width).
+
+    A cut that starts on the shore and runs along it for a short way before it leaves into the
+    water (the shore straight there, `dendritic(955700)`: 0.3 cells) gave the piece beside it a
+    spike out along the cut and back: a ring whose own vertex lies on its own edge, which
+    :func:`~.blocks.conform` inserted there a second time, and every scale's layout was refused
+    as self-intersecting.  Without the spike the piece and the water are the same area."""
+    r = np.asarray(r)
+    while len(r) > 3:
+        u = r - np.roll(r, 1, axis=0)  # the edge into each vertex
+        v = np.roll(r, -1, axis=0) - r  # ... and out of it
+        norm = np.hypot(*u.T) * np.hypot(*v.T)
+        cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+        back = (np.abs(cross) <= SPIKE_SINE * norm) & (np.einsum("ij,ij->i", u, v) < 0) & (norm > 0)
+        if not back.any():
+            break
+        r = np.delete(r, int(np.flatnonzero(back)[0]), axis=0)
+    return r
 
 
 def _check_pieces(poly, pieces: list[Piece]) -> None:

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["BULGING", "FAN_BULGE", "FAN_PAIRS", "fans", "unfan", "wraps"]
+__all__ = ["BULGING", "FAN_AREA", "FAN_BULGE", "FAN_PAIRS", "fans", "unfan", "wraps"]
 
 #: A piece whose chosen corners give :func:`~.corners.bulge_ratio` at least this fans.  On the
 #: 73 generated shapes of `fresh_sweep.py` base 791000 (both sets) every piece was below 2.6
@@ -38,6 +38,14 @@ FAN_BULGE = 3.0
 FAN_PAIRS = 8.0
 BULGING = 1.2
 
+#: ... or whose two ratios of opposite sides multiply to at least this (its cells differ in area
+#: by about the product: a polar fan whose short sides are unequally short).
+#: `round_lake(955400, kind='blob', n_islands=5)` at 15 000 cells: the east lobe as one block from a
+#: small island's side, ``R`` 1.24, sides 6.0× and 8.1× apart (49), 1 299 nodes beyond 3°; on the
+#: 72 generated shapes of `fresh_sweep.py` base 946000 (both sets) every other piece of ``R`` ≥ 1.2
+#: had a product below 20.
+FAN_AREA = 32.0
+
 #: ... and a piece one of whose sides runs back on itself — measured along the line between its
 #: corners — by more than this share of that line's length and by more than :data:`BACK_CELLS`
 #: cells beyond what its opposite side does: the side goes round a tip of land into a pocket of
@@ -47,14 +55,15 @@ WRAP_BACK = 0.5
 BACK_CELLS = 3.0
 
 
-def _pairs(ring: np.ndarray, corners) -> float:
-    """The smaller of the two ratios of opposite sides between ``corners``."""
+def _pairs(ring: np.ndarray, corners) -> tuple[float, float]:
+    """The two ratios of opposite sides between ``corners``, the smaller first."""
     from .corners import _arclength_closed
 
     s, total = _arclength_closed(ring)
     c = sorted(corners)
     L = [max((s[c[(k + 1) % 4]] - s[c[k]]) % total, 1e-300) for k in range(4)]
-    return min(max(L[0], L[2]) / min(L[0], L[2]), max(L[1], L[3]) / min(L[1], L[3]))
+    a, b = max(L[0], L[2]) / min(L[0], L[2]), max(L[1], L[3]) / min(L[1], L[3])
+    return min(a, b), max(a, b)
 
 
 def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
@@ -66,7 +75,10 @@ def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     if corners is None or not math.isfinite(cost):
         return False
     R = bulge_ratio(ring, corners)
-    return R >= FAN_BULGE or (R >= BULGING and _pairs(ring, corners) >= FAN_PAIRS)
+    if R >= FAN_BULGE:
+        return True
+    lo, hi = _pairs(ring, corners)
+    return R >= BULGING and (lo >= FAN_PAIRS or lo * hi >= FAN_AREA)
 
 
 def wraps(ring: np.ndarray, sigma: float, forced=()) -> bool:

@@ -26,6 +26,8 @@ CASES = {
     "needle island near the shore": "testing.small_islands(760001, n_islands=10)",
     "basin by a thin peninsula": "testing.small_islands(745801, n_islands=4, peninsulas=4, widths=(0.5, 3.0))",
     "headlands 779600": "testing.headlands(779600, n=6)",
+    # session 32: the east lobe as one block from a small island's side, sides 6.0× and 8.1× apart
+    "lobe fanning from a small island": "testing.round_lake(955400, kind='blob', n_islands=5)",
 }
 
 
@@ -37,13 +39,13 @@ def _sides(ring: np.ndarray, corners) -> list[float]:
     return [(s[c[(k + 1) % 4]] - s[c[k]]) % total for k in range(4)]
 
 
-def _fan(ring: np.ndarray, corners) -> tuple[float, float]:
-    """The bulge (area / mean of one pair × mean of the other) and the smaller of the two
-    ratios of opposite sides."""
+def _fan(ring: np.ndarray, corners) -> tuple[float, float, float]:
+    """The bulge (area / mean of one pair × mean of the other), the smaller of the two ratios of
+    opposite sides and their product."""
     L = _sides(ring, corners)
     bulge = Polygon(ring).area / (0.25 * (L[0] + L[2]) * (L[1] + L[3]))
-    pairs = min(max(L[0], L[2]) / min(L[0], L[2]), max(L[1], L[3]) / min(L[1], L[3]))
-    return bulge, pairs
+    a, b = max(L[0], L[2]) / min(L[0], L[2]), max(L[1], L[3]) / min(L[1], L[3])
+    return bulge, min(a, b), a * b
 
 
 @pytest.mark.parametrize("name", CASES)
@@ -51,11 +53,13 @@ def test_no_block_fans_from_two_short_sides(name):
     poly = eval(CASES[name])
     lay = auto_layout(poly, target_cells=15000, multiple=4)
     for pc in lay.pieces:
-        bulge, pairs = _fan(np.asarray(pc.ring), pc.corners)
+        bulge, pairs, product = _fan(np.asarray(pc.ring), pc.corners)
         # main: bulge 5.3 (a block 4 × 184 cells round a lobe), 6.0 (round a needle island),
-        # 3.1; 1.65 with both pairs of sides 11-12× apart (a basin's corners by a peninsula)
+        # 3.1; 1.65 with both pairs of sides 11-12× apart (a basin's corners by a peninsula);
+        # 1.24 with pairs 6.0× and 8.1× apart (product 49: the lobe from a small island)
         assert bulge < 3.0, (name, pc.ring.mean(axis=0), bulge)
         assert bulge < 1.2 or pairs < 8.0, (name, pc.ring.mean(axis=0), bulge, pairs)
+        assert bulge < 1.2 or product < 32.0, (name, pc.ring.mean(axis=0), bulge, product)
 
 
 def test_the_needle_island_keeps_its_blocks():
