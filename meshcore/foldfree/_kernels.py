@@ -49,7 +49,9 @@ neighbours once: it keeps each triangle's ``F, ∇F, D, ∇D`` at the node
 (:func:`_node_forms`), from which the energy, gradient and Hessian there
 (:func:`_form_local`, the same terms) and, ``F`` being quadratic and ``D``
 affine in the node, the energy at every trial point (:func:`_form_energy`)
-follow, both equal to the term-by-term sums up to rounding.
+follow, both equal to the term-by-term sums up to rounding.  The repair runs
+:func:`meshcore.foldfree._sweep.fast_sweep`: the same steps in one loop per node (this
+:func:`sweep` is its readable form and test oracle).
 """
 
 from __future__ import annotations
