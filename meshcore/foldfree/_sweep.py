@@ -33,22 +33,8 @@ STALL = 1e-3
 #: at 4): ``(apex, a, b)`` in :func:`._kernels._node_forms`' order; the node's role is ``n % 3`` (0 apex,
 #: 1 ``a``, 2 ``b``).
 _TRI = np.array(
-    [
-        (4, 1, 3),
-        (3, 4, 0),
-        (1, 0, 4),
-        (4, 3, 7),
-        (7, 4, 6),
-        (3, 6, 4),
-        (4, 5, 1),
-        (1, 4, 2),
-        (5, 2, 4),
-        (4, 7, 5),
-        (5, 4, 8),
-        (7, 8, 4),
-    ],
-    dtype=np.int64,
-)
+    [4, 1, 3, 3, 4, 0, 1, 0, 4, 4, 3, 7, 7, 4, 6, 3, 6, 4, 4, 5, 1, 1, 4, 2, 5, 2, 4, 4, 7, 5, 5, 4, 8, 7, 8, 4]
+).reshape(12, 3)
 
 
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
