@@ -60,6 +60,7 @@ KERNEL_MODULES = (
     "multiblock/_hier_kernels.py",
     "multiblock/_start_kernels.py",
     "foldfree/_kernels.py",
+    "foldfree/_sweep.py",
     "orthogonal/_kernels.py",
     "orthogonal/_equalize_kernels.py",
     "orthogonal/_bfgs.py",

@@ -192,25 +192,16 @@ _WORKSPACES: dict = {}
 last_run: dict = {}
 
 
-def _alt_lines(lv: _Level) -> None:
-    """One alternating zebra-line sweep of level ``lv``: every η line, then every ξ line.
+def _alt_lines(lv: _Level, sweeps: int = 1) -> None:
+    """``sweeps`` alternating zebra-line sweeps of level ``lv``: every η line, then every ξ line.
 
     The ξ lines are the η lines of the transposed level (:func:`._mg_lines.smooth_lines`
     on transposed copies): the discrete operator is the same under ``ξ ↔ η`` with ``α ↔ γ``
     and ``P ↔ Q`` (the cross term and ``D²`` do not change), so the same kernel relaxes
-    both; the copies cost about a quarter of a point sweep.
+    both; the copies cost about a quarter of a point sweep.  Each pass is damped by
+    ``LINE_OMEGA``; the sweeps run in one compiled call (:func:`._mg_lines.alt_lines`).
     """
-    w = LINE_OMEGA
-    x0, y0 = lv.x.copy(), lv.y.copy()
-    L.smooth_lines(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, 0, 1)
-    xt = np.ascontiguousarray((x0 + w * (lv.x - x0)).T)
-    yt = np.ascontiguousarray((y0 + w * (lv.y - y0)).T)
-    x0, y0 = xt.copy(), yt.copy()
-    fxt, fyt = np.ascontiguousarray(lv.fx.T), np.ascontiguousarray(lv.fy.T)
-    pt, qt = np.ascontiguousarray(lv.q.T), np.ascontiguousarray(lv.p.T)
-    L.smooth_lines(xt, yt, fxt, fyt, pt, qt, 0, 1)
-    lv.x[...] = (x0 + w * (xt - x0)).T
-    lv.y[...] = (y0 + w * (yt - y0)).T
+    L.alt_lines(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, LINE_OMEGA, sweeps)
 
 
 class _FAS:
@@ -471,8 +462,7 @@ class _FAS:
             self.updates += sweeps * lv.x.size
             fn = K.smooth_parallel if lv.par else K.smooth
             if lv.lines:
-                for _ in range(sweeps):
-                    _alt_lines(lv)
+                _alt_lines(lv, sweeps)
                 return
             if not lv.wake:
                 fn(lv.x, lv.y, lv.fx, lv.fy, lv.p, lv.q, self.periodic, sweeps)

@@ -49,7 +49,9 @@ neighbours once: it keeps each triangle's ``F, ∇F, D, ∇D`` at the node
 (:func:`_node_forms`), from which the energy, gradient and Hessian there
 (:func:`_form_local`, the same terms) and, ``F`` being quadratic and ``D``
 affine in the node, the energy at every trial point (:func:`_form_energy`)
-follow, both equal to the term-by-term sums up to rounding.
+follow, both equal to the term-by-term sums up to rounding.  The repair runs
+:func:`meshcore.foldfree._sweep.fast_sweep`: the same steps in one loop per node (this
+:func:`sweep` is its readable form and test oracle).
 """
 
 from __future__ import annotations
@@ -60,14 +62,6 @@ import numpy as np
 from numba import njit
 
 _INF = np.inf
-#: :func:`untangle` gives up when ε has shrunk below this fraction of the worst inverted corner's
-#: ``|D|`` (χ there is then ~ε²/(4|D|): a wall).  The failed pieces cost most of the untangling:
-#: on 79 saved Winslow grids (session 30) 1457 pieces failed in 303 000 sweeps, 1706 succeeded in
-#: 86 000; 4 of the 1706 went below 1e-3 before they succeeded, 9 below 1e-2.  1e-4 → 1e-3: the same
-#: outcome on all 79, the same grid on 76 (Garda and a headlands shape repaired by the transplant
-#: instead of a wide patch, lower energy), repair CPU -10 % (1e-2: -23 %, 9 grids differ, one moved
-#: 5× as far from Winslow).
-STALL = 1e-3
 
 
 @njit(cache=True, inline="always")
@@ -205,6 +199,86 @@ def _node_local(x, y, i, j, qx, qy, eps, out, periodic, cx, cy, full):
     return True
 
 
+@njit(cache=True, inline="always")
+def _tri_forms(ux, uy, vx, vy, r):
+    """The forms of one corner triangle with edges ``u, v`` from its apex w.r.t. the node in role
+    ``r`` (0 apex, 1 ``a``, 2 ``b``): ``(F, ∂F/∂x, ∂F/∂y, ∇²F/2, D, ∂D/∂x, ∂D/∂y)``."""
+    f = ux * ux + uy * uy + vx * vx + vy * vy
+    d = ux * vy - uy * vx
+    if r == 0:
+        return f, -2.0 * (ux + vx), -2.0 * (uy + vy), 2.0, d, uy - vy, vx - ux
+    if r == 1:
+        return f, 2.0 * ux, 2.0 * uy, 1.0, d, vy, -vx
+    return f, 2.0 * vx, 2.0 * vy, 1.0, d, -uy, ux
+
+
+@njit(cache=True, inline="always")
+def _terms(f2, gfx, gfy, hf, d, gdx, gdy, e2):
+    """One triangle's terms of the local energy, gradient and Hessian (``hf = ∇²F``) under
+    ``ε² = e2``: ``(c, E, gx, gy, hxx, hxy, hyy)``; ``c = χ(D, ε)`` (``D`` itself at ε = 0: the
+    caller checks ``D > 0`` there, ``c > 0`` otherwise)."""
+    if e2 == 0.0:
+        ic = 1.0 / d
+        k2 = ic * ic
+        k1 = f2 * k2
+        k3 = 2.0 * k1 * ic
+        c = d
+    else:
+        s = math.sqrt(e2 + d * d)
+        c = 0.5 * (d + s) if d >= 0.0 else 0.5 * e2 / (s - d)
+        ic = 1.0 / c
+        i_s = 1.0 / s
+        c1 = c * i_s
+        c2 = 0.5 * e2 * i_s * i_s * i_s
+        k2 = c1 * ic * ic
+        k1 = f2 * k2
+        k3 = f2 * (2.0 * c1 * c1 * ic * ic * ic - c2 * ic * ic)
+    return (
+        c,
+        f2 * ic,
+        gfx * ic - k1 * gdx,
+        gfy * ic - k1 * gdy,
+        hf * ic - 2.0 * k2 * gfx * gdx + k3 * gdx * gdx,
+        -k2 * (gfx * gdy + gdx * gfy) + k3 * gdx * gdy,
+        hf * ic - 2.0 * k2 * gfy * gdy + k3 * gdy * gdy,
+    )
+
+
+@njit(cache=True, inline="always")
+def _sum_terms(f0, f1, f2, f3, d0, d1, d2, n, e2):
+    """:func:`_terms` summed over the first ``n`` triangles of the forms ``f0 … d2`` (``f3`` =
+    ``∇²F/2``): ``(least c, E, gx, gy, hxx, hxy, hyy)``."""
+    cmin = _INF
+    e = gx = gy = hxx = hxy = hyy = 0.0
+    for k in range(n):
+        t = _terms(f0[k], f1[k], f2[k], 2.0 * f3[k], d0[k], d1[k], d2[k], e2)
+        cmin = min(cmin, t[0])
+        e += t[1]
+        gx += t[2]
+        gy += t[3]
+        hxx += t[4]
+        hxy += t[5]
+        hyy += t[6]
+    return cmin, e, gx, gy, hxx, hxy, hyy
+
+
+@njit(cache=True, inline="always")
+def _newton(gx, gy, hxx, hxy, hyy):
+    """The Newton step ``−H⁻¹ g`` of a node, the Hessian shifted to be positive definite:
+    ``(ok, sx, sy)``, ``ok = False`` when the shifted determinant is not positive."""
+    tr = hxx + hyy
+    det = hxx * hyy - hxy * hxy
+    lam_min = 0.5 * tr - math.sqrt(max(0.25 * (hxx - hyy) ** 2 + hxy * hxy, 0.0))
+    if lam_min <= 1e-12 * max(abs(tr), 1e-300):
+        shift = -lam_min + 1e-6 * max(abs(tr), 1e-300) + 1e-300
+        hxx += shift
+        hyy += shift
+        det = hxx * hyy - hxy * hxy
+    if det <= 0.0:
+        return False, 0.0, 0.0
+    return True, -(hyy * gx - hxy * gy) / det, -(-hxy * gx + hxx * gy) / det
+
+
 @njit(cache=True, nogil=True)
 def _node_forms(x, y, i, j, periodic, cx, cy, forms):
     """The forms of node ``(i, j)``'s 12 corner triangles, in :func:`_node_local`'s order:
@@ -236,17 +310,9 @@ def _node_forms(x, y, i, j, periodic, cx, cy, forms):
             kb = q0 + (0 if tb == 0 else (3 if tb == 1 else (4 if tb == 2 else 1)))
             ux, uy = cx[ka] - cx[kt], cy[ka] - cy[kt]
             vx, vy = cx[kb] - cx[kt], cy[kb] - cy[kt]
-            forms[0, n] = ux * ux + uy * uy + vx * vx + vy * vy
-            forms[4, n] = ux * vy - uy * vx
-            if r == 0:
-                forms[1, n], forms[2, n], forms[3, n] = -2.0 * (ux + vx), -2.0 * (uy + vy), 2.0
-                forms[5, n], forms[6, n] = uy - vy, vx - ux
-            elif r == 1:
-                forms[1, n], forms[2, n], forms[3, n] = 2.0 * ux, 2.0 * uy, 1.0
-                forms[5, n], forms[6, n] = vy, -vx
-            else:
-                forms[1, n], forms[2, n], forms[3, n] = 2.0 * vx, 2.0 * vy, 1.0
-                forms[5, n], forms[6, n] = -uy, ux
+            f = _tri_forms(ux, uy, vx, vy, r)
+            for q in range(7):
+                forms[q, n] = f[q]
             n += 1
     return n
 
@@ -267,45 +333,12 @@ def _form_local(forms, n, eps, out):
     dmin = _INF
     for k in range(n):
         dmin = min(dmin, forms[4, k])
-    e = gx = gy = hxx = hxy = hyy = 0.0
-    if eps == 0.0:
-        if dmin <= 0.0:
-            return False
-        for k in range(n):
-            f2, gfx, gfy, hf = forms[0, k], forms[1, k], forms[2, k], 2.0 * forms[3, k]
-            gdx, gdy = forms[5, k], forms[6, k]
-            ic = 1.0 / forms[4, k]
-            k2 = ic * ic
-            k1 = f2 * k2
-            e += f2 * ic
-            gx += gfx * ic - k1 * gdx
-            gy += gfy * ic - k1 * gdy
-            k3 = 2.0 * k1 * ic
-            hxx += hf * ic - 2.0 * k2 * gfx * gdx + k3 * gdx * gdx
-            hxy += -k2 * (gfx * gdy + gdx * gfy) + k3 * gdx * gdy
-            hyy += hf * ic - 2.0 * k2 * gfy * gdy + k3 * gdy * gdy
-    else:
-        e2 = eps * eps
-        for k in range(n):
-            f2, gfx, gfy, hf = forms[0, k], forms[1, k], forms[2, k], 2.0 * forms[3, k]
-            d, gdx, gdy = forms[4, k], forms[5, k], forms[6, k]
-            s = math.sqrt(e2 + d * d)
-            c = 0.5 * (d + s) if d >= 0.0 else 0.5 * e2 / (s - d)
-            if not (c > 0.0):
-                return False
-            ic = 1.0 / c
-            i_s = 1.0 / s
-            c1 = c * i_s
-            c2 = 0.5 * e2 * i_s * i_s * i_s
-            k2 = c1 * ic * ic
-            k1 = f2 * k2
-            e += f2 * ic
-            gx += gfx * ic - k1 * gdx
-            gy += gfy * ic - k1 * gdy
-            k3 = f2 * (2.0 * c1 * c1 * ic * ic * ic - c2 * ic * ic)
-            hxx += hf * ic - 2.0 * k2 * gfx * gdx + k3 * gdx * gdx
-            hxy += -k2 * (gfx * gdy + gdx * gfy) + k3 * gdx * gdy
-            hyy += hf * ic - 2.0 * k2 * gfy * gdy + k3 * gdy * gdy
+    if eps == 0.0 and dmin <= 0.0:
+        return False
+    t = _sum_terms(forms[0], forms[1], forms[2], forms[3], forms[4], forms[5], forms[6], n, eps * eps)
+    if not (t[0] > 0.0):
+        return False
+    e, gx, gy, hxx, hxy, hyy = t[1], t[2], t[3], t[4], t[5], t[6]
     out[0], out[1], out[2], out[3], out[4], out[5] = e, gx, gy, hxx, hxy, hyy
     return True
 
@@ -364,20 +397,9 @@ def sweep(x, y, nodes, eps, max_step, omega=1.0, periodic=False):
         if not _form_local(forms, nt, eps, out):
             continue
         e0, gx, gy = out[0], out[1], out[2]
-        hxx, hxy, hyy = out[3], out[4], out[5]
-        # positive-definite shift
-        tr = hxx + hyy
-        det = hxx * hyy - hxy * hxy
-        lam_min = 0.5 * tr - math.sqrt(max(0.25 * (hxx - hyy) ** 2 + hxy * hxy, 0.0))
-        if lam_min <= 1e-12 * max(abs(tr), 1e-300):
-            shift = -lam_min + 1e-6 * max(abs(tr), 1e-300) + 1e-300
-            hxx += shift
-            hyy += shift
-            det = hxx * hyy - hxy * hxy
-        if det <= 0.0:
+        ok, sx, sy = _newton(gx, gy, out[3], out[4], out[5])
+        if not ok:
             continue
-        sx = -(hyy * gx - hxy * gy) / det
-        sy = -(-hxy * gx + hxx * gy) / det
         slen = math.sqrt(sx * sx + sy * sy)
         if slen > max_step:
             sx *= max_step / slen
@@ -474,48 +496,3 @@ def corner_jacobians(x, y):
                 ux, uy = cx[ta] - cx[t], cy[ta] - cy[t]
                 out[t, ci, cj] = ux * (cy[tb] - cy[t]) - uy * (cx[tb] - cx[t])
     return out
-
-
-@njit(cache=True, nogil=True)
-def untangle(x, y, nodes, cells, exempt, eps, eps_floor, tol, inner, max_outer, periodic):
-    """The untangling loop of :func:`meshcore.foldfree.minimise.minimise` (its steps one for one,
-    kept here so that a piece's hundreds of ε steps make no Python calls): at each ε up to
-    ``inner`` sweeps until the energy stalls, then ε shrinks by the rule of Garanzha et al.
-    Returns ``(least corner Jacobian, sweeps)``."""
-    sweeps = 0
-    e_prev, _ = patch_stats(x, y, cells, eps, exempt)
-    dmin = -_INF
-    e = e_prev
-    for _outer in range(max_outer):
-        e_in = e_prev
-        for _ in range(inner):
-            d = sweep(x, y, nodes, eps, _INF, 1.0, periodic)
-            sweeps += 1
-            e, dmin = patch_stats(x, y, cells, eps, exempt)
-            if d <= tol or dmin > 0.0 or e_in - e <= 1e-3 * e:
-                break
-            e_in = e
-        if dmin > 0.0:
-            break
-        sigma = max(1.0 - e / e_prev, 0.1)
-        chi = 0.5 * (dmin + math.sqrt(eps * eps + dmin * dmin))
-        mu = (1.0 - sigma) * chi
-        eps = 2.0 * math.sqrt(mu * (mu - dmin)) if dmin < mu else eps_floor
-        eps = max(eps, eps_floor)
-        if eps < STALL * abs(dmin):
-            break  # stagnated: ε has vanished next to the worst inverted corner
-        e_prev, _ = patch_stats(x, y, cells, eps, exempt)
-    return dmin, sweeps
-
-
-@njit(cache=True, nogil=True)
-def barrier_sweeps(x, y, nodes, tol, max_sweeps, omega, periodic):
-    """Up to ``max_sweeps`` ε = 0 sweeps (over-relaxed by ``omega``), until no node moves more
-    than ``tol``; the sweeps made."""
-    sweeps = 0
-    for _ in range(max_sweeps):
-        d = sweep(x, y, nodes, 0.0, _INF, omega, periodic)
-        sweeps += 1
-        if d <= tol:
-            break
-    return sweeps

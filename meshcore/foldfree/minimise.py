@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from . import _kernels
+from . import _kernels, _sweep
 from .cells import _dilate, _median_area, _median_edge, _nodes_of, _touched_cells, invalid_cells
 
 __all__ = ["minimise", "patches"]
@@ -40,10 +40,10 @@ def minimise(
     if dmin <= 0.0:
         eps_floor = 1e-12 * _median_area(x, y, cells)
         eps = max(math.sqrt(0.04 * dmin * dmin), eps_floor)
-        dmin, sweeps = _kernels.untangle(x, y, nodes, cells, exempt, eps, eps_floor, tol, inner, max_outer, periodic)
+        dmin, sweeps = _sweep.untangle(x, y, nodes, cells, exempt, eps, eps_floor, tol, inner, max_outer, periodic)
         if dmin <= 0.0:
             return False, sweeps
-    sweeps += _kernels.barrier_sweeps(x, y, nodes, tol, max_sweeps, omega, periodic)
+    sweeps += _sweep.barrier_sweeps(x, y, nodes, tol, max_sweeps, omega, periodic)
     _, dmin = _kernels.patch_stats(x, y, cells, 0.0, exempt)
     return dmin > 0.0, sweeps
 

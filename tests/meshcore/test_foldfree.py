@@ -17,11 +17,13 @@ from meshcore.errors import BoundaryError, FoldedGridError
 from meshcore.foldfree import (
     _kernels,
     _reference,
+    _sweep,
     block_corner_problems,
     invalid_cells,
     repair,
     smooth,
 )
+from meshcore.foldfree.cells import _nodes_of
 from tests.conftest import annulus_sector, borders_of
 
 LAKES = Path(__file__).resolve().parent.parent / "data" / "lakes"
@@ -183,6 +185,45 @@ def test_sweeps_descend_and_never_invert():
         assert not invalid_cells(x, y).any()
     assert np.all(np.diff(e) <= 1e-12 * e[0])
     assert e[-1] < e[0]
+
+
+def _folded_square():
+    X, Y = np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 1, 9), indexing="ij")
+    X[4, 4], Y[4, 4] = 0.95, 0.9  # drag one node across many cells
+    X[2, 5], Y[2, 5] = 0.8, 0.1
+    return X, Y
+
+
+@pytest.mark.kernel
+@pytest.mark.parametrize(
+    "case, eps, omega",
+    [("random", 0.0, 1.0), ("random", 0.0, 1.9), ("folded", 0.05, 1.0), ("folded", 0.002, 1.0), ("o-grid", 0.0, 1.9)],
+)
+def test_fast_sweep_takes_the_steps_of_sweep(case, eps, omega):
+    # fast_sweep (one pass per node) against sweep (forms, then sums): the same steps, sums in
+    # another order, so the same grid up to rounding after every one of 20 sweeps
+    periodic = case == "o-grid"
+    if case == "random":
+        x, y = random_grid(ni=12, nj=9, amp=0.2, seed=11)
+    elif case == "folded":
+        x, y = _folded_square()
+        assert invalid_cells(x, y).any()
+    else:
+        x, y = o_grid()
+        x[0, 4:8] += 0.2
+        x[-1] = x[0]
+    nodes = _nodes_of(np.ones((x.shape[0] - 1, x.shape[1] - 1), bool), periodic)
+    xa, ya, xb, yb = x.copy(), y.copy(), x.copy(), y.copy()
+    scale = np.ptp(x) + np.ptp(y)
+    for _ in range(20):
+        da = _kernels.sweep(xa, ya, nodes, eps, np.inf, omega, periodic)
+        db = _sweep.fast_sweep(xb, yb, nodes, eps, omega, periodic)
+        assert db == pytest.approx(da, rel=1e-9, abs=1e-12 * scale)
+        np.testing.assert_allclose(xb, xa, rtol=0, atol=1e-10 * scale)
+        np.testing.assert_allclose(yb, ya, rtol=0, atol=1e-10 * scale)
+    assert np.abs(xb - x).max() > 1e-3 * scale  # the sweeps moved nodes
+    if periodic:
+        np.testing.assert_array_equal(xb[0], xb[-1])
 
 
 def test_smooth_recovers_uniform_square_grid():

@@ -143,3 +143,28 @@ def test_point_smoothing_that_stalls_goes_on_with_lines(monkeypatch):
     assert multigrid.last_run["lines"]
     ref = meshcore.solve(g0, method="sor", tolerance=1e-10)
     assert float(np.hypot(g.x - ref.x, g.y - ref.y).max()) <= 1e-6
+
+
+@pytest.mark.kernel
+@pytest.mark.parametrize("sources", [False, True])
+def test_compiled_alternating_sweeps_are_the_numpy_steps(sources):
+    """``_alt_lines(lv, 3)`` (one compiled call) against three sweeps of NumPy steps around the
+    η-line kernel: bit for bit."""
+    X, Y = _wavy(21, 9, seed=8)
+    rng = np.random.default_rng(9)
+    p, q = (rng.uniform(-1, 1, X.shape), rng.uniform(-1, 1, X.shape)) if sources else (E, E)
+    fx, fy = 0.01 * rng.standard_normal(X.shape), 0.01 * rng.standard_normal(X.shape)
+    lv = multigrid._Level(X.copy(), Y.copy(), fx, fy, p, q)
+    multigrid._alt_lines(lv, 3)
+    w, c = multigrid.LINE_OMEGA, np.ascontiguousarray
+    x, y = X.copy(), Y.copy()
+    for _ in range(3):
+        x0, y0 = x.copy(), y.copy()
+        _mg_lines.smooth_lines(x, y, fx, fy, p, q, 0, 1)
+        xt, yt = c((x0 + w * (x - x0)).T), c((y0 + w * (y - y0)).T)
+        x0, y0 = xt.copy(), yt.copy()
+        _mg_lines.smooth_lines(xt, yt, c(fx.T), c(fy.T), c(q.T), c(p.T), 0, 1)
+        x[...], y[...] = (x0 + w * (xt - x0)).T, (y0 + w * (yt - y0)).T
+    np.testing.assert_array_equal(lv.x, x)
+    np.testing.assert_array_equal(lv.y, y)
+    assert not np.array_equal(lv.x, X)
