@@ -12,7 +12,8 @@ orthogonal solve (cells of ``multiple`` × the size, 0.1–0.3 s) does: the mean
 :func:`chosen` draws the layout again at :data:`SCALES` × the cell size (the geometry only:
 the cells keep the asked size, as :data:`~meshcore.layout.LAYOUT_SCALES`), solves the coarsest
 level of each layout that differs, and keeps the one with the smallest deviation if that is
-:data:`MARGIN` below the first's and its largest interface ratio there is no larger (up to
+:data:`MARGIN` below the first's and its interface ratio there (the 99th percentile of the coarse
+cell pairs', :data:`meshcore.lakegrid.READING_PERCENTILE`) is no larger (up to
 :data:`RATIO_SLACK`; else the layout at the cell size itself).  Layouts of more than
 :data:`MAX_BLOCKS` blocks are kept as drawn (each other scale costs a layout: Saimaa's takes 10 s).
 """
@@ -37,7 +38,7 @@ MARGIN = 0.1
 #: A layout of more blocks than this is not drawn again (the time: a layout each).
 MAX_BLOCKS = 150
 
-#: How much (a share) another scale's largest coarse interface ratio may exceed the first's and
+#: How much (a share) another scale's coarse interface ratio may exceed the first's and
 #: still count as no larger: the same interface, left as it was by the other scale, reads a few
 #: parts in 10 000 apart on the two coarse grids (held-out g180759 at 10 000 cells: 2.45358 and
 #: 2.45377), and the strict test threw away a layout whose coarse deviation was 29 % lower (final
@@ -50,7 +51,7 @@ def chosen(
 ) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
     :data:`SCALES`, whose coarse grid deviates least from 90° on
-    average, if that is at most ``1 - MARGIN`` of ``first``'s and its largest interface ratio
+    average, if that is at most ``1 - MARGIN`` of ``first``'s and its coarse interface ratio
     is no larger than ``first``'s up to :data:`RATIO_SLACK` (``reading``: those two numbers of a
     layout's coarse grid, :func:`meshcore.lakegrid.coarse_reading`).  A scale whose layout or
     coarse solve fails is passed over; so is every other scale when ``first``'s coarse solve fails."""

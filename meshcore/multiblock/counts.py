@@ -101,6 +101,10 @@ SEARCH = True
 #: Pay for jumps next to chains shorter than ``multiple`` cells too, measured against the fewest
 #: cells they can have (``multiple``).  False: such chains were exempt, and a 1.6-cell shore piece
 #: beside a 12-cell cut on one block side could take 32 cells (a 48x jump, the block fanning into it).
+#: Measured again alone in session 32 (:data:`STEEP_WEIGHT` off), for the crowded tiny shore pieces
+#: of lakes of 40–110 blocks (held-out g180713 at 15 000 cells: 36 cells on 3.9 cells of shore beside
+#: a 43-cell cut with 12): mixed, still off — the counts are a new draw and interface ratios move
+#: both ways (docs/lake-grids-journal.md, "Tiny chains pay for their jumps").
 SHORT_JUMPS = False
 #: With :data:`STEEP_WEIGHT` on, pairs across a shared chain (two blocks' counts crossing it) pay it
 #: too; False: only two chains in a row along a block side, where a block fans into the dense one.

@@ -3,6 +3,7 @@ orthogonal (:mod:`meshcore.layout.choice`)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import meshcore.layout as layout_pkg
@@ -107,3 +108,21 @@ def test_the_same_interface_ratio_read_a_little_apart_does_not_block_a_better_la
     # not better by the margin: the first, whatever the ratio
     close = _scored("c", (1 - 0.5 * choice.MARGIN) * dev0, 0.5 * ratio0)
     assert choice.chosen(first, lambda s: close, lambda lay: lay.reading) is first
+
+
+def test_one_coarse_cell_pair_does_not_set_the_reading():
+    # the choice's guard compares coarse interface ratios; one odd pair of coarse cells read 7 607
+    # on held-out g180670 (its final grid 1.96) and turned down a grid 5 points more within 3°
+    from meshcore import StructuredGrid
+    from meshcore.lakegrid import READING_PERCENTILE, _reading
+
+    y = np.linspace(0.0, 200.0, 201)
+    a = StructuredGrid(*np.meshgrid([0.0, 1.0], y, indexing="ij"))
+    X, Y = np.meshgrid([1.0, 2.0], y, indexing="ij")
+    X[1, :2] = 1.01  # one cell of the second block a hundredth as wide
+    b = StructuredGrid(X, Y)
+    assert lake_metrics([a, b]).summary()["max_interface_ratio"] > 90
+    assert READING_PERCENTILE < 100
+    dev, ratio = _reading([a, b])
+    assert ratio < 2.5
+    assert dev >= 0
