@@ -223,26 +223,40 @@ def _patched_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
     return False
 
 
+#: Radii of the patches :func:`_repaired_to` tries, smallest first: the largest of
+#: :data:`PATCH_RADII`, then half as far again each time.  Where the solve laid several rows of a
+#: block side over a land tip, squeezed to a few hundredths of a cell, the rows that must move
+#: with the node run eight or more cells along the side (``channel_network(158204, …,
+#: roughness=0.15)`` at 15 000 cells: the patch of radius 8 leaves cells folded, 12 none).
+REPAIR_RADII = (PATCH_RADII[-1], 12, 18)
+
+
 def _repaired_to(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray) -> bool:
-    """Move node ``ij`` (on a block side) to ``p`` with the largest patch of :func:`_patched_to`,
-    then let the fold-free repair (:func:`meshcore.foldfree.repair`) move the interior nodes of that
-    patch's window (its edges fixed: the repair of the whole block, whose patches grow until they
-    are the block, reshaped blocks far from the tip; ``headlands(763605)``: 65 -> 44 % of nodes
-    within 3°) round the cells the move leaves non-convex; True if no cell of the block
-    is non-convex that was not before, else nothing moves.  Along a side that passes a sharp tip
-    the solve squeezes the rows next to the shore to a sliver: even the patch leaves the row inwards
-    of the node short of the tip (``channel_network(263005)``: the grid's edge 1.0 cells from it)."""
+    """Move node ``ij`` (on a block side) to ``p`` with a patch of :func:`_patch` of a radius of
+    :data:`REPAIR_RADII`, then let the fold-free repair (:func:`meshcore.foldfree.repair`) move the
+    interior nodes of that patch's window (its edges fixed: the repair of the whole block, whose
+    patches grow until they are the block, reshaped blocks far from the tip; ``headlands(763605)``:
+    65 -> 44 % of nodes within 3°) round the cells the move leaves non-convex; True for the first
+    radius after which no cell of the block is non-convex that was not before, else nothing moves.
+    Along a side that passes a sharp tip the solve squeezes the rows next to the shore to a sliver:
+    even the patch leaves the row inwards of the node short of the tip
+    (``channel_network(263005)``: the grid's edge 1.0 cells from it)."""
+    return any(_repaired_once(x, y, ij, p, r) for r in REPAIR_RADII)
+
+
+def _repaired_once(x: np.ndarray, y: np.ndarray, ij, p: np.ndarray, radius: int) -> bool:
+    """:func:`_repaired_to` with the patch of one ``radius``."""
     from ..foldfree import invalid_cells, repair
     from ..grid import StructuredGrid
 
     before = invalid_cells(x, y)
     ox, oy = x.copy(), y.copy()
-    ii, jj, w = _patch(x.shape, ij, PATCH_RADII[-1])
+    ii, jj, w = _patch(x.shape, ij, radius)
     x[ii, jj] += w * (p[0] - ox[ij])
     y[ii, jj] += w * (p[1] - oy[ij])
     x[ij], y[ij] = p[0], p[1]
     if invalid_cells(x, y).any():  # repaired within the patch's window only, its edges fixed
-        r = PATCH_RADII[-1] + 1
+        r = radius + 1
         win = (slice(max(0, ij[0] - r), ij[0] + r + 1), slice(max(0, ij[1] - r), ij[1] + r + 1))
         res = repair(StructuredGrid(x[win].copy(), y[win].copy()), strict=False)
         x[win], y[win] = res.grid.x, res.grid.y
