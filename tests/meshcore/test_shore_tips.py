@@ -62,6 +62,33 @@ def test_a_side_node_goes_onto_a_sharp_tip_its_grid_line_points_at(lean, tall):
     assert off.max() < 1e-9  # every shore node still on the shore
 
 
+@pytest.mark.parametrize("tall", [0.8, 1.0])
+def test_a_side_node_goes_onto_a_tip_beyond_squeezed_rows_with_a_larger_patch(tall):
+    # a sharp wedge of land (0.4 wide, 0.8–1.0 tall) in the middle of a block side of cells 0.125
+    # wide, its tip 2–2.6 cells beyond the edge that cuts it off, and four rows squeezed to 0.002
+    # along the side: the patch of radius 8 and its repair leave a cell folded, so the node stayed
+    # where it was (main: 2.06 and 2.55 cells from the tip); a patch of radius 12 puts it there
+    # (``channel_network(158204, …, roughness=0.15)``'s rough network at 15 000 cells: 0.61 cells)
+    h = 0.125
+    tip = (2.0, tall)
+    xs = np.r_[0.0, np.arange(h / 2, 4.0, h), 4.0]
+    ys = np.r_[0.0, 0.002 * np.arange(1, 5), np.linspace(0.25, 2.0, 8)]
+    shore = np.interp(xs, [0.0, 1.8, tip[0], 2.2, 4.0], [0.0, 0.0, tip[1], 0.0, 0.0])
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    Y = shore[:, None] * (1.0 - Y / 2.0) + Y
+    rings = _ring([(0, 0), (1.8, 0), tip, (2.2, 0), (4, 0), (4, 2), (0, 2)])
+    topo, g = _one_block(X, Y)
+    cells = topo.node_map.cells
+    assert np.hypot(X[:, 0] - tip[0], Y[:, 0] - tip[1]).min() > 2 * h
+    (out,), moved = fit_bends([g], topo, rings, 0.25 * h)
+    assert moved >= 1
+    bx, by = out.x[:, 0], out.y[:, 0]
+    assert np.hypot(bx - tip[0], by - tip[1]).min() <= 0.25 * h  # a node at the tip
+    assert not len(bad_cells(*_assemble([out], topo.node_map), cells))
+    _, _, off = project_to_rings(rings, np.c_[bx, by])
+    assert off.max() < 1e-9  # every shore node still on the shore
+
+
 def test_a_block_corner_on_a_notch_slides_along_the_shore_until_its_cell_is_convex():
     # the corner node sits on the tip of a tooth of land in the block's corner: the water turns
     # beyond 180° there and its one cell, between its neighbours (0.5, 0) and (0, 0.25), is
