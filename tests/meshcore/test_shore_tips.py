@@ -44,15 +44,10 @@ def _tip_block(lean: float, tall: float):
     return X, Y, rings, tip
 
 
-@pytest.mark.parametrize("lean", [-0.1, 0.0, 0.08])
-@pytest.mark.parametrize("tall", [0.4, 0.5])
-def test_a_side_node_goes_onto_a_sharp_tip_its_grid_line_points_at(lean, tall):
-    X, Y, rings, tip = _tip_block(lean, tall)
-    topo, g = _one_block(X, Y)
+def _fits_onto_the_tip(topo, g, rings, tip, h: float) -> None:
+    """:func:`fit_bends` on block ``g`` (cells ``h`` wide) puts a side node within a quarter cell of
+    ``tip``, folds no cell and leaves every shore node on the shore."""
     cells = topo.node_map.cells
-    assert not len(bad_cells(*_assemble([g], topo.node_map), cells))
-    h = 0.25
-    assert np.hypot(X[:, 0] - tip[0], Y[:, 0] - tip[1]).min() > 0.7 * h
     (out,), moved = fit_bends([g], topo, rings, 0.25 * h)
     assert moved >= 1
     bx, by = out.x[:, 0], out.y[:, 0]
@@ -60,6 +55,17 @@ def test_a_side_node_goes_onto_a_sharp_tip_its_grid_line_points_at(lean, tall):
     assert not len(bad_cells(*_assemble([out], topo.node_map), cells))
     _, _, off = project_to_rings(rings, np.c_[bx, by])
     assert off.max() < 1e-9  # every shore node still on the shore
+
+
+@pytest.mark.parametrize("lean", [-0.1, 0.0, 0.08])
+@pytest.mark.parametrize("tall", [0.4, 0.5])
+def test_a_side_node_goes_onto_a_sharp_tip_its_grid_line_points_at(lean, tall):
+    X, Y, rings, tip = _tip_block(lean, tall)
+    topo, g = _one_block(X, Y)
+    assert not len(bad_cells(*_assemble([g], topo.node_map), topo.node_map.cells))
+    h = 0.25
+    assert np.hypot(X[:, 0] - tip[0], Y[:, 0] - tip[1]).min() > 0.7 * h
+    _fits_onto_the_tip(topo, g, rings, tip, h)
 
 
 @pytest.mark.parametrize("tall", [0.8, 1.0])
@@ -78,15 +84,8 @@ def test_a_side_node_goes_onto_a_tip_beyond_squeezed_rows_with_a_larger_patch(ta
     Y = shore[:, None] * (1.0 - Y / 2.0) + Y
     rings = _ring([(0, 0), (1.8, 0), tip, (2.2, 0), (4, 0), (4, 2), (0, 2)])
     topo, g = _one_block(X, Y)
-    cells = topo.node_map.cells
     assert np.hypot(X[:, 0] - tip[0], Y[:, 0] - tip[1]).min() > 2 * h
-    (out,), moved = fit_bends([g], topo, rings, 0.25 * h)
-    assert moved >= 1
-    bx, by = out.x[:, 0], out.y[:, 0]
-    assert np.hypot(bx - tip[0], by - tip[1]).min() <= 0.25 * h  # a node at the tip
-    assert not len(bad_cells(*_assemble([out], topo.node_map), cells))
-    _, _, off = project_to_rings(rings, np.c_[bx, by])
-    assert off.max() < 1e-9  # every shore node still on the shore
+    _fits_onto_the_tip(topo, g, rings, tip, h)
 
 
 def test_a_block_corner_on_a_notch_slides_along_the_shore_until_its_cell_is_convex():
