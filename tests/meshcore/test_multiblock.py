@@ -930,11 +930,13 @@ def test_generated_layout_whose_cycles_stall_converges_by_damped_multigrid(monke
     (rate ~0.9) and, without the coarsest level, diverge; the solve fell back to SOR (4 275
     sweeps).  engine="auto" now retries with damped lines and converges by multigrid.  (The
     layout as drawn before blocks round a peninsula's tip were split, ``layout.fans.wraps``: the
-    33 blocks drawn now end in SOR, a case for the solver; ``mesh_outline`` keeps the same grid.)"""
+    33 blocks drawn now end in SOR, a case for the solver; ``mesh_outline`` keeps the same grid;
+    and before a fan's two side ratios were read by their product, ``layout.fans.FAN_AREA``.)"""
     from meshcore.layout import auto_layout, fans
     from meshcore.testing import headlands
 
     monkeypatch.setattr(fans, "_wraps", lambda *a, **k: False)
+    monkeypatch.setattr(fans, "FAN_AREA", math.inf)
     topo = auto_layout(headlands(861006), target_cells=15000, multiple=4).topology()
     assert len(topo.blocks) == 31
     mb = solve_multiblock(topo)
