@@ -65,6 +65,14 @@ _INF = np.inf
 
 
 @njit(cache=True, inline="always")
+def _regularised(d, e2):
+    """``(c, s)``: the regularised area ``c = (d + s) / 2`` (``ε² / (2 (s − d))`` for ``d < 0``: no
+    cancellation), ``s = sqrt(ε² + d²)``, under ``ε² = e2`` (:func:`_barrier`)."""
+    s = math.sqrt(e2 + d * d)
+    return (0.5 * (d + s) if d >= 0.0 else 0.5 * e2 / (s - d)), s
+
+
+@njit(cache=True, inline="always")
 def _barrier(d, eps):
     """The regularised area ``c(d) = (d + s) / 2``, ``s = sqrt(ε² + d²)`` (``ε² / (2 (s − d))`` for
     ``d < 0``: no cancellation; ``c = d`` at ε = 0), and ``c' = c / s``, ``c'' / 2 = ε² / (2 s³)``:
@@ -74,8 +82,7 @@ def _barrier(d, eps):
         if d <= 0.0:
             return 0.0, 1.0, 0.0
         return d, 1.0, 0.0
-    s = math.sqrt(eps * eps + d * d)
-    c = 0.5 * (d + s) if d >= 0.0 else 0.5 * eps * eps / (s - d)
+    c, s = _regularised(d, eps * eps)
     if c <= 0.0 or s <= 0.0:
         return 0.0, 1.0, 0.0
     return c, c / s, eps * eps / (2.0 * s * s * s)
@@ -224,8 +231,7 @@ def _terms(f2, gfx, gfy, hf, d, gdx, gdy, e2):
         k3 = 2.0 * k1 * ic
         c = d
     else:
-        s = math.sqrt(e2 + d * d)
-        c = 0.5 * (d + s) if d >= 0.0 else 0.5 * e2 / (s - d)
+        c, s = _regularised(d, e2)
         ic = 1.0 / c
         i_s = 1.0 / s
         c1 = c * i_s
@@ -343,30 +349,30 @@ def _form_local(forms, n, eps, out):
     return True
 
 
+@njit(cache=True, inline="always")
+def _trial_energy(f0, f1, f2, f3, d0, d1, d2, n, dx, dy, e2):
+    """The local energy of a node moved by ``(dx, dy)`` from where its triangles' forms ``f0 … d2``
+    (``f3`` = ``∇²F/2``) were taken, under ``ε² = e2``, and whether every triangle's area (``D`` at
+    ε = 0, else ``c``) stays positive: ``(E, ok)``."""
+    e = 0.0
+    dd = dx * dx + dy * dy
+    cm = _INF
+    for k in range(n):
+        d = d0[k] + d1[k] * dx + d2[k] * dy
+        c = d if e2 == 0.0 else _regularised(d, e2)[0]
+        cm = min(cm, c)
+        e += (f0[k] + f1[k] * dx + f2[k] * dy + f3[k] * dd) / c
+    return e, cm > 0.0
+
+
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
 def _form_energy(forms, n, dx, dy, eps):
     """The node's local energy with the node moved by ``(dx, dy)`` from where ``forms`` were
     taken (``+inf`` where a triangle inverts under the ε = 0 barrier): the trial points of
     :func:`sweep`, equal to :func:`_node_local` there up to rounding (division by a zero ``D``
     gives ±inf or nan here, never an error: the verdict is the least ``D``'s)."""
-    e = 0.0
-    dd = dx * dx + dy * dy
-    if eps == 0.0:
-        dmin = _INF
-        for k in range(n):
-            d = forms[4, k] + forms[5, k] * dx + forms[6, k] * dy
-            dmin = min(dmin, d)
-            e += (forms[0, k] + forms[1, k] * dx + forms[2, k] * dy + forms[3, k] * dd) / d
-        return e if dmin > 0.0 else _INF
-    e2 = eps * eps
-    for k in range(n):
-        d = forms[4, k] + forms[5, k] * dx + forms[6, k] * dy
-        s = math.sqrt(e2 + d * d)
-        c = 0.5 * (d + s) if d >= 0.0 else 0.5 * e2 / (s - d)
-        if not (c > 0.0):
-            return _INF
-        e += (forms[0, k] + forms[1, k] * dx + forms[2, k] * dy + forms[3, k] * dd) / c
-    return e
+    e, ok = _trial_energy(forms[0], forms[1], forms[2], forms[3], forms[4], forms[5], forms[6], n, dx, dy, eps * eps)
+    return e if ok else _INF
 
 
 @njit(cache=True, nogil=True)

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._kernels import _FM, _INF, _newton, _sum_terms, _tri_forms, patch_stats
+from ._kernels import _FM, _INF, _newton, _sum_terms, _tri_forms, _trial_energy, patch_stats
 
 __all__ = ["STALL", "barrier_sweeps", "fast_sweep", "untangle"]
 
@@ -90,25 +90,10 @@ def fast_sweep(x, y, nodes, eps, omega, periodic):
         alpha = omega if first else 1.0
         for _ in range(31 if first else 30):
             tx, ty = alpha * sx, alpha * sy
-            dd = tx * tx + ty * ty
-            e = 0.0
-            ok = True
             if eps == 0.0:
-                dm = _INF
-                for n in range(12):
-                    d = d0[n] + d1[n] * tx + d2[n] * ty
-                    dm = min(dm, d)
-                    e += (f0[n] + f1[n] * tx + f2[n] * ty + f3[n] * dd) / d
-                ok = dm > 0.0
+                e, ok = _trial_energy(f0, f1, f2, f3, d0, d1, d2, 12, tx, ty, 0.0)
             else:
-                cm = _INF
-                for n in range(12):
-                    d = d0[n] + d1[n] * tx + d2[n] * ty
-                    s = math.sqrt(e2 + d * d)
-                    c = 0.5 * (d + s) if d >= 0.0 else 0.5 * e2 / (s - d)
-                    cm = min(cm, c)
-                    e += (f0[n] + f1[n] * tx + f2[n] * ty + f3[n] * dd) / c
-                ok = cm > 0.0
+                e, ok = _trial_energy(f0, f1, f2, f3, d0, d1, d2, 12, tx, ty, e2)
             if ok and (e < e0 if first else e <= e0 + 1e-4 * alpha * slope):
                 nx, ny = x[i, j] + tx, y[i, j] + ty
                 x[i, j] = nx
