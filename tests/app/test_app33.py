@@ -1,0 +1,124 @@
+"""Session 33 (branch app33): a lake modeller's import-to-export path without stalls or noise."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.app.waits import wait_idle
+
+pytestmark = pytest.mark.gui
+
+LAKES = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
+
+
+def _big_outline(path: Path, n: int = 4000) -> Path:
+    """A wavy closed outline of ``n`` points in metres (no CRS: plain numbers, one block)."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    r = 1000 * (1 + 0.3 * np.sin(7 * t) + 0.05 * np.sin(97 * t))
+    rows = (f"{a:.3f},{b:.3f}" for a, b in zip(r * np.cos(t), 0.6 * r * np.sin(t), strict=True))
+    path.write_text("x,y\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def test_the_import_computes_off_the_gui_thread_which_keeps_drawing(qtbot, win, tmp_path, monkeypatch):
+    """The block's corners and cells (the Winslow cell ratio: 0.5 s on a 40 000-point outline) and the
+    file's reading ran in the GUI thread: the window froze.  They run in a thread of their own now,
+    the GUI thread's timers firing meanwhile, and the block is the same as computed directly."""
+    from PySide6 import QtCore
+
+    import app.io_controller as ioc
+    from app.project import block_from_points
+
+    gui = threading.current_thread()
+    ticked = threading.Event()
+    beat = QtCore.QTimer()
+    beat.setInterval(5)
+    beat.timeout.connect(ticked.set)
+    beat.start()
+    seen = {}
+
+    def watched(points, name):
+        seen["thread"] = threading.current_thread()
+        ticked.clear()
+        seen["gui_alive"] = ticked.wait(30)  # a hang guard only: the GUI thread's timer fires within ms
+        return block_from_points(points, name)
+
+    monkeypatch.setattr(ioc, "block_from_points", watched)
+    path = _big_outline(tmp_path / "big.csv")
+    assert win.io.import_points(path)
+    beat.stop()
+    assert seen["thread"] is not gui and seen["gui_alive"]
+    b = win.doc.block
+    direct = block_from_points(b.points, "x")
+    assert b.corners == direct.corners and b.cells == direct.cells and len(b.points) == 4000
+
+
+def test_a_file_that_cannot_be_read_off_the_gui_thread_says_why_and_keeps_the_document(qtbot, win, tmp_path):
+    """A reading error raised in the import's thread reaches the user as before (no traceback), and the
+    lake already open stays."""
+    path = _big_outline(tmp_path / "big.csv", 400)
+    assert win.io.import_points(path)
+    before = win.doc.project
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y\n1,2\nthree,4\n")
+    assert not win.io.import_points(bad)
+    assert win.doc.project is before
+    assert "Cannot import points" in win._status.text() and "bad.csv" in win._status.text()
+
+
+def test_input_is_held_while_a_step_runs_off_the_gui_thread(qtbot, win):
+    """A key pressed (Ctrl+Z) while the import's step computes does nothing then: the document cannot
+    change under the import."""
+    from PySide6 import QtCore, QtGui, QtWidgets
+
+    from app.off_gui import off_gui
+
+    win.editor.add_point((0.0, 0.0))
+    n = win.stack.count()
+
+    pressed = threading.Event()
+
+    def press() -> None:  # in the GUI thread, while the step runs
+        for key in (QtCore.Qt.Key.Key_Z, QtCore.Qt.Key.Key_Delete):
+            ev = QtGui.QKeyEvent(QtCore.QEvent.Type.KeyPress, key, QtCore.Qt.KeyboardModifier.ControlModifier)
+            QtWidgets.QApplication.sendEvent(win.canvas, ev)
+        pressed.set()
+
+    def step():
+        pressed.wait(30)  # a hang guard only
+        return 7
+
+    QtCore.QTimer.singleShot(0, press)
+    assert off_gui(step) == 7 and pressed.is_set()
+    qtbot.wait(50)
+    assert win.stack.count() == n and win.stack.index() == n  # not undone
+    assert QtWidgets.QApplication.overrideCursor() is None  # the busy cursor went with the step
+
+
+def test_an_imported_lake_offered_auto_layout_gets_no_corner_advice_until_f5_makes_one_block(qtbot, win):
+    """Atlin (sparse) imported: beside the Auto layout offer, Messages warned "corner NW is on point 45,
+    a reflex vertex ... move corner NW to a convex vertex" about the one block a lake modeller will not
+    make.  Now the advice waits: F5 on the one block gives it; Auto layout's blocks never."""
+    assert win.io.import_points(LAKES / "atlin_lake_sparse.geojson", project_lonlat=True)
+    assert win.lake_ctl.prompt is not None  # Auto layout offered
+    reflex = [t for _lv, t in win.messages_panel.messages() if "reflex" in t]
+    assert reflex == []
+    win.generate()  # the user wants the one block after all
+    reflex = [t for _lv, t in win.messages_panel.messages() if "reflex" in t]
+    assert len(reflex) == 1 and "corner NW" in reflex[0]
+    win.solver.stop()
+    wait_idle(qtbot, win)
+
+
+def test_corners_moved_on_an_imported_lake_are_advised_at_once(qtbot, win):
+    """The hold is for the import's automatic corners only: corners the user sets are advised as before."""
+    assert win.io.import_points(LAKES / "atlin_lake_sparse.geojson", project_lonlat=True)
+    c = list(win.doc.block.corners)
+    c[3] += 2  # NW two points on: point 47, reflex too (221°)
+    win.editor.set_corners(tuple(c))
+    reflex = [t for _lv, t in win.messages_panel.messages() if "reflex" in t]
+    assert len(reflex) == 1 and "point 47" in reflex[0]
