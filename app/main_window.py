@@ -470,7 +470,13 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         if b.corners is None or b.boundary is not None or key == self._corners_seen or project.layout is not None:
             return
         held, lake = self._advice_held, project.lake
-        if not generating and held is not None and lake is not None and (lake.outline, b.corners) == held:
+        if (
+            not generating
+            and held is not None
+            and lake is not None
+            and lake.outline is held[0]
+            and b.corners == held[1]
+        ):
             return  # (another lake, or corners the user moved: advice as for any block)
         self._corners_seen = key
         try:
