@@ -149,3 +149,35 @@ def test_the_autosave_after_an_edit_writes_in_a_thread_of_its_own(qtbot, win, tm
     win.editor.set_block_options(weights=(0.3, 0.7))
     win.io.autosave()  # asked for directly (a test, a clean exit's path): written when it returns
     assert threads[-1] is gui and recovery.read(win.io.recovery_path)[0] == win.doc.project
+
+
+def _small_lake():
+    from app.lake import Lake
+    from meshcore import testing
+
+    poly = testing.round_lake(850_031, kind="ring", radius=2000.0)
+    return Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        target_cells=1500,
+    )
+
+
+def test_a_lake_grid_exported_to_a_one_block_format_says_which_file_types_take_its_blocks(qtbot, win, tmp_path):
+    """File ▸ Export of a laid-out lake to ``lake.nc``: "the sgrid format holds one block, got 45", and no
+    way on.  Now it names the file types that take blocks (and those that merge them), writes nothing,
+    and the same grid goes to .vtm."""
+    from app.lake import compute_layout
+    from tests.app.waits import wait_for
+
+    lake = _small_lake()
+    win.editor.set_lake(lake.replaced(layout=compute_layout(lake)), "Auto layout")
+    win.generate()
+    wait_for(qtbot, win, lambda: bool(win.doc.grids) and not win.doc.stale and win.doc.multiblock is not None)
+    wait_idle(qtbot, win)
+    n = len(win.doc.project.layout.blocks)
+    assert not win.io.export_mesh(tmp_path / "lake.nc")
+    said = win._status.text()
+    assert f"NetCDF (.nc) holds one block and this grid has {n}" in said and ".vtm" in said and ".ddb" in said
+    assert not (tmp_path / "lake.nc").exists()
+    assert win.io.export_mesh(tmp_path / "lake.vtm") and (tmp_path / "lake.vtm").exists()
