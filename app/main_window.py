@@ -116,6 +116,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.focus_canvas()
         if restore_layout:
             self._restore_layout()
+        self.live_for_document()
         self.fit_to_screen()
         self.canvas.fit()
         self.message(
@@ -256,6 +257,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.doc.colour_changed.connect(self._misses_for_colours)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
+        self._live_seen = None  # the kind of document Live was last set for (live_for_document)
+        self.a_auto.triggered.connect(self._live_chosen)
+        self.doc.project_changed.connect(self.live_for_document)
         self.stack.cleanChanged.connect(self._update_title)
         self._in_sight = None  # the project the view was last kept on (_keep_in_sight)
         self.stack.indexChanged.connect(self._keep_in_sight)

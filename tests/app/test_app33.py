@@ -163,6 +163,34 @@ def _small_lake():
     )
 
 
+def test_live_is_on_for_a_lake_layout_and_remembered_apart_from_blocks(qtbot, win):
+    """Live (auto-generate) was off for everything by default: a cut end dragged left the old grid greyed
+    under "F5 makes the new one".  A lake's layout turns it on (the user's earlier choice for lakes
+    kept), one block keeps its own state; the choice made with a layout is remembered for lakes only."""
+    from app.lake import compute_layout
+    from app.window_frame import LIVE
+    from tests.app.waits import wait_for
+
+    win.settings.remove(LIVE["lake"][0])  # a user who never chose (the fixture's user turned it off)
+    assert not win.solver.auto and not win.a_auto.isChecked()  # a block document: off
+    lake = _small_lake()
+    win.editor.set_lake(lake.replaced(layout=compute_layout(lake)), "Auto layout")
+    assert win.solver.auto and win.a_auto.isChecked()
+    wait_for(qtbot, win, lambda: bool(win.doc.grids) and not win.doc.stale)  # gridded without F5
+    wait_idle(qtbot, win)
+    win.a_auto.trigger()  # the user turns it off, with a layout shown
+    assert not win.solver.auto
+    win.stack.undo()  # back to no layout: the blocks' state (off)
+    assert not win.solver.auto
+    win.a_auto.trigger()  # on for blocks
+    win.stack.redo()  # the layout again: off, as the user left it for lakes
+    assert not win.solver.auto and win.settings.value(LIVE["block"][0]) in (True, "true")
+    win.stack.undo()
+    assert win.solver.auto  # the blocks' on
+    win.a_auto.trigger()
+    wait_idle(qtbot, win)
+
+
 def test_a_lake_grid_exported_to_a_one_block_format_says_which_file_types_take_its_blocks(qtbot, win, tmp_path):
     """File ▸ Export of a laid-out lake to ``lake.nc``: "the sgrid format holds one block, got 45", and no
     way on.  Now it names the file types that take blocks (and those that merge them), writes nothing,
