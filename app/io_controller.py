@@ -330,8 +330,11 @@ class IOController(ExportMixin, QtCore.QObject):
         # plain numbers without a CRS (a duct, an airfoil, a shape of the paper) stay one block
         on_map = lake is not None and bool(pd.lonlat or pd.pointset.crs)
         offered = (branched or on_map) and not refused
-        if offered and lake is not None:  # the one block's automatic corners: advice about them is noise
-            self.win.hold_corner_advice(lake.outline, block.corners)  # until F5 makes that block
+        # the one block's automatic corners: advice about them is noise beside the Auto layout offer, or
+        # beside an outline that crosses itself (its "reflex vertex (interior angle 315°)" of a bow tie's
+        # crossing); until F5 makes that block or the user moves a corner
+        if (offered or refused) and lake is not None:
+            self.win.hold_corner_advice(lake.outline, block.corners)
         self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=title or stem)
         if recent:  # File ▸ Open recent imports it again (the same part of water) and remembers its folder
             self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)

@@ -209,3 +209,20 @@ def test_a_lake_grid_exported_to_a_one_block_format_says_which_file_types_take_i
     assert f"NetCDF (.nc) holds one block and this grid has {n}" in said and ".vtm" in said and ".ddb" in said
     assert not (tmp_path / "lake.nc").exists()
     assert win.io.export_mesh(tmp_path / "lake.vtm") and (tmp_path / "lake.vtm").exists()
+
+
+def test_an_outline_that_crosses_itself_is_said_so_without_corner_advice(qtbot, win, tmp_path):
+    """A bow tie imported: beside "the outline crosses itself: the edge from point 1 to 2 meets the edge
+    from point 3 to 4" came "corner NE is on point 3, a reflex vertex (interior angle 315°)" twice — advice
+    about corners of a loop that is no polygon.  The crossing alone is said; the document of before comes
+    back by one undo."""
+    path = tmp_path / "bowtie.csv"
+    path.write_text("x,y\n0,0\n1000,1000\n1000,0\n0,1000\n")
+    before = win.doc.project
+    assert win.io.import_points(path)
+    texts = [t for _lv, t in win.messages_panel.messages()]
+    assert any("crosses itself" in t and "point 1 to 2" in t for t in texts), texts
+    assert not any("reflex" in t for t in texts), texts
+    assert "crosses itself" in win._status.text()
+    win.stack.undo()
+    assert win.doc.project == before
