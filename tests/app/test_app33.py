@@ -226,3 +226,20 @@ def test_an_outline_that_crosses_itself_is_said_so_without_corner_advice(qtbot, 
     assert "crosses itself" in win._status.text()
     win.stack.undo()
     assert win.doc.project == before
+
+
+def test_another_lake_imported_clears_the_convergence_plot_of_the_one_before(qtbot, win, tmp_path):
+    """A lake gridded, then another imported over it: the Convergence dock went on showing the first
+    lake's sweeps and levels under the new lake's outline, with no grid of it."""
+    from app.lake import compute_layout
+    from tests.app.waits import wait_for
+
+    lake = _small_lake()
+    win.editor.set_lake(lake.replaced(layout=compute_layout(lake)), "Auto layout")
+    win.generate()
+    wait_for(qtbot, win, lambda: bool(win.doc.grids) and not win.doc.stale and win.doc.multiblock is not None)
+    wait_idle(qtbot, win)
+    assert len(win.conv_panel.curve.xData)  # the lake's sweeps
+    assert win.io.import_points(_big_outline(tmp_path / "other.csv", 400))
+    assert not win.doc.grids
+    assert win.conv_panel.curve.xData is None or len(win.conv_panel.curve.xData) == 0
