@@ -52,6 +52,20 @@ def _centroid(points) -> tuple[float, float]:
     return float(x), float(y)
 
 
+def _degrees_note(name: str, points) -> str:
+    """What a lon/lat outline kept in degrees costs: its cells' stretch east-west at its latitude."""
+    import math
+
+    _lon, lat = _centroid(points)
+    k = math.cos(math.radians(lat))
+    return (
+        f"{name}: kept in longitude/latitude degrees — at latitude {lat:.1f}° a degree east is {k:.2f} of a "
+        "degree north, so square cells in degrees are "
+        f"{1 / k:.1f}× longer north-south than east-west on the ground and a cell size is in degrees; "
+        "import it again and answer Yes to project it to metres"
+    )
+
+
 class IOController(ExportMixin, QtCore.QObject):
     """File operations of a :class:`~app.main_window.MainWindow`.
 
@@ -342,6 +356,9 @@ class IOController(ExportMixin, QtCore.QObject):
         if frame is not None and pd.lonlat:  # where it lands: a lon, lat header over lat, lon values shows here
             lon, lat = _centroid(pd.points)
             projected = f" (centroid lon {lon:.5f}, lat {lat:.5f}; projected to {frame.crs})"
+        elif pd.lonlat and project_lonlat is False:  # "No" to projecting: said, with what it costs
+            projected = " (kept in degrees, not projected)"
+            self.doc.report("warning", _degrees_note(path.name, pd.points))
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
         n_isl = len(lake.holes) if lake is not None else 0

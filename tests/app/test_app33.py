@@ -243,3 +243,13 @@ def test_another_lake_imported_clears_the_convergence_plot_of_the_one_before(qtb
     assert win.io.import_points(_big_outline(tmp_path / "other.csv", 400))
     assert not win.doc.grids
     assert win.conv_panel.curve.xData is None or len(win.conv_panel.curve.xData) == 0
+
+
+def test_a_lake_kept_in_degrees_is_said_to_be_with_its_distortion(qtbot, win):
+    """ "No" to "Project them to metres?": the lake came in as degrees, drawn stretched, and the status line
+    said only "Imported 578 points and 2 islands ...; Auto layout (Ctrl+L) lays it out" — nothing about
+    the degrees.  It says so, and Messages say what it costs at the lake's latitude."""
+    assert win.io.import_points(LAKES / "lake_como_sparse.geojson", project_lonlat=False)
+    assert "kept in degrees" in win._status.text()
+    notes = [t for lv, t in win.messages_panel.messages() if lv == "warning" and "degrees" in t]
+    assert len(notes) == 1 and "latitude 46." in notes[0] and "answer Yes" in notes[0], notes
