@@ -154,7 +154,7 @@ class IOController(ExportMixin, QtCore.QObject):
         if path.suffix.lower() != ".toml":
             return self.import_points(path, project_lonlat=project_lonlat)
         try:
-            project = fio.load_project(path)
+            project = off_gui(fio.load_project, path)  # (a laid-out lake of 45 blocks: 0.2-0.6 s of CPU)
         except (MeshcoreError, OSError) as exc:
             self.win.error("Cannot open project", exc)
             return False
