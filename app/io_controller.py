@@ -52,6 +52,22 @@ def _centroid(points) -> tuple[float, float]:
     return float(x), float(y)
 
 
+#: formats with a polygon type (a CSV's rows, a GPX track, a DXF polyline are an outline closed or not)
+_TYPED = frozenset({".kml", ".kmz", ".geojson", ".json", ".shp"})
+
+
+def _lines_only(path: Path, pointset) -> str | None:
+    """A note when a file that has polygons has none, only open lines (one of them becomes the outline)."""
+    if pointset is None or path.suffix.lower() not in _TYPED or any(pl.closed for pl in pointset.polylines):
+        return None
+    longest = max(pointset.polylines, key=lambda pl: len(pl.points))
+    n = len(pointset.polylines)
+    return (
+        f"{path.name} has no polygon, only {n} open line{'s' * (n != 1)}: the longest ('{longest.name}', "
+        f"{len(longest.points)} points) is closed into the outline — a lake's shore is a Polygon in the file"
+    )
+
+
 def _degrees_note(name: str, points) -> str:
     """What a lon/lat outline kept in degrees costs: its cells' stretch east-west at its latitude."""
     import math
@@ -278,6 +294,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         if pd.note:  # metres in a lon/lat format: read as local metres (the app has no --source-crs)
             self.doc.report("warning", pd.note)
+        lines_only = _lines_only(path, pd.pointset)
+        if lines_only:  # a KML of a road or a centreline became a lake of its points, unsaid
+            self.doc.report("warning", lines_only)
         # a lake's project gets a new lake, in the file's own frame (the UTM zone of a lon/lat outline,
         # none for metres); otherwise the points join the project in its frame (a background traced)
         replace = self.doc.project.lake is not None

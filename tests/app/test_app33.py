@@ -268,3 +268,20 @@ def test_a_project_is_read_off_the_gui_thread(qtbot, win, tmp_path, monkeypatch)
     assert win.io.open_path(tmp_path / "o.toml")
     assert threads and threads[0] is not threading.current_thread()
     assert len(win.doc.block.points) == len(saved.blocks[0].points)
+
+
+def test_a_kml_of_a_line_only_says_it_has_no_polygon(qtbot, win, tmp_path):
+    """A KML of one LineString (a road, a river's centre line) came in as a lake of its three points, the
+    status line "Imported 3 points ... Auto layout splits it into blocks": nothing said the file has no
+    polygon.  Messages say so and which line became the outline."""
+    kml = tmp_path / "road.kml"
+    kml.write_text(
+        '<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark><name>road</name><LineString>'
+        "<coordinates>10.0,60.0,0 10.1,60.1,0 10.2,60.0,0</coordinates></LineString></Placemark></Document></kml>"
+    )
+    assert win.io.import_points(kml, project_lonlat=True)
+    notes = [t for lv, t in win.messages_panel.messages() if lv == "warning" and "no polygon" in t]
+    assert len(notes) == 1 and "'road'" in notes[0] and "3 points" in notes[0], notes
+    csv = _big_outline(tmp_path / "shore.csv", 100)  # a CSV's rows are an outline: nothing said
+    assert win.io.import_points(csv)
+    assert len([t for _lv, t in win.messages_panel.messages() if "no polygon" in t]) == 1
