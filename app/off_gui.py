@@ -45,13 +45,17 @@ HELD = frozenset(
 
 
 class _Hold(QtCore.QObject):
-    """An application event filter that drops the user's input (a close is refused)."""
+    """An application event filter that drops the user's input (a window's close is refused).  A modal
+    dialog opened meanwhile (an error of another worker) gets its input: it blocks the window's anyway,
+    and held it would never close."""
 
-    def eventFilter(self, _obj: QtCore.QObject, ev: QtCore.QEvent) -> bool:
-        if ev.type() in HELD:
-            ev.ignore()
-            return True
-        return False
+    def eventFilter(self, obj: QtCore.QObject, ev: QtCore.QEvent) -> bool:
+        if ev.type() not in HELD or QtWidgets.QApplication.activeModalWidget() is not None:
+            return False
+        if ev.type() == _E.Close and not (isinstance(obj, QtWidgets.QWidget) and obj.isWindow()):
+            return False  # a part of the window closed by the program (an offer bar), not the user
+        ev.ignore()
+        return True
 
 
 class _Done(QtCore.QObject):

@@ -285,3 +285,24 @@ def test_a_kml_of_a_line_only_says_it_has_no_polygon(qtbot, win, tmp_path):
     csv = _big_outline(tmp_path / "shore.csv", 100)  # a CSV's rows are an outline: nothing said
     assert win.io.import_points(csv)
     assert len([t for _lv, t in win.messages_panel.messages() if "no polygon" in t]) == 1
+
+
+def test_a_dialog_opened_while_a_step_runs_off_the_gui_thread_takes_its_input(qtbot, win):
+    """An error of another worker shown in a modal dialog during the hold: the user's click on OK was
+    held too, the dialog never closed and the step's end waited behind it."""
+    from PySide6 import QtCore, QtWidgets
+
+    from app.off_gui import off_gui
+
+    shown = threading.Event()
+    closed = []
+
+    def dialog() -> None:  # in the GUI thread, while the step runs
+        box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Icon.Warning, "Error", "a worker failed", parent=win)
+        QtCore.QTimer.singleShot(50, lambda: qtbot.keyClick(box, QtCore.Qt.Key.Key_Escape))  # the user's key
+        shown.set()
+        closed.append(box.exec())
+
+    QtCore.QTimer.singleShot(0, dialog)
+    assert off_gui(lambda: shown.wait(30)) is True
+    assert closed  # the dialog closed by the user's key
