@@ -1,4 +1,6 @@
-"""Measure the app's interactive numbers: ``python -m app.bench [lake] [--profile FILE]`` (offscreen is fine).
+"""Measure the app's interactive numbers (offscreen is fine)::
+
+    python -m app.bench [lake] [--profile FILE] [--live-off]
 
 * redraws/s of the grid curve at 257×257 nodes (setData + forced paint), and
   the live rate the window reaches during a solve at that size;
@@ -7,6 +9,7 @@
 * Lake Como (~10 000 cells): import → Auto layout → orthogonal grid → Delft3D DD export, the
   computing time of each step; then a cut line's end dragged along the shore with
   auto-generate on: redraws/s while dragging and the frames that showed a start grid (0);
+  ``--live-off``: the drag again with auto-generate off and F5 at the release (the new grid's wait);
 * start-up time of the main window (see also ``python -m app --screenshot``).
 """
 
@@ -68,7 +71,7 @@ def main() -> int:
         redraw_rate(win)
         live_rate_and_stop(app, win)
         drag_to_converged(app, win)
-    lake_como(app, win, profile=profile)
+    lake_como(app, win, profile=profile, live_off="--live-off" in args)
     win.stack.setClean()
     win.close()
     return 0
@@ -164,7 +167,7 @@ def drag_to_converged(app, win) -> None:
     print(f"redraws showing an algebraic start grid during the drags: {len(start_frames)} of {len(frames)}")
 
 
-def lake_como(app, win, profile: str | None = None) -> None:
+def lake_como(app, win, profile: str | None = None, live_off: bool = False) -> None:
     """Como in, layout out, grid, .ddb; then a cut line's end dragged along the shore (auto-generate).
 
     ``profile``: a file for the cProfile statistics of the drag (the GUI thread's CPU time).
@@ -203,6 +206,10 @@ def lake_como(app, win, profile: str | None = None) -> None:
         print(f"  {name:16s} CPU {c:5.1f} s (GUI thread {g:4.1f} s)   wall {w:5.1f} s")
     print(f"Como import -> Delft3D DD: computing (CPU) {cpu:.1f} s, wall {wall:.1f} s")
     drag_cut_end(app, win, profile=profile)
+    if live_off:  # the same drag with auto-generate off, back and forth: what Live saves a modeller
+        win.stack.undo()
+        _wait(app, lambda: not win.lake_ctl.editing and not win.solver.running, timeout=600)
+        drag_cut_end(app, win, live=False)
 
 
 def _thread_cpu() -> dict[int, float]:
@@ -223,10 +230,12 @@ def _thread_cpu() -> dict[int, float]:
     return out
 
 
-def drag_cut_end(app, win, profile: str | None = None) -> dict:
+def drag_cut_end(app, win, profile: str | None = None, *, live: bool = True) -> dict:
     """A cut line's end of the window's lake layout dragged along the shore with auto-generate on:
     redraws/s of wall time, the CPU time per redraw of the GUI thread and of the other threads
     (the solver and layout workers), and the redraws that showed a start grid (must be 0).
+    ``live`` False: auto-generate off (the old grid greyed while dragging), F5 pressed at the release;
+    "done after release" is then the wait for the new grid after F5.
 
     The start-grid check runs after the drag (the frames' grids are kept until then): it would
     otherwise count in the GUI thread's CPU time it measures.  ``profile``: a file for the
@@ -239,7 +248,7 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
     from app.layout_edit import handles, place
 
     lay = win.doc.project.layout
-    if not win.solver.auto:
+    if win.solver.auto != live:
         win.a_auto.trigger()  # auto-generate on: the grid follows the layout
     win.set_tool("layout")
     end = next(h for h in handles(lay) if h.kind == "end")
@@ -291,6 +300,9 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
     tool.drag("finish", place(lay, end, (end.xy[0] + h, end.xy[1] + h)), end.xy)
     t_release, c_release, g_release = time.perf_counter(), time.process_time(), time.thread_time()
     threads1 = _thread_cpu()
+    if not live:  # the user presses F5 once the drag's last layout is shown
+        _wait(app, lambda: not win.lake_ctl.editing, timeout=600)
+        win.a_generate.trigger()
     if prof is not None:
         prof.disable()
         prof.dump_stats(profile)
@@ -306,8 +318,9 @@ def drag_cut_end(app, win, profile: str | None = None) -> dict:
     others = {t: c - threads0.get(t, 0.0) for t, c in threads1.items() if t != gui_id}
     busy = sorted((c for c in others.values() if c >= 0.05), reverse=True)
     n = max(n_during, 1)
+    how = "on" if live else "off, F5 at release"
     print(
-        f"drag a cut end on Como ({lay.n_cells} cells, auto-generate; load {os.getloadavg()[0]:.1f}): "
+        f"drag a cut end on Como ({lay.n_cells} cells, auto-generate {how}; load {os.getloadavg()[0]:.1f}): "
         f"{n_during / wall:.1f} redraws/s while dragging ({n_during} in {wall:.1f} s wall for 3 s of mouse "
         f"moves); {n_lay / wall:.1f} layouts/s while dragging, {n_lay / max(cpu, 1e-9):.1f} per CPU-s "
         f"({n_lay} shown, {n_made} made, "

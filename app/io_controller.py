@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import logging
 import re
+import threading
 import time
 from pathlib import Path
 
@@ -27,6 +28,7 @@ from . import recovery
 from .examples import LAKES, lake_file, load_example
 from .io_export import ExportMixin, export_default
 from .lake import Lake, looks_branched, read_lake, read_lake_parts, water
+from .off_gui import off_gui
 from .project import Block, Project, block_from_points
 
 __all__ = ["MAX_RECENT", "IOController", "export_default"]
@@ -50,6 +52,36 @@ def _centroid(points) -> tuple[float, float]:
     return float(x), float(y)
 
 
+#: formats with a polygon type (a CSV's rows, a GPX track, a DXF polyline are an outline closed or not)
+_TYPED = frozenset({".kml", ".kmz", ".geojson", ".json", ".shp"})
+
+
+def _lines_only(path: Path, pointset) -> str | None:
+    """A note when a file that has polygons has none, only open lines (one of them becomes the outline)."""
+    if pointset is None or path.suffix.lower() not in _TYPED or any(pl.closed for pl in pointset.polylines):
+        return None
+    longest = max(pointset.polylines, key=lambda pl: len(pl.points))
+    n = len(pointset.polylines)
+    return (
+        f"{path.name} has no polygon, only {n} open line{'s' * (n != 1)}: the longest ('{longest.name}', "
+        f"{len(longest.points)} points) is closed into the outline — a lake's shore is a Polygon in the file"
+    )
+
+
+def _degrees_note(name: str, points) -> str:
+    """What a lon/lat outline kept in degrees costs: its cells' stretch east-west at its latitude."""
+    import math
+
+    _lon, lat = _centroid(points)
+    k = math.cos(math.radians(lat))
+    return (
+        f"{name}: kept in longitude/latitude degrees — at latitude {lat:.1f}° a degree east is {k:.2f} of a "
+        "degree north, so square cells in degrees are "
+        f"{1 / k:.1f}× longer north-south than east-west on the ground and a cell size is in degrees; "
+        "import it again and answer Yes to project it to metres"
+    )
+
+
 class IOController(ExportMixin, QtCore.QObject):
     """File operations of a :class:`~app.main_window.MainWindow`.
 
@@ -69,7 +101,14 @@ class IOController(ExportMixin, QtCore.QObject):
         self._autosave = QtCore.QTimer(self)
         self._autosave.setSingleShot(True)
         self._autosave.setInterval(DEBOUNCE_MS)
-        self._autosave.timeout.connect(self.autosave)
+        self._autosave.timeout.connect(lambda: self.autosave(wait=False))
+        # the autosave's writes run in a thread of their own (a 40 000-point lake: 0.4 s of the GUI
+        # thread's CPU, a 1.6 s stall at load 9, one second after every edit); one at a time, the newest
+        # project next
+        self._writer: threading.Thread | None = None
+        self._write_lock = threading.Lock()
+        self._write_next: tuple | None = None  # (project, path saved to) the writer takes next
+        self.write_failed.connect(self._autosave_failed)
         self._first_unsaved = 0.0  # when the oldest edit not yet autosaved was made
         self.stack.indexChanged.connect(self._edited)
         self.stack.cleanChanged.connect(self._clean_changed)
@@ -131,7 +170,7 @@ class IOController(ExportMixin, QtCore.QObject):
         if path.suffix.lower() != ".toml":
             return self.import_points(path, project_lonlat=project_lonlat)
         try:
-            project = fio.load_project(path)
+            project = off_gui(fio.load_project, path)  # (a laid-out lake of 45 blocks: 0.2-0.6 s of CPU)
         except (MeshcoreError, OSError) as exc:
             self.win.error("Cannot open project", exc)
             return False
@@ -243,8 +282,8 @@ class IOController(ExportMixin, QtCore.QObject):
         lists it; ``title``: the project's (default: the file's name).
         """
         path = Path(path)
-        try:
-            pd = fio.read_points(path)
+        try:  # (reading and every heavy step of the import: off the GUI thread, the window drawing meanwhile)
+            pd = off_gui(fio.read_points, path)
         except (MeshcoreError, OSError, ValueError) as exc:
             self.win.error("Cannot import points", exc)
             return False
@@ -255,6 +294,9 @@ class IOController(ExportMixin, QtCore.QObject):
             return False
         if pd.note:  # metres in a lon/lat format: read as local metres (the app has no --source-crs)
             self.doc.report("warning", pd.note)
+        lines_only = _lines_only(path, pd.pointset)
+        if lines_only:  # a KML of a road or a centreline became a lake of its points, unsaid
+            self.doc.report("warning", lines_only)
         # a lake's project gets a new lake, in the file's own frame (the UTM zone of a lon/lat outline,
         # none for metres); otherwise the points join the project in its frame (a background traced)
         replace = self.doc.project.lake is not None
@@ -281,7 +323,7 @@ class IOController(ExportMixin, QtCore.QObject):
                 project_lonlat = r == QtWidgets.QMessageBox.StandardButton.Yes
             if project_lonlat is None or project_lonlat:
                 try:
-                    pts, frame = fio.to_local(pd, frame)
+                    pts, frame = off_gui(fio.to_local, pd, frame)
                 except (MeshcoreError, ValueError) as exc:
                     self.win.error("Cannot project coordinates", exc)
                     return False
@@ -293,7 +335,7 @@ class IOController(ExportMixin, QtCore.QObject):
             if frame is None or not frame.crs:
                 frame = None if is_web_mercator(pd.pointset.crs) else Frame(pd.pointset.crs, (0.0, 0.0), None)
             try:
-                pts, frame = fio.to_local(pd, frame)
+                pts, frame = off_gui(fio.to_local, pd, frame)
             except (MeshcoreError, ValueError) as exc:
                 self.win.error("Cannot project coordinates", exc)
                 return False
@@ -312,7 +354,20 @@ class IOController(ExportMixin, QtCore.QObject):
             self.win.error("Cannot import points", f"{path}: needs at least 4 points, found {len(pts)}")
             return False
         stem = f"{path.stem}_part{k_part}" if n_parts > 1 else path.stem  # as meshcore mesh --case names it
-        block = block_from_points(pts, stem)
+        # the corners and cells of the one block (the Winslow cell ratio: 0.5 s on 40 000 points)
+        block = off_gui(block_from_points, pts, stem)
+        # water the layout refuses (an outline that crosses itself): no Auto layout offered, only to fail
+        branched = lake is not None and not refused and off_gui(looks_branched, lake.outline, lake.holes)
+        # a lake on the map (lon/lat, or a CRS the file declares) is water to model: its grid is the layout
+        # meshcore mesh makes (one block with automatic corners was ~20° off orthogonal on a compact lake);
+        # plain numbers without a CRS (a duct, an airfoil, a shape of the paper) stay one block
+        on_map = lake is not None and bool(pd.lonlat or pd.pointset.crs)
+        offered = (branched or on_map) and not refused
+        # the one block's automatic corners: advice about them is noise beside the Auto layout offer, or
+        # beside an outline that crosses itself (its "reflex vertex (interior angle 315°)" of a bow tie's
+        # crossing); until F5 makes that block or the user moves a corner
+        if (offered or refused) and lake is not None:
+            self.win.hold_corner_advice(lake.outline, block.corners)
         self._add_imported(block, frame, path.name, lake=lake, replace=replace, title=title or stem)
         if recent:  # File ▸ Open recent imports it again (the same part of water) and remembers its folder
             self.add_recent(path, part=k_part if n_parts > 1 else None, lonlat=project_lonlat if pd.lonlat else None)
@@ -320,6 +375,9 @@ class IOController(ExportMixin, QtCore.QObject):
         if frame is not None and pd.lonlat:  # where it lands: a lon, lat header over lat, lon values shows here
             lon, lat = _centroid(pd.points)
             projected = f" (centroid lon {lon:.5f}, lat {lat:.5f}; projected to {frame.crs})"
+        elif pd.lonlat and project_lonlat is False:  # "No" to projecting: said, with what it costs
+            projected = " (kept in degrees, not projected)"
+            self.doc.report("warning", _degrees_note(path.name, pd.points))
         if pd.note:
             projected = " (as local metres: its numbers are no longitude/latitude)"
         n_isl = len(lake.holes) if lake is not None else 0
@@ -327,13 +385,6 @@ class IOController(ExportMixin, QtCore.QObject):
         which = f" (part {k_part} of {n_parts}: Messages list the others)" if n_parts > 1 else ""
         if n_parts > 1 and again and asked_part == k_part:
             which = f" (part {k_part} of {n_parts}, the one opened last time: File ▸ Import asks for another)"
-        # water the layout refuses (an outline that crosses itself): no Auto layout offered, only to fail
-        branched = lake is not None and not refused and looks_branched(lake.outline, lake.holes)
-        # a lake on the map (lon/lat, or a CRS the file declares) is water to model: its grid is the layout
-        # meshcore mesh makes (one block with automatic corners was ~20° off orthogonal on a compact lake);
-        # plain numbers without a CRS (a duct, an airfoil, a shape of the paper) stay one block
-        on_map = lake is not None and bool(pd.lonlat or pd.pointset.crs)
-        offered = (branched or on_map) and not refused
         if refused:
             self.win.message(
                 f"Imported {len(pts)} points{isl} from {path.name}{which}{projected}; {refused} — Auto layout "
@@ -370,7 +421,7 @@ class IOController(ExportMixin, QtCore.QObject):
         if pd.pointset is None:
             return None, (1, 1), None
         try:
-            parts, fr, notes = read_lake_parts(pd.pointset, frame, lonlat=lonlat)
+            parts, fr, notes = off_gui(read_lake_parts, pd.pointset, frame, lonlat=lonlat)
             metres = not (pd.lonlat and not lonlat)  # lon/lat kept as degrees: areas in degrees²
             if len(parts) == 1:
                 k = 1
@@ -380,7 +431,7 @@ class IOController(ExportMixin, QtCore.QObject):
                 k = self.choose_part(pd.path, parts, metres, frame=fr, lonlat=bool(pd.lonlat))
             if k == 0:
                 return None, (0, len(parts)), None
-            outer, islands, _fr, notes = read_lake(pd.pointset, frame, lonlat=lonlat, part=k, metres=metres)
+            outer, islands, _fr, notes = off_gui(read_lake, pd.pointset, frame, lonlat=lonlat, part=k, metres=metres)
         except (MeshcoreError, ValueError) as exc:  # meshcore mesh refuses the file: say why here too
             self.doc.report(
                 "warning",
@@ -389,7 +440,7 @@ class IOController(ExportMixin, QtCore.QObject):
             return None, (1, 1), None
         refused = None
         try:  # what the water polygon changes (islands that touch joined): meshcore mesh says it on reading
-            notes = notes + water(outer, islands)[1]
+            notes = notes + off_gui(water, outer, islands)[1]
         except (MeshcoreError, ValueError) as exc:  # the layout will refuse it, naming the ring: said now
             # (was only logged: the user saw the corners' "reflex vertex (interior angle 307°)" of a bow tie)
             refused = str(exc)
@@ -518,7 +569,7 @@ class IOController(ExportMixin, QtCore.QObject):
         if not self._autosave.isActive():
             self._first_unsaved = now
         if now - self._first_unsaved >= MAX_DELAY_S and not self._dragging():
-            self.autosave()
+            self.autosave(wait=False)
         else:
             self._autosave.start()
 
@@ -538,21 +589,61 @@ class IOController(ExportMixin, QtCore.QObject):
             self._autosave.stop()
             self.discard_recovery()
 
-    def autosave(self) -> None:
-        """Write the project to the recovery files when it has unsaved edits (after a drag ends)."""
+    def autosave(self, *, wait: bool = True) -> None:
+        """Write the project to the recovery files when it has unsaved edits (after a drag ends).
+        ``wait`` False (the debounce timer): in the writer thread, the GUI thread going on."""
         self._autosave.stop()
         if self.stack.isClean():
             return
         if self._dragging():
             self._autosave.start()
             return
-        try:
-            recovery.write(self.doc.project, self.recovery_path, self.doc.path)
-        except (OSError, MeshcoreError, ValueError) as exc:
-            log.exception("autosave to %s failed", self.recovery_path)
-            self.win.message(f"autosave failed: {exc}", error=True)
+        job = (self.doc.project, self.doc.path)  # immutable: the thread reads it as it is now
+        if wait:
+            self.wait_autosave()
+            try:
+                recovery.write(job[0], self.recovery_path, job[1])
+            except (OSError, MeshcoreError, ValueError) as exc:
+                self._autosave_failed(exc)
+            return
+        with self._write_lock:
+            self._write_next = job
+            if self._writer is not None and self._writer.is_alive():
+                return  # the running writer takes it next
+            self._writer = threading.Thread(target=self._write_loop, name="gcmesh-autosave", daemon=True)
+            self._writer.start()
+
+    write_failed = QtCore.Signal(object)  # an autosave in the writer thread failed (its exception)
+
+    def _write_loop(self) -> None:
+        while True:
+            with self._write_lock:
+                job, self._write_next = self._write_next, None
+                if job is None:
+                    return
+            try:
+                recovery.write(job[0], self.recovery_path, job[1])
+            except (OSError, MeshcoreError, ValueError) as exc:
+                self.write_failed.emit(exc)  # (to the GUI thread)
+
+    @property
+    def autosaving(self) -> bool:
+        """True while the writer thread writes the recovery files."""
+        return self._writer is not None and self._writer.is_alive()
+
+    def wait_autosave(self) -> None:
+        """Let the writer thread finish what it writes, and drop what it would write next."""
+        with self._write_lock:
+            self._write_next = None
+        if self._writer is not None:
+            self._writer.join()
+
+    def _autosave_failed(self, exc) -> None:
+        log.error("autosave to %s failed", self.recovery_path, exc_info=exc)
+        self.win.message(f"autosave failed: {exc}", error=True)
 
     def discard_recovery(self) -> None:
+        self.wait_autosave()  # (a write in flight would bring the files back after a save)
         try:
             recovery.discard(self.recovery_path)
         except OSError:

@@ -133,6 +133,10 @@ class ExportMixin:
         if getattr(self, "_export_worker", None) is not None:
             self.win.message("An export is being written: export again when it is done", error=True)
             return False
+        one = _one_block_format(path, format, len(grids)) if len(grids) > 1 else None
+        if one is not None:  # said before the fold question (was: the writer's "holds one block, got 45")
+            self.win.error("Cannot export mesh", f"{path.name}: {one}")
+            return False
         if not self._folds_confirmed():
             return False
         whole = mb is not None and (p.multiblock is not None or p.layout is not None) and not self.doc.stale
@@ -330,3 +334,32 @@ class ExportMixin:
         self.remember_export(Path(path))
         self.win.message(f"Saved figure {path}")
         return True
+
+
+def _one_block_format(path: Path, format: str | None, n: int) -> str | None:
+    """Why a grid of ``n`` blocks cannot go to the format of ``path`` (None: it can, or the format is
+    unknown: the writer says so), and the file types that take it."""
+    from meshcore.io import FORMATS, find_format
+
+    try:
+        fmt = find_format(path, format, role="write")
+    except (MeshcoreError, ValueError):
+        return None
+    if fmt.multiblock:
+        return None
+
+    def name(f) -> str:
+        return f"{f.description.split(' (')[0].split(':')[0]} ({f.suffixes[0]})"
+
+    grids = [f for f in FORMATS.values() if f.writer and f.multiblock and f.name not in _NOT_A_GRID]
+    blocks = ", ".join(name(f) for f in grids if f.name not in _ONE_DOMAIN)
+    merged = " or ".join(name(f) for f in grids if f.name in _ONE_DOMAIN)
+    return (
+        f"{name(fmt)} holds one block and this grid has {n}: choose a file type that holds blocks — {blocks} — "
+        f"or one that merges them into one domain: {merged}"
+    )
+
+
+#: formats that take blocks but are no grid for a model; formats that merge the blocks into one domain
+_NOT_A_GRID = frozenset({"figure", "metrics-csv"})
+_ONE_DOMAIN = frozenset({"delft3d-single", "efdc"})

@@ -110,11 +110,13 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self._shown = False
         self.fit_on_show = True  # False: a size asked for explicitly (``--size``) is kept as it is
         self._corners_seen = None  # (block, points, corners) last checked for corner advice
+        self._advice_held = None  # (lake shore, corners): an imported lake's automatic corners, advised at F5
         self.set_tool("draw")
         self._update_title()
         self.focus_canvas()
         if restore_layout:
             self._restore_layout()
+        self.live_for_document()
         self.fit_to_screen()
         self.canvas.fit()
         self.message(
@@ -255,6 +257,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.doc.colour_changed.connect(self._misses_for_colours)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
+        self._live_seen = None  # the kind of document Live was last set for (live_for_document)
+        self.a_auto.triggered.connect(self._live_chosen)
+        self.doc.project_changed.connect(self.live_for_document)
         self.stack.cleanChanged.connect(self._update_title)
         self._in_sight = None  # the project the view was last kept on (_keep_in_sight)
         self.stack.indexChanged.connect(self._keep_in_sight)
@@ -435,6 +440,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
                 f"one block over a lake with {n} island{'s' * (n != 1)}: the grid covers "
                 f"{'them' if n != 1 else 'it'} — Lake ▸ Auto layout puts blocks around islands",
             )
+        if lake is not None and lake.layout is None:  # one block of a lake: the advice held at its import
+            self._check_corners(self.doc.project, generating=True)
         self.solve_status.reset()
         self.solver.start()
 
@@ -452,12 +459,29 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             if pi.getAxis(side).labelText != text:
                 pi.setLabel(side, text)
 
-    def _check_corners(self, project: Project) -> None:
-        """New corners on reflex vertices: say which, and where to move them."""
+    def hold_corner_advice(self, shore, corners) -> None:
+        """The one block of an imported lake that Auto layout is offered for: its automatic ``corners``
+        are not advised on (a reflex corner NE of a block the user will not make read as a problem of
+        the lake) until the user moves one or makes that block (F5)."""
+        self._advice_held = (shore, tuple(corners) if corners is not None else None)
+
+    def _check_corners(self, project: Project, *, generating: bool = False) -> None:
+        """New corners on reflex vertices: say which, and where to move them.  Not for a lake's layout
+        (its blocks' corners are the layout's), nor for the held automatic corners of an imported lake
+        (:meth:`hold_corner_advice`) unless ``generating`` (F5 makes that one block)."""
         b = self.doc.block
         key = (self.doc.active, b.corners)
-        if b.corners is None or b.boundary is not None or key == self._corners_seen:
+        if b.corners is None or b.boundary is not None or key == self._corners_seen or project.layout is not None:
             return
+        held, lake = self._advice_held, project.lake
+        if (
+            not generating
+            and held is not None
+            and lake is not None
+            and lake.outline is held[0]
+            and b.corners == held[1]
+        ):
+            return  # (another lake, or corners the user moved: advice as for any block)
         self._corners_seen = key
         try:
             advice = geo.corner_advice(b.points, b.corners)

@@ -74,6 +74,8 @@ class SolveStatus(QtCore.QObject):
             not self.doc.grids and not self.doc.before_grids
         ):  # another lake, a new layout: the summary is of nothing here
             self.label.setText("idle")
+            self.conv.clear_history()  # nor the convergence of the grid of before (another lake's, shown on)
+            self._last_history = None
             return
         if not self.doc.stale:  # (auto-generate on too: after a failed solve the grid was greyed)
             self.on_final()

@@ -4,13 +4,14 @@ A single block of a generated lake's shore (:func:`meshcore.testing.lake_with_is
 with TOTAL cells along its longer side (1500: 1 752 000 cells), in an off-screen main window::
 
     python benchmarks/gui_stalls.py solve TOTAL STOP_AT [--before]
-    python benchmarks/gui_stalls.py steps TOTAL STEP...      (STEP: import draw colour export)
+    python benchmarks/gui_stalls.py steps TOTAL STEP...      (STEP: import layout draw colour export)
     python benchmarks/gui_stalls.py restop CELLS STOP_AT
 
 ``solve``: Generate, Stop after STOP_AT seconds (0: let it finish), then wait until the quality report is
 in; prints the longest gaps of the heartbeat (the GUI thread's stalls) and the longest one from Stop on.
 ``--before``: the quality measured in the GUI thread, as before session 29 (``Document.measure_async``
-None).  ``steps``: the stall of each step: import of a 40 000-point outline and Auto layout, the drawing
+None).  ``steps``: the stall and the GUI thread's CPU time of each step: three imports of a 40 000-point outline
+(the second and third replace the lake), Auto layout of it (``import layout``), the drawing
 and measure of the grid, colouring it by skewness and back, export to .vtm and EFDC.  Timings are wall
 time on a shared machine: compare runs made side by side.  Session 29 numbers: ``benchmarks/RESULTS.md``.
 ``restop``: a generated lake with islands laid out at about CELLS cells and solved; one block's cells
@@ -117,12 +118,14 @@ def steps(total: int, names: list[str]) -> None:
 
     def measure(name, action, limit=600) -> None:
         _run_until(lambda: False, 0.3)
-        t0, n0 = time.perf_counter(), len(beats)
+        t0, n0, c0 = time.perf_counter(), len(beats), time.thread_time()
         action()
         _run_until(lambda: not busy(), limit)
         b = np.array([t0, *beats[n0:]])
         print(
-            f"{name}: longest stall {np.diff(b).max():.2f} s, done after {time.perf_counter() - t0:.1f} s", flush=True
+            f"{name}: longest stall {np.diff(b).max():.2f} s, GUI thread CPU {time.thread_time() - c0:.2f} s, "
+            f"done after {time.perf_counter() - t0:.1f} s",
+            flush=True,
         )
 
     if "import" in names:
@@ -131,11 +134,13 @@ def steps(total: int, names: list[str]) -> None:
         csv = tmp / "big.csv"
         rows = (f"{a:.3f},{b:.3f}" for a, b in zip(r * np.cos(t), 0.6 * r * np.sin(t), strict=True))
         csv.write_text("x,y\n" + "\n".join(rows) + "\n")
-        measure("import of a 40 000-point outline", lambda: win.io.import_points(csv))
-        measure("Auto layout", win.a_auto_layout.trigger)
-    blk = _block(total)
-    g = block_initial_grid(blk)
+        for k in range(3):  # the first import, then two that replace the lake
+            measure(f"import {k + 1} of a 40 000-point outline", lambda: win.io.import_points(csv))
+        if "layout" in names:
+            measure("Auto layout", win.a_auto_layout.trigger)
     if any(s in names for s in ("draw", "colour", "export")):
+        blk = _block(total)
+        g = block_initial_grid(blk)
         win.io.set_project(Project(blocks=(blk,)))
         measure(f"draw and measure {g.cells[0] * g.cells[1]:,} cells", lambda: win.doc.set_grids({0: g}))
     if "colour" in names:

@@ -50,8 +50,13 @@ def win(qtbot, tmp_path):
     from PySide6 import QtCore
 
     from app.main_window import MainWindow
+    from app.window_frame import LIVE
 
     settings = QtCore.QSettings(str(tmp_path / "settings.ini"), QtCore.QSettings.Format.IniFormat)
+    # Live (auto-generate) off for lakes, as a user who turned it off: the app's default is on for a lake's
+    # layout (tests/app/test_app33.py checks it); these tests solve a layout when they say so (F5, or Live
+    # switched on by a click)
+    settings.setValue(LIVE["lake"][0], False)
     w = MainWindow(settings=settings, recovery=tmp_path / "recovery.gcmesh")
     w.quiet = True  # no modal dialogs in tests: errors go to the status bar
     qtbot.addWidget(w)

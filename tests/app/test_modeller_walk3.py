@@ -134,8 +134,10 @@ def test_a_laid_out_case_opened_first_thing_says_f5_not_auto_layout(qtbot, win, 
     from PySide6 import QtCore
 
     from app.main_window import MainWindow
+    from app.window_frame import LIVE
 
     settings = QtCore.QSettings(str(tmp_path / "fresh.ini"), QtCore.QSettings.Format.IniFormat)
+    settings.setValue(LIVE["lake"][0], False)  # no grid made on opening (Live is on for lakes by default)
     fresh = MainWindow(settings=settings, recovery=tmp_path / "fresh.gcmesh")
     fresh.quiet = True
     qtbot.addWidget(fresh)

@@ -61,7 +61,7 @@ def test_autosave_follows_edits_without_being_asked(qtbot, win):
     win.io.open_example("bottle-coarse", confirm=False)
     assert not recovery.exists(path)
     win.editor.set_block_options(weights=(0.25, 0.75))
-    wait_for(qtbot, win, lambda: path.exists())  # debounced: shortly after the edit
+    wait_for(qtbot, win, lambda: path.exists() and not win.io.autosaving)  # debounced: shortly after the edit
     q, _ = recovery.read(path)
     assert q == win.doc.project
     # a long drag: edits keep coming, and the work is saved while they do
