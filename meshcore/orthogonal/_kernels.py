@@ -76,13 +76,25 @@ def _worst(X, Y, cptr, cells, node, out):
 
 
 @njit(cache=True, inline="always")
-def _worse(before, after, q, floor):
+def _valid(before, nc, floor):
+    """Whether every one of a node's ``nc`` cells has its smallest corner Jacobian above ``floor``."""
+    for q in range(nc):  # noqa: SIM110 -- a loop: numba compiles no generator in all()
+        if before[q] <= floor:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _worse(before, after, q, floor, thin):
     """Whether cell ``q`` of a node's cells got worse below a floor (:func:`_worst`'s two
     readings before and after a move): its smallest corner Jacobian below ``floor`` and lower than
-    before, or the cell thinner than :data:`ASPECT_FLOOR` allows and thinner than before."""
+    before, or (``thin``) the cell thinner than :data:`ASPECT_FLOOR` allows and thinner than
+    before.  ``thin`` is False round a node with a cell below ``floor`` (a fold being undone may
+    thin a neighbour: unfolding comes first — with the thin rule there, a generated lake of narrow
+    arms kept 6 folded cells)."""
     if after[q] <= floor and after[q] < before[q]:
         return True
-    return after[16 + q] <= 0.0 and after[16 + q] < before[16 + q]
+    return thin and after[16 + q] <= 0.0 and after[16 + q] < before[16 + q]
 
 
 @njit(cache=True, nogil=True)
@@ -101,11 +113,12 @@ def _all_above(X, Y, cptr, cells, node, floor):
 
 
 @njit(cache=True, nogil=True)
-def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after):
+def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after, shore):
     """Move ``node`` towards ``(nx, ny)``, halving the step up to four times, so that every
     cell around it keeps its smallest corner Jacobian above ``jmin[node]`` and stays no thinner
     than :data:`ASPECT_FLOOR` allows — or, for a cell that was already below, at least where it
-    was (an invalid or thin cell may only get better; ``before``, ``after``: 32 numbers each)."""
+    was (an invalid or thin cell may only get better; ``before``, ``after``: 32 numbers each).
+    ``shore``: a shore node, held by the fold rule only (it follows the shore)."""
     ox, oy = X[node], Y[node]
     dx, dy = nx - ox, ny - oy
     X[node], Y[node] = nx, ny
@@ -114,12 +127,13 @@ def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after):
     X[node], Y[node] = ox, oy
     _worst(X, Y, cptr, cells, node, before)
     nc = cptr[node + 1] - cptr[node]
+    thin = not shore and _valid(before, nc, jmin[node])
     for _ in range(5):
         X[node], Y[node] = ox + dx, oy + dy
         _worst(X, Y, cptr, cells, node, after)
         ok = True
         for q in range(nc):
-            if _worse(before, after, q, jmin[node]):
+            if _worse(before, after, q, jmin[node], thin):
                 ok = False
                 break
         if ok:
@@ -241,7 +255,7 @@ def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, sm
         w = omega - (omega - 1.0) * t if omega > 1.0 else omega
         nx = X[p] + w * (tx - X[p])
         ny = Y[p] + w * (ty - Y[p])
-        d = _try_move(X, Y, p, nx, ny, cptr, cells, jmin, before, after)
+        d = _try_move(X, Y, p, nx, ny, cptr, cells, jmin, before, after, False)
         big = max(big, d)
     for k in range(len(irr_nodes)):
         p = irr_nodes[k]
@@ -250,7 +264,7 @@ def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, sm
         for q in range(irr_ptr[k], irr_ptr[k + 1]):
             sx += X[irr_ring[q]]
             sy += Y[irr_ring[q]]
-        d = _try_move(X, Y, p, sx / cnt, sy / cnt, cptr, cells, jmin, before, after)
+        d = _try_move(X, Y, p, sx / cnt, sy / cnt, cptr, cells, jmin, before, after, False)
         big = max(big, d)
     return big
 
@@ -506,8 +520,11 @@ def shore_sweep(
                     X[p], Y[p] = nx, ny
                     _worst(X, Y, cptr, cells, p, after)
                     ok = True
+                    # the fold rule only: a shore node follows the shore; a thin rule here
+                    # held a generated network's grid 0.51 cells off a tip (the interior nodes'
+                    # moves, where the slivers came from, keep it)
                     for qq in range(cptr[p + 1] - cptr[p]):
-                        if _worse(before, after, qq, jmin[p]):
+                        if _worse(before, after, qq, jmin[p], False):
                             ok = False
                 if ok:
                     bs[k] = snew % total
@@ -523,7 +540,7 @@ def shore_sweep(
             # grid inside follows it there over the sweeps instead of holding it where it is
             tx, ty = _ring_point(R, S, r0, s0, n, s, hint)
             if (tx - ox) ** 2 + (ty - oy) ** 2 > (1e-3 * gap) ** 2:
-                big = max(big, _try_move(X, Y, p, tx, ty, cptr, cells, jmin, before, after))
+                big = max(big, _try_move(X, Y, p, tx, ty, cptr, cells, jmin, before, after, True))
     return big
 
 
@@ -586,7 +603,17 @@ def hold_fans(X, Y, ends, fptr, fan, corner, cptr, cells, jmin, least, slack, lo
             phi = tau + min(max(off, -band), band)
             r = max(r, short)
             d = _try_move(
-                X, Y, p, X[c] + r * math.cos(t0 + phi), Y[c] + r * math.sin(t0 + phi), cptr, cells, jmin, before, after
+                X,
+                Y,
+                p,
+                X[c] + r * math.cos(t0 + phi),
+                Y[c] + r * math.sin(t0 + phi),
+                cptr,
+                cells,
+                jmin,
+                before,
+                after,
+                False,
             )
             big = max(big, d)
     return big

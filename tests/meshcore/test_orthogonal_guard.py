@@ -17,7 +17,7 @@ def _strip():
 
 def _move(X, Y, cptr, ncells, node, to, jmin):
     before, after = np.empty(32), np.empty(32)
-    return _kernels._try_move(X, Y, node, to[0], to[1], cptr, ncells, np.full(6, jmin), before, after)
+    return _kernels._try_move(X, Y, node, to[0], to[1], cptr, ncells, np.full(6, jmin), before, after, False)
 
 
 def test_a_move_that_would_squeeze_a_cell_to_a_sliver_is_cut_short():
