@@ -56,3 +56,16 @@ def test_the_guard_never_lets_a_thin_cell_fold():
                 n, m = (k + 1) % 4, (k + 3) % 4
                 j = (x[n] - x[k]) * (y[m] - y[k]) - (y[n] - y[k]) * (x[m] - x[k])
                 assert j > 0, (to, c, k, j)
+
+
+def test_the_first_row_off_the_shore_moves_under_the_fold_rule_only():
+    """``fold_only`` (the shore nodes and the first row off the shore): the sliver move that the
+    thin rule cuts short is taken whole, and a move that would fold a cell is still cut short."""
+    X, Y, cptr, ncells = _strip()
+    before, after = np.empty(32), np.empty(32)
+    jmin = np.full(6, 1e-9)
+    assert _kernels._try_move(X, Y, 1, 1.999, 0.0, cptr, ncells, jmin, before, after, True) > 0
+    assert X[1] == 1.999  # 0.001 wide: the thin rule would have stopped it short
+    X, Y, cptr, ncells = _strip()
+    _kernels._try_move(X, Y, 1, 2.5, 0.0, cptr, ncells, jmin, before, after, True)
+    assert X[1] < 2.0  # never past the right cell's far side: no fold
