@@ -1,9 +1,14 @@
-"""The orthogonal smoother's move guard: no fold, and no cell squeezed thinner than ~1 : 100."""
+"""The orthogonal smoother's move guard: no fold, and no cell squeezed thinner than ~1 : 100
+(the thin rule: only round cells that a stage left thinner, the stage run again)."""
 
 import numpy as np
+import pytest
 
-from meshcore.orthogonal import _kernels
-from meshcore.orthogonal.driver import _node_cells
+from meshcore import testing
+from meshcore.lakegrid import mesh_outline
+from meshcore.orthogonal import _kernels, driver
+from meshcore.orthogonal.driver import _node_cells, _thin_nodes, _thinness
+from meshcore.quality import lake_metrics
 
 
 def _strip():
@@ -17,7 +22,7 @@ def _strip():
 
 def _move(X, Y, cptr, ncells, node, to, jmin):
     before, after = np.empty(32), np.empty(32)
-    return _kernels._try_move(X, Y, node, to[0], to[1], cptr, ncells, np.full(6, jmin), before, after, False)
+    return _kernels._try_move(X, Y, node, to[0], to[1], cptr, ncells, np.full(6, jmin), before, after, True)
 
 
 def test_a_move_that_would_squeeze_a_cell_to_a_sliver_is_cut_short():
@@ -58,14 +63,67 @@ def test_the_guard_never_lets_a_thin_cell_fold():
                 assert j > 0, (to, c, k, j)
 
 
-def test_the_first_row_off_the_shore_moves_under_the_fold_rule_only():
-    """``fold_only`` (the shore nodes and the first row off the shore): the sliver move that the
-    thin rule cuts short is taken whole, and a move that would fold a cell is still cut short."""
+def test_without_the_thin_rule_a_node_moves_under_the_fold_rule_only():
+    """``thin`` False (shore nodes, and nodes the driver found by no thin cell): the sliver move
+    that the thin rule cuts short is taken whole, and a move that would fold a cell is still cut
+    short."""
     X, Y, cptr, ncells = _strip()
     before, after = np.empty(32), np.empty(32)
     jmin = np.full(6, 1e-9)
-    assert _kernels._try_move(X, Y, 1, 1.999, 0.0, cptr, ncells, jmin, before, after, True) > 0
+    assert _kernels._try_move(X, Y, 1, 1.999, 0.0, cptr, ncells, jmin, before, after, False) > 0
     assert X[1] == 1.999  # 0.001 wide: the thin rule would have stopped it short
     X, Y, cptr, ncells = _strip()
-    _kernels._try_move(X, Y, 1, 2.5, 0.0, cptr, ncells, jmin, before, after, True)
+    _kernels._try_move(X, Y, 1, 2.5, 0.0, cptr, ncells, jmin, before, after, False)
     assert X[1] < 2.0  # never past the right cell's far side: no fold
+
+
+def test_thinness_reads_a_short_edge_beside_a_long_one_at_any_corner():
+    """A rectangle 1 by 0.005 reads 0.005; a cell whose one edge collapsed (a fan's triangle:
+    edges 1, 0.005, 1, 0.2) reads 0.005 too, whichever corner comes first."""
+    X = np.array([0.0, 1.0, 1.0, 0.0, 2.0, 3.0, 3.0, 2.0])
+    Y = np.array([0.0, 0.0, 0.005, 0.005, 0.0, -0.1, 0.1, 0.0025])
+    cells = np.array([[0, 1, 2, 3], [4, 5, 6, 7], [5, 6, 7, 4]], dtype=np.int64)
+    t = _thinness(X, Y, cells)
+    assert t[0] == pytest.approx(0.005)
+    assert t[1] < 0.01 and t[2] == pytest.approx(t[1])
+
+
+def test_the_thin_rule_goes_round_the_cells_a_stage_left_thinner_and_no_further():
+    """Three cells in a row, the middle one squeezed to 1 : 200 in the run: its four nodes and one
+    ring of cells round them (every node here) are marked; a cell as thin at the start as now, or
+    one already inside the marked nodes, starts no new run."""
+    X = np.array([0.0, 1.0, 1.005, 2.005, 0.0, 1.0, 1.005, 2.005])
+    Y = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0])
+    cells = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6]], dtype=np.int64)
+    none = np.zeros(8, dtype=np.uint8)
+    wide = np.ones(3)
+    mark = _thin_nodes(X, Y, cells, wide, none)
+    assert mark is not None and mark.sum() == 8
+    rings, driver.THIN_RINGS = driver.THIN_RINGS, 0
+    try:
+        assert sorted(np.flatnonzero(_thin_nodes(X, Y, cells, wide, none))) == [1, 2, 5, 6]
+    finally:
+        driver.THIN_RINGS = rings
+    assert _thin_nodes(X, Y, cells, _thinness(X, Y, cells), none) is None  # thin from the start
+    assert _thin_nodes(X, Y, cells, wide, mark) is None  # marked already: a run would not change
+
+
+@pytest.mark.slow
+def test_a_rough_network_keeps_no_cell_thinner_than_1_to_100(monkeypatch):
+    """``channel_network(943202, …, roughness=0.15)`` at 8 000 cells (a fresh sweep's shape): the
+    stages without the thin rule leave a cell of aspect ratio 164 (the grid of main before the
+    rule); run again with the rule round it, the largest is 34, the interface ratio and the shore
+    as before (1.43, 0.32 cells)."""
+    poly = testing.channel_network(943202, n_branches=4, width=(1.0, 3.0), roughness=0.15)
+
+    def worst(runs):
+        monkeypatch.setattr(driver, "THIN_RUNS", runs)
+        mb = mesh_outline(poly, target_cells=8000)
+        return lake_metrics(mb, polygon=poly)
+
+    runs = driver.THIN_RUNS
+    off, on = worst(0), worst(runs)
+    assert off.max("aspect_ratio") > 100
+    assert on.max("aspect_ratio") < 50
+    assert on.summary()["folded_cells"] == 0
+    assert on.max("interface_ratio") < 1.5
