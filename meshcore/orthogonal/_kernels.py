@@ -16,7 +16,10 @@ mean of their edge neighbours.  Shore nodes slide along the shore to the foot of
 perpendicular from their inward neighbour (the grid line leaving the shore meets it at a right
 angle).  Every move is checked against the cells around the node: a move that would make a
 corner Jacobian of one of them fall below a small positive floor (``jmin``, per node) is
-halved, up to four times, and otherwise not made, so a valid grid stays valid.
+halved, up to four times, and otherwise not made, so a valid grid stays valid.  Where the driver
+asks for it (the nodes round cells a stage left thin, ``thin``), the floor is raised by
+:data:`ASPECT_FLOOR` of the square of the cell's longest edge: no cell is squeezed thinner than
+~1 : 100 there.
 """
 
 from __future__ import annotations
@@ -36,9 +39,34 @@ def _dist(X, Y, a, b):
     return math.sqrt(dx * dx + dy * dy)  # not math.hypot: a libm call, several times slower
 
 
+#: With ``jmin``, the guard's second floor: no move may leave a corner Jacobian of a cell round
+#: the node below this share of the square of the cell's longest edge (a cell thinner than about
+#: 1 : 100 — its short edge a hundredth of its long one at right angles).  The floor ``jmin`` alone
+#: (a thousandth of the mean area round the node) let an interior node slide to 0.08 m of a shore
+#: node (aspect ratio 1 889) and rows of a block side squeeze into a land tip (439).  Only for the
+#: nodes the driver marks (``thin``): everywhere, it changed the sweeps' path on lakes where no
+#: cell ended thin and cost interface ratios (``docs/lake-grids-journal.md``, thin-cell guard).
+ASPECT_FLOOR = 1e-2
+
+
+@njit(cache=True, inline="always")
+def _longest2(X, Y, cells, q):
+    """The square of the longest edge of cell ``q``."""
+    L = 0.0
+    for k in range(4):
+        a = cells[q, k]
+        b = cells[q, (k + 1) % 4]
+        dx = X[b] - X[a]
+        dy = Y[b] - Y[a]
+        L = max(L, dx * dx + dy * dy)
+    return L
+
+
 @njit(cache=True, nogil=True)
-def _worst(X, Y, cptr, cells, node, out):
-    """The smallest corner Jacobian of each cell around ``node``, into ``out``."""
+def _worst(X, Y, cptr, cells, node, out, thin):
+    """The smallest corner Jacobian of each cell around ``node`` into ``out[:16]``, and (``thin``)
+    the same less :data:`ASPECT_FLOOR` times the square of the cell's longest edge into
+    ``out[16:]``."""
     for q in range(cptr[node], cptr[node + 1]):
         w = 1e300
         for k in range(4):
@@ -48,40 +76,70 @@ def _worst(X, Y, cptr, cells, node, out):
             j = (X[n] - X[p]) * (Y[m] - Y[p]) - (Y[n] - Y[p]) * (X[m] - X[p])
             w = min(w, j)
         out[q - cptr[node]] = w
+        if thin:
+            out[16 + q - cptr[node]] = w - ASPECT_FLOOR * _longest2(X, Y, cells, q)
+
+
+@njit(cache=True, inline="always")
+def _valid(before, nc, floor):
+    """Whether every one of a node's ``nc`` cells has its smallest corner Jacobian above ``floor``."""
+    for q in range(nc):  # noqa: SIM110 -- a loop: numba compiles no generator in all()
+        if before[q] <= floor:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _worse(before, after, q, floor, thin):
+    """Whether cell ``q`` of a node's cells got worse below a floor (:func:`_worst`'s two
+    readings before and after a move): its smallest corner Jacobian below ``floor`` and lower than
+    before, or (``thin``) the cell thinner than :data:`ASPECT_FLOOR` allows and thinner than
+    before.  ``thin`` is False round a node with a cell below ``floor`` (a fold being undone may
+    thin a neighbour: unfolding comes first — with the thin rule there, a generated lake of narrow
+    arms kept 6 folded cells)."""
+    if after[q] <= floor and after[q] < before[q]:
+        return True
+    return thin and after[16 + q] <= 0.0 and after[16 + q] < before[16 + q]
 
 
 @njit(cache=True, nogil=True)
-def _all_above(X, Y, cptr, cells, node, floor):
-    """True when every corner Jacobian of the cells around ``node`` exceeds ``floor``."""
+def _all_above(X, Y, cptr, cells, node, floor, thin):
+    """True when every corner Jacobian of the cells around ``node`` exceeds ``floor`` — plus,
+    with ``thin``, :data:`ASPECT_FLOOR` times the square of the cell's longest edge."""
     for q in range(cptr[node], cptr[node + 1]):
+        f = floor + ASPECT_FLOOR * _longest2(X, Y, cells, q) if thin else floor
         for k in range(4):
             p = cells[q, k]
             n = cells[q, (k + 1) % 4]
             m = cells[q, (k + 3) % 4]
-            if (X[n] - X[p]) * (Y[m] - Y[p]) - (Y[n] - Y[p]) * (X[m] - X[p]) <= floor:
+            if (X[n] - X[p]) * (Y[m] - Y[p]) - (Y[n] - Y[p]) * (X[m] - X[p]) <= f:
                 return False
     return True
 
 
 @njit(cache=True, nogil=True)
-def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after):
+def _try_move(X, Y, node, nx, ny, cptr, cells, jmin, before, after, thin):
     """Move ``node`` towards ``(nx, ny)``, halving the step up to four times, so that every
-    cell around it keeps its smallest corner Jacobian above ``jmin[node]`` — or, for a cell
-    that was already below, at least where it was (an invalid cell may only get better)."""
+    cell around it keeps its smallest corner Jacobian above ``jmin[node]`` and (``thin``: the
+    thin rule) stays no thinner than :data:`ASPECT_FLOOR` allows — or, for a cell that was
+    already below, at least where it was (an invalid or thin cell may only get better;
+    ``before``, ``after``: 32 numbers each).  Without ``thin`` (shore nodes, which follow the
+    shore, and nodes the driver has not found by a thin cell) the fold rule alone holds it."""
     ox, oy = X[node], Y[node]
     dx, dy = nx - ox, ny - oy
     X[node], Y[node] = nx, ny
-    if _all_above(X, Y, cptr, cells, node, jmin[node]):  # the usual case: one check
+    if _all_above(X, Y, cptr, cells, node, jmin[node], thin):  # the usual case: one check
         return math.hypot(dx, dy)
     X[node], Y[node] = ox, oy
-    _worst(X, Y, cptr, cells, node, before)
+    _worst(X, Y, cptr, cells, node, before, thin)
     nc = cptr[node + 1] - cptr[node]
+    thin = thin and _valid(before, nc, jmin[node])
     for _ in range(5):
         X[node], Y[node] = ox + dx, oy + dy
-        _worst(X, Y, cptr, cells, node, after)
+        _worst(X, Y, cptr, cells, node, after, thin)
         ok = True
         for q in range(nc):
-            if after[q] <= jmin[node] and after[q] < before[q]:
+            if _worse(before, after, q, jmin[node], thin):
                 ok = False
                 break
         if ok:
@@ -168,12 +226,15 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, lo, hi, tx, ty):
 
 
 @njit(cache=True, nogil=True)
-def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lo, hi, bx, by, relax, jmin):
+def sweep(
+    X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lo, hi, bx, by, relax, jmin, thin
+):
     """One Gauss–Seidel sweep over the free interior nodes (``bx, by``: the size-blend state
-    of every regular node, updated; see :func:`_target`); returns the largest move."""
+    of every regular node, updated; see :func:`_target`; ``thin[node]``: the move guard's thin
+    rule for that node, see :func:`_try_move`); returns the largest move."""
     big = 0.0
-    before = np.empty(16)
-    after = np.empty(16)
+    before = np.empty(32)
+    after = np.empty(32)
     for k in range(len(nodes)):
         p = nodes[k]
         tx, ty, bx[k], by[k] = _target(
@@ -203,7 +264,7 @@ def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, sm
         w = omega - (omega - 1.0) * t if omega > 1.0 else omega
         nx = X[p] + w * (tx - X[p])
         ny = Y[p] + w * (ty - Y[p])
-        d = _try_move(X, Y, p, nx, ny, cptr, cells, jmin, before, after)
+        d = _try_move(X, Y, p, nx, ny, cptr, cells, jmin, before, after, thin[p] != 0)
         big = max(big, d)
     for k in range(len(irr_nodes)):
         p = irr_nodes[k]
@@ -212,7 +273,7 @@ def sweep(X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, sm
         for q in range(irr_ptr[k], irr_ptr[k + 1]):
             sx += X[irr_ring[q]]
             sy += Y[irr_ring[q]]
-        d = _try_move(X, Y, p, sx / cnt, sy / cnt, cptr, cells, jmin, before, after)
+        d = _try_move(X, Y, p, sx / cnt, sy / cnt, cptr, cells, jmin, before, after, thin[p] != 0)
         big = max(big, d)
     return big
 
@@ -383,6 +444,7 @@ def shore_sweep(
     relax,
     across,
     blo,
+    thin,
 ):
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours, pulled
@@ -393,10 +455,11 @@ def shore_sweep(
     the arc beyond it (where both limits cannot hold, halfway between them, but never nearer
     either neighbour than a tenth of the arc between the two).  ``blo[f]`` is the
     ratio that free node ``f`` keeps instead of ``lo`` (larger at a cut's end where both blocks
-    have a corner: its two arcs lie in two blocks); returns the largest move."""
+    have a corner: its two arcs lie in two blocks; ``thin[node]``: the thin rule, as in
+    :func:`sweep`); returns the largest move."""
     big = 0.0
-    before = np.empty(16)
-    after = np.empty(16)
+    before = np.empty(32)
+    after = np.empty(32)
     for f in range(len(free)):
         k = free[f]
         p = bnode[k]
@@ -453,6 +516,7 @@ def shore_sweep(
         if bad0 > 0.0:  # already too far from the shore: head for the middle of the arc
             sf = 0.5 * (sp + sn)
         ox, oy = X[p], Y[p]
+        tp = thin[p] != 0
         step = omega * (sf - s)
         moved = False
         for _ in range(5):
@@ -461,15 +525,19 @@ def shore_sweep(
             bad = _bend(R, S, r0, s0, n, sp, snew, sn, ppx, ppy, nx, ny, pnx, pny, gap, hint)
             if bad <= max(bad0, 0.0):
                 X[p], Y[p] = nx, ny
-                ok = _all_above(X, Y, cptr, cells, p, jmin[p])
+                ok = _all_above(X, Y, cptr, cells, p, jmin[p], tp)
                 if not ok:
                     X[p], Y[p] = ox, oy
-                    _worst(X, Y, cptr, cells, p, before)
+                    _worst(X, Y, cptr, cells, p, before, tp)
                     X[p], Y[p] = nx, ny
-                    _worst(X, Y, cptr, cells, p, after)
+                    _worst(X, Y, cptr, cells, p, after, tp)
                     ok = True
+                    # the fold rule, and the thin rule only where the driver marked the node:
+                    # a shore node follows the shore (the rule on every shore node held a
+                    # generated network's grid 0.51 cells off a tip)
+                    tq = tp and _valid(before, cptr[p + 1] - cptr[p], jmin[p])
                     for qq in range(cptr[p + 1] - cptr[p]):
-                        if after[qq] <= jmin[p] and after[qq] < before[qq]:
+                        if _worse(before, after, qq, jmin[p], tq):
                             ok = False
                 if ok:
                     bs[k] = snew % total
@@ -485,7 +553,7 @@ def shore_sweep(
             # grid inside follows it there over the sweeps instead of holding it where it is
             tx, ty = _ring_point(R, S, r0, s0, n, s, hint)
             if (tx - ox) ** 2 + (ty - oy) ** 2 > (1e-3 * gap) ** 2:
-                big = max(big, _try_move(X, Y, p, tx, ty, cptr, cells, jmin, before, after))
+                big = max(big, _try_move(X, Y, p, tx, ty, cptr, cells, jmin, before, after, tp))
     return big
 
 
@@ -505,7 +573,7 @@ def _fan_angles(w, corner, a0, m):
 
 
 @njit(cache=True, nogil=True)
-def hold_fans(X, Y, ends, fptr, fan, corner, cptr, cells, jmin, least, slack, lo):
+def hold_fans(X, Y, ends, fptr, fan, corner, cptr, cells, jmin, least, slack, lo, thin):
     """Keep the grid lines that leave each cut line's end on the shore near set angles:
     ``fan[fptr[k]:fptr[k + 1]]`` are the neighbours of ``ends[k]`` in counter-clockwise order, a
     shore node first and last, the nodes of the lines into the water between; the cell between
@@ -513,11 +581,11 @@ def hold_fans(X, Y, ends, fptr, fan, corner, cptr, cells, jmin, least, slack, lo
     (``corner[fptr[k] + q]``: it is the only cell of its block there).  A line more than
     ``slack`` times the mean cell angle off its place is turned about the end back to that
     distance, and no line is shorter than the shore edges at the end (their geometric mean) over
-    ``lo``.  Ends whose water angle is below ``least`` are left alone.  Moves are fold-guarded
-    as :func:`_try_move`; returns the largest."""
+    ``lo``.  Ends whose water angle is below ``least`` are left alone.  Moves are guarded as
+    :func:`_try_move` (``thin[node]``: the thin rule); returns the largest."""
     big = 0.0
-    before = np.empty(16)
-    after = np.empty(16)
+    before = np.empty(32)
+    after = np.empty(32)
     for k in range(len(ends)):
         c = ends[k]
         a0 = fptr[k]
@@ -548,7 +616,17 @@ def hold_fans(X, Y, ends, fptr, fan, corner, cptr, cells, jmin, least, slack, lo
             phi = tau + min(max(off, -band), band)
             r = max(r, short)
             d = _try_move(
-                X, Y, p, X[c] + r * math.cos(t0 + phi), Y[c] + r * math.sin(t0 + phi), cptr, cells, jmin, before, after
+                X,
+                Y,
+                p,
+                X[c] + r * math.cos(t0 + phi),
+                Y[c] + r * math.sin(t0 + phi),
+                cptr,
+                cells,
+                jmin,
+                before,
+                after,
+                thin[p] != 0,
             )
             big = max(big, d)
     return big

@@ -20,7 +20,10 @@ elliptic solution) and the shore it lies on, and iterates
    those fans but, holding only the first edge, makes a kink where the drawn cut bends a few
    cells on, and on 90 generated lakes the two effects cancel (see ``docs/lake-grids-journal.md``);
 
-until the largest move is below ``tol`` × the median edge length.
+until the largest move is below ``tol`` × the median edge length.  Where that leaves a cell
+thinner than 1 : 100 (aspect ratio over 100, :data:`._kernels.ASPECT_FLOOR`) that was not so thin
+at the start, the stage runs again from its start with the guard's thin rule on the nodes round
+such cells (:data:`THIN_RUNS`, :func:`_thin_nodes`); every other stage is the same as without it.
 
 The weak constraint accepts any orthogonal grid, also one whose cells grow tenfold from one
 to the next (a polar fan into a block corner, a jump across a cut line).  A blend towards
@@ -260,6 +263,68 @@ def _pin_features(X, Y, bn, bring, bs, bprev, bnext, free, rings, h: float, angl
 SHORE_GAP = 0.25
 
 
+#: How many times a stage runs again from its start with the thin rule (:func:`._kernels._try_move`)
+#: round the cells the run before left thinner than :data:`._kernels.ASPECT_FLOOR` allows, and how
+#: many rings of cells round them it takes in (:func:`_thin_nodes`).  Only there: the rule
+#: everywhere (session 32) changed the sweeps' path on every lake and lost interface ratios on
+#: lakes where no cell ended thin (``docs/lake-grids-journal.md``, "thin-cell guard").
+THIN_RUNS = 2
+THIN_RINGS = 2
+
+
+def _thinness(X, Y, cells) -> np.ndarray:
+    """Per cell, the least ratio of the shorter over the longer of the two edges at a corner (one
+    over the largest aspect ratio of :mod:`meshcore.quality`, which reads one corner of each cell;
+    here every corner: the block's direction is not known)."""
+    cx, cy = X[cells], Y[cells]
+    e = np.hypot(np.roll(cx, -1, axis=1) - cx, np.roll(cy, -1, axis=1) - cy)
+    f = np.roll(e, 1, axis=1)
+    return (np.minimum(e, f) / np.maximum(np.maximum(e, f), 1e-300)).min(axis=1)
+
+
+def _thin_nodes(X, Y, cells, thin0, thin):
+    """The node mask for the next run: ``thin`` with the nodes of every cell now thinner than
+    :data:`._kernels.ASPECT_FLOOR` (aspect ratio over 100) and thinner than at the stage's start
+    (``thin0``),
+    and :data:`THIN_RINGS` rings of cells round them; None when every such cell is inside
+    ``thin`` already (no run would change)."""
+    t = _thinness(X, Y, cells)
+    bad = (t < _kernels.ASPECT_FLOOR) & (t < thin0)
+    if not bad.any():
+        return None
+    mark = np.zeros(len(thin), dtype=bool)
+    mark[cells[bad]] = True
+    if mark[thin == 0].sum() == 0:
+        return None
+    for _ in range(THIN_RINGS):
+        mark[cells[mark[cells].any(axis=1)]] = True
+    return (mark | (thin != 0)).astype(np.uint8)
+
+
+def _interface_pairs(cells, cell_block):
+    """The cells of two blocks that share an edge: two arrays of cell indices."""
+    e = np.stack([cells, np.roll(cells, -1, axis=1)], axis=2).reshape(-1, 2)
+    e.sort(axis=1)
+    owner = np.repeat(np.arange(len(cells)), 4)
+    order = np.lexsort((e[:, 1], e[:, 0]))
+    e, owner = e[order], owner[order]
+    same = (e[1:] == e[:-1]).all(axis=1)
+    a, b = owner[:-1][same], owner[1:][same]
+    cross = cell_block[a] != cell_block[b]
+    return a[cross], b[cross]
+
+
+def _interface_ratio(X, Y, cells, pairs) -> float:
+    """The largest area ratio of two cells across a block interface (the lake grids' metric)."""
+    a, b = pairs
+    if not len(a):
+        return 1.0
+    cx, cy = X[cells], Y[cells]
+    area = np.abs((cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3]) - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2]))
+    lo, hi = np.minimum(area[a], area[b]), np.maximum(area[a], area[b])
+    return float(np.max(hi / np.maximum(lo, 1e-300)))
+
+
 def _ring_tables(rings):
     """Points of all rings in one array (ring k: ``R[roff[k]:roff[k+1]]``) and their cumulative
     arc lengths (ring k: ``S[roff[k]+k : roff[k+1]+k+1]``, from 0 to the perimeter)."""
@@ -339,7 +404,10 @@ def iterate_orthogonalize(
     20 sweeps (``archipelago(701003, n_islands=40)``: the 0.02 share 46.8 → 46.8 %, 3° 64.2 →
     68.9 %; 69.6 % of nodes within 3° at the end, 83.8 % after 400 sweeps).  The largest move per sweep is no measure of
     that: a few nodes held by the fold guard or by the shore keep it near 1e-2 while the
-    orthogonality of all the others still improves, or long after it stopped improving."""
+    orthogonality of all the others still improves, or long after it stopped improving.
+
+    ``guard`` also runs the stage again where it left a cell thin (the module docstring;
+    ``sweeps`` of the result counts every run's sweeps)."""
     t0 = time.perf_counter()
     lo, hi = size_ratio if size_ratio is not None else (np.inf, np.inf)
     bx, by = np.zeros(len(topology.node_map.nodes)), np.zeros(len(topology.node_map.nodes))
@@ -368,31 +436,17 @@ def iterate_orthogonalize(
     hist = []
     it = 0
     converged = False
-    share = [orthogonal_share(X, Y, m.nodes, m.nbr, q) for q in stall_limits] if stall is not None else []
-    for it in range(1, max_sweeps + 1):
-        d1 = _kernels.sweep(
-            X,
-            Y,
-            m.nodes,
-            m.nbr,
-            m.irr_nodes,
-            m.irr_ptr,
-            m.irr_ring,
-            cptr,
-            ncells,
-            omega,
-            smooth,
-            lo,
-            hi,
-            bx,
-            by,
-            size_relax,
-            jmin,
-        )
+    thin0 = _thinness(X, Y, cells) if guard else None
+    pairs = _interface_pairs(cells, m.cell_block) if guard else None
+
+    def one(nodes, nbr, irr, free, bx, by, bz, blo, smooth, thin):
+        """One sweep of the free nodes given (interior, irregular ``irr``, shore ``free``) with
+        their states; the largest move over ``h``."""
+        d1 = _kernels.sweep(X, Y, nodes, nbr, *irr, cptr, ncells, omega, smooth, lo, hi, bx, by, size_relax, jmin, thin)
         d2 = _kernels.shore_sweep(
             X,
             Y,
-            fidx,
+            free,
             bn,
             binner,
             bprev,
@@ -414,24 +468,63 @@ def iterate_orthogonalize(
             size_relax,
             across,
             blo,
+            thin,
         )
-        d3 = _kernels.hold_fans(X, Y, *fans, cptr, ncells, jmin, FAN_LEAST, FAN_SLACK, lo) if fans is not None else 0.0
-        d = max(d1, d2, d3) / h
-        hist.append(d)
-        if callback is not None and it % 50 == 0:
-            callback(it, d)
-        if d < tol:
-            converged = True
-            break
-        if stall is not None and it % stall_every == 0:
-            now = [orthogonal_share(X, Y, m.nodes, m.nbr, q) for q in stall_limits]
-            if all(b - a < stall for a, b in zip(share, now, strict=True)):
+        d3 = (
+            _kernels.hold_fans(X, Y, *fans, cptr, ncells, jmin, FAN_LEAST, FAN_SLACK, lo, thin)
+            if fans is not None
+            else 0.0
+        )
+        return max(d1, d2, d3) / h
+
+    irr = (m.irr_nodes, m.irr_ptr, m.irr_ring)
+    thin = np.zeros(m.n_nodes, dtype=np.uint8)  # the thin rule's nodes: none on the first run
+    state = (X, Y, bx, by, bs, bz)
+    start = tuple(a.copy() for a in state)
+    kept = None
+    done = 0
+    for run in range(THIN_RUNS + 1):
+        share = [orthogonal_share(X, Y, m.nodes, m.nbr, q) for q in stall_limits] if stall is not None else []
+        stopped = False
+        for it in range(1, max_sweeps + 1):
+            d = one(m.nodes, m.nbr, irr, fidx, bx, by, bz, blo, smooth, thin)
+            hist.append(d)
+            if callback is not None and (done + it) % 50 == 0:
+                callback(done + it, d)
+            if d < tol:
                 converged = True
                 break
-            share = now
-        if every and it % every == 0:
-            snap = tuple(g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True))
-            if (yield (it, d, snap)) == "stop":
-                break
+            if stall is not None and it % stall_every == 0:
+                now = [orthogonal_share(X, Y, m.nodes, m.nbr, q) for q in stall_limits]
+                if all(b - a < stall for a, b in zip(share, now, strict=True)):
+                    converged = True
+                    break
+                share = now
+            if every and (done + it) % every == 0:
+                snap = tuple(g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True))
+                if (yield (done + it, d, snap)) == "stop":
+                    stopped = True
+                    break
+        done += it
+        if stopped or not guard:
+            break
+        if kept is not None and _interface_ratio(X, Y, cells, pairs) > max(kept[0], hi):
+            # the run with the thin rule put two cells across a cut further apart than the
+            # modellers' limit and the run before it did: that one kept
+            for a, b in zip(state, kept[1], strict=True):
+                a[:] = b
+            converged = kept[2]
+            break
+        more = _thin_nodes(X, Y, cells, thin0, thin) if run < THIN_RUNS else None
+        if more is None:
+            break
+        # cells squeezed thin in this run: the run again from the stage's start, with the thin
+        # rule round them (and round those of the runs before)
+        kept = (_interface_ratio(X, Y, cells, pairs), tuple(a.copy() for a in state), converged)
+        thin = more
+        for a, b in zip(state, start, strict=True):
+            a[:] = b
+        converged = False
+    it = done
     out = [g.replaced(x=X[ids], y=Y[ids]) for g, ids in zip(grids, m.ids, strict=True)]
     return OrthoResult(tuple(out), it, converged, time.perf_counter() - t0, tuple(hist))

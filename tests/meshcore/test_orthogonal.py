@@ -343,7 +343,9 @@ def test_the_fan_hold_is_the_numpy_oracle(theta_deg, blocks):
     args = (np.radians(225.0), 0.3, 1.15)
     nodes, tx, ty = fan_targets(X, Y, ends, fptr, fan, corner, *args)
     x1, y1 = X.copy(), Y.copy()
-    _kernels.hold_fans(x1, y1, ends, fptr, fan, corner, cptr, ncells, np.full(len(X), -np.inf), *args)
+    _kernels.hold_fans(
+        x1, y1, ends, fptr, fan, corner, cptr, ncells, np.full(len(X), -np.inf), *args, np.zeros(len(X), np.uint8)
+    )
     moved = np.flatnonzero((x1 != X) | (y1 != Y))
     assert sorted(moved) == sorted(nodes)
     np.testing.assert_allclose(x1[nodes], tx, atol=1e-13)
@@ -418,7 +420,7 @@ def test_a_shore_node_between_two_cut_ends_never_passes_a_neighbour(beyond_next)
     for _ in range(30):
         _kernels.shore_sweep(
             X, Y, np.array([k]), bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells,
-            1.0, 0.15, 0.25, jmin, lo, hi, bz, 0.05, across, np.array([lo]),
+            1.0, 0.15, 0.25, jmin, lo, hi, bz, 0.05, across, np.array([lo]), np.zeros(m.n_nodes, np.uint8),
         )  # fmt: skip
         assert Y[p] == 0.0  # on the shore
         assert 1.0 + 0.1 * 2.0 - 1e-9 <= X[p] <= 3.0 - 0.1 * 2.0 + 1e-9  # within its own arc, a tenth from either end
