@@ -56,6 +56,7 @@ from .polygon import (
     without_slivers,
 )
 from .shore import shore_at_scale, transfer, without_narrow_arms
+from .tipcuts import splitting_tips
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
 from .widen import widen_starved
@@ -218,7 +219,11 @@ def _first_fit(draw, *, regular: bool, single: bool, reading) -> tuple[Layout | 
                 def at_scale(s: float, n: bool = normal) -> Layout:
                     return draw(regular=False, normal=n, scale=s)
 
-                lay = chosen(lay, at_scale, reading)
+                def with_tips(s: float, n: bool = normal) -> Layout:
+                    with splitting_tips():
+                        return draw(regular=False, normal=n, scale=s)
+
+                lay = chosen(lay, at_scale, reading, tips=with_tips if TIP_DRAW else None)
             return lay, None, None
         if kept is not None:
             return None, first, kept
@@ -246,6 +251,10 @@ def _folds_in_index_space(lay: Layout) -> str | None:
 #: Seen on generated lakes with islands (round_lake(2), lake_with_islands(429/432)): each
 #: failed at the cell size and passed at one of the others.
 LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
+
+#: The layout choice (:func:`~.choice.chosen`) also weighs the chosen scale's layout drawn again
+#: with every piece whose side runs round a land tip split from the tip (:mod:`.tipcuts`).
+TIP_DRAW = True
 
 
 def _layout(

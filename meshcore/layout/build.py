@@ -33,6 +33,7 @@ from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
+from .tipcuts import tips_split, untipped
 
 __all__ = ["layout_pieces"]
 
@@ -185,6 +186,8 @@ def layout_pieces(
                 tee=tee if tees and regular else None,
             )
             pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here, regular)
+            if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
+                pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts

@@ -47,14 +47,20 @@ RATIO_SLACK = 1e-3
 
 
 def chosen(
-    first: Layout, at_scale: Callable[[float], Layout], reading: Callable[[Layout], tuple[float, float]]
+    first: Layout,
+    at_scale: Callable[[float], Layout],
+    reading: Callable[[Layout], tuple[float, float]],
+    tips: Callable[[float], Layout] | None = None,
 ) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
     :data:`SCALES`, whose coarse grid deviates least from 90° on
     average, if that is at most ``1 - MARGIN`` of ``first``'s and its coarse interface ratio
     is no larger than ``first``'s up to :data:`RATIO_SLACK` (``reading``: those two numbers of a
     layout's coarse grid, :func:`meshcore.lakegrid.coarse_reading`).  A scale whose layout or
-    coarse solve fails is passed over; so is every other scale when ``first``'s coarse solve fails."""
+    coarse solve fails is passed over; so is every other scale when ``first``'s coarse solve fails.
+    ``tips``: the layout at a scale with its pieces round land tips split (:mod:`.tipcuts`),
+    drawn at the chosen scale and kept when its coarse deviation is :data:`MARGIN` below the
+    chosen layout's and its coarse interface ratio no larger than ``first``'s."""
     if first.multiple < 4 or len(first.blocks) > MAX_BLOCKS:
         return first
     try:
@@ -65,6 +71,7 @@ def chosen(
         return first
     best, score = first, (1.0 - MARGIN) * dev0
     seen = [first.blocks]
+    best_scale, best_dev = 1.0, dev0
     for s in SCALES:
         try:
             lay = at_scale(s)
@@ -75,5 +82,14 @@ def chosen(
         except MeshcoreError:
             continue
         if dev < score and ratio <= ratio0 * (1.0 + RATIO_SLACK):
-            best, score = lay, dev
+            best, score, best_scale, best_dev = lay, dev, s, dev
+    if tips is not None:  # the chosen scale drawn again with its pieces round land tips split
+        try:
+            lay = tips(best_scale)
+            if lay.blocks not in seen:
+                dev, ratio = reading(lay)
+                if dev < (1.0 - MARGIN) * best_dev and ratio <= ratio0 * (1.0 + RATIO_SLACK):
+                    best = lay
+        except MeshcoreError:
+            pass
     return best
