@@ -20,7 +20,7 @@ cell pairs', :data:`meshcore.lakegrid.READING_PERCENTILE`) is no larger (up to
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from ..errors import MeshcoreError
 from .model import Layout
@@ -50,10 +50,13 @@ def chosen(
     first: Layout,
     at_scale: Callable[[float], Layout],
     reading: Callable[[Layout], tuple[float, float]],
+    more: Sequence[Callable[[], Layout]] = (),
+    ratio_ok: float = 0.0,
     tips: Callable[[float], Layout] | None = None,
 ) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
-    :data:`SCALES`, whose coarse grid deviates least from 90° on
+    :data:`SCALES` (then each of ``more()``, other draws: a regular layout with more cuts from its
+    islands, :func:`~meshcore.layout.auto_layout`), whose coarse grid deviates least from 90° on
     average, if that is at most ``1 - MARGIN`` of ``first``'s and its coarse interface ratio
     is no larger than ``first``'s up to :data:`RATIO_SLACK` (``reading``: those two numbers of a
     layout's coarse grid, :func:`meshcore.lakegrid.coarse_reading`).  A scale whose layout or
@@ -71,19 +74,22 @@ def chosen(
         return first
     best, score = first, (1.0 - MARGIN) * dev0
     seen = [first.blocks]
-    best_scale, best_dev = 1.0, dev0
-    for s in SCALES:
+    best_scale: float | None = 1.0
+    best_dev = dev0
+    draws: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in SCALES]
+    draws += [(None, d) for d in more]
+    for scale, draw in draws:
         try:
-            lay = at_scale(s)
+            lay = draw()
             if lay.blocks in seen:
                 continue
             seen.append(lay.blocks)
             dev, ratio = reading(lay)
         except MeshcoreError:
             continue
-        if dev < score and ratio <= ratio0 * (1.0 + RATIO_SLACK):
-            best, score, best_scale, best_dev = lay, dev, s, dev
-    if tips is not None:  # the chosen scale drawn again with its pieces round land tips split
+        if dev < score and ratio <= max(ratio0 * (1.0 + RATIO_SLACK), ratio_ok):
+            best, score, best_scale, best_dev = lay, dev, scale, dev
+    if tips is not None and best_scale is not None:  # the chosen scale again, pieces round land tips split
         try:
             lay = tips(best_scale)
             if lay.blocks not in seen:
