@@ -58,15 +58,14 @@ def _tip(ring: np.ndarray, sigma: float) -> tuple[int, float] | None:
     (:data:`TIP_SCALE`, :data:`TIP_TURN`; no corner within ``sigma``), or None."""
     from .corners import _arclength_closed, turning
     from .split import corners_of
+    from .width import width
 
     corners, cost = corners_of(ring, sigma)
     if corners is None or not math.isfinite(cost):
         return None
     arc = _arclength_closed(ring)
     s, total = arc
-    x, y = ring[:, 0], ring[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
-    big = max(sigma, TIP_SCALE * 2.0 * area / max(total, 1e-300))
+    big = max(sigma, TIP_SCALE * width(ring))
     tb = turning(ring, big, arc)
     d = np.abs(s[None, :] - s[list(corners)][:, None])
     near = (np.minimum(d, total - d) < sigma).any(axis=0)
@@ -122,7 +121,8 @@ def tip_split(ring: np.ndarray, *, sigma: float, min_width: float, normal: bool 
     if got is None:
         return None
     v, big = got
-    room = shapely.Polygon(ring).buffer(1e-9 * math.sqrt(shapely.Polygon(ring).area))
+    poly = shapely.Polygon(ring)
+    room = poly.buffer(1e-9 * math.sqrt(poly.area))
     cuts = [c for c in _cuts_from(ring, v, big) if room.covers(shapely.LineString(c[2]))]
     best = None
     for pieces, segs, _ in _cut_options(cuts, sigma, min_width, thin):
