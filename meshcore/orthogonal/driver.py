@@ -314,13 +314,20 @@ def _interface_pairs(cells, cell_block):
     return a[cross], b[cross]
 
 
+def quad_areas(X: np.ndarray, Y: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Signed areas of the quads ``cells`` (corner ids, counter-clockwise: positive), half the
+    cross product of their diagonals — the NumPy form of ``_equalize_kernels._quad_area``."""
+    x0, x1, x2, x3 = (X[cells[:, k]] for k in range(4))
+    y0, y1, y2, y3 = (Y[cells[:, k]] for k in range(4))
+    return 0.5 * ((x2 - x0) * (y3 - y1) - (y2 - y0) * (x3 - x1))
+
+
 def _interface_ratio(X, Y, cells, pairs) -> float:
     """The largest area ratio of two cells across a block interface (the lake grids' metric)."""
     a, b = pairs
     if not len(a):
         return 1.0
-    cx, cy = X[cells], Y[cells]
-    area = np.abs((cx[:, 0] - cx[:, 2]) * (cy[:, 1] - cy[:, 3]) - (cx[:, 1] - cx[:, 3]) * (cy[:, 0] - cy[:, 2]))
+    area = np.abs(quad_areas(X, Y, cells))
     lo, hi = np.minimum(area[a], area[b]), np.maximum(area[a], area[b])
     return float(np.max(hi / np.maximum(lo, 1e-300)))
 

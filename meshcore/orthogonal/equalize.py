@@ -35,7 +35,7 @@ from collections.abc import Callable
 import numpy as np
 
 from . import _equalize_kernels
-from .driver import _assemble
+from .driver import _assemble, quad_areas
 from .shore import arc_lengths, project_to_rings, ring_point
 
 __all__ = ["equalize_interfaces", "warm_up"]
@@ -119,9 +119,7 @@ class _Tables:
 
 
 def _areas(P: np.ndarray, C: np.ndarray) -> np.ndarray:
-    p0, p1, p2, p3 = P[C[:, 0]], P[C[:, 1]], P[C[:, 2]], P[C[:, 3]]
-    d1, d2 = p2 - p0, p3 - p1
-    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    return quad_areas(P[:, 0], P[:, 1], C)
 
 
 def _jacobians(P: np.ndarray, C: np.ndarray) -> np.ndarray:
