@@ -28,8 +28,18 @@ runs before any kernel module is imported and does two things:
   read when numba first loads its OpenMP layer): under load two threads then
   cost about as much as one, and on an idle machine they still gain.
 
-``scripts/setup.sh`` compiles every kernel once (:func:`meshcore.elliptic.warmup`),
+``scripts/setup.sh`` compiles every kernel once (:func:`compile_all`),
 so that the first solve in a new environment loads them instead of compiling.
+
+It also makes runs reproducible.  The fold-free repair's sweeps
+(:mod:`meshcore.foldfree._sweep`, ``fastmath`` with ``reassoc``) give results that differ
+in the last bits between a kernel compiled in the running process and the same kernel
+loaded from the cache (session 34: ``repair`` of a 5 × 12 block, compiled in the process
+against loaded, different hashes; without ``reassoc`` the same, and 15–20 % slower).  A
+lake's grid amplifies that: its first run in a process that compiled the kernels came out
+different from every later run.  After :func:`compile_all` every kernel a lake run needs is
+loaded from the cache (no cache miss over default and regular layouts of two lakes with
+islands), so every run of the same input gives the same grid.
 """
 
 from __future__ import annotations
