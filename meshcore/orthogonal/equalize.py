@@ -34,6 +34,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..quality.interfaces import signed_area
 from . import _equalize_kernels
 from .driver import _assemble, quad_areas
 from .shore import arc_lengths, project_to_rings, ring_point
@@ -77,11 +78,7 @@ class _Tables:
             cells.append(c)
             cblock.append(np.full(len(c), b))
             self.start.append(self.start[-1] + len(c))
-            x, y = np.asarray(grids[b].x), np.asarray(grids[b].y)
-            area = 0.5 * (
-                (x[1:, 1:] - x[:-1, :-1]) * (y[:-1, 1:] - y[1:, :-1])
-                - (x[:-1, 1:] - x[1:, :-1]) * (y[1:, 1:] - y[:-1, :-1])
-            )
+            area = signed_area(np.asarray(grids[b].x), np.asarray(grids[b].y))
             sign.append(np.full(len(c), -1.0 if area.sum() < 0 else 1.0))
             if n1 >= 3 and m1 >= 3:
                 cos5.append(
