@@ -109,7 +109,7 @@ class _StopRelay:
         return event is not None and event.is_set()
 
 
-#: the readings of the last few layouts made: (layout, CoarseReadings, its stop relay), newest last
+#: the readings of the last few layouts made: (layout, the CoarseReadings that chose it), newest last
 _readings: list[tuple] = []
 #: layouts whose held readings are kept (each holds a paused solve of every layout it read)
 READINGS_KEPT = 2
