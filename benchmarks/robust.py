@@ -579,10 +579,13 @@ _TARGET_HEAD = ["| target | wanted | measured |", "|---|---|---|"]
 
 
 def _history(section: str) -> str:
-    """The paragraphs of a report section that begin ``Session `` (what each session measured and
-    tried there): a rerun replaces the section's tables and keeps them."""
+    """The paragraphs of a report section from the first that begins ``Session `` on (what each session
+    measured and tried there, with its own tables and paragraphs): a rerun replaces the section's tables
+    and keeps them (only the paragraphs that began ``Session `` were kept: session 16's changes and
+    their table went with a rerun of the app section)."""
     paras = re.split(r"\n[ \t]*\n", section)
-    return "\n\n".join(p.strip("\n") for p in paras if p.startswith("Session "))
+    first = next((k for k, p in enumerate(paras) if p.startswith("Session ")), len(paras))
+    return "\n\n".join(p.strip("\n") for p in paras[first:])
 
 
 def merge_report(old: str, header: list[str], sections: dict[str, list[str]], targets: list[str]) -> str:
