@@ -309,11 +309,12 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
             raise InvalidInputError(why.replace("give a cell size of", "set the cell size (Lake panel) to"))
     if cuts:
         return split_layout(poly, [np.asarray(c, float) for c in cuts], h, 2**LEVELS)
-    from meshcore.lakegrid import coarse_reading
+    from .lake_solve import coarse_readings, hold_readings
 
-    return auto_layout(
-        poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single, reading=coarse_reading
-    )
+    readings = coarse_readings()  # the chosen layout's coarse level solved once, as meshcore mesh does
+    lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single, reading=readings)
+    hold_readings(lay, readings)  # its grid (app.lake_solve.solve_layout) goes on from there
+    return lay
 
 
 def split_layout(poly: Any, cuts: list, cell_size: float, multiple: int) -> Any:

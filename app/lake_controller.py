@@ -254,8 +254,8 @@ class LakeController(QtCore.QObject):
         self.layout_done.emit(layout)
         self.win.set_tool("layout")
         self.win.show_lake()  # its blocks, cells and cell size (Parameters stayed in front: ξ, η of a block it locks)
-        if self.generate_after:
-            self.win.generate()
+        if self.generate_after:  # a new layout's grid, coarse to fine as meshcore mesh makes it
+            self.win.generate(cold=True)
 
     def _on_errored(self, exc) -> None:
         self._worker = None

@@ -5,7 +5,10 @@ returns a :class:`~app.results.BlockResult` carrying the
 :class:`~meshcore.multiblock.MultiBlockGrid` and its lake metrics.  Two ways, one result:
 
 * **cold** (a new layout, or blocks whose cell counts changed):
-  :func:`meshcore.lakegrid.iterate_layout`, coarse to fine, as ``meshcore mesh`` makes it;
+  :func:`meshcore.lakegrid.iterate_layout`, coarse to fine, as ``meshcore mesh`` makes it (the grid of
+  a layout just made by :func:`app.lake.compute_layout` goes on from the solve of its coarse level that
+  chose the layout, :func:`hold_readings`, as ``meshcore mesh`` goes on from it: that level is not
+  solved twice);
 * **warm** (the same blocks with the same cells, e.g. a cut line dragged): the previous grid
   moved onto the new borders (``A_new + (G_old − A_old)``, the rule of
   :func:`app.pipeline.warm_start`) and orthogonalised on the full level
@@ -37,7 +40,15 @@ from meshcore import SolverProgress, StructuredGrid
 
 from .results import ALL_BLOCKS, BlockResult
 
-__all__ = ["TOLERANCE", "LakeProgress", "layout_topology", "level_labels", "solve_layout"]
+__all__ = [
+    "TOLERANCE",
+    "LakeProgress",
+    "coarse_readings",
+    "hold_readings",
+    "layout_topology",
+    "level_labels",
+    "solve_layout",
+]
 
 #: the sweep tolerance of :func:`meshcore.lakegrid.iterate_layout` (largest move / cell size)
 TOLERANCE = 1e-5
@@ -45,6 +56,8 @@ TOLERANCE = 1e-5
 WARM_EVERY = 2
 #: seconds between looks at the stop event while a held warm solve waits for the end of a drag
 HOLD_POLL_S = 0.5
+#: sweeps between two snapshots of a cold solve (:func:`meshcore.lakegrid.iterate_layout`'s ``every``)
+COLD_EVERY = 25
 #: most sweeps of the full level from the previous grid (the live frames of an edit) before the grid is
 #: made again coarse to fine (what the final grid of an edit is)
 WARM_SWEEPS = 60
@@ -83,6 +96,48 @@ def layout_topology(layout):
         _topologies.pop(next(iter(_topologies)))
     _topologies[id(layout)] = (layout, topo)
     return topo
+
+
+class _StopRelay:
+    """The stop event of held coarse readings: that of the solve which goes on from one (none before)."""
+
+    def __init__(self) -> None:
+        self.event: threading.Event | None = None
+
+    def is_set(self) -> bool:
+        event = self.event
+        return event is not None and event.is_set()
+
+
+#: the readings of the last few layouts made: (layout, the CoarseReadings that chose it), newest last
+_readings: list[tuple] = []
+#: layouts whose held readings are kept (each holds a paused solve of every layout it read)
+READINGS_KEPT = 2
+
+
+def coarse_readings():
+    """A :class:`~meshcore.lakegrid.CoarseReadings` for :func:`meshcore.layout.auto_layout` (``reading=``)
+    whose held solves give the snapshots and take the stop of :func:`solve_layout`'s cold solve."""
+    from meshcore.lakegrid import CoarseReadings
+
+    return CoarseReadings(every=COLD_EVERY, stop_event=_StopRelay())
+
+
+def hold_readings(layout, readings) -> None:
+    """Keep ``readings`` (:func:`coarse_readings`, that chose ``layout``) for the first cold solve of ``layout``."""
+    _readings[:] = [r for r in _readings if r[0] is not layout][-(READINGS_KEPT - 1) :]
+    _readings.append((layout, readings))
+
+
+def _held_solve(layout, stop_event, callback):
+    """The solve of ``layout`` held after its coarse level by the readings that chose it (taken: once), or
+    None: ``(solve, coarse level, progress)`` of :meth:`meshcore.lakegrid.CoarseReadings.held`."""
+    for k, (lay, readings) in enumerate(_readings):
+        if lay is layout:
+            del _readings[k]
+            readings.stop_event.event = stop_event
+            return readings.held(layout, callback)
+    return None
 
 
 def _options() -> dict:
@@ -147,9 +202,15 @@ def _cold(layout, stop_event, *, shown: bool = True, before: tuple = ((), (), 0)
         if lev + 1 < n_levels:
             levels.append((levels[-1][0] + res.sweeps, labels[lev + 1]))
 
-    gen = iterate_layout(layout, stop_event=stop_event, level_callback=level_done)
+    held = _held_solve(layout, stop_event, level_done)
+    if held is not None:  # the layout's coarse level, solved as Auto layout read it: go on from there
+        gen, done, paused = held
+        level_done("level", done)
+    else:
+        gen = iterate_layout(layout, stop_event=stop_event, level_callback=level_done, every=COLD_EVERY)
+        paused = None
     try:
-        snap = next(gen)
+        snap = next(gen) if paused is None else paused
         while True:
             hist = (*history0, *((offset + k, d) for k, d in snap.history)) if history0 else snap.history
             s = snap

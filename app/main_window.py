@@ -419,7 +419,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.docks["lake"].show()
         self.docks["lake"].raise_()
 
-    def generate(self) -> None:
+    def generate(self, *_a, cold: bool = False) -> None:
+        """Generate (F5): solve the project (``cold``: a lake layout's grid from its start, no warm phase from
+        the grid shown; see :meth:`app.solver_controller.SolverController.start`)."""
         if not any(b.ready for b in self.doc.project.blocks):
             b = self.doc.block
             if len(b.points) == 0:
@@ -443,7 +445,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         if lake is not None and lake.layout is None:  # one block of a lake: the advice held at its import
             self._check_corners(self.doc.project, generating=True)
         self.solve_status.reset()
-        self.solver.start()
+        self.solver.start(cold=cold)
 
     # ---------------------------------------------------------- reactions
     def _on_project(self, project: Project) -> None:

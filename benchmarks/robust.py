@@ -492,8 +492,10 @@ def app(quick: bool, emit) -> dict:
         "until the solver controller reports the grid, live redraws included. Medians of 3 after a "
         "warm-up. CPU = the CLI's thread against the app's solver thread; the last column is every "
         "thread of the app during the solve (drawing included). A lake outline (taal_lake): CLI = the grid "
-        "stage of `meshcore mesh` on its layout, app = import, Auto layout (not timed), Generate; the run "
-        "checks that both made the same layout and bit-identical grids.\n"
+        "and quality stages of `meshcore mesh` (going on from the chosen layout's coarse level, as the command "
+        "does), app = import, Auto layout and the grid that follows it (Live on, as a user gets it), timed from "
+        "the layout set to the grid; the run checks that both made the same layout and bit-identical grids, "
+        "and that the app solved the grid once.\n"
     )
     cmd = [sys.executable, str(HERE / "app_vs_cli.py"), "--repeats", "1" if quick else "3"]
     env = dict(os.environ, PYTHONPATH=str(ROOT), QT_QPA_PLATFORM="offscreen")
@@ -577,10 +579,13 @@ _TARGET_HEAD = ["| target | wanted | measured |", "|---|---|---|"]
 
 
 def _history(section: str) -> str:
-    """The paragraphs of a report section that begin ``Session `` (what each session measured and
-    tried there): a rerun replaces the section's tables and keeps them."""
+    """The paragraphs of a report section from the first that begins ``Session `` on (what each session
+    measured and tried there, with its own tables and paragraphs): a rerun replaces the section's tables
+    and keeps them (only the paragraphs that began ``Session `` were kept: session 16's changes and
+    their table went with a rerun of the app section)."""
     paras = re.split(r"\n[ \t]*\n", section)
-    return "\n\n".join(p.strip("\n") for p in paras if p.startswith("Session "))
+    first = next((k for k, p in enumerate(paras) if p.startswith("Session ")), len(paras))
+    return "\n\n".join(p.strip("\n") for p in paras[first:])
 
 
 def merge_report(old: str, header: list[str], sections: dict[str, list[str]], targets: list[str]) -> str:

@@ -167,9 +167,13 @@ class CoarseReadings:
     True
     """
 
-    def __init__(self, levels: int | None = None) -> None:
+    def __init__(self, levels: int | None = None, *, every: int | None = None, stop_event: Any = None) -> None:
         self.levels = levels
-        self._held: list[tuple[Any, Any, Any, list]] = []  # (layout, paused solve, coarse level, callback box)
+        #: :func:`iterate_layout`'s ``every`` and ``stop_event`` of the held solves (they change no grid: a
+        #: caller that goes on with a held solve itself, :meth:`held`, gets its snapshots and its stops)
+        self.every, self.stop_event = every, stop_event
+        # (layout, paused solve, coarse level, callback box, the progress it paused on)
+        self._held: list[tuple[Any, Any, Any, list, Any]] = []
 
     def __call__(self, layout) -> tuple[float, float]:
         """:func:`coarse_reading` of ``layout``, its solve held."""
@@ -182,15 +186,32 @@ class CoarseReadings:
                 return "pause"
             return box[0](kind, value) if box[0] is not None else None
 
-        gen = iterate_layout(layout, levels=self.levels, level_callback=level, every=None)
+        gen = iterate_layout(
+            layout, levels=self.levels, level_callback=level, every=self.every, stop_event=self.stop_event
+        )
         try:
-            next(gen)
+            paused = next(gen)
+            while not first:  # the coarse level's snapshots (``every``): on to its end, where it pauses
+                paused = next(gen)
         except StopIteration as fin:  # one level: nothing to hold
             grids = fin.value.grids
         else:
             grids = first[0][1].grids
-            self._held.append((layout, gen, first[0], box))
+            self._held.append((layout, gen, first[0], box, paused))
         return _reading(grids)
+
+    def held(self, layout, callback: Callable[[str, Any], Any] | None = None):
+        """The solve of ``layout`` held after its coarse level, taken from here, or None: ``(solve, level,
+        progress)``, the paused :func:`iterate_layout` generator (``callback`` told of its later levels),
+        the ``(level, result)`` of its coarse level (not yet told to ``callback``) and the
+        :class:`~meshcore.elliptic.SolverProgress` it paused on.  What is sent to it next goes on
+        (``None``) or stops (``"stop"``)."""
+        for k, (lay, gen, done, box, paused) in enumerate(self._held):
+            if _same_layout(lay, layout):
+                del self._held[k]
+                box[0] = callback
+                return gen, done, paused
+        return None
 
     def resumed(self, layout, callback: Callable[[str, Any], Any] | None, options: dict[str, Any]):
         """The grid of ``layout`` from its held solve (``callback`` told of its coarse level first), or
@@ -198,18 +219,17 @@ class CoarseReadings:
         given to this object (the readings were solved with the defaults)."""
         if options != {"levels": self.levels}:
             return None
-        for k, (lay, gen, done, box) in enumerate(self._held):
-            if _same_layout(lay, layout):
-                del self._held[k]
-                box[0] = callback
-                said = callback("level", done) if callback is not None else None
-                try:
-                    gen.send("stop" if said == "stop" else None)  # (no more yields: it runs to the end)
-                    while True:
-                        gen.send(None)
-                except StopIteration as fin:
-                    return fin.value
-        return None
+        taken = self.held(layout, callback)
+        if taken is None:
+            return None
+        gen, done, _ = taken
+        said = callback("level", done) if callback is not None else None
+        try:
+            gen.send("stop" if said == "stop" else None)
+            while True:  # (snapshots only with ``every``)
+                gen.send(None)
+        except StopIteration as fin:
+            return fin.value
 
 
 def _same_layout(a, b) -> bool:
