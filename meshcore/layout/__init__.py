@@ -56,7 +56,7 @@ from .polygon import (
     without_slivers,
 )
 from .shore import shore_at_scale, transfer, without_narrow_arms
-from .tipcuts import splitting_tips
+from .tipcuts import splitting_tips, watching_tips
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
 from .widen import widen_starved
@@ -203,7 +203,8 @@ def _first_fit(
         # the layout without them (the splits of earlier versions) next
         for normal in (True, False):
             try:
-                lay = draw(regular=regular, normal=normal, scale=scale)
+                with watching_tips() as tipped:
+                    lay = draw(regular=regular, normal=normal, scale=scale)
             except TopologyError as exc:
                 first = first or exc
                 continue
@@ -223,11 +224,19 @@ def _first_fit(
                     first = first or TopologyError(folds)
                     continue
             if scale == 1.0 and not single and reading is not None:  # the best coarse grid of three scales
+                # the draws that left no piece with a land tip: drawn again splitting tips, the same
+                untipped = {1.0: lay} if not tipped[0] else {}
 
-                def at_scale(s: float, n: bool = normal) -> Layout:
-                    return _closing(draw(regular=regular, normal=n, scale=s), regular)
+                def at_scale(s: float, n: bool = normal, u: dict = untipped) -> Layout:
+                    with watching_tips() as tipped:
+                        got = draw(regular=regular, normal=n, scale=s)
+                    if not tipped[0]:
+                        u[s] = got
+                    return _closing(got, regular)
 
-                def with_tips(s: float, n: bool = normal) -> Layout:
+                def with_tips(s: float, n: bool = normal, u: dict = untipped) -> Layout:
+                    if TIP_GATE and s in u:  # nothing for .tipcuts to split: that draw itself
+                        return u[s]
                     with splitting_tips():
                         return draw(regular=False, normal=n, scale=s)
 
@@ -292,6 +301,10 @@ LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
 #: The layout choice (:func:`~.choice.chosen`) also weighs the chosen scale's layout drawn again
 #: with every piece whose side runs round a land tip split from the tip (:mod:`.tipcuts`).
 TIP_DRAW = True
+
+#: The tip draw is skipped where the draw at its scale left no piece with a land tip
+#: (:func:`~.tipcuts.watching_tips`): it would make that draw's layout again (session 34).
+TIP_GATE = True
 
 
 def _layout(

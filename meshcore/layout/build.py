@@ -16,6 +16,7 @@ nothing depends on the units or on a particular lake.
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import math
 
@@ -33,7 +34,7 @@ from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
-from .tipcuts import tips_split, untipped
+from .tipcuts import noted_tips, tips_split, untipped
 
 __all__ = ["layout_pieces"]
 
@@ -155,8 +156,7 @@ def layout_pieces(
     import shapely
     from shapely.geometry import Polygon
 
-    sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
-    chords = place_chords(poly, sk, min_length=2 * h, mouths=mouths)
+    sk, chords = _skeleton_and_chords(poly, h, mouths)
     dense = shapely.segmentize(poly, h)
     sigma = 1.5 * h
     junctions = sk.nodes[sk.degree() >= 3]
@@ -175,19 +175,11 @@ def layout_pieces(
         for r in regions:
             P = Polygon(r)
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
-            pieces, new_cuts, _ = best_split(
-                r,
-                sigma=sigma,
-                min_width=3 * h,
-                center=_junction_centre(r, junctions),
-                regular=regular,
-                normal=normal,
-                thin=here,
-                tee=tee if tees and regular else None,
-            )
-            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here, regular)
+            pieces, new_cuts = _split_region(r, junctions, sigma, 3 * h, regular, normal, here, tees and regular)
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
+            elif not regular:  # would the tip draw split any of these? (.tipcuts.watching_tips)
+                noted_tips(pieces, sigma)
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts
@@ -327,6 +319,60 @@ def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
     js = np.asarray(junctions, dtype=float).reshape(-1, 2)
     inside = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])]
     return np.mean(inside, axis=0) if len(inside) else None
+
+
+def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[Chord]]:
+    """The skeleton and chords of ``poly`` at cell size ``h`` (:func:`layout_pieces`), remembered
+    for the last polygon (keyed by a 128-bit digest of its WKB, ``h`` and ``mouths``): the layout
+    choice's tip draw (:mod:`.tipcuts`) is made at a scale drawn before.  The chords come back
+    as a new list of the same (frozen) chords."""
+    import shapely
+
+    key = (hashlib.blake2b(shapely.to_wkb(poly), digest_size=16).digest(), float(h), bool(mouths))
+    got = _skeletons.get(key)
+    if got is None:
+        sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
+        got = (sk, place_chords(poly, sk, min_length=2 * h, mouths=mouths))
+        if len(_skeletons) >= _SKELETONS_KEPT:
+            _skeletons.clear()
+        _skeletons[key] = got
+    return got[0], list(got[1])
+
+
+#: How many skeletons :func:`_skeleton_and_chords` remembers (a lake's draws: five scales at most).
+_SKELETONS_KEPT = 8
+_skeletons: dict[tuple, tuple] = {}
+
+
+def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):
+    """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`;
+    remembered for the last :data:`_SPLITS_KEPT` regions (keyed by a 128-bit digest of the ring, the
+    junctions' centre in it and the options): the layout choice's tip draw
+    (:mod:`.tipcuts`) partitions the water as the draw at its scale did and splits the same
+    regions again (copies are returned: callers own what they get)."""
+    center = _junction_centre(r, junctions)
+    ring = np.ascontiguousarray(r, dtype=float)
+    c = b"" if center is None else np.ascontiguousarray(center, dtype=float).tobytes()
+    digest = hashlib.blake2b(ring.tobytes() + b"|" + c, digest_size=16).digest()
+    key = (digest, ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
+    got = _splits.get(key)
+    if got is None:
+        kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}
+        pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, **kw)
+        got = _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular)
+        if len(_splits) >= _SPLITS_KEPT:
+            _splits.clear()
+        _splits[key] = got
+    pieces, cuts = got
+    return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
+        np.array(c) for c in cuts
+    ]
+
+
+#: How many regions' splits :func:`_split_region` remembers (then it starts again; a draw of a
+#: 90-block lake has ~200 regions).
+_SPLITS_KEPT = 2_000
+_splits: dict[tuple, tuple] = {}
 
 
 def _unfanned(

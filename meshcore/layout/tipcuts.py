@@ -27,7 +27,16 @@ import math
 
 import numpy as np
 
-__all__ = ["TIP_SCALE", "TIP_TURN", "splitting_tips", "tip_split", "tips_split", "untipped"]
+__all__ = [
+    "TIP_SCALE",
+    "TIP_TURN",
+    "noted_tips",
+    "splitting_tips",
+    "tip_split",
+    "tips_split",
+    "untipped",
+    "watching_tips",
+]
 
 #: The boundary is read at this share of the piece's width (at least the corners' scale).
 TIP_SCALE = 0.5
@@ -51,6 +60,33 @@ def splitting_tips():
 def tips_split() -> bool:
     """True within :func:`splitting_tips`."""
     return _on.get()
+
+
+_seen: contextvars.ContextVar[list[bool] | None] = contextvars.ContextVar("tips_seen", default=None)
+
+
+@contextlib.contextmanager
+def watching_tips():
+    """Yields ``[False]``, set to True when a layout drawn within this context (not within
+    :func:`splitting_tips`) leaves a piece that :func:`untipped` would look at and that has a tip
+    (:func:`_tip`; :func:`noted_tips`).  While it stays False the same draw within
+    :func:`splitting_tips` makes the same layout (:func:`tip_split` needs a tip), so the layout
+    choice's tip draw (:func:`~meshcore.layout.choice.chosen`) is skipped."""
+    box = [False]
+    token = _seen.set(box)
+    try:
+        yield box
+    finally:
+        _seen.reset(token)
+
+
+def noted_tips(pieces: list, sigma: float) -> None:
+    """Within :func:`watching_tips`: note whether a piece of ``pieces`` (``(ring, forced)``, as
+    :func:`untipped` takes them) without forced corners has a tip."""
+    box = _seen.get()
+    if box is None or box[0]:
+        return
+    box[0] = any(not len(fc) and _tip(ring, sigma) is not None for ring, fc in pieces)
 
 
 def _tip(ring: np.ndarray, sigma: float) -> tuple[int, float] | None:
