@@ -56,7 +56,7 @@ from .polygon import (
     without_slivers,
 )
 from .shore import shore_at_scale, transfer, without_narrow_arms
-from .tipcuts import splitting_tips, watching_tips
+from .tipcuts import splits, splitting_tips, watching_tips
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
 from .widen import widen_starved
@@ -224,19 +224,18 @@ def _first_fit(
                     first = first or TopologyError(folds)
                     continue
             if scale == 1.0 and not single and reading is not None:  # the best coarse grid of three scales
-                # the draws that left no piece with a land tip: drawn again splitting tips, the same
-                untipped = {1.0: lay} if not tipped[0] else {}
+                # each draw and the pieces it left round land tips (.tipcuts.watching_tips)
+                drawn = {1.0: (lay, tipped)}
 
-                def at_scale(s: float, n: bool = normal, u: dict = untipped) -> Layout:
+                def at_scale(s: float, n: bool = normal, d: dict = drawn) -> Layout:
                     with watching_tips() as tipped:
                         got = draw(regular=regular, normal=n, scale=s)
-                    if not tipped[0]:
-                        u[s] = got
+                    d[s] = (got, tipped)
                     return _closing(got, regular)
 
-                def with_tips(s: float, n: bool = normal, u: dict = untipped) -> Layout:
-                    if TIP_GATE and s in u:  # nothing for .tipcuts to split: that draw itself
-                        return u[s]
+                def with_tips(s: float, n: bool = normal, d: dict = drawn) -> Layout:
+                    if TIP_GATE and s in d and not splits(d[s][1]):  # no tip split: that draw itself
+                        return d[s][0]
                     with splitting_tips():
                         return draw(regular=False, normal=n, scale=s)
 
@@ -302,8 +301,9 @@ LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
 #: with every piece whose side runs round a land tip split from the tip (:mod:`.tipcuts`).
 TIP_DRAW = True
 
-#: The tip draw is skipped where the draw at its scale left no piece with a land tip
-#: (:func:`~.tipcuts.watching_tips`): it would make that draw's layout again (session 34).
+#: The tip draw is skipped where the draw at its scale left no piece that :mod:`.tipcuts` splits
+#: (:func:`~.tipcuts.watching_tips`, :func:`~.tipcuts.splits`): it would make that draw's layout
+#: again (session 34).
 TIP_GATE = True
 
 

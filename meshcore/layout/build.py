@@ -179,7 +179,7 @@ def layout_pieces(
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
             elif not regular:  # would the tip draw split any of these? (.tipcuts.watching_tips)
-                noted_tips(pieces, sigma)
+                noted_tips(pieces, sigma, 3 * h, normal, here)
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts

@@ -23,7 +23,9 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import hashlib
 import math
+from typing import Any
 
 import numpy as np
 
@@ -31,6 +33,7 @@ __all__ = [
     "TIP_SCALE",
     "TIP_TURN",
     "noted_tips",
+    "splits",
     "splitting_tips",
     "tip_split",
     "tips_split",
@@ -62,17 +65,18 @@ def tips_split() -> bool:
     return _on.get()
 
 
-_seen: contextvars.ContextVar[list[bool] | None] = contextvars.ContextVar("tips_seen", default=None)
+_seen: contextvars.ContextVar[list | None] = contextvars.ContextVar("tips_seen", default=None)
 
 
 @contextlib.contextmanager
 def watching_tips():
-    """Yields ``[False]``, set to True when a layout drawn within this context (not within
-    :func:`splitting_tips`) leaves a piece that :func:`untipped` would look at and that has a tip
-    (:func:`_tip`; :func:`noted_tips`).  While it stays False the same draw within
-    :func:`splitting_tips` makes the same layout (:func:`tip_split` needs a tip), so the layout
-    choice's tip draw (:func:`~meshcore.layout.choice.chosen`) is skipped."""
-    box = [False]
+    """Yields a list to which a layout drawn within this context (not within
+    :func:`splitting_tips`) adds every piece :func:`untipped` would look at that has a tip
+    (:func:`_tip`), with the arguments :func:`untipped` would split it with (:func:`noted_tips`).
+    Where none of them splits (:func:`splits`), the same draw within :func:`splitting_tips` makes
+    the same layout, so the layout choice's tip draw (:func:`~meshcore.layout.choice.chosen`) is
+    skipped."""
+    box: list = []
     token = _seen.set(box)
     try:
         yield box
@@ -80,13 +84,50 @@ def watching_tips():
         _seen.reset(token)
 
 
-def noted_tips(pieces: list, sigma: float) -> None:
-    """Within :func:`watching_tips`: note whether a piece of ``pieces`` (``(ring, forced)``, as
-    :func:`untipped` takes them) without forced corners has a tip."""
+def noted_tips(pieces: list, sigma: float, min_width: float, normal: bool, thin: bool) -> None:
+    """Within :func:`watching_tips`: note the pieces of ``pieces`` (``(ring, forced)``, as
+    :func:`untipped` takes them, with its other arguments) without forced corners that have a tip."""
     box = _seen.get()
-    if box is None or box[0]:
-        return
-    box[0] = any(not len(fc) and _tip(ring, sigma) is not None for ring, fc in pieces)
+    if box is not None:
+        box += [(np.array(r), sigma, min_width, normal, thin) for r, fc in pieces if not len(fc) and _tip(r, sigma)]
+
+
+def splits(noted: list) -> bool:
+    """Whether :func:`tip_split` splits any of the pieces ``noted`` (:func:`watching_tips`)."""
+    return any(
+        _kept_split(ring, sigma, min_width, normal, thin) is not None for ring, sigma, min_width, normal, thin in noted
+    )
+
+
+def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, thin: bool):
+    """:func:`tip_split`, remembered for the last :data:`_SPLITS_KEPT` rings (keyed by a 128-bit
+    digest of the ring and the arguments): :func:`splits` asks before the tip draw, which asks
+    again (copies are returned: callers own what they get)."""
+    data = np.ascontiguousarray(ring, dtype=float)
+    key = (
+        hashlib.blake2b(data.tobytes(), digest_size=16).digest(),
+        data.shape,
+        float(sigma),
+        float(min_width),
+        normal,
+        thin,
+    )
+    if key not in _splits:
+        if len(_splits) >= _SPLITS_KEPT:
+            _splits.clear()
+        _splits[key] = tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin)
+    got = _splits[key]
+    if got is None:
+        return None
+    pieces, cuts = got
+    return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
+        np.array(c) for c in cuts
+    ]
+
+
+#: How many pieces' tip splits :func:`_kept_split` remembers (then it starts again).
+_SPLITS_KEPT = 2_000
+_splits: dict[tuple, Any] = {}
 
 
 def _tip(ring: np.ndarray, sigma: float) -> tuple[int, float] | None:
@@ -180,7 +221,7 @@ def untipped(pieces: list, cuts: list, sigma: float, min_width: float, normal: b
     it (:func:`tip_split`; pieces with forced corners as they are)."""
     out: list = []
     for ring, fc in pieces:
-        got = None if len(fc) else tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin)
+        got = None if len(fc) else _kept_split(ring, sigma, min_width, normal, thin)
         out += [(ring, fc)] if got is None else got[0]
         cuts = cuts if got is None else [*cuts, *got[1]]
     return out, cuts

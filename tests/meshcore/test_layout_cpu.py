@@ -9,10 +9,10 @@ from shapely.geometry import Point, Polygon, box
 
 import meshcore.layout as lay
 from meshcore import testing
-from meshcore.layout import build
+from meshcore.layout import build, tipcuts
 from meshcore.layout.build import _skeleton_and_chords, _split_region, _unfanned
 from meshcore.layout.split import _orient, best_split
-from meshcore.layout.tipcuts import noted_tips, watching_tips
+from meshcore.layout.tipcuts import _kept_split, noted_tips, splits, tip_split, watching_tips
 
 
 def _blocks(layout) -> list:
@@ -31,19 +31,39 @@ def _tongue() -> Polygon:
     return box(0, 0, 10, 6).difference(tongue)
 
 
-def test_watching_tips_sees_a_tip_and_not_a_plain_piece():
+def test_watching_tips_notes_the_pieces_with_a_tip():
     u = _orient(np.asarray(_tongue().exterior.coords)[:-1])
     plain = _orient(np.asarray(box(0, 0, 10, 3).exterior.coords)[:-1])
     with watching_tips() as seen:
-        noted_tips([(plain, ())], 0.15)
-    assert seen == [False]
+        noted_tips([(plain, ())], 0.15, 0.3, True, False)
+    assert seen == [] and not splits(seen)
     with watching_tips() as seen:
-        noted_tips([(plain, ()), (u, ())], 0.15)
-    assert seen == [True]
+        noted_tips([(plain, ()), (u, ())], 0.15, 0.3, True, False)
+    assert len(seen) == 1 and np.array_equal(seen[0][0], u) and splits(seen)
     with watching_tips() as seen:  # forced corners: the tip draw leaves such pieces alone
-        noted_tips([(u, (tuple(u[0]),))], 0.15)
-    assert seen == [False]
-    noted_tips([(u, ())], 0.15)  # outside the context: nothing to note, no error
+        noted_tips([(u, (tuple(u[0]),))], 0.15, 0.3, True, False)
+    assert seen == []
+    noted_tips([(u, ())], 0.15, 0.3, True, False)  # outside the context: nothing to note, no error
+
+
+def test_a_remembered_tip_split_is_the_fresh_one():
+    u = _orient(np.asarray(_tongue().exterior.coords)[:-1])
+    fresh = tip_split(u, sigma=0.15, min_width=0.3)
+    tipcuts._splits.clear()
+    first = _kept_split(u, 0.15, 0.3, True, False)
+    first[0][0][0][:] = 0.0  # the caller's copy
+    again = _kept_split(u, 0.15, 0.3, True, False)
+    _same_split(fresh, again)
+    plain = _orient(np.asarray(box(0, 0, 10, 3).exterior.coords)[:-1])
+    assert _kept_split(plain, 0.15, 0.3, True, False) is None
+
+
+def _same_split(a, b) -> None:
+    assert len(a[0]) == len(b[0]) and len(a[1]) == len(b[1])
+    for (ra, fa), (rb, fb) in zip(a[0], b[0], strict=True):
+        assert np.array_equal(ra, rb) and len(fa) == len(fb)
+    for ca, cb in zip(a[1], b[1], strict=True):
+        assert np.array_equal(ca, cb)
 
 
 @pytest.mark.parametrize(
@@ -63,6 +83,7 @@ def test_the_gated_tip_draw_gives_the_ungated_layout(poly, monkeypatch):
     for gate in (False, True):
         build._splits.clear()
         build._skeletons.clear()
+        tipcuts._splits.clear()
         n = [0]
 
         def counting(n=n):
@@ -97,9 +118,4 @@ def test_a_remembered_region_split_is_the_fresh_one():
     first = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
     first[0][0][0][:] = 0.0  # the caller's copy: changing it leaves the remembered split as it was
     again = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
-    for a, b in ((fresh, again),):
-        assert len(a[0]) == len(b[0]) and len(a[1]) == len(b[1])
-        for (ra, fa), (rb, fb) in zip(a[0], b[0], strict=True):
-            assert np.array_equal(ra, rb) and len(fa) == len(fb)
-        for ca, cb in zip(a[1], b[1], strict=True):
-            assert np.array_equal(ca, cb)
+    _same_split(fresh, again)
