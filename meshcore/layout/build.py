@@ -347,13 +347,17 @@ _skeletons: dict[tuple, tuple] = {}
 def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):
     """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`;
     remembered for the last :data:`_SPLITS_KEPT` regions (keyed by a 128-bit digest of the ring, the
-    junctions' centre in it and the options): the layout choice's tip draw
+    skeleton's junctions inside it and the options): the layout choice's tip draw
     (:mod:`.tipcuts`) partitions the water as the draw at its scale did and splits the same
     regions again (copies are returned: callers own what they get)."""
+    import shapely
+
     center = _junction_centre(r, junctions)
     ring = np.ascontiguousarray(r, dtype=float)
-    c = b"" if center is None else np.ascontiguousarray(center, dtype=float).tobytes()
-    digest = hashlib.blake2b(ring.tobytes() + b"|" + c, digest_size=16).digest()
+    js = np.asarray(junctions, dtype=float).reshape(-1, 2)
+    # the junctions inside: the centre of the region's and of its pieces' star splits
+    js = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])] if len(js) else js
+    digest = hashlib.blake2b(ring.tobytes() + b"|" + np.ascontiguousarray(js).tobytes(), digest_size=16).digest()
     key = (digest, ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
     got = _splits.get(key)
     if got is None:
