@@ -39,7 +39,7 @@ import numpy as np
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from . import tipends
 from .blocks import block_counts
-from .build import layout_pieces
+from .build import layout_pieces, remembering
 from .choice import chosen
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
@@ -153,15 +153,31 @@ def auto_layout(
     shores = shore_at_scale(poly, h)
     if shores.change is not None:
         more.append(shores.change.note())
+    with remembering():  # the draws' skeletons and splits, for the choice's tip draw
+        return _drawn(
+            shores,
+            h,
+            notes + more,
+            details,
+            multiple=multiple,
+            regular=regular,
+            single=single,
+            options=options,
+            reading=reading,
+        )
+
+
+def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, single: bool, options, reading) -> Layout:
+    """The layout of :func:`auto_layout` from the water at its scales (:func:`_first_fit`), or the error."""
     from ..errors import TopologyError
 
-    # single: when no layout fits, the layouts again with four cut ends on every island (.ringcuts)
     first = kept = None
+    # single: when no layout fits, the layouts again with four cut ends on every island (.ringcuts)
     for ring in (False, True) if single else (False,):
         draw = functools.partial(
-            _layout, shores, h, notes + more, multiple=multiple, single=single, options=options, ring=ring
+            _layout, shores, h, notes, multiple=multiple, single=single, options=options, ring=ring
         )
-        ringed = functools.partial(_layout, shores, h, notes + more, multiple=multiple, options=options, ring=True)
+        ringed = functools.partial(_layout, shores, h, notes, multiple=multiple, options=options, ring=True)
         lay, error, closing = _first_fit(draw, regular=regular, single=single, reading=reading, ringed=ringed)
         if lay is not None:
             return dataclasses.replace(lay, details=tuple(details)) if details else lay

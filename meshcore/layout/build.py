@@ -16,6 +16,8 @@ nothing depends on the units or on a particular lake.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import hashlib
 import itertools
 import math
@@ -36,7 +38,7 @@ from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
 from .tipcuts import noted_tips, tips_split, untipped
 
-__all__ = ["layout_pieces"]
+__all__ = ["layout_pieces", "remembering"]
 
 
 def _densify(line: np.ndarray, step: float) -> np.ndarray:
@@ -321,35 +323,54 @@ def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
     return np.mean(inside, axis=0) if len(inside) else None
 
 
+_memo: contextvars.ContextVar[dict | None] = contextvars.ContextVar("layout_memo", default=None)
+
+
+@contextlib.contextmanager
+def remembering():
+    """Within this context (one :func:`~meshcore.layout.auto_layout` call) the draws remember
+    their skeletons, chords and region splits (:func:`_skeleton_and_chords`, :func:`_split_region`)
+    and :mod:`.tipcuts` its tip splits: the layout choice's tip draw repeats the draw at its scale.
+    Kept for the call only, so that a module option changed between calls (or by a test) is read."""
+    token = _memo.set({})
+    try:
+        yield
+    finally:
+        _memo.reset(token)
+
+
+def remembered(key: tuple, make):
+    """``make()``, remembered under ``key`` within :func:`remembering` (else made each time)."""
+    memo = _memo.get()
+    if memo is None:
+        return make()
+    if key not in memo:
+        memo[key] = make()
+    return memo[key]
+
+
 def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[Chord]]:
     """The skeleton and chords of ``poly`` at cell size ``h`` (:func:`layout_pieces`), remembered
-    for the last polygon (keyed by a 128-bit digest of its WKB, ``h`` and ``mouths``): the layout
-    choice's tip draw (:mod:`.tipcuts`) is made at a scale drawn before.  The chords come back
-    as a new list of the same (frozen) chords."""
+    within :func:`remembering` (keyed by a 128-bit digest of the polygon's WKB, ``h`` and
+    ``mouths``): the layout choice's tip draw (:mod:`.tipcuts`) is made at a scale drawn before.
+    The chords come back as a new list of the same (frozen) chords."""
     import shapely
 
-    key = (hashlib.blake2b(shapely.to_wkb(poly), digest_size=16).digest(), float(h), bool(mouths))
-    got = _skeletons.get(key)
-    if got is None:
+    def make():
         sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
-        got = (sk, place_chords(poly, sk, min_length=2 * h, mouths=mouths))
-        if len(_skeletons) >= _SKELETONS_KEPT:
-            _skeletons.clear()
-        _skeletons[key] = got
-    return got[0], list(got[1])
+        return sk, place_chords(poly, sk, min_length=2 * h, mouths=mouths)
 
-
-#: How many skeletons :func:`_skeleton_and_chords` remembers (a lake's draws: five scales at most).
-_SKELETONS_KEPT = 8
-_skeletons: dict[tuple, tuple] = {}
+    key = ("skeleton", hashlib.blake2b(shapely.to_wkb(poly), digest_size=16).digest(), float(h), bool(mouths))
+    sk, chords = remembered(key, make)
+    return sk, list(chords)
 
 
 def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):
     """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`;
-    remembered for the last :data:`_SPLITS_KEPT` regions (keyed by a 128-bit digest of the ring, the
-    skeleton's junctions inside it and the options): the layout choice's tip draw
-    (:mod:`.tipcuts`) partitions the water as the draw at its scale did and splits the same
-    regions again (copies are returned: callers own what they get)."""
+    remembered within :func:`remembering` (keyed by a 128-bit digest of the ring, the skeleton's
+    junctions inside it and the options): the layout choice's tip draw (:mod:`.tipcuts`)
+    partitions the water as the draw at its scale did and splits the same regions again (copies
+    are returned: callers own what they get)."""
     import shapely
 
     center = _junction_centre(r, junctions)
@@ -358,25 +379,23 @@ def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, n
     # the junctions inside: the centre of the region's and of its pieces' star splits
     js = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])] if len(js) else js
     digest = hashlib.blake2b(ring.tobytes() + b"|" + np.ascontiguousarray(js).tobytes(), digest_size=16).digest()
-    key = (digest, ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
-    got = _splits.get(key)
-    if got is None:
+    key = ("split", digest, ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
+
+    def make():
         kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}
         pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, **kw)
-        got = _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular)
-        if len(_splits) >= _SPLITS_KEPT:
-            _splits.clear()
-        _splits[key] = got
-    pieces, cuts = got
+        return _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular)
+
+    return copied(remembered(key, make))
+
+
+def copied(split):
+    """``(pieces, cuts)`` (``(ring, forced)`` and arrays) copied: what :func:`remembered` keeps
+    stays as it was made."""
+    pieces, cuts = split
     return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
         np.array(c) for c in cuts
     ]
-
-
-#: How many regions' splits :func:`_split_region` remembers (then it starts again; a draw of a
-#: 90-block lake has ~200 regions).
-_SPLITS_KEPT = 2_000
-_splits: dict[tuple, tuple] = {}
 
 
 def _unfanned(

@@ -25,7 +25,6 @@ import contextlib
 import contextvars
 import hashlib
 import math
-from typing import Any
 
 import numpy as np
 
@@ -100,34 +99,16 @@ def splits(noted: list) -> bool:
 
 
 def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, thin: bool):
-    """:func:`tip_split`, remembered for the last :data:`_SPLITS_KEPT` rings (keyed by a 128-bit
-    digest of the ring and the arguments): :func:`splits` asks before the tip draw, which asks
-    again (copies are returned: callers own what they get)."""
+    """:func:`tip_split`, remembered within :func:`~.build.remembering` (keyed by a 128-bit digest
+    of the ring and the arguments): :func:`splits` asks before the tip draw, which asks again
+    (copies are returned: callers own what they get)."""
+    from .build import copied, remembered
+
     data = np.ascontiguousarray(ring, dtype=float)
-    key = (
-        hashlib.blake2b(data.tobytes(), digest_size=16).digest(),
-        data.shape,
-        float(sigma),
-        float(min_width),
-        normal,
-        thin,
-    )
-    if key not in _splits:
-        if len(_splits) >= _SPLITS_KEPT:
-            _splits.clear()
-        _splits[key] = tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin)
-    got = _splits[key]
-    if got is None:
-        return None
-    pieces, cuts = got
-    return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
-        np.array(c) for c in cuts
-    ]
-
-
-#: How many pieces' tip splits :func:`_kept_split` remembers (then it starts again).
-_SPLITS_KEPT = 2_000
-_splits: dict[tuple, Any] = {}
+    digest = hashlib.blake2b(data.tobytes(), digest_size=16).digest()
+    key = ("tip", digest, data.shape, float(sigma), float(min_width), normal, thin)
+    got = remembered(key, lambda: tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin))
+    return None if got is None else copied(got)
 
 
 def _tip(ring: np.ndarray, sigma: float) -> tuple[int, float] | None:

@@ -9,8 +9,8 @@ from shapely.geometry import Point, Polygon, box
 
 import meshcore.layout as lay
 from meshcore import testing
-from meshcore.layout import build, tipcuts
-from meshcore.layout.build import _skeleton_and_chords, _split_region, _unfanned
+from meshcore.layout import build
+from meshcore.layout.build import _skeleton_and_chords, _split_region, _unfanned, remembering
 from meshcore.layout.split import _orient, best_split
 from meshcore.layout.tipcuts import _kept_split, noted_tips, splits, tip_split, watching_tips
 
@@ -49,13 +49,13 @@ def test_watching_tips_notes_the_pieces_with_a_tip():
 def test_a_remembered_tip_split_is_the_fresh_one():
     u = _orient(np.asarray(_tongue().exterior.coords)[:-1])
     fresh = tip_split(u, sigma=0.15, min_width=0.3)
-    tipcuts._splits.clear()
-    first = _kept_split(u, 0.15, 0.3, True, False)
-    first[0][0][0][:] = 0.0  # the caller's copy
-    again = _kept_split(u, 0.15, 0.3, True, False)
+    with remembering():
+        first = _kept_split(u, 0.15, 0.3, True, False)
+        first[0][0][0][:] = 0.0  # the caller's copy
+        again = _kept_split(u, 0.15, 0.3, True, False)
+        plain = _orient(np.asarray(box(0, 0, 10, 3).exterior.coords)[:-1])
+        assert _kept_split(plain, 0.15, 0.3, True, False) is None
     _same_split(fresh, again)
-    plain = _orient(np.asarray(box(0, 0, 10, 3).exterior.coords)[:-1])
-    assert _kept_split(plain, 0.15, 0.3, True, False) is None
 
 
 def _same_split(a, b) -> None:
@@ -81,9 +81,6 @@ def test_the_gated_tip_draw_gives_the_ungated_layout(poly, monkeypatch):
     got = {}
     real = lay.splitting_tips
     for gate in (False, True):
-        build._splits.clear()
-        build._skeletons.clear()
-        tipcuts._splits.clear()
         n = [0]
 
         def counting(n=n):
@@ -104,9 +101,10 @@ def test_the_gated_tip_draw_gives_the_ungated_layout(poly, monkeypatch):
 def test_a_remembered_region_split_is_the_fresh_one():
     poly = testing.headlands(4)
     h = (poly.area / 800) ** 0.5
-    sk, chords = _skeleton_and_chords(poly, h, False)
-    build._skeletons.clear()
-    sk2, chords2 = _skeleton_and_chords(poly, h, False)
+    sk, chords = _skeleton_and_chords(poly, h, False)  # outside remembering(): made afresh
+    with remembering():
+        sk2, chords2 = _skeleton_and_chords(poly, h, False)
+        assert _skeleton_and_chords(poly, h, False)[0] is sk2  # remembered
     assert np.array_equal(sk.nodes, sk2.nodes)
     assert [c.points.tolist() for c in chords] == [c.points.tolist() for c in chords2]
     junctions = sk.nodes[sk.degree() >= 3]
@@ -114,8 +112,8 @@ def test_a_remembered_region_split_is_the_fresh_one():
     sigma = 1.5 * h
     pieces, cuts, _ = best_split(ring, sigma=sigma, min_width=3 * h, center=build._junction_centre(ring, junctions))
     fresh = _unfanned(pieces, cuts, junctions, sigma, 3 * h, True, False)
-    build._splits.clear()
-    first = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
-    first[0][0][0][:] = 0.0  # the caller's copy: changing it leaves the remembered split as it was
-    again = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
+    with remembering():
+        first = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
+        first[0][0][0][:] = 0.0  # the caller's copy: changing it leaves the remembered split as it was
+        again = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
     _same_split(fresh, again)
