@@ -39,7 +39,7 @@ import numpy as np
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from . import tipends
 from .blocks import block_counts
-from .build import layout_pieces
+from .build import layout_pieces, remembering
 from .choice import chosen
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
@@ -56,7 +56,7 @@ from .polygon import (
     without_slivers,
 )
 from .shore import shore_at_scale, transfer, without_narrow_arms
-from .tipcuts import splitting_tips
+from .tipcuts import splits, splitting_tips, watching_tips
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
 from .widen import widen_starved
@@ -153,15 +153,31 @@ def auto_layout(
     shores = shore_at_scale(poly, h)
     if shores.change is not None:
         more.append(shores.change.note())
+    with remembering():  # the draws' skeletons and splits, for the choice's tip draw
+        return _drawn(
+            shores,
+            h,
+            notes + more,
+            details,
+            multiple=multiple,
+            regular=regular,
+            single=single,
+            options=options,
+            reading=reading,
+        )
+
+
+def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, single: bool, options, reading) -> Layout:
+    """The layout of :func:`auto_layout` from the water at its scales (:func:`_first_fit`), or the error."""
     from ..errors import TopologyError
 
-    # single: when no layout fits, the layouts again with four cut ends on every island (.ringcuts)
     first = kept = None
+    # single: when no layout fits, the layouts again with four cut ends on every island (.ringcuts)
     for ring in (False, True) if single else (False,):
         draw = functools.partial(
-            _layout, shores, h, notes + more, multiple=multiple, single=single, options=options, ring=ring
+            _layout, shores, h, notes, multiple=multiple, single=single, options=options, ring=ring
         )
-        ringed = functools.partial(_layout, shores, h, notes + more, multiple=multiple, options=options, ring=True)
+        ringed = functools.partial(_layout, shores, h, notes, multiple=multiple, options=options, ring=True)
         lay, error, closing = _first_fit(draw, regular=regular, single=single, reading=reading, ringed=ringed)
         if lay is not None:
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
@@ -203,7 +219,8 @@ def _first_fit(
         # the layout without them (the splits of earlier versions) next
         for normal in (True, False):
             try:
-                lay = draw(regular=regular, normal=normal, scale=scale)
+                with watching_tips() as tipped:
+                    lay = draw(regular=regular, normal=normal, scale=scale)
             except TopologyError as exc:
                 first = first or exc
                 continue
@@ -223,11 +240,18 @@ def _first_fit(
                     first = first or TopologyError(folds)
                     continue
             if scale == 1.0 and not single and reading is not None:  # the best coarse grid of three scales
+                # each draw and the pieces it left round land tips (.tipcuts.watching_tips)
+                drawn = {1.0: (lay, tipped)}
 
-                def at_scale(s: float, n: bool = normal) -> Layout:
-                    return _closing(draw(regular=regular, normal=n, scale=s), regular)
+                def at_scale(s: float, n: bool = normal, d: dict = drawn) -> Layout:
+                    with watching_tips() as tipped:
+                        got = draw(regular=regular, normal=n, scale=s)
+                    d[s] = (got, tipped)
+                    return _closing(got, regular)
 
-                def with_tips(s: float, n: bool = normal) -> Layout:
+                def with_tips(s: float, n: bool = normal, d: dict = drawn) -> Layout:
+                    if TIP_GATE and s in d and not splits(d[s][1]):  # no tip split: that draw itself
+                        return d[s][0]
                     with splitting_tips():
                         return draw(regular=False, normal=n, scale=s)
 
@@ -292,6 +316,11 @@ LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
 #: The layout choice (:func:`~.choice.chosen`) also weighs the chosen scale's layout drawn again
 #: with every piece whose side runs round a land tip split from the tip (:mod:`.tipcuts`).
 TIP_DRAW = True
+
+#: The tip draw is skipped where the draw at its scale left no piece that :mod:`.tipcuts` splits
+#: (:func:`~.tipcuts.watching_tips`, :func:`~.tipcuts.splits`): it would make that draw's layout
+#: again (session 34).
+TIP_GATE = True
 
 
 def _layout(

@@ -16,6 +16,9 @@ nothing depends on the units or on a particular lake.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+import hashlib
 import itertools
 import math
 
@@ -33,9 +36,9 @@ from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
-from .tipcuts import tips_split, untipped
+from .tipcuts import noted_tips, tips_split, untipped
 
-__all__ = ["layout_pieces"]
+__all__ = ["layout_pieces", "remembering"]
 
 
 def _densify(line: np.ndarray, step: float) -> np.ndarray:
@@ -155,8 +158,7 @@ def layout_pieces(
     import shapely
     from shapely.geometry import Polygon
 
-    sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
-    chords = place_chords(poly, sk, min_length=2 * h, mouths=mouths)
+    sk, chords = _skeleton_and_chords(poly, h, mouths)
     dense = shapely.segmentize(poly, h)
     sigma = 1.5 * h
     junctions = sk.nodes[sk.degree() >= 3]
@@ -175,19 +177,11 @@ def layout_pieces(
         for r in regions:
             P = Polygon(r)
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
-            pieces, new_cuts, _ = best_split(
-                r,
-                sigma=sigma,
-                min_width=3 * h,
-                center=_junction_centre(r, junctions),
-                regular=regular,
-                normal=normal,
-                thin=here,
-                tee=tee if tees and regular else None,
-            )
-            pieces, new_cuts = _unfanned(pieces, new_cuts, junctions, sigma, 3 * h, normal, here, regular)
+            pieces, new_cuts = _split_region(r, junctions, sigma, 3 * h, regular, normal, here, tees and regular)
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
+            elif not regular:  # would the tip draw split any of these? (.tipcuts.watching_tips)
+                noted_tips(pieces, sigma, 3 * h, normal, here)
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts
@@ -327,6 +321,81 @@ def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
     js = np.asarray(junctions, dtype=float).reshape(-1, 2)
     inside = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])]
     return np.mean(inside, axis=0) if len(inside) else None
+
+
+_memo: contextvars.ContextVar[dict | None] = contextvars.ContextVar("layout_memo", default=None)
+
+
+@contextlib.contextmanager
+def remembering():
+    """Within this context (one :func:`~meshcore.layout.auto_layout` call) the draws remember
+    their skeletons, chords and region splits (:func:`_skeleton_and_chords`, :func:`_split_region`)
+    and :mod:`.tipcuts` its tip splits: the layout choice's tip draw repeats the draw at its scale.
+    Kept for the call only, so that a module option changed between calls (or by a test) is read."""
+    token = _memo.set({})
+    try:
+        yield
+    finally:
+        _memo.reset(token)
+
+
+def remembered(key: tuple, make):
+    """``make()``, remembered under ``key`` within :func:`remembering` (else made each time)."""
+    memo = _memo.get()
+    if memo is None:
+        return make()
+    if key not in memo:
+        memo[key] = make()
+    return memo[key]
+
+
+def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[Chord]]:
+    """The skeleton and chords of ``poly`` at cell size ``h`` (:func:`layout_pieces`), remembered
+    within :func:`remembering` (keyed by a 128-bit digest of the polygon's WKB, ``h`` and
+    ``mouths``): the layout choice's tip draw (:mod:`.tipcuts`) is made at a scale drawn before.
+    The chords come back as a new list of the same (frozen) chords."""
+    import shapely
+
+    def make():
+        sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
+        return sk, place_chords(poly, sk, min_length=2 * h, mouths=mouths)
+
+    key = ("skeleton", hashlib.blake2b(shapely.to_wkb(poly), digest_size=16).digest(), float(h), bool(mouths))
+    sk, chords = remembered(key, make)
+    return sk, list(chords)
+
+
+def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):
+    """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`;
+    remembered within :func:`remembering` (keyed by a 128-bit digest of the ring, the skeleton's
+    junctions inside it and the options): the layout choice's tip draw (:mod:`.tipcuts`)
+    partitions the water as the draw at its scale did and splits the same regions again (copies
+    are returned: callers own what they get)."""
+    import shapely
+
+    center = _junction_centre(r, junctions)
+    ring = np.ascontiguousarray(r, dtype=float)
+    js = np.asarray(junctions, dtype=float).reshape(-1, 2)
+    # the junctions inside: the centre of the region's and of its pieces' star splits
+    js = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])] if len(js) else js
+    digest = hashlib.blake2b(ring.tobytes() + b"|" + np.ascontiguousarray(js).tobytes(), digest_size=16).digest()
+    key = ("split", digest, ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
+
+    def make():
+        kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}
+        pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, **kw)
+        return _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular)
+
+    return copied(remembered(key, make))
+
+
+def copied(split):
+    """``(pieces, cuts)`` (``(ring, forced)`` and arrays) copied: what :func:`remembered` keeps
+    stays as it was made."""
+    pieces, cuts = split
+    return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
+        np.array(c) for c in cuts
+    ]
 
 
 def _unfanned(

@@ -23,11 +23,22 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import hashlib
 import math
 
 import numpy as np
 
-__all__ = ["TIP_SCALE", "TIP_TURN", "splitting_tips", "tip_split", "tips_split", "untipped"]
+__all__ = [
+    "TIP_SCALE",
+    "TIP_TURN",
+    "noted_tips",
+    "splits",
+    "splitting_tips",
+    "tip_split",
+    "tips_split",
+    "untipped",
+    "watching_tips",
+]
 
 #: The boundary is read at this share of the piece's width (at least the corners' scale).
 TIP_SCALE = 0.5
@@ -51,6 +62,53 @@ def splitting_tips():
 def tips_split() -> bool:
     """True within :func:`splitting_tips`."""
     return _on.get()
+
+
+_seen: contextvars.ContextVar[list | None] = contextvars.ContextVar("tips_seen", default=None)
+
+
+@contextlib.contextmanager
+def watching_tips():
+    """Yields a list to which a layout drawn within this context (not within
+    :func:`splitting_tips`) adds every piece :func:`untipped` would look at that has a tip
+    (:func:`_tip`), with the arguments :func:`untipped` would split it with (:func:`noted_tips`).
+    Where none of them splits (:func:`splits`), the same draw within :func:`splitting_tips` makes
+    the same layout, so the layout choice's tip draw (:func:`~meshcore.layout.choice.chosen`) is
+    skipped."""
+    box: list = []
+    token = _seen.set(box)
+    try:
+        yield box
+    finally:
+        _seen.reset(token)
+
+
+def noted_tips(pieces: list, sigma: float, min_width: float, normal: bool, thin: bool) -> None:
+    """Within :func:`watching_tips`: note the pieces of ``pieces`` (``(ring, forced)``, as
+    :func:`untipped` takes them, with its other arguments) without forced corners that have a tip."""
+    box = _seen.get()
+    if box is not None:
+        box += [(np.array(r), sigma, min_width, normal, thin) for r, fc in pieces if not len(fc) and _tip(r, sigma)]
+
+
+def splits(noted: list) -> bool:
+    """Whether :func:`tip_split` splits any of the pieces ``noted`` (:func:`watching_tips`)."""
+    return any(
+        _kept_split(ring, sigma, min_width, normal, thin) is not None for ring, sigma, min_width, normal, thin in noted
+    )
+
+
+def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, thin: bool):
+    """:func:`tip_split`, remembered within :func:`~.build.remembering` (keyed by a 128-bit digest
+    of the ring and the arguments): :func:`splits` asks before the tip draw, which asks again
+    (copies are returned: callers own what they get)."""
+    from .build import copied, remembered
+
+    data = np.ascontiguousarray(ring, dtype=float)
+    digest = hashlib.blake2b(data.tobytes(), digest_size=16).digest()
+    key = ("tip", digest, data.shape, float(sigma), float(min_width), normal, thin)
+    got = remembered(key, lambda: tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin))
+    return None if got is None else copied(got)
 
 
 def _tip(ring: np.ndarray, sigma: float) -> tuple[int, float] | None:
@@ -144,7 +202,7 @@ def untipped(pieces: list, cuts: list, sigma: float, min_width: float, normal: b
     it (:func:`tip_split`; pieces with forced corners as they are)."""
     out: list = []
     for ring, fc in pieces:
-        got = None if len(fc) else tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin)
+        got = None if len(fc) else _kept_split(ring, sigma, min_width, normal, thin)
         out += [(ring, fc)] if got is None else got[0]
         cuts = cuts if got is None else [*cuts, *got[1]]
     return out, cuts
