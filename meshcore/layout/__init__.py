@@ -263,7 +263,8 @@ def _first_fit(
 
                     more.append(rings)
                 tips = with_tips if TIP_DRAW and not regular else None
-                lay = chosen(lay, at_scale, reading, more, ratio_ok=REGULAR_RATIO if regular else 0.0, tips=tips)
+                ratio_ok = REGULAR_RATIO if regular else 0.0
+                lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
             return lay, None, None
         if kept is not None:
             return None, first, kept

@@ -14,7 +14,11 @@ the cells keep the asked size, as :data:`~meshcore.layout.LAYOUT_SCALES`), solve
 level of each layout that differs, and keeps the one with the smallest deviation if that is
 :data:`MARGIN` below the first's and its interface ratio there (the 99th percentile of the coarse
 cell pairs', :data:`meshcore.lakegrid.READING_PERCENTILE`) is no larger (up to
-:data:`RATIO_SLACK`; else the layout at the cell size itself).  Layouts of more than
+:data:`RATIO_SLACK`; else the layout at the cell size itself).  A default layout whose blocks
+average fewer than :data:`SMALL_BLOCK_CELLS` cells can also be drawn at :data:`COARSE_SCALES` (off) × the
+cell size — fewer, larger blocks whose lines are long enough to grade their cells (edge pairs
+≤ 1.2, issue 12's lakes of 70–100 blocks at 10 000 cells) — and there the coarse ratio may also
+be up to :data:`SMALL_RATIO_OK`, which the final grid's equalize step brings under 2.  Layouts of more than
 :data:`MAX_BLOCKS` blocks are kept as drawn (each other scale costs a layout: Saimaa's takes 10 s).
 """
 
@@ -35,6 +39,22 @@ SCALES = (1.07, 0.93)
 #: 1020303: 7.17° against 7.30°, final 92.1 against 93.6 % within 3°).
 MARGIN = 0.1
 
+#: Layouts whose blocks average fewer cells than this (at most 16 × 16: lines too short to grade
+#: their cells smoothly, issue 12's many-block lakes at 10 000 cells) are also drawn at
+#: :data:`COARSE_SCALES` × the cell size: fewer, larger blocks at the same cell size.
+SMALL_BLOCK_CELLS = 256
+
+#: The coarser scales drawn for layouts of small blocks (:data:`SMALL_BLOCK_CELLS`).  OFF by
+#: default (empty): ``(1.3, 1.6)`` measured on sets 13–20 (session 34, docs/lake-grids-journal.md
+#: "Many-block lakes drawn coarser"): within 3° up on most lakes of 55–105 blocks at 10 000
+#: cells (g180779 78.5 → 91.0 %, g180759 every hard target), edge pairs ≤ 1.2 still under 95 % on
+#: most, and two lakes lost a target (g180875 its pairs, g180780 its shore distance).
+COARSE_SCALES: tuple[float, ...] = ()
+
+#: For a layout of small blocks another draw may also read a coarse interface ratio above the
+#: first's up to this (as regular layouts, :data:`meshcore.layout.REGULAR_RATIO`).
+SMALL_RATIO_OK = 2.5
+
 #: A layout of more blocks than this is not drawn again (the time: a layout each).
 MAX_BLOCKS = 150
 
@@ -53,6 +73,7 @@ def chosen(
     more: Sequence[Callable[[], Layout]] = (),
     ratio_ok: float = 0.0,
     tips: Callable[[float], Layout] | None = None,
+    coarse: bool = False,
 ) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
     :data:`SCALES` (then each of ``more()``, other draws: a regular layout with more cuts from its
@@ -63,7 +84,10 @@ def chosen(
     coarse solve fails is passed over; so is every other scale when ``first``'s coarse solve fails.
     ``tips``: the layout at a scale with its pieces round land tips split (:mod:`.tipcuts`),
     drawn at the chosen scale and kept when its coarse deviation is :data:`MARGIN` below the
-    chosen layout's and its coarse interface ratio no larger than ``first``'s."""
+    chosen layout's and its coarse interface ratio no larger than ``first``'s (or ``ratio_ok``).
+    ``coarse``: a layout of small blocks (:data:`SMALL_BLOCK_CELLS`) is also drawn at
+    :data:`COARSE_SCALES`, and ``ratio_ok`` is at least :data:`SMALL_RATIO_OK` for it (default
+    layouts; regular ones close their frames at other scales by moving corners)."""
     if first.multiple < 4 or len(first.blocks) > MAX_BLOCKS:
         return first
     try:
@@ -76,7 +100,15 @@ def chosen(
     seen = [first.blocks]
     best_scale: float | None = 1.0
     best_dev = dev0
-    draws: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in SCALES]
+    scales: tuple[float, ...] = SCALES
+    if (
+        coarse
+        and COARSE_SCALES
+        and sum(b.cells[0] * b.cells[1] for b in first.blocks) < SMALL_BLOCK_CELLS * len(first.blocks)
+    ):
+        scales = SCALES + COARSE_SCALES
+        ratio_ok = max(ratio_ok, SMALL_RATIO_OK)
+    draws: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in scales]
     draws += [(None, d) for d in more]
     for scale, draw in draws:
         try:
@@ -94,7 +126,7 @@ def chosen(
             lay = tips(best_scale)
             if lay.blocks not in seen:
                 dev, ratio = reading(lay)
-                if dev < (1.0 - MARGIN) * best_dev and ratio <= ratio0 * (1.0 + RATIO_SLACK):
+                if dev < (1.0 - MARGIN) * best_dev and ratio <= max(ratio0 * (1.0 + RATIO_SLACK), ratio_ok):
                     best = lay
         except MeshcoreError:
             pass

@@ -173,3 +173,50 @@ def test_one_coarse_cell_pair_does_not_set_the_reading():
     dev, ratio = _reading([a, b])
     assert ratio < 2.5
     assert dev >= 0
+
+
+def _blocks(n: int, ni: int, nj: int):
+    from types import SimpleNamespace
+
+    return tuple(SimpleNamespace(cells=(ni, nj), name=f"b{k}") for k in range(n))
+
+
+def test_a_layout_of_small_blocks_is_also_drawn_coarser(monkeypatch):
+    # issue 12's lakes of 70-100 blocks at 10 000 cells (blocks of 8-12 cells across, lines too
+    # short to grade): their layouts at 1.3 x the cell size read 30-48 % less coarse deviation and
+    # a coarse interface ratio 3-12 % above the first's (held-out g180632, dev set 14's g180629)
+    from types import SimpleNamespace
+
+    from meshcore.layout import choice
+
+    def lay(blocks, dev, ratio):
+        return SimpleNamespace(multiple=4, blocks=blocks, reading=(dev, ratio))
+
+    assert choice.COARSE_SCALES == ()  # off by default: measured mixed
+    monkeypatch.setattr(choice, "COARSE_SCALES", (1.3, 1.6))
+
+    small = lay(_blocks(80, 8, 12), 10.0, 2.2)  # 96 cells a block
+    drawn: list[float] = []
+
+    def at(other):
+        def at_scale(s):
+            drawn.append(s)
+            return other if s == choice.COARSE_SCALES[0] else small
+
+        return at_scale
+
+    for ratio, taken in ((2.3, True), (choice.SMALL_RATIO_OK, True), (choice.SMALL_RATIO_OK * 1.01, False)):
+        other = lay(_blocks(60, 12, 12), 6.5, ratio)
+        drawn.clear()
+        got = choice.chosen(small, at(other), lambda la: la.reading, coarse=True)
+        assert (got is other) is taken, ratio
+        assert set(choice.COARSE_SCALES) <= set(drawn)
+    # a regular layout (coarse=False) and a layout of large blocks: only the neighbouring scales
+    other = lay(_blocks(60, 12, 12), 6.5, 2.3)
+    drawn.clear()
+    assert choice.chosen(small, at(other), lambda la: la.reading) is small
+    assert drawn == list(choice.SCALES)
+    large = lay(_blocks(40, 16, 20), 10.0, 2.2)  # 320 cells a block
+    drawn.clear()
+    assert choice.chosen(large, at(other), lambda la: la.reading, coarse=True) is large
+    assert drawn == list(choice.SCALES)
