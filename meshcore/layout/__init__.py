@@ -39,12 +39,13 @@ import numpy as np
 from ..cellsize import DEFAULT_CELLS, default_cell_size
 from . import tipends
 from .blocks import block_counts
-from .build import layout_pieces, remembering
+from .build import layout_pieces
 from .choice import chosen
 from .curve import curved_shore
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
 from .islandgaps import without_island_gaps
+from .memo import remembering
 from .model import Layout, LayoutBlock, LayoutOptions
 from .outline import interior_cuts
 from .polygon import (

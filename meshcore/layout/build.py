@@ -16,8 +16,6 @@ nothing depends on the units or on a particular lake.
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import hashlib
 import itertools
 import math
@@ -31,6 +29,7 @@ from .chords import Chord, place_chords
 from .corners import wedge_corners
 from .fans import fans, unfan, wraps
 from .frames import _vertices, close_frames, corner_flaws, frame_defects, straight_corners
+from .memo import copied, remembered
 from .regions import partition
 from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
@@ -38,7 +37,7 @@ from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
 from .tipcuts import noted_tips, tips_split, untipped
 
-__all__ = ["layout_pieces", "remembering"]
+__all__ = ["layout_pieces"]
 
 
 def _densify(line: np.ndarray, step: float) -> np.ndarray:
@@ -323,35 +322,9 @@ def _junction_centre(ring: np.ndarray, junctions: np.ndarray):
     return np.mean(inside, axis=0) if len(inside) else None
 
 
-_memo: contextvars.ContextVar[dict | None] = contextvars.ContextVar("layout_memo", default=None)
-
-
-@contextlib.contextmanager
-def remembering():
-    """Within this context (one :func:`~meshcore.layout.auto_layout` call) the draws remember
-    their skeletons, chords and region splits (:func:`_skeleton_and_chords`, :func:`_split_region`)
-    and :mod:`.tipcuts` its tip splits: the layout choice's tip draw repeats the draw at its scale.
-    Kept for the call only, so that a module option changed between calls (or by a test) is read."""
-    token = _memo.set({})
-    try:
-        yield
-    finally:
-        _memo.reset(token)
-
-
-def remembered(key: tuple, make):
-    """``make()``, remembered under ``key`` within :func:`remembering` (else made each time)."""
-    memo = _memo.get()
-    if memo is None:
-        return make()
-    if key not in memo:
-        memo[key] = make()
-    return memo[key]
-
-
 def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[Chord]]:
     """The skeleton and chords of ``poly`` at cell size ``h`` (:func:`layout_pieces`), remembered
-    within :func:`remembering` (keyed by a 128-bit digest of the polygon's WKB, ``h`` and
+    within :func:`.memo.remembering` (keyed by a 128-bit digest of the polygon's WKB, ``h`` and
     ``mouths``): the layout choice's tip draw (:mod:`.tipcuts`) is made at a scale drawn before.
     The chords come back as a new list of the same (frozen) chords."""
     import shapely
@@ -367,7 +340,7 @@ def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[C
 
 def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):
     """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`;
-    remembered within :func:`remembering` (keyed by a 128-bit digest of the ring, the skeleton's
+    remembered within :func:`.memo.remembering` (keyed by a 128-bit digest of the ring, the skeleton's
     junctions inside it and the options): the layout choice's tip draw (:mod:`.tipcuts`)
     partitions the water as the draw at its scale did and splits the same regions again (copies
     are returned: callers own what they get)."""
@@ -387,15 +360,6 @@ def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, n
         return _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular)
 
     return copied(remembered(key, make))
-
-
-def copied(split):
-    """``(pieces, cuts)`` (``(ring, forced)`` and arrays) copied: what :func:`remembered` keeps
-    stays as it was made."""
-    pieces, cuts = split
-    return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
-        np.array(c) for c in cuts
-    ]
 
 
 def _unfanned(

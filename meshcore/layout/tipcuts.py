@@ -99,10 +99,10 @@ def splits(noted: list) -> bool:
 
 
 def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, thin: bool):
-    """:func:`tip_split`, remembered within :func:`~.build.remembering` (keyed by a 128-bit digest
+    """:func:`tip_split`, remembered within :func:`~.memo.remembering` (keyed by a 128-bit digest
     of the ring and the arguments): :func:`splits` asks before the tip draw, which asks again
     (copies are returned: callers own what they get)."""
-    from .build import copied, remembered
+    from .memo import copied, remembered
 
     data = np.ascontiguousarray(ring, dtype=float)
     digest = hashlib.blake2b(data.tobytes(), digest_size=16).digest()

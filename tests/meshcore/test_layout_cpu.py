@@ -10,7 +10,8 @@ from shapely.geometry import Point, Polygon, box
 import meshcore.layout as lay
 from meshcore import testing
 from meshcore.layout import build
-from meshcore.layout.build import _skeleton_and_chords, _split_region, _unfanned, remembering
+from meshcore.layout.build import _skeleton_and_chords, _split_region, _unfanned
+from meshcore.layout.memo import remembering
 from meshcore.layout.split import _orient, best_split
 from meshcore.layout.tipcuts import _kept_split, noted_tips, splits, tip_split, watching_tips
 

@@ -1,0 +1,51 @@
+"""What one :func:`~meshcore.layout.auto_layout` call remembers between its draws.
+
+The layout choice draws a lake several times (:mod:`.choice`); its tip draw (:mod:`.tipcuts`)
+repeats the draw at the chosen scale with the pieces round land tips split, so the skeleton, the
+chords and the region splits of that draw (:mod:`.build`) and the tip splits are made once and
+remembered here, within :func:`remembering` only: a module option changed between calls (or by a
+test) is read again.  Callers get copies (:func:`copied`) of what is kept.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+
+import numpy as np
+
+__all__ = ["copied", "remembered", "remembering"]
+
+_memo: contextvars.ContextVar[dict | None] = contextvars.ContextVar("layout_memo", default=None)
+
+
+@contextlib.contextmanager
+def remembering():
+    """Within this context (one :func:`~meshcore.layout.auto_layout` call) the draws remember
+    their skeletons, chords and region splits (:func:`.build._skeleton_and_chords`, :func:`.build._split_region`)
+    and :mod:`.tipcuts` its tip splits: the layout choice's tip draw repeats the draw at its scale.
+    Kept for the call only, so that a module option changed between calls (or by a test) is read."""
+    token = _memo.set({})
+    try:
+        yield
+    finally:
+        _memo.reset(token)
+
+
+def remembered(key: tuple, make):
+    """``make()``, remembered under ``key`` within :func:`remembering` (else made each time)."""
+    memo = _memo.get()
+    if memo is None:
+        return make()
+    if key not in memo:
+        memo[key] = make()
+    return memo[key]
+
+
+def copied(split):
+    """``(pieces, cuts)`` (``(ring, forced)`` and arrays) copied: what :func:`remembered` keeps
+    stays as it was made."""
+    pieces, cuts = split
+    return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
+        np.array(c) for c in cuts
+    ]
