@@ -16,7 +16,6 @@ nothing depends on the units or on a particular lake.
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import math
 
@@ -29,7 +28,7 @@ from .chords import Chord, place_chords
 from .corners import wedge_corners
 from .fans import fans, unfan, wraps
 from .frames import _vertices, close_frames, corner_flaws, frame_defects, straight_corners
-from .memo import copied, remembered
+from .memo import copied, digest, remembered
 from .regions import partition
 from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
@@ -333,7 +332,7 @@ def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[C
         sk = skeleton(poly, spacing=h / 2, prune=0.5, min_arm=3 * h)
         return sk, place_chords(poly, sk, min_length=2 * h, mouths=mouths)
 
-    key = ("skeleton", hashlib.blake2b(shapely.to_wkb(poly), digest_size=16).digest(), float(h), bool(mouths))
+    key = ("skeleton", digest(shapely.to_wkb(poly)), float(h), bool(mouths))
     sk, chords = remembered(key, make)
     return sk, list(chords)
 
@@ -351,8 +350,7 @@ def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, n
     js = np.asarray(junctions, dtype=float).reshape(-1, 2)
     # the junctions inside: the centre of the region's and of its pieces' star splits
     js = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])] if len(js) else js
-    digest = hashlib.blake2b(ring.tobytes() + b"|" + np.ascontiguousarray(js).tobytes(), digest_size=16).digest()
-    key = ("split", digest, ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
+    key = ("split", digest(ring, js), ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
 
     def make():
         kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}

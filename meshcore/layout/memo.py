@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import hashlib
 
 import numpy as np
 
-__all__ = ["copied", "remembered", "remembering"]
+__all__ = ["copied", "digest", "remembered", "remembering"]
 
 _memo: contextvars.ContextVar[dict | None] = contextvars.ContextVar("layout_memo", default=None)
 
@@ -49,3 +50,10 @@ def copied(split):
     return [(np.array(p), tuple(np.array(q) if isinstance(q, np.ndarray) else q for q in f)) for p, f in pieces], [
         np.array(c) for c in cuts
     ]
+
+
+def digest(*parts) -> bytes:
+    """A 128-bit digest of ``parts`` (bytes, or arrays taken as contiguous float64): a key's
+    geometry for :func:`remembered`."""
+    raw = [p if isinstance(p, bytes) else np.ascontiguousarray(p, dtype=float).tobytes() for p in parts]
+    return hashlib.blake2b(b"|".join(raw), digest_size=16).digest()

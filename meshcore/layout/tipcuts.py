@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-import hashlib
 import math
 
 import numpy as np
+
+from .memo import copied, digest, remembered
 
 __all__ = [
     "TIP_SCALE",
@@ -102,11 +103,7 @@ def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, 
     """:func:`tip_split`, remembered within :func:`~.memo.remembering` (keyed by a 128-bit digest
     of the ring and the arguments): :func:`splits` asks before the tip draw, which asks again
     (copies are returned: callers own what they get)."""
-    from .memo import copied, remembered
-
-    data = np.ascontiguousarray(ring, dtype=float)
-    digest = hashlib.blake2b(data.tobytes(), digest_size=16).digest()
-    key = ("tip", digest, data.shape, float(sigma), float(min_width), normal, thin)
+    key = ("tip", digest(ring), np.shape(ring), float(sigma), float(min_width), normal, thin)
     got = remembered(key, lambda: tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin))
     return None if got is None else copied(got)
 
