@@ -245,3 +245,30 @@ def test_whole_numbers_written_as_floats_are_counts(tmp_path, capsys):
     (tmp_path / "c.toml").write_text(text.replace("1e3", "10.5"))
     assert main(["generate", str(tmp_path / "c.toml"), "-q"]) == 2
     assert "max_iterations must be an integer, got 10.5" in capsys.readouterr().err
+
+
+def test_the_command_exits_without_the_teardown_but_as_a_normal_exit(tmp_path):
+    """``python -m meshcore`` (and the console script) end with ``os._exit`` after :func:`main`:
+    the exit code is main's, what was printed reaches the pipe, the atexit functions run."""
+    code = (
+        "import atexit, sys\n"
+        "atexit.register(lambda: print('atexit ran', file=sys.stderr))\n"
+        "sys.argv = ['meshcore'] + sys.argv[1:]\n"
+        "from meshcore.cli import console\n"
+        "print('before', end='')\n"  # buffered: flushed by console(), not by a teardown
+        "console()\n"
+        "print('never')\n"
+    )
+
+    def run(*argv: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, *argv], capture_output=True, text=True, cwd=ROOT, timeout=300)
+
+    ok = run("-c", code, "--version")
+    assert ok.returncode == 0
+    assert ok.stdout.startswith("before") and "meshcore " in ok.stdout and "never" not in ok.stdout
+    assert "atexit ran" in ok.stderr
+    bad = run("-c", code, "mesh", str(tmp_path / "missing.csv"), "-o", str(tmp_path / "g.vtm"))
+    assert bad.returncode == 2 and "missing.csv" in bad.stderr and "atexit ran" in bad.stderr
+    assert not list(tmp_path.iterdir())
+    module = run("-m", "meshcore", "--version")
+    assert module.returncode == 0 and module.stdout.startswith("meshcore ")
