@@ -31,6 +31,22 @@ __all__ = ["Piece", "block_counts", "conform", "weld"]
 #: with sharp ends 0.13 ×; issue 12 asks 0.5–2 ×).  Only then: weighed by area everywhere, two of 27
 #: generated hard shapes got folded cells.  Layouts above it keep their counts bit for bit.
 CELLS_FLOOR = 0.6
+#: When the counts give more than this share of the cells asked, they are solved again with the
+#: shore chains' ``least`` counts relaxed (:func:`_under_ceiling`) and the counts whose share comes
+#: closer to 1 kept.  A shore chain's ``least`` (:func:`~meshcore.multiblock.shorecells.least_cells`,
+#: up to :data:`~meshcore.multiblock.shorecells.MOST` × its cells: a corner's sag falls slowly) costs
+#: :data:`~meshcore.multiblock.counts.LEAST_WEIGHT` = 4 per missing cell, and raising a count carried
+#: across ``k < 4`` blocks costs ``k``: the program doubles the row (a compact held-out lake in three
+#: blocks in a row at 15 000 cells: 2.01 ×, one 87-cell chain with a corner asking for 164).  Generated
+#: shapes at 3000 cells: ``headlands(502605, n=6)`` 2.21 → 1.82 ×, ``dendritic(502701)`` 2.53 → 1.87 ×.
+#: Real lakes rarely reach it (the development sets' largest share before: 1.71 ×); layouts under it
+#: keep their counts bit for bit.
+CELLS_CEILING = 1.75
+#: The relaxations, in turn, while the share stays above :data:`CELLS_CEILING`: every ``least``
+#: capped at the chain's own count at the cell size (``None``: its shortfall weighed as before), then
+#: also its shortfall weighed this much per cell (1: as a block's deviation from the cell size) except
+#: where the coarse chords would cross an island (:data:`~meshcore.multiblock.counts.LAND_WEIGHT` kept).
+CEILING_STEPS = (None, 1.0)
 
 BORDERS = ("bottom", "right", "top", "left")
 
@@ -195,7 +211,10 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
 
     # targets rounded to 1e-6 cells: the program has many equally good counts, and lengths that
     # differ in the last bits (an outline shifted by a round number) must not choose among them
-    def solve(area_weights: bool) -> np.ndarray:
+    least = shore_least(pts, on_shore, cell_size, multiple) if best else None
+    weights = least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None
+
+    def solve(area_weights: bool, least=least, weights=weights) -> np.ndarray:
         return solve_counts(
             np.round(length / cell_size, 6),
             sides,
@@ -203,8 +222,8 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
             multiple=multiple,
             block_cells=block_cells,
             best=best,
-            least=shore_least(pts, on_shore, cell_size, multiple) if best else None,
-            least_weight=least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None,
+            least=least,
+            least_weight=weights,
             equal=equal,
             area_weights=area_weights,
         )
@@ -216,7 +235,42 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
             again = solve(True)
             if _cells_share(pieces, sides, again, cell_size) > share:
                 counts = again
+        elif share > CELLS_CEILING and least is not None:  # shore chains' least counts carried across
+            counts = _under_ceiling(
+                counts,
+                share,
+                solve,
+                least,
+                weights,
+                np.round(length / cell_size, 6),
+                multiple,
+                pieces,
+                sides,
+                cell_size,
+            )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts
+
+
+def _under_ceiling(counts, share, solve, least, weights, natural, multiple, pieces, sides, cell_size):
+    """The counts solved again with the shore chains' ``least`` counts relaxed, in
+    :data:`CEILING_STEPS`, while the share of the cells asked stays above :data:`CELLS_CEILING`;
+    the counts whose share is closest to 1 (``counts`` unless one comes closer)."""
+    from ..multiblock.counts import LAND_WEIGHT
+
+    m = max(int(multiple), 1)
+    relaxed = np.minimum(least, np.maximum(np.ceil(natural / m) * m, m))
+    best, closest = counts, abs(np.log(share))
+    for weight in CEILING_STEPS:
+        w = weights if weight is None else np.where(weights >= LAND_WEIGHT, weights, weight)
+        if weight is None and not np.any(relaxed < least):
+            continue
+        again = solve(False, relaxed, w)
+        got = _cells_share(pieces, sides, again, cell_size)
+        if abs(np.log(got)) < closest:
+            best, closest = again, abs(np.log(got))
+        if got <= CELLS_CEILING:
+            break
+    return best
 
 
 def _cells_share(pieces, sides, counts: np.ndarray, cell_size: float) -> float:
