@@ -42,11 +42,16 @@ CELLS_FLOOR = 0.6
 #: Real lakes rarely reach it (the development sets' largest share before: 1.71 ×); layouts under it
 #: keep their counts bit for bit.
 CELLS_CEILING = 1.75
-#: The relaxations, in turn, while the share stays above :data:`CELLS_CEILING`: every ``least``
-#: capped at the chain's own count at the cell size (``None``: its shortfall weighed as before), then
-#: also its shortfall weighed this much per cell (1: as a block's deviation from the cell size) except
-#: where the coarse chords would cross an island (:data:`~meshcore.multiblock.counts.LAND_WEIGHT` kept).
-CEILING_STEPS = (None, 1.0)
+#: The relaxations, in turn, each while the counts kept give more than its share: ``(weight, share)``.
+#: Every ``least`` capped at the chain's own count at the cell size (``None``: its shortfall weighed as
+#: before); then, above 2 × (issue 12's bound), also its shortfall weighed 1 per cell (as a block's
+#: deviation from the cell size) except where the coarse chords would cross an island
+#: (:data:`~meshcore.multiblock.counts.LAND_WEIGHT` kept).  At 3000 cells the first step took
+#: ``dendritic(502701)`` 2.53 → 2.33 ×, ``dendritic(882703)`` 2.55 → 2.20 ×, the second to 1.87 × and
+#: 1.68 × (their shores 0.48 → 0.73 and 0.42 → 0.53 cells: the cost).  The second step above the
+#: ceiling instead of 2 ×: ``dendritic(502702)`` 1.65 → 1.44 × and its shore 0.45 → 0.58 cells, where
+#: the first alone had given 1.61 × and 0.33 (both within 2 ×).
+CEILING_STEPS = ((None, CELLS_CEILING), (1.0, 2.0))
 
 BORDERS = ("bottom", "right", "top", "left")
 
@@ -252,24 +257,22 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
 
 
 def _under_ceiling(counts, share, solve, least, weights, natural, multiple, pieces, sides, cell_size):
-    """The counts solved again with the shore chains' ``least`` counts relaxed, in
-    :data:`CEILING_STEPS`, while the share of the cells asked stays above :data:`CELLS_CEILING`;
-    the counts whose share is closest to 1 (``counts`` unless one comes closer)."""
+    """The counts solved again with the shore chains' ``least`` counts relaxed by the steps of
+    :data:`CEILING_STEPS`, each while the counts kept give more than its share of the cells asked;
+    kept: the counts whose share is closest to 1 (``counts`` unless one comes closer)."""
     from ..multiblock.counts import LAND_WEIGHT
 
     m = max(int(multiple), 1)
     relaxed = np.minimum(least, np.maximum(np.ceil(natural / m) * m, m))
-    best, closest = counts, abs(np.log(share))
-    for weight in CEILING_STEPS:
-        w = weights if weight is None else np.where(weights >= LAND_WEIGHT, weights, weight)
-        if weight is None and not np.any(relaxed < least):
+    best, kept = counts, share
+    for weight, above in CEILING_STEPS:
+        if kept <= above or (weight is None and not np.any(relaxed < least)):
             continue
+        w = weights if weight is None else np.where(weights >= LAND_WEIGHT, weights, weight)
         again = solve(False, relaxed, w)
         got = _cells_share(pieces, sides, again, cell_size)
-        if abs(np.log(got)) < closest:
-            best, closest = again, abs(np.log(got))
-        if got <= CELLS_CEILING:
-            break
+        if abs(np.log(got)) < abs(np.log(kept)):
+            best, kept = again, got
     return best
 
 
