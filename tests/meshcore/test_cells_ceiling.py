@@ -63,7 +63,9 @@ def _share(pieces, cells, h: float) -> float:
 def test_counts_over_the_ceiling_come_closer_and_the_others_stay(shape):
     """On a generated layout's blocks: where the plain counts give more than
     :data:`~meshcore.layout.blocks.CELLS_CEILING` × the cells asked, counts that change come closer
-    to the cells asked (and within 2 ×); under it, the same counts bit for bit."""
+    to the cells asked (and within 2 ×); under it, the same counts bit for bit.  On the chosen
+    layouts' blocks: ``dendritic(990703)`` 2.02 → 1.84 ×, ``dendritic(882703)`` 2.62 → 1.72 ×,
+    ``lake_with_islands(880300)`` 1.77 × (no relaxation comes closer: kept), the other two under it."""
     poly = shape()
     lay = auto_layout(poly, target_cells=3000, multiple=4)
     pieces, h = list(lay.pieces), lay.cell_size
