@@ -31,6 +31,29 @@ __all__ = ["Piece", "block_counts", "conform", "weld"]
 #: with sharp ends 0.13 ×; issue 12 asks 0.5–2 ×).  Only then: weighed by area everywhere, two of 27
 #: generated hard shapes got folded cells.  Layouts above it keep their counts bit for bit.
 CELLS_FLOOR = 0.6
+#: When the counts give more than this share of the cells asked, they are solved again with the
+#: shore chains' ``least`` counts relaxed (:func:`_under_ceiling`) and the counts whose share comes
+#: closer to 1 kept.  A shore chain's ``least`` (:func:`~meshcore.multiblock.shorecells.least_cells`,
+#: up to :data:`~meshcore.multiblock.shorecells.MOST` × its cells: a corner's sag falls slowly) costs
+#: :data:`~meshcore.multiblock.counts.LEAST_WEIGHT` = 4 per missing cell, and raising a count carried
+#: across ``k < 4`` blocks costs ``k``: the program doubles the row (a compact held-out lake in three
+#: blocks in a row at 15 000 cells: 2.01 ×, one 87-cell chain with a corner asking for 164).  Generated
+#: shapes at 3000 cells: ``headlands(502605, n=6)`` 2.21 → 1.82 ×, ``dendritic(502701)`` 2.53 → 1.87 ×.
+#: Of 71 real lake-configs of the development sets whose cells passed 1.3 × one reaches it (1.762 →
+#: 1.754 ×, the same quality); of 20 generated shapes picked for their excess 13 changed, one for the worse
+#: (``dendritic(990705)`` 2.90 → 2.20 × with a folded cell: the choice took another layout; journal,
+#: session 35).  Layouts under it keep their counts bit for bit.
+CELLS_CEILING = 1.75
+#: The relaxations, in turn, each while the counts kept give more than its share: ``(weight, share)``.
+#: Every ``least`` capped at the chain's own count at the cell size (``None``: its shortfall weighed as
+#: before); then, above 2 × (issue 12's bound), also its shortfall weighed 1 per cell (as a block's
+#: deviation from the cell size) except where the coarse chords would cross an island
+#: (:data:`~meshcore.multiblock.counts.LAND_WEIGHT` kept).  At 3000 cells the first step took
+#: ``dendritic(502701)`` 2.53 → 2.33 ×, ``dendritic(882703)`` 2.55 → 2.20 ×, the second to 1.87 × and
+#: 1.68 × (their shores 0.48 → 0.73 and 0.42 → 0.53 cells: the cost).  The second step above the
+#: ceiling instead of 2 ×: ``dendritic(502702)`` 1.65 → 1.44 × and its shore 0.45 → 0.58 cells, where
+#: the first alone had given 1.61 × and 0.33 (both within 2 ×).
+CEILING_STEPS = ((None, CELLS_CEILING), (1.0, 2.0))
 
 BORDERS = ("bottom", "right", "top", "left")
 
@@ -195,7 +218,10 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
 
     # targets rounded to 1e-6 cells: the program has many equally good counts, and lengths that
     # differ in the last bits (an outline shifted by a round number) must not choose among them
-    def solve(area_weights: bool) -> np.ndarray:
+    least = shore_least(pts, on_shore, cell_size, multiple) if best else None
+    weights = least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None
+
+    def solve(area_weights: bool, least=least, weights=weights) -> np.ndarray:
         return solve_counts(
             np.round(length / cell_size, 6),
             sides,
@@ -203,8 +229,8 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
             multiple=multiple,
             block_cells=block_cells,
             best=best,
-            least=shore_least(pts, on_shore, cell_size, multiple) if best else None,
-            least_weight=least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None,
+            least=least,
+            least_weight=weights,
             equal=equal,
             area_weights=area_weights,
         )
@@ -216,7 +242,40 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
             again = solve(True)
             if _cells_share(pieces, sides, again, cell_size) > share:
                 counts = again
+        elif share > CELLS_CEILING and least is not None:  # shore chains' least counts carried across
+            counts = _under_ceiling(
+                counts,
+                share,
+                solve,
+                least,
+                weights,
+                np.round(length / cell_size, 6),
+                multiple,
+                pieces,
+                sides,
+                cell_size,
+            )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts
+
+
+def _under_ceiling(counts, share, solve, least, weights, natural, multiple, pieces, sides, cell_size):
+    """The counts solved again with the shore chains' ``least`` counts relaxed by the steps of
+    :data:`CEILING_STEPS`, each while the counts kept give more than its share of the cells asked;
+    kept: the counts whose share is closest to 1 (``counts`` unless one comes closer)."""
+    from ..multiblock.counts import LAND_WEIGHT
+
+    m = max(int(multiple), 1)
+    relaxed = np.minimum(least, np.maximum(np.ceil(natural / m) * m, m))
+    best, kept = counts, share
+    for weight, above in CEILING_STEPS:
+        if kept <= above or (weight is None and not np.any(relaxed < least)):
+            continue
+        w = weights if weight is None else np.where(weights >= LAND_WEIGHT, weights, weight)
+        again = solve(False, relaxed, w)
+        got = _cells_share(pieces, sides, again, cell_size)
+        if abs(np.log(got)) < abs(np.log(kept)):
+            best, kept = again, got
+    return best
 
 
 def _cells_share(pieces, sides, counts: np.ndarray, cell_size: float) -> float:
