@@ -53,3 +53,36 @@ def test_a_cut_far_from_any_tip_is_left_alone():
     east = np.array([(7, 0), (10, 0), (10, 10), (7, 10), *[(7, y) for y in ys[::-1]]], dtype=float)
     rings, _ = pinched([west, east], [(), ()], Water(water, H), 1.5 * H, 3 * H)
     assert len(rings) == 2
+
+
+def _within_3(layout) -> float:
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
+
+    mb = mesh_layout(layout)
+    s = lake_metrics(mb, polygon=layout.polygon, cell_size=layout.cell_size).summary()
+    assert s["folded_cells"] == 0
+    return s["pct_nodes_within_3deg"]
+
+
+@pytest.mark.slow
+def test_two_arms_joining_round_a_tongue_grid_better_with_the_cut_through_its_tip():
+    """A basin 12 × 10 with a pointed tongue 1 wide from its south shore (tip (5, 6.8)): the arms
+    either side of it join the basin round its tip.  Cut from (0, 8.5) to (12, 5.5), 1.1 cells
+    from the tip, the southern block runs round the tip and its lines fan out of it;
+    :func:`pinched` bends that cut through the tip, which leaves each arm a block with a corner on
+    the tip and the basin's side passing it."""
+    from shapely.geometry import Polygon as Poly
+
+    from meshcore.layout.edit import layout_from_cuts
+
+    tip = (5.0, 6.8)
+    water = box(0, 0, 12, 10).difference(Poly([(4.5, 0), (5.5, 0), (5.5, 6), tip, (4.5, 6)]))
+    straight = layout_from_cuts(water, [[(0.0, 8.5), (12.0, 5.5)]], cell_size=H, multiple=4)
+    rings, _ = pinched([p.ring for p in straight.pieces], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 3
+    assert all(np.any(np.hypot(*(r - tip).T) < 1e-9) for r in rings)
+    bent = layout_from_cuts(water, [[(0.0, 8.5), tip], [tip, (12.0, 5.5)]], cell_size=H, multiple=4)
+    assert len(straight.blocks) == 2 and len(bent.blocks) == 3
+    before, after = _within_3(straight), _within_3(bent)
+    assert before < 80.0 and after > 95.0, (before, after)
