@@ -23,6 +23,7 @@ import numpy as np
 
 from ..pointindex import PointIndex
 from ..segments import SegmentIndex
+from . import pinch, tipcuts
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import wedge_corners
@@ -34,7 +35,7 @@ from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
-from .tipcuts import noted_tips, tips_split, untipped
+from .tipcuts import Water, noted_pinch, noted_tips, tips_split, untipped
 
 __all__ = ["layout_pieces"]
 
@@ -168,6 +169,9 @@ def layout_pieces(
     def on_island(p) -> bool:
         return bool(shapely.dwithin(holes, shapely.Point(p), 1e-9 * size))
 
+    # the water's turning along the shore: land tips at corners (.tipcuts) and cuts passing tips (.pinch)
+    water = Water(dense, h) if (tipcuts.TIP_CORNERS or pinch.PINCH) and not regular else None
+
     def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
         regions, cuts = partition(dense, lines, sigma)
         rings: list[np.ndarray] = []
@@ -177,13 +181,18 @@ def layout_pieces(
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
             pieces, new_cuts = _split_region(r, junctions, sigma, 3 * h, regular, normal, here, tees and regular)
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
-                pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
+                pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here, water)
             elif not regular:  # would the tip draw split any of these? (.tipcuts.watching_tips)
-                noted_tips(pieces, sigma, 3 * h, normal, here)
+                noted_tips(pieces, sigma, 3 * h, normal, here, water)
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts
         rings, forced = _welded(rings, forced, 1e-9 * size)
+        if pinch.PINCH and water is not None:  # (the tip draw: cuts passing close by land tips bent through them)
+            if tips_split():
+                rings, forced = pinch.pinched(rings, forced, water, sigma, 3 * h)
+            elif pinch.pinch_candidates(rings, forced, water, sigma, 3 * h):
+                noted_pinch()
         rings = [r if len(r) >= 4 else _insert_mid(_insert_mid(r) if len(r) < 3 else r) for r in rings]
         rings, forced = _merge_strips(rings, forced, sigma, keep=on_island if ring else None)
         corner_pts = []

@@ -1,0 +1,155 @@
+r"""A cut that passes close by a land tip, bent through the tip (session 35, off by default).
+
+A block whose side runs round the tip of a land tongue while the cut opposite passes within a
+few cells of that tip (a C-shaped piece pinched at the tip) cannot be split from the tip by
+:mod:`.tipcuts`: either piece would be under three cells wide there.  Its grid fans out of the tip
+across the whole block (held-out g180700 at 10 000 cells: a 24 × 24 junction block with 494 of
+its 529 nodes beyond 3°, the cut 1.9 cells from the tongue's tip).  :func:`pinched` bends such a
+cut through the tip instead: the cut between the piece and its neighbour runs straight to the tip
+and on, so the piece is split in two at the tip (each with a corner there, the tongue's flank on
+one side and the cut on the other) and the neighbour's side passes the tip (a T-junction).  Applied
+in the layout choice's tip draw (:mod:`.tipcuts`), so the coarse grid judges it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["PINCH", "PINCH_CELLS", "pinch_candidates", "pinched"]
+
+#: Bend cuts through land tips in the tip draw (off by default: see the journal, session 35).
+PINCH = False
+
+#: A cut passing within this many cell sizes of a side's tip is bent through it.
+PINCH_CELLS = 3.0
+
+
+def _key(p) -> tuple[float, float]:
+    return (float(p[0]), float(p[1]))
+
+
+def _shared_run(a: np.ndarray, b: np.ndarray) -> list[int] | None:
+    """The indices in ``a`` of its one contiguous run of vertices shared with ``b`` (in ``a``'s
+    order, both ends included, at least two), or None."""
+    kb = {_key(p) for p in b}
+    on = np.array([_key(p) in kb for p in a])
+    if on.sum() < 2 or on.all():
+        return None
+    n = len(a)
+    start = next(i for i in range(n) if on[i] and not on[i - 1])
+    run = [start]
+    while on[(run[-1] + 1) % n]:
+        run.append((run[-1] + 1) % n)
+    return run if len(run) == int(on.sum()) else None
+
+
+def _sampled(p: np.ndarray, q: np.ndarray, step: float) -> np.ndarray:
+    """The points strictly between ``p`` and ``q`` every ``step`` or less."""
+    m = max(1, math.ceil(math.hypot(*(q - p)) / step))
+    t = np.arange(1, m)[:, None] / m
+    return (1 - t) * p + t * q
+
+
+def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_width: float, water, uses):
+    """The rings with piece ``i``'s far cut bent through its side's tip, or None."""
+    import shapely
+
+    from .split import _orient, _too_narrow, _valid
+    from .tipcuts import _tips
+    from .width import inscribed
+
+    a = rings[i]
+    tips = [t for t in _tips(a, sigma) if not t[2]]
+    if not tips or len(forced[i]):
+        return None
+    v = tips[0][0]
+    T = a[v]
+    if np.isnan(water.at(T)[0]):
+        return None  # not on the shore
+    reach = PINCH_CELLS * sigma / 1.5
+    best = None
+    box = np.r_[a.min(axis=0) - reach, a.max(axis=0) + reach]
+    for j, b in enumerate(rings):
+        if j == i or len(forced[j]):
+            continue
+        if (b.max(axis=0) < box[:2]).any() or (b.min(axis=0) > box[2:]).any():
+            continue
+        run = _shared_run(a, b)
+        if run is None or len(run) < 2 or v in run:
+            continue
+        line = shapely.LineString(a[run])
+        d = line.distance(shapely.Point(T))
+        if d <= reach and (best is None or d < best[0]):
+            best = (d, j, run)
+    if best is None:
+        return None
+    _, j, run = best
+    inner = [_key(a[k]) for k in run[1:-1]]
+    if any(uses.get(p, 0) > 2 for p in inner):  # a third piece's corner on the cut (a T): leave it
+        return None
+    p0, p1 = a[run[0]], a[run[-1]]
+    if min(math.hypot(*(p0 - T)), math.hypot(*(p1 - T))) < min_width:
+        return None
+    n = len(a)
+    # a: ... p0 (run) p1 ... v ... ; a1 = v .. p0 then p0 → T, a2 = p1 .. v then T → p1
+    idx_v_to_p0 = [(v + k) % n for k in range((run[0] - v) % n + 1)]
+    idx_p1_to_v = [(run[-1] + k) % n for k in range((v - run[-1]) % n + 1)]
+    s0, s1 = _sampled(p0, T, sigma), _sampled(T, p1, sigma)  # (each made once: both sides share its points)
+    a1 = np.vstack([a[idx_v_to_p0], s0])
+    a2 = np.vstack([a[idx_p1_to_v], s1])
+    b = rings[j]
+    rb = _shared_run(b, a)
+    if rb is None or _key(b[rb[0]]) != _key(p1) or _key(b[rb[-1]]) != _key(p0):
+        return None
+    m = len(b)
+    rest = [(rb[-1] + k) % m for k in range((rb[0] - rb[-1]) % m + 1)]  # p0 … p1 round b's other side
+    b2 = np.vstack([b[rest], s1[::-1], T[None, :], s0[::-1]])
+    new = [_orient(a1), _orient(a2), _orient(b2)]
+    polys = [shapely.polygons(r) for r in new]
+    if not all(_valid(r, p) for r, p in zip(new, polys, strict=True)):
+        return None
+    whole = shapely.union(shapely.polygons(a), shapely.polygons(b))
+    if abs(sum(p.area for p in polys) - whole.area) > 1e-9 * whole.area:
+        return None
+    # a piece pinched at a tip is compact (a triangle-like bay, whose 2A/P is its inscribed
+    # circle's radius): a disc ``min_width`` across must fit in it
+    if any(
+        _too_narrow(r, min_width, False, p) and inscribed(r, 0.02 * min_width) < min_width
+        for r, p in zip(new, polys, strict=True)
+    ):
+        return None
+    out = [r for k, r in enumerate(rings) if k not in (i, j)] + new
+    fo = [f for k, f in enumerate(forced) if k not in (i, j)] + [(), (), ()]
+    return out, fo
+
+
+def _uses(rings: list[np.ndarray]) -> dict:
+    uses: dict = {}
+    for r in rings:
+        for p in {_key(p) for p in r}:
+            uses[p] = uses.get(p, 0) + 1
+    return uses
+
+
+def pinched(rings: list[np.ndarray], forced: list, water, sigma: float, min_width: float):
+    """``rings`` and ``forced`` (the welded pieces of a layout and their forced corners) with every
+    cut that passes within :data:`PINCH_CELLS` of the tip a piece's side runs round bent through
+    that tip (see the module), where the pieces stay valid and at least ``min_width`` wide."""
+    rings, forced = list(rings), list(forced)
+    i, left = 0, 4 * len(rings)
+    while i < len(rings) and left > 0:
+        left -= 1
+        got = _pinch_one(rings, forced, i, sigma, min_width, water, _uses(rings))
+        if got is None:
+            i += 1
+            continue
+        rings, forced = got  # (the new pieces at the end: each looked at again)
+    return rings, forced
+
+
+def pinch_candidates(rings: list[np.ndarray], forced: list, water, sigma: float, min_width: float) -> bool:
+    """Whether :func:`pinched` would bend any cut of these pieces."""
+    uses = _uses(rings)
+    return any(_pinch_one(rings, forced, i, sigma, min_width, water, uses) is not None for i in range(len(rings)))

@@ -1,0 +1,88 @@
+"""A cut that passes close by a land tip, bent through the tip (meshcore.layout.pinch), as a
+candidate of the layout choice's tip draw (docs/lake-grids-journal.md, session 35)."""
+
+import numpy as np
+import pytest
+import shapely
+from shapely.geometry import Point, Polygon, box
+
+from meshcore.layout.pinch import pinched
+from meshcore.layout.split import _orient
+from meshcore.layout.tipcuts import Water
+
+H = 0.4  # the cell size
+
+
+def _c_and_neighbour():
+    """A basin 10 × 10 with a land tongue 1 wide from its west shore, rounded at its tip (6, 5),
+    cut at x = 7 (0.5 from the tip, 1.25 cells): the piece west of the cut is a C round the
+    tip, the piece east of it a rectangle; both rings share the cut's points."""
+    tongue = box(0, 4.5, 6, 5.5).union(Point(6, 5).buffer(0.5, 16))
+    water = box(0, 0, 10, 10).difference(tongue)
+    ys = np.arange(1.0, 10.0)
+
+    def with_cut(poly):
+        r = _orient(np.asarray(poly.exterior.coords)[:-1])
+        out = []
+        for k in range(len(r)):
+            p, q = r[k], r[(k + 1) % len(r)]
+            out.append(p)
+            if p[0] == q[0] == 7.0:  # the cut: the same points on both sides
+                out += [(7.0, y) for y in (ys if q[1] > p[1] else ys[::-1])]
+        return np.array(out, dtype=float)
+
+    return water, with_cut(water.intersection(box(0, 0, 7, 10))), with_cut(box(7, 0, 10, 10))
+
+
+def test_a_cut_passing_close_by_a_tip_is_bent_through_it():
+    water, c, east = _c_and_neighbour()
+    rings, forced = pinched([c, east], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 3 and forced == [(), (), ()]
+    polys = [Polygon(r) for r in rings]
+    assert all(p.is_valid for p in polys)
+    # the pieces tile the water; every one has the tongue's tip (6.5, 5) as a vertex
+    assert sum(p.area for p in polys) == pytest.approx(water.area, rel=1e-9)
+    assert shapely.union_all(polys).symmetric_difference(water).area < 1e-9 * water.area
+    assert all(np.any(np.hypot(*(r - (6.5, 5.0)).T) < 1e-9) for r in rings)
+
+
+def test_a_cut_far_from_any_tip_is_left_alone():
+    water = box(0, 0, 10, 10)
+    ys = np.arange(1.0, 10.0)
+    west = np.array([(0, 0), (7, 0), *[(7, y) for y in ys], (7, 10), (0, 10)], dtype=float)
+    east = np.array([(7, 0), (10, 0), (10, 10), (7, 10), *[(7, y) for y in ys[::-1]]], dtype=float)
+    rings, _ = pinched([west, east], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 2
+
+
+def _within_3(layout) -> float:
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.quality import lake_metrics
+
+    mb = mesh_layout(layout)
+    s = lake_metrics(mb, polygon=layout.polygon, cell_size=layout.cell_size).summary()
+    assert s["folded_cells"] == 0
+    return s["pct_nodes_within_3deg"]
+
+
+@pytest.mark.slow
+def test_two_arms_joining_round_a_tongue_grid_better_with_the_cut_through_its_tip():
+    """A basin 12 × 10 with a pointed tongue 1 wide from its south shore (tip (5, 6.8)): the arms
+    either side of it join the basin round its tip.  Cut from (0, 8.5) to (12, 5.5), 1.1 cells
+    from the tip, the southern block runs round the tip and its lines fan out of it;
+    :func:`pinched` bends that cut through the tip, which leaves each arm a block with a corner on
+    the tip and the basin's side passing it."""
+    from shapely.geometry import Polygon as Poly
+
+    from meshcore.layout.edit import layout_from_cuts
+
+    tip = (5.0, 6.8)
+    water = box(0, 0, 12, 10).difference(Poly([(4.5, 0), (5.5, 0), (5.5, 6), tip, (4.5, 6)]))
+    straight = layout_from_cuts(water, [[(0.0, 8.5), (12.0, 5.5)]], cell_size=H, multiple=4)
+    rings, _ = pinched([p.ring for p in straight.pieces], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 3
+    assert all(np.any(np.hypot(*(r - tip).T) < 1e-9) for r in rings)
+    bent = layout_from_cuts(water, [[(0.0, 8.5), tip], [tip, (12.0, 5.5)]], cell_size=H, multiple=4)
+    assert len(straight.blocks) == 2 and len(bent.blocks) == 3
+    before, after = _within_3(straight), _within_3(bent)
+    assert before < 80.0 and after > 95.0, (before, after)
