@@ -30,7 +30,10 @@ more orthogonal (GSHHG lakes held out in session 17, 10 000 cells: mean share wi
 94.4 → 95.5 %, the worst lake 75.9 → 87.6 %; generated lakes at 15 000 cells: ≥ 90 % within 3°
 in 43 → 45, 42 → 44 and 20 → 23 of 45, 45, 27), but fewer keep every interface ratio ≤ 2
 (21 → 19, 20 → 14, 5 → 4; held-out 9 → 7) and one generated network's short stub arm folded
-(42 cells).
+(42 cells).  Measured again in session 35 (held-out set 21, stress34, generated shapes): hard
+targets 28 → 28, 26 → 28, 26 → 27 on set 21 but 28 → 27, 26 → 25 on stress34, CPU +17–34 %;
+still off.  The layout drawn on the curve is another layout (:func:`onto_curves`: the layout of
+the straight segments with its blocks' shore on the curve, tried, ``CURVE_ON_STRAIGHT``).
 """
 
 from __future__ import annotations
