@@ -41,7 +41,7 @@ from . import tipends
 from .blocks import block_counts
 from .build import layout_pieces
 from .choice import chosen
-from .curve import curved_shore
+from .curve import curved_shores
 from .edit import layout_from_cuts, layout_from_outline, with_cells
 from .frames import frame_defects
 from .islandgaps import without_island_gaps
@@ -56,7 +56,7 @@ from .polygon import (
     without_dense_vertices,
     without_slivers,
 )
-from .shore import shore_at_scale, transfer, without_narrow_arms
+from .shore import Shores, shore_at_scale, transfer, without_narrow_arms
 from .tipcuts import splits, splitting_tips, watching_tips
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
@@ -64,6 +64,10 @@ from .widen import widen_starved
 
 #: No layout option on (:class:`LayoutOptions`).
 DEFAULT_OPTIONS = LayoutOptions()
+#: With ``LayoutOptions(curve=True)``: the layout is drawn on the outline's straight segments and
+#: only the blocks' shore follows the curve (:func:`~.curve.onto_curves`); off: session 35 measured it
+#: on five lakes only (journal, *Outlines with a point every few cells*).
+CURVE_ON_STRAIGHT = False
 
 __all__ = [
     "Layout",
@@ -148,10 +152,15 @@ def auto_layout(
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
     more = more + slivers + arms
+    straight, curves = poly, None
     if options.curve:
-        poly, curved = curved_shore(poly, h)
+        poly, curves, curved = curved_shores(poly, h)
         more = more + curved
     shores = shore_at_scale(poly, h)
+    if curves is not None and shores.change is None and CURVE_ON_STRAIGHT:
+        # the layout drawn on the straight segments (its corners and cuts as without the curve),
+        # its blocks' shore then moved onto the curves (:func:`~.curve.onto_curves`)
+        shores = Shores(poly, straight, None, curves)
     if shores.change is not None:
         more.append(shores.change.note())
     with remembering():  # the draws' skeletons and splits, for the choice's tip draw

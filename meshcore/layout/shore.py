@@ -264,11 +264,14 @@ def _spread(s: np.ndarray, total: float, need: np.ndarray, reach: float, mean: b
 class Shores:
     """The water as the grid follows it (``grid``) and as the layout reads it (``layout``,
     smoothed more where the shore bends back and forth at the scale of block corners).  Their
-    rings have the same vertices in the same order (``layout is grid`` when they are equal)."""
+    rings have the same vertices in the same order (``layout is grid`` when they are equal),
+    unless ``curves`` (:class:`~.curve.Curves`): then ``layout`` is the outline's straight
+    segments and ``grid`` their curves (:func:`~.curve.onto_curves`)."""
 
     grid: Any
     layout: Any
     change: ShoreChange | None
+    curves: Any = None
 
 
 def _ring_pairs(poly, h: float, layout: bool):
@@ -352,6 +355,10 @@ def transfer(pieces: list, shores: Shores) -> list | None:
 
     if shores.layout is shores.grid:
         return pieces
+    if shores.curves is not None:
+        from .curve import onto_curves
+
+        return onto_curves(pieces, shores.curves, shores.grid)
     src, dst = _rings(shores.layout), _rings(shores.grid)
     if any(len(a) != len(b) for a, b in zip(src, dst, strict=True)):
         return None

@@ -163,3 +163,21 @@ def test_auto_layout_uses_it_when_asked():
     t = np.linspace(0, 2 * np.pi, 2000)
     ellipse = LineString(np.column_stack([30 * np.cos(t), 10 * np.sin(t)]))
     assert on.polygon.exterior.hausdorff_distance(ellipse) < off.polygon.exterior.hausdorff_distance(ellipse)
+
+
+def test_layout_on_the_straight_segments_shore_on_the_curve(monkeypatch):
+    # CURVE_ON_STRAIGHT (off by default): the blocks of the straight outline, their shore on the curve
+    import meshcore.layout as layout
+
+    ring = _polygon_ngon(10, radius=10.0) * [3.0, 1.0]
+    off = auto_layout(ring, cell_size=0.5)
+    monkeypatch.setattr(layout, "CURVE_ON_STRAIGHT", True)
+    on = auto_layout(ring, cell_size=0.5, options=LayoutOptions(curve=True))
+    assert any("smooth curve" in n for n in on.notes)
+    assert len(on.blocks) == len(off.blocks)
+    curved = Polygon(curve_ring(np.asarray(Polygon(ring).exterior.coords)[:-1], 0.5))
+    pieces = [Polygon(pc.ring) for pc in on.pieces]
+    assert all(p.is_valid for p in pieces)
+    assert abs(sum(p.area for p in pieces) - curved.area) < 1e-6 * curved.area
+    for a, b in zip(on.blocks, off.blocks, strict=True):  # corners within a quarter cell of the straight ones
+        assert np.hypot(*(np.array(a.corners) - np.array(b.corners)).T).max() <= BULGE * 0.5 + 1e-9
