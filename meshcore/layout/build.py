@@ -23,7 +23,7 @@ import numpy as np
 
 from ..pointindex import PointIndex
 from ..segments import SegmentIndex
-from . import pinch, tipcuts
+from . import pinch
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import wedge_corners
@@ -35,7 +35,7 @@ from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
 from .tee import tee
-from .tipcuts import Water, noted_pinch, noted_tips, tips_split, untipped
+from .tipcuts import noted_pinch, noted_tips, tips_split, untipped
 
 __all__ = ["layout_pieces"]
 
@@ -169,8 +169,8 @@ def layout_pieces(
     def on_island(p) -> bool:
         return bool(shapely.dwithin(holes, shapely.Point(p), 1e-9 * size))
 
-    # the water's turning along the shore: land tips at corners (.tipcuts) and cuts passing tips (.pinch)
-    water = Water(dense, h) if (tipcuts.TIP_CORNERS or pinch.PINCH) and not regular else None
+    # the water's turning along the shore: cuts passing land tips (.pinch)
+    water = pinch.Water(dense, h) if pinch.PINCH and not regular else None
 
     def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
         regions, cuts = partition(dense, lines, sigma)
@@ -181,9 +181,9 @@ def layout_pieces(
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
             pieces, new_cuts = _split_region(r, junctions, sigma, 3 * h, regular, normal, here, tees and regular)
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
-                pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here, water)
+                pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
             elif not regular:  # would the tip draw split any of these? (.tipcuts.watching_tips)
-                noted_tips(pieces, sigma, 3 * h, normal, here, water)
+                noted_tips(pieces, sigma, 3 * h, normal, here)
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts

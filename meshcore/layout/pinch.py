@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-__all__ = ["PINCH", "PINCH_CELLS", "pinch_candidates", "pinched"]
+__all__ = ["PINCH", "PINCH_CELLS", "WATER_SCALE", "Water", "pinch_candidates", "pinched"]
 
 #: Bend cuts through land tips in the tip draw.  Session 35, with
 #: :data:`~.choice.TIP_RATIO_SLACK` 0.01, against the layouts without (the layout choice scanned
@@ -31,6 +31,40 @@ PINCH = True
 
 #: A cut passing within this many cell sizes of a side's tip is bent through it.
 PINCH_CELLS = 3.0
+
+
+#: The water's turning at a point on the shore is read this many cell sizes along it.
+WATER_SCALE = 3.0
+
+
+class Water:
+    """The water's turning (degrees, negative where the water's angle is reflex: a land tip) at
+    the points of its shore, read at :data:`WATER_SCALE` cells (``poly``: the water polygon, ``h``:
+    the cell size of the layout's geometry)."""
+
+    def __init__(self, poly, h: float) -> None:
+        import shapely
+        from scipy.spatial import cKDTree
+
+        from .corners import turning
+
+        xy, tt = [], []
+        for k, r in enumerate((poly.exterior, *poly.interiors)):
+            ring = shapely.LinearRing(r)
+            if ring.is_ccw != (k == 0):  # the water on the left of every ring
+                ring = shapely.LinearRing(list(ring.coords)[::-1])
+            pts = np.asarray(shapely.segmentize(ring, 0.25 * h).coords)[:-1]
+            xy.append(pts)
+            tt.append(turning(pts, WATER_SCALE * h))
+        self.points = np.vstack(xy)
+        self.turn = np.concatenate(tt)
+        self.tree = cKDTree(self.points)
+        self.tol = 1e-6 * math.sqrt(max(poly.area, 1e-300))
+
+    def at(self, pts: np.ndarray) -> np.ndarray:
+        """The water's turning at ``pts`` (nan at points not on its shore)."""
+        d, k = self.tree.query(np.asarray(pts, float).reshape(-1, 2))
+        return np.where(d <= self.tol, self.turn[k], np.nan)
 
 
 def _key(p) -> tuple[float, float]:
@@ -64,14 +98,14 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
     import shapely
 
     from .split import _orient, _too_narrow, _valid
-    from .tipcuts import _tips
+    from .tipcuts import _tip
     from .width import inscribed
 
     a = rings[i]
-    tips = [t for t in _tips(a, sigma) if not t[2]]
-    if not tips or len(forced[i]):
+    tip = _tip(a, sigma)
+    if tip is None or len(forced[i]):
         return None
-    v = tips[0][0]
+    v = tip[0]
     T = a[v]
     if np.isnan(water.at(T)[0]):
         return None  # not on the shore

@@ -17,13 +17,6 @@ tip, or at right angles onto the far side, each admissible cut's pieces split gr
 cheapest result in which no piece fans or wraps.  Such a split is not judged by the corner cost
 (which is what kept the piece whole): the layout with these splits is one more candidate of the
 layout choice (:mod:`.choice`), which keeps it only where its coarse grid is clearly more orthogonal.
-
-With :data:`TIP_CORNERS` (session 35) a piece whose *corner* sits on a land tip is split there too:
-a cut that ends on a tip where the water turns back (its angle there above 180° + :data:`WATER_TURN`
-read at 3 cells, :class:`Water`) leaves each piece beside it an obtuse corner on the tip (the piece
-turning by less than :data:`CORNER_TURN` there), and the grid's lines fan out of that corner across
-the piece.  Such a corner is cut from as a side's tip is (and also square to either of its sides),
-so that the tip's water angle is shared by three corners instead of two.
 """
 
 from __future__ import annotations
@@ -37,12 +30,8 @@ import numpy as np
 from .memo import copied, digest, remembered
 
 __all__ = [
-    "CORNER_TURN",
-    "TIP_CORNERS",
     "TIP_SCALE",
     "TIP_TURN",
-    "WATER_TURN",
-    "Water",
     "noted_pinch",
     "noted_tips",
     "splits",
@@ -58,52 +47,6 @@ TIP_SCALE = 0.5
 
 #: A side's reflex bend at that scale turning by at least this (degrees) is a tip to cut from.
 TIP_TURN = 60.0
-
-#: Pieces whose corner sits on a land tip are split from it too (see the module).
-TIP_CORNERS = False
-
-#: A piece's corner is obtuse when the piece turns there by less than this (degrees, read at the
-#: tip scale): an angle of 135° or more.
-CORNER_TURN = 45.0
-
-#: The water at a corner is a land tip when it turns back by this (degrees, at :data:`WATER_SCALE`
-#: cells; an angle above 200°).
-WATER_TURN = 20.0
-
-#: The water's turning at a point on the shore is read this many cell sizes along it.
-WATER_SCALE = 3.0
-
-
-class Water:
-    """The water's turning (degrees, negative where the water's angle is reflex: a land tip) at
-    the points of its shore, read at :data:`WATER_SCALE` cells (``poly``: the water polygon, ``h``:
-    the cell size of the layout's geometry)."""
-
-    def __init__(self, poly, h: float) -> None:
-        import shapely
-        from scipy.spatial import cKDTree
-
-        from .corners import turning
-
-        xy, tt = [], []
-        for k, r in enumerate((poly.exterior, *poly.interiors)):
-            ring = shapely.LinearRing(r)
-            if ring.is_ccw != (k == 0):  # the water on the left of every ring
-                ring = shapely.LinearRing(list(ring.coords)[::-1])
-            pts = np.asarray(shapely.segmentize(ring, 0.25 * h).coords)[:-1]
-            xy.append(pts)
-            tt.append(turning(pts, WATER_SCALE * h))
-        self.points = np.vstack(xy)
-        self.turn = np.concatenate(tt)
-        self.tree = cKDTree(self.points)
-        self.tol = 1e-6 * math.sqrt(max(poly.area, 1e-300))
-        self.key = (digest(self.points), float(h))
-
-    def at(self, pts: np.ndarray) -> np.ndarray:
-        """The water's turning at ``pts`` (nan at points not on its shore)."""
-        d, k = self.tree.query(np.asarray(pts, float).reshape(-1, 2))
-        return np.where(d <= self.tol, self.turn[k], np.nan)
-
 
 _on: contextvars.ContextVar[bool] = contextvars.ContextVar("tips_split", default=False)
 
@@ -142,17 +85,15 @@ def watching_tips():
         _seen.reset(token)
 
 
-def noted_tips(
-    pieces: list, sigma: float, min_width: float, normal: bool, thin: bool, water: Water | None = None
-) -> None:
+def noted_tips(pieces: list, sigma: float, min_width: float, normal: bool, thin: bool) -> None:
     """Within :func:`watching_tips`: note the pieces of ``pieces`` (``(ring, forced)``, as
     :func:`untipped` takes them, with its other arguments) without forced corners that have a tip."""
     box = _seen.get()
     if box is not None:
         box += [
-            (np.array(r), sigma, min_width, normal, thin, water)
+            (np.array(r), sigma, min_width, normal, thin)
             for r, fc in pieces
-            if not len(fc) and _tips(r, sigma, water)
+            if not len(fc) and _tip(r, sigma) is not None
         ]
 
 
@@ -170,37 +111,25 @@ def splits(noted: list) -> bool:
     return any(args is None or _kept_split(*args) is not None for args in noted)
 
 
-def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, thin: bool, water=None):
+def _kept_split(ring: np.ndarray, sigma: float, min_width: float, normal: bool, thin: bool):
     """:func:`tip_split`, remembered within :func:`~.memo.remembering` (keyed by a 128-bit digest
     of the ring and the arguments): :func:`splits` asks before the tip draw, which asks again
     (copies are returned: callers own what they get)."""
-    wkey = None if water is None else water.key
-    key = ("tip", digest(ring), np.shape(ring), float(sigma), float(min_width), normal, thin, wkey)
-    got = remembered(
-        key, lambda: tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin, water=water)
-    )
+    key = ("tip", digest(ring), np.shape(ring), float(sigma), float(min_width), normal, thin)
+    got = remembered(key, lambda: tip_split(ring, sigma=sigma, min_width=min_width, normal=normal, thin=thin))
     return None if got is None else copied(got)
 
 
 def _tip(ring: np.ndarray, sigma: float) -> tuple[int, float] | None:
     """``(vertex, scale)`` of the sharpest reflex bend of a side of ``ring`` at its own scale
     (:data:`TIP_SCALE`, :data:`TIP_TURN`; no corner within ``sigma``), or None."""
-    got = _tips(ring, sigma)
-    return got[0][:2] if got else None
-
-
-def _tips(ring: np.ndarray, sigma: float, water: Water | None = None) -> list[tuple[int, float, bool]]:
-    """``(vertex, scale, corner)`` of the tips of ``ring`` to cut from, in the order tried: the
-    sharpest reflex bend of a side at its own scale (:data:`TIP_SCALE`, :data:`TIP_TURN`; no
-    corner within ``sigma``), then (with ``water`` and :data:`TIP_CORNERS`) its obtuse corners on
-    a land tip (:data:`CORNER_TURN`, :data:`WATER_TURN`), the most obtuse first."""
     from .corners import _arclength_closed, turning
     from .split import corners_of
     from .width import width
 
     corners, cost = corners_of(ring, sigma)
     if corners is None or not math.isfinite(cost):
-        return []
+        return None
     arc = _arclength_closed(ring)
     s, total = arc
     big = max(sigma, TIP_SCALE * width(ring))
@@ -209,19 +138,12 @@ def _tips(ring: np.ndarray, sigma: float, water: Water | None = None) -> list[tu
     near = (np.minimum(d, total - d) < sigma).any(axis=0)
     side = np.where(near, np.inf, tb)
     v = int(np.argmin(side))
-    out = [(v, big, False)] if side[v] <= -TIP_TURN else []
-    if water is not None and TIP_CORNERS:
-        cs = [int(c) for c in corners]
-        w = water.at(ring[cs])
-        obtuse = [(float(tb[c]), c) for c, wt in zip(cs, w, strict=True) if wt <= -WATER_TURN and tb[c] < CORNER_TURN]
-        out += [(c, big, True) for _, c in sorted(obtuse)]
-    return out
+    return (v, big) if side[v] <= -TIP_TURN else None
 
 
-def _cuts_from(ring: np.ndarray, v: int, big: float, corner: bool = False):
+def _cuts_from(ring: np.ndarray, v: int, big: float):
     """Candidate cuts ``(piece_a, piece_b, segment)`` from vertex ``v``: on along either flank
-    (read ``big`` along the ring), along the tip's bisector, and square onto the far side
-    (``corner``: also square to either side at ``v``)."""
+    (read ``big`` along the ring), along the tip's bisector, and square onto the far side."""
     from .corners import _arclength_closed, _edges
     from .split import _point_along, _ray_to_boundary, _split_ring
 
@@ -232,9 +154,6 @@ def _cuts_from(ring: np.ndarray, v: int, big: float, corner: bool = False):
     dirs = [ring[v] - back, ring[v] - ahead]
     u = ahead - back
     dirs.append(np.array([-u[1], u[0]]))  # the inward normal of the chord across the tip
-    if corner:  # square to the side behind and to the side ahead (their inward normals)
-        for t in (ring[v] - back, ahead - ring[v]):
-            dirs.append(np.array([-t[1], t[0]]))
     # square onto the far side: the feet of the perpendiculars from v inside edges, nearest first
     L2 = np.maximum((e * e).sum(axis=1), 1e-300)
     w = ((ring[v] - ring) * e).sum(axis=1) / L2
@@ -263,20 +182,10 @@ def tip_split(
     min_width: float,
     normal: bool = True,
     thin: bool = False,
-    water: Water | None = None,
 ):
-    """``(pieces, cuts)`` of ``ring`` split from the tip its side runs round or (``water``,
-    :data:`TIP_CORNERS`) its obtuse corner on a land tip (see the module), or None (no such tip,
-    or no admissible cut from one whose pieces, split greedily again, neither fan nor wrap)."""
-    for v, big, corner in _tips(ring, sigma, water):
-        got = _split_from(ring, v, big, corner, sigma, min_width, normal, thin)
-        if got is not None:
-            return got
-    return None
-
-
-def _split_from(ring, v: int, big: float, corner: bool, sigma: float, min_width: float, normal: bool, thin: bool):
-    """:func:`tip_split` from vertex ``v`` (``big``: the scale the tip is read at)."""
+    """``(pieces, cuts)`` of ``ring`` split from the tip its side runs round (see the module), or
+    None (no such tip, or no admissible cut from it whose pieces, split greedily again, neither fan
+    nor wrap)."""
     import shapely
 
     from .fans import fans, wraps
@@ -284,7 +193,10 @@ def _split_from(ring, v: int, big: float, corner: bool, sigma: float, min_width:
 
     poly = shapely.Polygon(ring)
     room = poly.buffer(1e-9 * math.sqrt(poly.area))
-    cuts = [c for c in _cuts_from(ring, v, big, corner) if room.covers(shapely.LineString(c[2]))]
+    tip = _tip(ring, sigma)
+    if tip is None:
+        return None
+    cuts = [c for c in _cuts_from(ring, *tip) if room.covers(shapely.LineString(c[2]))]
     best = None
     for pieces, segs, _ in _cut_options(cuts, sigma, min_width, thin):
         out_p, out_c, total = [], list(segs), 0.0
@@ -300,14 +212,12 @@ def _split_from(ring, v: int, big: float, corner: bool, sigma: float, min_width:
     return None if best is None else best[:2]
 
 
-def untipped(
-    pieces: list, cuts: list, sigma: float, min_width: float, normal: bool, thin: bool, water: Water | None = None
-):
+def untipped(pieces: list, cuts: list, sigma: float, min_width: float, normal: bool, thin: bool):
     """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece round a land tip split from
     it (:func:`tip_split`; pieces with forced corners as they are)."""
     out: list = []
     for ring, fc in pieces:
-        got = None if len(fc) else _kept_split(ring, sigma, min_width, normal, thin, water)
+        got = None if len(fc) else _kept_split(ring, sigma, min_width, normal, thin)
         out += [(ring, fc)] if got is None else got[0]
         cuts = cuts if got is None else [*cuts, *got[1]]
     return out, cuts

@@ -6,9 +6,8 @@ import pytest
 import shapely
 from shapely.geometry import Point, Polygon, box
 
-from meshcore.layout.pinch import pinched
+from meshcore.layout.pinch import Water, pinched
 from meshcore.layout.split import _orient
-from meshcore.layout.tipcuts import Water
 
 H = 0.4  # the cell size
 
