@@ -60,7 +60,7 @@ EDGE_LOSS = 10  # edge pairs <= 1.2 a patch may lose
 RUN_WEIGHTS = EDGE_WEIGHTS[:1]
 RUN_METHOD = "bfgs-n2"
 RUN_SLIDE = False  # shore nodes (not cut ends or corners) slide in the run patches deeper than DEPTH
-RUN_DEPTHS = (DEPTH, 5)  # the run patches' depths, in turn while the pair stays above the limit
+RUN_DEPTHS = (DEPTH, 5, 7)  # the run patches' depths, in turn while the pair stays above the limit
 RUN = 8  # a second patch round a pair left above LIMIT: up to RUN neighbouring pairs above AIM with it (0: none)
 
 
