@@ -243,36 +243,29 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
             if _cells_share(pieces, sides, again, cell_size) > share:
                 counts = again
         elif share > CELLS_CEILING and least is not None:  # shore chains' least counts carried across
+            m = max(int(multiple), 1)
+            capped = np.minimum(least, np.maximum(np.ceil(np.round(length / cell_size, 6) / m) * m, m))
             counts = _under_ceiling(
-                counts,
-                share,
-                solve,
-                least,
-                weights,
-                np.round(length / cell_size, 6),
-                multiple,
-                pieces,
-                sides,
-                cell_size,
+                counts, share, solve, least, capped, weights, lambda c: _cells_share(pieces, sides, c, cell_size)
             )
     return [(int(counts[s[0]].sum()), int(counts[s[3]].sum())) for s in sides], counts
 
 
-def _under_ceiling(counts, share, solve, least, weights, natural, multiple, pieces, sides, cell_size):
-    """The counts solved again with the shore chains' ``least`` counts relaxed by the steps of
-    :data:`CEILING_STEPS`, each while the counts kept give more than its share of the cells asked;
-    kept: the counts whose share is closest to 1 (``counts`` unless one comes closer)."""
+def _under_ceiling(counts, share, solve, least, capped, weights, share_of):
+    """The counts solved again (``solve(area_weights, least, weights)``) with the shore chains'
+    ``least`` counts relaxed by the steps of :data:`CEILING_STEPS` (``capped``: each ``least`` capped
+    at its chain's own count), each while the counts kept give more than its share of the cells
+    asked (``share_of(counts)``); kept: the counts whose share is closest to 1 (``counts``, whose
+    share is ``share``, unless one comes closer)."""
     from ..multiblock.counts import LAND_WEIGHT
 
-    m = max(int(multiple), 1)
-    relaxed = np.minimum(least, np.maximum(np.ceil(natural / m) * m, m))
     best, kept = counts, share
     for weight, above in CEILING_STEPS:
-        if kept <= above or (weight is None and not np.any(relaxed < least)):
+        if kept <= above or (weight is None and not np.any(capped < least)):
             continue
         w = weights if weight is None else np.where(weights >= LAND_WEIGHT, weights, weight)
-        again = solve(False, relaxed, w)
-        got = _cells_share(pieces, sides, again, cell_size)
+        again = solve(False, capped, w)
+        got = share_of(again)
         if abs(np.log(got)) < abs(np.log(kept)):
             best, kept = again, got
     return best
