@@ -1,0 +1,66 @@
+"""Session 36 (branch app36): a lake modeller's walk under Xvfb — two windows, one autosave."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.gui
+
+_HOLD = """
+import sys
+from PySide6.QtCore import QLockFile
+lock = QLockFile(sys.argv[1])
+lock.setStaleLockTime(0)
+print("held" if lock.tryLock(0) else "refused", flush=True)
+sys.stdin.read()
+"""
+
+
+def test_a_second_gcmesh_keeps_off_the_autosave_of_one_still_running(qtbot, tmp_path, monkeypatch):
+    """Every gcmesh autosaved to one recovery.toml.  A second window started while the first had
+    unsaved work said "gcmesh did not shut down cleanly last time. Restore the autosaved project?"
+    about the first one's lake, and "No" deleted its autosave (seen under Xvfb: kyoga's 60 blocks
+    gone from the data folder, the first window still open); its own edits overwrote it and its clean
+    exit removed it.  Now each running gcmesh has its own recovery file; one whose process is gone
+    is offered to the next window."""
+    from PySide6 import QtCore, QtWidgets
+
+    from app import recovery
+    from app.main_window import MainWindow
+    from app.project import Project
+
+    path = tmp_path / "recovery.toml"
+    other = subprocess.Popen(
+        [sys.executable, "-c", _HOLD, str(path) + ".lock"], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert other.stdout.readline().strip() == "held"  # the first gcmesh, running
+        theirs = Project(title="the other window's lake")
+        recovery.write(theirs, path)  # its unsaved work, autosaved
+        asked = []
+        monkeypatch.setattr(QtWidgets.QMessageBox, "question", lambda *a, **k: asked.append(a[1]))
+        settings = QtCore.QSettings(str(tmp_path / "s.ini"), QtCore.QSettings.Format.IniFormat)
+        w = MainWindow(settings=settings, recovery=path)
+        w.quiet = True
+        qtbot.addWidget(w)
+        assert not w.io.offer_recovery() and asked == []  # not offered: it is not from a crash
+        assert w.io.recovery_path != path
+        w.editor.add_point((0.0, 0.0))
+        w.io.autosave()
+        w.io.shutdown()  # a clean exit of the second window
+        assert recovery.read(path)[0].title == "the other window's lake"  # still there
+    finally:
+        other.kill()  # the first gcmesh crashes
+        other.wait()
+        other.stdin.close()
+        other.stdout.close()
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", lambda *a, **k: QtWidgets.QMessageBox.StandardButton.Yes)
+    w2 = MainWindow(settings=settings, recovery=path)
+    w2.quiet = True
+    qtbot.addWidget(w2)
+    assert w2.io.recovery_path == path
+    assert w2.io.offer_recovery() and w2.doc.project.title == "the other window's lake"
+    w2.stack.setClean()
