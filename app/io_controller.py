@@ -213,10 +213,32 @@ class IOController(ExportMixin, QtCore.QObject):
             self.doc.report("info", f"layout (detail): {note}")
         # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
         self.win.set_tool("layout" if project.layout is not None else "edit")
+        if self._offer_layout(project, path):
+            return True
         if self.win.solver.auto and any(b.ready for b in project.blocks):  # it said "press F5" as it solved
             self.win.message(f"Opened {path.name}: generating its grid (auto-generate on)")
         else:
             self.win.message(f"Opened {path.name}: press F5 to generate")
+        return True
+
+    def _offer_layout(self, project: Project, path: Path) -> bool:
+        """A lake saved before its Auto layout, opened: Auto layout offered as its import offered it (it
+        said "press F5 to generate", and F5 makes the one block the offer calls poor).  True: offered."""
+        lake = project.lake
+        if lake is None or project.layout is not None or len(project.blocks) != 1:
+            return False
+        branched = off_gui(looks_branched, lake.outline, lake.holes)
+        if not (branched or project.crs):  # plain numbers of a compact shape: one block, as imported
+            return False
+        self.win.solver.skip_auto()
+        n_isl = len(lake.holes)
+        why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
+        self.win.show_lake()
+        self.win.lake_ctl.offer(path.name, why if branched else None)
+        self.win.message(
+            f"Opened {path.name}: a lake without a layout yet; Auto layout (Ctrl+L) lays it out in blocks for a "
+            "model grid (F5 alone: one block)"
+        )
         return True
 
     def open_example(self, name: str, *, confirm: bool = True) -> bool:

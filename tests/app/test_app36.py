@@ -64,3 +64,29 @@ def test_a_second_gcmesh_keeps_off_the_autosave_of_one_still_running(qtbot, tmp_
     assert w2.io.recovery_path == path
     assert w2.io.offer_recovery() and w2.doc.project.title == "the other window's lake"
     w2.stack.setClean()
+
+
+def test_a_lake_saved_before_its_layout_is_offered_auto_layout_when_opened(qtbot, win, tmp_path):
+    """Taal imported (one island), its cell size set, saved before Auto layout, opened the next day:
+    no Auto layout offer, and the status line said "press F5 to generate" — F5 makes the one block
+    over the island that the import had called a poor grid.  Opened, it is offered as imported."""
+    from pathlib import Path
+
+    from PySide6 import QtCore
+
+    from app.main_window import MainWindow
+
+    lakes = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
+    assert win.io.import_points(lakes / "taal_lake.kml", project_lonlat=True)
+    win.lake_ctl.set_cell_size(500.0)
+    assert win.io.save_to(tmp_path / "taal.toml")
+    settings = QtCore.QSettings(str(tmp_path / "s.ini"), QtCore.QSettings.Format.IniFormat)
+    w = MainWindow(settings=settings, recovery=tmp_path / "r.toml")  # the next day
+    w.quiet = True
+    qtbot.addWidget(w)
+    assert w.io.open_path(tmp_path / "taal.toml")
+    assert w.doc.project.layout is None and w.doc.project.lake.cell_size == 500.0
+    assert w.lake_ctl.prompt is not None  # Auto layout offered
+    assert "Auto layout (Ctrl+L)" in w._status.text() and "press F5 to generate" not in w._status.text()
+    assert not w.solver.running
+
