@@ -211,7 +211,7 @@ class SolveStatus(QtCore.QObject):
         if self._last_history is not None:  # the whole history (the plot is throttled while solving)
             self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
         m = self.doc.lake_metrics
-        dt = self.solver.t_done - self.solver.t_start
+        dt = self.solver.time_of(mb)  # (an undo brought back a grid of before: its solve's, not the last one's)
         cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
         # stopped (Stop, Esc): the grid as the sweeps left it, without the finest level's repair and the
         # interface equalizing; it was summed up as a finished grid, nothing said it was not

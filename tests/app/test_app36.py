@@ -90,3 +90,28 @@ def test_a_lake_saved_before_its_layout_is_offered_auto_layout_when_opened(qtbot
     assert "Auto layout (Ctrl+L)" in w._status.text() and "press F5 to generate" not in w._status.text()
     assert not w.solver.running
 
+
+def test_a_lake_grid_brought_back_by_undo_says_its_own_solve_time(qtbot, win, tmp_path):
+    """Another lake imported and gridded, then Ctrl+Z: the first lake's grid came back and the solver label
+    said its sweeps with the other grid's time ("orthogonal: 1240 sweeps, 9.8 s" for Kyoga's grid of 3.7 s,
+    after Taal's solve).  The label says the time the solve of the grid shown took, as it did after it."""
+    import numpy as np
+
+    from tests.app.test_lake import ISEO, lay_out
+    from tests.app.waits import wait_idle
+
+    lay_out(qtbot, win, ISEO)  # about 10 000 cells: a second or so, the oval's grid a tenth
+    mb = win.doc.multiblock
+    first = win.solve_status.label.text()
+    assert first.startswith(f"orthogonal: {mb.info.iterations} sweeps, ")
+    t = np.linspace(0, 2 * np.pi, 80, endpoint=False)
+    box = tmp_path / "oval.csv"
+    np.savetxt(box, np.c_[300 * np.cos(t), 100 * np.sin(t)], delimiter=",", header="x,y", comments="")
+    assert win.io.import_points(box)
+    win.generate()
+    wait_idle(qtbot, win)
+    assert win.solve_status.label.text() != first
+    win.a_undo.trigger()  # the import: Iseo's grid again
+    wait_idle(qtbot, win)
+    assert win.doc.multiblock is mb
+    assert win.solve_status.label.text() == first
