@@ -115,3 +115,22 @@ def test_a_lake_grid_brought_back_by_undo_says_its_own_solve_time(qtbot, win, tm
     wait_idle(qtbot, win)
     assert win.doc.multiblock is mb
     assert win.solve_status.label.text() == first
+
+
+def test_export_while_the_grid_is_being_made_does_not_ask_for_f5(qtbot, win, tmp_path):
+    """Export (Ctrl+E) while Auto layout's grid was being made said "Nothing to export yet: generate a grid
+    first (F5)" — F5 starts that grid over.  It says the grid is being made, and to export when it is done."""
+    from tests.app.test_lake import ISEO
+    from tests.app.waits import wait_for, wait_idle
+
+    assert win.io.import_points(ISEO, project_lonlat=True)
+    win.a_auto_layout.trigger()
+    assert win.lake_ctl.busy
+    win.io.export_dialog()  # (no dialog: refused before it)
+    assert "being made" in win._status.text() and "F5" not in win._status.text()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
+    assert win.solver.running
+    assert not win.io.export_mesh(tmp_path / "a.vtm")
+    assert "being made" in win._status.text() and "F5" not in win._status.text()
+    wait_idle(qtbot, win)
+    assert win.io.export_mesh(tmp_path / "a.vtm")
