@@ -44,8 +44,6 @@ log = logging.getLogger(__name__)
 DRAW_BUDGET = 0.08
 #: The longest gap between two live frames of such a solve (seconds).
 MAX_FRAME_GAP = 1.0
-#: Solve times remembered for grids an undo or redo may bring back (the document keeps 8 solves).
-KEPT_TIMES = 16
 #: The GUI thread's CPU time for a live frame until one was measured (seconds): the first frame of a
 #: solve waits until the process has spent this over :data:`DRAW_BUDGET`.
 FRAME_COST = 0.005
@@ -105,9 +103,6 @@ class SolverController(QtCore.QObject):
         self._t_before = (0.0, 0.0)
         self.last_result = None
         self.last_error: str | None = None
-        # the wall time of the solves whose grids the document keeps (undo, redo bring them back): id of the
-        # MultiBlockGrid -> (it, seconds)
-        self._times: dict[int, tuple] = {}
         #: the last lake solve was stopped before its full level: no grid of the layout (its coarse frames greyed)
         self.stopped_coarse = False
         #: that stopped solve left the finished grid shown before it (F5 on it, stopped on a coarse level)
@@ -139,14 +134,6 @@ class SolverController(QtCore.QObject):
         doc.project_changed.connect(self._on_project_changed)
 
     # ------------------------------------------------------------ control
-    def time_of(self, multiblock) -> float:
-        """The wall time of the solve that made ``multiblock`` (a grid an undo brought back: not the last
-        solve's), else of the last solve."""
-        kept = self._times.get(id(multiblock))
-        if kept is not None and kept[0] is multiblock:
-            return kept[1]
-        return self.t_done - self.t_start
-
     @property
     def running(self) -> bool:
         return self.state in ("running", "paused")
@@ -518,9 +505,6 @@ class SolverController(QtCore.QObject):
         metrics = getattr(result, "metrics", None)
         initial = {k: g for k, g in initial.items() if k in ready}
         self.doc.set_grids(grids, initial, multiblock=mb, metrics=metrics, project=self._project)
-        if mb is not None:
-            self._times = dict(list(self._times.items())[-(KEPT_TIMES - 1) :])
-            self._times[id(mb)] = (mb, self.t_done - self.t_start)
         self.last_result = result
         for w in result.warnings:  # what meshcore warned about (e.g. dropped duplicate points)
             self.doc.report("warning", w)

@@ -94,7 +94,8 @@ def test_a_lake_saved_before_its_layout_is_offered_auto_layout_when_opened(qtbot
 def test_a_lake_grid_brought_back_by_undo_says_its_own_solve_time(qtbot, win, tmp_path):
     """Another lake imported and gridded, then Ctrl+Z: the first lake's grid came back and the solver label
     said its sweeps with the other grid's time ("orthogonal: 1240 sweeps, 9.8 s" for Kyoga's grid of 3.7 s,
-    after Taal's solve).  The label says the time the solve of the grid shown took, as it did after it."""
+    after Taal's solve), and the convergence plot showed the other solve's history (or none after Clear
+    layout).  The label and the plot are of the grid shown, as they were after its solve."""
     import numpy as np
 
     from tests.app.test_lake import ISEO, lay_out
@@ -104,6 +105,8 @@ def test_a_lake_grid_brought_back_by_undo_says_its_own_solve_time(qtbot, win, tm
     mb = win.doc.multiblock
     first = win.solve_status.label.text()
     assert first.startswith(f"orthogonal: {mb.info.iterations} sweeps, ")
+    plot = win.conv_panel.curve.getData()[1].copy()
+    assert len(plot) > 10
     t = np.linspace(0, 2 * np.pi, 80, endpoint=False)
     box = tmp_path / "oval.csv"
     np.savetxt(box, np.c_[300 * np.cos(t), 100 * np.sin(t)], delimiter=",", header="x,y", comments="")
@@ -115,6 +118,7 @@ def test_a_lake_grid_brought_back_by_undo_says_its_own_solve_time(qtbot, win, tm
     wait_idle(qtbot, win)
     assert win.doc.multiblock is mb
     assert win.solve_status.label.text() == first
+    assert list(win.conv_panel.curve.getData()[1]) == list(plot)  # its convergence, not the oval's
 
 
 def test_export_while_the_grid_is_being_made_does_not_ask_for_f5(qtbot, win, tmp_path):
