@@ -31,13 +31,43 @@ from .lake import Lake, looks_branched, read_lake, read_lake_parts, water
 from .off_gui import off_gui
 from .project import Block, Project, block_from_points
 
-__all__ = ["MAX_RECENT", "IOController", "export_default"]
+__all__ = ["MAX_RECENT", "IOController", "claim_recovery", "export_default"]
 
 log = logging.getLogger(__name__)
 
 MAX_RECENT = 8
 DEBOUNCE_MS = 1000
 MAX_DELAY_S = 2.0
+#: recovery files one user's running gcmesh processes may hold at once (recovery.toml, recovery-2.toml, …)
+RECOVERY_SLOTS = 16
+_claimed: dict[str, QtCore.QLockFile] = {}  # the recovery files this process holds (kept until it exits)
+
+
+def claim_recovery(path: Path) -> Path:
+    """The recovery file of this process: ``path``, unless another running gcmesh holds it (its unsaved
+    work is autosaved there), then the first free one of ``NAME-2.toml``, ``NAME-3.toml`` …
+
+    Each is held by a lock file beside it while its process runs (the windows of one process share
+    theirs, as before); when the process ends without a clean exit, the lock is stale and the next
+    window to start takes the file over and offers its project back.  Every gcmesh used one file: a
+    second window offered the first one's unsaved lake as "did not shut down cleanly", and "No"
+    deleted that autosave while the first window still had the work open.
+    """
+    path = Path(path)
+    for k in range(1, RECOVERY_SLOTS + 1):
+        p = path if k == 1 else path.with_name(f"{path.stem}-{k}{path.suffix}")
+        if str(p) in _claimed:
+            return p
+        try:
+            p.parent.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            return path  # (the autosave says why it cannot write)
+        lock = QtCore.QLockFile(str(p) + ".lock")
+        lock.setStaleLockTime(0)  # stale only when its process is gone (Qt's default: after 30 s too)
+        if lock.tryLock(0):
+            _claimed[str(p)] = lock
+            return p
+    return path
 
 
 def _centroid(points) -> tuple[float, float]:
@@ -96,7 +126,7 @@ class IOController(ExportMixin, QtCore.QObject):
         self.stack = window.stack
         self.editor = window.editor
         self.settings = settings
-        self.recovery_path = Path(recovery_path)
+        self.recovery_path = claim_recovery(Path(recovery_path))
         self.recent_menu: QtWidgets.QMenu | None = None
         self._autosave = QtCore.QTimer(self)
         self._autosave.setSingleShot(True)
@@ -183,10 +213,32 @@ class IOController(ExportMixin, QtCore.QObject):
             self.doc.report("info", f"layout (detail): {note}")
         # a lake's layout is edited with the Layout tool (the Edit tool has no points of it to drag)
         self.win.set_tool("layout" if project.layout is not None else "edit")
+        if self._offer_layout(project, path):
+            return True
         if self.win.solver.auto and any(b.ready for b in project.blocks):  # it said "press F5" as it solved
             self.win.message(f"Opened {path.name}: generating its grid (auto-generate on)")
         else:
             self.win.message(f"Opened {path.name}: press F5 to generate")
+        return True
+
+    def _offer_layout(self, project: Project, path: Path) -> bool:
+        """A lake saved before its Auto layout, opened: Auto layout offered as its import offered it (it
+        said "press F5 to generate", and F5 makes the one block the offer calls poor).  True: offered."""
+        lake = project.lake
+        if lake is None or project.layout is not None or len(project.blocks) != 1:
+            return False
+        branched = off_gui(looks_branched, lake.outline, lake.holes)
+        if not (branched or project.crs):  # plain numbers of a compact shape: one block, as imported
+            return False
+        self.win.solver.skip_auto()
+        n_isl = len(lake.holes)
+        why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
+        self.win.show_lake()
+        self.win.lake_ctl.offer(path.name, why if branched else None)
+        self.win.message(
+            f"Opened {path.name}: a lake without a layout yet; Auto layout (Ctrl+L) lays it out in blocks for a "
+            "model grid (F5 alone: one block)"
+        )
         return True
 
     def open_example(self, name: str, *, confirm: bool = True) -> bool:

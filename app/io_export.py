@@ -53,6 +53,8 @@ def chosen_format(chosen: str, path: Path) -> str | None:
 
 
 _NOTHING_YET = "Nothing to export yet: generate a grid first (F5)"
+#: a layout or a grid being computed (it said "generate a grid first (F5)": F5 starts that grid over)
+_BEING_MADE = "The grid is being made: export it when it is done (the status bar says so)"
 #: the greyed grid on screen after an edit with auto-generate off (it said "Nothing to export yet")
 _BEFORE_EDIT = (
     "The grid on screen (greyed) is of before the last edit, not of this layout: F5 makes the grid of "
@@ -87,7 +89,9 @@ class ExportMixin:
 
     def _why_not(self) -> str | None:
         """Why the grid on screen cannot be exported now (None: it can)."""
-        doc = self.doc
+        doc, lake = self.doc, self.win.lake_ctl
+        if doc.solving or lake.busy or lake.editing:
+            return _BEING_MADE
         if not doc.grids:
             return _NOTHING_YET if not doc.before_grids else _BEFORE_EDIT
         if doc.project.layout is not None and (doc.multiblock is None or doc.stale or doc.solving):

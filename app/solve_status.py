@@ -12,6 +12,7 @@ import time
 
 from PySide6 import QtCore, QtWidgets
 
+from .document import KEPT_SOLVES
 from .pipeline import ALL_BLOCKS
 
 __all__ = ["SolveStatus"]
@@ -41,6 +42,9 @@ class SolveStatus(QtCore.QObject):
         self._label_timer.setSingleShot(True)
         self._label_timer.timeout.connect(self._show_label)
         self._last_history: tuple | None = None  # (history, tolerance, levels) of the last multiblock snapshot
+        # the solve time and history of the lake grids the document keeps: an undo or redo that brings one back
+        # said the last solve's time beside its sweeps, and left the plot empty or of another grid
+        self._kept: dict[int, tuple] = {}  # id of the MultiBlockGrid -> (it, seconds, history)
         self._due: set[str] = set()  # "summary", "notes": said once the large grid's quality is measured
         self.doc.grids_changed.connect(lambda: self.frames.append(time.perf_counter()))
         self.doc.active_changed.connect(lambda _k: self.on_final())
@@ -208,10 +212,15 @@ class SolveStatus(QtCore.QObject):
 
     def _lake_final(self, mb) -> None:
         info = mb.info
-        if self._last_history is not None:  # the whole history (the plot is throttled while solving)
-            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        kept = self._kept.get(id(mb))
+        if kept is None or kept[0] is not mb:  # the solve just ended: its time and history, kept for an undo
+            kept = (mb, self.solver.t_done - self.solver.t_start, self._last_history)
+            self._kept = dict(list(self._kept.items())[-(KEPT_SOLVES - 1) :])
+            self._kept[id(mb)] = kept
+        if kept[2] is not None:  # the whole history (the plot is throttled while solving)
+            self.conv.set_history(list(kept[2][0]), *kept[2][1:])
         m = self.doc.lake_metrics
-        dt = self.solver.t_done - self.solver.t_start
+        dt = self._kept[id(mb)][1]
         cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
         # stopped (Stop, Esc): the grid as the sweeps left it, without the finest level's repair and the
         # interface equalizing; it was summed up as a finished grid, nothing said it was not

@@ -76,7 +76,15 @@ def interior_cuts(pieces: list[Piece]) -> list[np.ndarray]:
 
 def shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
     """The shore as the pieces have it (every vertex a piece has on it): the edges that only one
-    piece uses, joined into rings; the ring of largest area is the outline, the others islands."""
+    piece uses, joined into rings; the ring of largest area is the outline, the others islands.
+
+    Each ring starts at its lexicographically smallest vertex and the islands come in the order
+    of those vertices: the same shore for the same pieces, whichever vertex their rings start at.
+    A layout read back from its case has the same pieces with rings that start elsewhere; the
+    grid's shore nodes slide along these rings, and a ring's start moved them by 0.03 cells
+    (Kyoga: ``meshcore mesh`` and ``meshcore generate`` of its ``--case`` 15 m apart, and each
+    save and reopen in the app gave the other of two grids).
+    """
     count = _edge_use(pieces)
     nxt: dict[tuple, tuple] = {}
     for pc in pieces:  # walked in each piece's own (counter-clockwise) direction
@@ -91,10 +99,11 @@ def shore_of(pieces: list[Piece]) -> tuple[np.ndarray, list[np.ndarray]]:
         while v in nxt:
             ring.append(v)
             v = nxt.pop(v)
-        rings.append(np.array(ring))
+        r = np.array(ring)
+        rings.append(np.roll(r, -int(np.lexsort((r[:, 1], r[:, 0]))[0]), axis=0))
     area = [abs(0.5 * float(np.sum(r[:, 0] * np.roll(r[:, 1], -1) - np.roll(r[:, 0], -1) * r[:, 1]))) for r in rings]
     k = int(np.argmax(area))
-    return rings[k], [r for i, r in enumerate(rings) if i != k]
+    return rings[k], sorted((r for i, r in enumerate(rings) if i != k), key=lambda r: (r[0, 0], r[0, 1]))
 
 
 def outline_parts(layout: Any) -> dict[str, Any]:

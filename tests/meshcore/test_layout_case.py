@@ -97,6 +97,31 @@ def test_a_layout_read_back_from_its_outline_parts_is_the_same_layout(name):
     assert again.polygon.area == pytest.approx(sum(pc_area(pc.ring) for pc in again.pieces), rel=1e-9)
 
 
+def test_the_shore_of_pieces_is_the_same_whichever_vertex_their_rings_start_at():
+    """A layout read back from its case has the same pieces, their rings started at other vertices:
+    the shore the grid's nodes slide along started elsewhere too, and the grid moved (Kyoga: 15 m,
+    0.03 cells, between ``meshcore mesh`` and ``meshcore generate`` of its ``--case``)."""
+    from dataclasses import replace
+
+    from meshcore.layout.outline import shore_of
+
+    lay = auto_layout(testing.lake_with_islands(3), target_cells=1500, multiple=4)
+    outer, holes = shore_of(list(lay.pieces))
+    assert len(holes) >= 2
+    for shift in (1, 2, 3):
+        turned = [
+            replace(
+                pc, ring=np.roll(pc.ring, -shift, axis=0), corners=tuple((c - shift) % len(pc.ring) for c in pc.corners)
+            )
+            for pc in reversed(lay.pieces)
+        ]
+        o2, h2 = shore_of(turned)
+        np.testing.assert_array_equal(o2, outer)
+        assert len(h2) == len(holes)
+        for a, b in zip(h2, holes, strict=True):
+            np.testing.assert_array_equal(a, b)
+
+
 def pc_area(r: np.ndarray) -> float:
     return 0.5 * abs(float(np.sum(r[:, 0] * np.roll(r[:, 1], -1) - np.roll(r[:, 0], -1) * r[:, 1])))
 
