@@ -14,7 +14,8 @@ the cells keep the asked size, as :data:`~meshcore.layout.LAYOUT_SCALES`), solve
 level of each layout that differs, and keeps the one with the smallest deviation if that is
 :data:`MARGIN` below the first's and its interface ratio there (the 99th percentile of the coarse
 cell pairs', :data:`meshcore.lakegrid.READING_PERCENTILE`) is no larger (up to
-:data:`RATIO_SLACK`; else the layout at the cell size itself).  A default layout whose blocks
+:data:`RATIO_SLACK`) or at most ``ratio_ok`` (:data:`meshcore.layout.DEFAULT_RATIO` and
+:data:`~meshcore.layout.REGULAR_RATIO`: 2.5); else the layout at the cell size itself.  A default layout whose blocks
 average fewer than :data:`SMALL_BLOCK_CELLS` cells can also be drawn at :data:`COARSE_SCALES` (off) × the
 cell size — fewer, larger blocks whose lines are long enough to grade their cells (edge pairs
 ≤ 1.2, issue 12's lakes of 70–100 blocks at 10 000 cells) — and there the coarse ratio may also

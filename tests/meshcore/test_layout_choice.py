@@ -50,11 +50,33 @@ def test_the_layout_with_the_most_orthogonal_coarse_grid_is_kept(monkeypatch, se
     poly = testing.channel_network(seed, n_branches=6)
     got = _coarse(auto_layout(poly, target_cells=3000, multiple=4, reading=coarse_reading))
     first, *others = [_coarse(_alone(monkeypatch, poly, s, 3000)) for s in (1.0, 1.07, 0.93)]
-    # better by the margin, interface ratios no larger (up to the slack)
-    fit = [d for d, r in others if d < (1 - choice.MARGIN) * first[0] and r <= first[1] * (1 + choice.RATIO_SLACK)]
+    # better by the margin, interface ratios no larger (up to the slack) or at most DEFAULT_RATIO
+    ok = max(first[1] * (1 + choice.RATIO_SLACK), layout_pkg.DEFAULT_RATIO)
+    fit = [d for d, r in others if d < (1 - choice.MARGIN) * first[0] and r <= ok]
     assert fit
     assert got[0] == pytest.approx(min(fit), abs=1e-9)
     assert got[0] < first[0] - 0.5
+
+
+def test_default_and_regular_layouts_may_take_a_coarse_ratio_up_to_theirs(monkeypatch):
+    """The choice among scales lets another draw's coarse interface ratio exceed the first's up to
+    ``DEFAULT_RATIO`` (default layouts, session 36) or ``REGULAR_RATIO`` (regular ones): both 2.5,
+    which the final grid's equalize step brings under 2."""
+    from meshcore.layout import choice
+
+    assert layout_pkg.DEFAULT_RATIO == layout_pkg.REGULAR_RATIO == 2.5
+    seen = []
+    real = choice.chosen
+
+    def spy(first, at_scale, reading, more=(), ratio_ok=0.0, **kw):
+        seen.append(ratio_ok)
+        return real(first, at_scale, reading, more, ratio_ok, **kw)
+
+    monkeypatch.setattr(layout_pkg, "chosen", spy)
+    poly = testing.channel_network(1030002, n_branches=6)
+    for regular in (False, True):
+        auto_layout(poly, target_cells=3000, multiple=4, regular=regular, reading=coarse_reading)
+    assert seen == [layout_pkg.DEFAULT_RATIO, layout_pkg.REGULAR_RATIO]
 
 
 def test_single_layouts_and_large_layouts_are_kept_as_drawn(monkeypatch):
