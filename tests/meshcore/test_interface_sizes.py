@@ -149,15 +149,19 @@ def test_cells_alike_across_a_cut_that_ends_beside_a_side(make, cells, options, 
         lambda: testing.y_junction(arm=5.0, width=1.2, angle0=100.0),
     ],
 )
-def test_a_y_junction_star_keeps_cells_alike_across_its_spokes(make):
+def test_a_y_junction_star_keeps_cells_alike_across_its_spokes(make, monkeypatch):
     """A Y's star: straight spokes from the centre to the three crotches and one to the middle of
     each arm's opening, six blocks round the centre.  With spokes curved to arrive along the
     continued shore (one block's corner at a crotch 60°, its neighbour's side straight there) the
     solves straightened them and opened that corner into a fan: cells 1.8-2.9 times apart across
-    the spoke at 4000 cells; now 1.00-1.04."""
+    the spoke at 4000 cells; now 1.00-1.04.  (The layout choice's coarse ratio guard as it was when
+    this was written: with ``DEFAULT_RATIO`` one of these Ys takes another scale's 6-block layout,
+    99.97 % within 3°, interface ratio 1.25 — not a star.)"""
+    import meshcore.layout as layout_pkg
     from meshcore.lakegrid import mesh_outline
     from meshcore.quality import lake_metrics
 
+    monkeypatch.setattr(layout_pkg, "DEFAULT_RATIO", 0.0)
     poly = make()
     mb = mesh_outline(poly, target_cells=4000)
     m = lake_metrics(mb, polygon=poly)
