@@ -230,11 +230,7 @@ class IOController(ExportMixin, QtCore.QObject):
         branched = off_gui(looks_branched, lake.outline, lake.holes)
         if not (branched or project.crs):  # plain numbers of a compact shape: one block, as imported
             return False
-        self.win.solver.skip_auto()
-        n_isl = len(lake.holes)
-        why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
-        self.win.show_lake()
-        self.win.lake_ctl.offer(path.name, why if branched else None)
+        self._offer_auto_layout(path.name, len(lake.holes), branched)
         self.win.message(
             f"Opened {path.name}: a lake without a layout yet; Auto layout (Ctrl+L) lays it out in blocks for a "
             "model grid (F5 alone: one block)"
@@ -458,13 +454,18 @@ class IOController(ExportMixin, QtCore.QObject):
                 f"automatically — adjust with the Corners tool, then F5; Lake ▸ Auto layout splits it into blocks"
             )
         if offered:
-            # auto-generate: not the one block the offer calls poor (its grid covered the islands, its
-            # repairs filled Messages, a big lake's solve ran on while the user chose Auto layout); F5 makes it
-            self.win.solver.skip_auto()
-            why = f"{n_isl} island{'s' * (n_isl != 1)}" if n_isl else "the water has arms or bends"
-            self.win.show_lake()
-            self.win.lake_ctl.offer(path.name, why if branched else None)
+            self._offer_auto_layout(path.name, n_isl, branched)
         return True
+
+    def _offer_auto_layout(self, name: str, n_islands: int, branched: bool) -> None:
+        """The Lake panel shown with Auto layout offered for ``name`` (why: its islands, or its arms
+        and bends when ``branched``), and auto-generate skipped: not the one block the offer calls poor
+        (its grid covered the islands, its repairs filled Messages, a big lake's solve ran on while the
+        user chose Auto layout); F5 makes it."""
+        self.win.solver.skip_auto()
+        why = f"{n_islands} island{'s' * (n_islands != 1)}" if n_islands else "the water has arms or bends"
+        self.win.show_lake()
+        self.win.lake_ctl.offer(name, why if branched else None)
 
     def _read_lake(self, pd, frame, *, lonlat: bool, part: int | None = None):
         """The lake (shore and islands) of the file's rings, in the frame of the imported block (None

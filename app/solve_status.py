@@ -220,7 +220,7 @@ class SolveStatus(QtCore.QObject):
         if kept[2] is not None:  # the whole history (the plot is throttled while solving)
             self.conv.set_history(list(kept[2][0]), *kept[2][1:])
         m = self.doc.lake_metrics
-        dt = self._kept[id(mb)][1]
+        dt = kept[1]
         cells = sum(g.cells[0] * g.cells[1] for g in mb.grids)
         # stopped (Stop, Esc): the grid as the sweeps left it, without the finest level's repair and the
         # interface equalizing; it was summed up as a finished grid, nothing said it was not
