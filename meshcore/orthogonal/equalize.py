@@ -427,10 +427,10 @@ def equalize_interfaces(
         if should_stop is not None and should_stop():
             break
         r = _ratios(P, t, pairs)
-        order = [q for q in np.argsort(-r) if r[q] > np.log(limit) and int(q) not in tried]
+        above = [int(q) for q in np.argsort(-r) if r[q] > np.log(limit)]
+        order = [q for q in above if q not in tried]
         if not order and again and kept:  # (the grid round them has moved since their own try)
-            again, tried = False, set()
-            order = [q for q in np.argsort(-r) if r[q] > np.log(limit)]
+            again, tried, order = False, set(), above
         if not order:
             break
         q = int(order[0])
