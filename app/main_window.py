@@ -245,6 +245,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.doc.opened.connect(self.focus_canvas)
         self.doc.path_changed.connect(self._update_title)
         self.canvas.hovered.connect(self._show_coords)
+        self.canvas.unhovered.connect(self._coords.clear)
         self.blocks_panel.border_selected.connect(self.params_panel.select_border)
         self.quality_panel.zoom_to_cell.connect(self.canvas.zoom_to_cell)
         self.params_panel.committed.connect(self.focus_canvas)

@@ -59,6 +59,8 @@ class Canvas(pg.PlotWidget):
     """The drawing area.  ``tool`` receives mouse events in model coordinates."""
 
     hovered = QtCore.Signal(float, float)
+    #: the cursor's point is not known any more (the view moved while the mouse was off the canvas)
+    unhovered = QtCore.Signal()
 
     def __init__(self, doc: Document, parent=None) -> None:
         self._vb = ToolViewBox(self)
@@ -97,6 +99,10 @@ class Canvas(pg.PlotWidget):
             lambda *_a: self._window_timer.start() if self._partial() or self._colour is not None else None
         )
         self.scene().sigMouseMoved.connect(self._on_mouse_moved)
+        self._hover_pos = None  # the scene position of the mouse over the plot (None: off the canvas)
+        # a fit or zoom moves the model under a still mouse: the read-out follows (it showed the point the
+        # mouse was over before the fit until the mouse moved)
+        self._vb.sigRangeChanged.connect(self._rehover)
         doc.project_changed.connect(self.refresh_boundary)
         doc.project_changed.connect(self.lake_items.refresh)
         doc.opened.connect(lambda: self.lake_items.set_misses(None))
@@ -239,10 +245,25 @@ class Canvas(pg.PlotWidget):
 
     def _on_mouse_moved(self, pos) -> None:
         if self._vb.sceneBoundingRect().contains(pos):
+            self._hover_pos = QtCore.QPointF(pos)
             xy = self.to_model(pos)
             self.hovered.emit(*xy)
             if self.tool is not None:
                 self.tool.hover(xy)
+
+    def leaveEvent(self, ev) -> None:
+        self._hover_pos = None
+        super().leaveEvent(ev)
+
+    def _rehover(self, *_args) -> None:
+        """The view changed under the mouse: the read-out names the point now under it, or nothing when
+        the mouse is off the canvas (a click on Fit in the toolbar)."""
+        pos = self._hover_pos
+        if pos is not None and self._vb.sceneBoundingRect().contains(pos):
+            self.hovered.emit(*self.to_model(pos))
+        else:
+            self._hover_pos = None
+            self.unhovered.emit()
 
     def zoom_to(self, bounds, margin: float = 0.16) -> None:
         if bounds is None:
