@@ -258,6 +258,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.doc.colour_changed.connect(self._misses_for_colours)
         self.messages_panel.attention.connect(self.show_messages)
         self.doc.project_changed.connect(self._check_corners)
+        self._had_layout = False  # whether the project had a layout at the last change (_tool_for_layout)
+        self.doc.project_changed.connect(self._tool_for_layout)
         self._live_seen = None  # the kind of document Live was last set for (live_for_document)
         self.a_auto.triggered.connect(self._live_chosen)
         self.doc.project_changed.connect(self.live_for_document)
@@ -322,6 +324,18 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         if key in self.tool_actions:
             self.tool_actions[key].setChecked(True)
         tool.activate()
+
+    def _tool_for_layout(self, project: Project) -> None:
+        """The layout gone (Clear layout, Auto layout undone) under the Layout tool, which has nothing
+        left to act on: the tool of a lake without a layout (Edit, as its import chooses).  The layout
+        back (Clear layout undone) under the Edit tool, which has no points of it: the Layout tool, as
+        Auto layout chooses."""
+        has = project.layout is not None
+        had, self._had_layout = self._had_layout, has
+        if not has and self.canvas.tool is self.tools["layout"]:
+            self.set_tool("edit")
+        elif has and not had and self.canvas.tool is self.tools["edit"]:
+            self.set_tool("layout")
 
     def keyPressEvent(self, ev: QtGui.QKeyEvent) -> None:
         if self.canvas.tool is not None and self.canvas.tool.key(ev.key()):

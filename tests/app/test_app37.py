@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytestmark = pytest.mark.gui
@@ -45,3 +46,36 @@ def test_the_cursor_readout_follows_a_fit_under_a_still_mouse(qtbot, win):
     assert _readout(win) == ""
     canvas.scene().sigMouseMoved.emit(pos)  # back over the canvas: read out again
     assert _said(*canvas.to_model(pos)) in _readout(win)
+
+
+def _small_lake():
+    from app.lake import Lake
+    from meshcore import testing
+
+    poly = testing.round_lake(850_031, kind="ring", radius=2000.0)
+    return Lake(
+        outline=np.asarray(poly.exterior.coords)[:-1],
+        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
+        target_cells=1500,
+    )
+
+
+def test_clear_layout_leaves_the_layout_tool_for_the_tool_of_a_lake_without_one(qtbot, win):
+    """Lake ▸ Clear layout left the Layout tool chosen, with no layout to act on (a click did nothing).
+    Now the tool falls back to Edit, the tool an imported lake starts in; Ctrl+Z brings the layout back
+    and with it the Layout tool, Ctrl+Y clears it again."""
+    from app.lake import compute_layout
+
+    lake = _small_lake()
+    win.editor.set_lake(lake.replaced(layout=compute_layout(lake)), "Auto layout")
+    win.set_tool("layout")  # as Auto layout leaves it
+    layout = win.doc.project.layout
+    assert layout is not None
+    win.a_clear_layout.trigger()
+    assert win.doc.project.layout is None
+    assert win.canvas.tool is win.tools["edit"] and win.tool_actions["edit"].isChecked()
+    win.stack.undo()  # an undoable edit: the layout back, and its tool
+    assert win.doc.project.layout == layout
+    assert win.canvas.tool is win.tools["layout"] and win.tool_actions["layout"].isChecked()
+    win.stack.redo()
+    assert win.doc.project.layout is None and win.canvas.tool is win.tools["edit"]
