@@ -1,6 +1,6 @@
 """``meshcore convert IN OUT`` — convert a grid file to another format.
 
-Reads any grid format (PLOT3D, .vts, .vtm, .npz, .cgns, .grd, .nc, metrics
+Reads any grid format (PLOT3D, .vts, .vtm, .npz, .cgns, .grd, .ddb, .nc, EFDC cell.inp, metrics
 CSV) and writes any format (the ones above plus .msh, .su2, figures), keeping
 the CRS, local origin, block and border names where both formats hold them.
 """

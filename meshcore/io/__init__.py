@@ -202,6 +202,7 @@ for _f in (
         (".grd",),
         "Delft3D single domain: the blocks merged into one .grd with inactive points (+ .enc)",
         writer="delft3d_single:write_grd_single",
+        grid_reader="delft3d_single:read_grd_single",
         crs=True,
         multiblock=True,
     ),
@@ -210,6 +211,7 @@ for _f in (
         (".inp",),
         "EFDC/EFDC+ grid: cell.inp and, next to it, celllt.inp, dxdy.inp, lxly.inp, corners.inp",
         writer="efdc:write_efdc",
+        grid_reader="efdc:read_efdc",
         crs=True,
         multiblock=True,
     ),
@@ -360,7 +362,7 @@ def _grid_as_points(gs: GridSet, p: Path) -> PointSet:
 
 
 def read_blocks(path: Any, *, format: str | None = None, **options: Any) -> GridSet:
-    """Read every block of a grid file (PLOT3D, .vts, .vtm, .npz, .cgns, .grd, .nc, metrics CSV).
+    """Read every block of a grid file (PLOT3D, .vts, .vtm, .npz, .cgns, .grd, .ddb, .nc, EFDC cell.inp, metrics CSV).
 
     Returns a :class:`GridSet`: blocks in local coordinates, the frame (CRS,
     origin), block names and (where stored) connectivity.

@@ -33,7 +33,7 @@ from ..crs import Frame, normalize_crs
 from ..errors import ReadError
 from ._base import GridSet, atomic_path, atomic_paths, check_nodes, grid_from_world, read_bytes
 
-__all__ = ["read_grd", "write_grd"]
+__all__ = ["read_grd", "read_grd_arrays", "write_grd"]
 
 MISSING = -999.0
 
@@ -131,14 +131,33 @@ def _header(path: Path, lines: list[str]) -> tuple[int, str | None, bool, float]
     return k, crs, spherical, missing
 
 
-def read_grd(path: Path, **_: Any) -> GridSet:
+def read_grd(path: Path, *, inactive: bool = True, **_: Any) -> GridSet:
     """Read an RGFGRID ``.grd`` file (Cartesian or Spherical).
 
     The grid size is checked against the node limit before the values are
     read (one pass, into an array of that size); every coordinate must be a
     finite number; a ``.enc`` next to the file that does not fit the grid (a
-    pair written by two different runs) is reported.
+    pair written by two different runs) is reported.  A grid with missing
+    (inactive) points is read as a single-domain grid
+    (:func:`meshcore.io.delft3d_single.read_grd_single`: its active cells as blocks), and so is
+    one whose ``.enc`` is not the full grid's (an island of inactive cells between active points);
+    ``inactive=False`` refuses one (a domain of a ``.ddb``, a full grid by definition).
     """
+    X, Y, crs, spherical, missing = read_grd_arrays(path)
+    _check_enclosure(path, *X.shape)
+    if np.any(missing == X) or np.any(missing == Y) or not _full_enclosure(path, *X.shape):
+        if not inactive:
+            raise ReadError(f"{path}: grid has missing (inactive) points; a full grid is expected here")
+        from .delft3d_single import read_grd_single
+
+        return read_grd_single(path)
+    frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
+    return GridSet((grid_from_world(X, Y, (0.0, 0.0), path),), frame, source=str(path))
+
+
+def read_grd_arrays(path: Path) -> tuple[np.ndarray, np.ndarray, str | None, bool, float]:
+    """The node arrays ``X, Y`` (MMAX × NMAX, the missing value at inactive points) of an RGFGRID
+    ``.grd``, its CRS (``* Projection:`` comment), whether it is Spherical, and its missing value."""
     text = read_bytes(path).decode("latin-1")
     lines = text.splitlines()
     k, crs, spherical, missing = _header(path, lines)
@@ -173,19 +192,26 @@ def read_grd(path: Path, **_: Any) -> GridSet:
         raise ReadError(f"{path}: {n} coordinates, expected 2 x {mmax} x {nmax}")
     X = a[: mmax * nmax].reshape((nmax, mmax)).T
     Y = a[mmax * nmax :].reshape((nmax, mmax)).T
-    if np.any(missing == X) or np.any(missing == Y):
-        raise ReadError(f"{path}: grid has missing (inactive) points; only full grids are read")
     if spherical:  # lon/lat: metres in a file that says Spherical would be read as degrees
-        bad = np.argwhere((np.abs(X) > 360) | (np.abs(Y) > 90))
+        bad = np.argwhere(((np.abs(X) > 360) | (np.abs(Y) > 90)) & np.not_equal(X, missing) & np.not_equal(Y, missing))
         if len(bad):
             m, nn = (int(v) for v in bad[0])
             raise ReadError(
                 f"{path}: Coordinate System = Spherical, but node (m={m + 1}, n={nn + 1}) is "
                 f"({X[m, nn]:.6g}, {Y[m, nn]:.6g}), not longitude, latitude: is the grid Cartesian?"
             )
-    _check_enclosure(path, mmax, nmax)
-    frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
-    return GridSet((grid_from_world(X, Y, (0.0, 0.0), path),), frame, source=str(path))
+    return X, Y, crs, spherical, missing
+
+
+def _full_enclosure(path: Path, mmax: int, nmax: int) -> bool:
+    """True when no ``.enc`` is beside ``path`` or it is the enclosure of the full grid."""
+    from .delft3d_single import read_enc
+
+    enc = Path(path).with_suffix(".enc")
+    if not enc.is_file():
+        return True
+    full = [(1, 1), (mmax + 1, 1), (mmax + 1, nmax + 1), (1, nmax + 1), (1, 1)]
+    return read_enc(enc) == [full]
 
 
 def _check_enclosure(path: Path, mmax: int, nmax: int) -> None:

@@ -33,6 +33,14 @@ fit one index space (a ring of blocks round an island whose cell counts do not a
 3- or 5-block corners, arms that fold onto each other in index space: write a ``.ddb``
 instead), and water in several parts (one outer enclosure only: write each part with
 ``--part``).  The two files are written as a set (:mod:`._atomic`).
+
+Reading (:func:`read_grd_single`; :func:`meshcore.io.read_blocks` of a ``.grd`` with missing
+points comes here): the merged node array, missing values inactive, and the water cells of the
+``.enc`` beside it (without one: every cell whose four corners are active) make an
+:class:`~meshcore.multiblock.indexspace.IndexSpace` (:func:`read_index_space`); the water cells
+cut into rectangles (:func:`~meshcore.multiblock.indexspace.from_mask`) are the blocks of the
+:class:`GridSet` returned, ready for the quality report or another format.  The blocks written
+are not kept (the format has no place for them): the cells and nodes are.
 """
 
 from __future__ import annotations
@@ -42,12 +50,22 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import WriteError
+from ..crs import Frame
+from ..errors import ReadError, WriteError
 from ._atomic import atomic_paths
-from ._base import GridSet
-from .delft3d import grd_text
+from ._base import GridSet, find_interfaces, grid_from_world, read_bytes
+from .delft3d import grd_text, read_grd_arrays
 
-__all__ = ["MISSING_VALUE", "enclosure_polygons", "merged", "write_grd_single"]
+__all__ = [
+    "MISSING_VALUE",
+    "enclosure_polygons",
+    "gridset_of",
+    "merged",
+    "read_enc",
+    "read_grd_single",
+    "read_index_space",
+    "write_grd_single",
+]
 
 #: RGFGRID's missing value (header and inactive points).
 MISSING_VALUE = -999.999
@@ -156,3 +174,101 @@ def write_grd_single(path: Path, gs: GridSet, *, lonlat: bool = False, **_: Any)
     with atomic_paths([path.with_suffix(".enc"), path]) as (tmp_enc, tmp_grd):
         tmp_grd.write_text(text, encoding="ascii")
         tmp_enc.write_text(enc, encoding="ascii")
+
+
+# ------------------------------------------------------------------- reading
+def read_enc(path: Path) -> list[list[tuple[int, int]]]:
+    """The polygons of an enclosure file: ``m n`` per line, each polygon closed by repeating its first
+    point (ReadError naming the file and line for anything else)."""
+    text = read_bytes(path).decode("latin-1")
+    polys: list[list[tuple[int, int]]] = []
+    cur: list[tuple[int, int]] = []
+    for no, ln in enumerate(text.splitlines(), 1):
+        toks = ln.split()
+        if not toks or ln.lstrip().startswith("*"):
+            continue
+        try:
+            p = (int(toks[0]), int(toks[1]))
+        except (ValueError, IndexError):
+            raise ReadError(f"{path}: line {no}: expected two integers 'M N', got {ln.strip()[:40]!r}") from None
+        cur.append(p)
+        if len(cur) > 1 and p == cur[0]:
+            polys.append(cur)
+            cur = []
+    if cur:
+        raise ReadError(
+            f"{path}: the last polygon (from point {cur[0]}) is not closed: its first point is not repeated"
+        )
+    if not polys:
+        raise ReadError(f"{path}: no enclosure polygon")
+    return polys
+
+
+def _enclosed(polys: list[list[tuple[int, int]]], shape: tuple[int, int]) -> np.ndarray:
+    """Cells ``(I, J)`` (water-level points ``(I + 2, J + 2)``) strictly inside the first polygon and
+    not inside or on another (see the module docstring)."""
+    import shapely
+
+    m, n = np.meshgrid(np.arange(shape[0]) + 2.0, np.arange(shape[1]) + 2.0, indexing="ij")
+
+    def geom(p):
+        u = list(dict.fromkeys(p))
+        return shapely.Polygon(p) if len(u) > 2 else shapely.LineString(u) if len(u) == 2 else shapely.Point(u[0])
+
+    inside = shapely.contains_xy(geom(polys[0]), m, n)
+    for p in polys[1:]:
+        inside &= ~shapely.intersects_xy(geom(p), m, n)
+    return inside
+
+
+def read_index_space(path: Path) -> tuple[Any, Frame]:
+    """The merged grid of a ``.grd`` (missing points inactive) and its water cells (from the ``.enc``
+    beside it, else every cell with four active corners), with its frame."""
+    from ..multiblock.indexspace import from_mask
+
+    path = Path(path)
+    X, Y, crs, spherical, missing = read_grd_arrays(path)
+    gone_x, gone_y = np.equal(X, missing), np.equal(Y, missing)
+    if (gone_x != gone_y).any():
+        m, n = (int(v) for v in np.argwhere(gone_x != gone_y)[0])
+        which = "x" if gone_x[m, n] else "y"
+        raise ReadError(
+            f"{path}: node (m={m + 1}, n={n + 1}): {which} is the missing value {missing:g} and the other "
+            f"coordinate is not"
+        )
+    act = ~gone_x
+    if act.sum() < 4:
+        raise ReadError(f"{path}: fewer than 4 active points: no cell")
+    x, y = np.where(act, X, np.nan), np.where(act, Y, np.nan)
+    corners = act[:-1, :-1] & act[1:, :-1] & act[1:, 1:] & act[:-1, 1:]
+    enc = path.with_suffix(".enc")
+    if enc.is_file():
+        water = _enclosed(read_enc(enc), corners.shape)
+        bad = water & ~corners
+        if bad.any():
+            i, j = (int(v) for v in np.argwhere(bad)[0])
+            raise ReadError(
+                f"{enc}: the enclosure makes cell (m={i + 2}, n={j + 2}) active, but a corner of it is a "
+                f"missing point of {path.name}: the two files come from different writes"
+            )
+    else:
+        water = corners
+    if not water.any():
+        raise ReadError(f"{path}: no active cell")
+    space = from_mask(x, y, water)
+    return space, Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
+
+
+def gridset_of(space: Any, frame: Frame, path: Path) -> GridSet:
+    """The blocks of an index space read back as a :class:`GridSet` (world coordinates: origin 0)."""
+    blocks = tuple(
+        grid_from_world(g.x, g.y, (0.0, 0.0), path, f"block {nm}")
+        for g, nm in zip(space.blocks(), space.names, strict=True)
+    )
+    return GridSet(blocks, frame, space.names, find_interfaces(blocks), str(path))
+
+
+def read_grd_single(path: Path, **_: Any) -> GridSet:
+    """Read a single-domain ``.grd`` (+ ``.enc``): its water cells as rectangular blocks (module docstring)."""
+    space, frame = read_index_space(path)
+    return gridset_of(space, frame, Path(path))

@@ -61,7 +61,7 @@ import numpy as np
 from ..errors import TopologyError
 from ..grid import StructuredGrid
 
-__all__ = ["EmbeddingError", "IndexSpace", "Placement", "embed"]
+__all__ = ["EmbeddingError", "IndexSpace", "Placement", "embed", "from_mask"]
 
 #: Nodes closer than this fraction of the domain's size are one node.
 RTOL = 1e-7
@@ -116,6 +116,23 @@ class IndexSpace:
     def water(self) -> np.ndarray:
         """Cells that belong to a block."""
         return self.owner >= 0
+
+    def block(self, k: int) -> StructuredGrid:
+        """Block ``k`` as a grid in its own index directions (the inverse of its placement)."""
+        cells = np.argwhere(self.owner == k)
+        if not len(cells):
+            raise ValueError(f"block {k} has no cells in the index space")
+        p = self.placements[k]
+        R = np.array(p.rotation)
+        box = np.array(cells.max(axis=0) - cells.min(axis=0) + 1)  # cells along I, J
+        ni, nj = (int(v) for v in np.abs(R.T) @ box)
+        ii, jj = np.meshgrid(np.arange(ni + 1), np.arange(nj + 1), indexing="ij")
+        gi, gj = p.apply(ii, jj)
+        return StructuredGrid(self.x[gi, gj], self.y[gi, gj], names={"block": self.names[k]})
+
+    def blocks(self) -> list[StructuredGrid]:
+        """Every block (:meth:`block`), in order."""
+        return [self.block(k) for k in range(len(self.placements))]
 
 
 _BORDER = {  # direction t, inward normal n, node of index k on a (ni, nj)-cell block
@@ -291,3 +308,44 @@ def embed(blocks: Sequence[StructuredGrid], names: Sequence[str] | None = None, 
         size = np.maximum(size, [ci.max() + 1, cj.max() + 1])
     x, y, owner = _fill(blocks, names, placements, (int(size[0]), int(size[1])), tol)
     return IndexSpace(x, y, owner, tuple(placements), names, max(comp) + 1)
+
+
+def from_mask(x: np.ndarray, y: np.ndarray, water: np.ndarray, *, prefix: str = "block") -> IndexSpace:
+    """A merged grid read back (nodes ``x, y``, NaN where inactive; its water cells ``water``) as an
+    :class:`IndexSpace` of rectangular blocks: the inverse of :func:`embed` for a file that keeps no
+    blocks (a Delft3D single-domain ``.grd``, EFDC's ``cell.inp``).
+
+    The water cells are cut into rectangles row by row, each as wide as its run of water and as
+    tall as the run stays water: blocks that share borders, with T-junctions where runs end.  Every
+    corner of a water cell must be an active node (``ValueError`` otherwise).
+    """
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    water = np.asarray(water, bool)
+    if water.shape != (x.shape[0] - 1, x.shape[1] - 1) or x.shape != y.shape:
+        raise ValueError(f"{water.shape} cells do not fit {x.shape} nodes")
+    act = np.isfinite(x) & np.isfinite(y)
+    corners = act[:-1, :-1] & act[1:, :-1] & act[1:, 1:] & act[:-1, 1:]
+    if (water & ~corners).any():
+        i, j = (int(v) for v in np.argwhere(water & ~corners)[0])
+        raise ValueError(f"water cell ({i}, {j}) has an inactive corner")
+    owner = np.full(water.shape, -1)
+    placements: list[Placement] = []
+    free = water.copy()
+    for J in range(water.shape[1]):
+        row = np.r_[False, free[:, J], False].astype(np.int8)
+        starts = np.flatnonzero(np.diff(row) == 1)
+        stops = np.flatnonzero(np.diff(row) == -1)
+        for i0, i1 in zip(starts, stops, strict=True):
+            j1 = J + 1
+            while j1 < water.shape[1] and free[i0:i1, j1].all():
+                j1 += 1
+            k = len(placements)
+            owner[i0:i1, J:j1] = k
+            free[i0:i1, J:j1] = False
+            placements.append(Placement(((1, 0), (0, 1)), (int(i0), int(J))))
+    from scipy import ndimage
+
+    n_components = int(ndimage.label(water)[1])
+    names = tuple(f"{prefix}{k + 1}" for k in range(len(placements)))
+    return IndexSpace(np.where(act, x, np.nan), np.where(act, y, np.nan), owner, tuple(placements), names, n_components)
