@@ -707,16 +707,30 @@ class Canvas(pg.PlotWidget):
         self.background_item.setTransform(tr)
         self.background_item.show()
 
+    def editing_items(self) -> list:
+        """The items that serve editing, not the figure: boundary points, the selection, corners and their
+        labels, the active block's coloured borders with their arrows and labels, block loops and cut
+        lines, folded-cell crosses, the tools' rubber line and box, the ring of the last click, and the
+        lake's layout marks (cut lines and ends, block corners and labels, preset misses, the drag ring)."""
+        items = [self.loop_curve, self.cut_curve, *self.border_curves.values(), *self.border_arrows.values()]
+        items += [*self.border_labels.values(), self.points_item, self.other_points_item, self.selected_item]
+        items += [self.corner_item, *self.corner_labels, self.folded_item]
+        items += [self.rubber_line, self.rubber_box, self.highlight_item]
+        return items + self.lake_items.editing_items()
+
     def export_image(self, path: str) -> None:
-        """Write the canvas to PNG (raster) or SVG (vector) by the file suffix."""
+        """Write the canvas to PNG (raster) or SVG (vector) by the file suffix: the grid and what colours
+        it, the shore, the background image and the axes, without the editing marks (:meth:`editing_items`)."""
         import pyqtgraph.exporters as ex
 
-        ring = self.highlight_item.isVisible()
-        self.highlight_item.hide()  # a marker of the last click, not part of the figure
+        hidden = [it for it in self.editing_items() if it.isVisible()]
+        for it in hidden:
+            it.hide()
         try:
             if str(path).lower().endswith(".svg"):
                 ex.SVGExporter(self.getPlotItem()).export(str(path))
             elif not self.grab().save(str(path)):
                 raise OSError(f"{path}: cannot write the image")
         finally:
-            self.highlight_item.setVisible(ring)
+            for it in hidden:
+                it.show()

@@ -320,6 +320,11 @@ class LakeOverlay:
         """Ring the handle being dragged where it will go (None: no drag)."""
         set_points(self.drag_point, None if xy is None else np.asarray(xy, float).reshape(1, 2))
 
+    def editing_items(self) -> list:
+        """The layout's editing marks (cut lines and ends, block corners and labels, preset misses, the
+        drag ring): left out of an exported figure, which keeps the shore."""
+        return [self.cuts, self.cut_ends, self.corners, *self.miss_marks.items(), self.drag_point, *self.labels]
+
     def set_markers_visible(self, on: bool) -> None:
         self.markers_visible = bool(on)
         self._size_markers(self.canvas.pixel())
