@@ -332,10 +332,16 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         Auto layout chooses."""
         has = project.layout is not None
         had, self._had_layout = self._had_layout, has
+        key = None
         if not has and self.canvas.tool is self.tools["layout"]:
-            self.set_tool("edit")
+            key = "edit"
         elif has and not had and self.canvas.tool is self.tools["edit"]:
-            self.set_tool("layout")
+            key = "layout"
+        if key is not None:  # the status line keeps what the change said (the tool's tip would cover it)
+            text, style = self._status.text(), self._status.styleSheet()
+            self.set_tool(key)
+            self._status.setText(text)
+            self._status.setStyleSheet(style)
 
     def keyPressEvent(self, ev: QtGui.QKeyEvent) -> None:
         if self.canvas.tool is not None and self.canvas.tool.key(ev.key()):
