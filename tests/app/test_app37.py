@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.app.test_app33 import _small_lake
+
 pytestmark = pytest.mark.gui
 
 LAKES = Path(__file__).resolve().parents[2] / "benchmarks" / "lakes"
@@ -46,18 +48,6 @@ def test_the_cursor_readout_follows_a_fit_under_a_still_mouse(qtbot, win):
     assert _readout(win) == ""
     canvas.scene().sigMouseMoved.emit(pos)  # back over the canvas: read out again
     assert _said(*canvas.to_model(pos)) in _readout(win)
-
-
-def _small_lake():
-    from app.lake import Lake
-    from meshcore import testing
-
-    poly = testing.round_lake(850_031, kind="ring", radius=2000.0)
-    return Lake(
-        outline=np.asarray(poly.exterior.coords)[:-1],
-        holes=tuple(np.asarray(r.coords)[:-1] for r in poly.interiors),
-        target_cells=1500,
-    )
 
 
 def test_clear_layout_leaves_the_layout_tool_for_the_tool_of_a_lake_without_one(qtbot, win):
