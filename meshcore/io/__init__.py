@@ -194,7 +194,7 @@ for _f in (
         (".grd",),
         "Delft3D RGFGRID grid (+ .enc enclosure)",
         writer="delft3d:write_grd",
-        grid_reader="delft3d:read_grd",
+        grid_reader="delft3d_single:read_grd_any",
         crs=True,
     ),
     Format(

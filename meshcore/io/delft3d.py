@@ -33,7 +33,7 @@ from ..crs import Frame, normalize_crs
 from ..errors import ReadError
 from ._base import GridSet, atomic_path, atomic_paths, check_nodes, grid_from_world, read_bytes
 
-__all__ = ["read_grd", "read_grd_arrays", "write_grd"]
+__all__ = ["full_grid", "read_enc", "read_grd", "read_grd_arrays", "write_grd"]
 
 MISSING = -999.0
 
@@ -131,26 +131,33 @@ def _header(path: Path, lines: list[str]) -> tuple[int, str | None, bool, float]
     return k, crs, spherical, missing
 
 
-def read_grd(path: Path, *, inactive: bool = True, **_: Any) -> GridSet:
-    """Read an RGFGRID ``.grd`` file (Cartesian or Spherical).
+def read_grd(path: Path, **_: Any) -> GridSet:
+    """Read an RGFGRID ``.grd`` file (Cartesian or Spherical) of a full grid.
 
     The grid size is checked against the node limit before the values are
     read (one pass, into an array of that size); every coordinate must be a
     finite number; a ``.enc`` next to the file that does not fit the grid (a
     pair written by two different runs) is reported.  A grid with missing
-    (inactive) points is read as a single-domain grid
-    (:func:`meshcore.io.delft3d_single.read_grd_single`: its active cells as blocks), and so is
-    one whose ``.enc`` is not the full grid's (an island of inactive cells between active points);
-    ``inactive=False`` refuses one (a domain of a ``.ddb``, a full grid by definition).
+    (inactive) points, or whose ``.enc`` is not the full grid's (an island of inactive cells
+    between active points), is refused here: ``meshcore.io.read_blocks`` (or
+    :func:`meshcore.io.delft3d_single.read_grd_any`) reads it as a single-domain grid.
     """
+    gs = full_grid(path)
+    if gs is None:
+        raise ReadError(
+            f"{path}: grid has missing (inactive) points or an enclosure that leaves cells out; "
+            "a full grid is expected here (meshcore.io.read_blocks reads it as a single-domain grid)"
+        )
+    return gs
+
+
+def full_grid(path: Path) -> GridSet | None:
+    """The grid of an RGFGRID ``.grd`` as one block, or None when it has missing (inactive) points or
+    its ``.enc`` is not the full grid's (:func:`read_grd`'s checks otherwise)."""
     X, Y, crs, spherical, missing = read_grd_arrays(path)
     _check_enclosure(path, *X.shape)
     if np.any(missing == X) or np.any(missing == Y) or not _full_enclosure(path, *X.shape):
-        if not inactive:
-            raise ReadError(f"{path}: grid has missing (inactive) points; a full grid is expected here")
-        from .delft3d_single import read_grd_single
-
-        return read_grd_single(path)
+        return None
     frame = Frame("EPSG:4326" if spherical else crs, (0.0, 0.0))
     return GridSet((grid_from_world(X, Y, (0.0, 0.0), path),), frame, source=str(path))
 
@@ -203,10 +210,35 @@ def read_grd_arrays(path: Path) -> tuple[np.ndarray, np.ndarray, str | None, boo
     return X, Y, crs, spherical, missing
 
 
+def read_enc(path: Path) -> list[list[tuple[int, int]]]:
+    """The polygons of an enclosure file: ``m n`` per line, each polygon closed by repeating its first
+    point (ReadError naming the file and line for anything else)."""
+    text = read_bytes(path).decode("latin-1")
+    polys: list[list[tuple[int, int]]] = []
+    cur: list[tuple[int, int]] = []
+    for no, ln in enumerate(text.splitlines(), 1):
+        toks = ln.split()
+        if not toks or ln.lstrip().startswith("*"):
+            continue
+        try:
+            p = (int(toks[0]), int(toks[1]))
+        except (ValueError, IndexError):
+            raise ReadError(f"{path}: line {no}: expected two integers 'M N', got {ln.strip()[:40]!r}") from None
+        cur.append(p)
+        if len(cur) > 1 and p == cur[0]:
+            polys.append(cur)
+            cur = []
+    if cur:
+        raise ReadError(
+            f"{path}: the last polygon (from point {cur[0]}) is not closed: its first point is not repeated"
+        )
+    if not polys:
+        raise ReadError(f"{path}: no enclosure polygon")
+    return polys
+
+
 def _full_enclosure(path: Path, mmax: int, nmax: int) -> bool:
     """True when no ``.enc`` is beside ``path`` or it is the enclosure of the full grid."""
-    from .delft3d_single import read_enc
-
     enc = Path(path).with_suffix(".enc")
     if not enc.is_file():
         return True

@@ -363,7 +363,7 @@ def read_dd(path: Any) -> DomainDecomposition:
                 gp = path.parent / f
                 if not gp.is_file():
                     raise ReadError(f"{path}: line {line}: grid file {f} not found next to the .ddb")
-                grids[f] = read_grd(gp, inactive=False)
+                grids[f] = read_grd(gp)
                 files.append(f)
         records.append((line, rec[0][1], nums[:4], rec[5][1], nums[4:]))
     stems = [Path(f).stem for f in files]

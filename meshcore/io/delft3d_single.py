@@ -53,8 +53,8 @@ import numpy as np
 from ..crs import Frame
 from ..errors import ReadError, WriteError
 from ._atomic import atomic_paths
-from ._base import GridSet, find_interfaces, grid_from_world, read_bytes
-from .delft3d import grd_text, read_grd_arrays
+from ._base import GridSet, find_interfaces, grid_from_world
+from .delft3d import full_grid, grd_text, read_enc, read_grd_arrays
 
 __all__ = [
     "MISSING_VALUE",
@@ -177,33 +177,6 @@ def write_grd_single(path: Path, gs: GridSet, *, lonlat: bool = False, **_: Any)
 
 
 # ------------------------------------------------------------------- reading
-def read_enc(path: Path) -> list[list[tuple[int, int]]]:
-    """The polygons of an enclosure file: ``m n`` per line, each polygon closed by repeating its first
-    point (ReadError naming the file and line for anything else)."""
-    text = read_bytes(path).decode("latin-1")
-    polys: list[list[tuple[int, int]]] = []
-    cur: list[tuple[int, int]] = []
-    for no, ln in enumerate(text.splitlines(), 1):
-        toks = ln.split()
-        if not toks or ln.lstrip().startswith("*"):
-            continue
-        try:
-            p = (int(toks[0]), int(toks[1]))
-        except (ValueError, IndexError):
-            raise ReadError(f"{path}: line {no}: expected two integers 'M N', got {ln.strip()[:40]!r}") from None
-        cur.append(p)
-        if len(cur) > 1 and p == cur[0]:
-            polys.append(cur)
-            cur = []
-    if cur:
-        raise ReadError(
-            f"{path}: the last polygon (from point {cur[0]}) is not closed: its first point is not repeated"
-        )
-    if not polys:
-        raise ReadError(f"{path}: no enclosure polygon")
-    return polys
-
-
 def _enclosed(polys: list[list[tuple[int, int]]], shape: tuple[int, int]) -> np.ndarray:
     """Cells ``(I, J)`` (water-level points ``(I + 2, J + 2)``) strictly inside the first polygon and
     not inside or on another (see the module docstring)."""
@@ -272,3 +245,10 @@ def read_grd_single(path: Path, **_: Any) -> GridSet:
     """Read a single-domain ``.grd`` (+ ``.enc``): its water cells as rectangular blocks (module docstring)."""
     space, frame = read_index_space(path)
     return gridset_of(space, frame, Path(path))
+
+
+def read_grd_any(path: Path, **_: Any) -> GridSet:
+    """Read an RGFGRID ``.grd``: a full grid as one block (:func:`.delft3d.read_grd`), one with missing
+    (inactive) points or an ``.enc`` that leaves cells out as a single-domain grid (:func:`read_grd_single`)."""
+    full = full_grid(path)
+    return full if full is not None else read_grd_single(path)

@@ -188,7 +188,10 @@ def test_an_enclosure_from_another_write_is_refused(grd):
 
 def test_a_ddb_domain_with_inactive_points_is_refused(tmp_path, grd):
     (tmp_path / "dd.ddb").write_text("lake.grd 1 1 1 3 lake.grd 1 1 1 3\n")
-    with pytest.raises(ReadError, match=r"lake\.grd: grid has missing \(inactive\) points; a full grid is expected"):
+    with pytest.raises(
+        ReadError,
+        match=r"lake\.grd: grid has missing \(inactive\) points or an enclosure that leaves cells out; a full grid",
+    ):
         read_blocks(tmp_path / "dd.ddb")
 
 
