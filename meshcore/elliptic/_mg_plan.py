@@ -65,16 +65,9 @@ def coarsening(cells: tuple[int, int], aspect: float, periodic: bool = False) ->
 
 def anisotropic(x: np.ndarray, y: np.ndarray) -> bool:
     """True if more than ``LINE_FRACTION`` of the (sampled) cells have an aspect beyond
-    ``LINE_ASPECT`` either way (first ξ side / first η side, as :func:`K.cell_stats`)."""
-    s = _stride(x)
-    i = np.arange(0, x.shape[0] - 1, s)[:, None]
-    j = np.arange(0, x.shape[1] - 1, s)[None, :]
-    a2 = (x[i + 1, j] - x[i, j]) ** 2 + (y[i + 1, j] - y[i, j]) ** 2
-    b2 = (x[i, j + 1] - x[i, j]) ** 2 + (y[i, j + 1] - y[i, j]) ** 2
-    lim = LINE_ASPECT**2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        far = (a2 > lim * b2) | (b2 > lim * a2)
-    return bool(far.mean() > LINE_FRACTION)
+    ``LINE_ASPECT`` either way (first ξ side / first η side, as :func:`K.cell_stats`;
+    :func:`K.far_fraction`, whose NumPy reference is in the tests)."""
+    return bool(K.far_fraction(x, y, _stride(x), LINE_ASPECT**2) > LINE_FRACTION)
 
 
 def _plan(x: np.ndarray, y: np.ndarray, periodic: bool = False, norm: tuple | None = None, wake: int = 0) -> list:

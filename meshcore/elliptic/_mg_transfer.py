@@ -23,6 +23,7 @@ from ._compile import ROW_CHUNKS, parallel, serial
 __all__ = [
     "cell_stats",
     "coarse_positions",
+    "far_fraction",
     "prolong_correct",
     "prolong_correct_parallel",
     "restrict",
@@ -229,6 +230,24 @@ def cell_stats(x, y, stride):  # pragma: no cover - compiled
     s += np.log(prod)
     ncell = (ni1 - 1) * (nj1 - 1)
     return (0.5 * s / cnt if cnt else 0.0), folded / max(ncell, 1)
+
+
+@njit(cache=True, nogil=True)
+def far_fraction(x, y, stride, lim2):  # pragma: no cover - compiled
+    """The fraction of the cells sampled every ``stride`` cells in each direction whose first ξ
+    side is longer than ``sqrt(lim2)`` times their first η side or the other way round (the
+    sides of :func:`cell_stats`; 0 when there is no cell)."""
+    ni1, nj1 = x.shape
+    far = 0
+    cnt = 0
+    for i in range(0, ni1 - 1, stride):
+        for j in range(0, nj1 - 1, stride):
+            a2 = (x[i + 1, j] - x[i, j]) ** 2 + (y[i + 1, j] - y[i, j]) ** 2
+            b2 = (x[i, j + 1] - x[i, j]) ** 2 + (y[i, j + 1] - y[i, j]) ** 2
+            cnt += 1
+            if a2 > lim2 * b2 or b2 > lim2 * a2:
+                far += 1
+    return far / cnt if cnt else 0.0
 
 
 #: Width of the restriction stencils (a coarse node collects from ≤ 4 fine nodes).

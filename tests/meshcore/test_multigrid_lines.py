@@ -87,6 +87,42 @@ def test_anisotropy_measure():
     assert multigrid.anisotropic(X * 10.0, Y)  # uniformly long cells too (one direction)
 
 
+def _far_fraction_numpy(x, y, stride, lim2):
+    """The NumPy reference of ``_mg_kernels.far_fraction`` (the measure ``anisotropic`` compares)."""
+    i = np.arange(0, x.shape[0] - 1, stride)[:, None]
+    j = np.arange(0, x.shape[1] - 1, stride)[None, :]
+    a2 = (x[i + 1, j] - x[i, j]) ** 2 + (y[i + 1, j] - y[i, j]) ** 2
+    b2 = (x[i, j + 1] - x[i, j]) ** 2 + (y[i, j + 1] - y[i, j]) ** 2
+    far = (a2 > lim2 * b2) | (b2 > lim2 * a2)
+    return float(far.mean()) if far.size else 0.0
+
+
+@pytest.mark.parametrize("stride", [1, 2, 3, 7])
+def test_the_compiled_aspect_share_is_the_numpy_one(stride):
+    """On mixed aspects, a plain square, uniformly long cells, a grid with zero-length sides (a
+    collapsed row) and random nodes: the same share, and so the same answer of ``anisotropic``."""
+    X, Y = np.meshgrid(np.linspace(0, 1, 41), np.linspace(0, 1, 37), indexing="ij")
+    Xc = X.copy()
+    Xc[5] = Xc[6]  # a collapsed row: sides of length zero
+    rng = np.random.default_rng(3)
+    grids = [
+        _mixed_aspect(64, 64),
+        _mixed_aspect(96, 48),
+        (X, Y),
+        (X * 10.0, Y),
+        (Xc, Y),
+        (rng.random((30, 20)), rng.random((30, 20))),
+    ]
+    lim2 = multigrid.LINE_ASPECT**2
+    shares = []
+    for x, y in grids:
+        got = _mg_kernels.far_fraction(x, y, stride, lim2)
+        assert got == pytest.approx(_far_fraction_numpy(x, y, stride, lim2), abs=1e-15)
+        shares.append(got)
+    assert shares[2] == 0.0 and shares[3] == 1.0 and 0.0 < shares[0] < 1.0
+    assert _mg_kernels.far_fraction(np.zeros((1, 5)), np.zeros((1, 5)), 1, lim2) == 0.0  # no cell
+
+
 @pytest.mark.parametrize("cells", [(64, 64), (96, 48)])
 def test_line_smoothing_rate_on_a_stretched_curved_grid(cells):
     """Cells 1:10 one way in one corner and 10:1 the other way in the opposite one: the
