@@ -580,12 +580,10 @@ def mesh_outline(
         reading=readings,
     )
     mb = mesh_layout(lay, levels=levels, readings=readings, **options)
-    from .quality.lake import block_metrics
-
     if mb.notes:
         n = len(mb.notes)
         mb = _with_info(mb, message=f"{mb.info.message}; {n} layout note{'s' * (n != 1)} (grid.notes)")
-    folded = sum(int(block_metrics(g).folded.sum()) for g in mb.grids)
+    folded = _n_folded(mb.grids)
     if folded:
         msg = f"{mb.info.message}; {folded} folded or non-convex cell(s) remain"
         if strict:

@@ -151,10 +151,11 @@ def read_grd(path: Path, **_: Any) -> GridSet:
     return gs
 
 
-def full_grid(path: Path) -> GridSet | None:
+def full_grid(path: Path, arrays: tuple | None = None) -> GridSet | None:
     """The grid of an RGFGRID ``.grd`` as one block, or None when it has missing (inactive) points or
-    its ``.enc`` is not the full grid's (:func:`read_grd`'s checks otherwise)."""
-    X, Y, crs, spherical, missing = read_grd_arrays(path)
+    its ``.enc`` is not the full grid's (:func:`read_grd`'s checks otherwise; ``arrays``: the file's
+    :func:`read_grd_arrays`, if read already)."""
+    X, Y, crs, spherical, missing = read_grd_arrays(path) if arrays is None else arrays
     _check_enclosure(path, *X.shape)
     if np.any(missing == X) or np.any(missing == Y) or not _full_enclosure(path, *X.shape):
         return None

@@ -194,13 +194,14 @@ def _enclosed(polys: list[list[tuple[int, int]]], shape: tuple[int, int]) -> np.
     return inside
 
 
-def read_index_space(path: Path) -> tuple[Any, Frame]:
+def read_index_space(path: Path, arrays: tuple | None = None) -> tuple[Any, Frame]:
     """The merged grid of a ``.grd`` (missing points inactive) and its water cells (from the ``.enc``
-    beside it, else every cell with four active corners), with its frame."""
+    beside it, else every cell with four active corners), with its frame (``arrays``: the file's
+    :func:`.delft3d.read_grd_arrays`, if read already)."""
     from ..multiblock.indexspace import from_mask
 
     path = Path(path)
-    X, Y, crs, spherical, missing = read_grd_arrays(path)
+    X, Y, crs, spherical, missing = read_grd_arrays(path) if arrays is None else arrays
     gone_x, gone_y = np.equal(X, missing), np.equal(Y, missing)
     if (gone_x != gone_y).any():
         m, n = (int(v) for v in np.argwhere(gone_x != gone_y)[0])
@@ -250,5 +251,6 @@ def read_grd_single(path: Path, **_: Any) -> GridSet:
 def read_grd_any(path: Path, **_: Any) -> GridSet:
     """Read an RGFGRID ``.grd``: a full grid as one block (:func:`.delft3d.read_grd`), one with missing
     (inactive) points or an ``.enc`` that leaves cells out as a single-domain grid (:func:`read_grd_single`)."""
-    full = full_grid(path)
-    return full if full is not None else read_grd_single(path)
+    arrays = read_grd_arrays(path)  # (read once for both)
+    full = full_grid(path, arrays)
+    return full if full is not None else gridset_of(*read_index_space(path, arrays), Path(path))
