@@ -29,6 +29,19 @@ DATA = Path(__file__).resolve().parent / "data"
 SHARED_LAKES = ROOT.parent / "shared" / "data" / "lakes"
 
 
+def benchmark_module(name: str):
+    """The script ``benchmarks/<name>.py`` loaded as a module (``benchmarks/`` on the path for
+    its own imports)."""
+    import importlib.util
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
 def annulus_sector(ni: int, nj: int, r0: float = 1.0, r1: float = 3.0, th0: float = 0.0, th1: float = math.pi / 2):
     """Exact Winslow grid of an annulus sector: i along ln r (geometric), j along θ."""
     r = r0 * (r1 / r0) ** np.linspace(0.0, 1.0, ni + 1)

@@ -3,18 +3,11 @@ session wrote there stays (a rerun deleted every session's paragraphs of the sec
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-
-from tests.conftest import ROOT
+from tests.conftest import benchmark_module
 
 
 def _robust():
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    spec = importlib.util.spec_from_file_location("robust", ROOT / "benchmarks" / "robust.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return benchmark_module("robust")
 
 
 OLD = """### Busy machine (257²)
