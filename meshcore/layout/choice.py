@@ -15,7 +15,9 @@ level of each layout that differs, and keeps the one with the smallest deviation
 :data:`MARGIN` below the first's and its interface ratio there (the 99th percentile of the coarse
 cell pairs', :data:`meshcore.lakegrid.READING_PERCENTILE`) is no larger (up to
 :data:`RATIO_SLACK`) or at most ``ratio_ok`` (:data:`meshcore.layout.DEFAULT_RATIO` and
-:data:`~meshcore.layout.REGULAR_RATIO`: 2.5); else the layout at the cell size itself.  A default layout whose blocks
+:data:`~meshcore.layout.REGULAR_RATIO`: 2.5); else the layout at the cell size itself.  Where
+every one of those reads far off 90° (:data:`WIDE_DEV`), the layout is drawn at the wider
+:data:`WIDE_SCALES` as well.  A default layout whose blocks
 average fewer than :data:`SMALL_BLOCK_CELLS` cells can also be drawn at :data:`COARSE_SCALES` (off) × the
 cell size — fewer, larger blocks whose lines are long enough to grade their cells (edge pairs
 ≤ 1.2, issue 12's lakes of 70–100 blocks at 10 000 cells) — and there the coarse ratio may also
@@ -30,10 +32,45 @@ from collections.abc import Callable, Sequence
 from ..errors import MeshcoreError
 from .model import Layout
 
-__all__ = ["MARGIN", "MAX_BLOCKS", "RATIO_SLACK", "SCALES", "chosen"]
+__all__ = [
+    "MARGIN",
+    "MAX_BLOCKS",
+    "RATIO_SLACK",
+    "SCALES",
+    "WIDE_DEV",
+    "WIDE_MAX_BLOCKS",
+    "WIDE_RATIO",
+    "WIDE_SCALES",
+    "chosen",
+]
 
 #: The other scales (× the cell size) the layout is drawn at, in the order tried.
 SCALES = (1.07, 0.93)
+
+#: When the best of those layouts' coarse grids still deviates from 90° by more than
+#: :data:`WIDE_DEV` degrees on average (the target for the final grid's mean, issue 12), the layout
+#: is also drawn at these scales.  The draws of 1, 1.07 and 0.93 × the cell size often share the same
+#: fault (a strip between a cut and the shore, a block wrapped round a junction); a wider scale moves
+#: the cuts and corners enough to lose it.  Session 38, held-out set 25 at 10 000 cells: regular
+#: layouts 23 → 26 of 28 lakes meeting every hard target (g182733 74.3 → 95.5 % of nodes within 3°,
+#: g181108 88.0 → 95.9 %), default ones 24 → 27 (g180663 91.1 → 96.8 %, g180899 89.4 → 95.1 %);
+#: generated ``fresh_sweep.py --base 430000`` 44 → 45 of 45 (islands 430306 72.6 → 95.5 %).  Of 21
+#: layouts taken from the wide round, 0.8 gave 9, 0.87 and 1.25 5 each, 1.15 none (dropped).  The
+#: whole comparison in ``docs/lake-grids-journal.md`` (session 38).
+WIDE_SCALES = (0.87, 1.25, 0.8)
+WIDE_DEV = 3.0
+
+#: ... for layouts of at most this many blocks: a draw of a lake's layout costs ~25 ms of CPU a
+#: block (Kivu's 90 blocks 1.7–3.6 s), and four wide draws took Kivu at 15 000 cells from 12.7 to
+#: 23.2 s of CPU (81.8 → 88.8 % within 3°), over issue 12's 20 s.
+WIDE_MAX_BLOCKS = 80
+
+#: ... and a layout of those wider scales is kept also when its coarse interface ratio is up to
+#: this (where the nearby ones allow :data:`meshcore.layout.DEFAULT_RATIO` or
+#: :data:`~meshcore.layout.REGULAR_RATIO`, 2.5): its coarse grid is far off 90° while the final
+#: grid's equalize step brings its interfaces under 2 (set 25: the wide layouts kept read coarse
+#: ratios of 2.7–3.4 and ended at 1.52–2.00; session 26's coarse 5.6 and 12.7 ended at 5.9 and 8.8).
+WIDE_RATIO = 3.5
 
 #: Another scale's layout is kept only if its coarse grid's mean deviation is below ``1 - MARGIN``
 #: of the first's: differences of a few percent did not rank the final grids (generated islands
@@ -96,7 +133,11 @@ def chosen(
     chosen layout's and its coarse interface ratio no larger than ``first``'s (or ``ratio_ok``).
     ``coarse``: a layout of small blocks (:data:`SMALL_BLOCK_CELLS`) is also drawn at
     :data:`COARSE_SCALES`, and ``ratio_ok`` is at least :data:`SMALL_RATIO_OK` for it (default
-    layouts; regular ones close their frames at other scales by moving corners)."""
+    layouts; regular ones close their frames at other scales by moving corners).  When the best
+    of all these still reads more than :data:`WIDE_DEV` degrees (and ``first`` has at most
+    :data:`WIDE_MAX_BLOCKS` blocks), the layout is drawn at
+    :data:`WIDE_SCALES` too, one of them kept when it reads :data:`MARGIN` below that best with a
+    coarse ratio up to :data:`WIDE_RATIO`."""
     if first.multiple < 4 or len(first.blocks) > MAX_BLOCKS:
         return first
     try:
@@ -119,17 +160,24 @@ def chosen(
         ratio_ok = max(ratio_ok, SMALL_RATIO_OK)
     draws: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in scales]
     draws += [(None, d) for d in more]
-    for scale, draw in draws:
-        try:
-            lay = draw()
-            if lay.blocks in seen:
+    wide: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in WIDE_SCALES]
+    guard = ratio_ok
+    while draws:
+        for scale, draw in draws:
+            try:
+                lay = draw()
+                if lay.blocks in seen:
+                    continue
+                seen.append(lay.blocks)
+                dev, ratio = reading(lay)
+            except MeshcoreError:
                 continue
-            seen.append(lay.blocks)
-            dev, ratio = reading(lay)
-        except MeshcoreError:
-            continue
-        if dev < score and ratio <= max(ratio0 * (1.0 + RATIO_SLACK), ratio_ok):
-            best, score, best_scale, best_dev = lay, dev, scale, dev
+            if dev < score and ratio <= max(ratio0 * (1.0 + RATIO_SLACK), guard):
+                best, score, best_scale, best_dev = lay, dev, scale, dev
+        # the nearby scales all read far from 90°: the wider ones once, with a looser ratio guard,
+        # each to read the margin below the best so far
+        draws, wide = (wide, []) if best_dev > WIDE_DEV and len(first.blocks) <= WIDE_MAX_BLOCKS else ([], [])
+        guard, score = max(ratio_ok, WIDE_RATIO), (1.0 - MARGIN) * best_dev
     if tips is not None and best_scale is not None:  # the chosen scale again, pieces round land tips split
         try:
             lay = tips(best_scale)
