@@ -27,6 +27,7 @@ be up to :data:`SMALL_RATIO_OK`, which the final grid's equalize step brings und
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 
 from ..errors import MeshcoreError
@@ -158,9 +159,12 @@ def chosen(
     ):
         scales = SCALES + COARSE_SCALES
         ratio_ok = max(ratio_ok, SMALL_RATIO_OK)
-    draws: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in scales]
-    draws += [(None, d) for d in more]
-    wide: list[tuple[float | None, Callable[[], Layout]]] = [(s, lambda s=s: at_scale(s)) for s in WIDE_SCALES]
+
+    def drawn_at(scales: Sequence[float]) -> list[tuple[float | None, Callable[[], Layout]]]:
+        return [(s, functools.partial(at_scale, s)) for s in scales]
+
+    draws = drawn_at(scales) + [(None, d) for d in more]
+    wide = drawn_at(WIDE_SCALES)
     guard = ratio_ok
     while draws:
         for scale, draw in draws:
