@@ -154,7 +154,7 @@ class IOController(ExportMixin, QtCore.QObject):
     # ---------------------------------------------------------- project
     def set_project(self, project: Project, path: Path | None = None) -> None:
         """Start over with ``project`` (no undo history, nothing unsaved)."""
-        self.win.solver.stop()
+        self.win.solver.drop()  # (stopped, its grid became the new project's)
         self.stack.clear()
         self.doc.reset(project, path)
         self.win.canvas.fit()
@@ -519,6 +519,7 @@ class IOController(ExportMixin, QtCore.QObject):
         ``replace`` (a project holding a lake) it replaces the lake, its layout, cuts and frame."""
         p = self.doc.project
         if replace:  # a new outline replaces the lake, laid out or not (undo brings it back)
+            self.win.solver.drop()  # the solve of the lake before: its grid is of no block of this one
             p = p.replaced(
                 blocks=(Block(name="block"),), lake=None, cut_lines=(), crs="", origin=(0.0, 0.0), source_crs=""
             )

@@ -240,6 +240,13 @@ class SolverController(QtCore.QObject):
         if not self.live and not self._debounce.isActive() and self._hold is not None:
             self._hold.set()
 
+    def drop(self) -> None:
+        """The running solve (if any) is of a project no longer open (another lake imported, a project
+        opened or started): it stops and its frames and grid are thrown away.  A stopped solve left its grid
+        to the new project: the first lake's block measured in the Quality dock, exported as the second's."""
+        if self._worker is not None:
+            self._drop()
+
     def _drop(self) -> None:
         """Stop the running solve and throw its frames and grids away: the document shows a kept grid of
         the project now (Redo of Auto layout while the undo's solve of the one block ran: that solve went
