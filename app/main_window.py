@@ -12,6 +12,7 @@ every action comes from the table in :mod:`app.actions`.
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 
 from PySide6 import QtCore, QtGui, QtWidgets
@@ -80,7 +81,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.editor = Editor(self.doc, self.stack)
         self.solver = SolverController(self.doc, self)
         self.lake_ctl = LakeController(self)
-        self._centres = (None, None)  # (grid, its cell centres) for the hover read-out
+        self._cell_centres: dict[int, tuple] = {}  # id(grid) → (grid, its cell centres, its box): the read-out
         self.canvas = Canvas(self.doc)
         self.canvas.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         # the canvas under a strip for offers (place_offer): an offer over the canvas covered the lake
@@ -303,17 +304,37 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self._coords.setText(f"{cell}   {text}" if cell else text)
 
     def _cell_readout(self, x: float, y: float) -> str:
-        """The coloured metric of the cell under the cursor (nearest cell centre, if inside it)."""
-        g, values, label = self.doc.colour_values()
-        if values is None or self.doc.solving:
+        """The coloured metric of the cell under the cursor (nearest cell centre, if inside it), in any
+        block the colours cover (deviation from 90° colours every block of a lake; the read-out was of the
+        active block alone: over the others' dark cells it said nothing).  Over several blocks it names
+        the block."""
+        if self.doc.solving:
             return ""
-        if self._centres[0] is not g:
-            self._centres = (g, geo.cell_centres(g.x, g.y))
-        cell = geo.cell_at(g.x, g.y, x, y, self._centres[1])
-        if cell is None:
+        layers = self.doc.colour_blocks()
+        best = None  # (distance to the cell's centre, block, i, j, values)
+        for k, g, values in layers:
+            entry = self._cell_centres.get(id(g))
+            if entry is None or entry[0] is not g:
+                box = (float(g.x.min()), float(g.y.min()), float(g.x.max()), float(g.y.max()))
+                entry = self._cell_centres[id(g)] = (g, geo.cell_centres(g.x, g.y), box)
+            if not (entry[2][0] <= x <= entry[2][2] and entry[2][1] <= y <= entry[2][3]):
+                continue  # (off this block: a lake of 100 blocks is read out at every mouse move)
+            cell = geo.cell_at(g.x, g.y, x, y, entry[1])
+            if cell is None:
+                continue
+            i, j = cell
+            d = math.hypot(float(entry[1][0][i, j]) - x, float(entry[1][1][i, j]) - y)
+            if best is None or d < best[0]:
+                best = (d, k, i, j, values)
+        if len(self._cell_centres) > len(layers):  # (the grids of earlier solves go)
+            shown = {id(g) for _k, g, _v in layers}
+            self._cell_centres = {key: e for key, e in self._cell_centres.items() if key in shown}
+        if best is None:
             return ""
-        i, j = cell
-        return f"cell ({i}, {j}): {label} {float(values[i, j]):.4g}"
+        _d, k, i, j, values = best
+        names = [b.name for b in self.doc.project.blocks]
+        where = f"{names[k]} " if len(layers) > 1 and k < len(names) else ""
+        return f"{where}cell ({i}, {j}): {self.doc.colour_by} {float(values[i, j]):.4g}"
 
     # -------------------------------------------------------------- tools
     def set_tool(self, key: str) -> None:

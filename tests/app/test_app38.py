@@ -108,3 +108,30 @@ def test_del_deletes_a_cut_line_pointed_at_along_its_line(qtbot, win):
     assert win.stack.undoText() == "Delete cut line"
     win.stack.undo()
     assert win.doc.project.layout is lay
+
+
+def test_the_cursor_reads_out_the_deviation_of_every_coloured_block(qtbot, win):
+    """Colour cells by deviation from 90° colours every block of a lake grid; the status bar read out the
+    cell under the cursor of the active block alone: over the dark cells of another block (where a
+    modeller looks) it said nothing.  Now it names the block and the cell of any block, with its value."""
+    from app.document import DEVIATION
+    from tests.app.waits import wait_for, wait_idle
+
+    p = _laid_out(win)
+    win.generate()
+    wait_for(qtbot, win, lambda: bool(win.doc.grids) and not win.doc.stale and win.doc.lake_metrics is not None)
+    wait_idle(qtbot, win)
+    win.quality_panel.metric.setCurrentText(DEVIATION)
+    assert len(win.doc.colour_layers()) == len(p.blocks) > 1  # every block coloured
+    win.doc.set_active(0)
+    k = 1  # a block that is not the active one, its worst cell
+    g, dev = win.doc.multiblock.grids[k], win.doc.lake_metrics.blocks[k].deviation
+    values = np.fmax(np.fmax(dev[:-1, :-1], dev[1:, :-1]), np.fmax(dev[1:, 1:], dev[:-1, 1:]))  # a cell's nodes' worst
+    i, j = np.unravel_index(int(np.nanargmax(values)), values.shape)
+    cx, cy = g.x[i : i + 2, j : j + 2].mean(), g.y[i : i + 2, j : j + 2].mean()
+    said = win._cell_readout(cx, cy)
+    assert said == f"{p.blocks[k].name} cell ({i}, {j}): {DEVIATION} {float(values[i, j]):.4g}"
+    win.quality_panel.metric.setCurrentText("skewness")  # a metric of the active block only: no block named
+    g0 = win.doc.quality_grid
+    assert win._cell_readout(g0.x[0:2, 0:2].mean(), g0.y[0:2, 0:2].mean()).startswith("cell (0, 0): skewness")
+    assert win._cell_readout(cx, cy) == ""  # over another block: not coloured, nothing read out
