@@ -703,8 +703,10 @@ class IOController(ExportMixin, QtCore.QObject):
         except OSError:
             log.warning("cannot remove the recovery file %s", self.recovery_path, exc_info=True)
 
-    def offer_recovery(self) -> bool:
-        """After a crash: offer the autosaved project back (True when restored)."""
+    def offer_recovery(self, instead_of: str | None = None) -> bool:
+        """After a crash: offer the autosaved project back (True when restored).  ``instead_of``: the
+        file the app was started on, which is not opened when the project is restored (the question
+        says so)."""
         if not recovery.exists(self.recovery_path):
             return False
         try:
@@ -714,6 +716,8 @@ class IOController(ExportMixin, QtCore.QObject):
             self.discard_recovery()
             return False
         what = recovery.describe(project, path, recovery.saved_at(self.recovery_path))
+        if instead_of:  # (Yes said nothing of the file double-clicked: another lake came up, the file unsaid)
+            what += f"\n\nYes: {instead_of} is not opened (File ▸ Open opens it then). No: {instead_of} opens."
         r = QtWidgets.QMessageBox.question(
             self._parent(),
             "Recover project",

@@ -135,3 +135,38 @@ def test_the_cursor_reads_out_the_deviation_of_every_coloured_block(qtbot, win):
     g0 = win.doc.quality_grid
     assert win._cell_readout(g0.x[0:2, 0:2].mean(), g0.y[0:2, 0:2].mean()).startswith("cell (0, 0): skewness")
     assert win._cell_readout(cx, cy) == ""  # over another block: not coloured, nothing read out
+
+
+def test_a_file_not_opened_for_a_restored_autosave_is_said_where_it_stays(qtbot, win, tmp_path, monkeypatch):
+    """gcmesh started on g180663.csv after a crash offered the autosaved lake; Yes restored it and, Live on,
+    solved it: the status line's "g180663.csv was not opened" was the restored grid's line a second later
+    and the question had not said the file would not open.  Now the question says what Yes and No do with
+    the file, and the Messages keep the note."""
+    from PySide6 import QtWidgets
+
+    from app.__main__ import open_at_start
+    from app.main_window import MainWindow
+    from tests.app.waits import wait_for, wait_idle
+
+    _laid_out(win)
+    win.io.autosave()  # the session that crashes
+    w = MainWindow(settings=win.settings, recovery=win.io.recovery_path)
+    w.quiet = True
+    qtbot.addWidget(w)
+    asked, reported = [], []
+    w.doc.reported.connect(lambda level, text: reported.append(text))
+
+    def question(_parent, _title, text, *_a):
+        asked.append(text)
+        return QtWidgets.QMessageBox.StandardButton.Yes
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    assert open_at_start(w, file=str(tmp_path / "g180663.csv"))
+    assert len(asked) == 1 and "g180663.csv is not opened" in asked[0]
+    w.generate()  # the restored lake's grid: its line replaces the status line's note
+    wait_for(qtbot, w, lambda: bool(w.doc.grids) and not w.doc.stale and not w.solver.running)
+    wait_idle(qtbot, w)
+    assert "g180663.csv was not opened" not in w._status.text()
+    assert any("g180663.csv was not opened" in t for t in reported)  # kept in the Messages
+    assert w.solver.shutdown(msecs=120_000)
+    w.stack.setClean()
