@@ -12,6 +12,8 @@ import math
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from meshcore.quality.presets import ok_percent
+
 from ..document import Document
 
 __all__ = ["LakePanel", "LakeQualityBox", "miss_points", "worst_miss"]
@@ -187,12 +189,6 @@ def miss_points(verdict, row: int | None = None) -> np.ndarray:
         over = v / r.limit.max if r.limit.max > 0 else v - r.limit.max
         out.append(np.column_stack([s.x[bad], s.y[bad], over]))
     return np.vstack(out) if out else np.zeros((0, 3))
-
-
-def ok_percent(fraction: float) -> str:
-    """A share within a limit, in per cent to a tenth, rounded down: 4 folded cells of 14 736 read
-    "FAIL (100.0 % ok)"; only a share of 1 reads 100.0."""
-    return f"{math.floor(1000 * float(fraction) + 1e-9) / 10:.1f}"
 
 
 def worst_miss(verdict, row: int):
