@@ -170,3 +170,33 @@ def test_a_file_not_opened_for_a_restored_autosave_is_said_where_it_stays(qtbot,
     assert any("g180663.csv was not opened" in t for t in reported)  # kept in the Messages
     assert w.solver.shutdown(msecs=120_000)
     w.stack.setClean()
+
+
+def test_an_undo_while_a_layout_edit_is_made_is_not_undone_by_the_edit(qtbot, win):
+    """Lake panel: a block's cells set, Ctrl+Z at once (the new layout still being made off the GUI
+    thread): the undo took Auto layout away, then the edit landed on the lake without a layout — the
+    layout was back, with the cells, and Redo (Auto layout) was gone from the history.  Now an edit of a
+    layout that an undo (or anything else) replaced before it was made is not set, and said so."""
+    from app.lake import compute_layout
+    from tests.app.waits import wait_for, wait_idle
+
+    lake = _small_lake()
+    win.editor.set_lake(lake, "Import lake.geojson")  # the lake imported, then laid out
+    lay = compute_layout(lake)
+    win.editor.set_lake(lake.replaced(layout=lay), "Auto layout")
+    c = lay.blocks[0].cells
+    win.lake_ctl.set_block_cells(0, (c[0] + 4, c[1]))
+    assert win.lake_ctl.editing
+    win.stack.undo()  # Ctrl+Z before the edit is made: Auto layout is undone
+    assert win.doc.project.layout is None
+    wait_for(qtbot, win, lambda: not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is None  # not set again by the edit
+    assert win.stack.redoText() == "Auto layout" and win.stack.index() == win.stack.count() - 1
+    assert "not made" in win._status.text()
+    win.stack.redo()
+    assert win.doc.project.layout is lay  # the layout as it was, its cells unchanged
+    win.lake_ctl.set_block_cells(0, (c[0] + 4, c[1]))  # an edit with nothing in between lands as before
+    wait_for(qtbot, win, lambda: not win.lake_ctl.editing)
+    assert win.doc.project.layout.blocks[0].cells == (c[0] + 4, c[1])
+    assert win.stack.undoText().startswith("Cells of")
