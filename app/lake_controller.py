@@ -204,8 +204,10 @@ class LakeController(QtCore.QObject):
         self.close_prompt()
         self.win.solver.stop()
         self.last_error = None
+        p = self.doc.project
+        water = (lake.outline, lake.holes, p.crs, tuple(p.origin))  # what the layout is of (_same_water)
         worker = create_worker(_layout_job, lake.replaced(layout=None), cuts, _start_thread=False)
-        worker.returned.connect(lambda value: self._on_returned(value, cuts))
+        worker.returned.connect(lambda value: self._on_returned(value, cuts, water))
         worker.errored.connect(self._on_errored)
         self._worker = worker
         self.busy_changed.emit(True)
@@ -224,11 +226,35 @@ class LakeController(QtCore.QObject):
         self.win.message(f"{self._busy_text} {k} s")
         self.ticked.emit(k)
 
-    def _on_returned(self, value, cuts=None) -> None:
+    def _same_water(self, water) -> bool:
+        """The project's lake is still the water (shore, islands, frame) a layout was asked for."""
+        now = self.lake()
+        if water is None or now is None:
+            return water is None
+        outline, holes, crs, origin = water
+        p = self.doc.project
+        return (
+            (p.crs, tuple(p.origin)) == (crs, origin)
+            and np.array_equal(now.outline, outline)
+            and len(now.holes) == len(holes)
+            and all(np.array_equal(a, b) for a, b in zip(now.holes, holes, strict=True))
+        )
+
+    def _on_returned(self, value, cuts=None, water=None) -> None:
         lake, layout, err = value
         self._worker = None
         self._ticker.stop()
         self.busy_changed.emit(False)
+        if layout is not None and not self._same_water(water):
+            # another lake imported (or opened, or the shore edited) while it was made: it was set, the first
+            # lake's outline and blocks in the second's frame under the second's name
+            self.win.message(
+                "The layout made is not set: the lake changed (another lake, or the shore edited) while it was "
+                "made — Auto layout (Ctrl+L) lays out this one",
+                error=True,
+            )
+            self.layout_done.emit(None)
+            return
         if layout is None:
             self.last_error = err
             self.win.error("Cannot split the lake by its cut lines" if cuts else "Cannot lay out the lake", err)

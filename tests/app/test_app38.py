@@ -200,3 +200,36 @@ def test_an_undo_while_a_layout_edit_is_made_is_not_undone_by_the_edit(qtbot, wi
     wait_for(qtbot, win, lambda: not win.lake_ctl.editing)
     assert win.doc.project.layout.blocks[0].cells == (c[0] + 4, c[1])
     assert win.stack.undoText().startswith("Cells of")
+
+
+def test_a_layout_made_while_another_lake_was_imported_is_not_set_on_it(qtbot, win, monkeypatch):
+    """Auto layout of Bolsena (it takes seconds on a real lake), File ▸ Import of Zurich meanwhile: when
+    Bolsena's layout was done it was set on the project — Bolsena's outline and blocks in Zurich's frame
+    under Zurich's name.  Now a layout of water the project no longer holds is not set, and said so."""
+    import threading
+
+    from app import lake_controller
+    from tests.app.waits import wait_for, wait_idle
+
+    imported = threading.Event()
+    made = lake_controller.compute_layout
+
+    def slow(*a, **k):  # the layout is done only after the second import (as on a lake of 20 s)
+        imported.wait(60)
+        return made(*a, **k)
+
+    monkeypatch.setattr(lake_controller, "compute_layout", slow)
+    assert win.io.import_points(DATA / "lake_bolsena_sparse.geojson", project_lonlat=True)
+    assert win.lake_ctl.auto_layout() and win.lake_ctl.busy
+    assert win.io.import_points(DATA / "lake_zurich_sparse.geojson", project_lonlat=True)
+    zurich = win.doc.project
+    imported.set()
+    wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
+    wait_idle(qtbot, win)
+    assert win.doc.project is zurich and zurich.layout is None  # Zurich as imported
+    assert "not set" in win._status.text()
+    assert win.stack.undoText() == "Import lake_zurich_sparse.geojson"
+    win.stack.undo()  # back to Bolsena: Auto layout lays it out as before
+    assert win.lake_ctl.auto_layout()
+    wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
+    assert win.doc.project.layout is not None and win.doc.project.title == "lake_bolsena_sparse"
