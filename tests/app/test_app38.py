@@ -233,3 +233,22 @@ def test_a_layout_made_while_another_lake_was_imported_is_not_set_on_it(qtbot, w
     assert win.lake_ctl.auto_layout()
     wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
     assert win.doc.project.layout is not None and win.doc.project.title == "lake_bolsena_sparse"
+
+
+def test_an_import_undone_while_its_lake_solves_leaves_none_of_its_grid(qtbot, win):
+    """The same through Ctrl+Z: a lake laid out (not solved yet), another imported and F5 on its one
+    block, Ctrl+Z (the import undone) while that solves: its grid became the first lake's block b0 grid
+    (greyed, measured in the Quality dock)."""
+    from tests.app.waits import wait_for, wait_idle
+
+    first = _laid_out(win)
+    assert win.io.import_points(DATA / "lake_zurich_sparse.geojson", project_lonlat=True)
+    win.generate()  # the one block of the second lake
+    assert win.solver.running
+    win.solver.pause()
+    win.stack.undo()  # the import undone: the first lake, its layout, no grid yet
+    assert win.doc.project.layout is first.layout
+    win.solver.resume()
+    wait_for(qtbot, win, lambda: not win.solver.running)
+    wait_idle(qtbot, win)
+    assert win.doc.grids == {} and win.doc.quality is None and win.doc.lake_metrics is None
