@@ -556,7 +556,10 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         text = str(where)
         if what.startswith("folded"):  # its limit "…: none" and a flag for a value read "none: 1 at b8(1,50)"
             what, text = what.removesuffix(": none"), "a cell at " + text.split(" at ", 1)[-1]
-        self.message(f"Worst of {what}: {text}")
+        k, n = self.lake_quality.rank(where)  # (a click again on the limit: the next worst)
+        lead = "Worst" if k == 0 else f"{k + 1}{'nd' if k == 1 else 'rd' if k == 2 else 'th'} worst"
+        more = f" ({k + 1} of the {n} worst: click the limit again for the next)" if n > 1 else ""
+        self.message(f"{lead} of {what}: {text}{more}")
 
     def _misses_for_colours(self, label: str) -> None:
         """Cells coloured by a metric: the misses step aside (they would hide the colours), and back."""

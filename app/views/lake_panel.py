@@ -191,6 +191,11 @@ def miss_points(verdict, row: int | None = None) -> np.ndarray:
     return np.vstack(out) if out else np.zeros((0, 3))
 
 
+def _same_measure(a: tuple, b: tuple) -> bool:
+    """Two ``(metrics, preset name)`` of :meth:`LakeQualityBox._measured` of one measure."""
+    return bool(a) and bool(b) and a[0] is b[0] and a[1] == b[1]
+
+
 def worst_miss(verdict, row: int):
     """The worst place (a :class:`meshcore.quality.lake.Location`) of failed limit ``row``, or None."""
     if verdict is None or not 0 <= row < len(verdict.results):
@@ -246,7 +251,11 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         # a click on a failed limit goes to its worst place (a new user clicked, saw dots somewhere
         # and did not guess that a double-click would go there); Enter (activated) too.  Only the
         # user's click: a new verdict selects its first failed limit without moving the view
-        self.table.clicked.connect(lambda index: self.go_to_worst(index.row()))
+        # a click again on the same limit goes to its next worst place (of the few the verdict keeps, then
+        # round again); Enter shows the place gone to last again.  It went to the worst only: the next
+        # worst, which meshcore quality prints, could be found only among the orange dots
+        self._visit: tuple | None = None  # (what the verdict is of, row, k): the k-th worst of limit row, gone to
+        self.table.clicked.connect(lambda index: self.go_to_worst(index.row(), step=True))
         self.table.activated.connect(lambda index: self.go_to_worst(index.row()))
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)
@@ -342,13 +351,34 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             self.table.selectRow(first)
             self._row_selected()
 
-    def go_to_worst(self, row: int) -> bool:
-        """Send the worst place of failed limit ``row`` (``go_to``); False if it has none."""
-        where = worst_miss(self.verdict, row)
-        if where is None:
+    def go_to_worst(self, row: int, step: bool = False) -> bool:
+        """Send the worst place of failed limit ``row`` (``go_to``); False if it has none.  ``step`` (a
+        click): when that limit was the one gone to last, its next worst place (round again after the
+        last the verdict keeps); else the place gone to last again (the worst, the first time)."""
+        if worst_miss(self.verdict, row) is None:
             return False
-        self.go_to.emit(where, self.verdict.results[row].limit.label)
+        worst = self.verdict.results[row].worst
+        k = 0
+        last, key = self._visit, self._measured()
+        if last is not None and _same_measure(last[0], key) and last[1] == row:
+            k = (last[2] + (1 if step else 0)) % len(worst)
+        self._visit = (key, row, k)
+        self.go_to.emit(worst[k], self.verdict.results[row].limit.label)
         return True
+
+    def rank(self, where) -> tuple[int, int]:
+        """``(k, n)``: ``where`` is the ``k``-th (0: the worst) of the ``n`` worst places kept of the limit
+        gone to last; ``(0, 1)`` for a place that is not one of them."""
+        last = self._visit
+        if last is None or not _same_measure(last[0], self._measured()) or self.verdict is None:
+            return 0, 1
+        worst = self.verdict.results[last[1]].worst
+        return (last[2], len(worst)) if last[2] < len(worst) and worst[last[2]] == where else (0, 1)
+
+    def _measured(self) -> tuple:
+        """What the verdict is of: the grid's metrics and the preset (a verdict is made again, alike, when
+        the block gone to becomes the active one)."""
+        return (self.verdict.metrics, self.verdict.preset.name) if self.verdict is not None else ()
 
     def _row_selected(self) -> None:
         rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []

@@ -252,3 +252,37 @@ def test_an_import_undone_while_its_lake_solves_leaves_none_of_its_grid(qtbot, w
     wait_for(qtbot, win, lambda: not win.solver.running)
     wait_idle(qtbot, win)
     assert win.doc.grids == {} and win.doc.quality is None and win.doc.lake_metrics is None
+
+
+def test_a_click_again_on_a_failed_limit_goes_to_its_next_worst_place(qtbot, win, tmp_path):
+    """Quality dock, a failed limit clicked: the view went to its worst place, and a click again went there
+    again — the second, third worst (which ``meshcore quality`` prints as "next worst") could be found only
+    among hundreds of orange dots.  Now each click again goes to the next of the worst places the verdict
+    keeps (round again after the last), the status line says which; Enter shows the same place again."""
+    from PySide6 import QtCore
+
+    from tests.app.test_modeller import _laid_out as laid_out_coarse
+
+    laid_out_coarse(qtbot, win, tmp_path, 850_021)  # coarse: it misses delft3d's limits in many places
+    box = win.lake_quality
+    row = next(k for k, r in enumerate(box.verdict.results) if r.passed is False and len(r.worst) >= 3)
+    worst, label = box.verdict.results[row].worst, box.verdict.results[row].limit.label
+    rect = box.table.visualRect(box.table.model().index(row, 2))
+
+    def click():
+        qtbot.mouseClick(box.table.viewport(), QtCore.Qt.MouseButton.LeftButton, pos=rect.center())
+        return win.canvas.highlight_item.data["x"][0], win._status.text()
+
+    def at(w, shown) -> bool:
+        return shown[0] == w.x
+
+    first = click()
+    assert at(worst[0], first) and first[1].startswith(f"Worst of {label}: {worst[0]}")
+    second = click()
+    assert at(worst[1], second) and second[1].startswith(f"2nd worst of {label}: {worst[1]}")
+    assert f"(2 of the {len(worst)} worst" in second[1]
+    box.table.activated.emit(box.table.model().index(row, 0))  # Enter: the same place again
+    assert win.canvas.highlight_item.data["x"][0] == worst[1].x
+    for _ in range(len(worst) - 1):
+        last = click()
+    assert at(worst[0], last)  # round again: the worst
