@@ -242,7 +242,7 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.setToolTip(
             "click a limit: the places that miss it are marked on the canvas (orange: the worst in each "
             "patch of the screen, so the grid stays in sight; ringed red: the worst of all) and the view "
-            "goes to the worst (Enter too)"
+            "goes to the worst (Enter too); a click again goes to the next worst"
         )
         lay.addWidget(self.table)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)
