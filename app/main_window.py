@@ -24,7 +24,7 @@ from . import actions
 from . import geometry as geo
 from . import io_adapter as fio
 from .background import BackgroundController
-from .commands import LAYOUT_HINT, Editor, SetBlockOptions
+from .commands import LAYOUT_CUT_HINT, LAYOUT_HINT, Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
@@ -386,6 +386,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.doc.set_selection(range(len(self.doc.block.points)))
 
     def auto_corners(self) -> None:
+        if self.doc.project.layout is not None:  # it said "needs a closed loop of at least 4 points"
+            self.message(LAYOUT_HINT)
+            return
         b = self.doc.block
         if not b.closed or len(b.points) < 4:
             lay = " (Lake ▸ Auto layout grids a closed loop of 3)" if b.closed and len(b.points) == 3 else ""
@@ -418,7 +421,10 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
 
         p = self.doc.project
         b = self.doc.block
-        if p.multiblock is not None or p.layout is not None or not b.closed or b.boundary is not None:
+        if p.layout is not None:  # ("needs a closed loop of points (draw or import one)" of an imported lake)
+            self.message(f"{LAYOUT_CUT_HINT}. {LAYOUT_HINT}")
+            return False
+        if p.multiblock is not None or not b.closed or b.boundary is not None:
             self.message("Split needs a closed loop of points (draw or import one) and cut lines across it")
             return False
         if not p.cut_lines:

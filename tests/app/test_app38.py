@@ -286,3 +286,21 @@ def test_a_click_again_on_a_failed_limit_goes_to_its_next_worst_place(qtbot, win
     for _ in range(len(worst) - 1):
         last = click()
     assert at(worst[0], last)  # round again: the worst
+
+
+def test_block_tools_on_a_laid_out_lake_say_what_to_do_with_a_layout(qtbot, win):
+    """On an imported lake laid out by Auto layout: A (Auto corners) said "Auto corners needs a closed loop
+    of at least 4 points", a click with the Corners tool "Corners need a closed loop of points: draw or import
+    one first", Ctrl+K "Split needs a closed loop of points (draw or import one)" — of a lake just imported.
+    Now they say how a layout is edited (and that a cut drawn over it splits at once), and change nothing."""
+    from app.commands import LAYOUT_HINT
+
+    p = _laid_out(win)
+    win.a_auto_corners.trigger()
+    assert win._status.text() == LAYOUT_HINT
+    win.set_tool("corners")
+    win.canvas.tool.click((0.0, 0.0))
+    assert win._status.text() == LAYOUT_HINT
+    win.a_split.trigger()
+    assert "splits the blocks it crosses at once" in win._status.text() and LAYOUT_HINT in win._status.text()
+    assert win.doc.project is p and not win.lake_ctl.busy
