@@ -165,12 +165,11 @@ def open_at_start(win, *, file=None, example=None, solve: bool = False, screensh
     the file is not opened (the status line names it).  False: the file or example did not open."""
     if example:
         return win.io.open_example(example, confirm=False)
-    if not screenshot and not (file and solve) and win.io.offer_recovery():
-        if file:
-            win.message(
-                f"Restored the autosaved project of the last session; {Path(file).name} was not opened "
-                "(File ▸ Open project opens it)"
-            )
+    if not screenshot and not (file and solve) and win.io.offer_recovery(Path(file).name if file else None):
+        if file:  # also in the Messages: the status line is the restored lake's grid's a second later
+            text = f"Restored the autosaved project of the last session; {Path(file).name} was not opened"
+            win.doc.report("info", f"{text} (File ▸ Open opens it)")
+            win.message(f"{text} (File ▸ Open project opens it)")
         return True
     if file:  # --solve asks for a grid: lon/lat degrees are projected as the question's default would (no dialog)
         return win.io.open_path(Path(file), project_lonlat=True if solve else None)

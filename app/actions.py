@@ -243,7 +243,10 @@ GESTURES: tuple[tuple[str, str], ...] = (
     ("Shift+drag", "snap a dragged point onto another point (Edit)"),
     ("drag on empty space", "box-select points (Edit); pan (other tools)"),
     ("wheel / right-drag", "zoom"),
-    ("click / Enter on a verdict row", "zoom to the worst place of that quality limit (Quality panel)"),
+    (
+        "click / Enter on a verdict row",
+        "zoom to the worst place of that quality limit (Quality panel); click again: the next worst",
+    ),
 )
 
 

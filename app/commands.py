@@ -21,6 +21,7 @@ from .project import Block, Project
 
 __all__ = [
     "DRAWN_TITLE",
+    "LAYOUT_CUT_HINT",
     "LAYOUT_HINT",
     "AddBlock",
     "AddCutLine",
@@ -43,6 +44,8 @@ _MERGE_ID = 4711
 
 
 #: what edits the blocks of a lake's layout (said where a block tool cannot: Edit, Convert to loop, Delete)
+#: Split (Ctrl+K) over a lake's layout: a cut drawn over it goes into it at once
+LAYOUT_CUT_HINT = "A cut line drawn over the layout (Cut line tool, L) splits the blocks it crosses at once: no Split"
 LAYOUT_HINT = (
     "These blocks are the lake's layout: drag its shore points, cut ends, junctions and corners with the "
     "Layout tool (Y); the Lake panel sets cells and cell size (Auto layout lays it out again); "

@@ -426,20 +426,24 @@ class Document:
         A metric of the block quality colours the active block; :data:`DEVIATION` colours every
         block of a lake grid (its lake metrics), or the active block's grid otherwise.
         """
+        return [(g, v) for _k, g, v in self.colour_blocks()]
+
+    def colour_blocks(self) -> list:
+        """:meth:`colour_layers` with the index of each layer's block: ``[(block, grid, values), …]``."""
         m = METRICS.get(self.colour_by)
         if m is None or self.quality is None:
             return []
         if self.colour_by != DEVIATION:
-            return [(self.quality_grid, self.quality.arrays[m[0]])]
+            return [(self.active, self.quality_grid, self.quality.arrays[m[0]])]
         lm, mb = self.lake_metrics, self.multiblock
         if lm is not None and mb is not None and len(lm.blocks) == len(mb.grids):
-            pairs = [(g, _cell_max(b.deviation)) for g, b in zip(mb.grids, lm.blocks, strict=True)]
-            k = self.active if 0 <= self.active < len(pairs) else 0
-            return [pairs[k], *pairs[:k], *pairs[k + 1 :]]
+            layers = [(k, g, _cell_max(b.deviation)) for k, (g, b) in enumerate(zip(mb.grids, lm.blocks, strict=True))]
+            k = self.active if 0 <= self.active < len(layers) else 0
+            return [layers[k], *layers[:k], *layers[k + 1 :]]
         from meshcore.quality.lake import block_metrics
 
         g = self.quality_grid
-        return [(g, _cell_max(block_metrics(g).deviation))]
+        return [(self.active, g, _cell_max(block_metrics(g).deviation))]
 
     @property
     def grid(self) -> StructuredGrid | None:

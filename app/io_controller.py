@@ -154,7 +154,7 @@ class IOController(ExportMixin, QtCore.QObject):
     # ---------------------------------------------------------- project
     def set_project(self, project: Project, path: Path | None = None) -> None:
         """Start over with ``project`` (no undo history, nothing unsaved)."""
-        self.win.solver.stop()
+        self.win.solver.drop()  # (stopped, its grid became the new project's)
         self.stack.clear()
         self.doc.reset(project, path)
         self.win.canvas.fit()
@@ -519,6 +519,7 @@ class IOController(ExportMixin, QtCore.QObject):
         ``replace`` (a project holding a lake) it replaces the lake, its layout, cuts and frame."""
         p = self.doc.project
         if replace:  # a new outline replaces the lake, laid out or not (undo brings it back)
+            self.win.solver.drop()  # the solve of the lake before: its grid is of no block of this one
             p = p.replaced(
                 blocks=(Block(name="block"),), lake=None, cut_lines=(), crs="", origin=(0.0, 0.0), source_crs=""
             )
@@ -702,8 +703,10 @@ class IOController(ExportMixin, QtCore.QObject):
         except OSError:
             log.warning("cannot remove the recovery file %s", self.recovery_path, exc_info=True)
 
-    def offer_recovery(self) -> bool:
-        """After a crash: offer the autosaved project back (True when restored)."""
+    def offer_recovery(self, instead_of: str | None = None) -> bool:
+        """After a crash: offer the autosaved project back (True when restored).  ``instead_of``: the
+        file the app was started on, which is not opened when the project is restored (the question
+        says so)."""
         if not recovery.exists(self.recovery_path):
             return False
         try:
@@ -713,6 +716,8 @@ class IOController(ExportMixin, QtCore.QObject):
             self.discard_recovery()
             return False
         what = recovery.describe(project, path, recovery.saved_at(self.recovery_path))
+        if instead_of:  # (Yes said nothing of the file double-clicked: another lake came up, the file unsaid)
+            what += f"\n\nYes: {instead_of} is not opened (File ▸ Open opens it then). No: {instead_of} opens."
         r = QtWidgets.QMessageBox.question(
             self._parent(),
             "Recover project",

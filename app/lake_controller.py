@@ -98,6 +98,13 @@ class LakeController(QtCore.QObject):
         self._edit_started = 0.0  # when the last layout edit was started
         self.edit_error: str | None = None
         self._dragging = False  # a drag of the layout is on (the layout tool says so)
+        # the layout changed by anything but an edit landing (an undo, a redo, Auto layout, an open) counts
+        # up: an edit asked for before it is of a layout no longer shown and is not set (it was, over the
+        # undo: Set cells then Ctrl+Z at once undid Auto layout, then set the layout again with the cells)
+        self._generation = 0
+        self._seen_layout = self.doc.project.layout
+        self._applying = False  # an edit is landing (its own change of the layout)
+        self.doc.project_changed.connect(self._layout_changed)
 
     @property
     def busy(self) -> bool:
@@ -197,8 +204,10 @@ class LakeController(QtCore.QObject):
         self.close_prompt()
         self.win.solver.stop()
         self.last_error = None
+        p = self.doc.project
+        water = (lake.outline, lake.holes, p.crs, tuple(p.origin))  # what the layout is of (_same_water)
         worker = create_worker(_layout_job, lake.replaced(layout=None), cuts, _start_thread=False)
-        worker.returned.connect(lambda value: self._on_returned(value, cuts))
+        worker.returned.connect(lambda value: self._on_returned(value, cuts, water))
         worker.errored.connect(self._on_errored)
         self._worker = worker
         self.busy_changed.emit(True)
@@ -217,11 +226,35 @@ class LakeController(QtCore.QObject):
         self.win.message(f"{self._busy_text} {k} s")
         self.ticked.emit(k)
 
-    def _on_returned(self, value, cuts=None) -> None:
+    def _same_water(self, water) -> bool:
+        """The project's lake is still the water (shore, islands, frame) a layout was asked for."""
+        now = self.lake()
+        if water is None or now is None:
+            return water is None
+        outline, holes, crs, origin = water
+        p = self.doc.project
+        return (
+            (p.crs, tuple(p.origin)) == (crs, origin)
+            and np.array_equal(now.outline, outline)
+            and len(now.holes) == len(holes)
+            and all(np.array_equal(a, b) for a, b in zip(now.holes, holes, strict=True))
+        )
+
+    def _on_returned(self, value, cuts=None, water=None) -> None:
         lake, layout, err = value
         self._worker = None
         self._ticker.stop()
         self.busy_changed.emit(False)
+        if layout is not None and not self._same_water(water):
+            # another lake imported (or opened, or the shore edited) while it was made: it was set, the first
+            # lake's outline and blocks in the second's frame under the second's name
+            self.win.message(
+                "The layout made is not set: the lake changed (another lake, or the shore edited) while it was "
+                "made — Auto layout (Ctrl+L) lays out this one",
+                error=True,
+            )
+            self.layout_done.emit(None)
+            return
         if layout is None:
             self.last_error = err
             self.win.error("Cannot split the lake by its cut lines" if cuts else "Cannot lay out the lake", err)
@@ -277,14 +310,25 @@ class LakeController(QtCore.QObject):
         when no newer request waits.  ``shore``: the edit moves the shore (the lake's outline
         and islands become those of the new layout).
         """
-        self._pending = (make, text, merge_key, shore)
+        self._pending = (make, text, merge_key, shore, self._generation)
         if self._edit_worker is None:
             self._next_edit()
+
+    def _layout_changed(self, project) -> None:
+        if project.layout is self._seen_layout:
+            return
+        self._seen_layout = project.layout
+        if not self._applying:
+            self._generation += 1
 
     def _next_edit(self) -> None:
         if self._pending is None or self._edit_worker is not None:
             return
-        make, text, key, shore = self._pending
+        make, text, key, shore, gen = self._pending
+        if gen != self._generation:  # of a layout undone (or replaced) since it was asked for
+            self._pending = None
+            self._dropped(text)
+            return
         wait = self._edit_started + EDIT_GAP_S - time.perf_counter()
         if key is not None and wait > 0:  # a drag's step: later (the newest step then)
             if not self._edit_timer.isActive():
@@ -292,14 +336,24 @@ class LakeController(QtCore.QObject):
             return
         self._pending = None
         worker = create_worker(_edit_job, make, _start_thread=False)
-        worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key, shore))
-        worker.errored.connect(lambda exc: self._edited((None, f"internal error: {exc}"), text, key, shore))
+        worker.returned.connect(lambda value, text=text, key=key: self._edited(value, text, key, shore, gen))
+        worker.errored.connect(lambda exc: self._edited((None, f"internal error: {exc}"), text, key, shore, gen))
         self._edit_worker = worker
         self._edit_started = time.perf_counter()
         worker.start()
 
-    def _edited(self, value, text: str, key, shore: bool = False) -> None:
+    def _dropped(self, text: str) -> None:
+        """An edit of a layout changed since it was asked for is not set: said, once nothing else waits."""
+        if self._pending is None:
+            self.win.message(f"{text}: not made — the layout changed (an undo or another layout) before it was done")
+        self._end_live()
+
+    def _edited(self, value, text: str, key, shore: bool = False, gen: int | None = None) -> None:
         self._edit_worker = None
+        if gen is not None and gen != self._generation:  # the layout it was made from is gone (undone)
+            self._dropped(text)
+            self._next_edit()
+            return
         layout, err = value
         lake = self.doc.project.lake
         if layout is not None and lake is not None:  # newer than what is shown: show it, even mid-drag
@@ -308,7 +362,11 @@ class LakeController(QtCore.QObject):
                 poly = layout.polygon
                 rings = tuple(np.asarray(r.coords)[:-1] for r in poly.interiors)
                 lake = lake.replaced(outline=np.asarray(poly.exterior.coords)[:-1], holes=rings)
-            self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
+            self._applying = True
+            try:
+                self.editor.set_lake(lake.replaced(layout=layout), text, merge_key=key)
+            finally:
+                self._applying = False
             self.layout_done.emit(layout)
             # one edit (a cut deleted, a block's cells), or a drag's last layout: the status line says the
             # new layout (after a drag it went on showing the grid of before's cell count)

@@ -106,6 +106,7 @@ class LayoutTool(Tool):
         self._last_xy = None  # where the drag's last step went (None: no step yet)
         self._cache: tuple | None = None  # (layout, its handles)
         self._hovered: tuple | None = None  # (layout, the handle ringed under the cursor)
+        self._hover_xy: tuple | None = None  # (layout, where the cursor was over it)
 
     def activate(self) -> None:
         if self.doc.project.layout is None:
@@ -141,26 +142,49 @@ class LayoutTool(Tool):
             return
         h = nearest_handle(self._near(lay, xy), xy, self.tol()) if lay is not None else None
         self._hovered = (lay, h)
+        self._hover_xy = (lay, (float(xy[0]), float(xy[1])))
         self.canvas.lake_items.set_drag_point(None if h is None else h.xy)
 
     def delete(self) -> bool:
-        """Del: the cut line whose end or point is ringed goes; the two blocks it parted become one."""
+        """Del: the cut line pointed at goes (its end or point ringed, or the cursor on the line between
+        them); the two blocks it parted become one.  Only a ringed end or point took: a cut from one
+        junction to another, straight, had none and could not be deleted; the tip says "the cut line
+        pointed at", and the cursor on a cut's line did nothing."""
         lay = self.doc.project.layout
         if lay is None or self.controller is None or self._handle is not None:
             return False
         was, h = self._hovered or (None, None)
-        if was is not lay or h is None or h.kind not in ("end", "cut"):
-            self.status("Delete a cut line: point at its end or one of its points (ringed), then Del")
+        k = h.cut if was is lay and h is not None and h.kind in ("end", "cut") else self._cut_under(lay)
+        if k is None:
+            self.status(
+                "Delete a cut line: point at it (along its line, away from where cut lines meet, or at its end "
+                "on the shore), then Del"
+            )
             return True
         from .block_names import names_kept
         from .layout_edit import without_cut
 
-        k = h.cut  # the blocks the cut did not bound keep their names
+        # (the blocks the cut did not bound keep their names)
         self.controller.edit_layout(lambda: names_kept(lay, without_cut(lay, k)), "Delete cut line")
         self._hovered = None  # the ringed end goes with its cut: no ring left until the mouse moves
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
         return True
+
+    def _cut_under(self, lay) -> int | None:
+        """The cut line of ``lay`` under the cursor (within the pick tolerance of its line), None when
+        there is none or the cursor is where two of them are as near (a junction)."""
+        was, xy = self._hover_xy or (None, None)
+        if was is not lay or xy is None:
+            return None
+        from shapely.geometry import LineString, Point
+
+        q, tol = Point(xy), self.tol()
+        near = sorted((LineString(np.asarray(c, float)).distance(q), k) for k, c in enumerate(lay.cuts) if len(c) >= 2)
+        near = [(d, k) for d, k in near if d <= tol]
+        if not near or (len(near) > 1 and near[1][0] - near[0][0] <= 0.25 * tol):
+            return None
+        return near[0][1]
 
     def deactivate(self) -> None:
         super().deactivate()

@@ -12,6 +12,7 @@ every action comes from the table in :mod:`app.actions`.
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 
 from PySide6 import QtCore, QtGui, QtWidgets
@@ -23,7 +24,7 @@ from . import actions
 from . import geometry as geo
 from . import io_adapter as fio
 from .background import BackgroundController
-from .commands import LAYOUT_HINT, Editor, SetBlockOptions
+from .commands import LAYOUT_CUT_HINT, LAYOUT_HINT, Editor, SetBlockOptions
 from .document import Document
 from .examples import LAKES, example_names
 from .io_controller import IOController
@@ -80,7 +81,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.editor = Editor(self.doc, self.stack)
         self.solver = SolverController(self.doc, self)
         self.lake_ctl = LakeController(self)
-        self._centres = (None, None)  # (grid, its cell centres) for the hover read-out
+        self._cell_centres: dict[int, tuple] = {}  # id(grid) → (grid, its cell centres, its box): the read-out
         self.canvas = Canvas(self.doc)
         self.canvas.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         # the canvas under a strip for offers (place_offer): an offer over the canvas covered the lake
@@ -303,17 +304,37 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self._coords.setText(f"{cell}   {text}" if cell else text)
 
     def _cell_readout(self, x: float, y: float) -> str:
-        """The coloured metric of the cell under the cursor (nearest cell centre, if inside it)."""
-        g, values, label = self.doc.colour_values()
-        if values is None or self.doc.solving:
+        """The coloured metric of the cell under the cursor (nearest cell centre, if inside it), in any
+        block the colours cover (deviation from 90° colours every block of a lake; the read-out was of the
+        active block alone: over the others' dark cells it said nothing).  Over several blocks it names
+        the block."""
+        if self.doc.solving:
             return ""
-        if self._centres[0] is not g:
-            self._centres = (g, geo.cell_centres(g.x, g.y))
-        cell = geo.cell_at(g.x, g.y, x, y, self._centres[1])
-        if cell is None:
+        layers = self.doc.colour_blocks()
+        best = None  # (distance to the cell's centre, block, i, j, values)
+        for k, g, values in layers:
+            entry = self._cell_centres.get(id(g))
+            if entry is None or entry[0] is not g:
+                box = (float(g.x.min()), float(g.y.min()), float(g.x.max()), float(g.y.max()))
+                entry = self._cell_centres[id(g)] = (g, geo.cell_centres(g.x, g.y), box)
+            if not (entry[2][0] <= x <= entry[2][2] and entry[2][1] <= y <= entry[2][3]):
+                continue  # (off this block: a lake of 100 blocks is read out at every mouse move)
+            cell = geo.cell_at(g.x, g.y, x, y, entry[1])
+            if cell is None:
+                continue
+            i, j = cell
+            d = math.hypot(float(entry[1][0][i, j]) - x, float(entry[1][1][i, j]) - y)
+            if best is None or d < best[0]:
+                best = (d, k, i, j, values)
+        if len(self._cell_centres) > len(layers):  # (the grids of earlier solves go)
+            shown = {id(g) for _k, g, _v in layers}
+            self._cell_centres = {key: e for key, e in self._cell_centres.items() if key in shown}
+        if best is None:
             return ""
-        i, j = cell
-        return f"cell ({i}, {j}): {label} {float(values[i, j]):.4g}"
+        _d, k, i, j, values = best
+        names = [b.name for b in self.doc.project.blocks]
+        where = f"{names[k]} " if len(layers) > 1 and k < len(names) else ""
+        return f"{where}cell ({i}, {j}): {self.doc.colour_by} {float(values[i, j]):.4g}"
 
     # -------------------------------------------------------------- tools
     def set_tool(self, key: str) -> None:
@@ -365,6 +386,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.doc.set_selection(range(len(self.doc.block.points)))
 
     def auto_corners(self) -> None:
+        if self.doc.project.layout is not None:  # it said "needs a closed loop of at least 4 points"
+            self.message(LAYOUT_HINT)
+            return
         b = self.doc.block
         if not b.closed or len(b.points) < 4:
             lay = " (Lake ▸ Auto layout grids a closed loop of 3)" if b.closed and len(b.points) == 3 else ""
@@ -397,7 +421,10 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
 
         p = self.doc.project
         b = self.doc.block
-        if p.multiblock is not None or p.layout is not None or not b.closed or b.boundary is not None:
+        if p.layout is not None:  # ("needs a closed loop of points (draw or import one)" of an imported lake)
+            self.message(f"{LAYOUT_CUT_HINT}. {LAYOUT_HINT}")
+            return False
+        if p.multiblock is not None or not b.closed or b.boundary is not None:
             self.message("Split needs a closed loop of points (draw or import one) and cut lines across it")
             return False
         if not p.cut_lines:
@@ -535,7 +562,10 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         text = str(where)
         if what.startswith("folded"):  # its limit "…: none" and a flag for a value read "none: 1 at b8(1,50)"
             what, text = what.removesuffix(": none"), "a cell at " + text.split(" at ", 1)[-1]
-        self.message(f"Worst of {what}: {text}")
+        k, n = self.lake_quality.rank(where)  # (a click again on the limit: the next worst)
+        lead = "Worst" if k == 0 else f"{k + 1}{'nd' if k == 1 else 'rd' if k == 2 else 'th'} worst"
+        more = f" ({k + 1} of the {n} worst: click the limit again for the next)" if n > 1 else ""
+        self.message(f"{lead} of {what}: {text}{more}")
 
     def _misses_for_colours(self, label: str) -> None:
         """Cells coloured by a metric: the misses step aside (they would hide the colours), and back."""

@@ -57,6 +57,11 @@ def _stopped(result) -> bool:
     return not result.grids or (info is not None and not info.converged and info.message == "stopped")
 
 
+def _another_lake(a, b) -> bool:
+    """Two projects of other water: another frame or title (an import, its undo or redo)."""
+    return (a.crs, tuple(a.origin)) != (b.crs, tuple(b.origin)) or bool(a.title and b.title and a.title != b.title)
+
+
 def _run(run_id, project, warm, stop_event, smooth, hold=None):
     """The worker body: tag every item with the run id; errors become results."""
     gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth, hold=hold)
@@ -152,6 +157,8 @@ class SolverController(QtCore.QObject):
             self.last_error = None  # back to a gridded one: its grid is current, not held back as failed)
         elif self.doc.restored is self.doc.project and self._project is not self.doc.project:
             self._drop()  # an undo or redo back to a grid the document kept: the solve of before it is of no use
+        elif self._project is not None and _another_lake(self._project, self.doc.project):
+            self._drop()  # an import undone or redone while its lake solved: that grid is of no block here
         if self.auto and self.doc.stale:  # not for an edit the grid is not made of (a lake's cell size)
             p = self.doc.project
             if p.lake is not None and p.layout is None and len(p.lake.holes) and len(p.blocks) == 1:
@@ -239,6 +246,13 @@ class SolverController(QtCore.QObject):
         self.live = bool(on)
         if not self.live and not self._debounce.isActive() and self._hold is not None:
             self._hold.set()
+
+    def drop(self) -> None:
+        """The running solve (if any) is of a project no longer open (another lake imported, a project
+        opened or started): it stops and its frames and grid are thrown away.  A stopped solve left its grid
+        to the new project: the first lake's block measured in the Quality dock, exported as the second's."""
+        if self._worker is not None:
+            self._drop()
 
     def _drop(self) -> None:
         """Stop the running solve and throw its frames and grids away: the document shows a kept grid of

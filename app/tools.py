@@ -254,6 +254,9 @@ class CornersTool(Tool):
 
     def click(self, xy, modifiers=None) -> bool:
         b = self.doc.block
+        if self.doc.project.layout is not None:  # ("draw or import one first" of an imported, laid-out lake)
+            self.status(LAYOUT_HINT)
+            return True
         if not b.closed or b.boundary is not None:
             self.status("Corners need a closed loop of points: draw or import one first")
             return True

@@ -12,6 +12,8 @@ import math
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from meshcore.quality.presets import ok_percent
+
 from ..document import Document
 
 __all__ = ["LakePanel", "LakeQualityBox", "miss_points", "worst_miss"]
@@ -189,10 +191,9 @@ def miss_points(verdict, row: int | None = None) -> np.ndarray:
     return np.vstack(out) if out else np.zeros((0, 3))
 
 
-def ok_percent(fraction: float) -> str:
-    """A share within a limit, in per cent to a tenth, rounded down: 4 folded cells of 14 736 read
-    "FAIL (100.0 % ok)"; only a share of 1 reads 100.0."""
-    return f"{math.floor(1000 * float(fraction) + 1e-9) / 10:.1f}"
+def _same_measure(a: tuple, b: tuple) -> bool:
+    """Two ``(metrics, preset name)`` of :meth:`LakeQualityBox._measured` of one measure."""
+    return bool(a) and bool(b) and a[0] is b[0] and a[1] == b[1]
 
 
 def worst_miss(verdict, row: int):
@@ -241,7 +242,7 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.table.setToolTip(
             "click a limit: the places that miss it are marked on the canvas (orange: the worst in each "
             "patch of the screen, so the grid stays in sight; ringed red: the worst of all) and the view "
-            "goes to the worst (Enter too)"
+            "goes to the worst (Enter too); a click again goes to the next worst"
         )
         lay.addWidget(self.table)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectionBehavior.SelectRows)
@@ -250,7 +251,11 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         # a click on a failed limit goes to its worst place (a new user clicked, saw dots somewhere
         # and did not guess that a double-click would go there); Enter (activated) too.  Only the
         # user's click: a new verdict selects its first failed limit without moving the view
-        self.table.clicked.connect(lambda index: self.go_to_worst(index.row()))
+        # a click again on the same limit goes to its next worst place (of the few the verdict keeps, then
+        # round again); Enter shows the place gone to last again.  It went to the worst only: the next
+        # worst, which meshcore quality prints, could be found only among the orange dots
+        self._visit: tuple | None = None  # (what the verdict is of, row, k): the k-th worst of limit row, gone to
+        self.table.clicked.connect(lambda index: self.go_to_worst(index.row(), step=True))
         self.table.activated.connect(lambda index: self.go_to_worst(index.row()))
         self.preset.currentTextChanged.connect(lambda _t: self.refresh())
         doc.quality_changed.connect(self.refresh)
@@ -346,13 +351,34 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             self.table.selectRow(first)
             self._row_selected()
 
-    def go_to_worst(self, row: int) -> bool:
-        """Send the worst place of failed limit ``row`` (``go_to``); False if it has none."""
-        where = worst_miss(self.verdict, row)
-        if where is None:
+    def go_to_worst(self, row: int, step: bool = False) -> bool:
+        """Send the worst place of failed limit ``row`` (``go_to``); False if it has none.  ``step`` (a
+        click): when that limit was the one gone to last, its next worst place (round again after the
+        last the verdict keeps); else the place gone to last again (the worst, the first time)."""
+        if worst_miss(self.verdict, row) is None:
             return False
-        self.go_to.emit(where, self.verdict.results[row].limit.label)
+        worst = self.verdict.results[row].worst
+        k = 0
+        last, key = self._visit, self._measured()
+        if last is not None and _same_measure(last[0], key) and last[1] == row:
+            k = (last[2] + (1 if step else 0)) % len(worst)
+        self._visit = (key, row, k)
+        self.go_to.emit(worst[k], self.verdict.results[row].limit.label)
         return True
+
+    def rank(self, where) -> tuple[int, int]:
+        """``(k, n)``: ``where`` is the ``k``-th (0: the worst) of the ``n`` worst places kept of the limit
+        gone to last; ``(0, 1)`` for a place that is not one of them."""
+        last = self._visit
+        if last is None or not _same_measure(last[0], self._measured()) or self.verdict is None:
+            return 0, 1
+        worst = self.verdict.results[last[1]].worst
+        return (last[2], len(worst)) if last[2] < len(worst) and worst[last[2]] == where else (0, 1)
+
+    def _measured(self) -> tuple:
+        """What the verdict is of: the grid's metrics and the preset (a verdict is made again, alike, when
+        the block gone to becomes the active one)."""
+        return (self.verdict.metrics, self.verdict.preset.name) if self.verdict is not None else ()
 
     def _row_selected(self) -> None:
         rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []

@@ -276,6 +276,19 @@ def test_metrics_are_invariant_under_similarity(ux, uy, angle, scale):
 
 
 # ------------------------------------------------------ presets, verdicts
+def test_a_share_just_short_of_all_is_not_printed_as_100_per_cent():
+    """``meshcore quality --preset efdc`` of a held-out lake's grid (1 node of 8598 over 3°) printed
+    "FAIL (100.0 % ok)": the share was rounded up.  The app rounded it down; now the table does too."""
+    xi, eta = np.meshgrid(np.arange(101.0), np.arange(101.0), indexing="ij")
+    y = eta.copy()
+    y[50, 50] += 0.1  # two of the 99 × 99 interior nodes miss the orthogonality limit
+    v = check(lake_metrics(StructuredGrid(xi, y)), "delft3d")
+    assert v.results[0].n_failed == 2 and v.results[0].value == pytest.approx(1 - 2 / 99**2)
+    text = v.table()
+    assert "FAIL (99.9 % ok)" in text and "FAIL (100.0 % ok)" not in text
+    assert "pass (100.0 % ok)" in text  # no folded cell: all of them, 100.0
+
+
 def test_presets_are_frozen_data_with_sources():
     assert {"delft3d", "efdc"} <= set(PRESETS)
     d = PRESETS["delft3d"]
