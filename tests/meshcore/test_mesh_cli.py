@@ -687,10 +687,11 @@ def test_places_in_notes_are_in_the_grids_crs(tmp_path, monkeypatch):
     """A note's ``near (x, y)`` names a place in the output's coordinates (the CRS, origin
     added), as the quality table does: a lon/lat lake whose layout has too few cells."""
     from meshcore import testing
-    from meshcore.layout import fans
+    from meshcore.layout import choice, fans
 
     poly = testing.round_lake(1021, kind="blob")  # regular: a layout with 0.25 × the asked cells
     monkeypatch.setattr(fans, "_wraps", lambda *a, **k: False)  # (with its C-shaped block round the island)
+    monkeypatch.setattr(choice, "WIDE_SCALES", ())  # (the wide scales find a layout with more cells)
     lon0, lat0, deg = 10.0, 45.0, 300.0 / 111_320.0  # 1 unit = 300 m
     rings = [np.asarray(r.coords) for r in (poly.exterior, *poly.interiors)]
     kx = deg / math.cos(math.radians(lat0))
