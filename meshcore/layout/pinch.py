@@ -180,13 +180,15 @@ def pinched(rings: list[np.ndarray], forced: list, water, sigma: float, min_widt
     that tip (see the module), where the pieces stay valid and at least ``min_width`` wide."""
     rings, forced = list(rings), list(forced)
     i, left = 0, 4 * len(rings)
+    uses = _uses(rings)  # (counted again only when the rings change)
     while i < len(rings) and left > 0:
         left -= 1
-        got = _pinch_one(rings, forced, i, sigma, min_width, water, _uses(rings))
+        got = _pinch_one(rings, forced, i, sigma, min_width, water, uses)
         if got is None:
             i += 1
             continue
         rings, forced = got  # (the new pieces at the end: each looked at again)
+        uses = _uses(rings)
     return rings, forced
 
 
