@@ -173,7 +173,7 @@ def layout_pieces(
     water = pinch.Water(dense, h) if pinch.PINCH and not regular else None
 
     def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
-        regions, cuts = partition(dense, lines, sigma)
+        regions, cuts = _partition(dense, lines, sigma)
         rings: list[np.ndarray] = []
         forced: list[tuple] = []
         for r in regions:
@@ -344,6 +344,23 @@ def _skeleton_and_chords(poly, h: float, mouths: bool) -> tuple[Skeleton, list[C
     key = ("skeleton", digest(shapely.to_wkb(poly)), float(h), bool(mouths))
     sk, chords = remembered(key, make)
     return sk, list(chords)
+
+
+def _partition(dense, lines: list[np.ndarray], sigma: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """:func:`~.regions.partition` of the water ``dense`` by ``lines``, remembered within
+    :func:`.memo.remembering` (keyed by a 128-bit digest of the water's WKB and the lines): the
+    layout choice's tip draw (:mod:`.tipcuts`) cuts the water as the draw at its scale did (copies
+    are returned: callers own what they get)."""
+    import shapely
+
+    key = (
+        "partition",
+        digest(shapely.to_wkb(dense), *(np.ascontiguousarray(c, dtype=float) for c in lines)),
+        tuple(np.shape(c) for c in lines),
+        float(sigma),
+    )
+    regions, cuts = remembered(key, lambda: partition(dense, lines, sigma))
+    return [np.array(r) for r in regions], [np.array(c) for c in cuts]
 
 
 def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):

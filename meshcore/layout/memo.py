@@ -2,8 +2,9 @@
 
 The layout choice draws a lake several times (:mod:`.choice`); its tip draw (:mod:`.tipcuts`)
 repeats the draw at the chosen scale with the pieces round land tips split, so the skeleton, the
-chords and the region splits of that draw (:mod:`.build`) and the tip splits are made once and
-remembered here, within :func:`remembering` only: a module option changed between calls (or by a
+chords, the partition and the region splits of that draw (:mod:`.build`) and the tip splits are made
+once and remembered here, and so are the cell counts of pieces counted again (:func:`.blocks._solved`),
+within :func:`remembering` only: a module option changed between calls (or by a
 test) is read again.  Callers get copies (:func:`copied`) of what is kept.
 """
 

@@ -128,7 +128,7 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
         return None
     _, j, run = best
     inner = [_key(a[k]) for k in run[1:-1]]
-    if any(uses.get(p, 0) > 2 for p in inner):  # a third piece's corner on the cut (a T): leave it
+    if any(uses().get(p, 0) > 2 for p in inner):  # a third piece's corner on the cut (a T): leave it
         return None
     p0, p1 = a[run[0]], a[run[-1]]
     if min(math.hypot(*(p0 - T)), math.hypot(*(p1 - T))) < min_width:
@@ -166,7 +166,16 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
     return out, fo
 
 
+def _counted(rings: list[np.ndarray]):
+    """:func:`_uses` of ``rings`` as a function that counts them when first called (most pieces
+    have no tip to bend a cut through: their count is not read)."""
+    import functools
+
+    return functools.cache(lambda: _uses(rings))
+
+
 def _uses(rings: list[np.ndarray]) -> dict:
+    """How many of ``rings`` have each vertex (keyed as :func:`_key`)."""
     uses: dict = {}
     for r in rings:
         for p in {_key(p) for p in r}:
@@ -180,17 +189,19 @@ def pinched(rings: list[np.ndarray], forced: list, water, sigma: float, min_widt
     that tip (see the module), where the pieces stay valid and at least ``min_width`` wide."""
     rings, forced = list(rings), list(forced)
     i, left = 0, 4 * len(rings)
+    uses = _counted(rings)  # (counted again only when the rings change)
     while i < len(rings) and left > 0:
         left -= 1
-        got = _pinch_one(rings, forced, i, sigma, min_width, water, _uses(rings))
+        got = _pinch_one(rings, forced, i, sigma, min_width, water, uses)
         if got is None:
             i += 1
             continue
         rings, forced = got  # (the new pieces at the end: each looked at again)
+        uses = _counted(rings)
     return rings, forced
 
 
 def pinch_candidates(rings: list[np.ndarray], forced: list, water, sigma: float, min_width: float) -> bool:
     """Whether :func:`pinched` would bend any cut of these pieces."""
-    uses = _uses(rings)
+    uses = _counted(rings)
     return any(_pinch_one(rings, forced, i, sigma, min_width, water, uses) is not None for i in range(len(rings)))

@@ -118,3 +118,48 @@ def test_a_remembered_region_split_is_the_fresh_one():
         first[0][0][0][:] = 0.0  # the caller's copy: changing it leaves the remembered split as it was
         again = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
     _same_split(fresh, again)
+
+
+def test_a_remembered_partition_is_the_fresh_one():
+    import shapely
+
+    from meshcore.layout.regions import partition
+
+    poly = testing.lake_with_islands(3)
+    h = (poly.area / 800) ** 0.5
+    dense = shapely.segmentize(poly, h)
+    _, chords = _skeleton_and_chords(poly, h, False)
+    lines = [build._densify(c.points, h) for c in chords]
+    fresh = partition(dense, lines, 1.5 * h)
+    with remembering():
+        first = build._partition(dense, lines, 1.5 * h)
+        first[0][0][:] = 0.0  # the caller's copy: changing it leaves the remembered partition as it was
+        first[1].append(np.zeros((2, 2)))
+        again = build._partition(dense, lines, 1.5 * h)
+    assert len(fresh[0]) == len(again[0]) and len(fresh[1]) == len(again[1])
+    assert all(np.array_equal(a, b) for a, b in zip(fresh[0] + fresh[1], again[0] + again[1], strict=True))
+
+
+def test_remembered_counts_give_the_layouts_made_without_memo(monkeypatch):
+    """The draws' cell counts (and partitions) remembered within one call: the same layouts as with
+    nothing remembered, regular (whose frames count the same pieces again) and default."""
+    import contextlib
+
+    from meshcore.layout import blocks
+
+    poly = testing.lake_with_islands(3)
+    solved = []
+    real = blocks.solve_counts
+    monkeypatch.setattr(blocks, "solve_counts", lambda *a, **k: solved.append(1) or real(*a, **k))
+    got = {}
+    for memo in (True, False):
+        if not memo:
+            monkeypatch.setattr(lay, "remembering", contextlib.nullcontext)
+        for regular in (False, True):
+            solved.clear()
+            out = lay.auto_layout(poly, target_cells=2000, multiple=4, reading=_reading, regular=regular)
+            got[memo, regular] = (_blocks(out), [c.tolist() for c in out.cuts], len(solved))
+    for regular in (False, True):
+        assert got[True, regular][:2] == got[False, regular][:2]
+        assert got[True, regular][2] <= got[False, regular][2]
+    assert got[True, True][2] < got[False, True][2]  # a regular layout's frames count pieces again
