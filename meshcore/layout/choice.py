@@ -147,10 +147,7 @@ def chosen(
         return first
     if dev0 == float("inf"):  # no interior node to read
         return first
-    best, score = first, (1.0 - MARGIN) * dev0
     seen = [first.blocks]
-    best_scale: float | None = 1.0
-    best_dev = dev0
     scales: tuple[float, ...] = SCALES
     if (
         coarse
@@ -160,13 +157,9 @@ def chosen(
         scales = SCALES + COARSE_SCALES
         ratio_ok = max(ratio_ok, SMALL_RATIO_OK)
 
-    def drawn_at(scales: Sequence[float]) -> list[tuple[float | None, Callable[[], Layout]]]:
-        return [(s, functools.partial(at_scale, s)) for s in scales]
-
-    draws = drawn_at(scales) + [(None, d) for d in more]
-    wide = drawn_at(WIDE_SCALES)
-    guard = ratio_ok
-    while draws:
+    def best_of(draws, taken, score: float, guard: float):
+        """``taken`` (layout, scale, reading) or the draw reading least below ``score`` whose coarse
+        ratio is no larger than the first's (up to the slack) or at most ``guard``."""
         for scale, draw in draws:
             try:
                 lay = draw()
@@ -177,11 +170,16 @@ def chosen(
             except MeshcoreError:
                 continue
             if dev < score and ratio <= max(ratio0 * (1.0 + RATIO_SLACK), guard):
-                best, score, best_scale, best_dev = lay, dev, scale, dev
-        # the nearby scales all read far from 90°: the wider ones once, with a looser ratio guard,
-        # each to read the margin below the best so far
-        draws, wide = (wide, []) if best_dev > WIDE_DEV and len(first.blocks) <= WIDE_MAX_BLOCKS else ([], [])
-        guard, score = max(ratio_ok, WIDE_RATIO), (1.0 - MARGIN) * best_dev
+                taken, score = (lay, scale, dev), dev
+        return taken
+
+    nearby = [(s, functools.partial(at_scale, s)) for s in scales] + [(None, d) for d in more]
+    best, best_scale, best_dev = best_of(nearby, (first, 1.0, dev0), (1.0 - MARGIN) * dev0, ratio_ok)
+    if best_dev > WIDE_DEV and len(first.blocks) <= WIDE_MAX_BLOCKS:  # every nearby draw far from 90°
+        wide = [(s, functools.partial(at_scale, s)) for s in WIDE_SCALES]
+        best, best_scale, best_dev = best_of(
+            wide, (best, best_scale, best_dev), (1.0 - MARGIN) * best_dev, max(ratio_ok, WIDE_RATIO)
+        )
     if tips is not None and best_scale is not None:  # the chosen scale again, pieces round land tips split
         try:
             lay = tips(best_scale)
