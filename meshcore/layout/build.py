@@ -599,11 +599,11 @@ def _make_countable(pieces: list[Piece], cuts: list, h: float, size: float):
     for _ in range(4 * len(pieces) + 4):
         if _countable(pieces, h):
             return pieces, cuts
-        n = len(t_junctions(pieces))
-        fewest, flat = (n, 0) if fewest is None or n < fewest else (fewest, flat + 1)
+        todo = t_junctions(pieces)
+        fewest, flat = (len(todo), 0) if fewest is None or len(todo) < fewest else (fewest, flat + 1)
         if flat >= PLATEAU_ROUNDS:
             break
-        new, new_cuts = extend_t_junctions(pieces)
+        new, new_cuts = extend_t_junctions(pieces, todo)
         if not new_cuts:
             break
         cuts = cuts + new_cuts

@@ -120,9 +120,11 @@ def _split(pc: Piece, v: int, wide: float = 0.0):
     return pieces, cut
 
 
-def extend_t_junctions(pieces: list[Piece]):
-    """One round: every T-junction continued across its block.  Returns new pieces and cuts."""
-    todo = t_junctions(pieces)
+def extend_t_junctions(pieces: list[Piece], todo=None):
+    """One round: every T-junction (``todo``, :func:`t_junctions` of the pieces if not given)
+    continued across its block.  Returns new pieces and cuts."""
+    if todo is None:
+        todo = t_junctions(pieces)
     by_piece: dict[int, int] = {}
     for pi, v in todo:
         by_piece.setdefault(pi, v)  # one split per block and round (its indices change)

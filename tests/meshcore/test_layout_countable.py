@@ -29,7 +29,7 @@ def _rigged(monkeypatch, t_counts, countable_at=None):
     def t_junctions(pieces):
         return [(0, 0)] * t_counts[min(len(rounds), len(t_counts) - 1)]
 
-    def extend(pieces):
+    def extend(pieces, todo=None):
         rounds.append(len(rounds))
         return [*pieces, _square(float(len(pieces)))], [np.zeros((2, 2))]
 
