@@ -368,3 +368,40 @@ def test_quad_areas_are_the_grid_areas_and_the_kernels():
     assert np.array_equal(a, np.array([_quad_area.py_func(P, c)[0] for c in cells]))
     # a quad traversed clockwise has the opposite sign
     assert np.array_equal(quad_areas(x.ravel(), y.ravel(), cells[:, ::-1]), -a)
+
+
+def test_the_edge_budget_counts_the_quality_reports_pairs_above_the_floor(solved):
+    """The step's edge pairs are the quality report's (``smoothness``), and its budget is how many
+    of them are ≤ 1.2 beyond ``EDGE_FLOOR`` of all."""
+    from meshcore.orthogonal import equalize as E
+
+    mb, _ = solved
+    t = E._Tables(mb.topology, mb.grids)
+    X, Y = _assemble(mb.grids, mb.topology.node_map)
+    t.budget(np.column_stack([X, Y]))
+    s = lake_metrics(mb).samples["smoothness"].values
+    assert len(t.tri) == len(s)
+    assert t.edge_budget == int((s <= 1.2).sum()) - int(np.ceil(E.EDGE_FLOOR * len(s)))
+
+
+@pytest.mark.parametrize("budget", [0, 3, None])
+def test_patches_lose_edge_pairs_beyond_the_fixed_allowance_only_within_the_budget(solved, budget, monkeypatch):
+    """A patch may lose ``EDGE_LOSS_SHARE`` of its edge pairs ≤ 1.2 (more than ``EDGE_LOSS``) only
+    while the grid keeps ``EDGE_FLOOR`` of all its pairs ≤ 1.2: with no fixed allowance, the whole
+    step loses at most the budget it started with (None: no floor, the step loses more)."""
+    from meshcore.orthogonal import equalize as E
+
+    mb, rings = solved
+    s0 = lake_metrics(mb).samples["smoothness"].values
+    ok0 = int((s0 <= 1.2).sum())
+    floor = 0.0 if budget is None else (ok0 - budget) / len(s0)
+    for name, value in (("AIM", 1.0), ("EDGE_LOSS", 0), ("EDGE_LOSS_SHARE", 1.0), ("EDGE_FLOOR", floor)):
+        monkeypatch.setattr(E, name, value)
+    grids, kept = equalize_interfaces(mb.topology, list(mb.grids), rings, limit=1.1, max_patches=6, run=8)
+    assert kept >= 1
+    ok1 = int((lake_metrics(grids).samples["smoothness"].values <= 1.2).sum())
+    if budget is None:
+        assert ok1 < ok0 - 3  # the guard below is what binds
+    else:
+        assert ok0 - budget <= ok1 <= ok0
+    assert lake_metrics(grids).summary()["folded_cells"] == 0
