@@ -111,7 +111,7 @@ class LakeController(QtCore.QObject):
         self._applying = False  # an edit is landing (its own change of the layout)
         self.doc.project_changed.connect(self._layout_changed)
         # a cell size set and not laid out yet: the layout Auto layout would make is made in a worker and
-        # the Lake panel gives its cells (it gave area / h², 0.26-3.8 x the layout's on lakes whose blocks
+        # the Lake panel gives its cells (it gave area / h²; the layout had 0.67-3.8 x that on lakes whose blocks
         # are a few cells across); Auto layout then takes that layout (or the count still running) as its own
         self._count: tuple | None = None  # (lake without layout, its layout or None, the error or None)
         self._count_worker = None

@@ -135,7 +135,7 @@ class LakePanel(QtWidgets.QWidget):
     def _count_text(self, lake) -> str:
         """The cells of the layout Auto layout makes of ``lake`` at its cell size, as counted by the
         controller (the layout made in a worker); while it is made, or for a lake too large to count, the
-        water's area over the cell size squared, said to be that (the layout's cells come out 0.26-3.8 x
+        water's area over the cell size squared, said to be that (the layout's cells come out 0.67-3.8 x
         it where blocks are a few cells across: each side's count is a multiple of 4)."""
         from ..lake import expected_cells
 
