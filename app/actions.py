@@ -239,7 +239,10 @@ ACTIONS: tuple[ActionSpec, ...] = (
 #: mouse gestures and keys the tools handle themselves (for the help only)
 GESTURES: tuple[tuple[str, str], ...] = (
     ("Enter / double-click", "close the loop being drawn (Draw) or finish a cut line"),
-    ("Del", "delete selected points (Edit); the cut line pointed at (Layout): its two blocks become one"),
+    (
+        "Del",
+        "delete selected points (Edit); the cut line pointed at, drawn in red (Layout): its two blocks become one",
+    ),
     ("Shift+drag", "snap a dragged point onto another point (Edit)"),
     ("drag on empty space", "box-select points (Edit); pan (other tools)"),
     ("wheel / right-drag", "zoom"),

@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.app.test_app38 import _h_layout
+
 pytestmark = pytest.mark.gui
 
 
@@ -51,3 +53,50 @@ def test_the_lake_panel_gives_the_cells_of_the_layout_a_cell_size_makes(qtbot, w
     win.lake_ctl.set_cell_size(h)
     wait_for(qtbot, win, lambda: win.lake_ctl.layout_count(win.lake_ctl.lake()) is not None)
     assert f"(at {h:.4g} m: {want.n_cells:,} cells in {n} blocks)" in win.lake_panel.summary.text()
+
+
+def _line(item) -> np.ndarray:
+    x, y = item.xData, item.yData
+    if x is None or len(x) == 0:
+        return np.zeros((0, 2))
+    a = np.column_stack([x, y])
+    return a[np.isfinite(a).all(axis=1)]
+
+
+def test_the_cut_line_del_would_delete_is_highlighted(qtbot, win):
+    """Layout tool: Del deletes "the cut line pointed at", but nothing on the canvas said which one (near a
+    junction: which of three, or none).  Now the cut Del would delete is drawn in a red band while the
+    cursor is on it — its line, or its end ringed — none at a junction, none in a drag; the cut deleted
+    is the one marked, and the mark goes with it."""
+    from tests.app.waits import wait_for, wait_idle
+
+    lay = _h_layout(win)
+    tool, items = win.canvas.tool, win.canvas.lake_items
+    mark = items.del_cut
+    tool.hover((1400.0, 500.0 + 0.5 * tool.tol()))  # on the middle cut, between its junctions
+    assert np.allclose(_line(mark), lay.cuts[2])
+    assert mark.isVisible() and mark in items.editing_items()  # (left out of an exported figure)
+    tool.hover((1000.0, 500.0))  # the junction: Del deletes nothing, nothing is marked
+    assert len(_line(mark)) == 0
+    tool.hover((1000.0 + 0.3 * tool.tol(), 0.0))  # the first cut's end on the shore, ringed
+    assert np.allclose(_line(mark), lay.cuts[0])
+    tool.hover((2500.0, 700.0))  # inside a block, away from every cut
+    assert len(_line(mark)) == 0
+    assert tool.drag("start", (1000.0, 0.0), (1000.0, 0.0))  # a drag marks nothing
+    assert len(_line(mark)) == 0
+    tool.hover((1000.0, 100.0))
+    assert len(_line(mark)) == 0
+    tool.drag("finish", (1000.0, 0.0), (1000.0, 0.0))  # back where it began
+    wait_idle(qtbot, win)
+    lay = win.doc.project.layout
+    tool.hover((1400.0, 500.0 + 0.5 * tool.tol()))
+    marked = _line(mark).copy()
+    assert np.allclose(marked, lay.cuts[2])
+    win.a_delete.trigger()
+    assert len(_line(mark)) == 0  # the cut goes: no mark left
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay and not win.lake_ctl.editing)
+    wait_idle(qtbot, win)
+    new = win.doc.project.layout
+    assert len(new.cuts) == len(lay.cuts) - 1
+    assert not any(len(c) == len(marked) and np.allclose(c, marked) for c in new.cuts)  # the one marked went
+    assert len(_line(mark)) == 0
