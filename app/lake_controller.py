@@ -103,6 +103,7 @@ class LakeController(QtCore.QObject):
         self._edit_started = 0.0  # when the last layout edit was started
         self.edit_error: str | None = None
         self._dragging = False  # a drag of the layout is on (the layout tool says so)
+        self._cancelled = None  # the merge key of the last drag cancelled (Ctrl+Z in it)
         # the layout changed by anything but an edit landing (an undo, a redo, Auto layout, an open) counts
         # up: an edit asked for before it is of a layout no longer shown and is not set (it was, over the
         # undo: Set cells then Ctrl+Z at once undid Auto layout, then set the layout again with the cells)
@@ -430,7 +431,7 @@ class LakeController(QtCore.QObject):
         make, text, key, shore, gen = self._pending
         if gen != self._generation:  # of a layout undone (or replaced) since it was asked for
             self._pending = None
-            self._dropped(text)
+            self._dropped(text, key)
             return
         wait = self._edit_started + EDIT_GAP_S - time.perf_counter()
         if key is not None and wait > 0:  # a drag's step: later (the newest step then)
@@ -445,16 +446,35 @@ class LakeController(QtCore.QObject):
         self._edit_started = time.perf_counter()
         worker.start()
 
-    def _dropped(self, text: str) -> None:
-        """An edit of a layout changed since it was asked for is not set: said, once nothing else waits."""
-        if self._pending is None:
+    def _dropped(self, text: str, key=None) -> None:
+        """An edit of a layout changed since it was asked for is not set: said, once nothing else waits
+        (not for a step of a drag cancelled: the cancel said it)."""
+        if self._pending is None and (key is None or key != self._cancelled):
             self.win.message(f"{text}: not made — the layout changed (an undo or another layout) before it was done")
+        self._end_live()
+
+    @property
+    def generation(self) -> int:
+        """Counts the changes of the project's layout by anything but a layout edit landing (an undo, a
+        redo, Auto layout, an open): a drag begun before one is of a layout no longer shown."""
+        return self._generation
+
+    def cancel_drag(self, key) -> None:
+        """Ctrl+Z in a drag of the layout (steps merged under ``key``): the step it made is undone and leaves
+        the history, its steps asked for or being made are dropped (they were set after the undo: the
+        dragged layout came back over it), and the grid goes to the end from the layout before the drag."""
+        self._cancelled = key
+        if self._pending is not None and self._pending[2] == key:
+            self._pending = None
+        self._generation += 1  # a step in the worker now is of the layout the drag made: dropped when done
+        self.editor.drop_merged(key)
+        self._dragging = False
         self._end_live()
 
     def _edited(self, value, text: str, key, shore: bool = False, gen: int | None = None) -> None:
         self._edit_worker = None
         if gen is not None and gen != self._generation:  # the layout it was made from is gone (undone)
-            self._dropped(text)
+            self._dropped(text, key)
             self._next_edit()
             return
         layout, err = value

@@ -107,6 +107,8 @@ class LayoutTool(Tool):
         self._cache: tuple | None = None  # (layout, its handles)
         self._hovered: tuple | None = None  # (layout, the handle ringed under the cursor)
         self._hover_xy: tuple | None = None  # (layout, where the cursor was over it)
+        self._cancelled = False  # the drag was cancelled (Ctrl+Z): the rest of the mouse's drag does nothing
+        self._generation = 0  # the controller's count of layout changes when the drag began
 
     def activate(self) -> None:
         if self.doc.project.layout is None:
@@ -116,6 +118,10 @@ class LayoutTool(Tool):
 
     @property
     def dragging(self) -> bool:
+        return self._handle is not None
+
+    @property
+    def in_drag(self) -> bool:
         return self._handle is not None
 
     def _handles(self, lay) -> list:
@@ -206,18 +212,33 @@ class LayoutTool(Tool):
 
     def deactivate(self) -> None:
         super().deactivate()
-        if self._handle is not None:  # switched away in the middle of a drag: it ends here
+        if self._handle is not None and self.controller.generation != self._generation:
+            self.cancel_drag()  # (the layout changed under it: as in drag)
+        elif self._handle is not None:  # switched away in the middle of a drag: it ends here
             self._end_drag()
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
             self.canvas.lake_items.set_del_cut(None)
+
+    def cancel_drag(self) -> bool:
+        """Ctrl+Z in a drag of the layout: the layout goes back to the one the drag began with, its step
+        out of the history and its steps still being made dropped (they landed after the undo: the layout
+        of an undone Auto layout came back, the redo history gone)."""
+        if self._handle is None:
+            return False
+        self._handle, self._cancelled = None, True
+        self.controller.cancel_drag(("layout", self._drag))
+        if self.canvas is not None:
+            self.canvas.lake_items.set_drag_point(None)
+            self.canvas.lake_items.set_labels_visible(True)
+        return True
 
     def drag(self, phase: str, xy, start, modifiers=None) -> bool:
         from .layout_edit import nearest_handle
 
         lay = self.doc.project.layout
         if phase == "start":
-            self._handle = None
+            self._handle, self._cancelled = None, False
             if lay is None or self.controller is None:
                 return False
             h = nearest_handle(self._near(lay, start), start, self.tol())
@@ -230,12 +251,22 @@ class LayoutTool(Tool):
             self._handle, self._base, self._parts = h, lay, outline_parts(lay)
             self._steps, self._last_xy = DragSteps(), None
             self._drag = self.editor.new_drag_id()
+            self._generation = self.controller.generation
             self.controller.begin_drag()
             if self.canvas is not None:  # the cell counts stay; they need not repaint with every grid
                 self.canvas.lake_items.set_labels_visible(False)
                 self.canvas.lake_items.set_del_cut(None)
         if self._handle is None:
+            if self._cancelled:  # the rest of a drag cancelled by Ctrl+Z does nothing (it panned the view)
+                self._cancelled = phase != "finish"
+                return True
             return False
+        if self.controller.generation != self._generation:
+            # the layout changed under the drag by other than its own steps (an undo from the history,
+            # Auto layout): its steps, made from the layout it began with, would undo that change
+            self.cancel_drag()
+            self.status("The layout changed under the drag (an undo or another layout): the drag stops here")
+            return True
         if phase == "move":
             self._move(xy)
         if phase == "finish":

@@ -100,3 +100,100 @@ def test_the_cut_line_del_would_delete_is_highlighted(qtbot, win):
     assert len(new.cuts) == len(lay.cuts) - 1
     assert not any(len(c) == len(marked) and np.allclose(c, marked) for c in new.cuts)  # the one marked went
     assert len(_line(mark)) == 0
+
+
+def _ctrl_z(qtbot, win) -> None:
+    from PySide6 import QtCore
+
+    win.canvas.setFocus()
+    qtbot.keyClick(win.canvas, QtCore.Qt.Key.Key_Z, QtCore.Qt.KeyboardModifier.ControlModifier)
+
+
+def test_ctrl_z_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
+    """Ctrl+Z with a cut end held: the stack undid under the drag — Auto layout itself when no step had
+    landed yet, then the next step set the dragged layout over the undone one (the layout back, Redo
+    gone); after a step, the drag's own step, and the next move pushed it again.  Now Ctrl+Z cancels the
+    drag: the layout it began with, no step of it to undo or redo, the rest of the drag (moves, release)
+    doing nothing; Ctrl+Z again undoes the step before it.  Ctrl+Y waits for the drag's end."""
+    from app.layout_edit import handles
+    from tests.app.waits import wait_for, wait_idle
+
+    lay0 = _h_layout(win)
+    wait_idle(qtbot, win)
+    tool, stack = win.canvas.tool, win.stack
+    n, idx, undo_text = stack.count(), stack.index(), stack.undoText()
+    end = next(h for h in handles(lay0) if h.kind == "end" and h.cut == 0)
+    x, y = end.xy
+
+    # 1. a step landed: Ctrl+Z takes the layout back to the drag's start, the step out of the history
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    assert stack.count() == n + 1
+    _ctrl_z(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    assert "Drag cancelled" in win._status.text()
+    assert tool.drag("move", (x + 500.0, y), end.xy)  # the rest of the drag: used (no pan), nothing made
+    assert tool.drag("finish", (x + 500.0, y), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    assert stack.undoText() == undo_text and stack.redoText() == ""
+
+    # 2. Ctrl+Z while the drag's first step is being made: Auto layout stays, the step is not set
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    assert win.lake_ctl.editing
+    _ctrl_z(qtbot, win)
+    tool.drag("move", (x + 400.0, y), end.xy)
+    tool.drag("finish", (x + 400.0, y), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    assert "not made" not in win._status.text()  # (the cancel said it)
+
+    # 3. Ctrl+Y in a drag waits; Ctrl+Z after the drag undoes the step before it (the split)
+    win.lake_ctl.set_cell_size(150.0)  # a step to redo (the layout stays)
+    stack.undo()
+    assert stack.redoText() == "Set cell size" and win.doc.project.layout is lay0
+    assert tool.drag("start", end.xy, end.xy)
+    win.a_redo.trigger()
+    assert "waits for the end of the drag" in win._status.text() and stack.redoText() == "Set cell size"
+    tool.drag("finish", end.xy, end.xy)  # back where it began: nothing made
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and stack.redoText() == "Set cell size"
+    _ctrl_z(qtbot, win)
+    assert win.doc.project.layout is None and stack.redoText() == undo_text
+
+
+def test_ctrl_z_in_the_middle_of_a_point_drag_cancels_the_drag(qtbot, win):
+    """Edit tool, a point just inserted held (nothing moved yet), Ctrl+Z: the insert was undone under the
+    drag and its next move set points by indices that were gone (IndexError, or the wrong points moved).
+    After a move, Ctrl+Z undid the move and the next move pushed it again.  Now Ctrl+Z cancels the drag:
+    the points as they were when it began, nothing of it in the history, the rest of it doing nothing."""
+    win.set_tool("draw")
+    for xy in ((0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)):
+        win.canvas.tool.click(xy)
+    win.canvas.tool.double_click((0.0, 6.0))
+    win.set_tool("edit")
+    tool, stack = win.canvas.tool, win.stack
+    tool.click((5.0, 0.0))  # a point inserted on the bottom side
+    assert stack.undoText() == "Insert point"
+    before, n, idx = win.doc.project, stack.count(), stack.index()
+
+    assert tool.drag("start", (5.0, 0.0), (5.0, 0.0))  # held, not moved yet
+    _ctrl_z(qtbot, win)
+    assert win.doc.project is before and (stack.count(), stack.index()) == (n, idx)
+    assert tool.drag("move", (5.0, -2.0), (5.0, 0.0))
+    assert tool.drag("finish", (5.0, -2.0), (5.0, 0.0))
+    assert win.doc.project is before and (stack.count(), stack.index()) == (n, idx)
+
+    assert tool.drag("start", (5.0, 0.0), (5.0, 0.0))  # moved, then Ctrl+Z
+    tool.drag("move", (5.0, -1.0), (5.0, 0.0))
+    assert stack.count() == n + 1 and not np.array_equal(win.doc.block.points, before.blocks[0].points)
+    _ctrl_z(qtbot, win)
+    assert win.doc.project is before and (stack.count(), stack.index()) == (n, idx)
+    assert stack.redoText() == ""  # no redo of half a drag
+    tool.drag("move", (5.0, -3.0), (5.0, 0.0))
+    tool.drag("finish", (5.0, -3.0), (5.0, 0.0))
+    assert win.doc.project is before and stack.undoText() == "Insert point"
+    _ctrl_z(qtbot, win)  # no drag: the insert is undone
+    assert len(win.doc.block.points) == 4 and stack.redoText() == "Insert point"
