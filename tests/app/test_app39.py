@@ -197,3 +197,91 @@ def test_ctrl_z_in_the_middle_of_a_point_drag_cancels_the_drag(qtbot, win):
     assert win.doc.project is before and stack.undoText() == "Insert point"
     _ctrl_z(qtbot, win)  # no drag: the insert is undone
     assert len(win.doc.block.points) == 4 and stack.redoText() == "Insert point"
+
+
+def test_auto_layout_takes_over_the_count_still_being_made(qtbot, win, monkeypatch):
+    """Ctrl+L while the Lake panel's count of the size just set is being made: that layout becomes Auto
+    layout's (busy, its seconds counted, set when made) — it is not made twice."""
+    import threading
+
+    from app import lake_controller
+    from tests.app.waits import wait_for, wait_idle
+
+    lake, area = _y_lake()
+    made, hold = [], threading.Event()
+    job = lake_controller._layout_job
+
+    def held_job(*args):
+        made.append(args)
+        hold.wait(60)
+        return job(*args)
+
+    monkeypatch.setattr(lake_controller, "_layout_job", held_job)
+    win.editor.set_lake(lake, "Import")
+    win.lake_ctl.set_cell_size(float(np.sqrt(area / 100)))
+    assert win.lake_ctl.counting(win.lake_ctl.lake())
+    wait_for(qtbot, win, lambda: len(made) == 1)  # the count is being made
+    assert win.lake_ctl.auto_layout()
+    assert win.lake_ctl.busy and "Computing the block layout" in win._status.text()
+    hold.set()
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not None)
+    wait_idle(qtbot, win)
+    assert len(made) == 1 and win.stack.undoText() == "Auto layout"
+    assert not win.lake_ctl.busy and "256 cells" in win.lake_panel.summary.text()
+
+
+def test_a_layout_drag_undone_from_the_history_stops(qtbot, win):
+    """An undo that is not Ctrl+Z (the Undo history dock) in a drag of the layout: the drag's next steps,
+    made from the layout it began with, would set it again over the undo; the drag stops instead."""
+    from app.layout_edit import handles
+    from tests.app.waits import wait_for, wait_idle
+
+    lay0 = _h_layout(win)
+    wait_idle(qtbot, win)
+    tool, stack = win.canvas.tool, win.stack
+    n = stack.count()
+    end = next(h for h in handles(lay0) if h.kind == "end" and h.cut == 0)
+    x, y = end.xy
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    stack.undo()  # the history dock's undo: the drag's step
+    assert win.doc.project.layout is lay0
+    assert tool.drag("move", (x + 500.0, y), end.xy)
+    assert "drag stops here" in win._status.text()
+    assert tool.drag("finish", (x + 500.0, y), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and stack.count() == n + 1 and stack.redoText().startswith("Move cut end")
+
+
+def test_two_ctrl_z_in_a_drag_leave_auto_layout_undone(qtbot, win):
+    """An imported lake laid out, a cut end dragged, Ctrl+Z twice with the button still down: the first
+    undid the drag's step, the second Auto layout; the next move set the dragged layout again over the
+    lake without one, and "Auto layout" was gone from the history (Import, Move cut end).  Now the first
+    cancels the drag, the second undoes Auto layout, and the rest of the drag does nothing."""
+    from app.lake import compute_layout
+    from app.layout_edit import handles
+    from tests.app.test_app33 import _small_lake
+    from tests.app.waits import wait_for, wait_idle
+
+    lake = _small_lake()
+    win.editor.set_lake(lake, "Import lake.geojson")
+    lay0 = compute_layout(lake)
+    win.editor.set_lake(lake.replaced(layout=lay0), "Auto layout")
+    win.set_tool("layout")
+    wait_idle(qtbot, win)
+    tool, stack = win.canvas.tool, win.stack
+    end = next(h for h in handles(lay0) if h.kind == "end")
+    (x, y), h = end.xy, lay0.cell_size
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + h, y + h), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    _ctrl_z(qtbot, win)
+    _ctrl_z(qtbot, win)
+    tool.drag("move", (x + 1.5 * h, y + 1.5 * h), end.xy)
+    tool.drag("finish", (x + 1.5 * h, y + 1.5 * h), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is None and win.doc.project.lake is not None
+    assert (stack.count(), stack.index()) == (2, 1) and stack.redoText() == "Auto layout"
+    win.a_redo.trigger()
+    assert win.doc.project.layout is lay0
