@@ -92,7 +92,7 @@ ACTIONS: tuple[ActionSpec, ...] = (
     ActionSpec("export", "&Export mesh…", "io.export_dialog", ("Ctrl+E",), menu="&File", separator=True),
     ActionSpec("figure", "Export &figure (PNG/SVG)…", "io.figure_dialog", ("Ctrl+Shift+E",), menu="&File"),
     ActionSpec("quit", "&Quit", "close", (K.Quit,), menu="&File", separator=True),
-    # Edit (undo/redo come from the undo stack: their text names the step)
+    # Edit (undo/redo name the step, as the undo stack's actions do; Ctrl+Z in a drag cancels it: MainWindow.undo)
     ActionSpec("undo", "&Undo", "@undo", ("Ctrl+Z",), menu="&Edit", help="undo"),
     ActionSpec("redo", "&Redo", "@redo", ("Ctrl+Y", "Ctrl+Shift+Z"), menu="&Edit", help="redo"),
     ActionSpec("delete", "&Delete selected points", "delete_selection", (K.Delete,), menu="&Edit", separator=True),
@@ -239,7 +239,11 @@ ACTIONS: tuple[ActionSpec, ...] = (
 #: mouse gestures and keys the tools handle themselves (for the help only)
 GESTURES: tuple[tuple[str, str], ...] = (
     ("Enter / double-click", "close the loop being drawn (Draw) or finish a cut line"),
-    ("Del", "delete selected points (Edit); the cut line pointed at (Layout): its two blocks become one"),
+    (
+        "Del",
+        "delete selected points (Edit); the cut line pointed at, drawn in red (Layout): its two blocks become one",
+    ),
+    ("Ctrl+Z in a drag", "cancel the drag: back to before it, nothing of it in the history"),
     ("Shift+drag", "snap a dragged point onto another point (Edit)"),
     ("drag on empty space", "box-select points (Edit); pan (other tools)"),
     ("wheel / right-drag", "zoom"),

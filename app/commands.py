@@ -64,12 +64,15 @@ class ProjectCommand(QUndoCommand):
         self.before = before if before is not None else doc.project
         self.after = after
         self.merge_key = merge_key
+        self.discard = False  # undone once more, it leaves the history (a drag cancelled half way)
 
     def redo(self) -> None:
         self.doc.set_project(self.after)
 
     def undo(self) -> None:
         self.doc.set_project(self.before)
+        if self.discard:  # QUndoStack deletes an obsolete command once undone: no redo of half a drag
+            self.setObsolete(True)
 
     def id(self) -> int:
         return _MERGE_ID if self.merge_key is not None else -1
@@ -154,6 +157,18 @@ class Editor:
 
     def new_drag_id(self) -> int:
         return next(_drag_ids)
+
+    def drop_merged(self, merge_key) -> bool:
+        """Undo the last step when it is the one merged under ``merge_key`` (a drag's steps, the drag
+        cancelled half way) and leave no redo of it; False, and nothing done, when the last step is
+        another (the drag made none yet)."""
+        stack = self.stack
+        top = stack.command(stack.index() - 1) if stack.index() > 0 else None
+        if merge_key is None or not isinstance(top, ProjectCommand) or top.merge_key != merge_key:
+            return False
+        top.discard = True
+        stack.undo()
+        return True
 
     def _push(self, cls: type[ProjectCommand], after: Project, text: str, merge_key=None) -> None:
         if after == self.doc.project:

@@ -10,6 +10,7 @@ outline it offers Auto layout in a strip above the canvas (never shown with ``wi
 from __future__ import annotations
 
 import logging
+import math
 import time
 
 import numpy as np
@@ -31,6 +32,9 @@ EDIT_GAP_S = 0.2
 #: Auto layout of more cells than this asks first (20 x the default 10 000): the layout and its grid
 #: take minutes and cannot be stopped half way (a cell size of 20 m typed for 200: 3.7 million cells)
 LARGE_LAYOUT = 200_000
+#: milliseconds after a cell size is set before its layout is counted (LakeController.layout_count): a
+#: size typed and laid out at once (Ctrl+L) is laid out once
+COUNT_DELAY_MS = 400
 
 log = logging.getLogger(__name__)
 
@@ -67,6 +71,7 @@ class LakeController(QtCore.QObject):
 
     layout_done = QtCore.Signal(object)  # the Layout, or None when it failed
     busy_changed = QtCore.Signal(bool)
+    counted = QtCore.Signal()  # the layout of a cell size set but not laid out was counted (layout_count)
     ticked = QtCore.Signal(int)  # seconds a layout has been computing (each second)
 
     def __init__(self, window) -> None:
@@ -98,6 +103,7 @@ class LakeController(QtCore.QObject):
         self._edit_started = 0.0  # when the last layout edit was started
         self.edit_error: str | None = None
         self._dragging = False  # a drag of the layout is on (the layout tool says so)
+        self._cancelled = None  # the merge key of the last drag cancelled (Ctrl+Z in it)
         # the layout changed by anything but an edit landing (an undo, a redo, Auto layout, an open) counts
         # up: an edit asked for before it is of a layout no longer shown and is not set (it was, over the
         # undo: Set cells then Ctrl+Z at once undid Auto layout, then set the layout again with the cells)
@@ -105,6 +111,18 @@ class LakeController(QtCore.QObject):
         self._seen_layout = self.doc.project.layout
         self._applying = False  # an edit is landing (its own change of the layout)
         self.doc.project_changed.connect(self._layout_changed)
+        # a cell size set and not laid out yet: the layout Auto layout would make is made in a worker and
+        # the Lake panel gives its cells (it gave area / h²; the layout had 0.67-3.8 x that on lakes whose blocks
+        # are a few cells across); Auto layout then takes that layout (or the count still running) as its own
+        self._count: tuple | None = None  # (lake without layout, its layout or None, the error or None)
+        self._count_worker = None
+        self._count_lake: Lake | None = None  # the lake being counted
+        self._adopted = None  # the water Auto layout asked for, when it took over the running count
+        self._count_timer = QtCore.QTimer(self)
+        self._count_timer.setSingleShot(True)
+        self._count_timer.setInterval(COUNT_DELAY_MS)
+        self._count_timer.timeout.connect(self._count_now)
+        self.doc.project_changed.connect(lambda _p: self._want_count())
 
     @property
     def busy(self) -> bool:
@@ -206,6 +224,8 @@ class LakeController(QtCore.QObject):
         self.last_error = None
         p = self.doc.project
         water = (lake.outline, lake.holes, p.crs, tuple(p.origin))  # what the layout is of (_same_water)
+        if cuts is None and self._take_count(lake, water, text):
+            return True
         worker = create_worker(_layout_job, lake.replaced(layout=None), cuts, _start_thread=False)
         worker.returned.connect(lambda value: self._on_returned(value, cuts, water))
         worker.errored.connect(self._on_errored)
@@ -216,6 +236,90 @@ class LakeController(QtCore.QObject):
         self._ticker.start()
         worker.start()
         return True
+
+    def _take_count(self, lake: Lake, water, text: str) -> bool:
+        """Auto layout of ``lake`` takes the layout counted for the Lake panel (made already: set at once;
+        being made: its worker becomes Auto layout's).  False when there is none of this lake."""
+        bare = lake.replaced(layout=None)
+        done = self._count
+        if done is not None and done[0] == bare:
+            self._count = None  # a layout is set once (its held coarse readings are its grid's start)
+            self.win.message(text)
+            self._on_returned(done, None, water)
+            return True
+        if self._count_worker is None or self._count_lake != bare:
+            return False
+        self._adopted, self._worker = water, self._count_worker
+        self.busy_changed.emit(True)
+        self.win.message(text)
+        self._busy_text, self._busy_since = text, time.monotonic()
+        self._ticker.start()
+        return True
+
+    # ------------------------------------------------- the panel's count
+    def count_wanted(self) -> Lake | None:
+        """The lake (without layout) whose layout the Lake panel counts: a cell size set and not laid out
+        yet, of at most :data:`LARGE_LAYOUT` cells by area; else None."""
+        from meshcore.cli.mesh_steps import MIN_CELLS
+
+        from .lake import expected_cells
+
+        lake = self.lake()
+        if lake is None or lake.cell_size is None:
+            return None
+        lay = self.doc.project.layout
+        if lay is not None and math.isclose(lake.cell_size, lay.cell_size, rel_tol=1e-6):
+            return None
+        if not MIN_CELLS <= expected_cells(lake) <= LARGE_LAYOUT:  # refused, or asked about first
+            return None
+        return lake.replaced(layout=None)
+
+    def layout_count(self, lake: Lake) -> tuple[int, int] | str | None:
+        """``(cells, blocks)`` of the layout Auto layout makes of ``lake`` at its cell size (made in a
+        worker when the size was set), the reason it makes none, or None when not counted (yet)."""
+        done, bare = self._count, lake.replaced(layout=None)
+        if done is None or done[0] != bare:
+            return None
+        return (done[1].n_cells, len(done[1].blocks)) if done[1] is not None else str(done[2])
+
+    def counting(self, lake: Lake) -> bool:
+        """True while the layout of ``lake`` is being counted (or about to be)."""
+        bare = lake.replaced(layout=None)
+        return self._count_lake == bare or (self._count_timer.isActive() and self.count_wanted() == bare)
+
+    def _want_count(self) -> None:
+        lake = self.count_wanted()
+        if lake is None or self.layout_count(lake) is not None or self._count_lake == lake:
+            return
+        self._count_timer.start()  # (again: the last size typed is counted)
+
+    def _count_now(self) -> None:
+        lake = self.count_wanted()
+        if lake is None or self.busy or self._count_worker is not None or self.layout_count(lake) is not None:
+            return  # (a count running: the next is started when it ends)
+        worker = create_worker(_layout_job, lake, None, _start_thread=False)
+        worker.returned.connect(self._counted)
+        worker.errored.connect(self._count_errored)
+        self._count_worker, self._count_lake = worker, lake
+        worker.start()
+
+    def _counted(self, value) -> None:
+        self._count_worker, self._count_lake = None, None
+        if self._adopted is not None:  # Auto layout took it over
+            water, self._adopted = self._adopted, None
+            self._on_returned(value, None, water)
+            return
+        self._count = value
+        self.counted.emit()
+        self._want_count()
+
+    def _count_errored(self, exc) -> None:
+        self._count_worker, self._count_lake = None, None
+        if self._adopted is not None:
+            self._adopted = None
+            self._on_errored(exc)
+            return
+        log.error("the count of a layout failed", exc_info=exc)
 
     def _tick(self) -> None:
         """The seconds the layout has taken so far, in the status line and the Auto layout button."""
@@ -327,7 +431,7 @@ class LakeController(QtCore.QObject):
         make, text, key, shore, gen = self._pending
         if gen != self._generation:  # of a layout undone (or replaced) since it was asked for
             self._pending = None
-            self._dropped(text)
+            self._dropped(text, key)
             return
         wait = self._edit_started + EDIT_GAP_S - time.perf_counter()
         if key is not None and wait > 0:  # a drag's step: later (the newest step then)
@@ -342,16 +446,35 @@ class LakeController(QtCore.QObject):
         self._edit_started = time.perf_counter()
         worker.start()
 
-    def _dropped(self, text: str) -> None:
-        """An edit of a layout changed since it was asked for is not set: said, once nothing else waits."""
-        if self._pending is None:
+    def _dropped(self, text: str, key=None) -> None:
+        """An edit of a layout changed since it was asked for is not set: said, once nothing else waits
+        (not for a step of a drag cancelled: the cancel said it)."""
+        if self._pending is None and (key is None or key != self._cancelled):
             self.win.message(f"{text}: not made — the layout changed (an undo or another layout) before it was done")
+        self._end_live()
+
+    @property
+    def generation(self) -> int:
+        """Counts the changes of the project's layout by anything but a layout edit landing (an undo, a
+        redo, Auto layout, an open): a drag begun before one is of a layout no longer shown."""
+        return self._generation
+
+    def cancel_drag(self, key) -> None:
+        """Ctrl+Z in a drag of the layout (steps merged under ``key``): the step it made is undone and leaves
+        the history, its steps asked for or being made are dropped (they were set after the undo: the
+        dragged layout came back over it), and the grid goes to the end from the layout before the drag."""
+        self._cancelled = key
+        if self._pending is not None and self._pending[2] == key:
+            self._pending = None
+        self._generation += 1  # a step in the worker now is of the layout the drag made: dropped when done
+        self.editor.drop_merged(key)
+        self._dragging = False
         self._end_live()
 
     def _edited(self, value, text: str, key, shore: bool = False, gen: int | None = None) -> None:
         self._edit_worker = None
         if gen is not None and gen != self._generation:  # the layout it was made from is gone (undone)
-            self._dropped(text)
+            self._dropped(text, key)
             self._next_edit()
             return
         layout, err = value

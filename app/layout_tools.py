@@ -107,6 +107,8 @@ class LayoutTool(Tool):
         self._cache: tuple | None = None  # (layout, its handles)
         self._hovered: tuple | None = None  # (layout, the handle ringed under the cursor)
         self._hover_xy: tuple | None = None  # (layout, where the cursor was over it)
+        self._cancelled = False  # the drag was cancelled (Ctrl+Z): the rest of the mouse's drag does nothing
+        self._generation = 0  # the controller's count of layout changes when the drag began
 
     def activate(self) -> None:
         if self.doc.project.layout is None:
@@ -118,13 +120,22 @@ class LayoutTool(Tool):
     def dragging(self) -> bool:
         return self._handle is not None
 
+    @property
+    def in_drag(self) -> bool:
+        return self._handle is not None
+
     def _handles(self, lay) -> list:
         """The handles of ``lay`` (remembered for the last layout: hovering asks often)."""
         from .layout_edit import handles
 
         if self._cache is None or self._cache[0] is not lay:
+            import shapely
+
             hs = handles(lay)
-            self._cache = (lay, hs, np.array([h.xy for h in hs], float).reshape(-1, 2))
+            lines = np.array(
+                [shapely.linestrings(np.asarray(c, float)) if len(c) >= 2 else None for c in lay.cuts], dtype=object
+            )
+            self._cache = (lay, hs, np.array([h.xy for h in hs], float).reshape(-1, 2), lines)
         return self._cache[1]
 
     def _near(self, lay, xy) -> list:
@@ -144,6 +155,18 @@ class LayoutTool(Tool):
         self._hovered = (lay, h)
         self._hover_xy = (lay, (float(xy[0]), float(xy[1])))
         self.canvas.lake_items.set_drag_point(None if h is None else h.xy)
+        # the cut line Del would delete, highlighted (it was said only by the tip: a user pointing near a
+        # junction could not tell which of three cuts would go, or that none would)
+        k = self._del_target(lay) if lay is not None else None
+        self.canvas.lake_items.set_del_cut(None if k is None else lay.cuts[k])
+
+    def _del_target(self, lay) -> int | None:
+        """The cut line of ``lay`` that Del deletes: the one whose end or point is ringed, else the one under
+        the cursor along its line (:meth:`_cut_under`); None for none."""
+        was, h = self._hovered or (None, None)
+        if was is lay and h is not None and h.kind in ("end", "cut"):
+            return h.cut
+        return self._cut_under(lay)
 
     def delete(self) -> bool:
         """Del: the cut line pointed at goes (its end or point ringed, or the cursor on the line between
@@ -153,8 +176,7 @@ class LayoutTool(Tool):
         lay = self.doc.project.layout
         if lay is None or self.controller is None or self._handle is not None:
             return False
-        was, h = self._hovered or (None, None)
-        k = h.cut if was is lay and h is not None and h.kind in ("end", "cut") else self._cut_under(lay)
+        k = self._del_target(lay)
         if k is None:
             self.status(
                 "Delete a cut line: point at it (along its line, away from where cut lines meet, or at its end "
@@ -169,6 +191,7 @@ class LayoutTool(Tool):
         self._hovered = None  # the ringed end goes with its cut: no ring left until the mouse moves
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
+            self.canvas.lake_items.set_del_cut(None)
         return True
 
     def _cut_under(self, lay) -> int | None:
@@ -177,28 +200,45 @@ class LayoutTool(Tool):
         was, xy = self._hover_xy or (None, None)
         if was is not lay or xy is None:
             return None
-        from shapely.geometry import LineString, Point
+        import shapely
 
-        q, tol = Point(xy), self.tol()
-        near = sorted((LineString(np.asarray(c, float)).distance(q), k) for k, c in enumerate(lay.cuts) if len(c) >= 2)
-        near = [(d, k) for d, k in near if d <= tol]
+        self._handles(lay)  # (the cuts' lines are remembered with the handles)
+        d = shapely.distance(self._cache[3], shapely.points(xy)) if len(lay.cuts) else np.zeros(0)
+        tol = self.tol()
+        near = sorted((float(d[k]), k) for k, c in enumerate(lay.cuts) if len(c) >= 2 and d[k] <= tol)
         if not near or (len(near) > 1 and near[1][0] - near[0][0] <= 0.25 * tol):
             return None
         return near[0][1]
 
     def deactivate(self) -> None:
         super().deactivate()
-        if self._handle is not None:  # switched away in the middle of a drag: it ends here
+        if self._handle is not None and self.controller.generation != self._generation:
+            self.cancel_drag()  # (the layout changed under it: as in drag)
+        elif self._handle is not None:  # switched away in the middle of a drag: it ends here
             self._end_drag()
         if self.canvas is not None:
             self.canvas.lake_items.set_drag_point(None)
+            self.canvas.lake_items.set_del_cut(None)
+
+    def cancel_drag(self) -> bool:
+        """Ctrl+Z in a drag of the layout: the layout goes back to the one the drag began with, its step
+        out of the history and its steps still being made dropped (they landed after the undo: the layout
+        of an undone Auto layout came back, the redo history gone)."""
+        if self._handle is None:
+            return False
+        self._handle, self._cancelled = None, True
+        self.controller.cancel_drag(("layout", self._drag))
+        if self.canvas is not None:
+            self.canvas.lake_items.set_drag_point(None)
+            self.canvas.lake_items.set_labels_visible(True)
+        return True
 
     def drag(self, phase: str, xy, start, modifiers=None) -> bool:
         from .layout_edit import nearest_handle
 
         lay = self.doc.project.layout
         if phase == "start":
-            self._handle = None
+            self._handle, self._cancelled = None, False
             if lay is None or self.controller is None:
                 return False
             h = nearest_handle(self._near(lay, start), start, self.tol())
@@ -211,11 +251,22 @@ class LayoutTool(Tool):
             self._handle, self._base, self._parts = h, lay, outline_parts(lay)
             self._steps, self._last_xy = DragSteps(), None
             self._drag = self.editor.new_drag_id()
+            self._generation = self.controller.generation
             self.controller.begin_drag()
             if self.canvas is not None:  # the cell counts stay; they need not repaint with every grid
                 self.canvas.lake_items.set_labels_visible(False)
+                self.canvas.lake_items.set_del_cut(None)
         if self._handle is None:
+            if self._cancelled:  # the rest of a drag cancelled by Ctrl+Z does nothing (it panned the view)
+                self._cancelled = phase != "finish"
+                return True
             return False
+        if self.controller.generation != self._generation:
+            # the layout changed under the drag by other than its own steps (an undo from the history,
+            # Auto layout): its steps, made from the layout it began with, would undo that change
+            self.cancel_drag()
+            self.status("The layout changed under the drag (an undo or another layout): the drag stops here")
+            return True
         if phase == "move":
             self._move(xy)
         if phase == "finish":

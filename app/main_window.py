@@ -191,9 +191,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
                 self.tool_group.addAction(a)
                 self.tool_actions[key] = a
         elif name in ("undo", "redo"):
-            make = self.stack.createUndoAction if name == "undo" else self.stack.createRedoAction
-            a = make(self, spec.text)
-            a.triggered.connect(lambda _c=False, n=name: self._say_undone(n))
+            a = self._history_action(name, spec.text)
         elif name == "recent":
             self.recent_menu = self.io.recent_menu = menu.addMenu(spec.text)
             return None
@@ -207,6 +205,45 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             raise KeyError(f"no placeholder {name!r} in the window")
         menu.addAction(a)
         return a
+
+    def _history_action(self, name: str, prefix: str) -> QtGui.QAction:
+        """Undo or Redo, named by the step it undoes or redoes as the stack's own actions are, through
+        :meth:`undo` / :meth:`redo` (the stack's action undid under a drag: see :meth:`undo`)."""
+        stack = self.stack
+        a = _StepAction(prefix, self)
+        if name == "undo":
+            a.set_step(stack.undoText())
+            a.setEnabled(stack.canUndo())
+            stack.undoTextChanged.connect(a.set_step)
+            stack.canUndoChanged.connect(a.setEnabled)
+        else:
+            a.set_step(stack.redoText())
+            a.setEnabled(stack.canRedo())
+            stack.redoTextChanged.connect(a.set_step)
+            stack.canRedoChanged.connect(a.setEnabled)
+        a.triggered.connect(self.undo if name == "undo" else self.redo)
+        return a
+
+    def undo(self) -> None:
+        """Ctrl+Z: the last step undone — in the middle of a drag (a cut end, a shore point, points of a
+        block), the drag cancelled instead: back to before it, no step of it left to undo or redo, the rest
+        of the mouse's drag doing nothing.  (The stack undid under the drag: the step before it went, then
+        the drag's next move set its own layout over the undo, or moved points that were gone.)"""
+        tool = self.canvas.tool
+        if tool is not None and tool.cancel_drag():
+            self.message("Drag cancelled (Ctrl+Z): back to before it — Ctrl+Z again undoes the step before")
+            return
+        self.stack.undo()
+        self._say_undone("undo")
+
+    def redo(self) -> None:
+        """Ctrl+Y: the step undone last redone; not in the middle of a drag (said)."""
+        tool = self.canvas.tool
+        if tool is not None and tool.in_drag:
+            self.message("Redo waits for the end of the drag (Ctrl+Z cancels the drag)")
+            return
+        self.stack.redo()
+        self._say_undone("redo")
 
     def _say_undone(self, name: str) -> None:
         """The status line says what Ctrl+Z (or Ctrl+Y) just did: it went on showing the message of
@@ -574,3 +611,14 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         if coloured and self.lake_quality.verdict is not None and not self.lake_quality.verdict.passed:
             key = self.a_misses.shortcut().toString(QtGui.QKeySequence.SequenceFormat.NativeText)
             self.message(f"Cells coloured by {label}; the preset's misses are hidden — View ▸ Preset misses ({key})")
+
+
+class _StepAction(QtGui.QAction):
+    """Undo or Redo named by its step ("&Undo Move cut end"), as the undo stack's own actions are."""
+
+    def __init__(self, prefix: str, parent) -> None:
+        super().__init__(prefix, parent)
+        self._prefix = prefix
+
+    def set_step(self, text: str) -> None:
+        self.setText(f"{self._prefix} {text}" if text else self._prefix)

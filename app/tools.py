@@ -78,6 +78,17 @@ class Tool:
         """True while a drag of this tool edits the project (the autosave waits for its end)."""
         return False
 
+    @property
+    def in_drag(self) -> bool:
+        """True while a drag of this tool is on (the mouse button still down), edit or not."""
+        return False
+
+    def cancel_drag(self) -> bool:
+        """Ctrl+Z in the middle of a drag: the drag is cancelled — the project goes back to what it was
+        when the drag began, with no step of it in the history (undo or redo) — and the rest of the
+        mouse's drag does nothing.  True when there was a drag to cancel (the undo is spent on it)."""
+        return False
+
 
 class PanTool(Tool):
     pass
@@ -181,6 +192,17 @@ class EditTool(Tool):
         if phase == "start" and self.doc.project.layout is not None:  # no points to drag or box-select
             self.status(LAYOUT_HINT)
             return False
+        if phase != "start" and self._drag is not None and self._drag[0] == "cancelled":
+            if phase == "finish":  # the rest of a cancelled drag did nothing (it panned the view)
+                self._drag = None
+            return True
+        moving = phase != "start" and self._drag is not None and self._drag[0] == "move"
+        if moving and self.editor.stack.index() != self._drag[1]["index"]:
+            # the history moved under the drag (an undo from the history dock): its points are not the
+            # ones it began with; it stops here (it moved them by indices that were gone)
+            self._drag = ("cancelled", None)
+            self.status("The points changed under the drag (undo or redo): the drag stops here")
+            return True
         if phase == "start":
             k = geo.nearest_point(b.points, start, self.tol()) if b.boundary is None else None
             if k is not None:
@@ -194,6 +216,7 @@ class EditTool(Tool):
                         "anchor": k,
                         "id": self.editor.new_drag_id(),
                         "start": start,
+                        "index": self.editor.stack.index(),  # where the history is, the drag's step on top
                     },
                 )
             else:
@@ -208,6 +231,7 @@ class EditTool(Tool):
             anchor_origin = d["origin"][d["idx"].index(d["anchor"])]
             new = d["origin"] + (np.asarray(target) - anchor_origin)
             self.editor.set_points(d["idx"], new, drag_id=d["id"])
+            d["index"] = self.editor.stack.index()  # (its first step pushed one; the others merge into it)
         else:
             x0, y0 = d["start"]
             if self.canvas is not None:
@@ -228,6 +252,23 @@ class EditTool(Tool):
     @property
     def dragging(self) -> bool:
         return self._drag is not None and self._drag[0] == "move"
+
+    @property
+    def in_drag(self) -> bool:
+        return self._drag is not None and self._drag[0] != "cancelled"
+
+    def cancel_drag(self) -> bool:
+        """Ctrl+Z in a drag of points: they go back where the drag took them from (its step undone and
+        out of the history); a box selection is dropped."""
+        if not self.in_drag:
+            return False
+        kind, d = self._drag
+        self._drag = ("cancelled", None)
+        if kind == "move":
+            self.editor.drop_merged(("move", d["id"]))
+        elif self.canvas is not None:
+            self.canvas.rubber_box.hide()
+        return True
 
     def key(self, key: int) -> bool:
         if key in (QtCore.Qt.Key.Key_Delete, QtCore.Qt.Key.Key_Backspace):

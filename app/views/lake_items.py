@@ -20,6 +20,8 @@ __all__ = ["LakeOverlay", "block_label_points", "left_out_islands"]
 CUT_COLOUR = "#9467bd"
 SHORE_COLOUR = "#1f5fa8"
 MISS_COLOUR = "#ff7f0e"
+#: the cut line Del would delete: the drag ring's red, translucent (the cut's own line shows inside it)
+DEL_COLOUR = (214, 39, 40, 150)
 #: a label may stick out of its block when the block's area is at least this many times the label's
 #: (half of a long arm's block stays in sight, and its cell counts are read at full view)
 LABEL_ROOM = 2.0
@@ -108,6 +110,11 @@ class LakeOverlay:
         self.misses_over_colours = False  # cells coloured: the misses are drawn as thin rings
         self.drag_point = Scatter(size=13, symbol="o", pen=pg.mkPen("#d62728", width=2), brush=None)
         self.drag_point.setZValue(43)
+        # the cut line Del would delete (the Layout tool's cursor on it): a wide red band under its line
+        self.del_cut = pg.PlotCurveItem(pen=pg.mkPen(DEL_COLOUR, width=8), connect="finite")
+        self.del_cut.setZValue(6.5)
+        self._del_shown = None  # the line marked
+        self._layout_drawn = None  # the layout the cut lines drawn are of
         for it in (
             self.shore,
             self.left_out,
@@ -116,6 +123,7 @@ class LakeOverlay:
             self.corners,
             *self.miss_marks.items(),
             self.drag_point,
+            self.del_cut,
         ):
             canvas.addItem(it)
             it.setAcceptedMouseButtons(QtCore.Qt.MouseButton.NoButton)
@@ -156,6 +164,9 @@ class LakeOverlay:
 
     def _draw_layout(self, layout) -> None:
         self._labels_due = None
+        if layout is not self._layout_drawn:  # the cut marked was of the layout before (the tool marks one of
+            self.set_del_cut(None)  # this one when the mouse moves)
+        self._layout_drawn = layout
         if layout is None:
             set_polylines(self.cuts, [])
             set_points(self.cut_ends, None)
@@ -320,10 +331,26 @@ class LakeOverlay:
         """Ring the handle being dragged where it will go (None: no drag)."""
         set_points(self.drag_point, None if xy is None else np.asarray(xy, float).reshape(1, 2))
 
+    def set_del_cut(self, line) -> None:
+        """Mark the cut line (a ``(k, 2)`` polyline) that Del would delete; None: none.  The same line
+        again is not set again (the tool says it with every mouse move)."""
+        if line is self._del_shown:
+            return
+        self._del_shown = line
+        set_polylines(self.del_cut, [] if line is None else [line])
+
     def editing_items(self) -> list:
         """The layout's editing marks (cut lines and ends, block corners and labels, preset misses, the
-        drag ring): left out of an exported figure, which keeps the shore."""
-        return [self.cuts, self.cut_ends, self.corners, *self.miss_marks.items(), self.drag_point, *self.labels]
+        drag ring, the cut Del would delete): left out of an exported figure, which keeps the shore."""
+        return [
+            self.cuts,
+            self.cut_ends,
+            self.corners,
+            *self.miss_marks.items(),
+            self.drag_point,
+            self.del_cut,
+            *self.labels,
+        ]
 
     def set_markers_visible(self, on: bool) -> None:
         self.markers_visible = bool(on)

@@ -89,6 +89,7 @@ class LakePanel(QtWidgets.QWidget):
         self.split.clicked.connect(lambda: self.ctl.win.split_by_cuts())
         controller.busy_changed.connect(self._busy)
         controller.ticked.connect(self._ticked)
+        controller.counted.connect(self.refresh)
         doc.project_changed.connect(lambda _p: self.refresh())
         self.refresh()
 
@@ -105,8 +106,10 @@ class LakePanel(QtWidgets.QWidget):
         lay = p.layout
         self.split.setEnabled(lay is None and bool(p.cut_lines) and not self.ctl.busy)
         if lay is None:
+            at = self._count_text(lake) if lake is not None and lake.cell_size is not None else ""
+            at = f" (at {lake.cell_size:.4g} m: {at})" if at else ""
             self.summary.setText(
-                "No layout yet: Auto layout splits the lake into blocks, or draw cut lines (L) and split by them."
+                f"No layout yet: Auto layout splits the lake into blocks{at}, or draw cut lines (L) and split by them."
                 if lake is not None
                 else "Import a lake outline (Ctrl+I) or draw and close a loop."
             )
@@ -119,9 +122,7 @@ class LakePanel(QtWidgets.QWidget):
         notes = f" — {k} note{'s' * (k != 1)} on the water (Messages)" if k else ""
         h = lake.cell_size if lake is not None else None
         if h is not None and not math.isclose(h, lay.cell_size, rel_tol=1e-6):  # set since: not applied yet
-            from ..lake import expected_cells
-
-            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m (about {expected_cells(lake):,} cells)"
+            notes += f" — Auto layout (Ctrl+L) makes them at {h:.4g} m: {self._count_text(lake)}"
         kind = " for one index space (EFDC, Delft3D single domain)" if lay.single else ""
         self.summary.setText(f"{n} block{'s' * (n != 1)}{kind}, {lay.n_cells:,} cells at {lay.cell_size:.4g} m{notes}")
         self.summary.setToolTip("\n\n".join(lay.notes))
@@ -130,6 +131,22 @@ class LakePanel(QtWidgets.QWidget):
             self.table.setItem(k, 0, QtWidgets.QTableWidgetItem(b.name))
             self.table.setItem(k, 1, QtWidgets.QTableWidgetItem(f"{b.cells[0]} × {b.cells[1]}"))
         self._show_active()
+
+    def _count_text(self, lake) -> str:
+        """The cells of the layout Auto layout makes of ``lake`` at its cell size, as counted by the
+        controller (the layout made in a worker); while it is made, or for a lake too large to count, the
+        water's area over the cell size squared, said to be that (the layout's cells come out 0.67-3.8 x
+        it where blocks are a few cells across: each side's count is a multiple of 4)."""
+        from ..lake import expected_cells
+
+        got = self.ctl.layout_count(lake)
+        if isinstance(got, tuple):
+            n, k = got
+            return f"{n:,} cells in {k} block{'s' * (k != 1)}"
+        if isinstance(got, str):
+            return f"no layout ({got})"
+        rough = f"about {expected_cells(lake):,} cells by area ÷ cell size²"
+        return f"{rough}; counting the layout's…" if self.ctl.counting(lake) else rough
 
     def _show_active(self) -> None:
         """The selected (active) block's cells in the spin boxes, in steps of the layout's multiple."""

@@ -205,7 +205,7 @@ def test_a_cell_size_for_millions_of_cells_asks_before_the_layout(qtbot, win, tm
     area = shapely.Polygon(lake.outline, lake.holes).area
     h = (area / (3 * LARGE_LAYOUT)) ** 0.5  # about 600 000 cells
     win.lake_ctl.set_cell_size(h)
-    assert "(about 6" in win.lake_panel.summary.text() and "cells)" in win.lake_panel.summary.text()
+    assert "m: about 6" in win.lake_panel.summary.text() and "cells by area" in win.lake_panel.summary.text()
     before = win.doc.project.layout
     assert not win.lake_ctl.auto_layout()
     assert not win.lake_ctl.busy and win.doc.project.layout is before
