@@ -315,7 +315,10 @@ def iterate_layout(
     ``level_callback(kind, value)`` is called with ``("level", (level, result))`` as each level
     ends (returning ``"stop"`` ends the solve there, as ``"stop"`` sent does; ``"pause"`` yields
     the level's grids, then goes on or stops as told by what is sent) and
-    ``("equalize", patches)`` after the equalize step (the patches it kept).
+    ``("equalize", patches)`` after the equalize step (the patches it kept); when the grid is made
+    again (:data:`FOLD_RETRY`), ``("retry", bad cells)`` before, each of that run's calls with its
+    kind prefixed ``"again "`` (its return value not heard), and ``("retried", (bad cells, bad cells
+    of the grid made again, whether that grid is the one returned))`` after.
     Every ``every`` sweeps it yields the current grids of every block (``grids``; on the
     coarse levels, the coarse grids); ``"stop"`` sent to it, or ``stop_event`` set, ends the
     solve with the grids as they are (``info.converged`` False, message "stopped"); ``stop_event``
@@ -454,16 +457,25 @@ def iterate_layout(
     # cells left folded or non-convex: the levels again with block corners and cut ends sliding (FOLD_RETRY)
     from ._generators import drain
 
+    heard: Callable[[str, Any], None] | None = None
+    if level_callback is not None:  # told as "retry", its levels and step as "again level", "again equalize"
+        level_callback("retry", n)
+        told = level_callback
+        heard = lambda kind, value: told(f"again {kind}", value)  # noqa: E731
+
     again = drain(
         iterate_layout(
             layout, start=start, levels=levels, sweeps=sweeps, stall=stall, stall_limits=stall_limits,
             smooth=smooth, omega=omega, pin_angle=pin_angle, shore_smooth=shore_smooth, size_ratio=size_ratio,
             hold_ends=hold_ends, end_ratio=end_ratio, slide_ends=True, equalize=equalize, spacing=spacing,
-            every=None, stop_event=stop_event,
+            every=None, level_callback=heard, stop_event=stop_event,
         )
     )  # fmt: skip
     m = _n_folded(again.grids)
-    if asked() or again.info.message == "stopped" or m >= n:
+    kept = not (asked() or again.info.message == "stopped" or m >= n)
+    if level_callback is not None:
+        level_callback("retried", (n, m, kept))
+    if not kept:
         return mb
     said = f"; made again with block corners and cut ends sliding along the shore: {n} → {m} bad cell(s)"
     info = dataclasses.replace(again.info, message=again.info.message + said)

@@ -88,3 +88,42 @@ def test_a_dendritic_reservoirs_corner_on_a_notch_of_the_shore_leaves_no_bad_cel
     assert "made again with block corners and cut ends sliding along the shore: 1 → 0" in mb.info.message
     assert s["pct_nodes_within_3deg"] >= 90.8 and s["pct_smoothness_le_1.2"] >= 92.4
     assert s["max_interface_ratio"] <= 2.0 and s["hausdorff_cells"] <= 0.5
+
+
+@pytest.mark.parametrize(("counts", "kept"), [([3, 1], True), ([2, 2], False)])
+def test_the_callback_hears_the_retry_its_levels_and_which_grid_is_kept(layout, monkeypatch, counts, kept):
+    """``meshcore mesh`` printed nothing while the grid was made again (held-out Vänern: its 8 s
+    showed as the quality's); the callback now hears the retry, its levels and its equalize step
+    (kinds prefixed ``again ``, so the app's level marks do not count them) and the outcome."""
+    _counted(monkeypatch, counts)
+    heard = []
+    mesh_layout(layout, levels=2, callback=lambda kind, value: heard.append((kind, value)))
+    kinds = [k for k, _ in heard]
+    first = kinds.index("retry")
+    assert kinds[:first] == ["level"] * 3 + ["equalize"]
+    assert heard[first] == ("retry", counts[0])
+    assert kinds[first + 1 :] == ["again level"] * 3 + ["again equalize", "retried"]
+    assert heard[-1] == ("retried", (counts[0], counts[1], kept))
+
+
+def test_the_command_says_the_grid_is_made_again(tmp_path, monkeypatch):
+    """The progress lines of ``meshcore mesh`` when the grid is made again: the retry, its levels,
+    which grid was kept."""
+    from tests.meshcore.test_mesh_cli import mesh
+
+    f = tmp_path / "y.csv"
+    ring = np.asarray(testing.y_junction().exterior.coords)[:-1] * 1000.0
+    f.write_text("x,y\n" + "\n".join(f"{x:.3f},{y:.3f}" for x, y in ring) + "\n")
+    said = [1, 0]
+
+    def n_folded(grids):
+        return said.pop(0) if said else 0
+
+    monkeypatch.setattr(lakegrid, "_n_folded", n_folded)
+    run = mesh(f, "--cells", 800, "-o", tmp_path / "y.vtm")
+    assert run.rc == 0, run.err
+    lines = run.err.splitlines()
+    at = next(k for k, line in enumerate(lines) if "made again with block corners" in line)
+    assert lines[at].startswith("grid: 1 folded or non-convex cell(s) left")
+    assert sum(line.startswith("grid level ") for line in lines[at:]) == 3
+    assert any(line.startswith("grid made again: 0 bad cell(s) against 1; that grid kept") for line in lines[at:])
