@@ -216,8 +216,9 @@ def _first_fit(
     """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
     shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, a regular
     layout whose blocks do not close up round an island or None)`` (the scales after the one that
-    drew it are not tried).  With ``reading`` (not ``single``) the layout at the cell size is
-    compared with those at :data:`~.choice.SCALES` (:func:`~.choice.chosen`); a regular one (whose
+    drew it are not tried).  With ``reading`` (not ``single``) the layout at the cell size (or at
+    the first other scale that drew one, :data:`FALLBACK_CHOICE`) is compared with those at
+    :data:`~.choice.SCALES` × its scale (:func:`~.choice.chosen`); a regular one (whose
     other scales must close up round every island too) also with ``ringed``'s, a draw with at least
     four cut ends on every island (:mod:`.ringcuts`)."""
     from ..errors import TopologyError
@@ -234,13 +235,9 @@ def _first_fit(
             except TopologyError as exc:
                 first = first or exc
                 continue
+            why = str(first).removeprefix("automatic layout: ").split(";")[0]
             if scale != 1.0:
-                why = str(first).removeprefix("automatic layout: ").split(";")[0]
-                note = (
-                    f"layout drawn at {scale:g} × the cell size (cuts, narrowest blocks, corners; the cells "
-                    f"keep the asked size): at the cell size itself {why}"
-                )
-                lay = dataclasses.replace(lay, notes=(*lay.notes, note))
+                lay = _noted(lay, scale, why)
             elif regular and frame_defects(list(lay.pieces), single=single):
                 kept = kept or lay  # the other splits may close up: tried next, this one if not
                 continue
@@ -249,21 +246,23 @@ def _first_fit(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
-            if scale == 1.0 and not single and reading is not None:  # the best coarse grid of three scales
-                # each draw and the pieces it left round land tips (.tipcuts.watching_tips)
+            if (scale == 1.0 or FALLBACK_CHOICE) and not single and reading is not None:
+                # the best coarse grid of three scales (× the scale drawn at: the cell size, or the
+                # first of LAYOUT_SCALES that drew a layout); each draw and the pieces it left round
+                # land tips (.tipcuts.watching_tips), keyed by the scale relative to that one
                 drawn = {1.0: (lay, tipped)}
 
-                def at_scale(s: float, n: bool = normal, d: dict = drawn) -> Layout:
+                def at_scale(s: float, n: bool = normal, d: dict = drawn, base: float = scale, w: str = why) -> Layout:
                     with watching_tips() as tipped:
-                        got = draw(regular=regular, normal=n, scale=s)
+                        got = _noted(draw(regular=regular, normal=n, scale=base * s), base * s, w, base)
                     d[s] = (got, tipped)
                     return _closing(got, regular)
 
-                def with_tips(s: float, n: bool = normal, d: dict = drawn) -> Layout:
+                def with_tips(s: float, n: bool = normal, d: dict = drawn, base: float = scale, w: str = why) -> Layout:
                     if TIP_GATE and s in d and not splits(d[s][1]):  # no tip split: that draw itself
                         return d[s][0]
                     with splitting_tips():
-                        return draw(regular=False, normal=n, scale=s)
+                        return _noted(draw(regular=False, normal=n, scale=base * s), base * s, w, base)
 
                 more = []
                 if regular and ringed is not None and len(lay.polygon.interiors):  # every island ringed
@@ -302,6 +301,19 @@ REGULAR_RATIO = 2.5
 DEFAULT_RATIO = 2.5
 
 
+def _noted(lay: Layout, scale: float, why: str, base: float | None = None) -> Layout:
+    """``lay`` drawn at ``scale`` × the cell size, with a note saying so and why (``why``: the error at
+    the cell size itself); none when it was drawn at the cell size (``base``: the scale of the layout
+    the choice's draws are compared with, the cell size's when 1)."""
+    if scale == 1.0 or base == 1.0:
+        return lay
+    note = (
+        f"layout drawn at {scale:.3g} × the cell size (cuts, narrowest blocks, corners; the cells "
+        f"keep the asked size): at the cell size itself {why}"
+    )
+    return dataclasses.replace(lay, notes=(*lay.notes, note))
+
+
 def _closing(lay: Layout, regular: bool) -> Layout:
     """``lay``; a regular one only if its blocks close up round every island (else a
     :class:`~meshcore.errors.TopologyError`: :func:`~.choice.chosen` passes it over)."""
@@ -333,6 +345,10 @@ def _folds_in_index_space(lay: Layout) -> str | None:
 #: Seen on generated lakes with islands (round_lake(2), lake_with_islands(429/432)): each
 #: failed at the cell size and passed at one of the others.
 LAYOUT_SCALES = (1.0, 1.15, 0.87, 1.3, 0.77)
+
+#: The layout choice (:func:`~.choice.chosen`) also for a layout drawn at another of
+#: :data:`LAYOUT_SCALES` than the cell size, its other draws at its own scale × the choice's.
+FALLBACK_CHOICE = True
 
 #: The layout choice (:func:`~.choice.chosen`) also weighs the chosen scale's layout drawn again
 #: with every piece whose side runs round a land tip split from the tip (:mod:`.tipcuts`).
