@@ -460,7 +460,7 @@ class LakeController(QtCore.QObject):
         return self._generation
 
     def cancel_drag(self, key) -> None:
-        """Ctrl+Z in a drag of the layout (steps merged under ``key``): the step it made is undone and leaves
+        """Ctrl+Z or Esc in a drag of the layout (steps merged under ``key``): the step it made is undone and leaves
         the history, its steps asked for or being made are dropped (they were set after the undo: the
         dragged layout came back over it), and the grid goes to the end from the layout before the drag."""
         self._cancelled = key

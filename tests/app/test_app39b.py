@@ -1,0 +1,129 @@
+"""Session 39 (branch app39b): what the app39 walk left — Esc in a drag cancels it as Ctrl+Z does, the
+cancel is said where it stays readable, a stale count of the Lake panel stops, and the caches a count shares
+with another layout's work are safe from two threads."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.app.test_app38 import _h_layout
+
+pytestmark = pytest.mark.gui
+
+
+def _esc(qtbot, win) -> None:
+    from PySide6 import QtCore
+
+    win.canvas.setFocus()
+    qtbot.keyClick(win.canvas, QtCore.Qt.Key.Key_Escape)
+
+
+def test_esc_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
+    """Esc with a cut end held did nothing (only Ctrl+Z cancelled; Esc is Generate ▸ Stop, disabled without
+    a solve, and the Layout tool had no use for it): the drag went on.  Now Esc cancels it as Ctrl+Z does —
+    the layout it began with, nothing of it in the history, the rest of the drag doing nothing — with or
+    without a solve running (Stop, which owns Esc, cancels the drag first)."""
+    from app.layout_edit import handles
+    from tests.app.waits import wait_for, wait_idle
+
+    lay0 = _h_layout(win)
+    wait_idle(qtbot, win)
+    tool, stack = win.canvas.tool, win.stack
+    n, idx, undo_text = stack.count(), stack.index(), stack.undoText()
+    end = next(h for h in handles(lay0) if h.kind == "end" and h.cut == 0)
+    x, y = end.xy
+
+    # 1. a step landed, no solve running (Stop disabled): Esc reaches the window
+    assert not win.a_stop.isEnabled()
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    assert stack.count() == n + 1
+    _esc(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    assert "Drag cancelled (Esc)" in win._status.text()
+    assert tool.drag("move", (x + 500.0, y), end.xy)  # the rest of the drag: used (no pan), nothing made
+    assert tool.drag("finish", (x + 500.0, y), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    assert stack.undoText() == undo_text and stack.redoText() == ""
+
+    # 2. Esc while the drag's first step is being made: the step is not set
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    assert win.lake_ctl.editing
+    _esc(qtbot, win)
+    tool.drag("move", (x + 400.0, y), end.xy)
+    tool.drag("finish", (x + 400.0, y), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+
+    # 3. Stop enabled (a solve running), Esc in a drag: the drag is cancelled, not the solve stopped
+    win.a_stop.setEnabled(True)  # (as while a grid is solved: the action then takes Esc)
+    stopped = []
+    win.solver.stop = lambda: stopped.append(True)
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    _esc(qtbot, win)
+    assert not stopped and not tool.in_drag
+    tool.drag("finish", (x + 300.0, y), end.xy)
+    wait_idle(qtbot, win)
+    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    _esc(qtbot, win)  # no drag: Esc stops the solver as before
+    assert stopped == [True]
+    win.a_stop.setEnabled(False)
+
+
+def test_esc_in_the_middle_of_a_point_drag_cancels_it_and_outside_a_drag_does_what_it_did(qtbot, win):
+    """Edit tool: Esc with a point held cancels the drag (the points as they were, nothing in the history);
+    Esc in the Cut line tool still clears the line being drawn."""
+    win.set_tool("draw")
+    for xy in ((0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)):
+        win.canvas.tool.click(xy)
+    win.canvas.tool.double_click((0.0, 6.0))
+    win.set_tool("edit")
+    tool, stack = win.canvas.tool, win.stack
+    before, n, idx = win.doc.project, stack.count(), stack.index()
+    assert tool.drag("start", (10.0, 0.0), (10.0, 0.0))
+    tool.drag("move", (12.0, -1.0), (10.0, 0.0))
+    assert stack.count() == n + 1
+    _esc(qtbot, win)
+    assert win.doc.project is before and (stack.count(), stack.index()) == (n, idx) and stack.redoText() == ""
+    tool.drag("move", (13.0, -2.0), (10.0, 0.0))
+    tool.drag("finish", (13.0, -2.0), (10.0, 0.0))
+    assert win.doc.project is before and (stack.count(), stack.index()) == (n, idx)
+
+    win.set_tool("cut")  # no drag: the tool's own Esc (the line drawn so far cleared)
+    cut = win.canvas.tool
+    cut.click((1.0, 1.0))
+    cut.click((5.0, 5.0))
+    _esc(qtbot, win)
+    assert cut.points == [] and "Drag cancelled" not in win._status.text()
+
+
+def test_a_cancelled_drag_is_said_in_the_messages_and_stays_ahead_of_the_grid_line(qtbot, win):
+    """ "Drag cancelled" was in the status line only, and the grid of before the drag, solved again a moment
+    later, wrote its line over it.  Now it is in the Messages and leads the grid's line that follows; a
+    message of something else done ends it."""
+    from app.layout_edit import handles
+    from tests.app.waits import wait_for, wait_idle
+
+    lay0 = _h_layout(win)
+    wait_idle(qtbot, win)
+    tool = win.canvas.tool
+    end = next(h for h in handles(lay0) if h.kind == "end" and h.cut == 0)
+    x, y = end.xy
+    assert tool.drag("start", end.xy, end.xy)
+    tool.drag("move", (x + 300.0, y), end.xy)
+    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
+    _esc(qtbot, win)
+    tool.drag("finish", (x + 300.0, y), end.xy)
+    assert any("Drag cancelled (Esc)" in text for _level, text in win.messages_panel.messages())
+    win.generate()  # the grid of the layout of before, with its line
+    wait_for(qtbot, win, lambda: "Lake grid" in win._status.text())
+    wait_idle(qtbot, win)
+    text = win._status.text()
+    assert text.startswith("Drag cancelled (Esc): back to before it — ") and "Lake grid:" in text
+    win.message("Saved")  # anything else said: the note goes
+    win.solve_status.on_final()
+    assert win._status.text().startswith("Lake grid:")
