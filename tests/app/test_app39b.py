@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.app.test_app38 import _h_layout
-from tests.app.test_app39 import _y_lake
+from tests.app.test_app39 import _y_lake, layout_drag_cancelled
 
 pytestmark = pytest.mark.gui
 
@@ -20,50 +20,22 @@ def _esc(qtbot, win) -> None:
     qtbot.keyClick(win.canvas, QtCore.Qt.Key.Key_Escape)
 
 
-def test_esc_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
+def test_esc_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win, monkeypatch):
     """Esc with a cut end held did nothing (only Ctrl+Z cancelled; Esc is Generate ▸ Stop, disabled without
     a solve, and the Layout tool had no use for it): the drag went on.  Now Esc cancels it as Ctrl+Z does —
     the layout it began with, nothing of it in the history, the rest of the drag doing nothing — with or
     without a solve running (Stop, which owns Esc, cancels the drag first)."""
-    from app.layout_edit import handles
-    from tests.app.waits import wait_for, wait_idle
+    from tests.app.waits import wait_idle
 
-    lay0 = _h_layout(win)
-    wait_idle(qtbot, win)
-    tool, stack = win.canvas.tool, win.stack
-    n, idx, undo_text = stack.count(), stack.index(), stack.undoText()
-    end = next(h for h in handles(lay0) if h.kind == "end" and h.cut == 0)
-    x, y = end.xy
-
-    # 1. a step landed, no solve running (Stop disabled): Esc reaches the window
-    assert not win.a_stop.isEnabled()
-    assert tool.drag("start", end.xy, end.xy)
-    tool.drag("move", (x + 300.0, y), end.xy)
-    wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
-    assert stack.count() == n + 1
-    _esc(qtbot, win)
-    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    assert not win.a_stop.isEnabled()  # no solve: the key reaches the window (Stop, which owns Esc, is off)
+    tool, stack, lay0, end, (n, idx, _undo) = layout_drag_cancelled(qtbot, win, _esc)
     assert "Drag cancelled (Esc)" in win._status.text()
-    assert tool.drag("move", (x + 500.0, y), end.xy)  # the rest of the drag: used (no pan), nothing made
-    assert tool.drag("finish", (x + 500.0, y), end.xy)
-    wait_idle(qtbot, win)
-    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
-    assert stack.undoText() == undo_text and stack.redoText() == ""
-
-    # 2. Esc while the drag's first step is being made: the step is not set
-    assert tool.drag("start", end.xy, end.xy)
-    tool.drag("move", (x + 300.0, y), end.xy)
-    assert win.lake_ctl.editing
-    _esc(qtbot, win)
-    tool.drag("move", (x + 400.0, y), end.xy)
-    tool.drag("finish", (x + 400.0, y), end.xy)
-    wait_idle(qtbot, win)
-    assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    x, y = end.xy
 
     # 3. Stop enabled (a solve running), Esc in a drag: the drag is cancelled, not the solve stopped
     win.a_stop.setEnabled(True)  # (as while a grid is solved: the action then takes Esc)
     stopped = []
-    win.solver.stop = lambda: stopped.append(True)
+    monkeypatch.setattr(win.solver, "stop", lambda: stopped.append(True))
     assert tool.drag("start", end.xy, end.xy)
     tool.drag("move", (x + 300.0, y), end.xy)
     _esc(qtbot, win)
@@ -79,10 +51,9 @@ def test_esc_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
 def test_esc_in_the_middle_of_a_point_drag_cancels_it_and_outside_a_drag_does_what_it_did(qtbot, win):
     """Edit tool: Esc with a point held cancels the drag (the points as they were, nothing in the history);
     Esc in the Cut line tool still clears the line being drawn."""
-    win.set_tool("draw")
-    for xy in ((0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)):
-        win.canvas.tool.click(xy)
-    win.canvas.tool.double_click((0.0, 6.0))
+    from tests.app.test_appwalk import _draw
+
+    _draw(win, [(0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)])
     win.set_tool("edit")
     tool, stack = win.canvas.tool, win.stack
     before, n, idx = win.doc.project, stack.count(), stack.index()

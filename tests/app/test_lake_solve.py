@@ -173,40 +173,13 @@ def test_a_held_warm_solve_waits_with_a_bound_and_sees_a_stop_that_left_the_hold
         np.testing.assert_array_equal(result.grids[k].x, g.x)
 
 
-def _hammer(work, threads: int = 4) -> list[str]:
-    """``work(k)`` in ``threads`` threads started together, thread switches as often as Python allows: the
-    exceptions they raised."""
-    import sys
-
-    errors: list[str] = []
-    start = threading.Barrier(threads)
-
-    def run(k: int) -> None:
-        start.wait()
-        try:
-            work(k)
-        except Exception as exc:  # what the test is about
-            errors.append(repr(exc))
-
-    switch = sys.getswitchinterval()
-    sys.setswitchinterval(1e-6)
-    try:
-        ts = [threading.Thread(target=run, args=(k,)) for k in range(threads)]
-        for t in ts:
-            t.start()
-        for t in ts:
-            t.join()
-    finally:
-        sys.setswitchinterval(switch)
-    return errors
-
-
 def test_the_topologies_and_held_readings_are_kept_safely_from_threads():
     """The Lake panel's count makes a layout in a worker beside Auto layout's, a layout edit's and the
     solve's: two evicting the same oldest topology raised KeyError (or "dictionary changed size during
     iteration") — the count or Auto layout said "internal error".  Held readings are taken by the layout
     they were held for, never another's."""
     from app import lake_solve
+    from tests.meshcore.test_shore_threads import hammer
 
     class Lay:
         def __init__(self, k: int) -> None:
@@ -222,7 +195,7 @@ def test_the_topologies_and_held_readings_are_kept_safely_from_threads():
             lay = lays[(i + k) % 6]
             assert lake_solve.layout_topology(lay) == lay.k
 
-    assert _hammer(topologies) == []
+    assert hammer(topologies) == []
 
     class Relay:
         event = None
@@ -240,4 +213,4 @@ def test_the_topologies_and_held_readings_are_kept_safely_from_threads():
             lake_solve.hold_readings(lay, Readings(lay))
             assert lake_solve._held_solve(lay, None, None) in (True, None)  # its own, or evicted by another's
 
-    assert _hammer(readings) == []
+    assert hammer(readings) == []
