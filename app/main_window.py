@@ -327,6 +327,8 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.stack.cleanChanged.connect(self._update_title)
         self._in_sight = None  # the project the view was last kept on (_keep_in_sight)
         self.stack.indexChanged.connect(self._keep_in_sight)
+        # a step done, undone or redone after a note (a drag cancelled): the next grid line is of that step
+        self.stack.indexChanged.connect(lambda _i: setattr(self, "_note", None))
         self.doc.opened.connect(lambda: setattr(self, "_in_sight", self.doc.project))
 
     # ------------------------------------------------------------ status
@@ -334,7 +336,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         """One line in the status bar; errors also go to the message panel, in full.  ``note``: what was
         just done (a drag cancelled), kept ahead of a ``summary`` (the grid's line at the end of a solve)
         that comes within :data:`NOTE_HOLD_S` ("Drag cancelled (Esc): back to before it — Lake grid: …");
-        any other message ends it."""
+        any other message, or a step done, undone or redone (a new drag's), ends it."""
         held, now = self._note, time.monotonic()
         if summary and held is not None and now - held[1] <= NOTE_HOLD_S:
             text = f"{held[0]} — {text}"

@@ -77,7 +77,7 @@ def test_esc_in_the_middle_of_a_point_drag_cancels_it_and_outside_a_drag_does_wh
 def test_a_cancelled_drag_is_said_in_the_messages_and_stays_ahead_of_the_grid_line(qtbot, win):
     """ "Drag cancelled" was in the status line only, and the grid of before the drag, solved again a moment
     later, wrote its line over it.  Now it is in the Messages and leads the grid's line that follows; a
-    message of something else done ends it."""
+    message of something else, or a step done (a new drag's), ends it."""
     from app.layout_edit import handles
     from tests.app.waits import wait_for, wait_idle
 
@@ -100,6 +100,10 @@ def test_a_cancelled_drag_is_said_in_the_messages_and_stays_ahead_of_the_grid_li
     win.message("Saved")  # anything else said: the note goes
     win.solve_status.on_final()
     assert win._status.text().startswith("Lake grid:")
+    win.message("Drag cancelled (Esc): back to before it", note=True)
+    win.lake_ctl.set_cell_size(150.0)  # a step done (a new drag's): the grid line that follows is its own
+    win.message("Lake grid: 3 blocks", summary=True)
+    assert win._status.text() == "Lake grid: 3 blocks"
 
 
 def test_a_count_of_a_cell_size_no_longer_wanted_stops(qtbot, win, monkeypatch):
