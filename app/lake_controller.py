@@ -319,6 +319,14 @@ class LakeController(QtCore.QObject):
         self._count_worker, self._count_lake = worker, lake
         worker.start()
 
+    def stop_count(self) -> None:
+        """The window closes: a count being made stops at its next coarse reading (the close waits for the
+        workers: it waited 2 s for a count of Shasta Lake at 26 m, then the process 6 s more, and the count's
+        worker, ending after the window, printed a traceback)."""
+        self._count_timer.stop()
+        if self._count_worker is not None and self._adopted is None:
+            self._count_stop.set()
+
     def _counted(self, value) -> None:
         self._count_worker, self._count_lake = None, None
         if value is None:  # stopped (stale): the count wanted now, if any

@@ -149,3 +149,42 @@ def test_a_count_of_a_cell_size_no_longer_wanted_stops(qtbot, win, monkeypatch):
     want = compute_layout(lake.replaced(cell_size=h2))
     assert win.lake_ctl.layout_count(win.lake_ctl.lake()) == (want.n_cells, len(want.blocks))
     assert f"{want.n_cells:,} cells in {len(want.blocks)} blocks" in win.lake_panel.summary.text()
+
+
+def test_a_count_being_made_stops_when_the_window_closes(qtbot, win, monkeypatch):
+    """The window closed while a count was made: the close waited for the workers 2 s, the process ~6 s more
+    (Shasta Lake at 26 m) and the count's worker, ending after the window, printed a traceback.  Now the
+    close stops it (at its next coarse reading) before it waits."""
+    import threading
+
+    import app.lake_controller as lc
+    from meshcore.lakegrid import CoarseReadings
+    from tests.app.waits import wait_for
+
+    entered, gate, read = threading.Event(), threading.Event(), []
+    real_reading, real_job = CoarseReadings.__call__, lc._layout_job
+
+    def gated(self, layout):
+        read.append(layout.cell_size)
+        entered.set()
+        gate.wait(60)
+        return real_reading(self, layout)
+
+    ended, done = [], threading.Event()
+
+    def job(*args):
+        ended.append(real_job(*args))
+        done.set()
+        return ended[-1]
+
+    monkeypatch.setattr(CoarseReadings, "__call__", gated)
+    monkeypatch.setattr(lc, "_layout_job", job)
+    lake, area = _y_lake()
+    win.editor.set_lake(lake, "Import")
+    win.lake_ctl.set_cell_size(float(np.sqrt(area / 100)))
+    wait_for(qtbot, win, entered.is_set)
+    win.stack.setClean()
+    gate.set()
+    win.close()  # (its wait for the workers quits them: a worker's end is then not signalled)
+    assert done.wait(600)  # (a hang guard)
+    assert ended == [None] and len(read) == 1  # stopped after the reading under way
