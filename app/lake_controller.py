@@ -293,10 +293,13 @@ class LakeController(QtCore.QObject):
         return (done[1].n_cells, len(done[1].blocks)) if done[1] is not None else str(done[2])
 
     def counting(self, lake: Lake) -> bool:
-        """True while the layout of ``lake`` is being counted (or about to be)."""
+        """True while the layout of ``lake`` is being counted (or about to be: the size just set, or a count
+        no longer wanted still stopping)."""
         bare = lake.replaced(layout=None)
-        counted = self._count_lake == bare and not self._count_stop.is_set()
-        return counted or (self._count_timer.isActive() and self.count_wanted() == bare)
+        if self._count_lake == bare and not self._count_stop.is_set():
+            return True
+        waits = self._count_timer.isActive() or (self._count_worker is not None and self._count_stop.is_set())
+        return waits and self.count_wanted() == bare
 
     def _want_count(self) -> None:
         lake = self.count_wanted()

@@ -143,6 +143,9 @@ def test_a_count_of_a_cell_size_no_longer_wanted_stops(qtbot, win, monkeypatch):
     wait_for(qtbot, win, entered.is_set)
     win.lake_ctl.set_cell_size(h2)
     assert win.lake_ctl.counting(win.lake_ctl.lake())
+    wait_for(qtbot, win, lambda: not win.lake_ctl._count_timer.isActive())  # its count waits for the stop
+    win.lake_panel.refresh()
+    assert win.lake_ctl.counting(win.lake_ctl.lake()) and "counting" in win.lake_panel.summary.text()
     gate.set()
     wait_for(qtbot, win, lambda: win.lake_ctl.layout_count(win.lake_ctl.lake()) is not None)
     assert ended[0] is None and read.count(h1) == 1  # stopped after the reading under way: nothing more of h1
