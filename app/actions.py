@@ -173,9 +173,10 @@ ACTIONS: tuple[ActionSpec, ...] = (
     ActionSpec(
         "stop",
         "&Stop",
-        "solver.stop",
+        "stop",
         ("Esc",),
-        "stop the solver (keeps the current grid; a lake grid stopped on a coarse level: none, that one greyed)",
+        "stop the solver (keeps the current grid; a lake grid stopped on a coarse level: none, that one greyed);"
+        " in a drag: cancel the drag",
         "&Generate",
         toolbar=4.3,
         enabled=False,
@@ -243,7 +244,7 @@ GESTURES: tuple[tuple[str, str], ...] = (
         "Del",
         "delete selected points (Edit); the cut line pointed at, drawn in red (Layout): its two blocks become one",
     ),
-    ("Ctrl+Z in a drag", "cancel the drag: back to before it, nothing of it in the history"),
+    ("Ctrl+Z or Esc in a drag", "cancel the drag: back to before it, nothing of it in the history"),
     ("Shift+drag", "snap a dragged point onto another point (Edit)"),
     ("drag on empty space", "box-select points (Edit); pan (other tools)"),
     ("wheel / right-drag", "zoom"),

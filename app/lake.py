@@ -29,6 +29,7 @@ from meshcore import MeshcoreError
 __all__ = [
     "BRANCHED_FILL",
     "Lake",
+    "LayoutStopped",
     "area_text",
     "cell_size_of",
     "compute_layout",
@@ -50,6 +51,12 @@ __all__ = [
 #: an outline whose water fills less than this share of its convex hull is "branched":
 #: one block would be poor, the app offers Auto layout on import
 BRANCHED_FILL = 0.5
+
+
+class LayoutStopped(Exception):
+    """:func:`compute_layout` ended by its ``stop_event`` (the caller asked: no layout, and no error to
+    report).  Not a :class:`~meshcore.MeshcoreError`: the layout choice takes those of a coarse reading as
+    a draw that reads nothing and goes on."""
 
 
 def _frozen(a: Any) -> np.ndarray:
@@ -277,7 +284,7 @@ def cell_size_of(lake: Lake) -> float:
     return default_cell_size(poly.area, lake.target_cells)
 
 
-def compute_layout(lake: Lake, cuts: Any = None) -> Any:
+def compute_layout(lake: Lake, cuts: Any = None, *, stop_event: Any = None) -> Any:
     """The :class:`meshcore.layout.Layout` of ``lake`` (what ``meshcore mesh`` would make).
 
     Runs :func:`meshcore.layout.auto_layout` (seconds on a 10 000-cell lake: call it off the
@@ -286,7 +293,10 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
     instead, each with four corners where it turns, the cuts' ends snapped as the Cut line tool
     snaps them over a layout.  Raises
     :class:`~meshcore.MeshcoreError` naming the problem (e.g. the region that cannot be
-    four-sided).
+    four-sided).  ``stop_event`` (a :class:`threading.Event`; Auto layout's own layout takes none): once
+    set, the layout ends with :class:`LayoutStopped` at its next coarse reading (a reading under way
+    stops at its next sweep; they are a third of its time, between draws of up to a second or two on a
+    lake of 200 000 cells) — a layout no longer wanted stops keeping a core busy.
     """
     from meshcore.cli.mesh_steps import LEVELS, MIN_CELLS
     from meshcore.errors import InvalidInputError
@@ -312,9 +322,33 @@ def compute_layout(lake: Lake, cuts: Any = None) -> Any:
     from .lake_solve import coarse_readings, hold_readings
 
     readings = coarse_readings()  # the chosen layout's coarse level solved once, as meshcore mesh does
-    lay = auto_layout(poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single, reading=readings)
+    reading = readings if stop_event is None else _stoppable(readings, stop_event)
+    try:
+        lay = auto_layout(
+            poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single, reading=reading
+        )
+    finally:
+        readings.stop_event.event = None  # the held solves take the stop of the solve that goes on from one
+    if stop_event is not None and stop_event.is_set():
+        raise LayoutStopped("the layout was stopped")
     hold_readings(lay, readings)  # its grid (app.lake_solve.solve_layout) goes on from there
     return lay
+
+
+def _stoppable(readings: Any, stop_event: Any):
+    """``readings`` (:func:`app.lake_solve.coarse_readings`) ending the layout with :class:`LayoutStopped`
+    once ``stop_event`` is set: before and after each reading, and a reading under way at its next sweep."""
+    readings.stop_event.event = stop_event
+
+    def reading(layout):
+        if stop_event.is_set():
+            raise LayoutStopped("the layout was stopped")
+        got = readings(layout)
+        if stop_event.is_set():  # (the reading, stopped half way, reads nothing true)
+            raise LayoutStopped("the layout was stopped")
+        return got
+
+    return reading
 
 
 def split_layout(poly: Any, cuts: list, cell_size: float, multiple: int) -> Any:

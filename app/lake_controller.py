@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 import time
 
 import numpy as np
@@ -20,7 +21,7 @@ from superqt.utils import create_worker
 from meshcore import MeshcoreError
 from meshcore.cellsize import SMALL_BLOCKS, finer_for_small_blocks, small_blocks_reason
 
-from .lake import Lake, compute_layout
+from .lake import Lake, LayoutStopped, compute_layout
 from .lake_solve import layout_topology
 from .views.offer_bar import OfferBar
 
@@ -39,12 +40,17 @@ COUNT_DELAY_MS = 400
 log = logging.getLogger(__name__)
 
 
-def _layout_job(lake: Lake, cuts=None):
-    """The worker body: the layout (of the cut lines drawn, if any), or the message of why there is none."""
+def _layout_job(lake: Lake, cuts=None, stop_event: threading.Event | None = None):
+    """The worker body: the layout (of the cut lines drawn, if any), or the message of why there is none;
+    None when ``stop_event`` stopped it (:func:`app.lake.compute_layout`)."""
     try:
-        layout = compute_layout(lake, cuts)
+        layout = compute_layout(lake, cuts, stop_event=stop_event)
+        if stop_event is not None and stop_event.is_set():
+            return None
         layout_topology(layout)
         return lake, layout, None
+    except LayoutStopped:
+        return None
     except MeshcoreError as exc:
         return lake, None, str(exc)
     except Exception as exc:  # a bug must not kill the window: report it, log where it happened
@@ -117,6 +123,10 @@ class LakeController(QtCore.QObject):
         self._count: tuple | None = None  # (lake without layout, its layout or None, the error or None)
         self._count_worker = None
         self._count_lake: Lake | None = None  # the lake being counted
+        # set when the lake being counted is no longer the one wanted (another cell size, an undo): the count
+        # stops at its next coarse reading (it ran to its end: 3.8 s of a core on Shasta Lake at 26 m after
+        # the size was typed twice more), and the count wanted starts when it has stopped (2 cores)
+        self._count_stop = threading.Event()
         self._adopted = None  # the water Auto layout asked for, when it took over the running count
         self._count_timer = QtCore.QTimer(self)
         self._count_timer.setSingleShot(True)
@@ -247,7 +257,7 @@ class LakeController(QtCore.QObject):
             self.win.message(text)
             self._on_returned(done, None, water)
             return True
-        if self._count_worker is None or self._count_lake != bare:
+        if self._count_worker is None or self._count_lake != bare or self._count_stop.is_set():
             return False
         self._adopted, self._worker = water, self._count_worker
         self.busy_changed.emit(True)
@@ -283,13 +293,21 @@ class LakeController(QtCore.QObject):
         return (done[1].n_cells, len(done[1].blocks)) if done[1] is not None else str(done[2])
 
     def counting(self, lake: Lake) -> bool:
-        """True while the layout of ``lake`` is being counted (or about to be)."""
+        """True while the layout of ``lake`` is being counted (or about to be: the size just set, or a count
+        no longer wanted still stopping)."""
         bare = lake.replaced(layout=None)
-        return self._count_lake == bare or (self._count_timer.isActive() and self.count_wanted() == bare)
+        if self._count_lake == bare and not self._count_stop.is_set():
+            return True
+        waits = self._count_timer.isActive() or (self._count_worker is not None and self._count_stop.is_set())
+        return waits and self.count_wanted() == bare
 
     def _want_count(self) -> None:
         lake = self.count_wanted()
-        if lake is None or self.layout_count(lake) is not None or self._count_lake == lake:
+        if self._count_worker is not None and self._adopted is None and self._count_lake != lake:
+            self._count_stop.set()  # stale: it stops at its next coarse reading, then the one wanted starts
+        if lake is None or self.layout_count(lake) is not None:
+            return
+        if self._count_lake == lake and not self._count_stop.is_set():
             return
         self._count_timer.start()  # (again: the last size typed is counted)
 
@@ -297,14 +315,26 @@ class LakeController(QtCore.QObject):
         lake = self.count_wanted()
         if lake is None or self.busy or self._count_worker is not None or self.layout_count(lake) is not None:
             return  # (a count running: the next is started when it ends)
-        worker = create_worker(_layout_job, lake, None, _start_thread=False)
+        self._count_stop = threading.Event()
+        worker = create_worker(_layout_job, lake, None, self._count_stop, _start_thread=False)
         worker.returned.connect(self._counted)
         worker.errored.connect(self._count_errored)
         self._count_worker, self._count_lake = worker, lake
         worker.start()
 
+    def stop_count(self) -> None:
+        """The window closes: a count being made stops at its next coarse reading (the close waits for the
+        workers: it waited 2 s for a count of Shasta Lake at 26 m, then the process 6 s more, and the count's
+        worker, ending after the window, printed a traceback)."""
+        self._count_timer.stop()
+        if self._count_worker is not None and self._adopted is None:
+            self._count_stop.set()
+
     def _counted(self, value) -> None:
         self._count_worker, self._count_lake = None, None
+        if value is None:  # stopped (stale): the count wanted now, if any
+            self._want_count()
+            return
         if self._adopted is not None:  # Auto layout took it over
             water, self._adopted = self._adopted, None
             self._on_returned(value, None, water)
@@ -460,7 +490,7 @@ class LakeController(QtCore.QObject):
         return self._generation
 
     def cancel_drag(self, key) -> None:
-        """Ctrl+Z in a drag of the layout (steps merged under ``key``): the step it made is undone and leaves
+        """Ctrl+Z or Esc in a drag of the layout (steps merged under ``key``): the step it made is undone and leaves
         the history, its steps asked for or being made are dropped (they were set after the undo: the
         dragged layout came back over it), and the grid goes to the end from the layout before the drag."""
         self._cancelled = key

@@ -84,17 +84,24 @@ def level_labels(n_levels: int) -> list[str]:
 
 
 _topologies: dict[int, tuple] = {}  # id(layout) -> (layout, topology): the last few layouts' topologies
+#: guards :data:`_topologies` and :data:`_readings`: the Lake panel's count of a cell size makes a layout in
+#: a worker beside Auto layout's, a layout edit's and the solve's threads (two evicting the same oldest
+#: topology raised KeyError: "internal error" for the count or Auto layout; a held reading taken while
+#: another was kept could delete the other, or an index no longer there)
+_LOCK = threading.Lock()
 
 
 def layout_topology(layout):
     """``layout.topology()``, remembered for the last few layouts (it takes a while on a big lake)."""
-    hit = _topologies.get(id(layout))
+    with _LOCK:
+        hit = _topologies.get(id(layout))
     if hit is not None and hit[0] is layout:
         return hit[1]
-    topo = layout.topology()
-    if len(_topologies) >= 4:
-        _topologies.pop(next(iter(_topologies)))
-    _topologies[id(layout)] = (layout, topo)
+    topo = layout.topology()  # (outside the lock: a layout's topology is made once, Layout.topology)
+    with _LOCK:
+        while len(_topologies) >= 4:
+            _topologies.pop(next(iter(_topologies)))
+        _topologies[id(layout)] = (layout, topo)
     return topo
 
 
@@ -125,19 +132,21 @@ def coarse_readings():
 
 def hold_readings(layout, readings) -> None:
     """Keep ``readings`` (:func:`coarse_readings`, that chose ``layout``) for the first cold solve of ``layout``."""
-    _readings[:] = [r for r in _readings if r[0] is not layout][-(READINGS_KEPT - 1) :]
-    _readings.append((layout, readings))
+    with _LOCK:
+        _readings[:] = [r for r in _readings if r[0] is not layout][-(READINGS_KEPT - 1) :]
+        _readings.append((layout, readings))
 
 
 def _held_solve(layout, stop_event, callback):
     """The solve of ``layout`` held after its coarse level by the readings that chose it (taken: once), or
     None: ``(solve, coarse level, progress)`` of :meth:`meshcore.lakegrid.CoarseReadings.held`."""
-    for k, (lay, readings) in enumerate(_readings):
-        if lay is layout:
-            del _readings[k]
-            readings.stop_event.event = stop_event
-            return readings.held(layout, callback)
-    return None
+    with _LOCK:
+        taken = next((r for lay, r in _readings if lay is layout), None)
+        _readings[:] = [r for r in _readings if r[0] is not layout]
+    if taken is None:
+        return None
+    taken.stop_event.event = stop_event
+    return taken.held(layout, callback)
 
 
 def _options() -> dict:

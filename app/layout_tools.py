@@ -221,7 +221,7 @@ class LayoutTool(Tool):
             self.canvas.lake_items.set_del_cut(None)
 
     def cancel_drag(self) -> bool:
-        """Ctrl+Z in a drag of the layout: the layout goes back to the one the drag began with, its step
+        """Ctrl+Z or Esc in a drag of the layout: the layout goes back to the one the drag began with, its step
         out of the history and its steps still being made dropped (they landed after the undo: the layout
         of an undone Auto layout came back, the redo history gone)."""
         if self._handle is None:

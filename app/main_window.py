@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from pathlib import Path
 
 from PySide6 import QtCore, QtGui, QtWidgets
@@ -47,6 +48,9 @@ __all__ = ["MainWindow"]
 log = logging.getLogger(__name__)
 
 DEFAULT_SIZE = (1400, 880)
+#: seconds a note of what was just done (a drag cancelled) leads the grid's line that follows it in the
+#: status line (the grid of before the drag, solved again, wrote over "Drag cancelled" a moment later)
+NOTE_HOLD_S = 6.0
 
 
 def default_recovery_path() -> Path:
@@ -92,6 +96,7 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self._central.addWidget(self.canvas, 1)
         self.setCentralWidget(central)
         self._status = ElidedLabel()
+        self._note: tuple[str, float] | None = None  # (a note of what was just done, when): see message
         self._coords = QtWidgets.QLabel()
         self.statusBar().addWidget(self._status, 1)
 
@@ -226,15 +231,33 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
 
     def undo(self) -> None:
         """Ctrl+Z: the last step undone — in the middle of a drag (a cut end, a shore point, points of a
-        block), the drag cancelled instead: back to before it, no step of it left to undo or redo, the rest
-        of the mouse's drag doing nothing.  (The stack undid under the drag: the step before it went, then
-        the drag's next move set its own layout over the undo, or moved points that were gone.)"""
-        tool = self.canvas.tool
-        if tool is not None and tool.cancel_drag():
-            self.message("Drag cancelled (Ctrl+Z): back to before it — Ctrl+Z again undoes the step before")
+        block), the drag cancelled instead (:meth:`cancel_drag`).  (The stack undid under the drag: the step
+        before it went, then the drag's next move set its own layout over the undo, or moved points that
+        were gone.)"""
+        if self.cancel_drag("Ctrl+Z"):
             return
         self.stack.undo()
         self._say_undone("undo")
+
+    def stop(self) -> None:
+        """Esc (Generate ▸ Stop): in the middle of a drag, the drag cancelled as Ctrl+Z cancels it (the drag
+        went on: Esc stopped the drag's solve, or did nothing); else the solver stopped."""
+        if not self.cancel_drag("Esc"):
+            self.solver.stop()
+
+    def cancel_drag(self, key: str) -> bool:
+        """The drag of the tool (a cut end, a shore point, a block's points, a box selection) cancelled:
+        back to before it, no step of it left to undo or redo, the rest of the mouse's drag doing nothing —
+        said in the Messages and in the status line, ahead of the grid's line that follows (the grid of
+        before the drag, solved again, wrote over it).  False when no drag is on."""
+        tool = self.canvas.tool
+        if tool is None or not tool.cancel_drag():
+            return False
+        text = f"Drag cancelled ({key}): back to before it"
+        self.doc.report("info", text)
+        again = " — Ctrl+Z again undoes the step before" if key == "Ctrl+Z" else ""
+        self.message(text + again, note=True)
+        return True
 
     def redo(self) -> None:
         """Ctrl+Y: the step undone last redone; not in the middle of a drag (said)."""
@@ -304,11 +327,21 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
         self.stack.cleanChanged.connect(self._update_title)
         self._in_sight = None  # the project the view was last kept on (_keep_in_sight)
         self.stack.indexChanged.connect(self._keep_in_sight)
+        # a step done, undone or redone after a note (a drag cancelled): the next grid line is of that step
+        self.stack.indexChanged.connect(lambda _i: setattr(self, "_note", None))
         self.doc.opened.connect(lambda: setattr(self, "_in_sight", self.doc.project))
 
     # ------------------------------------------------------------ status
-    def message(self, text: str, *, error: bool = False) -> None:
-        """One line in the status bar; errors also go to the message panel, in full."""
+    def message(self, text: str, *, error: bool = False, note: bool = False, summary: bool = False) -> None:
+        """One line in the status bar; errors also go to the message panel, in full.  ``note``: what was
+        just done (a drag cancelled), kept ahead of a ``summary`` (the grid's line at the end of a solve)
+        that comes within :data:`NOTE_HOLD_S` ("Drag cancelled (Esc): back to before it — Lake grid: …");
+        any other message, or a step done, undone or redone (a new drag's), ends it."""
+        held, now = self._note, time.monotonic()
+        if summary and held is not None and now - held[1] <= NOTE_HOLD_S:
+            text = f"{held[0]} — {text}"
+        elif not summary:
+            self._note = (text, now) if note else None
         self._status.setText(text)
         self._status.setStyleSheet("color: #b00000; font-weight: bold;" if error else "")
         if error:
@@ -402,6 +435,10 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
             self._status.setStyleSheet(style)
 
     def keyPressEvent(self, ev: QtGui.QKeyEvent) -> None:
+        # Esc with Stop disabled (no solve) reaches here: a drag is cancelled before the tool sees the key
+        if ev.key() == QtCore.Qt.Key.Key_Escape and self.cancel_drag("Esc"):
+            ev.accept()
+            return
         if self.canvas.tool is not None and self.canvas.tool.key(ev.key()):
             ev.accept()
             return

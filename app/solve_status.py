@@ -208,7 +208,7 @@ class SolveStatus(QtCore.QObject):
         if self.doc.measuring:
             warn += " — measuring its quality…"
         self.label.setText(f"{info.method}: {state}, {info.iterations} iterations, {dt * 1000:.0f} ms")
-        self.win.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}")
+        self.win.message(f"Grid {g.cells[0]}×{g.cells[1]} cells: {state}{warn}", summary=True)
 
     def _lake_final(self, mb) -> None:
         info = mb.info
@@ -233,7 +233,9 @@ class SolveStatus(QtCore.QObject):
         if m is None and self.doc.measuring:
             mean = " — measuring its quality…"
         what = "Lake grid, stopped before it was finished (F5 makes it again)" if stopped else "Lake grid"
-        self.win.message(f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded))
+        self.win.message(
+            f"{what}: {len(mb.grids)} blocks, {cells:,} cells{mean}{warn}", error=bool(folded), summary=True
+        )
 
     def _kept_final(self) -> None:
         """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept."""
@@ -241,7 +243,9 @@ class SolveStatus(QtCore.QObject):
             self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
         where = " on a coarse level" if self.solver.stopped_coarse else ""
         self.label.setText(f"stopped{where}: the grid of before kept")
-        self.win.message(f"Lake grid solve stopped{where}: the finished grid of before stays (F5 solves again)")
+        self.win.message(
+            f"Lake grid solve stopped{where}: the finished grid of before stays (F5 solves again)", summary=True
+        )
 
     def _coarse_final(self) -> None:
         """A lake solve stopped before its full level: no grid of the layout; its last coarse level, greyed."""
@@ -255,7 +259,9 @@ class SolveStatus(QtCore.QObject):
             grey = f"the greyed grid is a coarse level's ({level}), not the layout's"
         else:  # the grid of before an edit of the cells, left on screen through the coarse levels
             grey = "the greyed grid is of before the last edit" if shown else "nothing was drawn"
-        self.win.message(f"Lake grid stopped before its full level: no grid of this layout ({grey}); F5 makes it")
+        self.win.message(
+            f"Lake grid stopped before its full level: no grid of this layout ({grey}); F5 makes it", summary=True
+        )
 
     def report_notes(self) -> None:
         """Repairs, corner advice and other notes of the solver, in full, in the message panel."""

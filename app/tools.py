@@ -84,7 +84,7 @@ class Tool:
         return False
 
     def cancel_drag(self) -> bool:
-        """Ctrl+Z in the middle of a drag: the drag is cancelled — the project goes back to what it was
+        """Ctrl+Z or Esc in the middle of a drag: the drag is cancelled — the project goes back to what it was
         when the drag began, with no step of it in the history (undo or redo) — and the rest of the
         mouse's drag does nothing.  True when there was a drag to cancel (the undo is spent on it)."""
         return False
@@ -258,7 +258,7 @@ class EditTool(Tool):
         return self._drag is not None and self._drag[0] != "cancelled"
 
     def cancel_drag(self) -> bool:
-        """Ctrl+Z in a drag of points: they go back where the drag took them from (its step undone and
+        """Ctrl+Z or Esc in a drag of points: they go back where the drag took them from (its step undone and
         out of the history); a box selection is dropped."""
         if not self.in_drag:
             return False

@@ -59,6 +59,7 @@ class WindowFrame:
         if not self.io.maybe_save():
             ev.ignore()
             return
+        self.lake_ctl.stop_count()  # (before the solver's shutdown, which waits for every worker)
         self.solver.shutdown()
         self.io.shutdown()
         self.settings.setValue("geometry", self.saveGeometry())

@@ -6,6 +6,8 @@ as ``(ring, s)``: which ring and the arc length along it.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from ..segments import feet
@@ -29,6 +31,10 @@ def _segments(rings: list[np.ndarray]):
 #: asked about them 10-20 times a lake (shore data, fits, refinement, equalize patches).
 _TREES: dict[bytes, tuple] = {}
 _TREES_KEPT = 4
+#: guards :data:`_TREES`: solves in two threads (the app's lake grid and the coarse readings of a layout
+#: counted or laid out beside it) evicted the same oldest entry (KeyError) or iterated it while the other
+#: added one (RuntimeError: dictionary changed size during iteration)
+_TREES_LOCK = threading.Lock()
 
 
 def _tree(rings: list[np.ndarray]):
@@ -37,13 +43,15 @@ def _tree(rings: list[np.ndarray]):
 
     rs = [np.ascontiguousarray(r, dtype=float) for r in rings]
     key = np.array([r.shape for r in rs], dtype=np.int64).tobytes() + b"".join(r.tobytes() for r in rs)
-    hit = _TREES.pop(key, None)
-    if hit is None:
+    with _TREES_LOCK:
+        hit = _TREES.pop(key, None)
+    if hit is None:  # (made outside the lock: two threads may both make it, the same tree)
         a, b, ring, L, start = _segments(rs)
         hit = (shapely.STRtree(shapely.linestrings(np.stack([a, b], axis=1))), a, b, ring, L, start)
-    _TREES[key] = hit  # the most recent last
-    while len(_TREES) > _TREES_KEPT:
-        del _TREES[next(iter(_TREES))]
+    with _TREES_LOCK:
+        _TREES[key] = hit  # the most recent last
+        while len(_TREES) > _TREES_KEPT:
+            del _TREES[next(iter(_TREES))]
     return hit
 
 

@@ -109,12 +109,11 @@ def _ctrl_z(qtbot, win) -> None:
     qtbot.keyClick(win.canvas, QtCore.Qt.Key.Key_Z, QtCore.Qt.KeyboardModifier.ControlModifier)
 
 
-def test_ctrl_z_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
-    """Ctrl+Z with a cut end held: the stack undid under the drag — Auto layout itself when no step had
-    landed yet, then the next step set the dragged layout over the undone one (the layout back, Redo
-    gone); after a step, the drag's own step, and the next move pushed it again.  Now Ctrl+Z cancels the
-    drag: the layout it began with, no step of it to undo or redo, the rest of the drag (moves, release)
-    doing nothing; Ctrl+Z again undoes the step before it.  Ctrl+Y waits for the drag's end."""
+def layout_drag_cancelled(qtbot, win, cancel):
+    """A cut end of :func:`_h_layout` dragged and ``cancel(qtbot, win)`` pressed in the drag, after its step
+    landed, then while its first step is being made: each time the layout it began with, nothing of it in
+    the history, the rest of the drag doing nothing.  ``(tool, stack, layout, end, (count, index, undo
+    text))`` (also used by ``tests/app/test_app39b.py``)."""
     from app.layout_edit import handles
     from tests.app.waits import wait_for, wait_idle
 
@@ -125,12 +124,12 @@ def test_ctrl_z_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
     end = next(h for h in handles(lay0) if h.kind == "end" and h.cut == 0)
     x, y = end.xy
 
-    # 1. a step landed: Ctrl+Z takes the layout back to the drag's start, the step out of the history
+    # 1. a step landed: the layout back to the drag's start, the step out of the history
     assert tool.drag("start", end.xy, end.xy)
     tool.drag("move", (x + 300.0, y), end.xy)
     wait_for(qtbot, win, lambda: win.doc.project.layout is not lay0 and not win.lake_ctl.editing)
     assert stack.count() == n + 1
-    _ctrl_z(qtbot, win)
+    cancel(qtbot, win)
     assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
     assert "Drag cancelled" in win._status.text()
     assert tool.drag("move", (x + 500.0, y), end.xy)  # the rest of the drag: used (no pan), nothing made
@@ -139,15 +138,27 @@ def test_ctrl_z_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
     assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
     assert stack.undoText() == undo_text and stack.redoText() == ""
 
-    # 2. Ctrl+Z while the drag's first step is being made: Auto layout stays, the step is not set
+    # 2. cancelled while the drag's first step is being made: Auto layout stays, the step is not set
     assert tool.drag("start", end.xy, end.xy)
     tool.drag("move", (x + 300.0, y), end.xy)
     assert win.lake_ctl.editing
-    _ctrl_z(qtbot, win)
+    cancel(qtbot, win)
     tool.drag("move", (x + 400.0, y), end.xy)
     tool.drag("finish", (x + 400.0, y), end.xy)
     wait_idle(qtbot, win)
     assert win.doc.project.layout is lay0 and (stack.count(), stack.index()) == (n, idx)
+    return tool, stack, lay0, end, (n, idx, undo_text)
+
+
+def test_ctrl_z_in_the_middle_of_a_layout_drag_cancels_the_drag(qtbot, win):
+    """Ctrl+Z with a cut end held: the stack undid under the drag — Auto layout itself when no step had
+    landed yet, then the next step set the dragged layout over the undone one (the layout back, Redo
+    gone); after a step, the drag's own step, and the next move pushed it again.  Now Ctrl+Z cancels the
+    drag: the layout it began with, no step of it to undo or redo, the rest of the drag (moves, release)
+    doing nothing; Ctrl+Z again undoes the step before it.  Ctrl+Y waits for the drag's end."""
+    from tests.app.waits import wait_idle
+
+    tool, stack, lay0, end, (_n, _idx, undo_text) = layout_drag_cancelled(qtbot, win, _ctrl_z)
     assert "not made" not in win._status.text()  # (the cancel said it)
 
     # 3. Ctrl+Y in a drag waits; Ctrl+Z after the drag undoes the step before it (the split)

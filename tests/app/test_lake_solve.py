@@ -171,3 +171,46 @@ def test_a_held_warm_solve_waits_with_a_bound_and_sees_a_stop_that_left_the_hold
     assert len(hold.waits) == 1 and hold.waits[0] == len(items)  # stopped at the wait: nothing after it
     for k, g in enumerate(items[-1].grids):  # the live grid is the result, as with a stop that sets the hold
         np.testing.assert_array_equal(result.grids[k].x, g.x)
+
+
+def test_the_topologies_and_held_readings_are_kept_safely_from_threads():
+    """The Lake panel's count makes a layout in a worker beside Auto layout's, a layout edit's and the
+    solve's: two evicting the same oldest topology raised KeyError (or "dictionary changed size during
+    iteration") — the count or Auto layout said "internal error".  Held readings are taken by the layout
+    they were held for, never another's."""
+    from app import lake_solve
+    from tests.meshcore.test_shore_threads import hammer
+
+    class Lay:
+        def __init__(self, k: int) -> None:
+            self.k = k
+
+        def topology(self) -> int:
+            return self.k
+
+    lays = [Lay(k) for k in range(6)]
+
+    def topologies(k: int) -> None:
+        for i in range(200_000):
+            lay = lays[(i + k) % 6]
+            assert lake_solve.layout_topology(lay) == lay.k
+
+    assert hammer(topologies) == []
+
+    class Relay:
+        event = None
+
+    class Readings:
+        def __init__(self, lay) -> None:
+            self.lay, self.stop_event = lay, Relay()
+
+        def held(self, layout, callback):
+            return layout is self.lay
+
+    def readings(k: int) -> None:
+        for _ in range(20_000):
+            lay = object()
+            lake_solve.hold_readings(lay, Readings(lay))
+            assert lake_solve._held_solve(lay, None, None) in (True, None)  # its own, or evicted by another's
+
+    assert hammer(readings) == []
