@@ -64,6 +64,8 @@ def fit_docks(window: QtWidgets.QMainWindow, canvas: QtWidgets.QWidget, docks) -
     if not wide:
         return False
     for d in wide:
+        if d.property(WIDE_WIDTH) is None:  # narrowed at the first fit: the width it gets back is this one
+            d.setProperty(WIDE_WIDTH, d.width())
         d.setProperty(NARROWED, True)
     window.resizeDocks(wide, [int(DOCK_SHARE * width)] * len(wide), QtCore.Qt.Orientation.Horizontal)
     return True

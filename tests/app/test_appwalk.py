@@ -272,3 +272,31 @@ def test_the_layout_offer_after_importing_a_lake_with_islands_is_not_titled_bran
     box = win.lake_ctl.prompt
     assert box is not None and "island" in box.text()
     assert box.windowTitle() == "Islands in the lake"
+
+
+def test_side_panels_narrowed_at_their_first_fit_get_their_width_back(qtbot, win):
+    """A window first shown a little too narrow for its docks (1200 px: the docks narrowed from 330 to 300
+    px at their first fit, no width of before recorded yet) kept them at 300 px when made wider: the Lake
+    panel (~317 px) stayed cut behind a scroll bar."""
+    from PySide6 import QtCore
+
+    from app.views.docks import MIN_CANVAS_SHARE, NARROWED, WIDE_WIDTH
+
+    win.resize(1400, 880)
+    qtbot.waitUntil(lambda: win.width() == 1400 and win.docks["quality"].width() > 0, timeout=20_000)
+    left, right = win.docks["params"], win.docks["quality"]
+    win.resizeDocks([win.docks["blocks"], right], [330, 330], QtCore.Qt.Orientation.Horizontal)  # the first sizes
+    qtbot.waitUntil(lambda: left.width() >= 320 and right.width() >= 320, timeout=20_000)
+    qtbot.wait(300)
+    before = left.width(), right.width()
+    for d in win.docks.values():  # as before the first fit: no width recorded
+        d.setProperty(WIDE_WIDTH, None)
+        d.setProperty(NARROWED, None)
+    narrow = int((before[0] + before[1]) / (1 - MIN_CANVAS_SHARE)) - 60  # the drawing area under its share
+    win.resize(narrow, 880)
+    qtbot.waitUntil(lambda: win.width() == narrow and left.width() < before[0] - 8, timeout=20_000)
+    win.resize(1400, 880)
+    qtbot.waitUntil(
+        lambda: win.width() == 1400 and left.width() >= before[0] - 16 and right.width() >= before[1] - 16,
+        timeout=20_000,
+    )
