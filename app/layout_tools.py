@@ -120,10 +120,6 @@ class LayoutTool(Tool):
     def dragging(self) -> bool:
         return self._handle is not None
 
-    @property
-    def in_drag(self) -> bool:
-        return self._handle is not None
-
     def _handles(self, lay) -> list:
         """The handles of ``lay`` (remembered for the last layout: hovering asks often)."""
         from .layout_edit import handles

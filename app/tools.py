@@ -80,8 +80,9 @@ class Tool:
 
     @property
     def in_drag(self) -> bool:
-        """True while a drag of this tool is on (the mouse button still down), edit or not."""
-        return False
+        """True while a drag of this tool is on (the mouse button still down), edit or not (default: an
+        editing drag, :attr:`dragging`)."""
+        return self.dragging
 
     def cancel_drag(self) -> bool:
         """Ctrl+Z or Esc in the middle of a drag: the drag is cancelled — the project goes back to what it was
