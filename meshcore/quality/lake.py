@@ -12,6 +12,9 @@ Per block, on the node arrays ``x, y`` of shape ``(ni + 1, nj + 1)``:
   (RGFGRID: 1.1–1.2);
 * ``aspect_ratio`` — per cell, the longer over the shorter of its two edges
   from the ``(i, j)`` corner;
+* ``shrink`` — per cell, the grid's mean cell size ``h = sqrt(grid area / cells)`` (or the
+  ``cell_size`` given) over the cell's shortest edge: by about this factor a cell shortens the
+  time step an explicit model may take there (Courant), against a grid of cells of size ``h``;
 * ``folded`` — per cell, 1 when any of its four corner Jacobians is ``< 0``
   relative to the block's orientation beyond rounding (folded or non-convex:
   a corner sine below ``−``:data:`~.cells.STRAIGHT_SINE`), else 0;
@@ -66,6 +69,7 @@ METRICS: dict[str, tuple[str, str, str]] = {
     "deviation": ("nodes", "deviation from 90°", "°"),
     "smoothness": ("edge pairs", "consecutive edge-length ratio", ""),
     "aspect_ratio": ("cells", "aspect ratio", ""),
+    "shrink": ("cells", "mean cell size ÷ the cell's shortest edge", ""),
     "folded": ("cells", "folded or non-convex (1) cells", ""),
     "straight": ("cells", "cells with a straight (180°) corner (1)", ""),
     "interface_ratio": ("cell pairs", "cross-interface cell-area ratio", ""),
@@ -105,6 +109,7 @@ class BlockMetrics:
     area: np.ndarray  # (ni, nj) signed area, positive in the block's orientation
     folded: np.ndarray  # (ni, nj) bool: a corner Jacobian < 0 beyond rounding
     straight: np.ndarray  # (ni, nj) bool: not folded, a corner straight up to rounding
+    shortest: np.ndarray  # (ni, nj) the shortest of the cell's four edges
 
 
 def node_cos(x: np.ndarray, y: np.ndarray, periodic: bool = False) -> np.ndarray:
@@ -172,7 +177,10 @@ def block_metrics(grid: StructuredGrid, name: str = "block1") -> BlockMetrics:
     sines = orient * corner_sines(x, y)
     folded = np.asarray((sines < -STRAIGHT_SINE).any(axis=0))
     straight = np.asarray((sines <= STRAIGHT_SINE).any(axis=0)) & ~folded
-    return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded, straight)
+    exi = np.hypot(np.diff(x, axis=0), np.diff(y, axis=0))  # (ni, nj + 1)
+    eeta = np.hypot(np.diff(x, axis=1), np.diff(y, axis=1))  # (ni + 1, nj)
+    shortest = np.minimum(np.minimum(exi[:, :-1], exi[:, 1:]), np.minimum(eeta[:-1], eeta[1:]))
+    return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded, straight, shortest)
 
 
 def _names(obj: Any, n: int) -> tuple[str, ...]:
@@ -226,7 +234,19 @@ def _collect(metric: str, parts: list[tuple], axis: list | None = None) -> Sampl
     )
 
 
-def _samples(grids: Sequence[StructuredGrid], bms: Sequence[BlockMetrics], pairs: dict) -> dict[str, Samples]:
+def mean_cell_size(bms: Sequence[BlockMetrics]) -> float:
+    """``sqrt(grid area / cells)`` of the blocks' metrics (0 for no cells)."""
+    cells = sum(b.area.size for b in bms)
+    return float(np.sqrt(sum(float(np.abs(b.area).sum()) for b in bms) / cells)) if cells else 0.0
+
+
+def _shrink(shortest: np.ndarray, h: float) -> np.ndarray:
+    """``h / shortest`` (inf for a collapsed edge)."""
+    with np.errstate(divide="ignore"):
+        return np.where(shortest > 0, h / np.where(shortest > 0, shortest, 1.0), np.inf)
+
+
+def _samples(grids: Sequence[StructuredGrid], bms: Sequence[BlockMetrics], pairs: dict, h: float) -> dict[str, Samples]:
     nodes = [(k, np.asarray(g.x), np.asarray(g.y)) for k, g in enumerate(grids)]
     cents = []
     for k, g in enumerate(grids):
@@ -244,6 +264,9 @@ def _samples(grids: Sequence[StructuredGrid], bms: Sequence[BlockMetrics], pairs
         ),
         "aspect_ratio": _collect(
             "aspect_ratio", [(k, b.aspect_ratio, cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
+        ),
+        "shrink": _collect(
+            "shrink", [(k, _shrink(b.shortest, h), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
         ),
         "folded": _collect(
             "folded", [(k, b.folded.astype(float), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
@@ -279,6 +302,7 @@ class LakeMetrics:
     blocks: tuple[BlockMetrics, ...]
     samples: dict[str, Samples] = field(repr=False)
     coverage: Any = None  # meshcore.quality.coverage.Coverage
+    cell_size: float = 0.0  # the unit of ``shrink``: as given, or ``sqrt(grid area / cells)``
 
     def values(self, metric: str) -> np.ndarray:
         """Every value of ``metric`` (a key of :data:`METRICS`)."""
@@ -338,6 +362,7 @@ class LakeMetrics:
             "max_smoothness": self.max("smoothness"),
             "max_aspect_ratio": self.max("aspect_ratio"),
             "mean_aspect_ratio": self.mean("aspect_ratio"),
+            "min_edge_cells": 1.0 / self.max("shrink") if len(self.values("shrink")) else float("nan"),
             "folded_cells": int(self.values("folded").sum()),
             "straight_angle_cells": int(self.values("straight").sum()),
             "interface_cell_pairs": len(self.values("interface_ratio")),
@@ -382,6 +407,7 @@ class LakeMetrics:
                 f"{self.mean('aspect_ratio'):.3g} / {self.max('aspect_ratio'):.3g}",
                 w("aspect_ratio"),
             ),
+            self._shortest_row(w),
             ("folded or non-convex cells", str(n_folded), w("folded") if n_folded else ""),
         ]
         n_straight = int(self.values("straight").sum())
@@ -392,6 +418,16 @@ class LakeMetrics:
         if self.coverage is not None:
             rows += self.coverage.rows()
         return format_table(("metric", "value", "worst at"), rows)
+
+    def _shortest_row(self, w) -> tuple[str, str, str]:
+        """The table's row of the shortest edge: in mean cell sizes, and what it costs an explicit
+        model's time step (its worst place is the cell with the largest ``shrink``)."""
+        worst = self.max("shrink")
+        if not np.isfinite(worst):
+            value = "0 (a collapsed edge)" if worst == np.inf else "—"
+        else:
+            value = f"{1.0 / worst:.3g} cells (explicit time step ÷ {worst:.3g})"
+        return ("shortest edge (in mean cell sizes)", value, w("shrink") if len(self.values("shrink")) else "")
 
     def __str__(self) -> str:
         return self.table()
@@ -415,7 +451,7 @@ def lake_metrics(
     holes : sequence of (m, 2) arrays
         Islands, when ``polygon`` is given as the outer ring's points.
     cell_size : float, optional
-        Unit of the shoreline distance; default ``sqrt(grid area / cells)``.
+        Unit of the shoreline distance and of ``shrink``; default ``sqrt(grid area / cells)``.
 
     Returns
     -------
@@ -432,7 +468,8 @@ def lake_metrics(
     """
     grids, names = as_grids(grid)
     bms = tuple(block_metrics(g, n) for g, n in zip(grids, names, strict=True))
-    samples = _samples(grids, bms, interface_pairs(grids) if len(grids) > 1 else no_pairs())
+    h = float(cell_size) if cell_size else mean_cell_size(bms)
+    samples = _samples(grids, bms, interface_pairs(grids) if len(grids) > 1 else no_pairs(), h)
     cov = None
     if polygon is not None:
         from .coverage import coverage
@@ -440,4 +477,4 @@ def lake_metrics(
         cov = coverage(grids, bms, polygon, holes=holes, cell_size=cell_size)
         samples["area_error"] = cov.samples("area_error")
         samples["shore_distance"] = cov.samples("shore_distance")
-    return LakeMetrics(names, bms, samples, cov)
+    return LakeMetrics(names, bms, samples, cov, h)

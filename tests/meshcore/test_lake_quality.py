@@ -83,6 +83,32 @@ def test_smoothness_of_geometric_stretching_is_its_ratio(rx, ry):
     assert m.max("cos") < 1e-15
 
 
+def test_shrink_is_the_mean_cell_size_over_each_cells_shortest_edge():
+    # columns 1, 1, 0.01, 1, 2 wide, rows 1, 0.5, 1 high: cells of known edges and a known mean size
+    xs, ys = np.cumsum([0.0, 1, 1, 0.01, 1, 2]), np.cumsum([0.0, 1, 0.5, 1])
+    m = lake_metrics(product(xs, ys))
+    dx, dy = np.diff(xs), np.diff(ys)
+    h = math.sqrt(xs[-1] * ys[-1] / (len(dx) * len(dy)))
+    assert m.cell_size == pytest.approx(h, rel=1e-12)
+    np.testing.assert_allclose(m.blocks[0].shortest, np.minimum.outer(dx, dy), rtol=1e-12)
+    np.testing.assert_allclose(m.values("shrink"), (h / np.minimum.outer(dx, dy)).ravel(), rtol=1e-12)
+    assert m.summary()["min_edge_cells"] == pytest.approx(0.01 / h, rel=1e-12)
+    worst = m.worst("shrink", 3)  # the thin column's three cells, at their centres
+    assert {(w.i, w.j) for w in worst} == {(2, 0), (2, 1), (2, 2)} and worst[0].x == pytest.approx(2.005)
+    row = next(line for line in m.table().splitlines() if "shortest edge" in line)
+    assert f"{0.01 / h:.3g} cells" in row and f"time step ÷ {h / 0.01:.3g}" in row and "b" in row
+    # a given cell size is the unit instead (the CLI's asked size)
+    assert lake_metrics(product(xs, ys), cell_size=2.0).summary()["min_edge_cells"] == pytest.approx(0.005)
+
+
+def test_a_collapsed_edge_shrinks_without_limit():
+    X, Y = np.meshgrid([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], indexing="ij")
+    X[1, 2], Y[1, 2] = X[0, 2], Y[0, 2]  # top row: its first edge has length 0
+    m = lake_metrics(StructuredGrid(X, Y))
+    assert m.max("shrink") == math.inf and m.summary()["min_edge_cells"] == 0.0
+    assert "0 (a collapsed edge)" in m.table()
+
+
 def test_one_moved_node_fails_exactly_the_stencils_that_see_it():
     xi, eta = np.meshgrid(np.arange(7.0), np.arange(7.0), indexing="ij")
     y = eta.copy()
@@ -268,7 +294,7 @@ def test_metrics_are_invariant_under_similarity(ux, uy, angle, scale):
     m1 = lake_metrics(moved[1:], polygon=mpoly)
     w0, w1 = lake_metrics(blocks[0]), lake_metrics(moved[0])
     for a, b in ((m0, m1), (w0, w1)):
-        for k in ("cos", "smoothness", "aspect_ratio", "folded", "interface_ratio"):
+        for k in ("cos", "smoothness", "aspect_ratio", "shrink", "folded", "interface_ratio"):
             np.testing.assert_allclose(b.values(k), a.values(k), rtol=1e-7, atol=1e-9)
         np.testing.assert_allclose(b.values("deviation"), a.values("deviation"), atol=1e-6)
     assert m1.coverage.area_ratio == pytest.approx(m0.coverage.area_ratio, rel=1e-9)
@@ -341,6 +367,7 @@ def test_cli_quality_preset(tmp_path, capsys):
     assert data["presets"][0]["preset"] == "delft3d"
     assert rc == (0 if data["presets"][0]["passed"] else 2)
     assert data["lake_metrics"]["interface_cell_pairs"] == 16
+    assert 0 < data["lake_metrics"]["min_edge_cells"] < 1  # the ring's blocks are not all alike
 
 
 def test_docstring_examples_run():
