@@ -283,6 +283,9 @@ def finish(
         print(f"\n{len(mb.grids)} blocks, {m.summary()['cells']:,} cells in {time.perf_counter() - t_start:.1f} s")
     for w in m.coverage.warnings():  # islands lost or cut across: shown even with -q
         print(f"meshcore mesh: warning: {w}", file=sys.stderr)
+    small = m.small_cell_note()  # a cell far smaller than the rest: also with -q
+    if small:
+        print(f"meshcore mesh: note: {small}", file=sys.stderr)
     lost = len(m.coverage.islands_lost)
     if n_folded or not mb.converged or lost:
         why = f"{n_folded} folded or non-convex cells" if n_folded else "the solver did not converge"

@@ -101,12 +101,26 @@ def test_shrink_is_the_mean_cell_size_over_each_cells_shortest_edge():
     assert lake_metrics(product(xs, ys), cell_size=2.0).summary()["min_edge_cells"] == pytest.approx(0.005)
 
 
+def test_a_cell_far_smaller_than_the_rest_gets_a_note():
+    from meshcore.quality.lake import SHRINK_NOTE
+
+    even = lake_metrics(product(np.arange(6.0), np.arange(4.0)))
+    assert even.max("shrink") == pytest.approx(1.0) and even.small_cell_note() is None
+    xs = np.cumsum([0.0, 1, 1, 1e-3, 1, 2])  # a column 1/1000 wide
+    m = lake_metrics(product(xs, np.arange(4.0)))
+    assert m.max("shrink") > SHRINK_NOTE
+    note = m.small_cell_note()
+    assert note.startswith("cell block1(2,") and f"{m.max('shrink'):.3g} times shorter" in note
+    assert m.small_cell_note(limit=2 * m.max("shrink")) is None
+
+
 def test_a_collapsed_edge_shrinks_without_limit():
     X, Y = np.meshgrid([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], indexing="ij")
     X[1, 2], Y[1, 2] = X[0, 2], Y[0, 2]  # top row: its first edge has length 0
     m = lake_metrics(StructuredGrid(X, Y))
     assert m.max("shrink") == math.inf and m.summary()["min_edge_cells"] == 0.0
     assert "0 (a collapsed edge)" in m.table()
+    assert "a collapsed edge: an explicit model cannot step there" in m.small_cell_note()
 
 
 def test_one_moved_node_fails_exactly_the_stencils_that_see_it():

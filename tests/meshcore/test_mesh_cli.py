@@ -607,6 +607,20 @@ def test_a_grid_with_folds_or_not_converged_is_written_and_exits_3(tmp_path, syn
     assert (int(quality.split()[1]) > 0) == fold
 
 
+def test_a_cell_far_smaller_than_the_rest_is_told_even_quietly(tmp_path, synthetic_csv, monkeypatch):
+    from meshcore.quality import lake
+
+    run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "s.vtm", "-q")
+    assert run.rc == 0 and "note: cell" not in run.err  # this lake's cells are alike
+    monkeypatch.setattr(lake, "SHRINK_NOTE", 1.0)  # every grid's smallest cell told
+    run = mesh(synthetic_csv, "--cells", 400, "-o", tmp_path / "t.vtm", "-q")
+    notes = [ln for ln in run.err.splitlines() if ln.startswith("meshcore mesh: note: cell")]
+    assert run.rc == 0 and len(notes) == 1, run.err
+    shrink = float(re.search(r"time step there is ([0-9.]+) times shorter", notes[0]).group(1))
+    m = lake.lake_metrics(read_blocks(tmp_path / "t.vtm").blocks)
+    assert shrink == pytest.approx(m.max("shrink"), rel=0.05)  # against the written grid's own (its mean size)
+
+
 def test_a_bug_in_the_pipeline_is_one_line_and_exit_1(tmp_path, synthetic_csv, monkeypatch):
     from meshcore import lakegrid
 
