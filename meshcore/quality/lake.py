@@ -370,7 +370,7 @@ class LakeMetrics:
             "max_smoothness": self.max("smoothness"),
             "max_aspect_ratio": self.max("aspect_ratio"),
             "mean_aspect_ratio": self.mean("aspect_ratio"),
-            "min_edge_cells": 1.0 / self.max("shrink") if len(self.values("shrink")) else float("nan"),
+            "min_edge_cells": self._min_edge_cells(),
             "folded_cells": int(self.values("folded").sum()),
             "straight_angle_cells": int(self.values("straight").sum()),
             "interface_cell_pairs": len(self.values("interface_ratio")),
@@ -427,14 +427,23 @@ class LakeMetrics:
             rows += self.coverage.rows()
         return format_table(("metric", "value", "worst at"), rows)
 
+    def _min_edge_cells(self) -> float:
+        """The shortest edge of the grid over the mean cell size (NaN without cells or area)."""
+        shortest = [float(b.shortest.min()) for b in self.blocks if b.shortest.size]
+        if not shortest or not self.cell_size > 0:
+            return float("nan")
+        return min(shortest) / self.cell_size
+
     def _shortest_row(self, w) -> tuple[str, str, str]:
         """The table's row of the shortest edge: in mean cell sizes, and what it costs an explicit
         model's time step (its worst place is the cell with the largest ``shrink``)."""
-        worst = self.max("shrink")
-        if not np.isfinite(worst):
-            value = "0 (a collapsed edge)" if worst == np.inf else "—"
+        worst, least = self.max("shrink"), self._min_edge_cells()
+        if worst == np.inf:
+            value = "0 (a collapsed edge)"
+        elif not (np.isfinite(least) and least > 0):
+            value = "—"  # no cells, or no area to measure them by
         else:
-            value = f"{1.0 / worst:.3g} cells (explicit time step ÷ {worst:.3g})"
+            value = f"{least:.3g} cells (explicit time step ÷ {worst:.3g})"
         return ("shortest edge (in mean cell sizes)", value, w("shrink") if len(self.values("shrink")) else "")
 
     def small_cell_note(self, limit: float | None = None) -> str | None:

@@ -121,6 +121,10 @@ def test_a_collapsed_edge_shrinks_without_limit():
     assert m.max("shrink") == math.inf and m.summary()["min_edge_cells"] == 0.0
     assert "0 (a collapsed edge)" in m.table()
     assert "a collapsed edge: an explicit model cannot step there" in m.small_cell_note()
+    X, Y = np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij")
+    flat = lake_metrics(StructuredGrid(X + Y, X + Y))  # edges but no area: no mean cell size to measure by
+    assert flat.summary()["min_edge_cells"] is None and flat.small_cell_note() is None
+    assert "| shortest edge (in mean cell sizes)        | —" in flat.table()
 
 
 def test_one_moved_node_fails_exactly_the_stencils_that_see_it():
