@@ -157,6 +157,7 @@ def _per_part(water: WaterParts, kept: list, h: float):
     def lines(mb: Any, poly: Any) -> list[str]:
         from ..lakeparts import part_grids
         from ..quality import lake_metrics
+        from ..quality.samples import ok_percent
 
         out = [
             "| part | name | blocks | cells | folded | mean deviation | nodes within 3° | shore distance (cells) |",
@@ -167,7 +168,7 @@ def _per_part(water: WaterParts, kept: list, h: float):
             s = lake_metrics(grids[k], polygon=p, cell_size=h).summary()
             out.append(
                 f"| {k} | {water.names[k - 1]} | {s['blocks']} | {s['cells']:,} | {s['folded_cells']} | "
-                f"{s['mean_deviation_deg'] or 0:.2f}° | {s['pct_nodes_within_3deg']:.1f} % | "
+                f"{s['mean_deviation_deg'] or 0:.2f}° | {ok_percent((s['pct_nodes_within_3deg'] or 0) / 100)} % | "
                 f"{s['hausdorff_cells']:.2f} |"
             )
         return [*out, ""]

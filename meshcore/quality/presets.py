@@ -30,7 +30,7 @@ import numpy as np
 from .._validation import validate_choice
 from ..errors import InvalidInputError
 from .lake import METRICS, LakeMetrics, Location, lake_metrics
-from .samples import format_table
+from .samples import format_table, ok_percent
 
 __all__ = ["PRESETS", "Limit", "LimitResult", "Preset", "Verdict", "check", "format_table", "ok_percent"]
 
@@ -193,18 +193,6 @@ class Verdict:
 
     def __str__(self) -> str:
         return self.table()
-
-
-def ok_percent(fraction: float) -> str:
-    """A share within a limit, in per cent to a tenth, rounded down: 1 node of 8598 over the EFDC limit
-    read "FAIL (100.0 % ok)"; only a share of 1 reads 100.0.
-
-    Examples
-    --------
-    >>> ok_percent(8597 / 8598), ok_percent(1.0), ok_percent(0.9785)
-    ('99.9', '100.0', '97.8')
-    """
-    return f"{math.floor(1000 * float(fraction) + 1e-9) / 10:.1f}"
 
 
 def _result(m: LakeMetrics, lim: Limit, k: int) -> LimitResult:

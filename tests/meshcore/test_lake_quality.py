@@ -331,6 +331,10 @@ def test_a_share_just_short_of_all_is_not_printed_as_100_per_cent():
     text = v.table()
     assert "FAIL (99.9 % ok)" in text and "FAIL (100.0 % ok)" not in text
     assert "pass (100.0 % ok)" in text  # no folded cell: all of them, 100.0
+    # the metrics' own table reads the shares as the verdict does (it printed 97.8 % beside 97.7 % ok)
+    m = lake_metrics(StructuredGrid(xi, y))
+    row = next(line for line in m.table().splitlines() if "nodes within 3°" in line)
+    assert "| 100.0 % / 99.9 % / 100.0 %" in row, row  # |cos| ≤ 0.02 at 99.98 %: rounded up it read 100.0
 
 
 def test_presets_are_frozen_data_with_sources():
