@@ -41,6 +41,9 @@ def _layout_shape(layout) -> tuple | None:
 
 #: the metrics cells can be coloured by: label → (array of the quality report, colour map)
 DEVIATION = "deviation from 90° (deg)"
+SHRINK = "time step cost (cell size ÷ shortest edge)"
+#: the metrics measured over every block of a lake grid (its lake metrics), not of the active block alone
+LAKE_WIDE = frozenset({DEVIATION, SHRINK})
 METRICS = {
     "none": None,
     "Jacobian ratio": ("jacobian_ratio", "viridis"),
@@ -52,11 +55,18 @@ METRICS = {
     # the lake modellers' measure (EFDC: < 3°): the largest deviation from 90° at a cell's four nodes,
     # over every block of a lake grid (as ``meshcore mesh --colour deviation`` draws it)
     DEVIATION: ("deviation", "magma_r"),
+    # how much shorter an explicit model's time step is in a cell than in cells of the grid's mean size
+    # (its mean size over its shortest edge: meshcore.quality's ``shrink``), over every block of a lake grid
+    SHRINK: ("shrink", "magma_r"),
 }
 #: the metrics whose worst cells are their smallest values (cells merged for colouring show their smallest)
 LOW_IS_WORSE = frozenset({"Jacobian ratio"})
 #: the colour range of :data:`DEVIATION` (degrees; above it, the top colour)
 DEVIATION_LEVELS = (0.0, 10.0)
+#: ... and of :data:`SHRINK`: 1 for a cell of the mean size, the top colour from an edge of a twentieth
+SHRINK_LEVELS = (1.0, 20.0)
+#: the fixed colour ranges, by label (the others span their values)
+LEVELS = {DEVIATION: DEVIATION_LEVELS, SHRINK: SHRINK_LEVELS}
 
 
 #: a grid (with the lake grid its metrics are measured over) of at least this many cells is measured off the
@@ -415,7 +425,7 @@ class Document:
         m = METRICS.get(self.colour_by)
         if m is None or self.quality is None:
             return None, None, ""
-        if self.colour_by == DEVIATION:
+        if self.colour_by in LAKE_WIDE:
             layers = self.colour_layers()
             return (*layers[0], self.colour_by) if layers else (None, None, "")
         return self.quality_grid, self.quality.arrays[m[0]], self.colour_by
@@ -423,8 +433,8 @@ class Document:
     def colour_layers(self) -> list:
         """``[(grid, values), …]`` of the cell colouring: the active block first, then the lake's other blocks.
 
-        A metric of the block quality colours the active block; :data:`DEVIATION` colours every
-        block of a lake grid (its lake metrics), or the active block's grid otherwise.
+        A metric of the block quality colours the active block; :data:`DEVIATION` and :data:`SHRINK`
+        colour every block of a lake grid (its lake metrics), or the active block's grid otherwise.
         """
         return [(g, v) for _k, g, v in self.colour_blocks()]
 
@@ -433,17 +443,21 @@ class Document:
         m = METRICS.get(self.colour_by)
         if m is None or self.quality is None:
             return []
-        if self.colour_by != DEVIATION:
+        if self.colour_by not in LAKE_WIDE:
             return [(self.active, self.quality_grid, self.quality.arrays[m[0]])]
         lm, mb = self.lake_metrics, self.multiblock
         if lm is not None and mb is not None and len(lm.blocks) == len(mb.grids):
-            layers = [(k, g, _cell_max(b.deviation)) for k, (g, b) in enumerate(zip(mb.grids, lm.blocks, strict=True))]
+            layers = [
+                (k, g, _cell_values(self.colour_by, b, lm.cell_size))
+                for k, (g, b) in enumerate(zip(mb.grids, lm.blocks, strict=True))
+            ]
             k = self.active if 0 <= self.active < len(layers) else 0
             return [layers[k], *layers[:k], *layers[k + 1 :]]
-        from meshcore.quality.lake import block_metrics
+        from meshcore.quality.lake import block_metrics, mean_cell_size
 
         g = self.quality_grid
-        return [(self.active, g, _cell_max(block_metrics(g).deviation))]
+        b = block_metrics(g)
+        return [(self.active, g, _cell_values(self.colour_by, b, mean_cell_size([b])))]
 
     @property
     def grid(self) -> StructuredGrid | None:
@@ -469,6 +483,14 @@ class Document:
     def set_path(self, path) -> None:
         self.path = Path(path) if path else None
         self.path_changed.emit(self.path)
+
+
+def _cell_values(label: str, b, h: float) -> np.ndarray:
+    """Per cell of a block's lake metrics ``b``, the value :data:`DEVIATION` or :data:`SHRINK` colours
+    it by (``h``: the grid's mean cell size, the unit of ``SHRINK``)."""
+    from meshcore.quality.lake import cell_shrink
+
+    return cell_shrink(b.shortest, h) if label == SHRINK else _cell_max(b.deviation)
 
 
 def _cell_max(nodes: np.ndarray) -> np.ndarray:

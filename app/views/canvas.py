@@ -419,12 +419,12 @@ class Canvas(pg.PlotWidget):
 
     def refresh_quality(self) -> None:
         """Colour the cells and mark the folded ones as the document says."""
-        from ..document import DEVIATION, DEVIATION_LEVELS, LOW_IS_WORSE
+        from ..document import LEVELS, LOW_IS_WORSE, METRICS
 
         layers = self.doc.colour_layers()
         label = self.doc.colour_by if layers else ""
         grid, values = layers[0] if layers else (None, None)
-        kw = {"levels": DEVIATION_LEVELS, "cmap": "magma_r"} if label == DEVIATION else {}
+        kw = {"levels": LEVELS[label], "cmap": METRICS[label][1]} if label in LEVELS else {}
         try:
             self.set_quality(grid, values, label=label, more=layers[1:], low=label in LOW_IS_WORSE, **kw)
         except Exception:  # a drawing problem must not kill the window

@@ -57,10 +57,12 @@ __all__ = [
     "Location",
     "Samples",
     "block_metrics",
+    "cell_shrink",
     "corner_edges",
     "corner_jacobians",
     "interface_pairs",
     "lake_metrics",
+    "mean_cell_size",
     "node_cos",
 ]
 
@@ -248,8 +250,9 @@ def mean_cell_size(bms: Sequence[BlockMetrics]) -> float:
     return float(np.sqrt(sum(float(np.abs(b.area).sum()) for b in bms) / cells)) if cells else 0.0
 
 
-def _shrink(shortest: np.ndarray, h: float) -> np.ndarray:
-    """``h / shortest`` (inf for a collapsed edge)."""
+def cell_shrink(shortest: np.ndarray, h: float) -> np.ndarray:
+    """``shrink`` of cells whose shortest edges are ``shortest`` in a grid of mean cell size ``h``:
+    ``h / shortest`` (inf for a collapsed edge)."""
     with np.errstate(divide="ignore"):
         return np.where(shortest > 0, h / np.where(shortest > 0, shortest, 1.0), np.inf)
 
@@ -274,7 +277,7 @@ def _samples(grids: Sequence[StructuredGrid], bms: Sequence[BlockMetrics], pairs
             "aspect_ratio", [(k, b.aspect_ratio, cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
         ),
         "shrink": _collect(
-            "shrink", [(k, _shrink(b.shortest, h), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
+            "shrink", [(k, cell_shrink(b.shortest, h), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]
         ),
         "folded": _collect(
             "folded", [(k, b.folded.astype(float), cx, cy) for (k, cx, cy), b in zip(cents, bms, strict=True)]

@@ -333,6 +333,33 @@ def test_a_lake_refused_is_a_message(qtbot, win):
     assert "Cannot lay out the lake" in win._status.text() and "cell size" in win._status.text()
 
 
+def test_colour_by_time_step_cost_covers_every_block_of_a_lake(qtbot, win):
+    """``--quality "time step"`` colours every block by the lake metrics' ``shrink`` (the cell size over
+    the cell's shortest edge: where an explicit model must step shortest), on a fixed scale from 1."""
+    from app.__main__ import quality_label
+    from app.document import SHRINK, SHRINK_LEVELS
+
+    lay = lay_out(qtbot, win, ISEO, cell_size=600.0)
+    assert quality_label("time step") == SHRINK == quality_label("shortest")
+    win.quality_panel.metric.setCurrentText(SHRINK)
+    assert win.doc.colour_by == SHRINK
+    m = win.doc.lake_metrics
+    layers = win.doc.colour_blocks()
+    assert len(layers) == len(lay.blocks) and len(win.canvas.quality_items) == len(lay.blocks) - 1
+    every = np.concatenate([np.ravel(v) for _k, _g, v in layers])
+    assert np.sort(every) == pytest.approx(np.sort(m.values("shrink")))  # the report's own numbers
+    for k, g, values in layers:  # each the cell size over the cell's shortest edge, measured here
+        e1 = np.hypot(np.diff(g.x, axis=0), np.diff(g.y, axis=0))
+        e2 = np.hypot(np.diff(g.x, axis=1), np.diff(g.y, axis=1))
+        shortest = np.minimum(np.minimum(e1[:, :-1], e1[:, 1:]), np.minimum(e2[:-1], e2[1:]))
+        assert values == pytest.approx(lay.cell_size / shortest), k
+    bar = win.canvas.colorbar
+    assert bar is not None and tuple(bar.levels()) == pytest.approx(SHRINK_LEVELS)
+    g = layers[0][1]
+    assert SHRINK in win._cell_readout(g.x[1:3, 1:3].mean(), g.y[1:3, 1:3].mean())
+    win.quality_panel.metric.setCurrentText("none")
+
+
 def test_colour_by_deviation_covers_every_block_of_a_lake(qtbot, win):
     """``--quality deviation`` (and the Quality panel's combo) colours all blocks by the largest
     deviation from 90° at each cell's nodes, as ``meshcore mesh --colour deviation`` draws it."""
