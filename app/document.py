@@ -41,7 +41,7 @@ def _layout_shape(layout) -> tuple | None:
 
 #: the metrics cells can be coloured by: label → (array of the quality report, colour map)
 DEVIATION = "deviation from 90° (deg)"
-SHRINK = "time step cost (cell size ÷ shortest edge)"
+SHRINK = "time step cost (h ÷ shortest edge)"
 #: the metrics measured over every block of a lake grid (its lake metrics), not of the active block alone
 LAKE_WIDE = frozenset({DEVIATION, SHRINK})
 METRICS = {
