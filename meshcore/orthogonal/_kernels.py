@@ -161,7 +161,7 @@ def _ramp(h1, h2, lo, hi):
 
 
 @njit(cache=True, inline="always")
-def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax):
+def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax, lo_y=-1.0):
     """The Ryskin–Leal position of node ``p``, its weights along each grid line blended
     ``smooth`` towards their mean — and further, up to the full mean, where the line's two
     edges at ``p`` differ by a ratio above ``lo`` (:func:`_ramp`).
@@ -184,7 +184,7 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax):
     # blend with the symmetrised weights (equal spacing along each line: smoothness)
     am, bm = 0.5 * (ae + aw), 0.5 * (bn + bs)
     rx = bx + relax * (_ramp(he, hw, lo, hi) - bx)
-    ry = by + relax * (_ramp(hn, hs, lo, hi) - by)
+    ry = by + relax * (_ramp(hn, hs, lo if lo_y < 0.0 else lo_y, hi) - by)
     sx = smooth + (1.0 - smooth) * rx
     sy = smooth + (1.0 - smooth) * ry
     ae += sx * (am - ae)
@@ -227,7 +227,7 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, lo, hi, tx, ty):
 
 @njit(cache=True, nogil=True)
 def sweep(
-    X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lo, hi, bx, by, relax, jmin, thin
+    X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lox, loy, hi, bx, by, relax, jmin, thin
 ):
     """One Gauss–Seidel sweep over the free interior nodes (``bx, by``: the size-blend state
     of every regular node, updated; see :func:`_target`; ``thin[node]``: the move guard's thin
@@ -250,11 +250,12 @@ def sweep(
             nbr[k, 6],
             nbr[k, 7],
             smooth,
-            lo,
+            lox[k],
             hi,
             bx[k],
             by[k],
             relax,
+            loy[k],
         )
         t = max(bx[k], by[k])
         if tx != tx:

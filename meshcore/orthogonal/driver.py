@@ -272,6 +272,40 @@ THIN_RUNS = 2
 THIN_RINGS = 2
 
 
+#: The size blend's ``lo`` along a grid line that leaves the shore, at the first ``SHORE_ROWS`` interior
+#: nodes of that line (None: ``size_ratio[0]`` everywhere).
+SHORE_ROW_LO: float | None = None
+SHORE_ROWS = 1
+#: ... and along lines that leave an interface (a node of several blocks) too
+INTERFACE_ROWS = False
+
+
+def _row_limits(m, lo: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per regular node, the size blend's ``lo`` along its ξ-line (e–w) and η-line (n–s)."""
+    nb = m.nbr
+    lox = np.full(len(m.nodes), float(lo))
+    loy = np.full(len(m.nodes), float(lo))
+    if SHORE_ROW_LO is None or not len(m.nodes):
+        return lox, loy
+    row = np.asarray(m.boundary, dtype=bool).copy()  # the shore: row 0
+    if INTERFACE_ROWS:
+        row |= np.asarray(m.shared, dtype=bool)
+    at = np.full(m.n_nodes, -1, dtype=np.int64)
+    at[m.nodes] = np.arange(len(m.nodes))
+    near_x = np.zeros(len(m.nodes), dtype=bool)
+    near_y = np.zeros(len(m.nodes), dtype=bool)
+    for _ in range(SHORE_ROWS):
+        nx = row[nb[:, 0]] | row[nb[:, 1]]
+        ny = row[nb[:, 2]] | row[nb[:, 3]]
+        near_x |= nx
+        near_y |= ny
+        row = row.copy()
+        row[m.nodes[nx | ny]] = True
+    lox[near_x] = min(lo, SHORE_ROW_LO)
+    loy[near_y] = min(lo, SHORE_ROW_LO)
+    return lox, loy
+
+
 def _thinness(X, Y, cells) -> np.ndarray:
     """Per cell, the least ratio of the shorter over the longer of the two edges at a corner (one
     over the largest aspect ratio of :mod:`meshcore.quality`, which reads one corner of each cell;
@@ -449,7 +483,9 @@ def iterate_orthogonalize(
     def one(nodes, nbr, irr, free, bx, by, bz, blo, smooth, thin):
         """One sweep of the free nodes given (interior, irregular ``irr``, shore ``free``) with
         their states; the largest move over ``h``."""
-        d1 = _kernels.sweep(X, Y, nodes, nbr, *irr, cptr, ncells, omega, smooth, lo, hi, bx, by, size_relax, jmin, thin)
+        d1 = _kernels.sweep(
+            X, Y, nodes, nbr, *irr, cptr, ncells, omega, smooth, lox, loy, hi, bx, by, size_relax, jmin, thin
+        )
         d2 = _kernels.shore_sweep(
             X,
             Y,
@@ -485,6 +521,7 @@ def iterate_orthogonalize(
         return max(d1, d2, d3) / h
 
     irr = (m.irr_nodes, m.irr_ptr, m.irr_ring)
+    lox, loy = _row_limits(m, lo)
     thin = np.zeros(m.n_nodes, dtype=np.uint8)  # the thin rule's nodes: none on the first run
     state = (X, Y, bx, by, bs, bz)
     start = tuple(a.copy() for a in state)
