@@ -161,10 +161,11 @@ def _ramp(h1, h2, lo, hi):
 
 
 @njit(cache=True, inline="always")
-def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax, lo_y=-1.0):
+def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo_x, lo_y, hi, bx, by, relax):
     """The Ryskin–Leal position of node ``p``, its weights along each grid line blended
     ``smooth`` towards their mean — and further, up to the full mean, where the line's two
-    edges at ``p`` differ by a ratio above ``lo`` (:func:`_ramp`).
+    edges at ``p`` differ by a ratio above ``lo_x`` (the e–w line) or ``lo_y`` (the n–s line;
+    :func:`_ramp`).
 
     The extra blend of each line is the node's state ``bx, by`` moved ``relax`` of the way
     to the current ramp value (``relax = 1``: the ramp itself); a relaxed state keeps a node
@@ -183,8 +184,8 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax, 
     ae, aw, bn, bs = eta_e / he, eta_w / hw, xi_n / hn, xi_s / hs
     # blend with the symmetrised weights (equal spacing along each line: smoothness)
     am, bm = 0.5 * (ae + aw), 0.5 * (bn + bs)
-    rx = bx + relax * (_ramp(he, hw, lo, hi) - bx)
-    ry = by + relax * (_ramp(hn, hs, lo if lo_y < 0.0 else lo_y, hi) - by)
+    rx = bx + relax * (_ramp(he, hw, lo_x, hi) - bx)
+    ry = by + relax * (_ramp(hn, hs, lo_y, hi) - by)
     sx = smooth + (1.0 - smooth) * rx
     sy = smooth + (1.0 - smooth) * ry
     ae += sx * (am - ae)
@@ -201,8 +202,9 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo, hi, bx, by, relax, 
 
 
 @njit(cache=True, nogil=True)
-def jacobi_targets(X, Y, nodes, nbr, smooth, lo, hi, tx, ty):
-    """The update of every regular node from the same old positions (test oracle's twin)."""
+def jacobi_targets(X, Y, nodes, nbr, smooth, lox, loy, hi, tx, ty):
+    """The update of every regular node from the same old positions (test oracle's twin;
+    ``lox, loy``: each node's ``lo`` along its e–w and n–s lines)."""
     for k in range(len(nodes)):
         tx[k], ty[k], _, _ = _target(
             X,
@@ -217,7 +219,8 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, lo, hi, tx, ty):
             nbr[k, 6],
             nbr[k, 7],
             smooth,
-            lo,
+            lox[k],
+            loy[k],
             hi,
             0.0,
             0.0,
@@ -229,8 +232,8 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, lo, hi, tx, ty):
 def sweep(
     X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lox, loy, hi, bx, by, relax, jmin, thin
 ):
-    """One Gauss–Seidel sweep over the free interior nodes (``bx, by``: the size-blend state
-    of every regular node, updated; see :func:`_target`; ``thin[node]``: the move guard's thin
+    """One Gauss–Seidel sweep over the free interior nodes (``lox, loy``: each regular node's
+    size-blend ``lo`` along its two lines; ``bx, by``: its size-blend state, updated; see :func:`_target`; ``thin[node]``: the move guard's thin
     rule for that node, see :func:`_try_move`); returns the largest move."""
     big = 0.0
     before = np.empty(32)
@@ -251,11 +254,11 @@ def sweep(
             nbr[k, 7],
             smooth,
             lox[k],
+            loy[k],
             hi,
             bx[k],
             by[k],
             relax,
-            loy[k],
         )
         t = max(bx[k], by[k])
         if tx != tx:

@@ -41,10 +41,19 @@ def test_the_kernel_update_is_the_numpy_oracle(smooth, lo, hi):
     gx, gy = np.empty(m.n_nodes), np.empty(m.n_nodes)
     gx[ids], gy[ids] = X, Y
     tx, ty = np.empty(len(m.nodes)), np.empty(len(m.nodes))
-    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi, tx, ty)
+    lox, loy = np.full(len(m.nodes), lo), np.full(len(m.nodes), lo)
+    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, tx, ty)
     rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi)
     np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
     np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
+    if np.isfinite(lo):  # each node's own start of the blend along each of its lines (the shore rows')
+        lox, loy = np.where(rng.random(len(m.nodes)) < 0.5, 1.0, lo), np.where(rng.random(len(m.nodes)) < 0.5, 1.0, lo)
+        _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, tx, ty)
+        rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lox, hi, lo_y=loy)
+        np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
+        ux, uy = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi)
+        assert smooth == 1.0 or np.abs(tx - ux).max() > 1e-6  # (smooth 1: the blend is whole anyway)
 
 
 def test_an_orthogonal_grid_is_a_fixed_point():
