@@ -54,6 +54,8 @@ class SolveStatus(QtCore.QObject):
         self.solver.error.connect(self.on_error)
         self.solver.progress.connect(self.on_progress)
         self.solver.finished.connect(self.on_finished)
+        self.solver.retry_said.connect(self.on_retry)
+        window.lake_ctl.busy_changed.connect(lambda _b: self._stop_enabled())  # Stop ends Auto layout too
         self.doc.quality_changed.connect(self.on_measured)
 
     def reset(self) -> None:
@@ -124,6 +126,20 @@ class SolveStatus(QtCore.QObject):
             f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s"
         )
 
+    def on_retry(self, kind: str, text: str) -> None:
+        """The lake grid is being made again (its levels left folded or non-convex cells): seconds without a
+        frame (8 s on Vänern), in which the status sat on the last sweep of the first grid.  The solver label
+        follows its steps; its start and its end (which grid was kept) go to the status line and the Messages,
+        the end ahead of the grid's line that follows."""
+        self._label_timer.stop()  # (a sweep's text due would write over it)
+        self._label_text = f"lake {text}"
+        self._show_label()
+        if kind not in ("retry", "retried"):
+            return
+        line = text[0].upper() + text[1:]
+        self.doc.report("info", f"lake {text}")
+        self.win.message(line, note=kind == "retried")
+
     def _show_label(self) -> None:
         """The latest progress text, while the solve runs (never over "paused" or the final summary)."""
         if self.solver.state == "running":
@@ -134,12 +150,16 @@ class SolveStatus(QtCore.QObject):
         running = state != "idle"
         self.doc.set_solving(running)
         self.win.a_pause.setEnabled(running)
-        self.win.a_stop.setEnabled(running)
+        self._stop_enabled()
         self.win.a_pause.setChecked(state == "paused")
         if state == "paused":
             self.label.setText("paused")
         elif state == "running":  # until its first progress (a minute when the first solve compiles its kernels)
             self.label.setText("solving…")
+
+    def _stop_enabled(self) -> None:
+        """Stop (Esc) is on while the solver runs or Auto layout computes (:meth:`MainWindow.stop`)."""
+        self.win.a_stop.setEnabled(self.solver.running or self.win.lake_ctl.busy)
 
     def on_error(self, text: str) -> None:
         # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why
