@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from tests.app.test_app39 import _y_lake
+from tests.app.test_app39b import held_layout
 
 pytestmark = pytest.mark.gui
 
@@ -99,37 +100,13 @@ def test_a_stop_while_the_grid_is_made_again_ends_it_and_keeps_the_first_grid(qt
     assert [g.cells for g in mb.grids] == [tuple(b.cells) for b in win.doc.project.layout.blocks]
 
 
-def _held_layout(monkeypatch):
-    """Auto layout's worker held at its first coarse reading until ``go`` is set: ``(entered, go, ended, done)``
-    — ``ended`` gets the worker's return value, then ``done`` is set."""
-    import app.lake_controller as lc
-    from meshcore.lakegrid import CoarseReadings
-
-    entered, go, ended, done = threading.Event(), threading.Event(), [], threading.Event()
-    real_reading, real_job = CoarseReadings.__call__, lc._layout_job
-
-    def gated(self, layout):
-        entered.set()
-        go.wait(60)
-        return real_reading(self, layout)
-
-    def job(*args):
-        ended.append(real_job(*args))
-        done.set()
-        return ended[-1]
-
-    monkeypatch.setattr(CoarseReadings, "__call__", gated)
-    monkeypatch.setattr(lc, "_layout_job", job)
-    return entered, go, ended, done
-
-
 def test_stop_ends_a_running_auto_layout(qtbot, win, monkeypatch):
     """Ctrl+L on a big lake runs for seconds; Stop was greyed and Esc did nothing (the layout's worker took no
     stop).  Now Stop is on while the layout is computed, Esc (Generate ▸ Stop) ends it at its next coarse
     reading: the document unchanged, nothing to undo, "Auto layout stopped" said, and no grid started."""
     from tests.app.waits import wait_for, wait_idle
 
-    entered, go, ended, _done = _held_layout(monkeypatch)
+    entered, go, _read, ended, _done = held_layout(monkeypatch)
     lake, _ = _y_lake()
     win.editor.set_lake(lake, "Import")
     before, steps = win.doc.project, win.stack.count()
@@ -155,7 +132,7 @@ def test_stop_ends_an_auto_layout_that_took_over_the_count(qtbot, win, monkeypat
     it too (its stop is the count's), and nothing of it is set when it returns."""
     from tests.app.waits import wait_for, wait_idle
 
-    entered, go, ended, _done = _held_layout(monkeypatch)
+    entered, go, _read, ended, _done = held_layout(monkeypatch)
     lake, area = _y_lake()
     win.editor.set_lake(lake, "Import")
     win.lake_ctl.set_cell_size(float(np.sqrt(area / 100)))
@@ -174,7 +151,7 @@ def test_closing_the_window_stops_a_running_auto_layout(qtbot, win, monkeypatch)
     """The window closed while Auto layout ran: the close waited 2 s for the workers and the layout went on
     after the window (its worker, ending on a deleted controller, printed a traceback).  Now the close stops
     it at its next coarse reading before it waits."""
-    entered, go, ended, done = _held_layout(monkeypatch)
+    entered, go, _read, ended, done = held_layout(monkeypatch)
     lake, _ = _y_lake()
     win.editor.set_lake(lake, "Import")
     assert win.lake_ctl.auto_layout()
