@@ -145,6 +145,11 @@ class LakeController(QtCore.QObject):
     def busy(self) -> bool:
         return self._worker is not None
 
+    @property
+    def stopping(self) -> bool:
+        """Stop was asked of the layout being computed (it ends at its next coarse reading)."""
+        return self._worker is not None and self._stopping
+
     def stop_layout(self) -> bool:
         """Stop (Esc) while Auto layout computes: the layout stops at its next coarse reading (a reading under
         way, at its next sweep) and nothing is set (a split by cut lines, a second or so, runs to its end and
@@ -158,6 +163,7 @@ class LakeController(QtCore.QObject):
         self._stopping = True  # (a layout it returns all the same, made before the stop was seen, is not set)
         self._busy_text = f"Stopping {self._busy_kind}…"
         self.win.message(self._busy_text)
+        self.ticked.emit(int(time.monotonic() - self._busy_since))
         return True
 
     # ------------------------------------------------------------ the lake

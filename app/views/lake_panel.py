@@ -186,7 +186,8 @@ class LakePanel(QtWidgets.QWidget):
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
     def _ticked(self, seconds: int) -> None:
-        self.button.setText(f"Computing the layout… {seconds} s")
+        # (Stop asked: the layout ends at its next coarse reading, up to a few seconds on a big lake)
+        self.button.setText("Stopping the layout…" if self.ctl.stopping else f"Computing the layout… {seconds} s")
 
 
 def miss_points(verdict, row: int | None = None) -> np.ndarray:

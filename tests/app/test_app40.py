@@ -114,6 +114,7 @@ def test_stop_ends_a_running_auto_layout(qtbot, win, monkeypatch):
     wait_for(qtbot, win, entered.is_set)
     assert win.lake_ctl.busy and win.a_stop.isEnabled()
     win.a_stop.trigger()  # Esc
+    assert win.lake_panel.button.text() == "Stopping the layout…" and "Stopping Auto layout" in win._status.text()
     go.set()
     wait_for(qtbot, win, lambda: not win.lake_ctl.busy)
     wait_idle(qtbot, win)
