@@ -106,11 +106,9 @@ def retry_words(kind: str, value, labels: list[str], *, stopped: bool = False) -
     if kind == "again level":
         lev, res = value
         cells = sum(g.cells[0] * g.cells[1] for g in res.grids)
-        label = labels[lev] if lev < len(labels) else f"level {lev + 1}"
-        return (
-            f"grid made again: level {lev + 1}/{len(labels)} ({label.removeprefix('cells ')}, {cells:,} cells) "
-            f"done, {res.sweeps} sweeps"
-        )
+        label = (labels[lev] if lev < len(labels) else f"level {lev + 1}").removeprefix("cells ")
+        done = f"stopped after {res.sweeps} sweeps" if stopped else f"done, {res.sweeps} sweeps"
+        return f"grid made again: level {lev + 1}/{len(labels)} ({label}, {cells:,} cells) {done}"
     if kind == "again equalize":
         return f"grid made again: interfaces, {_cells(value, 'patch', 'es')} of cells more than 2× apart made alike"
     if kind == "retried":
