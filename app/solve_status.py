@@ -258,9 +258,13 @@ class SolveStatus(QtCore.QObject):
         )
 
     def _kept_final(self) -> None:
-        """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept."""
-        if self._last_history is not None:
-            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept, and the
+        convergence plot is its own (it was the stopped solve's, of a grid no longer shown)."""
+        mb = self.doc.multiblock
+        kept = self._kept.get(id(mb)) if mb is not None else None
+        history = kept[2] if kept is not None and kept[0] is mb else self._last_history
+        if history is not None:
+            self.conv.set_history(list(history[0]), *history[1:])
         where = " on a coarse level" if self.solver.stopped_coarse else ""
         self.label.setText(f"stopped{where}: the grid of before kept")
         self.win.message(

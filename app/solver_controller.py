@@ -161,6 +161,10 @@ class SolverController(QtCore.QObject):
     def _on_project_changed(self, _project) -> None:
         if not self.running:  # the last solve's error was of the project before this edit (an undo
             self.last_error = None  # back to a gridded one: its grid is current, not held back as failed)
+            # nor is a grid shown now "the grid of before kept" by a stopped solve (Ctrl+Z, Ctrl+Y after a
+            # stopped F5 said so of the grid the redo brought back, its convergence plot empty)
+            if self.kept_grid:  # (stopped_coarse with it: that stopped solve's level, not a grid missing)
+                self.kept_grid = self.stopped_coarse = False
         elif self.doc.restored is self.doc.project and self._project is not self.doc.project:
             self._drop()  # an undo or redo back to a grid the document kept: the solve of before it is of no use
         elif self._project is not None and _another_lake(self._project, self.doc.project):

@@ -162,3 +162,33 @@ def test_closing_the_window_stops_a_running_auto_layout(qtbot, win, monkeypatch)
     win.close()
     assert done.wait(600)  # (a hang guard)
     assert ended == [None]  # stopped after the reading under way
+
+
+def test_a_grid_kept_by_a_stopped_solve_shows_its_own_convergence_and_an_undo_redo_forgets_the_stop(qtbot, win):
+    """F5 on a finished lake grid, then Esc: the grid of before stays, but the convergence plot showed the
+    stopped solve's sweeps, not that grid's; then Ctrl+Z, Ctrl+Y (the layout and its grid back) said
+    "stopped: the grid of before kept" of the grid the redo brought back, its plot empty.  Now the plot is
+    the kept grid's, and after the redo the grid's own summary is said with its plot."""
+    from tests.app.waits import wait_idle
+
+    _laid_out(win)
+    win.generate()
+    wait_idle(qtbot, win)
+    curve = win.conv_panel.curve
+
+    def plotted():
+        return [] if curve.xData is None else list(curve.xData)
+
+    sweeps = plotted()
+    assert len(sweeps) > 3 and win.solve_status.label.text().startswith("orthogonal: ")
+    win.generate()  # F5 on the finished grid, stopped at once
+    win.stop()
+    wait_idle(qtbot, win)
+    assert win.solver.kept_grid and win.solve_status.label.text().endswith("the grid of before kept")
+    assert plotted() == sweeps  # the kept grid's sweeps
+    win.stack.undo()
+    win.stack.redo()
+    wait_idle(qtbot, win)
+    assert win.doc.multiblock is not None
+    assert win.solve_status.label.text().startswith("orthogonal: ")
+    assert plotted() == sweeps
