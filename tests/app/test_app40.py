@@ -192,3 +192,26 @@ def test_a_grid_kept_by_a_stopped_solve_shows_its_own_convergence_and_an_undo_re
     assert win.doc.multiblock is not None
     assert win.solve_status.label.text().startswith("orthogonal: ")
     assert plotted() == sweeps
+
+
+def test_the_cell_size_of_a_lake_a_few_units_across_can_be_typed(qtbot, win):
+    """A lake in plain numbers a few units across (a generated shape, a CSV in km): the Lake panel's cell
+    size had one decimal, so 0.0704 typed became 0.1 (or "auto" when it rounded to 0) and the cell size
+    such a lake needs could not be set.  Now its decimals follow the lake's extent; a lake in metres keeps
+    one."""
+    from PySide6 import QtCore
+
+    from app.lake import Lake
+    from meshcore import testing
+
+    ring = np.asarray(testing.y_junction().exterior.coords)[:-1]  # 11 units across
+    win.editor.set_lake(Lake(outline=ring), "Import")
+    box = win.lake_panel.cell_size
+    box.lineEdit().selectAll()
+    qtbot.keyClicks(box.lineEdit(), "0.0704")
+    qtbot.keyClick(box.lineEdit(), QtCore.Qt.Key.Key_Return)
+    assert win.lake_ctl.lake().cell_size == pytest.approx(0.0704)
+    assert box.text().startswith("0.0704")
+    lake, _ = _y_lake()  # 11 km across
+    win.editor.set_lake(lake, "Import")
+    assert box.decimals() == 1 and box.singleStep() == 10.0
