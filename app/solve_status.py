@@ -17,6 +17,8 @@ from .pipeline import ALL_BLOCKS
 
 __all__ = ["SolveStatus"]
 
+#: what the message of a lake grid made again with sliding ends (meshcore.lakegrid.FOLD_RETRY) says
+MADE_AGAIN = "made again with block corners and cut ends sliding along the shore"
 #: seconds between two updates of the convergence plot during a multiblock or lake solve
 HISTORY_EVERY = 1.0
 #: seconds between two updates of the solver label during such a solve: each one lays out and repaints
@@ -233,8 +235,12 @@ class SolveStatus(QtCore.QObject):
     def _lake_final(self, mb) -> None:
         info = mb.info
         kept = self._kept.get(id(mb))
+        again = MADE_AGAIN in info.message  # the grid made again (FOLD_RETRY): its sweeps are not in the plot
         if kept is None or kept[0] is not mb:  # the solve just ended: its time and history, kept for an undo
-            kept = (mb, self.solver.t_done - self.solver.t_start, self._last_history)
+            history = self._last_history
+            if again and history is not None and history[0]:  # where the plotted sweeps end and it was made again
+                history = (*history[:2], (*history[2], (int(history[0][-1][0]), "made again")))
+            kept = (mb, self.solver.t_done - self.solver.t_start, history)
             self._kept = dict(list(self._kept.items())[-(KEPT_SOLVES - 1) :])
             self._kept[id(mb)] = kept
         if kept[2] is not None:  # the whole history (the plot is throttled while solving)
@@ -246,7 +252,8 @@ class SolveStatus(QtCore.QObject):
         # interface equalizing; it was summed up as a finished grid, nothing said it was not
         stopped = not info.converged and info.message == "stopped"
         done = f"stopped after {info.iterations} sweeps" if stopped else f"{info.iterations} sweeps"
-        self.label.setText(f"orthogonal: {done}, {dt:.1f} s")
+        # (a grid made again: its own sweeps, made after those plotted; it said "1170 sweeps" beside a plot of 1325)
+        self.label.setText(f"orthogonal: {done}{' (made again)' if again else ''}, {dt:.1f} s")
         folded = int(m.values("folded").sum()) if m is not None else 0
         warn = f" — {folded} FOLDED or non-convex cells" if folded else ""
         mean = f", mean deviation from 90° {m.mean('deviation'):.2f}°" if m is not None else ""

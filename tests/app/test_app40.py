@@ -72,6 +72,11 @@ def test_a_lake_grid_made_again_is_said_while_it_is_made(qtbot, win, monkeypatch
     assert (
         "made again with block corners and cut ends sliding along the shore: 1 → 0" in win.doc.multiblock.info.message
     )
+    # its sweeps are its own, made after those plotted: the label says so, the plot marks where
+    assert win.solve_status.label.text().startswith(
+        f"orthogonal: {win.doc.multiblock.info.iterations} sweeps (made again)"
+    )
+    assert win.conv_panel.levels[-1][1] == "made again"
 
 
 def test_a_stop_while_the_grid_is_made_again_ends_it_and_keeps_the_first_grid(qtbot, win, monkeypatch):
