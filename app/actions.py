@@ -175,12 +175,12 @@ ACTIONS: tuple[ActionSpec, ...] = (
         "&Stop",
         "stop",
         ("Esc",),
-        "stop the solver (keeps the current grid; a lake grid stopped on a coarse level: none, that one greyed);"
-        " in a drag: cancel the drag",
+        "stop the solver (keeps the current grid; a lake grid stopped on a coarse level: none, that one greyed)"
+        " or Auto layout (nothing set); in a drag: cancel the drag",
         "&Generate",
         toolbar=4.3,
         enabled=False,
-        help="stop the solver",
+        help="stop the solver or Auto layout",
     ),
     ActionSpec(
         "auto",

@@ -31,7 +31,7 @@ __all__ = ["EDIT_GAP_S", "LakeController"]
 #: LakeController.edit_layout): five a second, each left a few smoothed frames of the grid
 EDIT_GAP_S = 0.2
 #: Auto layout of more cells than this asks first (20 x the default 10 000): the layout and its grid
-#: take minutes and cannot be stopped half way (a cell size of 20 m typed for 200: 3.7 million cells)
+#: take minutes and much memory (a cell size of 20 m typed for 200: 3.7 million cells)
 LARGE_LAYOUT = 200_000
 #: milliseconds after a cell size is set before its layout is counted (LakeController.layout_count): a
 #: size typed and laid out at once (Ctrl+L) is laid out once
@@ -133,10 +133,38 @@ class LakeController(QtCore.QObject):
         self._count_timer.setInterval(COUNT_DELAY_MS)
         self._count_timer.timeout.connect(self._count_now)
         self.doc.project_changed.connect(lambda _p: self._want_count())
+        # Auto layout's own worker stops at its next coarse reading once this is set (Stop, Esc, the window
+        # closed: on a big lake it ran on for seconds, and after the window); a worker taken over from the count
+        # stops by the count's event
+        self._stop = threading.Event()
+        self._stopping = False  # Stop was asked of the running Auto layout: what it returns is not set
+        self._busy_kind = "Auto layout"  # what is computed: "Auto layout", "the split by cut lines"
+        self._stopped_lake: Lake | None = None  # the lake whose Auto layout was stopped: not counted again unasked
 
     @property
     def busy(self) -> bool:
         return self._worker is not None
+
+    @property
+    def stopping(self) -> bool:
+        """Stop was asked of the layout being computed (it ends at its next coarse reading)."""
+        return self._worker is not None and self._stopping
+
+    def stop_layout(self) -> bool:
+        """Stop (Esc) while Auto layout computes: the layout stops at its next coarse reading (a reading under
+        way, at its next sweep) and nothing is set (a split by cut lines, a second or so, runs to its end and
+        is not set); False when no layout is being computed."""
+        if self._worker is None:
+            return False
+        if self._adopted is not None:  # the Lake panel's count, taken over
+            self._count_stop.set()
+        else:
+            self._stop.set()
+        self._stopping = True  # (a layout it returns all the same, made before the stop was seen, is not set)
+        self._busy_text = f"Stopping {self._busy_kind}…"
+        self.win.message(self._busy_text)
+        self.ticked.emit(int(time.monotonic() - self._busy_since))
+        return True
 
     # ------------------------------------------------------------ the lake
     def lake(self) -> Lake | None:
@@ -196,7 +224,7 @@ class LakeController(QtCore.QObject):
             return True
         text = (
             f"About {n:,} cells at {lake.cell_size:.4g} m ({n / 10_000:.0f}× the default): the layout and its grid "
-            "take minutes (they cannot be stopped half way) and much memory."
+            "take minutes and much memory."
         )
         if not self.win.quiet:
             ask = QtWidgets.QMessageBox.question(
@@ -229,6 +257,8 @@ class LakeController(QtCore.QObject):
     def _start(self, lake: Lake, cuts, text: str) -> bool:
         if self.busy:
             return False
+        self._stopping, self._stopped_lake = False, None
+        self._busy_kind = "Auto layout" if cuts is None else "the split by cut lines"
         self.close_prompt()
         self.win.solver.stop()
         self.last_error = None
@@ -236,7 +266,8 @@ class LakeController(QtCore.QObject):
         water = (lake.outline, lake.holes, p.crs, tuple(p.origin))  # what the layout is of (_same_water)
         if cuts is None and self._take_count(lake, water, text):
             return True
-        worker = create_worker(_layout_job, lake.replaced(layout=None), cuts, _start_thread=False)
+        self._stop = threading.Event()
+        worker = create_worker(_layout_job, lake.replaced(layout=None), cuts, self._stop, _start_thread=False)
         worker.returned.connect(lambda value: self._on_returned(value, cuts, water))
         worker.errored.connect(self._on_errored)
         self._worker = worker
@@ -303,6 +334,8 @@ class LakeController(QtCore.QObject):
 
     def _want_count(self) -> None:
         lake = self.count_wanted()
+        if lake is not None and lake == self._stopped_lake:  # its Auto layout was stopped: not made again unasked
+            lake = None
         if self._count_worker is not None and self._adopted is None and self._count_lake != lake:
             self._count_stop.set()  # stale: it stops at its next coarse reading, then the one wanted starts
         if lake is None or self.layout_count(lake) is not None:
@@ -325,13 +358,18 @@ class LakeController(QtCore.QObject):
     def stop_count(self) -> None:
         """The window closes: a count being made stops at its next coarse reading (the close waits for the
         workers: it waited 2 s for a count of Shasta Lake at 26 m, then the process 6 s more, and the count's
-        worker, ending after the window, printed a traceback)."""
+        worker, ending after the window, printed a traceback); Auto layout's too."""
         self._count_timer.stop()
-        if self._count_worker is not None and self._adopted is None:
+        if self._count_worker is not None:
             self._count_stop.set()
+        self._stop.set()
 
     def _counted(self, value) -> None:
         self._count_worker, self._count_lake = None, None
+        if value is None and self._adopted is not None:  # Auto layout took it over, then was stopped
+            self._adopted = None
+            self._on_returned(None)
+            return
         if value is None:  # stopped (stale): the count wanted now, if any
             self._want_count()
             return
@@ -375,10 +413,18 @@ class LakeController(QtCore.QObject):
         )
 
     def _on_returned(self, value, cuts=None, water=None) -> None:
-        lake, layout, err = value
         self._worker = None
         self._ticker.stop()
         self.busy_changed.emit(False)
+        stopped, self._stopping = self._stopping, False
+        if value is None or stopped:  # stopped (stop_layout): the document as it was
+            self._stopped_lake = self.count_wanted()  # (its count would make the layout again, unasked)
+            again = " (Ctrl+L lays it out)" if self._busy_kind == "Auto layout" else ""
+            kind = self._busy_kind[0].upper() + self._busy_kind[1:]
+            self.win.message(f"{kind} stopped: the lake is as it was{again}")
+            self.layout_done.emit(None)
+            return
+        lake, layout, err = value
         if layout is not None and not self._same_water(water):
             # another lake imported (or opened, or the shore edited) while it was made: it was set, the first
             # lake's outline and blocks in the second's frame under the second's name

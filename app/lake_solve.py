@@ -24,6 +24,10 @@ returns a :class:`~app.results.BlockResult` carrying the
 
 A stop (``stop_event``) ends either within a few sweeps; a cold solve stopped before its full
 level returns no grid (the coarse grids are never kept as a result).
+
+A grid whose levels end with folded or non-convex cells is made again with sliding block corners
+(:data:`meshcore.lakegrid.FOLD_RETRY`) without yielding anything (seconds on a large lake): ``notify(kind,
+text)`` is told of it as ``meshcore mesh`` prints it (:func:`retry_words`), from the worker's thread.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from __future__ import annotations
 import inspect
 import threading
 import time
-from collections.abc import Generator, Mapping
+from collections.abc import Callable, Generator, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,6 +51,7 @@ __all__ = [
     "hold_readings",
     "layout_topology",
     "level_labels",
+    "retry_words",
     "solve_layout",
 ]
 
@@ -81,6 +86,44 @@ def level_labels(n_levels: int) -> list[str]:
         ("cells " if k == 0 else "") + f"÷{2 ** (n_levels - 1 - k)}" if k < n_levels - 1 else "full"
         for k in range(n_levels)
     ]
+
+
+def retry_words(kind: str, value, labels: list[str], *, stopped: bool = False) -> str | None:
+    """What to say of a report of :func:`meshcore.lakegrid.iterate_layout` (``level_callback(kind, value)``)
+    about the grid made again (:data:`~meshcore.lakegrid.FOLD_RETRY`), as ``meshcore mesh`` prints it; None
+    for the other reports.  ``labels``: :func:`level_labels`; ``stopped``: the solve was stopped meanwhile.
+
+    >>> retry_words("retry", 1, ["cells ÷4", "÷2", "full"])
+    'grid: 1 folded or non-convex cell left — making it again with block corners and cut ends sliding along the shore…'
+    >>> retry_words("retried", (1, 0, True), [])
+    'grid made again: 0 bad cells against 1 — that grid kept'
+    """
+    if kind == "retry":
+        return (
+            f"grid: {_cells(value, 'folded or non-convex cell')} left — making it again with block corners and cut "
+            "ends sliding along the shore…"
+        )
+    if kind == "again level":
+        lev, res = value
+        cells = sum(g.cells[0] * g.cells[1] for g in res.grids)
+        label = (labels[lev] if lev < len(labels) else f"level {lev + 1}").removeprefix("cells ")
+        done = f"stopped after {res.sweeps} sweeps" if stopped else f"done, {res.sweeps} sweeps"
+        return f"grid made again: level {lev + 1}/{len(labels)} ({label}, {cells:,} cells) {done}"
+    if kind == "again equalize":
+        return f"grid made again: interfaces, {_cells(value, 'patch', 'es')} of cells more than 2× apart made alike"
+    if kind == "retried":
+        n, m, kept = value
+        if stopped:
+            return f"grid made again: stopped — the first grid kept ({_cells(n, 'bad cell')})"
+        return (
+            f"grid made again: {_cells(m, 'bad cell')} against {n} — "
+            f"{'that grid kept' if kept else 'the first grid kept'}"
+        )
+    return None
+
+
+def _cells(n: int, what: str, plural: str = "s") -> str:
+    return f"{n} {what}{plural * (n != 1)}"
 
 
 _topologies: dict[int, tuple] = {}  # id(layout) -> (layout, topology): the last few layouts' topologies
@@ -176,20 +219,24 @@ def solve_layout(
     warm: Mapping[int, tuple[StructuredGrid, StructuredGrid]] | None = None,
     stop_event: threading.Event | None = None,
     hold: threading.Event | None = None,
+    notify: Callable[[str, str], None] | None = None,
 ) -> Generator[tuple[int, object], object, BlockResult]:
     """Grid the lake's layout; yield ``(ALL_BLOCKS, SolverProgress)``; return the result.
 
     ``hold``: a warm solve waits for it after its live frames before it makes the final grid
     (set by the app when the drag ends; set with ``stop_event`` to stop the waiting solve).
+    ``notify(kind, text)``: told, from this generator's thread, of a grid made again and its steps
+    (:func:`retry_words`; ``kind`` as :func:`meshcore.lakegrid.iterate_layout` reports them), which
+    yield nothing.
     """
     layout = lake.layout
     cells = [tuple(b.cells) for b in layout.blocks]
     if warm and all(k in warm and warm[k][0].cells == c for k, c in enumerate(cells)):
-        return (yield from _warm(layout, warm, stop_event, hold))
-    return (yield from _cold(layout, stop_event))
+        return (yield from _warm(layout, warm, stop_event, hold, notify))
+    return (yield from _cold(layout, stop_event, notify=notify))
 
 
-def _cold(layout, stop_event, *, shown: bool = True, before: tuple = ((), (), 0)):
+def _cold(layout, stop_event, *, shown: bool = True, before: tuple = ((), (), 0), notify=None):
     """:func:`meshcore.lakegrid.iterate_layout` of ``layout`` (coarse to fine), as the CLI makes it.
 
     ``shown`` False: its snapshots carry no grids (the grid on screen stays until the result
@@ -205,7 +252,11 @@ def _cold(layout, stop_event, *, shown: bool = True, before: tuple = ((), (), 0)
     levels = [*levels0, (offset, labels[0])]
 
     def level_done(what, value):  # called by iterate_layout as a level ends, before the next one's sweeps
-        if what != "level":  # ("equalize", patches): after the last level
+        if what != "level":  # ("equalize", patches): after the last level; the grid made again ("retry", ...)
+            stopped = stop_event is not None and stop_event.is_set()
+            text = retry_words(what, value, labels, stopped=stopped) if notify is not None else None
+            if text is not None:
+                notify(what, text)
             return
         lev, res = value
         if lev + 1 < n_levels:
@@ -240,7 +291,7 @@ def _cold(layout, stop_event, *, shown: bool = True, before: tuple = ((), (), 0)
     return BlockResult(grids=dict(enumerate(mb.grids)), initial=starts, multiblock=mb, metrics=metrics)
 
 
-def _warm(layout, warm, stop_event, hold=None):
+def _warm(layout, warm, stop_event, hold=None, notify=None):
     """The previous grid moved onto the new layout and swept on the full level (the live frames of an
     edit), then, unless a newer edit stops it, the grid made again coarse to fine without showing its
     snapshots: the final grid of an edit is the one ``meshcore generate`` makes of the saved layout
@@ -296,7 +347,9 @@ def _warm(layout, warm, stop_event, hold=None):
                 break
     if stopped or (stop_event is not None and stop_event.is_set()):
         return moved
-    final = yield from _cold(layout, stop_event, shown=False, before=(tuple(history), warm_level, res.sweeps))
+    final = yield from _cold(
+        layout, stop_event, shown=False, before=(tuple(history), warm_level, res.sweeps), notify=notify
+    )
     if final.grids:
         return final
     # the remake stopped (Esc, F5 on a grid): the warm grid stays, said to be stopped (it was summed up as

@@ -241,8 +241,9 @@ class MainWindow(WindowFrame, QtWidgets.QMainWindow):
 
     def stop(self) -> None:
         """Esc (Generate ▸ Stop): in the middle of a drag, the drag cancelled as Ctrl+Z cancels it (the drag
-        went on: Esc stopped the drag's solve, or did nothing); else the solver stopped."""
+        went on: Esc stopped the drag's solve, or did nothing); else Auto layout and the solver stopped."""
         if not self.cancel_drag("Esc"):
+            self.lake_ctl.stop_layout()
             self.solver.stop()
 
     def cancel_drag(self, key: str) -> bool:

@@ -71,11 +71,13 @@ def solve_project(
     smooth: bool = True,
     blocks: list[int] | None = None,
     hold: threading.Event | None = None,
+    notify: Callable[[str, str], None] | None = None,
 ) -> Generator[tuple[int, object], object, BlockResult]:
     """Solve every ready block; yield ``(index, event)``; return :class:`BlockResult`.
 
     ``warm`` maps a block index to ``(previous algebraic grid, previous grid)``; ``hold``: a lake
-    layout's warm solve waits for it before its final grid (:func:`app.lake_solve.solve_layout`).
+    layout's warm solve waits for it before its final grid; ``notify``: told of a lake grid made again
+    (both :func:`app.lake_solve.solve_layout`).
     """
     solver = project.solver.replaced(report_interval=report_interval)
     if project.multiblock is not None:
@@ -83,7 +85,7 @@ def solve_project(
     if project.layout is not None:  # a lake layout: one orthogonal grid over all its blocks
         from .lake_solve import solve_layout
 
-        return (yield from solve_layout(project.lake, warm=warm, stop_event=stop_event, hold=hold))
+        return (yield from solve_layout(project.lake, warm=warm, stop_event=stop_event, hold=hold, notify=notify))
     grids: dict[int, StructuredGrid] = {}
     starts: dict[int, StructuredGrid] = {}
     notes: list[str] = []

@@ -17,6 +17,8 @@ from .pipeline import ALL_BLOCKS
 
 __all__ = ["SolveStatus"]
 
+#: what the message of a lake grid made again with sliding ends (meshcore.lakegrid.FOLD_RETRY) says
+MADE_AGAIN = "made again with block corners and cut ends sliding along the shore"
 #: seconds between two updates of the convergence plot during a multiblock or lake solve
 HISTORY_EVERY = 1.0
 #: seconds between two updates of the solver label during such a solve: each one lays out and repaints
@@ -54,6 +56,8 @@ class SolveStatus(QtCore.QObject):
         self.solver.error.connect(self.on_error)
         self.solver.progress.connect(self.on_progress)
         self.solver.finished.connect(self.on_finished)
+        self.solver.retry_said.connect(self.on_retry)
+        window.lake_ctl.busy_changed.connect(lambda _b: self._stop_enabled())  # Stop ends Auto layout too
         self.doc.quality_changed.connect(self.on_measured)
 
     def reset(self) -> None:
@@ -124,6 +128,20 @@ class SolveStatus(QtCore.QObject):
             f"(tol {snap.tolerance:.1e}), {len(fr)} redraws/s"
         )
 
+    def on_retry(self, kind: str, text: str) -> None:
+        """The lake grid is being made again (its levels left folded or non-convex cells): seconds without a
+        frame (8 s on Vänern), in which the status sat on the last sweep of the first grid.  The solver label
+        follows its steps; its start and its end (which grid was kept) go to the status line and the Messages,
+        the end ahead of the grid's line that follows."""
+        self._label_timer.stop()  # (a sweep's text due would write over it)
+        self._label_text = f"lake {text}"
+        self._show_label()
+        if kind not in ("retry", "retried"):
+            return
+        line = text[0].upper() + text[1:]
+        self.doc.report("info", f"lake {text}")
+        self.win.message(line, note=kind == "retried")
+
     def _show_label(self) -> None:
         """The latest progress text, while the solve runs (never over "paused" or the final summary)."""
         if self.solver.state == "running":
@@ -134,12 +152,16 @@ class SolveStatus(QtCore.QObject):
         running = state != "idle"
         self.doc.set_solving(running)
         self.win.a_pause.setEnabled(running)
-        self.win.a_stop.setEnabled(running)
+        self._stop_enabled()
         self.win.a_pause.setChecked(state == "paused")
         if state == "paused":
             self.label.setText("paused")
         elif state == "running":  # until its first progress (a minute when the first solve compiles its kernels)
             self.label.setText("solving…")
+
+    def _stop_enabled(self) -> None:
+        """Stop (Esc) is on while the solver runs or Auto layout computes (:meth:`MainWindow.stop`)."""
+        self.win.a_stop.setEnabled(self.solver.running or self.win.lake_ctl.busy)
 
     def on_error(self, text: str) -> None:
         # the boundary cannot be gridded as it is: keep the old grid, greyed, and say why
@@ -213,8 +235,12 @@ class SolveStatus(QtCore.QObject):
     def _lake_final(self, mb) -> None:
         info = mb.info
         kept = self._kept.get(id(mb))
+        again = MADE_AGAIN in info.message  # the grid made again (FOLD_RETRY): its sweeps are not in the plot
         if kept is None or kept[0] is not mb:  # the solve just ended: its time and history, kept for an undo
-            kept = (mb, self.solver.t_done - self.solver.t_start, self._last_history)
+            history = self._last_history
+            if again and history is not None and history[0]:  # where the plotted sweeps end and it was made again
+                history = (*history[:2], (*history[2], (int(history[0][-1][0]), "made again")))
+            kept = (mb, self.solver.t_done - self.solver.t_start, history)
             self._kept = dict(list(self._kept.items())[-(KEPT_SOLVES - 1) :])
             self._kept[id(mb)] = kept
         if kept[2] is not None:  # the whole history (the plot is throttled while solving)
@@ -226,7 +252,8 @@ class SolveStatus(QtCore.QObject):
         # interface equalizing; it was summed up as a finished grid, nothing said it was not
         stopped = not info.converged and info.message == "stopped"
         done = f"stopped after {info.iterations} sweeps" if stopped else f"{info.iterations} sweeps"
-        self.label.setText(f"orthogonal: {done}, {dt:.1f} s")
+        # (a grid made again: its own sweeps, made after those plotted; it said "1170 sweeps" beside a plot of 1325)
+        self.label.setText(f"orthogonal: {done}{' (made again)' if again else ''}, {dt:.1f} s")
         folded = int(m.values("folded").sum()) if m is not None else 0
         warn = f" — {folded} FOLDED or non-convex cells" if folded else ""
         mean = f", mean deviation from 90° {m.mean('deviation'):.2f}°" if m is not None else ""
@@ -238,9 +265,13 @@ class SolveStatus(QtCore.QObject):
         )
 
     def _kept_final(self) -> None:
-        """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept."""
-        if self._last_history is not None:
-            self.conv.set_history(list(self._last_history[0]), *self._last_history[1:])
+        """A solve of a finished lake grid's layout stopped (F5 on it, then Stop): that grid is kept, and the
+        convergence plot is its own (it was the stopped solve's, of a grid no longer shown)."""
+        mb = self.doc.multiblock
+        kept = self._kept.get(id(mb)) if mb is not None else None
+        history = kept[2] if kept is not None and kept[0] is mb else self._last_history
+        if history is not None:
+            self.conv.set_history(list(history[0]), *history[1:])
         where = " on a coarse level" if self.solver.stopped_coarse else ""
         self.label.setText(f"stopped{where}: the grid of before kept")
         self.win.message(

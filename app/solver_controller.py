@@ -62,9 +62,9 @@ def _another_lake(a, b) -> bool:
     return (a.crs, tuple(a.origin)) != (b.crs, tuple(b.origin)) or bool(a.title and b.title and a.title != b.title)
 
 
-def _run(run_id, project, warm, stop_event, smooth, hold=None):
+def _run(run_id, project, warm, stop_event, smooth, hold=None, notify=None):
     """The worker body: tag every item with the run id; errors become results."""
-    gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth, hold=hold)
+    gen = solve_project(project, warm=warm, stop_event=stop_event, smooth=smooth, hold=hold, notify=notify)
     try:
         while True:
             k, event = next(gen)
@@ -86,6 +86,11 @@ class SolverController(QtCore.QObject):
     finished = QtCore.Signal(object)  # BlockResult, or None on error/stop
     error = QtCore.Signal(str)
     redrawn = QtCore.Signal()
+    #: a lake grid being made again, unseen, because its levels left bad cells (``kind`` of
+    #: :func:`meshcore.lakegrid.iterate_layout`'s report: "retry", "again level", "again equalize", "retried";
+    #: the words of :func:`app.lake_solve.retry_words`): seconds on a large lake in which no frame comes
+    retry_said = QtCore.Signal(str, str)
+    _noted = QtCore.Signal(int, str, str)  # (run, kind, text) from the worker's thread: queued to retry_said
 
     def __init__(self, doc: Document, parent=None, *, frame_interval_ms: int = 25) -> None:
         super().__init__(parent)
@@ -137,6 +142,7 @@ class SolverController(QtCore.QObject):
         self._debounce.setInterval(0)
         self._debounce.timeout.connect(self._start_edit)
         doc.project_changed.connect(self._on_project_changed)
+        self._noted.connect(self._on_noted, QtCore.Qt.ConnectionType.QueuedConnection)
 
     # ------------------------------------------------------------ control
     @property
@@ -155,6 +161,10 @@ class SolverController(QtCore.QObject):
     def _on_project_changed(self, _project) -> None:
         if not self.running:  # the last solve's error was of the project before this edit (an undo
             self.last_error = None  # back to a gridded one: its grid is current, not held back as failed)
+            # nor is a grid shown now "the grid of before kept" by a stopped solve (Ctrl+Z, Ctrl+Y after a
+            # stopped F5 said so of the grid the redo brought back, its convergence plot empty)
+            if self.kept_grid:  # (stopped_coarse with it: that stopped solve's level, not a grid missing)
+                self.kept_grid = self.stopped_coarse = False
         elif self.doc.restored is self.doc.project and self._project is not self.doc.project:
             self._drop()  # an undo or redo back to a grid the document kept: the solve of before it is of no use
         elif self._project is not None and _another_lake(self._project, self.doc.project):
@@ -222,7 +232,8 @@ class SolverController(QtCore.QObject):
         self._smoothed = set()  # blocks whose snapshots of this run are on screen
         self._drawn = False
         self._project = project  # what this run solves (an edit may come before it ends)
-        worker = create_worker(_run, self._run, project, warm, ev, self.smooth, hold, _start_thread=False)
+        notify = self._notifier(self._run)
+        worker = create_worker(_run, self._run, project, warm, ev, self.smooth, hold, notify, _start_thread=False)
         worker.yielded.connect(self._on_yielded)
         worker.returned.connect(self._on_returned)
         worker.errored.connect(self._on_errored)
@@ -238,6 +249,25 @@ class SolverController(QtCore.QObject):
         self._set_state("running")
         worker.start()
         return True
+
+    def _notifier(self, run: int):
+        """``notify(kind, text)`` of run ``run``'s worker (its thread): the words reach :attr:`retry_said` in the
+        GUI thread (a window closed meanwhile: they go nowhere, the solve ends as told)."""
+        noted = self._noted
+
+        def notify(kind: str, text: str) -> None:
+            try:
+                noted.emit(run, kind, text)
+            except RuntimeError:  # the controller is gone (the window closed while the grid was made again)
+                pass
+
+        return notify
+
+    @QtCore.Slot(int, str, str)
+    def _on_noted(self, run: int, kind: str, text: str) -> None:
+        self._check_thread()
+        if run == self._run and self._worker is not None and not (self._dropped or self._restart_pending):
+            self.retry_said.emit(kind, text)
 
     def set_live(self, on: bool) -> None:
         """A drag of the layout begins (True) or ends.  While it is on, a lake solve waits after its live

@@ -98,6 +98,7 @@ class LakePanel(QtWidgets.QWidget):
         p = self.doc.project
         for w in (self.cell_size, self.regular):
             w.blockSignals(True)
+        self._fit_cell_size(lake)
         self.cell_size.setValue((lake.cell_size or 0.0) if lake is not None else 0.0)
         self.regular.setChecked(bool(lake is not None and lake.regular))
         for w in (self.cell_size, self.regular):
@@ -131,6 +132,21 @@ class LakePanel(QtWidgets.QWidget):
             self.table.setItem(k, 0, QtWidgets.QTableWidgetItem(b.name))
             self.table.setItem(k, 1, QtWidgets.QTableWidgetItem(f"{b.cells[0]} × {b.cells[1]}"))
         self._show_active()
+
+    def _fit_cell_size(self, lake) -> None:
+        """The cell size's decimals and step for the lake's extent: a lake under 1 000 units across (cells of
+        about a hundredth of it and less) gets 3 significant digits of such a cell and a step of a tenth of
+        its decade; larger ones one decimal and steps of 10, as before.  With one decimal always, a lake in
+        plain numbers a few units across (a generated shape, a CSV in km) could not be given a cell size below
+        0.1: 0.0704 typed became "auto" (0.0)."""
+        outline = np.asarray(lake.outline, dtype=float) if lake is not None else np.zeros((0, 2))
+        span = float(np.max(np.ptp(outline, axis=0))) if len(outline) >= 2 else 0.0
+        if not (span > 0 and math.isfinite(span)):
+            return
+        e = math.floor(math.log10(span / 100))  # the decade of a cell a hundredth of the extent
+        small = e < 1
+        self.cell_size.setDecimals(min(8, 3 - e) if small else 1)
+        self.cell_size.setSingleStep(10.0 ** (e - 1) if small else 10.0)
 
     def _count_text(self, lake) -> str:
         """The cells of the layout Auto layout makes of ``lake`` at its cell size, as counted by the
@@ -186,7 +202,8 @@ class LakePanel(QtWidgets.QWidget):
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
     def _ticked(self, seconds: int) -> None:
-        self.button.setText(f"Computing the layout… {seconds} s")
+        # (Stop asked: the layout ends at its next coarse reading, up to a few seconds on a big lake)
+        self.button.setText("Stopping the layout…" if self.ctl.stopping else f"Computing the layout… {seconds} s")
 
 
 def miss_points(verdict, row: int | None = None) -> np.ndarray:

@@ -66,7 +66,7 @@ def test_f5_on_a_finished_lake_grid_stopped_after_a_few_sweeps_keeps_the_finishe
     grids, mb, initial = dict(doc.grids), doc.multiblock, dict(doc.initial)
     report = doc.lake_metrics
 
-    def warm_then_stopped(project, *, warm, stop_event, smooth, hold):
+    def warm_then_stopped(project, *, warm, stop_event, smooth, hold, notify=None):
         """A warm solve of the same layout whose Stop lands after its first sweeps (as app.lake_solve ends it)."""
         moved = tuple(g.replaced(x=g.x + 1e-3, y=g.y) for _k, g in sorted(grids.items()))
         progress = LakeProgress(2, 0.1, 1e-5, None, 0.1, "orthogonal", ((2, 0.1),), moved, ((0, "warm start"),))

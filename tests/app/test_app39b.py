@@ -154,15 +154,14 @@ def test_a_count_of_a_cell_size_no_longer_wanted_stops(qtbot, win, monkeypatch):
     assert f"{want.n_cells:,} cells in {len(want.blocks)} blocks" in win.lake_panel.summary.text()
 
 
-def test_a_count_being_made_stops_when_the_window_closes(qtbot, win, monkeypatch):
-    """The window closed while a count was made: the close waited for the workers 2 s, the process ~6 s more
-    (Shasta Lake at 26 m) and the count's worker, ending after the window, printed a traceback.  Now the
-    close stops it (at its next coarse reading) before it waits."""
+def held_layout(monkeypatch):
+    """A layout's worker (the count's, Auto layout's) held at each coarse reading until ``gate`` is set:
+    ``(entered, gate, read, ended, done)`` — ``read`` gets the cell size of each reading, ``ended`` the worker's
+    return value, then ``done`` is set."""
     import threading
 
     import app.lake_controller as lc
     from meshcore.lakegrid import CoarseReadings
-    from tests.app.waits import wait_for
 
     entered, gate, read = threading.Event(), threading.Event(), []
     real_reading, real_job = CoarseReadings.__call__, lc._layout_job
@@ -182,6 +181,16 @@ def test_a_count_being_made_stops_when_the_window_closes(qtbot, win, monkeypatch
 
     monkeypatch.setattr(CoarseReadings, "__call__", gated)
     monkeypatch.setattr(lc, "_layout_job", job)
+    return entered, gate, read, ended, done
+
+
+def test_a_count_being_made_stops_when_the_window_closes(qtbot, win, monkeypatch):
+    """The window closed while a count was made: the close waited for the workers 2 s, the process ~6 s more
+    (Shasta Lake at 26 m) and the count's worker, ending after the window, printed a traceback.  Now the
+    close stops it (at its next coarse reading) before it waits."""
+    from tests.app.waits import wait_for
+
+    entered, gate, read, ended, done = held_layout(monkeypatch)
     lake, area = _y_lake()
     win.editor.set_lake(lake, "Import")
     win.lake_ctl.set_cell_size(float(np.sqrt(area / 100)))

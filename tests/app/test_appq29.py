@@ -94,7 +94,7 @@ def test_a_measure_of_an_older_grid_never_replaces_the_newer_one(qtbot, win, mea
         assert win.quality_panel.table.rowCount() == 0
 
 
-def coarse_then_stopped(project, *, warm, stop_event, smooth, hold):
+def coarse_then_stopped(project, *, warm, stop_event, smooth, hold, notify=None):
     """A lake solve whose Stop lands on the level of half the cells (as app.lake_solve ends it)."""
     from app.lake_solve import LakeProgress
     from app.results import ALL_BLOCKS, BlockResult
