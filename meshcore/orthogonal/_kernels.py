@@ -233,8 +233,9 @@ def sweep(
     X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lox, loy, hi, bx, by, relax, jmin, thin
 ):
     """One Gauss–Seidel sweep over the free interior nodes (``lox, loy``: each regular node's
-    size-blend ``lo`` along its two lines; ``bx, by``: its size-blend state, updated; see :func:`_target`; ``thin[node]``: the move guard's thin
-    rule for that node, see :func:`_try_move`); returns the largest move."""
+    size-blend ``lo`` along its two lines; ``bx, by``: its size-blend state, updated; see
+    :func:`_target`; ``thin[node]``: the move guard's thin rule for that node, see
+    :func:`_try_move`); returns the largest move."""
     big = 0.0
     before = np.empty(32)
     after = np.empty(32)

@@ -31,8 +31,8 @@ def ortho_targets(
     """Where one point-Jacobi step of the Ryskin–Leal update moves every regular node.
 
     ``nbr`` holds ``E, W, N, S, NE, NW, SE, SW`` per node; ``lo`` the size blend's start along
-    each node's e–w line and ``lo_y`` (default ``lo``) along its n–s line (one for all, or per node).  See :mod:`._kernels` for the
-    formula; here every length is one vectorised ``hypot``.
+    each node's e–w line and ``lo_y`` (default ``lo``) along its n–s line (one for all, or per
+    node).  See :mod:`._kernels` for the formula; here every length is one vectorised ``hypot``.
     """
     e, w, n, s, ne, nw, se, sw = (nbr[:, k] for k in range(8))
     p = nodes
