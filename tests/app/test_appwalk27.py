@@ -156,7 +156,10 @@ def test_refused_steps_of_a_drag_are_not_errors_when_it_ends_on_a_good_place(qtb
     from tests.app.test_modeller import _laid_out
     from tests.app.waits import wait_for, wait_idle
 
-    _laid_out(qtbot, win, tmp_path, 270503)
+    for seed in (270503, 270504, 270505, 270506):  # a generated lake whose layout has a cut end to drag
+        _laid_out(qtbot, win, tmp_path, seed)
+        if any(h.kind == "end" for h in handles(win.doc.project.layout)):
+            break
     win.messages_panel.clear()
     lay0 = win.doc.project.layout
     end = next(h for h in handles(lay0) if h.kind == "end")
