@@ -345,7 +345,7 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             before = "<i>Grid stopped before it was finished</i> (F5 makes it again) — "
         self.headline.setText(
             f"{before}<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
-            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded"
+            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded{_small_cell(m)}"
         )
         self.table.setRowCount(len(v.results))
         for k, r in enumerate(v.results):
@@ -417,3 +417,17 @@ class LakeQualityBox(QtWidgets.QGroupBox):
     def _row_selected(self) -> None:
         rows = self.table.selectionModel().selectedRows() if self.verdict is not None else []
         self.misses.emit(miss_points(self.verdict, rows[0].row()) if rows else None)
+
+
+def _small_cell(m) -> str:
+    """The headline's word on a cell far smaller than the rest (:data:`meshcore.quality.lake.SHRINK_NOTE`),
+    or nothing: where an explicit model's time step would be set (the Quality panel colours them all,
+    "time step cost")."""
+    from meshcore.quality import lake
+
+    worst = m.max("shrink")
+    if not worst >= lake.SHRINK_NOTE:
+        return ""
+    if not math.isfinite(worst):
+        return ", a collapsed edge"
+    return f", shortest edge {1.0 / worst:.2g} cells (time step ÷ {worst:.3g})"

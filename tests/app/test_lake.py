@@ -333,7 +333,7 @@ def test_a_lake_refused_is_a_message(qtbot, win):
     assert "Cannot lay out the lake" in win._status.text() and "cell size" in win._status.text()
 
 
-def test_colour_by_time_step_cost_covers_every_block_of_a_lake(qtbot, win):
+def test_colour_by_time_step_cost_covers_every_block_of_a_lake(qtbot, win, monkeypatch):
     """``--quality "time step"`` colours every block by the lake metrics' ``shrink`` (the cell size over
     the cell's shortest edge: where an explicit model must step shortest), on a fixed scale from 1."""
     from app.__main__ import quality_label
@@ -358,6 +358,14 @@ def test_colour_by_time_step_cost_covers_every_block_of_a_lake(qtbot, win):
     g = layers[0][1]
     assert SHRINK in win._cell_readout(g.x[1:3, 1:3].mean(), g.y[1:3, 1:3].mean())
     win.quality_panel.metric.setCurrentText("none")
+    # the verdict's headline names the smallest cell when it is far smaller than the rest
+    from meshcore.quality import lake
+
+    assert "shortest edge" not in win.lake_quality.headline.text()  # Iseo at 600 m: no such cell
+    monkeypatch.setattr(lake, "SHRINK_NOTE", 1.0)
+    win.lake_quality.refresh()
+    worst = m.max("shrink")
+    assert f"shortest edge {1 / worst:.2g} cells (time step ÷ {worst:.3g})" in win.lake_quality.headline.text()
 
 
 def test_colour_by_deviation_covers_every_block_of_a_lake(qtbot, win):
