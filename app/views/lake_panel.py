@@ -345,7 +345,7 @@ class LakeQualityBox(QtWidgets.QGroupBox):
             before = "<i>Grid stopped before it was finished</i> (F5 makes it again) — "
         self.headline.setText(
             f"{before}<b>{v.preset.name}: {word}</b> — {s['cells']:,} cells, mean deviation from 90° "
-            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded{_small_cell(m)}"
+            f"{s['mean_deviation_deg']:.2f}°, {s['folded_cells']} folded{_small_cell(s)}"
         )
         self.table.setRowCount(len(v.results))
         for k, r in enumerate(v.results):
@@ -419,15 +419,16 @@ class LakeQualityBox(QtWidgets.QGroupBox):
         self.misses.emit(miss_points(self.verdict, rows[0].row()) if rows else None)
 
 
-def _small_cell(m) -> str:
-    """The headline's word on a cell far smaller than the rest (:data:`meshcore.quality.lake.SHRINK_NOTE`),
-    or nothing: where an explicit model's time step would be set (the Quality panel colours them all,
-    "time step cost")."""
+def _small_cell(s: dict) -> str:
+    """The headline's word on a cell far smaller than the rest (``s``: the lake metrics' summary; its
+    shortest edge under 1/:data:`meshcore.quality.lake.SHRINK_NOTE` of the cell size), or nothing:
+    where an explicit model's time step would be set (the Quality panel colours them all, "time step
+    cost")."""
     from meshcore.quality import lake
 
-    worst = m.max("shrink")
-    if not worst >= lake.SHRINK_NOTE:
+    least = s.get("min_edge_cells")
+    if least is None or not least < 1.0 / lake.SHRINK_NOTE:
         return ""
-    if not math.isfinite(worst):
+    if least <= 0.0:
         return ", a collapsed edge"
-    return f", shortest edge {1.0 / worst:.2g} cells (time step ÷ {worst:.3g})"
+    return f", shortest edge {least:.2g} cells (time step ÷ {1.0 / least:.3g})"
