@@ -180,15 +180,14 @@ def block_metrics(grid: StructuredGrid, name: str = "block1") -> BlockMetrics:
     cos = node_cos(x, y, grid.periodic)
     dev = np.degrees(np.arcsin(cos))
     sxi, seta = _smoothness(x, y, grid.periodic)
-    lxi = np.hypot(x[1:, :-1] - x[:-1, :-1], y[1:, :-1] - y[:-1, :-1])
-    leta = np.hypot(x[:-1, 1:] - x[:-1, :-1], y[:-1, 1:] - y[:-1, :-1])
+    exi = np.hypot(np.diff(x, axis=0), np.diff(y, axis=0))  # (ni, nj + 1): every ξ-edge
+    eeta = np.hypot(np.diff(x, axis=1), np.diff(y, axis=1))  # (ni + 1, nj): every η-edge
+    lxi, leta = exi[:, :-1], eeta[:-1]  # the two edges from each cell's (i, j) corner
     area = signed_area(x, y)
     orient = -1.0 if area.sum() < 0 else 1.0  # a mirrored (clockwise) block is judged in its own sense
     sines = orient * corner_sines(x, y)
     folded = np.asarray((sines < -STRAIGHT_SINE).any(axis=0))
     straight = np.asarray((sines <= STRAIGHT_SINE).any(axis=0)) & ~folded
-    exi = np.hypot(np.diff(x, axis=0), np.diff(y, axis=0))  # (ni, nj + 1)
-    eeta = np.hypot(np.diff(x, axis=1), np.diff(y, axis=1))  # (ni + 1, nj)
     shortest = np.minimum(np.minimum(exi[:, :-1], exi[:, 1:]), np.minimum(eeta[:-1], eeta[1:]))
     return BlockMetrics(name, cos, dev, sxi, seta, ratio(lxi, leta), orient * area, folded, straight, shortest)
 
