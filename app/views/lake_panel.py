@@ -202,7 +202,7 @@ class LakePanel(QtWidgets.QWidget):
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
     def _ticked(self, seconds: int) -> None:
-        # (Stop asked: the layout ends at its next coarse reading, up to a few seconds on a big lake)
+        # (Stop asked: the layout ends at its next check, a tenth of a second or so on a big lake)
         self.button.setText("Stopping the layout…" if self.ctl.stopping else f"Computing the layout… {seconds} s")
 
 

@@ -156,7 +156,7 @@ def test_the_command_says_the_grid_is_made_again(tmp_path, monkeypatch):
         ("equalize", 0, False, None),
     ],
 )
-def test_the_words_of_a_grid_made_again_are_one_function_s(kind, value, stopped, words):
+def test_the_words_of_a_grid_made_again(kind, value, stopped, words):
     """``meshcore mesh`` and the app said the grid made again in two wordings ("1 folded or non-convex
     cell(s) left; made again …" against "1 folded or non-convex cell left — making it again …"); both now
     take :func:`meshcore.lakegrid.retry_words` (the app's wording), the CLI adding its seconds."""
