@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 
 from meshcore import MeshcoreError
+from meshcore.errors import Stopped
 
 __all__ = [
     "BRANCHED_FILL",
     "Lake",
-    "LayoutStopped",
     "area_text",
     "cell_size_of",
     "compute_layout",
@@ -51,12 +51,6 @@ __all__ = [
 #: an outline whose water fills less than this share of its convex hull is "branched":
 #: one block would be poor, the app offers Auto layout on import
 BRANCHED_FILL = 0.5
-
-
-class LayoutStopped(Exception):
-    """:func:`compute_layout` ended by its ``stop_event`` (the caller asked: no layout, and no error to
-    report).  Not a :class:`~meshcore.MeshcoreError`: the layout choice takes those of a coarse reading as
-    a draw that reads nothing and goes on."""
 
 
 def _frozen(a: Any) -> np.ndarray:
@@ -293,10 +287,11 @@ def compute_layout(lake: Lake, cuts: Any = None, *, stop_event: Any = None) -> A
     instead, each with four corners where it turns, the cuts' ends snapped as the Cut line tool
     snaps them over a layout.  Raises
     :class:`~meshcore.MeshcoreError` naming the problem (e.g. the region that cannot be
-    four-sided).  ``stop_event`` (a :class:`threading.Event`; Auto layout's own layout takes none): once
-    set, the layout ends with :class:`LayoutStopped` at its next coarse reading (a reading under way
-    stops at its next sweep; they are a third of its time, between draws of up to a second or two on a
-    lake of 200 000 cells) — a layout no longer wanted stops keeping a core busy.
+    four-sided).  ``stop_event`` (a :class:`threading.Event`): once set, the layout ends with
+    :class:`meshcore.errors.Stopped` at its next check — between the stages of a draw and between draws
+    (:mod:`meshcore.layout.stopping`: a tenth of a second or so on Vänern at 10 000 cells, whose first
+    coarse reading comes ~4 s after the start), before and after each coarse reading, and at the next
+    sweep of a reading under way — a layout no longer wanted stops keeping a core busy.
     """
     from meshcore.cli.mesh_steps import LEVELS, MIN_CELLS
     from meshcore.errors import InvalidInputError
@@ -325,27 +320,33 @@ def compute_layout(lake: Lake, cuts: Any = None, *, stop_event: Any = None) -> A
     reading = readings if stop_event is None else _stoppable(readings, stop_event)
     try:
         lay = auto_layout(
-            poly, cell_size=h, multiple=2**LEVELS, regular=lake.regular, single=lake.single, reading=reading
+            poly,
+            cell_size=h,
+            multiple=2**LEVELS,
+            regular=lake.regular,
+            single=lake.single,
+            reading=reading,
+            stop_event=stop_event,
         )
     finally:
         readings.stop_event.event = None  # the held solves take the stop of the solve that goes on from one
     if stop_event is not None and stop_event.is_set():
-        raise LayoutStopped("the layout was stopped")
+        raise Stopped("the layout was stopped")
     hold_readings(lay, readings)  # its grid (app.lake_solve.solve_layout) goes on from there
     return lay
 
 
 def _stoppable(readings: Any, stop_event: Any):
-    """``readings`` (:func:`app.lake_solve.coarse_readings`) ending the layout with :class:`LayoutStopped`
+    """``readings`` (:func:`app.lake_solve.coarse_readings`) ending the layout with :class:`~meshcore.errors.Stopped`
     once ``stop_event`` is set: before and after each reading, and a reading under way at its next sweep."""
     readings.stop_event.event = stop_event
 
     def reading(layout):
         if stop_event.is_set():
-            raise LayoutStopped("the layout was stopped")
+            raise Stopped("the layout was stopped")
         got = readings(layout)
         if stop_event.is_set():  # (the reading, stopped half way, reads nothing true)
-            raise LayoutStopped("the layout was stopped")
+            raise Stopped("the layout was stopped")
         return got
 
     return reading

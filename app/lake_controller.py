@@ -20,8 +20,9 @@ from superqt.utils import create_worker
 
 from meshcore import MeshcoreError
 from meshcore.cellsize import SMALL_BLOCKS, finer_for_small_blocks, small_blocks_reason
+from meshcore.errors import Stopped
 
-from .lake import Lake, LayoutStopped, compute_layout
+from .lake import Lake, compute_layout
 from .lake_solve import layout_topology
 from .views.offer_bar import OfferBar
 
@@ -49,7 +50,7 @@ def _layout_job(lake: Lake, cuts=None, stop_event: threading.Event | None = None
             return None
         layout_topology(layout)
         return lake, layout, None
-    except LayoutStopped:
+    except Stopped:
         return None
     except MeshcoreError as exc:
         return lake, None, str(exc)
@@ -124,7 +125,7 @@ class LakeController(QtCore.QObject):
         self._count_worker = None
         self._count_lake: Lake | None = None  # the lake being counted
         # set when the lake being counted is no longer the one wanted (another cell size, an undo): the count
-        # stops at its next coarse reading (it ran to its end: 3.8 s of a core on Shasta Lake at 26 m after
+        # stops at its next check (it ran to its end: 3.8 s of a core on Shasta Lake at 26 m after
         # the size was typed twice more), and the count wanted starts when it has stopped (2 cores)
         self._count_stop = threading.Event()
         self._adopted = None  # the water Auto layout asked for, when it took over the running count
@@ -133,7 +134,7 @@ class LakeController(QtCore.QObject):
         self._count_timer.setInterval(COUNT_DELAY_MS)
         self._count_timer.timeout.connect(self._count_now)
         self.doc.project_changed.connect(lambda _p: self._want_count())
-        # Auto layout's own worker stops at its next coarse reading once this is set (Stop, Esc, the window
+        # Auto layout's own worker stops at its next check once this is set (Stop, Esc, the window
         # closed: on a big lake it ran on for seconds, and after the window); a worker taken over from the count
         # stops by the count's event
         self._stop = threading.Event()
@@ -147,13 +148,14 @@ class LakeController(QtCore.QObject):
 
     @property
     def stopping(self) -> bool:
-        """Stop was asked of the layout being computed (it ends at its next coarse reading)."""
+        """Stop was asked of the layout being computed (it ends at its next check)."""
         return self._worker is not None and self._stopping
 
     def stop_layout(self) -> bool:
-        """Stop (Esc) while Auto layout computes: the layout stops at its next coarse reading (a reading under
-        way, at its next sweep) and nothing is set (a split by cut lines, a second or so, runs to its end and
-        is not set); False when no layout is being computed."""
+        """Stop (Esc) while Auto layout computes: the layout stops at its next check (between the stages of a
+        draw and between draws, :mod:`meshcore.layout.stopping`; a coarse reading under way, at its next sweep)
+        and nothing is set (a split by cut lines, a second or so, runs to its end and is not set); False when
+        no layout is being computed."""
         if self._worker is None:
             return False
         if self._adopted is not None:  # the Lake panel's count, taken over
@@ -337,7 +339,7 @@ class LakeController(QtCore.QObject):
         if lake is not None and lake == self._stopped_lake:  # its Auto layout was stopped: not made again unasked
             lake = None
         if self._count_worker is not None and self._adopted is None and self._count_lake != lake:
-            self._count_stop.set()  # stale: it stops at its next coarse reading, then the one wanted starts
+            self._count_stop.set()  # stale: it stops at its next check, then the one wanted starts
         if lake is None or self.layout_count(lake) is not None:
             return
         if self._count_lake == lake and not self._count_stop.is_set():
@@ -356,7 +358,7 @@ class LakeController(QtCore.QObject):
         worker.start()
 
     def stop_count(self) -> None:
-        """The window closes: a count being made stops at its next coarse reading (the close waits for the
+        """The window closes: a count being made stops at its next check (the close waits for the
         workers: it waited 2 s for a count of Shasta Lake at 26 m, then the process 6 s more, and the count's
         worker, ending after the window, printed a traceback); Auto layout's too."""
         self._count_timer.stop()

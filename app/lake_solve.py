@@ -27,7 +27,8 @@ level returns no grid (the coarse grids are never kept as a result).
 
 A grid whose levels end with folded or non-convex cells is made again with sliding block corners
 (:data:`meshcore.lakegrid.FOLD_RETRY`) without yielding anything (seconds on a large lake): ``notify(kind,
-text)`` is told of it as ``meshcore mesh`` prints it (:func:`retry_words`), from the worker's thread.
+text)`` is told of it in the words ``meshcore mesh`` prints (:func:`meshcore.lakegrid.retry_words`), from the
+worker's thread.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshcore import SolverProgress, StructuredGrid
+from meshcore.lakegrid import level_labels, retry_words
 
 from .results import ALL_BLOCKS, BlockResult
 
@@ -78,52 +80,6 @@ class LakeProgress(SolverProgress):
     """
 
     levels: tuple[tuple[int, str], ...] = field(default=(), repr=False)
-
-
-def level_labels(n_levels: int) -> list[str]:
-    """The labels of ``n_levels`` levels, coarsest first: ``["cells ÷4", "÷2", "full"]``."""
-    return [
-        ("cells " if k == 0 else "") + f"÷{2 ** (n_levels - 1 - k)}" if k < n_levels - 1 else "full"
-        for k in range(n_levels)
-    ]
-
-
-def retry_words(kind: str, value, labels: list[str], *, stopped: bool = False) -> str | None:
-    """What to say of a report of :func:`meshcore.lakegrid.iterate_layout` (``level_callback(kind, value)``)
-    about the grid made again (:data:`~meshcore.lakegrid.FOLD_RETRY`), as ``meshcore mesh`` prints it; None
-    for the other reports.  ``labels``: :func:`level_labels`; ``stopped``: the solve was stopped meanwhile.
-
-    >>> retry_words("retry", 1, ["cells ÷4", "÷2", "full"])
-    'grid: 1 folded or non-convex cell left — making it again with block corners and cut ends sliding along the shore…'
-    >>> retry_words("retried", (1, 0, True), [])
-    'grid made again: 0 bad cells against 1 — that grid kept'
-    """
-    if kind == "retry":
-        return (
-            f"grid: {_cells(value, 'folded or non-convex cell')} left — making it again with block corners and cut "
-            "ends sliding along the shore…"
-        )
-    if kind == "again level":
-        lev, res = value
-        cells = sum(g.cells[0] * g.cells[1] for g in res.grids)
-        label = (labels[lev] if lev < len(labels) else f"level {lev + 1}").removeprefix("cells ")
-        done = f"stopped after {res.sweeps} sweeps" if stopped else f"done, {res.sweeps} sweeps"
-        return f"grid made again: level {lev + 1}/{len(labels)} ({label}, {cells:,} cells) {done}"
-    if kind == "again equalize":
-        return f"grid made again: interfaces, {_cells(value, 'patch', 'es')} of cells more than 2× apart made alike"
-    if kind == "retried":
-        n, m, kept = value
-        if stopped:
-            return f"grid made again: stopped — the first grid kept ({_cells(n, 'bad cell')})"
-        return (
-            f"grid made again: {_cells(m, 'bad cell')} against {n} — "
-            f"{'that grid kept' if kept else 'the first grid kept'}"
-        )
-    return None
-
-
-def _cells(n: int, what: str, plural: str = "s") -> str:
-    return f"{n} {what}{plural * (n != 1)}"
 
 
 _topologies: dict[int, tuple] = {}  # id(layout) -> (layout, topology): the last few layouts' topologies
@@ -226,7 +182,7 @@ def solve_layout(
     ``hold``: a warm solve waits for it after its live frames before it makes the final grid
     (set by the app when the drag ends; set with ``stop_event`` to stop the waiting solve).
     ``notify(kind, text)``: told, from this generator's thread, of a grid made again and its steps
-    (:func:`retry_words`; ``kind`` as :func:`meshcore.lakegrid.iterate_layout` reports them), which
+    (:func:`meshcore.lakegrid.retry_words`; ``kind`` as :func:`meshcore.lakegrid.iterate_layout` reports them), which
     yield nothing.
     """
     layout = lake.layout

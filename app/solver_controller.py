@@ -88,7 +88,7 @@ class SolverController(QtCore.QObject):
     redrawn = QtCore.Signal()
     #: a lake grid being made again, unseen, because its levels left bad cells (``kind`` of
     #: :func:`meshcore.lakegrid.iterate_layout`'s report: "retry", "again level", "again equalize", "retried";
-    #: the words of :func:`app.lake_solve.retry_words`): seconds on a large lake in which no frame comes
+    #: the words of :func:`meshcore.lakegrid.retry_words`): seconds on a large lake in which no frame comes
     retry_said = QtCore.Signal(str, str)
     _noted = QtCore.Signal(int, str, str)  # (run, kind, text) from the worker's thread: queued to retry_said
 

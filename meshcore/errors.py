@@ -18,7 +18,11 @@ catch ``ValueError`` keep working.
      ├── FoldedGridError               raised only when a caller asks for strictness
      └── SolverError                   an internal solver failure (not non-convergence)
 
-Non-convergence is *not* an error: it is reported on the result.
+    Stopped                            the caller's stop ended a long computation (not an error)
+
+Non-convergence is *not* an error: it is reported on the result.  A stop is not one either:
+:class:`Stopped` is no :class:`MeshcoreError`, so that code which takes a failed step as a step that
+reads nothing and goes on (the layout choice's draws) does not go on after a stop.
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ __all__ = [
     "MeshcoreWarning",
     "ReadError",
     "SolverError",
+    "Stopped",
     "TopologyError",
     "WriteError",
 ]
@@ -76,6 +81,12 @@ class FoldedGridError(MeshcoreError):
 
 class SolverError(MeshcoreError):
     """An internal solver failure (not plain non-convergence)."""
+
+
+class Stopped(Exception):
+    """A computation ended by its caller's stop event (e.g. :func:`meshcore.layout.auto_layout`'s
+    ``stop_event``): nothing is returned, and there is nothing to report.  Not a :class:`MeshcoreError`
+    (see the module's docstring)."""
 
 
 class MeshcoreWarning(UserWarning):

@@ -32,7 +32,15 @@ from .grid import SolveInfo
 if TYPE_CHECKING:
     from .elliptic import SolverProgress
 
-__all__ = ["CoarseReadings", "coarse_reading", "iterate_layout", "mesh_layout", "mesh_outline"]
+__all__ = [
+    "CoarseReadings",
+    "coarse_reading",
+    "iterate_layout",
+    "level_labels",
+    "mesh_layout",
+    "mesh_outline",
+    "retry_words",
+]
 
 
 def _shore_rings(poly, step: float) -> list[np.ndarray]:
@@ -491,6 +499,53 @@ def iterate_layout(
 #: and ``dendritic(380701)`` at 15 000 cells, 1 and 3 cells at block corners on notches of the shore, 0
 #: and 0; ``slide_ends`` for every grid was measured mixed, see :func:`iterate_layout`).
 FOLD_RETRY = True
+
+
+def level_labels(n_levels: int) -> list[str]:
+    """The labels of ``n_levels`` levels, coarsest first: ``["cells ÷4", "÷2", "full"]``."""
+    return [
+        ("cells " if k == 0 else "") + f"÷{2 ** (n_levels - 1 - k)}" if k < n_levels - 1 else "full"
+        for k in range(n_levels)
+    ]
+
+
+def retry_words(kind: str, value: Any, labels: list[str], *, stopped: bool = False) -> str | None:
+    """What to say of a report of :func:`iterate_layout` (``level_callback(kind, value)``) about the grid
+    made again (:data:`FOLD_RETRY`: kinds ``"retry"``, ``"again level"``, ``"again equalize"``,
+    ``"retried"``); None for the other reports.  ``labels``: :func:`level_labels`; ``stopped``: the solve
+    was stopped meanwhile.  The one wording of ``meshcore mesh`` (which adds the seconds) and the app.
+
+    >>> retry_words("retry", 1, ["cells ÷4", "÷2", "full"])
+    'grid: 1 folded or non-convex cell left — making it again with block corners and cut ends sliding along the shore…'
+    >>> retry_words("retried", (1, 0, True), [])
+    'grid made again: 0 bad cells against 1 — that grid kept'
+    """
+    if kind == "retry":
+        return (
+            f"grid: {_counted(value, 'folded or non-convex cell')} left — making it again with block corners and "
+            "cut ends sliding along the shore…"
+        )
+    if kind == "again level":
+        lev, res = value
+        cells = sum(g.cells[0] * g.cells[1] for g in res.grids)
+        label = (labels[lev] if lev < len(labels) else f"level {lev + 1}").removeprefix("cells ")
+        done = f"stopped after {res.sweeps} sweeps" if stopped else f"done, {res.sweeps} sweeps"
+        return f"grid made again: level {lev + 1}/{len(labels)} ({label}, {cells:,} cells) {done}"
+    if kind == "again equalize":
+        return f"grid made again: interfaces, {_counted(value, 'patch', 'es')} of cells more than 2× apart made alike"
+    if kind == "retried":
+        n, m, kept = value
+        if stopped:
+            return f"grid made again: stopped — the first grid kept ({_counted(n, 'bad cell')})"
+        return (
+            f"grid made again: {_counted(m, 'bad cell')} against {n} — "
+            f"{'that grid kept' if kept else 'the first grid kept'}"
+        )
+    return None
+
+
+def _counted(n: int, what: str, plural: str = "s") -> str:
+    return f"{n} {what}{plural * (n != 1)}"
 
 
 def _n_folded(grids) -> int:

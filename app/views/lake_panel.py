@@ -202,7 +202,7 @@ class LakePanel(QtWidgets.QWidget):
         self.button.setText("Computing the layout…" if busy else "Auto layout")
 
     def _ticked(self, seconds: int) -> None:
-        # (Stop asked: the layout ends at its next coarse reading, up to a few seconds on a big lake)
+        # (Stop asked: the layout ends at its next check, a tenth of a second or so on a big lake)
         self.button.setText("Stopping the layout…" if self.ctl.stopping else f"Computing the layout… {seconds} s")
 
 
@@ -421,14 +421,11 @@ class LakeQualityBox(QtWidgets.QGroupBox):
 
 def _small_cell(s: dict) -> str:
     """The headline's word on a cell far smaller than the rest (``s``: the lake metrics' summary; its
-    shortest edge under 1/:data:`meshcore.quality.lake.SHRINK_NOTE` of the cell size), or nothing:
-    where an explicit model's time step would be set (the Quality panel colours them all, "time step
-    cost")."""
-    from meshcore.quality import lake
+    shortest edge at most 1/:data:`meshcore.quality.lake.SHRINK_NOTE` of the cell size,
+    :func:`~meshcore.quality.lake.small_edge`), or nothing: where an explicit model's time step would be
+    set (the Quality panel colours them all, "time step cost").  In the words of the quality table and
+    ``meshcore mesh`` (:func:`~meshcore.quality.lake.shortest_edge_words`)."""
+    from meshcore.quality.lake import shortest_edge_words, small_edge
 
     least = s.get("min_edge_cells")
-    if least is None or not least < 1.0 / lake.SHRINK_NOTE:
-        return ""
-    if least <= 0.0:
-        return ", a collapsed edge"
-    return f", shortest edge {least:.2g} cells (time step ÷ {1.0 / least:.3g})"
+    return f", shortest edge {shortest_edge_words(least)}" if small_edge(least) else ""

@@ -187,25 +187,17 @@ def _layout(args, poly, h: float, regular: bool, say: _Say, frame: Any = None, r
 
 
 def _grid(lay, say: _Say, readings: Any = None):
-    from ..lakegrid import mesh_layout
+    from ..lakegrid import level_labels, mesh_layout, retry_words
 
     n_levels = LEVELS + 1
+    labels = level_labels(n_levels)
 
     def level(kind: str, value: Any) -> None:
-        if kind == "retry":  # cells left folded or non-convex: the levels again (lakegrid.FOLD_RETRY)
-            say(
-                f"grid: {value} folded or non-convex cell(s) left; made again with block corners and cut ends "
-                f"sliding along the shore, {say.lap():.1f} s"
-            )
+        # the grid made again (cells left folded or non-convex, lakegrid.FOLD_RETRY): the words the app shows, timed
+        again = retry_words(kind, value, labels)
+        if again is not None:
+            say(f"{again.removesuffix('…')}, {say.lap():.1f} s")
             return
-        if kind == "retried":
-            n, m, kept = value
-            say(
-                f"grid made again: {m} bad cell(s) against {n}; "
-                f"{'that grid kept' if kept else 'the first grid kept'}, {say.lap():.1f} s"
-            )
-            return
-        kind = kind.removeprefix("again ")
         if kind == "equalize":
             say(f"interfaces: {value} patch(es) of cells more than 2× apart across a cut made alike, {say.lap():.1f} s")
             return

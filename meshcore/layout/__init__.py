@@ -57,6 +57,7 @@ from .polygon import (
     without_slivers,
 )
 from .shore import Shores, shore_at_scale, transfer, without_narrow_arms
+from .stopping import check, stoppable
 from .tipcuts import splits, splitting_tips, watching_tips
 from .tipends import counted_without_tip_fans
 from .tipsplit import counted_with_tip_splits
@@ -91,6 +92,7 @@ def auto_layout(
     single: bool = False,
     options: LayoutOptions = DEFAULT_OPTIONS,
     reading: Callable[[Layout], tuple[float, float]] | None = None,
+    stop_event: Any = None,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
 
@@ -128,6 +130,11 @@ def auto_layout(
         (:mod:`.choice`); a regular one also against a draw with at least four cut ends on every
         island (:mod:`.ringcuts`), and each other draw only if its blocks close up round every
         island.
+    stop_event : threading.Event, optional
+        Once set (anything with ``is_set()``), the layout ends with :class:`~meshcore.errors.Stopped`
+        at its next check (:mod:`.stopping`): between the stages of a draw (the skeleton and chords,
+        each region's split, the corners, the counts) and between draws; a ``reading`` under way is the
+        caller's to stop.
 
     Returns
     -------
@@ -138,7 +145,16 @@ def auto_layout(
     ------
     InvalidInputError
         A polygon that crosses itself, islands outside the water, …, naming the place.
+    Stopped
+        ``stop_event`` was set (not a :class:`~meshcore.errors.MeshcoreError`).
     """
+    with stoppable(stop_event):
+        return _auto_layout(outline, holes, cell_size, target_cells, multiple, regular, single, options, reading)
+
+
+def _auto_layout(outline, holes, cell_size, target_cells, multiple, regular, single, options, reading) -> Layout:
+    """:func:`auto_layout` within its :func:`~.stopping.stoppable`."""
+    check()
     regular = regular or single
     poly, notes = water_polygon(outline, holes=holes)
     h = float(cell_size) if cell_size is not None else default_cell_size(poly.area, target_cells)
@@ -152,11 +168,13 @@ def auto_layout(
     poly, slivers = without_slivers(poly, 0.5 * h)
     poly, arms = without_narrow_arms(poly, h)
     more = more + slivers + arms
+    check()
     straight, curves = poly, None
     if options.curve:
         poly, curves, curved = curved_shores(poly, h)
         more = more + curved
     shores = shore_at_scale(poly, h)
+    check()
     if curves is not None and shores.change is None and CURVE_ON_STRAIGHT:
         # the layout drawn on the straight segments (its corners and cuts as without the curve),
         # its blocks' shore then moved onto the curves (:func:`~.curve.onto_curves`)
@@ -373,6 +391,7 @@ def _layout(
     options: LayoutOptions = DEFAULT_OPTIONS,
     ring: bool = False,
 ) -> Layout:
+    check()  # (each draw: a second on Vänern at 10 000 cells; its stages check too)
     poly = shores.grid
     thin, mouths, wedges = options.thin_arms, options.mouths, options.wedges
     tees = options.tees and regular
@@ -392,12 +411,14 @@ def _layout(
     if moved is None:  # the layout's blocks do not fit the grid's shore: made on it directly
         sk, chords, _, moved = layout_pieces(poly, hl, ring=ring, **kw)
     pieces = moved
+    check()
     if regular:
         cells = block_counts(pieces, h, multiple=multiple, closed=single)
     elif not tipends.SLIDE:  # (with tipsplit.SPLIT: a block side crowding a short piece of shore, split there)
         pieces, cells = counted_with_tip_splits(pieces, h, multiple=multiple)
     else:  # (with tipends.SLIDE: a block side crowding its cells into an island's tip, a cut's end slid onto it)
         pieces, cells = counted_without_tip_fans(pieces, h, hl, multiple=multiple)
+    check()
 
     def made(pieces, cells) -> Layout:
         blocks = tuple(

@@ -21,6 +21,7 @@ from ..errors import TopologyError
 from ..multiblock.counts import solve_counts
 from ..multiblock.shorecells import least_weights, shore_least
 from ..pointindex import PointIndex, point_key, point_keys
+from .stopping import check
 
 __all__ = ["Piece", "block_counts", "conform", "weld"]
 
@@ -222,6 +223,7 @@ def _counts(work, pieces, cell_size, min_cells, multiple, block_cells, best, clo
     weights = least_weights(pts, on_shore, [pc.ring for pc in pieces]) if best else None
 
     def solve(area_weights: bool, least=least, weights=weights) -> np.ndarray:
+        check()  # (each program a HiGHS solve, up to a second on a large lake: a stop is heard between them)
         return _solved(
             np.round(length / cell_size, 6),
             sides,

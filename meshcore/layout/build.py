@@ -34,6 +34,7 @@ from .regions import partition
 from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
 from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
+from .stopping import check
 from .tee import tee
 from .tipcuts import noted_pinch, noted_tips, tips_split, untipped
 
@@ -158,6 +159,7 @@ def layout_pieces(
     from shapely.geometry import Polygon
 
     sk, chords = _skeleton_and_chords(poly, h, mouths)
+    check()
     dense = shapely.segmentize(poly, h)
     sigma = 1.5 * h
     junctions = sk.nodes[sk.degree() >= 3]
@@ -177,6 +179,7 @@ def layout_pieces(
         rings: list[np.ndarray] = []
         forced: list[tuple] = []
         for r in regions:
+            check()  # (a region's split: up to a tenth of a second on Vänern)
             P = Polygon(r)
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
             pieces, new_cuts = _split_region(r, junctions, sigma, 3 * h, regular, normal, here, tees and regular)
@@ -187,6 +190,7 @@ def layout_pieces(
             rings += [p for p, _ in pieces]
             forced += [f for _, f in pieces]
             cuts += new_cuts
+        check()
         rings, forced = _welded(rings, forced, 1e-9 * size)
         if pinch.PINCH and water is not None:  # (the tip draw: cuts passing close by land tips bent through them)
             if tips_split():
@@ -207,6 +211,7 @@ def layout_pieces(
             elif c is not None:  # (regular layouts: no T-junction, only onto a vertex that turns)
                 c = _flat_corner_on_cut(r, c, on_shore, fi, sigma / 1.5, onto_cut=not regular)
             corner_pts.append([r[i] for i in c])
+        check()
         rings = conform(rings, 1e-9 * size)
         pieces = []
         for r, cs in zip(rings, corner_pts, strict=True):
@@ -223,6 +228,7 @@ def layout_pieces(
             break
         lines = lines + more
         pieces, cuts = made(lines)
+    check()
     _check_pieces(poly, pieces)
     if regular:  # every island's ring of blocks closes up (Delft3D's domain decomposition)
         pieces, cuts = _closed(pieces, cuts, h, size, sigma, single, ring)

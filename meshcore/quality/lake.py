@@ -64,6 +64,8 @@ __all__ = [
     "lake_metrics",
     "mean_cell_size",
     "node_cos",
+    "shortest_edge_words",
+    "small_edge",
 ]
 
 #: metric → (what it is measured on, description, unit); "worst" is always the largest value.
@@ -86,6 +88,33 @@ METRICS: dict[str, tuple[str, str, str]] = {
 #: this many times shorter than on the rest of the grid.  Held-out lakes at 10 000 cells: 3 of 28
 #: in set 27 (fans of a block into a short side, session 40).
 SHRINK_NOTE = 50.0
+
+
+def small_edge(least: float | None, limit: float | None = None) -> bool:
+    """A grid's shortest edge ``least``, in mean cell sizes (the summary's ``min_edge_cells``; None or NaN
+    without cells or area), is at most ``1 / limit`` (default :data:`SHRINK_NOTE`): its cell is told on
+    its own (:meth:`LakeMetrics.small_cell_note`, the app's lake verdict)."""
+    limit = SHRINK_NOTE if limit is None else limit
+    return least is not None and bool(least <= 1.0 / limit)
+
+
+def shortest_edge_words(least: float | None) -> str:
+    """A grid's shortest edge ``least`` in mean cell sizes (the summary's ``min_edge_cells``) and what it
+    costs an explicit model's time step: the one wording of the quality table's row, of ``meshcore
+    mesh``'s note (:meth:`LakeMetrics.small_cell_note`) and of the app's lake verdict.
+
+    >>> shortest_edge_words(0.0123)
+    '0.0123 cells (explicit time step ÷ 81.3)'
+    >>> shortest_edge_words(0.0)
+    '0 cells (a collapsed edge: an explicit model cannot step there)'
+    >>> shortest_edge_words(None)  # no cells, or no area to measure them by
+    '—'
+    """
+    if least is None or not least >= 0.0:
+        return "—"
+    if least == 0.0:
+        return "0 cells (a collapsed edge: an explicit model cannot step there)"
+    return f"{least:.3g} cells (explicit time step ÷ {1.0 / least:.3g})"
 
 
 @dataclass(frozen=True, slots=True)
@@ -442,34 +471,23 @@ class LakeMetrics:
 
     def _shortest_row(self, w) -> tuple[str, str, str]:
         """The table's row of the shortest edge: in mean cell sizes, and what it costs an explicit
-        model's time step (its worst place is the cell with the largest ``shrink``)."""
-        worst, least = self.max("shrink"), self._min_edge_cells()
-        if worst == np.inf:
-            value = "0 (a collapsed edge)"
-        elif not (np.isfinite(least) and least > 0):
-            value = "—"  # no cells, or no area to measure them by
-        else:
-            value = f"{least:.3g} cells (explicit time step ÷ {worst:.3g})"
+        model's time step (:func:`shortest_edge_words`; its worst place is the cell with the largest
+        ``shrink``)."""
+        value = shortest_edge_words(self._min_edge_cells())
         return ("shortest edge (in mean cell sizes)", value, w("shrink") if len(self.values("shrink")) else "")
 
     def small_cell_note(self, limit: float | None = None) -> str | None:
-        """A sentence about the cell with the shortest edge when that edge is under ``1 / limit`` of
-        the mean cell size (default :data:`SHRINK_NOTE`), else None."""
-        limit = SHRINK_NOTE if limit is None else limit
+        """A sentence about the cell with the shortest edge when that edge is at most ``1 / limit`` of
+        the mean cell size (default :data:`SHRINK_NOTE`, :func:`small_edge`), else None."""
+        least = self._min_edge_cells()
         worst = self.worst("shrink", 1)
-        if not worst or not worst[0].value >= limit:
+        if not worst or not small_edge(least, limit):
             return None
         w = worst[0]
-        if np.isfinite(w.value):
-            what = (
-                f"an edge of {1.0 / w.value:.2g} cells: an explicit model's time step there is {w.value:.3g} "
-                f"times shorter than on cells of the mean size"
-            )
-        else:
-            what = "a collapsed edge: an explicit model cannot step there"
         return (
-            f"cell {w.block}({w.i},{w.j}) near ({w.x:.8g}, {w.y:.8g}) has {what} (the grid's lines crowd into "
-            f"a short side or a corner; another cell size or an edit of the layout there moves them)"
+            f"cell {w.block}({w.i},{w.j}) near ({w.x:.8g}, {w.y:.8g}) has the grid's shortest edge, "
+            f"{shortest_edge_words(least)}: the grid's lines crowd into a short side or a corner; another cell "
+            f"size or an edit of the layout there moves them"
         )
 
     def __str__(self) -> str:

@@ -365,7 +365,7 @@ def test_colour_by_time_step_cost_covers_every_block_of_a_lake(qtbot, win, monke
     monkeypatch.setattr(lake, "SHRINK_NOTE", 1.0)
     win.lake_quality.refresh()
     worst = m.max("shrink")
-    assert f"shortest edge {1 / worst:.2g} cells (time step ÷ {worst:.3g})" in win.lake_quality.headline.text()
+    assert f"shortest edge {1 / worst:.3g} cells (explicit time step ÷ {worst:.3g})" in win.lake_quality.headline.text()
 
 
 def test_colour_by_deviation_covers_every_block_of_a_lake(qtbot, win):

@@ -4,6 +4,8 @@ such cells is the one returned: what ``meshcore mesh``, the app and ``mesh_outli
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -129,10 +131,42 @@ def test_the_command_says_the_grid_is_made_again(tmp_path, monkeypatch):
     run = mesh(f, "--cells", 800, "-o", tmp_path / "y.vtm")
     assert run.rc == 0, run.err
     lines = run.err.splitlines()
-    at = next(k for k, line in enumerate(lines) if "made again with block corners" in line)
-    assert lines[at].startswith("grid: 1 folded or non-convex cell(s) left")
-    assert sum(line.startswith("grid level ") for line in lines[at:]) == 3
-    assert any(line.startswith("grid made again: 0 bad cell(s) against 1; that grid kept") for line in lines[at:])
+    at = next(k for k, line in enumerate(lines) if "making it again with block corners" in line)
+    assert lines[at].startswith("grid: 1 folded or non-convex cell left — making it again with block corners")
+    assert re.fullmatch(r".*sliding along the shore, \d+\.\d s", lines[at])  # (timed, without the "…")
+    assert sum(line.startswith("grid level ") for line in lines[:at]) == 3  # the first grid's levels
+    again = [line for line in lines[at:] if line.startswith("grid made again: level ")]
+    assert [line.split(" (")[0] for line in again] == [f"grid made again: level {k}/3" for k in (1, 2, 3)]
+    assert again[-1].startswith("grid made again: level 3/3 (full, ")
+    assert re.search(r"cells\) done, \d+ sweeps, [\d.]+ s$", again[-1])
+    assert any(line.startswith("grid made again: interfaces, ") for line in lines[at:])
+    kept = [line for line in lines[at:] if line.startswith("grid made again: 0 bad cells against 1 — that grid kept, ")]
+    assert len(kept) == 1, lines[at:]
+
+
+@pytest.mark.parametrize(
+    ("kind", "value", "stopped", "words"),
+    [
+        ("retry", 2, False, "grid: 2 folded or non-convex cells left — making it again"),
+        ("again equalize", 1, False, "grid made again: interfaces, 1 patch of cells more than 2× apart made alike"),
+        ("retried", (3, 1, True), False, "grid made again: 1 bad cell against 3 — that grid kept"),
+        ("retried", (2, 2, False), False, "grid made again: 2 bad cells against 2 — the first grid kept"),
+        ("retried", (2, 0, False), True, "grid made again: stopped — the first grid kept (2 bad cells)"),
+        ("level", (0, None), False, None),
+        ("equalize", 0, False, None),
+    ],
+)
+def test_the_words_of_a_grid_made_again(kind, value, stopped, words):
+    """``meshcore mesh`` and the app said the grid made again in two wordings ("1 folded or non-convex
+    cell(s) left; made again …" against "1 folded or non-convex cell left — making it again …"); both now
+    take :func:`meshcore.lakegrid.retry_words` (the app's wording), the CLI adding its seconds."""
+    from meshcore.lakegrid import retry_words
+
+    said = retry_words(kind, value, ["cells ÷4", "÷2", "full"], stopped=stopped)
+    if kind == "retry":
+        assert said.startswith(words) and said.endswith("sliding along the shore…")
+    else:
+        assert said == words
 
 
 def test_a_stop_during_a_level_of_the_retry_ends_it_within_every_sweeps(layout, monkeypatch):

@@ -110,7 +110,8 @@ def test_a_cell_far_smaller_than_the_rest_gets_a_note():
     m = lake_metrics(product(xs, np.arange(4.0)))
     assert m.max("shrink") > SHRINK_NOTE
     note = m.small_cell_note()
-    assert note.startswith("cell block1(2,") and f"{m.max('shrink'):.3g} times shorter" in note
+    assert note.startswith("cell block1(2,") and f"explicit time step ÷ {m.max('shrink'):.3g})" in note
+    assert f"shortest edge, {1 / m.max('shrink'):.3g} cells (" in note
     assert m.small_cell_note(limit=2 * m.max("shrink")) is None
 
 
@@ -119,7 +120,7 @@ def test_a_collapsed_edge_shrinks_without_limit():
     X[1, 2], Y[1, 2] = X[0, 2], Y[0, 2]  # top row: its first edge has length 0
     m = lake_metrics(StructuredGrid(X, Y))
     assert m.max("shrink") == math.inf and m.summary()["min_edge_cells"] == 0.0
-    assert "0 (a collapsed edge)" in m.table()
+    assert "| 0 cells (a collapsed edge: an explicit model cannot step there) |" in m.table()
     assert "a collapsed edge: an explicit model cannot step there" in m.small_cell_note()
     X, Y = np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij")
     flat = lake_metrics(StructuredGrid(X + Y, X + Y))  # edges but no area: no mean cell size to measure by
