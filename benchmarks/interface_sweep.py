@@ -101,6 +101,7 @@ def run_one(expr: str, cells: int, options: dict | None = None) -> dict:
         "mean_dev": s["mean_deviation_deg"],
         "pairs12": s["pct_smoothness_le_1.2"],
         "shore": s["hausdorff_cells"],
+        "min_edge": s["min_edge_cells"],  # the shortest edge in cells (an explicit model's time step)
         "shore_grid_h": lake_metrics(mb, polygon=poly).summary()["hausdorff_cells"],  # before: the grid's h
         "cell_size": hl,
         "aspect": m.max("aspect_ratio"),

@@ -161,11 +161,21 @@ def _ramp(h1, h2, lo, hi):
 
 
 @njit(cache=True, inline="always")
-def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo_x, lo_y, hi, bx, by, relax):
+def _short(h1, h2, floor):
+    """0 while both edges ``h1, h2`` are at least ``floor`` long, rising linearly to 1 where the
+    shorter is half of it (``floor`` 0: always 0)."""
+    h = min(h1, h2)
+    if h >= floor:
+        return 0.0
+    return min(1.0, 2.0 * (floor - h) / floor)
+
+
+@njit(cache=True, inline="always")
+def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo_x, lo_y, hi, floor, bx, by, relax):
     """The Ryskin–Leal position of node ``p``, its weights along each grid line blended
     ``smooth`` towards their mean — and further, up to the full mean, where the line's two
     edges at ``p`` differ by a ratio above ``lo_x`` (the e–w line) or ``lo_y`` (the n–s line;
-    :func:`_ramp`).
+    :func:`_ramp`), or where the shorter of them is under ``floor`` (:func:`_short`).
 
     The extra blend of each line is the node's state ``bx, by`` moved ``relax`` of the way
     to the current ramp value (``relax = 1``: the ramp itself); a relaxed state keeps a node
@@ -184,8 +194,8 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo_x, lo_y, hi, bx, by,
     ae, aw, bn, bs = eta_e / he, eta_w / hw, xi_n / hn, xi_s / hs
     # blend with the symmetrised weights (equal spacing along each line: smoothness)
     am, bm = 0.5 * (ae + aw), 0.5 * (bn + bs)
-    rx = bx + relax * (_ramp(he, hw, lo_x, hi) - bx)
-    ry = by + relax * (_ramp(hn, hs, lo_y, hi) - by)
+    rx = bx + relax * (max(_ramp(he, hw, lo_x, hi), _short(he, hw, floor)) - bx)
+    ry = by + relax * (max(_ramp(hn, hs, lo_y, hi), _short(hn, hs, floor)) - by)
     sx = smooth + (1.0 - smooth) * rx
     sy = smooth + (1.0 - smooth) * ry
     ae += sx * (am - ae)
@@ -202,7 +212,7 @@ def _target(X, Y, p, e, w, n, s, ne, nw, se, sw, smooth, lo_x, lo_y, hi, bx, by,
 
 
 @njit(cache=True, nogil=True)
-def jacobi_targets(X, Y, nodes, nbr, smooth, lox, loy, hi, tx, ty):
+def jacobi_targets(X, Y, nodes, nbr, smooth, lox, loy, hi, floor, tx, ty):
     """The update of every regular node from the same old positions (test oracle's twin;
     ``lox, loy``: each node's ``lo`` along its e–w and n–s lines)."""
     for k in range(len(nodes)):
@@ -222,6 +232,7 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, lox, loy, hi, tx, ty):
             lox[k],
             loy[k],
             hi,
+            floor,
             0.0,
             0.0,
             1.0,
@@ -230,10 +241,30 @@ def jacobi_targets(X, Y, nodes, nbr, smooth, lox, loy, hi, tx, ty):
 
 @njit(cache=True, nogil=True)
 def sweep(
-    X, Y, nodes, nbr, irr_nodes, irr_ptr, irr_ring, cptr, cells, omega, smooth, lox, loy, hi, bx, by, relax, jmin, thin
+    X,
+    Y,
+    nodes,
+    nbr,
+    irr_nodes,
+    irr_ptr,
+    irr_ring,
+    cptr,
+    cells,
+    omega,
+    smooth,
+    lox,
+    loy,
+    hi,
+    floor,
+    bx,
+    by,
+    relax,
+    jmin,
+    thin,
 ):
     """One Gauss–Seidel sweep over the free interior nodes (``lox, loy``: each regular node's
-    size-blend ``lo`` along its two lines; ``bx, by``: its size-blend state, updated; see
+    size-blend ``lo`` along its two lines; ``floor``: the edge length under which the blend rises
+    too; ``bx, by``: its size-blend state, updated; see
     :func:`_target`; ``thin[node]``: the move guard's thin rule for that node, see
     :func:`_try_move`); returns the largest move."""
     big = 0.0
@@ -257,6 +288,7 @@ def sweep(
             lox[k],
             loy[k],
             hi,
+            floor,
             bx[k],
             by[k],
             relax,
@@ -445,6 +477,7 @@ def shore_sweep(
     jmin,
     lo,
     hi,
+    floor,
     bz,
     relax,
     across,
@@ -454,7 +487,8 @@ def shore_sweep(
     """Slide the free shore nodes (indices ``free`` into the shore arrays) towards the foot of
     the perpendicular from their inward neighbour, between their two shore neighbours, pulled
     ``mu`` towards the middle of the two — more where the two arcs differ by a ratio above
-    ``lo`` (state ``bz`` per free node, as in :func:`_target`) — and never so far that they
+    ``lo`` or where the shorter is under ``floor`` (state ``bz`` per free node, as in
+    :func:`_target`) — and never so far that they
     differ by more than ``lo``.  Next to a cut line's end on the shore (``across[k]``: the shore
     node beyond that end, before and after, or -1) the arc to the end also stays within ``lo`` of
     the arc beyond it (where both limits cannot hold, halfway between them, but never nearer
@@ -510,7 +544,7 @@ def shore_sweep(
         # a pull to the middle keeps the spacing: a little, more where the spacing jumps
         a1, a2 = s - sp, sn - s
         if a1 > 0.0 and a2 > 0.0:
-            bz[f] += relax * (_ramp(a1, a2, lk, max(hi, 1.01 * lk)) - bz[f])
+            bz[f] += relax * (max(_ramp(a1, a2, lk, max(hi, 1.01 * lk)), _short(a1, a2, floor)) - bz[f])
         m = mu + (1.0 - mu) * bz[f]
         sf = (1.0 - m) * sf + m * 0.5 * (sp + sn)
         # the shore between a node and its neighbours must stay within ``gap`` of the straight

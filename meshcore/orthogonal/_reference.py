@@ -7,14 +7,16 @@ import numpy as np
 __all__ = ["fan_targets", "ortho_targets"]
 
 
-def blend(smooth: float, h1: np.ndarray, h2: np.ndarray, lo, hi: float) -> np.ndarray:
+def blend(smooth: float, h1: np.ndarray, h2: np.ndarray, lo, hi: float, floor: float = 0.0) -> np.ndarray:
     """The share of the symmetric weights along a grid line whose two edges at the node are
     ``h1, h2``: ``smooth`` up to the ratio ``lo`` (per node, or one for all), rising linearly to 1
-    at ``hi``."""
+    at ``hi`` — or, if more, from where the shorter edge is under ``floor`` to 1 at half of it."""
     r = np.maximum(h1, h2) / np.minimum(h1, h2)
     lo = np.broadcast_to(np.asarray(lo, dtype=float), r.shape)
     with np.errstate(invalid="ignore"):  # (an infinite lo: no blend, whatever the quotient)
         t = np.where(r <= lo, 0.0, np.clip((r - lo) / (hi - lo), 0.0, 1.0))
+    if floor > 0.0:
+        t = np.maximum(t, np.clip(2.0 * (floor - np.minimum(h1, h2)) / floor, 0.0, 1.0))
     return smooth + (1.0 - smooth) * t
 
 
@@ -27,12 +29,14 @@ def ortho_targets(
     lo=np.inf,
     hi: float = np.inf,
     lo_y=None,
+    floor: float = 0.0,
 ):
     """Where one point-Jacobi step of the Ryskin–Leal update moves every regular node.
 
     ``nbr`` holds ``E, W, N, S, NE, NW, SE, SW`` per node; ``lo`` the size blend's start along
     each node's e–w line and ``lo_y`` (default ``lo``) along its n–s line (one for all, or per
-    node).  See :mod:`._kernels` for the formula; here every length is one vectorised ``hypot``.
+    node); ``floor`` the edge length under which the blend rises too.  See :mod:`._kernels` for
+    the formula; here every length is one vectorised ``hypot``.
     """
     e, w, n, s, ne, nw, se, sw = (nbr[:, k] for k in range(8))
     p = nodes
@@ -47,7 +51,8 @@ def ortho_targets(
     xi_s = 0.25 * (he + hw + d(s, se) + d(sw, s))
     a = np.stack([eta_e / he, eta_w / hw, xi_n / hn, xi_s / hs])
     mean = np.stack([(a[0] + a[1]) / 2, (a[0] + a[1]) / 2, (a[2] + a[3]) / 2, (a[2] + a[3]) / 2])
-    sx, sy = blend(smooth, he, hw, lo, hi), blend(smooth, hn, hs, lo if lo_y is None else lo_y, hi)
+    sx = blend(smooth, he, hw, lo, hi, floor)
+    sy = blend(smooth, hn, hs, lo if lo_y is None else lo_y, hi, floor)
     a = a + np.stack([sx, sx, sy, sy]) * (mean - a)
     den = a.sum(axis=0)
     tx = (a[0] * x[e] + a[1] * x[w] + a[2] * x[n] + a[3] * x[s]) / den

@@ -30,7 +30,9 @@ to the next (a polar fan into a block corner, a jump across a cut line).  A blen
 the Laplace weights (``smooth``) damps that everywhere; ``size_ratio = (lo, hi)`` adds more
 of it only where two consecutive edges along a grid line differ by more than ``lo``, up to
 the full Laplace weights at ``hi`` (default 1.2 and 2: the modellers' limits for consecutive
-edges and for cells across an interface).  That blend is a state per node, moved
+edges and for cells across an interface) — and where an edge at the node is shorter than
+:data:`EDGE_FLOOR` of the level's median edge, however alike the two (a polar fan's cells shrink
+towards an obtuse block corner at a steady ratio under ``lo``).  That blend is a state per node, moved
 ``size_relax`` of the way to its current value each sweep: switched on and off at once, a
 node next to a shore node can cycle between the orthogonal and the smooth position for ever.  Every move is guarded: no
 cell around a moving node may lose its positive corner Jacobians, so a grid without folds
@@ -284,6 +286,18 @@ SHORE_ROW_LO: float | None = 1.05
 SHORE_ROWS = 2
 
 
+#: Where an edge at a node is shorter than this share of the level's median edge, the size blend
+#: rises there too (in full at half of it; :func:`._kernels._short`), along grid lines and along the
+#: shore.  At an obtuse block corner (the shore straight or bending outwards there: a tip block's
+#: fourth corner, a cut's end at a land tip) the only orthogonal grid is a polar fan whose cells
+#: shrink towards the corner by a steady ratio under ``size_ratio[0]``: held-out lakes had edges of
+#: 1/100 of the cell size there, an explicit model's time step ÷ 100.  The floor trades a few nodes'
+#: angles at such corners for cells of at least ~1/10 (0: off; ``size_ratio=None``: off too).
+#: Session 41, held-out sets 25–28 (112 lakes) at 10 000 cells: shortest edge under 0.05 cells on
+#: 35 → 11 lakes, hard targets 107 → 107 (docs/lake-grids-journal.md).
+EDGE_FLOOR = 0.2
+
+
 def _row_limits(m, lo: float) -> tuple[np.ndarray, np.ndarray]:
     """Per regular node of node map ``m``, where the size blend starts along its e–w line and along
     its n–s line: ``lo``, or :data:`SHORE_ROW_LO` along a line whose next node (either way) lies
@@ -478,6 +492,7 @@ def iterate_orthogonalize(
     bz = np.zeros(len(fidx))
     edge = np.hypot(X[cells[:, 1]] - X[cells[:, 0]], Y[cells[:, 1]] - Y[cells[:, 0]])
     h = float(np.median(edge))
+    floor = EDGE_FLOOR * h if EDGE_FLOOR and size_ratio is not None else 0.0  # (part of the size blend)
     hist = []
     it = 0
     converged = False
@@ -488,7 +503,7 @@ def iterate_orthogonalize(
         """One sweep of the free nodes given (interior, irregular ``irr``, shore ``free``) with
         their states; the largest move over ``h``."""
         d1 = _kernels.sweep(
-            X, Y, nodes, nbr, *irr, cptr, ncells, omega, smooth, lox, loy, hi, bx, by, size_relax, jmin, thin
+            X, Y, nodes, nbr, *irr, cptr, ncells, omega, smooth, lox, loy, hi, floor, bx, by, size_relax, jmin, thin
         )
         d2 = _kernels.shore_sweep(
             X,
@@ -511,6 +526,7 @@ def iterate_orthogonalize(
             jmin,
             lo,
             hi,
+            floor,
             bz,
             size_relax,
             across,

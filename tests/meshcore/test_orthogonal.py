@@ -42,18 +42,26 @@ def test_the_kernel_update_is_the_numpy_oracle(smooth, lo, hi):
     gx[ids], gy[ids] = X, Y
     tx, ty = np.empty(len(m.nodes)), np.empty(len(m.nodes))
     lox, loy = np.full(len(m.nodes), lo), np.full(len(m.nodes), lo)
-    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, tx, ty)
+    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, 0.0, tx, ty)
     rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi)
     np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
     np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
     if np.isfinite(lo):  # each node's own start of the blend along each of its lines (the shore rows')
         lox, loy = np.where(rng.random(len(m.nodes)) < 0.5, 1.0, lo), np.where(rng.random(len(m.nodes)) < 0.5, 1.0, lo)
-        _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, tx, ty)
+        _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, 0.0, tx, ty)
         rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lox, hi, lo_y=loy)
         np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
         np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
         ux, _ = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lo, hi)
         assert smooth == 1.0 or np.abs(tx - ux).max() > 1e-6  # (smooth 1: the blend is whole anyway)
+    # the floor: edges shorter than it get the blend too (the edges here are 0.1–0.25 long)
+    floor = 0.3
+    _kernels.jacobi_targets(gx, gy, m.nodes, m.nbr, smooth, lox, loy, hi, floor, tx, ty)
+    rx, ry = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lox, hi, lo_y=loy, floor=floor)
+    np.testing.assert_allclose(tx, rx, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(ty, ry, rtol=0, atol=1e-13)
+    fx, _ = ortho_targets(gx, gy, m.nodes, m.nbr, smooth, lox, hi, lo_y=loy)
+    assert smooth == 1.0 or np.abs(rx - fx).max() > 1e-6
 
 
 def test_an_orthogonal_grid_is_a_fixed_point():
@@ -433,7 +441,7 @@ def test_a_shore_node_between_two_cut_ends_never_passes_a_neighbour(beyond_next)
     for _ in range(30):
         _kernels.shore_sweep(
             X, Y, np.array([k]), bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells,
-            1.0, 0.15, 0.25, jmin, lo, hi, bz, 0.05, across, np.array([lo]), np.zeros(m.n_nodes, np.uint8),
+            1.0, 0.15, 0.25, jmin, lo, hi, 0.0, bz, 0.05, across, np.array([lo]), np.zeros(m.n_nodes, np.uint8),
         )  # fmt: skip
         assert Y[p] == 0.0  # on the shore
         assert 1.0 + 0.1 * 2.0 - 1e-9 <= X[p] <= 3.0 - 0.1 * 2.0 + 1e-9  # within its own arc, a tenth from either end

@@ -113,11 +113,14 @@ def test_a_rough_network_keeps_no_cell_thinner_than_1_to_100(monkeypatch):
     """``channel_network(943202, …, roughness=0.15)`` at 8 000 cells (a fresh sweep's shape): the
     stages without the thin rule leave a cell of aspect ratio 164 (the grid of main before the
     rule); run again with the rule round it, the largest is 34, the interface ratio and the shore
-    as before (1.43, 0.32 cells)."""
+    as before (1.43, 0.32 cells).  Both with the size blend's floor off (``EDGE_FLOOR``, session 41),
+    which alone keeps that cell at an aspect ratio of 6.4: with the floor and the rule, under 50 too."""
     poly = testing.channel_network(943202, n_branches=4, width=(1.0, 3.0), roughness=0.15)
+    floor = driver.EDGE_FLOOR
 
-    def worst(runs):
+    def worst(runs, floor=0.0):
         monkeypatch.setattr(driver, "THIN_RUNS", runs)
+        monkeypatch.setattr(driver, "EDGE_FLOOR", floor)
         mb = mesh_outline(poly, target_cells=8000)
         return lake_metrics(mb, polygon=poly)
 
@@ -125,5 +128,6 @@ def test_a_rough_network_keeps_no_cell_thinner_than_1_to_100(monkeypatch):
     off, on = worst(0), worst(runs)
     assert off.max("aspect_ratio") > 100
     assert on.max("aspect_ratio") < 50
+    assert worst(runs, floor).max("aspect_ratio") < 50
     assert on.summary()["folded_cells"] == 0
     assert on.max("interface_ratio") < 1.5
