@@ -317,7 +317,9 @@ def compute_layout(lake: Lake, cuts: Any = None, *, stop_event: Any = None) -> A
     from .lake_solve import coarse_readings, hold_readings
 
     readings = coarse_readings()  # the chosen layout's coarse level solved once, as meshcore mesh does
-    reading = readings if stop_event is None else _stoppable(readings, stop_event)
+    # a reading under way stops at its next sweep; auto_layout's own checks (between the stages of a draw and
+    # between draws) end the layout with Stopped, and a reading a stop cut short is never used (raised below)
+    readings.stop_event.event = stop_event
     try:
         lay = auto_layout(
             poly,
@@ -325,7 +327,7 @@ def compute_layout(lake: Lake, cuts: Any = None, *, stop_event: Any = None) -> A
             multiple=2**LEVELS,
             regular=lake.regular,
             single=lake.single,
-            reading=reading,
+            reading=readings,
             stop_event=stop_event,
         )
     finally:
@@ -334,22 +336,6 @@ def compute_layout(lake: Lake, cuts: Any = None, *, stop_event: Any = None) -> A
         raise Stopped("the layout was stopped")
     hold_readings(lay, readings)  # its grid (app.lake_solve.solve_layout) goes on from there
     return lay
-
-
-def _stoppable(readings: Any, stop_event: Any):
-    """``readings`` (:func:`app.lake_solve.coarse_readings`) ending the layout with :class:`~meshcore.errors.Stopped`
-    once ``stop_event`` is set: before and after each reading, and a reading under way at its next sweep."""
-    readings.stop_event.event = stop_event
-
-    def reading(layout):
-        if stop_event.is_set():
-            raise Stopped("the layout was stopped")
-        got = readings(layout)
-        if stop_event.is_set():  # (the reading, stopped half way, reads nothing true)
-            raise Stopped("the layout was stopped")
-        return got
-
-    return reading
 
 
 def split_layout(poly: Any, cuts: list, cell_size: float, multiple: int) -> Any:
