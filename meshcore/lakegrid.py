@@ -184,7 +184,7 @@ class CoarseReadings:
         # (layout, paused solve, coarse level, callback box, the progress it paused on)
         self._held: list[tuple[Any, Any, Any, list, Any]] = []
 
-    def __call__(self, layout) -> tuple[float, float]:
+    def __call__(self, layout) -> tuple[float, float, float]:
         """:func:`coarse_reading` of ``layout``, its solve held."""
         first: list = []
         box: list = [None]  # the callback of :meth:`mesh`, for the levels after the first
@@ -255,20 +255,22 @@ def _same_layout(a, b) -> bool:
 READING_PERCENTILE = 99.0
 
 
-def _reading(grids) -> tuple[float, float]:
+def _reading(grids) -> tuple[float, float, float]:
     from .quality import lake_metrics
 
     m = lake_metrics(list(grids))
-    d = m.summary()["mean_deviation_deg"]
+    summary = m.summary()
+    d, least = summary["mean_deviation_deg"], summary["min_edge_cells"]
     v = np.asarray(m.values("interface_ratio"), dtype=float)
     r = float(np.percentile(v, READING_PERCENTILE)) if len(v) else 1.0
-    return (float("inf") if d is None else float(d)), r
+    return (float("inf") if d is None else float(d)), r, (1.0 if least is None else float(least))
 
 
-def coarse_reading(layout) -> tuple[float, float]:
+def coarse_reading(layout) -> tuple[float, float, float]:
     """The mean deviation from 90° (degrees) of the block-interior nodes of ``layout``'s grid on
-    the coarsest level of :func:`mesh_layout` (cells ``layout.multiple`` × the size), and the
-    :data:`READING_PERCENTILE` th percentile of its cross-interface cell-area ratios: what
+    the coarsest level of :func:`mesh_layout` (cells ``layout.multiple`` × the size), the
+    :data:`READING_PERCENTILE` th percentile of its cross-interface cell-area ratios and its
+    shortest edge in its mean cell sizes (a collapsed cell: :data:`~meshcore.layout.choice.COLLAPSED`): what
     :func:`~meshcore.layout.auto_layout` (``reading=``) compares layouts drawn at neighbouring
     scales by (:mod:`meshcore.layout.choice`)."""
     grids = mesh_layout(layout, callback=lambda kind, _: "stop" if kind == "level" else None).grids

@@ -91,7 +91,7 @@ def auto_layout(
     regular: bool = False,
     single: bool = False,
     options: LayoutOptions = DEFAULT_OPTIONS,
-    reading: Callable[[Layout], tuple[float, float]] | None = None,
+    reading: Callable[[Layout], tuple[float, ...]] | None = None,
     stop_event: Any = None,
 ) -> Layout:
     """Decompose a water polygon into four-sided blocks that follow its channels.
@@ -123,13 +123,14 @@ def auto_layout(
         Layout choices that are off by default (thin arms, mouths, curve, wedges; each measured
         mixed): :class:`~.model.LayoutOptions`.
     reading : callable, optional
-        A layout's coarse grid read as (mean deviation from 90°, largest interface ratio)
-        (:func:`meshcore.lakegrid.coarse_reading`, as :func:`meshcore.mesh_outline` and
-        ``meshcore mesh`` pass): with it a layout (not ``single``) is drawn again at
-        neighbouring scales and the one whose coarse grid is clearly more orthogonal is kept
-        (:mod:`.choice`); a regular one also against a draw with at least four cut ends on every
-        island (:mod:`.ringcuts`), and each other draw only if its blocks close up round every
-        island.
+        A layout's coarse grid read as (mean deviation from 90°, largest interface ratio[,
+        shortest edge in cell sizes]) (:func:`meshcore.lakegrid.coarse_reading`, as
+        :func:`meshcore.mesh_outline` and ``meshcore mesh`` pass): with it a layout (not
+        ``single``) is drawn again at neighbouring scales and the one whose coarse grid is clearly
+        more orthogonal is kept (:mod:`.choice`), unless its coarse grid has a collapsed cell and
+        another's, not much less orthogonal, has none; a regular one also against a draw with at
+        least four cut ends on every island (:mod:`.ringcuts`), and each other draw only if its
+        blocks close up round every island.
     stop_event : threading.Event, optional
         Once set (anything with ``is_set()``), the layout ends with :class:`~meshcore.errors.Stopped`
         at its next check (:mod:`.stopping`): between the stages of a draw (the skeleton and chords,
