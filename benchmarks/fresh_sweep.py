@@ -29,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import interface_sweep
+from lake_grids import SHORTEST
 
 
 def cases(base: int) -> dict[str, str]:
@@ -136,8 +137,8 @@ def main(argv: list[str] | None = None) -> int:
         f"mean deviation ≤ 3° {sum(r['mean_dev'] <= 3 for r in ok)}, |cos| ≤ 0.02 at ≥ 80 % "
         f"{sum(r['cos02'] >= 80 for r in ok)}, edge pairs ≥ 95 % "
         f"{sum(r['pairs12'] >= 95 for r in ok)}, every interface ratio ≤ 2 {sum(r['max_ratio'] <= 2 for r in ok)}, "
-        f"shore ≤ 0.5 cells {sum(r['shore'] <= 0.5 for r in ok)}, shortest edge ≥ 0.05 cells "
-        f"{sum(r['min_edge'] >= 0.05 for r in ok)}; CPU median "
+        f"shore ≤ 0.5 cells {sum(r['shore'] <= 0.5 for r in ok)}, shortest edge ≥ {SHORTEST} cells "
+        f"{sum(r['min_edge'] >= SHORTEST for r in ok)}; CPU median "
         f"{np.median([r['cpu'] for r in ok]) if ok else float('nan'):.1f} s, max "
         f"{max((r['cpu'] for r in ok), default=float('nan')):.1f} s",
         flush=True,
