@@ -27,6 +27,9 @@ chains around it, so the programs are small (tens to hundreds of unknowns); with
 Optionally every count is a multiple of ``multiple`` (2**k lets a multigrid coarsen k times).
 When every block's cells are given, most chains are forced and the few solutions are searched
 instead (:mod:`.countsearch`, :data:`SEARCH`).
+Among otherwise equally good counts, the spacings that meet are made alike and each cell earns a
+hair (:data:`ALIKE`, :data:`TIE_BREAK`), so that the optimum is one count vector whatever HiGHS's
+search meets first.
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ import numpy as np
 
 from ..errors import TopologyError
 
-__all__ = ["objective", "solve_counts"]
+__all__ = ["ALIKE", "TIE_BREAK", "objective", "solve_counts", "tie_weights"]
 
 #: Spacings that meet (two chains in a row along a block side, two blocks across their
 #: interface) may differ by this factor before the program pays for it ...
@@ -115,6 +118,32 @@ SHORT_JUMPS = False
 #: and 776000 (15 000 and 10 000 cells): within-3° means 98.37/97.75 → 98.32/97.79 (768000), the
 #: shore distance of ``rough net 768204`` 0.79 → 0.19 cells.
 STEEP_ACROSS = False
+
+
+#: Equally good counts are common: a T-junction can slide along a block side over a few multiples
+#: while both of its chains stay above (or below) their targets, and ``|n − t|`` adds up alike;
+#: two sides' T-junctions can slide together.  HiGHS then returns whichever optimum its search meets
+#: first, which its random seed, version or platform can change (held-out set 29 at 10 000 cells:
+#: with ``random_seed`` 0–3, 12 of 131 programs gave two different optima, on 5 of 28 lakes; an
+#: install with another scipy would get other grids).  So every pair of spacings that meet (the
+#: pairs of :data:`JUMP`) also pays this per cell of their difference, however small (``JUMP`` = 1
+#: at a thousandth of the weight): among otherwise equally good counts the cells along a side are
+#: spread alike, a T-junction placed where its two chains' spacings agree ...
+ALIKE = 1e-3
+#: ... and every cell earns this (times ``1 + t / (10 max(t))``, ``t`` its chain's target,
+#: :func:`tie_weights`): a hair more cells is better, a hair more on a longer chain, so that chains
+#: of different lengths differ in weight and the optimum is one count vector unless the layout has
+#: chains of exactly one length (a symmetric shape).  With both, each of those 131 programs had one
+#: optimum for every seed.
+TIE_BREAK = 1e-3
+
+
+def tie_weights(t: np.ndarray) -> np.ndarray:
+    """Per chain (``t``: the chains' targets), the cost of one of its cells that breaks ties
+    (negative: more cells are a hair better, :data:`TIE_BREAK`)."""
+    t = np.asarray(t, dtype=float)
+    top = float(t.max()) if len(t) else 0.0
+    return -TIE_BREAK * (1.0 + 0.1 * t / top) if top > 0 else np.full(len(t), -TIE_BREAK)
 
 
 def _block_targets(t: np.ndarray, sides) -> np.ndarray:
@@ -227,6 +256,7 @@ def objective(
     want = np.array([v for _, v in short], dtype=float)
     per = np.full(len(short), LEAST_WEIGHT) if weights is None else np.asarray(weights, dtype=float)
     bw = _block_weights(t, sides, area_weights)
+    tie = tie_weights(t)
 
     def cost(n: np.ndarray) -> np.ndarray:
         n = np.atleast_2d(n).astype(float)
@@ -234,10 +264,11 @@ def objective(
         excess = np.maximum(0.0, w * np.maximum(x1 - JUMP * x2, x2 - JUMP * x1))
         steep = np.maximum(0.0, w * np.maximum(x1 - STEEP * x2, x2 - STEEP * x1))
         return (
-            -1e-3 * n.sum(axis=1)
+            n @ tie
             + 0.25 * np.abs(n - t).sum(axis=1)
             + (bw * np.abs((across @ n.T).T - mean)).sum(axis=1)
             + JUMP_WEIGHT * excess.sum(axis=1)
+            + ALIKE * (w * np.abs(x1 - x2)).sum(axis=1)
             + (steep * (STEEP_WEIGHT if steep_w is None else steep_w)).sum(axis=1)
             + (per * np.maximum(0.0, want - n[:, held])).sum(axis=1)
         )
@@ -340,15 +371,16 @@ def solve_counts(
     nj, ns = len(jumps), len(short)
     paid = {int(p): k for k, p in enumerate(np.flatnonzero(steep_w))}  # ... and s_p ≥ 0 per pair that pays
     nst = len(paid)  # for the cells beyond STEEP times (STEEP_WEIGHT, STEEP_ACROSS)
-    nv = 2 * n + 2 * nb + nj + ns + nst
+    nv = 2 * n + 2 * nb + nj + ns + nst + nj  # (last: q_p ≥ |difference| of each pair, ALIKE)
     cost = np.concatenate(
         [
-            np.full(n, -1e-3 * m),
+            m * tie_weights(t),
             np.full(n, 0.25),
             _block_weights(t, sides, area_weights),
             np.full(len(jumps), JUMP_WEIGHT),
             weights,
             steep_w[steep_w > 0],
+            np.full(nj, ALIKE),
         ]
     )
     rows: list[dict[int, float]] = []  # sparse: {unknown: coefficient} per row
@@ -412,6 +444,13 @@ def solve_counts(
                 r[c] -= w * m / t1
             for c in c2:
                 r[c] += JUMP * w * m / t2
+            add(r, 0.0, np.inf)
+            r = row()  # q ≥ w (N1/T1 − N2/T2)
+            r[2 * n + 2 * nb + nj + ns + nst + p] = 1.0
+            for c in c1:
+                r[c] -= w * m / t1
+            for c in c2:
+                r[c] += w * m / t2
             add(r, 0.0, np.inf)
             if p not in paid:
                 continue
