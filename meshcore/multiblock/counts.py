@@ -438,29 +438,19 @@ def solve_counts(
     for p, (ca, ta, cb, tb) in enumerate(jumps):
         w = min(ta, tb)
         for (c1, t1), (c2, t2) in (((ca, ta), (cb, tb)), ((cb, tb), (ca, ta))):
-            r = row()  # g ≥ w (N1/T1 − JUMP N2/T2)
-            r[2 * n + 2 * nb + p] = 1.0
-            for c in c1:
-                r[c] -= w * m / t1
-            for c in c2:
-                r[c] += JUMP * w * m / t2
-            add(r, 0.0, np.inf)
-            r = row()  # q ≥ w (N1/T1 − N2/T2)
-            r[2 * n + 2 * nb + nj + ns + nst + p] = 1.0
-            for c in c1:
-                r[c] -= w * m / t1
-            for c in c2:
-                r[c] += w * m / t2
-            add(r, 0.0, np.inf)
-            if p not in paid:
-                continue
-            r = row()  # s ≥ w (N1/T1 − STEEP N2/T2)
-            r[2 * n + 2 * nb + nj + ns + paid[p]] = 1.0
-            for c in c1:
-                r[c] -= w * m / t1
-            for c in c2:
-                r[c] += STEEP * w * m / t2
-            add(r, 0.0, np.inf)
+            # g ≥ w (N1/T1 − JUMP N2/T2), q ≥ w (N1/T1 − N2/T2), and for a pair that pays,
+            # s ≥ w (N1/T1 − STEEP N2/T2)
+            excess = [(2 * n + 2 * nb + p, JUMP), (2 * n + 2 * nb + nj + ns + nst + p, 1.0)]
+            if p in paid:
+                excess.append((2 * n + 2 * nb + nj + ns + paid[p], STEEP))
+            for var, factor in excess:
+                r = row()
+                r[var] = 1.0
+                for c in c1:
+                    r[c] -= w * m / t1
+                for c in c2:
+                    r[c] += factor * w * m / t2
+                add(r, 0.0, np.inf)
     for q, (c, v) in enumerate(short):
         r = row()  # h ≥ least − n_c
         r[2 * n + 2 * nb + len(jumps) + q] = 1.0
