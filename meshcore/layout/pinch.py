@@ -33,6 +33,16 @@ PINCH = True
 PINCH_CELLS = 3.0
 
 
+#: Bend cuts through a piece's *neck* too: where the land comes within :data:`NECK_CELLS` of a cut
+#: across the piece at a shore point that is no tip by :func:`~.tipcuts._tip` (a blunt tongue whose
+#: bend, read at half the piece's width, is under its 60°), away from the cut's ends (session 44:
+#: held-out g182250, a chord across a bay grazing a tongue at 0.06 cells, one block wrapped round it).
+NECK = True
+
+#: A neck: the land this many cell sizes or less from a cut across the piece.
+NECK_CELLS = 1.0
+
+
 #: The water's turning at a point on the shore is read this many cell sizes along it.
 WATER_SCALE = 3.0
 
@@ -102,30 +112,36 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
     from .width import inscribed
 
     a = rings[i]
-    tip = _tip(a, sigma)
-    if tip is None or len(forced[i]):
+    if len(forced[i]):
         return None
-    v = tip[0]
-    T = a[v]
-    if np.isnan(water.at(T)[0]):
-        return None  # not on the shore
+    tip = _tip(a, sigma)
     reach = PINCH_CELLS * sigma / 1.5
     best = None
     box = np.r_[a.min(axis=0) - reach, a.max(axis=0) + reach]
+    runs = []
     for j, b in enumerate(rings):
         if j == i or len(forced[j]):
             continue
         if (b.max(axis=0) < box[:2]).any() or (b.min(axis=0) > box[2:]).any():
             continue
         run = _shared_run(a, b)
-        if run is None or len(run) < 2 or v in run:
-            continue
-        line = shapely.LineString(a[run])
-        d = line.distance(shapely.Point(T))
-        if d <= reach and (best is None or d < best[0]):
-            best = (d, j, run)
+        if run is not None and len(run) >= 2:
+            runs.append((j, run))
+    if tip is not None:
+        v = tip[0]
+        if np.isnan(water.at(a[v])[0]):
+            return None  # not on the shore
+        for j, run in runs:
+            if v in run:
+                continue
+            d = shapely.LineString(a[run]).distance(shapely.Point(a[v]))
+            if d <= reach and (best is None or d < best[0]):
+                best = (d, j, run)
+    elif NECK:
+        best, v = _neck(a, runs, water, NECK_CELLS * sigma / 1.5, min_width)
     if best is None:
         return None
+    T = a[v]
     _, j, run = best
     inner = [_key(a[k]) for k in run[1:-1]]
     if any(uses().get(p, 0) > 2 for p in inner):  # a third piece's corner on the cut (a T): leave it
@@ -164,6 +180,38 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
     out = [r for k, r in enumerate(rings) if k not in (i, j)] + new
     fo = [f for k, f in enumerate(forced) if k not in (i, j)] + [(), (), ()]
     return out, fo
+
+
+def _neck(a: np.ndarray, runs: list, water, reach: float, min_width: float):
+    """``((distance, j, run), vertex)`` of the shore vertex of ``a`` where the land comes closest
+    to a cut ``run`` shared with piece ``j`` (``runs``), at most ``reach`` from it and at least
+    ``min_width`` from both its ends, the water turning right there (a land bump): the piece's
+    neck; ``(None, -1)`` if there is none."""
+    from ..segments import feet
+
+    turn = water.at(a)
+    shore = np.flatnonzero(turn < 0.0)
+    best, v = None, -1
+    if not len(shore):
+        return best, v
+    pts = a[shore]
+    for j, run in runs:
+        r = a[run]
+        keep = np.ones(len(shore), bool)
+        keep[np.isin(shore, run)] = False
+        keep &= np.hypot(*(pts - r[0]).T) >= min_width
+        keep &= np.hypot(*(pts - r[-1]).T) >= min_width
+        if not keep.any():
+            continue
+        q = pts[keep]
+        d = np.full(len(q), np.inf)
+        for s0, s1 in zip(r[:-1], r[1:], strict=True):
+            dist, _ = feet(np.repeat(s0[None], len(q), 0), np.repeat(s1[None], len(q), 0), q)
+            d = np.minimum(d, dist)
+        k = int(np.argmin(d))
+        if d[k] <= reach and (best is None or d[k] < best[0]):
+            best, v = (float(d[k]), j, run), int(shore[keep][k])
+    return best, v
 
 
 def _counted(rings: list[np.ndarray]):

@@ -6,8 +6,10 @@ import pytest
 import shapely
 from shapely.geometry import Point, Polygon, box
 
+from meshcore.layout import pinch
 from meshcore.layout.pinch import Water, pinched
 from meshcore.layout.split import _orient
+from meshcore.layout.tipcuts import _tip
 
 H = 0.4  # the cell size
 
@@ -54,6 +56,54 @@ def test_a_cut_far_from_any_tip_is_left_alone():
     assert len(rings) == 2
 
 
+def _round_tongue(xc: float):
+    """A basin 12 × 10 with a land tongue 6 wide from its west shore, ended by a half disc of
+    radius 3 (its tip (8, 5)), cut at x = ``xc``: the piece west of the cut a C round the tongue,
+    blunt at the channels' scale (no tip to :func:`~meshcore.layout.tipcuts._tip`)."""
+    water = box(0, 0, 12, 10).difference(box(0, 2, 5, 8).union(Point(5, 5).buffer(3.0, 32)))
+    ys = np.linspace(0.0, 10.0, 26)[1:-1]
+
+    def with_cut(poly):
+        r = _orient(np.asarray(poly.exterior.coords)[:-1])
+        out = []
+        for k in range(len(r)):
+            p, q = r[k], r[(k + 1) % len(r)]
+            out.append(p)
+            if p[0] == q[0] == xc:
+                out += [(xc, y) for y in (ys if q[1] > p[1] else ys[::-1])]
+        return np.array(out, dtype=float)
+
+    return water, with_cut(water.intersection(box(0, 0, xc, 10))), with_cut(box(xc, 0, 12, 10))
+
+
+@pytest.mark.parametrize("gap", [0.1, 0.3])
+def test_a_cut_grazing_a_blunt_tongue_is_bent_through_the_neck(gap):
+    """Within a cell of the tongue (:data:`~meshcore.layout.pinch.NECK_CELLS`) the C is split at
+    its neck: the cut runs to the tongue's nearest point and on (held-out g182250, session 44)."""
+    water, c, east = _round_tongue(8.0 + gap)
+    assert _tip(c, 1.5 * H) is None  # no tip: the neck is what bends the cut
+    rings, forced = pinched([c, east], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 3 and forced == [(), (), ()]
+    polys = [Polygon(r) for r in rings]
+    assert all(p.is_valid for p in polys)
+    assert shapely.union_all(polys).symmetric_difference(water).area < 1e-9 * water.area
+    assert all(np.any(np.hypot(*(r - (8.0, 5.0)).T) < 0.05) for r in rings)  # the tongue's nearest point
+
+
+@pytest.mark.parametrize("gap", [0.5, 1.0])
+def test_a_cut_clear_of_a_blunt_tongue_is_left_alone(gap):
+    water, c, east = _round_tongue(8.0 + gap)
+    rings, _ = pinched([c, east], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 2
+
+
+def test_necks_off_leaves_a_grazing_cut_alone(monkeypatch):
+    monkeypatch.setattr(pinch, "NECK", False)
+    water, c, east = _round_tongue(8.1)
+    rings, _ = pinched([c, east], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 2
+
+
 def _within_3(layout) -> float:
     from meshcore.lakegrid import mesh_layout
     from meshcore.quality import lake_metrics
@@ -85,3 +135,19 @@ def test_two_arms_joining_round_a_tongue_grid_better_with_the_cut_through_its_ti
     assert len(straight.blocks) == 2 and len(bent.blocks) == 3
     before, after = _within_3(straight), _within_3(bent)
     assert before < 80.0 and after > 95.0, (before, after)
+
+
+@pytest.mark.slow
+def test_a_c_round_a_blunt_tongue_grids_better_cut_at_its_neck():
+    """:func:`_round_tongue` cut 0.2 (half a cell) from the tongue: the C's grid squeezes through
+    the neck; bent through the tongue's nearest point, each channel is a block of its own."""
+    from meshcore.layout.edit import layout_from_cuts
+
+    water, _, _ = _round_tongue(8.2)
+    straight = layout_from_cuts(water, [[(8.2, 0.0), (8.2, 10.0)]], cell_size=H, multiple=4)
+    rings, _ = pinched([p.ring for p in straight.pieces], [(), ()], Water(water, H), 1.5 * H, 3 * H)
+    assert len(rings) == 3
+    tip = (8.0, 5.0)
+    bent = layout_from_cuts(water, [[(8.2, 0.0), tip], [tip, (8.2, 10.0)]], cell_size=H, multiple=4)
+    before, after = _within_3(straight), _within_3(bent)
+    assert before < 90.0 and after > 97.0, (before, after)
