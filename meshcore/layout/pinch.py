@@ -187,30 +187,22 @@ def _neck(a: np.ndarray, runs: list, water, reach: float, min_width: float):
     to a cut ``run`` shared with piece ``j`` (``runs``), at most ``reach`` from it and at least
     ``min_width`` from both its ends, the water turning right there (a land bump): the piece's
     neck; ``(None, -1)`` if there is none."""
-    from ..segments import feet
+    import shapely
 
-    turn = water.at(a)
-    shore = np.flatnonzero(turn < 0.0)
+    shore = np.flatnonzero(water.at(a) < 0.0)
     best, v = None, -1
     if not len(shore):
         return best, v
-    pts = a[shore]
+    pts = shapely.points(a[shore])
     for j, run in runs:
         r = a[run]
-        keep = np.ones(len(shore), bool)
-        keep[np.isin(shore, run)] = False
-        keep &= np.hypot(*(pts - r[0]).T) >= min_width
-        keep &= np.hypot(*(pts - r[-1]).T) >= min_width
-        if not keep.any():
-            continue
-        q = pts[keep]
-        d = np.full(len(q), np.inf)
-        for s0, s1 in zip(r[:-1], r[1:], strict=True):
-            dist, _ = feet(np.repeat(s0[None], len(q), 0), np.repeat(s1[None], len(q), 0), q)
-            d = np.minimum(d, dist)
+        d = shapely.distance(pts, shapely.LineString(r))
+        d[np.isin(shore, run)] = np.inf
+        d[np.hypot(*(a[shore] - r[0]).T) < min_width] = np.inf
+        d[np.hypot(*(a[shore] - r[-1]).T) < min_width] = np.inf
         k = int(np.argmin(d))
         if d[k] <= reach and (best is None or d[k] < best[0]):
-            best, v = (float(d[k]), j, run), int(shore[keep][k])
+            best, v = (float(d[k]), j, run), int(shore[k])
     return best, v
 
 
