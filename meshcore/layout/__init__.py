@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..cellsize import DEFAULT_CELLS, default_cell_size
-from . import tipends
+from . import pinch, tipends
 from .blocks import block_counts
 from .build import layout_pieces
 from .choice import chosen
@@ -280,8 +280,9 @@ def _first_fit(
                 def with_tips(s: float, n: bool = normal, d: dict = drawn, base: float = scale, w: str = why) -> Layout:
                     if TIP_GATE and s in d and not splits(d[s][1]):  # no tip split: that draw itself
                         return d[s][0]
-                    with splitting_tips():
-                        return _noted(draw(regular=False, normal=n, scale=base * s), base * s, w, base)
+                    with splitting_tips():  # (regular layouts: only chords split at a neck, .pinch)
+                        got = _noted(draw(regular=regular, normal=n, scale=base * s), base * s, w, base)
+                    return _closing(got, regular)
 
                 more = []
                 if regular and ringed is not None and len(lay.polygon.interiors):  # every island ringed
@@ -290,7 +291,7 @@ def _first_fit(
                         return _closing(ringed(regular=True, normal=n, scale=1.0), True)
 
                     more.append(rings)
-                tips = with_tips if TIP_DRAW and not regular else None
+                tips = with_tips if TIP_DRAW and (pinch.NECK or not regular) else None
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
                 lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
             return lay, None, None

@@ -219,7 +219,15 @@ def layout_pieces(
             pieces.append(Piece(r, idx))
         return pieces, cuts
 
-    lines = [_densify(c.points, h) for c in chords]
+    lines = [c.points for c in chords]
+    if regular and pinch.NECK:  # chords grazing the land (default layouts: .pinch.pinched in the tip draw)
+        split = pinch.necked_lines(lines, pinch.Water(dense, h), h, 2 * h)
+        if len(split) != len(lines):
+            if tips_split():  # (the layout choice's tip draw)
+                lines = split
+            else:
+                noted_pinch()
+    lines = [_densify(c, h) for c in lines]
     pieces, cuts = made(lines)
     for _ in range(RING_ROUNDS if ring else 0):  # islands with fewer than four cut ends: more cuts
         v = _vertices(pieces)

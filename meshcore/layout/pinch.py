@@ -17,7 +17,17 @@ import math
 
 import numpy as np
 
-__all__ = ["PINCH", "PINCH_CELLS", "WATER_SCALE", "Water", "pinch_candidates", "pinched"]
+__all__ = [
+    "NECK",
+    "NECK_CELLS",
+    "PINCH",
+    "PINCH_CELLS",
+    "WATER_SCALE",
+    "Water",
+    "necked_lines",
+    "pinch_candidates",
+    "pinched",
+]
 
 #: Bend cuts through land tips in the tip draw.  Session 35, with
 #: :data:`~.choice.TIP_RATIO_SLACK` 0.01, against the layouts without (the layout choice scanned
@@ -245,3 +255,34 @@ def pinch_candidates(rings: list[np.ndarray], forced: list, water, sigma: float,
     """Whether :func:`pinched` would bend any cut of these pieces."""
     uses = _counted(rings)
     return any(_pinch_one(rings, forced, i, sigma, min_width, water, uses) is not None for i in range(len(rings)))
+
+
+def necked_lines(lines: list[np.ndarray], water, h: float, min_width: float) -> list[np.ndarray]:
+    """``lines`` (the chords, each from shore to shore) with every one that comes within
+    :data:`NECK_CELLS` of the land away from its ends (at least ``min_width`` from both, where the
+    water turns right: a land bump) split in two at the land's nearest shore point (``water``: a
+    :class:`Water` of the water polygon sampled every ``h`` or finer).  For layouts that do not
+    :func:`pinched` their pieces (regular ones): the piece beyond such a chord would hold two
+    channels joined by a neck under a cell wide."""
+    import shapely
+
+    out: list[np.ndarray] = []
+    reach = NECK_CELLS * h
+    shore = water.turn < 0.0
+    pts = water.points[shore]
+    if not len(pts):
+        return list(lines)
+    for line in lines:
+        a, b = np.asarray(line[0], float), np.asarray(line[-1], float)
+        far = (np.hypot(*(pts - a).T) >= min_width) & (np.hypot(*(pts - b).T) >= min_width)
+        if not far.any():
+            out.append(line)
+            continue
+        d = shapely.distance(shapely.points(pts[far]), shapely.LineString(line))
+        k = int(np.argmin(d))
+        if d[k] > reach:
+            out.append(line)
+            continue
+        P = pts[far][k]
+        out += [np.vstack([a, P]), np.vstack([P, b])]
+    return out

@@ -151,3 +151,46 @@ def test_a_c_round_a_blunt_tongue_grids_better_cut_at_its_neck():
     bent = layout_from_cuts(water, [[(8.2, 0.0), tip], [tip, (8.2, 10.0)]], cell_size=H, multiple=4)
     before, after = _within_3(straight), _within_3(bent)
     assert before < 90.0 and after > 97.0, (before, after)
+
+
+def test_necked_lines_split_a_chord_grazing_the_land_at_its_nearest_point():
+    """The regular layouts' form (:func:`~meshcore.layout.pinch.necked_lines`): the chord across
+    :func:`_round_tongue`'s channels 0.1 from the tongue becomes two, meeting on the tongue's end;
+    one 1.0 from it stays whole."""
+    from meshcore.layout.pinch import necked_lines
+
+    water, _, _ = _round_tongue(8.1)
+    dense = shapely.segmentize(water, H)
+    near = np.array([(8.1, 0.0), (8.1, 10.0)])
+    got = necked_lines([near], Water(dense, H), H, 2 * H)
+    assert len(got) == 2
+    assert np.allclose(got[0][0], near[0]) and np.allclose(got[1][-1], near[1])
+    assert np.allclose(got[0][-1], got[1][0]) and np.hypot(*(got[0][-1] - (8.0, 5.0))) < 0.5 * H
+    far = np.array([(9.0, 0.0), (9.0, 10.0)])
+    assert len(necked_lines([far], Water(dense, H), H, 2 * H)) == 1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("regular", [False, True])
+def test_a_bay_chord_grazing_a_tongue_leaves_no_neck(regular):
+    """Held-out g182250 (session 44; `tests/data/README.md`): at 10 000 cells the junction chord
+    across its north-east bay runs on past a blunt tongue, 0.06 cells from it, to the far shore of
+    the north arm; the block beyond held both lobes joined by that neck (82.6 % of nodes within 3°,
+    an edge of 0.03 cells).  Default layouts bend the cut in the tip draw, regular ones split the
+    chord."""
+    from pathlib import Path
+
+    from meshcore.cli.lakefile import local_frame
+    from meshcore.io import read_points
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.layout.polygon import water_from_points, water_polygon
+    from meshcore.quality import lake_metrics
+
+    f = Path(__file__).parents[1] / "data" / "gshhg_g182250.geojson"
+    pts, _ = local_frame(read_points(f), "auto")
+    outer, islands = water_from_points(pts)
+    poly, _ = water_polygon(outer, holes=islands)
+    mb = mesh_outline(poly, target_cells=10_000, regular=regular)
+    s = lake_metrics(mb, polygon=poly, cell_size=(poly.area / 10_000) ** 0.5).summary()
+    assert s["folded_cells"] == 0
+    assert s["pct_nodes_within_3deg"] > 95.0 and s["min_edge_cells"] > 0.05, s
