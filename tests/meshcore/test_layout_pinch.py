@@ -21,18 +21,20 @@ def _c_and_neighbour():
     tongue = box(0, 4.5, 6, 5.5).union(Point(6, 5).buffer(0.5, 16))
     water = box(0, 0, 10, 10).difference(tongue)
     ys = np.arange(1.0, 10.0)
+    return water, _with_cut(water.intersection(box(0, 0, 7, 10)), 7.0, ys), _with_cut(box(7, 0, 10, 10), 7.0, ys)
 
-    def with_cut(poly):
-        r = _orient(np.asarray(poly.exterior.coords)[:-1])
-        out = []
-        for k in range(len(r)):
-            p, q = r[k], r[(k + 1) % len(r)]
-            out.append(p)
-            if p[0] == q[0] == 7.0:  # the cut: the same points on both sides
-                out += [(7.0, y) for y in (ys if q[1] > p[1] else ys[::-1])]
-        return np.array(out, dtype=float)
 
-    return water, with_cut(water.intersection(box(0, 0, 7, 10))), with_cut(box(7, 0, 10, 10))
+def _with_cut(poly, xc: float, ys: np.ndarray) -> np.ndarray:
+    """The exterior ring of ``poly`` (the water on its left) with the points ``(xc, ys)`` along its
+    side on the line x = ``xc``: the cut, the same points on both sides."""
+    r = _orient(np.asarray(poly.exterior.coords)[:-1])
+    out = []
+    for k in range(len(r)):
+        p, q = r[k], r[(k + 1) % len(r)]
+        out.append(p)
+        if p[0] == q[0] == xc:
+            out += [(xc, y) for y in (ys if q[1] > p[1] else ys[::-1])]
+    return np.array(out, dtype=float)
 
 
 def test_a_cut_passing_close_by_a_tip_is_bent_through_it():
@@ -62,18 +64,7 @@ def _round_tongue(xc: float):
     blunt at the channels' scale (no tip to :func:`~meshcore.layout.tipcuts._tip`)."""
     water = box(0, 0, 12, 10).difference(box(0, 2, 5, 8).union(Point(5, 5).buffer(3.0, 32)))
     ys = np.linspace(0.0, 10.0, 26)[1:-1]
-
-    def with_cut(poly):
-        r = _orient(np.asarray(poly.exterior.coords)[:-1])
-        out = []
-        for k in range(len(r)):
-            p, q = r[k], r[(k + 1) % len(r)]
-            out.append(p)
-            if p[0] == q[0] == xc:
-                out += [(xc, y) for y in (ys if q[1] > p[1] else ys[::-1])]
-        return np.array(out, dtype=float)
-
-    return water, with_cut(water.intersection(box(0, 0, xc, 10))), with_cut(box(xc, 0, 12, 10))
+    return water, _with_cut(water.intersection(box(0, 0, xc, 10)), xc, ys), _with_cut(box(xc, 0, 12, 10), xc, ys)
 
 
 @pytest.mark.parametrize("gap", [0.1, 0.3])
