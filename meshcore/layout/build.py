@@ -171,8 +171,9 @@ def layout_pieces(
     def on_island(p) -> bool:
         return bool(shapely.dwithin(holes, shapely.Point(p), 1e-9 * size))
 
-    # the water's turning along the shore: cuts passing land tips (.pinch)
-    water = pinch.Water(dense, h) if pinch.PINCH and not regular else None
+    # the water's turning along the shore: cuts passing land tips or grazing the land (.pinch)
+    pinching = pinch.PINCH and not regular
+    water = pinch.Water(dense, h) if pinching or (regular and pinch.NECK) else None
 
     def made(lines: list[np.ndarray]) -> tuple[list[Piece], list]:
         regions, cuts = _partition(dense, lines, sigma)
@@ -192,7 +193,7 @@ def layout_pieces(
             cuts += new_cuts
         check()
         rings, forced = _welded(rings, forced, 1e-9 * size)
-        if pinch.PINCH and water is not None:  # (the tip draw: cuts passing close by land tips bent through them)
+        if pinching and water is not None:  # (the tip draw: cuts passing close by land tips bent through them)
             if tips_split():
                 rings, forced = pinch.pinched(rings, forced, water, sigma, 3 * h)
             elif pinch.pinch_candidates(rings, forced, water, sigma, 3 * h):
@@ -220,8 +221,8 @@ def layout_pieces(
         return pieces, cuts
 
     lines = [c.points for c in chords]
-    if regular and pinch.NECK:  # chords grazing the land (default layouts: .pinch.pinched in the tip draw)
-        split = pinch.necked_lines(lines, pinch.Water(dense, h), h, 2 * h)
+    if regular and water is not None:  # chords grazing the land (default layouts: .pinch.pinched in the tip draw)
+        split = pinch.necked_lines(lines, water, h, 2 * h)
         if len(split) != len(lines):
             if tips_split():  # (the layout choice's tip draw)
                 lines = split

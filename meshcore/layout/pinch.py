@@ -125,6 +125,14 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
     if len(forced[i]):
         return None
     tip = _tip(a, sigma)
+    if tip is not None:
+        v = tip[0]
+        if np.isnan(water.at(a[v])[0]):
+            return None  # not on the shore
+    else:
+        bumps = np.flatnonzero(water.at(a) < 0.0) if NECK else np.empty(0, dtype=np.intp)
+        if not len(bumps):
+            return None  # no tip, no land bump to be a neck
     reach = PINCH_CELLS * sigma / 1.5
     best = None
     box = np.r_[a.min(axis=0) - reach, a.max(axis=0) + reach]
@@ -138,17 +146,14 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
         if run is not None and len(run) >= 2:
             runs.append((j, run))
     if tip is not None:
-        v = tip[0]
-        if np.isnan(water.at(a[v])[0]):
-            return None  # not on the shore
         for j, run in runs:
             if v in run:
                 continue
             d = shapely.LineString(a[run]).distance(shapely.Point(a[v]))
             if d <= reach and (best is None or d < best[0]):
                 best = (d, j, run)
-    elif NECK:
-        best, v = _neck(a, runs, water, NECK_CELLS * sigma / 1.5, min_width)
+    else:
+        best, v = _neck(a, bumps, runs, NECK_CELLS * sigma / 1.5, min_width)
     if best is None:
         return None
     T = a[v]
@@ -192,27 +197,31 @@ def _pinch_one(rings: list[np.ndarray], forced: list, i: int, sigma: float, min_
     return out, fo
 
 
-def _neck(a: np.ndarray, runs: list, water, reach: float, min_width: float):
-    """``((distance, j, run), vertex)`` of the shore vertex of ``a`` where the land comes closest
-    to a cut ``run`` shared with piece ``j`` (``runs``), at most ``reach`` from it and at least
-    ``min_width`` from both its ends, the water turning right there (a land bump): the piece's
-    neck; ``(None, -1)`` if there is none."""
+def _nearest_bump(pts: np.ndarray, line: np.ndarray, min_width: float) -> tuple[float, int]:
+    """``(distance, index)`` of the point of ``pts`` (land bumps on the shore) nearest to the cut
+    ``line`` among those at least ``min_width`` from both its ends; ``(inf, -1)`` if none is."""
     import shapely
 
-    shore = np.flatnonzero(water.at(a) < 0.0)
+    far = (np.hypot(*(pts - line[0]).T) >= min_width) & (np.hypot(*(pts - line[-1]).T) >= min_width)
+    if not far.any():
+        return math.inf, -1
+    d = np.full(len(pts), np.inf)
+    d[far] = shapely.distance(shapely.points(pts[far]), shapely.LineString(line))
+    k = int(np.argmin(d))
+    return float(d[k]), k
+
+
+def _neck(a: np.ndarray, bumps: np.ndarray, runs: list, reach: float, min_width: float):
+    """``((distance, j, run), vertex)`` of the vertex of ``a`` among ``bumps`` (its shore vertices
+    where the water turns right: land bumps) nearest to a cut ``run`` shared with piece ``j``
+    (``runs``), off the run, at most ``reach`` from it and at least ``min_width`` from both its
+    ends: the piece's neck; ``(None, -1)`` if there is none."""
     best, v = None, -1
-    if not len(shore):
-        return best, v
-    pts = shapely.points(a[shore])
     for j, run in runs:
-        r = a[run]
-        d = shapely.distance(pts, shapely.LineString(r))
-        d[np.isin(shore, run)] = np.inf
-        d[np.hypot(*(a[shore] - r[0]).T) < min_width] = np.inf
-        d[np.hypot(*(a[shore] - r[-1]).T) < min_width] = np.inf
-        k = int(np.argmin(d))
-        if d[k] <= reach and (best is None or d[k] < best[0]):
-            best, v = (float(d[k]), j, run), int(shore[k])
+        off = bumps[~np.isin(bumps, run)]
+        d, k = _nearest_bump(a[off], a[run], min_width)
+        if d <= reach and (best is None or d < best[0]):
+            best, v = (d, j, run), int(off[k])
     return best, v
 
 
@@ -264,25 +273,12 @@ def necked_lines(lines: list[np.ndarray], water, h: float, min_width: float) -> 
     :class:`Water` of the water polygon sampled every ``h`` or finer).  For layouts that do not
     :func:`pinched` their pieces (regular ones): the piece beyond such a chord would hold two
     channels joined by a neck under a cell wide."""
-    import shapely
-
     out: list[np.ndarray] = []
-    reach = NECK_CELLS * h
-    shore = water.turn < 0.0
-    pts = water.points[shore]
-    if not len(pts):
-        return list(lines)
+    pts = water.points[water.turn < 0.0]
     for line in lines:
-        a, b = np.asarray(line[0], float), np.asarray(line[-1], float)
-        far = (np.hypot(*(pts - a).T) >= min_width) & (np.hypot(*(pts - b).T) >= min_width)
-        if not far.any():
+        d, k = _nearest_bump(pts, np.asarray(line, float), min_width) if len(pts) else (math.inf, -1)
+        if d > NECK_CELLS * h:
             out.append(line)
             continue
-        d = shapely.distance(shapely.points(pts[far]), shapely.LineString(line))
-        k = int(np.argmin(d))
-        if d[k] > reach:
-            out.append(line)
-            continue
-        P = pts[far][k]
-        out += [np.vstack([a, P]), np.vstack([P, b])]
+        out += [np.vstack([line[0], pts[k]]), np.vstack([pts[k], line[-1]])]
     return out
