@@ -480,26 +480,13 @@ def _first_countable(
     """The first choice of :func:`~.frames.close_frames` (``own``, ``bends``) whose cells can be
     counted (with ``single``, in one index space), as ``(pieces, cuts)``; None if there is none
     (``least``: :func:`~.frames.close_frames`' least turning of a new corner, if given)."""
-    from ..errors import TopologyError
-
-    # each choice as it is first; the T-junction extensions of :func:`_make_countable` only when
-    # none can be counted so (they cost 10-20 count programs a choice that fails, and on 421 calls,
-    # sessions 38 and 44, never made a choice countable)
-    later = []
+    # each choice as it is: the T-junction extensions of :func:`_make_countable` never made a
+    # closure choice countable (sessions 38 and 44: 421 calls) and cost 10-20 count programs a choice
     for closed in close_frames(
         pieces, sigma, own=own, single=single, tries=SINGLE_TRIES if single else 3, bends=bends, **(least or {})
     ):
-        if not _countable(closed, h):
-            later.append(closed)
-        elif not single or _countable(closed, h, closed=True):
+        if _countable(closed, h) and (not single or _countable(closed, h, closed=True)):
             return closed, cuts
-    for closed in later:
-        try:
-            got = _make_countable(closed, cuts, h, size)
-        except TopologyError:
-            continue
-        if not single or _countable(got[0], h, closed=True):
-            return got
     return None
 
 

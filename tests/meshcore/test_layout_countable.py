@@ -72,3 +72,30 @@ def test_a_flat_stretch_shorter_than_the_plateau_does_not_stop_them(monkeypatch)
     rounds = _rigged(monkeypatch, counts, countable_at=p + 2)
     pieces, _ = build._make_countable(START, [], 0.1, 1.0)
     assert len(pieces) == len(START) + p + 2 and len(rounds) == p + 2
+
+
+def _choices(monkeypatch, countable_ids):
+    """``close_frames`` replaced by three closure choices (piece lists told apart by their first
+    square's x) of which those in ``countable_ids`` can be counted; T-junction extensions fail
+    the test."""
+    choices = [[_square(10.0 * k)] for k in range(3)]
+    monkeypatch.setattr(build, "close_frames", lambda pieces, sigma, **kw: iter(choices))
+    monkeypatch.setattr(build, "_countable", lambda pieces, h, closed=False: pieces[0].ring[0, 0] / 10.0 in countable_ids)
+
+    def extend(pieces, todo=None):
+        raise AssertionError("a closure choice was extended")
+
+    monkeypatch.setattr(tjunction, "extend_t_junctions", extend)
+    return choices
+
+
+def test_closure_choices_are_counted_as_they_are(monkeypatch):
+    choices = _choices(monkeypatch, {1.0, 2.0})
+    got = build._first_countable(START, ["cut"], 0.1, 1.0, 0.2, False, True, 0)
+    assert got is not None and got[0] is choices[1] and got[1] == ["cut"]
+
+
+def test_no_countable_closure_choice_gives_none_without_extending_any(monkeypatch):
+    # session 45: the extensions cost 10-20 count programs a choice and never made one countable
+    _choices(monkeypatch, set())
+    assert build._first_countable(START, [], 0.1, 1.0, 0.2, False, True, 0) is None
