@@ -80,7 +80,11 @@ def _choices(monkeypatch, countable_ids):
     the test."""
     choices = [[_square(10.0 * k)] for k in range(3)]
     monkeypatch.setattr(build, "close_frames", lambda pieces, sigma, **kw: iter(choices))
-    monkeypatch.setattr(build, "_countable", lambda pieces, h, closed=False: pieces[0].ring[0, 0] / 10.0 in countable_ids)
+
+    def countable(pieces, h, closed=False):
+        return pieces[0].ring[0, 0] / 10.0 in countable_ids
+
+    monkeypatch.setattr(build, "_countable", countable)
 
     def extend(pieces, todo=None):
         raise AssertionError("a closure choice was extended")
