@@ -74,6 +74,7 @@ KERNEL_MODULES = (
     "orthogonal/_kernels.py",
     "orthogonal/_equalize_kernels.py",
     "orthogonal/_bfgs.py",
+    "layout/_corner_kernels.py",
 )
 STAMP_NAME = "gcmesh-kernels.stamp"
 

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-__all__ = ["bulge_ratio", "choose_corners", "corner_cost", "raw_turning", "set_cost", "turning"]
+__all__ = ["bulge_ratio", "choose_corners", "choose_corners_numpy", "corner_cost", "raw_turning", "set_cost", "turning"]
 
 #: A vertex turning more than this (degrees, at scale) counts as a sharp feature.
 SHARP = 30.0
@@ -211,7 +211,45 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     corners are placed on the smooth convex stretches in between, in proportion to how much
     each stretch turns, at the quantiles of its turning.  Returns ``(None, inf)`` when the ring
     has fewer than four vertices.
+
+    The work runs in the compiled kernels of :mod:`._corner_kernels`; :func:`choose_corners_numpy`
+    is the same in NumPy, the reference they are tested against (the same corners and cost, bit
+    for bit).
     """
+    from . import _corner_kernels as kernels
+
+    n = len(ring)
+    if n < 4:
+        return None, math.inf
+    ring = np.ascontiguousarray(ring, dtype=float)
+    s, total, at_scale, between = kernels.ring_terms(ring, float(sigma))
+    t = np.degrees(np.arctan2(at_scale[0], at_scale[1]))  # (NumPy's arctan2: the reference's bits)
+    raw = np.degrees(np.arctan2(between[0], between[1]))
+    forced = sorted({int(f) for f in forced})
+    tt = t.copy()
+    tt[forced] = 1e9  # forced first
+    mask = np.zeros(n, dtype=np.bool_)
+    mask[forced] = True
+    picks, corner_term = kernels.choose(s, total, t, raw, np.argsort(-tt), mask, float(sigma))
+    arc = (s, total)
+    if len(picks) != 4:  # (rare: the reference's last resort)
+        return _fourth_resort(ring, sigma, picks.tolist(), t, arc)
+    picks = tuple(int(p) for p in picks)
+    return picks, corner_term + side_cost(s, total, picks) + bulge_cost(ring, picks, arc)
+
+
+def _fourth_resort(ring: np.ndarray, sigma: float, picks: list[int], t: np.ndarray, arc) -> tuple:
+    """The corners of :func:`choose_corners` when its steps found other than four: the most turning
+    vertices not among ``picks`` fill them up."""
+    order = [int(i) for i in np.argsort(-t) if int(i) not in picks]
+    picks = sorted(set(picks + order[: 4 - len(picks)]))[:4]
+    if len(picks) != 4:
+        return None, math.inf
+    return tuple(picks), set_cost(ring, sigma, picks, t=t, arc=arc)
+
+
+def choose_corners_numpy(ring: np.ndarray, sigma: float, *, forced=()):
+    """:func:`choose_corners` in NumPy: the reference of its compiled kernels."""
     n = len(ring)
     if n < 4:
         return None, math.inf
@@ -245,10 +283,7 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
             picks = picks + extra
     picks = sorted(set(picks))
     if len(picks) != 4:
-        order = [int(i) for i in np.argsort(-t) if int(i) not in picks]
-        picks = sorted(set(picks + order[: 4 - len(picks)]))[:4]
-    if len(picks) != 4:
-        return None, math.inf
+        return _fourth_resort(ring, sigma, picks, t, arc)
     return tuple(picks), set_cost(ring, sigma, picks, t=t, arc=arc)
 
 
