@@ -16,6 +16,8 @@ from meshcore.layout import _corner_kernels as kernels
 from meshcore.layout import auto_layout, corners
 from meshcore.layout.corners import choose_corners, choose_corners_numpy
 
+pytestmark = pytest.mark.kernel  # (test_kernels_interpreted.py runs them with the JIT off too)
+
 
 def _same(ring, sigma, forced=()):
     want = choose_corners_numpy(ring, sigma, forced=forced)

@@ -27,5 +27,5 @@ def test_kernel_tests_pass_with_the_jit_off():
     r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=1200)
     assert r.returncode == 0, r.stdout[-4000:] + r.stderr[-2000:]
     # the tier covers every package with numba kernels
-    for module in ("test_elliptic", "test_multigrid", "test_multiblock", "test_foldfree"):
+    for module in ("test_elliptic", "test_multigrid", "test_multiblock", "test_foldfree", "test_corner_kernels"):
         assert f"PASSED tests/meshcore/{module}.py::" in r.stdout, module
