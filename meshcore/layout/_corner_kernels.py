@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-SHARP = 30.0  # = corners.SHARP (asserted by the tests)
+SHARP = 30.0  # = corners.SHARP, a copy: importing it makes an import cycle (tests/test_imports.py); asserted equal
 
 
 @njit(cache=True)
