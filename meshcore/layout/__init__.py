@@ -112,9 +112,10 @@ def auto_layout(
     regular : bool
         No node where three or five blocks meet (no star at Y junctions, no butterfly in
         basins) and block corners round every island that close up (:mod:`.frames`): what
-        Delft3D's domain decomposition can couple.  Where the corners cannot be made to close,
-        the layout is returned as it is; :func:`~.frames.frame_defects` of its pieces names
-        the islands.
+        Delft3D's domain decomposition can couple.  Where the corners cannot be made to close
+        at the cell size, the layout is drawn at the other scales; where they close at none,
+        the first draw is returned as it is (:func:`~.frames.frame_defects` of its pieces names
+        the islands).
     single : bool
         A regular layout whose cell counts also close every ring of blocks round an island in one
         ``(I, J)`` index space (:func:`~meshcore.multiblock.closure.closure_rows`): what a
@@ -233,13 +234,14 @@ def _first_fit(
     draw, *, regular: bool, single: bool, reading, ringed=None
 ) -> tuple[Layout | None, Exception | None, Layout | None]:
     """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
-    shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, a regular
-    layout whose blocks do not close up round an island or None)`` (the scales after the one that
-    drew it are not tried).  With ``reading`` (not ``single``) the layout at the cell size (or at
-    the first other scale that drew one, :data:`FALLBACK_CHOICE`) is compared with those at
-    :data:`~.choice.SCALES` × its scale (:func:`~.choice.chosen`); a regular one (whose
-    other scales must close up round every island too) also with ``ringed``'s, a draw with at least
-    four cut ends on every island (:mod:`.ringcuts`)."""
+    shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, the first
+    regular layout drawn whose blocks do not close up round an island, or None)``.  A regular draw
+    that does not close up is passed over for the next (the other splits, then the other scales:
+    where the cuts from an island fall moves with them).  With ``reading`` (not ``single``) the
+    layout at the cell size (or at the first other scale that drew one, :data:`FALLBACK_CHOICE`)
+    is compared with those at :data:`~.choice.SCALES` × its scale (:func:`~.choice.chosen`); a
+    regular one (whose other scales must close up round every island too) also with ``ringed``'s,
+    a draw with at least four cut ends on every island (:mod:`.ringcuts`)."""
     from ..errors import TopologyError
 
     first = None
@@ -255,11 +257,12 @@ def _first_fit(
                 first = first or exc
                 continue
             why = str(first).removeprefix("automatic layout: ").split(";")[0]
-            if scale != 1.0:
-                lay = _noted(lay, scale, why)
-            elif regular and frame_defects(list(lay.pieces), single=single):
-                kept = kept or lay  # the other splits may close up: tried next, this one if not
+            if regular and frame_defects(list(lay.pieces), single=single):
+                # the other splits, then the other scales, may close up: tried next, this one if none
+                kept = kept or _noted(lay, scale, why)
+                first = first or TopologyError(UNCLOSED)
                 continue
+            lay = _noted(lay, scale, why)
             if single:  # arms that fold onto each other in index space: another scale may not
                 folds = _folds_in_index_space(lay)
                 if folds:
@@ -295,9 +298,7 @@ def _first_fit(
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
                 lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
             return lay, None, None
-        if kept is not None:
-            return None, first, kept
-    return None, first, None
+    return None, first, kept
 
 
 #: A regular layout drawn at another scale or with more cuts from its islands replaces the first
@@ -340,8 +341,13 @@ def _closing(lay: Layout, regular: bool) -> Layout:
     from ..errors import TopologyError
 
     if regular and frame_defects(list(lay.pieces)):
-        raise TopologyError("automatic layout: the blocks do not close up round an island")
+        raise TopologyError(f"automatic layout: {UNCLOSED}")
     return lay
+
+
+#: Why a regular layout was drawn at another scale than the cell size: its draws there left blocks
+#: that do not close up round an island (:func:`~.frames.frame_defects`).
+UNCLOSED = "the blocks do not close up round an island"
 
 
 def _folds_in_index_space(lay: Layout) -> str | None:

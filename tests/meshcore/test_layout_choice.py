@@ -415,3 +415,49 @@ def test_the_choice_passes_over_a_layout_whose_coarse_grid_collapses(monkeypatch
         assert a["folded_cells"] == 0
         assert a["pct_nodes_within_3deg"] >= 95.0
     assert s["pct_nodes_within_3deg"] >= s0["pct_nodes_within_3deg"] - 0.5  # (97.94 against 97.17)
+
+
+@pytest.mark.parametrize("closes_at", [1.15, None])
+def test_a_regular_layout_that_does_not_close_is_drawn_at_the_other_scales(monkeypatch, closes_at):
+    """A regular layout whose blocks do not close up round an island at the cell size is passed over
+    for the other scales' draws (where the cuts from an island fall moves with them); the first that
+    closes is taken, and read against its neighbours.  Only where none closes is the first draw kept
+    (session 46; before, the draw at the cell size was kept at once: generated ``round_lake(945401,
+    kind='arms')``, regular at 10 000 cells, 59.3 → 92.5 % of nodes within 3°)."""
+    real = layout_pkg._layout
+    drawn_at: dict[int, float] = {}
+    scales: list[float] = []
+    kept = []  # (no id reused)
+
+    def draw(*args, scale: float = 1.0, **kw):
+        lay = real(*args, scale=scale, **kw)
+        scales.append(round(scale, 6))
+        drawn_at[id(lay.pieces[0])] = scale  # (its pieces come as a list)
+        kept.append(lay)
+        return lay
+
+    def defects(pieces, single=False):  # the draws at the cell size (and up to closes_at) do not close
+        s = drawn_at[id(pieces[0])]
+        return [] if closes_at is not None and s >= closes_at else ["an island (test)"]
+
+    chosen_from = []
+    real_chosen = layout_pkg.chosen
+
+    def spy(first, *args, **kw):
+        chosen_from.append(first)
+        return real_chosen(first, *args, **kw)
+
+    monkeypatch.setattr(layout_pkg, "_layout", draw)
+    monkeypatch.setattr(layout_pkg, "frame_defects", defects)
+    monkeypatch.setattr(layout_pkg, "chosen", spy)
+    poly = testing.channel_network(1030002, n_branches=6)
+    got = auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=coarse_reading)
+    assert scales[:2] == [1.0, 1.0]  # both splits at the cell size drawn first
+    if closes_at is None:  # none closes: every scale tried, the first draw kept, not read
+        assert scales == [round(s, 6) for s in layout_pkg.LAYOUT_SCALES for _ in (0, 1)]
+        assert drawn_at[id(got.pieces[0])] == 1.0 and not chosen_from
+        assert not any("layout drawn at" in str(n) for n in got.notes)
+    else:  # the first scale that closes is taken and read against its neighbours
+        assert scales[2] == closes_at and defects(got.pieces) == []
+        assert len(chosen_from) == 1 and drawn_at[id(chosen_from[0].pieces[0])] == closes_at
+        assert any("do not close up round an island" in str(n) for n in got.notes)
