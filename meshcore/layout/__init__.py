@@ -208,7 +208,16 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
             _layout, shores, h, notes, multiple=multiple, single=single, options=options, ring=ring
         )
         ringed = functools.partial(_layout, shores, h, notes, multiple=multiple, options=options, ring=True)
-        lay, error, closing = _first_fit(draw, regular=regular, single=single, reading=reading, ringed=ringed)
+        teed = (
+            functools.partial(
+                _layout, shores, h, notes, multiple=multiple, options=dataclasses.replace(options, tees=True)
+            )
+            if TEE_DRAW and regular and not options.tees
+            else None
+        )
+        lay, error, closing = _first_fit(
+            draw, regular=regular, single=single, reading=reading, ringed=ringed, teed=teed
+        )
         if lay is not None:
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
         first, kept = first or error, kept or closing
@@ -231,7 +240,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
 
 
 def _first_fit(
-    draw, *, regular: bool, single: bool, reading, ringed=None
+    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None
 ) -> tuple[Layout | None, Exception | None, Layout | None]:
     """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
     shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, the first
@@ -294,6 +303,12 @@ def _first_fit(
                         return _closing(ringed(regular=True, normal=n, scale=1.0), True)
 
                     more.append(rings)
+                if regular and teed is not None:  # junctions split as a T where that pays (.tee)
+
+                    def tees(n: bool = normal, base: float = scale, w: str = why) -> Layout:
+                        return _closing(_noted(teed(regular=True, normal=n, scale=base), base, w), True)
+
+                    more.append(tees)
                 tips = with_tips if TIP_DRAW and (pinch.NECK or not regular) else None
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
                 lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
@@ -379,6 +394,11 @@ FALLBACK_CHOICE = True
 #: The layout choice (:func:`~.choice.chosen`) also weighs the chosen scale's layout drawn again
 #: with every piece whose side runs round a land tip split from the tip (:mod:`.tipcuts`).
 TIP_DRAW = True
+
+#: The layout choice of a regular layout also weighs its draw with wide junctions split as a T
+#: (:mod:`.tee`, ``LayoutOptions(tees=True)``) at the scale drawn: as an option for every layout
+#: it helped some lakes and hurt others (journal, *Junctions of regular layouts as a T*).
+TEE_DRAW = True
 
 #: The tip draw is skipped where the draw at its scale left no piece that :mod:`.tipcuts` splits
 #: (:func:`~.tipcuts.watching_tips`, :func:`~.tipcuts.splits`): it would make that draw's layout

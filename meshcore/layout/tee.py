@@ -1,7 +1,9 @@
 r"""A junction as a T: what a regular layout may use where the default layout uses a star.
 
-**Off by default** (``LayoutOptions(tees=True)``, ``--layout-option tees``; regular layouts only):
-measured mixed, see ``docs/lake-grids-journal.md`` (*Junctions of regular layouts as a T*).
+**Off as the layout of every lake** (``LayoutOptions(tees=True)``, ``--layout-option tees``; regular
+layouts only): measured mixed, see ``docs/lake-grids-journal.md`` (*Junctions of regular layouts as a
+T*).  The regular layout choice reads the draw with tees as one more candidate
+(:data:`meshcore.layout.TEE_DRAW`) and keeps it where its coarse grid is the most orthogonal.
 
 Delft3D's domain decomposition couples no node where three blocks take a corner each
 (:mod:`.frames`), so a regular layout has no star (:func:`~.split._star`).  Without one, a wide

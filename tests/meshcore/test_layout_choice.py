@@ -461,3 +461,35 @@ def test_a_regular_layout_that_does_not_close_is_drawn_at_the_other_scales(monke
         assert scales[2] == closes_at and defects(got.pieces) == []
         assert len(chosen_from) == 1 and drawn_at[id(chosen_from[0].pieces[0])] == closes_at
         assert any("do not close up round an island" in str(n) for n in got.notes)
+
+
+@pytest.mark.parametrize("on", [True, False])
+def test_a_regular_layout_is_read_against_its_draw_with_junctions_as_a_t(monkeypatch, on):
+    """The layout choice of a regular layout also reads its draw with wide junctions split as a T
+    (``.tee``, ``LayoutOptions(tees=True)``; ``TEE_DRAW``) and keeps it where its coarse grid reads
+    best; default layouts have no such draw."""
+    from meshcore.layout.model import LayoutOptions
+
+    poly = testing.y_junction()
+    teed = auto_layout(poly, target_cells=3000, multiple=4, regular=True, options=LayoutOptions(tees=True))
+    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
+    assert teed.blocks != plain.blocks  # the junction as a T (5 blocks) or not (7)
+
+    def reading(lay):  # the T reads best; the rest alike
+        return (1.0, 1.5) if lay.blocks == teed.blocks else (5.0, 1.5)
+
+    real = layout_pkg._layout
+    drawn_with_tees = []
+
+    def draw(*args, options=layout_pkg.DEFAULT_OPTIONS, **kw):
+        drawn_with_tees.append(options.tees)
+        return real(*args, options=options, **kw)
+
+    monkeypatch.setattr(layout_pkg, "_layout", draw)
+    monkeypatch.setattr(layout_pkg, "TEE_DRAW", on)
+    got = auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=reading)
+    assert (got.blocks == teed.blocks) is on
+    assert any(drawn_with_tees) is on
+    drawn_with_tees.clear()  # a default layout is never drawn with tees (regular layouts only)
+    auto_layout(poly, target_cells=3000, multiple=4, reading=reading)
+    assert drawn_with_tees and not any(drawn_with_tees)
