@@ -42,6 +42,19 @@ def _alone(monkeypatch, poly, scale: float, cells: int):
         return auto_layout(poly, target_cells=cells, multiple=4)
 
 
+def _chosen_from(monkeypatch) -> list:
+    """The layouts :func:`~meshcore.layout.choice.chosen` is called with (it runs as it does)."""
+    seen = []
+    real = layout_pkg.chosen
+
+    def spy(first, *args, **kw):
+        seen.append(first)
+        return real(first, *args, **kw)
+
+    monkeypatch.setattr(layout_pkg, "chosen", spy)
+    return seen
+
+
 @pytest.mark.parametrize("seed", [1030002])
 def test_the_layout_with_the_most_orthogonal_coarse_grid_is_kept(monkeypatch, seed):
     # a network whose layout at the cell size has a coarse grid 3.2° off on average, 2.0° at 0.93 × it
@@ -72,7 +85,6 @@ def test_default_and_regular_layouts_may_take_a_coarse_ratio_up_to_theirs(monkey
         seen.append(ratio_ok)
         return real(first, at_scale, reading, more, ratio_ok, **kw)
 
-    monkeypatch.setattr(layout_pkg, "chosen", spy)
     poly = testing.channel_network(1030002, n_branches=6)
     for regular in (False, True):
         auto_layout(poly, target_cells=3000, multiple=4, regular=regular, reading=coarse_reading)
@@ -335,15 +347,8 @@ def test_a_layout_drawn_at_a_fallback_scale_is_chosen_among_its_neighbours(monke
             raise TopologyError("automatic layout: made to fail at the cell size (test)")
         return real(*args, scale=scale, **kw)
 
-    chosen_from = []
-    real_chosen = layout_pkg.chosen
-
-    def spy(first, *args, **kw):
-        chosen_from.append(first)
-        return real_chosen(first, *args, **kw)
-
+    chosen_from = _chosen_from(monkeypatch)
     monkeypatch.setattr(layout_pkg, "_layout", draw)
-    monkeypatch.setattr(layout_pkg, "chosen", spy)
     monkeypatch.setattr(layout_pkg, "FALLBACK_CHOICE", on)
     poly = testing.channel_network(1030002, n_branches=6)
     got = auto_layout(poly, target_cells=3000, multiple=4, reading=coarse_reading)
@@ -440,16 +445,9 @@ def test_a_regular_layout_that_does_not_close_is_drawn_at_the_other_scales(monke
         s = drawn_at[id(pieces[0])]
         return [] if closes_at is not None and s >= closes_at else ["an island (test)"]
 
-    chosen_from = []
-    real_chosen = layout_pkg.chosen
-
-    def spy(first, *args, **kw):
-        chosen_from.append(first)
-        return real_chosen(first, *args, **kw)
-
+    chosen_from = _chosen_from(monkeypatch)
     monkeypatch.setattr(layout_pkg, "_layout", draw)
     monkeypatch.setattr(layout_pkg, "frame_defects", defects)
-    monkeypatch.setattr(layout_pkg, "chosen", spy)
     poly = testing.channel_network(1030002, n_branches=6)
     got = auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=coarse_reading)
     assert scales[:2] == [1.0, 1.0]  # both splits at the cell size drawn first
