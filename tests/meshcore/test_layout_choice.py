@@ -85,6 +85,7 @@ def test_default_and_regular_layouts_may_take_a_coarse_ratio_up_to_theirs(monkey
         seen.append(ratio_ok)
         return real(first, at_scale, reading, more, ratio_ok, **kw)
 
+    monkeypatch.setattr(layout_pkg, "chosen", spy)
     poly = testing.channel_network(1030002, n_branches=6)
     for regular in (False, True):
         auto_layout(poly, target_cells=3000, multiple=4, regular=regular, reading=coarse_reading)
