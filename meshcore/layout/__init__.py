@@ -360,8 +360,9 @@ def _closing(lay: Layout, regular: bool) -> Layout:
     return lay
 
 
-#: Why a regular layout was drawn at another scale than the cell size: its draws there left blocks
-#: that do not close up round an island (:func:`~.frames.frame_defects`).
+#: Why a regular draw is passed over (:func:`_first_fit`, :func:`_closing`), and why the layout
+#: taken was drawn at another scale than the cell size when that is the reason: its blocks do not
+#: close up round an island (:func:`~.frames.frame_defects`).
 UNCLOSED = "the blocks do not close up round an island"
 
 
