@@ -43,6 +43,7 @@ from .build import layout_pieces
 from .choice import chosen
 from .curve import curved_shores
 from .edit import layout_from_cuts, layout_from_outline, with_cells
+from .fans import watching_bulges
 from .frames import frame_defects
 from .islandgaps import without_island_gaps
 from .memo import remembering
@@ -215,8 +216,15 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
             if TEE_DRAW and regular and not options.tees
             else None
         )
+        bulged = (
+            functools.partial(
+                _layout, shores, h, notes, multiple=multiple, options=dataclasses.replace(options, bulges=True)
+            )
+            if BULGE_DRAW and regular and not options.bulges
+            else None
+        )
         lay, error, closing = _first_fit(
-            draw, regular=regular, single=single, reading=reading, ringed=ringed, teed=teed
+            draw, regular=regular, single=single, reading=reading, ringed=ringed, teed=teed, bulged=bulged
         )
         if lay is not None:
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
@@ -240,7 +248,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
 
 
 def _first_fit(
-    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None
+    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None, bulged=None
 ) -> tuple[Layout | None, Exception | None, Layout | None]:
     """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
     shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, the first
@@ -250,7 +258,9 @@ def _first_fit(
     layout at the cell size (or at the first other scale that drew one, :data:`FALLBACK_CHOICE`)
     is compared with those at :data:`~.choice.SCALES` × its scale (:func:`~.choice.chosen`); a
     regular one (whose other scales must close up round every island too) also with ``ringed``'s,
-    a draw with at least four cut ends on every island (:mod:`.ringcuts`)."""
+    a draw with at least four cut ends on every island (:mod:`.ringcuts`), ``teed``'s (junctions as a
+    T, :mod:`.tee`) and, where a piece of the layout bulges (:func:`~.fans.watching_bulges`),
+    ``bulged``'s (such pieces split, ``LayoutOptions(bulges=True)``)."""
     from ..errors import TopologyError
 
     first = None
@@ -260,7 +270,7 @@ def _first_fit(
         # the layout without them (the splits of earlier versions) next
         for normal in (True, False):
             try:
-                with watching_tips() as tipped:
+                with watching_tips() as tipped, watching_bulges() as bulging:
                     lay = draw(regular=regular, normal=normal, scale=scale)
             except TopologyError as exc:
                 first = first or exc
@@ -309,6 +319,12 @@ def _first_fit(
                         return _closing(_noted(teed(regular=True, normal=n, scale=base), base, w), True)
 
                     more.append(tees)
+                if regular and bulged is not None and bulging:  # pieces that bulge split (.fans)
+
+                    def unbulged(n: bool = normal, base: float = scale, w: str = why) -> Layout:
+                        return _closing(_noted(bulged(regular=True, normal=n, scale=base), base, w), True)
+
+                    more.append(unbulged)
                 tips = with_tips if TIP_DRAW and (pinch.NECK or not regular) else None
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
                 lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
@@ -401,6 +417,12 @@ TIP_DRAW = True
 #: it helped some lakes and hurt others (journal, *Junctions of regular layouts as a T*).
 TEE_DRAW = True
 
+#: The layout choice of a regular layout also weighs its draw with every piece that bulges split
+#: (``LayoutOptions(bulges=True)``, :func:`~.fans.bulges`) at the scale drawn, where a piece of the
+#: draw bulges (:func:`~.fans.watching_bulges`): as a rule for every regular layout the split helped
+#: some lakes and hurt others (journal, *Bulging blocks of regular layouts*).
+BULGE_DRAW = True
+
 #: The tip draw is skipped where the draw at its scale left no piece that :mod:`.tipcuts` splits
 #: (:func:`~.tipcuts.watching_tips`, :func:`~.tipcuts.splits`): it would make that draw's layout
 #: again (session 34).
@@ -433,6 +455,7 @@ def _layout(
         "mouths": mouths,
         "wedges": wedges,
         "tees": tees,
+        "bulges": options.bulges and regular,
         "single": single,
     }
     sk, chords, _, pieces = layout_pieces(shores.layout, hl, ring=ring, **kw)

@@ -27,7 +27,8 @@ from . import pinch
 from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import wedge_corners
-from .fans import fans, unfan, wraps
+from .fans import bulges as bulging
+from .fans import fans, noted_bulge, unfan, wraps
 from .frames import _vertices, close_frames, corner_flaws, frame_defects, straight_corners
 from .memo import copied, digest, remembered
 from .regions import partition
@@ -143,6 +144,7 @@ def layout_pieces(
     mouths: bool = False,
     wedges: bool = False,
     tees: bool = False,
+    bulges: bool = False,
     single: bool = False,
     ring: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
@@ -152,7 +154,8 @@ def layout_pieces(
     junction chords at the arms' mouths, :func:`~.chords.place_chords`; see
     :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
     side of it, :func:`~.corners.wedge_corners`; ``tees``: junctions of regular layouts may be split
-    as a T, :mod:`.tee`; ``single``: with ``regular``, every island's ring of blocks turns once,
+    as a T, :mod:`.tee`; ``bulges``: regular layouts split pieces that bulge, :func:`~.fans.bulges`;
+    ``single``: with ``regular``, every island's ring of blocks turns once,
     :data:`~.frames.ONE_TURN`, so that it can close in one index space; ``ring``: every island gets
     at least four cut ends, :func:`~.ringcuts.ring_cuts`, without which its ring cannot turn once)."""
     import shapely
@@ -183,7 +186,9 @@ def layout_pieces(
             check()  # (a region's split: up to a tenth of a second on Vänern)
             P = Polygon(r)
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
-            pieces, new_cuts = _split_region(r, junctions, sigma, 3 * h, regular, normal, here, tees and regular)
+            pieces, new_cuts = _split_region(
+                r, junctions, sigma, 3 * h, regular, normal, here, tees and regular, bulges and regular
+            )
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
             elif not regular:  # would the tip draw split any of these? (.tipcuts.watching_tips)
@@ -378,8 +383,20 @@ def _partition(dense, lines: list[np.ndarray], sigma: float) -> tuple[list[np.nd
     return [np.array(r) for r in regions], [np.array(c) for c in cuts]
 
 
-def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, normal: bool, thin: bool, tees: bool):
-    """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`;
+def _split_region(
+    r,
+    junctions,
+    sigma: float,
+    min_width: float,
+    regular: bool,
+    normal: bool,
+    thin: bool,
+    tees: bool,
+    bulges: bool = False,
+):
+    """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`
+    (``bulges``: regular layouts split pieces that bulge too; without it a piece kept that bulges
+    is noted, :func:`~.fans.noted_bulge`);
     remembered within :func:`.memo.remembering` (keyed by a 128-bit digest of the ring, the skeleton's
     junctions inside it and the options): the layout choice's tip draw (:mod:`.tipcuts`)
     partitions the water as the draw at its scale did and splits the same regions again (copies
@@ -391,18 +408,31 @@ def _split_region(r, junctions, sigma: float, min_width: float, regular: bool, n
     js = np.asarray(junctions, dtype=float).reshape(-1, 2)
     # the junctions inside: the centre of the region's and of its pieces' star splits
     js = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])] if len(js) else js
-    key = ("split", digest(ring, js), ring.shape, float(sigma), float(min_width), regular, normal, thin, tees)
+    key = ("split", digest(ring, js), ring.shape, float(sigma), float(min_width), regular, normal, thin, tees, bulges)
 
     def make():
         kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}
         pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, **kw)
-        return _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular)
+        pieces, cuts = _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular, bulges)
+        bulged = regular and not bulges and any(not len(fc) and bulging(p, sigma) for p, fc in pieces)
+        return pieces, cuts, bulged
 
-    return copied(remembered(key, make))
+    pieces, cuts, bulged = remembered(key, make)
+    if bulged:  # (the layout choice's draw with LayoutOptions(bulges=True) would split it)
+        noted_bulge()
+    return copied((pieces, cuts))
 
 
 def _unfanned(
-    pieces: list, cuts: list, junctions, sigma: float, min_width: float, normal: bool, thin: bool, regular: bool = False
+    pieces: list,
+    cuts: list,
+    junctions,
+    sigma: float,
+    min_width: float,
+    normal: bool,
+    thin: bool,
+    regular: bool = False,
+    bulges: bool = False,
 ):
     """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece that fans
     (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be, and every piece with a
@@ -412,7 +442,7 @@ def _unfanned(
     of nodes within 3°; the fan splits there changed a round lake's grid for the worse, not kept)."""
     out: list = []
     for ring, fc in pieces:
-        fan = not regular and not len(fc) and fans(ring, sigma)
+        fan = not len(fc) and (bulges and bulging(ring, sigma) if regular else fans(ring, sigma))
         if len(fc) or not (fan or wraps(ring, sigma)):
             out.append((ring, fc))
             continue

@@ -21,11 +21,13 @@ look-ahead everywhere helped some lakes and hurt others: ``docs/lake-grids-journ
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 
 import numpy as np
 
-__all__ = ["BULGING", "FAN_AREA", "FAN_BULGE", "FAN_PAIRS", "fans", "unfan", "wraps"]
+__all__ = ["BULGING", "FAN_AREA", "FAN_BULGE", "FAN_PAIRS", "bulges", "fans", "unfan", "watching_bulges", "wraps"]
 
 #: A piece whose chosen corners give :func:`~.corners.bulge_ratio` at least this fans.  On the
 #: 73 generated shapes of `fresh_sweep.py` base 791000 (both sets) every piece was below 2.6
@@ -79,6 +81,19 @@ def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
         return True
     lo, hi = _pairs(ring, corners)
     return R >= BULGING and (lo >= FAN_PAIRS or lo * hi >= FAN_AREA)
+
+
+def bulges(ring: np.ndarray, sigma: float, forced=()) -> bool:
+    """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) has
+    :func:`~.corners.bulge_ratio` at least :data:`FAN_BULGE`: what regular layouts split with
+    ``LayoutOptions(bulges=True)`` (:func:`~.build._unfanned`)."""
+    from .corners import bulge_ratio
+    from .split import corners_of, forced_indices
+
+    corners, cost = corners_of(ring, sigma, forced_indices(ring, forced))
+    if corners is None or not math.isfinite(cost):
+        return False
+    return bulge_ratio(ring, corners) >= FAN_BULGE
 
 
 def wraps(ring: np.ndarray, sigma: float, forced=()) -> bool:
@@ -167,3 +182,27 @@ def unfan(
             if best is None or total < best[2] or (total == best[2] and k < best[3]):
                 best = (out_p, out_c, total, k)
     return None if best is None else best[:2]
+
+
+_bulged: contextvars.ContextVar[list | None] = contextvars.ContextVar("bulged", default=None)
+
+
+@contextlib.contextmanager
+def watching_bulges():
+    """Yields a list to which a regular layout drawn within this context without
+    ``LayoutOptions(bulges=True)`` adds True where a piece it kept bulges (:func:`bulges`,
+    :func:`noted_bulge`).  Where none does, the draw with the option makes the same layout, so the
+    layout choice does not make it (:data:`~meshcore.layout.BULGE_DRAW`)."""
+    box: list = []
+    token = _bulged.set(box)
+    try:
+        yield box
+    finally:
+        _bulged.reset(token)
+
+
+def noted_bulge() -> None:
+    """Within :func:`watching_bulges`: note that a piece of the draw bulges."""
+    box = _bulged.get()
+    if box is not None:
+        box.append(True)

@@ -36,6 +36,11 @@ class LayoutOptions:
         between two of its reflex corners, a stem from a third reflex corner or the opposite shore
         meeting it at right angles), kept where its pieces, split on, cost less than the greedy
         split's.
+    bulges
+        Regular layouts only: a piece whose corners bunch on part of a round basin (its bulge, the
+        area over the product of the mean lengths of its opposite sides, at least
+        :data:`~.fans.FAN_BULGE`) is split as default layouts split every fanning piece
+        (:func:`~.fans.unfan`, by the splits regular layouts allow).
     islands_apart
         Islands less than three cells apart stay apart (by default they are joined into one, the
         water between given up with a note: :mod:`.islandgaps`); the layout then cuts blocks a
@@ -47,12 +52,13 @@ class LayoutOptions:
     curve: bool = False
     wedges: bool = False
     tees: bool = False
+    bulges: bool = False
     islands_apart: bool = False
 
     def __str__(self) -> str:
         on = [
             f.replace("_", " ")
-            for f in ("thin_arms", "mouths", "curve", "wedges", "tees", "islands_apart")
+            for f in ("thin_arms", "mouths", "curve", "wedges", "tees", "bulges", "islands_apart")
             if getattr(self, f)
         ]
         return ", ".join(on) or "defaults"

@@ -492,3 +492,40 @@ def test_a_regular_layout_is_read_against_its_draw_with_junctions_as_a_t(monkeyp
     drawn_with_tees.clear()  # a default layout is never drawn with tees (regular layouts only)
     auto_layout(poly, target_cells=3000, multiple=4, reading=reading)
     assert drawn_with_tees and not any(drawn_with_tees)
+
+
+@pytest.mark.parametrize("on", [True, False])
+def test_a_regular_layout_is_read_against_its_draw_with_bulging_blocks_split(monkeypatch, on):
+    """The layout choice of a regular layout also reads its draw with every piece that bulges
+    split (``.fans.bulges``, ``LayoutOptions(bulges=True)``; ``BULGE_DRAW``) and keeps it where its
+    coarse grid reads best; that draw is made only where a piece bulges, and never for default
+    layouts."""
+    from meshcore.layout.model import LayoutOptions
+    from tests.meshcore.test_layout_fans import _g183546
+
+    poly = _g183546()  # as one regular block: bulge 3.6
+    split = auto_layout(poly, target_cells=3000, multiple=4, regular=True, options=LayoutOptions(bulges=True))
+    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
+    assert split.blocks != plain.blocks
+
+    def reading(lay):  # the split reads best; the rest alike
+        return (1.0, 1.5) if lay.blocks == split.blocks else (5.0, 1.5)
+
+    real = layout_pkg._layout
+    drawn_with = []
+
+    def draw(*args, options=layout_pkg.DEFAULT_OPTIONS, **kw):
+        drawn_with.append(options.bulges)
+        return real(*args, options=options, **kw)
+
+    monkeypatch.setattr(layout_pkg, "_layout", draw)
+    monkeypatch.setattr(layout_pkg, "BULGE_DRAW", on)
+    got = auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=reading)
+    assert (got.blocks == split.blocks) is on
+    assert any(drawn_with) is on
+    drawn_with.clear()  # no piece bulges: no such draw
+    auto_layout(testing.y_junction(), target_cells=3000, multiple=4, regular=True, reading=reading)
+    assert drawn_with and not any(drawn_with)
+    drawn_with.clear()  # default layouts split fanning pieces anyway: never drawn with the option
+    auto_layout(poly, target_cells=3000, multiple=4, reading=reading)
+    assert drawn_with and not any(drawn_with)

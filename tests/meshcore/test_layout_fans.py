@@ -13,6 +13,8 @@ opposite sides.
 from __future__ import annotations
 
 import math
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -182,3 +184,51 @@ def test_regular_layouts_split_a_block_round_a_peninsulas_tip_too():
     poly, _ = water_polygon(outer, holes=islands)
     lay = auto_layout(poly, target_cells=10000, multiple=4, regular=True)
     assert not any(_wraps(p.ring, p.corners, 1.5 * lay.cell_size) for p in lay.pieces)
+
+
+def _g183546():
+    from meshcore.cli.lakefile import local_frame
+    from meshcore.io import read_points
+    from meshcore.layout.polygon import water_from_points, water_polygon
+    from tests.conftest import ROOT
+
+    ps, _ = local_frame(read_points(ROOT / "tests" / "data" / "gshhg_g183546.geojson"), "auto")
+    outer, islands = water_from_points(ps)
+    return water_polygon(outer, holes=islands)[0]
+
+
+def test_regular_layouts_can_split_a_bulging_block():
+    """A regular layout kept a round lake with a notch as one block whose corners bunched at the
+    notch and at a blunt end (GSHHG lake 183546, 10 000 cells: bulge 3.6, 0.37 × the cells asked);
+    the default layout splits it (a star).  ``LayoutOptions(bulges=True)`` splits it by the splits
+    regular layouts allow (a T here): no piece bulges, and Delft3D DD couples the blocks."""
+    from meshcore.layout import LayoutOptions
+    from tests.meshcore.test_layout_frames import _written_and_read_back
+
+    poly = _g183546()
+    plain = auto_layout(poly, target_cells=10000, multiple=4, regular=True)
+    assert len(plain.blocks) == 1 and _fan(np.asarray(plain.pieces[0].ring), plain.pieces[0].corners)[0] >= 3.0
+    lay = auto_layout(poly, target_cells=10000, multiple=4, regular=True, options=LayoutOptions(bulges=True))
+    assert len(lay.blocks) > 1
+    for pc in lay.pieces:
+        bulge, _, _ = _fan(np.asarray(pc.ring), pc.corners)
+        assert bulge < 3.0, (pc.ring.mean(axis=0), bulge)
+    cells = sum(ni * nj for ni, nj in (b.cells for b in lay.blocks))
+    assert 0.5 * 10000 <= cells <= 2 * 10000
+    with tempfile.TemporaryDirectory() as d:  # the .ddb reads back, M lines coupled to M lines
+        _written_and_read_back(lay, Path(d) / "lake.ddb")
+
+
+def test_the_regular_grid_of_a_bulging_lake_is_a_model_grid():
+    """What a user of ``meshcore mesh --regular`` gets on that lake: the layout choice reads the
+    draw with the bulging block split (``layout.BULGE_DRAW``) and keeps it (before: one block, 0.37 ×
+    the cells asked, 89.4 % of nodes within 3°, the shore 0.56 cells off)."""
+    from meshcore.lakegrid import mesh_outline
+    from meshcore.quality import lake_metrics
+
+    poly = _g183546()
+    mb = mesh_outline(poly, target_cells=10000, regular=True)
+    m = lake_metrics(mb, polygon=poly, cell_size=math.sqrt(poly.area / 10000)).summary()
+    assert len(mb.grids) > 1 and m["folded_cells"] == 0
+    assert 0.5 <= m["cells"] / 10000 <= 2
+    assert m["pct_nodes_within_3deg"] >= 90 and m["hausdorff_cells"] <= 0.5
