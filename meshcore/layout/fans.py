@@ -27,6 +27,8 @@ import math
 
 import numpy as np
 
+from .memo import watching
+
 __all__ = ["BULGING", "FAN_AREA", "FAN_BULGE", "FAN_PAIRS", "bulges", "fans", "unfan", "watching_bulges", "wraps"]
 
 #: A piece whose chosen corners give :func:`~.corners.bulge_ratio` at least this fans.  On the
@@ -193,12 +195,8 @@ def watching_bulges():
     ``LayoutOptions(bulges=True)`` adds True where a piece it kept bulges (:func:`bulges`,
     :func:`noted_bulge`).  Where none does, the draw with the option makes the same layout, so the
     layout choice does not make it (:data:`~meshcore.layout.BULGE_DRAW`)."""
-    box: list = []
-    token = _bulged.set(box)
-    try:
+    with watching(_bulged) as box:
         yield box
-    finally:
-        _bulged.reset(token)
 
 
 def noted_bulge() -> None:

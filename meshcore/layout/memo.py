@@ -16,7 +16,7 @@ import hashlib
 
 import numpy as np
 
-__all__ = ["copied", "digest", "remembered", "remembering"]
+__all__ = ["copied", "digest", "remembered", "remembering", "watching"]
 
 _memo: contextvars.ContextVar[dict | None] = contextvars.ContextVar("layout_memo", default=None)
 
@@ -58,3 +58,16 @@ def digest(*parts) -> bytes:
     geometry for :func:`remembered`."""
     raw = [p if isinstance(p, bytes) else np.ascontiguousarray(p, dtype=float).tobytes() for p in parts]
     return hashlib.blake2b(b"|".join(raw), digest_size=16).digest()
+
+
+@contextlib.contextmanager
+def watching(var: contextvars.ContextVar):
+    """Yields a new list set as ``var`` within this context: what a draw made within it notes
+    there (a draw's pieces with a land tip, :func:`.tipcuts.watching_tips`; whether a piece bulges,
+    :func:`.fans.watching_bulges`), for the layout choice to skip a draw that would change nothing."""
+    box: list = []
+    token = var.set(box)
+    try:
+        yield box
+    finally:
+        var.reset(token)

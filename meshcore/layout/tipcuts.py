@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from .memo import copied, digest, remembered
+from .memo import copied, digest, remembered, watching
 
 __all__ = [
     "TIP_SCALE",
@@ -77,12 +77,8 @@ def watching_tips():
     Where none of them splits (:func:`splits`), the same draw within :func:`splitting_tips` makes
     the same layout, so the layout choice's tip draw (:func:`~meshcore.layout.choice.chosen`) is
     skipped."""
-    box: list = []
-    token = _seen.set(box)
-    try:
+    with watching(_seen) as box:
         yield box
-    finally:
-        _seen.reset(token)
 
 
 def noted_tips(pieces: list, sigma: float, min_width: float, normal: bool, thin: bool) -> None:

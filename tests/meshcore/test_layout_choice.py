@@ -462,36 +462,48 @@ def test_a_regular_layout_that_does_not_close_is_drawn_at_the_other_scales(monke
         assert any("do not close up round an island" in str(n) for n in got.notes)
 
 
+def _read_against_a_draw_with(monkeypatch, poly, option: str, switch: str, on: bool):
+    """Regular layouts of ``poly`` read (a fake reading: the draw with ``LayoutOptions(option=True)``
+    best, the rest alike) with the module switch ``switch`` ``on``: the layout got, and for each
+    draw whether it was drawn with the option."""
+    from meshcore.layout.model import LayoutOptions
+
+    wanted = auto_layout(poly, target_cells=3000, multiple=4, regular=True, options=LayoutOptions(**{option: True}))
+    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
+    assert wanted.blocks != plain.blocks
+
+    def reading(lay):
+        return (1.0, 1.5) if lay.blocks == wanted.blocks else (5.0, 1.5)
+
+    real = layout_pkg._layout
+    drawn_with: list[bool] = []
+
+    def draw(*args, options=layout_pkg.DEFAULT_OPTIONS, **kw):
+        drawn_with.append(getattr(options, option))
+        return real(*args, options=options, **kw)
+
+    monkeypatch.setattr(layout_pkg, "_layout", draw)
+    monkeypatch.setattr(layout_pkg, switch, on)
+
+    def read(p, **kw):  # the layout got, whether it is the option's, the draws made with the option
+        drawn_with.clear()
+        got = auto_layout(p, target_cells=3000, multiple=4, reading=reading, **kw)
+        return got.blocks == wanted.blocks, list(drawn_with)
+
+    return read
+
+
 @pytest.mark.parametrize("on", [True, False])
 def test_a_regular_layout_is_read_against_its_draw_with_junctions_as_a_t(monkeypatch, on):
     """The layout choice of a regular layout also reads its draw with wide junctions split as a T
     (``.tee``, ``LayoutOptions(tees=True)``; ``TEE_DRAW``) and keeps it where its coarse grid reads
     best; default layouts have no such draw."""
-    from meshcore.layout.model import LayoutOptions
-
-    poly = testing.y_junction()
-    teed = auto_layout(poly, target_cells=3000, multiple=4, regular=True, options=LayoutOptions(tees=True))
-    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
-    assert teed.blocks != plain.blocks  # the junction as a T (5 blocks) or not (7)
-
-    def reading(lay):  # the T reads best; the rest alike
-        return (1.0, 1.5) if lay.blocks == teed.blocks else (5.0, 1.5)
-
-    real = layout_pkg._layout
-    drawn_with_tees = []
-
-    def draw(*args, options=layout_pkg.DEFAULT_OPTIONS, **kw):
-        drawn_with_tees.append(options.tees)
-        return real(*args, options=options, **kw)
-
-    monkeypatch.setattr(layout_pkg, "_layout", draw)
-    monkeypatch.setattr(layout_pkg, "TEE_DRAW", on)
-    got = auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=reading)
-    assert (got.blocks == teed.blocks) is on
-    assert any(drawn_with_tees) is on
-    drawn_with_tees.clear()  # a default layout is never drawn with tees (regular layouts only)
-    auto_layout(poly, target_cells=3000, multiple=4, reading=reading)
-    assert drawn_with_tees and not any(drawn_with_tees)
+    poly = testing.y_junction()  # the junction as a T (5 blocks) or not (7)
+    read = _read_against_a_draw_with(monkeypatch, poly, "tees", "TEE_DRAW", on)
+    got, drawn = read(poly, regular=True)
+    assert got is on and any(drawn) is on
+    _, drawn = read(poly)  # a default layout is never drawn with tees (regular layouts only)
+    assert drawn and not any(drawn)
 
 
 @pytest.mark.parametrize("on", [True, False])
@@ -500,32 +512,13 @@ def test_a_regular_layout_is_read_against_its_draw_with_bulging_blocks_split(mon
     split (``.fans.bulges``, ``LayoutOptions(bulges=True)``; ``BULGE_DRAW``) and keeps it where its
     coarse grid reads best; that draw is made only where a piece bulges, and never for default
     layouts."""
-    from meshcore.layout.model import LayoutOptions
     from tests.meshcore.test_layout_fans import _g183546
 
     poly = _g183546()  # as one regular block: bulge 3.6
-    split = auto_layout(poly, target_cells=3000, multiple=4, regular=True, options=LayoutOptions(bulges=True))
-    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
-    assert split.blocks != plain.blocks
-
-    def reading(lay):  # the split reads best; the rest alike
-        return (1.0, 1.5) if lay.blocks == split.blocks else (5.0, 1.5)
-
-    real = layout_pkg._layout
-    drawn_with = []
-
-    def draw(*args, options=layout_pkg.DEFAULT_OPTIONS, **kw):
-        drawn_with.append(options.bulges)
-        return real(*args, options=options, **kw)
-
-    monkeypatch.setattr(layout_pkg, "_layout", draw)
-    monkeypatch.setattr(layout_pkg, "BULGE_DRAW", on)
-    got = auto_layout(poly, target_cells=3000, multiple=4, regular=True, reading=reading)
-    assert (got.blocks == split.blocks) is on
-    assert any(drawn_with) is on
-    drawn_with.clear()  # no piece bulges: no such draw
-    auto_layout(testing.y_junction(), target_cells=3000, multiple=4, regular=True, reading=reading)
-    assert drawn_with and not any(drawn_with)
-    drawn_with.clear()  # default layouts split fanning pieces anyway: never drawn with the option
-    auto_layout(poly, target_cells=3000, multiple=4, reading=reading)
-    assert drawn_with and not any(drawn_with)
+    read = _read_against_a_draw_with(monkeypatch, poly, "bulges", "BULGE_DRAW", on)
+    got, drawn = read(poly, regular=True)
+    assert got is on and any(drawn) is on
+    _, drawn = read(testing.y_junction(), regular=True)  # no piece bulges: no such draw
+    assert drawn and not any(drawn)
+    _, drawn = read(poly)  # default layouts split fanning pieces anyway: never drawn with the option
+    assert drawn and not any(drawn)
