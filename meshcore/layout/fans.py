@@ -72,13 +72,10 @@ def _pairs(ring: np.ndarray, corners) -> tuple[float, float]:
 
 def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) fans."""
-    from .corners import bulge_ratio
-    from .split import corners_of, forced_indices
-
-    corners, cost = corners_of(ring, sigma, forced_indices(ring, forced))
-    if corners is None or not math.isfinite(cost):
+    got = _bulge(ring, sigma, forced)
+    if got is None:
         return False
-    R = bulge_ratio(ring, corners)
+    corners, R = got
     if R >= FAN_BULGE:
         return True
     lo, hi = _pairs(ring, corners)
@@ -89,13 +86,19 @@ def bulges(ring: np.ndarray, sigma: float, forced=()) -> bool:
     """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) has
     :func:`~.corners.bulge_ratio` at least :data:`FAN_BULGE`: what regular layouts split with
     ``LayoutOptions(bulges=True)`` (:func:`~.build._unfanned`)."""
+    got = _bulge(ring, sigma, forced)
+    return got is not None and got[1] >= FAN_BULGE
+
+
+def _bulge(ring: np.ndarray, sigma: float, forced=()) -> tuple[list, float] | None:
+    """``(corners, bulge ratio)`` of ``ring`` as one block, or None where it has no corners."""
     from .corners import bulge_ratio
     from .split import corners_of, forced_indices
 
     corners, cost = corners_of(ring, sigma, forced_indices(ring, forced))
     if corners is None or not math.isfinite(cost):
-        return False
-    return bulge_ratio(ring, corners) >= FAN_BULGE
+        return None
+    return corners, bulge_ratio(ring, corners)
 
 
 def wraps(ring: np.ndarray, sigma: float, forced=()) -> bool:
