@@ -309,8 +309,8 @@ def _first_fit(
                 more = []
                 if regular and ringed is not None and len(lay.polygon.interiors):  # every island ringed
 
-                    def rings(n: bool = normal) -> Layout:
-                        return _closing(ringed(regular=True, normal=n, scale=1.0), True)
+                    def rings(n: bool = normal, base: float = scale, w: str = why) -> Layout:
+                        return _closing(_noted(ringed(regular=True, normal=n, scale=base), base, w), True)
 
                     more.append(rings)
                 if regular and teed is not None:  # junctions split as a T where that pays (.tee)
