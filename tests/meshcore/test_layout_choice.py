@@ -522,3 +522,31 @@ def test_a_regular_layout_is_read_against_its_draw_with_bulging_blocks_split(mon
     assert drawn and not any(drawn)
     _, drawn = read(poly)  # default layouts split fanning pieces anyway: never drawn with the option
     assert drawn and not any(drawn)
+
+
+def test_a_regular_layout_drawn_at_another_scale_is_read_against_its_rings_at_that_scale(monkeypatch):
+    """The regular layout choice's draw with four cut ends on every island (``.ringcuts``) is made at
+    the scale the layout was drawn at (before session 47 always at the cell size, where that layout
+    had not closed up)."""
+    real = layout_pkg._layout
+    drawn_at: dict[int, float] = {}
+    rings: list[float] = []
+    kept = []  # (no id reused)
+
+    def draw(*args, scale: float = 1.0, ring: bool = False, **kw):
+        lay = real(*args, scale=scale, ring=ring, **kw)
+        drawn_at[id(lay.pieces[0])] = scale
+        if ring:
+            rings.append(round(scale, 6))
+        kept.append(lay)
+        return lay
+
+    def defects(pieces, single=False):  # nothing drawn at the cell size closes up
+        return [] if drawn_at[id(pieces[0])] >= 1.15 else ["an island (test)"]
+
+    monkeypatch.setattr(layout_pkg, "_layout", draw)
+    monkeypatch.setattr(layout_pkg, "frame_defects", defects)
+    poly = testing.lake_with_islands(3)
+    got = auto_layout(poly, target_cells=2000, multiple=4, regular=True, reading=coarse_reading)
+    assert drawn_at[id(got.pieces[0])] >= 1.15
+    assert rings and all(s == 1.15 for s in rings)
