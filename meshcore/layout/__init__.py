@@ -218,7 +218,13 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
         )
         bulged = (
             functools.partial(
-                _layout, shores, h, notes, multiple=multiple, options=dataclasses.replace(options, bulges=True)
+                _layout,
+                shores,
+                h,
+                notes,
+                multiple=multiple,
+                ring=ring,
+                options=dataclasses.replace(options, bulges=True),
             )
             if BULGE_DRAW and regular and not options.bulges
             else None
@@ -287,6 +293,8 @@ def _first_fit(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
+                if reading is not None and bulged is not None and bulging:  # no other scale read: this draw
+                    return _single_unbulged(lay, bulged, reading, normal, scale, why), None, None
             if (scale == 1.0 or FALLBACK_CHOICE) and not single and reading is not None:
                 # the best coarse grid of three scales (× the scale drawn at: the cell size, or the
                 # first of LAYOUT_SCALES that drew a layout); each draw and the pieces it left round
@@ -330,6 +338,25 @@ def _first_fit(
                 lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
             return lay, None, None
     return None, first, kept
+
+
+def _single_unbulged(lay: Layout, bulged, reading, normal: bool, scale: float, why: str) -> Layout:
+    """``lay``, a ``single`` layout with a piece that bulges, or its draw with such pieces split
+    (``bulged``, ``LayoutOptions(bulges=True)``) where that fits one index space too and the
+    layout choice's rule keeps it (:func:`~.choice.chosen`; no other scale: single layouts read
+    none)."""
+    from ..errors import TopologyError
+
+    def unbulged() -> Layout:
+        got = _noted(bulged(regular=True, normal=normal, scale=scale, single=True), scale, why)
+        if frame_defects(list(got.pieces), single=True):
+            raise TopologyError(f"automatic layout: {UNCLOSED}")
+        folds = _folds_in_index_space(got)
+        if folds:
+            raise TopologyError(folds)
+        return got
+
+    return chosen(lay, lambda s: lay, reading, [unbulged], ratio_ok=REGULAR_RATIO)
 
 
 #: A regular layout drawn at another scale or with more cuts from its islands replaces the first

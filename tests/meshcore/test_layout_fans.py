@@ -219,15 +219,17 @@ def test_regular_layouts_can_split_a_bulging_block():
         _written_and_read_back(lay, Path(d) / "lake.ddb")
 
 
-def test_the_regular_grid_of_a_bulging_lake_is_a_model_grid():
-    """What a user of ``meshcore mesh --regular`` gets on that lake: the layout choice reads the
-    draw with the bulging block split (``layout.BULGE_DRAW``) and keeps it (before: one block, 0.37 ×
-    the cells asked, 89.4 % of nodes within 3°, the shore 0.56 cells off)."""
+@pytest.mark.parametrize("mode", ["regular", "single"])
+def test_the_regular_grid_of_a_bulging_lake_is_a_model_grid(mode):
+    """What a user of ``meshcore mesh --regular`` (or ``--single``, one index space) gets on that
+    lake: the layout choice reads the draw with the bulging block split (``layout.BULGE_DRAW``; a
+    single layout reads that draw alone) and keeps it (before: one block, 0.37 × the cells asked,
+    89.4 % of nodes within 3°, the shore 0.56 cells off)."""
     from meshcore.lakegrid import mesh_outline
     from meshcore.quality import lake_metrics
 
     poly = _g183546()
-    mb = mesh_outline(poly, target_cells=10000, regular=True)
+    mb = mesh_outline(poly, target_cells=10000, **{mode: True})
     m = lake_metrics(mb, polygon=poly, cell_size=math.sqrt(poly.area / 10000)).summary()
     assert len(mb.grids) > 1 and m["folded_cells"] == 0
     assert 0.5 <= m["cells"] / 10000 <= 2
