@@ -50,12 +50,6 @@ BULGING = 1.2
 #: had a product below 20.
 FAN_AREA = 32.0
 
-#: ... and (session 47) a wedge: a piece of any bulge whose two ratios of opposite sides multiply to
-#: :data:`FAN_AREA` or more (its cells too differ in area by about the product).  Held-out g180615 at
-#: 15 000 cells: a block from a neck into a basin, bulge 0.90, sides 3.2× and 13.5× apart (43),
-#: most of the lake's nodes beyond 3° in it; split, 90.3 → 94.7 % within 3° (journal, *Wedges*).
-WEDGES = True
-
 #: ... and a piece one of whose sides runs back on itself — measured along the line between its
 #: corners — by more than this share of that line's length and by more than :data:`BACK_CELLS`
 #: cells beyond what its opposite side does: the side goes round a tip of land into a pocket of
@@ -85,7 +79,7 @@ def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     if R >= FAN_BULGE:
         return True
     lo, hi = _pairs(ring, corners)
-    return (R >= BULGING and (lo >= FAN_PAIRS or lo * hi >= FAN_AREA)) or (WEDGES and lo * hi >= FAN_AREA)
+    return R >= BULGING and (lo >= FAN_PAIRS or lo * hi >= FAN_AREA)
 
 
 def bulges(ring: np.ndarray, sigma: float, forced=()) -> bool:
