@@ -316,28 +316,23 @@ def _first_fit(
 
                 more = []
                 if regular and ringed is not None and len(lay.polygon.interiors):  # every island ringed
-
-                    def rings(n: bool = normal, base: float = scale, w: str = why) -> Layout:
-                        return _closing(_noted(ringed(regular=True, normal=n, scale=base), base, w), True)
-
-                    more.append(rings)
+                    more.append(functools.partial(_redrawn, ringed, normal, scale, why))
                 if regular and teed is not None:  # junctions split as a T where that pays (.tee)
-
-                    def tees(n: bool = normal, base: float = scale, w: str = why) -> Layout:
-                        return _closing(_noted(teed(regular=True, normal=n, scale=base), base, w), True)
-
-                    more.append(tees)
+                    more.append(functools.partial(_redrawn, teed, normal, scale, why))
                 if regular and bulged is not None and bulging:  # pieces that bulge split (.fans)
-
-                    def unbulged(n: bool = normal, base: float = scale, w: str = why) -> Layout:
-                        return _closing(_noted(bulged(regular=True, normal=n, scale=base), base, w), True)
-
-                    more.append(unbulged)
+                    more.append(functools.partial(_redrawn, bulged, normal, scale, why))
                 tips = with_tips if TIP_DRAW and (pinch.NECK or not regular) else None
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
                 lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
             return lay, None, None
     return None, first, kept
+
+
+def _redrawn(draw, normal: bool, scale: float, why: str) -> Layout:
+    """A regular layout's other draw (``ringed``, ``teed``, ``bulged`` of :func:`_first_fit`) at the
+    scale the layout was drawn at, noted so; a :class:`~meshcore.errors.TopologyError` where its blocks
+    do not close up (:func:`_closing`: the layout choice passes it over)."""
+    return _closing(_noted(draw(regular=True, normal=normal, scale=scale), scale, why), True)
 
 
 def _single_unbulged(lay: Layout, bulged, reading, normal: bool, scale: float, why: str) -> Layout:
