@@ -116,7 +116,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "cells), thin-arms = blocks two cells across at junctions of arms 2-4 cells wide, mouths = junction "
         "cuts at the arms' mouths, wedges = two corners beside the tip of an arm tapering to a point, "
         "tees = junctions of regular (.ddb) layouts split as a T, bulges = blocks of regular layouts whose corners "
-        "bunch on part of a round basin split, islands-apart = islands less than three "
+        "bunch on part of a round basin split, tapers = blocks of default layouts whose opposite sides differ much "
+        "(a wedge) split, islands-apart = islands less than three "
         "cells apart kept apart (by default joined into one, the water between given up with a note)",
     )
     p.add_argument(

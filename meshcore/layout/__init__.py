@@ -43,7 +43,7 @@ from .build import layout_pieces
 from .choice import chosen
 from .curve import curved_shores
 from .edit import layout_from_cuts, layout_from_outline, with_cells
-from .fans import watching_bulges
+from .fans import watching_unsplit
 from .frames import frame_defects
 from .islandgaps import without_island_gaps
 from .memo import remembering
@@ -229,8 +229,22 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
             if BULGE_DRAW and regular and not options.bulges
             else None
         )
+        tapered = (
+            functools.partial(
+                _layout, shores, h, notes, multiple=multiple, options=dataclasses.replace(options, tapers=True)
+            )
+            if TAPER_DRAW and not regular and not options.tapers
+            else None
+        )
         lay, error, closing = _first_fit(
-            draw, regular=regular, single=single, reading=reading, ringed=ringed, teed=teed, bulged=bulged
+            draw,
+            regular=regular,
+            single=single,
+            reading=reading,
+            ringed=ringed,
+            teed=teed,
+            bulged=bulged,
+            tapered=tapered,
         )
         if lay is not None:
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
@@ -254,7 +268,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
 
 
 def _first_fit(
-    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None, bulged=None
+    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None, bulged=None, tapered=None
 ) -> tuple[Layout | None, Exception | None, Layout | None]:
     """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
     shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, the first
@@ -265,8 +279,10 @@ def _first_fit(
     is compared with those at :data:`~.choice.SCALES` × its scale (:func:`~.choice.chosen`); a
     regular one (whose other scales must close up round every island too) also with ``ringed``'s,
     a draw with at least four cut ends on every island (:mod:`.ringcuts`), ``teed``'s (junctions as a
-    T, :mod:`.tee`) and, where a piece of the layout bulges (:func:`~.fans.watching_bulges`),
-    ``bulged``'s (such pieces split, ``LayoutOptions(bulges=True)``)."""
+    T, :mod:`.tee`) and, where a piece of the layout bulges (:func:`~.fans.watching_unsplit`),
+    ``bulged``'s (such pieces split, ``LayoutOptions(bulges=True)``); a default one's chosen scale
+    is also drawn with ``tapered`` where a piece of its draw tapers (such pieces split,
+    ``LayoutOptions(tapers=True)``)."""
     from ..errors import TopologyError
 
     first = None
@@ -276,7 +292,7 @@ def _first_fit(
         # the layout without them (the splits of earlier versions) next
         for normal in (True, False):
             try:
-                with watching_tips() as tipped, watching_bulges() as bulging:
+                with watching_tips() as tipped, watching_unsplit() as unsplit:
                     lay = draw(regular=regular, normal=normal, scale=scale)
             except TopologyError as exc:
                 first = first or exc
@@ -293,18 +309,18 @@ def _first_fit(
                 if folds:
                     first = first or TopologyError(folds)
                     continue
-                if reading is not None and bulged is not None and bulging:  # no other scale read: this draw
+                if reading is not None and bulged is not None and "bulge" in unsplit:  # no other scale read: this draw
                     return _single_unbulged(lay, bulged, reading, normal, scale, why), None, None
             if (scale == 1.0 or FALLBACK_CHOICE) and not single and reading is not None:
                 # the best coarse grid of three scales (× the scale drawn at: the cell size, or the
                 # first of LAYOUT_SCALES that drew a layout); each draw and the pieces it left round
                 # land tips (.tipcuts.watching_tips), keyed by the scale relative to that one
-                drawn = {1.0: (lay, tipped)}
+                drawn = {1.0: (lay, tipped, unsplit)}
 
                 def at_scale(s: float, n: bool = normal, d: dict = drawn, base: float = scale, w: str = why) -> Layout:
-                    with watching_tips() as tipped:
+                    with watching_tips() as tipped, watching_unsplit() as unsplit:
                         got = _noted(draw(regular=regular, normal=n, scale=base * s), base * s, w, base)
-                    d[s] = (got, tipped)
+                    d[s] = (got, tipped, unsplit)
                     return _closing(got, regular)
 
                 def with_tips(s: float, n: bool = normal, d: dict = drawn, base: float = scale, w: str = why) -> Layout:
@@ -314,16 +330,25 @@ def _first_fit(
                         got = _noted(draw(regular=regular, normal=n, scale=base * s), base * s, w, base)
                     return _closing(got, regular)
 
+                def with_tapers(
+                    s: float, n: bool = normal, d: dict = drawn, base: float = scale, w: str = why
+                ) -> Layout:
+                    if s in d and "taper" not in d[s][2]:  # no piece tapers: that draw itself
+                        return d[s][0]
+                    return _noted(tapered(regular=False, normal=n, scale=base * s), base * s, w, base)
+
                 more = []
                 if regular and ringed is not None and len(lay.polygon.interiors):  # every island ringed
                     more.append(functools.partial(_redrawn, ringed, normal, scale, why))
                 if regular and teed is not None:  # junctions split as a T where that pays (.tee)
                     more.append(functools.partial(_redrawn, teed, normal, scale, why))
-                if regular and bulged is not None and bulging:  # pieces that bulge split (.fans)
+                if regular and bulged is not None and "bulge" in unsplit:  # pieces that bulge split (.fans)
                     more.append(functools.partial(_redrawn, bulged, normal, scale, why))
-                tips = with_tips if TIP_DRAW and (pinch.NECK or not regular) else None
+                again = [with_tips] if TIP_DRAW and (pinch.NECK or not regular) else []
+                if not regular and tapered is not None:  # the chosen scale's pieces that taper split
+                    again.append(with_tapers)
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
-                lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, tips=tips, coarse=not regular)
+                lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, again=again, coarse=not regular)
             return lay, None, None
     return None, first, kept
 
@@ -441,9 +466,16 @@ TEE_DRAW = True
 
 #: The layout choice of a regular layout also weighs its draw with every piece that bulges split
 #: (``LayoutOptions(bulges=True)``, :func:`~.fans.bulges`) at the scale drawn, where a piece of the
-#: draw bulges (:func:`~.fans.watching_bulges`): as a rule for every regular layout the split helped
+#: draw bulges (:func:`~.fans.watching_unsplit`): as a rule for every regular layout the split helped
 #: some lakes and hurt others (journal, *Bulging blocks of regular layouts*).
 BULGE_DRAW = True
+
+#: The layout choice of a default layout also weighs its draw with every piece that tapers split
+#: (``LayoutOptions(tapers=True)``, :func:`~.fans.tapers`: a wedge whose opposite sides differ by a
+#: product of :data:`~.fans.FAN_AREA` or more, whatever its bulge) at the chosen scale, where a piece
+#: of the draw at that scale tapers (:func:`~.fans.watching_unsplit`): as a rule for every default layout the split
+#: helped some lakes and hurt others (journal, *Wedges*).
+TAPER_DRAW = True
 
 #: The tip draw is skipped where the draw at its scale left no piece that :mod:`.tipcuts` splits
 #: (:func:`~.tipcuts.watching_tips`, :func:`~.tipcuts.splits`): it would make that draw's layout
@@ -478,6 +510,7 @@ def _layout(
         "wedges": wedges,
         "tees": tees,
         "bulges": options.bulges and regular,
+        "tapers": options.tapers and not regular,
         "single": single,
     }
     sk, chords, _, pieces = layout_pieces(shores.layout, hl, ring=ring, **kw)

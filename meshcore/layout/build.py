@@ -28,7 +28,8 @@ from .blocks import Piece, conform, weld
 from .chords import Chord, place_chords
 from .corners import wedge_corners
 from .fans import bulges as bulging
-from .fans import fans, noted_bulge, unfan, wraps
+from .fans import fans, noted_unsplit, unfan, wraps
+from .fans import tapers as tapering
 from .frames import _vertices, close_frames, corner_flaws, frame_defects, straight_corners
 from .memo import copied, digest, remembered
 from .regions import partition
@@ -145,6 +146,7 @@ def layout_pieces(
     wedges: bool = False,
     tees: bool = False,
     bulges: bool = False,
+    tapers: bool = False,
     single: bool = False,
     ring: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
@@ -155,6 +157,7 @@ def layout_pieces(
     :func:`~.split.best_split`; ``wedges``: a block ending in a wedge's tip has two corners either
     side of it, :func:`~.corners.wedge_corners`; ``tees``: junctions of regular layouts may be split
     as a T, :mod:`.tee`; ``bulges``: regular layouts split pieces that bulge, :func:`~.fans.bulges`;
+    ``tapers``: default layouts split pieces that taper, :func:`~.fans.tapers`;
     ``single``: with ``regular``, every island's ring of blocks turns once,
     :data:`~.frames.ONE_TURN`, so that it can close in one index space; ``ring``: every island gets
     at least four cut ends, :func:`~.ringcuts.ring_cuts`, without which its ring cannot turn once)."""
@@ -187,7 +190,16 @@ def layout_pieces(
             P = Polygon(r)
             here = thin and (islands is None or islands.is_empty or P.exterior.distance(islands) > 1e-6 * h)
             pieces, new_cuts = _split_region(
-                r, junctions, sigma, 3 * h, regular, normal, here, tees and regular, bulges and regular
+                r,
+                junctions,
+                sigma,
+                3 * h,
+                regular,
+                normal,
+                here,
+                tees and regular,
+                bulges and regular,
+                tapers and not regular,
             )
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
@@ -393,10 +405,11 @@ def _split_region(
     thin: bool,
     tees: bool,
     bulges: bool = False,
+    tapers: bool = False,
 ):
     """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`
-    (``bulges``: regular layouts split pieces that bulge too; without it a piece kept that bulges
-    is noted, :func:`~.fans.noted_bulge`);
+    (``bulges``: regular layouts split pieces that bulge too, ``tapers``: default layouts pieces
+    that taper; without it a piece kept that bulges, or tapers, is noted, :func:`~.fans.noted_unsplit`);
     remembered within :func:`.memo.remembering` (keyed by a 128-bit digest of the ring, the skeleton's
     junctions inside it and the options): the layout choice's tip draw (:mod:`.tipcuts`)
     partitions the water as the draw at its scale did and splits the same regions again (copies
@@ -408,18 +421,35 @@ def _split_region(
     js = np.asarray(junctions, dtype=float).reshape(-1, 2)
     # the junctions inside: the centre of the region's and of its pieces' star splits
     js = js[shapely.contains_xy(shapely.Polygon(ring), js[:, 0], js[:, 1])] if len(js) else js
-    key = ("split", digest(ring, js), ring.shape, float(sigma), float(min_width), regular, normal, thin, tees, bulges)
+    key = (
+        "split",
+        digest(ring, js),
+        ring.shape,
+        float(sigma),
+        float(min_width),
+        regular,
+        normal,
+        thin,
+        tees,
+        bulges,
+        tapers,
+    )
 
     def make():
         kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}
         pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, **kw)
-        pieces, cuts = _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular, bulges)
-        bulged = regular and not bulges and any(not len(fc) and bulging(p, sigma) for p, fc in pieces)
-        return pieces, cuts, bulged
+        pieces, cuts = _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular, bulges, tapers)
+        kept = [p for p, fc in pieces if not len(fc)]
+        unsplit = None  # what the layout choice's draw with LayoutOptions(bulges=, tapers=True) would split
+        if regular and not bulges and any(bulging(p, sigma) for p in kept):
+            unsplit = "bulge"
+        elif not regular and not tapers and any(tapering(p, sigma) and not fans(p, sigma) for p in kept):
+            unsplit = "taper"
+        return pieces, cuts, unsplit
 
-    pieces, cuts, bulged = remembered(key, make)
-    if bulged:  # (the layout choice's draw with LayoutOptions(bulges=True) would split it)
-        noted_bulge()
+    pieces, cuts, unsplit = remembered(key, make)
+    if unsplit:
+        noted_unsplit(unsplit)
     return copied((pieces, cuts))
 
 
@@ -433,16 +463,18 @@ def _unfanned(
     thin: bool,
     regular: bool = False,
     bulges: bool = False,
+    tapers: bool = False,
 ):
     """``pieces`` (``(ring, forced)``) and ``cuts`` with every piece that fans
-    (:func:`~.fans.fans`) split by :func:`~.fans.unfan` where it can be, and every piece with a
-    side round a tip of land (:func:`~.fans.wraps`) where that split costs less (the split's
+    (:func:`~.fans.fans`; ``tapers``: or tapers, :func:`~.fans.tapers`) split by
+    :func:`~.fans.unfan` where it can be, and every piece with a side round a tip of land
+    (:func:`~.fans.wraps`) where that split costs less (the split's
     ``min_width``, ``normal`` and ``thin`` as the region's).  ``regular``: only the pieces round a
     tip, by the splits regular layouts allow (session 29: a block wrapping a peninsula, 79.6 → 97.1 %
     of nodes within 3°; the fan splits there changed a round lake's grid for the worse, not kept)."""
     out: list = []
     for ring, fc in pieces:
-        fan = not len(fc) and (bulges and bulging(ring, sigma) if regular else fans(ring, sigma))
+        fan = not len(fc) and (bulges and bulging(ring, sigma) if regular else fans(ring, sigma, tapered=tapers))
         if len(fc) or not (fan or wraps(ring, sigma)):
             out.append((ring, fc))
             continue
@@ -455,6 +487,7 @@ def _unfanned(
             thin=thin,
             wrapped=not fan,
             regular=regular,
+            tapered=tapers,
         )
         if got is not None and not fan and sum(region_cost(r, sigma, f) for r, f in got[0]) >= region_cost(ring, sigma):
             got = None  # a C round a thin peninsula grids well: split only where that costs less

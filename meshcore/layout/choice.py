@@ -111,7 +111,8 @@ MAX_BLOCKS = 150
 #: grid 93.1 → 97.8 % of nodes within 3°, edge pairs ≤ 1.2 94.98 → 96.72 %).
 RATIO_SLACK = 1e-3
 
-#: :data:`RATIO_SLACK` for the tip draw (``tips``): it changes the layout only round a few land
+#: :data:`RATIO_SLACK` for the draws at the chosen scale (``again``).  The tip draw changes the layout
+#: only round a few land
 #: tips, where a new cut end can lift the lake's 99th percentile of the coarse pairs by a hair
 #: (held-out g180700 at 10 000 cells with :data:`~meshcore.layout.pinch.PINCH`: 1.936 → 1.945,
 #: +0.5 %, the coarse deviation 36 % lower; final grid 91.5 → 96.2 % within 3°).  Session 35
@@ -147,7 +148,7 @@ def chosen(
     reading: Callable[[Layout], tuple[float, ...]],
     more: Sequence[Callable[[], Layout]] = (),
     ratio_ok: float = 0.0,
-    tips: Callable[[float], Layout] | None = None,
+    again: Sequence[Callable[[float], Layout]] = (),
     coarse: bool = False,
 ) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
@@ -158,9 +159,10 @@ def chosen(
     layout's coarse grid and, optionally, its shortest edge,
     :func:`meshcore.lakegrid.coarse_reading`).  A scale whose layout or coarse solve fails is
     passed over; so is every other scale when ``first``'s coarse solve fails.
-    ``tips``: the layout at a scale with its pieces round land tips split (:mod:`.tipcuts`),
-    drawn at the chosen scale and kept when its coarse deviation is :data:`MARGIN` below the
-    chosen layout's and its coarse interface ratio no larger than ``first``'s (or ``ratio_ok``).
+    ``again``: other draws at a scale (the pieces round land tips split, :mod:`.tipcuts`; the
+    pieces that taper split, :func:`~.fans.tapers`), each drawn in turn at the chosen scale and
+    kept when its coarse deviation is :data:`MARGIN` below the layout chosen so far and its coarse
+    interface ratio no larger than ``first``'s (up to :data:`TIP_RATIO_SLACK`, or ``ratio_ok``).
     ``coarse``: a layout of small blocks (:data:`SMALL_BLOCK_CELLS`) is also drawn at
     :data:`COARSE_SCALES`, and ``ratio_ok`` is at least :data:`SMALL_RATIO_OK` for it (default
     layouts; regular ones close their frames at other scales by moving corners).  When the best
@@ -216,18 +218,20 @@ def chosen(
         best, best_scale, best_dev = best_of(
             wide, (best, best_scale, best_dev), (1.0 - MARGIN) * best_dev, max(ratio_ok, WIDE_RATIO)
         )
-    if tips is not None and best_scale is not None:  # the chosen scale again, pieces round land tips split
+    for redraw in again if best_scale is not None else ():  # the chosen scale again, drawn otherwise
         try:
-            lay = tips(best_scale)
-            if lay.blocks not in seen:
-                got = reading(lay)
-                dev, ratio = got[:2]
-                if ratio <= max(ratio0 * (1.0 + TIP_RATIO_SLACK), ratio_ok):
-                    read.append((lay, dev, _shortest(got)))
-                    if dev < (1.0 - MARGIN) * best_dev:
-                        best, best_dev = lay, dev
+            lay = redraw(best_scale)
+            if lay.blocks in seen:
+                continue
+            seen.append(lay.blocks)
+            got = reading(lay)
         except MeshcoreError:
-            pass
+            continue
+        dev, ratio = got[:2]
+        if ratio <= max(ratio0 * (1.0 + TIP_RATIO_SLACK), ratio_ok):
+            read.append((lay, dev, _shortest(got)))
+            if dev < (1.0 - MARGIN) * best_dev:
+                best, best_dev = lay, dev
     return _uncollapsed(best, best_dev, read)
 
 

@@ -29,7 +29,19 @@ import numpy as np
 
 from .memo import watching
 
-__all__ = ["BULGING", "FAN_AREA", "FAN_BULGE", "FAN_PAIRS", "bulges", "fans", "unfan", "watching_bulges", "wraps"]
+__all__ = [
+    "BULGING",
+    "FAN_AREA",
+    "FAN_BULGE",
+    "FAN_PAIRS",
+    "bulges",
+    "fans",
+    "noted_unsplit",
+    "tapers",
+    "unfan",
+    "watching_unsplit",
+    "wraps",
+]
 
 #: A piece whose chosen corners give :func:`~.corners.bulge_ratio` at least this fans.  On the
 #: 73 generated shapes of `fresh_sweep.py` base 791000 (both sets) every piece was below 2.6
@@ -49,6 +61,7 @@ BULGING = 1.2
 #: 72 generated shapes of `fresh_sweep.py` base 946000 (both sets) every other piece of ``R`` ≥ 1.2
 #: had a product below 20.
 FAN_AREA = 32.0
+
 
 #: ... and a piece one of whose sides runs back on itself — measured along the line between its
 #: corners — by more than this share of that line's length and by more than :data:`BACK_CELLS`
@@ -70,8 +83,9 @@ def _pairs(ring: np.ndarray, corners) -> tuple[float, float]:
     return min(a, b), max(a, b)
 
 
-def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
-    """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) fans."""
+def fans(ring: np.ndarray, sigma: float, forced=(), tapered: bool = False) -> bool:
+    """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) fans
+    (``tapered``: or :func:`tapers`)."""
     got = _bulge(ring, sigma, forced)
     if got is None:
         return False
@@ -79,7 +93,19 @@ def fans(ring: np.ndarray, sigma: float, forced=()) -> bool:
     if R >= FAN_BULGE:
         return True
     lo, hi = _pairs(ring, corners)
-    return R >= BULGING and (lo >= FAN_PAIRS or lo * hi >= FAN_AREA)
+    return (R >= BULGING and (lo >= FAN_PAIRS or lo * hi >= FAN_AREA)) or (tapered and lo * hi >= FAN_AREA)
+
+
+def tapers(ring: np.ndarray, sigma: float, forced=()) -> bool:
+    """True when ``ring`` as one block (its corners by :func:`~.corners.choose_corners`) is a wedge
+    whose two ratios of opposite sides multiply to :data:`FAN_AREA` or more, whatever its bulge (its
+    cells differ in area by about the product): what default layouts split with
+    ``LayoutOptions(tapers=True)`` (:func:`~.build._unfanned`)."""
+    got = _bulge(ring, sigma, forced)
+    if got is None:
+        return False
+    lo, hi = _pairs(ring, got[0])
+    return lo * hi >= FAN_AREA
 
 
 def bulges(ring: np.ndarray, sigma: float, forced=()) -> bool:
@@ -150,11 +176,13 @@ def unfan(
     spaced points of the last resort) is followed by the greedy split of its pieces
     (``depth`` − 1 levels); the cheapest result without a fanning piece (``wrapped``: nor one
     with a side round a tip, :func:`wraps`) is returned.
-    ``kw``: ``regular``, ``normal``, ``thin`` of :func:`~.split.best_split`.
+    ``kw``: ``regular``, ``normal``, ``thin`` of :func:`~.split.best_split`; ``tapered``: a piece
+    that tapers (:func:`tapers`) counts as fanning.
     """
     from .split import _cut_options, _normal_cuts, _options, best_split
 
     regular, normal, thin = kw.get("regular", False), kw.get("normal", True), kw.get("thin", False)
+    tapered = kw.get("tapered", False)
     options = _options(ring, sigma, min_width, center, (), regular, normal, thin)
     if normal:
         options += _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width)
@@ -182,28 +210,31 @@ def unfan(
             out_c += cc
             total += c
         else:
-            if any(not len(f) and (fans(p, sigma) or (wrapped and wraps(p, sigma))) for p, f in out_p):
+            if any(not len(f) and (fans(p, sigma, tapered=tapered) or (wrapped and wraps(p, sigma))) for p, f in out_p):
                 continue
             if best is None or total < best[2] or (total == best[2] and k < best[3]):
                 best = (out_p, out_c, total, k)
     return None if best is None else best[:2]
 
 
-_bulged: contextvars.ContextVar[list | None] = contextvars.ContextVar("bulged", default=None)
+_unsplit: contextvars.ContextVar[list | None] = contextvars.ContextVar("unsplit", default=None)
 
 
 @contextlib.contextmanager
-def watching_bulges():
-    """Yields a list to which a regular layout drawn within this context without
-    ``LayoutOptions(bulges=True)`` adds True where a piece it kept bulges (:func:`bulges`,
-    :func:`noted_bulge`).  Where none does, the draw with the option makes the same layout, so the
-    layout choice does not make it (:data:`~meshcore.layout.BULGE_DRAW`)."""
-    with watching(_bulged) as box:
+def watching_unsplit():
+    """Yields a list to which a layout drawn within this context adds ``"bulge"`` where a regular
+    draw without ``LayoutOptions(bulges=True)`` kept a piece that bulges (:func:`bulges`) and
+    ``"taper"`` where a default draw without ``LayoutOptions(tapers=True)`` kept a piece that tapers
+    (:func:`tapers`; :func:`noted_unsplit`).  Where none is noted, the draw with that option makes
+    the same layout, so the layout choice does not make it (:data:`~meshcore.layout.BULGE_DRAW`,
+    :data:`~meshcore.layout.TAPER_DRAW`)."""
+    with watching(_unsplit) as box:
         yield box
 
 
-def noted_bulge() -> None:
-    """Within :func:`watching_bulges`: note that a piece of the draw bulges."""
-    box = _bulged.get()
+def noted_unsplit(kind: str) -> None:
+    """Within :func:`watching_unsplit`: note that the draw kept a piece of ``kind`` (``"bulge"``,
+    ``"taper"``) unsplit."""
+    box = _unsplit.get()
     if box is not None:
-        box.append(True)
+        box.append(kind)

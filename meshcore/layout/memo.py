@@ -64,7 +64,7 @@ def digest(*parts) -> bytes:
 def watching(var: contextvars.ContextVar):
     """Yields a new list set as ``var`` within this context: what a draw made within it notes
     there (a draw's pieces with a land tip, :func:`.tipcuts.watching_tips`; whether a piece bulges,
-    :func:`.fans.watching_bulges`), for the layout choice to skip a draw that would change nothing."""
+    :func:`.fans.watching_unsplit`), for the layout choice to skip a draw that would change nothing."""
     box: list = []
     token = var.set(box)
     try:

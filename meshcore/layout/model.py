@@ -41,6 +41,11 @@ class LayoutOptions:
         area over the product of the mean lengths of its opposite sides, at least
         :data:`~.fans.FAN_BULGE`) is split as default layouts split every fanning piece
         (:func:`~.fans.unfan`, by the splits regular layouts allow).
+    tapers
+        Default layouts only: a piece whose two ratios of opposite sides multiply to
+        :data:`~.fans.FAN_AREA` or more (a wedge from a neck into a basin: its cells differ in area
+        by about the product) is split as a fanning piece whatever its bulge
+        (:func:`~.fans.tapers`, :func:`~.fans.unfan`).
     islands_apart
         Islands less than three cells apart stay apart (by default they are joined into one, the
         water between given up with a note: :mod:`.islandgaps`); the layout then cuts blocks a
@@ -53,12 +58,13 @@ class LayoutOptions:
     wedges: bool = False
     tees: bool = False
     bulges: bool = False
+    tapers: bool = False
     islands_apart: bool = False
 
     def __str__(self) -> str:
         on = [
             f.replace("_", " ")
-            for f in ("thin_arms", "mouths", "curve", "wedges", "tees", "bulges", "islands_apart")
+            for f in ("thin_arms", "mouths", "curve", "wedges", "tees", "bulges", "tapers", "islands_apart")
             if getattr(self, f)
         ]
         return ", ".join(on) or "defaults"

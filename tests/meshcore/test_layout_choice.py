@@ -326,7 +326,7 @@ def test_the_tip_draw_keeps_the_nearby_ratio_guard():
             lambda s: wide if s == choice.WIDE_SCALES[0] else bad,
             lambda la: la.reading,
             ratio_ok=2.5,
-            tips=lambda s, t=tip: t,
+            again=[lambda s, t=tip: t],
         )
         assert got is (tip if taken else wide), tip_ratio
 
@@ -462,14 +462,15 @@ def test_a_regular_layout_that_does_not_close_is_drawn_at_the_other_scales(monke
         assert any("do not close up round an island" in str(n) for n in got.notes)
 
 
-def _read_against_a_draw_with(monkeypatch, poly, option: str, switch: str, on: bool):
-    """Regular layouts of ``poly`` read (a fake reading: the draw with ``LayoutOptions(option=True)``
-    best, the rest alike) with the module switch ``switch`` ``on``: the layout got, and for each
-    draw whether it was drawn with the option."""
+def _read_against_a_draw_with(monkeypatch, poly, option: str, switch: str, on: bool, regular: bool = True):
+    """Regular (or default) layouts of ``poly`` read (a fake reading: the draw with
+    ``LayoutOptions(option=True)`` best, the rest alike) with the module switch ``switch`` ``on``: the
+    layout got, and for each draw whether it was drawn with the option."""
     from meshcore.layout.model import LayoutOptions
 
-    wanted = auto_layout(poly, target_cells=3000, multiple=4, regular=True, options=LayoutOptions(**{option: True}))
-    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=True)
+    opts = LayoutOptions(**{option: True})
+    wanted = auto_layout(poly, target_cells=3000, multiple=4, regular=regular, options=opts)
+    plain = auto_layout(poly, target_cells=3000, multiple=4, regular=regular)
     assert wanted.blocks != plain.blocks
 
     def reading(lay):
@@ -521,6 +522,21 @@ def test_a_regular_layout_is_read_against_its_draw_with_bulging_blocks_split(mon
     _, drawn = read(testing.y_junction(), regular=True)  # no piece bulges: no such draw
     assert drawn and not any(drawn)
     _, drawn = read(poly)  # default layouts split fanning pieces anyway: never drawn with the option
+    assert drawn and not any(drawn)
+
+
+@pytest.mark.parametrize("on", [True, False])
+def test_a_default_layout_is_read_against_its_draw_with_tapering_blocks_split(monkeypatch, on):
+    """The layout choice of a default layout also reads its draw with every piece that tapers split
+    (``.fans.tapers``, ``LayoutOptions(tapers=True)``; ``TAPER_DRAW``) and keeps it where its coarse
+    grid reads best; that draw is made only where a piece tapers, and never for regular layouts."""
+    poly = testing.round_lake(2, kind="disc")  # a wedge between two islands and the west shore
+    read = _read_against_a_draw_with(monkeypatch, poly, "tapers", "TAPER_DRAW", on, regular=False)
+    got, drawn = read(poly)
+    assert got is on and any(drawn) is on
+    _, drawn = read(testing.y_junction(), regular=False)  # no piece tapers: no such draw
+    assert drawn and not any(drawn)
+    _, drawn = read(poly, regular=True)  # regular layouts are never drawn with the option
     assert drawn and not any(drawn)
 
 

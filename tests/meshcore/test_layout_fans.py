@@ -234,3 +234,25 @@ def test_the_regular_grid_of_a_bulging_lake_is_a_model_grid(mode):
     assert len(mb.grids) > 1 and m["folded_cells"] == 0
     assert 0.5 <= m["cells"] / 10000 <= 2
     assert m["pct_nodes_within_3deg"] >= 90 and m["hausdorff_cells"] <= 0.5
+
+
+def test_a_wedge_whose_sides_differ_by_much_tapers():
+    """A wedge (a trapezoid 0.3 across at one end and 12 at the other) bulges little (0.7) but its
+    cells differ in area by about the product of its ratios of opposite sides (40): it tapers, and
+    fans where tapering pieces count (``LayoutOptions(tapers=True)``, session 48: held-out g180615's
+    block from a neck into a basin); a rectangle does not taper."""
+    from meshcore.layout import fans
+    from meshcore.layout.split import corners_of
+
+    top = np.c_[np.linspace(5.85, 6.15, 4), np.full(4, 6.0)]
+    bottom = np.c_[np.linspace(0.0, 12.0, 41), np.zeros(41)]
+    left = np.c_[np.linspace(5.85, 0.0, 21)[1:-1], np.linspace(6.0, 0.0, 21)[1:-1]]
+    right = np.c_[np.linspace(12.0, 6.15, 21)[1:-1], np.linspace(0.0, 6.0, 21)[1:-1]]
+    ring = np.vstack([bottom, right, top[::-1], left])  # counter-clockwise
+    corners, _ = corners_of(ring, 0.45)
+    bulge, _, product = _fan(ring, corners)
+    assert bulge < 1.2 and product >= 32.0, (bulge, product)
+    assert fans.tapers(ring, 0.45) and fans.fans(ring, 0.45, tapered=True)
+    assert not fans.fans(ring, 0.45)  # a bulge under 1.2 does not fan by itself
+    rect = np.array([(0, 0), (12, 0), (12, 6), (0, 6)], float)
+    assert not fans.tapers(rect, 0.45) and not fans.fans(rect, 0.45, tapered=True)
