@@ -73,11 +73,11 @@ def test_the_layout_with_the_most_orthogonal_coarse_grid_is_kept(monkeypatch, se
 
 def test_default_and_regular_layouts_may_take_a_coarse_ratio_up_to_theirs(monkeypatch):
     """The choice among scales lets another draw's coarse interface ratio exceed the first's up to
-    ``DEFAULT_RATIO`` (default layouts, session 36) or ``REGULAR_RATIO`` (regular ones): both 2.5,
-    which the final grid's equalize step brings under 2."""
+    ``DEFAULT_RATIO`` (default layouts, session 36; 3.0 since session 48) or ``REGULAR_RATIO``
+    (regular ones, 2.5), which the final grid's equalize step brings under 2."""
     from meshcore.layout import choice
 
-    assert layout_pkg.DEFAULT_RATIO == layout_pkg.REGULAR_RATIO == 2.5
+    assert (layout_pkg.DEFAULT_RATIO, layout_pkg.REGULAR_RATIO) == (3.0, 2.5)
     seen = []
     real = choice.chosen
 
@@ -268,7 +268,7 @@ def test_wider_scales_are_drawn_when_the_nearby_ones_all_read_far_from_90_degree
     from meshcore.layout import choice
 
     assert choice.WIDE_DEV > 0 and choice.WIDE_SCALES and not set(choice.WIDE_SCALES) & set(choice.SCALES)
-    assert choice.WIDE_RATIO > layout_pkg.DEFAULT_RATIO == layout_pkg.REGULAR_RATIO
+    assert choice.WIDE_RATIO > layout_pkg.DEFAULT_RATIO >= layout_pkg.REGULAR_RATIO
 
     def run(first, by_scale, ratio_ok=2.5):
         drawn: list[float] = []
