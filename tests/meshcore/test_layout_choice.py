@@ -73,11 +73,11 @@ def test_the_layout_with_the_most_orthogonal_coarse_grid_is_kept(monkeypatch, se
 
 def test_default_and_regular_layouts_may_take_a_coarse_ratio_up_to_theirs(monkeypatch):
     """The choice among scales lets another draw's coarse interface ratio exceed the first's up to
-    ``DEFAULT_RATIO`` (default layouts, session 36; 3.0 since session 48) or ``REGULAR_RATIO``
-    (regular ones, 2.5), which the final grid's equalize step brings under 2."""
+    ``DEFAULT_RATIO`` (default layouts, session 36) or ``REGULAR_RATIO`` (regular ones, session 33):
+    both 3.0 since session 48, which the final grid's equalize step brings under 2."""
     from meshcore.layout import choice
 
-    assert (layout_pkg.DEFAULT_RATIO, layout_pkg.REGULAR_RATIO) == (3.0, 2.5)
+    assert layout_pkg.DEFAULT_RATIO == layout_pkg.REGULAR_RATIO == 3.0
     seen = []
     real = choice.chosen
 
