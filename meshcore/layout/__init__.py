@@ -482,8 +482,8 @@ BULGE_DRAW = True
 #: The layout choice of a default layout also weighs its draw with every piece that tapers split
 #: (``LayoutOptions(tapers=True)``, :func:`~.fans.tapers`: a wedge whose opposite sides differ by a
 #: product of :data:`~.fans.FAN_AREA` or more, whatever its bulge) at the chosen scale, where a piece
-#: of the draw at that scale tapers (:func:`~.fans.watching_unsplit`): as a rule for every default layout the split
-#: helped some lakes and hurt others (journal, *Wedges*).
+#: of the draw at that scale tapers (:func:`~.fans.watching_unsplit`): as a rule for every default
+#: layout the split helped some lakes and hurt others (journal, *Wedges*, *Tapering pieces*).
 TAPER_DRAW = True
 
 #: The tip draw is skipped where the draw at its scale left no piece that :mod:`.tipcuts` splits

@@ -111,13 +111,13 @@ MAX_BLOCKS = 150
 #: grid 93.1 → 97.8 % of nodes within 3°, edge pairs ≤ 1.2 94.98 → 96.72 %).
 RATIO_SLACK = 1e-3
 
-#: :data:`RATIO_SLACK` for the draws at the chosen scale (``again``).  The tip draw changes the layout
-#: only round a few land
-#: tips, where a new cut end can lift the lake's 99th percentile of the coarse pairs by a hair
-#: (held-out g180700 at 10 000 cells with :data:`~meshcore.layout.pinch.PINCH`: 1.936 → 1.945,
-#: +0.5 %, the coarse deviation 36 % lower; final grid 91.5 → 96.2 % within 3°).  Session 35
-#: measured 0.01 (journal); an absolute guard tried first (up to 2.0) took tip draws of small
-#: lakes whose coarse ratio rose 3–17 % for grids already 99.9 % within 3°, final ratios up to 1.71.
+#: :data:`RATIO_SLACK` for the draws at the chosen scale (``again``).  The tip draw changes the
+#: layout only round a few land tips, where a new cut end can lift the lake's 99th percentile of
+#: the coarse pairs by a hair (held-out g180700 at 10 000 cells with
+#: :data:`~meshcore.layout.pinch.PINCH`: 1.936 → 1.945, +0.5 %, the coarse deviation 36 % lower;
+#: final grid 91.5 → 96.2 % within 3°).  Session 35 measured 0.01 (journal); an absolute guard
+#: tried first (up to 2.0) took tip draws of small lakes whose coarse ratio rose 3–17 % for grids
+#: already 99.9 % within 3°, final ratios up to 1.71.
 TIP_RATIO_SLACK = 0.01
 
 

@@ -62,7 +62,6 @@ BULGING = 1.2
 #: had a product below 20.
 FAN_AREA = 32.0
 
-
 #: ... and a piece one of whose sides runs back on itself — measured along the line between its
 #: corners — by more than this share of that line's length and by more than :data:`BACK_CELLS`
 #: cells beyond what its opposite side does: the side goes round a tip of land into a pocket of

@@ -63,8 +63,9 @@ def digest(*parts) -> bytes:
 @contextlib.contextmanager
 def watching(var: contextvars.ContextVar):
     """Yields a new list set as ``var`` within this context: what a draw made within it notes
-    there (a draw's pieces with a land tip, :func:`.tipcuts.watching_tips`; whether a piece bulges,
-    :func:`.fans.watching_unsplit`), for the layout choice to skip a draw that would change nothing."""
+    there (a draw's pieces with a land tip, :func:`.tipcuts.watching_tips`; whether a piece bulges
+    or tapers, :func:`.fans.watching_unsplit`), for the layout choice to skip a draw that would
+    change nothing."""
     box: list = []
     token = var.set(box)
     try:
