@@ -76,7 +76,10 @@ def _relax_row_vec(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, nj1, tx, ty):  
             y[i, j] = ty[j]
 
 
-@njit(cache=True, nogil=True)
+# inline="always": :func:`smooth_band` calls it per row for a band a few nodes wide (the FMG band
+# of width 2: 1 node per colour), where the call cost as much as the nodes: 10.6 → 7.9 ns per node
+# update there on a 33 × 17 level, the same bits
+@njit(cache=True, nogil=True, inline="always")
 def _relax_range(x, y, fx, fy, p, q, use_f, use_pq, i, iw, ie, j0, j1):  # pragma: no cover
     """Gauss–Seidel update of row ``i`` for ``j0 ≤ j < j1`` (odd j first, as in ``_smooth``)."""
     for cj in range(2):
