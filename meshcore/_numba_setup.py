@@ -31,15 +31,12 @@ runs before any kernel module is imported and does two things:
 ``scripts/setup.sh`` compiles every kernel once (:func:`compile_all`),
 so that the first solve in a new environment loads them instead of compiling.
 
-It also makes runs reproducible.  The fold-free repair's sweeps
-(:mod:`meshcore.foldfree._sweep`, ``fastmath`` with ``reassoc``) give results that differ
-in the last bits between a kernel compiled in the running process and the same kernel
-loaded from the cache (session 34: ``repair`` of a 5 × 12 block, compiled in the process
-against loaded, different hashes; without ``reassoc`` the same, and 15–20 % slower).  A
-lake's grid amplifies that: its first run in a process that compiled the kernels came out
-different from every later run.  After :func:`compile_all` every kernel a lake run needs is
-loaded from the cache (no cache miss over default and regular layouts of two lakes with
-islands), so every run of the same input gives the same grid.
+Runs are reproducible with or without it: a kernel compiled in the running process computes what
+the same kernel loaded from the cache computes (tested).  The fold-free repair's sweeps
+(:mod:`meshcore.foldfree._sweep`) were compiled with ``fastmath`` ``reassoc`` until session 49,
+and then did not: a lake's first run in a process that compiled them came out different from
+every later run (a 5 × 6 block's repair differed in the last bits, and the lake's whole grid with
+it); they keep the other fast-math flags (:data:`meshcore.foldfree._kernels._FM`).
 """
 
 from __future__ import annotations

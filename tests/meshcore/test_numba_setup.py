@@ -65,6 +65,30 @@ def test_the_stamp_covers_every_module_with_kernels():
     assert with_kernels <= listed, sorted(with_kernels - listed)
 
 
+def test_a_kernel_compiled_in_the_process_gives_what_the_cached_one_gives(tmp_path):
+    """The same input gives the same grid whether the kernels were compiled by the running process
+    or loaded from numba's cache (an emptied or new cache, a kernel edit, a temp cache wiped at a
+    reboot).  The fold-free sweeps with ``fastmath`` ``reassoc`` did not: a repair compiled in the
+    process and the same repair loaded came out different in the last bits, and a lake's grid
+    amplified that into another grid (session 49)."""
+    code = (
+        "import hashlib, numpy as np, meshcore\n"
+        "from meshcore.foldfree import repair\n"
+        "X, Y = np.meshgrid(np.linspace(0, 2, 13), np.linspace(0, 1, 9), indexing='ij')\n"
+        "X = X + 0.03 * np.sin(7 * Y) * np.sin(3 * X)\n"
+        "Y = Y + 0.02 * np.cos(5 * X)\n"
+        "X[5, 4], Y[5, 4] = X[8, 5], Y[8, 5]\n"
+        "X[9, 2] = X[7, 2]\n"
+        "r = repair(meshcore.StructuredGrid(X, Y), strict=False)\n"
+        "assert meshcore.quality(r.grid).n_folded == 0\n"
+        "print(hashlib.sha1(r.grid.x.tobytes() + r.grid.y.tobytes()).hexdigest())\n"
+    )
+    env = {"NUMBA_CACHE_DIR": str(tmp_path)}
+    compiled = _run(code, **env)  # an empty cache: compiled here (and written)
+    loaded = _run(code, **env)  # loaded
+    assert compiled == loaded
+
+
 @pytest.mark.slow
 def test_after_compile_all_a_new_process_compiles_nothing(tmp_path):
     """The set-up step compiles every kernel the solvers use: in a new process (same cache)
