@@ -35,6 +35,7 @@ if [ ! -f "$STAMP" ] || [ pyproject.toml -nt "$STAMP" ]; then
   touch "$STAMP"
 fi
 # Compile every numba kernel once (cached on disk, see meshcore/_numba_setup.py), so that the
-# first solve loads them instead of compiling (2-4 min on a busy 2-core machine); a second run only loads them (~3 s).
+# first solve loads them instead of compiling (50 s on a quiet 2-core machine, two processes side by side);
+# a second run only loads them (~1 s).
 .venv/bin/python -c "from meshcore._numba_setup import compile_all, cache_dir; \
 print(f'[setup] numba kernels ready in {compile_all():.1f} s (cache: {cache_dir()})')" >&2

@@ -65,6 +65,15 @@ def test_the_stamp_covers_every_module_with_kernels():
     assert with_kernels <= listed, sorted(with_kernels - listed)
 
 
+def test_the_side_by_side_compile_copies_into_the_directories_numba_reads(tmp_path, monkeypatch):
+    """:func:`compile_all`'s second process compiles into a cache of its own whose package
+    directories are copied into the ones numba reads (:func:`cache_dirs`): the two rules agree."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert set(_numba_setup._package_dirs(str(tmp_path)).values()) == set(_numba_setup.cache_dirs())
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
+    assert set(_numba_setup._package_dirs(None).values()) == set(_numba_setup.cache_dirs())
+
+
 def test_a_kernel_compiled_in_the_process_gives_what_the_cached_one_gives(tmp_path):
     """The same input gives the same grid whether the kernels were compiled by the running process
     or loaded from numba's cache (an emptied or new cache, a kernel edit, a temp cache wiped at a
