@@ -229,22 +229,31 @@ def _compile_side_by_side() -> None:
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
     with tempfile.TemporaryDirectory(prefix="gcmesh-kernels-") as own:
         envs = [dict(os.environ, PYTHONPATH=path), dict(os.environ, PYTHONPATH=path, NUMBA_CACHE_DIR=own)]
-        procs = [
-            subprocess.Popen([sys.executable, "-c", code, part], env=env, **quiet)
-            for part, env in zip(PARTS, envs, strict=True)
-        ]
-        for proc in procs:
-            proc.wait()
+        procs = []
+        try:
+            for part, env in zip(PARTS, envs, strict=True):
+                procs.append(subprocess.Popen([sys.executable, "-c", code, part], env=env, **quiet))
+            for proc in procs:
+                proc.wait()
+        except OSError:  # no second process: all in this one
+            return
+        finally:
+            for proc in procs:  # (an interrupt: no compiler left behind)
+                if proc.poll() is None:
+                    proc.kill()
         ours = _package_dirs(os.environ.get("NUMBA_CACHE_DIR"))
-        for pkg, d in _package_dirs(own).items():
-            if pkg == "elliptic" or not d.is_dir():
-                continue
-            ours[pkg].mkdir(parents=True, exist_ok=True)
-            for f in d.iterdir():
-                if f.suffix in (".nbi", ".nbc"):
-                    tmp = ours[pkg] / f".{f.name}.{os.getpid()}"
-                    shutil.copyfile(f, tmp)
-                    os.replace(tmp, ours[pkg] / f.name)
+        try:
+            for pkg, d in _package_dirs(own).items():
+                if pkg == "elliptic" or not d.is_dir():
+                    continue
+                ours[pkg].mkdir(parents=True, exist_ok=True)
+                for f in d.iterdir():
+                    if f.suffix in (".nbi", ".nbc"):
+                        tmp = ours[pkg] / f".{f.name}.{os.getpid()}"
+                        shutil.copyfile(f, tmp)
+                        os.replace(tmp, ours[pkg] / f.name)
+        except OSError:  # a cache we cannot write: what is missing compiles in this process
+            pass
 
 
 def _compile_part(part: str) -> None:
