@@ -226,13 +226,13 @@ def _compile_side_by_side() -> None:
 
     path = os.pathsep.join(filter(None, [str(_ROOT.parent), os.environ.get("PYTHONPATH")]))
     code = "import sys; from meshcore._numba_setup import _compile_part; _compile_part(sys.argv[1])"
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
     with tempfile.TemporaryDirectory(prefix="gcmesh-kernels-") as own:
         envs = [dict(os.environ, PYTHONPATH=path), dict(os.environ, PYTHONPATH=path, NUMBA_CACHE_DIR=own)]
         procs = []
         try:
             for part, env in zip(PARTS, envs, strict=True):
-                procs.append(subprocess.Popen([sys.executable, "-c", code, part], env=env, **quiet))
+                quiet = subprocess.DEVNULL
+                procs.append(subprocess.Popen([sys.executable, "-c", code, part], env=env, stdout=quiet, stderr=quiet))
             for proc in procs:
                 proc.wait()
         except OSError:  # no second process: all in this one
