@@ -326,11 +326,12 @@ def _node_forms(x, y, i, j, periodic, cx, cy, forms):
 #: The flags of the two sums over a node's 12 triangles: they may be fused (no assumption on
 #: infinities: the ε = 0 trial energy is +inf on an inverted triangle).  With them and the forms
 #: stored by form (``forms[f, k]``) a node update took 176 → 141 ns (ε = 0) and 281 → 238 ns
-#: (ε > 0; session 26, with ``reassoc`` too), CPU, a lake's whole-block relax; the energies equal the term-by-term sums up to
-#: rounding.  Not ``reassoc``: with it a kernel compiled in the running process and the same kernel
-#: loaded from numba's cache summed in other orders, and a lake's first run after the cache was
-#: emptied gave another grid than every later run (session 49; without it the repair of the four
-#: branched lakes of ``benchmarks/robust.py`` took the same CPU time within ±3 %).
+#: (ε > 0; session 26, with ``reassoc`` too), CPU, a lake's whole-block relax; the energies equal
+#: the term-by-term sums up to rounding.  Not ``reassoc``: with it a kernel compiled in the running
+#: process and the same kernel loaded from numba's cache summed in other orders, and a lake's first
+#: run after the cache was emptied gave another grid than every later run (session 49; without it
+#: the repair of the four branched lakes of ``benchmarks/robust.py`` took the same CPU time within
+#: ±3 %).
 _FM = {"nsz", "contract", "arcp"}
 
 
