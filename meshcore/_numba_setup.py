@@ -194,7 +194,10 @@ def compile_all(jobs: int | None = None) -> float:
         except AttributeError:  # pragma: no cover - not Linux
             jobs = os.cpu_count() or 1
     if jobs > 1 and not _warm():
-        _compile_side_by_side()
+        try:
+            _compile_side_by_side()
+        except OSError:  # (no temporary directory, say): all in this process
+            pass
     for part in PARTS:
         _compile_part(part)
     return time.perf_counter() - t0
