@@ -94,16 +94,8 @@ def cache_dir() -> str:
 
 def cache_dirs() -> list[Path]:
     """The cache directory of each package with kernels (numba's own rule, see above)."""
-    base = os.environ.get("NUMBA_CACHE_DIR")
-    out = []
-    for pkg in sorted({Path(m).parent.name for m in KERNEL_MODULES}, key=lambda p: p != "elliptic"):
-        src = _ROOT / pkg
-        if base:
-            path = os.path.abspath(src)
-            out.append(Path(base) / f"{src.name}_{hashlib.sha1(path.encode()).hexdigest()}")
-        else:
-            out.append(src / "__pycache__")
-    return out
+    dirs = _package_dirs(os.environ.get("NUMBA_CACHE_DIR"))
+    return [dirs["elliptic"], *(d for pkg, d in dirs.items() if pkg != "elliptic")]
 
 
 def _stamp() -> str:
@@ -205,7 +197,7 @@ def compile_all(jobs: int | None = None) -> float:
 
 def _package_dirs(base: str | None) -> dict[str, Path]:
     """Each kernel package's cache directory under ``NUMBA_CACHE_DIR`` = ``base`` (None: the
-    packages' ``__pycache__``), numba's rule (see :func:`cache_dirs`)."""
+    packages' ``__pycache__``), numba's rule: ``base/<package>_<sha1 of its path>``."""
     out = {}
     for pkg in sorted({Path(m).parent.name for m in KERNEL_MODULES}):
         src = _ROOT / pkg
