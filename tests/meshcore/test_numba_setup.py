@@ -65,13 +65,26 @@ def test_the_stamp_covers_every_module_with_kernels():
     assert with_kernels <= listed, sorted(with_kernels - listed)
 
 
-def test_the_side_by_side_compile_copies_into_the_directories_numba_reads(tmp_path, monkeypatch):
+def test_the_side_by_side_compile_copies_into_the_directories_numba_reads(tmp_path):
     """:func:`compile_all`'s second process compiles into a cache of its own whose package
-    directories are copied into the ones numba reads (:func:`cache_dirs`): the two rules agree."""
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
-    assert set(_numba_setup._package_dirs(str(tmp_path)).values()) == set(_numba_setup.cache_dirs())
-    monkeypatch.delenv("NUMBA_CACHE_DIR")
-    assert set(_numba_setup._package_dirs(None).values()) == set(_numba_setup.cache_dirs())
+    directories are copied into ours (:func:`_package_dirs`): they are where numba itself reads
+    and writes each package's kernels, with and without ``NUMBA_CACHE_DIR``."""
+    code = (
+        "import os\n"
+        "from meshcore import _numba_setup as s\n"
+        "from meshcore.elliptic import _mg_relax\n"
+        "from meshcore.foldfree import _sweep\n"
+        "from meshcore.layout import _corner_kernels\n"
+        "from meshcore.multiblock import _kernels as mb\n"
+        "from meshcore.orthogonal import _kernels as ok\n"
+        "kernels = {'elliptic': _mg_relax._relax_range, 'foldfree': _sweep.fast_sweep,\n"
+        "           'layout': _corner_kernels.ring_terms, 'multiblock': mb.table_defect, 'orthogonal': ok.sweep}\n"
+        "ours = s._package_dirs(os.environ.get('NUMBA_CACHE_DIR'))\n"
+        "bad = [p for p, k in kernels.items() if os.path.abspath(k._cache._cache_path) != os.path.abspath(ours[p])]\n"
+        "print(sorted(ours) == sorted(kernels), bad)\n"
+    )
+    assert _run(code, NUMBA_CACHE_DIR=str(tmp_path)) == "True []"
+    assert _run(code, NUMBA_CACHE_DIR=None) == "True []"
 
 
 def test_a_kernel_compiled_in_the_process_gives_what_the_cached_one_gives(tmp_path):
