@@ -117,7 +117,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "cuts at the arms' mouths, wedges = two corners beside the tip of an arm tapering to a point, "
         "tees = junctions of regular (.ddb) layouts split as a T, bulges = blocks of regular layouts whose corners "
         "bunch on part of a round basin split, tapers = blocks of default layouts whose opposite sides differ much "
-        "(a wedge) split, islands-apart = islands less than three "
+        "(a wedge) split, lookahead = each region's first split the one of its three cheapest whose pieces, split "
+        "on, cost least, islands-apart = islands less than three "
         "cells apart kept apart (by default joined into one, the water between given up with a note)",
     )
     p.add_argument(

@@ -143,7 +143,17 @@ def _notes(notes: Any, frame: Any = None) -> None:
 
 
 #: ``--layout-option`` names: the fields of :class:`~meshcore.layout.LayoutOptions`, with dashes.
-LAYOUT_OPTIONS = ("curve", "thin-arms", "mouths", "wedges", "tees", "bulges", "tapers", "islands-apart")
+LAYOUT_OPTIONS = (
+    "curve",
+    "thin-arms",
+    "mouths",
+    "wedges",
+    "tees",
+    "bulges",
+    "tapers",
+    "lookahead",
+    "islands-apart",
+)
 
 
 def layout_options(args):

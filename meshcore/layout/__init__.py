@@ -236,6 +236,13 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
             if TAPER_DRAW and not regular and not options.tapers
             else None
         )
+        looked = (
+            functools.partial(
+                _layout, shores, h, notes, multiple=multiple, options=dataclasses.replace(options, lookahead=True)
+            )
+            if LOOK_DRAW and not options.lookahead
+            else None
+        )
         lay, error, closing = _first_fit(
             draw,
             regular=regular,
@@ -245,6 +252,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
             teed=teed,
             bulged=bulged,
             tapered=tapered,
+            looked=looked,
         )
         if lay is not None:
             return dataclasses.replace(lay, details=tuple(details)) if details else lay
@@ -268,7 +276,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
 
 
 def _first_fit(
-    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None, bulged=None, tapered=None
+    draw, *, regular: bool, single: bool, reading, ringed=None, teed=None, bulged=None, tapered=None, looked=None
 ) -> tuple[Layout | None, Exception | None, Layout | None]:
     """The first layout ``draw`` makes at :data:`LAYOUT_SCALES` (with and without cuts along the
     shore's normal) that fits: ``(layout, None, None)``; else ``(None, the first error, the first
@@ -282,7 +290,8 @@ def _first_fit(
     T, :mod:`.tee`) and, where a piece of the layout bulges (:func:`~.fans.watching_unsplit`),
     ``bulged``'s (such pieces split, ``LayoutOptions(bulges=True)``); a default one's chosen scale
     is also drawn with ``tapered`` where a piece of its draw tapers (such pieces split,
-    ``LayoutOptions(tapers=True)``)."""
+    ``LayoutOptions(tapers=True)``); where the layout chosen still reads far off 90°, the chosen scale
+    is drawn with ``looked`` too (each region's first split looking ahead, ``LayoutOptions(lookahead=True)``)."""
     from ..errors import TopologyError
 
     first = None
@@ -337,6 +346,10 @@ def _first_fit(
                         return d[s][0]
                     return _noted(tapered(regular=False, normal=n, scale=base * s), base * s, w, base)
 
+                def with_look(s: float, n: bool = normal, base: float = scale, w: str = why) -> Layout:
+                    got = _noted(looked(regular=regular, normal=n, scale=base * s), base * s, w, base)
+                    return _closing(got, regular)
+
                 more = []
                 if regular and ringed is not None and len(lay.polygon.interiors):  # every island ringed
                     more.append(functools.partial(_redrawn, ringed, normal, scale, why))
@@ -348,7 +361,8 @@ def _first_fit(
                 if not regular and tapered is not None:  # the chosen scale's pieces that taper split
                     again.append(with_tapers)
                 ratio_ok = REGULAR_RATIO if regular else DEFAULT_RATIO
-                lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, again=again, coarse=not regular)
+                far = [with_look] if looked is not None else []
+                lay = chosen(lay, at_scale, reading, more, ratio_ok=ratio_ok, again=again, coarse=not regular, far=far)
             return lay, None, None
     return None, first, kept
 
@@ -491,6 +505,12 @@ TAPER_DRAW = True
 #: again (session 34).
 TIP_GATE = True
 
+#: Where the layout the choice took still reads more than :data:`~.choice.WIDE_DEV` off 90°, its
+#: scale is drawn once more with each region's first split looking ahead
+#: (``LayoutOptions(lookahead=True)``, :data:`~.split.LOOKAHEAD`), kept by the rule of the choice's
+#: other draws at that scale.  False: not drawn.
+LOOK_DRAW = True
+
 
 def _layout(
     shores,
@@ -521,6 +541,7 @@ def _layout(
         "bulges": options.bulges and regular,
         "tapers": options.tapers and not regular,
         "single": single,
+        "lookahead": options.lookahead,
     }
     sk, chords, _, pieces = layout_pieces(shores.layout, hl, ring=ring, **kw)
     moved = transfer(pieces, shores)

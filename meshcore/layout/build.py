@@ -35,7 +35,7 @@ from .memo import copied, digest, remembered
 from .regions import partition
 from .ringcuts import ring_cuts
 from .skeleton import Skeleton, skeleton
-from .split import _GOOD, best_split, corners_of, forced_indices, region_cost
+from .split import _GOOD, LOOKAHEAD, best_split, corners_of, forced_indices, region_cost
 from .stopping import check
 from .tee import tee
 from .tipcuts import noted_pinch, noted_tips, tips_split, untipped
@@ -149,6 +149,7 @@ def layout_pieces(
     tapers: bool = False,
     single: bool = False,
     ring: bool = False,
+    lookahead: bool = False,
 ) -> tuple[Skeleton, list[Chord], list[np.ndarray], list[Piece]]:
     """Skeleton, chords, all cut lines and the conforming pieces of ``poly`` for cell size ``h``
     (``regular``: only nodes where four blocks meet; ``normal``: splits may cut along the shore's
@@ -160,7 +161,8 @@ def layout_pieces(
     ``tapers``: default layouts split pieces that taper, :func:`~.fans.tapers`;
     ``single``: with ``regular``, every island's ring of blocks turns once,
     :data:`~.frames.ONE_TURN`, so that it can close in one index space; ``ring``: every island gets
-    at least four cut ends, :func:`~.ringcuts.ring_cuts`, without which its ring cannot turn once)."""
+    at least four cut ends, :func:`~.ringcuts.ring_cuts`, without which its ring cannot turn once;
+    ``lookahead``: each region's first split looks ahead, :data:`~.split.LOOKAHEAD`)."""
     import shapely
     from shapely.geometry import Polygon
 
@@ -200,6 +202,7 @@ def layout_pieces(
                 tees and regular,
                 bulges and regular,
                 tapers and not regular,
+                LOOKAHEAD if lookahead else 1,
             )
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
@@ -406,8 +409,10 @@ def _split_region(
     tees: bool,
     bulges: bool = False,
     tapers: bool = False,
+    look: int = 1,
 ):
-    """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split`, then :func:`_unfanned`
+    """``(pieces, cuts)`` of the region ``r``: :func:`~.split.best_split` (``look``: its first split
+    looks ahead, :data:`~.split.LOOKAHEAD`), then :func:`_unfanned`
     (``bulges``: regular layouts split pieces that bulge too, ``tapers``: default layouts pieces
     that taper; without it a piece kept that bulges, or tapers, is noted, :func:`~.fans.noted_unsplit`);
     remembered within :func:`.memo.remembering` (keyed by a 128-bit digest of the ring, the skeleton's
@@ -433,11 +438,12 @@ def _split_region(
         tees,
         bulges,
         tapers,
+        look,
     )
 
     def make():
         kw: dict = {"regular": regular, "normal": normal, "thin": thin, "tee": tee if tees else None}
-        pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, **kw)
+        pieces, cuts, _ = best_split(r, sigma=sigma, min_width=min_width, center=center, look=look, **kw)
         pieces, cuts = _unfanned(pieces, cuts, junctions, sigma, min_width, normal, thin, regular, bulges, tapers)
         kept = [p for p, fc in pieces if not len(fc)]
         unsplit = None  # what the layout choice's draw with LayoutOptions(bulges=, tapers=True) would split

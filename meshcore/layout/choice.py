@@ -150,6 +150,7 @@ def chosen(
     ratio_ok: float = 0.0,
     again: Sequence[Callable[[float], Layout]] = (),
     coarse: bool = False,
+    far: Sequence[Callable[[float], Layout]] = (),
 ) -> Layout:
     """``first`` (the layout at the cell size) or the layout ``at_scale(s)``, ``s`` in
     :data:`SCALES` (then each of ``more()``, other draws: a regular layout with more cuts from its
@@ -171,7 +172,9 @@ def chosen(
     :data:`WIDE_SCALES` too, one of them kept when it reads :data:`MARGIN` below that best with a
     coarse ratio up to :data:`WIDE_RATIO`.  Last, a chosen layout whose coarse grid has a collapsed
     cell (:data:`COLLAPSED`) gives way to the least deviating layout read whose grid has none, if that
-    deviates at most :data:`COLLAPSE_WEIGHT` × as much."""
+    deviates at most :data:`COLLAPSE_WEIGHT` × as much.  ``far``: draws at the chosen scale as
+    ``again``, tried after those only when the layout kept so far reads more than :data:`WIDE_DEV` (and
+    ``first`` has at most :data:`WIDE_MAX_BLOCKS` blocks)."""
     if first.multiple < 4 or len(first.blocks) > MAX_BLOCKS:
         return first
     try:
@@ -218,20 +221,28 @@ def chosen(
         best, best_scale, best_dev = best_of(
             wide, (best, best_scale, best_dev), (1.0 - MARGIN) * best_dev, max(ratio_ok, WIDE_RATIO)
         )
-    for redraw in again if best_scale is not None else ():  # the chosen scale again, drawn otherwise
-        try:
-            lay = redraw(best_scale)
-            if lay.blocks in seen:
+
+    def redrawn(draws, best: Layout, best_dev: float) -> tuple[Layout, float]:
+        """The chosen scale again, drawn otherwise: ``(best, best_dev)`` or the draw kept instead."""
+        for redraw in draws if best_scale is not None else ():
+            try:
+                lay = redraw(best_scale)
+                if lay.blocks in seen:
+                    continue
+                seen.append(lay.blocks)
+                got = reading(lay)
+            except MeshcoreError:
                 continue
-            seen.append(lay.blocks)
-            got = reading(lay)
-        except MeshcoreError:
-            continue
-        dev, ratio = got[:2]
-        if ratio <= max(ratio0 * (1.0 + TIP_RATIO_SLACK), ratio_ok):
-            read.append((lay, dev, _shortest(got)))
-            if dev < (1.0 - MARGIN) * best_dev:
-                best, best_dev = lay, dev
+            dev, ratio = got[:2]
+            if ratio <= max(ratio0 * (1.0 + TIP_RATIO_SLACK), ratio_ok):
+                read.append((lay, dev, _shortest(got)))
+                if dev < (1.0 - MARGIN) * best_dev:
+                    best, best_dev = lay, dev
+        return best, best_dev
+
+    best, best_dev = redrawn(again, best, best_dev)
+    if best_dev > WIDE_DEV and len(first.blocks) <= WIDE_MAX_BLOCKS:  # (each draw costs its blocks' time)
+        best, best_dev = redrawn(far, best, best_dev)
     return _uncollapsed(best, best_dev, read)
 
 

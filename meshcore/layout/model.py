@@ -46,6 +46,10 @@ class LayoutOptions:
         :data:`~.fans.FAN_AREA` or more (a wedge from a neck into a basin: its cells differ in area
         by about the product) is split as a fanning piece whatever its bulge
         (:func:`~.fans.tapers`, :func:`~.fans.unfan`).
+    lookahead
+        Each region's first split is the one of its :data:`~.split.LOOKAHEAD` cheapest whose pieces,
+        split on, cost least (by default the cheapest as it is: the greedy split).  The layout choice
+        also draws it where the layout it chose reads far off 90° (:data:`~.choice.WIDE_DEV`).
     islands_apart
         Islands less than three cells apart stay apart (by default they are joined into one, the
         water between given up with a note: :mod:`.islandgaps`); the layout then cuts blocks a
@@ -59,12 +63,23 @@ class LayoutOptions:
     tees: bool = False
     bulges: bool = False
     tapers: bool = False
+    lookahead: bool = False
     islands_apart: bool = False
 
     def __str__(self) -> str:
         on = [
             f.replace("_", " ")
-            for f in ("thin_arms", "mouths", "curve", "wedges", "tees", "bulges", "tapers", "islands_apart")
+            for f in (
+                "thin_arms",
+                "mouths",
+                "curve",
+                "wedges",
+                "tees",
+                "bulges",
+                "tapers",
+                "lookahead",
+                "islands_apart",
+            )
             if getattr(self, f)
         ]
         return ", ".join(on) or "defaults"

@@ -259,6 +259,7 @@ def best_split(
     normal: bool = True,
     thin: bool = False,
     tee=None,
+    look: int = 1,
 ):
     """Pieces and cuts (segments) of a greedy split of ``ring`` (maybe none).
 
@@ -273,19 +274,25 @@ def best_split(
     ``thin``: motorcycle cuts may leave pieces two cells across (:data:`.width.THIN_ACROSS`).
     ``tee`` (where ``center`` is given): a function ``(ring, center, sigma, min_width)`` giving one
     more split, :func:`.tee.tee` in regular layouts with ``LayoutOptions(tees=True)``, kept when its
-    pieces, split on, cost less than those of the cheapest other split.
+    pieces, split on, cost less than those of the cheapest other split.  ``look``: the first split is
+    the one of its ``look`` cheapest options whose pieces, split on, cost least (:data:`LOOKAHEAD`).
     """
     base = region_cost(ring, sigma, forced)
     if depth <= 0 or base <= _GOOD:
         return [(ring, tuple(forced))], [], base
     # only an option cheaper than base - _GOOD is applied: cuts that cost more are not costed in full
-    options = _options(ring, sigma, min_width, center, forced, regular, normal, thin, bound=base - _GOOD)
+    # (unless the first split looks ahead: then the LOOKAHEAD cheapest are needed)
+    ahead = max(int(look), 1)
+    options = _options(
+        ring, sigma, min_width, center, forced, regular, normal, thin, bound=None if ahead > 1 else base - _GOOD
+    )
     best = min(options, key=lambda o: o[2]) if options else None
     if (best is None or best[2] >= base - _GOOD) and normal and not len(forced):
         # last resort (a round basin): cuts along the shore's normal from evenly spaced points
         bound = base - _GOOD if best is None else min(best[2], base - _GOOD)
         more = _cut_options(_normal_cuts(ring, sigma, even=True), sigma, min_width, bound=bound)
         best = min(more + options, key=lambda o: o[2]) if more else best
+        options = more + options
     t = (
         tee(ring, np.asarray(center, float), sigma, min_width)
         if tee and center is not None and not len(forced)
@@ -302,6 +309,14 @@ def best_split(
         "thin": thin,
     }
     out = _split_on(best, **kw) if best is not None and best[2] < base - _GOOD else None
+    if out is not None and ahead > 1:  # the next cheapest splits, split on: the least in all
+        others = sorted((o for o in options if o is not best), key=lambda o: o[2])
+        for o in others[: ahead - 1]:
+            if o[2] >= base - _GOOD:
+                break
+            alt = _split_on(o, **kw)
+            if alt[2] < out[2]:
+                out = alt
     if t is not None and t[2] < base - _GOOD:  # a T where its pieces, split on, cost less in all
         alt = _split_on(t, **kw)
         if out is None or alt[2] < out[2]:
@@ -372,6 +387,11 @@ def _options(ring, sigma, min_width, center, forced, regular, normal, thin=False
         options.append(fly)
     return options
 
+
+#: The first split of a region is chosen among its this many cheapest options by the cost of their
+#: pieces split on (greedily), not by their own: a cut that leaves a bay on one piece may lead to
+#: cheaper pieces than the cut whose two pieces cost least as they are.  1: the cheapest as it is.
+LOOKAHEAD = 3
 
 #: A region whose corner cost is below this (four corners within ~20° of a right angle, no
 #: sharp bend left on a side) is not split further.

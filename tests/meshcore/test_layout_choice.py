@@ -406,6 +406,9 @@ def test_the_choice_passes_over_a_layout_whose_coarse_grid_collapses(monkeypatch
     from meshcore.layout import choice
 
     poly = testing.channel_network(552011, n_branches=8)
+    # (the draw that looks ahead, made where the layout kept reads far off 90°, finds a third layout
+    # here, 99.1 % within 3° and no collapse either way: off, to see the collapse rule alone)
+    monkeypatch.setattr(layout_pkg, "LOOK_DRAW", False)
 
     def grid():
         mb = mesh_outline(poly, target_cells=15_000)
