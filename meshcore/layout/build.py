@@ -196,13 +196,13 @@ def layout_pieces(
                 junctions,
                 sigma,
                 3 * h,
-                regular,
-                normal,
-                here,
-                tees and regular,
-                bulges and regular,
-                tapers and not regular,
-                LOOKAHEAD if lookahead else 1,
+                regular=regular,
+                normal=normal,
+                thin=here,
+                tees=tees and regular,
+                bulges=bulges and regular,
+                tapers=tapers and not regular,
+                look=LOOKAHEAD if lookahead else 1,
             )
             if tips_split() and not regular:  # (a candidate of the layout choice, .tipcuts)
                 pieces, new_cuts = untipped(pieces, new_cuts, sigma, 3 * h, normal, here)
@@ -403,6 +403,7 @@ def _split_region(
     junctions,
     sigma: float,
     min_width: float,
+    *,
     regular: bool,
     normal: bool,
     thin: bool,

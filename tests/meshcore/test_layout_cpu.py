@@ -114,9 +114,9 @@ def test_a_remembered_region_split_is_the_fresh_one():
     pieces, cuts, _ = best_split(ring, sigma=sigma, min_width=3 * h, center=build._junction_centre(ring, junctions))
     fresh = _unfanned(pieces, cuts, junctions, sigma, 3 * h, True, False)
     with remembering():
-        first = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
+        first = _split_region(ring, junctions, sigma, 3 * h, regular=False, normal=True, thin=False, tees=False)
         first[0][0][0][:] = 0.0  # the caller's copy: changing it leaves the remembered split as it was
-        again = _split_region(ring, junctions, sigma, 3 * h, False, True, False, False)
+        again = _split_region(ring, junctions, sigma, 3 * h, regular=False, normal=True, thin=False, tees=False)
     _same_split(fresh, again)
 
 
