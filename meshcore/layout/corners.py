@@ -203,6 +203,21 @@ def _where_they_bend(raw: np.ndarray, s: np.ndarray, total: float, picks: list[i
     return [jk if raw[jk] > max(raw[i], SHARP) else i for i, jk in zip(picks, j, strict=True)]
 
 
+#: The turning is read at no more than this share of a ring's perimeter: a piece about as large as
+#: the corner scale (a block in a neck one cell wide between two islands) read at that scale turns
+#: ~130° at most of its vertices, and its fourth corner went to a flat vertex of a short shore side
+#: (its corner cell non-convex).  The share the sharp peaks' spacing has (:func:`choose_corners_numpy`).
+TURN_SHARE = 0.1
+
+
+def _piece_scale(ring: np.ndarray, sigma: float) -> float:
+    """``sigma``, or :data:`TURN_SHARE` of the perimeter of ``ring`` where that is smaller."""
+    if TURN_SHARE <= 0:
+        return float(sigma)
+    d = np.diff(ring, axis=0, append=ring[:1])
+    return float(min(sigma, TURN_SHARE * np.hypot(d[:, 0], d[:, 1]).sum()))
+
+
 def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     """The four corner indices (increasing, counter-clockwise) of a CCW ring, and their cost.
 
@@ -222,6 +237,7 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     if n < 4:
         return None, math.inf
     ring = np.ascontiguousarray(ring, dtype=float)
+    sigma = _piece_scale(ring, sigma)
     s, total, at_scale, between = kernels.ring_terms(ring, float(sigma))
     t = np.degrees(np.arctan2(at_scale[0], at_scale[1]))  # (NumPy's arctan2: the reference's bits)
     raw = np.degrees(np.arctan2(between[0], between[1]))
@@ -253,6 +269,7 @@ def choose_corners_numpy(ring: np.ndarray, sigma: float, *, forced=()):
     n = len(ring)
     if n < 4:
         return None, math.inf
+    sigma = _piece_scale(ring, sigma)
     d = _edges(ring)
     arc = _arclength_closed(ring, d)
     s, total = arc
