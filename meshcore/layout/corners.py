@@ -210,12 +210,9 @@ def _where_they_bend(raw: np.ndarray, s: np.ndarray, total: float, picks: list[i
 TURN_SHARE = 0.1
 
 
-def _piece_scale(ring: np.ndarray, sigma: float) -> float:
-    """``sigma``, or :data:`TURN_SHARE` of the perimeter of ``ring`` where that is smaller."""
-    if TURN_SHARE <= 0:
-        return float(sigma)
-    d = np.diff(ring, axis=0, append=ring[:1])
-    return float(min(sigma, TURN_SHARE * np.hypot(d[:, 0], d[:, 1]).sum()))
+def _capped(sigma: float, total: float) -> float:
+    """``sigma``, or :data:`TURN_SHARE` of the perimeter ``total`` where that is smaller."""
+    return float(sigma) if TURN_SHARE <= 0 else float(min(sigma, TURN_SHARE * total))
 
 
 def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
@@ -237,8 +234,10 @@ def choose_corners(ring: np.ndarray, sigma: float, *, forced=()):
     if n < 4:
         return None, math.inf
     ring = np.ascontiguousarray(ring, dtype=float)
-    sigma = _piece_scale(ring, sigma)
     s, total, at_scale, between = kernels.ring_terms(ring, float(sigma))
+    if _capped(sigma, total) < sigma:  # a piece about as large as the scale (TURN_SHARE): read again
+        sigma = _capped(sigma, total)
+        s, total, at_scale, between = kernels.ring_terms(ring, sigma)
     t = np.degrees(np.arctan2(at_scale[0], at_scale[1]))  # (NumPy's arctan2: the reference's bits)
     raw = np.degrees(np.arctan2(between[0], between[1]))
     forced = sorted({int(f) for f in forced})
@@ -269,10 +268,10 @@ def choose_corners_numpy(ring: np.ndarray, sigma: float, *, forced=()):
     n = len(ring)
     if n < 4:
         return None, math.inf
-    sigma = _piece_scale(ring, sigma)
     d = _edges(ring)
     arc = _arclength_closed(ring, d)
     s, total = arc
+    sigma = _capped(sigma, total)
     t = turning(ring, sigma, arc)
     raw = raw_turning(ring, d)
     forced = sorted({int(f) for f in forced})

@@ -2,7 +2,7 @@ r"""The layout model: blocks (name, corners, cells) on a water polygon, with the
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -67,21 +67,7 @@ class LayoutOptions:
     islands_apart: bool = False
 
     def __str__(self) -> str:
-        on = [
-            f.replace("_", " ")
-            for f in (
-                "thin_arms",
-                "mouths",
-                "curve",
-                "wedges",
-                "tees",
-                "bulges",
-                "tapers",
-                "lookahead",
-                "islands_apart",
-            )
-            if getattr(self, f)
-        ]
+        on = [f.name.replace("_", " ") for f in fields(self) if getattr(self, f.name)]
         return ", ".join(on) or "defaults"
 
 

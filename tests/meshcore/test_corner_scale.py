@@ -35,8 +35,10 @@ def test_large_pieces_are_read_at_the_scale_given():
     ring = np.vstack(
         [np.c_[xs, 0 * xs], np.c_[0 * ys + 40, ys], np.c_[xs[::-1] + 0.5, 0 * xs + 10], np.c_[0 * ys, ys[::-1] + 0.5]]
     )
-    assert corners._piece_scale(ring, 1.5) == 1.5
-    assert corners._piece_scale(ring, 100.0) == pytest.approx(0.1 * 100.0)
+    d = np.diff(ring, axis=0, append=ring[:1])
+    total = np.hypot(d[:, 0], d[:, 1]).sum()
+    assert corners._capped(1.5, total) == 1.5
+    assert corners._capped(100.0, total) == pytest.approx(0.1 * 100.0)
 
 
 @pytest.mark.slow
