@@ -527,6 +527,13 @@ def shore_sweep(
             sn += total
         while sn >= s + total:
             sn -= total
+        if sn - sp > 0.5 * total:
+            # its neighbours are not on its two sides along the shore (round a spike of water
+            # narrower than a cell, nodes on its two flanks projected onto one): measured so, the
+            # node's arc would run round the whole ring, and the foot or the middle of that arc lie
+            # anywhere on it (generated `dendritic(952505)` at 15 000 cells: a node thrown 190 cells
+            # along the shore, one edge across the land).  It stays where it is.
+            continue
         # the node stays far enough from both neighbours that its two arcs differ by at most
         # ``lo`` (the smoothness limit): sliding to the foot of the perpendicular, shore nodes
         # next to an obtuse block corner otherwise crowd into it, each arc 1.7 times the next

@@ -445,3 +445,41 @@ def test_a_shore_node_between_two_cut_ends_never_passes_a_neighbour(beyond_next)
         )  # fmt: skip
         assert Y[p] == 0.0  # on the shore
         assert 1.0 + 0.1 * 2.0 - 1e-9 <= X[p] <= 3.0 - 0.1 * 2.0 + 1e-9  # within its own arc, a tenth from either end
+
+
+def test_a_shore_node_whose_neighbours_are_not_on_its_two_sides_stays_put():
+    # Round a spike of water narrower than a cell, nodes on its two flanks can be projected onto one
+    # flank, so that a node's previous neighbour lies a little ahead of it along the shore.  Its arcs
+    # to its neighbours then measured round the whole ring, the foot or the middle of that arc lay
+    # anywhere on it: generated `dendritic(952505)` at 15 000 cells had a node thrown 190 cells along
+    # the shore (one edge 11 units long across the land, nodes 0.0025 apart beside it).
+    from meshcore.orthogonal import driver
+
+    x, y = np.meshgrid(np.arange(5.0), np.arange(3.0), indexing="ij")
+    topo, g = _one_block(x, y)
+    m = topo.node_map
+    X, Y = driver._assemble([g], m)
+    cells = m.cells.astype(np.int64)
+    cptr, ncells, cnt = driver._node_cells(cells, m.n_nodes)
+    ring = np.array([[-10.0, 0.0], [40.0, 0.0], [40.0, -5.0], [-10.0, -5.0]])  # the shore y = 0, x from -10
+    bn, binner, bprev, bnext, bring, bs, free = driver._shore_data(X, Y, m, cells, cnt, [ring])
+    at = {(round(X[p], 6), round(Y[p], 6)): i for i, p in enumerate(bn)}
+    k = at[(2.0, 0.0)]
+    assert free[k] and (bprev[k], bnext[k]) == (at[(1.0, 0.0)], at[(3.0, 0.0)])
+    R, S, roff = driver._ring_tables([ring])
+    jmin = np.full(m.n_nodes, -np.inf)  # no fold guard: the slide's own rule alone
+    p = bn[k]
+
+    def sweep(bs):
+        X1, Y1 = X.copy(), Y.copy()
+        _kernels.shore_sweep(
+            X1, Y1, np.array([k]), bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells,
+            1.0, 0.15, 0.25, jmin, 1.2, 2.0, 0.0, np.zeros(1), 0.05, -np.ones((len(bn), 2), dtype=np.int64),
+            np.array([1.2]), np.zeros(m.n_nodes, np.uint8),
+        )  # fmt: skip
+        return X1[p], Y1[p]
+
+    assert sweep(bs.copy()) == (2.0, 0.0)  # between its neighbours at its foot already: it stays
+    crossed = bs.copy()
+    crossed[bprev[k]] = bs[k] + 0.05  # the previous neighbour a little ahead of it
+    assert sweep(crossed) == (2.0, 0.0)  # (before: thrown to the far side of the ring)
