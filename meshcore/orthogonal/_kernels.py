@@ -527,12 +527,15 @@ def shore_sweep(
             sn += total
         while sn >= s + total:
             sn -= total
-        if sn - sp > 0.5 * total:
+        if sn - sp > 0.75 * total:
             # its neighbours are not on its two sides along the shore (round a spike of water
-            # narrower than a cell, nodes on its two flanks projected onto one): measured so, the
-            # node's arc would run round the whole ring, and the foot or the middle of that arc lie
-            # anywhere on it (generated `dendritic(952505)` at 15 000 cells: a node thrown 190 cells
-            # along the shore, one edge across the land).  It stays where it is.
+            # narrower than a cell, nodes on its two flanks projected onto one: a neighbour a little
+            # ahead of the node where it should be behind, and the arc between them a whole perimeter
+            # less that little): measured so, the node's arc would run round the whole ring, and the
+            # foot or the middle of that arc lie anywhere on it (generated `dendritic(952505)` at
+            # 15 000 cells: a node thrown 190 cells along the shore, one edge across the land).  It
+            # stays where it is.  (A node between two neighbours has an arc over 3/4 of its ring only
+            # on a ring of three nodes or fewer, unevenly spread.)
             continue
         # the node stays far enough from both neighbours that its two arcs differ by at most
         # ``lo`` (the smoothness limit): sliding to the foot of the perpendicular, shore nodes
