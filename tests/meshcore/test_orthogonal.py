@@ -409,6 +409,26 @@ def test_no_block_corner_opens_into_a_fan_at_a_cut_end(make, monkeypatch):
     assert lake_metrics(mb, polygon=poly).values("folded").sum() == 0
 
 
+def _shore_row(cols):
+    """A block of nodes ``cols × (0, 1, 2)`` whose row y = 0 lies on the shore (a ring along y = 0 from
+    x = -10): the shore sweep's tables, and each shore node's index by its point."""
+    from types import SimpleNamespace
+
+    from meshcore.orthogonal import driver
+
+    x, y = np.meshgrid(np.asarray(cols, float), np.arange(3.0), indexing="ij")
+    topo, g = _one_block(x, y)
+    m = topo.node_map
+    X, Y = driver._assemble([g], m)
+    cells = m.cells.astype(np.int64)
+    cptr, ncells, cnt = driver._node_cells(cells, m.n_nodes)
+    ring = np.array([[-10.0, 0.0], [40.0, 0.0], [40.0, -5.0], [-10.0, -5.0]])
+    bn, binner, bprev, bnext, bring, bs, free = driver._shore_data(X, Y, m, cells, cnt, [ring])
+    R, S, roff = driver._ring_tables([ring])
+    at = {(round(X[p], 6), round(Y[p], 6)): i for i, p in enumerate(bn)}
+    return SimpleNamespace(**{k: v for k, v in locals().items() if k not in ("topo", "g", "driver", "SimpleNamespace")})
+
+
 @pytest.mark.parametrize("beyond_next", [4.0, 8.0, 20.0])
 def test_a_shore_node_between_two_cut_ends_never_passes_a_neighbour(beyond_next):
     # A free shore node (x = 2) between two fixed cut ends (x = 1 and 3) keeps its edge to each
@@ -417,30 +437,20 @@ def test_a_shore_node_between_two_cut_ends_never_passes_a_neighbour(beyond_next)
     # node past a cut's end measures its arcs the other way round the ring and may end anywhere
     # on it (generated `lake_with_islands(955300, n_islands=6, lobes=4)`: a coarse node round an
     # island's corner, the grid 1.19 cells over the island).
-    from meshcore.orthogonal import driver
-
-    cols = np.array([0.0, 1.0, 2.0, 3.0, 3.0 + beyond_next])
-    x, y = np.meshgrid(cols, np.arange(3.0), indexing="ij")
-    topo, g = _one_block(x, y)
-    m = topo.node_map
-    X, Y = driver._assemble([g], m)
-    cells = m.cells.astype(np.int64)
-    cptr, ncells, cnt = driver._node_cells(cells, m.n_nodes)
-    ring = np.array([[-10.0, 0.0], [40.0, 0.0], [40.0, -5.0], [-10.0, -5.0]])  # the shore y = 0, x from -10
-    bn, binner, bprev, bnext, bring, bs, free = driver._shore_data(X, Y, m, cells, cnt, [ring])
-    at = {(round(X[p], 6), round(Y[p], 6)): i for i, p in enumerate(bn)}
+    c = _shore_row([0.0, 1.0, 2.0, 3.0, 3.0 + beyond_next])
+    X, Y, m, bn, bs, at = c.X, c.Y, c.m, c.bn, c.bs, c.at
+    bprev, bnext = c.bprev, c.bnext
     k, before, after = at[(2.0, 0.0)], at[(0.0, 0.0)], at[(3.0 + beyond_next, 0.0)]
-    assert free[k] and (bprev[k], bnext[k]) == (at[(1.0, 0.0)], at[(3.0, 0.0)])
+    assert c.free[k] and (bprev[k], bnext[k]) == (at[(1.0, 0.0)], at[(3.0, 0.0)])
     across = -np.ones((len(bn), 2), dtype=np.int64)
     across[k] = before, after
-    R, S, roff = driver._ring_tables([ring])
     jmin = np.full(m.n_nodes, 1e-3)  # the fold guard's floor (cells of area >= 1 here)
     lo, hi = 1.15, 2.0
     bz = np.zeros(1)
     p = bn[k]
     for _ in range(30):
         _kernels.shore_sweep(
-            X, Y, np.array([k]), bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells,
+            X, Y, np.array([k]), bn, c.binner, bprev, bnext, c.bring, bs, c.R, c.S, c.roff, c.cptr, c.ncells,
             1.0, 0.15, 0.25, jmin, lo, hi, 0.0, bz, 0.05, across, np.array([lo]), np.zeros(m.n_nodes, np.uint8),
         )  # fmt: skip
         assert Y[p] == 0.0  # on the shore
@@ -453,27 +463,17 @@ def test_a_shore_node_whose_neighbours_are_not_on_its_two_sides_stays_put():
     # to its neighbours then measured round the whole ring, the foot or the middle of that arc lay
     # anywhere on it: generated `dendritic(952505)` at 15 000 cells had a node thrown 190 cells along
     # the shore (one edge 11 units long across the land, nodes 0.0025 apart beside it).
-    from meshcore.orthogonal import driver
-
-    x, y = np.meshgrid(np.arange(5.0), np.arange(3.0), indexing="ij")
-    topo, g = _one_block(x, y)
-    m = topo.node_map
-    X, Y = driver._assemble([g], m)
-    cells = m.cells.astype(np.int64)
-    cptr, ncells, cnt = driver._node_cells(cells, m.n_nodes)
-    ring = np.array([[-10.0, 0.0], [40.0, 0.0], [40.0, -5.0], [-10.0, -5.0]])  # the shore y = 0, x from -10
-    bn, binner, bprev, bnext, bring, bs, free = driver._shore_data(X, Y, m, cells, cnt, [ring])
-    at = {(round(X[p], 6), round(Y[p], 6)): i for i, p in enumerate(bn)}
+    c = _shore_row(np.arange(5.0))
+    X, Y, m, bn, bs, at, bprev = c.X, c.Y, c.m, c.bn, c.bs, c.at, c.bprev
     k = at[(2.0, 0.0)]
-    assert free[k] and (bprev[k], bnext[k]) == (at[(1.0, 0.0)], at[(3.0, 0.0)])
-    R, S, roff = driver._ring_tables([ring])
+    assert c.free[k] and (bprev[k], c.bnext[k]) == (at[(1.0, 0.0)], at[(3.0, 0.0)])
     jmin = np.full(m.n_nodes, -np.inf)  # no fold guard: the slide's own rule alone
     p = bn[k]
 
     def sweep(bs):
         X1, Y1 = X.copy(), Y.copy()
         _kernels.shore_sweep(
-            X1, Y1, np.array([k]), bn, binner, bprev, bnext, bring, bs, R, S, roff, cptr, ncells,
+            X1, Y1, np.array([k]), bn, c.binner, bprev, c.bnext, c.bring, bs, c.R, c.S, c.roff, c.cptr, c.ncells,
             1.0, 0.15, 0.25, jmin, 1.2, 2.0, 0.0, np.zeros(1), 0.05, -np.ones((len(bn), 2), dtype=np.int64),
             np.array([1.2]), np.zeros(m.n_nodes, np.uint8),
         )  # fmt: skip
