@@ -237,9 +237,7 @@ def chosen(
     def redrawn(draws, best: Layout, best_dev: float, local: bool = False) -> tuple[Layout, float]:
         """The chosen scale again, drawn otherwise: ``(best, best_dev)`` or the draw kept instead
         (``local``: draws that change the layout round tips and tapers only, :data:`COLLAPSE_MARGIN`)."""
-        shortest = next((e for lay, _, e in read if lay is best), None)
-        collapsed = local and shortest is not None and shortest < COLLAPSED
-        margin = COLLAPSE_MARGIN if collapsed else MARGIN
+        margin = COLLAPSE_MARGIN if local and _collapses(best, read) else MARGIN
         for redraw in draws if best_scale is not None else ():
             try:
                 lay = redraw(best_scale)
@@ -267,12 +265,18 @@ def _shortest(got: Sequence[float]) -> float | None:
     return float(got[2]) if len(got) > 2 else None
 
 
+def _collapses(lay: Layout, read: list) -> bool:
+    """True when the reading of ``lay`` in ``read`` (``(layout, deviation, shortest edge)``) has a
+    collapsed coarse cell (:data:`COLLAPSED`); False without a shortest edge."""
+    e = next((e for la, _, e in read if la is lay), None)
+    return e is not None and e < COLLAPSED
+
+
 def _uncollapsed(best: Layout, dev: float, read: list) -> Layout:
     """``best`` (reading ``dev``), or where its coarse grid collapses (:data:`COLLAPSED`) the layout
     of ``read`` (``(layout, deviation, shortest edge)``) whose coarse grid does not and that deviates
     least, if at most :data:`COLLAPSE_WEIGHT` × ``dev`` (readings without a shortest edge: ``best``)."""
-    mine = next((e for lay, _, e in read if lay is best), None)
-    if mine is None or mine >= COLLAPSED:
+    if not _collapses(best, read):
         return best
     whole = [(d, k) for k, (_, d, e) in enumerate(read) if e is not None and e >= COLLAPSED]
     if not whole:

@@ -534,8 +534,8 @@ def shore_sweep(
             # less that little): measured so, the node's arc would run round the whole ring, and the
             # foot or the middle of that arc lie anywhere on it (generated `dendritic(952505)` at
             # 15 000 cells: a node thrown 190 cells along the shore, one edge across the land).  It
-            # stays where it is.  (A node between two neighbours has an arc over 3/4 of its ring only
-            # on a ring of three nodes or fewer, unevenly spread.)
+            # stays where it is.  (A node truly between its neighbours has an arc that long only
+            # where they hold three quarters of its ring: a ring of a few nodes, unevenly spread.)
             continue
         # the node stays far enough from both neighbours that its two arcs differ by at most
         # ``lo`` (the smoothness limit): sliding to the foot of the perpendicular, shore nodes

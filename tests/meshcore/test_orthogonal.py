@@ -426,7 +426,10 @@ def _shore_row(cols):
     bn, binner, bprev, bnext, bring, bs, free = driver._shore_data(X, Y, m, cells, cnt, [ring])
     R, S, roff = driver._ring_tables([ring])
     at = {(round(X[p], 6), round(Y[p], 6)): i for i, p in enumerate(bn)}
-    return SimpleNamespace(**{k: v for k, v in locals().items() if k not in ("topo", "g", "driver", "SimpleNamespace")})
+    return SimpleNamespace(
+        X=X, Y=Y, m=m, cptr=cptr, ncells=ncells, bn=bn, binner=binner, bprev=bprev, bnext=bnext, bring=bring,
+        bs=bs, free=free, R=R, S=S, roff=roff, at=at,
+    )  # fmt: skip
 
 
 @pytest.mark.parametrize("beyond_next", [4.0, 8.0, 20.0])
