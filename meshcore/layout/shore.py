@@ -450,20 +450,31 @@ def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
 
 def _tapering(core: Any, part: Any, h: float) -> bool:
     """True when ``part`` continues a narrow end of ``core`` (the water a disc of radius ``h``
-    reaches): within four cells of the mouth the core holds no disc of radius 1.75 cells, so
-    the lake narrows into the arm and the block there narrows with it; a side arm leaving a
-    wider channel or a basin is False."""
-    from shapely.ops import polylabel
+    reaches): no disc of radius :data:`TAPER_ROOM` cells lies in the core with its centre within
+    :data:`TAPER_REACH` cells of the mouth, so the lake narrows into the arm and the block there
+    narrows with it; a side arm leaving a wider channel or a basin is False.
 
+    The disc may reach beyond those cells: a side arm leaving a basin in a corner between the
+    shore and a spit (a quarter of the water round the mouth) has room for one further out, where
+    a lake tapering into the arm has none (held-out g180510, Long Point: the bay behind the spit,
+    0.74 cells wide, was kept as a tapering end and the block round the spit's tip fanned into it,
+    aspect ratios of 419; journal, session 52).
+    """
     mouth = part.buffer(1e-6 * h).intersection(core.boundary)
     if mouth.is_empty:
         return False
-    near = core.intersection(mouth.centroid.buffer(4.0 * h))
-    pieces = [g for g in getattr(near, "geoms", [near]) if g.geom_type == "Polygon" and not g.is_empty]
-    if not pieces:
-        return False
-    room = max(pieces, key=lambda g: g.area)
-    return room.exterior.distance(polylabel(room, tolerance=0.05 * h)) < 1.75 * h
+    c = mouth.centroid
+    # a disc whose centre is within the reach lies within reach + room of the mouth: the core
+    # clipped there holds it when the core does
+    near = core.intersection(c.buffer((TAPER_REACH + TAPER_ROOM + 0.1) * h))
+    centres = near.buffer(-TAPER_ROOM * h)
+    return centres.is_empty or not centres.intersects(c.buffer(TAPER_REACH * h))
+
+
+#: An arm is a narrow end the lake tapers into (kept, :func:`without_narrow_arms`) when the water
+#: within :data:`TAPER_REACH` cells of its mouth holds no disc of radius :data:`TAPER_ROOM` cells.
+TAPER_REACH = 4.0
+TAPER_ROOM = 1.75
 
 
 #: A shore with more vertices than this per cell length is simplified before the layout ...

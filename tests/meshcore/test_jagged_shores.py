@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 import pytest
 from shapely.geometry import Point, Polygon, box
 
@@ -189,6 +190,23 @@ def test_a_lake_that_tapers_into_a_narrow_end_keeps_it():
     lake = Polygon([(0, 0), (3, 0), (4.8, 0.375), (8.4, 0.375), (8.4, 0.525), (4.8, 0.525), (3, 0.9), (0, 0.9)])
     out, notes = without_narrow_arms(lake, h)
     assert out is lake and notes == []
+
+
+def test_a_narrow_arm_leaving_a_basin_at_its_corner_is_left_out():
+    """Round a mouth in a corner the water within four cells is a quarter disc, too small for a
+    disc of 1.75 cells, but the basin holds one a little further out: a side arm, not a narrow end
+    the lake tapers into (a block of the basin fanned into it; held-out g180510, Long Point)."""
+    from meshcore.layout.shore import without_narrow_arms
+
+    h = 0.3
+    arm = box(0.0, -3.0, 0.22, 0.0)  # 0.73 cells wide, 10 cells long, from the basin's corner
+    lake = shapely.union_all([box(0.0, 0.0, 10.0, 10.0), arm])
+    out, notes = without_narrow_arms(lake, h)
+    assert len(notes) == 1 and "near (0.11, -1.5)" in notes[0]
+    assert out.area == pytest.approx(100.0, rel=1e-6) and not out.buffer(-1e-6).intersects(arm)
+    # the same arm at the end of a channel 3 cells wide that narrows into it: kept
+    funnel = shapely.union_all([box(-0.34, 0.0, 0.56, 10.0), arm])
+    assert without_narrow_arms(funnel, h)[1] == []
 
 
 @pytest.mark.slow
