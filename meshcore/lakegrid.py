@@ -461,7 +461,10 @@ def iterate_layout(
     grids = _block_infos(grids, info)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology
-    mb = MultiBlockGrid(tuple(grids), names, tp.interfaces, "orthogonal", info, tp, notes=tuple(layout.notes))
+    arms = None if layout.arms is None else tuple(layout.arms)
+    mb = MultiBlockGrid(
+        tuple(grids), names, tp.interfaces, "orthogonal", info, tp, notes=tuple(layout.notes), arms=arms
+    )
     if stopped or slide_ends or not FOLD_RETRY or not (n := _n_folded(grids)):
         return mb
     # cells left folded or non-convex: the levels again with block corners and cut ends sliding (FOLD_RETRY)

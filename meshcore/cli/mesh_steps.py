@@ -67,7 +67,8 @@ def _world(mb: Any, poly: Any, frame: Any) -> tuple[Any, Any, Any]:
         return mb, poly, frame
     grids = tuple(g.replaced(x=g.x + ox, y=g.y + oy) for g in mb.grids)
     world = dataclasses.replace(frame, origin=(0.0, 0.0))
-    return dataclasses.replace(mb, grids=grids, frame=world), affinity.translate(poly, ox, oy), world
+    arms = None if mb.arms is None else tuple(affinity.translate(p, ox, oy) for p in mb.arms)
+    return dataclasses.replace(mb, grids=grids, frame=world, arms=arms), affinity.translate(poly, ox, oy), world
 
 
 def lake_table(args: argparse.Namespace, poly: Any, h: float, regular: bool) -> Any:

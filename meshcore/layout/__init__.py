@@ -169,7 +169,8 @@ def _auto_layout(outline, holes, cell_size, target_cells, multiple, regular, sin
     poly, gaps = (poly, []) if options.islands_apart else without_island_gaps(poly, h)
     more = dense + more + gaps
     poly, slivers = without_slivers(poly, 0.5 * h)
-    poly, arms = without_narrow_arms(poly, h)
+    cut_arms: list = []
+    poly, arms = without_narrow_arms(poly, h, left_out=cut_arms)
     more = more + slivers + arms
     check()
     straight, curves = poly, None
@@ -189,7 +190,7 @@ def _auto_layout(outline, holes, cell_size, target_cells, multiple, regular, sin
             shores,
             h,
             notes + more,
-            details,
+            {"details": tuple(details), "arms": tuple(cut_arms)},
             multiple=multiple,
             regular=regular,
             single=single,
@@ -198,8 +199,16 @@ def _auto_layout(outline, holes, cell_size, target_cells, multiple, regular, sin
         )
 
 
-def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, single: bool, options, reading) -> Layout:
-    """The layout of :func:`auto_layout` from the water at its scales (:func:`_first_fit`), or the error."""
+def _with(lay: Layout, extra: dict) -> Layout:
+    """``lay`` with the fields ``extra``, its topology as made already."""
+    out = dataclasses.replace(lay, **extra)
+    object.__setattr__(out, "_topology", lay._topology)  # the same blocks: the same topology
+    return out
+
+
+def _drawn(shores, h: float, notes, extra, *, multiple: int, regular: bool, single: bool, options, reading) -> Layout:
+    """The layout of :func:`auto_layout` from the water at its scales (:func:`_first_fit`), or the error
+    (``extra``: the layout's fields made before the draws, :class:`Layout` ``details`` and ``arms``)."""
     from ..errors import TopologyError
 
     first = kept = None
@@ -255,7 +264,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
             looked=looked,
         )
         if lay is not None:
-            return dataclasses.replace(lay, details=tuple(details)) if details else lay
+            return _with(lay, extra)
         first, kept = first or error, kept or closing
     if kept is not None:
         if single:  # a single index space cannot hold it: say where, before the grid is made
@@ -264,7 +273,7 @@ def _drawn(shores, h: float, notes, details, *, multiple: int, regular: bool, si
                 f"automatic layout: no layout found whose blocks fit one index space (Delft3D single "
                 f"domain, EFDC): {d.note()}; write a .ddb (domain decomposition) or .vtm instead"
             )
-        return dataclasses.replace(kept, details=tuple(details)) if details else kept
+        return _with(kept, extra)
     assert first is not None
     if single:
         why = str(first).removeprefix("automatic layout: ")

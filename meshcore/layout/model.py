@@ -89,7 +89,10 @@ class Layout:
     the regions with their corners, ``blocks`` their names, corners and cell counts;
     ``single``: the cell counts close every ring of blocks in one index space (``auto_layout(single=True)``);
     ``details``: the notes that one of ``notes`` sums up (each island left out as too narrow, when
-    there are many: :func:`~.polygon.summarised_islands`).
+    there are many: :func:`~.polygon.summarised_islands`); ``arms``: the dead-end arms narrower than
+    two cells left out of the water (shapely Polygons, :func:`~.shore.without_narrow_arms`; None: not
+    known, a layout read from a case), which the quality report's shore distance leaves out
+    (:class:`~meshcore.multiblock.MultiBlockGrid` ``arms``, :func:`meshcore.quality.lake_metrics`).
     """
 
     polygon: Any
@@ -103,6 +106,7 @@ class Layout:
     notes: tuple[str, ...] = ()
     single: bool = False
     details: tuple[str, ...] = ()
+    arms: tuple[Any, ...] | None = field(default=None, repr=False)
     _topology: Any = field(default=None, init=False, repr=False, compare=False)  # made once
 
     @property

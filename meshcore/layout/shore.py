@@ -400,7 +400,7 @@ def _moved(q: np.ndarray, src: SegmentIndex, dst: list[np.ndarray]) -> np.ndarra
     return r[i] + u * (r[(i + 1) % len(r)] - r[i])
 
 
-def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
+def without_narrow_arms(poly: Any, h: float, left_out: list | None = None) -> tuple[Any, list[str]]:
     """The water without its dead-end arms narrower than two cells, and a note naming each.
 
     An arm narrower than ``2h`` gets fewer than two cells across: as part of the block it
@@ -410,7 +410,9 @@ def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
     much water that is, and which cell size would keep it.  Passages between two parts of the
     lake, or between an island and the shore, are kept (cutting them would change the lake),
     and so are bits smaller than four cells or shorter than three cells (corners, teeth), and
-    the narrow end of a lake that tapers into it (its block's cells narrow with it).
+    the narrow end of a lake that tapers into it (its block's cells narrow with it).  ``left_out``,
+    a list, gets each arm left out (a shapely Polygon), for the quality report to measure the shore
+    against the same water (:class:`~.model.Layout` ``arms``).
     """
     import shapely
     from shapely.geometry.polygon import orient
@@ -436,6 +438,8 @@ def without_narrow_arms(poly: Any, h: float) -> tuple[Any, list[str]]:
         cut = shapely.make_valid(cut) if not cut.is_valid else cut
         if cut.geom_type != "Polygon" or len(cut.interiors) != len(out.interiors):
             continue  # a passage: the water would fall apart or an island join the shore
+        if left_out is not None:
+            left_out.append(part)
         c = part.representative_point()
         notes.append(
             f"an arm about {width / h:.2g} cells wide near ({c.x:.6g}, {c.y:.6g}) is narrower than two cells: "

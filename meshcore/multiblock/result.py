@@ -73,6 +73,10 @@ class MultiBlockGrid:
     #: smoothed, cell counts far from the asked size): a lake grid's layout notes
     #: (:func:`meshcore.mesh_outline`; what ``meshcore mesh`` prints as notes)
     notes: tuple[str, ...] = ()
+    #: The dead-end arms narrower than two cells the layout left out of the water (shapely Polygons
+    #: in the grid's coordinates, :class:`meshcore.layout.Layout` ``arms``; None: not known): the
+    #: quality report measures the shore across their mouths (:func:`meshcore.quality.lake_metrics`)
+    arms: tuple[Any, ...] | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.grids)

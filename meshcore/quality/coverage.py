@@ -329,8 +329,13 @@ def coverage(
     *,
     holes: Sequence[Any] = (),
     cell_size: float | None = None,
+    arms: Sequence[Any] | None = None,
 ) -> Coverage:
-    """Coverage of ``polygon`` (shapely, or an outer ring plus ``holes``) by the grid."""
+    """Coverage of ``polygon`` (shapely, or an outer ring plus ``holes``) by the grid.
+
+    ``arms``: the dead-end arms the layout left out (:class:`meshcore.layout.Layout` ``arms``); by
+    default they are found again by the layout's rule on this shore, which a shore the layout
+    prepared otherwise (islands joined, spikes smoothed) can find other ones on."""
     import shapely
 
     from ..layout.shore import DENSE_TOLERANCE, without_dense_vertices
@@ -359,15 +364,22 @@ def coverage(
     # measured against the water without them, whose shore crosses their mouths; found as the
     # layout finds them, on the shore without its spikes (below): a Z-shaped sliver of land and
     # water narrower than half a cell is smoothed out there, not left out as an arm
-    despiked = without_spikes(simple, 0.5 * h) or simple
-    found = _without_narrow_arms(despiked, h)  # on the layout's shore
-    if found is not despiked:
-        water = found if simple is poly else _cut_off(poly, simple.difference(found), slack)
+    if arms is None:
+        despiked = without_spikes(simple, 0.5 * h) or simple
+        found = _without_narrow_arms(despiked, h)  # on the layout's shore
+        water = None
+        if found is not despiked:
+            water = found if simple is poly else _cut_off(poly, simple.difference(found), slack)
+        ruled = found if found is not despiked else poly
+    else:  # the layout's own, found on its shore (simplified, cleaned): cut off the shore as given
+        water = _cut_off(poly, shapely.union_all(list(arms)), DENSE_TOLERANCE * h) if len(arms) else None
+        ruled = water if water is not None else poly
+    if water is not None:
         sb = shapely.union_all(_islands(water, union, h)[1])
         sp = _boundary_points(sb, step)
     # islands closer than the layout keeps apart, joined with a note (to each other or to the
     # shore, :func:`meshcore.layout.islandgaps.without_island_gaps`): measured against the joined land
-    joined = _joined_islands(found if found is not despiked else poly, h)
+    joined = _joined_islands(ruled, h)
     if joined is not None:
         sb = shapely.union_all(_islands(joined, union, h)[1])
         sp = _boundary_points(sb, step)

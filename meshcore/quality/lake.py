@@ -500,6 +500,7 @@ def lake_metrics(
     polygon: Any = None,
     holes: Sequence[Any] = (),
     cell_size: float | None = None,
+    arms: Sequence[Any] | None = None,
 ) -> LakeMetrics:
     """Measure a grid the way lake modellers do (``shared/design/lake-grids.md``).
 
@@ -513,6 +514,11 @@ def lake_metrics(
         Islands, when ``polygon`` is given as the outer ring's points.
     cell_size : float, optional
         Unit of the shoreline distance and of ``shrink``; default ``sqrt(grid area / cells)``.
+    arms : sequence of shapely Polygons, optional
+        The dead-end arms the layout left out (:class:`meshcore.layout.Layout` ``arms``, in the grid's
+        coordinates): the shoreline distance is measured across their mouths.  By default a
+        MultiBlockGrid's own (``grid.arms``), else the layout's rule finds them again on ``polygon``
+        (:func:`meshcore.layout.shore.without_narrow_arms`).
 
     Returns
     -------
@@ -535,7 +541,9 @@ def lake_metrics(
     if polygon is not None:
         from .coverage import coverage
 
-        cov = coverage(grids, bms, polygon, holes=holes, cell_size=cell_size)
+        if arms is None:
+            arms = getattr(grid, "arms", None)  # a lake grid's (MultiBlockGrid)
+        cov = coverage(grids, bms, polygon, holes=holes, cell_size=cell_size, arms=arms)
         samples["area_error"] = cov.samples("area_error")
         samples["shore_distance"] = cov.samples("shore_distance")
     return LakeMetrics(names, bms, samples, cov, h)

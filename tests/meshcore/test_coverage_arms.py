@@ -1,8 +1,9 @@
 """The shoreline distance leaves out the dead-end arms narrower than two cells that the layout
 leaves out on purpose (:func:`meshcore.layout.shore.without_narrow_arms`, with a note), measured
 against the water without them (its shore crosses their mouths), as it leaves out spikes narrower
-than half a cell; the distance to the shore as given keeps them (``hausdorff_as_given``).  The
-rule is the layout's at the cell size given: an arm the layout would keep stays in."""
+than half a cell; the distance to the shore as given keeps them (``hausdorff_as_given``).  A lake
+grid carries the arms its layout left out (``MultiBlockGrid.arms``); without them the rule is the
+layout's at the cell size given: an arm the layout would keep stays in."""
 
 from __future__ import annotations
 
@@ -40,7 +41,8 @@ def test_an_arm_the_layout_leaves_out_is_measured_apart(arm_lake):
 def test_an_arm_wide_enough_at_the_cell_size_given_stays_in(arm_lake):
     poly, mb = arm_lake
     h = default_cell_size(poly.area, CELLS) / 3  # at this size the layout keeps the arm
-    cov = lake_metrics(mb, polygon=poly, cell_size=h).coverage
+    # the blocks alone, without the layout's arms (``mb.arms``): the layout's rule at the size given
+    cov = lake_metrics(list(mb.grids), polygon=poly, cell_size=h).coverage
     assert cov.hausdorff_cells > 20 * 3
     assert cov.hausdorff == pytest.approx(cov.hausdorff_as_given)
 
@@ -76,3 +78,25 @@ def test_a_dense_outline_is_measured_as_the_layout_saw_it(arm_lake):
     assert cov.hausdorff_cells <= 0.5  # the arm left out as on the plain outline
     assert cov.hausdorff == pytest.approx(plain.hausdorff, abs=0.06 * h)  # the mouth within the slack
     assert cov.area_ratio == pytest.approx(plain.area_ratio, rel=1e-4)
+
+
+def test_the_layouts_own_arms_are_the_ones_measured_apart():
+    """Given the arms the layout left out (``Layout.arms``, ``MultiBlockGrid.arms``), the shore
+    distance is measured across their mouths whatever the rule would find again on the shore as
+    given (the two can differ where the layout's shore was prepared otherwise: big lakes g180507,
+    g180510, session 52); given none, the arm's head counts."""
+    from meshcore.lakegrid import mesh_layout
+    from meshcore.layout import auto_layout
+
+    h = 0.3
+    arm = box(0.0, -3.0, 0.22, 0.0)  # 0.73 cells wide, 10 long, from a basin's corner
+    poly = shapely.union_all([box(0.0, 0.0, 10.0, 10.0), arm])
+    lay = auto_layout(poly, cell_size=h)
+    assert len(lay.arms) == 1 and lay.arms[0].symmetric_difference(arm).area < 1e-6 * arm.area
+    mb = mesh_layout(lay)
+    assert mb.arms == lay.arms  # the grid carries them: the CLI's and the benchmarks' report use them
+    own = lake_metrics(mb, polygon=poly, cell_size=h).coverage
+    assert own.hausdorff_cells <= 0.5
+    none = lake_metrics(mb, polygon=poly, cell_size=h, arms=()).coverage
+    assert none.hausdorff / h == pytest.approx(10.0, abs=0.5)  # the arm's head, 3 below the basin
+    assert own.hausdorff_as_given == none.hausdorff_as_given == pytest.approx(none.hausdorff)

@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import shapely
 import pytest
+import shapely
 from shapely.geometry import Point, Polygon, box
 
 from meshcore import testing
