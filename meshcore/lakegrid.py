@@ -242,10 +242,12 @@ class CoarseReadings:
 
 
 def _same_layout(a, b) -> bool:
-    """``b`` is ``a``, or ``a`` with other ``details`` (:func:`dataclasses.replace` keeps the other fields)."""
+    """``b`` is ``a``, or ``a`` with other ``details`` or ``arms`` (:func:`dataclasses.replace` keeps the
+    other fields)."""
     import dataclasses
 
-    return a is b or all(getattr(a, f.name) is getattr(b, f.name) for f in dataclasses.fields(a) if f.name != "details")
+    skip = ("details", "arms")
+    return a is b or all(getattr(a, f.name) is getattr(b, f.name) for f in dataclasses.fields(a) if f.name not in skip)
 
 
 #: The share of the coarse grid's cross-interface area ratios at or below the ratio a reading
