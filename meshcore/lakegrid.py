@@ -156,8 +156,9 @@ def mesh_layout(
 
     if readings is not None:
         mb = readings.resumed(layout, callback, options)
-        if mb is not None:
-            return mb
+        if mb is not None:  # held for the layout as read, before its details and arms were set
+            arms = None if layout.arms is None else tuple(layout.arms)
+            return dataclasses.replace(mb, notes=tuple(layout.notes), arms=arms)
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
 
 
@@ -496,7 +497,10 @@ def iterate_layout(
         return mb
     said = f"; made again with block corners and cut ends sliding along the shore: {n} → {m} bad cell(s)"
     info = dataclasses.replace(again.info, message=again.info.message + said)
-    return dataclasses.replace(again, info=info, grids=tuple(_block_infos(list(again.grids), info)))
+    grids = tuple(_block_infos(list(again.grids), info))
+    return dataclasses.replace(
+        again, info=info, grids=grids, notes=mb.notes, arms=mb.arms
+    )  # the layout's, as the first
 
 
 #: A grid whose levels end with folded or non-convex cells is made once more with ``slide_ends`` (block
