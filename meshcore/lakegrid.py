@@ -156,9 +156,8 @@ def mesh_layout(
 
     if readings is not None:
         mb = readings.resumed(layout, callback, options)
-        if mb is not None:  # held for the layout as read, before its details and arms were set
-            arms = None if layout.arms is None else tuple(layout.arms)
-            return dataclasses.replace(mb, notes=tuple(layout.notes), arms=arms)
+        if mb is not None:  # held for the layout as read, before its arms were set (:func:`_same_layout`)
+            return dataclasses.replace(mb, arms=layout.arms)
     return drain(iterate_layout(layout, level_callback=callback, every=None, **options))
 
 
@@ -464,9 +463,8 @@ def iterate_layout(
     grids = _block_infos(grids, info)
     names = tuple(b.name for b in topo.blocks)
     # stopped on a coarse level: the grid of that level, with its topology
-    arms = None if layout.arms is None else tuple(layout.arms)
     mb = MultiBlockGrid(
-        tuple(grids), names, tp.interfaces, "orthogonal", info, tp, notes=tuple(layout.notes), arms=arms
+        tuple(grids), names, tp.interfaces, "orthogonal", info, tp, notes=tuple(layout.notes), arms=layout.arms
     )
     if stopped or slide_ends or not FOLD_RETRY or not (n := _n_folded(grids)):
         return mb
@@ -497,10 +495,7 @@ def iterate_layout(
         return mb
     said = f"; made again with block corners and cut ends sliding along the shore: {n} → {m} bad cell(s)"
     info = dataclasses.replace(again.info, message=again.info.message + said)
-    grids = tuple(_block_infos(list(again.grids), info))
-    return dataclasses.replace(
-        again, info=info, grids=grids, notes=mb.notes, arms=mb.arms
-    )  # the layout's, as the first
+    return dataclasses.replace(again, info=info, grids=tuple(_block_infos(list(again.grids), info)))
 
 
 #: A grid whose levels end with folded or non-convex cells is made once more with ``slide_ends`` (block
